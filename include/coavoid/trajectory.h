@@ -101,7 +101,8 @@ coa_vec3_t coa_reference_at(const coa_vehicle_t *v, coa_real_t t);
 /* Samples the reference at t_k = k*dt, k = 0..horizon, into out[0..horizon] (the
  * initial offset is NOT applied: out is the reference itself). Returns COA_OK, or
  * COA_ERR_ARGUMENT (NULL, invalid vehicle, dt not finite or <= 0, horizon == 0 or >
- * COA_MAX_HORIZON). Cost O(horizon + route_count) in one walk along the route. */
+ * COA_MAX_HORIZON, or a sample that overflows to a non-finite position). Cost
+ * O(horizon + route_count) in one walk along the route. */
 int coa_reference_sample(const coa_vehicle_t *v, coa_real_t dt, uint32_t horizon,
                          coa_vec3_t *out);
 
