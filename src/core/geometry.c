@@ -1,0 +1,558 @@
+/*
+ * geometry.c: exact continuous-time conflict tests over one step.
+ *
+ * Volume-volume and volume-box tests reduce every condition to an interval of the step
+ * parameter u and intersect them; the polytope test runs libccd's MPR on the swept volume
+ * with a support-call budget, because MPR's own loops only end on tolerance.
+ */
+#include "coavoid/geometry.h"
+
+#include <math.h>
+
+#include <ccd/ccd.h>
+
+#ifdef COA_SINGLE_PRECISION
+#define coa_sqrt(x) sqrtf(x)
+#define coa_fabs(x) fabsf(x)
+#define coa_hypot(x, y) hypotf((x), (y))
+#else
+#define coa_sqrt(x) sqrt(x)
+#define coa_fabs(x) fabs(x)
+#define coa_hypot(x, y) hypot((x), (y))
+#endif
+
+/* MPR works in ccd_real_t whatever coa_real_t is; these follow libccd's precision. */
+#ifdef CCD_SINGLE
+#define ccd_sqrt(x) sqrtf(x)
+#define ccd_fabs(x) fabsf(x)
+#define ccd_frexp(x, e) frexpf((x), (e))
+#define ccd_ldexp(x, e) ldexpf((x), (e))
+/* A float MPR cannot resolve 1e-9 of the scene; stop refining near its own rounding. */
+#define COA_MPR_RELATIVE_TOLERANCE 1e-5f
+#else
+#define ccd_sqrt(x) sqrt(x)
+#define ccd_fabs(x) fabs(x)
+#define ccd_frexp(x, e) frexp((x), (e))
+#define ccd_ldexp(x, e) ldexp((x), (e))
+#define COA_MPR_RELATIVE_TOLERANCE 1e-9
+#endif
+
+/* ---------------------------------------------------------------------------------- */
+/* Intervals of the step parameter u.                                                  */
+
+/* An interval of u whose ends are open or closed as its constructor says; it is empty
+ * unless lo < hi, so a single point never counts (see union_pieces for why that is safe). */
+typedef struct {
+    coa_real_t lo;
+    coa_real_t hi;
+} coa_span_t;
+
+static coa_span_t span_all(void)
+{
+    coa_span_t s = {-(coa_real_t)INFINITY, (coa_real_t)INFINITY};
+    return s;
+}
+
+static coa_span_t span_empty(void)
+{
+    coa_span_t s = {(coa_real_t)INFINITY, -(coa_real_t)INFINITY};
+    return s;
+}
+
+static bool span_nonempty(coa_span_t s)
+{
+    return s.lo < s.hi;
+}
+
+static coa_span_t span_meet(coa_span_t a, coa_span_t b)
+{
+    coa_span_t s;
+    s.lo = a.lo > b.lo ? a.lo : b.lo;
+    s.hi = a.hi < b.hi ? a.hi : b.hi;
+    return s;
+}
+
+/* The u with p + u*v in (bmin, bmax) (open) or [bmin, bmax] (closed). Only the numbers
+ * differ between the two: which ends belong to the set matters only when v == 0. */
+static coa_span_t span_linear(coa_real_t p, coa_real_t v, coa_real_t bmin, coa_real_t bmax,
+                              bool closed)
+{
+    coa_real_t t1;
+    coa_real_t t2;
+    coa_span_t s;
+
+    if (v == (coa_real_t)0) {
+        bool inside = closed ? (bmin <= p && p <= bmax) : (bmin < p && p < bmax);
+        return inside ? span_all() : span_empty();
+    }
+    t1 = (bmin - p) / v;
+    t2 = (bmax - p) / v;
+    if (t1 <= t2) {
+        s.lo = t1;
+        s.hi = t2;
+    } else {
+        s.lo = t2;
+        s.hi = t1;
+    }
+    /* A zero-width closed slab gives lo == hi: one instant, which span_nonempty rejects
+     * (union_pieces explains why that loses nothing). */
+    return s;
+}
+
+/* The open set of u with |q + u*w| < radius in the plane: a quadratic inequality.
+ * Its discriminant is written as radius^2*|w|^2 - (q x w)^2, the squared margin between
+ * the radius and the line's closest approach, which keeps tangency (no conflict) exact
+ * where b^2 - 4ac would cancel; the roots use the cancellation-free pair t/a, c/t. */
+static coa_span_t span_disc(coa_real_t qx, coa_real_t qy, coa_real_t wx, coa_real_t wy,
+                            coa_real_t radius)
+{
+    coa_real_t a = wx * wx + wy * wy;
+    coa_real_t qn;
+    coa_real_t c;
+    coa_real_t b;
+    coa_real_t cross;
+    coa_real_t ra;
+    coa_real_t disc;
+    coa_real_t sd;
+    coa_real_t t;
+    coa_real_t u1;
+    coa_real_t u2;
+    coa_span_t s;
+
+    qn = coa_hypot(qx, qy);
+    c = (qn - radius) * (qn + radius);
+    if (a == (coa_real_t)0) {
+        return c < (coa_real_t)0 ? span_all() : span_empty();
+    }
+    cross = coa_fabs(qx * wy - qy * wx);
+    ra = radius * coa_sqrt(a);
+    disc = (ra - cross) * (ra + cross);
+    if (!(disc > (coa_real_t)0)) {
+        return span_empty();
+    }
+    sd = coa_sqrt(disc);
+    b = qx * wx + qy * wy;
+    t = b >= (coa_real_t)0 ? -(b + sd) : sd - b;
+    u1 = t / a;
+    u2 = c / t;
+    if (u1 <= u2) {
+        s.lo = u1;
+        s.hi = u2;
+    } else {
+        s.lo = u2;
+        s.hi = u1;
+    }
+    return s;
+}
+
+/* Whether some u in the closed step [0, 1] lies in the open interval s. */
+static bool span_meets_step(coa_span_t s)
+{
+    return s.lo < s.hi && s.lo < (coa_real_t)1 && s.hi > (coa_real_t)0;
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* Closed-form tests.                                                                  */
+
+bool coa_conflict_volumes(const coa_sweep_t *a, const coa_sweep_t *b)
+{
+    coa_real_t d0x = a->p0.x - b->p0.x;
+    coa_real_t d0y = a->p0.y - b->p0.y;
+    coa_real_t d0z = a->p0.z - b->p0.z;
+    coa_real_t vx = (a->p1.x - b->p1.x) - d0x;
+    coa_real_t vy = (a->p1.y - b->p1.y) - d0y;
+    coa_real_t vz = (a->p1.z - b->p1.z) - d0z;
+    coa_real_t rsum = a->volume.radius + b->volume.radius;
+    coa_real_t hsum = a->volume.half_height + b->volume.half_height;
+    coa_span_t vert;
+    coa_span_t horiz;
+
+    vert = span_linear(d0z, vz, -hsum, hsum, false);
+    if (!span_meets_step(vert)) {
+        return false;
+    }
+    horiz = span_disc(d0x, d0y, vx, vy, rsum);
+    return span_meets_step(span_meet(horiz, vert));
+}
+
+/* The open rounded rectangle {distance to the closed rectangle < r} is convex, so its
+ * u-set is one open interval: the inf and sup over the pieces that cover it (two open
+ * slabs crossed with closed strips, four open corner discs). Pieces that are a single
+ * instant are dropped; that is safe because the whole set is open, so any such instant
+ * has a neighbourhood covered by pieces of positive length, which give the same inf/sup. */
+static coa_span_t union_pieces(const coa_span_t *pieces, size_t n)
+{
+    coa_span_t u = span_empty();
+    size_t i;
+
+    for (i = 0; i < n; ++i) {
+        if (!span_nonempty(pieces[i])) {
+            continue;
+        }
+        if (pieces[i].lo < u.lo) {
+            u.lo = pieces[i].lo;
+        }
+        if (pieces[i].hi > u.hi) {
+            u.hi = pieces[i].hi;
+        }
+    }
+    return u;
+}
+
+bool coa_conflict_box(const coa_sweep_t *a, const coa_box_t *box)
+{
+    coa_real_t r = a->volume.radius;
+    coa_real_t h = a->volume.half_height;
+    coa_real_t px = a->p0.x;
+    coa_real_t py = a->p0.y;
+    coa_real_t vx = a->p1.x - a->p0.x;
+    coa_real_t vy = a->p1.y - a->p0.y;
+    coa_real_t vz = a->p1.z - a->p0.z;
+    coa_span_t vert;
+    coa_span_t pieces[6];
+    coa_span_t horiz;
+
+    vert = span_linear(a->p0.z, vz, box->min.z - h, box->max.z + h, false);
+    if (!span_meets_step(vert)) {
+        return false;
+    }
+    pieces[0] = span_meet(span_linear(px, vx, box->min.x - r, box->max.x + r, false),
+                          span_linear(py, vy, box->min.y, box->max.y, true));
+    pieces[1] = span_meet(span_linear(px, vx, box->min.x, box->max.x, true),
+                          span_linear(py, vy, box->min.y - r, box->max.y + r, false));
+    pieces[2] = span_disc(px - box->min.x, py - box->min.y, vx, vy, r);
+    pieces[3] = span_disc(px - box->max.x, py - box->min.y, vx, vy, r);
+    pieces[4] = span_disc(px - box->min.x, py - box->max.y, vx, vy, r);
+    pieces[5] = span_disc(px - box->max.x, py - box->max.y, vx, vy, r);
+    horiz = union_pieces(pieces, sizeof pieces / sizeof pieces[0]);
+    return span_meets_step(span_meet(horiz, vert));
+}
+
+coa_box_t coa_sweep_bounds(const coa_sweep_t *a)
+{
+    coa_box_t b;
+    coa_real_t r = a->volume.radius;
+    coa_real_t h = a->volume.half_height;
+
+    b.min.x = (a->p0.x < a->p1.x ? a->p0.x : a->p1.x) - r;
+    b.min.y = (a->p0.y < a->p1.y ? a->p0.y : a->p1.y) - r;
+    b.min.z = (a->p0.z < a->p1.z ? a->p0.z : a->p1.z) - h;
+    b.max.x = (a->p0.x > a->p1.x ? a->p0.x : a->p1.x) + r;
+    b.max.y = (a->p0.y > a->p1.y ? a->p0.y : a->p1.y) + r;
+    b.max.z = (a->p0.z > a->p1.z ? a->p0.z : a->p1.z) + h;
+    return b;
+}
+
+bool coa_boxes_touch(const coa_box_t *a, const coa_box_t *b)
+{
+    return a->min.x <= b->max.x && b->min.x <= a->max.x && a->min.y <= b->max.y &&
+           b->min.y <= a->max.y && a->min.z <= b->max.z && b->min.z <= a->max.z;
+}
+
+/* ---------------------------------------------------------------------------------- */
+/* Swept volume against a convex polytope: bounded MPR.                                */
+
+/* Shared by both MPR objects. libccd hands callbacks const pointers, so the mutable
+ * budget lives behind a pointer rather than in the objects themselves. */
+typedef struct {
+    unsigned long calls; /* polytope support evaluations so far (the O(count) ones) */
+    bool exhausted;      /* the budget ran out or a direction was not finite */
+} coa_mpr_budget_t;
+
+/* MPR's zero tests are absolute (CCD_EPS) and its arithmetic reaches the fourth power of
+ * the coordinates (the squared length of a cross product). So MPR sees the scene moved
+ * to the sweep's midpoint and scaled to unit size, by powers of two so that scaling
+ * itself rounds nothing: x -> (x * pre - mid) * post. `pre` only keeps the subtraction
+ * from overflowing when raw coordinates are near the top of the range. */
+typedef struct {
+    ccd_real_t pre;
+    ccd_vec3_t mid; /* the sweep's midpoint, times pre */
+    ccd_real_t post;
+} coa_mpr_frame_t;
+
+typedef struct {
+    ccd_vec3_t half; /* p1 - midpoint in the frame; p0 - midpoint is its negative */
+    ccd_real_t radius;
+    ccd_real_t half_height;
+    coa_mpr_budget_t *budget;
+} coa_mpr_sweep_t;
+
+typedef struct {
+    const coa_vec3_t *vertices;
+    size_t count;
+    coa_mpr_frame_t frame;
+    ccd_vec3_t centre; /* vertex mean, in the frame */
+    coa_mpr_budget_t *budget;
+} coa_mpr_poly_t;
+
+/* Beyond every support point of either object in the unit frame (|coordinate| <= 1). */
+#define COA_MPR_FAR ((ccd_real_t)8)
+
+static bool ccd_vec_finite(const ccd_vec3_t *v)
+{
+    return isfinite(v->v[0]) && isfinite(v->v[1]) && isfinite(v->v[2]);
+}
+
+/* Once the budget is spent, both supports answer the point at distance COA_MPR_FAR
+ * opposite the requested direction. The Minkowski-difference support s1(d) - s2(-d) then
+ * has a strictly negative dot with d even if only one side has switched yet, which every
+ * MPR exit test reads as "origin outside": discovery and refinement return at their next
+ * check. A non-finite direction (a degenerate portal) ends the test the same way. */
+static bool support_stop(coa_mpr_budget_t *budget, const ccd_vec3_t *dir, ccd_vec3_t *out)
+{
+    ccd_real_t len;
+
+    if (!budget->exhausted && ccd_vec_finite(dir)) {
+        return false;
+    }
+    budget->exhausted = true;
+    out->v[0] = 0;
+    out->v[1] = 0;
+    out->v[2] = 0;
+    if (!ccd_vec_finite(dir)) {
+        return true;
+    }
+    len = ccd_sqrt(dir->v[0] * dir->v[0] + dir->v[1] * dir->v[1] + dir->v[2] * dir->v[2]);
+    if (len > 0 && isfinite(len)) {
+        out->v[0] = -COA_MPR_FAR * (dir->v[0] / len);
+        out->v[1] = -COA_MPR_FAR * (dir->v[1] / len);
+        out->v[2] = -COA_MPR_FAR * (dir->v[2] / len);
+    }
+    return true;
+}
+
+static void sweep_support(const void *obj, const ccd_vec3_t *dir, ccd_vec3_t *out)
+{
+    const coa_mpr_sweep_t *s = (const coa_mpr_sweep_t *)obj;
+    ccd_real_t dx = dir->v[0];
+    ccd_real_t dy = dir->v[1];
+    ccd_real_t dz = dir->v[2];
+    ccd_real_t along = dx * s->half.v[0] + dy * s->half.v[1] + dz * s->half.v[2];
+    ccd_real_t sign = along > 0 ? (ccd_real_t)1 : (ccd_real_t)-1;
+    ccd_real_t lxy;
+
+    if (support_stop(s->budget, dir, out)) {
+        return;
+    }
+    out->v[0] = sign * s->half.v[0];
+    out->v[1] = sign * s->half.v[1];
+    out->v[2] = sign * s->half.v[2];
+    lxy = ccd_sqrt(dx * dx + dy * dy);
+    if (lxy > 0) {
+        out->v[0] += s->radius * (dx / lxy);
+        out->v[1] += s->radius * (dy / lxy);
+    }
+    if (dz > 0) {
+        out->v[2] += s->half_height;
+    } else if (dz < 0) {
+        out->v[2] -= s->half_height;
+    }
+}
+
+static void sweep_centre(const void *obj, ccd_vec3_t *out)
+{
+    (void)obj;
+    out->v[0] = 0;
+    out->v[1] = 0;
+    out->v[2] = 0;
+}
+
+static void frame_point(const coa_mpr_frame_t *f, const coa_vec3_t *p, ccd_vec3_t *out)
+{
+    out->v[0] = ((ccd_real_t)p->x * f->pre - f->mid.v[0]) * f->post;
+    out->v[1] = ((ccd_real_t)p->y * f->pre - f->mid.v[1]) * f->post;
+    out->v[2] = ((ccd_real_t)p->z * f->pre - f->mid.v[2]) * f->post;
+}
+
+static void poly_support(const void *obj, const ccd_vec3_t *dir, ccd_vec3_t *out)
+{
+    const coa_mpr_poly_t *p = (const coa_mpr_poly_t *)obj;
+    ccd_vec3_t v;
+    ccd_real_t best;
+    ccd_real_t dot;
+    size_t i;
+
+    p->budget->calls++;
+    if (p->budget->calls > COA_MPR_MAX_SUPPORT_CALLS) {
+        p->budget->exhausted = true;
+    }
+    if (support_stop(p->budget, dir, out)) {
+        return;
+    }
+    frame_point(&p->frame, &p->vertices[0], out);
+    best = out->v[0] * dir->v[0] + out->v[1] * dir->v[1] + out->v[2] * dir->v[2];
+    for (i = 1; i < p->count; ++i) {
+        frame_point(&p->frame, &p->vertices[i], &v);
+        dot = v.v[0] * dir->v[0] + v.v[1] * dir->v[1] + v.v[2] * dir->v[2];
+        if (dot > best) {
+            best = dot;
+            *out = v;
+        }
+    }
+}
+
+static void poly_centre(const void *obj, ccd_vec3_t *out)
+{
+    const coa_mpr_poly_t *p = (const coa_mpr_poly_t *)obj;
+    *out = p->centre;
+}
+
+static bool vec_finite(const coa_vec3_t *v)
+{
+    return isfinite(v->x) && isfinite(v->y) && isfinite(v->z);
+}
+
+static ccd_real_t ccd_max(ccd_real_t a, ccd_real_t b)
+{
+    return a > b ? a : b;
+}
+
+static ccd_real_t vec_max_abs(const coa_vec3_t *v)
+{
+    return ccd_max(ccd_fabs((ccd_real_t)v->x),
+                   ccd_max(ccd_fabs((ccd_real_t)v->y), ccd_fabs((ccd_real_t)v->z)));
+}
+
+static ccd_real_t ccd_vec_max_abs(const ccd_vec3_t *v)
+{
+    return ccd_max(ccd_fabs(v->v[0]), ccd_max(ccd_fabs(v->v[1]), ccd_fabs(v->v[2])));
+}
+
+/* 2^-e for the exponent e of m > 0 (m = f * 2^e, 0.5 <= f < 1); infinite when m is too
+ * small for that to be represented. */
+static ccd_real_t inverse_power_of_two(ccd_real_t m)
+{
+    int e = 0;
+    (void)ccd_frexp(m, &e);
+    return ccd_ldexp((ccd_real_t)1, -e);
+}
+
+int coa_conflict_polytope(const coa_sweep_t *a, const coa_polytope_t *poly)
+{
+    coa_box_t sweep_box;
+    coa_box_t poly_box;
+    coa_mpr_budget_t budget;
+    coa_mpr_sweep_t sweep;
+    coa_mpr_poly_t hull;
+    ccd_t ccd;
+    ccd_vec3_t v;
+    ccd_real_t m;
+    ccd_real_t pre;
+    ccd_real_t n;
+    size_t i;
+    int hit;
+
+    if (a == NULL || poly == NULL || poly->vertices == NULL ||
+        poly->count < 4u || poly->count > COA_POLYTOPE_MAX_VERTICES) {
+        return COA_ERR_ARGUMENT;
+    }
+    if (!vec_finite(&a->p0) || !vec_finite(&a->p1) || !isfinite(a->volume.radius) ||
+        !isfinite(a->volume.half_height) || !(a->volume.radius > (coa_real_t)0) ||
+        !(a->volume.half_height > (coa_real_t)0)) {
+        return COA_ERR_ARGUMENT;
+    }
+    poly_box.min = poly->vertices[0];
+    poly_box.max = poly->vertices[0];
+    m = ccd_max(vec_max_abs(&a->p0), vec_max_abs(&a->p1));
+    m = ccd_max(m, ccd_max((ccd_real_t)a->volume.radius, (ccd_real_t)a->volume.half_height));
+    for (i = 0; i < poly->count; ++i) {
+        const coa_vec3_t *p = &poly->vertices[i];
+        if (!vec_finite(p)) {
+            return COA_ERR_ARGUMENT;
+        }
+        poly_box.min.x = p->x < poly_box.min.x ? p->x : poly_box.min.x;
+        poly_box.min.y = p->y < poly_box.min.y ? p->y : poly_box.min.y;
+        poly_box.min.z = p->z < poly_box.min.z ? p->z : poly_box.min.z;
+        poly_box.max.x = p->x > poly_box.max.x ? p->x : poly_box.max.x;
+        poly_box.max.y = p->y > poly_box.max.y ? p->y : poly_box.max.y;
+        poly_box.max.z = p->z > poly_box.max.z ? p->z : poly_box.max.z;
+        m = ccd_max(m, vec_max_abs(p));
+    }
+    sweep_box = coa_sweep_bounds(a);
+    if (!coa_boxes_touch(&sweep_box, &poly_box)) {
+        return 0;
+    }
+
+    budget.calls = 0;
+    budget.exhausted = false;
+
+    /* Raw coordinates up to 1 in magnitude need no pre-scaling; larger ones get it. */
+    pre = m > (ccd_real_t)1 ? inverse_power_of_two(m) : (ccd_real_t)1;
+    sweep.half.v[0] = ((ccd_real_t)a->p1.x * pre - (ccd_real_t)a->p0.x * pre) / 2;
+    sweep.half.v[1] = ((ccd_real_t)a->p1.y * pre - (ccd_real_t)a->p0.y * pre) / 2;
+    sweep.half.v[2] = ((ccd_real_t)a->p1.z * pre - (ccd_real_t)a->p0.z * pre) / 2;
+    hull.frame.pre = pre;
+    hull.frame.mid.v[0] = (ccd_real_t)a->p0.x * pre + sweep.half.v[0];
+    hull.frame.mid.v[1] = (ccd_real_t)a->p0.y * pre + sweep.half.v[1];
+    hull.frame.mid.v[2] = (ccd_real_t)a->p0.z * pre + sweep.half.v[2];
+    sweep.radius = (ccd_real_t)a->volume.radius * pre;
+    sweep.half_height = (ccd_real_t)a->volume.half_height * pre;
+
+    /* The scene's size about the midpoint, before post-scaling. */
+    hull.frame.post = 1;
+    m = ccd_max(ccd_fabs(sweep.half.v[0]), ccd_fabs(sweep.half.v[1])) + sweep.radius;
+    m = ccd_max(m, ccd_fabs(sweep.half.v[2]) + sweep.half_height);
+    for (i = 0; i < poly->count; ++i) {
+        frame_point(&hull.frame, &poly->vertices[i], &v);
+        m = ccd_max(m, ccd_vec_max_abs(&v));
+    }
+    hull.frame.post = inverse_power_of_two(m);
+    if (!(m > 0) || !isfinite(m) || !(hull.frame.post > 0) || !isfinite(hull.frame.post)) {
+        /* The sizes are too far apart for one floating-point frame (below 2^-1000 of the
+         * coordinates): no answer would mean anything. */
+        return COA_ERR_ARGUMENT;
+    }
+
+    sweep.half.v[0] *= hull.frame.post;
+    sweep.half.v[1] *= hull.frame.post;
+    sweep.half.v[2] *= hull.frame.post;
+    sweep.radius *= hull.frame.post;
+    sweep.half_height *= hull.frame.post;
+    sweep.budget = &budget;
+
+    hull.vertices = poly->vertices;
+    hull.count = poly->count;
+    hull.budget = &budget;
+    hull.centre.v[0] = 0;
+    hull.centre.v[1] = 0;
+    hull.centre.v[2] = 0;
+    for (i = 0; i < poly->count; ++i) {
+        frame_point(&hull.frame, &poly->vertices[i], &v);
+        hull.centre.v[0] += v.v[0];
+        hull.centre.v[1] += v.v[1];
+        hull.centre.v[2] += v.v[2];
+    }
+    n = (ccd_real_t)poly->count;
+    hull.centre.v[0] /= n;
+    hull.centre.v[1] /= n;
+    hull.centre.v[2] /= n;
+
+    CCD_INIT(&ccd);
+    ccd.support1 = sweep_support;
+    ccd.support2 = poly_support;
+    ccd.center1 = sweep_centre;
+    ccd.center2 = poly_centre;
+    ccd.max_iterations = COA_MPR_MAX_SUPPORT_CALLS;
+    ccd.mpr_tolerance = COA_MPR_RELATIVE_TOLERANCE; /* the frame has unit size */
+
+    hit = ccdMPRIntersect(&sweep, &hull, &ccd);
+    if (budget.exhausted) {
+        return 1;
+    }
+    return hit ? 1 : 0;
+}
+
+int coa_conflict_obstacle(const coa_sweep_t *a, const coa_obstacle_t *obstacle)
+{
+    if (a == NULL || obstacle == NULL) {
+        return COA_ERR_ARGUMENT;
+    }
+    switch (obstacle->kind) {
+    case COA_OBSTACLE_BOX:
+        return coa_conflict_box(a, &obstacle->box) ? 1 : 0;
+    case COA_OBSTACLE_POLYTOPE:
+        return coa_conflict_polytope(a, &obstacle->polytope);
+    default:
+        return COA_ERR_ARGUMENT;
+    }
+}
