@@ -87,8 +87,11 @@ bool coa_conflict_box(const coa_sweep_t *a, const coa_box_t *box);
  * libccd's MPR on the swept volume. Returns 1 (conflict), 0 (none), or
  * COA_ERR_ARGUMENT when a pointer is NULL, count < 4 or > COA_POLYTOPE_MAX_VERTICES,
  * or any number is not finite (MPR can spin on non-finite input, so it is never called
- * with one). MPR's refinement is bounded: after COA_MPR_MAX_SUPPORT_CALLS support
- * evaluations the test stops and answers 1 (conflict), the safe side.
+ * with one), radius or half_height is not > 0, or the scene's size is below about 1e-300
+ * of its largest coordinate (no floating-point frame holds both; MPR runs on the scene
+ * moved to the sweep's midpoint and scaled to unit size). MPR's refinement is bounded:
+ * after COA_MPR_MAX_SUPPORT_CALLS support evaluations the test stops and answers 1
+ * (conflict), the safe side.
  * Cost O(COA_MPR_MAX_SUPPORT_CALLS * count), no heap, O(1) stack. */
 #define COA_MPR_MAX_SUPPORT_CALLS 128u
 int coa_conflict_polytope(const coa_sweep_t *a, const coa_polytope_t *poly);
