@@ -1,0 +1,443 @@
+/*
+ * coavoid: the command-line front end of the core.
+ *
+ *   coavoid plan SCENARIO.json --mode centralised|decoupled [--priority ID,...] [--beta N]
+ *                [--reorder]
+ *
+ * reads a scenario (SCENARIO_FORMAT.md), plans, and prints the plan result as JSON. Exit
+ * status: 0 solved, 1 infeasible or budget exhausted, 2 invalid input or usage (one line
+ * on stderr naming the input and why), 3 internal error.
+ */
+#define _POSIX_C_SOURCE 200809L
+
+#include <stdarg.h>
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "coavoid/coavoid.h"
+#include "output.h"
+#include "scenario.h"
+
+/* The closed-set bound beta when neither --beta nor the scenario's "beta" gives one. */
+#define COAVOID_DEFAULT_BETA 20000u
+
+enum {
+    EXIT_SOLVED = 0,
+    EXIT_NOT_SOLVED = 1, /* infeasible or budget exhausted */
+    EXIT_INVALID = 2,    /* bad usage or bad input */
+    EXIT_INTERNAL = 3    /* a bug, or the result could not be written */
+};
+
+/* malloc's alignment is what the workspace buffer relies on. */
+_Static_assert(_Alignof(max_align_t) >= COA_WORKSPACE_ALIGNMENT,
+               "malloc does not align enough for the planner workspace");
+
+/* Usage texts are printf formats so that the limits they quote come from one place. */
+#define USAGE                                                                              \
+    "usage: coavoid <command> [options]\n"                                                 \
+    "\n"                                                                                   \
+    "commands:\n"                                                                          \
+    "  plan     plan collision-free altitude manoeuvres for a scenario\n"                   \
+    "\n"                                                                                   \
+    "Run 'coavoid plan --help' for the options of plan.\n"
+
+#define PLAN_USAGE                                                                         \
+    "usage: coavoid plan SCENARIO.json --mode centralised|decoupled\n"                      \
+    "                    [--priority ID,ID,...] [--beta N] [--reorder]\n"                   \
+    "\n"                                                                                   \
+    "Reads a scenario (JSON, at most %u MiB) and prints the plan result as JSON.\n"         \
+    "\n"                                                                                   \
+    "options:\n"                                                                           \
+    "  --mode centralised  one search over all UAVs together (at most %u UAVs)\n"           \
+    "  --mode decoupled    each UAV in turn, in priority order\n"                          \
+    "  --priority ID,...   decoupled: plan in this order (every vehicle id exactly once)\n" \
+    "  --beta N            closed-set bound, N >= 1; overrides the scenario's \"beta\";\n" \
+    "                      default %u; the centralised workspace grows as beta * 5^UAVs\n" \
+    "  --reorder           decoupled: when a UAV fails, try other priority orders\n"       \
+    "  -h, --help          show this help\n"                                               \
+    "\n"                                                                                   \
+    "Fields of the scenario that the format does not define are ignored.\n"                \
+    "\n"                                                                                   \
+    "exit status: 0 solved, 1 infeasible or budget exhausted, 2 invalid input or usage\n"  \
+    "(one line on stderr naming the input and why), 3 internal error\n"
+
+/* Prints "coavoid: <message>" as exactly one line: control characters that came from the
+ * input (a file name, an option value) are replaced so they cannot split it. */
+static int fail(int status, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+
+static int fail(int status, const char *fmt, ...)
+{
+    char line[1024];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(line, sizeof line, fmt, ap);
+    va_end(ap);
+    for (char *c = line; *c != '\0'; c++) {
+        if ((unsigned char)*c < 0x20u || *c == 0x7f) {
+            *c = '?';
+        }
+    }
+    fprintf(stderr, "coavoid: %s\n", line);
+    return status;
+}
+
+/* ---- options ---- */
+
+typedef struct {
+    const char *scenario_path;
+    const char *mode;     /* NULL until given */
+    bool decoupled;
+    const char *priority; /* NULL: priority order */
+    const char *beta_text;
+    uint32_t beta;
+    bool reorder;
+} plan_options_t;
+
+/* A decimal number of digits only (no sign, no spaces) in 1..max. */
+static bool parse_count(const char *text, size_t length, uint64_t max, uint64_t *out)
+{
+    uint64_t value = 0;
+    if (length == 0) {
+        return false;
+    }
+    for (size_t i = 0; i < length; i++) {
+        if (text[i] < '0' || text[i] > '9') {
+            return false;
+        }
+        value = value * 10u + (uint64_t)(text[i] - '0');
+        if (value > max) {
+            return false;
+        }
+    }
+    *out = value;
+    return value >= 1;
+}
+
+/* Takes an option's value from "--opt=value" or from the next argument. */
+static bool option_value(int argc, char **argv, int *i, const char *arg, const char *name,
+                         const char **value)
+{
+    size_t length = strlen(name);
+    if (arg[length] == '=') {
+        *value = arg + length + 1;
+        return true;
+    }
+    if (*i + 1 >= argc) {
+        return false;
+    }
+    *value = argv[++*i];
+    return true;
+}
+
+static bool option_is(const char *arg, const char *name)
+{
+    size_t length = strlen(name);
+    return strncmp(arg, name, length) == 0 && (arg[length] == '\0' || arg[length] == '=');
+}
+
+/* Returns -1 to go on, or the exit status (help printed: 0; a usage error: 2). */
+static int parse_plan_options(int argc, char **argv, plan_options_t *o)
+{
+    bool options_done = false;
+    memset(o, 0, sizeof *o);
+    for (int i = 2; i < argc; i++) {
+        const char *arg = argv[i];
+        const char *value = NULL;
+        if (options_done || arg[0] != '-' || strcmp(arg, "-") == 0) {
+            if (o->scenario_path != NULL) {
+                return fail(EXIT_INVALID, "plan: unexpected argument '%.80s' (one scenario only)",
+                            arg);
+            }
+            o->scenario_path = arg;
+        } else if (strcmp(arg, "--") == 0) {
+            options_done = true;
+        } else if (strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0) {
+            printf(PLAN_USAGE, SCENARIO_MAX_BYTES / (1024u * 1024u), COA_MAX_CENTRALISED,
+                   COAVOID_DEFAULT_BETA);
+            return EXIT_SOLVED;
+        } else if (option_is(arg, "--mode")) {
+            if (o->mode != NULL) {
+                return fail(EXIT_INVALID, "--mode: given more than once");
+            }
+            if (!option_value(argc, argv, &i, arg, "--mode", &value)) {
+                return fail(EXIT_INVALID, "--mode: missing value (centralised or decoupled)");
+            }
+            if (strcmp(value, "centralised") != 0 && strcmp(value, "decoupled") != 0) {
+                return fail(EXIT_INVALID,
+                            "--mode: unknown mode '%.40s' (expected centralised or decoupled)",
+                            value);
+            }
+            o->mode = value;
+            o->decoupled = strcmp(value, "decoupled") == 0;
+        } else if (option_is(arg, "--priority")) {
+            if (o->priority != NULL) {
+                return fail(EXIT_INVALID, "--priority: given more than once");
+            }
+            if (!option_value(argc, argv, &i, arg, "--priority", &value)) {
+                return fail(EXIT_INVALID, "--priority: missing value (vehicle ids, e.g. 3,1,2)");
+            }
+            o->priority = value;
+        } else if (option_is(arg, "--beta")) {
+            uint64_t beta;
+            if (o->beta_text != NULL) {
+                return fail(EXIT_INVALID, "--beta: given more than once");
+            }
+            if (!option_value(argc, argv, &i, arg, "--beta", &value)) {
+                return fail(EXIT_INVALID, "--beta: missing value (an integer >= 1)");
+            }
+            if (!parse_count(value, strlen(value), UINT32_MAX, &beta)) {
+                return fail(EXIT_INVALID,
+                            "--beta: must be an integer from 1 to %lu, got '%.40s'",
+                            (unsigned long)UINT32_MAX, value);
+            }
+            o->beta_text = value;
+            o->beta = (uint32_t)beta;
+        } else if (strcmp(arg, "--reorder") == 0) {
+            if (o->reorder) {
+                return fail(EXIT_INVALID, "--reorder: given more than once");
+            }
+            o->reorder = true;
+        } else if (option_is(arg, "--reorder")) {
+            return fail(EXIT_INVALID, "--reorder: takes no value");
+        } else {
+            return fail(EXIT_INVALID, "plan: unknown option '%.40s' (see 'coavoid plan --help')",
+                        arg);
+        }
+    }
+    if (o->scenario_path == NULL) {
+        return fail(EXIT_INVALID, "plan: missing SCENARIO.json (see 'coavoid plan --help')");
+    }
+    if (o->mode == NULL) {
+        return fail(EXIT_INVALID, "--mode: required (centralised or decoupled)");
+    }
+    /* Centralised plans everyone in one search: an order would mean nothing, so asking
+     * for one is more likely a mistake than something to ignore. */
+    if (!o->decoupled && o->priority != NULL) {
+        return fail(EXIT_INVALID, "--priority: only valid with --mode decoupled");
+    }
+    if (!o->decoupled && o->reorder) {
+        return fail(EXIT_INVALID, "--reorder: only valid with --mode decoupled");
+    }
+    return -1;
+}
+
+/* --priority as vehicle indices into order[0..n-1]: a permutation of the ids. Returns -1
+ * when valid, else the exit status after the message. */
+static int parse_priority(const char *text, const scenario_t *s, size_t *order)
+{
+    bool listed[COA_MAX_VEHICLES] = {false};
+    size_t count = 0;
+    const char *token = text;
+    for (;;) {
+        const char *comma = strchr(token, ',');
+        size_t length = comma != NULL ? (size_t)(comma - token) : strlen(token);
+        uint64_t id;
+        if (!parse_count(token, length, 65535u, &id)) {
+            if (text[0] == '\0') {
+                return fail(EXIT_INVALID, "--priority: empty (expected vehicle ids separated "
+                                          "by commas)");
+            }
+            if (length == 0) {
+                return fail(EXIT_INVALID, "--priority: empty entry in '%.80s' "
+                                          "(expected vehicle ids separated by commas)",
+                            text);
+            }
+            return fail(EXIT_INVALID, "--priority: '%.*s' is not a vehicle id",
+                        (int)(length > 40 ? 40 : length), token);
+        }
+        long index = scenario_vehicle_index(s, (long)id);
+        if (index < 0) {
+            return fail(EXIT_INVALID, "--priority: %lu is not a vehicle id", (unsigned long)id);
+        }
+        if (listed[index]) {
+            return fail(EXIT_INVALID, "--priority: %lu is listed twice", (unsigned long)id);
+        }
+        listed[index] = true;
+        order[count++] = (size_t)index;
+        if (comma == NULL) {
+            break;
+        }
+        token = comma + 1;
+    }
+    for (size_t i = 0; i < s->vehicle_count; i++) {
+        if (!listed[i]) {
+            return fail(EXIT_INVALID, "--priority: vehicle %u is missing (list every id once)",
+                        (unsigned)s->vehicles[i].id);
+        }
+    }
+    return -1;
+}
+
+static int64_t elapsed_us(const struct timespec *start, const struct timespec *end)
+{
+    return (int64_t)(end->tv_sec - start->tv_sec) * 1000000 +
+           (int64_t)(end->tv_nsec - start->tv_nsec) / 1000;
+}
+
+/* The core's COA_ERR_RANGE: the worst-case offsets and integer costs over this horizon
+ * would overflow. Horizon is what the user is most likely to change. */
+static int range_error(const char *file, const scenario_t *s)
+{
+    return fail(EXIT_INVALID,
+                "%s: horizon: %lu steps is too long for these vehicles' offsets and costs "
+                "(beyond the core's integer range; shorten it or bound max_offset)",
+                file, (unsigned long)s->horizon);
+}
+
+/* beta from --beta, else the scenario, else the default; *source names it for messages. */
+static uint32_t choose_beta(const plan_options_t *o, const scenario_t *s, char *source,
+                            size_t source_size)
+{
+    if (o->beta_text != NULL) {
+        snprintf(source, source_size, "--beta %lu", (unsigned long)o->beta);
+        return o->beta;
+    }
+    if (s->has_beta) {
+        snprintf(source, source_size, "%.400s: beta %lu", o->scenario_path,
+                 (unsigned long)s->beta);
+        return s->beta;
+    }
+    snprintf(source, source_size, "default beta %lu", (unsigned long)COAVOID_DEFAULT_BETA);
+    return COAVOID_DEFAULT_BETA;
+}
+
+/* Everything after the scenario is loaded. Returns the exit status. */
+static int plan(const plan_options_t *o, scenario_t *s)
+{
+    const char *file = o->scenario_path;
+    char err[SCENARIO_ERROR_MAX];
+    size_t order_storage[COA_MAX_VEHICLES];
+    const size_t *order = NULL;
+    const size_t n = s->vehicle_count;
+
+    if (o->priority != NULL) {
+        int status = parse_priority(o->priority, s, order_storage);
+        if (status >= 0) {
+            return status;
+        }
+        order = order_storage;
+    }
+
+    char beta_source[SCENARIO_ERROR_MAX];
+    uint32_t beta = choose_beta(o, s, beta_source, sizeof beta_source);
+
+    if (!o->decoupled && n > COA_MAX_CENTRALISED) {
+        return fail(EXIT_INVALID,
+                    "--mode centralised: %zu vehicles, at most %u (COA_MAX_CENTRALISED) can be "
+                    "planned together",
+                    n, COA_MAX_CENTRALISED);
+    }
+
+    if (scenario_sample(s, err, sizeof err) != 0) {
+        return fail(EXIT_INVALID, "%s: %s", file, err);
+    }
+    coa_problem_t problem = scenario_problem(s);
+    int rc = coa_problem_check(&problem);
+    if (rc == COA_ERR_RANGE) {
+        return range_error(file, s);
+    }
+    if (rc != COA_OK) {
+        return fail(EXIT_INVALID, "%s: rejected by the core's problem check (%s)", file,
+                    coa_status_name(rc));
+    }
+
+    size_t searched = o->decoupled ? 1u : n;
+    size_t size = coa_planner_workspace_size(searched, beta);
+    if (size == 0) {
+        return fail(EXIT_INVALID,
+                    "%s: too large: the workspace for %zu vehicle(s) would not fit in memory "
+                    "(lower it with --beta)",
+                    beta_source, searched);
+    }
+    void *workspace = malloc(size);
+    if (workspace == NULL) {
+        return fail(EXIT_INVALID,
+                    "%s: cannot allocate %zu bytes of workspace for %zu vehicle(s) "
+                    "(lower it with --beta)",
+                    beta_source, size, searched);
+    }
+    coa_planner_t *planner = coa_planner_init(workspace, size, searched, beta);
+    int32_t *offsets = calloc(n * ((size_t)s->horizon + 1u), sizeof *offsets);
+    if (planner == NULL || offsets == NULL) {
+        free(workspace);
+        free(offsets);
+        return fail(EXIT_INTERNAL, "%s",
+                    planner == NULL ? "internal error: the planner refused its workspace"
+                                    : "out of memory for the plan");
+    }
+
+    coa_plan_result_t result;
+    memset(&result, 0, sizeof result);
+    struct timespec start, end;
+    clock_gettime(CLOCK_MONOTONIC, &start);
+    if (o->decoupled) {
+        rc = coa_plan_decoupled(planner, &problem, order, o->reorder ? UINT32_MAX : 1u, offsets,
+                                &result);
+    } else {
+        rc = coa_plan_centralised(planner, &problem, offsets, &result);
+    }
+    clock_gettime(CLOCK_MONOTONIC, &end);
+    free(workspace);
+
+    int status;
+    if (rc == COA_ERR_RANGE) {
+        status = range_error(file, s);
+    } else if (rc != COA_OK) {
+        status = fail(EXIT_INTERNAL, "internal error: the planner failed (%s)",
+                      coa_status_name(rc));
+    } else {
+        output_plan_t view = {s, o->decoupled, &result, offsets, elapsed_us(&start, &end)};
+        if (output_plan(stdout, &view, err, sizeof err) != 0) {
+            status = fail(EXIT_INTERNAL, "%s", err);
+        } else {
+            status = result.status == COA_PLAN_SOLVED ? EXIT_SOLVED : EXIT_NOT_SOLVED;
+        }
+    }
+    free(offsets);
+    return status;
+}
+
+static int command_plan(int argc, char **argv)
+{
+    plan_options_t options;
+    int status = parse_plan_options(argc, argv, &options);
+    if (status >= 0) {
+        return status;
+    }
+    scenario_t scenario;
+    char err[SCENARIO_ERROR_MAX];
+    if (scenario_load(options.scenario_path, &scenario, err, sizeof err) != 0) {
+        scenario_free(&scenario);
+        return fail(EXIT_INVALID, "%s: %s", options.scenario_path, err);
+    }
+    status = plan(&options, &scenario);
+    scenario_free(&scenario);
+    return status;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        return fail(EXIT_INVALID, "missing command (see 'coavoid --help')");
+    }
+    const char *command = argv[1];
+    if (strcmp(command, "-h") == 0 || strcmp(command, "--help") == 0) {
+        fputs(USAGE, stdout);
+        return EXIT_SOLVED;
+    }
+    if (strcmp(command, "plan") == 0) {
+        return command_plan(argc, argv);
+    }
+    if (command[0] == '-') {
+        return fail(EXIT_INVALID, "unknown option '%.40s' (see 'coavoid --help')", command);
+    }
+    return fail(EXIT_INVALID, "unknown command '%.40s' (see 'coavoid --help')", command);
+}

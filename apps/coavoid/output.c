@@ -1,0 +1,215 @@
+#include "output.h"
+
+#include <errno.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cjson/cJSON.h>
+
+const char *output_status_name(coa_plan_status_t status)
+{
+    switch (status) {
+    case COA_PLAN_SOLVED:
+        return "solved";
+    case COA_PLAN_INFEASIBLE:
+        return "infeasible";
+    case COA_PLAN_BUDGET_EXHAUSTED:
+        return "budget_exhausted";
+    }
+    return "unknown";
+}
+
+static int set_error(char *err, size_t err_size, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+static int set_error(char *err, size_t err_size, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(err, err_size, fmt, ap);
+    va_end(ap);
+    return -1;
+}
+
+/* cJSON keeps numbers as doubles and prints them with the shortest of %.15g and %.17g that
+ * reads back to the same double, so every value here round-trips exactly (integers up to
+ * 2^53, far beyond any count the planner reaches). */
+static bool add_number(cJSON *obj, const char *key, double value)
+{
+    return cJSON_AddNumberToObject(obj, key, value) != NULL;
+}
+
+static bool append(cJSON *array, cJSON *item)
+{
+    if (item == NULL) {
+        return false;
+    }
+    if (!cJSON_AddItemToArray(array, item)) {
+        cJSON_Delete(item);
+        return false;
+    }
+    return true;
+}
+
+/* One entry of "vehicles". Returns 0, -1 out of memory, -2 a row the core should never
+ * have produced (err set). */
+static int add_vehicle(cJSON *array, const scenario_t *s, size_t index, const int32_t *row,
+                       char *err, size_t err_size)
+{
+    const coa_vehicle_t *v = &s->vehicles[index];
+    double deviation = 0;
+    uint32_t effort = 0;
+    if (coa_plan_vehicle_cost(v, s->dt, s->horizon, row, &deviation, &effort) != COA_OK) {
+        set_error(err, err_size, "internal error: vehicle %u's plan is not a sequence of actions",
+                  (unsigned)v->id);
+        return -2;
+    }
+    cJSON *entry = cJSON_CreateObject();
+    if (!append(array, entry) || !add_number(entry, "id", v->id)) {
+        return -1;
+    }
+    cJSON *offsets = cJSON_AddArrayToObject(entry, "offsets");
+    cJSON *actions = cJSON_AddArrayToObject(entry, "actions");
+    if (offsets == NULL || actions == NULL) {
+        return -1;
+    }
+    for (uint32_t k = 0; k <= s->horizon; k++) {
+        if (!append(offsets, cJSON_CreateNumber(row[k]))) {
+            return -1;
+        }
+    }
+    for (uint32_t k = 0; k < s->horizon; k++) {
+        int action = coa_action_between(row[k], row[k + 1], v->steep_factor);
+        if (action < 0) {
+            set_error(err, err_size,
+                      "internal error: vehicle %u moves from offset %ld to %ld at step %lu",
+                      (unsigned)v->id, (long)row[k], (long)row[k + 1], (unsigned long)k);
+            return -2;
+        }
+        if (!append(actions, cJSON_CreateString(coa_action_name((coa_action_t)action)))) {
+            return -1;
+        }
+    }
+    if (!add_number(entry, "deviation", deviation) || !add_number(entry, "effort", effort)) {
+        return -1;
+    }
+    return 0;
+}
+
+/* Builds the result object; NULL with err set on failure. */
+static cJSON *build(const output_plan_t *plan, char *err, size_t err_size)
+{
+    const scenario_t *s = plan->scenario;
+    const coa_plan_result_t *r = plan->result;
+    const size_t n = s->vehicle_count;
+    const size_t per_row = (size_t)s->horizon + 1u;
+    const bool solved = r->status == COA_PLAN_SOLVED;
+
+    cJSON *root = cJSON_CreateObject();
+    if (root == NULL) {
+        goto out_of_memory;
+    }
+    if (cJSON_AddStringToObject(root, "scenario", s->name) == NULL ||
+        cJSON_AddStringToObject(root, "mode", plan->decoupled ? "decoupled" : "centralised") ==
+            NULL ||
+        cJSON_AddStringToObject(root, "status", output_status_name(r->status)) == NULL) {
+        goto out_of_memory;
+    }
+
+    cJSON *order = cJSON_AddArrayToObject(root, "priority_order");
+    if (order == NULL) {
+        goto out_of_memory;
+    }
+    for (size_t j = 0; j < n; j++) {
+        /* Centralised plans everyone at once: its "order" is the input order. */
+        size_t i = plan->decoupled ? r->order[j] : j;
+        if (i >= n) {
+            set_error(err, err_size, "internal error: planning order names vehicle index %zu", i);
+            goto fail;
+        }
+        if (!append(order, cJSON_CreateNumber(s->vehicles[i].id))) {
+            goto out_of_memory;
+        }
+    }
+
+    if (plan->decoupled && !solved) {
+        if (r->failed_vehicle >= n) {
+            set_error(err, err_size, "internal error: no failed vehicle reported");
+            goto fail;
+        }
+        if (!add_number(root, "failed_vehicle", s->vehicles[r->failed_vehicle].id)) {
+            goto out_of_memory;
+        }
+    }
+
+    if (solved) {
+        cJSON *cost = cJSON_AddObjectToObject(root, "cost");
+        if (cost == NULL || !add_number(cost, "deviation", r->deviation) ||
+            !add_number(cost, "effort", r->effort)) {
+            goto out_of_memory;
+        }
+    }
+
+    cJSON *stats = cJSON_AddObjectToObject(root, "stats");
+    if (stats == NULL || !add_number(stats, "nodes_expanded", (double)r->nodes_expanded) ||
+        !add_number(stats, "nodes_generated", (double)r->nodes_generated) ||
+        !add_number(stats, "time_us", (double)plan->time_us) ||
+        !add_number(stats, "workspace_bytes", (double)r->workspace_bytes) ||
+        (plan->decoupled && !add_number(stats, "orders_tried", r->orders_tried))) {
+        goto out_of_memory;
+    }
+
+    cJSON *vehicles = cJSON_AddArrayToObject(root, "vehicles");
+    if (vehicles == NULL) {
+        goto out_of_memory;
+    }
+    /* Solved: everyone in input order. Decoupled and not solved: those planned before the
+     * failure, in planning order. Centralised and not solved: nobody has a plan. */
+    size_t listed = solved ? n : (plan->decoupled ? r->planned_count : 0);
+    if (listed > n) {
+        set_error(err, err_size, "internal error: %zu planned vehicles of %zu", listed, n);
+        goto fail;
+    }
+    for (size_t j = 0; j < listed; j++) {
+        size_t i = solved ? j : r->order[j];
+        int rc = add_vehicle(vehicles, s, i, plan->offsets + i * per_row, err, err_size);
+        if (rc == -1) {
+            goto out_of_memory;
+        }
+        if (rc < 0) {
+            goto fail;
+        }
+    }
+    return root;
+
+out_of_memory:
+    set_error(err, err_size, "out of memory printing the result");
+fail:
+    cJSON_Delete(root);
+    return NULL;
+}
+
+int output_plan(FILE *out, const output_plan_t *plan, char *err, size_t err_size)
+{
+    cJSON *root = build(plan, err, err_size);
+    if (root == NULL) {
+        return -1;
+    }
+    char *text = cJSON_Print(root);
+    cJSON_Delete(root);
+    if (text == NULL) {
+        return set_error(err, err_size, "out of memory printing the result");
+    }
+    errno = 0;
+    bool written = fputs(text, out) >= 0 && fputc('\n', out) != EOF && fflush(out) == 0;
+    free(text);
+    if (!written) {
+        return set_error(err, err_size, "cannot write the result: %s",
+                         errno != 0 ? strerror(errno) : "write error");
+    }
+    return 0;
+}
