@@ -1,0 +1,1279 @@
+/*
+ * test_plan.c: the A* planner against exhaustive searches written here, plus the budget,
+ * workspace, reordering and edge-case contracts of plan.h.
+ *
+ * The exhaustive search (layered dynamic programming over every reachable offset vector)
+ * shares no code with plan.c: it uses only the geometry conflict tests and the trajectory
+ * cost functions, so an error in the engine's duplicate handling, ordering, validity
+ * tables or bookkeeping shows up as a different status or cost.
+ */
+#include <check.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "coavoid/coavoid.h"
+
+#define MAXV 4u
+#define MAXN 24u
+#define MAXOBS 4u
+#define MAXTR 2u
+#define ROW(f) ((size_t)(f)->p.horizon + 1u)
+
+/* ------------------------------------------------------------------------------------ */
+/* Deterministic random numbers                                                          */
+
+static uint64_t splitmix(uint64_t *s)
+{
+    uint64_t z = (*s += 0x9e3779b97f4a7c15u);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9u;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebu;
+    return z ^ (z >> 31);
+}
+
+static double unif(uint64_t *s, double lo, double hi)
+{
+    return lo + (hi - lo) * ((double)(splitmix(s) >> 11) / 9007199254740992.0);
+}
+
+static uint32_t pick(uint64_t *s, uint32_t n)
+{
+    return (uint32_t)(splitmix(s) % n);
+}
+
+static coa_real_t R(double x)
+{
+    return (coa_real_t)x;
+}
+
+static coa_vec3_t V(double x, double y, double z)
+{
+    coa_vec3_t v;
+    v.x = R(x);
+    v.y = R(y);
+    v.z = R(z);
+    return v;
+}
+
+/* ------------------------------------------------------------------------------------ */
+/* Problems                                                                              */
+
+typedef struct {
+    coa_vehicle_t veh[MAXV];
+    coa_vec3_t route[MAXV][2];
+    coa_vec3_t ref[MAXV][MAXN + 1u];
+    const coa_vec3_t *refp[MAXV];
+    coa_obstacle_t obs[MAXOBS];
+    coa_vec3_t poly[MAXOBS][8];
+    coa_track_t tr[MAXTR];
+    coa_vec3_t trs[MAXTR][MAXN + 1u];
+    const coa_vec3_t *trp[MAXTR];
+    coa_problem_t p;
+} fx_t;
+
+static void fx_init(fx_t *f, uint32_t horizon)
+{
+    memset(f, 0, sizeof *f);
+    f->p.dt = R(1.0);
+    f->p.horizon = horizon;
+    f->p.vehicles = f->veh;
+    f->p.references = f->refp;
+    f->p.obstacles = f->obs;
+    f->p.tracks = f->tr;
+    f->p.track_samples = f->trp;
+}
+
+static coa_vehicle_t *fx_vehicle(fx_t *f, uint16_t id, uint32_t priority, double speed,
+                                 double climb, uint32_t steep, double radius, double half,
+                                 coa_vec3_t start, coa_vec3_t end)
+{
+    size_t i = f->p.vehicle_count++;
+    coa_vehicle_t *v = &f->veh[i];
+    ck_assert_uint_lt(i, MAXV);
+    f->route[i][0] = start;
+    f->route[i][1] = end;
+    v->id = id;
+    v->priority = priority;
+    v->cruise_speed = R(speed);
+    v->climb_rate = R(climb);
+    v->steep_factor = steep;
+    v->volume.radius = R(radius);
+    v->volume.half_height = R(half);
+    v->route = f->route[i];
+    v->route_count = 2u;
+    v->initial_offset = 0;
+    v->max_offset = -1;
+    return v;
+}
+
+static void fx_box(fx_t *f, coa_vec3_t min, coa_vec3_t max)
+{
+    coa_obstacle_t *o = &f->obs[f->p.obstacle_count++];
+    o->kind = COA_OBSTACLE_BOX;
+    o->box.min = min;
+    o->box.max = max;
+}
+
+static void fx_track(fx_t *f, coa_vec3_t pos, coa_vec3_t vel, double radius, double half)
+{
+    coa_track_t *t = &f->tr[f->p.track_count++];
+    t->id = (uint32_t)(100u + f->p.track_count);
+    t->volume.radius = R(radius);
+    t->volume.half_height = R(half);
+    t->position = pos;
+    t->velocity = vel;
+}
+
+static void fx_finish(fx_t *f)
+{
+    size_t i;
+    for (i = 0; i < f->p.vehicle_count; ++i) {
+        ck_assert_int_eq(coa_reference_sample(&f->veh[i], f->p.dt, f->p.horizon, f->ref[i]),
+                         COA_OK);
+        f->refp[i] = f->ref[i];
+    }
+    for (i = 0; i < f->p.track_count; ++i) {
+        ck_assert_int_eq(coa_track_sample(&f->tr[i], f->p.dt, f->p.horizon, f->trs[i]), COA_OK);
+        f->trp[i] = f->trs[i];
+    }
+    ck_assert_int_eq(coa_problem_check(&f->p), COA_OK);
+}
+
+/* UAVs converging on one point at random times, so that conflicts are common, with
+ * obstacles and tracks around that point. */
+static void fx_random(fx_t *f, uint64_t *rng, size_t n, uint32_t horizon, uint32_t max_steep)
+{
+    double cx = unif(rng, -10, 10);
+    double cy = unif(rng, -10, 10);
+    double cz = 100;
+    size_t i;
+    uint32_t count;
+
+    fx_init(f, horizon);
+    for (i = 0; i < n; ++i) {
+        double speed = unif(rng, 8, 16);
+        double th = unif(rng, 0, 6.283185307179586);
+        double tm = unif(rng, 0.3, (double)horizon - 0.3);
+        double dx = cos(th);
+        double dy = sin(th);
+        double sx = cx - dx * speed * tm + unif(rng, -3, 3);
+        double sy = cy - dy * speed * tm + unif(rng, -3, 3);
+        double sz = cz + unif(rng, -4, 4);
+        double len = speed * ((double)horizon + 5.0);
+        coa_vehicle_t *v = fx_vehicle(f, (uint16_t)(10u + pick(rng, 5u) * 10u + i),
+                                      1u + pick(rng, 3u), speed, unif(rng, 2, 5),
+                                      2u + pick(rng, max_steep - 1u), unif(rng, 4, 8),
+                                      unif(rng, 2, 4), V(sx, sy, sz),
+                                      V(sx + dx * len, sy + dy * len, sz + unif(rng, -3, 3)));
+        if (pick(rng, 5u) == 0u) {
+            v->initial_offset = pick(rng, 2u) == 0u ? 1 : -1;
+        }
+        if (pick(rng, 4u) == 0u) {
+            v->max_offset = (int32_t)(1u + pick(rng, 3u));
+        }
+    }
+    count = pick(rng, 3u);
+    for (i = 0; i < count; ++i) {
+        double ox = cx + unif(rng, -15, 15);
+        double oy = cy + unif(rng, -15, 15);
+        double oz = cz + (pick(rng, 2u) == 0u ? 1.0 : -1.0) * unif(rng, 6, 15);
+        if (pick(rng, 2u) == 0u) {
+            double sx = unif(rng, 3, 10);
+            double sy = unif(rng, 3, 10);
+            double sz = unif(rng, 2, 6);
+            fx_box(f, V(ox - sx, oy - sy, oz - sz), V(ox + sx, oy + sy, oz + sz));
+        } else {
+            size_t o = f->p.obstacle_count++;
+            size_t j;
+            double rad = unif(rng, 4, 8);
+            f->obs[o].kind = COA_OBSTACLE_POLYTOPE;
+            for (j = 0; j < 8u; ++j) {
+                f->poly[o][j] = V(ox + unif(rng, -rad, rad), oy + unif(rng, -rad, rad),
+                                  oz + unif(rng, -rad, rad));
+            }
+            f->obs[o].polytope.vertices = f->poly[o];
+            f->obs[o].polytope.count = 8u;
+        }
+    }
+    if (pick(rng, 5u) < 2u) {
+        double speed = unif(rng, 10, 20);
+        double th = unif(rng, 0, 6.283185307179586);
+        double tm = unif(rng, 0.5, (double)horizon);
+        double vz = unif(rng, -1, 1);
+        coa_vec3_t vel = V(speed * cos(th), speed * sin(th), vz);
+        fx_track(f, V(cx - (double)vel.x * tm, cy - (double)vel.y * tm, cz + unif(rng, -8, 8) - vz * tm),
+                 vel, unif(rng, 3, 6), unif(rng, 2, 4));
+    }
+    fx_finish(f);
+}
+
+/* ------------------------------------------------------------------------------------ */
+/* Independent checks                                                                    */
+
+static int32_t limit_of(const coa_vehicle_t *v)
+{
+    return v->max_offset >= 0 ? v->max_offset : COA_MAX_OFFSET;
+}
+
+static coa_sweep_t sweep_of(const fx_t *f, size_t v, uint32_t k, int32_t a, int32_t b)
+{
+    coa_real_t dh = coa_climb_step(&f->veh[v], f->p.dt);
+    coa_sweep_t s;
+    s.volume = f->veh[v].volume;
+    s.p0 = f->ref[v][k];
+    s.p0.z += (coa_real_t)a * dh;
+    s.p1 = f->ref[v][k + 1u];
+    s.p1.z += (coa_real_t)b * dh;
+    return s;
+}
+
+/* A sweep against obstacles and tracks over step k. */
+static bool static_ok(const fx_t *f, const coa_sweep_t *s, uint32_t k)
+{
+    size_t j;
+    for (j = 0; j < f->p.obstacle_count; ++j) {
+        int rc = coa_conflict_obstacle(s, &f->obs[j]);
+        ck_assert_int_ge(rc, 0);
+        if (rc != 0) {
+            return false;
+        }
+    }
+    for (j = 0; j < f->p.track_count; ++j) {
+        coa_sweep_t t;
+        t.volume = f->tr[j].volume;
+        t.p0 = f->trs[j][k];
+        t.p1 = f->trs[j][k + 1u];
+        if (coa_conflict_volumes(s, &t)) {
+            return false;
+        }
+    }
+    return true;
+}
+
+/* Rows start at the initial offset, move by actions, respect max_offset. */
+static bool rows_well_formed(const fx_t *f, const int32_t *rows, const size_t *which, size_t count)
+{
+    size_t i;
+    uint32_t k;
+    for (i = 0; i < count; ++i) {
+        const coa_vehicle_t *v = &f->veh[which[i]];
+        const int32_t *r = &rows[which[i] * ROW(f)];
+        int32_t s = (int32_t)v->steep_factor;
+        if (r[0] != v->initial_offset) {
+            return false;
+        }
+        for (k = 0; k <= f->p.horizon; ++k) {
+            if (r[k] > limit_of(v) || r[k] < -limit_of(v)) {
+                return false;
+            }
+            if (k < f->p.horizon) {
+                int32_t d = r[k + 1u] - r[k];
+                if (d != 0 && d != 1 && d != -1 && d != s && d != -s) {
+                    return false;
+                }
+            }
+        }
+    }
+    return true;
+}
+
+static bool plan_conflict_free(const fx_t *f, const int32_t *rows, const size_t *which,
+                               size_t count)
+{
+    uint32_t k;
+    size_t i;
+    size_t j;
+    for (k = 0; k < f->p.horizon; ++k) {
+        for (i = 0; i < count; ++i) {
+            const int32_t *ri = &rows[which[i] * ROW(f)];
+            coa_sweep_t si = sweep_of(f, which[i], k, ri[k], ri[k + 1u]);
+            if (!static_ok(f, &si, k)) {
+                return false;
+            }
+            for (j = i + 1u; j < count; ++j) {
+                const int32_t *rj = &rows[which[j] * ROW(f)];
+                coa_sweep_t sj = sweep_of(f, which[j], k, rj[k], rj[k + 1u]);
+                if (coa_conflict_volumes(&si, &sj)) {
+                    return false;
+                }
+            }
+        }
+    }
+    return true;
+}
+
+static int64_t weight_of(const fx_t *f, size_t v)
+{
+    int64_t w[MAXV];
+    ck_assert_int_eq(coa_deviation_weights(f->veh, f->p.vehicle_count, f->p.dt, w), COA_OK);
+    return w[v];
+}
+
+static uint32_t effort_of_delta(int32_t d)
+{
+    return d == 0 ? 0u : (d == 1 || d == -1) ? 1u : 3u;
+}
+
+static void row_cost(const fx_t *f, size_t v, const int32_t *rows, int64_t *units,
+                     uint32_t *effort, double *dev)
+{
+    const int32_t *r = &rows[v * ROW(f)];
+    uint32_t scale = coa_area_scale(f->veh, f->p.vehicle_count);
+    int64_t w = weight_of(f, v);
+    double l = (double)f->veh[v].cruise_speed * (double)f->p.dt;
+    double dh = (double)f->veh[v].climb_rate * (double)f->p.dt;
+    uint32_t k;
+    for (k = 0; k < f->p.horizon; ++k) {
+        *units += w * coa_area_scaled(r[k], r[k + 1u], scale);
+        *effort += effort_of_delta(r[k + 1u] - r[k]);
+        *dev += l * dh * coa_area(r[k], r[k + 1u]);
+    }
+}
+
+/* ------------------------------------------------------------------------------------ */
+/* Exhaustive search: layered dynamic programming over offset vectors                    */
+
+#define DP_MAXM 3u
+#define DP_MAXR 41u    /* offsets a vehicle can reach, when several move together */
+#define DP_MAXSPAN 129u /* the same for one vehicle alone */
+#define DP_MAXSTATES (DP_MAXR * DP_MAXR * DP_MAXR)
+#define DP_CELLS (DP_MAXR * 5u)
+
+static int64_t dp_dev[2][DP_MAXSTATES];
+static uint32_t dp_eff[2][DP_MAXSTATES];
+static unsigned char dp_reach[2][DP_MAXSTATES];
+static signed char dp_env[DP_MAXM][DP_MAXSPAN][5];
+static signed char dp_pair[DP_MAXM][DP_CELLS][DP_CELLS];
+
+typedef struct {
+    bool found;
+    int64_t dev;
+    uint32_t eff;
+} dp_out_t;
+
+static int32_t delta_of(int a, uint32_t s)
+{
+    static const int32_t unit[5] = {0, 1, -1, 1, -1};
+    return a >= 3 ? unit[a] * (int32_t)s : unit[a];
+}
+
+/* The least (deviation units, effort) of the vehicles sv[0..m-1] moving together, with
+ * the vehicles fixed[0..nfixed-1] flying their rows of `rows`. */
+static dp_out_t dp_solve(const fx_t *f, const size_t *sv, size_t m, const int32_t *rows,
+                         const size_t *fixed, size_t nfixed)
+{
+    const uint32_t horizon = f->p.horizon;
+    uint32_t scale = coa_area_scale(f->veh, f->p.vehicle_count);
+    int32_t lo[DP_MAXM];
+    size_t span[DP_MAXM];
+    size_t stride[DP_MAXM];
+    int64_t w[DP_MAXM];
+    size_t states = 1u;
+    size_t start = 0u;
+    size_t i;
+    size_t idx;
+    uint32_t k;
+    dp_out_t out = {false, 0, 0u};
+
+    ck_assert_uint_le(m, DP_MAXM);
+    for (i = 0; i < m; ++i) {
+        const coa_vehicle_t *v = &f->veh[sv[i]];
+        lo[i] = v->initial_offset - (int32_t)(horizon * v->steep_factor);
+        span[i] = 2u * horizon * v->steep_factor + 1u;
+        ck_assert_uint_le(span[i], m == 1u ? DP_MAXSPAN : DP_MAXR);
+        stride[i] = states;
+        states *= span[i];
+        start += (size_t)(v->initial_offset - lo[i]) * stride[i];
+        w[i] = weight_of(f, sv[i]);
+    }
+    memset(dp_reach[0], 0, states);
+    dp_reach[0][start] = 1u;
+    dp_dev[0][start] = 0;
+    dp_eff[0][start] = 0u;
+
+    for (k = 0; k < horizon; ++k) {
+        unsigned cur = k & 1u;
+        unsigned nxt = cur ^ 1u;
+        memset(dp_reach[nxt], 0, states);
+        memset(dp_env, 0, sizeof dp_env);
+        memset(dp_pair, 0, sizeof dp_pair);
+        for (idx = 0; idx < states; ++idx) {
+            int32_t o[DP_MAXM];
+            size_t cell[DP_MAXM];
+            int32_t to[DP_MAXM];
+            int a[DP_MAXM];
+            size_t combos = 1u;
+            size_t c;
+            if (!dp_reach[cur][idx]) {
+                continue;
+            }
+            for (i = 0; i < m; ++i) {
+                o[i] = lo[i] + (int32_t)((idx / stride[i]) % span[i]);
+                combos *= 5u;
+            }
+            for (c = 0; c < combos; ++c) {
+                size_t rest = c;
+                bool ok = true;
+                size_t nidx = 0u;
+                int64_t dev = dp_dev[cur][idx];
+                uint32_t eff = dp_eff[cur][idx];
+                size_t j;
+                for (i = 0; i < m && ok; ++i) {
+                    const coa_vehicle_t *v = &f->veh[sv[i]];
+                    size_t oc = (size_t)(o[i] - lo[i]);
+                    a[i] = (int)(rest % 5u);
+                    rest /= 5u;
+                    to[i] = o[i] + delta_of(a[i], v->steep_factor);
+                    if (to[i] > limit_of(v) || to[i] < -limit_of(v)) {
+                        ok = false;
+                        break;
+                    }
+                    cell[i] = oc * 5u + (size_t)a[i];
+                    if (dp_env[i][oc][a[i]] == 0) {
+                        coa_sweep_t s = sweep_of(f, sv[i], k, o[i], to[i]);
+                        bool clear = static_ok(f, &s, k);
+                        for (j = 0; clear && j < nfixed; ++j) {
+                            const int32_t *r = &rows[fixed[j] * ROW(f)];
+                            coa_sweep_t t = sweep_of(f, fixed[j], k, r[k], r[k + 1u]);
+                            clear = !coa_conflict_volumes(&s, &t);
+                        }
+                        dp_env[i][oc][a[i]] = clear ? 1 : 2;
+                    }
+                    if (dp_env[i][oc][a[i]] != 1) {
+                        ok = false;
+                        break;
+                    }
+                    for (j = 0; j < i; ++j) {
+                        size_t pi = i + j - 1u; /* (0,1) -> 0, (0,2) -> 1, (1,2) -> 2 */
+                        signed char *pc = &dp_pair[pi][cell[j]][cell[i]];
+                        if (*pc == 0) {
+                            coa_sweep_t s = sweep_of(f, sv[i], k, o[i], to[i]);
+                            coa_sweep_t t = sweep_of(f, sv[j], k, o[j], to[j]);
+                            *pc = coa_conflict_volumes(&s, &t) ? 2 : 1;
+                        }
+                        if (*pc != 1) {
+                            ok = false;
+                            break;
+                        }
+                    }
+                    nidx += (size_t)(to[i] - lo[i]) * stride[i];
+                    dev += w[i] * coa_area_scaled(o[i], to[i], scale);
+                    eff += effort_of_delta(to[i] - o[i]);
+                }
+                if (!ok) {
+                    continue;
+                }
+                if (!dp_reach[nxt][nidx] || dev < dp_dev[nxt][nidx] ||
+                    (dev == dp_dev[nxt][nidx] && eff < dp_eff[nxt][nidx])) {
+                    dp_reach[nxt][nidx] = 1u;
+                    dp_dev[nxt][nidx] = dev;
+                    dp_eff[nxt][nidx] = eff;
+                }
+            }
+        }
+    }
+    for (idx = 0; idx < states; ++idx) {
+        unsigned last = horizon & 1u;
+        if (dp_reach[last][idx] &&
+            (!out.found || dp_dev[last][idx] < out.dev ||
+             (dp_dev[last][idx] == out.dev && dp_eff[last][idx] < out.eff))) {
+            out.found = true;
+            out.dev = dp_dev[last][idx];
+            out.eff = dp_eff[last][idx];
+        }
+    }
+    return out;
+}
+
+/* States with k < N the search could ever close: beta above this never interferes. */
+static uint32_t state_bound(const fx_t *f, const size_t *sv, size_t m)
+{
+    uint64_t total = 0u;
+    uint32_t k;
+    size_t i;
+    for (k = 0; k < f->p.horizon; ++k) {
+        uint64_t layer = 1u;
+        for (i = 0; i < m; ++i) {
+            const coa_vehicle_t *v = &f->veh[sv[i]];
+            uint64_t reach = 2u * (uint64_t)k * v->steep_factor + 1u;
+            uint64_t lim = 2u * (uint64_t)limit_of(v) + 1u;
+            layer *= reach < lim ? reach : lim;
+        }
+        total += layer;
+    }
+    return (uint32_t)total;
+}
+
+/* ------------------------------------------------------------------------------------ */
+/* Planner helpers                                                                       */
+
+typedef struct {
+    void *mem;
+    coa_planner_t *pl;
+    size_t bytes;
+} ws_t;
+
+static ws_t ws_make(size_t m, uint32_t beta)
+{
+    ws_t w;
+    w.bytes = coa_planner_workspace_size(m, beta);
+    ck_assert_uint_gt(w.bytes, 0u);
+    w.mem = malloc(w.bytes);
+    ck_assert_ptr_nonnull(w.mem);
+    w.pl = coa_planner_init(w.mem, w.bytes, m, beta);
+    ck_assert_ptr_nonnull(w.pl);
+    return w;
+}
+
+static void ws_free(ws_t *w)
+{
+    free(w->mem);
+    w->mem = NULL;
+    w->pl = NULL;
+}
+
+static const size_t ALL[MAXV] = {0u, 1u, 2u, 3u};
+
+/* The priority order by its definition: ascending priority, ties by ascending id. */
+static void expected_order(const fx_t *f, size_t *order)
+{
+    size_t n = f->p.vehicle_count;
+    size_t i;
+    size_t j;
+    for (i = 0; i < n; ++i) {
+        order[i] = i;
+    }
+    for (i = 0; i < n; ++i) {
+        for (j = i + 1u; j < n; ++j) {
+            const coa_vehicle_t *a = &f->veh[order[i]];
+            const coa_vehicle_t *b = &f->veh[order[j]];
+            if (b->priority < a->priority || (b->priority == a->priority && b->id < a->id)) {
+                size_t t = order[i];
+                order[i] = order[j];
+                order[j] = t;
+            }
+        }
+    }
+}
+
+/* A solved result describes exactly the rows it returned. */
+static void check_solved_plan(const fx_t *f, const int32_t *rows, const coa_plan_result_t *r)
+{
+    size_t n = f->p.vehicle_count;
+    int64_t units = 0;
+    uint32_t effort = 0u;
+    double dev = 0.0;
+    size_t i;
+    size_t bad_v = 99u;
+    uint32_t bad_k = 99u;
+
+    ck_assert(rows_well_formed(f, rows, ALL, n));
+    ck_assert(plan_conflict_free(f, rows, ALL, n));
+    ck_assert_int_eq(coa_plan_find_conflict(&f->p, rows, ALL, n, &bad_v, &bad_k), 0);
+    for (i = 0; i < n; ++i) {
+        row_cost(f, i, rows, &units, &effort, &dev);
+    }
+    ck_assert_int_eq(units, r->deviation_units);
+    ck_assert_uint_eq(effort, r->effort);
+    ck_assert_double_eq_tol(dev, r->deviation, 1e-9 * (1.0 + dev));
+    ck_assert_uint_eq(r->planned_count, n);
+    ck_assert_uint_eq(r->failed_vehicle, COA_NO_VEHICLE);
+}
+
+/* ------------------------------------------------------------------------------------ */
+/* Centralised optimality                                                                */
+
+START_TEST(centralised_matches_exhaustive_search)
+{
+    static fx_t f;
+    static int32_t rows[MAXV * (MAXN + 1u)];
+    const uint32_t beta = 9500u;
+    ws_t w = ws_make(3u, beta);
+    uint64_t rng = 0x5eed0001u;
+    unsigned solved = 0u;
+    unsigned infeasible = 0u;
+    unsigned moved = 0u;
+    unsigned trial;
+
+    for (trial = 0; trial < 400u; ++trial) {
+        size_t n = 2u + pick(&rng, 2u);
+        uint32_t horizon = 2u + pick(&rng, 4u);
+        coa_plan_result_t r;
+        dp_out_t best;
+        /* Three UAVs over five steps only with s = 2: keeps the exhaustive layer small. */
+        fx_random(&f, &rng, n, horizon, (n == 3u && horizon == 5u) ? 2u : 3u);
+        ck_assert_uint_lt(state_bound(&f, ALL, n), beta);
+
+        memset(rows, 0x55, sizeof rows);
+        ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
+        best = dp_solve(&f, ALL, n, rows, NULL, 0u);
+        ck_assert_msg(r.status == (best.found ? COA_PLAN_SOLVED : COA_PLAN_INFEASIBLE),
+                      "trial %u: planner status %d, exhaustive search %s", trial, (int)r.status,
+                      best.found ? "found a plan" : "found none");
+        ck_assert_uint_eq(r.workspace_bytes, w.bytes);
+        ck_assert_uint_eq(r.orders_tried, 1u);
+        ck_assert_uint_le(r.nodes_expanded, beta);
+        if (best.found) {
+            ck_assert_msg(r.deviation_units == best.dev && r.effort == best.eff,
+                          "trial %u: planner (%lld, %u), exhaustive (%lld, %u)", trial,
+                          (long long)r.deviation_units, r.effort, (long long)best.dev, best.eff);
+            check_solved_plan(&f, rows, &r);
+            ++solved;
+            if (best.eff > 0u) {
+                ++moved;
+            }
+        } else {
+            ++infeasible;
+        }
+    }
+    /* The generator must produce both outcomes and real manoeuvres, or this proves little. */
+    ck_assert_uint_ge(solved, 100u);
+    ck_assert_uint_ge(infeasible, 40u);
+    ck_assert_uint_ge(moved, 60u);
+    ws_free(&w);
+}
+END_TEST
+
+/* ------------------------------------------------------------------------------------ */
+/* Decoupled                                                                             */
+
+/* Each planned UAV is optimal given the ones before it; the failing one has no plan. */
+static void check_decoupled_attempt(const fx_t *f, const int32_t *rows, const coa_plan_result_t *r)
+{
+    size_t level;
+    for (level = 0; level < r->planned_count; ++level) {
+        size_t v = r->order[level];
+        int64_t units = 0;
+        uint32_t effort = 0u;
+        double dev = 0.0;
+        dp_out_t best = dp_solve(f, &r->order[level], 1u, rows, r->order, level);
+        ck_assert(best.found);
+        row_cost(f, v, rows, &units, &effort, &dev);
+        ck_assert_int_eq(units, best.dev);
+        ck_assert_uint_eq(effort, best.eff);
+        ck_assert(rows_well_formed(f, rows, &r->order[level], 1u));
+    }
+    ck_assert(plan_conflict_free(f, rows, r->order, r->planned_count));
+    if (r->status == COA_PLAN_SOLVED) {
+        check_solved_plan(f, rows, r);
+    } else {
+        ck_assert_uint_lt(r->planned_count, f->p.vehicle_count);
+        ck_assert_uint_eq(r->failed_vehicle, r->order[r->planned_count]);
+        ck_assert(!dp_solve(f, &r->failed_vehicle, 1u, rows, r->order, r->planned_count).found);
+    }
+}
+
+START_TEST(decoupled_each_vehicle_optimal_given_earlier)
+{
+    static fx_t f;
+    static int32_t rows[MAXV * (MAXN + 1u)];
+    const uint32_t beta = 2000u;
+    ws_t w = ws_make(1u, beta);
+    uint64_t rng = 0x5eed0002u;
+    unsigned solved = 0u;
+    unsigned failed = 0u;
+    unsigned trial;
+
+    for (trial = 0; trial < 200u; ++trial) {
+        size_t n = 2u + pick(&rng, 3u);
+        uint32_t horizon = 3u + pick(&rng, 4u);
+        size_t prio[MAXV];
+        size_t given[MAXV];
+        coa_plan_result_t r;
+        size_t i;
+        fx_random(&f, &rng, n, horizon, 3u);
+        expected_order(&f, prio);
+
+        memset(rows, 0x55, sizeof rows);
+        ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, NULL, 1u, rows, &r), COA_OK);
+        ck_assert_uint_eq(r.orders_tried, 1u);
+        ck_assert_uint_eq(r.workspace_bytes, w.bytes);
+        ck_assert(r.status != COA_PLAN_BUDGET_EXHAUSTED);
+        for (i = 0; i < n; ++i) {
+            ck_assert_uint_eq(r.order[i], prio[i]);
+        }
+        check_decoupled_attempt(&f, rows, &r);
+        if (r.status == COA_PLAN_SOLVED) {
+            ++solved;
+        } else {
+            ++failed;
+        }
+
+        /* An explicit order is followed as given. */
+        for (i = 0; i < n; ++i) {
+            given[i] = prio[n - 1u - i];
+        }
+        memset(rows, 0x55, sizeof rows);
+        ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, given, 1u, rows, &r), COA_OK);
+        for (i = 0; i < n; ++i) {
+            ck_assert_uint_eq(r.order[i], given[i]);
+        }
+        check_decoupled_attempt(&f, rows, &r);
+    }
+    ck_assert_uint_ge(solved, 50u);
+    ck_assert_uint_ge(failed, 20u);
+    ws_free(&w);
+}
+END_TEST
+
+static void next_permutation(size_t *a, size_t n)
+{
+    size_t i = n - 1u;
+    size_t j = n - 1u;
+    while (i > 0u && a[i - 1u] >= a[i]) {
+        --i;
+    }
+    if (i > 0u) {
+        size_t t;
+        while (a[j] <= a[i - 1u]) {
+            --j;
+        }
+        t = a[i - 1u];
+        a[i - 1u] = a[j];
+        a[j] = t;
+    }
+    for (j = n - 1u; i < j; ++i, --j) {
+        size_t t = a[i];
+        a[i] = a[j];
+        a[j] = t;
+    }
+}
+
+/* Reordering succeeds exactly when some order works, and otherwise reports the first
+ * order's attempt as a single-order call would. */
+START_TEST(reordering_finds_an_order_iff_one_exists)
+{
+    static fx_t f;
+    static int32_t rows[MAXV * (MAXN + 1u)];
+    static int32_t single[MAXV * (MAXN + 1u)];
+    ws_t w = ws_make(1u, 2000u);
+    uint64_t rng = 0x5eed0003u;
+    unsigned rescued = 0u;
+    unsigned hopeless = 0u;
+    unsigned trial;
+
+    for (trial = 0; trial < 120u; ++trial) {
+        size_t n = 3u;
+        size_t perm[3] = {0u, 1u, 2u};
+        bool works[6];
+        bool any = false;
+        coa_plan_result_t r;
+        coa_plan_result_t first;
+        size_t prio[MAXV];
+        unsigned p;
+        size_t i;
+
+        fx_random(&f, &rng, n, 3u + pick(&rng, 3u), 3u);
+        expected_order(&f, prio);
+        for (p = 0; p < 6u; ++p) {
+            ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, perm, 1u, single, &r), COA_OK);
+            works[p] = r.status == COA_PLAN_SOLVED;
+            any = any || works[p];
+            next_permutation(perm, n);
+        }
+        ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, NULL, 1u, single, &first), COA_OK);
+
+        memset(rows, 0x55, sizeof rows);
+        ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, NULL, 6u, rows, &r), COA_OK);
+        ck_assert_uint_le(r.orders_tried, 6u);
+        ck_assert_msg((r.status == COA_PLAN_SOLVED) == any,
+                      "trial %u: status %d after %u orders; orders that work alone: %d%d%d%d%d%d "
+                      "prio %zu%zu%zu failed %zu at %zu",
+                      trial, (int)r.status, r.orders_tried, works[0], works[1], works[2], works[3],
+                      works[4], works[5], prio[0], prio[1], prio[2], r.failed_vehicle, r.planned_count);
+        if (any) {
+            /* The order it reports works on its own and gives the same plan. */
+            check_solved_plan(&f, rows, &r);
+            ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, r.order, 1u, single, &first), COA_OK);
+            ck_assert_int_eq(first.status, COA_PLAN_SOLVED);
+            ck_assert_mem_eq(rows, single, n * ROW(&f) * sizeof rows[0]);
+            if (r.orders_tried > 1u) {
+                ++rescued;
+            }
+        } else {
+            ck_assert_int_eq(r.status, first.status);
+            ck_assert_uint_eq(r.planned_count, first.planned_count);
+            ck_assert_uint_eq(r.failed_vehicle, first.failed_vehicle);
+            for (i = 0; i < n; ++i) {
+                ck_assert_uint_eq(r.order[i], prio[i]);
+            }
+            for (i = 0; i < r.planned_count; ++i) {
+                size_t v = r.order[i];
+                ck_assert_mem_eq(&rows[v * ROW(&f)], &single[v * ROW(&f)],
+                                 ROW(&f) * sizeof rows[0]);
+            }
+            ck_assert_int_eq(r.deviation_units, first.deviation_units);
+            ck_assert_uint_eq(r.effort, first.effort);
+            check_decoupled_attempt(&f, rows, &r);
+            ++hopeless;
+        }
+    }
+    ck_assert_uint_ge(rescued, 3u);
+    ck_assert_uint_ge(hopeless, 3u);
+    ws_free(&w);
+}
+END_TEST
+
+/* A (priority 1) and B (priority 2) meet at a crossing. B flies between a thin roof and
+ * floor of terrain that leave it no vertical room; A passes the crossing inside the same
+ * slot unless it climbs over the roof or dives under the floor. A plans first and stays
+ * level, so B fails; planned first, B stays level and A goes around. */
+static void fx_tunnel(fx_t *f)
+{
+    fx_init(f, 16u);
+    fx_vehicle(f, 1u, 1u, 20.0, 4.0, 2u, 10.0, 5.0, V(-200, 0, 100), V(200, 0, 100));
+    fx_vehicle(f, 2u, 2u, 10.0, 4.0, 2u, 10.0, 5.0, V(0, -100, 100), V(0, 100, 100));
+    fx_box(f, V(-11, -160, 105.5), V(11, 160, 106.5));
+    fx_box(f, V(-11, -160, 93.5), V(11, 160, 94.5));
+}
+
+START_TEST(reordering_rescues_boxed_in_vehicle)
+{
+    static fx_t f;
+    static int32_t rows[MAXV * (MAXN + 1u)];
+    ws_t w = ws_make(2u, 4000u);
+    coa_plan_result_t r;
+    coa_plan_result_t c;
+    uint32_t k;
+    int32_t peak = 0;
+
+    fx_tunnel(&f);
+    fx_finish(&f);
+    ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, NULL, 1u, rows, &r), COA_OK);
+    ck_assert_int_eq(r.status, COA_PLAN_INFEASIBLE);
+    ck_assert_uint_eq(r.failed_vehicle, 1u);
+    ck_assert_uint_eq(r.planned_count, 1u);
+    ck_assert_uint_eq(r.order[0], 0u);
+    ck_assert_uint_eq(r.orders_tried, 1u);
+    check_decoupled_attempt(&f, rows, &r);
+
+    ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, NULL, 2u, rows, &r), COA_OK);
+    ck_assert_int_eq(r.status, COA_PLAN_SOLVED);
+    ck_assert_uint_eq(r.orders_tried, 2u);
+    ck_assert_uint_eq(r.order[0], 1u);
+    ck_assert_uint_eq(r.order[1], 0u);
+    check_decoupled_attempt(&f, rows, &r);
+    for (k = 0; k <= f.p.horizon; ++k) {
+        ck_assert_int_eq(rows[1u * ROW(&f) + k], 0);
+        peak = abs(rows[k]) > peak ? abs(rows[k]) : peak;
+    }
+    ck_assert_int_ge(peak, 3);
+
+    /* The centralised planner finds the same: only A can move. */
+    ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &c), COA_OK);
+    ck_assert_int_eq(c.status, COA_PLAN_SOLVED);
+    check_solved_plan(&f, rows, &c);
+    ck_assert_int_eq(c.deviation_units, r.deviation_units);
+    ws_free(&w);
+}
+END_TEST
+
+/* The tunnel plus C, held level by max_offset, through the same crossing at the same
+ * time: C and B can never both fly, and A must go around whichever of them planned first.
+ * Depth-first over the orders (failing vehicle first at the position backtracked to):
+ *   [A B C] B fails after A      [A C B] C fails after A      [C A B] B fails (A around C)
+ *   [C B A] B fails after C      [B C A] C fails after B      [B A C] C fails (A around B)
+ * Nothing works; the report is the first order's attempt, whose A row (level) must be
+ * planned again after the last orders left A's row going around. */
+START_TEST(reordering_reports_first_order_when_none_works)
+{
+    static fx_t f;
+    static int32_t rows[MAXV * (MAXN + 1u)];
+    ws_t w = ws_make(1u, 4000u);
+    coa_plan_result_t r;
+    coa_vehicle_t *c;
+    uint32_t k;
+
+    fx_tunnel(&f);
+    c = fx_vehicle(&f, 3u, 3u, 14.142135623730951, 4.0, 2u, 10.0, 5.0, V(100, 100, 100),
+                   V(-100, -100, 100));
+    c->max_offset = 0;
+    fx_finish(&f);
+
+    ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, NULL, 100u, rows, &r), COA_OK);
+    ck_assert_int_eq(r.status, COA_PLAN_INFEASIBLE);
+    ck_assert_uint_eq(r.orders_tried, 6u);
+    ck_assert_uint_eq(r.order[0], 0u);
+    ck_assert_uint_eq(r.order[1], 1u);
+    ck_assert_uint_eq(r.order[2], 2u);
+    ck_assert_uint_eq(r.planned_count, 1u);
+    ck_assert_uint_eq(r.failed_vehicle, 1u);
+    for (k = 0; k <= f.p.horizon; ++k) {
+        ck_assert_int_eq(rows[k], 0);
+    }
+    ck_assert_int_eq(r.deviation_units, 0);
+    check_decoupled_attempt(&f, rows, &r);
+
+    /* Stopping early reports the same first attempt. */
+    ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, NULL, 4u, rows, &r), COA_OK);
+    ck_assert_int_eq(r.status, COA_PLAN_INFEASIBLE);
+    ck_assert_uint_eq(r.orders_tried, 4u);
+    ck_assert_uint_eq(r.failed_vehicle, 1u);
+    for (k = 0; k <= f.p.horizon; ++k) {
+        ck_assert_int_eq(rows[k], 0);
+    }
+    ws_free(&w);
+}
+END_TEST
+
+/* ------------------------------------------------------------------------------------ */
+/* Budget, workspace, edge cases                                                         */
+
+/* Two identical UAVs head-on at the same altitude. */
+static void fx_head_on(fx_t *f, uint32_t horizon, double half)
+{
+    fx_init(f, horizon);
+    fx_vehicle(f, 1u, 1u, 10.0, 4.0, 2u, 5.0, half, V(-60, 0, 100), V(60, 0, 100));
+    fx_vehicle(f, 2u, 1u, 10.0, 4.0, 2u, 5.0, half, V(60, 0, 100), V(-60, 0, 100));
+}
+
+START_TEST(tiny_beta_is_budget_exhausted)
+{
+    static fx_t f;
+    static int32_t rows[MAXV * (MAXN + 1u)];
+    ws_t w;
+    coa_plan_result_t r;
+
+    fx_head_on(&f, 12u, 3.0);
+    fx_finish(&f);
+    w = ws_make(2u, 3u);
+    ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
+    ck_assert_int_eq(r.status, COA_PLAN_BUDGET_EXHAUSTED);
+    ck_assert_uint_eq(r.nodes_expanded, 3u);
+    ws_free(&w);
+
+    /* With room, the same problem is solved: the budget was the only obstacle. */
+    w = ws_make(2u, 20000u);
+    ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
+    ck_assert_int_eq(r.status, COA_PLAN_SOLVED);
+    ck_assert_uint_gt(r.nodes_expanded, 3u);
+    ws_free(&w);
+
+    /* Decoupled: B has to move around A, which takes more than a few expansions. */
+    w = ws_make(1u, 14u);
+    ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, NULL, 2u, rows, &r), COA_OK);
+    ck_assert_int_eq(r.status, COA_PLAN_BUDGET_EXHAUSTED);
+    ck_assert_uint_eq(r.failed_vehicle, r.order[r.planned_count]);
+    ws_free(&w);
+}
+END_TEST
+
+START_TEST(workspace_size_is_exact)
+{
+    size_t bytes = coa_planner_workspace_size(2u, 50u);
+    size_t bytes1 = coa_planner_workspace_size(1u, 50u);
+    unsigned char *mem;
+    unsigned char *guard;
+    coa_planner_t *pl;
+    static fx_t f;
+    static int32_t rows[MAXV * (MAXN + 1u)];
+    coa_plan_result_t r;
+    size_t i;
+
+    ck_assert_uint_gt(bytes, 0u);
+    ck_assert_uint_gt(bytes, bytes1);
+    ck_assert_uint_gt(coa_planner_workspace_size(2u, 51u), bytes);
+    ck_assert_uint_eq(coa_planner_workspace_size(0u, 50u), 0u);
+    ck_assert_uint_eq(coa_planner_workspace_size(COA_MAX_CENTRALISED + 1u, 50u), 0u);
+    ck_assert_uint_eq(coa_planner_workspace_size(2u, 0u), 0u);
+    ck_assert_uint_gt(coa_planner_workspace_size(COA_MAX_CENTRALISED, 1u), 0u);
+    ck_assert_uint_eq(coa_planner_workspace_size(COA_MAX_CENTRALISED, UINT32_MAX), 0u);
+    ck_assert_uint_eq(coa_planner_workspace_size(1u, UINT32_MAX), 0u);
+
+    /* 16 spare bytes: 8 for a misaligned start, 8 of guard after the workspace. */
+    mem = malloc(bytes + 16u);
+    ck_assert_ptr_nonnull(mem);
+    ck_assert_ptr_null(coa_planner_init(NULL, bytes, 2u, 50u));
+    ck_assert_ptr_null(coa_planner_init(mem, bytes - 1u, 2u, 50u));
+    ck_assert_ptr_null(coa_planner_init(mem + 1, bytes, 2u, 50u));
+    ck_assert_ptr_null(coa_planner_init(mem + 4, bytes, 2u, 50u));
+    ck_assert_ptr_null(coa_planner_init(mem, bytes, 0u, 50u));
+    ck_assert_ptr_null(coa_planner_init(mem, bytes, 3u, 50u));
+    ck_assert_ptr_null(coa_planner_init(mem, bytes, 2u, 51u));
+
+    guard = mem + bytes;
+    memset(guard, 0xA5, 16u);
+    pl = coa_planner_init(mem, bytes, 2u, 50u);
+    ck_assert_ptr_eq((void *)pl, (void *)mem);
+
+    /* Run it to its budget and then solve: it never writes past its size. */
+    fx_head_on(&f, 12u, 3.0);
+    fx_finish(&f);
+    ck_assert_int_eq(coa_plan_centralised(pl, &f.p, rows, &r), COA_OK);
+    ck_assert_int_eq(r.status, COA_PLAN_BUDGET_EXHAUSTED);
+    ck_assert_uint_eq(r.workspace_bytes, bytes);
+    ck_assert_int_eq(coa_plan_decoupled(pl, &f.p, NULL, 2u, rows, &r), COA_OK);
+    ck_assert_int_eq(r.status, COA_PLAN_SOLVED);
+    for (i = 0; i < 16u; ++i) {
+        ck_assert_uint_eq(guard[i], 0xA5u);
+    }
+
+    /* A planner for one vehicle refuses a centralised search of two. */
+    pl = coa_planner_init(mem, bytes1, 1u, 50u);
+    ck_assert_ptr_nonnull(pl);
+    ck_assert_int_eq(coa_plan_centralised(pl, &f.p, rows, &r), COA_ERR_WORKSPACE);
+    ck_assert_int_eq(coa_plan_decoupled(pl, &f.p, NULL, 1u, rows, &r), COA_OK);
+    ck_assert_int_eq(coa_plan_decoupled(pl, &f.p, NULL, 0u, rows, &r), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coa_plan_centralised(NULL, &f.p, rows, &r), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coa_plan_centralised(pl, &f.p, NULL, &r), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coa_plan_centralised(pl, NULL, rows, &r), COA_ERR_ARGUMENT);
+    /* A buffer that is not a planner. */
+    memset(mem, 0, 64u);
+    ck_assert_int_eq(coa_plan_decoupled((coa_planner_t *)(void *)mem, &f.p, NULL, 1u, rows, &r),
+                     COA_ERR_WORKSPACE);
+    free(mem);
+}
+END_TEST
+
+START_TEST(initial_conflict_is_infeasible_without_expanding)
+{
+    static fx_t f;
+    static int32_t rows[MAXV * (MAXN + 1u)];
+    ws_t w = ws_make(2u, 1000u);
+    coa_plan_result_t r;
+
+    /* Two UAVs overlapping at t = 0, diverging at once. */
+    fx_init(&f, 6u);
+    fx_vehicle(&f, 1u, 1u, 10.0, 4.0, 2u, 5.0, 3.0, V(0, 0, 100), V(100, 0, 100));
+    fx_vehicle(&f, 2u, 2u, 10.0, 4.0, 2u, 5.0, 3.0, V(2, 0, 101), V(-100, 0, 101));
+    fx_finish(&f);
+    ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
+    ck_assert_int_eq(r.status, COA_PLAN_INFEASIBLE);
+    ck_assert_uint_eq(r.nodes_expanded, 0u);
+    ck_assert_uint_eq(r.nodes_generated, 0u);
+    ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, NULL, 1u, rows, &r), COA_OK);
+    ck_assert_int_eq(r.status, COA_PLAN_INFEASIBLE);
+    ck_assert_uint_eq(r.planned_count, 1u);
+    ck_assert_uint_eq(r.failed_vehicle, 1u);
+    ck_assert_uint_eq(r.nodes_expanded, 6u); /* vehicle 0 alone: one expansion a step */
+
+    /* One UAV starting inside a box; a track sitting on the other at t = 0. */
+    fx_init(&f, 6u);
+    fx_vehicle(&f, 1u, 1u, 10.0, 4.0, 2u, 5.0, 3.0, V(0, 0, 100), V(100, 0, 100));
+    fx_box(&f, V(-3, -3, 90), V(3, 3, 98));
+    fx_finish(&f);
+    ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
+    ck_assert_int_eq(r.status, COA_PLAN_INFEASIBLE);
+    ck_assert_uint_eq(r.nodes_expanded, 0u);
+    fx_init(&f, 6u);
+    fx_vehicle(&f, 1u, 1u, 10.0, 4.0, 2u, 5.0, 3.0, V(0, 0, 100), V(100, 0, 100));
+    fx_track(&f, V(-3, 3, 104), V(0, -30, 0), 3.0, 2.0);
+    fx_finish(&f);
+    ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
+    ck_assert_int_eq(r.status, COA_PLAN_INFEASIBLE);
+    ck_assert_uint_eq(r.nodes_expanded, 0u);
+    ws_free(&w);
+}
+END_TEST
+
+START_TEST(max_offset_is_respected)
+{
+    static fx_t f;
+    static int32_t rows[MAXV * (MAXN + 1u)];
+    ws_t w = ws_make(2u, 20000u);
+    coa_plan_result_t r;
+    uint32_t k;
+    int32_t peak0 = 0;
+    int32_t peak1 = 0;
+
+    /* Separation needs 10 m vertically, dh = 4 m: the offsets must differ by 3. */
+    fx_head_on(&f, 12u, 5.0);
+    fx_finish(&f);
+    ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
+    ck_assert_int_eq(r.status, COA_PLAN_SOLVED);
+    for (k = 0; k <= f.p.horizon; ++k) {
+        peak1 = abs(rows[ROW(&f) + k]) > peak1 ? abs(rows[ROW(&f) + k]) : peak1;
+    }
+    ck_assert_int_gt(peak1, 0); /* unbounded, both share the manoeuvre */
+
+    f.veh[1].max_offset = 0;
+    ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
+    ck_assert_int_eq(r.status, COA_PLAN_SOLVED);
+    check_solved_plan(&f, rows, &r);
+    for (k = 0; k <= f.p.horizon; ++k) {
+        ck_assert_int_eq(rows[ROW(&f) + k], 0);
+        peak0 = abs(rows[k]) > peak0 ? abs(rows[k]) : peak0;
+    }
+    ck_assert_int_ge(peak0, 3);
+
+    f.veh[0].max_offset = 2;
+    ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
+    ck_assert_int_eq(r.status, COA_PLAN_INFEASIBLE);
+    ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, NULL, 2u, rows, &r), COA_OK);
+    ck_assert_int_eq(r.status, COA_PLAN_INFEASIBLE);
+
+    f.veh[0].max_offset = 2;
+    f.veh[1].max_offset = 1;
+    ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
+    ck_assert_int_eq(r.status, COA_PLAN_SOLVED);
+    check_solved_plan(&f, rows, &r);
+    ws_free(&w);
+}
+END_TEST
+
+START_TEST(head_on_is_separated)
+{
+    static fx_t f;
+    static int32_t rows[MAXV * (MAXN + 1u)];
+    ws_t w = ws_make(2u, 20000u);
+    coa_plan_result_t r;
+    uint32_t k;
+    int mode;
+
+    fx_head_on(&f, 12u, 3.0);
+    fx_finish(&f);
+    ck_assert_int_eq(coa_plan_find_conflict(&f.p, (int32_t[26]){0}, ALL, 2u, NULL, NULL), 1);
+    for (mode = 0; mode < 2; ++mode) {
+        if (mode == 0) {
+            ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
+        } else {
+            ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, NULL, 1u, rows, &r), COA_OK);
+        }
+        ck_assert_int_eq(r.status, COA_PLAN_SOLVED);
+        check_solved_plan(&f, rows, &r);
+        ck_assert_int_gt(r.effort, 0u);
+        /* They meet at t = 6: there they must be vertically apart by the two half-heights
+         * (dh = 4 m, 6 m needed), which moving the same way could not give. */
+        k = 6u;
+        ck_assert_int_ge(abs(rows[k] - rows[ROW(&f) + k]) * 4, 6);
+    }
+    /* Centralised shares the manoeuvre: the vertical gap must grow from 0 at t = 5 to
+     * 1.5 climb steps by t = 5.5, so 3 steps at t = 6: one UAV climbs 1, the other dives 2
+     * steeply (area 1 + 2 climb-step-steps of L dh = 40 m^2; effort 1+1 + 3+3). */
+    ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
+    ck_assert_int_eq(abs(rows[6] - rows[ROW(&f) + 6u]), 3);
+    ck_assert_int_lt(rows[6] * rows[ROW(&f) + 6u], 0);
+    ck_assert_double_eq_tol(r.deviation, 120.0, 1e-9);
+    ck_assert_uint_eq(r.effort, 8u);
+    ws_free(&w);
+}
+END_TEST
+
+START_TEST(problem_check_and_helpers)
+{
+    static fx_t f;
+    static coa_vec3_t big[9][COA_MAX_HORIZON + 1u];
+    static coa_vehicle_t many[9];
+    static const coa_vec3_t *bigp[9];
+    static const coa_vec3_t route[2] = {{0, 0, 100}, {100, 0, 100}};
+    coa_problem_t p;
+    size_t order[MAXV];
+    double dev;
+    uint32_t eff;
+    size_t i;
+    size_t bad_v = 99u;
+    uint32_t bad_k = 99u;
+    int32_t offs[5] = {0, 1, 3, 2, 2};
+
+    ck_assert_int_eq(coa_problem_check(NULL), COA_ERR_ARGUMENT);
+    fx_head_on(&f, 12u, 3.0);
+    fx_finish(&f);
+    f.refp[1] = NULL;
+    ck_assert_int_eq(coa_problem_check(&f.p), COA_ERR_ARGUMENT);
+    f.refp[1] = f.ref[1];
+    f.ref[1][3].x = R(NAN);
+    ck_assert_int_eq(coa_problem_check(&f.p), COA_ERR_ARGUMENT);
+    f.ref[1][3].x = R(0);
+    f.veh[1].id = 1u;
+    ck_assert_int_eq(coa_problem_check(&f.p), COA_ERR_ARGUMENT);
+    f.veh[1].id = 2u;
+    fx_box(&f, V(0, 0, 0), V(-1, 1, 1));
+    ck_assert_int_eq(coa_problem_check(&f.p), COA_ERR_ARGUMENT);
+    f.p.obstacle_count = 0u;
+    ck_assert_int_eq(coa_problem_check(&f.p), COA_OK);
+
+    /* The conflict finder names the first conflicting step. */
+    {
+        int32_t zero[2 * 13] = {0};
+        ck_assert_int_eq(coa_plan_find_conflict(&f.p, zero, ALL, 2u, &bad_v, &bad_k), 1);
+        ck_assert_uint_eq(bad_v, 0u);
+        ck_assert_uint_eq(bad_k, 5u); /* 120 m apart closing at 20 m/s: 10 m at t = 5.5 */
+        ck_assert_int_eq(coa_plan_find_conflict(&f.p, zero, ALL, 1u, &bad_v, &bad_k), 0);
+        ck_assert_int_eq(coa_plan_find_conflict(&f.p, zero, (size_t[]){0u, 0u}, 2u, NULL, NULL),
+                         COA_ERR_ARGUMENT);
+        ck_assert_int_eq(coa_plan_find_conflict(&f.p, zero, (size_t[]){0u, 5u}, 2u, NULL, NULL),
+                         COA_ERR_ARGUMENT);
+    }
+
+    /* Nine UAVs with steep factors 2..10 over the longest horizon: S = 5040 and the worst
+     * case no longer fits int64, unless max_offset bounds the offsets. */
+    for (i = 0; i < 9u; ++i) {
+        many[i] = f.veh[0];
+        many[i].id = (uint16_t)(i + 1u);
+        many[i].route = route;
+        many[i].steep_factor = (uint32_t)(2u + i);
+        many[i].max_offset = -1;
+        ck_assert_int_eq(coa_reference_sample(&many[i], R(1.0), COA_MAX_HORIZON, big[i]), COA_OK);
+        bigp[i] = big[i];
+    }
+    memset(&p, 0, sizeof p);
+    p.dt = R(1.0);
+    p.horizon = COA_MAX_HORIZON;
+    p.vehicles = many;
+    p.vehicle_count = 9u;
+    p.references = bigp;
+    ck_assert_int_eq(coa_problem_check(&p), COA_ERR_RANGE);
+    for (i = 0; i < 9u; ++i) {
+        many[i].max_offset = 100;
+    }
+    ck_assert_int_eq(coa_problem_check(&p), COA_OK);
+
+    /* Priority order: ascending priority, ties by id. */
+    many[0].priority = 3u;
+    many[1].priority = 1u;
+    many[2].priority = 1u;
+    many[2].id = 1u;
+    many[3].priority = 2u;
+    ck_assert_int_eq(coa_priority_order(many, 4u, order), COA_OK);
+    ck_assert_uint_eq(order[0], 2u);
+    ck_assert_uint_eq(order[1], 1u);
+    ck_assert_uint_eq(order[2], 3u);
+    ck_assert_uint_eq(order[3], 0u);
+    ck_assert_int_eq(coa_priority_order(many, 0u, order), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coa_priority_order(NULL, 2u, order), COA_ERR_ARGUMENT);
+
+    /* Vehicle cost: L = 10, dh = 4 (steep factor 2): areas 0.5, 2, 2.5, 2. */
+    ck_assert_int_eq(coa_plan_vehicle_cost(&f.veh[0], R(1.0), 4u, offs, &dev, &eff), COA_OK);
+    ck_assert_double_eq_tol(dev, 40.0 * 7.0, 1e-9);
+    ck_assert_uint_eq(eff, 1u + 3u + 1u + 0u);
+    offs[2] = 4;
+    ck_assert_int_eq(coa_plan_vehicle_cost(&f.veh[0], R(1.0), 4u, offs, &dev, &eff),
+                     COA_ERR_ARGUMENT);
+    offs[2] = 3;
+    offs[1] = -1; /* 0 -> -1 -> 3 is not an action either */
+    ck_assert_int_eq(coa_plan_vehicle_cost(&f.veh[0], R(1.0), 4u, offs, &dev, &eff),
+                     COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coa_plan_vehicle_cost(NULL, R(1.0), 4u, offs, &dev, &eff),
+                     COA_ERR_ARGUMENT);
+}
+END_TEST
+
+static Suite *plan_suite(void)
+{
+    Suite *s = suite_create("plan");
+    TCase *tc = tcase_create("plan");
+    tcase_set_timeout(tc, 300);
+    tcase_add_test(tc, workspace_size_is_exact);
+    tcase_add_test(tc, initial_conflict_is_infeasible_without_expanding);
+    tcase_add_test(tc, tiny_beta_is_budget_exhausted);
+    tcase_add_test(tc, max_offset_is_respected);
+    tcase_add_test(tc, head_on_is_separated);
+    tcase_add_test(tc, problem_check_and_helpers);
+    tcase_add_test(tc, reordering_rescues_boxed_in_vehicle);
+    tcase_add_test(tc, reordering_reports_first_order_when_none_works);
+    tcase_add_test(tc, centralised_matches_exhaustive_search);
+    tcase_add_test(tc, decoupled_each_vehicle_optimal_given_earlier);
+    tcase_add_test(tc, reordering_finds_an_order_iff_one_exists);
+    suite_add_tcase(s, tc);
+    return s;
+}
+
+int main(void)
+{
+    SRunner *sr = srunner_create(plan_suite());
+    int failed;
+    srunner_run_all(sr, CK_NORMAL);
+    failed = srunner_ntests_failed(sr);
+    srunner_free(sr);
+    return failed == 0 ? EXIT_SUCCESS : EXIT_FAILURE;
+}
