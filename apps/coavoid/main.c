@@ -24,6 +24,10 @@
 
 /* The closed-set bound beta when neither --beta nor the scenario's "beta" gives one. */
 #define COAVOID_DEFAULT_BETA 20000u
+/* The default beta is lowered until the worst-case workspace fits this many bytes: the
+ * workspace grows as beta * 5^n, and a default that asks a laptop for 18 GB (6 UAVs
+ * centralised) is a trap. An explicit --beta or scenario beta is taken as given. */
+#define COAVOID_DEFAULT_WORKSPACE_MAX ((size_t)1u << 30)
 
 enum {
     EXIT_SOLVED = 0,
@@ -56,7 +60,8 @@ _Static_assert(_Alignof(max_align_t) >= COA_WORKSPACE_ALIGNMENT,
     "  --mode decoupled    each UAV in turn, in priority order\n"                          \
     "  --priority ID,...   decoupled: plan in this order (every vehicle id exactly once)\n" \
     "  --beta N            closed-set bound, N >= 1; overrides the scenario's \"beta\";\n" \
-    "                      default %u; the centralised workspace grows as beta * 5^UAVs\n" \
+    "                      default %u, lowered so the workspace stays within 1 GiB;\n"      \
+    "                      the centralised workspace grows as beta * 5^UAVs\n" \
     "  --reorder           decoupled: when a UAV fails, try other priority orders\n"       \
     "  -h, --help          show this help\n"                                               \
     "\n"                                                                                   \
@@ -292,9 +297,28 @@ static int range_error(const char *file, const scenario_t *s)
                 file, (unsigned long)s->horizon);
 }
 
+/* The default beta for `searched` vehicles a search: COAVOID_DEFAULT_BETA, or the largest
+ * beta whose workspace fits COAVOID_DEFAULT_WORKSPACE_MAX when that is smaller (the size
+ * grows with beta, so a bisection finds it). */
+static uint32_t default_beta(size_t searched)
+{
+    uint32_t lo = 1u;
+    uint32_t hi = COAVOID_DEFAULT_BETA;
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo + 1u) / 2u;
+        size_t size = coa_planner_workspace_size(searched, mid);
+        if (size != 0u && size <= COAVOID_DEFAULT_WORKSPACE_MAX) {
+            lo = mid;
+        } else {
+            hi = mid - 1u;
+        }
+    }
+    return lo;
+}
+
 /* beta from --beta, else the scenario, else the default; *source names it for messages. */
-static uint32_t choose_beta(const plan_options_t *o, const scenario_t *s, char *source,
-                            size_t source_size)
+static uint32_t choose_beta(const plan_options_t *o, const scenario_t *s, size_t searched,
+                            char *source, size_t source_size)
 {
     if (o->beta_text != NULL) {
         snprintf(source, source_size, "--beta %lu", (unsigned long)o->beta);
@@ -305,8 +329,9 @@ static uint32_t choose_beta(const plan_options_t *o, const scenario_t *s, char *
                  (unsigned long)s->beta);
         return s->beta;
     }
-    snprintf(source, source_size, "default beta %lu", (unsigned long)COAVOID_DEFAULT_BETA);
-    return COAVOID_DEFAULT_BETA;
+    uint32_t beta = default_beta(searched);
+    snprintf(source, source_size, "default beta %lu", (unsigned long)beta);
+    return beta;
 }
 
 /* Everything after the scenario is loaded. Returns the exit status. */
@@ -326,8 +351,9 @@ static int plan(const plan_options_t *o, scenario_t *s)
         order = order_storage;
     }
 
+    const size_t searched = o->decoupled ? 1u : n;
     char beta_source[SCENARIO_ERROR_MAX];
-    uint32_t beta = choose_beta(o, s, beta_source, sizeof beta_source);
+    uint32_t beta = choose_beta(o, s, searched, beta_source, sizeof beta_source);
 
     if (!o->decoupled && n > COA_MAX_CENTRALISED) {
         return fail(EXIT_INVALID,
@@ -349,7 +375,6 @@ static int plan(const plan_options_t *o, scenario_t *s)
                     coa_status_name(rc));
     }
 
-    size_t searched = o->decoupled ? 1u : n;
     size_t size = coa_planner_workspace_size(searched, beta);
     if (size == 0) {
         return fail(EXIT_INVALID,
@@ -394,7 +419,7 @@ static int plan(const plan_options_t *o, scenario_t *s)
         status = fail(EXIT_INTERNAL, "internal error: the planner failed (%s)",
                       coa_status_name(rc));
     } else {
-        output_plan_t view = {s, o->decoupled, &result, offsets, elapsed_us(&start, &end)};
+        output_plan_t view = {s, o->decoupled, &result, offsets, elapsed_us(&start, &end), beta};
         if (output_plan(stdout, &view, err, sizeof err) != 0) {
             status = fail(EXIT_INTERNAL, "%s", err);
         } else {

@@ -159,6 +159,7 @@ static cJSON *build(const output_plan_t *plan, char *err, size_t err_size)
         !add_number(stats, "nodes_generated", (double)r->nodes_generated) ||
         !add_number(stats, "time_us", (double)plan->time_us) ||
         !add_number(stats, "workspace_bytes", (double)r->workspace_bytes) ||
+        !add_number(stats, "beta", plan->beta) ||
         (plan->decoupled && !add_number(stats, "orders_tried", r->orders_tried))) {
         goto out_of_memory;
     }

@@ -85,7 +85,25 @@ cost(r) >= $central
 # A small beta runs out of budget on the centralised paper problem: never "infeasible".
 check paper_budget 1 '
 r["status"] == "budget_exhausted"
+r["stats"]["beta"] == 100
 ' -- "$paper" --mode centralised --beta 100
+
+# The default beta is lowered for big composite searches so the workspace stays within
+# 1 GiB (5 UAVs at beta 20000 would need 3.4 GB); the scenario's own beta is honoured.
+python3 - "$work/five.json" <<'PY'
+import json, sys
+v = [{"id": i + 1, "priority": 1, "cruise_speed": 10, "climb_rate": 2, "radius": 15,
+      "half_height": 5, "route": [[0, 100 * i, 100], [1000, 100 * i, 100]]} for i in range(5)]
+json.dump({"name": "five abreast", "dt": 1, "horizon": 6, "vehicles": v}, open(sys.argv[1], "w"))
+PY
+check default_beta_bounded 0 '
+r["status"] == "solved"
+0 < r["stats"]["beta"] < 20000
+r["stats"]["workspace_bytes"] <= 2 ** 30
+' -- "$work/five.json" --mode centralised
+check scenario_beta_honoured 0 '
+r["stats"]["beta"] == 60000
+' -- "$paper" --mode centralised
 
 # Head-on at exactly the same altitude: separated, never both the same way into each other
 # (the BlueSky/ArduPilot failure): either opposite senses or one UAV manoeuvring alone.
