@@ -23,17 +23,17 @@
 
 /* MPR works in ccd_real_t whatever coa_real_t is; these follow libccd's precision. */
 #ifdef CCD_SINGLE
-#define ccd_sqrt(x) sqrtf(x)
-#define ccd_fabs(x) fabsf(x)
-#define ccd_frexp(x, e) frexpf((x), (e))
-#define ccd_ldexp(x, e) ldexpf((x), (e))
+#define mpr_sqrt(x) sqrtf(x)
+#define mpr_fabs(x) fabsf(x)
+#define mpr_frexp(x, e) frexpf((x), (e))
+#define mpr_ldexp(x, e) ldexpf((x), (e))
 /* A float MPR cannot resolve 1e-9 of the scene; stop refining near its own rounding. */
 #define COA_MPR_RELATIVE_TOLERANCE 1e-5f
 #else
-#define ccd_sqrt(x) sqrt(x)
-#define ccd_fabs(x) fabs(x)
-#define ccd_frexp(x, e) frexp((x), (e))
-#define ccd_ldexp(x, e) ldexp((x), (e))
+#define mpr_sqrt(x) sqrt(x)
+#define mpr_fabs(x) fabs(x)
+#define mpr_frexp(x, e) frexp((x), (e))
+#define mpr_ldexp(x, e) ldexp((x), (e))
 #define COA_MPR_RELATIVE_TOLERANCE 1e-9
 #endif
 
@@ -288,7 +288,7 @@ typedef struct {
 /* Beyond every support point of either object in the unit frame (|coordinate| <= 1). */
 #define COA_MPR_FAR ((ccd_real_t)8)
 
-static bool ccd_vec_finite(const ccd_vec3_t *v)
+static bool mpr_vec_finite(const ccd_vec3_t *v)
 {
     return isfinite(v->v[0]) && isfinite(v->v[1]) && isfinite(v->v[2]);
 }
@@ -302,17 +302,17 @@ static bool support_stop(coa_mpr_budget_t *budget, const ccd_vec3_t *dir, ccd_ve
 {
     ccd_real_t len;
 
-    if (!budget->exhausted && ccd_vec_finite(dir)) {
+    if (!budget->exhausted && mpr_vec_finite(dir)) {
         return false;
     }
     budget->exhausted = true;
     out->v[0] = 0;
     out->v[1] = 0;
     out->v[2] = 0;
-    if (!ccd_vec_finite(dir)) {
+    if (!mpr_vec_finite(dir)) {
         return true;
     }
-    len = ccd_sqrt(dir->v[0] * dir->v[0] + dir->v[1] * dir->v[1] + dir->v[2] * dir->v[2]);
+    len = mpr_sqrt(dir->v[0] * dir->v[0] + dir->v[1] * dir->v[1] + dir->v[2] * dir->v[2]);
     if (len > 0 && isfinite(len)) {
         out->v[0] = -COA_MPR_FAR * (dir->v[0] / len);
         out->v[1] = -COA_MPR_FAR * (dir->v[1] / len);
@@ -337,7 +337,7 @@ static void sweep_support(const void *obj, const ccd_vec3_t *dir, ccd_vec3_t *ou
     out->v[0] = sign * s->half.v[0];
     out->v[1] = sign * s->half.v[1];
     out->v[2] = sign * s->half.v[2];
-    lxy = ccd_sqrt(dx * dx + dy * dy);
+    lxy = mpr_sqrt(dx * dx + dy * dy);
     if (lxy > 0) {
         out->v[0] += s->radius * (dx / lxy);
         out->v[1] += s->radius * (dy / lxy);
@@ -402,20 +402,20 @@ static bool vec_finite(const coa_vec3_t *v)
     return isfinite(v->x) && isfinite(v->y) && isfinite(v->z);
 }
 
-static ccd_real_t ccd_max(ccd_real_t a, ccd_real_t b)
+static ccd_real_t mpr_max(ccd_real_t a, ccd_real_t b)
 {
     return a > b ? a : b;
 }
 
 static ccd_real_t vec_max_abs(const coa_vec3_t *v)
 {
-    return ccd_max(ccd_fabs((ccd_real_t)v->x),
-                   ccd_max(ccd_fabs((ccd_real_t)v->y), ccd_fabs((ccd_real_t)v->z)));
+    return mpr_max(mpr_fabs((ccd_real_t)v->x),
+                   mpr_max(mpr_fabs((ccd_real_t)v->y), mpr_fabs((ccd_real_t)v->z)));
 }
 
-static ccd_real_t ccd_vec_max_abs(const ccd_vec3_t *v)
+static ccd_real_t mpr_vec_max_abs(const ccd_vec3_t *v)
 {
-    return ccd_max(ccd_fabs(v->v[0]), ccd_max(ccd_fabs(v->v[1]), ccd_fabs(v->v[2])));
+    return mpr_max(mpr_fabs(v->v[0]), mpr_max(mpr_fabs(v->v[1]), mpr_fabs(v->v[2])));
 }
 
 /* 2^-e for the exponent e of m > 0 (m = f * 2^e, 0.5 <= f < 1); infinite when m is too
@@ -423,8 +423,8 @@ static ccd_real_t ccd_vec_max_abs(const ccd_vec3_t *v)
 static ccd_real_t inverse_power_of_two(ccd_real_t m)
 {
     int e = 0;
-    (void)ccd_frexp(m, &e);
-    return ccd_ldexp((ccd_real_t)1, -e);
+    (void)mpr_frexp(m, &e);
+    return mpr_ldexp((ccd_real_t)1, -e);
 }
 
 int coa_conflict_polytope(const coa_sweep_t *a, const coa_polytope_t *poly)
@@ -453,8 +453,8 @@ int coa_conflict_polytope(const coa_sweep_t *a, const coa_polytope_t *poly)
     }
     poly_box.min = poly->vertices[0];
     poly_box.max = poly->vertices[0];
-    m = ccd_max(vec_max_abs(&a->p0), vec_max_abs(&a->p1));
-    m = ccd_max(m, ccd_max((ccd_real_t)a->volume.radius, (ccd_real_t)a->volume.half_height));
+    m = mpr_max(vec_max_abs(&a->p0), vec_max_abs(&a->p1));
+    m = mpr_max(m, mpr_max((ccd_real_t)a->volume.radius, (ccd_real_t)a->volume.half_height));
     for (i = 0; i < poly->count; ++i) {
         const coa_vec3_t *p = &poly->vertices[i];
         if (!vec_finite(p)) {
@@ -466,7 +466,7 @@ int coa_conflict_polytope(const coa_sweep_t *a, const coa_polytope_t *poly)
         poly_box.max.x = p->x > poly_box.max.x ? p->x : poly_box.max.x;
         poly_box.max.y = p->y > poly_box.max.y ? p->y : poly_box.max.y;
         poly_box.max.z = p->z > poly_box.max.z ? p->z : poly_box.max.z;
-        m = ccd_max(m, vec_max_abs(p));
+        m = mpr_max(m, vec_max_abs(p));
     }
     sweep_box = coa_sweep_bounds(a);
     if (!coa_boxes_touch(&sweep_box, &poly_box)) {
@@ -490,11 +490,11 @@ int coa_conflict_polytope(const coa_sweep_t *a, const coa_polytope_t *poly)
 
     /* The scene's size about the midpoint, before post-scaling. */
     hull.frame.post = 1;
-    m = ccd_max(ccd_fabs(sweep.half.v[0]), ccd_fabs(sweep.half.v[1])) + sweep.radius;
-    m = ccd_max(m, ccd_fabs(sweep.half.v[2]) + sweep.half_height);
+    m = mpr_max(mpr_fabs(sweep.half.v[0]), mpr_fabs(sweep.half.v[1])) + sweep.radius;
+    m = mpr_max(m, mpr_fabs(sweep.half.v[2]) + sweep.half_height);
     for (i = 0; i < poly->count; ++i) {
         frame_point(&hull.frame, &poly->vertices[i], &v);
-        m = ccd_max(m, ccd_vec_max_abs(&v));
+        m = mpr_max(m, mpr_vec_max_abs(&v));
     }
     hull.frame.post = inverse_power_of_two(m);
     if (!(m > 0) || !isfinite(m) || !(hull.frame.post > 0) || !isfinite(hull.frame.post)) {
