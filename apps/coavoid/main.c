@@ -2,7 +2,7 @@
  * coavoid: the command-line front end of the core.
  *
  *   coavoid plan SCENARIO.json --mode centralised|decoupled [--priority ID,...] [--beta N]
- *                [--reorder]
+ *                [--reorder [--max-orders N]]
  *
  * reads a scenario (SCENARIO_FORMAT.md), plans, and prints the plan result as JSON. Exit
  * status: 0 solved, 1 infeasible or budget exhausted, 2 invalid input or usage (one line
@@ -29,6 +29,16 @@
  * centralised) is a trap. An explicit --beta or scenario beta is taken as given. */
 #define COAVOID_DEFAULT_WORKSPACE_MAX ((size_t)1u << 30)
 
+/* How many priority orders --reorder tries unless --max-orders says otherwise. n UAVs have
+ * n! orders and a failing order costs up to n searches, so an unbounded search can run for
+ * hours (12! is 479 million); 7! tries every order of up to 7 UAVs, which is still well
+ * under a second for small problems, and bounds the rest. */
+#define COAVOID_DEFAULT_MAX_ORDERS 5040u
+#define COAVOID_DEFAULT_MAX_ORDERS_COVER 7u /* the UAV count whose orders it covers */
+_Static_assert(COAVOID_DEFAULT_MAX_ORDERS == 7u * 6u * 5u * 4u * 3u * 2u * 1u &&
+                   COAVOID_DEFAULT_MAX_ORDERS_COVER == 7u,
+               "the default max orders is COAVOID_DEFAULT_MAX_ORDERS_COVER factorial");
+
 enum {
     EXIT_SOLVED = 0,
     EXIT_NOT_SOLVED = 1, /* infeasible or budget exhausted */
@@ -51,7 +61,7 @@ _Static_assert(_Alignof(max_align_t) >= COA_WORKSPACE_ALIGNMENT,
 
 #define PLAN_USAGE                                                                         \
     "usage: coavoid plan SCENARIO.json --mode centralised|decoupled\n"                      \
-    "                    [--priority ID,ID,...] [--beta N] [--reorder]\n"                   \
+    "                    [--priority ID,ID,...] [--beta N] [--reorder [--max-orders N]]\n"  \
     "\n"                                                                                   \
     "Reads a scenario (JSON, at most %u MiB) and prints the plan result as JSON.\n"         \
     "\n"                                                                                   \
@@ -63,6 +73,9 @@ _Static_assert(_Alignof(max_align_t) >= COA_WORKSPACE_ALIGNMENT,
     "                      default %u, lowered so the workspace stays within 1 GiB;\n"      \
     "                      the centralised workspace grows as beta * 5^UAVs\n" \
     "  --reorder           decoupled: when a UAV fails, try other priority orders\n"       \
+    "  --max-orders N      with --reorder: try at most N orders, N >= 1; default %u\n"     \
+    "                      (every order of up to %u UAVs); stats.all_orders_covered\n"    \
+    "                      says whether a failure is proven for every order\n"            \
     "  -h, --help          show this help\n"                                               \
     "\n"                                                                                   \
     "Fields of the scenario that the format does not define are ignored.\n"                \
@@ -104,6 +117,8 @@ typedef struct {
     const char *beta_text;
     uint32_t beta;
     bool reorder;
+    const char *max_orders_text; /* NULL: COAVOID_DEFAULT_MAX_ORDERS */
+    uint32_t max_orders;
 } plan_options_t;
 
 /* A decimal number of digits only (no sign, no spaces) in 1..max. */
@@ -166,7 +181,8 @@ static int parse_plan_options(int argc, char **argv, plan_options_t *o)
             options_done = true;
         } else if (strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0) {
             printf(PLAN_USAGE, SCENARIO_MAX_BYTES / (1024u * 1024u), COA_MAX_CENTRALISED,
-                   COAVOID_DEFAULT_BETA);
+                   COAVOID_DEFAULT_BETA, COAVOID_DEFAULT_MAX_ORDERS,
+                   COAVOID_DEFAULT_MAX_ORDERS_COVER);
             return EXIT_SOLVED;
         } else if (option_is(arg, "--mode")) {
             if (o->mode != NULL) {
@@ -212,6 +228,21 @@ static int parse_plan_options(int argc, char **argv, plan_options_t *o)
             o->reorder = true;
         } else if (option_is(arg, "--reorder")) {
             return fail(EXIT_INVALID, "--reorder: takes no value");
+        } else if (option_is(arg, "--max-orders")) {
+            uint64_t max_orders;
+            if (o->max_orders_text != NULL) {
+                return fail(EXIT_INVALID, "--max-orders: given more than once");
+            }
+            if (!option_value(argc, argv, &i, arg, "--max-orders", &value)) {
+                return fail(EXIT_INVALID, "--max-orders: missing value (an integer >= 1)");
+            }
+            if (!parse_count(value, strlen(value), UINT32_MAX, &max_orders)) {
+                return fail(EXIT_INVALID,
+                            "--max-orders: must be an integer from 1 to %lu, got '%.40s'",
+                            (unsigned long)UINT32_MAX, value);
+            }
+            o->max_orders_text = value;
+            o->max_orders = (uint32_t)max_orders;
         } else {
             return fail(EXIT_INVALID, "plan: unknown option '%.40s' (see 'coavoid plan --help')",
                         arg);
@@ -230,6 +261,13 @@ static int parse_plan_options(int argc, char **argv, plan_options_t *o)
     }
     if (!o->decoupled && o->reorder) {
         return fail(EXIT_INVALID, "--reorder: only valid with --mode decoupled");
+    }
+    /* Without --reorder exactly one order is planned: a bound on orders would do nothing. */
+    if (o->max_orders_text != NULL && !o->reorder) {
+        return fail(EXIT_INVALID, "--max-orders: only valid with --reorder (and --mode decoupled)");
+    }
+    if (o->max_orders_text == NULL) {
+        o->max_orders = COAVOID_DEFAULT_MAX_ORDERS;
     }
     return -1;
 }
@@ -287,8 +325,10 @@ static int64_t elapsed_us(const struct timespec *start, const struct timespec *e
            (int64_t)(end->tv_nsec - start->tv_nsec) / 1000;
 }
 
-/* The core's COA_ERR_RANGE: the worst-case offsets and integer costs over this horizon
- * would overflow. Horizon is what the user is most likely to change. */
+/* The core's COA_ERR_RANGE from the problem check or the planner. Weights that cannot be
+ * exact (the only cause the current limits allow) are named by the parser first, so what
+ * is left is the worst-case cost over the horizon outgrowing the core's exact integers:
+ * horizon is what the user is most likely to change. A backstop. */
 static int range_error(const char *file, const scenario_t *s)
 {
     return fail(EXIT_INVALID,
@@ -404,8 +444,8 @@ static int plan(const plan_options_t *o, scenario_t *s)
     struct timespec start, end;
     clock_gettime(CLOCK_MONOTONIC, &start);
     if (o->decoupled) {
-        rc = coa_plan_decoupled(planner, &problem, order, o->reorder ? UINT32_MAX : 1u, offsets,
-                                &result);
+        rc = coa_plan_decoupled(planner, &problem, order, o->reorder ? o->max_orders : 1u,
+                                offsets, &result);
     } else {
         rc = coa_plan_centralised(planner, &problem, offsets, &result);
     }

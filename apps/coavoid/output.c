@@ -163,6 +163,12 @@ static cJSON *build(const output_plan_t *plan, char *err, size_t err_size)
         (plan->decoupled && !add_number(stats, "orders_tried", r->orders_tried))) {
         goto out_of_memory;
     }
+    /* Whether the failure, if any, holds for every order: with --max-orders an unsolved
+     * result may only say that the orders tried failed. */
+    if (plan->decoupled &&
+        cJSON_AddBoolToObject(stats, "all_orders_covered", r->all_orders_covered) == NULL) {
+        goto out_of_memory;
+    }
 
     cJSON *vehicles = cJSON_AddArrayToObject(root, "vehicles");
     if (vehicles == NULL) {

@@ -10,6 +10,14 @@
 
 #include <cjson/cJSON.h>
 
+/* The core's square root at the core's precision: leg lengths are checked here exactly as
+ * coa_vehicle_check computes them. */
+#ifdef COA_SINGLE_PRECISION
+#define real_sqrt(x) sqrtf(x)
+#else
+#define real_sqrt(x) sqrt(x)
+#endif
+
 /* Longest field path we build ("tracks[123456].path[1234567][3]" and the like). */
 #define PATH_SIZE 128u
 
@@ -431,11 +439,47 @@ static const int_range_t RANGE_HORIZON = {1, COA_MAX_HORIZON, "COA_MAX_HORIZON"}
 static const int_range_t RANGE_BETA = {1, UINT32_MAX, NULL};
 static const int_range_t RANGE_TRACK_ID = {0, UINT32_MAX, NULL};
 
+/* The leg from `prev` to `cur` (the route point at `path`), computed as the core's vehicle
+ * check computes it: in coa_real_t, the horizontal length as sqrt(dx*dx + dy*dy), and the
+ * running total of the lengths. Each of these can be 0 or overflow while every coordinate
+ * is finite (1e-300 apart, or 1e200 apart), and the core would then refuse the vehicle as
+ * a whole; here the message names the point and says which. */
+static bool check_route_leg(parser_t *p, const coa_vec3_t *prev, const coa_vec3_t *cur,
+                            coa_real_t *total, const char *path)
+{
+    /* Compared as coa_real_t: points distinct in the file may coincide in float. */
+    if (cur->x == prev->x && cur->y == prev->y) {
+        return fail(p, path, "consecutive points have no horizontal separation");
+    }
+    coa_real_t dx = cur->x - prev->x;
+    coa_real_t dy = cur->y - prev->y;
+    coa_real_t length = real_sqrt(dx * dx + dy * dy);
+    if (!isfinite(length)) {
+        return fail(p, path, "leg length is not finite (coordinates too large)");
+    }
+    if (!(length > 0)) {
+        return fail(p, path,
+                    "consecutive points have no horizontal separation (their distance "
+                    "underflows to 0)");
+    }
+    if (!isfinite(cur->z - prev->z)) {
+        return fail(p, path, "altitude change is not finite (coordinates too large)");
+    }
+    /* Unreachable today (a leg overflows first: its squares pass the range at 1e154 m,
+     * float 1e19 m, so the total would need 1e154 legs), but the core checks it. */
+    *total += length;
+    if (!isfinite(*total)) {
+        return fail(p, path, "route length up to this point is not finite (coordinates too large)");
+    }
+    return true;
+}
+
 static bool parse_route(parser_t *p, const cJSON *obj, const char *obj_path, coa_vehicle_t *v)
 {
     char path[PATH_SIZE];
     const cJSON *route;
     size_t n;
+    coa_real_t total = 0;
     if (!get_field(p, obj, obj_path, "route", REQUIRED, &route, path) ||
         !read_array(p, route, path, 2, SIZE_MAX, "point", NULL, &n)) {
         return false;
@@ -453,9 +497,8 @@ static bool parse_route(parser_t *p, const cJSON *obj, const char *obj_path, coa
         if (!read_vec3(p, item, point_path, &points[i])) {
             return false;
         }
-        /* Compared as coa_real_t: points distinct in the file may coincide in float. */
-        if (i > 0 && points[i].x == points[i - 1].x && points[i].y == points[i - 1].y) {
-            return fail(p, point_path, "consecutive points have no horizontal separation");
+        if (i > 0 && !check_route_leg(p, &points[i - 1], &points[i], &total, point_path)) {
+            return false;
         }
         i++;
     }
@@ -494,10 +537,18 @@ static bool parse_vehicle(parser_t *p, const cJSON *obj, const char *path, coa_v
     v->steep_factor = (uint32_t)steep;
     v->initial_offset = (int32_t)initial;
     v->max_offset = bounded ? (int32_t)max_offset : -1;
+    /* A backstop: every rule of the core's check is tested above with its field's path, so
+     * only a rule added to the core later can reach this. */
     if (coa_vehicle_check(v) != COA_OK) {
         return fail(p, path, "rejected by the core's vehicle check");
     }
     return true;
+}
+
+/* A vehicle's deviation weight L * dh in m^2, in double as the core computes it. */
+static double step_area(const coa_vehicle_t *v, coa_real_t dt)
+{
+    return ((double)v->cruise_speed * (double)dt) * ((double)v->climb_rate * (double)dt);
 }
 
 /* The step length L = cruise_speed * dt, the climb step dh = climb_rate * dt and their
@@ -520,6 +571,42 @@ static bool check_step_sizes(parser_t *p, const coa_vehicle_t *v, coa_real_t dt,
                     l, dh);
     }
     return true;
+}
+
+/* The core weighs each vehicle's deviation by w = cruise_speed*dt * climb_rate*dt written
+ * exactly as a 64-bit integer times a power of two common to the problem, and refuses
+ * (COA_ERR_RANGE) vehicles whose w are too far apart in binary magnitude for that. The
+ * problem check would report it as a range error of the whole problem; here the first
+ * pair of vehicles that cannot be weighed together is named. The test is the core's own,
+ * on two vehicles at a time: the set fails exactly when the pair of its extremes does. */
+static bool check_weights(parser_t *p, const scenario_t *s, const char *path)
+{
+    uint64_t weights[COA_MAX_VEHICLES];
+    int exponent;
+    if (coa_deviation_weights(s->vehicles, s->vehicle_count, s->dt, weights, &exponent) !=
+        COA_ERR_RANGE) {
+        return true; /* arguments were checked vehicle by vehicle above */
+    }
+    for (size_t j = 1; j < s->vehicle_count; j++) {
+        for (size_t i = 0; i < j; i++) {
+            const coa_vehicle_t pair[2] = {s->vehicles[i], s->vehicles[j]};
+            if (coa_deviation_weights(pair, 2, s->dt, weights, &exponent) == COA_ERR_RANGE) {
+                char vehicle_path[PATH_SIZE];
+                path_index(vehicle_path, path, j);
+                return fail(p, vehicle_path,
+                            "cruise_speed * dt * climb_rate * dt (%.17g m^2) and "
+                            "vehicles[%zu]'s (%.17g m^2) are too far apart for the core's exact "
+                            "64-bit cost weights (make them closer in size, or use numbers with "
+                            "fewer binary digits, e.g. multiples of 1/8)",
+                            step_area(&s->vehicles[j], s->dt), i,
+                            step_area(&s->vehicles[i], s->dt));
+            }
+        }
+    }
+    return fail(p, path,
+                "cruise_speed * dt * climb_rate * dt of the vehicles are too far apart for "
+                "the core's exact 64-bit cost weights (make them closer in size, or use numbers "
+                "with fewer binary digits, e.g. multiples of 1/8)");
 }
 
 static bool parse_vehicles(parser_t *p, const cJSON *root)
@@ -557,7 +644,7 @@ static bool parse_vehicles(parser_t *p, const cJSON *root)
         i++;
     }
     s->vehicle_count = n;
-    return true;
+    return check_weights(p, s, path);
 }
 
 static bool parse_box(parser_t *p, const cJSON *obj, const char *path, coa_obstacle_t *o)
@@ -666,6 +753,38 @@ static bool parse_obstacles(parser_t *p, const cJSON *root)
     return true;
 }
 
+/* The path leg from `prev` to `cur` (the point at `path`, whose t is already known to be
+ * greater), in coa_real_t as the core takes it: its duration, its displacement and so its
+ * velocity must be finite, or the core refuses the track or its samples run off to
+ * infinity, and the message would then name neither the point nor the reason. */
+static bool check_track_leg(parser_t *p, const coa_track_point_t *prev,
+                            const coa_track_point_t *cur, const char *path)
+{
+    coa_real_t duration = cur->t - prev->t;
+    if (!isfinite(duration)) {
+        return fail(p, path, "time since the previous point is not finite (times too large)");
+    }
+    if (!(duration > 0)) {
+        return fail(p, path, "time since the previous point underflows to 0");
+    }
+    const coa_real_t d[3] = {cur->p.x - prev->p.x, cur->p.y - prev->p.y, cur->p.z - prev->p.z};
+    for (size_t axis = 0; axis < 3; axis++) {
+        if (!isfinite(d[axis])) {
+            return fail(p, path,
+                        "displacement from the previous point is not finite on the %c axis "
+                        "(coordinates too large)",
+                        "xyz"[axis]);
+        }
+        if (!isfinite(d[axis] / duration)) {
+            return fail(p, path,
+                        "velocity from the previous point is not finite on the %c axis "
+                        "(%.15g m in %.15g s)",
+                        "xyz"[axis], (double)d[axis], (double)duration);
+        }
+    }
+    return true;
+}
+
 static bool parse_track_path(parser_t *p, const cJSON *array, const char *path, coa_track_t *t)
 {
     size_t n;
@@ -696,6 +815,9 @@ static bool parse_track_path(parser_t *p, const cJSON *array, const char *path, 
         points[i].p.x = txyz[1];
         points[i].p.y = txyz[2];
         points[i].p.z = txyz[3];
+        if (i > 0 && !check_track_leg(p, &points[i - 1], &points[i], point_path)) {
+            return false;
+        }
         i++;
     }
     t->path = points;
@@ -740,6 +862,7 @@ static bool parse_track(parser_t *p, const cJSON *obj, const char *path, coa_tra
         t->sigma_horizontal = sigma[0];
         t->sigma_vertical = sigma[1];
     }
+    /* A backstop, as for vehicles: the rules are all tested above with their paths. */
     if (coa_track_check(t) != COA_OK) {
         return fail(p, path, "rejected by the core's track check");
     }

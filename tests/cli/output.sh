@@ -6,14 +6,8 @@
 #
 # usage: bash output.sh <path-to-coavoid> <source-dir>
 set -u
-bin=${1:?usage: output.sh COAVOID SOURCE_DIR}
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-passed=0
-failed=0
-
-pass() { passed=$((passed + 1)); }
-fail() { failed=$((failed + 1)); echo "FAIL: $*"; }
+# shellcheck source=tests/cli/lib.bash
+. "$(dirname "${BASH_SOURCE[0]}")/lib.bash" "$@"
 
 # Two UAVs head-on at the same altitude, meeting at t = 10 s: the last two samples need
 # 10 m of vertical separation, which takes a search.
@@ -75,6 +69,29 @@ cat >"$tmp/initial.json" <<'JSON'
   ]
 }
 JSON
+
+# Three UAVs; 1 cannot leave its altitude (max_offset 0) and crosses 2's path at t = 10.
+# In priority order 2 plans first, flies level, and 1 then has no plan; with 1 before 2
+# (2 climbs over it) there is one. 3 is far away.
+cat >"$tmp/blocked.json" <<'JSON'
+{
+  "name": "blocked",
+  "dt": 1.0,
+  "horizon": 12,
+  "vehicles": [
+    {"id": 1, "priority": 2, "cruise_speed": 10, "climb_rate": 2, "radius": 10,
+     "half_height": 5, "route": [[0, 0, 100], [200, 0, 100]], "max_offset": 0},
+    {"id": 2, "priority": 1, "cruise_speed": 10, "climb_rate": 2, "radius": 10,
+     "half_height": 5, "route": [[100, -100, 100], [100, 100, 100]]},
+    {"id": 3, "priority": 3, "cruise_speed": 10, "climb_rate": 2, "radius": 10,
+     "half_height": 5, "route": [[0, 5000, 100], [200, 5000, 100]]}
+  ]
+}
+JSON
+
+# As blocked, but neither crossing UAV can leave its altitude: every order fails.
+python3 -c 'import json,sys; s=json.load(open(sys.argv[1])); s["name"]="stuck"; s["vehicles"][1]["max_offset"]=0; json.dump(s, open(sys.argv[2], "w"))' \
+    "$tmp/blocked.json" "$tmp/stuck.json"
 
 cat >"$tmp/check.py" <<'PY'
 """check.py RESULT SCENARIO MODE STATUS [ORDER] [FAILED]: the result obeys the contract."""
@@ -154,6 +171,13 @@ if mode == "decoupled":
 expect(isinstance(stats, dict), "stats %r" % stats)
 for key in keys:
     expect(is_int((stats or {}).get(key)) and stats[key] >= 0, "stats.%s %r" % (key, (stats or {}).get(key)))
+if mode == "decoupled":
+    expect((stats or {}).get("orders_tried", 0) >= 1, "stats.orders_tried is 0")
+    expect(isinstance((stats or {}).get("all_orders_covered"), bool),
+           "stats.all_orders_covered %r" % (stats or {}).get("all_orders_covered"))
+else:
+    expect("orders_tried" not in (stats or {}) and "all_orders_covered" not in (stats or {}),
+           "centralised stats report orders")
 expect((stats or {}).get("workspace_bytes", 0) > 0, "stats.workspace_bytes is 0")
 
 vs = r.get("vehicles")
@@ -273,6 +297,42 @@ expect_result initial_central 1 infeasible centralised "$i" "" "" plan "$i" --mo
 expect_result initial_decoupled 1 infeasible decoupled "$i" 4,5 5 plan "$i" --mode decoupled
 expect_result initial_reorder 1 infeasible decoupled "$i" "" "" plan "$i" --mode decoupled --reorder
 
+# expect_stats NAME PYTHON: the result of the expect_result run NAME satisfies PYTHON, an
+# expression over `r` (the result) and `st` (its stats).
+expect_stats() {
+    if python3 - "$tmp/$1.out" "$2" <<'PY'
+import json, sys
+r = json.load(open(sys.argv[1]))
+st = r["stats"]
+sys.exit(0 if eval(sys.argv[2]) else 1)
+PY
+    then pass; else fail "$1: not ($2): $(python3 -c 'import json,sys; print(json.dumps(json.load(open(sys.argv[1]))["stats"]))' "$tmp/$1.out")"; fi
+}
+
+# A t = 0 conflict holds in every order: reordering proves the failure for all of them.
+expect_stats initial_reorder 'st["all_orders_covered"] is True'
+
+# ---- --reorder and --max-orders ----
+b=$tmp/blocked.json
+expect_result blocked_decoupled 1 infeasible decoupled "$b" 2,1,3 1 plan "$b" --mode decoupled
+expect_stats blocked_decoupled 'st["orders_tried"] == 1 and st["all_orders_covered"] is False'
+# Reordering (default bound) finds an order with 1 before 2.
+expect_result blocked_reorder 0 solved decoupled "$b" "" "" plan "$b" --mode decoupled --reorder
+expect_stats blocked_reorder 'st["orders_tried"] > 1 and r["priority_order"].index(1) < r["priority_order"].index(2)'
+# --max-orders 1 stops after the first order: its failure is reported, and it is not
+# proven for the other orders.
+expect_result blocked_max1 1 infeasible decoupled "$b" 2,1,3 1 plan "$b" --mode decoupled --reorder --max-orders 1
+expect_stats blocked_max1 'st["orders_tried"] == 1 and st["all_orders_covered"] is False'
+expect_result blocked_max1_equals 1 infeasible decoupled "$b" 2,1,3 1 plan "$b" --mode decoupled --reorder --max-orders=1
+# A bound larger than needed changes nothing.
+expect_result blocked_max_big 0 solved decoupled "$b" "" "" plan "$b" --mode decoupled --reorder --max-orders 4294967295
+# Every order fails: exhausting them proves it; one order does not.
+t=$tmp/stuck.json
+expect_result stuck_reorder 1 infeasible decoupled "$t" 2,1,3 1 plan "$t" --mode decoupled --reorder
+expect_stats stuck_reorder 'st["all_orders_covered"] is True and 1 < st["orders_tried"] <= 6'
+expect_result stuck_max1 1 infeasible decoupled "$t" 2,1,3 1 plan "$t" --mode decoupled --reorder --max-orders 1
+expect_stats stuck_max1 'st["orders_tried"] == 1 and st["all_orders_covered"] is False'
+
 # ---- budget exhausted: beta 1 cannot reach k = 10 ----
 expect_result budget_central 1 budget_exhausted centralised "$h" "" "" plan "$h" --mode centralised --beta 1
 expect_result budget_decoupled 1 budget_exhausted decoupled "$h" 1,2 1 plan "$h" --mode decoupled --beta 1
@@ -290,5 +350,4 @@ sys.exit(0 if a == b else 1)
 PY
 then pass; else fail "two runs of the same plan differ"; fi
 
-echo "$passed passed, $failed failed"
-[ "$failed" -eq 0 ]
+finish
