@@ -90,15 +90,22 @@ START_TEST(planner_makes_no_heap_call)
     static coa_obstacle_t obs[3];
     static coa_track_t track;
     static int32_t rows[2 * (N + 1u)];
+    static int32_t rows_at_start[2 * (N + 1u)];
+    coa_vec3_t b_start;
     coa_problem_t p;
     coa_plan_result_t central;
     coa_plan_result_t decoupled;
+    coa_plan_result_t at_start;
     coa_planner_t *pl;
     void *mem;
     size_t bytes;
     size_t i;
     int rc_central;
     int rc_decoupled;
+    int rc_at_start;
+    int rc_weights;
+    uint64_t weights[2];
+    int exponent;
 
     route_a[0] = V(-200, 0, 100);
     route_a[1] = V(200, 0, 100);
@@ -165,7 +172,13 @@ START_TEST(planner_makes_no_heap_call)
     pl = coa_planner_init(mem, bytes, 2u, 2000u);
     rc_central = coa_plan_centralised(pl, &p, rows, &central);
     rc_decoupled = coa_plan_decoupled(pl, &p, NULL, 2u, rows, &decoupled);
+    rc_weights = coa_deviation_weights(veh, 2u, p.dt, weights, &exponent);
+    /* B moved onto A's start: the t = 0 check that ends reordering runs here too. */
+    b_start = ref[1][0];
+    ref[1][0] = ref[0][0];
+    rc_at_start = coa_plan_decoupled(pl, &p, NULL, 100u, rows_at_start, &at_start);
     armed = false;
+    ref[1][0] = b_start;
 
     ck_assert_uint_eq(heap_calls, 0u);
     ck_assert_ptr_nonnull(pl);
@@ -174,6 +187,14 @@ START_TEST(planner_makes_no_heap_call)
     ck_assert_int_eq(rc_decoupled, COA_OK);
     ck_assert_int_eq(decoupled.status, COA_PLAN_SOLVED);
     ck_assert_uint_eq(decoupled.orders_tried, 2u);
+    ck_assert_int_eq(rc_weights, COA_OK);
+    ck_assert_uint_eq(weights[0], 10u); /* L*dh = 80 = 10 * 2^3 and 40 = 5 * 2^3 */
+    ck_assert_uint_eq(weights[1], 5u);
+    ck_assert_int_eq(exponent, 3);
+    ck_assert_int_eq(rc_at_start, COA_OK);
+    ck_assert_int_eq(at_start.status, COA_PLAN_INFEASIBLE);
+    ck_assert(at_start.all_orders_covered);
+    ck_assert_uint_eq(at_start.orders_tried, 1u);
     ck_assert_int_eq(coa_plan_find_conflict(&p, rows, (const size_t[]){0u, 1u}, 2u, NULL, NULL), 0);
     free(mem);
 

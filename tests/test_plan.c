@@ -3,9 +3,13 @@
  * workspace, reordering and edge-case contracts of plan.h.
  *
  * The exhaustive search (layered dynamic programming over every reachable offset vector)
- * shares no code with plan.c: it uses only the geometry conflict tests and the trajectory
- * cost functions, so an error in the engine's duplicate handling, ordering, validity
- * tables or bookkeeping shows up as a different status or cost.
+ * shares no code with plan.c and none with the core's cost code: it uses only the geometry
+ * conflict tests, and it prices plans itself, exactly, from the contract (SCENARIO_FORMAT
+ * "Costs"): each w_i = fl(fl(v dt) fl(c dt)) taken apart with frexp, the areas as exact
+ * rationals, everything summed in the compiler's 128-bit integers (this test runs on
+ * 64-bit hosts only). So an error in the engine's duplicate handling, ordering, validity
+ * tables, bookkeeping or cost arithmetic shows up as a different status or cost, and a tie
+ * between vehicles with different L*dh is broken by effort as the contract says.
  */
 #include <check.h>
 #include <math.h>
@@ -14,11 +18,27 @@
 
 #include "coavoid/coavoid.h"
 
-#define MAXV 4u
+#ifndef __SIZEOF_INT128__
+#error "test_plan's cost oracle needs unsigned __int128 (a 64-bit GCC or Clang host)"
+#endif
+/* __extension__: 128-bit integers are a GCC and Clang extension, fine in a host test. */
+__extension__ typedef unsigned __int128 u128_t;
+
+#define MAXV 10u
+#define MAXPTS 4u   /* route points of a random vehicle */
+#define MAXTRPTS 3u /* path points of a random track */
 #define MAXN 24u
 #define MAXOBS 4u
 #define MAXTR 2u
 #define ROW(f) ((size_t)(f)->p.horizon + 1u)
+/* An assertion for the oracle's inner loops: Check logs the place of every ck_assert it
+ * passes, which in a loop run millions of times costs more than the search itself. */
+#define REQUIRE(cond)                                                                       \
+    do {                                                                                    \
+        if (!(cond)) {                                                                      \
+            ck_abort_msg("%s:%d: %s", __FILE__, __LINE__, #cond);                          \
+        }                                                                                   \
+    } while (0)
 
 /* ------------------------------------------------------------------------------------ */
 /* Deterministic random numbers                                                          */
@@ -60,12 +80,13 @@ static coa_vec3_t V(double x, double y, double z)
 
 typedef struct {
     coa_vehicle_t veh[MAXV];
-    coa_vec3_t route[MAXV][2];
+    coa_vec3_t route[MAXV][MAXPTS];
     coa_vec3_t ref[MAXV][MAXN + 1u];
     const coa_vec3_t *refp[MAXV];
     coa_obstacle_t obs[MAXOBS];
     coa_vec3_t poly[MAXOBS][8];
     coa_track_t tr[MAXTR];
+    coa_track_point_t trpath[MAXTR][MAXTRPTS];
     coa_vec3_t trs[MAXTR][MAXN + 1u];
     const coa_vec3_t *trp[MAXTR];
     coa_problem_t p;
@@ -140,36 +161,111 @@ static void fx_finish(fx_t *f)
 }
 
 /* UAVs converging on one point at random times, so that conflicts are common, with
- * obstacles and tracks around that point. */
+ * obstacles and tracks around that point. dt is 0.5, 1 or 2 s. Two problems in three draw
+ * speeds from {10, 20} and climb rates from {1, 2, 3} m/s, so L*dh differs between
+ * vehicles by simple ratios and exact ties between different vehicles' manoeuvres are
+ * common; the others draw both from intervals. Routes have 1 to 3 legs that turn and
+ * climb or descend, some ending inside the window (the reference then continues along the
+ * last leg); tracks fly constant velocity or a path whose first point may come after
+ * t = 0; initial offsets go up to +-3 and max_offset can equal |initial_offset|. */
+/* What the generator produced, so that the tests can check it covers what it claims. */
+static struct {
+    unsigned dt_half;
+    unsigned dt_two;
+    unsigned extrapolated;     /* a route that ends inside the window */
+    unsigned multi_leg_climb;  /* a route of 2 or more legs with a climbing or descending leg */
+    unsigned path_late_start;  /* a track path whose first point comes after t = 0 */
+    unsigned far_offset;       /* |initial_offset| >= 2 */
+    unsigned pinned;           /* max_offset == |initial_offset| */
+} gen;
+
 static void fx_random(fx_t *f, uint64_t *rng, size_t n, uint32_t horizon, uint32_t max_steep)
 {
+    static const double dts[3] = {0.5, 1.0, 2.0};
+    static const double tie_speed[3] = {10.0, 10.0, 20.0};
+    double dt = dts[pick(rng, 3u)];
+    double span = dt * (double)horizon; /* seconds in the window */
+    bool ties = pick(rng, 3u) != 0u;
     double cx = unif(rng, -10, 10);
     double cy = unif(rng, -10, 10);
     double cz = 100;
+    double base = unif(rng, 0, 6.283185307179586);
     size_t i;
+    size_t j;
     uint32_t count;
 
     fx_init(f, horizon);
+    f->p.dt = R(dt);
+    gen.dt_half += dt == 0.5 ? 1u : 0u;
+    gen.dt_two += dt == 2.0 ? 1u : 0u;
     for (i = 0; i < n; ++i) {
-        double speed = unif(rng, 8, 16);
-        double th = unif(rng, 0, 6.283185307179586);
-        double tm = unif(rng, 0.3, (double)horizon - 0.3);
-        double dx = cos(th);
-        double dy = sin(th);
-        double sx = cx - dx * speed * tm + unif(rng, -3, 3);
-        double sy = cy - dy * speed * tm + unif(rng, -3, 3);
-        double sz = cz + unif(rng, -4, 4);
-        double len = speed * ((double)horizon + 5.0);
+        double speed = ties ? tie_speed[pick(rng, 3u)] : unif(rng, 8, 16);
+        double climb = ties ? (double)(1u + pick(rng, 3u)) : unif(rng, 1, 5);
+        double dh = climb * dt;
+        size_t npts = 2u + pick(rng, 3u);
+        double total = speed * span * unif(rng, 0.4, 1.4);
+        /* Headings spread around the circle: UAVs flying side by side from t = 0 would
+         * mostly be infeasible at once. */
+        double th = base + 6.283185307179586 * (double)i / (double)n + unif(rng, -0.6, 0.6);
+        /* Not too early: a conflict already at t = 0 proves little. */
+        double tm = unif(rng, fmax(dt, 0.35 * span), span - 0.2 * dt);
+        double x = 0.0;
+        double y = 0.0;
+        double z = 0.0;
+        double length = 0.0;
+        bool climbs = false;
+        coa_vec3_t at;
+        coa_vec3_t shift;
         coa_vehicle_t *v = fx_vehicle(f, (uint16_t)(10u + pick(rng, 5u) * 10u + i),
-                                      1u + pick(rng, 3u), speed, unif(rng, 2, 5),
-                                      2u + pick(rng, max_steep - 1u), unif(rng, 4, 8),
-                                      unif(rng, 2, 4), V(sx, sy, sz),
-                                      V(sx + dx * len, sy + dy * len, sz + unif(rng, -3, 3)));
-        if (pick(rng, 5u) == 0u) {
-            v->initial_offset = pick(rng, 2u) == 0u ? 1 : -1;
+                                      1u + pick(rng, 3u), speed, climb,
+                                      2u + pick(rng, max_steep - 1u),
+                                      speed * dt * unif(rng, 0.3, 0.6), dh * unif(rng, 0.6, 1.6),
+                                      V(0, 0, 0), V(1, 0, 0));
+        f->route[i][0] = V(0, 0, 0);
+        for (j = 1; j < npts; ++j) {
+            double len = total / (double)(npts - 1u) * unif(rng, 0.6, 1.4);
+            double slope = pick(rng, 3u) == 0u ? 0.0 : unif(rng, -0.25, 0.25);
+            th += unif(rng, -0.5, 0.5);
+            x += cos(th) * len;
+            y += sin(th) * len;
+            z += slope * len;
+            f->route[i][j] = V(x, y, z);
+            length += len;
+            climbs = climbs || slope != 0.0;
         }
-        if (pick(rng, 4u) == 0u) {
-            v->max_offset = (int32_t)(1u + pick(rng, 3u));
+        v->route_count = npts;
+        gen.extrapolated += length < speed * span ? 1u : 0u;
+        gen.multi_leg_climb += (npts > 2u && climbs) ? 1u : 0u;
+        /* Move the route so that the reference passes near the meeting point at tm. */
+        at = coa_reference_at(v, R(tm));
+        shift = V(cx + unif(rng, -3, 3) - (double)at.x, cy + unif(rng, -3, 3) - (double)at.y,
+                  cz + unif(rng, -4, 4) - (double)at.z);
+        for (j = 0; j < npts; ++j) {
+            f->route[i][j].x += shift.x;
+            f->route[i][j].y += shift.y;
+            f->route[i][j].z += shift.z;
+        }
+        switch (pick(rng, 6u)) {
+        case 0u:
+            v->initial_offset = pick(rng, 2u) == 0u ? 1 : -1;
+            break;
+        case 1u:
+            v->initial_offset = (int32_t)(2u + pick(rng, 2u)) * (pick(rng, 2u) == 0u ? 1 : -1);
+            break;
+        default:
+            break;
+        }
+        gen.far_offset += abs(v->initial_offset) >= 2 ? 1u : 0u;
+        switch (pick(rng, 5u)) {
+        case 0u:
+            v->max_offset = abs(v->initial_offset); /* it may never move further out */
+            ++gen.pinned;
+            break;
+        case 1u:
+            v->max_offset = abs(v->initial_offset) + (int32_t)(1u + pick(rng, 2u));
+            break;
+        default:
+            break;
         }
     }
     count = pick(rng, 3u);
@@ -184,7 +280,6 @@ static void fx_random(fx_t *f, uint64_t *rng, size_t n, uint32_t horizon, uint32
             fx_box(f, V(ox - sx, oy - sy, oz - sz), V(ox + sx, oy + sy, oz + sz));
         } else {
             size_t o = f->p.obstacle_count++;
-            size_t j;
             double rad = unif(rng, 4, 8);
             f->obs[o].kind = COA_OBSTACLE_POLYTOPE;
             for (j = 0; j < 8u; ++j) {
@@ -198,11 +293,31 @@ static void fx_random(fx_t *f, uint64_t *rng, size_t n, uint32_t horizon, uint32
     if (pick(rng, 5u) < 2u) {
         double speed = unif(rng, 10, 20);
         double th = unif(rng, 0, 6.283185307179586);
-        double tm = unif(rng, 0.5, (double)horizon);
+        double tm = unif(rng, 0.5 * dt, span);
         double vz = unif(rng, -1, 1);
+        double bz = cz + unif(rng, -8, 8);
         coa_vec3_t vel = V(speed * cos(th), speed * sin(th), vz);
-        fx_track(f, V(cx - (double)vel.x * tm, cy - (double)vel.y * tm, cz + unif(rng, -8, 8) - vz * tm),
-                 vel, unif(rng, 3, 6), unif(rng, 2, 4));
+        coa_track_t *t;
+        fx_track(f, V(cx - (double)vel.x * tm, cy - (double)vel.y * tm, bz - vz * tm), vel,
+                 unif(rng, 3, 6), unif(rng, 2, 4));
+        t = &f->tr[f->p.track_count - 1u];
+        if (pick(rng, 2u) == 0u) {
+            /* The same encounter as a path that bends a little at each point; its first
+             * point can come after t = 0, when the first leg is extended backwards. */
+            size_t np = 2u + pick(rng, 2u);
+            double tj = unif(rng, -0.5 * span, 0.8 * span);
+            gen.path_late_start += tj > 0.0 ? 1u : 0u;
+            for (j = 0; j < np; ++j) {
+                double d = tj - tm;
+                f->trpath[f->p.track_count - 1u][j].t = R(tj);
+                f->trpath[f->p.track_count - 1u][j].p =
+                    V(cx + (double)vel.x * d + unif(rng, -2, 2),
+                      cy + (double)vel.y * d + unif(rng, -2, 2), bz + vz * d + unif(rng, -1, 1));
+                tj += dt * unif(rng, 0.5, 2.0);
+            }
+            t->path = f->trpath[f->p.track_count - 1u];
+            t->path_count = np;
+        }
     }
     fx_finish(f);
 }
@@ -233,7 +348,7 @@ static bool static_ok(const fx_t *f, const coa_sweep_t *s, uint32_t k)
     size_t j;
     for (j = 0; j < f->p.obstacle_count; ++j) {
         int rc = coa_conflict_obstacle(s, &f->obs[j]);
-        ck_assert_int_ge(rc, 0);
+        REQUIRE(rc >= 0);
         if (rc != 0) {
             return false;
         }
@@ -302,11 +417,92 @@ static bool plan_conflict_free(const fx_t *f, const int32_t *rows, const size_t 
     return true;
 }
 
-static int64_t weight_of(const fx_t *f, size_t v)
+/* ------------------------------------------------------------------------------------ */
+/* The cost oracle: the contract's costs, exactly, without the core's cost code          */
+
+/* Exact costs of a problem: deviation in units of 2^e / scale m^2, so that vehicle i's
+ * step from a to b costs w[i] * area(a, b) units, an integer. */
+typedef struct {
+    u128_t w[MAXV];
+    int e;
+    uint32_t scale;
+} oracle_t;
+
+static uint32_t gcd32(uint32_t a, uint32_t b)
 {
-    int64_t w[MAXV];
-    ck_assert_int_eq(coa_deviation_weights(f->veh, f->p.vehicle_count, f->p.dt, w), COA_OK);
-    return w[v];
+    return b == 0u ? a : gcd32(b, a % b);
+}
+
+static void oracle_make(const fx_t *f, oracle_t *o)
+{
+    uint64_t mant[MAXV];
+    int ex[MAXV];
+    size_t n = f->p.vehicle_count;
+    size_t i;
+
+    o->scale = 1u;
+    for (i = 0; i < n; ++i) {
+        /* w_i as the contract's formula evaluates in double: fl(fl(v dt) * fl(c dt)). */
+        double l = (double)f->veh[i].cruise_speed * (double)f->p.dt;
+        double dh = (double)f->veh[i].climb_rate * (double)f->p.dt;
+        double w = l * dh;
+        double m = frexp(w, &ex[i]); /* w = m 2^ex, 0.5 <= m < 1: m 2^53 is an integer */
+        uint32_t two_s = 2u * f->veh[i].steep_factor;
+        mant[i] = (uint64_t)ldexp(m, 53);
+        REQUIRE(ldexp((double)mant[i], ex[i] - 53) == w);
+        ex[i] -= 53;
+        while ((mant[i] & 1u) == 0u) {
+            mant[i] >>= 1;
+            ++ex[i];
+        }
+        o->e = (i == 0u || ex[i] < o->e) ? ex[i] : o->e;
+        /* Every area has denominator 2 or 2|a - b| = 2 s_i. */
+        o->scale = o->scale / gcd32(o->scale, two_s) * two_s;
+    }
+    for (i = 0; i < n; ++i) {
+        REQUIRE(ex[i] - o->e < 64);
+        o->w[i] = (u128_t)mant[i] << (ex[i] - o->e);
+    }
+}
+
+/* A(a, b) * scale by the contract's formula, checked to be an integer. */
+static u128_t oracle_area(int32_t a, int32_t b, uint32_t scale)
+{
+    int64_t la = a;
+    int64_t lb = b;
+    u128_t num;
+    u128_t den;
+    if (la * lb >= 0) {
+        num = (u128_t)(uint64_t)(llabs(la) + llabs(lb)) * scale;
+        den = 2u;
+    } else {
+        num = (u128_t)(uint64_t)(la * la + lb * lb) * scale;
+        den = 2u * (u128_t)(uint64_t)llabs(la - lb);
+    }
+    REQUIRE(num % den == 0u);
+    return num / den;
+}
+
+static u128_t to_u128(coa_cost_t c)
+{
+    return ((u128_t)c.hi << 64) | (u128_t)c.lo;
+}
+
+/* Decimal, for messages. */
+static const char *u128_str(u128_t x, char *buf)
+{
+    char tmp[40];
+    size_t n = 0u;
+    size_t i;
+    do {
+        tmp[n++] = (char)('0' + (int)(x % 10u));
+        x /= 10u;
+    } while (x != 0u);
+    for (i = 0; i < n; ++i) {
+        buf[i] = tmp[n - 1u - i];
+    }
+    buf[n] = '\0';
+    return buf;
 }
 
 static uint32_t effort_of_delta(int32_t d)
@@ -314,19 +510,24 @@ static uint32_t effort_of_delta(int32_t d)
     return d == 0 ? 0u : (d == 1 || d == -1) ? 1u : 3u;
 }
 
-static void row_cost(const fx_t *f, size_t v, const int32_t *rows, int64_t *units,
+static void row_cost(const fx_t *f, size_t v, const int32_t *rows, u128_t *units,
                      uint32_t *effort, double *dev)
 {
     const int32_t *r = &rows[v * ROW(f)];
-    uint32_t scale = coa_area_scale(f->veh, f->p.vehicle_count);
-    int64_t w = weight_of(f, v);
+    oracle_t o;
     double l = (double)f->veh[v].cruise_speed * (double)f->p.dt;
     double dh = (double)f->veh[v].climb_rate * (double)f->p.dt;
     uint32_t k;
+    oracle_make(f, &o);
     for (k = 0; k < f->p.horizon; ++k) {
-        *units += w * coa_area_scaled(r[k], r[k + 1u], scale);
-        *effort += effort_of_delta(r[k + 1u] - r[k]);
-        *dev += l * dh * coa_area(r[k], r[k + 1u]);
+        int32_t a = r[k];
+        int32_t b = r[k + 1u];
+        double area = (int64_t)a * b < 0
+                          ? ((double)a * a + (double)b * b) / (2.0 * fabs((double)a - b))
+                          : (fabs((double)a) + fabs((double)b)) / 2.0;
+        *units += o.w[v] * oracle_area(a, b, o.scale);
+        *effort += effort_of_delta(b - a);
+        *dev += l * dh * area;
     }
 }
 
@@ -339,16 +540,21 @@ static void row_cost(const fx_t *f, size_t v, const int32_t *rows, int64_t *unit
 #define DP_MAXSTATES (DP_MAXR * DP_MAXR * DP_MAXR)
 #define DP_CELLS (DP_MAXR * 5u)
 
-static int64_t dp_dev[2][DP_MAXSTATES];
+static u128_t dp_dev[2][DP_MAXSTATES];
 static uint32_t dp_eff[2][DP_MAXSTATES];
+/* The highest effort among the least-deviation paths to a state. */
+static uint32_t dp_effmax[2][DP_MAXSTATES];
 static unsigned char dp_reach[2][DP_MAXSTATES];
 static signed char dp_env[DP_MAXM][DP_MAXSPAN][5];
 static signed char dp_pair[DP_MAXM][DP_CELLS][DP_CELLS];
 
 typedef struct {
     bool found;
-    int64_t dev;
+    u128_t dev;
     uint32_t eff;
+    /* Plans of the least deviation differ in effort: the effort tie-break had real work
+     * to do. */
+    bool tie;
 } dp_out_t;
 
 static int32_t delta_of(int a, uint32_t s)
@@ -363,18 +569,19 @@ static dp_out_t dp_solve(const fx_t *f, const size_t *sv, size_t m, const int32_
                          const size_t *fixed, size_t nfixed)
 {
     const uint32_t horizon = f->p.horizon;
-    uint32_t scale = coa_area_scale(f->veh, f->p.vehicle_count);
+    oracle_t orc;
     int32_t lo[DP_MAXM];
     size_t span[DP_MAXM];
     size_t stride[DP_MAXM];
-    int64_t w[DP_MAXM];
+    u128_t w[DP_MAXM];
     size_t states = 1u;
     size_t start = 0u;
     size_t i;
     size_t idx;
     uint32_t k;
-    dp_out_t out = {false, 0, 0u};
+    dp_out_t out = {false, 0u, 0u, false};
 
+    oracle_make(f, &orc);
     ck_assert_uint_le(m, DP_MAXM);
     for (i = 0; i < m; ++i) {
         const coa_vehicle_t *v = &f->veh[sv[i]];
@@ -384,12 +591,13 @@ static dp_out_t dp_solve(const fx_t *f, const size_t *sv, size_t m, const int32_
         stride[i] = states;
         states *= span[i];
         start += (size_t)(v->initial_offset - lo[i]) * stride[i];
-        w[i] = weight_of(f, sv[i]);
+        w[i] = orc.w[sv[i]];
     }
     memset(dp_reach[0], 0, states);
     dp_reach[0][start] = 1u;
     dp_dev[0][start] = 0;
     dp_eff[0][start] = 0u;
+    dp_effmax[0][start] = 0u;
 
     for (k = 0; k < horizon; ++k) {
         unsigned cur = k & 1u;
@@ -415,8 +623,9 @@ static dp_out_t dp_solve(const fx_t *f, const size_t *sv, size_t m, const int32_
                 size_t rest = c;
                 bool ok = true;
                 size_t nidx = 0u;
-                int64_t dev = dp_dev[cur][idx];
+                u128_t dev = dp_dev[cur][idx];
                 uint32_t eff = dp_eff[cur][idx];
+                uint32_t effmax = dp_effmax[cur][idx];
                 size_t j;
                 for (i = 0; i < m && ok; ++i) {
                     const coa_vehicle_t *v = &f->veh[sv[i]];
@@ -457,30 +666,44 @@ static dp_out_t dp_solve(const fx_t *f, const size_t *sv, size_t m, const int32_
                         }
                     }
                     nidx += (size_t)(to[i] - lo[i]) * stride[i];
-                    dev += w[i] * coa_area_scaled(o[i], to[i], scale);
+                    dev += w[i] * oracle_area(o[i], to[i], orc.scale);
                     eff += effort_of_delta(to[i] - o[i]);
+                    effmax += effort_of_delta(to[i] - o[i]);
                 }
                 if (!ok) {
                     continue;
                 }
-                if (!dp_reach[nxt][nidx] || dev < dp_dev[nxt][nidx] ||
-                    (dev == dp_dev[nxt][nidx] && eff < dp_eff[nxt][nidx])) {
+                if (!dp_reach[nxt][nidx] || dev < dp_dev[nxt][nidx]) {
                     dp_reach[nxt][nidx] = 1u;
                     dp_dev[nxt][nidx] = dev;
                     dp_eff[nxt][nidx] = eff;
+                    dp_effmax[nxt][nidx] = effmax;
+                } else if (dev == dp_dev[nxt][nidx]) {
+                    dp_eff[nxt][nidx] = eff < dp_eff[nxt][nidx] ? eff : dp_eff[nxt][nidx];
+                    dp_effmax[nxt][nidx] =
+                        effmax > dp_effmax[nxt][nidx] ? effmax : dp_effmax[nxt][nidx];
                 }
             }
         }
     }
-    for (idx = 0; idx < states; ++idx) {
+    {
         unsigned last = horizon & 1u;
-        if (dp_reach[last][idx] &&
-            (!out.found || dp_dev[last][idx] < out.dev ||
-             (dp_dev[last][idx] == out.dev && dp_eff[last][idx] < out.eff))) {
-            out.found = true;
-            out.dev = dp_dev[last][idx];
-            out.eff = dp_eff[last][idx];
+        uint32_t effmax = 0u;
+        for (idx = 0; idx < states; ++idx) {
+            if (!dp_reach[last][idx]) {
+                continue;
+            }
+            if (!out.found || dp_dev[last][idx] < out.dev) {
+                out.found = true;
+                out.dev = dp_dev[last][idx];
+                out.eff = dp_eff[last][idx];
+                effmax = dp_effmax[last][idx];
+            } else if (dp_dev[last][idx] == out.dev) {
+                out.eff = dp_eff[last][idx] < out.eff ? dp_eff[last][idx] : out.eff;
+                effmax = dp_effmax[last][idx] > effmax ? dp_effmax[last][idx] : effmax;
+            }
         }
+        out.tie = out.found && effmax > out.eff;
     }
     return out;
 }
@@ -532,7 +755,7 @@ static void ws_free(ws_t *w)
     w->pl = NULL;
 }
 
-static const size_t ALL[MAXV] = {0u, 1u, 2u, 3u};
+static const size_t ALL[MAXV] = {0u, 1u, 2u, 3u, 4u, 5u, 6u, 7u, 8u, 9u};
 
 /* The priority order by its definition: ascending priority, ties by ascending id. */
 static void expected_order(const fx_t *f, size_t *order)
@@ -560,7 +783,7 @@ static void expected_order(const fx_t *f, size_t *order)
 static void check_solved_plan(const fx_t *f, const int32_t *rows, const coa_plan_result_t *r)
 {
     size_t n = f->p.vehicle_count;
-    int64_t units = 0;
+    u128_t units = 0u;
     uint32_t effort = 0u;
     double dev = 0.0;
     size_t i;
@@ -573,7 +796,7 @@ static void check_solved_plan(const fx_t *f, const int32_t *rows, const coa_plan
     for (i = 0; i < n; ++i) {
         row_cost(f, i, rows, &units, &effort, &dev);
     }
-    ck_assert_int_eq(units, r->deviation_units);
+    ck_assert(units == to_u128(r->deviation_units));
     ck_assert_uint_eq(effort, r->effort);
     ck_assert_double_eq_tol(dev, r->deviation, 1e-9 * (1.0 + dev));
     ck_assert_uint_eq(r->planned_count, n);
@@ -593,9 +816,10 @@ START_TEST(centralised_matches_exhaustive_search)
     unsigned solved = 0u;
     unsigned infeasible = 0u;
     unsigned moved = 0u;
+    unsigned ties = 0u;
     unsigned trial;
 
-    for (trial = 0; trial < 400u; ++trial) {
+    for (trial = 0; trial < 600u; ++trial) {
         size_t n = 2u + pick(&rng, 2u);
         uint32_t horizon = 2u + pick(&rng, 4u);
         coa_plan_result_t r;
@@ -614,11 +838,17 @@ START_TEST(centralised_matches_exhaustive_search)
         ck_assert_uint_eq(r.orders_tried, 1u);
         ck_assert_uint_le(r.nodes_expanded, beta);
         if (best.found) {
-            ck_assert_msg(r.deviation_units == best.dev && r.effort == best.eff,
-                          "trial %u: planner (%lld, %u), exhaustive (%lld, %u)", trial,
-                          (long long)r.deviation_units, r.effort, (long long)best.dev, best.eff);
+            char b1[40];
+            char b2[40];
+            ck_assert_msg(to_u128(r.deviation_units) == best.dev && r.effort == best.eff,
+                          "trial %u: planner (%s, %u), exhaustive (%s, %u)", trial,
+                          u128_str(to_u128(r.deviation_units), b1), r.effort,
+                          u128_str(best.dev, b2), best.eff);
             check_solved_plan(&f, rows, &r);
             ++solved;
+            if (best.tie) {
+                ++ties;
+            }
             if (best.eff > 0u) {
                 ++moved;
             }
@@ -627,9 +857,18 @@ START_TEST(centralised_matches_exhaustive_search)
         }
     }
     /* The generator must produce both outcomes and real manoeuvres, or this proves little. */
-    ck_assert_uint_ge(solved, 100u);
-    ck_assert_uint_ge(infeasible, 40u);
-    ck_assert_uint_ge(moved, 60u);
+    ck_assert_uint_ge(gen.dt_half, 100u);
+    ck_assert_uint_ge(gen.dt_two, 100u);
+    ck_assert_uint_ge(gen.extrapolated, 200u);
+    ck_assert_uint_ge(gen.multi_leg_climb, 200u);
+    ck_assert_uint_ge(gen.path_late_start, 20u);
+    ck_assert_uint_ge(gen.far_offset, 100u);
+    ck_assert_uint_ge(gen.pinned, 100u);
+    ck_assert_uint_ge(solved, 150u);
+    ck_assert_uint_ge(infeasible, 60u);
+    ck_assert_uint_ge(moved, 150u);
+    /* ... and least-deviation plans that only the effort tells apart. */
+    ck_assert_uint_ge(ties, 40u);
     ws_free(&w);
 }
 END_TEST
@@ -637,19 +876,58 @@ END_TEST
 /* ------------------------------------------------------------------------------------ */
 /* Decoupled                                                                             */
 
+/* A sweep standing still at sample 0, at the vehicle's initial offset. */
+static coa_sweep_t start_of(const fx_t *f, size_t v)
+{
+    coa_sweep_t s = sweep_of(f, v, 0u, f->veh[v].initial_offset, f->veh[v].initial_offset);
+    s.p1 = s.p0;
+    return s;
+}
+
+/* Whether anything is already in conflict at t = 0, which no plan and no order can undo. */
+static bool conflict_at_start(const fx_t *f)
+{
+    size_t i;
+    size_t j;
+    for (i = 0; i < f->p.vehicle_count; ++i) {
+        coa_sweep_t a = start_of(f, i);
+        for (j = 0; j < f->p.obstacle_count; ++j) {
+            if (coa_conflict_obstacle(&a, &f->obs[j]) != 0) {
+                return true;
+            }
+        }
+        for (j = 0; j < f->p.track_count; ++j) {
+            coa_sweep_t t;
+            t.volume = f->tr[j].volume;
+            t.p0 = f->trs[j][0];
+            t.p1 = t.p0;
+            if (coa_conflict_volumes(&a, &t)) {
+                return true;
+            }
+        }
+        for (j = 0; j < i; ++j) {
+            coa_sweep_t b = start_of(f, j);
+            if (coa_conflict_volumes(&a, &b)) {
+                return true;
+            }
+        }
+    }
+    return false;
+}
+
 /* Each planned UAV is optimal given the ones before it; the failing one has no plan. */
 static void check_decoupled_attempt(const fx_t *f, const int32_t *rows, const coa_plan_result_t *r)
 {
     size_t level;
     for (level = 0; level < r->planned_count; ++level) {
         size_t v = r->order[level];
-        int64_t units = 0;
+        u128_t units = 0u;
         uint32_t effort = 0u;
         double dev = 0.0;
         dp_out_t best = dp_solve(f, &r->order[level], 1u, rows, r->order, level);
         ck_assert(best.found);
         row_cost(f, v, rows, &units, &effort, &dev);
-        ck_assert_int_eq(units, best.dev);
+        ck_assert(units == best.dev);
         ck_assert_uint_eq(effort, best.eff);
         ck_assert(rows_well_formed(f, rows, &r->order[level], 1u));
     }
@@ -672,6 +950,7 @@ START_TEST(decoupled_each_vehicle_optimal_given_earlier)
     uint64_t rng = 0x5eed0002u;
     unsigned solved = 0u;
     unsigned failed = 0u;
+    unsigned covered = 0u;
     unsigned trial;
 
     for (trial = 0; trial < 200u; ++trial) {
@@ -693,10 +972,15 @@ START_TEST(decoupled_each_vehicle_optimal_given_earlier)
             ck_assert_uint_eq(r.order[i], prio[i]);
         }
         check_decoupled_attempt(&f, rows, &r);
+        /* One order only: every order is covered just when a proof covers them all. */
+        ck_assert(r.all_orders_covered ==
+                  (r.status == COA_PLAN_INFEASIBLE &&
+                   (r.planned_count == 0u || conflict_at_start(&f))));
         if (r.status == COA_PLAN_SOLVED) {
             ++solved;
         } else {
             ++failed;
+            covered += r.all_orders_covered ? 1u : 0u;
         }
 
         /* An explicit order is followed as given. */
@@ -712,6 +996,8 @@ START_TEST(decoupled_each_vehicle_optimal_given_earlier)
     }
     ck_assert_uint_ge(solved, 50u);
     ck_assert_uint_ge(failed, 20u);
+    ck_assert_uint_ge(covered, 5u);
+    ck_assert_uint_ge(failed - covered, 5u);
     ws_free(&w);
 }
 END_TEST
@@ -750,6 +1036,7 @@ START_TEST(reordering_finds_an_order_iff_one_exists)
     uint64_t rng = 0x5eed0003u;
     unsigned rescued = 0u;
     unsigned hopeless = 0u;
+    unsigned at_start = 0u;
     unsigned trial;
 
     for (trial = 0; trial < 120u; ++trial) {
@@ -781,6 +1068,13 @@ START_TEST(reordering_finds_an_order_iff_one_exists)
                       "prio %zu%zu%zu failed %zu at %zu",
                       trial, (int)r.status, r.orders_tried, works[0], works[1], works[2], works[3],
                       works[4], works[5], prio[0], prio[1], prio[2], r.failed_vehicle, r.planned_count);
+        /* Six orders are all there are: a failure covers every one of them, and a
+         * conflict at t = 0 is found without trying a second order. */
+        ck_assert(r.all_orders_covered == !any);
+        if (conflict_at_start(&f)) {
+            ck_assert_uint_eq(r.orders_tried, 1u);
+            ++at_start;
+        }
         if (any) {
             /* The order it reports works on its own and gives the same plan. */
             check_solved_plan(&f, rows, &r);
@@ -802,7 +1096,7 @@ START_TEST(reordering_finds_an_order_iff_one_exists)
                 ck_assert_mem_eq(&rows[v * ROW(&f)], &single[v * ROW(&f)],
                                  ROW(&f) * sizeof rows[0]);
             }
-            ck_assert_int_eq(r.deviation_units, first.deviation_units);
+            ck_assert(to_u128(r.deviation_units) == to_u128(first.deviation_units));
             ck_assert_uint_eq(r.effort, first.effort);
             check_decoupled_attempt(&f, rows, &r);
             ++hopeless;
@@ -810,6 +1104,7 @@ START_TEST(reordering_finds_an_order_iff_one_exists)
     }
     ck_assert_uint_ge(rescued, 3u);
     ck_assert_uint_ge(hopeless, 3u);
+    ck_assert_uint_ge(at_start, 2u);
     ws_free(&w);
 }
 END_TEST
@@ -845,10 +1140,12 @@ START_TEST(reordering_rescues_boxed_in_vehicle)
     ck_assert_uint_eq(r.planned_count, 1u);
     ck_assert_uint_eq(r.order[0], 0u);
     ck_assert_uint_eq(r.orders_tried, 1u);
+    ck_assert(!r.all_orders_covered); /* the other order was never tried */
     check_decoupled_attempt(&f, rows, &r);
 
     ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, NULL, 2u, rows, &r), COA_OK);
     ck_assert_int_eq(r.status, COA_PLAN_SOLVED);
+    ck_assert(!r.all_orders_covered);
     ck_assert_uint_eq(r.orders_tried, 2u);
     ck_assert_uint_eq(r.order[0], 1u);
     ck_assert_uint_eq(r.order[1], 0u);
@@ -863,7 +1160,7 @@ START_TEST(reordering_rescues_boxed_in_vehicle)
     ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &c), COA_OK);
     ck_assert_int_eq(c.status, COA_PLAN_SOLVED);
     check_solved_plan(&f, rows, &c);
-    ck_assert_int_eq(c.deviation_units, r.deviation_units);
+    ck_assert(to_u128(c.deviation_units) == to_u128(r.deviation_units));
     ws_free(&w);
 }
 END_TEST
@@ -893,6 +1190,7 @@ START_TEST(reordering_reports_first_order_when_none_works)
     ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, NULL, 100u, rows, &r), COA_OK);
     ck_assert_int_eq(r.status, COA_PLAN_INFEASIBLE);
     ck_assert_uint_eq(r.orders_tried, 6u);
+    ck_assert(r.all_orders_covered);
     ck_assert_uint_eq(r.order[0], 0u);
     ck_assert_uint_eq(r.order[1], 1u);
     ck_assert_uint_eq(r.order[2], 2u);
@@ -901,13 +1199,14 @@ START_TEST(reordering_reports_first_order_when_none_works)
     for (k = 0; k <= f.p.horizon; ++k) {
         ck_assert_int_eq(rows[k], 0);
     }
-    ck_assert_int_eq(r.deviation_units, 0);
+    ck_assert(to_u128(r.deviation_units) == 0u);
     check_decoupled_attempt(&f, rows, &r);
 
     /* Stopping early reports the same first attempt. */
     ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, NULL, 4u, rows, &r), COA_OK);
     ck_assert_int_eq(r.status, COA_PLAN_INFEASIBLE);
     ck_assert_uint_eq(r.orders_tried, 4u);
+    ck_assert(!r.all_orders_covered); /* two orders were left */
     ck_assert_uint_eq(r.failed_vehicle, 1u);
     for (k = 0; k <= f.p.horizon; ++k) {
         ck_assert_int_eq(rows[k], 0);
@@ -979,6 +1278,12 @@ START_TEST(workspace_size_is_exact)
     ck_assert_uint_gt(coa_planner_workspace_size(COA_MAX_CENTRALISED, 1u), 0u);
     ck_assert_uint_eq(coa_planner_workspace_size(COA_MAX_CENTRALISED, UINT32_MAX), 0u);
     ck_assert_uint_eq(coa_planner_workspace_size(1u, UINT32_MAX), 0u);
+    /* Bytes per node as plan.h states them, 50 + 2m: between these betas the pool grows
+     * by 3000 nodes and the hash table keeps its 16384 slots. */
+    ck_assert_uint_eq(coa_planner_workspace_size(1u, 1600u) - coa_planner_workspace_size(1u, 1000u),
+                      3000u * (50u + 2u));
+    ck_assert_uint_eq(coa_planner_workspace_size(2u, 320u) - coa_planner_workspace_size(2u, 200u),
+                      3000u * (50u + 4u));
 
     /* 16 spare bytes: 8 for a misaligned start, 8 of guard after the workspace. */
     mem = malloc(bytes + 16u);
@@ -1195,8 +1500,9 @@ START_TEST(problem_check_and_helpers)
                          COA_ERR_ARGUMENT);
     }
 
-    /* Nine UAVs with steep factors 2..10 over the longest horizon: S = 5040 and the worst
-     * case no longer fits int64, unless max_offset bounds the offsets. */
+    /* Nine UAVs with steep factors 2..10 over the longest horizon, unbounded: S = 5040,
+     * and the worst case 2 N sum W S B is far beyond int64 but well inside the 128-bit
+     * costs (< 2^112 by the core's limits). */
     for (i = 0; i < 9u; ++i) {
         many[i] = f.veh[0];
         many[i].id = (uint16_t)(i + 1u);
@@ -1212,11 +1518,30 @@ START_TEST(problem_check_and_helpers)
     p.vehicles = many;
     p.vehicle_count = 9u;
     p.references = bigp;
-    ck_assert_int_eq(coa_problem_check(&p), COA_ERR_RANGE);
-    for (i = 0; i < 9u; ++i) {
-        many[i].max_offset = 100;
-    }
     ck_assert_int_eq(coa_problem_check(&p), COA_OK);
+    /* Weights that would need more than 64 bits to be exact are refused, not rounded:
+     * L*dh = 1.1 * 1.3 (an odd mantissa of 47 bits from floats, about 53 from doubles)
+     * against 2^20 times it. */
+    many[0].cruise_speed = R(1.1);
+    many[0].climb_rate = R(1.3);
+    many[1].cruise_speed = R(1.1 * 1048576.0);
+    many[1].climb_rate = R(1.3);
+    ck_assert_int_eq(coa_problem_check(&p), COA_ERR_RANGE);
+    {
+        static int32_t big_rows[9 * (COA_MAX_HORIZON + 1u)];
+        coa_plan_result_t r;
+        ws_t w = ws_make(1u, 10u);
+        ck_assert_int_eq(coa_plan_decoupled(w.pl, &p, NULL, 1u, big_rows, &r), COA_ERR_RANGE);
+        ck_assert_int_eq(r.status, COA_PLAN_INFEASIBLE); /* cleared */
+        ck_assert_uint_eq(r.orders_tried, 0u);
+        ws_free(&w);
+    }
+    many[1].cruise_speed = R(1.1 * 512.0);
+    ck_assert_int_eq(coa_problem_check(&p), COA_OK);
+    for (i = 0; i < 9u; ++i) {
+        many[i].cruise_speed = f.veh[0].cruise_speed;
+        many[i].climb_rate = f.veh[0].climb_rate;
+    }
 
     /* Priority order: ascending priority, ties by id. */
     many[0].priority = 3u;
@@ -1248,6 +1573,186 @@ START_TEST(problem_check_and_helpers)
 }
 END_TEST
 
+/* ------------------------------------------------------------------------------------ */
+/* Review findings                                                                       */
+
+/* Two UAVs crossing at right angles with the same speed and steep factor 3, climb rates 3
+ * and 1 (L*dh = 30 and 10). Separating them costs 60 m^2 either way: UAV 1 one climb step
+ * for two steps ([0, 1, 1, 0], areas 1/2 + 1 + 1/2, effort 2) or UAV 2 three ([0, -3, -3,
+ * 0] by steep actions, effort 6). The exact tie must go to the lower effort; the rounded
+ * weights 2^20 and 349525 once made UAV 2's manoeuvre look cheaper (6 * 349525 <
+ * 2 * 2^20) and won. */
+START_TEST(tie_between_vehicles_goes_to_lower_effort)
+{
+    static fx_t f;
+    static int32_t rows[MAXV * (MAXN + 1u)];
+    ws_t w = ws_make(2u, 20000u);
+    coa_plan_result_t r;
+    dp_out_t best;
+    uint32_t k;
+
+    fx_init(&f, 3u);
+    fx_vehicle(&f, 1u, 1u, 10.0, 3.0, 3u, 2.5, 1.4, V(-15, 0, 100), V(100, 0, 100));
+    fx_vehicle(&f, 2u, 2u, 10.0, 1.0, 3u, 2.5, 1.4, V(0, -15, 100), V(0, 100, 100));
+    fx_finish(&f);
+    ck_assert_int_eq(coa_plan_find_conflict(&f.p, (int32_t[8]){0}, ALL, 2u, NULL, NULL), 1);
+
+    ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
+    ck_assert_int_eq(r.status, COA_PLAN_SOLVED);
+    ck_assert_double_eq_tol(r.deviation, 60.0, 1e-12);
+    ck_assert_uint_eq(r.effort, 2u);
+    for (k = 0; k <= 3u; ++k) {
+        ck_assert_int_eq(rows[ROW(&f) + k], 0);
+        ck_assert_int_eq(abs(rows[k]), (k == 1u || k == 2u) ? 1 : 0);
+    }
+    /* w = 30 = 15 * 2 and 10 = 5 * 2, S = 6: (3 + 6 + 3) * 15 units of 2/6 m^2. */
+    ck_assert(to_u128(r.deviation_units) == 180u);
+    best = dp_solve(&f, ALL, 2u, rows, NULL, 0u);
+    ck_assert(best.found && best.tie);
+    ck_assert(best.dev == 180u);
+    ck_assert_uint_eq(best.eff, 2u);
+    check_solved_plan(&f, rows, &r);
+    ws_free(&w);
+}
+END_TEST
+
+/* A goal on top of the open list is taken even when beta states have been closed. */
+START_TEST(goal_on_top_is_taken_at_the_budget)
+{
+    static fx_t f;
+    static int32_t rows[MAXV * (MAXN + 1u)];
+    coa_plan_result_t r;
+    uint32_t n;
+
+    for (n = 1u; n <= 7u; n += 3u) {
+        ws_t w;
+        /* One UAV with nothing around: the search closes k = 0..N-1 and then sees the
+         * goal at k = N on top. */
+        fx_init(&f, n);
+        fx_vehicle(&f, 1u, 1u, 10.0, 2.0, 2u, 5.0, 2.0, V(0, 0, 100), V(100, 0, 100));
+        fx_finish(&f);
+        w = ws_make(1u, n);
+        ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
+        ck_assert_int_eq(r.status, COA_PLAN_SOLVED);
+        ck_assert_uint_eq(r.nodes_expanded, n);
+        ck_assert_uint_eq(r.effort, 0u);
+        ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, NULL, 1u, rows, &r), COA_OK);
+        ck_assert_int_eq(r.status, COA_PLAN_SOLVED);
+        ck_assert_uint_eq(r.nodes_expanded, n);
+        /* A second UAV far away: each single-UAV search fits the same beta. */
+        fx_vehicle(&f, 2u, 2u, 10.0, 2.0, 2u, 5.0, 2.0, V(0, 500, 100), V(100, 500, 100));
+        fx_finish(&f);
+        ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, NULL, 1u, rows, &r), COA_OK);
+        ck_assert_int_eq(r.status, COA_PLAN_SOLVED);
+        ck_assert_uint_eq(r.nodes_expanded, 2u * n);
+        ws_free(&w);
+        if (n > 1u) {
+            w = ws_make(1u, n - 1u);
+            ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, NULL, 1u, rows, &r), COA_OK);
+            ck_assert_int_eq(r.status, COA_PLAN_BUDGET_EXHAUSTED);
+            ck_assert_uint_eq(r.nodes_expanded, n - 1u);
+            ck_assert_uint_eq(r.failed_vehicle, 0u);
+            ck_assert(!r.all_orders_covered);
+            ws_free(&w);
+        }
+    }
+}
+END_TEST
+
+/* Ten UAVs in separate lanes that never meet, except that two of them (3 and 7 in
+ * priority order) already overlap at t = 0. No order can work, and the planner must say
+ * so after one attempt instead of walking through up to 10! orders. */
+START_TEST(conflict_at_start_rules_out_every_order)
+{
+    static fx_t f;
+    static int32_t rows[MAXV * (MAXN + 1u)];
+    ws_t w = ws_make(1u, 100u);
+    coa_plan_result_t r;
+    uint32_t max_orders[3] = {1u, 100000u, UINT32_MAX};
+    size_t i;
+    int variant;
+    unsigned m;
+
+    for (variant = 0; variant < 3; ++variant) {
+        fx_init(&f, 6u);
+        for (i = 0; i < 10u; ++i) {
+            double y = 1000.0 * (double)i;
+            fx_vehicle(&f, (uint16_t)(i + 1u), (uint32_t)(i + 1u), 10.0, 2.0, 2u, 5.0, 2.0,
+                       V(0, y, 100), V(100, y, 100));
+        }
+        if (variant == 0) {
+            /* 7 starts 4 m from 3, the same lane as 3, crossing it. */
+            f.route[7][0] = V(4, 3000, 101);
+            f.route[7][1] = V(4, 3100, 101);
+        } else if (variant == 1) {
+            /* 7 starts inside a box. */
+            fx_box(&f, V(-3, 6997, 90), V(3, 7003, 99));
+        } else {
+            /* A track sits on 7 at t = 0 (and passes over 3 later, which is fine). */
+            fx_track(&f, V(0, 7003, 102), V(0, 0, 50), 3.0, 2.0);
+        }
+        fx_finish(&f);
+        ck_assert(conflict_at_start(&f));
+        for (m = 0; m < 3u; ++m) {
+            memset(rows, 0x55, sizeof rows);
+            ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, NULL, max_orders[m], rows, &r),
+                             COA_OK);
+            ck_assert_int_eq(r.status, COA_PLAN_INFEASIBLE);
+            ck_assert(r.all_orders_covered);
+            ck_assert_uint_eq(r.orders_tried, 1u);
+            ck_assert_uint_eq(r.planned_count, 7u);
+            ck_assert_uint_eq(r.failed_vehicle, 7u);
+            ck_assert_uint_eq(r.nodes_expanded, 7u * 6u); /* the seven before it, free */
+            check_decoupled_attempt(&f, rows, &r);
+        }
+    }
+    ws_free(&w);
+}
+END_TEST
+
+/* A proof that every order fails outranks an attempt that ran out of beta. A (priority
+ * 1) is free but needs 6 expansions and beta is 3, so the first attempt ends with A's
+ * budget exhausted; then either B flies into a wall, which it cannot survive even alone
+ * (tried first in the second order), or B and C overlap at t = 0. */
+START_TEST(proof_for_every_order_outranks_budget)
+{
+    static fx_t f;
+    static int32_t rows[MAXV * (MAXN + 1u)];
+    ws_t w = ws_make(1u, 3u);
+    coa_plan_result_t r;
+    int variant;
+
+    for (variant = 0; variant < 2; ++variant) {
+        fx_init(&f, 6u);
+        fx_vehicle(&f, 1u, 1u, 10.0, 2.0, 2u, 3.0, 2.0, V(0, 0, 100), V(100, 0, 100));
+        fx_vehicle(&f, 2u, 2u, 10.0, 2.0, 2u, 3.0, 2.0, V(0, 500, 100), V(100, 500, 100));
+        if (variant == 0) {
+            /* B's first step ends inside a wall taller than any offset it can reach. */
+            fx_box(&f, V(11, 400, 0), V(20, 600, 300));
+        } else {
+            fx_vehicle(&f, 3u, 3u, 10.0, 2.0, 2u, 3.0, 2.0, V(2, 501, 101), V(2, 601, 101));
+        }
+        fx_finish(&f);
+        ck_assert(conflict_at_start(&f) == (variant == 1));
+        ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, NULL, 100u, rows, &r), COA_OK);
+        ck_assert_int_eq(r.status, COA_PLAN_INFEASIBLE);
+        ck_assert(r.all_orders_covered);
+        ck_assert_uint_eq(r.orders_tried, variant == 0 ? 2u : 1u);
+        /* The report is still the first order's attempt: A failed first, through beta. */
+        ck_assert_uint_eq(r.planned_count, 0u);
+        ck_assert_uint_eq(r.failed_vehicle, 0u);
+        ck_assert_uint_eq(r.order[0], 0u);
+        /* Without the proof it stays budget exhausted. */
+        ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, (const size_t[]){0u, 1u, 2u}, 1u, rows,
+                                            &r),
+                         COA_OK);
+        ck_assert_int_eq(r.status, variant == 0 ? COA_PLAN_BUDGET_EXHAUSTED : COA_PLAN_INFEASIBLE);
+        ck_assert(r.all_orders_covered == (variant == 1));
+    }
+    ws_free(&w);
+}
+END_TEST
+
 static Suite *plan_suite(void)
 {
     Suite *s = suite_create("plan");
@@ -1259,6 +1764,10 @@ static Suite *plan_suite(void)
     tcase_add_test(tc, max_offset_is_respected);
     tcase_add_test(tc, head_on_is_separated);
     tcase_add_test(tc, problem_check_and_helpers);
+    tcase_add_test(tc, tie_between_vehicles_goes_to_lower_effort);
+    tcase_add_test(tc, goal_on_top_is_taken_at_the_budget);
+    tcase_add_test(tc, conflict_at_start_rules_out_every_order);
+    tcase_add_test(tc, proof_for_every_order_outranks_budget);
     tcase_add_test(tc, reordering_rescues_boxed_in_vehicle);
     tcase_add_test(tc, reordering_reports_first_order_when_none_works);
     tcase_add_test(tc, centralised_matches_exhaustive_search);

@@ -960,88 +960,235 @@ START_TEST(test_area_scale)
 }
 END_TEST
 
+/* Whether w == weight * 2^exponent exactly: ldexp of an integer of at most 64 bits is
+ * exact when the integer is (it has at most 53 significant bits for a finite double). */
+static int weight_is_exact(double w, uint64_t weight, int exponent)
+{
+    double m = (double)weight;
+    if ((uint64_t)m != weight) {
+        return 0; /* more than 53 significant bits: cannot be a double's mantissa */
+    }
+    return ldexp(m, exponent) == w;
+}
+
+static double product_of(const coa_vehicle_t *v, coa_real_t dt)
+{
+    double l = (double)v->cruise_speed * (double)dt;
+    double dh = (double)v->climb_rate * (double)dt;
+    return l * dh;
+}
+
 START_TEST(test_deviation_weights)
 {
     static coa_vec3_t route[2];
     coa_vehicle_t vs[4];
     coa_vehicle_t bad[2];
-    int64_t w[4];
+    uint64_t w[4];
+    int e = 99;
     int i;
+    int trial;
 
     route[0] = v3(0, 0, 0);
     route[1] = v3(1, 0, 0);
     for (i = 0; i < 4; ++i) {
         vs[i] = make_vehicle(route, 2, 10.0);
     }
-    /* Equal vehicles: equal, full weights. */
-    ck_assert_int_eq(coa_deviation_weights(vs, 4, R(0.5), w), COA_OK);
+    /* Equal vehicles (L = 5, dh = 1): the weight 5 itself, no factor of two to move. */
+    ck_assert_int_eq(coa_deviation_weights(vs, 4, R(0.5), w, &e), COA_OK);
+    ck_assert_int_eq(e, 0);
     for (i = 0; i < 4; ++i) {
-        ck_assert_int_eq(w[i], (int64_t)1 << 20);
+        ck_assert_uint_eq(w[i], 5u);
     }
-    /* Twice L*dh (by speed or by climb rate): the others get half. */
+    /* Twice L*dh (by speed or by climb rate): twice the weight, exactly. */
     vs[1].cruise_speed = R(20);
-    ck_assert_int_eq(coa_deviation_weights(vs, 4, R(0.5), w), COA_OK);
-    ck_assert_int_eq(w[0], (int64_t)1 << 19);
-    ck_assert_int_eq(w[1], (int64_t)1 << 20);
     vs[2].climb_rate = R(4);
-    ck_assert_int_eq(coa_deviation_weights(vs, 4, R(0.5), w), COA_OK);
-    ck_assert_int_eq(w[1], w[2]);
-    ck_assert_int_eq(w[0], w[3]);
-    /* Rounding to nearest: 0.15 * 2^20 = 157286.4. */
+    ck_assert_int_eq(coa_deviation_weights(vs, 4, R(0.5), w, &e), COA_OK);
+    ck_assert_int_eq(e, 0);
+    ck_assert_uint_eq(w[0], 5u);
+    ck_assert_uint_eq(w[1], 10u);
+    ck_assert_uint_eq(w[2], 10u);
+    ck_assert_uint_eq(w[3], 5u);
+    /* L*dh = 1.5 = 3 * 2^-1 moves the common exponent down: 5 becomes 10. */
     vs[3].cruise_speed = R(3);
-    ck_assert_int_eq(coa_deviation_weights(vs, 4, R(0.5), w), COA_OK);
-    ck_assert_int_eq(w[3], 157286);
-    /* 2^20 * 0.3 = 314572.8 rounds up: w = 1.5 against 5. */
-    vs[2].climb_rate = R(2);
-    vs[2].cruise_speed = R(10);
-    ck_assert_int_eq(coa_deviation_weights(vs + 2, 2, R(0.5), w), COA_OK);
-    ck_assert_int_eq(w[0], (int64_t)1 << 20);
-    ck_assert_int_eq(w[1], 314573);
-    ck_assert_int_eq(coa_deviation_weights(vs + 3, 1, R(0.5), w), COA_OK);
-    ck_assert_int_eq(w[0], (int64_t)1 << 20);
-    /* Never below 1. */
-    vs[3].cruise_speed = R(1e-6);
-    ck_assert_int_eq(coa_deviation_weights(vs, 4, R(0.5), w), COA_OK);
-    ck_assert_int_eq(w[3], 1);
-    /* The weights do not depend on dt (it scales every product alike, up to rounding). */
-    vs[3].cruise_speed = R(7);
-    {
-        int64_t w2[4];
-        ck_assert_int_eq(coa_deviation_weights(vs, 4, R(0.5), w), COA_OK);
-        ck_assert_int_eq(coa_deviation_weights(vs, 4, R(2), w2), COA_OK);
+    ck_assert_int_eq(coa_deviation_weights(vs, 4, R(0.5), w, &e), COA_OK);
+    ck_assert_int_eq(e, -1);
+    ck_assert_uint_eq(w[0], 10u);
+    ck_assert_uint_eq(w[1], 20u);
+    ck_assert_uint_eq(w[2], 20u);
+    ck_assert_uint_eq(w[3], 3u);
+    /* Common factors of two go to the exponent: 30 and 10 (the review's tie) are 15 and
+     * 5 times 2. */
+    vs[0].climb_rate = R(3);
+    vs[1] = vs[0];
+    vs[1].climb_rate = R(1);
+    ck_assert_int_eq(coa_deviation_weights(vs, 2, R(1), w, &e), COA_OK);
+    ck_assert_int_eq(e, 1);
+    ck_assert_uint_eq(w[0], 15u);
+    ck_assert_uint_eq(w[1], 5u);
+    /* Powers of two far apart are still exact: 2^-30 * 2 against 10 * 2 = 5 * 2^2. */
+    vs[1].cruise_speed = R(1.0 / 1073741824.0);
+    vs[1].climb_rate = R(2);
+    ck_assert_int_eq(coa_deviation_weights(vs, 2, R(1), w, &e), COA_OK);
+    ck_assert_int_eq(e, -29);
+    ck_assert_uint_eq(w[0], UINT64_C(15) << 30);
+    ck_assert_uint_eq(w[1], 1u);
+    /* A single vehicle: its odd mantissa. */
+    ck_assert_int_eq(coa_deviation_weights(vs + 2, 1, R(0.5), w, &e), COA_OK);
+    ck_assert_uint_eq(w[0], 5u);
+    ck_assert_int_eq(e, 1);
+
+    /* Random speeds, climb rates and dt: every weight is exactly w_i = W_i 2^E with w_i
+     * the contract's double product, and some W_i is odd (E is as large as it can be). */
+    rng_state = 0x77e1u;
+    for (trial = 0; trial < 2000; ++trial) {
+        coa_real_t dt = R(trial % 3 == 0 ? 1.0 : rng_uniform(0.1, 3.0));
+        bool odd = false;
+        int rc;
         for (i = 0; i < 4; ++i) {
-            ck_assert_int_eq(w[i], w2[i]);
+            vs[i].cruise_speed = R(trial % 2 == 0 ? (double)(5u + rng_below(20u))
+                                                  : rng_uniform(5.0, 30.0));
+            vs[i].climb_rate = R(trial % 2 == 0 ? (double)(1u + rng_below(4u))
+                                                : rng_uniform(1.0, 6.0));
         }
+        rc = coa_deviation_weights(vs, 4, dt, w, &e);
+        ck_assert_int_eq(rc, COA_OK); /* ratios below 2^6: W_i fit in 54 + 6 bits */
+        for (i = 0; i < 4; ++i) {
+            ck_assert_msg(weight_is_exact(product_of(&vs[i], dt), w[i], e),
+                          "trial %d vehicle %d: %.17g != %llu * 2^%d", trial, i,
+                          product_of(&vs[i], dt), (unsigned long long)w[i], e);
+            odd = odd || (w[i] & 1u) != 0u;
+        }
+        ck_assert(odd);
     }
 
+    /* Full mantissas 2^13 apart need 53 + 13 bits: refused rather than rounded. */
+    vs[0].cruise_speed = R(1.1);
+    vs[0].climb_rate = R(1.3);
+    vs[1] = vs[0];
+    vs[1].cruise_speed = R(1.1 * 8192.0);
+    {
+        int ex;
+        double m = frexp(product_of(&vs[0], R(0.7)), &ex);
+        /* Precondition: the mantissa really has (almost) all 53 bits. */
+        ck_assert(fmod(ldexp(m, 52), 2.0) != 0.0 || fmod(ldexp(m, 53), 2.0) != 0.0);
+        ck_assert_double_eq(product_of(&vs[1], R(0.7)), 8192.0 * product_of(&vs[0], R(0.7)));
+    }
+    ck_assert_int_eq(coa_deviation_weights(vs, 2, R(0.7), w, &e), COA_ERR_RANGE);
+    /* 2^9 apart fits (53 + 9 <= 64). */
+    vs[1].cruise_speed = R(1.1 * 512.0);
+    ck_assert_int_eq(coa_deviation_weights(vs, 2, R(0.7), w, &e), COA_OK);
+    ck_assert_uint_eq(w[1], w[0] << 9);
+    ck_assert(weight_is_exact(product_of(&vs[0], R(0.7)), w[0], e));
+
     /* Errors. */
-    ck_assert_int_eq(coa_deviation_weights(NULL, 1, R(0.5), w), COA_ERR_ARGUMENT);
-    ck_assert_int_eq(coa_deviation_weights(vs, 1, R(0.5), NULL), COA_ERR_ARGUMENT);
-    ck_assert_int_eq(coa_deviation_weights(vs, 0, R(0.5), w), COA_ERR_ARGUMENT);
-    ck_assert_int_eq(coa_deviation_weights(vs, 1, R(0), w), COA_ERR_ARGUMENT);
-    ck_assert_int_eq(coa_deviation_weights(vs, 1, R(-1), w), COA_ERR_ARGUMENT);
-    ck_assert_int_eq(coa_deviation_weights(vs, 1, R(NAN), w), COA_ERR_ARGUMENT);
-    ck_assert_int_eq(coa_deviation_weights(vs, 1, R(INFINITY), w), COA_ERR_ARGUMENT);
+    vs[0] = make_vehicle(route, 2, 10.0);
+    ck_assert_int_eq(coa_deviation_weights(NULL, 1, R(0.5), w, &e), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coa_deviation_weights(vs, 1, R(0.5), NULL, &e), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coa_deviation_weights(vs, 1, R(0.5), w, NULL), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coa_deviation_weights(vs, 0, R(0.5), w, &e), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coa_deviation_weights(vs, 1, R(0), w, &e), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coa_deviation_weights(vs, 1, R(-1), w, &e), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coa_deviation_weights(vs, 1, R(NAN), w, &e), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coa_deviation_weights(vs, 1, R(INFINITY), w, &e), COA_ERR_ARGUMENT);
     bad[0] = vs[0];
     bad[1] = vs[0];
     bad[1].cruise_speed = R(-10);
-    ck_assert_int_eq(coa_deviation_weights(bad, 2, R(0.5), w), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coa_deviation_weights(bad, 2, R(0.5), w, &e), COA_ERR_ARGUMENT);
     bad[1].climb_rate = R(-2); /* two negatives make a positive product */
-    ck_assert_int_eq(coa_deviation_weights(bad, 2, R(0.5), w), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coa_deviation_weights(bad, 2, R(0.5), w, &e), COA_ERR_ARGUMENT);
     bad[1] = vs[0];
     bad[1].climb_rate = R(0);
-    ck_assert_int_eq(coa_deviation_weights(bad, 2, R(0.5), w), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coa_deviation_weights(bad, 2, R(0.5), w, &e), COA_ERR_ARGUMENT);
     bad[1].climb_rate = R(NAN);
-    ck_assert_int_eq(coa_deviation_weights(bad, 2, R(0.5), w), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coa_deviation_weights(bad, 2, R(0.5), w, &e), COA_ERR_ARGUMENT);
 #ifndef COA_SINGLE_PRECISION
     /* Finite speeds whose product overflows (float inputs cannot overflow a double). */
     bad[1] = vs[0];
     bad[1].cruise_speed = R(REAL_MAX);
     bad[1].climb_rate = R(REAL_MAX);
-    ck_assert_int_eq(coa_deviation_weights(bad, 2, R(4), w), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coa_deviation_weights(bad, 2, R(4), w, &e), COA_ERR_ARGUMENT);
+    /* A subnormal product is still split exactly, and alone it is fine. */
+    bad[1] = vs[0];
+    bad[1].cruise_speed = R(1e-160);
+    bad[1].climb_rate = R(1e-160);
+    ck_assert_int_eq(coa_deviation_weights(bad + 1, 1, R(1), w, &e), COA_OK);
+    ck_assert(weight_is_exact(product_of(&bad[1], R(1)), w[0], e));
+    ck_assert_int_lt(e, -1022);
+    ck_assert_int_eq(coa_deviation_weights(bad, 2, R(1), w, &e), COA_ERR_RANGE);
 #endif
 }
 END_TEST
+
+/* The 128-bit helpers against the compiler's own 128-bit integers (tests run on 64-bit
+ * hosts; the core itself must not use them). */
+#ifdef __SIZEOF_INT128__
+/* __extension__: 128-bit integers are a GCC and Clang extension, fine in a host test. */
+__extension__ typedef unsigned __int128 u128_t;
+
+static u128_t to_u128(coa_cost_t c)
+{
+    return ((u128_t)c.hi << 64) | (u128_t)c.lo;
+}
+
+static coa_cost_t from_u128(u128_t x)
+{
+    coa_cost_t c;
+    c.hi = (uint64_t)(x >> 64);
+    c.lo = (uint64_t)x;
+    return c;
+}
+
+START_TEST(test_cost_arithmetic)
+{
+    static const uint64_t edge[] = {0u, 1u, 2u, 0xffffffffu, UINT64_C(0x100000000),
+                                    UINT64_C(0x1ffffffff), UINT64_C(0x8000000000000000),
+                                    UINT64_MAX - 1u, UINT64_MAX};
+    const size_t ne = sizeof edge / sizeof edge[0];
+    size_t i;
+    size_t j;
+    int trial;
+
+    for (i = 0; i < ne; ++i) {
+        for (j = 0; j < ne; ++j) {
+            u128_t p = (u128_t)edge[i] * edge[j];
+            ck_assert(to_u128(coa_cost_mul(edge[i], edge[j])) == p);
+        }
+    }
+    /* (2^64 - 1)^2 = 2^128 - 2^65 + 1. */
+    ck_assert_uint_eq(coa_cost_mul(UINT64_MAX, UINT64_MAX).hi, UINT64_MAX - 1u);
+    ck_assert_uint_eq(coa_cost_mul(UINT64_MAX, UINT64_MAX).lo, 1u);
+    /* The carry out of the low word. */
+    {
+        coa_cost_t a = {0u, UINT64_MAX};
+        coa_cost_t b = {0u, 1u};
+        coa_cost_t c = coa_cost_add(a, b);
+        ck_assert_uint_eq(c.hi, 1u);
+        ck_assert_uint_eq(c.lo, 0u);
+        c = coa_cost_add(from_u128(((u128_t)1 << 127) - 1u), b);
+        ck_assert(to_u128(c) == (u128_t)1 << 127);
+    }
+    rng_state = 0xc057u;
+    for (trial = 0; trial < 200000; ++trial) {
+        /* Mixed magnitudes, so carries and equal high words both occur often. */
+        uint64_t a = rng_next() >> rng_below(64u);
+        uint64_t b = rng_next() >> rng_below(64u);
+        u128_t x = (u128_t)rng_next() << rng_below(64u) | rng_next();
+        u128_t y = (trial % 4 == 0) ? x + (u128_t)(rng_below(3u)) - 1u
+                                    : ((u128_t)rng_next() << rng_below(64u) | rng_next());
+        int want;
+        ck_assert(to_u128(coa_cost_mul(a, b)) == (u128_t)a * b);
+        x >>= 1; /* keep the sum below 2^128 (the precondition) */
+        y >>= 1;
+        ck_assert(to_u128(coa_cost_add(from_u128(x), from_u128(y))) == x + y);
+        want = x < y ? -1 : x > y ? 1 : 0;
+        ck_assert_int_eq(coa_cost_compare(from_u128(x), from_u128(y)), want);
+    }
+    ck_assert_int_eq(coa_cost_compare(from_u128(5u), from_u128(5u)), 0);
+    ck_assert_int_eq(coa_cost_compare(from_u128((u128_t)1 << 64), from_u128(UINT64_MAX)), 1);
+    ck_assert_int_eq(coa_cost_compare(from_u128(UINT64_MAX), from_u128((u128_t)1 << 64)), -1);
+}
+END_TEST
+#endif
 
 static Suite *trajectory_suite(void)
 {
@@ -1078,6 +1225,9 @@ static Suite *trajectory_suite(void)
     tcase_add_test(cost, test_heuristic_admissible_consistent);
     tcase_add_test(cost, test_area_scale);
     tcase_add_test(cost, test_deviation_weights);
+#ifdef __SIZEOF_INT128__
+    tcase_add_test(cost, test_cost_arithmetic);
+#endif
     suite_add_tcase(s, cost);
     return s;
 }

@@ -13,9 +13,12 @@
  * f-deviation, then f-effort, then larger k first (as the paper orders it), then by the
  * order nodes were generated, so results are deterministic. Duplicate states are found
  * by a hash table: a better path to an open state updates it; closed states are final
- * (the heuristic is consistent). The search stops when the goal is taken from the open
- * list (solved), when the open list empties (infeasible: the space is exhausted), or when
- * beta states have been closed (budget exhausted: nothing proven).
+ * (the heuristic is consistent). The search looks at the top of the open list before
+ * each expansion: a goal there is optimal and ends the search (solved), even when beta
+ * states have already been closed; otherwise the search stops when beta states have been
+ * closed (budget exhausted: nothing proven) or when the open list empties (infeasible:
+ * the space is exhausted). So a problem whose plan needs exactly beta expansions is
+ * solved: a free single UAV over N steps needs beta = N.
  *
  *   - Centralised: one search over the composite state of all UAVs, with the composite
  *     action space (every combination of five actions per UAV, 5^n children a node).
@@ -36,10 +39,14 @@
  * there is infeasible with nothing expanded.
  *
  * Costs. The search minimises, lexicographically, the integer deviation
- * sum_i W_i * coa_area_scaled(a, b, S) (S = coa_area_scale and W_i = coa_deviation_weights
- * over all the problem's UAVs, whichever are searched) and then the effort; the heuristic
- * is sum_i W_i * coa_heuristic_scaled(offset_i, N - k, s_i, S) for the deviation and 0
- * for the effort.
+ * sum_i W_i * coa_area_scaled(a, b, S) (S = coa_area_scale and W_i 2^E =
+ * coa_deviation_weights over all the problem's UAVs, whichever are searched), one unit
+ * being 2^E / S m^2, and then the effort; the heuristic is
+ * sum_i W_i * coa_heuristic_scaled(offset_i, N - k, s_i, S) for the deviation and 0 for
+ * the effort. Deviations are exact 128-bit integers (coa_cost_t): the worst f = g + h,
+ * 2 N sum_i W_i S B_i with B_i the largest |offset| vehicle i can reach, is below
+ * 2^64 * 2^13 * 2^15 * 2^15 * 2^5 = 2^112 by the limits of common.h (W_i < 2^64,
+ * S <= 5040, B_i <= 32767, 2N <= 20000, n <= 32), so no sum the search forms can wrap.
  *
  * Memory. The planner lives in a buffer the caller provides, as in o1heap: ask
  * coa_planner_workspace_size(n, beta) for the byte count, hand coa_planner_init a buffer
@@ -49,12 +56,13 @@
  * case (1 + beta * 5^n nodes), so running out of room can only happen through beta and is
  * always reported as COA_PLAN_BUDGET_EXHAUSTED, never as infeasible.
  *
- * A node takes 34 + 2n bytes (k 2, parent 4, g and f deviation 8 + 8, g effort 4, heap
+ * A node takes 50 + 2n bytes (k 2, parent 4, g and f deviation 16 + 16, g effort 4, heap
  * position 4, heap entry 4, offsets 2 per UAV) plus 8 to 16 bytes of hash table (a power
- * of two of at least two slots per node, 4 bytes a slot): 44 to 52 bytes for n = 1, 54 to
- * 62 for n = 6. Add a fixed header of about 6.5 kB (the per-expansion validity tables and
- * sweeps live there, not on the stack). For example n = 1, beta = 10000: 2.3 MB; n = 3,
- * beta = 1000: 6.1 MB; n = 4, beta = 1000: 35 MB. The planner keeps state between calls
+ * of two of at least two slots per node, 4 bytes a slot): 60 to 68 bytes for n = 1, 70 to
+ * 78 for n = 6 (16 more than with 64-bit costs, the price of exact ties between any
+ * vehicles). Add a fixed header of about 6.9 kB (the per-expansion validity tables and
+ * sweeps live there, not on the stack). For example n = 1, beta = 10000: 3.1 MB; n = 3,
+ * beta = 1000: 8.1 MB; n = 4, beta = 1000: 45 MB. The planner keeps state between calls
  * in its buffer: one planner serves one thread at a time.
  *
  * Time. One expansion costs 25 n(n-1)/2 pairwise volume checks among the searched UAVs,
@@ -63,7 +71,10 @@
  * with an expected O(n) hash look-up and O(log pool) heap work; a search does at most
  * beta expansions. Measured (x86-64, -O2): two UAVs head-on over 12 steps take 121
  * expansions (0.24 ms); four UAVs converging on one point over 20 steps take 72k
- * expansions and 36M children (2.4 s), against 271 expansions (0.2 ms) decoupled.
+ * expansions and 36M children (2.4 s), against 271 expansions (0.2 ms) decoupled. Exact
+ * 128-bit costs make large searches about 8% slower: the paper scenario's centralised plan
+ * (three UAVs, 24 steps, 48.5k expansions, 4.2M children) went from 0.215 s to 0.233 s
+ * (medians of seven runs, coavoid plan, RelWithDebInfo).
  */
 #ifndef COAVOID_PLAN_H
 #define COAVOID_PLAN_H
@@ -105,7 +116,8 @@ typedef struct {
     /* Costs: totals over every vehicle when solved; decoupled and not solved, over the
      * planned_count vehicles of `order`; otherwise 0. */
     double deviation;          /* m^2, by the exact formula */
-    int64_t deviation_units;   /* the exact integer the planner minimised (trajectory.h) */
+    coa_cost_t deviation_units; /* the exact integer the planner minimised, in units of
+                                   2^E / S m^2 (file comment, "Costs") */
     uint32_t effort;
     uint64_t nodes_expanded;   /* over every search this call ran */
     uint64_t nodes_generated;  /* children that passed the conflict checks */
@@ -118,6 +130,12 @@ typedef struct {
     size_t planned_count;
     size_t failed_vehicle;     /* decoupled, not solved: index of the first UAV with no plan */
     uint32_t orders_tried;     /* decoupled: priority orders attempted (1 without reordering) */
+    bool all_orders_covered;   /* decoupled, not solved: every order was tried or ruled out
+                                  (a failing prefix; a UAV infeasible when planned first; a
+                                  conflict at t = 0, which no order avoids). With status
+                                  infeasible, no order has a plan; with budget exhausted,
+                                  some order failed only through beta. false when solved,
+                                  centralised, or when max_orders ended the search first */
 } coa_plan_result_t;
 
 typedef struct coa_planner coa_planner_t;
@@ -139,10 +157,12 @@ coa_planner_t *coa_planner_init(void *buffer, size_t size, size_t max_vehicles, 
 
 /* Checks a problem in full (counts, finite numbers, every vehicle and track, unique ids,
  * obstacles, non-NULL and finite samples) before a search trusts it. Returns COA_OK,
- * COA_ERR_ARGUMENT, or COA_ERR_RANGE when the worst-case f = g + h could overflow int64:
- * with B_i = min(|initial_offset| + N s_i, max_offset when bounded, COA_MAX_OFFSET), the
- * bound is 2 N sum_i W_i S B_i. Cost O(vehicles * (route + N + vehicles) + tracks *
- * (path + N) + polytope vertices), no memory. */
+ * COA_ERR_ARGUMENT, or COA_ERR_RANGE when the costs cannot be exact: the deviation
+ * weights do not fit 64 bits (coa_deviation_weights), or the worst-case f = g + h,
+ * 2 N sum_i W_i S B_i with B_i = min(|initial_offset| + N s_i, max_offset when bounded,
+ * COA_MAX_OFFSET), reaches 2^127 (which the limits of common.h rule out today: see the
+ * file comment; the check guards against raising them). Cost O(vehicles * (route + N +
+ * vehicles) + tracks * (path + N) + polytope vertices), no memory. */
 int coa_problem_check(const coa_problem_t *problem);
 
 /* Centralised plan of every vehicle of the problem in one composite search.
@@ -168,20 +188,29 @@ int coa_plan_centralised(coa_planner_t *planner, const coa_problem_t *problem,
  * not been tried at P, else the first untried one in the current order; the vehicles
  * after P keep their relative order. So the failing vehicle moves earlier as the orders
  * below each prefix run out, and no part of the tree is left behind: the search stops
- * when an order succeeds, when every order has been tried or ruled out (a failing prefix
- * rules out every order that starts with it; a vehicle infeasible in first position,
- * against obstacles and tracks alone, rules out every order), or after max_orders
- * attempts. Exhaustion thus takes at most n! attempts. If none succeeds the result
- * reports the first order's attempt (order, planned_count, failed_vehicle and the rows of
- * the planned vehicles, re-planned if a later attempt overwrote them); if any attempt
- * failed through beta the status is budget exhausted rather than infeasible.
- * orders_tried counts the attempts; nodes are summed over every search, re-plans
- * included. The costs cover the planned_count vehicles of the reported order. Rows of
- * other vehicles are unspecified.
+ * when an order succeeds, when every order has been tried or ruled out, or after
+ * max_orders attempts. Orders are ruled out by a failing prefix (every order that starts
+ * with it), and all at once by a proof that none can work: a vehicle infeasible in first
+ * position, against obstacles and tracks alone; or, checked once the first attempt has
+ * failed, a conflict at t = 0 (two vehicles at their k = 0 positions and initial offsets,
+ * or one of them and an obstacle or a track), which is in the way of every order. If
+ * none succeeds the result reports the first order's attempt (order, planned_count,
+ * failed_vehicle and the rows of the planned vehicles, re-planned if a later attempt
+ * overwrote them) and all_orders_covered. The status is infeasible when a proof covers
+ * every order (even if some attempt, the reported one included, ran out of beta) or when
+ * no attempt ran out of beta; otherwise budget exhausted. orders_tried counts the
+ * attempts; nodes are summed over every search, re-plans included. The costs cover the
+ * planned_count vehicles of the reported order. Rows of other vehicles are unspecified.
  * Errors as coa_plan_centralised (the planner needs room for one vehicle), and
  * COA_ERR_ARGUMENT when max_orders is 0 or `order` is not a permutation.
- * Cost: at most beta expansions per single-UAV search, at most n searches per attempt
- * (the first order's re-plans included), no memory beyond the workspace, O(n) stack. */
+ * Cost: in the worst case min(max_orders, n!) attempts of at most n single-UAV searches
+ * each (fewer when attempts share a prefix), each search at most beta expansions, then
+ * at most n re-plans of the first order; plus, after a failed first attempt,
+ * n (obstacles + tracks) + n(n-1)/2 volume checks at t = 0. The rules above only cut
+ * this short in the cases they name: two UAVs that can never pass each other (but are
+ * clear at t = 0) among n-2 that never interact still take about half of the n! orders
+ * (measured: 3262 attempts for n = 7, 191802 for n = 9), so bound max_orders when n is
+ * more than a few. No memory beyond the workspace, O(n) stack. */
 int coa_plan_decoupled(coa_planner_t *planner, const coa_problem_t *problem,
                        const size_t *order, uint32_t max_orders, int32_t *offsets,
                        coa_plan_result_t *result);

@@ -22,11 +22,18 @@
  *   A(a, b) = (a^2 + b^2) / (2 |a - b|)  when the profile crosses the reference.
  * A is a rational with denominator 2 or 2|a - b| = 2s, so A * S is an integer for the
  * problem's area scale S = lcm of 2*s_i over its vehicles. To compare sums over vehicles
- * with different L*dh exactly, each vehicle's L_i*dh_i is turned into an integer weight
- * W_i = round(2^20 * L_i dh_i / max_j L_j dh_j) (at least 1). The planner minimises
- * sum W_i * S * A_i exactly in 64-bit integers: vehicles with equal L*dh get equal weights,
- * so ties (climb or dive, which UAV moves) compare exactly and a plan is the same on every
- * machine. The deviation reported in m^2 is the exact formula sum L_i dh_i A_i.
+ * with different L*dh exactly, each vehicle's w_i = L_i*dh_i (evaluated in double as
+ * fl(fl(v*dt) * fl(c*dt)), which is what the contract's formula means on a computer) is
+ * written exactly as W_i * 2^E: W_i an unsigned 64-bit integer, E common to the problem
+ * (coa_deviation_weights). A double is a 53-bit integer times a power of two, so this
+ * always fits when the largest and smallest weight are within 2^10 of each other, and
+ * much further apart when the weights have short binary expansions (integers such as 30
+ * and 10, or halves); otherwise the problem is refused with COA_ERR_RANGE rather than
+ * compared inexactly. The planner minimises
+ * sum W_i * (A_i * S) exactly in 128-bit unsigned integers (coa_cost_t): ties between any
+ * vehicles (climb or dive, which UAV moves) compare exactly, so the effort tie-break the
+ * contract asks for is honoured, and a plan is the same on every machine. The deviation
+ * reported in m^2 is the contract's formula sum L_i dh_i A_i in double.
  *
  * The heuristic (cost to go) is the paper's return-to-reference triangle truncated at the
  * horizon: with R steps left the profile can at best shrink by s per step, so
@@ -117,17 +124,18 @@ int coa_track_check(const coa_track_t *tr);
  * Cost O(horizon + path_count). */
 int coa_track_sample(const coa_track_t *tr, coa_real_t dt, uint32_t horizon, coa_vec3_t *out);
 
-/* Climb step dh = climb_rate * dt (m). Cannot fail. */
+/* Climb step dh = climb_rate * dt (m). Cannot fail. Cost O(1). */
 coa_real_t coa_climb_step(const coa_vehicle_t *v, coa_real_t dt);
 
-/* Offset change of an action for steep factor s. Cannot fail (an unknown action is level). */
+/* Offset change of an action for steep factor s. Cannot fail (an unknown action is level).
+ * Cost O(1). */
 int32_t coa_action_delta(coa_action_t action, uint32_t steep_factor);
 
-/* Effort of an action: 0, 1 or 3. Cannot fail. */
+/* Effort of an action: 0, 1 or 3. Cannot fail. Cost O(1). */
 uint32_t coa_action_effort(coa_action_t action);
 
 /* Contract name of an action ("level", "climb", "dive", "steep_climb", "steep_dive").
- * Never NULL. */
+ * Never NULL. Cost O(1). */
 const char *coa_action_name(coa_action_t action);
 
 /* The action that moves offset a to offset b for steep factor s, or -1 when no action
@@ -151,11 +159,33 @@ int64_t coa_heuristic_scaled(int32_t a, uint32_t steps_left, uint32_t steep_fact
  * is 0 or a steep factor is out of range. Cost O(n). */
 uint32_t coa_area_scale(const coa_vehicle_t *vehicles, size_t n);
 
-/* The integer deviation weights W_i described above, into weights[0..n-1]. Returns COA_OK
- * or COA_ERR_ARGUMENT (NULL, n == 0, dt or a product L*dh not finite or <= 0).
- * Computed in double whatever coa_real_t is, so host and firmware agree. Cost O(n). */
+/* The exact deviation weights of the file comment: w_i = weights[i] * 2^(*exponent) for
+ * i = 0..n-1, with the common factors of two moved into the exponent (some weights[i] is
+ * odd), e.g. w = 30 and 10 give 15 and 5 with exponent 1. Returns COA_OK,
+ * COA_ERR_ARGUMENT (NULL, n == 0, dt, L or dh not finite or <= 0), or COA_ERR_RANGE
+ * (the weights span too many binary orders of magnitude for 64-bit integers); on an
+ * error the outputs are unspecified. Computed in double whatever coa_real_t is, read
+ * from the IEEE 754 bits rather than through libm, so host and firmware agree. Cost O(n). */
 int coa_deviation_weights(const coa_vehicle_t *vehicles, size_t n, coa_real_t dt,
-                          int64_t *weights);
+                          uint64_t *weights, int *exponent);
+
+/* An exact non-negative cost in the planner's deviation unit: hi * 2^64 + lo. The
+ * helpers below use only 64-bit arithmetic (no __int128), so they build for 32-bit
+ * microcontrollers too. */
+typedef struct {
+    uint64_t hi;
+    uint64_t lo;
+} coa_cost_t;
+
+/* a + b. Precondition: no overflow past 2^128 (the planner's range check ensures it).
+ * Cost O(1). */
+coa_cost_t coa_cost_add(coa_cost_t a, coa_cost_t b);
+
+/* The exact 128-bit product of two 64-bit integers (portable: no __int128). Cost O(1). */
+coa_cost_t coa_cost_mul(uint64_t a, uint64_t b);
+
+/* -1, 0 or 1 as a <, ==, > b. Cost O(1). */
+int coa_cost_compare(coa_cost_t a, coa_cost_t b);
 
 #ifdef __cplusplus
 }

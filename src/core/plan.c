@@ -5,7 +5,7 @@
  * Workspace layout (every array starts on an 8-byte boundary):
  *
  *   coa_planner_t header (limits, per-call context, per-expansion scratch)
- *   int64_t  g_dev[C], f_dev[C]
+ *   coa_cost_t g_dev[C], f_dev[C]    (16 bytes each: exact 128-bit deviation units)
  *   uint32_t parent[C], g_eff[C], heap_pos[C], heap[C]
  *   uint32_t table[T]                (T = power of two >= 2C, open addressing)
  *   uint16_t k[C]
@@ -35,8 +35,8 @@ struct coa_planner {
     uint32_t capacity;
     uint32_t table_mask;
 
-    int64_t *g_dev;
-    int64_t *f_dev;
+    coa_cost_t *g_dev;
+    coa_cost_t *f_dev;
     uint32_t *parent;
     uint32_t *g_eff;
     uint32_t *heap_pos;
@@ -54,7 +54,7 @@ struct coa_planner {
     /* Per call: the problem and its exact cost parameters. */
     const coa_problem_t *problem;
     uint32_t scale;
-    int64_t weight[COA_MAX_VEHICLES];
+    uint64_t weight[COA_MAX_VEHICLES];
     coa_real_t dh[COA_MAX_VEHICLES];
     int32_t limit[COA_MAX_VEHICLES];
 
@@ -71,8 +71,8 @@ struct coa_planner {
     coa_sweep_t fixed_sweep[COA_MAX_VEHICLES];
     coa_sweep_t sweep[MAXM][ACTIONS];
     int32_t next[MAXM][ACTIONS];
-    int64_t dev[MAXM][ACTIONS];
-    int64_t heur[MAXM][ACTIONS];
+    coa_cost_t dev[MAXM][ACTIONS];
+    coa_cost_t heur[MAXM][ACTIONS];
     bool env_ok[MAXM][ACTIONS];
     bool pair_ok[MAXM][MAXM][ACTIONS][ACTIONS];
 };
@@ -97,6 +97,34 @@ typedef struct {
     uint64_t expanded;
     uint64_t generated;
 } search_out_t;
+
+/* ------------------------------------------------------------------------------------ */
+/* Exact costs on the hot path                                                           */
+
+/* The same arithmetic as coa_cost_add and coa_cost_compare (trajectory.c), repeated for
+ * the search loop so that the compiler can inline it: the open list compares costs
+ * O(log pool) times per child, and the out-of-line calls made the paper scenario's
+ * centralised search about a quarter slower. Colder code calls the public pair.
+ * test_trajectory pins the public pair and test_plan checks the planner's costs against
+ * an independent exact oracle, so the copies cannot drift unnoticed. */
+static inline coa_cost_t cost_add(coa_cost_t a, coa_cost_t b)
+{
+    coa_cost_t r;
+    r.lo = a.lo + b.lo;
+    r.hi = a.hi + b.hi + (r.lo < a.lo ? 1u : 0u);
+    return r;
+}
+
+static inline int cost_compare(coa_cost_t a, coa_cost_t b)
+{
+    if (a.hi != b.hi) {
+        return a.hi < b.hi ? -1 : 1;
+    }
+    if (a.lo != b.lo) {
+        return a.lo < b.lo ? -1 : 1;
+    }
+    return 0;
+}
 
 /* ------------------------------------------------------------------------------------ */
 /* Sizes                                                                                 */
@@ -164,8 +192,8 @@ static bool layout_compute(size_t max_vehicles, uint32_t beta, plan_layout_t *lo
     if (!size_round(sizeof(coa_planner_t), &cursor)) {
         return false;
     }
-    if (!reserve(&cursor, c, sizeof(int64_t), &lo->at_g_dev) ||
-        !reserve(&cursor, c, sizeof(int64_t), &lo->at_f_dev) ||
+    if (!reserve(&cursor, c, sizeof(coa_cost_t), &lo->at_g_dev) ||
+        !reserve(&cursor, c, sizeof(coa_cost_t), &lo->at_f_dev) ||
         !reserve(&cursor, c, sizeof(uint32_t), &lo->at_parent) ||
         !reserve(&cursor, c, sizeof(uint32_t), &lo->at_g_eff) ||
         !reserve(&cursor, c, sizeof(uint32_t), &lo->at_heap_pos) ||
@@ -205,8 +233,8 @@ coa_planner_t *coa_planner_init(void *buffer, size_t size, size_t max_vehicles, 
     pl->bytes = lo.total;
     pl->capacity = lo.capacity;
     pl->table_mask = lo.table_size - 1u;
-    pl->g_dev = (int64_t *)(void *)(base + lo.at_g_dev);
-    pl->f_dev = (int64_t *)(void *)(base + lo.at_f_dev);
+    pl->g_dev = (coa_cost_t *)(void *)(base + lo.at_g_dev);
+    pl->f_dev = (coa_cost_t *)(void *)(base + lo.at_f_dev);
     pl->parent = (uint32_t *)(void *)(base + lo.at_parent);
     pl->g_eff = (uint32_t *)(void *)(base + lo.at_g_eff);
     pl->heap_pos = (uint32_t *)(void *)(base + lo.at_heap_pos);
@@ -310,15 +338,6 @@ static int check_arguments(const coa_problem_t *p)
     return COA_OK;
 }
 
-static bool u64_mul(uint64_t a, uint64_t b, uint64_t *out)
-{
-    if (a != 0u && b > UINT64_MAX / a) {
-        return false;
-    }
-    *out = a * b;
-    return true;
-}
-
 /* The largest |offset| a vehicle may take: its own bound, and the int16 node storage. */
 static int32_t offset_limit(const coa_vehicle_t *v)
 {
@@ -326,34 +345,46 @@ static int32_t offset_limit(const coa_vehicle_t *v)
                                                                    : COA_MAX_OFFSET;
 }
 
-/* Whether the worst case f = g + h of any node fits int64. One step costs at most
+/* Whether the worst case f = g + h of any node stays below 2^127, which leaves every sum
+ * the search forms (g + one step, g + h) far from the 2^128 wrap. One step costs at most
  * W * S * max(|a|, |b|) <= W * S * B and the heuristic at most W * S * R * B, so
- * f <= 2 N * sum_i W_i S B_i. Fills the weights and the scale on success. */
-static int check_range(const coa_problem_t *p, int64_t *weights, uint32_t *scale)
+ * f <= 2 N * sum_i W_i S B_i. With the limits of common.h that is below 2^64 * 2^13 *
+ * 2^15 * 2^15 * 2^5 = 2^112, so only coa_deviation_weights' own COA_ERR_RANGE (weights
+ * that do not fit 64 bits) can refuse a problem today; the check stays so that raising a
+ * limit cannot silently break exactness. Fills the weights and the scale on success. */
+static int check_range(const coa_problem_t *p, uint64_t *weights, uint32_t *scale)
 {
-    uint64_t total = 0u;
+    coa_cost_t total = {0u, 0u};
     uint32_t s;
+    int exponent;
+    int rc;
     size_t i;
 
     s = coa_area_scale(p->vehicles, p->vehicle_count);
-    if (s == 0u || coa_deviation_weights(p->vehicles, p->vehicle_count, p->dt, weights) != COA_OK) {
+    if (s == 0u) {
         return COA_ERR_ARGUMENT;
+    }
+    rc = coa_deviation_weights(p->vehicles, p->vehicle_count, p->dt, weights, &exponent);
+    if (rc != COA_OK) {
+        return rc;
     }
     for (i = 0; i < p->vehicle_count; ++i) {
         const coa_vehicle_t *v = &p->vehicles[i];
         uint64_t init = (uint64_t)(v->initial_offset < 0 ? -(int64_t)v->initial_offset
                                                          : (int64_t)v->initial_offset);
         uint64_t bound = init + (uint64_t)p->horizon * v->steep_factor;
-        uint64_t term;
+        uint64_t factor;
         if (bound > (uint64_t)offset_limit(v)) {
             bound = (uint64_t)offset_limit(v);
         }
-        if (!u64_mul((uint64_t)weights[i], s, &term) || !u64_mul(term, bound, &term) ||
-            !u64_mul(term, 2u * (uint64_t)p->horizon, &term) ||
-            term > (uint64_t)INT64_MAX - total) {
+        /* S <= 5040, B <= 32767, 2N <= 20000: the factor is below 2^42. */
+        factor = (uint64_t)s * bound * 2u * (uint64_t)p->horizon;
+        /* Each term is below 2^106 and there are at most 32: the sum cannot wrap before
+         * the test. */
+        total = coa_cost_add(total, coa_cost_mul(weights[i], factor));
+        if (total.hi >= (UINT64_C(1) << 63)) {
             return COA_ERR_RANGE;
         }
-        total += term;
     }
     *scale = s;
     return COA_OK;
@@ -361,7 +392,7 @@ static int check_range(const coa_problem_t *p, int64_t *weights, uint32_t *scale
 
 int coa_problem_check(const coa_problem_t *problem)
 {
-    int64_t weights[COA_MAX_VEHICLES];
+    uint64_t weights[COA_MAX_VEHICLES];
     uint32_t scale;
     int rc = check_arguments(problem);
     if (rc != COA_OK) {
@@ -438,13 +469,28 @@ int coa_plan_vehicle_cost(const coa_vehicle_t *vehicle, coa_real_t dt, uint32_t 
     return COA_OK;
 }
 
-/* The exact integer deviation of a row, as the search counts it. */
-static int64_t row_units(const coa_planner_t *pl, size_t v, const int32_t *row)
+/* The exact deviation of one step in the search's units. Areas and heuristics are never
+ * negative, so the casts below are exact. */
+static coa_cost_t step_units(const coa_planner_t *pl, size_t v, int32_t a, int32_t b)
 {
-    int64_t units = 0;
+    return coa_cost_mul(pl->weight[v], (uint64_t)coa_area_scaled(a, b, pl->scale));
+}
+
+/* The heuristic for vehicle v at offset a with `left` steps to go, in the same units. */
+static coa_cost_t heuristic_units(const coa_planner_t *pl, size_t v, int32_t a, uint32_t left)
+{
+    const coa_vehicle_t *veh = &pl->problem->vehicles[v];
+    return coa_cost_mul(pl->weight[v],
+                        (uint64_t)coa_heuristic_scaled(a, left, veh->steep_factor, pl->scale));
+}
+
+/* The exact integer deviation of a row, as the search counts it. */
+static coa_cost_t row_units(const coa_planner_t *pl, size_t v, const int32_t *row)
+{
+    coa_cost_t units = {0u, 0u};
     uint32_t k;
     for (k = 0; k < pl->problem->horizon; ++k) {
-        units += pl->weight[v] * coa_area_scaled(row[k], row[k + 1u], pl->scale);
+        units = coa_cost_add(units, step_units(pl, v, row[k], row[k + 1u]));
     }
     return units;
 }
@@ -600,8 +646,9 @@ static void table_reset(coa_planner_t *pl)
 /* Open-list order: f_dev, then f_eff (= g_eff), then larger k, then generation order. */
 static bool node_before(const coa_planner_t *pl, uint32_t a, uint32_t b)
 {
-    if (pl->f_dev[a] != pl->f_dev[b]) {
-        return pl->f_dev[a] < pl->f_dev[b];
+    int c = cost_compare(pl->f_dev[a], pl->f_dev[b]);
+    if (c != 0) {
+        return c < 0;
     }
     if (pl->g_eff[a] != pl->g_eff[b]) {
         return pl->g_eff[a] < pl->g_eff[b];
@@ -678,7 +725,7 @@ static uint32_t heap_pop(coa_planner_t *pl)
 /* A new child, or a better path to an open one. Returns false only if the pool is full,
  * which the sizing makes impossible; the caller then reports the budget as exhausted. */
 static bool add_child(coa_planner_t *pl, uint32_t parent, uint16_t k, const int16_t *key,
-                      int64_t g, int64_t f, uint32_t eff)
+                      coa_cost_t g, coa_cost_t f, uint32_t eff)
 {
     uint32_t slot = 0u;
     uint32_t n = table_find(pl, k, key, &slot);
@@ -688,7 +735,8 @@ static bool add_child(coa_planner_t *pl, uint32_t parent, uint16_t k, const int1
         if (pl->heap_pos[n] == NONE) {
             return true; /* closed: final, the heuristic is consistent */
         }
-        if (g < pl->g_dev[n] || (g == pl->g_dev[n] && eff < pl->g_eff[n])) {
+        int c = cost_compare(g, pl->g_dev[n]);
+        if (c < 0 || (c == 0 && eff < pl->g_eff[n])) {
             pl->parent[n] = parent;
             pl->g_dev[n] = g;
             pl->f_dev[n] = f;
@@ -748,9 +796,8 @@ static bool expand(coa_planner_t *pl, uint32_t n, search_out_t *out)
             pl->env_ok[i][a] = ok;
             if (ok) {
                 pl->next[i][a] = to;
-                pl->dev[i][a] = pl->weight[v] * coa_area_scaled(from, to, pl->scale);
-                pl->heur[i][a] = pl->weight[v] * coa_heuristic_scaled(to, left, veh->steep_factor,
-                                                                      pl->scale);
+                pl->dev[i][a] = step_units(pl, v, from, to);
+                pl->heur[i][a] = heuristic_units(pl, v, to, left);
             }
         }
     }
@@ -793,17 +840,17 @@ static bool expand(coa_planner_t *pl, uint32_t n, search_out_t *out)
         }
         {
             int16_t child[MAXM];
-            int64_t g = pl->g_dev[n];
-            int64_t h = 0;
+            coa_cost_t g = pl->g_dev[n];
+            coa_cost_t h = {0u, 0u};
             uint32_t eff = pl->g_eff[n];
             for (i = 0; i < m; ++i) {
                 child[i] = (int16_t)pl->next[i][act[i]];
-                g += pl->dev[i][act[i]];
-                h += pl->heur[i][act[i]];
+                g = cost_add(g, pl->dev[i][act[i]]);
+                h = cost_add(h, pl->heur[i][act[i]]);
                 eff += coa_action_effort((coa_action_t)act[i]);
             }
             ++out->generated;
-            if (!add_child(pl, n, (uint16_t)k1, child, g, g + h, eff)) {
+            if (!add_child(pl, n, (uint16_t)k1, child, g, cost_add(g, h), eff)) {
                 return false;
             }
         }
@@ -843,7 +890,8 @@ static void search(coa_planner_t *pl, size_t m, search_out_t *out)
     const uint32_t horizon = pr->horizon;
     int16_t key[MAXM];
     uint32_t closed = 0u;
-    int64_t h = 0;
+    coa_cost_t h = {0u, 0u};
+    coa_cost_t zero = {0u, 0u};
     size_t i;
 
     out->status = COA_PLAN_INFEASIBLE;
@@ -859,16 +907,17 @@ static void search(coa_planner_t *pl, size_t m, search_out_t *out)
     for (i = 0; i < m; ++i) {
         const coa_vehicle_t *v = &pr->vehicles[pl->searched[i]];
         key[i] = (int16_t)v->initial_offset;
-        h += pl->weight[pl->searched[i]] *
-             coa_heuristic_scaled(v->initial_offset, horizon, v->steep_factor, pl->scale);
+        h = coa_cost_add(h, heuristic_units(pl, pl->searched[i], v->initial_offset, horizon));
     }
-    if (!add_child(pl, NONE, 0u, key, 0, h, 0u)) {
+    if (!add_child(pl, NONE, 0u, key, zero, h, 0u)) {
         out->status = COA_PLAN_BUDGET_EXHAUSTED;
         return;
     }
 
-    while (pl->heap_count > 0u && closed < pl->beta) {
-        uint32_t n = heap_pop(pl);
+    /* The goal test comes before the budget test: a goal on top of the open list is
+     * optimal however many states were closed to get there, and closing it costs nothing. */
+    while (pl->heap_count > 0u) {
+        uint32_t n = pl->heap[0];
         if (pl->node_k[n] == horizon) {
             uint32_t step;
             for (step = 0; step <= horizon && n != NONE; ++step) {
@@ -881,6 +930,11 @@ static void search(coa_planner_t *pl, size_t m, search_out_t *out)
             out->status = COA_PLAN_SOLVED;
             return;
         }
+        if (closed >= pl->beta) {
+            out->status = COA_PLAN_BUDGET_EXHAUSTED;
+            return;
+        }
+        (void)heap_pop(pl);
         if (!expand(pl, n, out)) {
             out->status = COA_PLAN_BUDGET_EXHAUSTED;
             return;
@@ -888,7 +942,7 @@ static void search(coa_planner_t *pl, size_t m, search_out_t *out)
         ++closed;
         ++out->expanded;
     }
-    out->status = pl->heap_count == 0u ? COA_PLAN_INFEASIBLE : COA_PLAN_BUDGET_EXHAUSTED;
+    out->status = COA_PLAN_INFEASIBLE;
 }
 
 /* ------------------------------------------------------------------------------------ */
@@ -899,7 +953,8 @@ static void result_clear(coa_plan_result_t *r)
     size_t i;
     r->status = COA_PLAN_INFEASIBLE;
     r->deviation = 0.0;
-    r->deviation_units = 0;
+    r->deviation_units.hi = 0u;
+    r->deviation_units.lo = 0u;
     r->effort = 0u;
     r->nodes_expanded = 0u;
     r->nodes_generated = 0u;
@@ -910,6 +965,7 @@ static void result_clear(coa_plan_result_t *r)
     r->planned_count = 0u;
     r->failed_vehicle = COA_NO_VEHICLE;
     r->orders_tried = 0u;
+    r->all_orders_covered = false;
 }
 
 /* Validates the call and loads the problem's cost parameters into the planner. */
@@ -948,7 +1004,8 @@ static void fill_costs(const coa_planner_t *pl, const size_t *which, size_t coun
     const coa_problem_t *pr = pl->problem;
     size_t i;
     r->deviation = 0.0;
-    r->deviation_units = 0;
+    r->deviation_units.hi = 0u;
+    r->deviation_units.lo = 0u;
     r->effort = 0u;
     for (i = 0; i < count; ++i) {
         const int32_t *row = &pl->rows[which[i] * ((size_t)pr->horizon + 1u)];
@@ -958,7 +1015,7 @@ static void fill_costs(const coa_planner_t *pl, const size_t *which, size_t coun
         (void)coa_plan_vehicle_cost(&pr->vehicles[which[i]], pr->dt, pr->horizon, row, &dev, &eff);
         r->deviation += dev;
         r->effort += eff;
-        r->deviation_units += row_units(pl, which[i], row);
+        r->deviation_units = coa_cost_add(r->deviation_units, row_units(pl, which[i], row));
     }
 }
 
@@ -1013,6 +1070,33 @@ static coa_plan_status_t plan_one(coa_planner_t *pl, const size_t *order, size_t
     return out.status;
 }
 
+/* Whether some vehicle meets an obstacle, a track or another vehicle at t = 0 (positions
+ * at k = 0 with the initial offsets). Every order then fails: the root of whichever
+ * vehicle of the pair is planned second (or of the vehicle itself) is in conflict.
+ * Uses the planner's fixed-vehicle scratch, which the next search rebuilds anyway. */
+static bool any_initial_conflict(coa_planner_t *pl)
+{
+    const coa_problem_t *pr = pl->problem;
+    coa_sweep_t *at0 = pl->fixed_sweep;
+    size_t i;
+    size_t j;
+
+    pl->fixed_ready = false;
+    for (i = 0; i < pr->vehicle_count; ++i) {
+        int32_t o = pr->vehicles[i].initial_offset;
+        at0[i] = vehicle_sweep(pr, pl->dh, i, 0u, o, 0u, o);
+        if (!static_clear(pr, &at0[i], 0u, 0u)) {
+            return true;
+        }
+        for (j = 0; j < i; ++j) {
+            if (coa_conflict_volumes(&at0[i], &at0[j])) {
+                return true;
+            }
+        }
+    }
+    return false;
+}
+
 /* order without the vehicle at `from`, that vehicle re-inserted at `to` <= from. */
 static void promote(size_t *order, size_t from, size_t to)
 {
@@ -1037,6 +1121,8 @@ int coa_plan_decoupled(coa_planner_t *planner, const coa_problem_t *problem,
     size_t keep;          /* levels below this still hold the first attempt's plans */
     size_t first_fail = 0u;
     bool any_budget = false;
+    bool proven = false;  /* infeasible in every order, whatever beta did */
+    bool covered = false; /* every order tried or ruled out */
     size_t i;
     int rc;
 
@@ -1100,17 +1186,26 @@ int coa_plan_decoupled(coa_planner_t *planner, const coa_problem_t *problem,
             fill_costs(planner, cur, n, result);
             return COA_OK;
         }
-        if (result->orders_tried == 1u) {
-            first_fail = fail;
-        }
         if (st == COA_PLAN_BUDGET_EXHAUSTED) {
             any_budget = true;
         }
-        v = cur[fail];
         /* Alone against obstacles and tracks, nothing it could meet later is easier. */
         if (fail == 0u && st == COA_PLAN_INFEASIBLE) {
+            proven = true;
+        }
+        if (result->orders_tried == 1u) {
+            first_fail = fail;
+            /* Checked only once an order has failed, so a solved call never pays for it;
+             * without it, two vehicles in conflict at t = 0 among n would cost up to n!
+             * attempts before the order space ran out. */
+            if (!proven && any_initial_conflict(planner)) {
+                proven = true;
+            }
+        }
+        if (proven) {
             break;
         }
+        v = cur[fail];
         /* Depth-first: every order below cur[0..fail] is ruled out, so go back to the
          * deepest position that still has an untried candidate under its prefix (deeper
          * positions have been exhausted). There the failing vehicle goes first if it has
@@ -1131,7 +1226,8 @@ int coa_plan_decoupled(coa_planner_t *planner, const coa_problem_t *problem,
             }
         }
         if (!found) {
-            break; /* every order tried or ruled out */
+            covered = true; /* every order tried or ruled out */
+            break;
         }
         for (i = to + 1u; i < n; ++i) {
             tried[i] = 0u;
@@ -1140,8 +1236,11 @@ int coa_plan_decoupled(coa_planner_t *planner, const coa_problem_t *problem,
     }
 
     /* No order worked: report the first attempt, re-planning the part of its prefix that
-     * later attempts overwrote (the searches are deterministic, so they succeed again). */
-    result->status = any_budget ? COA_PLAN_BUDGET_EXHAUSTED : COA_PLAN_INFEASIBLE;
+     * later attempts overwrote (the searches are deterministic, so they succeed again).
+     * A proof for every order outranks an attempt that ran out of beta: more beta could
+     * not have helped it. */
+    result->all_orders_covered = proven || covered;
+    result->status = (any_budget && !proven) ? COA_PLAN_BUDGET_EXHAUSTED : COA_PLAN_INFEASIBLE;
     result->planned_count = first_fail;
     for (i = 0; i < n; ++i) {
         result->order[i] = first[i];

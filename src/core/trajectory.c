@@ -4,6 +4,7 @@
  */
 #include "coavoid/trajectory.h"
 
+#include <float.h>
 #include <math.h>
 
 #ifdef COA_SINGLE_PRECISION
@@ -494,36 +495,137 @@ uint32_t coa_area_scale(const coa_vehicle_t *vehicles, size_t n)
     return scale;
 }
 
-int coa_deviation_weights(const coa_vehicle_t *vehicles, size_t n, coa_real_t dt,
-                          int64_t *weights)
+/* The bit reading below is only right for IEEE 754 binary64 stored in the byte order of
+ * uint64_t, as on x86, ARM EABI and every target the core is built for. */
+_Static_assert(sizeof(double) == sizeof(uint64_t) && DBL_MANT_DIG == 53 &&
+                   DBL_MAX_EXP == 1024 && DBL_MIN_EXP == -1021,
+               "coa_deviation_weights needs IEEE 754 binary64 doubles");
+
+/* A positive finite double as mant * 2^e exactly, mant odd. Read from the bits rather
+ * than with frexp so no libm rounding mode or implementation can enter: binary64 is a
+ * 52-bit fraction, an 11-bit biased exponent and, unless subnormal, an implicit 1. */
+static void split_double(double x, uint64_t *mant, int *e_out)
 {
-    double w_max = 0.0;
+    union {
+        double d;
+        uint64_t u;
+    } bits;
+    uint64_t field;
+    uint64_t m;
+    int e;
+
+    bits.d = x;
+    field = (bits.u >> 52) & UINT64_C(0x7ff);
+    m = bits.u & ((UINT64_C(1) << 52) - 1u);
+    if (field == 0u) {
+        e = -1074; /* subnormal: no implicit bit */
+    } else {
+        m |= UINT64_C(1) << 52;
+        e = (int)field - 1075;
+    }
+    /* x > 0, so m != 0 and this ends within 53 steps. */
+    while ((m & 1u) == 0u) {
+        m >>= 1;
+        ++e;
+    }
+    *mant = m;
+    *e_out = e;
+}
+
+/* w = fl(fl(v * dt) * fl(c * dt)) in double, or false when a factor or the product is not
+ * finite and positive. Both passes below go through here, so they see the same w. */
+static bool vehicle_weight(const coa_vehicle_t *v, double step, double *w)
+{
+    double l = (double)v->cruise_speed * step;
+    double dh = (double)v->climb_rate * step;
+    double p = l * dh;
+    /* Each factor must be positive on its own: two negative speeds multiply to a positive
+     * product. */
+    if (!(isfinite(l) && l > 0.0 && isfinite(dh) && dh > 0.0 && isfinite(p) && p > 0.0)) {
+        return false;
+    }
+    *w = p;
+    return true;
+}
+
+int coa_deviation_weights(const coa_vehicle_t *vehicles, size_t n, coa_real_t dt,
+                          uint64_t *weights, int *exponent)
+{
     double step = (double)dt;
+    int low = 0;
     size_t i;
 
-    if (vehicles == NULL || weights == NULL || n == 0u || !(isfinite(step) && step > 0.0)) {
+    if (vehicles == NULL || weights == NULL || exponent == NULL || n == 0u ||
+        !(isfinite(step) && step > 0.0)) {
         return COA_ERR_ARGUMENT;
     }
+    /* The common exponent is the smallest of the weights' own (odd mantissa) exponents:
+     * every weight is then an integer multiple of 2^low, and the one that sets it is odd,
+     * so no common factor of two is left. */
     for (i = 0; i < n; ++i) {
-        double l = (double)vehicles[i].cruise_speed * step;
-        double dh = (double)vehicles[i].climb_rate * step;
-        double w = l * dh;
-        /* Each factor must be positive on its own: two negative speeds multiply to a
-         * positive product. */
-        if (!(isfinite(l) && l > 0.0 && isfinite(dh) && dh > 0.0 && isfinite(w) && w > 0.0)) {
+        double w;
+        uint64_t m;
+        int e;
+        if (!vehicle_weight(&vehicles[i], step, &w)) {
             return COA_ERR_ARGUMENT;
         }
-        if (w > w_max) {
-            w_max = w;
+        split_double(w, &m, &e);
+        if (i == 0u || e < low) {
+            low = e;
         }
     }
     for (i = 0; i < n; ++i) {
-        double l = (double)vehicles[i].cruise_speed * step;
-        double dh = (double)vehicles[i].climb_rate * step;
-        /* w / w_max <= 1 then an exact power-of-two scaling: the same as 2^20 * w / w_max
-         * without the risk of overflowing 2^20 * w. */
-        long long q = llround((l * dh / w_max) * 1048576.0);
-        weights[i] = q < 1 ? 1 : (int64_t)q;
+        double w = 0.0;
+        uint64_t m;
+        int e;
+        int shift;
+        (void)vehicle_weight(&vehicles[i], step, &w);
+        split_double(w, &m, &e);
+        shift = e - low;
+        if (shift >= 64 || m > (UINT64_MAX >> shift)) {
+            return COA_ERR_RANGE;
+        }
+        weights[i] = m << shift;
     }
+    *exponent = low;
     return COA_OK;
+}
+
+coa_cost_t coa_cost_add(coa_cost_t a, coa_cost_t b)
+{
+    coa_cost_t r;
+    r.lo = a.lo + b.lo;
+    r.hi = a.hi + b.hi + (r.lo < a.lo ? 1u : 0u);
+    return r;
+}
+
+coa_cost_t coa_cost_mul(uint64_t a, uint64_t b)
+{
+    /* Schoolbook on 32-bit halves: every partial product fits 64 bits, and so does the
+     * middle column (at most 3 * (2^32 - 1)), which a 32-bit core does with UMULL. */
+    const uint64_t mask = UINT64_C(0xffffffff);
+    uint64_t a0 = a & mask;
+    uint64_t a1 = a >> 32;
+    uint64_t b0 = b & mask;
+    uint64_t b1 = b >> 32;
+    uint64_t p00 = a0 * b0;
+    uint64_t p01 = a0 * b1;
+    uint64_t p10 = a1 * b0;
+    uint64_t p11 = a1 * b1;
+    uint64_t mid = (p00 >> 32) + (p01 & mask) + (p10 & mask);
+    coa_cost_t r;
+    r.lo = (mid << 32) | (p00 & mask);
+    r.hi = p11 + (p01 >> 32) + (p10 >> 32) + (mid >> 32);
+    return r;
+}
+
+int coa_cost_compare(coa_cost_t a, coa_cost_t b)
+{
+    if (a.hi != b.hi) {
+        return a.hi < b.hi ? -1 : 1;
+    }
+    if (a.lo != b.lo) {
+        return a.lo < b.lo ? -1 : 1;
+    }
+    return 0;
 }
