@@ -1574,7 +1574,7 @@ START_TEST(problem_check_and_helpers)
 END_TEST
 
 /* ------------------------------------------------------------------------------------ */
-/* Review findings                                                                       */
+/* Regressions: each case below broke an earlier version of the planner.              */
 
 /* Two UAVs crossing at right angles with the same speed and steep factor 3, climb rates 3
  * and 1 (L*dh = 30 and 10). Separating them costs 60 m^2 either way: UAV 1 one climb step
