@@ -1,0 +1,76 @@
+/*
+ * cli.h: what every coavoid command shares: exit statuses, the one-line error report,
+ * option parsing in one style ("--opt value" or "--opt=value", each option at most once),
+ * and loading a scenario with the loader's messages.
+ *
+ * Every command reports a usage or input error as exactly one line on stderr,
+ * "coavoid: <what>: <why>", naming the option or the file and field, and exits
+ * CLI_EXIT_INVALID; the tests rely on that shape.
+ */
+#ifndef COAVOID_APP_CLI_H
+#define COAVOID_APP_CLI_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <time.h>
+
+#include "coavoid/common.h"
+#include "scenario.h"
+
+/* malloc's alignment is what every workspace buffer (planner, predictor) relies on. */
+_Static_assert(_Alignof(max_align_t) >= COA_WORKSPACE_ALIGNMENT,
+               "malloc does not align enough for the core's workspaces");
+
+enum {
+    CLI_EXIT_OK = 0,
+    CLI_EXIT_NOT_SOLVED = 1, /* plan: infeasible or budget exhausted */
+    CLI_EXIT_INVALID = 2,    /* bad usage or bad input */
+    CLI_EXIT_INTERNAL = 3    /* a bug, or the result could not be written */
+};
+
+/* Returned by a command's steps to mean "go on": any other value is the exit status
+ * (help printed: CLI_EXIT_OK; a usage or input error: CLI_EXIT_INVALID; ...). */
+#define CLI_CONTINUE (-1)
+
+#if defined(__GNUC__)
+#define CLI_PRINTF_LIKE(fmt, args) __attribute__((format(printf, fmt, args)))
+#else
+#define CLI_PRINTF_LIKE(fmt, args)
+#endif
+
+/* Prints "coavoid: <message>" as exactly one line (control characters that came from the
+ * input, such as a file name or an option value, are replaced so they cannot split it) and
+ * returns `status`, so that every check reads `return cli_fail(...)`. */
+int cli_fail(int status, const char *fmt, ...) CLI_PRINTF_LIKE(2, 3);
+
+/* Whether `arg` is the option `name`, alone or as "name=value". */
+bool cli_option_is(const char *arg, const char *name);
+
+/* The value of option `name` (argv[*i], already matched by cli_option_is): the text after
+ * '=', or the next argument (consumed). false when there is none. */
+bool cli_option_value(int argc, char **argv, int *i, const char *name, const char **value);
+
+/* `length` characters of decimal digits only (no sign, no spaces) whose value is in
+ * 1..max. */
+bool cli_parse_count(const char *text, size_t length, uint64_t max, uint64_t *out);
+
+/* A whole string that is one finite decimal number (an optional sign, digits with at most
+ * one point, an optional exponent): strtod alone would also take leading spaces, "nan",
+ * "inf" and hexadecimal, which in an option are more likely a mistake than meant. */
+bool cli_parse_real(const char *text, double *out);
+
+/* Microseconds from start to end. */
+int64_t cli_elapsed_us(const struct timespec *start, const struct timespec *end);
+
+/* Loads and validates the scenario at `path` (scenario_load). Returns CLI_CONTINUE, or
+ * CLI_EXIT_INVALID after the loader's one-line message ("coavoid: FILE: field: reason").
+ * Either way the caller calls scenario_free(s) afterwards. */
+int cli_load_scenario(const char *path, scenario_t *s);
+
+/* Samples every reference and track of a loaded scenario over its horizon
+ * (scenario_sample). Returns CLI_CONTINUE, or CLI_EXIT_INVALID after the one-line message
+ * naming `path` and the field. */
+int cli_sample_scenario(const char *path, scenario_t *s);
+
+#endif /* COAVOID_APP_CLI_H */

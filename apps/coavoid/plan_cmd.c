@@ -1,0 +1,400 @@
+/*
+ * coavoid plan: reads a scenario (SCENARIO_FORMAT.md), plans altitude manoeuvres
+ * centrally or decoupled, and prints the plan result as JSON. See PLAN_USAGE below.
+ */
+#define _POSIX_C_SOURCE 200809L
+
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "cli.h"
+#include "commands.h"
+#include "coavoid/coavoid.h"
+#include "output.h"
+#include "scenario.h"
+
+/* The closed-set bound beta when neither --beta nor the scenario's "beta" gives one. */
+#define COAVOID_DEFAULT_BETA 20000u
+/* The default beta is lowered until the worst-case workspace fits this many bytes: the
+ * workspace grows as beta * 5^n, and a default that asks a laptop for 18 GB (6 UAVs
+ * centralised) is a trap. An explicit --beta or scenario beta is taken as given. */
+#define COAVOID_DEFAULT_WORKSPACE_MAX ((size_t)1u << 30)
+
+/* How many priority orders --reorder tries unless --max-orders says otherwise. n UAVs have
+ * n! orders and a failing order costs up to n searches, so an unbounded search can run for
+ * hours (12! is 479 million); 7! tries every order of up to 7 UAVs, which is still well
+ * under a second for small problems, and bounds the rest. */
+#define COAVOID_DEFAULT_MAX_ORDERS 5040u
+#define COAVOID_DEFAULT_MAX_ORDERS_COVER 7u /* the UAV count whose orders it covers */
+_Static_assert(COAVOID_DEFAULT_MAX_ORDERS == 7u * 6u * 5u * 4u * 3u * 2u * 1u &&
+                   COAVOID_DEFAULT_MAX_ORDERS_COVER == 7u,
+               "the default max orders is COAVOID_DEFAULT_MAX_ORDERS_COVER factorial");
+
+/* A printf format so that the limits it quotes come from one place. */
+#define PLAN_USAGE                                                                          \
+    "usage: coavoid plan SCENARIO.json --mode centralised|decoupled\n"                      \
+    "                    [--priority ID,ID,...] [--beta N] [--reorder [--max-orders N]]\n"  \
+    "\n"                                                                                    \
+    "Reads a scenario (JSON, at most %u MiB) and prints the plan result as JSON.\n"         \
+    "\n"                                                                                    \
+    "options:\n"                                                                            \
+    "  --mode centralised  one search over all UAVs together (at most %u UAVs)\n"           \
+    "  --mode decoupled    each UAV in turn, in priority order\n"                           \
+    "  --priority ID,...   decoupled: plan in this order (every vehicle id exactly once)\n" \
+    "  --beta N            closed-set bound, N >= 1; overrides the scenario's \"beta\";\n"  \
+    "                      default %u, lowered so the workspace stays within 1 GiB;\n"      \
+    "                      the centralised workspace grows as beta * 5^UAVs\n"              \
+    "  --reorder           decoupled: when a UAV fails, try other priority orders\n"        \
+    "  --max-orders N      with --reorder: try at most N orders, N >= 1; default %u\n"      \
+    "                      (every order of up to %u UAVs); stats.all_orders_covered\n"      \
+    "                      says whether a failure is proven for every order\n"              \
+    "  -h, --help          show this help\n"                                                \
+    "\n"                                                                                    \
+    "Fields of the scenario that the format does not define are ignored.\n"                 \
+    "\n"                                                                                    \
+    "exit status: 0 solved, 1 infeasible or budget exhausted, 2 invalid input or usage\n"   \
+    "(one line on stderr naming the input and why), 3 internal error\n"
+
+/* ---- options ---- */
+
+typedef struct {
+    const char *scenario_path;
+    const char *mode; /* NULL until given */
+    bool decoupled;
+    const char *priority; /* NULL: priority order */
+    const char *beta_text;
+    uint32_t beta;
+    bool reorder;
+    const char *max_orders_text; /* NULL: COAVOID_DEFAULT_MAX_ORDERS */
+    uint32_t max_orders;
+} plan_options_t;
+
+/* Returns CLI_CONTINUE, or the exit status (help printed: 0; a usage error: 2). */
+static int parse_plan_options(int argc, char **argv, plan_options_t *o)
+{
+    bool options_done = false;
+    memset(o, 0, sizeof *o);
+    for (int i = 2; i < argc; i++) {
+        const char *arg = argv[i];
+        const char *value = NULL;
+        if (options_done || arg[0] != '-' || strcmp(arg, "-") == 0) {
+            if (o->scenario_path != NULL) {
+                return cli_fail(CLI_EXIT_INVALID,
+                                "plan: unexpected argument '%.80s' (one scenario only)", arg);
+            }
+            o->scenario_path = arg;
+        } else if (strcmp(arg, "--") == 0) {
+            options_done = true;
+        } else if (strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0) {
+            printf(PLAN_USAGE, SCENARIO_MAX_BYTES / (1024u * 1024u), COA_MAX_CENTRALISED,
+                   COAVOID_DEFAULT_BETA, COAVOID_DEFAULT_MAX_ORDERS,
+                   COAVOID_DEFAULT_MAX_ORDERS_COVER);
+            return CLI_EXIT_OK;
+        } else if (cli_option_is(arg, "--mode")) {
+            if (o->mode != NULL) {
+                return cli_fail(CLI_EXIT_INVALID, "--mode: given more than once");
+            }
+            if (!cli_option_value(argc, argv, &i, "--mode", &value)) {
+                return cli_fail(CLI_EXIT_INVALID,
+                                "--mode: missing value (centralised or decoupled)");
+            }
+            if (strcmp(value, "centralised") != 0 && strcmp(value, "decoupled") != 0) {
+                return cli_fail(CLI_EXIT_INVALID,
+                                "--mode: unknown mode '%.40s' (expected centralised or decoupled)",
+                                value);
+            }
+            o->mode = value;
+            o->decoupled = strcmp(value, "decoupled") == 0;
+        } else if (cli_option_is(arg, "--priority")) {
+            if (o->priority != NULL) {
+                return cli_fail(CLI_EXIT_INVALID, "--priority: given more than once");
+            }
+            if (!cli_option_value(argc, argv, &i, "--priority", &value)) {
+                return cli_fail(CLI_EXIT_INVALID,
+                                "--priority: missing value (vehicle ids, e.g. 3,1,2)");
+            }
+            o->priority = value;
+        } else if (cli_option_is(arg, "--beta")) {
+            uint64_t beta;
+            if (o->beta_text != NULL) {
+                return cli_fail(CLI_EXIT_INVALID, "--beta: given more than once");
+            }
+            if (!cli_option_value(argc, argv, &i, "--beta", &value)) {
+                return cli_fail(CLI_EXIT_INVALID, "--beta: missing value (an integer >= 1)");
+            }
+            if (!cli_parse_count(value, strlen(value), UINT32_MAX, &beta)) {
+                return cli_fail(CLI_EXIT_INVALID,
+                                "--beta: must be an integer from 1 to %lu, got '%.40s'",
+                                (unsigned long)UINT32_MAX, value);
+            }
+            o->beta_text = value;
+            o->beta = (uint32_t)beta;
+        } else if (strcmp(arg, "--reorder") == 0) {
+            if (o->reorder) {
+                return cli_fail(CLI_EXIT_INVALID, "--reorder: given more than once");
+            }
+            o->reorder = true;
+        } else if (cli_option_is(arg, "--reorder")) {
+            return cli_fail(CLI_EXIT_INVALID, "--reorder: takes no value");
+        } else if (cli_option_is(arg, "--max-orders")) {
+            uint64_t max_orders;
+            if (o->max_orders_text != NULL) {
+                return cli_fail(CLI_EXIT_INVALID, "--max-orders: given more than once");
+            }
+            if (!cli_option_value(argc, argv, &i, "--max-orders", &value)) {
+                return cli_fail(CLI_EXIT_INVALID, "--max-orders: missing value (an integer >= 1)");
+            }
+            if (!cli_parse_count(value, strlen(value), UINT32_MAX, &max_orders)) {
+                return cli_fail(CLI_EXIT_INVALID,
+                                "--max-orders: must be an integer from 1 to %lu, got '%.40s'",
+                                (unsigned long)UINT32_MAX, value);
+            }
+            o->max_orders_text = value;
+            o->max_orders = (uint32_t)max_orders;
+        } else {
+            return cli_fail(CLI_EXIT_INVALID,
+                            "plan: unknown option '%.40s' (see 'coavoid plan --help')", arg);
+        }
+    }
+    if (o->scenario_path == NULL) {
+        return cli_fail(CLI_EXIT_INVALID,
+                        "plan: missing SCENARIO.json (see 'coavoid plan --help')");
+    }
+    if (o->mode == NULL) {
+        return cli_fail(CLI_EXIT_INVALID, "--mode: required (centralised or decoupled)");
+    }
+    /* Centralised plans everyone in one search: an order would mean nothing, so asking
+     * for one is more likely a mistake than something to ignore. */
+    if (!o->decoupled && o->priority != NULL) {
+        return cli_fail(CLI_EXIT_INVALID, "--priority: only valid with --mode decoupled");
+    }
+    if (!o->decoupled && o->reorder) {
+        return cli_fail(CLI_EXIT_INVALID, "--reorder: only valid with --mode decoupled");
+    }
+    /* Without --reorder exactly one order is planned: a bound on orders would do nothing. */
+    if (o->max_orders_text != NULL && !o->reorder) {
+        return cli_fail(CLI_EXIT_INVALID,
+                        "--max-orders: only valid with --reorder (and --mode decoupled)");
+    }
+    if (o->max_orders_text == NULL) {
+        o->max_orders = COAVOID_DEFAULT_MAX_ORDERS;
+    }
+    return CLI_CONTINUE;
+}
+
+/* --priority as vehicle indices into order[0..n-1]: a permutation of the ids. Returns
+ * CLI_CONTINUE when valid, else the exit status after the message. */
+static int parse_priority(const char *text, const scenario_t *s, size_t *order)
+{
+    bool listed[COA_MAX_VEHICLES] = {false};
+    size_t count = 0;
+    const char *token = text;
+    for (;;) {
+        const char *comma = strchr(token, ',');
+        size_t length = comma != NULL ? (size_t)(comma - token) : strlen(token);
+        uint64_t id;
+        if (!cli_parse_count(token, length, 65535u, &id)) {
+            if (text[0] == '\0') {
+                return cli_fail(CLI_EXIT_INVALID,
+                                "--priority: empty (expected vehicle ids separated "
+                                "by commas)");
+            }
+            if (length == 0) {
+                return cli_fail(CLI_EXIT_INVALID,
+                                "--priority: empty entry in '%.80s' "
+                                "(expected vehicle ids separated by commas)",
+                                text);
+            }
+            return cli_fail(CLI_EXIT_INVALID, "--priority: '%.*s' is not a vehicle id",
+                            (int)(length > 40 ? 40 : length), token);
+        }
+        long index = scenario_vehicle_index(s, (long)id);
+        if (index < 0) {
+            return cli_fail(CLI_EXIT_INVALID, "--priority: %lu is not a vehicle id",
+                            (unsigned long)id);
+        }
+        if (listed[index]) {
+            return cli_fail(CLI_EXIT_INVALID, "--priority: %lu is listed twice", (unsigned long)id);
+        }
+        listed[index] = true;
+        order[count++] = (size_t)index;
+        if (comma == NULL) {
+            break;
+        }
+        token = comma + 1;
+    }
+    for (size_t i = 0; i < s->vehicle_count; i++) {
+        if (!listed[i]) {
+            return cli_fail(CLI_EXIT_INVALID,
+                            "--priority: vehicle %u is missing (list every id once)",
+                            (unsigned)s->vehicles[i].id);
+        }
+    }
+    return CLI_CONTINUE;
+}
+
+/* The core's COA_ERR_RANGE from the problem check or the planner. Weights that cannot be
+ * exact (the only cause the current limits allow) are named by the parser first, so what
+ * is left is the worst-case cost over the horizon outgrowing the core's exact integers:
+ * horizon is what the user is most likely to change. A backstop. */
+static int range_error(const char *file, const scenario_t *s)
+{
+    return cli_fail(CLI_EXIT_INVALID,
+                    "%s: horizon: %lu steps is too long for these vehicles' offsets and costs "
+                    "(beyond the core's integer range; shorten it or bound max_offset)",
+                    file, (unsigned long)s->horizon);
+}
+
+/* The default beta for `searched` vehicles a search: COAVOID_DEFAULT_BETA, or the largest
+ * beta whose workspace fits COAVOID_DEFAULT_WORKSPACE_MAX when that is smaller (the size
+ * grows with beta, so a bisection finds it). */
+static uint32_t default_beta(size_t searched)
+{
+    uint32_t lo = 1u;
+    uint32_t hi = COAVOID_DEFAULT_BETA;
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo + 1u) / 2u;
+        size_t size = coa_planner_workspace_size(searched, mid);
+        if (size != 0u && size <= COAVOID_DEFAULT_WORKSPACE_MAX) {
+            lo = mid;
+        } else {
+            hi = mid - 1u;
+        }
+    }
+    return lo;
+}
+
+/* beta from --beta, else the scenario, else the default; *source names it for messages. */
+static uint32_t choose_beta(const plan_options_t *o, const scenario_t *s, size_t searched,
+                            char *source, size_t source_size)
+{
+    if (o->beta_text != NULL) {
+        snprintf(source, source_size, "--beta %lu", (unsigned long)o->beta);
+        return o->beta;
+    }
+    if (s->has_beta) {
+        snprintf(source, source_size, "%.400s: beta %lu", o->scenario_path, (unsigned long)s->beta);
+        return s->beta;
+    }
+    uint32_t beta = default_beta(searched);
+    snprintf(source, source_size, "default beta %lu", (unsigned long)beta);
+    return beta;
+}
+
+/* Everything after the scenario is loaded. Returns the exit status. */
+static int plan(const plan_options_t *o, scenario_t *s)
+{
+    const char *file = o->scenario_path;
+    char err[SCENARIO_ERROR_MAX];
+    size_t order_storage[COA_MAX_VEHICLES];
+    const size_t *order = NULL;
+    const size_t n = s->vehicle_count;
+
+    if (o->priority != NULL) {
+        int status = parse_priority(o->priority, s, order_storage);
+        if (status != CLI_CONTINUE) {
+            return status;
+        }
+        order = order_storage;
+    }
+
+    const size_t searched = o->decoupled ? 1u : n;
+    char beta_source[SCENARIO_ERROR_MAX];
+    uint32_t beta = choose_beta(o, s, searched, beta_source, sizeof beta_source);
+
+    if (!o->decoupled && n > COA_MAX_CENTRALISED) {
+        return cli_fail(CLI_EXIT_INVALID,
+                        "--mode centralised: %zu vehicles, at most %u (COA_MAX_CENTRALISED) can be "
+                        "planned together",
+                        n, COA_MAX_CENTRALISED);
+    }
+
+    int rc = cli_sample_scenario(file, s);
+    if (rc != CLI_CONTINUE) {
+        return rc;
+    }
+    coa_problem_t problem = scenario_problem(s);
+    rc = coa_problem_check(&problem);
+    if (rc == COA_ERR_RANGE) {
+        return range_error(file, s);
+    }
+    if (rc != COA_OK) {
+        return cli_fail(CLI_EXIT_INVALID, "%s: rejected by the core's problem check (%s)", file,
+                        coa_status_name(rc));
+    }
+
+    size_t size = coa_planner_workspace_size(searched, beta);
+    if (size == 0) {
+        return cli_fail(CLI_EXIT_INVALID,
+                        "%s: too large: the workspace for %zu vehicle(s) would not fit in memory "
+                        "(lower it with --beta)",
+                        beta_source, searched);
+    }
+    void *workspace = malloc(size);
+    if (workspace == NULL) {
+        return cli_fail(CLI_EXIT_INVALID,
+                        "%s: cannot allocate %zu bytes of workspace for %zu vehicle(s) "
+                        "(lower it with --beta)",
+                        beta_source, size, searched);
+    }
+    coa_planner_t *planner = coa_planner_init(workspace, size, searched, beta);
+    int32_t *offsets = calloc(n * ((size_t)s->horizon + 1u), sizeof *offsets);
+    if (planner == NULL || offsets == NULL) {
+        free(workspace);
+        free(offsets);
+        return cli_fail(CLI_EXIT_INTERNAL, "%s",
+                        planner == NULL ? "internal error: the planner refused its workspace"
+                                        : "out of memory for the plan");
+    }
+
+    coa_plan_result_t result;
+    memset(&result, 0, sizeof result);
+    struct timespec start, end;
+    clock_gettime(CLOCK_MONOTONIC, &start);
+    if (o->decoupled) {
+        rc = coa_plan_decoupled(planner, &problem, order, o->reorder ? o->max_orders : 1u, offsets,
+                                &result);
+    } else {
+        rc = coa_plan_centralised(planner, &problem, offsets, &result);
+    }
+    clock_gettime(CLOCK_MONOTONIC, &end);
+    free(workspace);
+
+    int status;
+    if (rc == COA_ERR_RANGE) {
+        status = range_error(file, s);
+    } else if (rc != COA_OK) {
+        status = cli_fail(CLI_EXIT_INTERNAL, "internal error: the planner failed (%s)",
+                          coa_status_name(rc));
+    } else {
+        output_plan_t view = {s,   o->decoupled, &result, offsets, cli_elapsed_us(&start, &end),
+                              beta};
+        if (output_plan(stdout, &view, err, sizeof err) != 0) {
+            status = cli_fail(CLI_EXIT_INTERNAL, "%s", err);
+        } else {
+            status = result.status == COA_PLAN_SOLVED ? CLI_EXIT_OK : CLI_EXIT_NOT_SOLVED;
+        }
+    }
+    free(offsets);
+    return status;
+}
+
+int command_plan(int argc, char **argv)
+{
+    plan_options_t options;
+    int status = parse_plan_options(argc, argv, &options);
+    if (status != CLI_CONTINUE) {
+        return status;
+    }
+    scenario_t scenario;
+    status = cli_load_scenario(options.scenario_path, &scenario);
+    if (status == CLI_CONTINUE) {
+        status = plan(&options, &scenario);
+    }
+    scenario_free(&scenario);
+    return status;
+}
