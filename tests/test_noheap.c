@@ -1,5 +1,5 @@
 /*
- * test_noheap.c: the planner never touches the heap.
+ * test_noheap.c: the planner and the predictor never touch the heap.
  *
  * The link wraps malloc, calloc, realloc and free (-Wl,--wrap=..., see CMakeLists.txt):
  * every call from a statically linked object (the core archive, this file, Check) goes
@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "coavoid/coavoid.h"
+#include "coavoid/predict.h"
 
 void *__real_malloc(size_t size);
 void *__real_calloc(size_t count, size_t size);
@@ -207,6 +208,108 @@ START_TEST(planner_makes_no_heap_call)
 }
 END_TEST
 
+/* One prediction cycle over everything it can meet: unaligned plans (one a single sample),
+ * UAVs and a track with growing sigma, a box and a polytope, a capacity too small for
+ * every conflict; then the clusters and the probability alone. Broad phase and all-pairs. */
+START_TEST(predictor_makes_no_heap_call)
+{
+    static coa_vec3_t samples[4][12];
+    static coa_vec3_t hull[8];
+    static coa_intent_plan_t plans[4];
+    static coa_obstacle_t obs[2];
+    static coa_track_t track;
+    static coa_conflict_t conflicts[2][3];
+    static uint32_t cluster[4];
+    coa_predict_config_t cfg;
+    coa_predict_result_t res[2];
+    coa_predictor_t *pr;
+    void *mem;
+    size_t bytes;
+    size_t cluster_count = 0u;
+    size_t i;
+    size_t j;
+    int rc[2];
+    int rc_clusters;
+    double p;
+
+    for (i = 0; i < 4u; ++i) {
+        memset(&plans[i], 0, sizeof plans[i]);
+        plans[i].id = (uint16_t)(i + 1u);
+        plans[i].volume.radius = (coa_real_t)10.0;
+        plans[i].volume.half_height = (coa_real_t)5.0;
+        plans[i].t0 = (coa_real_t)(-0.25 * (double)i);
+        plans[i].step = (coa_real_t)(i == 2u ? 2.0 : 1.0);
+        plans[i].count = i == 3u ? 1u : 12u;
+        plans[i].samples = samples[i];
+        plans[i].sigma_horizontal = (coa_real_t)(i == 1u ? 2.0 : 0.0);
+        for (j = 0; j < 12u; ++j) {
+            double t = (double)plans[i].t0 + (double)j * (double)plans[i].step;
+            /* 0 and 1 meet head-on; 2 crosses them; 3 hovers where 0 passes. */
+            samples[i][j] = i == 0u ? V(-60.0 + 10.0 * t, 0, 100)
+                          : i == 1u ? V(60.0 - 10.0 * t, 5, 100)
+                          : i == 2u ? V(0, -40.0 + 8.0 * t, 102)
+                                    : V(30, 3, 98);
+        }
+    }
+    obs[0].kind = COA_OBSTACLE_BOX;
+    obs[0].box.min = V(-5, -5, 80);
+    obs[0].box.max = V(5, 5, 96);
+    for (i = 0; i < 8u; ++i) {
+        hull[i] = V(40.0 + 10.0 * (double)(i & 1u), -5.0 + 10.0 * (double)((i >> 1) & 1u),
+                    90.0 + 20.0 * (double)((i >> 2) & 1u));
+    }
+    obs[1].kind = COA_OBSTACLE_POLYTOPE;
+    obs[1].polytope.vertices = hull;
+    obs[1].polytope.count = 8u;
+    memset(&track, 0, sizeof track);
+    track.id = 7u;
+    track.volume.radius = (coa_real_t)15.0;
+    track.volume.half_height = (coa_real_t)5.0;
+    track.position = V(-20, 40, 100);
+    track.velocity = V(2, -6, 0);
+    track.sigma_horizontal = (coa_real_t)5.0;
+    track.sigma_vertical = (coa_real_t)2.0;
+    memset(&cfg, 0, sizeof cfg);
+    cfg.dt = (coa_real_t)1.0;
+    cfg.horizon = 10u;
+    cfg.vehicle_sigma_rate_horizontal = (coa_real_t)0.2;
+    cfg.track_sigma_rate_horizontal = (coa_real_t)0.5;
+    cfg.threshold = 0.01;
+
+    bytes = coa_predictor_workspace_size(4u, 1u, 10u, 64u);
+    ck_assert_uint_gt(bytes, 0u);
+    mem = malloc(bytes);
+    ck_assert_ptr_nonnull(mem);
+
+    heap_calls = 0u;
+    armed = true;
+    pr = coa_predictor_init(mem, bytes, 4u, 1u, 10u, 64u);
+    for (i = 0; i < 2u; ++i) {
+        cfg.all_pairs = i == 1u;
+        rc[i] = coa_predict(pr, &cfg, plans, 4u, obs, 2u, &track, 1u, conflicts[i], 3u, &res[i]);
+    }
+    rc_clusters = coa_predict_clusters(conflicts[0], res[0].conflict_count, 4u, cluster,
+                                       &cluster_count);
+    p = coa_conflict_probability((coa_real_t)25.0, (coa_real_t)2.0, (coa_real_t)20.0,
+                                 (coa_real_t)10.0, (coa_real_t)5.0, (coa_real_t)1.0);
+    armed = false;
+
+    ck_assert_uint_eq(heap_calls, 0u);
+    ck_assert_ptr_nonnull(pr);
+    for (i = 0; i < 2u; ++i) {
+        ck_assert_int_eq(rc[i], COA_OK);
+        ck_assert_uint_eq(res[i].conflict_count, 3u);
+        ck_assert(res[i].overflow);
+        ck_assert_uint_gt(res[i].conflicts_found, 3u);
+    }
+    ck_assert_uint_eq(res[0].conflicts_found, res[1].conflicts_found);
+    ck_assert_int_eq(rc_clusters, COA_OK);
+    ck_assert_uint_ge(cluster_count, 1u);
+    ck_assert(p > 0.0 && p < 1.0);
+    free(mem);
+}
+END_TEST
+
 int main(void)
 {
     Suite *s = suite_create("noheap");
@@ -216,6 +319,7 @@ int main(void)
 
     tcase_set_timeout(tc, 120);
     tcase_add_test(tc, planner_makes_no_heap_call);
+    tcase_add_test(tc, predictor_makes_no_heap_call);
     suite_add_tcase(s, tc);
     sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);
