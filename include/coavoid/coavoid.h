@@ -4,6 +4,7 @@
  *   geometry.h   protected volumes, obstacles, exact conflict tests over one step
  *   trajectory.h vehicles, reference sampling, tracks, actions and exact integer costs
  *   plan.h       the allocation-free A* planner: centralised and decoupled
+ *   predict.h    collision prediction over the horizon: conflicts, probability, clusters
  */
 #ifndef COAVOID_COAVOID_H
 #define COAVOID_COAVOID_H
@@ -12,5 +13,6 @@
 #include "coavoid/geometry.h"
 #include "coavoid/trajectory.h"
 #include "coavoid/plan.h"
+#include "coavoid/predict.h"
 
 #endif /* COAVOID_COAVOID_H */
