@@ -1,11 +1,13 @@
 /*
  * commands.h: the coavoid subcommands main() dispatches to. Each takes main's argc and
- * argv unchanged (argv[1] is the command's name, its arguments start at argv[2]) and
- * returns the process exit status (cli.h).
+ * argv unchanged (argv[1] is the command's name, its arguments start at argv[2]; bench
+ * takes its benchmark's name at argv[2]) and returns the process exit status (cli.h).
  */
 #ifndef COAVOID_APP_COMMANDS_H
 #define COAVOID_APP_COMMANDS_H
 
 int command_plan(int argc, char **argv);    /* plan_cmd.c */
+int command_predict(int argc, char **argv); /* predict_cmd.c */
+int command_bench(int argc, char **argv);   /* bench.c */
 
 #endif /* COAVOID_APP_COMMANDS_H */

@@ -4,6 +4,8 @@
  * scenario loading through cli.h.
  *
  *   coavoid plan SCENARIO.json --mode centralised|decoupled [...]   plan_cmd.c
+ *   coavoid predict SCENARIO.json [--threshold P] [...]             predict_cmd.c
+ *   coavoid bench predict --vehicles N --horizon H [...]            bench.c
  *
  * Exit status: 0 success, 1 plan infeasible or budget exhausted, 2 invalid input or usage
  * (one line on stderr naming the input and why), 3 internal error.
@@ -19,6 +21,8 @@
     "\n"                                                                        \
     "commands:\n"                                                               \
     "  plan     plan collision-free altitude manoeuvres for a scenario\n"       \
+    "  predict  predict the conflicts of a scenario's reference trajectories\n" \
+    "  bench    time a core function on a random airspace (bench predict)\n"    \
     "\n"                                                                        \
     "Run 'coavoid <command> --help' for the options of a command.\n"
 
@@ -34,6 +38,12 @@ int main(int argc, char **argv)
     }
     if (strcmp(command, "plan") == 0) {
         return command_plan(argc, argv);
+    }
+    if (strcmp(command, "predict") == 0) {
+        return command_predict(argc, argv);
+    }
+    if (strcmp(command, "bench") == 0) {
+        return command_bench(argc, argv);
     }
     if (command[0] == '-') {
         return cli_fail(CLI_EXIT_INVALID, "unknown option '%.40s' (see 'coavoid --help')", command);

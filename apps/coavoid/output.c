@@ -200,12 +200,9 @@ fail:
     return NULL;
 }
 
-int output_plan(FILE *out, const output_plan_t *plan, char *err, size_t err_size)
+/* Prints and frees `root`. Returns 0, or -1 with err set. */
+static int print_object(FILE *out, cJSON *root, char *err, size_t err_size)
 {
-    cJSON *root = build(plan, err, err_size);
-    if (root == NULL) {
-        return -1;
-    }
     char *text = cJSON_Print(root);
     cJSON_Delete(root);
     if (text == NULL) {
@@ -219,4 +216,85 @@ int output_plan(FILE *out, const output_plan_t *plan, char *err, size_t err_size
                          errno != 0 ? strerror(errno) : "write error");
     }
     return 0;
+}
+
+int output_plan(FILE *out, const output_plan_t *plan, char *err, size_t err_size)
+{
+    cJSON *root = build(plan, err, err_size);
+    if (root == NULL) {
+        return -1;
+    }
+    return print_object(out, root, err, err_size);
+}
+
+const char *output_conflict_kind_name(coa_conflict_kind_t kind)
+{
+    switch (kind) {
+    case COA_CONFLICT_VEHICLE:
+        return "vehicle";
+    case COA_CONFLICT_TRACK:
+        return "track";
+    case COA_CONFLICT_OBSTACLE:
+        return "obstacle";
+    }
+    return "unknown";
+}
+
+static bool add_conflict(cJSON *array, const output_conflict_t *c)
+{
+    cJSON *entry = cJSON_CreateObject();
+    return append(array, entry) &&
+           cJSON_AddStringToObject(entry, "kind", output_conflict_kind_name(c->kind)) != NULL &&
+           add_number(entry, "a", c->a) && add_number(entry, "b", c->b) &&
+           add_number(entry, "first_step", c->first_step) &&
+           add_number(entry, "probability", c->probability) &&
+           add_number(entry, "first_time", c->first_time) &&
+           add_number(entry, "min_horizontal", c->min_horizontal) &&
+           add_number(entry, "min_vertical", c->min_vertical);
+}
+
+static cJSON *build_prediction(const output_predict_t *p)
+{
+    cJSON *root = cJSON_CreateObject();
+    if (root == NULL || cJSON_AddStringToObject(root, "scenario", p->scenario) == NULL) {
+        goto fail;
+    }
+    cJSON *conflicts = cJSON_AddArrayToObject(root, "conflicts");
+    if (conflicts == NULL) {
+        goto fail;
+    }
+    for (size_t i = 0; i < p->conflict_count; i++) {
+        if (!add_conflict(conflicts, &p->conflicts[i])) {
+            goto fail;
+        }
+    }
+    cJSON *clusters = cJSON_AddArrayToObject(root, "clusters");
+    if (clusters == NULL) {
+        goto fail;
+    }
+    for (size_t c = 0; c < p->cluster_count; c++) {
+        cJSON *cluster = cJSON_CreateArray();
+        if (!append(clusters, cluster)) {
+            goto fail;
+        }
+        for (size_t j = p->cluster_start[c]; j < p->cluster_start[c + 1]; j++) {
+            if (!append(cluster, cJSON_CreateNumber(p->cluster_ids[j]))) {
+                goto fail;
+            }
+        }
+    }
+    return root;
+
+fail:
+    cJSON_Delete(root);
+    return NULL;
+}
+
+int output_predict(FILE *out, const output_predict_t *prediction, char *err, size_t err_size)
+{
+    cJSON *root = build_prediction(prediction);
+    if (root == NULL) {
+        return set_error(err, err_size, "out of memory printing the result");
+    }
+    return print_object(out, root, err, err_size);
 }

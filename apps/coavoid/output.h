@@ -1,5 +1,6 @@
 /*
- * output.h: the plan result object of SCENARIO_FORMAT.md ("Plan result"), printed as JSON.
+ * output.h: the result objects of SCENARIO_FORMAT.md ("Plan result", "Prediction result"),
+ * printed as JSON.
  */
 #ifndef COAVOID_APP_OUTPUT_H
 #define COAVOID_APP_OUTPUT_H
@@ -10,6 +11,7 @@
 #include <stdio.h>
 
 #include "coavoid/coavoid.h"
+#include "coavoid/predict.h"
 #include "scenario.h"
 
 typedef struct {
@@ -28,5 +30,34 @@ int output_plan(FILE *out, const output_plan_t *plan, char *err, size_t err_size
 
 /* The contract's name of a plan status ("solved", "infeasible", "budget_exhausted"). */
 const char *output_status_name(coa_plan_status_t status);
+
+/* One entry of the prediction result's "conflicts", already in the contract's terms. */
+typedef struct {
+    coa_conflict_kind_t kind;
+    uint32_t a;             /* UAV id */
+    uint32_t b;             /* the other UAV's id (a < b), the track's id or the obstacle's index */
+    uint32_t first_step;
+    double first_time;      /* s, t of first_step */
+    double min_horizontal;  /* m, as coa_conflict_t */
+    double min_vertical;    /* m */
+    double probability;
+} output_conflict_t;
+
+typedef struct {
+    const char *scenario;                /* the scenario's name */
+    const output_conflict_t *conflicts;  /* in the order to print */
+    size_t conflict_count;
+    const uint32_t *cluster_ids;         /* the clusters' UAV ids, one cluster after another */
+    const size_t *cluster_start;         /* cluster c is cluster_ids[cluster_start[c] ..
+                                            cluster_start[c + 1] - 1]: cluster_count + 1 entries */
+    size_t cluster_count;
+} output_predict_t;
+
+/* Writes the prediction result object (and a newline) to `out`. Returns 0, or -1 with the
+ * reason in err (out of memory, a write error). */
+int output_predict(FILE *out, const output_predict_t *prediction, char *err, size_t err_size);
+
+/* The contract's name of a conflict kind ("vehicle", "track", "obstacle"). */
+const char *output_conflict_kind_name(coa_conflict_kind_t kind);
 
 #endif /* COAVOID_APP_OUTPUT_H */

@@ -1,0 +1,481 @@
+/*
+ * coavoid predict: one prediction cycle of the core (predict.h) over a scenario, printed
+ * as SCENARIO_FORMAT.md's "Prediction result". See PREDICT_USAGE below.
+ *
+ * A scenario has no published plans, so each UAV's plan is taken to be its reference at
+ * its initial_offset, sampled on the scenario's own grid (t0 = 0, step dt, N+1 samples):
+ * the predictor's alignment is then the identity and the answer is exactly the planner's
+ * view of "no manoeuvre".
+ */
+#define _POSIX_C_SOURCE 200809L
+
+#include <math.h>
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+#include "coavoid/coavoid.h"
+#include "coavoid/predict.h"
+#include "commands.h"
+#include "output.h"
+#include "scenario.h"
+
+/* The probability from which a pair with uncertainty is listed, unless --threshold says
+ * otherwise: a 1 % chance of losing separation is worth planning for. */
+#define COAVOID_DEFAULT_THRESHOLD 0.01
+
+/* A printf format so that the numbers it quotes come from one place. */
+#define PREDICT_USAGE                                                                        \
+    "usage: coavoid predict SCENARIO.json [--threshold P] [--sigma-growth H,V]\n"            \
+    "\n"                                                                                     \
+    "Reads a scenario (JSON, at most %u MiB) and predicts its conflicts over the horizon,\n" \
+    "taking every UAV's plan to be its reference trajectory at its initial_offset (no\n"     \
+    "manoeuvre) and every track and obstacle as given. Prints the prediction result as\n"    \
+    "JSON: the conflicting pairs, and the clusters of UAVs to plan together.\n"              \
+    "\n"                                                                                     \
+    "options:\n"                                                                             \
+    "  --threshold P       list a pair with position uncertainty (a track with \"sigma\")\n" \
+    "                      when its probability of conflict is >= P, 0 < P <= 1;\n"          \
+    "                      default %g. Pairs without uncertainty are listed whenever\n"      \
+    "                      they conflict (probability 1)\n"                                  \
+    "  --sigma-growth H,V  every track's one-sigma position error grows by H m/s\n"          \
+    "                      horizontally and V m/s vertically of look-ahead time\n"           \
+    "                      (H, V >= 0; default 0,0: a track's \"sigma\" as given)\n"         \
+    "  -h, --help          show this help\n"                                                 \
+    "\n"                                                                                     \
+    "Conflicts are listed UAV pairs first, then tracks, then obstacles, each by a then b.\n" \
+    "\n"                                                                                     \
+    "exit status: 0 predicted (whether or not there are conflicts), 2 invalid input or\n"    \
+    "usage (one line on stderr naming the input and why), 3 internal error\n"
+
+typedef struct {
+    const char *scenario_path;
+    const char *threshold_text; /* NULL: COAVOID_DEFAULT_THRESHOLD */
+    double threshold;
+    const char *growth_text; /* NULL: no growth */
+    double growth_horizontal;
+    double growth_vertical;
+} predict_options_t;
+
+/* --sigma-growth's "H,V": two finite numbers >= 0. */
+static bool parse_growth(const char *text, double *horizontal, double *vertical)
+{
+    const char *comma = strchr(text, ',');
+    char first[64];
+    size_t length = comma != NULL ? (size_t)(comma - text) : 0;
+    if (comma == NULL || length >= sizeof first) {
+        return false;
+    }
+    memcpy(first, text, length);
+    first[length] = '\0';
+    return cli_parse_real(first, horizontal) && cli_parse_real(comma + 1, vertical) &&
+           *horizontal >= 0 && *vertical >= 0;
+}
+
+/* Returns CLI_CONTINUE, or the exit status (help printed: 0; a usage error: 2). */
+static int parse_predict_options(int argc, char **argv, predict_options_t *o)
+{
+    bool options_done = false;
+    memset(o, 0, sizeof *o);
+    for (int i = 2; i < argc; i++) {
+        const char *arg = argv[i];
+        const char *value = NULL;
+        if (options_done || arg[0] != '-' || strcmp(arg, "-") == 0) {
+            if (o->scenario_path != NULL) {
+                return cli_fail(CLI_EXIT_INVALID,
+                                "predict: unexpected argument '%.80s' (one scenario only)", arg);
+            }
+            o->scenario_path = arg;
+        } else if (strcmp(arg, "--") == 0) {
+            options_done = true;
+        } else if (strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0) {
+            printf(PREDICT_USAGE, SCENARIO_MAX_BYTES / (1024u * 1024u), COAVOID_DEFAULT_THRESHOLD);
+            return CLI_EXIT_OK;
+        } else if (cli_option_is(arg, "--threshold")) {
+            if (o->threshold_text != NULL) {
+                return cli_fail(CLI_EXIT_INVALID, "--threshold: given more than once");
+            }
+            if (!cli_option_value(argc, argv, &i, "--threshold", &value)) {
+                return cli_fail(CLI_EXIT_INVALID,
+                                "--threshold: missing value (a probability, 0 < P <= 1)");
+            }
+            if (!cli_parse_real(value, &o->threshold) || !(o->threshold > 0) || o->threshold > 1) {
+                return cli_fail(CLI_EXIT_INVALID,
+                                "--threshold: must be a number with 0 < P <= 1, got '%.40s'",
+                                value);
+            }
+            o->threshold_text = value;
+        } else if (cli_option_is(arg, "--sigma-growth")) {
+            if (o->growth_text != NULL) {
+                return cli_fail(CLI_EXIT_INVALID, "--sigma-growth: given more than once");
+            }
+            if (!cli_option_value(argc, argv, &i, "--sigma-growth", &value)) {
+                return cli_fail(CLI_EXIT_INVALID,
+                                "--sigma-growth: missing value (H,V in m/s, e.g. 0.5,0.1)");
+            }
+            if (!parse_growth(value, &o->growth_horizontal, &o->growth_vertical)) {
+                return cli_fail(CLI_EXIT_INVALID,
+                                "--sigma-growth: must be two numbers >= 0 as H,V (m/s), "
+                                "got '%.40s'",
+                                value);
+            }
+            o->growth_text = value;
+        } else {
+            return cli_fail(CLI_EXIT_INVALID,
+                            "predict: unknown option '%.40s' (see 'coavoid predict --help')", arg);
+        }
+    }
+    if (o->scenario_path == NULL) {
+        return cli_fail(CLI_EXIT_INVALID,
+                        "predict: missing SCENARIO.json (see 'coavoid predict --help')");
+    }
+    if (o->threshold_text == NULL) {
+        o->threshold = COAVOID_DEFAULT_THRESHOLD;
+    }
+    return CLI_CONTINUE;
+}
+
+/* a * b + c without wrapping; false when it would. */
+static bool size_mul_add(size_t a, size_t b, size_t c, size_t *out)
+{
+    if (b != 0 && a > (SIZE_MAX - c) / b) {
+        return false;
+    }
+    *out = a * b + c;
+    return true;
+}
+
+static int compare_conflicts(const void *pa, const void *pb)
+{
+    const output_conflict_t *a = pa;
+    const output_conflict_t *b = pb;
+    if (a->kind != b->kind) {
+        return a->kind < b->kind ? -1 : 1;
+    }
+    if (a->a != b->a) {
+        return a->a < b->a ? -1 : 1;
+    }
+    if (a->b != b->b) {
+        return a->b < b->b ? -1 : 1;
+    }
+    return 0;
+}
+
+/* The core's conflicts (plan, track and obstacle indices) in the contract's terms (ids),
+ * sorted by kind, a, b. Returns false when the core named an index out of range. */
+static bool map_conflicts(const scenario_t *s, const coa_conflict_t *in, size_t count,
+                          output_conflict_t *out)
+{
+    for (size_t i = 0; i < count; i++) {
+        const coa_conflict_t *c = &in[i];
+        output_conflict_t *o = &out[i];
+        if (c->a >= s->vehicle_count) {
+            return false;
+        }
+        o->kind = c->kind;
+        o->a = s->vehicles[c->a].id;
+        switch (c->kind) {
+        case COA_CONFLICT_VEHICLE: {
+            if (c->b >= s->vehicle_count || c->b == c->a) {
+                return false;
+            }
+            /* The core orders by index; the contract by id. */
+            uint32_t other = s->vehicles[c->b].id;
+            o->b = other > o->a ? other : o->a;
+            o->a = other > o->a ? o->a : other;
+            break;
+        }
+        case COA_CONFLICT_TRACK:
+            if (c->b >= s->track_count) {
+                return false;
+            }
+            o->b = s->tracks[c->b].id;
+            break;
+        case COA_CONFLICT_OBSTACLE:
+            if (c->b >= s->obstacle_count) {
+                return false;
+            }
+            o->b = c->b;
+            break;
+        default:
+            return false;
+        }
+        o->first_step = c->first_step;
+        o->first_time = (double)c->first_time;
+        o->min_horizontal = (double)c->min_horizontal;
+        o->min_vertical = (double)c->min_vertical;
+        o->probability = c->probability;
+    }
+    qsort(out, count, sizeof *out, compare_conflicts);
+    return true;
+}
+
+typedef struct {
+    uint32_t id;
+    uint32_t label;
+} labelled_t;
+
+static int compare_labelled(const void *pa, const void *pb)
+{
+    const labelled_t *a = pa;
+    const labelled_t *b = pb;
+    return a->id < b->id ? -1 : (a->id > b->id ? 1 : 0);
+}
+
+/* The core's cluster labels (by plan index, clusters numbered by smallest plan index) as
+ * the contract's clusters: ids ascending within each, clusters by their smallest id.
+ * `ids` and `start` have room for n and n + 1 entries; `scratch` for n. Returns false
+ * when a label is out of range or names no UAV, or out of memory. */
+static bool build_clusters(const scenario_t *s, const uint32_t *label, size_t label_count,
+                           labelled_t *scratch, uint32_t *ids, size_t *start, size_t *cluster_count)
+{
+    const size_t n = s->vehicle_count;
+    size_t clustered = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (label[i] == COA_NO_CLUSTER) {
+            continue;
+        }
+        if (label[i] >= label_count) {
+            return false;
+        }
+        scratch[clustered].id = s->vehicles[i].id;
+        scratch[clustered].label = label[i];
+        clustered++;
+    }
+    qsort(scratch, clustered, sizeof *scratch, compare_labelled);
+    /* Walking the ids in ascending order meets each cluster first at its smallest id:
+     * that is the contract's order of clusters. rank maps a core label to it. */
+    size_t *rank = calloc(label_count + 1u, sizeof *rank);
+    size_t *size = calloc(label_count + 1u, sizeof *size);
+    if (rank == NULL || size == NULL) {
+        free(rank);
+        free(size);
+        return false;
+    }
+    for (size_t c = 0; c < label_count; c++) {
+        rank[c] = SIZE_MAX;
+    }
+    size_t ranked = 0;
+    for (size_t j = 0; j < clustered; j++) {
+        if (rank[scratch[j].label] == SIZE_MAX) {
+            rank[scratch[j].label] = ranked++;
+        }
+        scratch[j].label = (uint32_t)rank[scratch[j].label];
+        size[scratch[j].label]++;
+    }
+    free(rank);
+    bool ok = ranked == label_count; /* every label the core counted has a member */
+    start[0] = 0;
+    for (size_t c = 0; c < label_count; c++) {
+        start[c + 1] = start[c] + size[c];
+    }
+    /* Placing members in id order keeps every cluster ascending. */
+    for (size_t c = 0; c <= label_count; c++) {
+        size[c] = 0;
+    }
+    for (size_t j = 0; j < clustered; j++) {
+        size_t c = scratch[j].label;
+        ids[start[c] + size[c]++] = scratch[j].id;
+    }
+    free(size);
+    *cluster_count = label_count;
+    return ok;
+}
+
+typedef struct {
+    coa_vec3_t *samples;
+    coa_intent_plan_t *plans;
+    void *workspace;
+    coa_conflict_t *conflicts;
+    output_conflict_t *listed;
+    uint32_t *label;
+    labelled_t *scratch;
+    uint32_t *cluster_ids;
+    size_t *cluster_start;
+} predict_memory_t;
+
+static void predict_memory_free(predict_memory_t *m)
+{
+    free(m->samples);
+    free(m->plans);
+    free(m->workspace);
+    free(m->conflicts);
+    free(m->listed);
+    free(m->label);
+    free(m->scratch);
+    free(m->cluster_ids);
+    free(m->cluster_start);
+}
+
+/* Each UAV's plan: its sampled reference raised by initial_offset climb steps. */
+static int build_plans(const char *file, const scenario_t *s, predict_memory_t *m)
+{
+    const size_t per_row = (size_t)s->horizon + 1u;
+    for (size_t i = 0; i < s->vehicle_count; i++) {
+        const coa_vehicle_t *v = &s->vehicles[i];
+        const coa_real_t lift = (coa_real_t)v->initial_offset * coa_climb_step(v, s->dt);
+        coa_vec3_t *row = m->samples + i * per_row;
+        for (size_t k = 0; k < per_row; k++) {
+            row[k] = s->references[i][k];
+            row[k].z += lift;
+            if (!isfinite(row[k].z)) {
+                return cli_fail(CLI_EXIT_INVALID,
+                                "%s: vehicles[%zu]: initial_offset: the altitude it gives is "
+                                "not finite",
+                                file, i);
+            }
+        }
+        coa_intent_plan_t *p = &m->plans[i];
+        p->id = v->id;
+        p->volume = v->volume;
+        p->t0 = 0;
+        p->step = s->dt;
+        p->samples = row;
+        p->count = per_row;
+        p->sigma_horizontal = 0;
+        p->sigma_vertical = 0;
+    }
+    return CLI_CONTINUE;
+}
+
+/* Everything after the scenario is loaded. Returns the exit status. */
+static int predict(const predict_options_t *o, scenario_t *s)
+{
+    const char *file = o->scenario_path;
+    const size_t n = s->vehicle_count;
+    const size_t tracks = s->track_count;
+    int status = cli_sample_scenario(file, s);
+    if (status != CLI_CONTINUE) {
+        return status;
+    }
+
+    /* Every pair (UAV-UAV, UAV-track and UAV-obstacle) may be a candidate and may
+     * conflict: a scenario is small enough to size for that, so neither the pair set nor
+     * the conflict array can run out here. */
+    size_t vehicle_pairs = n * (n - 1u) / 2u; /* n <= COA_MAX_VEHICLES */
+    size_t with_tracks, max_pairs;
+    if (!size_mul_add(n, tracks, vehicle_pairs, &with_tracks) ||
+        !size_mul_add(n, s->obstacle_count, with_tracks, &max_pairs)) {
+        return cli_fail(CLI_EXIT_INVALID, "%s: too many tracks and obstacles to size for", file);
+    }
+    if (max_pairs == 0) {
+        max_pairs = 1; /* one UAV alone: the size function refuses a limit of 0 */
+    }
+    const size_t capacity = max_pairs;
+    size_t size = coa_predictor_workspace_size(n, tracks, s->horizon, max_pairs);
+    if (size == 0) {
+        return cli_fail(CLI_EXIT_INVALID,
+                        "%s: too large: the predictor's workspace for %zu vehicles, %zu tracks, "
+                        "%zu obstacles and %lu steps is beyond its limits",
+                        file, n, tracks, s->obstacle_count, (unsigned long)s->horizon);
+    }
+
+    predict_memory_t m;
+    memset(&m, 0, sizeof m);
+    m.samples = calloc(n * ((size_t)s->horizon + 1u), sizeof *m.samples);
+    m.plans = calloc(n, sizeof *m.plans);
+    m.workspace = malloc(size);
+    m.conflicts = calloc(capacity, sizeof *m.conflicts);
+    m.listed = calloc(capacity, sizeof *m.listed);
+    m.label = calloc(n, sizeof *m.label);
+    m.scratch = calloc(n, sizeof *m.scratch);
+    m.cluster_ids = calloc(n, sizeof *m.cluster_ids);
+    m.cluster_start = calloc(n + 1u, sizeof *m.cluster_start);
+    if (m.samples == NULL || m.plans == NULL || m.workspace == NULL || m.conflicts == NULL ||
+        m.listed == NULL || m.label == NULL || m.scratch == NULL || m.cluster_ids == NULL ||
+        m.cluster_start == NULL) {
+        predict_memory_free(&m);
+        return cli_fail(CLI_EXIT_INVALID,
+                        "%s: cannot allocate %zu bytes of predictor workspace and %zu "
+                        "conflicts",
+                        file, size, capacity);
+    }
+    status = build_plans(file, s, &m);
+    if (status != CLI_CONTINUE) {
+        predict_memory_free(&m);
+        return status;
+    }
+
+    coa_predictor_t *predictor =
+        coa_predictor_init(m.workspace, size, n, tracks, s->horizon, max_pairs);
+    if (predictor == NULL) {
+        predict_memory_free(&m);
+        return cli_fail(CLI_EXIT_INTERNAL, "internal error: the predictor refused its workspace");
+    }
+
+    coa_predict_config_t config;
+    memset(&config, 0, sizeof config);
+    config.t0 = 0;
+    config.dt = s->dt;
+    config.horizon = s->horizon;
+    config.track_sigma_rate_horizontal = (coa_real_t)o->growth_horizontal;
+    config.track_sigma_rate_vertical = (coa_real_t)o->growth_vertical;
+    config.threshold = o->threshold;
+    config.all_pairs = false;
+
+    coa_predict_result_t result;
+    memset(&result, 0, sizeof result);
+    int rc = coa_predict(predictor, &config, m.plans, n, s->obstacles, s->obstacle_count, s->tracks,
+                         tracks, m.conflicts, capacity, &result);
+    size_t cluster_labels = 0;
+    char err[SCENARIO_ERROR_MAX];
+    if (rc == COA_ERR_ARGUMENT) {
+        /* The loader checked every field the contract defines; what is left is a
+         * combination the core refuses (like plan's problem check). */
+        status = cli_fail(CLI_EXIT_INVALID, "%s: rejected by the core's predictor (%s)", file,
+                          coa_status_name(rc));
+    } else if (rc != COA_OK) {
+        status = cli_fail(CLI_EXIT_INTERNAL, "internal error: the predictor failed (%s)",
+                          coa_status_name(rc));
+    } else if (result.overflow || result.conflict_count > capacity ||
+               result.conflicts_found != result.conflict_count) {
+        status = cli_fail(CLI_EXIT_INTERNAL,
+                          "internal error: the predictor found %zu conflicts, room for %zu",
+                          result.conflicts_found, capacity);
+    } else if (coa_predict_clusters(m.conflicts, result.conflict_count, n, m.label,
+                                    &cluster_labels) != COA_OK ||
+               cluster_labels > n) {
+        status = cli_fail(CLI_EXIT_INTERNAL, "internal error: the conflicts do not cluster");
+    } else if (!map_conflicts(s, m.conflicts, result.conflict_count, m.listed)) {
+        status = cli_fail(CLI_EXIT_INTERNAL,
+                          "internal error: the predictor named a vehicle, track or obstacle "
+                          "out of range");
+    } else {
+        output_predict_t view;
+        memset(&view, 0, sizeof view);
+        view.scenario = s->name;
+        view.conflicts = m.listed;
+        view.conflict_count = result.conflict_count;
+        view.cluster_ids = m.cluster_ids;
+        view.cluster_start = m.cluster_start;
+        if (!build_clusters(s, m.label, cluster_labels, m.scratch, m.cluster_ids, m.cluster_start,
+                            &view.cluster_count)) {
+            status = cli_fail(CLI_EXIT_INTERNAL, "internal error: bad cluster labels");
+        } else if (output_predict(stdout, &view, err, sizeof err) != 0) {
+            status = cli_fail(CLI_EXIT_INTERNAL, "%s", err);
+        } else {
+            status = CLI_EXIT_OK;
+        }
+    }
+    predict_memory_free(&m);
+    return status;
+}
+
+int command_predict(int argc, char **argv)
+{
+    predict_options_t options;
+    int status = parse_predict_options(argc, argv, &options);
+    if (status != CLI_CONTINUE) {
+        return status;
+    }
+    scenario_t scenario;
+    status = cli_load_scenario(options.scenario_path, &scenario);
+    if (status == CLI_CONTINUE) {
+        status = predict(&options, &scenario);
+    }
+    scenario_free(&scenario);
+    return status;
+}
