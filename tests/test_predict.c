@@ -647,6 +647,53 @@ START_TEST(broad_phase_finds_exactly_what_all_pairs_finds)
 }
 END_TEST
 
+START_TEST(broad_phase_grid_handles_degenerate_scenes)
+{
+    /* The grid's shape comes from the boxes of each step: check it against all-pairs on
+     * scenes that bend it: everyone on one line (one row of cells), one UAV far away (a
+     * huge, sparse bounding square), a crowd in a small square (cells that hold many),
+     * and large track sigmas (boxes wider than several cells). */
+    fleet_t *f = fleet_new();
+    static coa_conflict_t got[2][MAXC];
+    coa_predict_result_t res[2];
+    int variant;
+
+    for (variant = 0; variant < 4; ++variant) {
+        ws_t w;
+        size_t i;
+        size_t j;
+        city_fleet(f, 40u + (uint64_t)variant, variant == 2 ? 150u : 300u,
+                   variant == 2 ? 300.0 : 2500.0, true, 30u, 1.0, 0.0);
+        for (i = 0; i < f->n; ++i) {
+            for (j = 0; j < f->plans[i].count; ++j) {
+                coa_vec3_t *q = &f->samples[i][j];
+                if (variant == 0) {
+                    q->y = R(0.25 * (double)q->y * 1e-3);
+                } else if (variant == 1 && i == 7u) {
+                    q->x = R((double)q->x + 4.0e6);
+                    q->y = R((double)q->y - 3.0e6);
+                }
+            }
+        }
+        if (variant == 3) {
+            f->cfg.track_sigma_rate_horizontal = R(20.0);
+        }
+        ws_make(&w, f->n, f->m, 30u, 40000u);
+        ck_assert_int_eq(run(&w, f, false, got[0], MAXC, &res[0]), COA_OK);
+        ck_assert_int_eq(run(&w, f, true, got[1], MAXC, &res[1]), COA_OK);
+        ck_assert(!res[0].overflow && !res[1].overflow);
+        ck_assert_uint_eq(res[0].conflicts_found, res[1].conflicts_found);
+        ck_assert_uint_eq(res[0].conflict_count, res[1].conflict_count);
+        ck_assert_uint_gt(res[0].conflict_count, 0u);
+        for (i = 0; i < res[0].conflict_count; ++i) {
+            REQUIRE(same_conflict(&got[0][i], &got[1][i]));
+        }
+        ws_free(&w);
+    }
+    free(f);
+}
+END_TEST
+
 /* ------------------------------------------------------------------------------------ */
 /* Probability                                                                           */
 
@@ -1390,14 +1437,14 @@ START_TEST(workspace_size_is_exact)
     ck_assert_uint_eq(coa_predictor_workspace_size(SIZE_MAX / 8u, 2u, 60u, 100u), 0u);
     ck_assert_uint_eq(coa_predictor_workspace_size(10u, SIZE_MAX, 60u, 100u), 0u);
     ck_assert_uint_eq(coa_predictor_workspace_size(10u, 2u, 60u, SIZE_MAX / 2u), 0u);
-    /* Sizes as predict.h states them (double): a mover 24 (N + 1) + 108 bytes, a plan 48
+    /* Sizes as predict.h states them (double): a mover 24 (N + 1) + 124 bytes, a plan 48
      * more, a pair 12 bytes plus its table slots (2P rounded up to a power of two). Two
      * at a time, so the 4-byte entries keep their arrays' 8-byte rounding. */
 #ifndef COA_SINGLE_PRECISION
     ck_assert_uint_eq(coa_predictor_workspace_size(12u, 2u, 60u, 100u) - bytes,
-                      2u * (24u * 61u + 108u + 48u));
+                      2u * (24u * 61u + 124u + 48u));
     ck_assert_uint_eq(coa_predictor_workspace_size(10u, 4u, 60u, 100u) - bytes,
-                      2u * (24u * 61u + 108u));
+                      2u * (24u * 61u + 124u));
     ck_assert_uint_eq(coa_predictor_workspace_size(10u, 2u, 60u, 110u) - bytes, 10u * 12u);
     ck_assert_uint_eq(coa_predictor_workspace_size(10u, 2u, 60u, 130u) - bytes, 30u * 12u + 256u * 8u);
 #endif
@@ -1767,6 +1814,7 @@ static Suite *predict_suite(void)
     tcase_add_test(tc, deterministic_conflicts_equal_the_planners_check);
     tcase_add_test(tc, separations_are_the_exact_minima);
     tcase_add_test(tc, broad_phase_finds_exactly_what_all_pairs_finds);
+    tcase_add_test(tc, broad_phase_grid_handles_degenerate_scenes);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -16,11 +16,14 @@
  *      clock. Between grid samples everything moves in a straight line.
  *   2. Broad phase. For every step, the swept bounding boxes of all UAVs and tracks
  *      (inflated by COA_PREDICT_SIGMA_MARGIN standard deviations when there is
- *      uncertainty) are sorted along x and swept (sweep and prune, insertion-sorted from
- *      the previous step, so the order changes little and the sort stays near-linear for
- *      coherent motion; the sweep visits every pair of boxes overlapping in x, which for
- *      sparse traffic is a small multiple of the boxes). Pairs whose boxes overlap in
- *      x, y and z in some step become candidates, kept once
+ *      uncertainty) are counting-sorted into a uniform square grid laid over that step's
+ *      boxes: cells two median box extents wide, or wider so that there are at most four
+ *      cells per mover. A box reaching at most into the next column and row belongs to
+ *      the cell of its min corner and meets only the boxes of that cell and the 8 around
+ *      it; a wider box (a track with a large sigma) is checked against the cells it
+ *      reaches and, by a sweep along x, against the other wide ones. So the work per box
+ *      is the traffic within a few cells of it: for sparse traffic, a small constant.
+ *      Pairs whose boxes overlap in x, y and z in some step become candidates, kept once
  *      each in a hash set in the workspace. Obstacles are tested against each UAV's swept
  *      box of the whole horizon first (a polytope by the box of its vertices); those pairs
  *      are candidates too. Track-track pairs are never candidates.
@@ -147,11 +150,12 @@ typedef struct coa_predictor coa_predictor_t;
  * and UAV-obstacle together). Returns 0 when a limit is 0 (max_tracks may be 0),
  * max_horizon > COA_MAX_HORIZON, max_vehicles + max_tracks > 2^30, max_pairs > 2^30 or
  * the size overflows. Exact: one byte less is refused. Cost O(1).
- * Per mover (plan or track), 24 (N + 1) + 108 bytes in double (12 (N + 1) + 56 in
- * float), plus 48 (24) per plan; per pair 12 bytes plus 16 to 32 bytes of hash table (a
- * power of two of at least 2 max_pairs slots of 8 bytes); a header of about 170 bytes.
- * For example, N = 60 and max_pairs = 4 max_vehicles, no tracks: 1,000 plans 1.73 MB,
- * 10,000 plans 17.7 MB. */
+ * Per mover (plan or track), 24 (N + 1) + 124 bytes in double (12 (N + 1) + 72 in
+ * float; of these, 16 are the broad phase's grid of at most 4 cells per mover), plus 48
+ * (24) per plan; per pair 12 bytes plus 16 to 32 bytes of hash table (a power of two of
+ * at least 2 max_pairs slots of 8 bytes); a header of about 180 bytes. For example,
+ * N = 60 and max_pairs = 4 max_vehicles, no tracks: 1,000 plans 1.75 MB, 10,000 plans
+ * 17.9 MB. */
 size_t coa_predictor_workspace_size(size_t max_vehicles, size_t max_tracks, uint32_t max_horizon,
                                     size_t max_pairs);
 
@@ -178,12 +182,12 @@ coa_predictor_t *coa_predictor_init(void *buffer, size_t size, size_t max_vehicl
  * with all_pairs, n(n-1)/2 + n (tracks + obstacles)); candidate_pairs the distinct
  * pairs the broad phase produced (0 with all_pairs).
  * Cost: alignment O((n + m) N + plan samples + track paths * N); broad phase
- * O(N (n + m + pairs of boxes overlapping in x)) with an insertion sort carried from step
- * to step (O(N (n + m) + boxes overtaking each other in x) for coherent motion;
- * O((n + m) log(n + m)) at k = 0). Both extra terms grow with the traffic in a strip
- * across the whole area: at a fixed density over a square they grow as (n + m)^1.5
- * (measured, -O2, one core, 10 UAVs per km^2 and N = 60: 1,000 UAVs 4 ms a cycle,
- * 10,000 UAVs 94 ms; the pair tests grow linearly, 468 and 5,024). Plus
+ * O(N (n + m + pairs of boxes in neighbouring grid cells + wide boxes x (the cells they
+ * reach + log wide boxes) + wide pairs overlapping in x)): near-linear for sparse traffic (measured, -O3,
+ * one core, 10 UAVs per km^2 and N = 60: 1,000 UAVs 3.3 ms a cycle, 10,000 UAVs 44 ms,
+ * the rest of the growth being cache misses on the samples; the pair tests grow
+ * linearly, 394 and 4,922); quadratic only when every box is in a few cells (a crowd)
+ * or wide. Plus
  * O(n * obstacles + obstacle vertices); sorting the candidates O(P log P); narrow phase
  * O(candidates * N), a polytope step costing what coa_conflict_polytope does, an
  * uncertain step at most 7 coa_conflict_probability calls. No heap, O(1) stack. */

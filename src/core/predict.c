@@ -10,8 +10,10 @@
  *   coa_vec3_t  pos[M * S]      aligned samples, mover-major: plans 0..n-1, then tracks
  *   mover_t     mover[M]        volume and sigma model of each mover, this call
  *   coa_box_t   reach[V]        each UAV's box over the whole horizon (obstacle broad phase)
- *   sap_entry_t sap[M]          this step's boxes in x order
- *   uint32_t    order[M]        the x order, carried from one step to the next
+ *   sap_entry_t sap[M]          this step's boxes, sorted by grid cell (wide boxes last)
+ *   uint32_t    place[M]        each box's cell, then its place in sap[] (the permutation)
+ *   uint32_t    cell_start[C+2] where each cell's run (and, last, the wide boxes') starts,
+ *                               C = GRID_CELLS_PER_MOVER * M cells at most
  *   uint64_t    table[T]        the candidate-pair set (open addressing, EMPTY_KEY is free)
  *   uint64_t    cand[P]         distinct candidate keys, sorted before the narrow phase
  *   uint32_t    slot[P]         the table slot of each key, so a call clears what it used
@@ -50,6 +52,8 @@
  * scene's largest coordinate, so that no rounding in them can reject a step that the
  * exact tests (whose own rounding is a few ulps) would accept. */
 #define SLACK_ULPS 64
+/* The broad phase's grid has at most this many cells per mover. */
+#define GRID_CELLS_PER_MOVER 4u
 
 typedef struct {
     coa_volume_t volume;
@@ -82,7 +86,8 @@ struct coa_predictor {
     mover_t *mover;
     coa_box_t *reach;
     sap_entry_t *sap;
-    uint32_t *order;
+    uint32_t *place;
+    uint32_t *cell_start;
     uint64_t *table;
     uint64_t *cand;
     uint32_t *slot;
@@ -102,7 +107,8 @@ typedef struct {
     size_t at_mover;
     size_t at_reach;
     size_t at_sap;
-    size_t at_order;
+    size_t at_place;
+    size_t at_cell_start;
     size_t at_table;
     size_t at_cand;
     size_t at_slot;
@@ -154,6 +160,7 @@ static bool layout_compute(size_t max_vehicles, size_t max_tracks, uint32_t max_
     size_t samples;
     size_t table = 1u;
     size_t cursor;
+    size_t cells;
 
     if (max_vehicles == 0u || max_horizon == 0u || max_horizon > COA_MAX_HORIZON ||
         max_pairs == 0u || max_pairs > MAX_PAIRS || max_vehicles > MAX_MOVERS ||
@@ -171,7 +178,9 @@ static bool layout_compute(size_t max_vehicles, size_t max_tracks, uint32_t max_
         !reserve(&cursor, movers, sizeof(mover_t), &lo->at_mover) ||
         !reserve(&cursor, max_vehicles, sizeof(coa_box_t), &lo->at_reach) ||
         !reserve(&cursor, movers, sizeof(sap_entry_t), &lo->at_sap) ||
-        !reserve(&cursor, movers, sizeof(uint32_t), &lo->at_order) ||
+        !reserve(&cursor, movers, sizeof(uint32_t), &lo->at_place) ||
+        !size_mul(movers, GRID_CELLS_PER_MOVER, &cells) ||
+        !reserve(&cursor, cells + 2u, sizeof(uint32_t), &lo->at_cell_start) ||
         !reserve(&cursor, table, sizeof(uint64_t), &lo->at_table) ||
         !reserve(&cursor, max_pairs, sizeof(uint64_t), &lo->at_cand) ||
         !reserve(&cursor, max_pairs, sizeof(uint32_t), &lo->at_slot)) {
@@ -215,7 +224,8 @@ coa_predictor_t *coa_predictor_init(void *buffer, size_t size, size_t max_vehicl
     pr->mover = (mover_t *)(void *)(base + lo.at_mover);
     pr->reach = (coa_box_t *)(void *)(base + lo.at_reach);
     pr->sap = (sap_entry_t *)(void *)(base + lo.at_sap);
-    pr->order = (uint32_t *)(void *)(base + lo.at_order);
+    pr->place = (uint32_t *)(void *)(base + lo.at_place);
+    pr->cell_start = (uint32_t *)(void *)(base + lo.at_cell_start);
     pr->table = (uint64_t *)(void *)(base + lo.at_table);
     pr->cand = (uint64_t *)(void *)(base + lo.at_cand);
     pr->slot = (uint32_t *)(void *)(base + lo.at_slot);
@@ -783,60 +793,6 @@ static void step_box(const coa_predictor_t *pr, uint32_t id, uint32_t k, sap_ent
     e->id = id;
 }
 
-/* Heap sort by min_x: the first step has no previous order to start from. */
-static void sap_sift(sap_entry_t *a, size_t root, size_t n)
-{
-    sap_entry_t v = a[root];
-    size_t child;
-
-    while ((child = 2u * root + 1u) < n) {
-        if (child + 1u < n && a[child + 1u].min_x > a[child].min_x) {
-            ++child;
-        }
-        if (!(a[child].min_x > v.min_x)) {
-            break;
-        }
-        a[root] = a[child];
-        root = child;
-    }
-    a[root] = v;
-}
-
-static void sap_heap_sort(sap_entry_t *a, size_t n)
-{
-    size_t i;
-    if (n < 2u) {
-        return;
-    }
-    for (i = n / 2u; i > 0u; --i) {
-        sap_sift(a, i - 1u, n);
-    }
-    for (i = n - 1u; i > 0u; --i) {
-        sap_entry_t t = a[0];
-        a[0] = a[i];
-        a[i] = t;
-        sap_sift(a, 0u, i);
-    }
-}
-
-/* Insertion sort by min_x: the previous step's order is nearly right for coherent motion,
- * so this costs O(n + swaps). */
-static void sap_insertion_sort(sap_entry_t *a, size_t n)
-{
-    size_t i;
-    for (i = 1; i < n; ++i) {
-        if (a[i].min_x < a[i - 1u].min_x) {
-            sap_entry_t v = a[i];
-            size_t j = i;
-            while (j > 0u && a[j - 1u].min_x > v.min_x) {
-                a[j] = a[j - 1u];
-                --j;
-            }
-            a[j] = v;
-        }
-    }
-}
-
 static uint64_t make_key(uint64_t kind, uint64_t a, uint64_t b)
 {
     return (kind << KIND_SHIFT) | (a << A_SHIFT) | b;
@@ -895,54 +851,328 @@ static coa_box_t obstacle_bounds(const coa_obstacle_t *o)
     return b;
 }
 
-/* Sweep and prune over every step, then the obstacles against each UAV's reach. */
+/* A pair of this step's boxes: a candidate when they overlap in x, y and z and are not
+ * both tracks. */
+static int sap_pair(coa_predictor_t *pr, const sap_entry_t *e, const sap_entry_t *f,
+                    size_t *count)
+{
+    size_t n = pr->n;
+    uint32_t lo;
+    uint32_t hi;
+
+    if (f->min_x > e->max_x || e->min_x > f->max_x || f->min_y > e->max_y ||
+        e->min_y > f->max_y || (e->id >= n && f->id >= n) || f->min_z > e->max_z ||
+        e->min_z > f->max_z) {
+        return COA_OK;
+    }
+    lo = e->id < f->id ? e->id : f->id;
+    hi = e->id < f->id ? f->id : e->id;
+    return set_insert(pr, hi < n ? make_key(0u, lo, hi) : make_key(1u, lo, hi - n), count);
+}
+
+/* Every pair within sap[a, b). */
+static int pairs_within(coa_predictor_t *pr, size_t a, size_t b, size_t *count)
+{
+    size_t i;
+    size_t j;
+    int rc = COA_OK;
+
+    for (i = a; i < b && rc == COA_OK; ++i) {
+        for (j = i + 1u; j < b && rc == COA_OK; ++j) {
+            rc = sap_pair(pr, &pr->sap[i], &pr->sap[j], count);
+        }
+    }
+    return rc;
+}
+
+/* Every pair of sap[i] with a box of sap[a, b). */
+static int pairs_across(coa_predictor_t *pr, size_t i, size_t a, size_t b, size_t *count)
+{
+    size_t j;
+    int rc = COA_OK;
+
+    for (j = a; j < b && rc == COA_OK; ++j) {
+        rc = sap_pair(pr, &pr->sap[i], &pr->sap[j], count);
+    }
+    return rc;
+}
+
+/* Heap sort by min_x (the wide boxes: few, and in id order). */
+static void sap_sift(sap_entry_t *a, size_t root, size_t n)
+{
+    sap_entry_t v = a[root];
+    size_t child;
+
+    while ((child = 2u * root + 1u) < n) {
+        if (child + 1u < n && a[child + 1u].min_x > a[child].min_x) {
+            ++child;
+        }
+        if (!(a[child].min_x > v.min_x)) {
+            break;
+        }
+        a[root] = a[child];
+        root = child;
+    }
+    a[root] = v;
+}
+
+static void sap_heap_sort(sap_entry_t *a, size_t n)
+{
+    size_t i;
+    if (n < 2u) {
+        return;
+    }
+    for (i = n / 2u; i > 0u; --i) {
+        sap_sift(a, i - 1u, n);
+    }
+    for (i = n - 1u; i > 0u; --i) {
+        sap_entry_t t = a[0];
+        a[0] = a[i];
+        a[i] = t;
+        sap_sift(a, 0u, i);
+    }
+}
+
+/* The grid column (or row) of a coordinate: monotone in it (a subtraction, a product by
+ * a non-negative number, a clamp and a truncation each are), which is all correctness
+ * needs. */
+static uint32_t cell_of(coa_real_t v, coa_real_t v0, coa_real_t inv_w, uint32_t cells)
+{
+    coa_real_t t = (v - v0) * inv_w;
+    if (!(t < (coa_real_t)(cells - 1u))) {
+        return cells - 1u;
+    }
+    return (uint32_t)t;
+}
+
+#define GRID_SAMPLES 31u /* boxes whose median extent sets the cell width */
+#define GRID_EXTENTS 2   /* cell width in median box extents */
+#define GRID_GROWTH 64   /* steps of 1/8 of the cell width, at most (a few suffice) */
+
+typedef struct {
+    coa_real_t x0;
+    coa_real_t y0;
+    coa_real_t inv_w; /* 0 on an axis of one cell */
+    coa_real_t inv_h;
+    uint32_t nx;
+    uint32_t ny;
+} grid_t;
+
+static void box_cells(const grid_t *g, const sap_entry_t *e, uint32_t *lx, uint32_t *hx,
+                      uint32_t *ly, uint32_t *hy)
+{
+    *lx = cell_of(e->min_x, g->x0, g->inv_w, g->nx);
+    *hx = cell_of(e->max_x, g->x0, g->inv_w, g->nx);
+    *ly = cell_of(e->min_y, g->y0, g->inv_h, g->ny);
+    *hy = cell_of(e->max_y, g->y0, g->inv_h, g->ny);
+}
+
+/* The cell of a box that reaches at most into the next column and row: the one of its
+ * min corner; a larger box ("wide") goes to the last run, index nx * ny. */
+static uint32_t box_slot(const grid_t *g, const sap_entry_t *e)
+{
+    uint32_t lx;
+    uint32_t hx;
+    uint32_t ly;
+    uint32_t hy;
+    box_cells(g, e, &lx, &hx, &ly, &hy);
+    if (hx - lx > 1u || hy - ly > 1u) {
+        return g->nx * g->ny;
+    }
+    return ly * g->nx + lx;
+}
+
+/* Lays a uniform square grid over this step's boxes, at most GRID_CELLS_PER_MOVER cells
+ * per mover, cells GRID_EXTENTS median box extents wide where that fits (a robust width:
+ * a few large boxes, such as tracks with a large sigma, do not coarsen every cell), and
+ * counting-sorts the boxes into it (one cell when the scene is degenerate). */
+static void grid_fill(coa_predictor_t *pr, grid_t *g)
+{
+    sap_entry_t *sap = pr->sap;
+    size_t m = pr->movers;
+    uint32_t *start = pr->cell_start;
+    coa_real_t sample[GRID_SAMPLES];
+    coa_real_t x1 = sap[0].max_x;
+    coa_real_t y1 = sap[0].max_y;
+    coa_real_t rx;
+    coa_real_t ry;
+    coa_real_t w;
+    size_t s = m < GRID_SAMPLES ? m : GRID_SAMPLES;
+    size_t cells;
+    size_t p;
+    size_t i;
+    int grow;
+
+    g->x0 = sap[0].min_x;
+    g->y0 = sap[0].min_y;
+    for (p = 1; p < m; ++p) {
+        g->x0 = sap[p].min_x < g->x0 ? sap[p].min_x : g->x0;
+        g->y0 = sap[p].min_y < g->y0 ? sap[p].min_y : g->y0;
+        x1 = sap[p].max_x > x1 ? sap[p].max_x : x1;
+        y1 = sap[p].max_y > y1 ? sap[p].max_y : y1;
+    }
+    for (i = 0; i < s; ++i) {
+        const sap_entry_t *e = &sap[i * m / s];
+        coa_real_t ex = e->max_x - e->min_x;
+        coa_real_t ey = e->max_y - e->min_y;
+        coa_real_t h = ex > ey ? ex : ey;
+        size_t j = i;
+        while (j > 0u && sample[j - 1u] > h) {
+            sample[j] = sample[j - 1u];
+            --j;
+        }
+        sample[j] = h;
+    }
+    w = sample[s / 2u] * (coa_real_t)GRID_EXTENTS;
+    rx = x1 - g->x0;
+    ry = y1 - g->y0;
+    g->nx = 1u;
+    g->ny = 1u;
+    g->inv_w = (coa_real_t)0;
+    g->inv_h = (coa_real_t)0;
+    if (m >= 4u && w > (coa_real_t)0 && real_ok(w) && real_ok(rx) && real_ok(ry)) {
+        /* At least wide enough that rx ry / w^2 and (rx + ry) / w are within the room,
+         * so that (rx / w + 1) (ry / w + 1) is within about twice it; then grown in
+         * steps of 1/8 until it fits (a few steps). */
+        double room = (double)m * (double)GRID_CELLS_PER_MOVER;
+        double fit = sqrt((double)rx * (double)ry / room);
+        double line = ((double)rx + (double)ry) / room; /* a long thin scene */
+        double wd = (double)w > fit ? (double)w : fit;
+        wd = wd > line ? wd : line;
+        for (grow = 0; grow < GRID_GROWTH; ++grow) {
+            double cx = (double)rx > wd ? (double)rx / wd : 0.0;
+            double cy = (double)ry > wd ? (double)ry / wd : 0.0;
+            if ((cx + 1.0) * (cy + 1.0) <= room) {
+                /* floor(c) + 1 <= c + 1, so nx ny <= the cells' room. */
+                g->nx = (uint32_t)cx + 1u;
+                g->ny = (uint32_t)cy + 1u;
+                g->inv_w = g->nx > 1u ? (coa_real_t)(1.0 / wd) : (coa_real_t)0;
+                g->inv_h = g->ny > 1u ? (coa_real_t)(1.0 / wd) : (coa_real_t)0;
+                break;
+            }
+            wd *= 1.125;
+        }
+    }
+    cells = (size_t)g->nx * g->ny;
+    for (i = 0; i <= cells + 1u; ++i) {
+        start[i] = 0u;
+    }
+    for (p = 0; p < m; ++p) {
+        uint32_t slot = box_slot(g, &sap[p]);
+        pr->place[p] = slot;
+        start[slot] += 1u;
+    }
+    {
+        uint32_t sum = 0u;
+        for (i = 0; i <= cells; ++i) {
+            uint32_t c = start[i];
+            start[i] = sum;
+            sum += c;
+        }
+        start[cells + 1u] = sum;
+    }
+    for (p = 0; p < m; ++p) {
+        pr->place[p] = start[pr->place[p]]++;
+    }
+    /* Moves each box to its place in cell order, in place: every swap puts one box
+     * where it belongs, so at most m swaps. */
+    for (p = 0; p < m; ++p) {
+        while (pr->place[p] != (uint32_t)p) {
+            uint32_t d = pr->place[p];
+            sap_entry_t t = pr->sap[d];
+            pr->sap[d] = pr->sap[p];
+            pr->sap[p] = t;
+            pr->place[p] = pr->place[d];
+            pr->place[d] = d;
+        }
+    }
+    /* Placing advanced each start to the next run's; shift back. */
+    for (i = cells; i > 0u; --i) {
+        start[i] = start[i - 1u];
+    }
+    start[0] = 0u;
+}
+
+/* This step's pairs. Two boxes that overlap in x and y have columns (rows) at most one
+ * apart: if e starts no later than f in x, f starts within e, so f's column is at most
+ * e's last, which is at most one past e's first (cell_of is monotone). So a small box's
+ * partners are in its own cell and the 8 around it: each cell is paired with itself and
+ * 4 of its neighbours, which finds each pair once. A wide box is checked against the
+ * small boxes of every cell from one before its own first to its last on each axis, and
+ * against every other wide box. */
+static int grid_pairs(coa_predictor_t *pr, const grid_t *g, size_t *count)
+{
+    const uint32_t *start = pr->cell_start;
+    uint32_t wide = g->nx * g->ny;
+    uint32_t cx;
+    uint32_t cy;
+    size_t i;
+    int rc = COA_OK;
+
+    for (cy = 0; cy < g->ny && rc == COA_OK; ++cy) {
+        for (cx = 0; cx < g->nx && rc == COA_OK; ++cx) {
+            uint32_t c = cy * g->nx + cx;
+            uint32_t right = cx + 1u < g->nx ? c + 2u : c + 1u;
+            if (start[c + 1u] == start[c]) {
+                continue;
+            }
+            rc = pairs_within(pr, start[c], start[c + 1u], count);
+            for (i = start[c]; i < start[c + 1u] && rc == COA_OK; ++i) {
+                /* The cell to the right; then above-left, above and above-right, one
+                 * run. */
+                rc = pairs_across(pr, i, start[c + 1u], start[right], count);
+                if (rc == COA_OK && cy + 1u < g->ny) {
+                    uint32_t u = c + g->nx;
+                    uint32_t lo = cx > 0u ? u - 1u : u;
+                    uint32_t hi = cx + 1u < g->nx ? u + 1u : u;
+                    rc = pairs_across(pr, i, start[lo], start[hi + 1u], count);
+                }
+            }
+        }
+    }
+    /* The wide boxes: by x among themselves (sweep and prune), each against the small
+     * boxes of the cells it reaches. */
+    sap_heap_sort(&pr->sap[start[wide]], start[wide + 1u] - start[wide]);
+    for (i = start[wide]; i < start[wide + 1u] && rc == COA_OK; ++i) {
+        const sap_entry_t *e = &pr->sap[i];
+        uint32_t lx;
+        uint32_t hx;
+        uint32_t ly;
+        uint32_t hy;
+        size_t j;
+        box_cells(g, e, &lx, &hx, &ly, &hy);
+        for (cy = ly > 0u ? ly - 1u : 0u; cy <= hy && rc == COA_OK; ++cy) {
+            uint32_t first = cy * g->nx + (lx > 0u ? lx - 1u : 0u);
+            uint32_t last = cy * g->nx + hx;
+            rc = pairs_across(pr, i, start[first], start[last + 1u], count);
+        }
+        for (j = i + 1u; j < start[wide + 1u] && pr->sap[j].min_x <= e->max_x && rc == COA_OK;
+             ++j) {
+            rc = sap_pair(pr, e, &pr->sap[j], count);
+        }
+    }
+    return rc;
+}
+
+/* Pairs on a uniform grid over every step, then the obstacles against each UAV's
+ * reach. */
 static int broad_phase(coa_predictor_t *pr, size_t obstacle_count, size_t *count)
 {
     size_t m = pr->movers;
     size_t n = pr->n;
-    sap_entry_t *sap = pr->sap;
     uint32_t k;
     size_t p;
     size_t o;
     int rc = COA_OK;
 
     *count = 0u;
-    for (k = 0; k < pr->config->horizon && rc == COA_OK; ++k) {
+    for (k = 0; k < pr->config->horizon && rc == COA_OK && m > 0u; ++k) {
+        grid_t g;
         for (p = 0; p < m; ++p) {
-            step_box(pr, k == 0u ? (uint32_t)p : pr->order[p], k, &sap[p]);
+            step_box(pr, (uint32_t)p, k, &pr->sap[p]);
         }
-        if (k == 0u) {
-            sap_heap_sort(sap, m);
-        } else {
-            sap_insertion_sort(sap, m);
-        }
-        for (p = 0; p < m; ++p) {
-            pr->order[p] = sap[p].id;
-        }
-        for (p = 0; p < m && rc == COA_OK; ++p) {
-            const sap_entry_t *e = &sap[p];
-            bool e_track = e->id >= n;
-            coa_real_t max_x = e->max_x;
-            coa_real_t min_y = e->min_y;
-            coa_real_t max_y = e->max_y;
-            size_t q;
-            for (q = p + 1u; q < m && sap[q].min_x <= max_x; ++q) {
-                const sap_entry_t *f = &sap[q];
-                uint32_t lo;
-                uint32_t hi;
-                if (f->min_y > max_y || min_y > f->max_y || (e_track && f->id >= n) ||
-                    f->min_z > e->max_z || e->min_z > f->max_z) {
-                    continue;
-                }
-                lo = e->id < f->id ? e->id : f->id;
-                hi = e->id < f->id ? f->id : e->id;
-                rc = set_insert(pr, hi < n ? make_key(0u, lo, hi) : make_key(1u, lo, hi - n),
-                                count);
-                if (rc != COA_OK) {
-                    break;
-                }
-            }
-        }
+        grid_fill(pr, &g);
+        rc = grid_pairs(pr, &g, count);
     }
     /* The set has done its work (the keys are distinct); leave the table empty. */
     set_clear(pr, *count);
