@@ -10,6 +10,7 @@
  */
 #include <check.h>
 #include <math.h>
+#include <string.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -1084,6 +1085,44 @@ START_TEST(test_polytope_near_contact)
 }
 END_TEST
 
+/* The obstacle check the planner and the predictor both rely on before any test runs. */
+START_TEST(test_obstacle_check)
+{
+    coa_vec3_t pts[5] = {vec(0, 0, 0), vec(1, 0, 0), vec(0, 1, 0), vec(0, 0, 1), vec(1, 1, 1)};
+    coa_obstacle_t o;
+
+    memset(&o, 0, sizeof o);
+    o.kind = COA_OBSTACLE_BOX;
+    o.box.min = vec(0, 0, 0);
+    o.box.max = vec(1, 2, 3);
+    ck_assert_int_eq(coa_obstacle_check(&o), COA_OK);
+    o.box.max = vec(1, 0, 3); /* zero thickness is a box */
+    ck_assert_int_eq(coa_obstacle_check(&o), COA_OK);
+    o.box.max = vec(1, -0.5, 3); /* inverted on y */
+    ck_assert_int_eq(coa_obstacle_check(&o), COA_ERR_ARGUMENT);
+    o.box.max = vec(1, 2, (double)INFINITY);
+    ck_assert_int_eq(coa_obstacle_check(&o), COA_ERR_ARGUMENT);
+
+    o.kind = COA_OBSTACLE_POLYTOPE;
+    o.polytope.vertices = pts;
+    o.polytope.count = 5u;
+    ck_assert_int_eq(coa_obstacle_check(&o), COA_OK);
+    o.polytope.count = 3u;
+    ck_assert_int_eq(coa_obstacle_check(&o), COA_ERR_ARGUMENT);
+    o.polytope.count = COA_POLYTOPE_MAX_VERTICES + 1u;
+    ck_assert_int_eq(coa_obstacle_check(&o), COA_ERR_ARGUMENT);
+    o.polytope.count = 5u;
+    pts[4] = vec((double)NAN, 0, 0);
+    ck_assert_int_eq(coa_obstacle_check(&o), COA_ERR_ARGUMENT);
+    o.polytope.vertices = NULL;
+    ck_assert_int_eq(coa_obstacle_check(&o), COA_ERR_ARGUMENT);
+
+    o.kind = (coa_obstacle_kind_t)7;
+    ck_assert_int_eq(coa_obstacle_check(&o), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coa_obstacle_check(NULL), COA_ERR_ARGUMENT);
+}
+END_TEST
+
 static Suite *geometry_suite(void)
 {
     Suite *s = suite_create("geometry");
@@ -1091,6 +1130,7 @@ static Suite *geometry_suite(void)
     TCase *random = tcase_create("random");
 
     tcase_add_test(hand, test_volumes_touching);
+    tcase_add_test(hand, test_obstacle_check);
     tcase_add_test(hand, test_volumes_crossing);
     tcase_add_test(hand, test_volumes_step_ends);
     tcase_add_test(hand, test_volumes_degenerate_motion);

@@ -96,6 +96,11 @@ bool coa_conflict_box(const coa_sweep_t *a, const coa_box_t *box);
 #define COA_MPR_MAX_SUPPORT_CALLS 128u
 int coa_conflict_polytope(const coa_sweep_t *a, const coa_polytope_t *poly);
 
+/* Checks an obstacle: a known kind; a box with finite corners and min <= max on every
+ * axis; a polytope with non-NULL vertices, 4..COA_POLYTOPE_MAX_VERTICES of them, all
+ * finite. Returns COA_OK or COA_ERR_ARGUMENT. Cost O(count), no memory. */
+int coa_obstacle_check(const coa_obstacle_t *obstacle);
+
 /* Dispatch on the obstacle kind. Returns 1, 0, or COA_ERR_ARGUMENT (NULL, unknown kind,
  * or the polytope test's errors). Cost as the test it dispatches to. */
 int coa_conflict_obstacle(const coa_sweep_t *a, const coa_obstacle_t *obstacle);

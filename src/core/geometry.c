@@ -542,6 +542,31 @@ int coa_conflict_polytope(const coa_sweep_t *a, const coa_polytope_t *poly)
     return hit ? 1 : 0;
 }
 
+int coa_obstacle_check(const coa_obstacle_t *obstacle)
+{
+    size_t i;
+    if (obstacle == NULL) {
+        return COA_ERR_ARGUMENT;
+    }
+    if (obstacle->kind == COA_OBSTACLE_BOX) {
+        const coa_box_t *b = &obstacle->box;
+        return (vec_finite(&b->min) && vec_finite(&b->max) && b->min.x <= b->max.x &&
+                b->min.y <= b->max.y && b->min.z <= b->max.z)
+                   ? COA_OK
+                   : COA_ERR_ARGUMENT;
+    }
+    if (obstacle->kind != COA_OBSTACLE_POLYTOPE || obstacle->polytope.vertices == NULL ||
+        obstacle->polytope.count < 4u || obstacle->polytope.count > COA_POLYTOPE_MAX_VERTICES) {
+        return COA_ERR_ARGUMENT;
+    }
+    for (i = 0; i < obstacle->polytope.count; ++i) {
+        if (!vec_finite(&obstacle->polytope.vertices[i])) {
+            return COA_ERR_ARGUMENT;
+        }
+    }
+    return COA_OK;
+}
+
 int coa_conflict_obstacle(const coa_sweep_t *a, const coa_obstacle_t *obstacle)
 {
     if (a == NULL || obstacle == NULL) {

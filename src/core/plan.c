@@ -18,11 +18,12 @@
 
 #include <math.h>
 
+#include "internal.h"
+
 #define PLAN_MAGIC 0x434f4150u      /* marks a buffer built by coa_planner_init */
 #define NONE UINT32_MAX             /* no node, empty table slot, not in the heap */
 #define ACTIONS COA_ACTION_COUNT
 #define MAXM COA_MAX_CENTRALISED
-#define WS_ALIGN ((size_t)COA_WORKSPACE_ALIGNMENT)
 /* Node indices, heap positions and table slots are uint32 with NONE reserved; a pool of
  * at most 2^30 nodes keeps the table (>= 2C slots, a power of two) below 2^32 too. */
 #define MAX_NODES (UINT32_C(1) << 30)
@@ -129,39 +130,6 @@ static inline int cost_compare(coa_cost_t a, coa_cost_t b)
 /* ------------------------------------------------------------------------------------ */
 /* Sizes                                                                                 */
 
-static bool size_mul(size_t a, size_t b, size_t *out)
-{
-    if (a != 0u && b > SIZE_MAX / a) {
-        return false;
-    }
-    *out = a * b;
-    return true;
-}
-
-static bool size_add(size_t a, size_t b, size_t *out)
-{
-    if (b > SIZE_MAX - a) {
-        return false;
-    }
-    *out = a + b;
-    return true;
-}
-
-static bool size_round(size_t a, size_t *out)
-{
-    return size_add(a, (WS_ALIGN - a % WS_ALIGN) % WS_ALIGN, out);
-}
-
-/* Reserves count * elem bytes at *cursor, rounded up so the next array stays aligned. */
-static bool reserve(size_t *cursor, size_t count, size_t elem, size_t *at)
-{
-    size_t bytes;
-    if (!size_mul(count, elem, &bytes) || !size_round(bytes, &bytes)) {
-        return false;
-    }
-    *at = *cursor;
-    return size_add(*cursor, bytes, cursor);
-}
 
 static bool layout_compute(size_t max_vehicles, uint32_t beta, plan_layout_t *lo)
 {
@@ -253,15 +221,6 @@ coa_planner_t *coa_planner_init(void *buffer, size_t size, size_t max_vehicles, 
 /* ------------------------------------------------------------------------------------ */
 /* Problem validation                                                                    */
 
-static bool real_ok(coa_real_t x)
-{
-    return isfinite(x) != 0;
-}
-
-static bool vec_ok(const coa_vec3_t *p)
-{
-    return real_ok(p->x) && real_ok(p->y) && real_ok(p->z);
-}
 
 static bool samples_ok(const coa_vec3_t *s, uint32_t horizon)
 {
@@ -277,24 +236,6 @@ static bool samples_ok(const coa_vec3_t *s, uint32_t horizon)
     return true;
 }
 
-static bool obstacle_ok(const coa_obstacle_t *o)
-{
-    size_t i;
-    if (o->kind == COA_OBSTACLE_BOX) {
-        return vec_ok(&o->box.min) && vec_ok(&o->box.max) && o->box.min.x <= o->box.max.x &&
-               o->box.min.y <= o->box.max.y && o->box.min.z <= o->box.max.z;
-    }
-    if (o->kind != COA_OBSTACLE_POLYTOPE || o->polytope.vertices == NULL ||
-        o->polytope.count < 4u || o->polytope.count > COA_POLYTOPE_MAX_VERTICES) {
-        return false;
-    }
-    for (i = 0; i < o->polytope.count; ++i) {
-        if (!vec_ok(&o->polytope.vertices[i])) {
-            return false;
-        }
-    }
-    return true;
-}
 
 /* Everything but the integer range: what a conflict check needs to be safe to run. */
 static int check_arguments(const coa_problem_t *p)
@@ -322,7 +263,7 @@ static int check_arguments(const coa_problem_t *p)
         return COA_ERR_ARGUMENT;
     }
     for (i = 0; i < p->obstacle_count; ++i) {
-        if (!obstacle_ok(&p->obstacles[i])) {
+        if (coa_obstacle_check(&p->obstacles[i]) != COA_OK) {
             return COA_ERR_ARGUMENT;
         }
     }

@@ -27,6 +27,8 @@
 #include <float.h>
 #include <math.h>
 
+#include "internal.h"
+
 #ifdef COA_SINGLE_PRECISION
 #define coa_sqrt(x) sqrtf(x)
 #define coa_fabs(x) fabsf(x)
@@ -38,7 +40,6 @@
 #endif
 
 #define PREDICT_MAGIC 0x434f5052u /* marks a buffer built by coa_predictor_init */
-#define WS_ALIGN ((size_t)COA_WORKSPACE_ALIGNMENT)
 #define NONE UINT32_MAX
 #define EMPTY_KEY UINT64_MAX /* never a key: the kind field of a key is at most 2 */
 #define KIND_SHIFT 62
@@ -119,39 +120,6 @@ typedef struct {
 /* ------------------------------------------------------------------------------------ */
 /* Sizes                                                                                 */
 
-static bool size_mul(size_t a, size_t b, size_t *out)
-{
-    if (a != 0u && b > SIZE_MAX / a) {
-        return false;
-    }
-    *out = a * b;
-    return true;
-}
-
-static bool size_add(size_t a, size_t b, size_t *out)
-{
-    if (b > SIZE_MAX - a) {
-        return false;
-    }
-    *out = a + b;
-    return true;
-}
-
-static bool size_round(size_t a, size_t *out)
-{
-    return size_add(a, (WS_ALIGN - a % WS_ALIGN) % WS_ALIGN, out);
-}
-
-/* Reserves count * elem bytes at *cursor, rounded up so the next array stays aligned. */
-static bool reserve(size_t *cursor, size_t count, size_t elem, size_t *at)
-{
-    size_t bytes;
-    if (!size_mul(count, elem, &bytes) || !size_round(bytes, &bytes)) {
-        return false;
-    }
-    *at = *cursor;
-    return size_add(*cursor, bytes, cursor);
-}
 
 static bool layout_compute(size_t max_vehicles, size_t max_tracks, uint32_t max_horizon,
                            size_t max_pairs, predict_layout_t *lo)
@@ -560,15 +528,6 @@ static double log_probability_bound(double gap_h, double sigma_h, double gap_v, 
 /* ------------------------------------------------------------------------------------ */
 /* Input checks                                                                          */
 
-static bool real_ok(coa_real_t x)
-{
-    return isfinite(x) != 0;
-}
-
-static bool vec_ok(const coa_vec3_t *p)
-{
-    return real_ok(p->x) && real_ok(p->y) && real_ok(p->z);
-}
 
 static bool positive(coa_real_t x)
 {
@@ -613,25 +572,6 @@ static bool plan_ok(const coa_intent_plan_t *p)
     return true;
 }
 
-/* As plan.c checks a problem's obstacles. */
-static bool obstacle_ok(const coa_obstacle_t *o)
-{
-    size_t i;
-    if (o->kind == COA_OBSTACLE_BOX) {
-        return vec_ok(&o->box.min) && vec_ok(&o->box.max) && o->box.min.x <= o->box.max.x &&
-               o->box.min.y <= o->box.max.y && o->box.min.z <= o->box.max.z;
-    }
-    if (o->kind != COA_OBSTACLE_POLYTOPE || o->polytope.vertices == NULL ||
-        o->polytope.count < 4u || o->polytope.count > COA_POLYTOPE_MAX_VERTICES) {
-        return false;
-    }
-    for (i = 0; i < o->polytope.count; ++i) {
-        if (!vec_ok(&o->polytope.vertices[i])) {
-            return false;
-        }
-    }
-    return true;
-}
 
 /* ------------------------------------------------------------------------------------ */
 /* Alignment                                                                             */
@@ -1628,7 +1568,7 @@ static int check_inputs(const coa_predictor_t *pr, const coa_predict_config_t *c
         }
     }
     for (i = 0; i < obstacle_count; ++i) {
-        if (!obstacle_ok(&obstacles[i])) {
+        if (coa_obstacle_check(&obstacles[i]) != COA_OK) {
             return COA_ERR_ARGUMENT;
         }
     }

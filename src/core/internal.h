@@ -1,0 +1,65 @@
+/*
+ * internal.h: helpers the core's modules share. Private: not installed, not API.
+ *
+ * The planner and the predictor both lay out a workspace inside the caller's buffer; the
+ * arithmetic that sizes it must report overflow instead of wrapping, identically in both,
+ * because each module's size function promises to be exact.
+ */
+#ifndef COAVOID_CORE_INTERNAL_H
+#define COAVOID_CORE_INTERNAL_H
+
+#include <math.h>
+
+#include "coavoid/common.h"
+
+#define WS_ALIGN ((size_t)COA_WORKSPACE_ALIGNMENT)
+
+/* a * b, false when it would overflow size_t. */
+static inline bool size_mul(size_t a, size_t b, size_t *out)
+{
+    if (a != 0u && b > SIZE_MAX / a) {
+        return false;
+    }
+    *out = a * b;
+    return true;
+}
+
+/* a + b, false when it would overflow size_t. */
+static inline bool size_add(size_t a, size_t b, size_t *out)
+{
+    if (b > SIZE_MAX - a) {
+        return false;
+    }
+    *out = a + b;
+    return true;
+}
+
+/* a rounded up to the workspace alignment. */
+static inline bool size_round(size_t a, size_t *out)
+{
+    return size_add(a, (WS_ALIGN - a % WS_ALIGN) % WS_ALIGN, out);
+}
+
+/* Reserves count * elem bytes at *cursor, rounded up so the next array stays aligned;
+ * *at receives the array's offset. False on overflow. */
+static inline bool reserve(size_t *cursor, size_t count, size_t elem, size_t *at)
+{
+    size_t bytes;
+    if (!size_mul(count, elem, &bytes) || !size_round(bytes, &bytes)) {
+        return false;
+    }
+    *at = *cursor;
+    return size_add(*cursor, bytes, cursor);
+}
+
+static inline bool real_ok(coa_real_t x)
+{
+    return isfinite(x) != 0;
+}
+
+static inline bool vec_ok(const coa_vec3_t *p)
+{
+    return real_ok(p->x) && real_ok(p->y) && real_ok(p->z);
+}
+
+#endif /* COAVOID_CORE_INTERNAL_H */
