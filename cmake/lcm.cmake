@@ -1,0 +1,31 @@
+# LCM messaging: the generated message types (lcmtypes/) and the validation and
+# conversion library coavoid_lcm (src/lcm/). Included from the top-level CMakeLists.txt
+# after coavoid_core is defined.
+option(COAVOID_BUILD_LCM "Build the LCM message types and the messaging library (needs LCM)" ON)
+if(NOT COAVOID_BUILD_LCM)
+  return()
+endif()
+#
+# LCM 1.3.1 (Debian liblcm-dev) has no CMake package, and its lcm.pc needs glib's
+# development files which liblcm-dev does not pull in; LCM's public headers do not
+# include glib, so the header and the library are found directly.
+find_path(LCM_INCLUDE_DIR lcm/lcm.h)
+find_library(LCM_LIBRARY lcm)
+set(LCM_JAR /usr/share/java/lcm.jar CACHE FILEPATH "LCM's Java runtime (liblcm-java)")
+if(NOT LCM_INCLUDE_DIR OR NOT LCM_LIBRARY)
+  message(FATAL_ERROR "coavoid: LCM not found (Debian: apt-get install liblcm-dev liblcm-bin); "
+                      "or configure with -DCOAVOID_BUILD_LCM=OFF")
+endif()
+
+add_subdirectory(${PROJECT_SOURCE_DIR}/lcmtypes ${PROJECT_BINARY_DIR}/lcmtypes)
+
+add_library(coavoid_lcm STATIC
+  ${PROJECT_SOURCE_DIR}/src/lcm/convert.c)
+target_include_directories(coavoid_lcm PUBLIC ${PROJECT_SOURCE_DIR}/src/lcm)
+target_link_libraries(coavoid_lcm PUBLIC coavoid_core coavoid_lcmtypes)
+# The generated headers must exist before coavoid_lcm's sources compile, whatever the
+# generator's ordering between static libraries.
+add_dependencies(coavoid_lcm coavoid_lcmtypes_gen)
+# Lets tests/test_lcm.c (picked up by the tests' glob whatever the options) know that
+# the messaging library is there.
+target_compile_definitions(coavoid_lcm PUBLIC COAVOID_HAVE_LCM)

@@ -1,0 +1,222 @@
+/*
+ * coavoid_lcm.h: validation of LCM messages and conversion between them and core types.
+ *
+ * Everything that arrives over the network is untrusted. Each *_check function applies
+ * every rule of its message (finite numbers within sane bounds, counts within the
+ * message's capacity, known enum values, valid ids, sane times); each *_to_core function
+ * runs the check, then the sender's sequence rule, and only then converts, so the core
+ * never sees a number that was not validated. A refusal returns a named negative
+ * COA_LCM_ERR_* code and sets *reason to a static string naming the message and the
+ * field; the caller counts it and reports it in its status message: it is never fatal.
+ *
+ * *_from_core functions build a message from core types and run the same check on the
+ * result, so a node cannot publish what its peers would refuse.
+ *
+ * Times. Messages carry int64 microseconds (utime); the core works in seconds of
+ * coa_real_t on a clock whose origin the caller chooses (context epoch_utime):
+ * t = (utime - epoch_utime) * 1e-6.
+ *
+ * Memory: nothing is allocated. Arrays the core types point into are the caller's.
+ */
+#ifndef COAVOID_LCM_H
+#define COAVOID_LCM_H
+
+#include "coavoid/common.h"
+#include "coavoid/geometry.h"
+#include "coavoid/plan.h"
+#include "coavoid/predict.h"
+#include "coavoid/trajectory.h"
+
+#include <coavoid_lcmtypes/coavoid_conflict_report_t.h>
+#include <coavoid_lcmtypes/coavoid_intent_t.h>
+#include <coavoid_lcmtypes/coavoid_obstacle_map_t.h>
+#include <coavoid_lcmtypes/coavoid_plan_t.h>
+#include <coavoid_lcmtypes/coavoid_status_t.h>
+#include <coavoid_lcmtypes/coavoid_track_t.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Refusals. Distinct from the core's -1..-3 so that a status message's last_reject_code
+ * says which rule refused. COA_ERR_ARGUMENT is still returned for NULL arguments. */
+#define COA_LCM_ERR_DECODE (-100)    /* bytes do not decode: wrong type (fingerprint) or truncated */
+#define COA_LCM_ERR_NONFINITE (-101) /* NaN or infinity */
+#define COA_LCM_ERR_VALUE (-102)     /* a finite number outside its range (negative size, 1e300 m, ...) */
+#define COA_LCM_ERR_COUNT (-103)     /* a count beyond the message's capacity or inconsistent */
+#define COA_LCM_ERR_ENUM (-104)      /* an unknown mode, status, kind, ... */
+#define COA_LCM_ERR_ID (-105)        /* an id out of range or repeated */
+#define COA_LCM_ERR_TIME (-106)      /* a time stamp in the future, stale, or out of order */
+#define COA_LCM_ERR_SEQUENCE (-107)  /* a sequence number (or version) that went backwards */
+#define COA_LCM_ERR_SENDERS (-108)   /* the caller's sequence table is full */
+#define COA_LCM_ERR_CAPACITY (-109)  /* the caller's output array is too small */
+
+/* Bounds on numbers, beyond finiteness. They keep every converted value finite in float
+ * too (COA_SINGLE_PRECISION) and refuse values no aircraft has. */
+#define COA_LCM_MAX_COORDINATE 1.0e7 /* m, |x|, |y|, |z| of any position */
+#define COA_LCM_MAX_SPEED 1.0e4      /* m/s, each velocity component */
+#define COA_LCM_MAX_SIZE 1.0e5       /* m: radius, half-height, sigma */
+#define COA_LCM_MAX_STEP 3600.0      /* s: plan step or dt */
+#define COA_LCM_MAX_ID 65535         /* UAV and node ids are 1..65535 (coa_vehicle_t.id) */
+
+/* How the receiver judges times. All microseconds. */
+typedef struct {
+    int64_t now_utime;    /* receiver's clock; 0 disables the age and future checks */
+    int64_t max_age_us;   /* utime < now - max_age: stale (also bounds plan/estimate
+                             times around utime) */
+    int64_t max_future_us; /* utime > now + max_future: a clock ahead or a bad stamp */
+    int64_t epoch_utime;  /* origin of the core's clock */
+} coa_lcm_context_t;
+
+/* Per-sender last sequence numbers, in the caller's array (one table per message type). */
+typedef struct {
+    uint32_t sender;
+    int64_t last;
+} coa_lcm_sender_t;
+
+typedef struct {
+    coa_lcm_sender_t *entries;
+    size_t capacity;
+    size_t count;
+} coa_lcm_sequence_table_t;
+
+/* Empties the table over entries[0..capacity-1]. Cannot fail on non-NULL table. */
+void coa_lcm_sequence_init(coa_lcm_sequence_table_t *table, coa_lcm_sender_t *entries,
+                           size_t capacity);
+
+/* Accepts `sequence` from `sender` when it is greater than the last one accepted (or
+ * equal, with allow_equal: a republished version), recording it. Returns COA_OK,
+ * COA_LCM_ERR_SEQUENCE (backwards: nothing recorded), COA_LCM_ERR_SENDERS (new sender,
+ * table full) or COA_ERR_ARGUMENT. A sender that restarts its numbering is refused until
+ * coa_lcm_sequence_forget (e.g. after its heartbeat went silent). Cost O(count). */
+int coa_lcm_sequence_accept(coa_lcm_sequence_table_t *table, uint32_t sender, int64_t sequence,
+                            bool allow_equal);
+
+/* Forgets a sender. Cost O(count). */
+void coa_lcm_sequence_forget(coa_lcm_sequence_table_t *table, uint32_t sender);
+
+/* A short English name of any COA_LCM_ERR_* or core status. Never NULL. */
+const char *coa_lcm_error_name(int status);
+
+/* ---- intent ---- */
+
+/* What an intent carries beyond coa_intent_plan_t. */
+typedef struct {
+    int64_t utime;
+    int64_t sequence;
+    uint32_t priority;
+    int8_t mode;        /* COAVOID_INTENT_T_MODE_* */
+    coa_vec3_t position;
+    coa_vec3_t velocity;
+} coa_lcm_intent_info_t;
+
+int coa_lcm_intent_check(const coavoid_intent_t *msg, const coa_lcm_context_t *ctx,
+                         const char **reason);
+/* samples: capacity >= msg->sample_count; plan->samples points into it. seq may be NULL
+ * (no sequence rule). */
+int coa_lcm_intent_to_core(const coavoid_intent_t *msg, const coa_lcm_context_t *ctx,
+                           coa_lcm_sequence_table_t *seq, coa_lcm_intent_info_t *info,
+                           coa_intent_plan_t *plan, coa_vec3_t *samples, size_t capacity,
+                           const char **reason);
+int coa_lcm_intent_from_core(const coa_intent_plan_t *plan, const coa_lcm_intent_info_t *info,
+                             const coa_lcm_context_t *ctx, coavoid_intent_t *msg,
+                             const char **reason);
+
+/* ---- plan ---- */
+
+typedef struct {
+    int64_t utime;
+    uint32_t coordinator_id;
+    int64_t plan_id;
+    coa_real_t valid_from;  /* core clock (s) of sample 0 */
+    coa_real_t valid_until;
+    coa_real_t dt;
+    uint32_t horizon;
+    int8_t mode;            /* COAVOID_PLAN_T_MODE_* */
+    size_t vehicle_count;
+    uint16_t uav_ids[COAVOID_PLAN_T_MAX_VEHICLES];
+} coa_lcm_plan_info_t;
+
+int coa_lcm_plan_check(const coavoid_plan_t *msg, const coa_lcm_context_t *ctx,
+                       const char **reason);
+/* offsets: capacity >= vehicle_count * (horizon + 1) int32, row i = uav_ids[i] (the
+ * layout the planner writes); result's status, costs, nodes_expanded and planned_count
+ * are set, order is 0..n-1. */
+int coa_lcm_plan_to_core(const coavoid_plan_t *msg, const coa_lcm_context_t *ctx,
+                         coa_lcm_sequence_table_t *seq, coa_lcm_plan_info_t *info,
+                         coa_plan_result_t *result, int32_t *offsets, size_t capacity,
+                         const char **reason);
+/* offsets as the planner wrote them for info->vehicle_count vehicles (rows in vehicle
+ * index order; the message lists them in result->order). */
+int coa_lcm_plan_from_core(const coa_lcm_plan_info_t *info, const coa_plan_result_t *result,
+                           const int32_t *offsets, const coa_lcm_context_t *ctx,
+                           coavoid_plan_t *msg, const char **reason);
+
+/* ---- track ---- */
+
+typedef struct {
+    int64_t utime;
+    uint32_t source_id;
+    int64_t sequence;
+} coa_lcm_track_info_t;
+
+int coa_lcm_track_check(const coavoid_track_t *msg, const coa_lcm_context_t *ctx,
+                        const char **reason);
+/* track->position is extrapolated to the core clock's t = 0 (the core's convention);
+ * path: capacity >= msg->path_count. */
+int coa_lcm_track_to_core(const coavoid_track_t *msg, const coa_lcm_context_t *ctx,
+                          coa_lcm_sequence_table_t *seq, coa_lcm_track_info_t *info,
+                          coa_track_t *track, coa_track_point_t *path, size_t capacity,
+                          const char **reason);
+int coa_lcm_track_from_core(const coa_track_t *track, const coa_lcm_track_info_t *info,
+                            const coa_lcm_context_t *ctx, coavoid_track_t *msg,
+                            const char **reason);
+
+/* ---- obstacle map ---- */
+
+int coa_lcm_obstacle_map_check(const coavoid_obstacle_map_t *msg, const coa_lcm_context_t *ctx,
+                               const char **reason);
+/* Boxes first, then polytopes. obstacles: capacity >= box_count + polytope_count;
+ * vertices: vertex_capacity >= the sum of vertex_count. Equal versions are accepted
+ * (a republished map). */
+int coa_lcm_obstacle_map_to_core(const coavoid_obstacle_map_t *msg, const coa_lcm_context_t *ctx,
+                                 coa_lcm_sequence_table_t *seq, coa_obstacle_t *obstacles,
+                                 size_t capacity, size_t *count, coa_vec3_t *vertices,
+                                 size_t vertex_capacity, const char **reason);
+int coa_lcm_obstacle_map_from_core(const coa_obstacle_t *obstacles, size_t count, int64_t utime,
+                                   uint32_t map_id, int64_t version, const coa_lcm_context_t *ctx,
+                                   coavoid_obstacle_map_t *msg, const char **reason);
+
+/* ---- conflict report (monitoring) ---- */
+
+int coa_lcm_conflict_report_check(const coavoid_conflict_report_t *msg,
+                                  const coa_lcm_context_t *ctx, const char **reason);
+/* From a prediction: a and b indices are mapped to ids through plan_ids (and track_ids
+ * for track conflicts); obstacles keep their index. cluster may be NULL. Conflicts past
+ * the message's capacity are counted in conflicts_found only. */
+int coa_lcm_conflict_report_from_core(const coa_conflict_t *conflicts, size_t count,
+                                      size_t conflicts_found, const uint16_t *plan_ids,
+                                      size_t plan_count, const uint32_t *track_ids,
+                                      size_t track_count, const uint32_t *cluster,
+                                      int64_t utime, uint32_t reporter_id, int64_t sequence,
+                                      int64_t prediction_utime, coa_real_t dt, uint32_t horizon,
+                                      const coa_lcm_context_t *ctx,
+                                      coavoid_conflict_report_t *msg, const char **reason);
+
+/* ---- status ---- */
+
+int coa_lcm_status_check(const coavoid_status_t *msg, const coa_lcm_context_t *ctx,
+                         const char **reason);
+
+/* Check + sequence rule for the two types that have no core counterpart to convert to. */
+int coa_lcm_conflict_report_accept(const coavoid_conflict_report_t *msg,
+                                   const coa_lcm_context_t *ctx, coa_lcm_sequence_table_t *seq,
+                                   const char **reason);
+int coa_lcm_status_accept(const coavoid_status_t *msg, const coa_lcm_context_t *ctx,
+                          coa_lcm_sequence_table_t *seq, const char **reason);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* COAVOID_LCM_H */

@@ -1,0 +1,1063 @@
+/*
+ * Validation of LCM messages and conversion to and from core types (coavoid_lcm.h).
+ * Every rule is a REJECT(code, reason) with a reason naming the field, so a refusal
+ * in a log says exactly what was wrong.
+ */
+#include "coavoid_lcm.h"
+
+#include <math.h>
+#include <string.h>
+
+#define REJECT(code, text)       \
+    do {                         \
+        if (reason != NULL) {    \
+            *reason = (text);    \
+        }                        \
+        return (code);           \
+    } while (0)
+
+#define OK_REASON()           \
+    do {                      \
+        if (reason != NULL) { \
+            *reason = "ok";   \
+        }                     \
+    } while (0)
+
+/* 0 ok, COA_LCM_ERR_NONFINITE, or COA_LCM_ERR_VALUE when |x| > bound. */
+static int number_rule(double x, double bound)
+{
+    if (!isfinite(x)) {
+        return COA_LCM_ERR_NONFINITE;
+    }
+    return (fabs(x) <= bound) ? COA_OK : COA_LCM_ERR_VALUE;
+}
+
+/* Sizes and sigmas: finite, in (0, COA_LCM_MAX_SIZE] when positive, else [0, COA_LCM_MAX_SIZE]. */
+static int size_rule(double x, bool positive)
+{
+    int rc = number_rule(x, COA_LCM_MAX_SIZE);
+    if (rc != COA_OK) {
+        return rc;
+    }
+    return (positive ? x > 0.0 : x >= 0.0) ? COA_OK : COA_LCM_ERR_VALUE;
+}
+
+static int vec_rule(const double v[3], double bound)
+{
+    int i;
+    for (i = 0; i < 3; ++i) {
+        int rc = number_rule(v[i], bound);
+        if (rc != COA_OK) {
+            return rc;
+        }
+    }
+    return COA_OK;
+}
+
+static bool id_ok(int32_t id)
+{
+    return id >= 1 && id <= COA_LCM_MAX_ID;
+}
+
+/* utime > 0 and, with a clock, neither stale nor in the future. */
+static int utime_rule(int64_t utime, const coa_lcm_context_t *ctx)
+{
+    if (utime <= 0) {
+        return COA_LCM_ERR_TIME;
+    }
+    if (ctx != NULL && ctx->now_utime > 0) {
+        if (ctx->max_future_us >= 0 && utime > ctx->now_utime &&
+            utime - ctx->now_utime > ctx->max_future_us) {
+            return COA_LCM_ERR_TIME;
+        }
+        if (ctx->max_age_us >= 0 && utime < ctx->now_utime &&
+            ctx->now_utime - utime > ctx->max_age_us) {
+            return COA_LCM_ERR_TIME;
+        }
+    }
+    return COA_OK;
+}
+
+/* A time stamp that belongs to the message (plan start, estimate): > 0 and within the
+ * age window of its utime in either direction, so a converted time stays small. */
+static int related_time_rule(int64_t t, int64_t utime, const coa_lcm_context_t *ctx)
+{
+    int64_t window = (ctx != NULL && ctx->max_age_us > 0) ? ctx->max_age_us : INT64_C(3600000000);
+    if (t <= 0) {
+        return COA_LCM_ERR_TIME;
+    }
+    if ((t > utime && t - utime > window) || (t < utime && utime - t > window)) {
+        return COA_LCM_ERR_TIME;
+    }
+    return COA_OK;
+}
+
+static coa_real_t core_time(int64_t utime, const coa_lcm_context_t *ctx)
+{
+    int64_t epoch = (ctx != NULL) ? ctx->epoch_utime : 0;
+    /* Difference first, in integers, so that double keeps microseconds. */
+    return (coa_real_t)((double)(utime - epoch) * 1e-6);
+}
+
+static int64_t utime_of(coa_real_t t, const coa_lcm_context_t *ctx)
+{
+    int64_t epoch = (ctx != NULL) ? ctx->epoch_utime : 0;
+    double us = (double)t * 1e6;
+    if (!isfinite(us) || fabs(us) > 9.0e18) {
+        return 0; /* the check refuses it */
+    }
+    return epoch + (int64_t)llround(us);
+}
+
+static coa_vec3_t vec_of(const double v[3])
+{
+    coa_vec3_t out;
+    out.x = (coa_real_t)v[0];
+    out.y = (coa_real_t)v[1];
+    out.z = (coa_real_t)v[2];
+    return out;
+}
+
+static void vec_to(coa_vec3_t v, double out[3])
+{
+    out[0] = (double)v.x;
+    out[1] = (double)v.y;
+    out[2] = (double)v.z;
+}
+
+/* ---- sequence table ---- */
+
+void coa_lcm_sequence_init(coa_lcm_sequence_table_t *table, coa_lcm_sender_t *entries,
+                           size_t capacity)
+{
+    if (table == NULL) {
+        return;
+    }
+    table->entries = entries;
+    table->capacity = (entries != NULL) ? capacity : 0u;
+    table->count = 0u;
+}
+
+int coa_lcm_sequence_accept(coa_lcm_sequence_table_t *table, uint32_t sender, int64_t sequence,
+                            bool allow_equal)
+{
+    size_t i;
+    if (table == NULL || table->count > table->capacity) {
+        return COA_ERR_ARGUMENT;
+    }
+    for (i = 0; i < table->count; ++i) {
+        if (table->entries[i].sender == sender) {
+            int64_t last = table->entries[i].last;
+            if (sequence < last || (sequence == last && !allow_equal)) {
+                return COA_LCM_ERR_SEQUENCE;
+            }
+            table->entries[i].last = sequence;
+            return COA_OK;
+        }
+    }
+    if (table->count == table->capacity) {
+        return COA_LCM_ERR_SENDERS;
+    }
+    table->entries[table->count].sender = sender;
+    table->entries[table->count].last = sequence;
+    table->count++;
+    return COA_OK;
+}
+
+void coa_lcm_sequence_forget(coa_lcm_sequence_table_t *table, uint32_t sender)
+{
+    size_t i;
+    if (table == NULL || table->count > table->capacity) {
+        return;
+    }
+    for (i = 0; i < table->count; ++i) {
+        if (table->entries[i].sender == sender) {
+            table->entries[i] = table->entries[table->count - 1u];
+            table->count--;
+            return;
+        }
+    }
+}
+
+const char *coa_lcm_error_name(int status)
+{
+    switch (status) {
+    case COA_LCM_ERR_DECODE: return "message does not decode";
+    case COA_LCM_ERR_NONFINITE: return "non-finite number";
+    case COA_LCM_ERR_VALUE: return "number out of range";
+    case COA_LCM_ERR_COUNT: return "count out of range";
+    case COA_LCM_ERR_ENUM: return "unknown enum value";
+    case COA_LCM_ERR_ID: return "invalid id";
+    case COA_LCM_ERR_TIME: return "bad time stamp";
+    case COA_LCM_ERR_SEQUENCE: return "sequence went backwards";
+    case COA_LCM_ERR_SENDERS: return "too many senders";
+    case COA_LCM_ERR_CAPACITY: return "output too small";
+    default: return coa_status_name(status);
+    }
+}
+
+/* The sequence rule after a message passed its check. */
+static int sequence_rule(coa_lcm_sequence_table_t *seq, int32_t sender, int64_t sequence,
+                         bool allow_equal, const char **reason, const char *backwards,
+                         const char *full)
+{
+    int rc;
+    if (seq == NULL) {
+        return COA_OK;
+    }
+    rc = coa_lcm_sequence_accept(seq, (uint32_t)sender, sequence, allow_equal);
+    if (rc == COA_LCM_ERR_SEQUENCE) {
+        REJECT(rc, backwards);
+    }
+    if (rc == COA_LCM_ERR_SENDERS) {
+        REJECT(rc, full);
+    }
+    if (rc != COA_OK) {
+        REJECT(rc, "sequence table invalid");
+    }
+    return COA_OK;
+}
+
+/* ---- intent ---- */
+
+int coa_lcm_intent_check(const coavoid_intent_t *msg, const coa_lcm_context_t *ctx,
+                         const char **reason)
+{
+    int rc;
+    int32_t j;
+    if (msg == NULL) {
+        REJECT(COA_ERR_ARGUMENT, "intent: NULL");
+    }
+    if ((rc = utime_rule(msg->utime, ctx)) != COA_OK) {
+        REJECT(rc, "intent: utime stale, in the future or not positive");
+    }
+    if (!id_ok(msg->uav_id)) {
+        REJECT(COA_LCM_ERR_ID, "intent: uav_id not in 1..65535");
+    }
+    if (msg->sequence < 0) {
+        REJECT(COA_LCM_ERR_VALUE, "intent: sequence negative");
+    }
+    if (msg->priority < 1) {
+        REJECT(COA_LCM_ERR_VALUE, "intent: priority < 1");
+    }
+    if (msg->mode != COAVOID_INTENT_T_MODE_CENTRALISED &&
+        msg->mode != COAVOID_INTENT_T_MODE_DECOUPLED && msg->mode != COAVOID_INTENT_T_MODE_REFERENCE) {
+        REJECT(COA_LCM_ERR_ENUM, "intent: unknown mode");
+    }
+    if ((rc = vec_rule(msg->position, COA_LCM_MAX_COORDINATE)) != COA_OK) {
+        REJECT(rc, "intent: position non-finite or out of range");
+    }
+    if ((rc = vec_rule(msg->velocity, COA_LCM_MAX_SPEED)) != COA_OK) {
+        REJECT(rc, "intent: velocity non-finite or out of range");
+    }
+    if ((rc = size_rule(msg->radius, true)) != COA_OK) {
+        REJECT(rc, "intent: radius not in (0, 1e5] m");
+    }
+    if ((rc = size_rule(msg->half_height, true)) != COA_OK) {
+        REJECT(rc, "intent: half_height not in (0, 1e5] m");
+    }
+    if ((rc = related_time_rule(msg->plan_utime, msg->utime, ctx)) != COA_OK) {
+        REJECT(rc, "intent: plan_utime not positive or too far from utime");
+    }
+    if ((rc = number_rule(msg->step, COA_LCM_MAX_STEP)) != COA_OK || !(msg->step > 0.0)) {
+        REJECT(rc != COA_OK ? rc : COA_LCM_ERR_VALUE, "intent: step not in (0, 3600] s");
+    }
+    if (msg->sample_count < 1 || msg->sample_count > COAVOID_INTENT_T_MAX_SAMPLES) {
+        REJECT(COA_LCM_ERR_COUNT, "intent: sample_count not in 1..MAX_SAMPLES");
+    }
+    for (j = 0; j < msg->sample_count; ++j) {
+        if ((rc = vec_rule(msg->samples[j], COA_LCM_MAX_COORDINATE)) != COA_OK) {
+            REJECT(rc, "intent: a sample non-finite or out of range");
+        }
+    }
+    if ((rc = size_rule(msg->sigma_horizontal, false)) != COA_OK) {
+        REJECT(rc, "intent: sigma_horizontal not in [0, 1e5] m");
+    }
+    if ((rc = size_rule(msg->sigma_vertical, false)) != COA_OK) {
+        REJECT(rc, "intent: sigma_vertical not in [0, 1e5] m");
+    }
+    OK_REASON();
+    return COA_OK;
+}
+
+int coa_lcm_intent_to_core(const coavoid_intent_t *msg, const coa_lcm_context_t *ctx,
+                           coa_lcm_sequence_table_t *seq, coa_lcm_intent_info_t *info,
+                           coa_intent_plan_t *plan, coa_vec3_t *samples, size_t capacity,
+                           const char **reason)
+{
+    int rc;
+    int32_t j;
+    if (info == NULL || plan == NULL || samples == NULL) {
+        REJECT(COA_ERR_ARGUMENT, "intent: NULL output");
+    }
+    if ((rc = coa_lcm_intent_check(msg, ctx, reason)) != COA_OK) {
+        return rc;
+    }
+    if ((size_t)msg->sample_count > capacity) {
+        REJECT(COA_LCM_ERR_CAPACITY, "intent: more samples than the caller's array holds");
+    }
+    if ((rc = sequence_rule(seq, msg->uav_id, msg->sequence, false, reason,
+                            "intent: sequence not after the last one from this UAV",
+                            "intent: sequence table full")) != COA_OK) {
+        return rc;
+    }
+    for (j = 0; j < msg->sample_count; ++j) {
+        samples[j] = vec_of(msg->samples[j]);
+    }
+    memset(plan, 0, sizeof *plan);
+    plan->id = (uint16_t)msg->uav_id;
+    plan->volume.radius = (coa_real_t)msg->radius;
+    plan->volume.half_height = (coa_real_t)msg->half_height;
+    plan->t0 = core_time(msg->plan_utime, ctx);
+    plan->step = (coa_real_t)msg->step;
+    plan->samples = samples;
+    plan->count = (size_t)msg->sample_count;
+    plan->sigma_horizontal = (coa_real_t)msg->sigma_horizontal;
+    plan->sigma_vertical = (coa_real_t)msg->sigma_vertical;
+    info->utime = msg->utime;
+    info->sequence = msg->sequence;
+    info->priority = (uint32_t)msg->priority;
+    info->mode = msg->mode;
+    info->position = vec_of(msg->position);
+    info->velocity = vec_of(msg->velocity);
+    OK_REASON();
+    return COA_OK;
+}
+
+int coa_lcm_intent_from_core(const coa_intent_plan_t *plan, const coa_lcm_intent_info_t *info,
+                             const coa_lcm_context_t *ctx, coavoid_intent_t *msg,
+                             const char **reason)
+{
+    size_t j;
+    if (plan == NULL || info == NULL || msg == NULL || (plan->samples == NULL && plan->count > 0u)) {
+        REJECT(COA_ERR_ARGUMENT, "intent: NULL argument");
+    }
+    if (plan->count < 1u || plan->count > (size_t)COAVOID_INTENT_T_MAX_SAMPLES) {
+        REJECT(COA_LCM_ERR_COUNT, "intent: sample count not in 1..MAX_SAMPLES");
+    }
+    if (info->priority > (uint32_t)INT32_MAX) {
+        REJECT(COA_LCM_ERR_VALUE, "intent: priority too large");
+    }
+    memset(msg, 0, sizeof *msg);
+    msg->utime = info->utime;
+    msg->uav_id = plan->id;
+    msg->sequence = info->sequence;
+    msg->priority = (int32_t)info->priority;
+    msg->mode = info->mode;
+    vec_to(info->position, msg->position);
+    vec_to(info->velocity, msg->velocity);
+    msg->radius = (double)plan->volume.radius;
+    msg->half_height = (double)plan->volume.half_height;
+    msg->plan_utime = utime_of(plan->t0, ctx);
+    msg->step = (double)plan->step;
+    msg->sample_count = (int32_t)plan->count;
+    for (j = 0; j < plan->count; ++j) {
+        vec_to(plan->samples[j], msg->samples[j]);
+    }
+    msg->sigma_horizontal = (double)plan->sigma_horizontal;
+    msg->sigma_vertical = (double)plan->sigma_vertical;
+    return coa_lcm_intent_check(msg, ctx, reason);
+}
+
+/* ---- plan ---- */
+
+int coa_lcm_plan_check(const coavoid_plan_t *msg, const coa_lcm_context_t *ctx,
+                       const char **reason)
+{
+    int rc;
+    int32_t i;
+    int32_t j;
+    int32_t k;
+    if (msg == NULL) {
+        REJECT(COA_ERR_ARGUMENT, "plan: NULL");
+    }
+    if ((rc = utime_rule(msg->utime, ctx)) != COA_OK) {
+        REJECT(rc, "plan: utime stale, in the future or not positive");
+    }
+    if (!id_ok(msg->coordinator_id)) {
+        REJECT(COA_LCM_ERR_ID, "plan: coordinator_id not in 1..65535");
+    }
+    if (msg->plan_id < 0) {
+        REJECT(COA_LCM_ERR_VALUE, "plan: plan_id negative");
+    }
+    if ((rc = related_time_rule(msg->valid_from_utime, msg->utime, ctx)) != COA_OK) {
+        REJECT(rc, "plan: valid_from_utime not positive or too far from utime");
+    }
+    if (msg->valid_until_utime <= msg->valid_from_utime ||
+        related_time_rule(msg->valid_until_utime, msg->utime, ctx) != COA_OK) {
+        REJECT(COA_LCM_ERR_TIME, "plan: valid_until_utime not after valid_from_utime or too far");
+    }
+    if ((rc = number_rule(msg->dt, COA_LCM_MAX_STEP)) != COA_OK || !(msg->dt > 0.0)) {
+        REJECT(rc != COA_OK ? rc : COA_LCM_ERR_VALUE, "plan: dt not in (0, 3600] s");
+    }
+    if (msg->horizon < 1 || msg->horizon > COAVOID_PLAN_T_MAX_SAMPLES - 1) {
+        REJECT(COA_LCM_ERR_COUNT, "plan: horizon not in 1..MAX_SAMPLES-1");
+    }
+    if (msg->mode != COAVOID_PLAN_T_MODE_CENTRALISED && msg->mode != COAVOID_PLAN_T_MODE_DECOUPLED) {
+        REJECT(COA_LCM_ERR_ENUM, "plan: unknown mode");
+    }
+    if (msg->status != COAVOID_PLAN_T_STATUS_SOLVED && msg->status != COAVOID_PLAN_T_STATUS_INFEASIBLE &&
+        msg->status != COAVOID_PLAN_T_STATUS_BUDGET_EXHAUSTED) {
+        REJECT(COA_LCM_ERR_ENUM, "plan: unknown status");
+    }
+    if ((rc = number_rule(msg->deviation, 1.0e300)) != COA_OK || msg->deviation < 0.0) {
+        REJECT(rc != COA_OK ? rc : COA_LCM_ERR_VALUE, "plan: deviation negative or non-finite");
+    }
+    if (msg->effort < 0) {
+        REJECT(COA_LCM_ERR_VALUE, "plan: effort negative");
+    }
+    if (msg->nodes_expanded < 0) {
+        REJECT(COA_LCM_ERR_VALUE, "plan: nodes_expanded negative");
+    }
+    if (msg->vehicle_count < 1 || msg->vehicle_count > COAVOID_PLAN_T_MAX_VEHICLES) {
+        REJECT(COA_LCM_ERR_COUNT, "plan: vehicle_count not in 1..MAX_VEHICLES");
+    }
+    if (msg->planned_count < 0 || msg->planned_count > msg->vehicle_count ||
+        (msg->status == COAVOID_PLAN_T_STATUS_SOLVED && msg->planned_count != msg->vehicle_count)) {
+        REJECT(COA_LCM_ERR_COUNT, "plan: planned_count not in 0..vehicle_count (all when solved)");
+    }
+    for (i = 0; i < msg->vehicle_count; ++i) {
+        if (!id_ok(msg->uav_ids[i])) {
+            REJECT(COA_LCM_ERR_ID, "plan: a uav_id not in 1..65535");
+        }
+        for (j = 0; j < i; ++j) {
+            if (msg->uav_ids[j] == msg->uav_ids[i]) {
+                REJECT(COA_LCM_ERR_ID, "plan: a uav_id repeated");
+            }
+        }
+    }
+    for (i = 0; i < msg->planned_count; ++i) {
+        for (k = 0; k <= msg->horizon; ++k) {
+            int32_t o = msg->offsets[i][k];
+            if (o > COA_MAX_OFFSET || o < -COA_MAX_OFFSET) {
+                REJECT(COA_LCM_ERR_VALUE, "plan: an offset beyond COA_MAX_OFFSET");
+            }
+            /* No action moves more than the largest steep factor in one step. */
+            if (k > 0) {
+                int32_t d = o - msg->offsets[i][k - 1];
+                if (d > (int32_t)COA_MAX_STEEP_FACTOR || d < -(int32_t)COA_MAX_STEEP_FACTOR) {
+                    REJECT(COA_LCM_ERR_VALUE, "plan: an offset step no action makes");
+                }
+            }
+        }
+    }
+    OK_REASON();
+    return COA_OK;
+}
+
+int coa_lcm_plan_to_core(const coavoid_plan_t *msg, const coa_lcm_context_t *ctx,
+                         coa_lcm_sequence_table_t *seq, coa_lcm_plan_info_t *info,
+                         coa_plan_result_t *result, int32_t *offsets, size_t capacity,
+                         const char **reason)
+{
+    int rc;
+    size_t i;
+    size_t k;
+    size_t n;
+    size_t samples;
+    if (info == NULL || result == NULL || offsets == NULL) {
+        REJECT(COA_ERR_ARGUMENT, "plan: NULL output");
+    }
+    if ((rc = coa_lcm_plan_check(msg, ctx, reason)) != COA_OK) {
+        return rc;
+    }
+    n = (size_t)msg->vehicle_count;
+    samples = (size_t)msg->horizon + 1u;
+    if (n * samples > capacity) {
+        REJECT(COA_LCM_ERR_CAPACITY, "plan: more offsets than the caller's array holds");
+    }
+    if ((rc = sequence_rule(seq, msg->coordinator_id, msg->plan_id, false, reason,
+                            "plan: plan_id not after the last one from this coordinator",
+                            "plan: sequence table full")) != COA_OK) {
+        return rc;
+    }
+    memset(info, 0, sizeof *info);
+    memset(result, 0, sizeof *result);
+    info->utime = msg->utime;
+    info->coordinator_id = (uint32_t)msg->coordinator_id;
+    info->plan_id = msg->plan_id;
+    info->valid_from = core_time(msg->valid_from_utime, ctx);
+    info->valid_until = core_time(msg->valid_until_utime, ctx);
+    info->dt = (coa_real_t)msg->dt;
+    info->horizon = (uint32_t)msg->horizon;
+    info->mode = msg->mode;
+    info->vehicle_count = n;
+    for (i = 0; i < n; ++i) {
+        info->uav_ids[i] = (uint16_t)msg->uav_ids[i];
+        result->order[i] = i;
+        for (k = 0; k < samples; ++k) {
+            offsets[i * samples + k] = (i < (size_t)msg->planned_count) ? msg->offsets[i][k] : 0;
+        }
+    }
+    result->status = (coa_plan_status_t)msg->status;
+    result->deviation = msg->deviation;
+    result->effort = (uint32_t)msg->effort;
+    result->nodes_expanded = (uint64_t)msg->nodes_expanded;
+    result->planned_count = (size_t)msg->planned_count;
+    result->failed_vehicle = (result->planned_count < n) ? result->planned_count : COA_NO_VEHICLE;
+    OK_REASON();
+    return COA_OK;
+}
+
+int coa_lcm_plan_from_core(const coa_lcm_plan_info_t *info, const coa_plan_result_t *result,
+                           const int32_t *offsets, const coa_lcm_context_t *ctx,
+                           coavoid_plan_t *msg, const char **reason)
+{
+    size_t i;
+    size_t k;
+    size_t n;
+    size_t samples;
+    if (info == NULL || result == NULL || offsets == NULL || msg == NULL) {
+        REJECT(COA_ERR_ARGUMENT, "plan: NULL argument");
+    }
+    n = info->vehicle_count;
+    if (n < 1u || n > (size_t)COAVOID_PLAN_T_MAX_VEHICLES || result->planned_count > n) {
+        REJECT(COA_LCM_ERR_COUNT, "plan: vehicle_count not in 1..MAX_VEHICLES");
+    }
+    if (info->horizon < 1u || info->horizon > (uint32_t)COAVOID_PLAN_T_MAX_SAMPLES - 1u) {
+        REJECT(COA_LCM_ERR_COUNT, "plan: horizon not in 1..MAX_SAMPLES-1");
+    }
+    if (result->effort > (uint32_t)INT32_MAX || result->nodes_expanded > (uint64_t)INT64_MAX ||
+        info->coordinator_id > (uint32_t)COA_LCM_MAX_ID) {
+        REJECT(COA_LCM_ERR_VALUE, "plan: a number too large for the message");
+    }
+    samples = (size_t)info->horizon + 1u;
+    memset(msg, 0, sizeof *msg);
+    msg->utime = info->utime;
+    msg->coordinator_id = (int32_t)info->coordinator_id;
+    msg->plan_id = info->plan_id;
+    msg->valid_from_utime = utime_of(info->valid_from, ctx);
+    msg->valid_until_utime = utime_of(info->valid_until, ctx);
+    msg->dt = (double)info->dt;
+    msg->horizon = (int32_t)info->horizon;
+    msg->mode = info->mode;
+    msg->status = (int8_t)result->status;
+    msg->deviation = result->deviation;
+    msg->effort = (int32_t)result->effort;
+    msg->nodes_expanded = (int64_t)result->nodes_expanded;
+    msg->vehicle_count = (int32_t)n;
+    msg->planned_count = (int32_t)result->planned_count;
+    for (i = 0; i < n; ++i) {
+        size_t v = result->order[i];
+        if (v >= n) {
+            REJECT(COA_ERR_ARGUMENT, "plan: result order names no vehicle");
+        }
+        msg->uav_ids[i] = info->uav_ids[v];
+        if (i < result->planned_count) {
+            for (k = 0; k < samples; ++k) {
+                msg->offsets[i][k] = offsets[v * samples + k];
+            }
+        }
+    }
+    return coa_lcm_plan_check(msg, ctx, reason);
+}
+
+/* ---- track ---- */
+
+int coa_lcm_track_check(const coavoid_track_t *msg, const coa_lcm_context_t *ctx,
+                        const char **reason)
+{
+    int rc;
+    int32_t j;
+    if (msg == NULL) {
+        REJECT(COA_ERR_ARGUMENT, "track: NULL");
+    }
+    if ((rc = utime_rule(msg->utime, ctx)) != COA_OK) {
+        REJECT(rc, "track: utime stale, in the future or not positive");
+    }
+    if (!id_ok(msg->source_id)) {
+        REJECT(COA_LCM_ERR_ID, "track: source_id not in 1..65535");
+    }
+    if (msg->sequence < 0) {
+        REJECT(COA_LCM_ERR_VALUE, "track: sequence negative");
+    }
+    if (msg->track_id < 1) {
+        REJECT(COA_LCM_ERR_ID, "track: track_id < 1");
+    }
+    if ((rc = related_time_rule(msg->estimate_utime, msg->utime, ctx)) != COA_OK) {
+        REJECT(rc, "track: estimate_utime not positive or too far from utime");
+    }
+    if ((rc = vec_rule(msg->position, COA_LCM_MAX_COORDINATE)) != COA_OK) {
+        REJECT(rc, "track: position non-finite or out of range");
+    }
+    if ((rc = vec_rule(msg->velocity, COA_LCM_MAX_SPEED)) != COA_OK) {
+        REJECT(rc, "track: velocity non-finite or out of range");
+    }
+    if ((rc = size_rule(msg->radius, true)) != COA_OK) {
+        REJECT(rc, "track: radius not in (0, 1e5] m");
+    }
+    if ((rc = size_rule(msg->half_height, true)) != COA_OK) {
+        REJECT(rc, "track: half_height not in (0, 1e5] m");
+    }
+    if (msg->path_count < 0 || msg->path_count > COAVOID_TRACK_T_MAX_PATH) {
+        REJECT(COA_LCM_ERR_COUNT, "track: path_count not in 0..MAX_PATH");
+    }
+    for (j = 0; j < msg->path_count; ++j) {
+        if (related_time_rule(msg->path_utime[j], msg->utime, ctx) != COA_OK) {
+            REJECT(COA_LCM_ERR_TIME, "track: a path time not positive or too far from utime");
+        }
+        if (j > 0 && msg->path_utime[j] <= msg->path_utime[j - 1]) {
+            REJECT(COA_LCM_ERR_TIME, "track: path times not strictly ascending");
+        }
+        if ((rc = vec_rule(msg->path[j], COA_LCM_MAX_COORDINATE)) != COA_OK) {
+            REJECT(rc, "track: a path point non-finite or out of range");
+        }
+    }
+    if ((rc = size_rule(msg->sigma_horizontal, false)) != COA_OK) {
+        REJECT(rc, "track: sigma_horizontal not in [0, 1e5] m");
+    }
+    if ((rc = size_rule(msg->sigma_vertical, false)) != COA_OK) {
+        REJECT(rc, "track: sigma_vertical not in [0, 1e5] m");
+    }
+    OK_REASON();
+    return COA_OK;
+}
+
+int coa_lcm_track_to_core(const coavoid_track_t *msg, const coa_lcm_context_t *ctx,
+                          coa_lcm_sequence_table_t *seq, coa_lcm_track_info_t *info,
+                          coa_track_t *track, coa_track_point_t *path, size_t capacity,
+                          const char **reason)
+{
+    int rc;
+    int32_t j;
+    double tau;
+    if (info == NULL || track == NULL || (path == NULL && capacity > 0u)) {
+        REJECT(COA_ERR_ARGUMENT, "track: NULL output");
+    }
+    if ((rc = coa_lcm_track_check(msg, ctx, reason)) != COA_OK) {
+        return rc;
+    }
+    if ((size_t)msg->path_count > capacity) {
+        REJECT(COA_LCM_ERR_CAPACITY, "track: more path points than the caller's array holds");
+    }
+    /* The core predicts from position at t = 0 of its clock: move the estimate there.
+     * Both the epoch and the estimate are caller-bounded, so this stays finite. */
+    tau = (double)core_time(msg->estimate_utime, ctx);
+    {
+        double p[3];
+        int a;
+        for (a = 0; a < 3; ++a) {
+            p[a] = msg->position[a] - msg->velocity[a] * tau;
+            if (!isfinite(p[a])) {
+                REJECT(COA_LCM_ERR_VALUE, "track: position at the core epoch overflows");
+            }
+        }
+        track->position = vec_of(p);
+    }
+    if ((rc = sequence_rule(seq, msg->source_id, msg->sequence, false, reason,
+                            "track: sequence not after the last one from this source",
+                            "track: sequence table full")) != COA_OK) {
+        return rc;
+    }
+    for (j = 0; j < msg->path_count; ++j) {
+        path[j].t = core_time(msg->path_utime[j], ctx);
+        path[j].p = vec_of(msg->path[j]);
+    }
+    track->id = (uint32_t)msg->track_id;
+    track->volume.radius = (coa_real_t)msg->radius;
+    track->volume.half_height = (coa_real_t)msg->half_height;
+    track->velocity = vec_of(msg->velocity);
+    track->path = (msg->path_count > 0) ? path : NULL;
+    track->path_count = (size_t)msg->path_count;
+    track->sigma_horizontal = (coa_real_t)msg->sigma_horizontal;
+    track->sigma_vertical = (coa_real_t)msg->sigma_vertical;
+    info->utime = msg->utime;
+    info->source_id = (uint32_t)msg->source_id;
+    info->sequence = msg->sequence;
+    OK_REASON();
+    return COA_OK;
+}
+
+int coa_lcm_track_from_core(const coa_track_t *track, const coa_lcm_track_info_t *info,
+                            const coa_lcm_context_t *ctx, coavoid_track_t *msg,
+                            const char **reason)
+{
+    size_t j;
+    if (track == NULL || info == NULL || msg == NULL ||
+        (track->path == NULL && track->path_count > 0u)) {
+        REJECT(COA_ERR_ARGUMENT, "track: NULL argument");
+    }
+    if (track->path_count > (size_t)COAVOID_TRACK_T_MAX_PATH) {
+        REJECT(COA_LCM_ERR_COUNT, "track: path_count not in 0..MAX_PATH");
+    }
+    if (track->id > (uint32_t)INT32_MAX || info->source_id > (uint32_t)COA_LCM_MAX_ID) {
+        REJECT(COA_LCM_ERR_ID, "track: id too large for the message");
+    }
+    memset(msg, 0, sizeof *msg);
+    msg->utime = info->utime;
+    msg->source_id = (int32_t)info->source_id;
+    msg->sequence = info->sequence;
+    msg->track_id = (int32_t)track->id;
+    /* The core's position is at its t = 0: publish it as an estimate at the epoch. */
+    msg->estimate_utime = (ctx != NULL) ? ctx->epoch_utime : 0;
+    vec_to(track->position, msg->position);
+    vec_to(track->velocity, msg->velocity);
+    msg->radius = (double)track->volume.radius;
+    msg->half_height = (double)track->volume.half_height;
+    msg->path_count = (int32_t)track->path_count;
+    for (j = 0; j < track->path_count; ++j) {
+        msg->path_utime[j] = utime_of(track->path[j].t, ctx);
+        vec_to(track->path[j].p, msg->path[j]);
+    }
+    msg->sigma_horizontal = (double)track->sigma_horizontal;
+    msg->sigma_vertical = (double)track->sigma_vertical;
+    return coa_lcm_track_check(msg, ctx, reason);
+}
+
+/* ---- obstacle map ---- */
+
+int coa_lcm_obstacle_map_check(const coavoid_obstacle_map_t *msg, const coa_lcm_context_t *ctx,
+                               const char **reason)
+{
+    int rc;
+    int32_t i;
+    int32_t j;
+    int a;
+    if (msg == NULL) {
+        REJECT(COA_ERR_ARGUMENT, "obstacle_map: NULL");
+    }
+    /* A map is latched and long-lived: only positivity, not age, applies to utime. */
+    if (msg->utime <= 0) {
+        REJECT(COA_LCM_ERR_TIME, "obstacle_map: utime not positive");
+    }
+    if (ctx != NULL && ctx->now_utime > 0 && ctx->max_future_us >= 0 && msg->utime > ctx->now_utime &&
+        msg->utime - ctx->now_utime > ctx->max_future_us) {
+        REJECT(COA_LCM_ERR_TIME, "obstacle_map: utime in the future");
+    }
+    if (!id_ok(msg->map_id)) {
+        REJECT(COA_LCM_ERR_ID, "obstacle_map: map_id not in 1..65535");
+    }
+    if (msg->version < 0) {
+        REJECT(COA_LCM_ERR_VALUE, "obstacle_map: version negative");
+    }
+    if (msg->box_count < 0 || msg->box_count > COAVOID_OBSTACLE_MAP_T_MAX_BOXES) {
+        REJECT(COA_LCM_ERR_COUNT, "obstacle_map: box_count not in 0..MAX_BOXES");
+    }
+    for (i = 0; i < msg->box_count; ++i) {
+        if ((rc = vec_rule(msg->box_min[i], COA_LCM_MAX_COORDINATE)) != COA_OK ||
+            (rc = vec_rule(msg->box_max[i], COA_LCM_MAX_COORDINATE)) != COA_OK) {
+            REJECT(rc, "obstacle_map: a box corner non-finite or out of range");
+        }
+        for (a = 0; a < 3; ++a) {
+            if (msg->box_min[i][a] > msg->box_max[i][a]) {
+                REJECT(COA_LCM_ERR_VALUE, "obstacle_map: a box with min > max");
+            }
+        }
+    }
+    if (msg->polytope_count < 0 || msg->polytope_count > COAVOID_OBSTACLE_MAP_T_MAX_POLYTOPES) {
+        REJECT(COA_LCM_ERR_COUNT, "obstacle_map: polytope_count not in 0..MAX_POLYTOPES");
+    }
+    for (i = 0; i < msg->polytope_count; ++i) {
+        if (msg->vertex_count[i] < 4 || msg->vertex_count[i] > COAVOID_OBSTACLE_MAP_T_MAX_VERTICES) {
+            REJECT(COA_LCM_ERR_COUNT, "obstacle_map: a vertex_count not in 4..MAX_VERTICES");
+        }
+        for (j = 0; j < msg->vertex_count[i]; ++j) {
+            if ((rc = vec_rule(msg->vertices[i][j], COA_LCM_MAX_COORDINATE)) != COA_OK) {
+                REJECT(rc, "obstacle_map: a vertex non-finite or out of range");
+            }
+        }
+    }
+    OK_REASON();
+    return COA_OK;
+}
+
+int coa_lcm_obstacle_map_to_core(const coavoid_obstacle_map_t *msg, const coa_lcm_context_t *ctx,
+                                 coa_lcm_sequence_table_t *seq, coa_obstacle_t *obstacles,
+                                 size_t capacity, size_t *count, coa_vec3_t *vertices,
+                                 size_t vertex_capacity, const char **reason)
+{
+    int rc;
+    int32_t i;
+    int32_t j;
+    size_t n = 0;
+    size_t used = 0;
+    size_t need = 0;
+    if (obstacles == NULL || count == NULL || (vertices == NULL && vertex_capacity > 0u)) {
+        REJECT(COA_ERR_ARGUMENT, "obstacle_map: NULL output");
+    }
+    if ((rc = coa_lcm_obstacle_map_check(msg, ctx, reason)) != COA_OK) {
+        return rc;
+    }
+    for (i = 0; i < msg->polytope_count; ++i) {
+        need += (size_t)msg->vertex_count[i];
+    }
+    if ((size_t)msg->box_count + (size_t)msg->polytope_count > capacity || need > vertex_capacity) {
+        REJECT(COA_LCM_ERR_CAPACITY, "obstacle_map: more obstacles than the caller's arrays hold");
+    }
+    if ((rc = sequence_rule(seq, msg->map_id, msg->version, true, reason,
+                            "obstacle_map: version lower than one already seen",
+                            "obstacle_map: sequence table full")) != COA_OK) {
+        return rc;
+    }
+    for (i = 0; i < msg->box_count; ++i, ++n) {
+        memset(&obstacles[n], 0, sizeof obstacles[n]);
+        obstacles[n].kind = COA_OBSTACLE_BOX;
+        obstacles[n].box.min = vec_of(msg->box_min[i]);
+        obstacles[n].box.max = vec_of(msg->box_max[i]);
+    }
+    for (i = 0; i < msg->polytope_count; ++i, ++n) {
+        memset(&obstacles[n], 0, sizeof obstacles[n]);
+        obstacles[n].kind = COA_OBSTACLE_POLYTOPE;
+        obstacles[n].polytope.vertices = &vertices[used];
+        obstacles[n].polytope.count = (size_t)msg->vertex_count[i];
+        for (j = 0; j < msg->vertex_count[i]; ++j) {
+            vertices[used++] = vec_of(msg->vertices[i][j]);
+        }
+    }
+    *count = n;
+    OK_REASON();
+    return COA_OK;
+}
+
+int coa_lcm_obstacle_map_from_core(const coa_obstacle_t *obstacles, size_t count, int64_t utime,
+                                   uint32_t map_id, int64_t version, const coa_lcm_context_t *ctx,
+                                   coavoid_obstacle_map_t *msg, const char **reason)
+{
+    size_t i;
+    size_t j;
+    int32_t boxes = 0;
+    int32_t polys = 0;
+    if ((obstacles == NULL && count > 0u) || msg == NULL) {
+        REJECT(COA_ERR_ARGUMENT, "obstacle_map: NULL argument");
+    }
+    if (map_id > (uint32_t)COA_LCM_MAX_ID) {
+        REJECT(COA_LCM_ERR_ID, "obstacle_map: map_id not in 1..65535");
+    }
+    memset(msg, 0, sizeof *msg);
+    msg->utime = utime;
+    msg->map_id = (int32_t)map_id;
+    msg->version = version;
+    for (i = 0; i < count; ++i) {
+        const coa_obstacle_t *o = &obstacles[i];
+        if (o->kind == COA_OBSTACLE_BOX) {
+            if (boxes >= COAVOID_OBSTACLE_MAP_T_MAX_BOXES) {
+                REJECT(COA_LCM_ERR_COUNT, "obstacle_map: more than MAX_BOXES boxes");
+            }
+            vec_to(o->box.min, msg->box_min[boxes]);
+            vec_to(o->box.max, msg->box_max[boxes]);
+            boxes++;
+        } else if (o->kind == COA_OBSTACLE_POLYTOPE) {
+            if (polys >= COAVOID_OBSTACLE_MAP_T_MAX_POLYTOPES ||
+                o->polytope.count > (size_t)COAVOID_OBSTACLE_MAP_T_MAX_VERTICES ||
+                o->polytope.vertices == NULL) {
+                REJECT(COA_LCM_ERR_COUNT, "obstacle_map: too many polytopes or vertices");
+            }
+            msg->vertex_count[polys] = (int32_t)o->polytope.count;
+            for (j = 0; j < o->polytope.count; ++j) {
+                vec_to(o->polytope.vertices[j], msg->vertices[polys][j]);
+            }
+            polys++;
+        } else {
+            REJECT(COA_LCM_ERR_ENUM, "obstacle_map: unknown obstacle kind");
+        }
+    }
+    msg->box_count = boxes;
+    msg->polytope_count = polys;
+    return coa_lcm_obstacle_map_check(msg, ctx, reason);
+}
+
+/* ---- conflict report ---- */
+
+int coa_lcm_conflict_report_check(const coavoid_conflict_report_t *msg,
+                                  const coa_lcm_context_t *ctx, const char **reason)
+{
+    int rc;
+    int32_t i;
+    if (msg == NULL) {
+        REJECT(COA_ERR_ARGUMENT, "conflict_report: NULL");
+    }
+    if ((rc = utime_rule(msg->utime, ctx)) != COA_OK) {
+        REJECT(rc, "conflict_report: utime stale, in the future or not positive");
+    }
+    if (!id_ok(msg->reporter_id)) {
+        REJECT(COA_LCM_ERR_ID, "conflict_report: reporter_id not in 1..65535");
+    }
+    if (msg->sequence < 0) {
+        REJECT(COA_LCM_ERR_VALUE, "conflict_report: sequence negative");
+    }
+    if ((rc = related_time_rule(msg->prediction_utime, msg->utime, ctx)) != COA_OK) {
+        REJECT(rc, "conflict_report: prediction_utime not positive or too far from utime");
+    }
+    if ((rc = number_rule(msg->dt, COA_LCM_MAX_STEP)) != COA_OK || !(msg->dt > 0.0)) {
+        REJECT(rc != COA_OK ? rc : COA_LCM_ERR_VALUE, "conflict_report: dt not in (0, 3600] s");
+    }
+    if (msg->horizon < 1 || msg->horizon > (int32_t)COA_MAX_HORIZON) {
+        REJECT(COA_LCM_ERR_COUNT, "conflict_report: horizon not in 1..COA_MAX_HORIZON");
+    }
+    if (msg->conflict_count < 0 || msg->conflict_count > COAVOID_CONFLICT_REPORT_T_MAX_CONFLICTS ||
+        msg->conflicts_found < msg->conflict_count) {
+        REJECT(COA_LCM_ERR_COUNT, "conflict_report: conflict_count not in 0..MAX_CONFLICTS or > conflicts_found");
+    }
+    for (i = 0; i < msg->conflict_count; ++i) {
+        int8_t kind = msg->kind[i];
+        if (kind != COAVOID_CONFLICT_REPORT_T_KIND_VEHICLE && kind != COAVOID_CONFLICT_REPORT_T_KIND_TRACK &&
+            kind != COAVOID_CONFLICT_REPORT_T_KIND_OBSTACLE) {
+            REJECT(COA_LCM_ERR_ENUM, "conflict_report: unknown kind");
+        }
+        if (!id_ok(msg->a_id[i])) {
+            REJECT(COA_LCM_ERR_ID, "conflict_report: an a_id not in 1..65535");
+        }
+        if (msg->b_id[i] < 0 || (kind == COAVOID_CONFLICT_REPORT_T_KIND_VEHICLE &&
+                                 (!id_ok(msg->b_id[i]) || msg->b_id[i] == msg->a_id[i]))) {
+            REJECT(COA_LCM_ERR_ID, "conflict_report: a b_id invalid for its kind");
+        }
+        if (msg->first_step[i] < 0 || msg->first_step[i] >= msg->horizon) {
+            REJECT(COA_LCM_ERR_VALUE, "conflict_report: a first_step not in 0..horizon-1");
+        }
+        if ((rc = number_rule(msg->min_horizontal[i], COA_LCM_MAX_COORDINATE * 4.0)) != COA_OK ||
+            (rc = number_rule(msg->min_vertical[i], COA_LCM_MAX_COORDINATE * 4.0)) != COA_OK ||
+            msg->min_horizontal[i] < 0.0 || msg->min_vertical[i] < 0.0) {
+            REJECT(rc != COA_OK ? rc : COA_LCM_ERR_VALUE, "conflict_report: a distance negative or non-finite");
+        }
+        if (!isfinite(msg->probability[i])) {
+            REJECT(COA_LCM_ERR_NONFINITE, "conflict_report: a probability non-finite");
+        }
+        if (msg->probability[i] < 0.0 || msg->probability[i] > 1.0) {
+            REJECT(COA_LCM_ERR_VALUE, "conflict_report: a probability outside [0, 1]");
+        }
+        if (msg->cluster[i] < -1 || msg->cluster[i] >= COAVOID_CONFLICT_REPORT_T_MAX_CONFLICTS * 2) {
+            REJECT(COA_LCM_ERR_VALUE, "conflict_report: a cluster label out of range");
+        }
+    }
+    OK_REASON();
+    return COA_OK;
+}
+
+int coa_lcm_conflict_report_from_core(const coa_conflict_t *conflicts, size_t count,
+                                      size_t conflicts_found, const uint16_t *plan_ids,
+                                      size_t plan_count, const uint32_t *track_ids,
+                                      size_t track_count, const uint32_t *cluster,
+                                      int64_t utime, uint32_t reporter_id, int64_t sequence,
+                                      int64_t prediction_utime, coa_real_t dt, uint32_t horizon,
+                                      const coa_lcm_context_t *ctx,
+                                      coavoid_conflict_report_t *msg, const char **reason)
+{
+    size_t i;
+    size_t n;
+    if ((conflicts == NULL && count > 0u) || msg == NULL || (plan_ids == NULL && plan_count > 0u) ||
+        (track_ids == NULL && track_count > 0u)) {
+        REJECT(COA_ERR_ARGUMENT, "conflict_report: NULL argument");
+    }
+    if (reporter_id > (uint32_t)COA_LCM_MAX_ID || horizon > (uint32_t)INT32_MAX) {
+        REJECT(COA_LCM_ERR_VALUE, "conflict_report: reporter_id or horizon too large");
+    }
+    if (conflicts_found < count) {
+        conflicts_found = count;
+    }
+    n = count < (size_t)COAVOID_CONFLICT_REPORT_T_MAX_CONFLICTS ? count
+                                                                  : (size_t)COAVOID_CONFLICT_REPORT_T_MAX_CONFLICTS;
+    memset(msg, 0, sizeof *msg);
+    msg->utime = utime;
+    msg->reporter_id = (int32_t)reporter_id;
+    msg->sequence = sequence;
+    msg->prediction_utime = prediction_utime;
+    msg->dt = (double)dt;
+    msg->horizon = (int32_t)horizon;
+    msg->conflicts_found = conflicts_found > (size_t)INT32_MAX ? INT32_MAX : (int32_t)conflicts_found;
+    msg->conflict_count = (int32_t)n;
+    for (i = 0; i < n; ++i) {
+        const coa_conflict_t *c = &conflicts[i];
+        if (c->a >= plan_count) {
+            REJECT(COA_ERR_ARGUMENT, "conflict_report: a names no plan");
+        }
+        msg->kind[i] = (int8_t)c->kind;
+        msg->a_id[i] = plan_ids[c->a];
+        if (c->kind == COA_CONFLICT_VEHICLE) {
+            if (c->b >= plan_count) {
+                REJECT(COA_ERR_ARGUMENT, "conflict_report: b names no plan");
+            }
+            msg->b_id[i] = plan_ids[c->b];
+        } else if (c->kind == COA_CONFLICT_TRACK) {
+            if (c->b >= track_count || track_ids[c->b] > (uint32_t)INT32_MAX) {
+                REJECT(COA_ERR_ARGUMENT, "conflict_report: b names no track");
+            }
+            msg->b_id[i] = (int32_t)track_ids[c->b];
+        } else {
+            msg->b_id[i] = (c->b > (uint32_t)INT32_MAX) ? -1 : (int32_t)c->b;
+        }
+        msg->first_step[i] = (c->first_step > (uint32_t)INT32_MAX) ? -1 : (int32_t)c->first_step;
+        msg->min_horizontal[i] = (double)c->min_horizontal;
+        msg->min_vertical[i] = (double)c->min_vertical;
+        msg->probability[i] = c->probability;
+        msg->cluster[i] = (cluster == NULL || cluster[c->a] == COA_NO_CLUSTER ||
+                           cluster[c->a] > (uint32_t)INT32_MAX)
+                              ? -1
+                              : (int32_t)cluster[c->a];
+    }
+    return coa_lcm_conflict_report_check(msg, ctx, reason);
+}
+
+int coa_lcm_conflict_report_accept(const coavoid_conflict_report_t *msg,
+                                   const coa_lcm_context_t *ctx, coa_lcm_sequence_table_t *seq,
+                                   const char **reason)
+{
+    int rc = coa_lcm_conflict_report_check(msg, ctx, reason);
+    if (rc != COA_OK) {
+        return rc;
+    }
+    return sequence_rule(seq, msg->reporter_id, msg->sequence, false, reason,
+                         "conflict_report: sequence not after the last one from this reporter",
+                         "conflict_report: sequence table full");
+}
+
+/* ---- status ---- */
+
+int coa_lcm_status_check(const coavoid_status_t *msg, const coa_lcm_context_t *ctx,
+                         const char **reason)
+{
+    int rc;
+    if (msg == NULL) {
+        REJECT(COA_ERR_ARGUMENT, "status: NULL");
+    }
+    if ((rc = utime_rule(msg->utime, ctx)) != COA_OK) {
+        REJECT(rc, "status: utime stale, in the future or not positive");
+    }
+    if (!id_ok(msg->node_id)) {
+        REJECT(COA_LCM_ERR_ID, "status: node_id not in 1..65535");
+    }
+    if (msg->node_kind != COAVOID_STATUS_T_NODE_COORDINATOR && msg->node_kind != COAVOID_STATUS_T_NODE_VEHICLE) {
+        REJECT(COA_LCM_ERR_ENUM, "status: unknown node_kind");
+    }
+    if (msg->sequence < 0) {
+        REJECT(COA_LCM_ERR_VALUE, "status: sequence negative");
+    }
+    if (msg->health != COAVOID_STATUS_T_HEALTH_OK && msg->health != COAVOID_STATUS_T_HEALTH_DEGRADED &&
+        msg->health != COAVOID_STATUS_T_HEALTH_FAULT) {
+        REJECT(COA_LCM_ERR_ENUM, "status: unknown health");
+    }
+    if (msg->mode != COAVOID_STATUS_T_MODE_CENTRALISED && msg->mode != COAVOID_STATUS_T_MODE_DECOUPLED &&
+        msg->mode != COAVOID_STATUS_T_MODE_REFERENCE) {
+        REJECT(COA_LCM_ERR_ENUM, "status: unknown mode");
+    }
+    if (msg->outcome != COAVOID_STATUS_T_OUTCOME_SOLVED && msg->outcome != COAVOID_STATUS_T_OUTCOME_INFEASIBLE &&
+        msg->outcome != COAVOID_STATUS_T_OUTCOME_BUDGET_EXHAUSTED && msg->outcome != COAVOID_STATUS_T_OUTCOME_NONE) {
+        REJECT(COA_LCM_ERR_ENUM, "status: unknown outcome");
+    }
+    if (msg->last_plan_utime < 0 || msg->last_plan_utime > msg->utime) {
+        REJECT(COA_LCM_ERR_TIME, "status: last_plan_utime negative or after utime");
+    }
+    if (msg->last_plan_duration_us < 0 || msg->nodes_expanded < 0 || msg->conflicts < 0) {
+        REJECT(COA_LCM_ERR_VALUE, "status: a negative duration, node count or conflict count");
+    }
+    if (msg->messages_received < 0 || msg->messages_rejected < 0 ||
+        msg->messages_rejected > msg->messages_received) {
+        REJECT(COA_LCM_ERR_COUNT, "status: messages_rejected not in 0..messages_received");
+    }
+    if (msg->last_reject_code > 0) {
+        REJECT(COA_LCM_ERR_VALUE, "status: last_reject_code positive");
+    }
+    OK_REASON();
+    return COA_OK;
+}
+
+int coa_lcm_status_accept(const coavoid_status_t *msg, const coa_lcm_context_t *ctx,
+                          coa_lcm_sequence_table_t *seq, const char **reason)
+{
+    int rc = coa_lcm_status_check(msg, ctx, reason);
+    if (rc != COA_OK) {
+        return rc;
+    }
+    return sequence_rule(seq, msg->node_id, msg->sequence, false, reason,
+                         "status: sequence not after the last one from this node",
+                         "status: sequence table full");
+}
