@@ -17,6 +17,7 @@
 #include <string.h>
 
 #include "coavoid/coavoid.h"
+#include "test_support.h"
 
 #ifndef __SIZEOF_INT128__
 #error "test_plan's cost oracle needs unsigned __int128 (a 64-bit GCC or Clang host)"
@@ -31,35 +32,6 @@ __extension__ typedef unsigned __int128 u128_t;
 #define MAXOBS 4u
 #define MAXTR 2u
 #define ROW(f) ((size_t)(f)->p.horizon + 1u)
-/* An assertion for the oracle's inner loops: Check logs the place of every ck_assert it
- * passes, which in a loop run millions of times costs more than the search itself. */
-#define REQUIRE(cond)                                                                       \
-    do {                                                                                    \
-        if (!(cond)) {                                                                      \
-            ck_abort_msg("%s:%d: %s", __FILE__, __LINE__, #cond);                          \
-        }                                                                                   \
-    } while (0)
-
-/* ------------------------------------------------------------------------------------ */
-/* Deterministic random numbers                                                          */
-
-static uint64_t splitmix(uint64_t *s)
-{
-    uint64_t z = (*s += 0x9e3779b97f4a7c15u);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9u;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebu;
-    return z ^ (z >> 31);
-}
-
-static double unif(uint64_t *s, double lo, double hi)
-{
-    return lo + (hi - lo) * ((double)(splitmix(s) >> 11) / 9007199254740992.0);
-}
-
-static uint32_t pick(uint64_t *s, uint32_t n)
-{
-    return (uint32_t)(splitmix(s) % n);
-}
 
 static coa_real_t R(double x)
 {

@@ -21,6 +21,7 @@
 
 #include "coavoid/coavoid.h"
 #include "coavoid/predict.h"
+#include "test_support.h"
 
 /* Strict C11 has no PI. */
 #define PI 3.14159265358979323846
@@ -42,35 +43,6 @@
 #define PROB_REL 1e-9
 #endif
 
-/* An assertion for inner loops: Check logs every ck_assert it passes, which in a loop run
- * a million times costs more than the code under test. */
-#define REQUIRE(cond)                                                                       \
-    do {                                                                                    \
-        if (!(cond)) {                                                                      \
-            ck_abort_msg("%s:%d: %s", __FILE__, __LINE__, #cond);                          \
-        }                                                                                   \
-    } while (0)
-
-/* ------------------------------------------------------------------------------------ */
-/* Deterministic random numbers                                                          */
-
-static uint64_t splitmix(uint64_t *s)
-{
-    uint64_t z = (*s += 0x9e3779b97f4a7c15u);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9u;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebu;
-    return z ^ (z >> 31);
-}
-
-static double unif(uint64_t *s, double lo, double hi)
-{
-    return lo + (hi - lo) * ((double)(splitmix(s) >> 11) / 9007199254740992.0);
-}
-
-static uint32_t pick(uint64_t *s, uint32_t n)
-{
-    return (uint32_t)(splitmix(s) % n);
-}
 
 /* Two independent standard normals (Box-Muller; u1 in (0, 1] so the log is finite). */
 static void normal_pair(uint64_t *s, double *z1, double *z2)

@@ -110,30 +110,6 @@ check() {
     fi
 }
 
-# expect_bad DESCRIPTION PATTERN ARGS...: coavoid ARGS exits 2, prints nothing on stdout
-# and exactly one stderr line that starts with "coavoid: " and contains PATTERN.
-expect_bad() {
-    local what=$1 pattern=$2
-    shift 2
-    "$bin" "$@" >"$tmp/out" 2>"$tmp/err"
-    local rc=$?
-    local lines
-    lines=$(wc -l <"$tmp/err")
-    if [ -n "${VERBOSE:-}" ]; then sed "s|$tmp/||" "$tmp/err"; fi
-    if [ "$rc" -ne 2 ]; then
-        fail "$what: exit $rc, expected 2 (stderr: $(head -c 300 "$tmp/err"))"
-    elif [ "$lines" -ne 1 ]; then
-        fail "$what: $lines lines on stderr, expected 1: $(head -c 600 "$tmp/err")"
-    elif ! grep -q '^coavoid: ' "$tmp/err"; then
-        fail "$what: stderr does not start with 'coavoid: ': $(cat "$tmp/err")"
-    elif ! grep -qF -- "$pattern" "$tmp/err"; then
-        fail "$what: stderr does not name '$pattern': $(cat "$tmp/err")"
-    elif [ -s "$tmp/out" ]; then
-        fail "$what: stdout is not empty"
-    else
-        pass
-    fi
-}
 
 # ---- the shipped scenarios ----
 
