@@ -100,25 +100,59 @@ const char *coa_lcm_error_name(int status);
 
 /* ---- intent ---- */
 
-/* What an intent carries beyond coa_intent_plan_t. */
+/* What an intent carries beyond the core's vehicle and plan. */
 typedef struct {
     int64_t utime;
     int64_t sequence;
-    uint32_t priority;
     int8_t mode;        /* COAVOID_INTENT_T_MODE_* */
     coa_vec3_t position;
     coa_vec3_t velocity;
+    int64_t plan_utime; /* time of sample 0 (us) */
+    coa_real_t step;    /* s */
+    coa_real_t sigma_horizontal;
+    coa_real_t sigma_vertical;
 } coa_lcm_intent_info_t;
 
+/* The arrays an intent's core view points into (9.7 kB in double): the caller's, so that
+ * nothing is allocated. */
+typedef struct {
+    coa_vec3_t reference[COAVOID_INTENT_T_MAX_SAMPLES];
+    coa_vec3_t samples[COAVOID_INTENT_T_MAX_SAMPLES]; /* reference + offset * dh */
+    int32_t offsets[COAVOID_INTENT_T_MAX_SAMPLES];
+} coa_lcm_intent_arrays_t;
+
+/* Every rule of intent_t (its .lcm file): times, id, priority, mode, finite and bounded
+ * state, volume and performance, sample count 2..MAX_SAMPLES, reference points that differ
+ * horizontally, offsets within |32767| and max_offset whose consecutive changes are
+ * actions, and positions that stay finite and bounded once the offsets are applied.
+ * Returns COA_OK or a COA_LCM_ERR_* with *reason naming the field. Cost O(sample_count). */
 int coa_lcm_intent_check(const coavoid_intent_t *msg, const coa_lcm_context_t *ctx,
                          const char **reason);
-/* samples: capacity >= msg->sample_count; plan->samples points into it. seq may be NULL
- * (no sequence rule). */
+
+/* The core's views of an intent, after the check and the sequence rule (seq may be NULL:
+ * no sequence rule):
+ *   - *vehicle: a coa_vehicle_t a planner can plan for over the intent's samples: id,
+ *     priority, speeds, steep factor, volume, max_offset, initial_offset = offsets[0],
+ *     and route = arrays->reference (sample_count points), so coa_vehicle_check accepts
+ *     it; plan it with dt = info->step and references[j] = arrays->reference[j].
+ *   - *plan: the positions as the predictor takes them, t0 on ctx's clock, samples =
+ *     arrays->samples computed as the planner computes positions (reference z +
+ *     (coa_real_t)offset * coa_climb_step(vehicle, step)).
+ * arrays must outlive both views. Errors as the check, plus COA_LCM_ERR_SEQUENCE /
+ * COA_LCM_ERR_SENDERS, COA_ERR_ARGUMENT for NULL outputs; outputs are unspecified on an
+ * error. Cost O(sample_count), no memory. */
 int coa_lcm_intent_to_core(const coavoid_intent_t *msg, const coa_lcm_context_t *ctx,
                            coa_lcm_sequence_table_t *seq, coa_lcm_intent_info_t *info,
-                           coa_intent_plan_t *plan, coa_vec3_t *samples, size_t capacity,
-                           const char **reason);
-int coa_lcm_intent_from_core(const coa_intent_plan_t *plan, const coa_lcm_intent_info_t *info,
+                           coa_vehicle_t *vehicle, coa_intent_plan_t *plan,
+                           coa_lcm_intent_arrays_t *arrays, const char **reason);
+
+/* An intent from a vehicle (its id, priority, volume, speeds, steep factor, max_offset;
+ * its route is not read), info, and `count` reference points with their offsets. The
+ * result is checked as a receiver would check it, so a node cannot publish what its
+ * peers refuse. Returns COA_OK, COA_ERR_ARGUMENT (NULL), COA_LCM_ERR_COUNT (count not in
+ * 2..MAX_SAMPLES) or the check's refusal. Cost O(count). */
+int coa_lcm_intent_from_core(const coa_vehicle_t *vehicle, const coa_lcm_intent_info_t *info,
+                             const coa_vec3_t *reference, const int32_t *offsets, size_t count,
                              const coa_lcm_context_t *ctx, coavoid_intent_t *msg,
                              const char **reason);
 
@@ -214,6 +248,24 @@ int coa_lcm_conflict_report_accept(const coavoid_conflict_report_t *msg,
                                    const char **reason);
 int coa_lcm_status_accept(const coavoid_status_t *msg, const coa_lcm_context_t *ctx,
                           coa_lcm_sequence_table_t *seq, const char **reason);
+
+/* ---- counting what arrives ---- */
+
+/* What a node received and refused since it started, for its status message. */
+typedef struct {
+    int64_t received;          /* messages handed to the node, decoded or not */
+    int64_t rejected;          /* refused by decoding or validation; <= received */
+    int32_t last_reject_code;  /* the last refusal's code (<= 0; 0: none yet) */
+    const char *last_reason;   /* its reason (static string), or "none" */
+} coa_lcm_rx_stats_t;
+
+/* Zeroes the counters. Cannot fail on non-NULL stats. */
+void coa_lcm_rx_init(coa_lcm_rx_stats_t *stats);
+
+/* Counts one received message whose decode-and-validate step returned rc (COA_OK or a
+ * refusal with its reason); saturates rather than wrapping. Cannot fail on non-NULL stats.
+ * Cost O(1). */
+void coa_lcm_rx_count(coa_lcm_rx_stats_t *stats, int rc, const char *reason);
 
 #ifdef __cplusplus
 }

@@ -220,6 +220,15 @@ static int sequence_rule(coa_lcm_sequence_table_t *seq, int32_t sender, int64_t 
 
 /* ---- intent ---- */
 
+/* The position of sample j as the planner computes it (plan.c, vehicle_sweep): the
+ * reference in core precision plus the offset times the core's climb step. */
+static coa_vec3_t intent_position(const coa_vec3_t *reference, int32_t offset, coa_real_t dh)
+{
+    coa_vec3_t p = *reference;
+    p.z += (coa_real_t)offset * dh;
+    return p;
+}
+
 int coa_lcm_intent_check(const coavoid_intent_t *msg, const coa_lcm_context_t *ctx,
                          const char **reason)
 {
@@ -256,18 +265,58 @@ int coa_lcm_intent_check(const coavoid_intent_t *msg, const coa_lcm_context_t *c
     if ((rc = size_rule(msg->half_height, true)) != COA_OK) {
         REJECT(rc, "intent: half_height not in (0, 1e5] m");
     }
+    if ((rc = number_rule(msg->cruise_speed, COA_LCM_MAX_SPEED)) != COA_OK || !(msg->cruise_speed > 0.0)) {
+        REJECT(rc != COA_OK ? rc : COA_LCM_ERR_VALUE, "intent: cruise_speed not in (0, 1e4] m/s");
+    }
+    if ((rc = number_rule(msg->climb_rate, COA_LCM_MAX_SPEED)) != COA_OK || !(msg->climb_rate > 0.0)) {
+        REJECT(rc != COA_OK ? rc : COA_LCM_ERR_VALUE, "intent: climb_rate not in (0, 1e4] m/s");
+    }
+    if (msg->steep_factor < 2 || msg->steep_factor > (int32_t)COA_MAX_STEEP_FACTOR) {
+        REJECT(COA_LCM_ERR_VALUE, "intent: steep_factor not in 2..10");
+    }
+    if (msg->max_offset < -1 || msg->max_offset > COA_MAX_OFFSET) {
+        REJECT(COA_LCM_ERR_VALUE, "intent: max_offset not in -1..32767");
+    }
     if ((rc = related_time_rule(msg->plan_utime, msg->utime, ctx)) != COA_OK) {
         REJECT(rc, "intent: plan_utime not positive or too far from utime");
     }
     if ((rc = number_rule(msg->step, COA_LCM_MAX_STEP)) != COA_OK || !(msg->step > 0.0)) {
         REJECT(rc != COA_OK ? rc : COA_LCM_ERR_VALUE, "intent: step not in (0, 3600] s");
     }
-    if (msg->sample_count < 1 || msg->sample_count > COAVOID_INTENT_T_MAX_SAMPLES) {
-        REJECT(COA_LCM_ERR_COUNT, "intent: sample_count not in 1..MAX_SAMPLES");
+    if (msg->sample_count < 2 || msg->sample_count > COAVOID_INTENT_T_MAX_SAMPLES) {
+        REJECT(COA_LCM_ERR_COUNT, "intent: sample_count not in 2..MAX_SAMPLES");
     }
-    for (j = 0; j < msg->sample_count; ++j) {
-        if ((rc = vec_rule(msg->samples[j], COA_LCM_MAX_COORDINATE)) != COA_OK) {
-            REJECT(rc, "intent: a sample non-finite or out of range");
+    {
+        /* Positions and the route rule are judged in the core's precision, as the
+         * planner and coa_vehicle_check will see them. */
+        coa_real_t dh = (coa_real_t)msg->climb_rate * (coa_real_t)msg->step;
+        int32_t bound = (msg->max_offset >= 0) ? msg->max_offset : COA_MAX_OFFSET;
+        coa_vec3_t previous = {0, 0, 0};
+        for (j = 0; j < msg->sample_count; ++j) {
+            coa_vec3_t r;
+            coa_vec3_t p;
+            int32_t o = msg->offsets[j];
+            if ((rc = vec_rule(msg->reference[j], COA_LCM_MAX_COORDINATE)) != COA_OK) {
+                REJECT(rc, "intent: a reference point non-finite or out of range");
+            }
+            r = vec_of(msg->reference[j]);
+            if (j > 0 && r.x == previous.x && r.y == previous.y) {
+                REJECT(COA_LCM_ERR_VALUE, "intent: consecutive reference points without horizontal separation");
+            }
+            if (o < -bound || o > bound) {
+                REJECT(COA_LCM_ERR_VALUE, "intent: an offset beyond max_offset or 32767");
+            }
+            if (j > 0) {
+                int32_t d = o - msg->offsets[j - 1];
+                if (d != 0 && d != 1 && d != -1 && d != msg->steep_factor && d != -msg->steep_factor) {
+                    REJECT(COA_LCM_ERR_VALUE, "intent: consecutive offsets differ by no action");
+                }
+            }
+            p = intent_position(&r, o, dh);
+            if (!isfinite((double)p.z) || fabs((double)p.z) > COA_LCM_MAX_COORDINATE) {
+                REJECT(COA_LCM_ERR_VALUE, "intent: a planned position out of range");
+            }
+            previous = r;
         }
     }
     if ((rc = size_rule(msg->sigma_horizontal, false)) != COA_OK) {
@@ -282,80 +331,101 @@ int coa_lcm_intent_check(const coavoid_intent_t *msg, const coa_lcm_context_t *c
 
 int coa_lcm_intent_to_core(const coavoid_intent_t *msg, const coa_lcm_context_t *ctx,
                            coa_lcm_sequence_table_t *seq, coa_lcm_intent_info_t *info,
-                           coa_intent_plan_t *plan, coa_vec3_t *samples, size_t capacity,
-                           const char **reason)
+                           coa_vehicle_t *vehicle, coa_intent_plan_t *plan,
+                           coa_lcm_intent_arrays_t *arrays, const char **reason)
 {
     int rc;
     int32_t j;
-    if (info == NULL || plan == NULL || samples == NULL) {
+    coa_real_t dh;
+    if (info == NULL || vehicle == NULL || plan == NULL || arrays == NULL) {
         REJECT(COA_ERR_ARGUMENT, "intent: NULL output");
     }
     if ((rc = coa_lcm_intent_check(msg, ctx, reason)) != COA_OK) {
         return rc;
-    }
-    if ((size_t)msg->sample_count > capacity) {
-        REJECT(COA_LCM_ERR_CAPACITY, "intent: more samples than the caller's array holds");
     }
     if ((rc = sequence_rule(seq, msg->uav_id, msg->sequence, false, reason,
                             "intent: sequence not after the last one from this UAV",
                             "intent: sequence table full")) != COA_OK) {
         return rc;
     }
+    memset(vehicle, 0, sizeof *vehicle);
+    vehicle->id = (uint16_t)msg->uav_id;
+    vehicle->priority = (uint32_t)msg->priority;
+    vehicle->cruise_speed = (coa_real_t)msg->cruise_speed;
+    vehicle->climb_rate = (coa_real_t)msg->climb_rate;
+    vehicle->steep_factor = (uint32_t)msg->steep_factor;
+    vehicle->volume.radius = (coa_real_t)msg->radius;
+    vehicle->volume.half_height = (coa_real_t)msg->half_height;
+    vehicle->route = arrays->reference;
+    vehicle->route_count = (size_t)msg->sample_count;
+    vehicle->initial_offset = msg->offsets[0];
+    vehicle->max_offset = msg->max_offset;
+    dh = coa_climb_step(vehicle, (coa_real_t)msg->step);
     for (j = 0; j < msg->sample_count; ++j) {
-        samples[j] = vec_of(msg->samples[j]);
+        arrays->reference[j] = vec_of(msg->reference[j]);
+        arrays->offsets[j] = msg->offsets[j];
+        arrays->samples[j] = intent_position(&arrays->reference[j], msg->offsets[j], dh);
     }
     memset(plan, 0, sizeof *plan);
     plan->id = (uint16_t)msg->uav_id;
-    plan->volume.radius = (coa_real_t)msg->radius;
-    plan->volume.half_height = (coa_real_t)msg->half_height;
+    plan->volume = vehicle->volume;
     plan->t0 = core_time(msg->plan_utime, ctx);
     plan->step = (coa_real_t)msg->step;
-    plan->samples = samples;
+    plan->samples = arrays->samples;
     plan->count = (size_t)msg->sample_count;
     plan->sigma_horizontal = (coa_real_t)msg->sigma_horizontal;
     plan->sigma_vertical = (coa_real_t)msg->sigma_vertical;
     info->utime = msg->utime;
     info->sequence = msg->sequence;
-    info->priority = (uint32_t)msg->priority;
     info->mode = msg->mode;
     info->position = vec_of(msg->position);
     info->velocity = vec_of(msg->velocity);
+    info->plan_utime = msg->plan_utime;
+    info->step = (coa_real_t)msg->step;
+    info->sigma_horizontal = plan->sigma_horizontal;
+    info->sigma_vertical = plan->sigma_vertical;
     OK_REASON();
     return COA_OK;
 }
 
-int coa_lcm_intent_from_core(const coa_intent_plan_t *plan, const coa_lcm_intent_info_t *info,
+int coa_lcm_intent_from_core(const coa_vehicle_t *vehicle, const coa_lcm_intent_info_t *info,
+                             const coa_vec3_t *reference, const int32_t *offsets, size_t count,
                              const coa_lcm_context_t *ctx, coavoid_intent_t *msg,
                              const char **reason)
 {
     size_t j;
-    if (plan == NULL || info == NULL || msg == NULL || (plan->samples == NULL && plan->count > 0u)) {
+    if (vehicle == NULL || info == NULL || msg == NULL || reference == NULL || offsets == NULL) {
         REJECT(COA_ERR_ARGUMENT, "intent: NULL argument");
     }
-    if (plan->count < 1u || plan->count > (size_t)COAVOID_INTENT_T_MAX_SAMPLES) {
-        REJECT(COA_LCM_ERR_COUNT, "intent: sample count not in 1..MAX_SAMPLES");
+    if (count < 2u || count > (size_t)COAVOID_INTENT_T_MAX_SAMPLES) {
+        REJECT(COA_LCM_ERR_COUNT, "intent: sample count not in 2..MAX_SAMPLES");
     }
-    if (info->priority > (uint32_t)INT32_MAX) {
-        REJECT(COA_LCM_ERR_VALUE, "intent: priority too large");
+    if (vehicle->priority > (uint32_t)INT32_MAX || vehicle->steep_factor > (uint32_t)INT32_MAX) {
+        REJECT(COA_LCM_ERR_VALUE, "intent: priority or steep factor too large");
     }
     memset(msg, 0, sizeof *msg);
     msg->utime = info->utime;
-    msg->uav_id = plan->id;
+    msg->uav_id = vehicle->id;
     msg->sequence = info->sequence;
-    msg->priority = (int32_t)info->priority;
+    msg->priority = (int32_t)vehicle->priority;
     msg->mode = info->mode;
     vec_to(info->position, msg->position);
     vec_to(info->velocity, msg->velocity);
-    msg->radius = (double)plan->volume.radius;
-    msg->half_height = (double)plan->volume.half_height;
-    msg->plan_utime = utime_of(plan->t0, ctx);
-    msg->step = (double)plan->step;
-    msg->sample_count = (int32_t)plan->count;
-    for (j = 0; j < plan->count; ++j) {
-        vec_to(plan->samples[j], msg->samples[j]);
+    msg->radius = (double)vehicle->volume.radius;
+    msg->half_height = (double)vehicle->volume.half_height;
+    msg->cruise_speed = (double)vehicle->cruise_speed;
+    msg->climb_rate = (double)vehicle->climb_rate;
+    msg->steep_factor = (int32_t)vehicle->steep_factor;
+    msg->max_offset = (vehicle->max_offset < 0) ? -1 : vehicle->max_offset;
+    msg->plan_utime = info->plan_utime;
+    msg->step = (double)info->step;
+    msg->sample_count = (int32_t)count;
+    for (j = 0; j < count; ++j) {
+        vec_to(reference[j], msg->reference[j]);
+        msg->offsets[j] = offsets[j];
     }
-    msg->sigma_horizontal = (double)plan->sigma_horizontal;
-    msg->sigma_vertical = (double)plan->sigma_vertical;
+    msg->sigma_horizontal = (double)info->sigma_horizontal;
+    msg->sigma_vertical = (double)info->sigma_vertical;
     return coa_lcm_intent_check(msg, ctx, reason);
 }
 
@@ -1060,4 +1130,34 @@ int coa_lcm_status_accept(const coavoid_status_t *msg, const coa_lcm_context_t *
     return sequence_rule(seq, msg->node_id, msg->sequence, false, reason,
                          "status: sequence not after the last one from this node",
                          "status: sequence table full");
+}
+
+/* ---- counting what arrives ---- */
+
+void coa_lcm_rx_init(coa_lcm_rx_stats_t *stats)
+{
+    if (stats == NULL) {
+        return;
+    }
+    stats->received = 0;
+    stats->rejected = 0;
+    stats->last_reject_code = 0;
+    stats->last_reason = "none";
+}
+
+void coa_lcm_rx_count(coa_lcm_rx_stats_t *stats, int rc, const char *reason)
+{
+    if (stats == NULL) {
+        return;
+    }
+    if (stats->received < INT64_MAX) {
+        stats->received++;
+    }
+    if (rc != COA_OK) {
+        if (stats->rejected < stats->received) {
+            stats->rejected++;
+        }
+        stats->last_reject_code = rc;
+        stats->last_reason = (reason != NULL) ? reason : coa_lcm_error_name(rc);
+    }
 }

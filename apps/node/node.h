@@ -1,0 +1,237 @@
+/*
+ * node.h: the coavoid nodes (a UAV, the ground coordinator, and the "world" that stands
+ * in for the terrain database and the tracker), written once and driven two ways:
+ *   - in real time over UDP multicast by apps/vehicle, apps/coordinator and
+ *     `coavoid world` (apps/node/realtime.h), one process each;
+ *   - deterministically in one process over LCM's memq provider by `coavoid sim`, which
+ *     calls the same functions at simulated times.
+ * A node never reads a clock: every call takes the time (utime, microseconds), and the
+ * message handlers read the driver's clock through the pointer given at init. So a
+ * simulation is repeatable bit for bit, and a real-time run is the same code.
+ *
+ * Time. All nodes share an epoch and the scenario's dt: cycle k starts at
+ *     cycle_utime(k) = epoch_utime + k * dt_us,   dt_us = llround(dt * 1e6),
+ * which is scenario time t_k = k * dt (a UAV's reference is sampled at k * dt exactly).
+ *
+ * One cycle (the closed loop of SCENARIO_FORMAT.md, "Simulation result"):
+ *   1. At cycle_utime(k) the world publishes the obstacle map and every track's estimate.
+ *   2. At cycle_utime(k) every UAV steps its simulated flight to sample k (the offset its
+ *      adopted plan gives for k; a plan past its end holds its last offset).
+ *      - centralised (a coordinator heartbeat heard within coordinator_timeout_us, or
+ *        still inside that time since start): it publishes its intent at once (reference
+ *        and offsets for samples k..k+N) and follows the coordinator;
+ *      - decoupled: it predicts over samples k..k+N with its own plan and its peers'
+ *        latest intents. With no conflict in its cluster (coa_predict_clusters over its
+ *        view) it publishes its intent at once. Otherwise it waits until every
+ *        higher-priority UAV of its cluster has published an intent for this cycle
+ *        (plan_utime == cycle_utime(k)), or until priority_wait_us has passed, then plans
+ *        for itself alone (one-UAV A*) against obstacles, tracks and the intents of every
+ *        UAV that is not a lower-priority member of its cluster (as moving obstacles, in
+ *        the planner's track form), adopts the plan when solved, and publishes its intent.
+ *        So a cluster plans in priority order, as coa_plan_decoupled does.
+ *   3. At cycle_utime(k) + collect_us the coordinator predicts over samples k..k+N from the
+ *      intents for this cycle, plans each conflicting cluster in one centralised search
+ *      (decoupled, in the coordinator, for a cluster larger than its workspace holds),
+ *      clusters in ascending order, each later cluster treating the new plans of the
+ *      earlier ones as moving obstacles; publishes one plan_t per cluster (valid_from =
+ *      cycle_utime(k), valid_until = cycle_utime(k + 1)), the conflict report, and its
+ *      heartbeat.
+ *   4. A UAV adopts a plan_t that lists it among the planned rows, is solved, is newer
+ *      than the last one adopted (plan_id), arrives before valid_until, has valid_from ==
+ *      the current cycle's start, and starts at the offset the UAV flies now; anything
+ *      else is not adopted (counted in status as rejected with the reason).
+ * Every node publishes its heartbeat (status_t) once per cycle.
+ *
+ * A peer whose last intent is older than stale_after_us is no longer a co-operative UAV
+ * to its receivers: they treat it as a non-cooperative track, extrapolated at constant
+ * velocity from the state in its last intent, with its sigma grown by
+ * stale_sigma_rate * age (the predictor then grows it further with look-ahead).
+ *
+ * Messages arrive through LCM subscriptions made at init; each is decoded and validated
+ * (src/lcm) with the driver's clock, counted, and stored (the latest intent per UAV, per
+ * track, the obstacle map, the coordinator's heartbeat); a refused message is counted in
+ * the node's status and otherwise ignored, never fatal.
+ *
+ * Memory: a node is one struct of fixed size plus the planner and predictor workspaces,
+ * allocated once by init and released by fini: nothing is allocated per cycle.
+ * Errors: negative codes (COA_ERR_*, COA_LCM_ERR_*); a failed planning call is not an
+ * error of the node (it keeps its plan, reports HEALTH_DEGRADED and the outcome).
+ */
+#ifndef COAVOID_APP_NODE_H
+#define COAVOID_APP_NODE_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <lcm/lcm.h>
+
+#include "coavoid/coavoid.h"
+#include "coavoid_lcm.h"
+
+#define COA_CHANNEL_INTENT "COAVOID_INTENT"
+#define COA_CHANNEL_PLAN "COAVOID_PLAN"
+#define COA_CHANNEL_TRACK "COAVOID_TRACK"
+#define COA_CHANNEL_OBSTACLES "COAVOID_OBSTACLES"
+#define COA_CHANNEL_CONFLICTS "COAVOID_CONFLICTS"
+#define COA_CHANNEL_STATUS "COAVOID_STATUS"
+
+/* Capacities of one node's view of the airspace. */
+#define COA_NODE_MAX_PEERS 64u      /* co-operative UAVs a node tracks, itself included */
+#define COA_NODE_MAX_TRACKS 32u     /* non-cooperative tracks */
+#define COA_NODE_MAX_HORIZON 127u   /* N: intent_t carries N + 1 samples */
+
+/* The world's id (map_id of the obstacle map, source_id of tracks) by default. */
+#define COA_NODE_WORLD_ID 65000u
+#define COA_NODE_COORDINATOR_ID 65001u
+
+typedef enum {
+    COA_NODE_CENTRALISED = 0, /* follow the coordinator; plan for itself when it is silent */
+    COA_NODE_DECOUPLED = 1    /* always plan for itself in priority order */
+} coa_node_mode_t;
+
+/* What every node shares. */
+typedef struct {
+    int64_t epoch_utime;    /* cycle 0 starts here; > 0 */
+    coa_real_t dt;          /* s, > 0: the scenario's dt */
+    int64_t dt_us;          /* llround(dt * 1e6), >= 1 */
+    uint32_t horizon;       /* N, 1..COA_NODE_MAX_HORIZON */
+    const int64_t *clock;   /* the driver's current utime, read by the message handlers */
+    /* Optional: a monotonic microsecond reader used only to measure how long planning
+     * took (status_t.last_plan_duration_us). NULL in simulation, where durations are 0 so
+     * that a run's output is repeatable. */
+    int64_t (*stopwatch_us)(void *user);
+    void *stopwatch_user;
+    /* Prediction: threshold and sigma growth per second of look-ahead (m/s), as
+     * coavoid predict; and the growth of a silent UAV's sigma per second since its last
+     * intent. */
+    double threshold;
+    coa_real_t vehicle_sigma_rate_horizontal;
+    coa_real_t vehicle_sigma_rate_vertical;
+    coa_real_t track_sigma_rate_horizontal;
+    coa_real_t track_sigma_rate_vertical;
+    coa_real_t stale_sigma_rate;
+    int64_t stale_after_us;     /* peer intent older than this: a track (default 2.5 dt) */
+    uint32_t beta;              /* closed-set bound of the node's planner */
+} coa_node_common_t;
+
+/* Fills c with the defaults for (epoch, dt, horizon, clock): threshold 0.01, no sigma
+ * growth, stale_after 2.5 cycles, stale_sigma_rate 1 m/s, beta 20000. Returns COA_OK or
+ * COA_ERR_ARGUMENT (dt, horizon, epoch or clock invalid). */
+int coa_node_common_defaults(coa_node_common_t *c, int64_t epoch_utime, coa_real_t dt,
+                             uint32_t horizon, const int64_t *clock);
+
+/* utime of cycle k's start, and the cycle a time falls in (floor; negative before epoch). */
+int64_t coa_node_cycle_utime(const coa_node_common_t *c, int64_t k);
+int64_t coa_node_cycle_of(const coa_node_common_t *c, int64_t utime);
+
+/* ---- vehicle ---- */
+
+typedef struct {
+    coa_node_common_t common;
+    coa_vehicle_t vehicle;          /* its route is the caller's and must outlive the node */
+    coa_node_mode_t mode;
+    int64_t coordinator_timeout_us; /* heartbeat silence before it plans for itself (default 2.5 dt) */
+    int64_t priority_wait_us;       /* bounded wait for higher-priority intents (default dt / 2) */
+    coa_real_t sigma_horizontal;    /* its own position uncertainty, published (default 0) */
+    coa_real_t sigma_vertical;
+} coa_vehicle_node_config_t;
+
+/* What a vehicle did; read by drivers, the simulation and tests. */
+typedef struct {
+    int64_t cycle;                  /* the current cycle k (-1 before the first) */
+    int32_t offset;                 /* offset flown at sample k */
+    coa_vec3_t reference;           /* reference at t_k */
+    coa_vec3_t position;            /* reference + offset * dh: where it is */
+    bool coordinated;               /* following the coordinator this cycle */
+    bool waiting;                   /* decoupled: still waiting for higher priorities */
+    bool published;                 /* published its intent for this cycle */
+    uint32_t plans_run;             /* its own planning calls since start */
+    uint32_t plans_adopted;         /* plans adopted (own and coordinator's) */
+    int last_outcome;               /* coa_plan_status_t of its last call, -1 none */
+    uint64_t last_nodes_expanded;
+    int64_t last_plan_duration_us;  /* measured by the driver's clock: 0 in simulation */
+    uint32_t conflicts;             /* conflicts in its last prediction */
+    uint32_t fallbacks;             /* switches from coordinated to own planning */
+    coa_lcm_rx_stats_t rx;
+} coa_vehicle_node_state_t;
+
+typedef struct coa_vehicle_node coa_vehicle_node_t;
+
+/* Creates a vehicle node publishing and subscribing on lcm (not owned). Allocates the node,
+ * its one-UAV planner (beta) and its predictor once. Returns NULL on bad config (invalid
+ * vehicle, horizon > COA_NODE_MAX_HORIZON, ...) or out of memory, with *error set. */
+coa_vehicle_node_t *coa_vehicle_node_create(const coa_vehicle_node_config_t *config, lcm_t *lcm,
+                                            int *error);
+/* Unsubscribes and frees. NULL is fine. */
+void coa_vehicle_node_destroy(coa_vehicle_node_t *node);
+
+/* Starts cycle k = coa_node_cycle_of(now): flies to sample k, then step 2 of the file
+ * comment. Calling it again within the same cycle does nothing. Returns COA_OK or a
+ * negative error (publishing failed, internal). */
+int coa_vehicle_node_cycle(coa_vehicle_node_t *node, int64_t now);
+
+/* Completes a decoupled wait once its condition holds at `now` (the intents arrived, or
+ * priority_wait_us has passed since the cycle began). Returns 1 when it planned and
+ * published, 0 when there was nothing to do or it still waits, negative on error. */
+int coa_vehicle_node_poll(coa_vehicle_node_t *node, int64_t now);
+
+/* The utime by which poll must be called again (the end of a wait), or INT64_MAX. */
+int64_t coa_vehicle_node_deadline(const coa_vehicle_node_t *node);
+
+const coa_vehicle_node_state_t *coa_vehicle_node_state(const coa_vehicle_node_t *node);
+
+/* ---- coordinator ---- */
+
+typedef struct {
+    coa_node_common_t common;
+    uint16_t id;                     /* default COA_NODE_COORDINATOR_ID */
+    size_t max_centralised;          /* largest cluster planned in one composite search
+                                        (1..COA_MAX_CENTRALISED; default 3); larger clusters
+                                        are planned decoupled by the coordinator */
+    int64_t collect_us;              /* after the cycle start, when it plans (default dt / 4) */
+} coa_coordinator_config_t;
+
+typedef struct {
+    int64_t cycle;
+    uint32_t conflicts;              /* in its last prediction */
+    uint32_t clusters_planned;       /* planning calls in the last cycle */
+    uint32_t plans_run;              /* planning calls since start */
+    uint32_t plans_published;        /* solved plans published since start */
+    int last_outcome;
+    uint64_t last_nodes_expanded;
+    int64_t last_plan_duration_us;
+    coa_lcm_rx_stats_t rx;
+} coa_coordinator_state_t;
+
+typedef struct coa_coordinator coa_coordinator_t;
+
+coa_coordinator_t *coa_coordinator_create(const coa_coordinator_config_t *config, lcm_t *lcm,
+                                          int *error);
+void coa_coordinator_destroy(coa_coordinator_t *node);
+/* Step 3 of the file comment for the cycle `now` falls in (call it at cycle start +
+ * collect_us). Once per cycle; again within one cycle does nothing. */
+int coa_coordinator_cycle(coa_coordinator_t *node, int64_t now);
+const coa_coordinator_state_t *coa_coordinator_state(const coa_coordinator_t *node);
+
+/* ---- world: the terrain database and the tracker of a scenario ---- */
+
+typedef struct {
+    coa_node_common_t common;
+    uint16_t id;                      /* map_id and track source_id; default COA_NODE_WORLD_ID */
+    const coa_obstacle_t *obstacles;  /* the caller's, outliving the node */
+    size_t obstacle_count;
+    const coa_track_t *tracks;        /* positions at scenario t = 0 (epoch) */
+    size_t track_count;
+} coa_world_config_t;
+
+typedef struct coa_world coa_world_t;
+
+coa_world_t *coa_world_create(const coa_world_config_t *config, lcm_t *lcm, int *error);
+void coa_world_destroy(coa_world_t *node);
+/* Step 1 of the file comment: the obstacle map (version 1, republished every cycle so that
+ * late joiners get it) and every track's estimate at the cycle's start (its position and
+ * velocity there; with the remaining path points of a path track). */
+int coa_world_cycle(coa_world_t *node, int64_t now);
+
+#endif /* COAVOID_APP_NODE_H */
