@@ -30,9 +30,10 @@ typedef struct {
     coa_vehicle_t vehicle;      /* as in the scenario (route, speeds, volume, priority) */
     coa_vec3_t *reference;      /* steps + 1: reference at t_k = k * dt */
     int32_t *offsets;           /* steps + 1: offset flown at t_k */
-    bool *known;                /* steps + 1, or NULL (all known): false where a log had
-                                   no intent for that sample (filled from earlier plans
-                                   when they covered it, else from the reference) */
+    bool *known;                /* steps + 1, or NULL (all known): false where no intent
+                                   in a log covered that sample (neither the cycle's own
+                                   nor an earlier plan reaching it): reference and offset
+                                   there are stand-ins, not what was flown */
 } coa_flight_vehicle_t;
 
 typedef struct {
@@ -60,17 +61,63 @@ typedef struct {
 } coa_flight_eval_t;
 
 /* Returns COA_OK, COA_ERR_ARGUMENT (a flown step is not an action, more than
- * COA_MAX_VEHICLES UAVs, steps out of range, NULL) or COA_ERR_WORKSPACE (out of memory). */
+ * COA_MAX_VEHICLES UAVs, steps out of range, NULL, or what coa_plan_find_conflict refuses:
+ * an invalid vehicle, obstacle or track, repeated ids, a non-finite sample) or
+ * COA_ERR_WORKSPACE (out of memory). When lost, first_vehicle and first_step are
+ * coa_plan_find_conflict's (the earliest step, the first UAV in conflict there); else
+ * first_vehicle is COA_NO_VEHICLE and first_step 0. Cost O(K n (n + obstacles + tracks))
+ * plus sampling the tracks; allocates O(K (n + tracks)) scratch. */
 int coa_flight_evaluate(const coa_flight_t *flight, coa_flight_eval_t *eval);
 
-/* Writes the SVG document to out. Returns COA_OK, COA_ERR_ARGUMENT, or COA_ERR_WORKSPACE
- * (out of memory or a write failed). */
+/* Where UAV i is at sample k when it flies `offset` there: reference[k] +
+ * (coa_real_t)offset * coa_climb_step(vehicle, dt) * z_hat, the planner's formula, so
+ * that every consumer of a record computes the same positions bit for bit.
+ * Preconditions: i < vehicle_count, k <= steps. Cost O(1). */
+coa_vec3_t coa_flight_position(const coa_flight_t *flight, size_t i, uint32_t k, int32_t offset);
+
+/* Which trajectories coa_flight_conflicts judges. */
+typedef enum {
+    COA_FLIGHT_FLOWN = 0,      /* offsets[k] at every sample: what was flown */
+    COA_FLIGHT_REFERENCE = 1   /* offsets[0] at every sample: the run without manoeuvres */
+} coa_flight_trajectory_t;
+
+/* One conflicting pair over one step. */
+typedef struct {
+    coa_conflict_kind_t kind;  /* what `other` indexes */
+    size_t vehicle;            /* UAV index */
+    size_t other;              /* a UAV index (> vehicle), a track or an obstacle index */
+    uint32_t step;             /* the interval [t_k, t_k+1] */
+} coa_flight_conflict_t;
+
+/* Every (pair, step) in conflict by the same geometry tests as coa_flight_evaluate (so
+ * with COA_FLIGHT_FLOWN the list is empty exactly when no separation was lost), ordered by
+ * step, then UAV, then UAV-UAV, track, obstacle pairs. Writes the first `capacity` to out
+ * (out may be NULL when capacity is 0) and the total to *found. Returns COA_OK,
+ * COA_ERR_ARGUMENT (as coa_flight_evaluate, except that steps need not be actions) or
+ * COA_ERR_WORKSPACE (out of memory). Cost O(K n (n + obstacles + tracks)); allocates the
+ * tracks' samples. */
+int coa_flight_conflicts(const coa_flight_t *flight, coa_flight_trajectory_t which,
+                         coa_flight_conflict_t *out, size_t capacity, size_t *found);
+
+/* Writes the SVG document to out: self-contained (no scripts, no external references).
+ * eval may be NULL (no result line). Returns COA_OK, COA_ERR_ARGUMENT (as
+ * coa_flight_conflicts, or a NULL flight or out), or COA_ERR_WORKSPACE (out of memory or
+ * a write failed). Cost O(K n (n + obstacles + tracks)); allocates O(K (n + tracks)). */
 int coa_flight_svg(const coa_flight_t *flight, const coa_flight_eval_t *eval, FILE *out);
 
 /* Writes the simulation result of SCENARIO_FORMAT.md ("Simulation result") as JSON:
  * scenario, mode, steps, replans, loss_of_separation, deviation, effort, and per UAV id and
- * flown (steps + 1 samples [t, x, y, z]). Returns COA_OK or COA_ERR_WORKSPACE (write
- * failed). */
+ * flown (steps + 1 samples [t, x, y, z]). Extra fields, beyond the contract: when lost,
+ * "first_loss": {"vehicle": id, "step": k, "t": s}; per UAV "deviation" and "effort" when
+ * eval has the per-vehicle arrays, and "unknown_samples" (samples no intent covered) when
+ * known is not NULL. Numbers round-trip (cJSON prints %.17g when %.15g does not). Returns
+ * COA_OK, COA_ERR_ARGUMENT (NULL, or an invalid record as coa_flight_conflicts) or
+ * COA_ERR_WORKSPACE (out of memory, write failed). Allocates the document while printing. */
 int coa_flight_json(const coa_flight_t *flight, const coa_flight_eval_t *eval, FILE *out);
+
+/* Writes the result for a reader, one fact a line ("loss of separation: no", "deviation:
+ * ... m^2", per UAV its costs), as `coavoid sim` and `coavoid summary` print it without
+ * --json. Returns COA_OK, COA_ERR_ARGUMENT (NULL) or COA_ERR_WORKSPACE (write failed). */
+int coa_flight_text(const coa_flight_t *flight, const coa_flight_eval_t *eval, FILE *out);
 
 #endif /* COAVOID_APP_FLIGHT_H */
