@@ -125,6 +125,9 @@ typedef struct {
  * state, volume and performance, sample count 2..MAX_SAMPLES, reference points that differ
  * horizontally, offsets within |32767| and max_offset whose consecutive changes are
  * actions, and positions that stay finite and bounded once the offsets are applied.
+ * Speeds, step, volume and route legs are also judged as the core sees them, in its
+ * precision (coa_vehicle_check, a positive deviation weight and climb step), so every
+ * accepted intent gives a vehicle the planner accepts.
  * Returns COA_OK or a COA_LCM_ERR_* with *reason naming the field. Cost O(sample_count). */
 int coa_lcm_intent_check(const coavoid_intent_t *msg, const coa_lcm_context_t *ctx,
                          const char **reason);
@@ -262,9 +265,10 @@ typedef struct {
 /* Zeroes the counters. Cannot fail on non-NULL stats. */
 void coa_lcm_rx_init(coa_lcm_rx_stats_t *stats);
 
-/* Counts one received message whose decode-and-validate step returned rc (COA_OK or a
- * refusal with its reason); saturates rather than wrapping. Cannot fail on non-NULL stats.
- * Cost O(1). */
+/* Counts one received message whose decode-and-validate step returned rc: a negative rc
+ * (COA_LCM_ERR_*, COA_ERR_*) is a refusal, recorded with its reason (NULL: the code's
+ * name); COA_OK or any rc >= 0 (a decoder's byte count) is an acceptance. Saturates rather
+ * than wrapping. Cannot fail on non-NULL stats. Cost O(1). */
 void coa_lcm_rx_count(coa_lcm_rx_stats_t *stats, int rc, const char *reason);
 
 #ifdef __cplusplus

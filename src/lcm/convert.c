@@ -229,6 +229,57 @@ static coa_vec3_t intent_position(const coa_vec3_t *reference, int32_t offset, c
     return p;
 }
 
+/* The vehicle a receiver builds from an intent, over `route`. One function for the check
+ * and for to_core, so that what the check judges is what the planner gets. */
+static coa_vehicle_t intent_vehicle(const coavoid_intent_t *msg, const coa_vec3_t *route,
+                                    size_t route_count, int32_t initial_offset)
+{
+    coa_vehicle_t v;
+    memset(&v, 0, sizeof v);
+    v.id = (uint16_t)msg->uav_id;
+    v.priority = (uint32_t)msg->priority;
+    v.cruise_speed = (coa_real_t)msg->cruise_speed;
+    v.climb_rate = (coa_real_t)msg->climb_rate;
+    v.steep_factor = (uint32_t)msg->steep_factor;
+    v.volume.radius = (coa_real_t)msg->radius;
+    v.volume.half_height = (coa_real_t)msg->half_height;
+    v.route = route;
+    v.route_count = route_count;
+    v.initial_offset = initial_offset;
+    v.max_offset = msg->max_offset;
+    return v;
+}
+
+/* The numbers the double rules accepted must still be usable once in core precision: a
+ * speed or size of 1e-50 is positive in double and 0 in float, and a product of two tiny
+ * factors can vanish in either. The core's own rules judge it (coa_vehicle_check over a
+ * two-point probe route, the planner's deviation weight, a positive climb step), so a
+ * receiver never gets a vehicle its planner refuses. */
+static bool intent_core_numbers_ok(const coavoid_intent_t *msg)
+{
+    static const coa_vec3_t probe[2] = {{0, 0, 0}, {1, 0, 0}};
+    coa_vehicle_t v = intent_vehicle(msg, probe, 2u, 0);
+    coa_real_t step = (coa_real_t)msg->step;
+    uint64_t weight;
+    int exponent;
+    return coa_vehicle_check(&v) == COA_OK &&
+           coa_deviation_weights(&v, 1u, step, &weight, &exponent) == COA_OK &&
+           coa_climb_step(&v, step) > (coa_real_t)0;
+}
+
+/* Whether the leg a -> b (core precision) is one coa_vehicle_check accepts: judged by it
+ * rather than by comparing coordinates, since two points that differ by 1e-200 have a
+ * horizontal length of 0 once squared. */
+static bool intent_leg_ok(const coavoid_intent_t *msg, coa_vec3_t a, coa_vec3_t b)
+{
+    coa_vec3_t leg[2];
+    coa_vehicle_t v;
+    leg[0] = a;
+    leg[1] = b;
+    v = intent_vehicle(msg, leg, 2u, 0);
+    return coa_vehicle_check(&v) == COA_OK;
+}
+
 int coa_lcm_intent_check(const coavoid_intent_t *msg, const coa_lcm_context_t *ctx,
                          const char **reason)
 {
@@ -283,13 +334,18 @@ int coa_lcm_intent_check(const coavoid_intent_t *msg, const coa_lcm_context_t *c
     if ((rc = number_rule(msg->step, COA_LCM_MAX_STEP)) != COA_OK || !(msg->step > 0.0)) {
         REJECT(rc != COA_OK ? rc : COA_LCM_ERR_VALUE, "intent: step not in (0, 3600] s");
     }
+    if (!intent_core_numbers_ok(msg)) {
+        REJECT(COA_LCM_ERR_VALUE, "intent: cruise_speed, climb_rate, step, radius or half_height "
+                                  "vanishes in the core's precision");
+    }
     if (msg->sample_count < 2 || msg->sample_count > COAVOID_INTENT_T_MAX_SAMPLES) {
         REJECT(COA_LCM_ERR_COUNT, "intent: sample_count not in 2..MAX_SAMPLES");
     }
     {
         /* Positions and the route rule are judged in the core's precision, as the
          * planner and coa_vehicle_check will see them. */
-        coa_real_t dh = (coa_real_t)msg->climb_rate * (coa_real_t)msg->step;
+        coa_vehicle_t v = intent_vehicle(msg, NULL, 0u, 0);
+        coa_real_t dh = coa_climb_step(&v, (coa_real_t)msg->step);
         int32_t bound = (msg->max_offset >= 0) ? msg->max_offset : COA_MAX_OFFSET;
         coa_vec3_t previous = {0, 0, 0};
         for (j = 0; j < msg->sample_count; ++j) {
@@ -300,7 +356,7 @@ int coa_lcm_intent_check(const coavoid_intent_t *msg, const coa_lcm_context_t *c
                 REJECT(rc, "intent: a reference point non-finite or out of range");
             }
             r = vec_of(msg->reference[j]);
-            if (j > 0 && r.x == previous.x && r.y == previous.y) {
+            if (j > 0 && !intent_leg_ok(msg, previous, r)) {
                 REJECT(COA_LCM_ERR_VALUE, "intent: consecutive reference points without horizontal separation");
             }
             if (o < -bound || o > bound) {
@@ -348,18 +404,7 @@ int coa_lcm_intent_to_core(const coavoid_intent_t *msg, const coa_lcm_context_t 
                             "intent: sequence table full")) != COA_OK) {
         return rc;
     }
-    memset(vehicle, 0, sizeof *vehicle);
-    vehicle->id = (uint16_t)msg->uav_id;
-    vehicle->priority = (uint32_t)msg->priority;
-    vehicle->cruise_speed = (coa_real_t)msg->cruise_speed;
-    vehicle->climb_rate = (coa_real_t)msg->climb_rate;
-    vehicle->steep_factor = (uint32_t)msg->steep_factor;
-    vehicle->volume.radius = (coa_real_t)msg->radius;
-    vehicle->volume.half_height = (coa_real_t)msg->half_height;
-    vehicle->route = arrays->reference;
-    vehicle->route_count = (size_t)msg->sample_count;
-    vehicle->initial_offset = msg->offsets[0];
-    vehicle->max_offset = msg->max_offset;
+    *vehicle = intent_vehicle(msg, arrays->reference, (size_t)msg->sample_count, msg->offsets[0]);
     dh = coa_climb_step(vehicle, (coa_real_t)msg->step);
     for (j = 0; j < msg->sample_count; ++j) {
         arrays->reference[j] = vec_of(msg->reference[j]);
@@ -1153,7 +1198,9 @@ void coa_lcm_rx_count(coa_lcm_rx_stats_t *stats, int rc, const char *reason)
     if (stats->received < INT64_MAX) {
         stats->received++;
     }
-    if (rc != COA_OK) {
+    /* Only a negative rc is a refusal: a decoder's byte count is a success, and a
+     * positive last_reject_code would make the status message itself refused. */
+    if (rc < 0) {
         if (stats->rejected < stats->received) {
             stats->rejected++;
         }
