@@ -6,6 +6,7 @@
  *   coavoid plan SCENARIO.json --mode centralised|decoupled [...]   plan_cmd.c
  *   coavoid predict SCENARIO.json [--threshold P] [...]             predict_cmd.c
  *   coavoid bench predict --vehicles N --horizon H [...]            bench.c
+ *   coavoid world SCENARIO.json [--lcm-url URL] [--epoch UTIME] [...] world_cmd.c
  *
  * Exit status: 0 success, 1 plan infeasible or budget exhausted, 2 invalid input or usage
  * (one line on stderr naming the input and why), 3 internal error.
@@ -44,6 +45,9 @@ int main(int argc, char **argv)
     }
     if (strcmp(command, "bench") == 0) {
         return command_bench(argc, argv);
+    }
+    if (strcmp(command, "world") == 0) {
+        return command_world(argc, argv);
     }
     if (command[0] == '-') {
         return cli_fail(CLI_EXIT_INVALID, "unknown option '%.40s' (see 'coavoid --help')", command);

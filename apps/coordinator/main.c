@@ -1,0 +1,281 @@
+/*
+ * coavoid-coordinator: the ground station as a process of its own. Every cycle, a
+ * collection time after the cycle starts, it predicts from the intents the vehicles
+ * published, plans each conflicting cluster in one centralised search, and publishes the
+ * plans, the conflict report and its heartbeat. The node is apps/node/coordinator.c; this
+ * file only reads the options and runs it in real time (realtime.h). See
+ * COORDINATOR_USAGE below.
+ */
+#define _POSIX_C_SOURCE 200809L
+
+#include <math.h>
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "cli.h"
+#include "node.h"
+#include "realtime.h"
+#include "scenario.h"
+
+/* The closed-set bound when neither --beta nor the scenario gives one: as `coavoid plan`,
+ * lowered until the workspace for the largest cluster fits COORDINATOR_WORKSPACE_MAX. */
+#define COORDINATOR_DEFAULT_BETA 20000u
+#define COORDINATOR_WORKSPACE_MAX ((size_t)1u << 30)
+#define COORDINATOR_DEFAULT_MAX_CENTRALISED 3u
+
+#define COORDINATOR_USAGE                                                                      \
+    "usage: coavoid-coordinator --scenario FILE [--lcm-url URL] [--epoch UTIME] [--speed S]\n" \
+    "                           [--steps K] [--beta B] [--max-centralised N] [--collect S]\n"  \
+    "\n"                                                                                       \
+    "The ground coordinator of a real-time run: plans the conflicting clusters of the\n"      \
+    "vehicles it hears over LCM centrally and publishes the plans. The scenario gives dt,\n"  \
+    "the horizon and the default beta; the vehicles and obstacles come from the messages.\n" \
+    "\n"                                                                                       \
+    "options:\n"                                                                               \
+    "  --scenario FILE     the scenario (SCENARIO_FORMAT.md)\n"                                \
+    COA_RT_OPTIONS_USAGE                                                                       \
+    "  --beta B            closed-set bound of its planner, B >= 1; default the scenario's\n"  \
+    "                      \"beta\", else %u lowered so the workspace fits 1 GiB\n"            \
+    "  --max-centralised N largest cluster planned in one search, 1..%u (default %u);\n"      \
+    "                      the workspace grows as beta * 5^N; a larger cluster is planned\n"  \
+    "                      decoupled by the coordinator\n"                                     \
+    "  --collect S         scenario seconds after each cycle start at which it plans,\n"       \
+    "                      0 < S < dt; default dt / 4. Its plans must reach the vehicles\n"    \
+    "                      before the next cycle starts: planning gets (dt - S) / speed\n"     \
+    "                      wall seconds\n"                                                     \
+    "  -h, --help          show this help\n"                                                   \
+    "\n"                                                                                       \
+    "At the end (after K cycles, or on SIGINT/SIGTERM) it prints one summary line on\n"       \
+    "stderr.\n"                                                                                \
+    "\n"                                                                                       \
+    "exit status: 0 done, 2 invalid input or usage (one line on stderr), 3 internal error\n"
+
+typedef struct {
+    const char *scenario_path;
+    const char *beta_text;
+    uint32_t beta;
+    const char *max_text;
+    size_t max_centralised;
+    const char *collect_text;
+    double collect;
+    coa_rt_options_t rt;
+} coordinator_options_t;
+
+static int parse_options(int argc, char **argv, coordinator_options_t *o)
+{
+    memset(o, 0, sizeof *o);
+    coa_rt_options_init(&o->rt);
+    o->max_centralised = COORDINATOR_DEFAULT_MAX_CENTRALISED;
+    for (int i = 1; i < argc; i++) {
+        const char *arg = argv[i];
+        const char *value = NULL;
+        int rc = coa_rt_parse_option(argc, argv, &i, &o->rt);
+        if (rc == 1) {
+            continue;
+        }
+        if (rc != 0) {
+            return rc;
+        }
+        if (strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0) {
+            printf(COORDINATOR_USAGE, COORDINATOR_DEFAULT_BETA, COA_MAX_CENTRALISED,
+                   COORDINATOR_DEFAULT_MAX_CENTRALISED);
+            return CLI_EXIT_OK;
+        } else if (cli_option_is(arg, "--scenario")) {
+            if (o->scenario_path != NULL) {
+                return cli_fail(CLI_EXIT_INVALID, "--scenario: given more than once");
+            }
+            if (!cli_option_value(argc, argv, &i, "--scenario", &value) || value[0] == '\0') {
+                return cli_fail(CLI_EXIT_INVALID, "--scenario: missing value (a scenario file)");
+            }
+            o->scenario_path = value;
+        } else if (cli_option_is(arg, "--beta")) {
+            uint64_t beta;
+            if (o->beta_text != NULL) {
+                return cli_fail(CLI_EXIT_INVALID, "--beta: given more than once");
+            }
+            if (!cli_option_value(argc, argv, &i, "--beta", &value)) {
+                return cli_fail(CLI_EXIT_INVALID, "--beta: missing value (an integer >= 1)");
+            }
+            if (!cli_parse_count(value, strlen(value), UINT32_MAX, &beta)) {
+                return cli_fail(CLI_EXIT_INVALID,
+                                "--beta: must be an integer from 1 to %lu, got '%.40s'",
+                                (unsigned long)UINT32_MAX, value);
+            }
+            o->beta_text = value;
+            o->beta = (uint32_t)beta;
+        } else if (cli_option_is(arg, "--max-centralised")) {
+            uint64_t max;
+            if (o->max_text != NULL) {
+                return cli_fail(CLI_EXIT_INVALID, "--max-centralised: given more than once");
+            }
+            if (!cli_option_value(argc, argv, &i, "--max-centralised", &value)) {
+                return cli_fail(CLI_EXIT_INVALID,
+                                "--max-centralised: missing value (an integer from 1 to %u)",
+                                COA_MAX_CENTRALISED);
+            }
+            if (!cli_parse_count(value, strlen(value), COA_MAX_CENTRALISED, &max)) {
+                return cli_fail(CLI_EXIT_INVALID,
+                                "--max-centralised: must be an integer from 1 to %u, got '%.40s'",
+                                COA_MAX_CENTRALISED, value);
+            }
+            o->max_text = value;
+            o->max_centralised = (size_t)max;
+        } else if (cli_option_is(arg, "--collect")) {
+            if (o->collect_text != NULL) {
+                return cli_fail(CLI_EXIT_INVALID, "--collect: given more than once");
+            }
+            if (!cli_option_value(argc, argv, &i, "--collect", &value)) {
+                return cli_fail(CLI_EXIT_INVALID, "--collect: missing value (scenario seconds)");
+            }
+            if (!cli_parse_real(value, &o->collect) || !(o->collect > 0)) {
+                return cli_fail(CLI_EXIT_INVALID,
+                                "--collect: must be a number of seconds > 0, got '%.40s'", value);
+            }
+            o->collect_text = value;
+        } else if (arg[0] != '-') {
+            return cli_fail(CLI_EXIT_INVALID,
+                            "coordinator: unexpected argument '%.80s' (the scenario is "
+                            "--scenario FILE)",
+                            arg);
+        } else {
+            return cli_fail(CLI_EXIT_INVALID,
+                            "coordinator: unknown option '%.40s' (see 'coavoid-coordinator --help')",
+                            arg);
+        }
+    }
+    if (o->scenario_path == NULL) {
+        return cli_fail(CLI_EXIT_INVALID, "--scenario: required (a scenario file)");
+    }
+    return CLI_CONTINUE;
+}
+
+/* The largest beta up to COORDINATOR_DEFAULT_BETA whose workspace for `searched` UAVs
+ * fits COORDINATOR_WORKSPACE_MAX (the size grows with beta: bisection). */
+static uint32_t default_beta(size_t searched)
+{
+    uint32_t lo = 1u;
+    uint32_t hi = COORDINATOR_DEFAULT_BETA;
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo + 1u) / 2u;
+        size_t size = coa_planner_workspace_size(searched, mid);
+        if (size != 0u && size <= COORDINATOR_WORKSPACE_MAX) {
+            lo = mid;
+        } else {
+            hi = mid - 1u;
+        }
+    }
+    return lo;
+}
+
+/* Everything after the options. Returns the exit status. */
+static int run(coordinator_options_t *o, scenario_t *s)
+{
+    int64_t now = 0; /* the node's clock (common.clock), written by the loop */
+    coa_coordinator_config_t config;
+    memset(&config, 0, sizeof config);
+    int status = coa_rt_setup(o->scenario_path, s, &o->rt, &now, &config.common);
+    if (status != CLI_CONTINUE) {
+        return status;
+    }
+    const int64_t dt_us = config.common.dt_us;
+    config.id = COA_NODE_COORDINATOR_ID;
+    config.max_centralised = o->max_centralised;
+    config.collect_us = o->collect_text != NULL ? llround(o->collect * 1e6) : dt_us / 4;
+    if (config.collect_us < 1 || config.collect_us >= dt_us) {
+        return cli_fail(CLI_EXIT_INVALID,
+                        "--collect: must be above 0 and below the scenario's dt (%g s), got %g",
+                        (double)s->dt, o->collect);
+    }
+    const char *beta_source;
+    if (o->beta_text != NULL) {
+        config.common.beta = o->beta;
+        beta_source = "--beta";
+    } else if (s->has_beta) {
+        beta_source = "the scenario's beta";
+    } else {
+        config.common.beta = default_beta(o->max_centralised);
+        beta_source = "the default beta";
+    }
+    size_t size = coa_planner_workspace_size(o->max_centralised, config.common.beta);
+    if (size == 0) {
+        return cli_fail(CLI_EXIT_INVALID,
+                        "%s %lu: the workspace for %zu vehicles would not fit in memory (lower "
+                        "--beta or --max-centralised)",
+                        beta_source, (unsigned long)config.common.beta, o->max_centralised);
+    }
+
+    char err[512];
+    lcm_t *lcm = coa_rt_lcm_create(o->rt.lcm_url, err, sizeof err);
+    if (lcm == NULL) {
+        return cli_fail(CLI_EXIT_INVALID, "%s", err);
+    }
+    int error = COA_OK;
+    coa_coordinator_t *node = coa_coordinator_create(&config, lcm, &error);
+    if (node == NULL) {
+        lcm_destroy(lcm);
+        if (error == COA_ERR_WORKSPACE) {
+            return cli_fail(CLI_EXIT_INVALID,
+                            "%s %lu: cannot allocate the planner's %zu bytes for %zu vehicles "
+                            "(lower --beta or --max-centralised)",
+                            beta_source, (unsigned long)config.common.beta, size,
+                            o->max_centralised);
+        }
+        return cli_fail(error == COA_ERR_ARGUMENT ? CLI_EXIT_INVALID : CLI_EXIT_INTERNAL,
+                        "coordinator: cannot start (%s)", coa_lcm_error_name(error));
+    }
+    if (coa_rt_install_signal_handlers() != 0) {
+        coa_coordinator_destroy(node);
+        lcm_destroy(lcm);
+        return cli_fail(CLI_EXIT_INTERNAL, "coordinator: cannot handle SIGINT/SIGTERM");
+    }
+
+    coa_rt_loop_t loop;
+    memset(&loop, 0, sizeof loop);
+    loop.clock.epoch_utime = o->rt.epoch_utime;
+    loop.clock.speed = o->rt.speed;
+    loop.lcm = lcm;
+    loop.now = &now;
+    loop.common = &config.common;
+    loop.steps = o->rt.steps;
+    loop.collect_us = config.collect_us;
+    loop.coordinator = node;
+    loop.name = "coordinator";
+    loop.warnings = stderr;
+    coa_rt_result_t result;
+    int rc = coa_rt_run(&loop, &result);
+
+    const coa_coordinator_state_t *st = coa_coordinator_state(node);
+    char tail[256];
+    coa_rt_result_text(&result, tail, sizeof tail);
+    fprintf(stderr,
+            "coordinator: %lld cycles, plans run %u, plans published %u, last plan %.1f ms "
+            "(%llu nodes expanded), messages received %lld, rejected %lld (last: %s)%s\n",
+            (long long)result.cycles, (unsigned)st->plans_run, (unsigned)st->plans_published,
+            (double)st->last_plan_duration_us * 1e-3,
+            (unsigned long long)st->last_nodes_expanded, (long long)st->rx.received,
+            (long long)st->rx.rejected, st->rx.last_reason != NULL ? st->rx.last_reason : "none",
+            tail);
+    coa_coordinator_destroy(node);
+    lcm_destroy(lcm);
+    if (rc != COA_OK) {
+        return cli_fail(CLI_EXIT_INTERNAL, "coordinator: LCM failed while running (%s)",
+                        o->rt.lcm_url);
+    }
+    return result.errors > 0 ? CLI_EXIT_INTERNAL : CLI_EXIT_OK;
+}
+
+int main(int argc, char **argv)
+{
+    coordinator_options_t options;
+    int status = parse_options(argc, argv, &options);
+    if (status != CLI_CONTINUE) {
+        return status;
+    }
+    scenario_t scenario;
+    memset(&scenario, 0, sizeof scenario);
+    status = run(&options, &scenario);
+    scenario_free(&scenario);
+    return status;
+}

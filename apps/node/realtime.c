@@ -1,0 +1,608 @@
+/*
+ * realtime.c: the scenario clock, the options every real-time driver shares, and the
+ * loop that calls the nodes at their times (realtime.h).
+ */
+#define _POSIX_C_SOURCE 200809L
+
+#include "realtime.h"
+
+#include <errno.h>
+#include <limits.h>
+#include <math.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+#include <sys/select.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "cli.h"
+
+/* Longest single wait: the stop flag is also looked at this often, whatever a signal's
+ * delivery does to select. */
+#define RT_MAX_WAIT_US 100000
+
+/* Largest --steps: a day of 0.1 s cycles; more is a typo, not a run. */
+#define RT_MAX_STEPS 1000000u
+
+static volatile sig_atomic_t rt_stop_signal = 0;
+
+static void rt_on_signal(int sig)
+{
+    rt_stop_signal = sig;
+}
+
+int coa_rt_install_signal_handlers(void)
+{
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = rt_on_signal;
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = 0;
+    if (sigaction(SIGINT, &sa, NULL) != 0 || sigaction(SIGTERM, &sa, NULL) != 0) {
+        return -1;
+    }
+    return 0;
+}
+
+int64_t coa_rt_wall_utime(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    return (int64_t)ts.tv_sec * 1000000 + (int64_t)ts.tv_nsec / 1000;
+}
+
+int64_t coa_rt_stopwatch_us(void *user)
+{
+    (void)user;
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (int64_t)ts.tv_sec * 1000000 + (int64_t)ts.tv_nsec / 1000;
+}
+
+int64_t coa_rt_scenario_utime(const coa_rt_clock_t *clock, int64_t wall_utime)
+{
+    if (wall_utime < clock->epoch_utime) {
+        return wall_utime;
+    }
+    double elapsed = (double)(wall_utime - clock->epoch_utime) * clock->speed;
+    return clock->epoch_utime + (int64_t)floor(elapsed);
+}
+
+int64_t coa_rt_wall_at(const coa_rt_clock_t *clock, int64_t scenario_utime)
+{
+    if (scenario_utime <= clock->epoch_utime) {
+        return scenario_utime;
+    }
+    double elapsed = (double)(scenario_utime - clock->epoch_utime) / clock->speed;
+    int64_t wall = clock->epoch_utime + (int64_t)ceil(elapsed);
+    /* Rounding in the division can leave it a microsecond short of the inverse. */
+    while (coa_rt_scenario_utime(clock, wall) < scenario_utime) {
+        wall++;
+    }
+    return wall;
+}
+
+/* ---- options ---- */
+
+void coa_rt_options_init(coa_rt_options_t *o)
+{
+    memset(o, 0, sizeof *o);
+    o->speed = 1.0;
+}
+
+int coa_rt_parse_option(int argc, char **argv, int *i, coa_rt_options_t *o)
+{
+    const char *arg = argv[*i];
+    const char *value = NULL;
+    if (cli_option_is(arg, "--lcm-url")) {
+        if (o->lcm_url != NULL) {
+            return cli_fail(CLI_EXIT_INVALID, "--lcm-url: given more than once");
+        }
+        if (!cli_option_value(argc, argv, i, "--lcm-url", &value) || value[0] == '\0') {
+            return cli_fail(CLI_EXIT_INVALID,
+                            "--lcm-url: missing value (an LCM URL, e.g. %s)",
+                            COA_RT_DEFAULT_LCM_URL);
+        }
+        o->lcm_url = value;
+        return 1;
+    }
+    if (cli_option_is(arg, "--epoch")) {
+        uint64_t epoch;
+        if (o->have_epoch) {
+            return cli_fail(CLI_EXIT_INVALID, "--epoch: given more than once");
+        }
+        if (!cli_option_value(argc, argv, i, "--epoch", &value)) {
+            return cli_fail(CLI_EXIT_INVALID,
+                            "--epoch: missing value (wall-clock microseconds since 1970)");
+        }
+        if (!cli_parse_count(value, strlen(value), (uint64_t)INT64_MAX, &epoch)) {
+            return cli_fail(CLI_EXIT_INVALID,
+                            "--epoch: must be a positive integer (wall-clock microseconds "
+                            "since 1970), got '%.40s'",
+                            value);
+        }
+        o->have_epoch = true;
+        o->epoch_utime = (int64_t)epoch;
+        return 1;
+    }
+    if (cli_option_is(arg, "--speed")) {
+        double speed;
+        if (o->speed_text != NULL) {
+            return cli_fail(CLI_EXIT_INVALID, "--speed: given more than once");
+        }
+        if (!cli_option_value(argc, argv, i, "--speed", &value)) {
+            return cli_fail(CLI_EXIT_INVALID,
+                            "--speed: missing value (scenario seconds per wall second)");
+        }
+        if (!cli_parse_real(value, &speed) || !(speed > 0) || speed > COA_RT_MAX_SPEED) {
+            return cli_fail(CLI_EXIT_INVALID,
+                            "--speed: must be a number with 0 < S <= %g, got '%.40s'",
+                            COA_RT_MAX_SPEED, value);
+        }
+        o->speed_text = value;
+        o->speed = speed;
+        return 1;
+    }
+    if (cli_option_is(arg, "--steps")) {
+        uint64_t steps;
+        if (o->steps_text != NULL) {
+            return cli_fail(CLI_EXIT_INVALID, "--steps: given more than once");
+        }
+        if (!cli_option_value(argc, argv, i, "--steps", &value)) {
+            return cli_fail(CLI_EXIT_INVALID, "--steps: missing value (an integer >= 1)");
+        }
+        if (!cli_parse_count(value, strlen(value), RT_MAX_STEPS, &steps)) {
+            return cli_fail(CLI_EXIT_INVALID, "--steps: must be an integer from 1 to %u, got '%.40s'",
+                            RT_MAX_STEPS, value);
+        }
+        o->steps_text = value;
+        o->steps = (int64_t)steps;
+        return 1;
+    }
+    return 0;
+}
+
+int coa_rt_options_finish(coa_rt_options_t *o, int64_t dt_us, uint32_t horizon)
+{
+    if (o->lcm_url == NULL) {
+        o->lcm_url = COA_RT_DEFAULT_LCM_URL;
+    }
+    if (o->steps_text == NULL) {
+        o->steps = 2 * (int64_t)horizon;
+    }
+    int64_t now = coa_rt_wall_utime();
+    if (!o->have_epoch) {
+        o->epoch_utime = now;
+        return CLI_CONTINUE;
+    }
+    if (o->epoch_utime > now && o->epoch_utime - now > COA_RT_MAX_EPOCH_AHEAD_US) {
+        return cli_fail(CLI_EXIT_INVALID,
+                        "--epoch: %lld is more than a day ahead of this clock (%lld): it is "
+                        "microseconds since 1970, e.g. $(( $(date +%%s) + 2 ))000000",
+                        (long long)o->epoch_utime, (long long)now);
+    }
+    /* The run's last event is the start of cycle K, in wall time. */
+    double run_us = (double)o->steps * (double)dt_us / o->speed;
+    double end = (double)o->epoch_utime + run_us;
+    if (end < (double)now) {
+        return cli_fail(CLI_EXIT_INVALID,
+                        "--epoch: the run of %lld cycles from %lld ended %.1f s ago (this "
+                        "clock: %lld)",
+                        (long long)o->steps, (long long)o->epoch_utime,
+                        ((double)now - end) * 1e-6, (long long)now);
+    }
+    return CLI_CONTINUE;
+}
+
+int coa_rt_setup(const char *path, scenario_t *s, coa_rt_options_t *o, const int64_t *now,
+                 coa_node_common_t *common)
+{
+    int status = cli_load_scenario(path, s);
+    if (status != CLI_CONTINUE) {
+        return status;
+    }
+    status = cli_sample_scenario(path, s);
+    if (status != CLI_CONTINUE) {
+        return status;
+    }
+    if (s->horizon > COA_NODE_MAX_HORIZON) {
+        return cli_fail(CLI_EXIT_INVALID,
+                        "%s: horizon: %lu steps, the nodes' messages carry at most %u",
+                        path, (unsigned long)s->horizon, COA_NODE_MAX_HORIZON);
+    }
+    int64_t dt_us = llround((double)s->dt * 1e6);
+    if (dt_us < 1) {
+        return cli_fail(CLI_EXIT_INVALID, "%s: dt: below a microsecond", path);
+    }
+    status = coa_rt_options_finish(o, dt_us, s->horizon);
+    if (status != CLI_CONTINUE) {
+        return status;
+    }
+    if (coa_node_common_defaults(common, o->epoch_utime, s->dt, s->horizon, now) != COA_OK) {
+        return cli_fail(CLI_EXIT_INVALID, "%s: dt or horizon refused by the nodes", path);
+    }
+    common->stopwatch_us = coa_rt_stopwatch_us;
+    common->stopwatch_user = NULL;
+    if (s->has_beta) {
+        common->beta = s->beta;
+    }
+    return CLI_CONTINUE;
+}
+
+/* ---- LCM ---- */
+
+/* The first line of LCM's messages that says something (they start with blank lines). */
+static void first_line(const char *text, char *out, size_t size)
+{
+    const char *c = text;
+    while (*c == '\n' || *c == '\r' || *c == ' ') {
+        c++;
+    }
+    size_t n = strcspn(c, "\r\n");
+    if (n >= size) {
+        n = size - 1u;
+    }
+    memcpy(out, c, n);
+    out[n] = '\0';
+}
+
+lcm_t *coa_rt_lcm_create(const char *url, char *err, size_t err_size)
+{
+    char said[4096];
+    size_t said_length = 0;
+    said[0] = '\0';
+
+    /* LCM explains a failure in a dozen lines on stderr; the drivers promise one. So its
+     * output goes to a temporary file while it starts, and is read back. */
+    fflush(stderr);
+    FILE *capture = tmpfile();
+    int saved = capture != NULL ? dup(STDERR_FILENO) : -1;
+    bool captured = saved >= 0 && dup2(fileno(capture), STDERR_FILENO) >= 0;
+    lcm_t *lcm = lcm_create(url);
+    if (captured) {
+        fflush(stderr);
+        dup2(saved, STDERR_FILENO);
+        rewind(capture);
+        said_length = fread(said, 1, sizeof said - 1u, capture);
+        said[said_length] = '\0';
+    }
+    if (saved >= 0) {
+        close(saved);
+    }
+    if (capture != NULL) {
+        fclose(capture);
+    }
+
+    if (lcm != NULL) {
+        if (said_length > 0) {
+            fwrite(said, 1, said_length, stderr);
+        }
+        return lcm;
+    }
+    char line[256];
+    first_line(said, line, sizeof line);
+    if (strstr(said, "multicast route") != NULL || strstr(said, "No route") != NULL ||
+        strstr(said, "unreachable") != NULL) {
+        snprintf(err, err_size,
+                 "--lcm-url: cannot open '%.200s': this host has no multicast route "
+                 "(as root: ip link set lo up multicast on && ip route add 224.0.0.0/4 dev lo)",
+                 url);
+    } else if (line[0] != '\0') {
+        const char *text = strncmp(line, "Error: ", 7) == 0 ? line + 7 : line;
+        snprintf(err, err_size, "--lcm-url: cannot open '%.200s' (LCM: %.200s)", url, text);
+    } else {
+        snprintf(err, err_size, "--lcm-url: cannot open '%.200s' (LCM refused it)", url);
+    }
+    return NULL;
+}
+
+/* ---- the loop ---- */
+
+typedef struct {
+    const coa_rt_loop_t *loop;
+    coa_rt_result_t *result;
+    const coa_node_common_t *common;
+} rt_run_t;
+
+static int64_t rt_now(const rt_run_t *r)
+{
+    return coa_rt_scenario_utime(&r->loop->clock, coa_rt_wall_utime());
+}
+
+static void rt_warn(const rt_run_t *r, const char *fmt, ...) CLI_PRINTF_LIKE(2, 3);
+
+static void rt_warn(const rt_run_t *r, const char *fmt, ...)
+{
+    char line[512];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(line, sizeof line, fmt, ap);
+    va_end(ap);
+    if (r->loop->warnings != NULL) {
+        fprintf(r->loop->warnings, "%s: %s\n", r->loop->name != NULL ? r->loop->name : "node",
+                line);
+        fflush(r->loop->warnings);
+    }
+}
+
+static void rt_error(const rt_run_t *r, const char *what, int64_t cycle, int rc)
+{
+    r->result->errors++;
+    if (r->result->first_error == 0) {
+        r->result->first_error = rc;
+    }
+    rt_warn(r, "cycle %lld: %s failed (%s)", (long long)cycle, what, coa_lcm_error_name(rc));
+}
+
+/* Work that ended at `end` (scenario time) for an event whose successor is due at `next`;
+ * `started` is the stopwatch when the call began. */
+static void rt_check_overrun(const rt_run_t *r, const char *what, int64_t cycle, int64_t end,
+                             int64_t next, int64_t started)
+{
+    if (end < next) {
+        return;
+    }
+    r->result->overruns++;
+    int64_t took = coa_rt_stopwatch_us(NULL) - started;
+    rt_warn(r,
+            "cycle %lld: %s overran: it ended %.0f ms (scenario time) after cycle %lld began, "
+            "having taken %.0f ms of wall time at speed %g; lower --speed",
+            (long long)cycle, what, (double)(end - next) * 1e-3, (long long)(cycle + 1),
+            (double)took * 1e-3, r->loop->clock.speed);
+}
+
+/* Cycle k's start for the world and the vehicles. */
+static void rt_cycle_start(const rt_run_t *r, int64_t k)
+{
+    const coa_rt_loop_t *loop = r->loop;
+    int64_t next = coa_node_cycle_utime(r->common, k + 1);
+    if (loop->world != NULL) {
+        int64_t started = coa_rt_stopwatch_us(NULL);
+        *loop->now = rt_now(r);
+        int rc = coa_world_cycle(loop->world, *loop->now);
+        if (rc < 0) {
+            rt_error(r, "the world's cycle", k, rc);
+        }
+        rt_check_overrun(r, "publishing the world", k, rt_now(r), next, started);
+    }
+    for (size_t i = 0; i < loop->vehicle_count; i++) {
+        int64_t started = coa_rt_stopwatch_us(NULL);
+        *loop->now = rt_now(r);
+        int rc = coa_vehicle_node_cycle(loop->vehicles[i], *loop->now);
+        if (rc < 0) {
+            rt_error(r, "the vehicle's cycle", k, rc);
+        }
+        rt_check_overrun(r, "the vehicle's cycle", k, rt_now(r), next, started);
+    }
+    r->result->cycles++;
+}
+
+/* Polls vehicle i at `now`; `deadline_polled` remembers the deadline it was polled for, so
+ * that a deadline the node does not move cannot make the loop spin. */
+static void rt_poll(const rt_run_t *r, size_t i, int64_t *deadline_polled)
+{
+    const coa_rt_loop_t *loop = r->loop;
+    int64_t started = coa_rt_stopwatch_us(NULL);
+    int64_t deadline = coa_vehicle_node_deadline(loop->vehicles[i]);
+    *loop->now = rt_now(r);
+    int64_t k = coa_node_cycle_of(r->common, *loop->now);
+    int rc = coa_vehicle_node_poll(loop->vehicles[i], *loop->now);
+    if (deadline <= *loop->now) {
+        *deadline_polled = deadline;
+    }
+    if (rc < 0) {
+        rt_error(r, "the vehicle's poll", k, rc);
+    } else if (rc > 0) {
+        rt_check_overrun(r, "the vehicle's planning", k, rt_now(r),
+                         coa_node_cycle_utime(r->common, k + 1), started);
+    }
+}
+
+/* The vehicle's deadline unless it was already polled for. */
+static int64_t rt_pending_deadline(const rt_run_t *r, size_t i, int64_t deadline_polled)
+{
+    int64_t deadline = coa_vehicle_node_deadline(r->loop->vehicles[i]);
+    return deadline == deadline_polled ? INT64_MAX : deadline;
+}
+
+/* Dispatches every message waiting, each with the clock set just before. Returns how
+ * many, or COA_RT_ERR_LCM. */
+static int rt_drain(const rt_run_t *r)
+{
+    int handled = 0;
+    for (;;) {
+        *r->loop->now = rt_now(r);
+        int rc = lcm_handle_timeout(r->loop->lcm, 0);
+        if (rc < 0) {
+            return COA_RT_ERR_LCM;
+        }
+        if (rc == 0) {
+            return handled;
+        }
+        if (handled < INT_MAX) {
+            handled++;
+        }
+    }
+}
+
+/* Waits until wall time `wake` or a message, whichever is first. Returns 1 when LCM has a
+ * message, 0 on time-out or a signal, COA_RT_ERR_LCM on failure. */
+static int rt_wait(const rt_run_t *r, int fd, int64_t wake_wall)
+{
+    int64_t wait_us = wake_wall - coa_rt_wall_utime();
+    if (wait_us < 0) {
+        wait_us = 0;
+    }
+    if (wait_us > RT_MAX_WAIT_US) {
+        wait_us = RT_MAX_WAIT_US;
+    }
+    (void)r;
+    fd_set fds;
+    FD_ZERO(&fds);
+    FD_SET(fd, &fds);
+    struct timeval tv;
+    tv.tv_sec = (time_t)(wait_us / 1000000);
+    tv.tv_usec = (suseconds_t)(wait_us % 1000000);
+    int rc = select(fd + 1, &fds, NULL, NULL, &tv);
+    if (rc < 0) {
+        return errno == EINTR ? 0 : COA_RT_ERR_LCM;
+    }
+    return rc > 0 ? 1 : 0;
+}
+
+int coa_rt_run(const coa_rt_loop_t *loop, coa_rt_result_t *result)
+{
+    if (result != NULL) {
+        memset(result, 0, sizeof *result);
+    }
+    if (loop == NULL || result == NULL || loop->lcm == NULL || loop->now == NULL ||
+        loop->common == NULL || loop->steps < 1 || !(loop->clock.speed > 0) ||
+        loop->vehicle_count > COA_NODE_MAX_PEERS ||
+        (loop->vehicle_count > 0 && loop->vehicles == NULL) ||
+        (loop->world == NULL && loop->coordinator == NULL && loop->vehicle_count == 0)) {
+        return COA_ERR_ARGUMENT;
+    }
+    int fd = lcm_get_fileno(loop->lcm);
+    if (fd < 0 || fd >= FD_SETSIZE) {
+        return COA_RT_ERR_LCM;
+    }
+    rt_run_t run = {loop, result, loop->common};
+    const rt_run_t *r = &run;
+    const coa_node_common_t *c = loop->common;
+    const int64_t K = loop->steps;
+    int64_t polled[COA_NODE_MAX_PEERS];
+    for (size_t i = 0; i < loop->vehicle_count; i++) {
+        polled[i] = INT64_MIN;
+    }
+
+    /* A process started late joins at the current cycle; the coordinator, if its collect
+     * time for that cycle has passed, at the next one. */
+    int64_t now = rt_now(r);
+    int64_t first = now < c->epoch_utime ? 0 : coa_node_cycle_of(c, now);
+    if (first < 0) {
+        first = 0;
+    }
+    bool has_starts = loop->world != NULL || loop->vehicle_count > 0;
+    int64_t next_start = has_starts ? first : K + 1;
+    int64_t next_collect = K;
+    if (loop->coordinator != NULL) {
+        next_collect = first;
+        if (now > coa_node_cycle_utime(c, first) + loop->collect_us) {
+            next_collect++;
+        }
+    }
+
+    for (;;) {
+        if (rt_stop_signal != 0) {
+            result->signal = (int)rt_stop_signal;
+            break;
+        }
+        now = rt_now(r);
+
+        if (next_start <= K && now >= coa_node_cycle_utime(c, next_start)) {
+            int64_t k = coa_node_cycle_of(c, now);
+            if (k > K) {
+                k = K;
+            }
+            if (k > next_start) {
+                result->skipped += (uint32_t)(k - next_start);
+                rt_warn(r, "cycles %lld..%lld skipped: the loop was %.0f ms (scenario time) late",
+                        (long long)next_start, (long long)(k - 1),
+                        (double)(now - coa_node_cycle_utime(c, next_start)) * 1e-3);
+            }
+            rt_cycle_start(r, k);
+            next_start = k + 1;
+            continue;
+        }
+
+        if (next_collect < K && now >= coa_node_cycle_utime(c, next_collect) + loop->collect_us) {
+            int64_t k = coa_node_cycle_of(c, now);
+            if (k > next_collect) {
+                /* Its plans would be valid until a cycle start already past: nobody could
+                 * adopt them. */
+                int64_t missed = (k < K ? k : K) - next_collect;
+                result->skipped += (uint32_t)missed;
+                rt_warn(r, "cycles %lld..%lld: no plans: the loop was %.0f ms (scenario time) late",
+                        (long long)next_collect, (long long)(next_collect + missed - 1),
+                        (double)(now - coa_node_cycle_utime(c, next_collect) - loop->collect_us) *
+                            1e-3);
+                next_collect += missed;
+                continue;
+            }
+            int64_t started = coa_rt_stopwatch_us(NULL);
+            *loop->now = now;
+            int rc = coa_coordinator_cycle(loop->coordinator, now);
+            if (rc < 0) {
+                rt_error(r, "the coordinator's cycle", k, rc);
+            }
+            rt_check_overrun(r, "the coordinator's planning", k, rt_now(r),
+                             coa_node_cycle_utime(c, k + 1), started);
+            if (!has_starts) {
+                result->cycles++;
+            }
+            next_collect = k + 1;
+            continue;
+        }
+
+        int64_t wake = INT64_MAX;
+        for (size_t i = 0; i < loop->vehicle_count; i++) {
+            int64_t deadline = rt_pending_deadline(r, i, polled[i]);
+            if (deadline <= now) {
+                rt_poll(r, i, &polled[i]);
+                deadline = rt_pending_deadline(r, i, polled[i]);
+            }
+            if (deadline < wake) {
+                wake = deadline;
+            }
+        }
+        if (next_start > K && next_collect >= K && wake == INT64_MAX) {
+            break;
+        }
+        if (next_start <= K) {
+            int64_t t = coa_node_cycle_utime(c, next_start);
+            wake = t < wake ? t : wake;
+        }
+        if (next_collect < K) {
+            int64_t t = coa_node_cycle_utime(c, next_collect) + loop->collect_us;
+            wake = t < wake ? t : wake;
+        }
+
+        int rc = rt_wait(r, fd, coa_rt_wall_at(&loop->clock, wake));
+        if (rc < 0) {
+            return rc;
+        }
+        if (rc > 0) {
+            rc = rt_drain(r);
+            if (rc < 0) {
+                return rc;
+            }
+            /* A message may be the intent a waiting vehicle needed. */
+            for (size_t i = 0; i < loop->vehicle_count; i++) {
+                const coa_vehicle_node_state_t *s = coa_vehicle_node_state(loop->vehicles[i]);
+                if (s != NULL && s->waiting) {
+                    rt_poll(r, i, &polled[i]);
+                }
+            }
+        }
+    }
+    *loop->now = rt_now(r);
+    return COA_OK;
+}
+
+void coa_rt_result_text(const coa_rt_result_t *result, char *out, size_t size)
+{
+    const char *signal_name = result->signal == SIGINT    ? "SIGINT"
+                              : result->signal == SIGTERM ? "SIGTERM"
+                                                          : "a signal";
+    int n = snprintf(out, size, ", overruns %u, skipped %u", (unsigned)result->overruns,
+                     (unsigned)result->skipped);
+    if (n >= 0 && (size_t)n < size && result->errors > 0) {
+        n += snprintf(out + n, size - (size_t)n, ", errors %u (first: %s)",
+                      (unsigned)result->errors, coa_lcm_error_name(result->first_error));
+    }
+    if (n >= 0 && (size_t)n < size && result->signal != 0) {
+        snprintf(out + n, size - (size_t)n, ", stopped by %s", signal_name);
+    }
+}

@@ -1,0 +1,298 @@
+/*
+ * coavoid-vehicle: one simulated UAV of a scenario as a process of its own. It flies its
+ * route, publishes its intent every cycle, follows the coordinator's plans while the
+ * coordinator's heartbeat is heard and plans for itself in priority order when it is not
+ * (or always, in decoupled mode). The node is apps/node/vehicle.c; this file only reads
+ * the options and runs it in real time (realtime.h). See VEHICLE_USAGE below.
+ */
+#define _POSIX_C_SOURCE 200809L
+
+#include <math.h>
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "cli.h"
+#include "node.h"
+#include "realtime.h"
+#include "scenario.h"
+
+#define VEHICLE_USAGE                                                                          \
+    "usage: coavoid-vehicle --scenario FILE --id ID [--mode centralised|decoupled]\n"          \
+    "                       [--lcm-url URL] [--epoch UTIME] [--speed S] [--steps K]\n"         \
+    "                       [--coordinator-timeout S] [--priority-wait S]\n"                   \
+    "       coavoid-vehicle --scenario FILE --list-ids\n"                                      \
+    "\n"                                                                                       \
+    "Flies the UAV with this id from the scenario in real time, exchanging intents and\n"     \
+    "plans over LCM with the other vehicles, the coordinator and `coavoid world`.\n"          \
+    "\n"                                                                                       \
+    "options:\n"                                                                               \
+    "  --scenario FILE     the scenario (SCENARIO_FORMAT.md): route, dt, horizon, beta\n"      \
+    "  --id ID             which of its vehicles this process flies\n"                         \
+    "  --mode centralised  follow the coordinator; plan for itself while the coordinator\n"    \
+    "                      is silent (default)\n"                                              \
+    "  --mode decoupled    always plan for itself, in priority order\n"                        \
+    COA_RT_OPTIONS_USAGE                                                                       \
+    "  --coordinator-timeout S  scenario seconds of coordinator silence after which it\n"     \
+    "                      plans for itself; default 2.5 * dt\n"                               \
+    "  --priority-wait S   decoupled: scenario seconds it waits for the intents of the\n"     \
+    "                      higher-priority UAVs of its cluster, 0 <= S < dt; default dt / 2\n" \
+    "  --list-ids          print the scenario's vehicle ids, one per line, and exit (for\n"   \
+    "                      scripts that start one process per UAV)\n"                         \
+    "  -h, --help          show this help\n"                                                   \
+    "\n"                                                                                       \
+    "At the end (after K cycles, or on SIGINT/SIGTERM) it prints one summary line on\n"       \
+    "stderr: cycles, plans run and adopted, fallbacks to its own planning, messages\n"        \
+    "received and rejected.\n"                                                                 \
+    "\n"                                                                                       \
+    "exit status: 0 done, 2 invalid input or usage (one line on stderr), 3 internal error\n"
+
+typedef struct {
+    const char *scenario_path;
+    const char *id_text;
+    uint16_t id;
+    bool list_ids;
+    const char *mode;
+    bool decoupled;
+    const char *timeout_text;
+    double timeout;
+    const char *wait_text;
+    double wait;
+    coa_rt_options_t rt;
+} vehicle_options_t;
+
+/* A duration option in scenario seconds: finite, >= 0 (> 0 unless zero_ok). */
+static int parse_seconds(int argc, char **argv, int *i, const char *name, bool zero_ok,
+                         const char **text, double *out)
+{
+    const char *value = NULL;
+    if (*text != NULL) {
+        return cli_fail(CLI_EXIT_INVALID, "%s: given more than once", name);
+    }
+    if (!cli_option_value(argc, argv, i, name, &value)) {
+        return cli_fail(CLI_EXIT_INVALID, "%s: missing value (scenario seconds)", name);
+    }
+    if (!cli_parse_real(value, out) || *out < 0 || (*out == 0 && !zero_ok) ||
+        *out > COA_LCM_MAX_STEP) {
+        return cli_fail(CLI_EXIT_INVALID, "%s: must be a number of seconds, %s %g, got '%.40s'",
+                        name, zero_ok ? "0 <= S <=" : "0 < S <=", COA_LCM_MAX_STEP, value);
+    }
+    *text = value;
+    return CLI_CONTINUE;
+}
+
+static int parse_options(int argc, char **argv, vehicle_options_t *o)
+{
+    memset(o, 0, sizeof *o);
+    coa_rt_options_init(&o->rt);
+    for (int i = 1; i < argc; i++) {
+        const char *arg = argv[i];
+        const char *value = NULL;
+        int rc = coa_rt_parse_option(argc, argv, &i, &o->rt);
+        if (rc == 1) {
+            continue;
+        }
+        if (rc != 0) {
+            return rc;
+        }
+        if (strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0) {
+            fputs(VEHICLE_USAGE, stdout);
+            return CLI_EXIT_OK;
+        } else if (cli_option_is(arg, "--scenario")) {
+            if (o->scenario_path != NULL) {
+                return cli_fail(CLI_EXIT_INVALID, "--scenario: given more than once");
+            }
+            if (!cli_option_value(argc, argv, &i, "--scenario", &value) || value[0] == '\0') {
+                return cli_fail(CLI_EXIT_INVALID, "--scenario: missing value (a scenario file)");
+            }
+            o->scenario_path = value;
+        } else if (cli_option_is(arg, "--id")) {
+            uint64_t id;
+            if (o->id_text != NULL) {
+                return cli_fail(CLI_EXIT_INVALID, "--id: given more than once");
+            }
+            if (!cli_option_value(argc, argv, &i, "--id", &value)) {
+                return cli_fail(CLI_EXIT_INVALID, "--id: missing value (a vehicle id)");
+            }
+            if (!cli_parse_count(value, strlen(value), 65535u, &id)) {
+                return cli_fail(CLI_EXIT_INVALID,
+                                "--id: must be a vehicle id from 1 to 65535, got '%.40s'", value);
+            }
+            o->id_text = value;
+            o->id = (uint16_t)id;
+        } else if (strcmp(arg, "--list-ids") == 0) {
+            if (o->list_ids) {
+                return cli_fail(CLI_EXIT_INVALID, "--list-ids: given more than once");
+            }
+            o->list_ids = true;
+        } else if (cli_option_is(arg, "--list-ids")) {
+            return cli_fail(CLI_EXIT_INVALID, "--list-ids: takes no value");
+        } else if (cli_option_is(arg, "--mode")) {
+            if (o->mode != NULL) {
+                return cli_fail(CLI_EXIT_INVALID, "--mode: given more than once");
+            }
+            if (!cli_option_value(argc, argv, &i, "--mode", &value)) {
+                return cli_fail(CLI_EXIT_INVALID,
+                                "--mode: missing value (centralised or decoupled)");
+            }
+            if (strcmp(value, "centralised") != 0 && strcmp(value, "decoupled") != 0) {
+                return cli_fail(CLI_EXIT_INVALID,
+                                "--mode: unknown mode '%.40s' (expected centralised or decoupled)",
+                                value);
+            }
+            o->mode = value;
+            o->decoupled = strcmp(value, "decoupled") == 0;
+        } else if (cli_option_is(arg, "--coordinator-timeout")) {
+            rc = parse_seconds(argc, argv, &i, "--coordinator-timeout", false, &o->timeout_text,
+                               &o->timeout);
+            if (rc != CLI_CONTINUE) {
+                return rc;
+            }
+        } else if (cli_option_is(arg, "--priority-wait")) {
+            rc = parse_seconds(argc, argv, &i, "--priority-wait", true, &o->wait_text, &o->wait);
+            if (rc != CLI_CONTINUE) {
+                return rc;
+            }
+        } else if (arg[0] != '-') {
+            return cli_fail(CLI_EXIT_INVALID,
+                            "vehicle: unexpected argument '%.80s' (the scenario is --scenario FILE)",
+                            arg);
+        } else {
+            return cli_fail(CLI_EXIT_INVALID,
+                            "vehicle: unknown option '%.40s' (see 'coavoid-vehicle --help')", arg);
+        }
+    }
+    if (o->scenario_path == NULL) {
+        return cli_fail(CLI_EXIT_INVALID, "--scenario: required (a scenario file)");
+    }
+    if (o->list_ids) {
+        if (o->id_text != NULL || o->mode != NULL || o->timeout_text != NULL ||
+            o->wait_text != NULL || o->rt.lcm_url != NULL || o->rt.have_epoch ||
+            o->rt.speed_text != NULL || o->rt.steps_text != NULL) {
+            return cli_fail(CLI_EXIT_INVALID, "--list-ids: takes only --scenario FILE");
+        }
+        return CLI_CONTINUE;
+    }
+    if (o->id_text == NULL) {
+        return cli_fail(CLI_EXIT_INVALID, "--id: required (which vehicle of the scenario)");
+    }
+    /* The coordinator timeout only decides when a centralised vehicle plans for itself. */
+    if (o->decoupled && o->timeout_text != NULL) {
+        return cli_fail(CLI_EXIT_INVALID, "--coordinator-timeout: only valid with --mode centralised");
+    }
+    return CLI_CONTINUE;
+}
+
+/* Everything after the options. Returns the exit status. */
+static int run(vehicle_options_t *o, scenario_t *s)
+{
+    int64_t now = 0; /* the nodes' clock (common.clock), written by the loop */
+    coa_vehicle_node_config_t config;
+    memset(&config, 0, sizeof config);
+    int status = coa_rt_setup(o->scenario_path, s, &o->rt, &now, &config.common);
+    if (status != CLI_CONTINUE) {
+        return status;
+    }
+    long index = scenario_vehicle_index(s, (long)o->id);
+    if (index < 0) {
+        return cli_fail(CLI_EXIT_INVALID, "--id: %s has no vehicle %u", o->scenario_path,
+                        (unsigned)o->id);
+    }
+    const int64_t dt_us = config.common.dt_us;
+    config.vehicle = s->vehicles[index];
+    config.mode = o->decoupled ? COA_NODE_DECOUPLED : COA_NODE_CENTRALISED;
+    config.coordinator_timeout_us =
+        o->timeout_text != NULL ? llround(o->timeout * 1e6) : llround(2.5 * (double)dt_us);
+    config.priority_wait_us = o->wait_text != NULL ? llround(o->wait * 1e6) : dt_us / 2;
+    if (config.coordinator_timeout_us < 1) {
+        return cli_fail(CLI_EXIT_INVALID, "--coordinator-timeout: below a microsecond");
+    }
+    /* A wait into the next cycle would publish this cycle's intent after the next one's. */
+    if (config.priority_wait_us >= dt_us) {
+        return cli_fail(CLI_EXIT_INVALID,
+                        "--priority-wait: %g s is not less than the scenario's dt (%g s)", o->wait,
+                        (double)s->dt);
+    }
+
+    char err[512];
+    lcm_t *lcm = coa_rt_lcm_create(o->rt.lcm_url, err, sizeof err);
+    if (lcm == NULL) {
+        return cli_fail(CLI_EXIT_INVALID, "%s", err);
+    }
+    int error = COA_OK;
+    coa_vehicle_node_t *node = coa_vehicle_node_create(&config, lcm, &error);
+    if (node == NULL) {
+        lcm_destroy(lcm);
+        return cli_fail(error == COA_ERR_ARGUMENT ? CLI_EXIT_INVALID : CLI_EXIT_INTERNAL,
+                        "vehicle %u: cannot start (%s)", (unsigned)o->id,
+                        coa_lcm_error_name(error));
+    }
+    if (coa_rt_install_signal_handlers() != 0) {
+        coa_vehicle_node_destroy(node);
+        lcm_destroy(lcm);
+        return cli_fail(CLI_EXIT_INTERNAL, "vehicle %u: cannot handle SIGINT/SIGTERM",
+                        (unsigned)o->id);
+    }
+
+    char name[32];
+    snprintf(name, sizeof name, "vehicle %u", (unsigned)o->id);
+    coa_vehicle_node_t *const vehicles[1] = {node};
+    coa_rt_loop_t loop;
+    memset(&loop, 0, sizeof loop);
+    loop.clock.epoch_utime = o->rt.epoch_utime;
+    loop.clock.speed = o->rt.speed;
+    loop.lcm = lcm;
+    loop.now = &now;
+    loop.common = &config.common;
+    loop.steps = o->rt.steps;
+    loop.vehicles = vehicles;
+    loop.vehicle_count = 1;
+    loop.name = name;
+    loop.warnings = stderr;
+    coa_rt_result_t result;
+    int rc = coa_rt_run(&loop, &result);
+
+    const coa_vehicle_node_state_t *st = coa_vehicle_node_state(node);
+    char tail[256];
+    coa_rt_result_text(&result, tail, sizeof tail);
+    fprintf(stderr,
+            "%s: %lld cycles, plans run %u, plans adopted %u, fallbacks %u, messages received "
+            "%lld, rejected %lld (last: %s)%s\n",
+            name, (long long)result.cycles, (unsigned)st->plans_run, (unsigned)st->plans_adopted,
+            (unsigned)st->fallbacks, (long long)st->rx.received, (long long)st->rx.rejected,
+            st->rx.last_reason != NULL ? st->rx.last_reason : "none", tail);
+    coa_vehicle_node_destroy(node);
+    lcm_destroy(lcm);
+    if (rc != COA_OK) {
+        return cli_fail(CLI_EXIT_INTERNAL, "%s: LCM failed while running (%s)", name,
+                        o->rt.lcm_url);
+    }
+    return result.errors > 0 ? CLI_EXIT_INTERNAL : CLI_EXIT_OK;
+}
+
+int main(int argc, char **argv)
+{
+    vehicle_options_t options;
+    int status = parse_options(argc, argv, &options);
+    if (status != CLI_CONTINUE) {
+        return status;
+    }
+    scenario_t scenario;
+    memset(&scenario, 0, sizeof scenario);
+    if (options.list_ids) {
+        status = cli_load_scenario(options.scenario_path, &scenario);
+        if (status == CLI_CONTINUE) {
+            for (size_t i = 0; i < scenario.vehicle_count; i++) {
+                printf("%u\n", (unsigned)scenario.vehicles[i].id);
+            }
+            status = fflush(stdout) == 0 ? CLI_EXIT_OK
+                                         : cli_fail(CLI_EXIT_INTERNAL, "--list-ids: cannot write");
+        }
+        scenario_free(&scenario);
+        return status;
+    }
+    status = run(&options, &scenario);
+    scenario_free(&scenario);
+    return status;
+}
