@@ -1,7 +1,9 @@
 /*
  * LCM messages: every type round-trips through encode/decode and through the core
- * types; each validation rule refuses its bad message; decoding random, truncated and
- * corrupted bytes never crashes (run under the sanitizers).
+ * types; each validation rule refuses its bad message; an accepted intent is one the
+ * planner accepts and plans with the positions its sender computed, bit for bit;
+ * decoding random, truncated and corrupted bytes never crashes (run under the
+ * sanitizers); receive counters for the status message.
  */
 #include <check.h>
 #include <stdio.h>
@@ -11,6 +13,7 @@
 #ifdef COAVOID_HAVE_LCM
 
 #include "coavoid_lcm.h"
+#include "test_support.h"
 
 #include <math.h>
 
@@ -29,14 +32,14 @@ static coa_lcm_context_t ctx_now(void)
 static uint64_t rng_state;
 static uint64_t rng_next(void)
 {
-    /* splitmix64: fixed seeds, same cases on every machine. */
-    uint64_t z = (rng_state += UINT64_C(0x9E3779B97F4A7C15));
-    z = (z ^ (z >> 30)) * UINT64_C(0xBF58476D1CE4E5B9);
-    z = (z ^ (z >> 27)) * UINT64_C(0x94D049BB133111EB);
-    return z ^ (z >> 31);
+    return splitmix(&rng_state);
 }
 
 /* ---- valid messages ---- */
+
+/* The good intent's offsets step through every action (steep factor 3) and return: net 0
+ * every ten steps, -2, -5, -5, -4, -1, 2, 3, 3, 0, -1, -2, ... so in -5..3. */
+static const int32_t ACTION_CYCLE[10] = {-3, 0, 1, 3, 3, 1, 0, -3, -1, -1};
 
 static coavoid_intent_t good_intent(void)
 {
@@ -54,13 +57,20 @@ static coavoid_intent_t good_intent(void)
     m.velocity[0] = 20.0;
     m.radius = 30.0;
     m.half_height = 10.0;
+    /* Numbers with no short binary expansion (1.8 * 0.9, 0.3 * j), so that computing a
+     * position any other way than the planner does shows in the last bit. */
+    m.cruise_speed = 18.0;
+    m.climb_rate = 1.8;
+    m.steep_factor = 3;
+    m.max_offset = 40;
     m.plan_utime = T0 - 500000;
-    m.step = 1.0;
+    m.step = 0.9;
     m.sample_count = 61;
     for (j = 0; j < m.sample_count; ++j) {
-        m.samples[j][0] = 100.0 + 20.0 * j;
-        m.samples[j][1] = -50.0;
-        m.samples[j][2] = 120.0 + (j % 5);
+        m.reference[j][0] = 100.0 + 16.2 * j;
+        m.reference[j][1] = -50.0 + 0.1 * j;
+        m.reference[j][2] = 120.0 + 0.3 * j;
+        m.offsets[j] = (j == 0) ? -2 : m.offsets[j - 1] + ACTION_CYCLE[(j - 1) % 10];
     }
     m.sigma_horizontal = 5.0;
     m.sigma_vertical = 2.5;
@@ -246,27 +256,357 @@ START_TEST(test_round_trip_wire)
 }
 END_TEST
 
+/* The core's views of an intent, as a receiver holds them. */
+typedef struct {
+    coa_lcm_intent_info_t info;
+    coa_vehicle_t vehicle;
+    coa_intent_plan_t plan;
+    coa_lcm_intent_arrays_t arrays;
+} intent_view_t;
+
+static int intent_view(const coavoid_intent_t *m, intent_view_t *v, const char **why)
+{
+    coa_lcm_context_t ctx = ctx_now();
+    memset(v, 0, sizeof *v);
+    return coa_lcm_intent_to_core(m, &ctx, NULL, &v->info, &v->vehicle, &v->plan, &v->arrays, why);
+}
+
+/* Bits, not values: -0.0 == 0.0 and the test is about the last bit. */
+static bool same_vec(coa_vec3_t a, coa_vec3_t b)
+{
+    return memcmp(&a.x, &b.x, sizeof a.x) == 0 && memcmp(&a.y, &b.y, sizeof a.y) == 0 &&
+           memcmp(&a.z, &b.z, sizeof a.z) == 0;
+}
+
+static coa_vec3_t vec_from(const double v[3])
+{
+    coa_vec3_t r;
+    r.x = (coa_real_t)v[0];
+    r.y = (coa_real_t)v[1];
+    r.z = (coa_real_t)v[2];
+    return r;
+}
+
+/* A one-vehicle planning problem over an intent's reference, as a coordinator builds it. */
+static coa_problem_t intent_problem(const intent_view_t *v, const coa_vec3_t *const *references)
+{
+    coa_problem_t p;
+    memset(&p, 0, sizeof p);
+    p.dt = v->info.step;
+    p.horizon = (uint32_t)(v->plan.count - 1u);
+    p.vehicles = &v->vehicle;
+    p.vehicle_count = 1u;
+    p.references = references;
+    return p;
+}
+
 START_TEST(test_round_trip_intent_core)
 {
     coavoid_intent_t m = good_intent();
     coavoid_intent_t back;
     coa_lcm_context_t ctx = ctx_now();
-    coa_lcm_intent_info_t info;
-    coa_intent_plan_t plan;
-    coa_vec3_t samples[COAVOID_INTENT_T_MAX_SAMPLES];
+    intent_view_t *v = malloc(sizeof *v);
+    intent_view_t *w = malloc(sizeof *w);
+    coa_real_t dh;
+    coa_vehicle_t unbounded;
+    int32_t j;
     const char *why = NULL;
-    ck_assert_int_eq(coa_lcm_intent_to_core(&m, &ctx, NULL, &info, &plan, samples,
-                                            COAVOID_INTENT_T_MAX_SAMPLES, &why), COA_OK);
-    ck_assert_uint_eq(plan.id, 7u);
-    ck_assert_uint_eq(plan.count, 61u);
-    ck_assert(fabs((double)plan.t0 - 4.5) < 1e-6);
-    ck_assert_uint_eq(info.priority, 2u);
-    ck_assert_int_eq(coa_lcm_intent_from_core(&plan, &info, &ctx, &back, &why), COA_OK);
+    ck_assert_ptr_nonnull(v);
+    ck_assert_ptr_nonnull(w);
+    ck_assert_int_eq(intent_view(&m, v, &why), COA_OK);
+    ck_assert_str_eq(why, "ok");
+
+    /* The vehicle a coordinator re-plans: every performance field, the reference as its
+     * route, and the offset it flies now. */
+    ck_assert_uint_eq(v->vehicle.id, 7u);
+    ck_assert_uint_eq(v->vehicle.priority, 2u);
+    ck_assert(v->vehicle.cruise_speed == (coa_real_t)18.0);
+    ck_assert(v->vehicle.climb_rate == (coa_real_t)1.8);
+    ck_assert_uint_eq(v->vehicle.steep_factor, 3u);
+    ck_assert(v->vehicle.volume.radius == (coa_real_t)30.0);
+    ck_assert(v->vehicle.volume.half_height == (coa_real_t)10.0);
+    ck_assert_int_eq(v->vehicle.max_offset, 40);
+    ck_assert_int_eq(v->vehicle.initial_offset, -2);
+    ck_assert_ptr_eq(v->vehicle.route, v->arrays.reference);
+    ck_assert_uint_eq(v->vehicle.route_count, 61u);
+    ck_assert_int_eq(coa_vehicle_check(&v->vehicle), COA_OK);
+
+    ck_assert(v->info.utime == m.utime);
+    ck_assert(v->info.sequence == 42);
+    ck_assert_int_eq(v->info.mode, COAVOID_INTENT_T_MODE_DECOUPLED);
+    ck_assert(same_vec(v->info.position, vec_from(m.position)));
+    ck_assert(same_vec(v->info.velocity, vec_from(m.velocity)));
+    ck_assert(v->info.plan_utime == m.plan_utime);
+    ck_assert(v->info.step == (coa_real_t)0.9);
+    ck_assert(v->info.sigma_horizontal == (coa_real_t)5.0);
+    ck_assert(v->info.sigma_vertical == (coa_real_t)2.5);
+
+    ck_assert_uint_eq(v->plan.id, 7u);
+    ck_assert_uint_eq(v->plan.count, 61u);
+    ck_assert_ptr_eq(v->plan.samples, v->arrays.samples);
+    ck_assert(fabs((double)v->plan.t0 - 4.5) < 1e-6);
+    ck_assert(v->plan.step == v->info.step);
+    ck_assert(v->plan.volume.radius == v->vehicle.volume.radius);
+    ck_assert(v->plan.sigma_vertical == (coa_real_t)2.5);
+
+    /* Positions as the planner computes them (plan.c, vehicle_sweep): the reference in
+     * core precision, plus the offset times the climb step of the problem's dt. */
+    dh = coa_climb_step(&v->vehicle, v->info.step);
+    ck_assert(dh == (coa_real_t)1.8 * (coa_real_t)0.9);
+    for (j = 0; j < m.sample_count; ++j) {
+        coa_vec3_t ref = vec_from(m.reference[j]);
+        coa_vec3_t expect = ref;
+        expect.z = ref.z + (coa_real_t)m.offsets[j] * dh;
+        ck_assert(same_vec(v->arrays.reference[j], ref));
+        ck_assert_int_eq(v->arrays.offsets[j], m.offsets[j]);
+        ck_assert(same_vec(v->arrays.samples[j], expect));
+    }
+    /* And back: the sender's message, bit for bit in double; in float, a message that
+     * gives the same core views again. */
+    ck_assert_int_eq(coa_lcm_intent_from_core(&v->vehicle, &v->info, v->arrays.reference,
+                                              v->arrays.offsets, v->plan.count, &ctx, &back, &why),
+                     COA_OK);
 #ifndef COA_SINGLE_PRECISION
     ck_assert_int_eq(memcmp(&back, &m, sizeof m), 0);
 #endif
-    ck_assert_int_eq(coa_lcm_intent_to_core(&m, &ctx, NULL, &info, &plan, samples, 60, &why),
-                     COA_LCM_ERR_CAPACITY);
+    ck_assert_int_eq(intent_view(&back, w, &why), COA_OK);
+    ck_assert_int_eq(memcmp(&w->arrays, &v->arrays, sizeof w->arrays), 0);
+    /* Field by field: struct padding is not part of the promise. */
+    ck_assert(w->info.utime == v->info.utime && w->info.sequence == v->info.sequence);
+    ck_assert(w->info.mode == v->info.mode && w->info.plan_utime == v->info.plan_utime);
+    ck_assert(same_vec(w->info.position, v->info.position));
+    ck_assert(same_vec(w->info.velocity, v->info.velocity));
+    ck_assert(w->info.step == v->info.step);
+    ck_assert(w->info.sigma_horizontal == v->info.sigma_horizontal);
+    ck_assert(w->info.sigma_vertical == v->info.sigma_vertical);
+    ck_assert(w->vehicle.id == v->vehicle.id && w->vehicle.priority == v->vehicle.priority);
+    ck_assert(w->vehicle.cruise_speed == v->vehicle.cruise_speed);
+    ck_assert(w->vehicle.climb_rate == v->vehicle.climb_rate);
+    ck_assert(w->vehicle.steep_factor == v->vehicle.steep_factor);
+    ck_assert(w->vehicle.volume.radius == v->vehicle.volume.radius);
+    ck_assert(w->vehicle.volume.half_height == v->vehicle.volume.half_height);
+    ck_assert(w->vehicle.route_count == v->vehicle.route_count);
+    ck_assert(w->vehicle.initial_offset == v->vehicle.initial_offset);
+    ck_assert(w->vehicle.max_offset == v->vehicle.max_offset);
+
+    /* An unbounded vehicle publishes max_offset -1 whatever negative number it holds. */
+    unbounded = v->vehicle;
+    unbounded.max_offset = -5;
+    ck_assert_int_eq(coa_lcm_intent_from_core(&unbounded, &v->info, v->arrays.reference,
+                                              v->arrays.offsets, v->plan.count, &ctx, &back, &why),
+                     COA_OK);
+    ck_assert_int_eq(back.max_offset, -1);
+
+    /* What from_core and to_core refuse themselves. */
+    ck_assert_int_eq(coa_lcm_intent_from_core(&v->vehicle, &v->info, v->arrays.reference,
+                                              v->arrays.offsets, 1, &ctx, &back, &why),
+                     COA_LCM_ERR_COUNT);
+    ck_assert_int_eq(coa_lcm_intent_from_core(&v->vehicle, &v->info, v->arrays.reference,
+                                              v->arrays.offsets, 129, &ctx, &back, &why),
+                     COA_LCM_ERR_COUNT);
+    ck_assert_int_eq(coa_lcm_intent_from_core(&v->vehicle, &v->info, NULL, v->arrays.offsets, 61,
+                                              &ctx, &back, &why),
+                     COA_ERR_ARGUMENT);
+    unbounded.id = 0;
+    ck_assert_int_eq(coa_lcm_intent_from_core(&unbounded, &v->info, v->arrays.reference,
+                                              v->arrays.offsets, v->plan.count, &ctx, &back, &why),
+                     COA_LCM_ERR_ID);
+    ck_assert_int_eq(coa_lcm_intent_to_core(&m, &ctx, NULL, &v->info, &v->vehicle, &v->plan, NULL,
+                                            &why),
+                     COA_ERR_ARGUMENT);
+    free(v);
+    free(w);
+}
+END_TEST
+
+typedef struct {
+    void *mem;
+    coa_planner_t *planner;
+} workspace_t;
+
+static workspace_t workspace(uint32_t beta)
+{
+    workspace_t ws;
+    size_t bytes = coa_planner_workspace_size(1u, beta);
+    ck_assert_uint_gt(bytes, 0u);
+    ws.mem = malloc(bytes);
+    ck_assert_ptr_nonnull(ws.mem);
+    ws.planner = coa_planner_init(ws.mem, bytes, 1u, beta);
+    ck_assert_ptr_nonnull(ws.planner);
+    return ws;
+}
+
+/* The next coa_real_t up or down. */
+static coa_real_t real_next(coa_real_t x, int up)
+{
+#ifdef COA_SINGLE_PRECISION
+    return nextafterf(x, up ? INFINITY : -INFINITY);
+#else
+    return nextafter(x, up ? INFINITY : -INFINITY);
+#endif
+}
+
+START_TEST(test_plan_from_intent)
+{
+    coavoid_intent_t m = good_intent();
+    coavoid_intent_t replanned;
+    coa_lcm_context_t ctx = ctx_now();
+    intent_view_t *v = malloc(sizeof *v);
+    workspace_t ws = workspace(2000u);
+    int32_t offsets[COAVOID_INTENT_T_MAX_SAMPLES];
+    const coa_vec3_t *references[1];
+    coa_problem_t problem;
+    coa_plan_result_t result;
+    coa_obstacle_t slabs[2];
+    coa_real_t z;
+    coa_real_t h;
+    size_t k;
+    const char *why = NULL;
+    ck_assert_ptr_nonnull(v);
+
+    /* A coordinator re-plans the UAV from its intent alone. Free airspace: it returns to
+     * its reference from the offset it flies now, and the new plan is publishable. */
+    ck_assert_int_eq(intent_view(&m, v, &why), COA_OK);
+    references[0] = v->arrays.reference;
+    problem = intent_problem(v, references);
+    ck_assert_int_eq(coa_problem_check(&problem), COA_OK);
+    ck_assert_int_eq(coa_plan_centralised(ws.planner, &problem, offsets, &result), COA_OK);
+    ck_assert_int_eq(result.status, COA_PLAN_SOLVED);
+    ck_assert_int_eq(offsets[0], -2);
+    ck_assert_int_eq(offsets[60], 0);
+    ck_assert(result.deviation > 0.0);
+    ck_assert_int_eq(coa_lcm_intent_from_core(&v->vehicle, &v->info, v->arrays.reference, offsets,
+                                              v->plan.count, &ctx, &replanned, &why),
+                     COA_OK);
+
+    /* The positions the receiver computed are the planner's to the last bit. The UAV flies
+     * level at offset -5 over a level reference between two slabs that touch its
+     * protected volume exactly, above and below: touching is no conflict, and any other
+     * altitude, one ulp up or down, is one. So the plan exists only if the planner puts
+     * the UAV exactly where arrays.samples says. */
+    m.sample_count = 21;
+    m.max_offset = -1;
+    for (k = 0; k < 21u; ++k) {
+        m.reference[k][2] = 100.3;
+        m.offsets[k] = -5;
+    }
+    ck_assert_int_eq(intent_view(&m, v, &why), COA_OK);
+    z = v->arrays.samples[0].z;
+    h = v->vehicle.volume.half_height;
+    for (k = 0; k < 21u; ++k) {
+        ck_assert(v->arrays.samples[k].z == z);
+    }
+    /* The test has teeth: the altitude as a sender might compute it its own way, in
+     * double, is off by an ulp in either precision. */
+    ck_assert(z != (coa_real_t)(100.3 + -5.0 * 1.8 * 0.9));
+    ck_assert((z - h) + h == z); /* the slabs' faces are exact */
+    ck_assert((z + h) - h == z);
+    memset(slabs, 0, sizeof slabs);
+    slabs[0].kind = COA_OBSTACLE_BOX;
+    slabs[0].box.min.x = (coa_real_t)-1e5;
+    slabs[0].box.min.y = (coa_real_t)-1e5;
+    slabs[0].box.min.z = z - h - (coa_real_t)50;
+    slabs[0].box.max.x = (coa_real_t)1e5;
+    slabs[0].box.max.y = (coa_real_t)1e5;
+    slabs[0].box.max.z = z - h;
+    slabs[1] = slabs[0];
+    slabs[1].box.min.z = z + h;
+    slabs[1].box.max.z = z + h + (coa_real_t)50;
+    problem = intent_problem(v, references);
+    problem.obstacles = slabs;
+    problem.obstacle_count = 2u;
+    ck_assert_int_eq(coa_plan_find_conflict(&problem, v->arrays.offsets, (const size_t[]){0u}, 1u,
+                                             NULL, NULL),
+                      0);
+    ck_assert_int_eq(coa_plan_centralised(ws.planner, &problem, offsets, &result), COA_OK);
+    ck_assert_int_eq(result.status, COA_PLAN_SOLVED);
+    ck_assert_uint_eq(result.nodes_expanded, 20u);
+    for (k = 0; k < 21u; ++k) {
+        ck_assert_int_eq(offsets[k], -5);
+    }
+    /* Each slab one ulp closer: now it is a conflict from t = 0. */
+    slabs[0].box.max.z = real_next(z - h, 1);
+    ck_assert_int_eq(coa_plan_find_conflict(&problem, v->arrays.offsets, (const size_t[]){0u}, 1u,
+                                            NULL, NULL),
+                     1);
+    ck_assert_int_eq(coa_plan_centralised(ws.planner, &problem, offsets, &result), COA_OK);
+    ck_assert_int_eq(result.status, COA_PLAN_INFEASIBLE);
+    ck_assert_uint_eq(result.nodes_expanded, 0u);
+    slabs[0].box.max.z = z - h;
+    slabs[1].box.min.z = real_next(z + h, 0);
+    ck_assert_int_eq(coa_plan_find_conflict(&problem, v->arrays.offsets, (const size_t[]){0u}, 1u,
+                                            NULL, NULL),
+                     1);
+    free(ws.mem);
+    free(v);
+}
+END_TEST
+
+/* What every accepted intent must give a receiver: a vehicle coa_vehicle_check accepts, a
+ * problem coa_problem_check accepts, and finite positions. REQUIRE: it runs in loops. */
+static void require_usable_intent(const coavoid_intent_t *m)
+{
+    static intent_view_t v;
+    const coa_vec3_t *references[1];
+    coa_problem_t problem;
+    size_t k;
+    const char *why = NULL;
+    REQUIRE(intent_view(m, &v, &why) == COA_OK);
+    REQUIRE(coa_vehicle_check(&v.vehicle) == COA_OK);
+    references[0] = v.arrays.reference;
+    problem = intent_problem(&v, references);
+    REQUIRE(coa_problem_check(&problem) == COA_OK);
+    for (k = 0; k < v.plan.count; ++k) {
+        REQUIRE(isfinite(v.arrays.samples[k].z));
+    }
+}
+
+/* A random magnitude 10^[-320, 8), sometimes negative, sometimes exactly 0. */
+static double wild(void)
+{
+    double x = pow(10.0, unif(&rng_state, -320.0, 8.0));
+    uint32_t r = pick(&rng_state, 16u);
+    return r == 0u ? 0.0 : (r == 1u ? -x : x);
+}
+
+/* The check's promise, pushed to the numbers where double and the core's precision part:
+ * speeds, step and volume of any magnitude, and reference legs of any length. Whatever it
+ * accepts, a coordinator can plan. */
+START_TEST(test_accepted_intent_is_plannable)
+{
+    int i;
+    int accepted = 0;
+    int refused = 0;
+    rng_state = UINT64_C(0xC0A1D);
+    for (i = 0; i < 4000; ++i) {
+        coavoid_intent_t m = good_intent();
+        coa_lcm_context_t ctx = ctx_now();
+        int changes = 1 + (int)pick(&rng_state, 3u);
+        int c;
+        const char *why = NULL;
+        for (c = 0; c < changes; ++c) {
+            int32_t j = 1 + (int32_t)pick(&rng_state, 60u);
+            switch (pick(&rng_state, 6u)) {
+            case 0: m.cruise_speed = wild(); break;
+            case 1: m.climb_rate = wild(); break;
+            case 2: m.step = wild(); break;
+            case 3: m.radius = wild(); break;
+            case 4: m.half_height = wild(); break;
+            default:
+                m.reference[j][0] = m.reference[j - 1][0] + wild();
+                m.reference[j][1] = m.reference[j - 1][1] + (pick(&rng_state, 2u) ? wild() : 0.0);
+                break;
+            }
+        }
+        if (coa_lcm_intent_check(&m, &ctx, &why) == COA_OK) {
+            require_usable_intent(&m);
+            accepted++;
+        } else {
+            refused++;
+        }
+    }
+    ck_assert_int_gt(accepted, 150);
+    ck_assert_int_gt(refused, 400);
 }
 END_TEST
 
@@ -392,35 +732,130 @@ END_TEST
 #define good_conflict_report_msg good_report
 #define good_status_msg good_status
 
+/* An intent mutation refused with `code`, by the rule whose reason contains `field`: many
+ * rules share COA_LCM_ERR_VALUE, and the reason shows which one fired. */
+#define EXPECT_INTENT(mutate, code, field)                                                 \
+    do {                                                                                   \
+        coavoid_intent_t m_ = good_intent();                                               \
+        const char *why_ = NULL;                                                           \
+        coa_lcm_context_t ctx_ = ctx_now();                                                \
+        mutate;                                                                            \
+        ck_assert_int_eq(coa_lcm_intent_check(&m_, &ctx_, &why_), (code));                 \
+        ck_assert_ptr_nonnull(why_);                                                       \
+        ck_assert_msg(strstr(why_, (field)) != NULL, "reason \"%s\" does not name %s", why_, \
+                      (field));                                                            \
+    } while (0)
+
 START_TEST(test_reject_intent)
 {
-    EXPECT(coavoid_intent_t, intent, m_.utime = 0, COA_LCM_ERR_TIME);
-    EXPECT(coavoid_intent_t, intent, m_.utime = T0 - 20000000, COA_LCM_ERR_TIME);
-    EXPECT(coavoid_intent_t, intent, m_.utime = T0 + 2000000, COA_LCM_ERR_TIME);
-    EXPECT(coavoid_intent_t, intent, m_.uav_id = 0, COA_LCM_ERR_ID);
-    EXPECT(coavoid_intent_t, intent, m_.uav_id = 65536, COA_LCM_ERR_ID);
-    EXPECT(coavoid_intent_t, intent, m_.sequence = -1, COA_LCM_ERR_VALUE);
-    EXPECT(coavoid_intent_t, intent, m_.priority = 0, COA_LCM_ERR_VALUE);
-    EXPECT(coavoid_intent_t, intent, m_.mode = 3, COA_LCM_ERR_ENUM);
-    EXPECT(coavoid_intent_t, intent, m_.position[1] = NAN, COA_LCM_ERR_NONFINITE);
-    EXPECT(coavoid_intent_t, intent, m_.position[2] = 1e300, COA_LCM_ERR_VALUE);
-    EXPECT(coavoid_intent_t, intent, m_.velocity[0] = INFINITY, COA_LCM_ERR_NONFINITE);
-    EXPECT(coavoid_intent_t, intent, m_.velocity[0] = 2e4, COA_LCM_ERR_VALUE);
-    EXPECT(coavoid_intent_t, intent, m_.radius = 0.0, COA_LCM_ERR_VALUE);
-    EXPECT(coavoid_intent_t, intent, m_.half_height = -1.0, COA_LCM_ERR_VALUE);
-    EXPECT(coavoid_intent_t, intent, m_.half_height = NAN, COA_LCM_ERR_NONFINITE);
-    EXPECT(coavoid_intent_t, intent, m_.plan_utime = 0, COA_LCM_ERR_TIME);
-    EXPECT(coavoid_intent_t, intent, m_.plan_utime = T0 + 20000000, COA_LCM_ERR_TIME);
-    EXPECT(coavoid_intent_t, intent, m_.step = 0.0, COA_LCM_ERR_VALUE);
-    EXPECT(coavoid_intent_t, intent, m_.step = NAN, COA_LCM_ERR_NONFINITE);
-    EXPECT(coavoid_intent_t, intent, m_.sample_count = 0, COA_LCM_ERR_COUNT);
-    EXPECT(coavoid_intent_t, intent, m_.sample_count = 129, COA_LCM_ERR_COUNT);
-    EXPECT(coavoid_intent_t, intent, m_.sample_count = -5, COA_LCM_ERR_COUNT);
-    EXPECT(coavoid_intent_t, intent, m_.samples[60][0] = NAN, COA_LCM_ERR_NONFINITE);
-    EXPECT(coavoid_intent_t, intent, m_.sigma_horizontal = -0.1, COA_LCM_ERR_VALUE);
-    EXPECT(coavoid_intent_t, intent, m_.sigma_vertical = INFINITY, COA_LCM_ERR_NONFINITE);
-    /* A sample past sample_count is not part of the message. */
-    EXPECT(coavoid_intent_t, intent, m_.samples[61][0] = NAN, COA_OK);
+    EXPECT_INTENT(m_.utime = 0, COA_LCM_ERR_TIME, "utime");
+    EXPECT_INTENT(m_.utime = T0 - 20000000, COA_LCM_ERR_TIME, "utime");
+    EXPECT_INTENT(m_.utime = T0 + 2000000, COA_LCM_ERR_TIME, "utime");
+    EXPECT_INTENT(m_.uav_id = 0, COA_LCM_ERR_ID, "uav_id");
+    EXPECT_INTENT(m_.uav_id = 65536, COA_LCM_ERR_ID, "uav_id");
+    EXPECT_INTENT(m_.sequence = -1, COA_LCM_ERR_VALUE, "sequence");
+    EXPECT_INTENT(m_.priority = 0, COA_LCM_ERR_VALUE, "priority");
+    EXPECT_INTENT(m_.mode = 3, COA_LCM_ERR_ENUM, "mode");
+    EXPECT_INTENT(m_.position[1] = NAN, COA_LCM_ERR_NONFINITE, "position");
+    EXPECT_INTENT(m_.position[2] = 1e300, COA_LCM_ERR_VALUE, "position");
+    EXPECT_INTENT(m_.velocity[0] = INFINITY, COA_LCM_ERR_NONFINITE, "velocity");
+    EXPECT_INTENT(m_.velocity[0] = 2e4, COA_LCM_ERR_VALUE, "velocity");
+    EXPECT_INTENT(m_.radius = 0.0, COA_LCM_ERR_VALUE, "radius");
+    EXPECT_INTENT(m_.half_height = -1.0, COA_LCM_ERR_VALUE, "half_height");
+    EXPECT_INTENT(m_.half_height = NAN, COA_LCM_ERR_NONFINITE, "half_height");
+
+    /* Performance. */
+    EXPECT_INTENT(m_.cruise_speed = 0.0, COA_LCM_ERR_VALUE, "cruise_speed");
+    EXPECT_INTENT(m_.cruise_speed = -18.0, COA_LCM_ERR_VALUE, "cruise_speed");
+    EXPECT_INTENT(m_.cruise_speed = NAN, COA_LCM_ERR_NONFINITE, "cruise_speed");
+    EXPECT_INTENT(m_.cruise_speed = 1.0001e4, COA_LCM_ERR_VALUE, "cruise_speed");
+    EXPECT_INTENT(m_.climb_rate = 0.0, COA_LCM_ERR_VALUE, "climb_rate");
+    EXPECT_INTENT(m_.climb_rate = -1.7, COA_LCM_ERR_VALUE, "climb_rate");
+    EXPECT_INTENT(m_.climb_rate = NAN, COA_LCM_ERR_NONFINITE, "climb_rate");
+    EXPECT_INTENT(m_.climb_rate = -INFINITY, COA_LCM_ERR_NONFINITE, "climb_rate");
+    EXPECT_INTENT(m_.climb_rate = 1.0001e4, COA_LCM_ERR_VALUE, "climb_rate");
+    EXPECT_INTENT(m_.steep_factor = 1, COA_LCM_ERR_VALUE, "steep_factor");
+    EXPECT_INTENT(m_.steep_factor = 11, COA_LCM_ERR_VALUE, "steep_factor");
+    EXPECT_INTENT(m_.max_offset = -2, COA_LCM_ERR_VALUE, "max_offset");
+    EXPECT_INTENT(m_.max_offset = 32768, COA_LCM_ERR_VALUE, "max_offset");
+    /* The bounds themselves are accepted. */
+    EXPECT_INTENT((m_.cruise_speed = 1e4, m_.climb_rate = 1e4), COA_OK, "ok");
+    EXPECT_INTENT((m_.steep_factor = 10, memset(m_.offsets, 0, sizeof m_.offsets)), COA_OK, "ok");
+    EXPECT_INTENT(m_.steep_factor = 2, COA_LCM_ERR_VALUE, "no action");
+    EXPECT_INTENT(m_.max_offset = 32767, COA_OK, "ok");
+    EXPECT_INTENT(m_.max_offset = -1, COA_OK, "ok");
+    /* Positive in double but nothing in the core: two tiny factors whose product (the
+     * climb step, the planner's deviation weight) is 0 in either precision; and a volume
+     * that is 0 once in float. */
+    EXPECT_INTENT((m_.climb_rate = 1e-200, m_.step = 1e-200), COA_LCM_ERR_VALUE, "core's precision");
+    EXPECT_INTENT((m_.cruise_speed = 1e-200, m_.climb_rate = 1e-200), COA_LCM_ERR_VALUE,
+                  "core's precision");
+#ifdef COA_SINGLE_PRECISION
+    EXPECT_INTENT(m_.radius = 1e-300, COA_LCM_ERR_VALUE, "core's precision");
+    EXPECT_INTENT(m_.cruise_speed = 1e-50, COA_LCM_ERR_VALUE, "core's precision");
+#else
+    EXPECT_INTENT(m_.radius = 1e-300, COA_OK, "ok");
+    EXPECT_INTENT(m_.cruise_speed = 1e-50, COA_OK, "ok");
+#endif
+
+    /* The plan's time and step. */
+    EXPECT_INTENT(m_.plan_utime = 0, COA_LCM_ERR_TIME, "plan_utime");
+    EXPECT_INTENT(m_.plan_utime = T0 + 20000000, COA_LCM_ERR_TIME, "plan_utime");
+    EXPECT_INTENT(m_.step = 0.0, COA_LCM_ERR_VALUE, "step");
+    EXPECT_INTENT(m_.step = NAN, COA_LCM_ERR_NONFINITE, "step");
+    EXPECT_INTENT(m_.step = 3601.0, COA_LCM_ERR_VALUE, "step");
+
+    /* Sample count. */
+    EXPECT_INTENT(m_.sample_count = 1, COA_LCM_ERR_COUNT, "sample_count");
+    EXPECT_INTENT(m_.sample_count = 129, COA_LCM_ERR_COUNT, "sample_count");
+    EXPECT_INTENT(m_.sample_count = 0, COA_LCM_ERR_COUNT, "sample_count");
+    EXPECT_INTENT(m_.sample_count = -5, COA_LCM_ERR_COUNT, "sample_count");
+    EXPECT_INTENT(m_.sample_count = 2, COA_OK, "ok");
+
+    /* The reference. */
+    EXPECT_INTENT(m_.reference[60][0] = NAN, COA_LCM_ERR_NONFINITE, "reference point");
+    EXPECT_INTENT(m_.reference[0][2] = INFINITY, COA_LCM_ERR_NONFINITE, "reference point");
+    EXPECT_INTENT(m_.reference[10][1] = -2e7, COA_LCM_ERR_VALUE, "reference point");
+    EXPECT_INTENT((m_.reference[5][0] = m_.reference[4][0], m_.reference[5][1] = m_.reference[4][1]),
+                  COA_LCM_ERR_VALUE, "horizontal separation");
+    /* Only z differs: a vertical leg, which no cruise speed flies. */
+    EXPECT_INTENT((m_.reference[5][0] = m_.reference[4][0], m_.reference[5][1] = m_.reference[4][1],
+                   m_.reference[5][2] += 50.0),
+                  COA_LCM_ERR_VALUE, "horizontal separation");
+    /* Different numbers, but the horizontal length squares to 0 (in float they are equal
+     * once converted). */
+    EXPECT_INTENT((m_.reference[4][0] = 0.0, m_.reference[4][1] = 0.0, m_.reference[5][0] = 1e-200,
+                   m_.reference[5][1] = 0.0),
+                  COA_LCM_ERR_VALUE, "horizontal separation");
+    /* A point past sample_count is not part of the message. */
+    EXPECT_INTENT(m_.reference[61][0] = NAN, COA_OK, "ok");
+    EXPECT_INTENT(m_.offsets[61] = 99999, COA_OK, "ok");
+
+    /* Offsets. The good intent's offsets reach -5. */
+    EXPECT_INTENT(m_.max_offset = 4, COA_LCM_ERR_VALUE, "offset beyond max_offset");
+    EXPECT_INTENT(m_.max_offset = 5, COA_OK, "ok");
+    EXPECT_INTENT((m_.max_offset = -1, m_.offsets[0] = 32768, m_.offsets[1] = 32768),
+                  COA_LCM_ERR_VALUE, "offset beyond max_offset");
+    EXPECT_INTENT((m_.max_offset = -1, m_.offsets[0] = -32768), COA_LCM_ERR_VALUE,
+                  "offset beyond max_offset");
+    /* +3 is a steep climb for steep factor 3, no action for 2; +2 is none for 3. */
+    EXPECT_INTENT(m_.steep_factor = 2, COA_LCM_ERR_VALUE, "no action");
+    EXPECT_INTENT(m_.offsets[1] = m_.offsets[0] + 2, COA_LCM_ERR_VALUE, "no action");
+    EXPECT_INTENT(m_.offsets[60] = m_.offsets[59] - 4, COA_LCM_ERR_VALUE, "no action");
+
+    /* A planned position out of range although its reference point is in range: offset 3
+     * at sample 6 climbs 3 * 1e4 * 0.9 m above 9.99e6 m; offset -5 at sample 1 dives
+     * 45 km below -9.99e6 m. */
+    ck_assert_int_eq(good_intent().offsets[6], 3);
+    ck_assert_int_eq(good_intent().offsets[1], -5);
+    EXPECT_INTENT((m_.climb_rate = 1e4, m_.reference[6][2] = 9.99e6), COA_LCM_ERR_VALUE,
+                  "planned position out of range");
+    EXPECT_INTENT((m_.climb_rate = 1e4, m_.reference[1][2] = -9.99e6), COA_LCM_ERR_VALUE,
+                  "planned position out of range");
+    EXPECT_INTENT((m_.climb_rate = 1e4, m_.reference[6][2] = 9.97e6), COA_OK, "ok");
+
+    EXPECT_INTENT(m_.sigma_horizontal = -0.1, COA_LCM_ERR_VALUE, "sigma_horizontal");
+    EXPECT_INTENT(m_.sigma_vertical = INFINITY, COA_LCM_ERR_NONFINITE, "sigma_vertical");
 }
 END_TEST
 
@@ -543,41 +978,40 @@ START_TEST(test_sequence_rules)
     coa_lcm_sequence_table_t table;
     coa_lcm_context_t ctx = ctx_now();
     coavoid_intent_t m = good_intent();
-    coa_lcm_intent_info_t info;
-    coa_intent_plan_t plan;
-    coa_vec3_t samples[COAVOID_INTENT_T_MAX_SAMPLES];
+    intent_view_t *v = malloc(sizeof *v);
     coavoid_obstacle_map_t map = good_map();
     coa_obstacle_t obstacles[80];
     coa_vec3_t vertices[512];
     size_t n;
     const char *why = NULL;
+    ck_assert_ptr_nonnull(v);
+#define INTENT_IN() \
+    coa_lcm_intent_to_core(&m, &ctx, &table, &v->info, &v->vehicle, &v->plan, &v->arrays, &why)
     coa_lcm_sequence_init(&table, entries, 2);
-    ck_assert_int_eq(coa_lcm_intent_to_core(&m, &ctx, &table, &info, &plan, samples, 128, &why), COA_OK);
+    ck_assert_int_eq(INTENT_IN(), COA_OK);
     /* The same sequence again, and an older one: refused, nothing recorded. */
-    ck_assert_int_eq(coa_lcm_intent_to_core(&m, &ctx, &table, &info, &plan, samples, 128, &why),
-                     COA_LCM_ERR_SEQUENCE);
+    ck_assert_int_eq(INTENT_IN(), COA_LCM_ERR_SEQUENCE);
     m.sequence = 41;
-    ck_assert_int_eq(coa_lcm_intent_to_core(&m, &ctx, &table, &info, &plan, samples, 128, &why),
-                     COA_LCM_ERR_SEQUENCE);
+    ck_assert_int_eq(INTENT_IN(), COA_LCM_ERR_SEQUENCE);
     m.sequence = 43;
-    ck_assert_int_eq(coa_lcm_intent_to_core(&m, &ctx, &table, &info, &plan, samples, 128, &why), COA_OK);
+    ck_assert_int_eq(INTENT_IN(), COA_OK);
     /* An invalid message does not advance the sequence. */
     m.sequence = 100;
-    m.radius = NAN;
-    ck_assert_int_eq(coa_lcm_intent_to_core(&m, &ctx, &table, &info, &plan, samples, 128, &why),
-                     COA_LCM_ERR_NONFINITE);
-    m.radius = 30.0;
+    m.steep_factor = 2;
+    ck_assert_int_eq(INTENT_IN(), COA_LCM_ERR_VALUE);
+    m.steep_factor = 3;
     m.sequence = 44;
-    ck_assert_int_eq(coa_lcm_intent_to_core(&m, &ctx, &table, &info, &plan, samples, 128, &why), COA_OK);
+    ck_assert_int_eq(INTENT_IN(), COA_OK);
     /* Senders are independent; the table is bounded. */
     m.uav_id = 8;
     m.sequence = 0;
-    ck_assert_int_eq(coa_lcm_intent_to_core(&m, &ctx, &table, &info, &plan, samples, 128, &why), COA_OK);
+    ck_assert_int_eq(INTENT_IN(), COA_OK);
     m.uav_id = 9;
-    ck_assert_int_eq(coa_lcm_intent_to_core(&m, &ctx, &table, &info, &plan, samples, 128, &why),
-                     COA_LCM_ERR_SENDERS);
+    ck_assert_int_eq(INTENT_IN(), COA_LCM_ERR_SENDERS);
     coa_lcm_sequence_forget(&table, 8);
-    ck_assert_int_eq(coa_lcm_intent_to_core(&m, &ctx, &table, &info, &plan, samples, 128, &why), COA_OK);
+    ck_assert_int_eq(INTENT_IN(), COA_OK);
+#undef INTENT_IN
+    free(v);
     /* A map may be republished with the same version, never an older one. */
     coa_lcm_sequence_init(&table, entries, 2);
     ck_assert_int_eq(coa_lcm_obstacle_map_to_core(&map, &ctx, &table, obstacles, 80, &n, vertices, 512, &why), COA_OK);
@@ -589,11 +1023,82 @@ START_TEST(test_sequence_rules)
 }
 END_TEST
 
+/* ---- counting what arrives ---- */
+
+START_TEST(test_rx_count)
+{
+    coa_lcm_rx_stats_t rx;
+    coavoid_status_t st = good_status();
+    coa_lcm_context_t ctx = ctx_now();
+    const char *why = "untouched";
+    coavoid_intent_t bad = good_intent();
+    int rc;
+    coa_lcm_rx_init(&rx);
+    ck_assert(rx.received == 0 && rx.rejected == 0);
+    ck_assert_int_eq(rx.last_reject_code, 0);
+    ck_assert_str_eq(rx.last_reason, "none");
+
+    coa_lcm_rx_count(&rx, COA_OK, "ok");
+    ck_assert(rx.received == 1 && rx.rejected == 0);
+    ck_assert_str_eq(rx.last_reason, "none");
+    /* A refusal as a node meets it: the check's code and its reason string. */
+    bad.climb_rate = NAN;
+    rc = coa_lcm_intent_check(&bad, &ctx, &why); /* before reading why: argument order */
+    coa_lcm_rx_count(&rx, rc, why);
+    ck_assert(rx.received == 2 && rx.rejected == 1);
+    ck_assert_int_eq(rx.last_reject_code, COA_LCM_ERR_NONFINITE);
+    ck_assert_ptr_eq(rx.last_reason, why);
+    ck_assert_ptr_nonnull(strstr(rx.last_reason, "climb_rate"));
+    /* An acceptance leaves the last refusal as it was. */
+    coa_lcm_rx_count(&rx, COA_OK, "ok");
+    ck_assert(rx.received == 3 && rx.rejected == 1);
+    ck_assert_int_eq(rx.last_reject_code, COA_LCM_ERR_NONFINITE);
+    /* No reason given: the code's name. */
+    coa_lcm_rx_count(&rx, COA_LCM_ERR_DECODE, NULL);
+    ck_assert(rx.received == 4 && rx.rejected == 2);
+    ck_assert_int_eq(rx.last_reject_code, COA_LCM_ERR_DECODE);
+    ck_assert_str_eq(rx.last_reason, "message does not decode");
+    /* A decoder's byte count is a success, not a positive reject code (which would make
+     * the status message itself refused). */
+    coa_lcm_rx_count(&rx, 3791, NULL);
+    ck_assert(rx.received == 5 && rx.rejected == 2);
+    ck_assert_int_eq(rx.last_reject_code, COA_LCM_ERR_DECODE);
+
+    /* What the status message carries passes the status check. */
+    st.messages_received = rx.received;
+    st.messages_rejected = rx.rejected;
+    st.last_reject_code = rx.last_reject_code;
+    ck_assert_int_eq(coa_lcm_status_check(&st, &ctx, &why), COA_OK);
+
+    /* Saturation: neither counter wraps, and rejected never passes received. */
+    rx.received = INT64_MAX - 1;
+    rx.rejected = INT64_MAX - 2;
+    coa_lcm_rx_count(&rx, COA_LCM_ERR_TIME, "t");
+    ck_assert(rx.received == INT64_MAX && rx.rejected == INT64_MAX - 1);
+    coa_lcm_rx_count(&rx, COA_LCM_ERR_ID, "i");
+    ck_assert(rx.received == INT64_MAX && rx.rejected == INT64_MAX);
+    coa_lcm_rx_count(&rx, COA_LCM_ERR_COUNT, "c");
+    ck_assert(rx.received == INT64_MAX && rx.rejected == INT64_MAX);
+    ck_assert_int_eq(rx.last_reject_code, COA_LCM_ERR_COUNT);
+    ck_assert_str_eq(rx.last_reason, "c");
+    coa_lcm_rx_count(&rx, COA_OK, NULL);
+    ck_assert(rx.received == INT64_MAX && rx.rejected == INT64_MAX);
+    st.messages_received = rx.received;
+    st.messages_rejected = rx.rejected;
+    st.last_reject_code = rx.last_reject_code;
+    ck_assert_int_eq(coa_lcm_status_check(&st, &ctx, &why), COA_OK);
+
+    /* NULL is harmless. */
+    coa_lcm_rx_init(NULL);
+    coa_lcm_rx_count(NULL, COA_LCM_ERR_TIME, "t");
+}
+END_TEST
+
 /* ---- hostile bytes ---- */
 
-/* Decodes buf[0..len) as `type` and, when it decodes, validates and converts it. Either
- * way nothing may crash, leak or read out of bounds. Returns 1 when it decoded. */
-#define HOSTILE(type, checker, buf, len)                                                    \
+/* Decodes buf[0..len) as `type` and, when it decodes, validates it and runs `usable` on
+ * what the check accepted. Either way nothing may crash, leak or read out of bounds. */
+#define HOSTILE(type, checker, buf, len, usable)                                            \
     do {                                                                                    \
         type m_;                                                                            \
         const char *why_ = NULL;                                                            \
@@ -603,8 +1108,9 @@ END_TEST
             decoded++;                                                                      \
             if (coa_lcm_##checker##_check(&m_, &ctx_, &why_) == COA_OK) {                    \
                 accepted++;                                                                 \
+                usable;                                                                     \
             }                                                                               \
-            ck_assert_ptr_nonnull(why_);                                                    \
+            REQUIRE(why_ != NULL);                                                          \
             type##_decode_cleanup(&m_);                                                     \
         }                                                                                   \
     } while (0)
@@ -615,12 +1121,13 @@ static void hostile_all(const unsigned char *buf, size_t len, int which, int *de
     int decoded = 0;
     int accepted = 0;
     switch (which) {
-    case 0: HOSTILE(coavoid_intent_t, intent, buf, len); break;
-    case 1: HOSTILE(coavoid_plan_t, plan, buf, len); break;
-    case 2: HOSTILE(coavoid_track_t, track, buf, len); break;
-    case 3: HOSTILE(coavoid_obstacle_map_t, obstacle_map, buf, len); break;
-    case 4: HOSTILE(coavoid_conflict_report_t, conflict_report, buf, len); break;
-    default: HOSTILE(coavoid_status_t, status, buf, len); break;
+    /* An intent a receiver accepts is one its planner can take. */
+    case 0: HOSTILE(coavoid_intent_t, intent, buf, len, require_usable_intent(&m_)); break;
+    case 1: HOSTILE(coavoid_plan_t, plan, buf, len, (void)0); break;
+    case 2: HOSTILE(coavoid_track_t, track, buf, len, (void)0); break;
+    case 3: HOSTILE(coavoid_obstacle_map_t, obstacle_map, buf, len, (void)0); break;
+    case 4: HOSTILE(coavoid_conflict_report_t, conflict_report, buf, len, (void)0); break;
+    default: HOSTILE(coavoid_status_t, status, buf, len, (void)0); break;
     }
     *decoded_out += decoded;
     *accepted_out += accepted;
@@ -719,6 +1226,10 @@ START_TEST(test_random_bytes)
         }
         /* The flipped cases of full length decode (fixed sizes): the checks ran on them. */
         ck_assert_int_gt(decoded, 100);
+        /* Both ways: some corrupted messages pass their check (a flip in a field's slack;
+         * for intents, require_usable_intent then ran on them), and some are refused. */
+        ck_assert_int_gt(accepted, 20);
+        ck_assert_int_gt(decoded - accepted, 5);
         free(buf);
         free(good);
     }
@@ -731,6 +1242,8 @@ static Suite *lcm_suite(void)
     TCase *tc = tcase_create("messages");
     tcase_add_test(tc, test_round_trip_wire);
     tcase_add_test(tc, test_round_trip_intent_core);
+    tcase_add_test(tc, test_plan_from_intent);
+    tcase_add_test(tc, test_accepted_intent_is_plannable);
     tcase_add_test(tc, test_round_trip_plan_core);
     tcase_add_test(tc, test_round_trip_track_core);
     tcase_add_test(tc, test_round_trip_map_core);
@@ -742,6 +1255,7 @@ static Suite *lcm_suite(void)
     tcase_add_test(tc, test_reject_conflict_report);
     tcase_add_test(tc, test_reject_status);
     tcase_add_test(tc, test_sequence_rules);
+    tcase_add_test(tc, test_rx_count);
     tcase_add_test(tc, test_truncated_bytes);
     tcase_add_test(tc, test_random_bytes);
     suite_add_tcase(s, tc);
