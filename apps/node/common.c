@@ -1,0 +1,709 @@
+/*
+ * What the nodes share (node.h, node_internal.h): the clock arithmetic, the inbox that
+ * decodes, validates, counts and stores what arrives, the view of one cycle, the
+ * planner's track list, prediction and publishing.
+ */
+#include "node_internal.h"
+
+#include <limits.h>
+#include <math.h>
+#include <string.h>
+
+/* A generous queue per subscription: a cycle publishes one intent and one heartbeat per
+ * UAV and one estimate per track, all handled before the next cycle. LCM's default (30)
+ * would drop messages of a large fleet without a word. */
+#define COA_NODE_QUEUE_CAPACITY ((int)(4u * COA_NODE_MAX_PEERS + 2u * COA_NODE_MAX_TRACKS + 16u))
+
+int coa_node_common_defaults(coa_node_common_t *c, int64_t epoch_utime, coa_real_t dt,
+                             uint32_t horizon, const int64_t *clock)
+{
+    if (c == NULL || clock == NULL || epoch_utime <= 0 || !isfinite((double)dt) ||
+        !(dt > (coa_real_t)0) || (double)dt > COA_LCM_MAX_STEP || horizon < 1u ||
+        horizon > COA_NODE_MAX_HORIZON) {
+        return COA_ERR_ARGUMENT;
+    }
+    int64_t dt_us = (int64_t)llround((double)dt * 1e6);
+    if (dt_us < 1) {
+        return COA_ERR_ARGUMENT;
+    }
+    memset(c, 0, sizeof *c);
+    c->epoch_utime = epoch_utime;
+    c->dt = dt;
+    c->dt_us = dt_us;
+    c->horizon = horizon;
+    c->clock = clock;
+    c->stopwatch_us = NULL;
+    c->stopwatch_user = NULL;
+    c->threshold = 0.01;
+    c->stale_after_us = (int64_t)llround(2.5 * (double)dt_us);
+    c->stale_sigma_rate = (coa_real_t)1;
+    c->beta = 20000u;
+    return COA_OK;
+}
+
+static bool rate_ok(coa_real_t r)
+{
+    return isfinite((double)r) && r >= (coa_real_t)0;
+}
+
+int coa_node_common_check(const coa_node_common_t *c)
+{
+    if (c == NULL || c->clock == NULL || c->epoch_utime <= 0 || !isfinite((double)c->dt) ||
+        !(c->dt > (coa_real_t)0) || (double)c->dt > COA_LCM_MAX_STEP || c->horizon < 1u ||
+        c->horizon > COA_NODE_MAX_HORIZON || c->dt_us < 1 ||
+        c->dt_us != (int64_t)llround((double)c->dt * 1e6)) {
+        return COA_ERR_ARGUMENT;
+    }
+    if (!(c->threshold > 0.0) || !(c->threshold <= 1.0) ||
+        !rate_ok(c->vehicle_sigma_rate_horizontal) || !rate_ok(c->vehicle_sigma_rate_vertical) ||
+        !rate_ok(c->track_sigma_rate_horizontal) || !rate_ok(c->track_sigma_rate_vertical) ||
+        !rate_ok(c->stale_sigma_rate) || c->stale_after_us < 1 || c->beta < 1u) {
+        return COA_ERR_ARGUMENT;
+    }
+    /* Cycle arithmetic stays far from overflow for any run a node can make. */
+    if (c->epoch_utime > INT64_MAX / 4) {
+        return COA_ERR_ARGUMENT;
+    }
+    return COA_OK;
+}
+
+int64_t coa_node_cycle_utime(const coa_node_common_t *c, int64_t k)
+{
+    return c->epoch_utime + k * c->dt_us;
+}
+
+int64_t coa_node_cycle_of(const coa_node_common_t *c, int64_t utime)
+{
+    int64_t d = utime - c->epoch_utime;
+    int64_t k = d / c->dt_us;
+    if (d % c->dt_us != 0 && d < 0) {
+        k -= 1; /* floor, not truncation */
+    }
+    return k;
+}
+
+int64_t coa_node_stopwatch(const coa_node_common_t *c)
+{
+    return (c->stopwatch_us != NULL) ? c->stopwatch_us(c->stopwatch_user) : 0;
+}
+
+bool coa_node_outranks(uint32_t priority_a, uint16_t id_a, uint32_t priority_b, uint16_t id_b)
+{
+    return priority_a < priority_b || (priority_a == priority_b && id_a < id_b);
+}
+
+/* ---- senders ---- */
+
+static void senders_init(coa_node_senders_t *s)
+{
+    coa_lcm_sequence_init(&s->table, s->entries, COA_NODE_MAX_SENDERS);
+    s->heard_count = 0;
+}
+
+static void senders_heard(coa_node_senders_t *s, uint32_t sender, int64_t now)
+{
+    for (size_t i = 0; i < s->heard_count; i++) {
+        if (s->heard_sender[i] == sender) {
+            s->heard_utime[i] = now;
+            return;
+        }
+    }
+    if (s->heard_count < COA_NODE_MAX_SENDERS) {
+        s->heard_sender[s->heard_count] = sender;
+        s->heard_utime[s->heard_count] = now;
+        s->heard_count++;
+    }
+}
+
+/* Forgets every sender not heard for longer than limit, so its numbering may restart. */
+static void senders_expire(coa_node_senders_t *s, int64_t now, int64_t limit)
+{
+    size_t i = 0;
+    while (i < s->heard_count) {
+        if (now - s->heard_utime[i] > limit) {
+            coa_lcm_sequence_forget(&s->table, s->heard_sender[i]);
+            s->heard_count--;
+            s->heard_sender[i] = s->heard_sender[s->heard_count];
+            s->heard_utime[i] = s->heard_utime[s->heard_count];
+        } else {
+            i++;
+        }
+    }
+}
+
+/* ---- the inbox ---- */
+
+coa_lcm_context_t coa_node_context(const coa_node_inbox_t *in, int64_t now, int64_t epoch)
+{
+    coa_lcm_context_t ctx;
+    ctx.now_utime = now;
+    ctx.max_age_us = in->max_age_us;
+    ctx.max_future_us = in->common.dt_us;
+    ctx.epoch_utime = epoch;
+    return ctx;
+}
+
+/* The bytes of one received message, or false when they cannot be a message. */
+static bool received_size(const lcm_recv_buf_t *rbuf, int *size)
+{
+    if (rbuf == NULL || rbuf->data == NULL || rbuf->data_size > (uint32_t)INT_MAX) {
+        return false;
+    }
+    *size = (int)rbuf->data_size;
+    return true;
+}
+
+static void count_undecodable(coa_node_inbox_t *in, const char *reason)
+{
+    coa_lcm_rx_count(in->rx, COA_LCM_ERR_DECODE, reason);
+}
+
+static void on_intent(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
+{
+    coa_node_inbox_t *in = user;
+    coavoid_intent_t *msg = &in->rx_msg.intent;
+    int size = 0;
+    (void)channel;
+    if (!received_size(rbuf, &size) || coavoid_intent_t_decode(rbuf->data, 0, size, msg) < 0) {
+        count_undecodable(in, "intent: does not decode");
+        return;
+    }
+    if (msg->uav_id == (int32_t)in->self_uav) {
+        return; /* its own, looped back */
+    }
+    const int64_t now = *in->common.clock;
+    /* A place to keep it before the sequence rule, so that a full table does not
+     * swallow a sequence number it then drops. */
+    size_t slot = COA_NODE_MAX_PEERS;
+    size_t used = 0;
+    for (size_t i = 0; i < COA_NODE_MAX_PEERS; i++) {
+        if (in->peers[i].used) {
+            used++;
+            if (in->peers[i].msg.uav_id == msg->uav_id) {
+                slot = i;
+            }
+        }
+    }
+    if (slot == COA_NODE_MAX_PEERS && used < in->peer_capacity) {
+        for (size_t i = 0; i < COA_NODE_MAX_PEERS; i++) {
+            if (!in->peers[i].used) {
+                slot = i;
+                break;
+            }
+        }
+    }
+    if (slot == COA_NODE_MAX_PEERS) {
+        coa_lcm_rx_count(in->rx, COA_LCM_ERR_SENDERS, "intent: more UAVs than the node holds");
+        return;
+    }
+    coa_lcm_context_t ctx = coa_node_context(in, now, now);
+    coa_lcm_intent_info_t info;
+    coa_vehicle_t vehicle;
+    coa_intent_plan_t plan;
+    const char *reason = NULL;
+    int rc = coa_lcm_intent_to_core(msg, &ctx, &in->intent_seq.table, &info, &vehicle, &plan,
+                                    &in->rx_arrays, &reason);
+    coa_lcm_rx_count(in->rx, rc, reason);
+    if (rc != COA_OK) {
+        return;
+    }
+    senders_heard(&in->intent_seq, (uint32_t)msg->uav_id, now);
+    in->peers[slot].used = true;
+    in->peers[slot].forgotten = false;
+    in->peers[slot].msg = *msg;
+}
+
+static void on_track(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
+{
+    coa_node_inbox_t *in = user;
+    coavoid_track_t *msg = &in->rx_msg.track;
+    int size = 0;
+    (void)channel;
+    if (!received_size(rbuf, &size) || coavoid_track_t_decode(rbuf->data, 0, size, msg) < 0) {
+        count_undecodable(in, "track: does not decode");
+        return;
+    }
+    const int64_t now = *in->common.clock;
+    size_t slot = COA_NODE_MAX_TRACKS;
+    for (size_t i = 0; i < COA_NODE_MAX_TRACKS; i++) {
+        if (in->tracks[i].used && in->tracks[i].msg.source_id == msg->source_id &&
+            in->tracks[i].msg.track_id == msg->track_id) {
+            slot = i;
+            break;
+        }
+    }
+    if (slot == COA_NODE_MAX_TRACKS) {
+        for (size_t i = 0; i < COA_NODE_MAX_TRACKS; i++) {
+            if (!in->tracks[i].used) {
+                slot = i;
+                break;
+            }
+        }
+    }
+    if (slot == COA_NODE_MAX_TRACKS) {
+        coa_lcm_rx_count(in->rx, COA_LCM_ERR_CAPACITY, "track: more tracks than the node holds");
+        return;
+    }
+    coa_lcm_context_t ctx = coa_node_context(in, now, now);
+    coa_lcm_track_info_t info;
+    coa_track_t track;
+    coa_track_point_t path[COAVOID_TRACK_T_MAX_PATH];
+    const char *reason = NULL;
+    int rc = coa_lcm_track_to_core(msg, &ctx, &in->track_seq.table, &info, &track, path,
+                                   COAVOID_TRACK_T_MAX_PATH, &reason);
+    coa_lcm_rx_count(in->rx, rc, reason);
+    if (rc != COA_OK) {
+        return;
+    }
+    senders_heard(&in->track_seq, (uint32_t)msg->source_id, now);
+    in->tracks[slot].used = true;
+    in->tracks[slot].msg = *msg;
+}
+
+static void on_map(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
+{
+    coa_node_inbox_t *in = user;
+    coavoid_obstacle_map_t *msg = &in->rx_msg.map;
+    int size = 0;
+    (void)channel;
+    if (!received_size(rbuf, &size) ||
+        coavoid_obstacle_map_t_decode(rbuf->data, 0, size, msg) < 0) {
+        count_undecodable(in, "obstacle_map: does not decode");
+        return;
+    }
+    const int64_t now = *in->common.clock;
+    coa_lcm_context_t ctx = coa_node_context(in, now, now);
+    size_t count = 0;
+    const char *reason = NULL;
+    /* The conversion checks everything before it writes, so a refused map leaves the
+     * one in use untouched. */
+    int rc = coa_lcm_obstacle_map_to_core(msg, &ctx, &in->map_seq.table, in->obstacles,
+                                          COA_NODE_MAX_OBSTACLES, &count, in->vertices,
+                                          COA_NODE_MAX_VERTICES, &reason);
+    coa_lcm_rx_count(in->rx, rc, reason);
+    if (rc != COA_OK) {
+        return;
+    }
+    senders_heard(&in->map_seq, (uint32_t)msg->map_id, now);
+    in->obstacle_count = count;
+    in->have_map = true;
+}
+
+static void on_status(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
+{
+    coa_node_inbox_t *in = user;
+    coavoid_status_t *msg = &in->rx_msg.status;
+    int size = 0;
+    (void)channel;
+    if (!received_size(rbuf, &size) || coavoid_status_t_decode(rbuf->data, 0, size, msg) < 0) {
+        count_undecodable(in, "status: does not decode");
+        return;
+    }
+    if (msg->node_id == (int32_t)in->self_node) {
+        return;
+    }
+    const int64_t now = *in->common.clock;
+    coa_lcm_context_t ctx = coa_node_context(in, now, now);
+    const char *reason = NULL;
+    int rc = coa_lcm_status_accept(msg, &ctx, &in->status_seq.table, &reason);
+    coa_lcm_rx_count(in->rx, rc, reason);
+    if (rc != COA_OK) {
+        return;
+    }
+    senders_heard(&in->status_seq, (uint32_t)msg->node_id, now);
+    if (msg->node_kind == COAVOID_STATUS_T_NODE_COORDINATOR) {
+        in->heard_coordinator = true;
+        in->coordinator_utime = now;
+        /* Its plan numbering lives as long as its heartbeat does. */
+        senders_heard(&in->plan_seq, (uint32_t)msg->node_id, now);
+    }
+}
+
+static void on_plan(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
+{
+    coa_node_inbox_t *in = user;
+    coavoid_plan_t *msg = &in->rx_msg.plan;
+    int size = 0;
+    (void)channel;
+    if (!received_size(rbuf, &size) || coavoid_plan_t_decode(rbuf->data, 0, size, msg) < 0) {
+        count_undecodable(in, "plan: does not decode");
+        return;
+    }
+    if (msg->coordinator_id == (int32_t)in->self_node) {
+        return;
+    }
+    const int64_t now = *in->common.clock;
+    coa_lcm_context_t ctx = coa_node_context(in, now, now);
+    coa_lcm_plan_info_t info;
+    coa_plan_result_t result;
+    const char *reason = NULL;
+    int rc = coa_lcm_plan_to_core(msg, &ctx, &in->plan_seq.table, &info, &result, in->rx_offsets,
+                                  sizeof in->rx_offsets / sizeof in->rx_offsets[0], &reason);
+    if (rc != COA_OK) {
+        coa_lcm_rx_count(in->rx, rc, reason);
+        return;
+    }
+    senders_heard(&in->plan_seq, (uint32_t)msg->coordinator_id, now);
+    in->on_plan(in->owner, msg, &info, &result, in->rx_offsets);
+}
+
+static int subscribe(coa_node_inbox_t *in, const char *channel, lcm_msg_handler_t handler)
+{
+    lcm_subscription_t *sub = lcm_subscribe(in->tx.lcm, channel, handler, in);
+    if (sub == NULL) {
+        return COA_ERR_ARGUMENT;
+    }
+    lcm_subscription_set_queue_capacity(sub, COA_NODE_QUEUE_CAPACITY);
+    in->subs[in->sub_count++] = sub;
+    return COA_OK;
+}
+
+int coa_node_inbox_init(coa_node_inbox_t *in, const coa_node_common_t *common, uint16_t self_uav,
+                        uint16_t self_node, size_t peer_capacity, int64_t coordinator_timeout_us,
+                        lcm_t *lcm, coa_lcm_rx_stats_t *rx, bool want_status,
+                        coa_node_plan_handler_t plan_handler, void *owner)
+{
+    in->common = *common;
+    in->self_uav = self_uav;
+    in->self_node = self_node;
+    in->rx = rx;
+    in->peer_capacity = peer_capacity > COA_NODE_MAX_PEERS ? COA_NODE_MAX_PEERS : peer_capacity;
+    /* Old enough to still extrapolate a silent UAV for a horizon, and wide enough for a
+     * track's path and a plan's samples around their stamps. */
+    int64_t horizon_us = ((int64_t)common->horizon + 2) * common->dt_us;
+    in->max_age_us = common->stale_after_us + horizon_us;
+    in->coordinator_timeout_us = coordinator_timeout_us;
+    in->tx.lcm = lcm;
+    in->sub_count = 0;
+    coa_lcm_rx_init(in->rx);
+    senders_init(&in->intent_seq);
+    senders_init(&in->track_seq);
+    senders_init(&in->map_seq);
+    senders_init(&in->status_seq);
+    senders_init(&in->plan_seq);
+    memset(in->peers, 0, sizeof in->peers);
+    memset(in->tracks, 0, sizeof in->tracks);
+    in->have_map = false;
+    in->obstacle_count = 0;
+    in->heard_coordinator = false;
+    in->coordinator_utime = 0;
+    in->on_plan = plan_handler;
+    in->owner = owner;
+    int rc = subscribe(in, COA_CHANNEL_INTENT, on_intent);
+    if (rc == COA_OK) {
+        rc = subscribe(in, COA_CHANNEL_TRACK, on_track);
+    }
+    if (rc == COA_OK) {
+        rc = subscribe(in, COA_CHANNEL_OBSTACLES, on_map);
+    }
+    if (rc == COA_OK && want_status) {
+        rc = subscribe(in, COA_CHANNEL_STATUS, on_status);
+    }
+    if (rc == COA_OK && plan_handler != NULL) {
+        rc = subscribe(in, COA_CHANNEL_PLAN, on_plan);
+    }
+    if (rc != COA_OK) {
+        coa_node_inbox_fini(in);
+    }
+    return rc;
+}
+
+void coa_node_inbox_fini(coa_node_inbox_t *in)
+{
+    for (size_t i = 0; i < in->sub_count; i++) {
+        lcm_unsubscribe(in->tx.lcm, in->subs[i]);
+    }
+    in->sub_count = 0;
+}
+
+static int64_t drop_after(const coa_node_inbox_t *in)
+{
+    return in->common.stale_after_us +
+           (int64_t)COA_NODE_DROP_HORIZONS * (int64_t)in->common.horizon * in->common.dt_us;
+}
+
+void coa_node_inbox_expire(coa_node_inbox_t *in, int64_t now)
+{
+    const int64_t stale = in->common.stale_after_us;
+    const int64_t drop = drop_after(in);
+    for (size_t i = 0; i < COA_NODE_MAX_PEERS; i++) {
+        coa_node_peer_t *p = &in->peers[i];
+        if (!p->used) {
+            continue;
+        }
+        int64_t age = now - p->msg.utime;
+        if (age > stale && !p->forgotten) {
+            /* A UAV that comes back after a restart numbers from 0 again. */
+            coa_lcm_sequence_forget(&in->intent_seq.table, (uint32_t)p->msg.uav_id);
+            p->forgotten = true;
+        }
+        if (age > drop) {
+            p->used = false;
+        }
+    }
+    for (size_t i = 0; i < COA_NODE_MAX_TRACKS; i++) {
+        if (in->tracks[i].used && now - in->tracks[i].msg.utime > stale) {
+            in->tracks[i].used = false;
+        }
+    }
+    senders_expire(&in->intent_seq, now, stale);
+    senders_expire(&in->track_seq, now, stale);
+    senders_expire(&in->map_seq, now, stale);
+    senders_expire(&in->status_seq, now, stale);
+    senders_expire(&in->plan_seq, now,
+                   in->coordinator_timeout_us > stale ? in->coordinator_timeout_us : stale);
+}
+
+/* ---- the view ---- */
+
+static bool vec_finite(coa_vec3_t v)
+{
+    return isfinite((double)v.x) && isfinite((double)v.y) && isfinite((double)v.z);
+}
+
+long coa_node_view_find(const coa_node_view_t *view, uint16_t id)
+{
+    for (size_t i = 0; i < view->live_count; i++) {
+        if (view->live_id[i] == id) {
+            return (long)i;
+        }
+    }
+    return -1;
+}
+
+/* A stale UAV as a track: constant velocity from the state of its last intent, moved to
+ * t = 0 at cycle_start, its sigma grown with the silence. */
+static bool stale_track(const coavoid_intent_t *msg, const coa_node_common_t *c,
+                        int64_t cycle_start, int64_t now, coa_track_t *tr)
+{
+    double lead = (double)(cycle_start - msg->utime) * 1e-6;
+    double silence = (double)(now - msg->utime) * 1e-6;
+    double p[3];
+    for (int a = 0; a < 3; a++) {
+        p[a] = msg->position[a] + msg->velocity[a] * lead;
+    }
+    memset(tr, 0, sizeof *tr);
+    tr->id = (uint32_t)msg->uav_id;
+    tr->volume.radius = (coa_real_t)msg->radius;
+    tr->volume.half_height = (coa_real_t)msg->half_height;
+    tr->position.x = (coa_real_t)p[0];
+    tr->position.y = (coa_real_t)p[1];
+    tr->position.z = (coa_real_t)p[2];
+    tr->velocity.x = (coa_real_t)msg->velocity[0];
+    tr->velocity.y = (coa_real_t)msg->velocity[1];
+    tr->velocity.z = (coa_real_t)msg->velocity[2];
+    tr->path = NULL;
+    tr->path_count = 0;
+    double grow = (double)c->stale_sigma_rate * (silence > 0.0 ? silence : 0.0);
+    tr->sigma_horizontal = (coa_real_t)(msg->sigma_horizontal + grow);
+    tr->sigma_vertical = (coa_real_t)(msg->sigma_vertical + grow);
+    return vec_finite(tr->position) && isfinite((double)tr->sigma_horizontal) &&
+           isfinite((double)tr->sigma_vertical) && coa_track_check(tr) == COA_OK;
+}
+
+void coa_node_view_build(coa_node_view_t *view, const coa_node_inbox_t *in,
+                         int64_t cycle_start, int64_t now)
+{
+    const coa_node_common_t *c = &in->common;
+    const coa_lcm_context_t ctx = coa_node_context(in, now, cycle_start);
+    const int64_t drop = drop_after(in);
+    size_t order[COA_NODE_MAX_PEERS];
+    size_t n = 0;
+
+    view->cycle_start = cycle_start;
+    view->live_count = 0;
+    view->track_count = 0;
+    view->real_track_count = 0;
+    view->stale_count = 0;
+
+    /* UAVs by ascending id, so that plan indices (and the clusters' order) do not depend
+     * on the order intents arrived in. */
+    for (size_t i = 0; i < COA_NODE_MAX_PEERS; i++) {
+        if (!in->peers[i].used) {
+            continue;
+        }
+        size_t j = n++;
+        while (j > 0 && in->peers[order[j - 1]].msg.uav_id > in->peers[i].msg.uav_id) {
+            order[j] = order[j - 1];
+            j--;
+        }
+        order[j] = i;
+    }
+    bool stale[COA_NODE_MAX_PEERS];
+    for (size_t s = 0; s < n; s++) {
+        const coavoid_intent_t *msg = &in->peers[order[s]].msg;
+        int64_t age = now - msg->utime;
+        stale[s] = age > c->stale_after_us;
+        if (stale[s]) {
+            continue;
+        }
+        size_t i = view->live_count;
+        if (coa_lcm_intent_to_core(msg, &ctx, NULL, &view->live_info[i], &view->live_vehicle[i],
+                                   &view->live_plan[i], &view->live_arrays[i], NULL) != COA_OK) {
+            continue; /* e.g. stamped further ahead of this clock than allowed */
+        }
+        view->live_id[i] = (uint16_t)msg->uav_id;
+        view->live_current[i] = msg->plan_utime == cycle_start && msg->step == (double)c->dt &&
+                                msg->sample_count == (int32_t)c->horizon + 1;
+        view->live_count++;
+    }
+
+    /* Real tracks by (source, id). */
+    size_t torder[COA_NODE_MAX_TRACKS];
+    size_t m = 0;
+    for (size_t i = 0; i < COA_NODE_MAX_TRACKS; i++) {
+        const coa_node_track_slot_t *t = &in->tracks[i];
+        if (!t->used || now - t->msg.utime > c->stale_after_us) {
+            continue;
+        }
+        size_t j = m++;
+        while (j > 0) {
+            const coavoid_track_t *prev = &in->tracks[torder[j - 1]].msg;
+            if (prev->source_id < t->msg.source_id ||
+                (prev->source_id == t->msg.source_id && prev->track_id < t->msg.track_id)) {
+                break;
+            }
+            torder[j] = torder[j - 1];
+            j--;
+        }
+        torder[j] = i;
+    }
+    for (size_t s = 0; s < m; s++) {
+        const coavoid_track_t *msg = &in->tracks[torder[s]].msg;
+        size_t i = view->track_count;
+        coa_lcm_track_info_t info;
+        if (coa_lcm_track_to_core(msg, &ctx, NULL, &info, &view->tracks[i], view->real_paths[s],
+                                  COAVOID_TRACK_T_MAX_PATH, NULL) != COA_OK) {
+            continue;
+        }
+        view->track_ids[i] = (uint32_t)msg->track_id;
+        view->track_count++;
+    }
+    view->real_track_count = view->track_count;
+
+    for (size_t s = 0; s < n; s++) {
+        const coavoid_intent_t *msg = &in->peers[order[s]].msg;
+        if (!stale[s] || now - msg->utime > drop) {
+            continue;
+        }
+        size_t i = view->track_count;
+        if (!stale_track(msg, c, cycle_start, now, &view->tracks[i])) {
+            continue;
+        }
+        view->track_ids[i] = (uint32_t)msg->uav_id;
+        view->track_count++;
+        view->stale_count++;
+    }
+}
+
+int coa_node_problem_tracks(coa_node_problem_tracks_t *out, const coa_node_view_t *view,
+                            const bool *include, const coa_node_common_t *c)
+{
+    size_t n = 0;
+    size_t paths = 0;
+    for (size_t i = 0; i < view->real_track_count; i++, n++) {
+        out->tracks[n] = view->tracks[i];
+        if (coa_track_sample(&out->tracks[n], c->dt, c->horizon, out->storage[n]) != COA_OK) {
+            return COA_ERR_ARGUMENT;
+        }
+        out->samples[n] = out->storage[n];
+    }
+    for (size_t i = 0; i < view->live_count; i++) {
+        if (include == NULL || !include[i]) {
+            continue;
+        }
+        const coa_intent_plan_t *plan = &view->live_plan[i];
+        coa_track_point_t *path = out->paths[paths++];
+        for (size_t j = 0; j < plan->count; j++) {
+            path[j].t = plan->t0 + (coa_real_t)j * plan->step;
+            path[j].p = plan->samples[j];
+        }
+        coa_track_t *tr = &out->tracks[n];
+        memset(tr, 0, sizeof *tr);
+        tr->id = view->live_id[i];
+        tr->volume = plan->volume;
+        tr->position = plan->samples[0];
+        tr->path = path;
+        tr->path_count = plan->count;
+        if (view->live_current[i]) {
+            /* Its own samples: the positions it flies, bit for bit. */
+            out->samples[n] = plan->samples;
+        } else {
+            if (coa_track_sample(tr, c->dt, c->horizon, out->storage[n]) != COA_OK) {
+                return COA_ERR_ARGUMENT;
+            }
+            out->samples[n] = out->storage[n];
+        }
+        n++;
+    }
+    for (size_t i = view->real_track_count; i < view->track_count; i++, n++) {
+        out->tracks[n] = view->tracks[i];
+        if (coa_track_sample(&out->tracks[n], c->dt, c->horizon, out->storage[n]) != COA_OK) {
+            return COA_ERR_ARGUMENT;
+        }
+        out->samples[n] = out->storage[n];
+    }
+    out->count = n;
+    return COA_OK;
+}
+
+size_t coa_node_max_pairs(void)
+{
+    const size_t n = COA_NODE_MAX_PEERS;
+    return n * (n - 1u) / 2u + n * COA_NODE_TRACK_CAPACITY + n * COA_NODE_MAX_OBSTACLES;
+}
+
+int coa_node_predict(coa_predictor_t *predictor, const coa_node_common_t *c,
+                     const coa_intent_plan_t *plans, size_t n, const coa_node_view_t *view,
+                     const coa_node_inbox_t *in, coa_conflict_t *conflicts, size_t capacity,
+                     coa_predict_result_t *result, uint32_t *labels, size_t *cluster_count)
+{
+    memset(result, 0, sizeof *result);
+    *cluster_count = 0;
+    if (n == 0) {
+        return COA_OK;
+    }
+    coa_predict_config_t config;
+    memset(&config, 0, sizeof config);
+    config.t0 = 0;
+    config.dt = c->dt;
+    config.horizon = c->horizon;
+    config.vehicle_sigma_rate_horizontal = c->vehicle_sigma_rate_horizontal;
+    config.vehicle_sigma_rate_vertical = c->vehicle_sigma_rate_vertical;
+    config.track_sigma_rate_horizontal = c->track_sigma_rate_horizontal;
+    config.track_sigma_rate_vertical = c->track_sigma_rate_vertical;
+    config.threshold = c->threshold;
+    config.all_pairs = false;
+    int rc = coa_predict(predictor, &config, plans, n, in->obstacles, in->obstacle_count,
+                         view->tracks, view->track_count, conflicts, capacity, result);
+    if (rc != COA_OK) {
+        return rc;
+    }
+    if (result->overflow) {
+        return COA_ERR_WORKSPACE;
+    }
+    return coa_predict_clusters(conflicts, result->conflict_count, n, labels, cluster_count);
+}
+
+/* ---- publishing ---- */
+
+#define COA_NODE_DEFINE_PUBLISH(function, type, channel)                                   \
+    int function(coa_node_tx_t *tx, const type *msg)                                       \
+    {                                                                                       \
+        int size = type##_encoded_size(msg);                                                \
+        if (size <= 0 || (size_t)size > sizeof tx->buf ||                                   \
+            type##_encode(tx->buf, 0, size, msg) != size) {                                 \
+            return COA_ERR_WORKSPACE;                                                       \
+        }                                                                                   \
+        return lcm_publish(tx->lcm, channel, tx->buf, (unsigned int)size) == 0             \
+                   ? COA_OK                                                                 \
+                   : COA_ERR_ARGUMENT;                                                      \
+    }
+
+COA_NODE_DEFINE_PUBLISH(coa_node_publish_intent, coavoid_intent_t, COA_CHANNEL_INTENT)
+COA_NODE_DEFINE_PUBLISH(coa_node_publish_plan, coavoid_plan_t, COA_CHANNEL_PLAN)
+COA_NODE_DEFINE_PUBLISH(coa_node_publish_track, coavoid_track_t, COA_CHANNEL_TRACK)
+COA_NODE_DEFINE_PUBLISH(coa_node_publish_map, coavoid_obstacle_map_t, COA_CHANNEL_OBSTACLES)
+COA_NODE_DEFINE_PUBLISH(coa_node_publish_conflicts, coavoid_conflict_report_t,
+                        COA_CHANNEL_CONFLICTS)
+COA_NODE_DEFINE_PUBLISH(coa_node_publish_status, coavoid_status_t, COA_CHANNEL_STATUS)

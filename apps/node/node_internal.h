@@ -1,0 +1,223 @@
+/*
+ * node_internal.h: what the vehicle and the coordinator share beyond node.h (common.c):
+ *   - the inbox: the LCM subscriptions, decoding and validation of what arrives, the
+ *     counters, and the latest message of every sender (intents per UAV, tracks per
+ *     source and track, the obstacle map, heartbeats);
+ *   - the view of one cycle: the stored intents converted to the core's types on the
+ *     cycle's clock (t = 0 at the cycle's start), stale UAVs turned into tracks;
+ *   - the planner's track list for one problem (real tracks, UAVs as moving obstacles);
+ *   - publishing into a buffer the node owns, so that nothing is allocated per cycle by
+ *     our code (LCM's provider may allocate inside lcm_publish: that is LCM's).
+ * Not part of the nodes' API: a driver includes node.h only.
+ */
+#ifndef COAVOID_APP_NODE_INTERNAL_H
+#define COAVOID_APP_NODE_INTERNAL_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include <lcm/lcm.h>
+
+#include "node.h"
+
+#define COA_NODE_MAX_SAMPLES (COA_NODE_MAX_HORIZON + 1u)
+_Static_assert(COA_NODE_MAX_SAMPLES == (unsigned)COAVOID_INTENT_T_MAX_SAMPLES &&
+                   COA_NODE_MAX_SAMPLES == (unsigned)COAVOID_PLAN_T_MAX_SAMPLES,
+               "an intent and a plan carry N + 1 samples of the node's largest horizon");
+
+/* Room for one obstacle map (boxes, then polytopes) and its vertices. */
+#define COA_NODE_MAX_OBSTACLES \
+    ((size_t)COAVOID_OBSTACLE_MAP_T_MAX_BOXES + (size_t)COAVOID_OBSTACLE_MAP_T_MAX_POLYTOPES)
+#define COA_NODE_MAX_VERTICES \
+    ((size_t)COAVOID_OBSTACLE_MAP_T_MAX_POLYTOPES * (size_t)COAVOID_OBSTACLE_MAP_T_MAX_VERTICES)
+
+/* Tracks one cycle can hold: the real ones plus every UAV as a moving obstacle (live or
+ * stale: together at most MAX_PEERS). */
+#define COA_NODE_TRACK_CAPACITY (COA_NODE_MAX_TRACKS + COA_NODE_MAX_PEERS)
+
+/* Senders per sequence table: every UAV, plus a few coordinators and trackers. */
+#define COA_NODE_MAX_SENDERS (COA_NODE_MAX_PEERS + 8u)
+
+/* An intent older than this many horizons is dropped, not extrapolated: its constant-
+ * velocity guess is meaningless by then. */
+#define COA_NODE_DROP_HORIZONS 1
+
+/* Encoded messages are written here before lcm_publish: the largest type (plan_t) is
+ * about 16.6 kB. */
+#define COA_NODE_TX_BYTES 20000u
+
+/* Where a node encodes what it publishes. */
+typedef struct {
+    lcm_t *lcm;
+    uint8_t buf[COA_NODE_TX_BYTES];
+} coa_node_tx_t;
+
+/* A sequence table with the time each sender was last heard, so that a sender silent
+ * past a limit is forgotten (a restarted node numbers from 0 again). */
+typedef struct {
+    coa_lcm_sequence_table_t table;
+    coa_lcm_sender_t entries[COA_NODE_MAX_SENDERS];
+    uint32_t heard_sender[COA_NODE_MAX_SENDERS];
+    int64_t heard_utime[COA_NODE_MAX_SENDERS];
+    size_t heard_count;
+} coa_node_senders_t;
+
+typedef struct {
+    bool used;
+    bool forgotten;           /* its sequence was forgotten when it went stale */
+    coavoid_intent_t msg;     /* validated on arrival */
+} coa_node_peer_t;
+
+typedef struct {
+    bool used;
+    coavoid_track_t msg;      /* validated on arrival */
+} coa_node_track_slot_t;
+
+typedef struct coa_node_inbox coa_node_inbox_t;
+
+/* Called for a plan_t that decoded, is not the node's own and passed validation and the
+ * sequence rule (vehicle.c decides on adoption and counts the outcome itself). */
+typedef void (*coa_node_plan_handler_t)(void *owner, const coavoid_plan_t *msg,
+                                        const coa_lcm_plan_info_t *info,
+                                        const coa_plan_result_t *result, const int32_t *offsets);
+
+struct coa_node_inbox {
+    coa_node_common_t common;
+    uint16_t self_uav;              /* intents from this UAV are the node's own (0: none) */
+    uint16_t self_node;             /* status and plans from this node id are its own */
+    size_t peer_capacity;           /* other UAVs it keeps (vehicle: MAX_PEERS - 1) */
+    int64_t max_age_us;             /* validation window (context max_age) */
+    int64_t coordinator_timeout_us; /* when a silent coordinator is forgotten */
+    lcm_subscription_t *subs[6];
+    size_t sub_count;
+    coa_lcm_rx_stats_t *rx;         /* the owner's counters (its state's rx) */
+
+    coa_node_senders_t intent_seq;
+    coa_node_senders_t track_seq;
+    coa_node_senders_t map_seq;
+    coa_node_senders_t status_seq;
+    coa_node_senders_t plan_seq;
+
+    coa_node_peer_t peers[COA_NODE_MAX_PEERS];
+    coa_node_track_slot_t tracks[COA_NODE_MAX_TRACKS];
+
+    bool have_map;
+    coa_obstacle_t obstacles[COA_NODE_MAX_OBSTACLES];
+    size_t obstacle_count;
+    coa_vec3_t vertices[COA_NODE_MAX_VERTICES];
+
+    bool heard_coordinator;         /* a coordinator's status_t was received */
+    int64_t coordinator_utime;      /* when (driver clock) */
+
+    coa_node_plan_handler_t on_plan;
+    void *owner;
+
+    /* Decoding buffers (LCM dispatches one message at a time) and the transmit buffer. */
+    union {
+        coavoid_intent_t intent;
+        coavoid_plan_t plan;
+        coavoid_track_t track;
+        coavoid_obstacle_map_t map;
+        coavoid_status_t status;
+    } rx_msg;
+    coa_lcm_intent_arrays_t rx_arrays;
+    int32_t rx_offsets[(size_t)COAVOID_PLAN_T_MAX_VEHICLES * COA_NODE_MAX_SAMPLES];
+    coa_node_tx_t tx;
+};
+
+/* The cycle's view: live UAVs (ascending id) and tracks (real ones first, by source and
+ * id, then the stale UAVs by id), on the clock whose t = 0 is cycle_start. */
+typedef struct {
+    int64_t cycle_start;
+    size_t live_count;
+    uint16_t live_id[COA_NODE_MAX_PEERS];
+    bool live_current[COA_NODE_MAX_PEERS]; /* an intent for this cycle: plan_utime ==
+                                              cycle_start, step dt, N + 1 samples */
+    coa_vehicle_t live_vehicle[COA_NODE_MAX_PEERS];
+    coa_intent_plan_t live_plan[COA_NODE_MAX_PEERS];
+    coa_lcm_intent_info_t live_info[COA_NODE_MAX_PEERS];
+    coa_lcm_intent_arrays_t live_arrays[COA_NODE_MAX_PEERS];
+
+    size_t real_track_count;
+    size_t track_count;             /* real + stale UAVs */
+    coa_track_t tracks[COA_NODE_TRACK_CAPACITY];
+    uint32_t track_ids[COA_NODE_TRACK_CAPACITY];
+    coa_track_point_t real_paths[COA_NODE_MAX_TRACKS][COAVOID_TRACK_T_MAX_PATH];
+    size_t stale_count;             /* tracks[real_track_count ..] are stale UAVs */
+} coa_node_view_t;
+
+/* The tracks of one planning problem, sampled over the horizon. */
+typedef struct {
+    size_t count;
+    coa_track_t tracks[COA_NODE_TRACK_CAPACITY];
+    const coa_vec3_t *samples[COA_NODE_TRACK_CAPACITY];
+    coa_vec3_t storage[COA_NODE_TRACK_CAPACITY][COA_NODE_MAX_SAMPLES];
+    coa_track_point_t paths[COA_NODE_MAX_PEERS][COA_NODE_MAX_SAMPLES];
+} coa_node_problem_tracks_t;
+
+/* Checks a common configuration (node.h's ranges). COA_OK or COA_ERR_ARGUMENT. */
+int coa_node_common_check(const coa_node_common_t *c);
+
+/* The validation context at `now` with t = 0 at `epoch`. */
+coa_lcm_context_t coa_node_context(const coa_node_inbox_t *in, int64_t now, int64_t epoch);
+
+/* Initialises the inbox and subscribes to intents, tracks and the obstacle map, and to
+ * heartbeats (want_status) and plans (plan_handler non-NULL) when asked; counts into rx. Returns COA_OK, or COA_ERR_ARGUMENT when LCM refused a subscription
+ * (everything subscribed so far is unsubscribed). */
+int coa_node_inbox_init(coa_node_inbox_t *in, const coa_node_common_t *common, uint16_t self_uav,
+                        uint16_t self_node, size_t peer_capacity, int64_t coordinator_timeout_us,
+                        lcm_t *lcm, coa_lcm_rx_stats_t *rx, bool want_status,
+                        coa_node_plan_handler_t plan_handler, void *owner);
+
+/* Unsubscribes everything. */
+void coa_node_inbox_fini(coa_node_inbox_t *in);
+
+/* Forgets senders silent for too long (intents past stale_after, the coordinator past its
+ * timeout, ...) and drops intents and tracks too old to be of use. Cost O(senders). */
+void coa_node_inbox_expire(coa_node_inbox_t *in, int64_t now);
+
+/* Builds the view of the cycle starting at cycle_start, at `now`. Cost O(peers * samples +
+ * tracks). Cannot fail: a stored message that no longer converts is left out. */
+void coa_node_view_build(coa_node_view_t *view, const coa_node_inbox_t *in,
+                         int64_t cycle_start, int64_t now);
+
+/* Index of a live UAV in the view, or -1. */
+long coa_node_view_find(const coa_node_view_t *view, uint16_t id);
+
+/* Whether a outranks b in the decoupled order (ascending priority, ties by ascending id). */
+bool coa_node_outranks(uint32_t priority_a, uint16_t id_a, uint32_t priority_b, uint16_t id_b);
+
+/* Fills out with the planner's tracks: every real and stale track of the view and each
+ * live UAV i with include[i] (its positions as a path; exactly its samples when the intent
+ * is for this cycle), each sampled over samples 0..N. Returns COA_OK or COA_ERR_ARGUMENT
+ * (a track that does not sample). */
+int coa_node_problem_tracks(coa_node_problem_tracks_t *out, const coa_node_view_t *view,
+                            const bool *include, const coa_node_common_t *c);
+
+/* Predicts over samples 0..N of the view's clock for plans[0..n) against the view's
+ * tracks and the inbox's obstacles, then clusters. n == 0 gives no conflict. Returns
+ * COA_OK or the predictor's error. */
+int coa_node_predict(coa_predictor_t *predictor, const coa_node_common_t *c,
+                     const coa_intent_plan_t *plans, size_t n, const coa_node_view_t *view,
+                     const coa_node_inbox_t *in, coa_conflict_t *conflicts, size_t capacity,
+                     coa_predict_result_t *result, uint32_t *labels, size_t *cluster_count);
+
+/* The predictor's limits for a node: MAX_PEERS plans, TRACK_CAPACITY tracks, every pair
+ * that can exist (so that the broad phase cannot run out). */
+size_t coa_node_max_pairs(void);
+
+/* Publishing: encodes into tx->buf and publishes on the type's channel. COA_OK, or
+ * COA_ERR_WORKSPACE (does not encode into the buffer) or COA_ERR_ARGUMENT (LCM refused
+ * it). */
+int coa_node_publish_intent(coa_node_tx_t *tx, const coavoid_intent_t *msg);
+int coa_node_publish_plan(coa_node_tx_t *tx, const coavoid_plan_t *msg);
+int coa_node_publish_track(coa_node_tx_t *tx, const coavoid_track_t *msg);
+int coa_node_publish_map(coa_node_tx_t *tx, const coavoid_obstacle_map_t *msg);
+int coa_node_publish_conflicts(coa_node_tx_t *tx, const coavoid_conflict_report_t *msg);
+int coa_node_publish_status(coa_node_tx_t *tx, const coavoid_status_t *msg);
+
+/* The common stopwatch's reading (us), 0 without one: durations are differences. */
+int64_t coa_node_stopwatch(const coa_node_common_t *c);
+
+#endif /* COAVOID_APP_NODE_INTERNAL_H */

@@ -1,0 +1,202 @@
+/*
+ * The world node (node.h): a scenario's terrain database and tracker. Every cycle it
+ * republishes the obstacle map (so that a node that joins late gets it) and each track's
+ * estimate at the cycle's start.
+ */
+#include "node_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+struct coa_world {
+    coa_world_config_t config;
+    coa_node_tx_t tx;
+    bool started;
+    int64_t cycle;
+    int64_t track_sequence;
+    int64_t max_age_us;
+    coavoid_obstacle_map_t map_msg;
+    coavoid_track_t track_msg;
+};
+
+/* The velocity a track has at t: its constant velocity, or that of the path leg that
+ * coa_track_at uses there. */
+static coa_vec3_t track_velocity(const coa_track_t *tr, coa_real_t t)
+{
+    coa_vec3_t v = {0, 0, 0};
+    if (tr->path_count == 0u) {
+        return tr->velocity;
+    }
+    if (tr->path_count == 1u) {
+        return v;
+    }
+    size_t last = tr->path_count - 1u;
+    size_t i = 0;
+    if (!(t < tr->path[last].t)) {
+        i = last - 1u;
+    } else {
+        while (i + 1u < last && t >= tr->path[i + 1u].t) {
+            i++;
+        }
+    }
+    const coa_track_point_t *a = &tr->path[i];
+    const coa_track_point_t *b = &tr->path[i + 1u];
+    coa_real_t span = b->t - a->t;
+    v.x = (b->p.x - a->p.x) / span;
+    v.y = (b->p.y - a->p.y) / span;
+    v.z = (b->p.z - a->p.z) / span;
+    return v;
+}
+
+/* A path track's estimate at scenario time t: its position there, then the path points
+ * after it within one horizon W, closed by the position at the first point left out (or
+ * at t + W), all relative to t. So the receiver's path is exact over the horizon up to
+ * the message's capacity, and its times stay within the validation window. */
+static size_t estimate_path(const coa_track_t *tr, coa_real_t t, coa_real_t window,
+                            coa_track_point_t *out)
+{
+    const size_t cap = (size_t)COAVOID_TRACK_T_MAX_PATH;
+    size_t n = 0;
+    out[n].t = 0;
+    out[n].p = coa_track_at(tr, t);
+    n++;
+    coa_real_t end = t + window;
+    for (size_t j = 0; j < tr->path_count; j++) {
+        coa_real_t tj = tr->path[j].t;
+        if (!(tj > t)) {
+            continue;
+        }
+        if (!(tj < t + window)) {
+            break;
+        }
+        if (n + 1u >= cap) {
+            end = tj;
+            break;
+        }
+        out[n].t = tj - t;
+        out[n].p = tr->path[j].p;
+        n++;
+    }
+    out[n].t = end - t;
+    out[n].p = coa_track_at(tr, end);
+    n++;
+    return n;
+}
+
+static coa_lcm_context_t world_context(const coa_world_t *w, int64_t now, int64_t epoch)
+{
+    coa_lcm_context_t ctx;
+    ctx.now_utime = now;
+    ctx.max_age_us = w->max_age_us;
+    ctx.max_future_us = w->config.common.dt_us;
+    ctx.epoch_utime = epoch;
+    return ctx;
+}
+
+coa_world_t *coa_world_create(const coa_world_config_t *config, lcm_t *lcm, int *error)
+{
+    int dummy;
+    if (error == NULL) {
+        error = &dummy;
+    }
+    *error = COA_ERR_ARGUMENT;
+    if (config == NULL || lcm == NULL || coa_node_common_check(&config->common) != COA_OK ||
+        (config->obstacles == NULL && config->obstacle_count > 0u) ||
+        (config->tracks == NULL && config->track_count > 0u) ||
+        config->track_count > COA_NODE_MAX_TRACKS) {
+        return NULL;
+    }
+    for (size_t i = 0; i < config->track_count; i++) {
+        if (coa_track_check(&config->tracks[i]) != COA_OK || config->tracks[i].id < 1u ||
+            config->tracks[i].id > (uint32_t)INT32_MAX) {
+            return NULL;
+        }
+        for (size_t j = 0; j < i; j++) {
+            if (config->tracks[j].id == config->tracks[i].id) {
+                return NULL;
+            }
+        }
+    }
+    coa_world_t *w = calloc(1, sizeof *w);
+    if (w == NULL) {
+        *error = COA_ERR_WORKSPACE;
+        return NULL;
+    }
+    w->config = *config;
+    if (w->config.id == 0u) {
+        w->config.id = (uint16_t)COA_NODE_WORLD_ID;
+    }
+    w->tx.lcm = lcm;
+    w->cycle = -1;
+    w->max_age_us = config->common.stale_after_us +
+                    ((int64_t)config->common.horizon + 2) * config->common.dt_us;
+    /* The map must fit the message and pass its check: find out now, not every cycle. */
+    coa_lcm_context_t ctx = world_context(w, 0, config->common.epoch_utime);
+    if (coa_lcm_obstacle_map_from_core(config->obstacles, config->obstacle_count,
+                                       config->common.epoch_utime, w->config.id, 1, &ctx,
+                                       &w->map_msg, NULL) != COA_OK) {
+        free(w);
+        return NULL;
+    }
+    *error = COA_OK;
+    return w;
+}
+
+void coa_world_destroy(coa_world_t *node)
+{
+    free(node);
+}
+
+int coa_world_cycle(coa_world_t *node, int64_t now)
+{
+    if (node == NULL) {
+        return COA_ERR_ARGUMENT;
+    }
+    const coa_node_common_t *c = &node->config.common;
+    int64_t k = coa_node_cycle_of(c, now);
+    if (k < 0) {
+        return COA_ERR_ARGUMENT;
+    }
+    if (node->started && k <= node->cycle) {
+        return COA_OK;
+    }
+    node->started = true;
+    node->cycle = k;
+    const int64_t cycle_start = coa_node_cycle_utime(c, k);
+    coa_lcm_context_t ctx = world_context(node, now, cycle_start);
+    int rc = coa_lcm_obstacle_map_from_core(node->config.obstacles, node->config.obstacle_count,
+                                            now, node->config.id, 1, &ctx, &node->map_msg, NULL);
+    if (rc == COA_OK) {
+        rc = coa_node_publish_map(&node->tx, &node->map_msg);
+    }
+    int first_error = rc;
+
+    const coa_real_t t = (coa_real_t)k * c->dt;
+    const coa_real_t window = (coa_real_t)c->horizon * c->dt;
+    for (size_t i = 0; i < node->config.track_count; i++) {
+        const coa_track_t *tr = &node->config.tracks[i];
+        coa_track_point_t path[COAVOID_TRACK_T_MAX_PATH];
+        coa_track_t estimate = *tr;
+        estimate.position = coa_track_at(tr, t);
+        estimate.velocity = track_velocity(tr, t);
+        estimate.path = NULL;
+        estimate.path_count = 0;
+        if (tr->path_count > 0u) {
+            estimate.path_count = estimate_path(tr, t, window, path);
+            estimate.path = path;
+        }
+        coa_lcm_track_info_t info;
+        info.utime = now;
+        info.source_id = node->config.id;
+        info.sequence = node->track_sequence++;
+        rc = coa_lcm_track_from_core(&estimate, &info, &ctx, &node->track_msg, NULL);
+        if (rc == COA_OK) {
+            rc = coa_node_publish_track(&node->tx, &node->track_msg);
+        }
+        if (first_error == COA_OK) {
+            first_error = rc;
+        }
+    }
+    return first_error;
+}
