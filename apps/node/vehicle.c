@@ -1,0 +1,569 @@
+/*
+ * The vehicle node (node.h): one simulated UAV that flies its adopted plan, publishes its
+ * intent, follows the coordinator while its heartbeat lasts, and otherwise plans for
+ * itself in priority order (steps 2 and 4 of node.h's cycle).
+ */
+#include "node_internal.h"
+
+#include <limits.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+struct coa_vehicle_node {
+    coa_vehicle_node_config_t config;
+    coa_vehicle_node_state_t state;
+    coa_real_t dh;
+    bool started;
+    int64_t first_cycle_start;
+    int64_t cycle_start;
+    int64_t wait_deadline;
+    bool was_coordinated;
+    bool fault;                      /* an internal error in this cycle */
+    int64_t intent_sequence;
+    int64_t status_sequence;
+    int64_t last_plan_utime;
+
+    /* The adopted plan: offsets of samples plan_start .. plan_start + plan_count - 1; past
+     * its end the last offset holds. */
+    int64_t plan_start;
+    uint32_t plan_count;
+    int32_t plan_offsets[COA_NODE_MAX_SAMPLES];
+
+    /* This cycle's intent: samples k .. k + N. */
+    coa_vec3_t own_reference[COA_NODE_MAX_SAMPLES];
+    int32_t own_offsets[COA_NODE_MAX_SAMPLES];
+    coa_vec3_t own_samples[COA_NODE_MAX_SAMPLES];
+
+    int32_t plan_out[COA_NODE_MAX_SAMPLES];
+    coa_intent_plan_t plans[COA_NODE_MAX_PEERS]; /* itself first, then the live peers */
+    uint32_t labels[COA_NODE_MAX_PEERS];
+    bool include[COA_NODE_MAX_PEERS];
+    coavoid_intent_t tx_intent;
+    coavoid_status_t tx_status;
+
+    coa_conflict_t *conflicts;
+    size_t conflict_capacity;
+    void *predictor_memory;
+    coa_predictor_t *predictor;
+    void *planner_memory;
+    coa_planner_t *planner;
+
+    coa_node_inbox_t inbox;
+    coa_node_view_t view;
+    coa_node_problem_tracks_t problem_tracks;
+};
+
+static int32_t offset_at(const coa_vehicle_node_t *node, int64_t k)
+{
+    int64_t i = k - node->plan_start;
+    if (i < 0) {
+        i = 0;
+    }
+    if (i >= (int64_t)node->plan_count) {
+        i = (int64_t)node->plan_count - 1;
+    }
+    return node->plan_offsets[i];
+}
+
+static coa_vec3_t lifted(coa_vec3_t reference, int32_t offset, coa_real_t dh)
+{
+    /* As the planner and every receiver compute it (coa_lcm_intent_to_core). */
+    reference.z += (coa_real_t)offset * dh;
+    return reference;
+}
+
+/* The intent of cycle k from the adopted plan, which is then re-based at k so that its
+ * storage never needs more than N + 1 samples. */
+static void build_own(coa_vehicle_node_t *node, int64_t k)
+{
+    const coa_node_common_t *c = &node->config.common;
+    const uint32_t n = c->horizon + 1u;
+    for (uint32_t j = 0; j < n; j++) {
+        node->own_reference[j] =
+            coa_reference_at(&node->config.vehicle, (coa_real_t)(k + (int64_t)j) * c->dt);
+        node->own_offsets[j] = offset_at(node, k + (int64_t)j);
+    }
+    for (uint32_t j = 0; j < n; j++) {
+        node->plan_offsets[j] = node->own_offsets[j];
+        node->own_samples[j] = lifted(node->own_reference[j], node->own_offsets[j], node->dh);
+    }
+    node->plan_start = k;
+    node->plan_count = n;
+}
+
+static void adopt(coa_vehicle_node_t *node, const int32_t *offsets, uint32_t count)
+{
+    const uint32_t n = node->config.common.horizon + 1u;
+    node->plan_start = node->state.cycle;
+    node->plan_count = count < COA_NODE_MAX_SAMPLES ? count : COA_NODE_MAX_SAMPLES;
+    memcpy(node->plan_offsets, offsets, node->plan_count * sizeof offsets[0]);
+    for (uint32_t j = 0; j < n; j++) {
+        node->own_offsets[j] = offset_at(node, node->state.cycle + (int64_t)j);
+        node->own_samples[j] = lifted(node->own_reference[j], node->own_offsets[j], node->dh);
+    }
+    node->state.plans_adopted++;
+}
+
+static bool stale_inputs(const coa_vehicle_node_t *node, int64_t now)
+{
+    for (size_t i = 0; i < COA_NODE_MAX_PEERS; i++) {
+        const coa_node_peer_t *p = &node->inbox.peers[i];
+        if (p->used && now - p->msg.utime > node->config.common.stale_after_us) {
+            return true;
+        }
+    }
+    return false;
+}
+
+static int publish_status(coa_vehicle_node_t *node, int64_t now)
+{
+    coavoid_status_t *m = &node->tx_status;
+    const coa_vehicle_node_state_t *s = &node->state;
+    memset(m, 0, sizeof *m);
+    m->utime = now;
+    m->node_id = node->config.vehicle.id;
+    m->node_kind = COAVOID_STATUS_T_NODE_VEHICLE;
+    m->sequence = node->status_sequence++;
+    if (node->fault) {
+        m->health = COAVOID_STATUS_T_HEALTH_FAULT;
+    } else if (s->last_outcome > 0 || stale_inputs(node, now) ||
+               (node->config.mode == COA_NODE_CENTRALISED && !s->coordinated)) {
+        m->health = COAVOID_STATUS_T_HEALTH_DEGRADED;
+    } else {
+        m->health = COAVOID_STATUS_T_HEALTH_OK;
+    }
+    m->mode = s->coordinated ? COAVOID_STATUS_T_MODE_CENTRALISED : COAVOID_STATUS_T_MODE_DECOUPLED;
+    m->last_plan_utime = node->last_plan_utime;
+    m->last_plan_duration_us = s->last_plan_duration_us;
+    m->nodes_expanded = s->last_nodes_expanded > (uint64_t)INT64_MAX ? INT64_MAX
+                                                                      : (int64_t)s->last_nodes_expanded;
+    m->outcome = s->last_outcome < 0 ? COAVOID_STATUS_T_OUTCOME_NONE : (int8_t)s->last_outcome;
+    m->conflicts = s->conflicts > (uint32_t)INT32_MAX ? INT32_MAX : (int32_t)s->conflicts;
+    m->messages_received = s->rx.received;
+    m->messages_rejected = s->rx.rejected;
+    m->last_reject_code = s->rx.last_reject_code;
+    coa_lcm_context_t ctx = coa_node_context(&node->inbox, now, node->cycle_start);
+    int rc = coa_lcm_status_check(m, &ctx, NULL);
+    if (rc != COA_OK) {
+        return COA_ERR_ARGUMENT;
+    }
+    return coa_node_publish_status(&node->inbox.tx, m);
+}
+
+/* Publishes this cycle's intent and heartbeat; the wait, if any, is over. Returns 1 or a
+ * negative error. */
+static int finish(coa_vehicle_node_t *node, int64_t now)
+{
+    const coa_node_common_t *c = &node->config.common;
+    coa_lcm_intent_info_t info;
+    memset(&info, 0, sizeof info);
+    info.utime = now;
+    info.sequence = node->intent_sequence++;
+    info.mode = node->state.coordinated ? COAVOID_INTENT_T_MODE_CENTRALISED
+                                        : COAVOID_INTENT_T_MODE_DECOUPLED;
+    /* The state at `now`: it moves straight from sample k to sample k + 1. */
+    coa_vec3_t p0 = node->own_samples[0];
+    coa_vec3_t p1 = node->own_samples[1];
+    double u = (double)(now - node->cycle_start) / (double)c->dt_us;
+    u = u < 0.0 ? 0.0 : (u > 1.0 ? 1.0 : u);
+    info.velocity.x = (p1.x - p0.x) / c->dt;
+    info.velocity.y = (p1.y - p0.y) / c->dt;
+    info.velocity.z = (p1.z - p0.z) / c->dt;
+    info.position.x = p0.x + (coa_real_t)u * (p1.x - p0.x);
+    info.position.y = p0.y + (coa_real_t)u * (p1.y - p0.y);
+    info.position.z = p0.z + (coa_real_t)u * (p1.z - p0.z);
+    info.plan_utime = node->cycle_start;
+    info.step = c->dt;
+    info.sigma_horizontal = node->config.sigma_horizontal;
+    info.sigma_vertical = node->config.sigma_vertical;
+    coa_lcm_context_t ctx = coa_node_context(&node->inbox, now, node->cycle_start);
+    int rc = coa_lcm_intent_from_core(&node->config.vehicle, &info, node->own_reference,
+                                      node->own_offsets, (size_t)c->horizon + 1u, &ctx,
+                                      &node->tx_intent, NULL);
+    if (rc == COA_OK) {
+        rc = coa_node_publish_intent(&node->inbox.tx, &node->tx_intent);
+    } else {
+        rc = COA_ERR_ARGUMENT; /* its own reference left the range a message can carry */
+    }
+    if (rc != COA_OK) {
+        node->fault = true;
+    }
+    node->state.waiting = false;
+    node->state.published = rc == COA_OK;
+    node->wait_deadline = INT64_MAX;
+    int status_rc = publish_status(node, now);
+    if (rc != COA_OK) {
+        return rc;
+    }
+    return status_rc != COA_OK ? status_rc : 1;
+}
+
+/* One one-UAV A* search for itself around the view's tracks and the live UAVs marked in
+ * node->include. Returns COA_OK with *result, or a negative error. */
+static int search_self(coa_vehicle_node_t *node, int64_t now, coa_plan_result_t *result)
+{
+    const coa_node_common_t *c = &node->config.common;
+    int rc = coa_node_problem_tracks(&node->problem_tracks, &node->view, node->include, c);
+    if (rc != COA_OK) {
+        return rc;
+    }
+    coa_vehicle_t vehicle = node->config.vehicle;
+    vehicle.initial_offset = node->state.offset;
+    const coa_vec3_t *references[1] = {node->own_reference};
+    coa_problem_t problem;
+    memset(&problem, 0, sizeof problem);
+    problem.dt = c->dt;
+    problem.horizon = c->horizon;
+    problem.vehicles = &vehicle;
+    problem.vehicle_count = 1;
+    problem.references = references;
+    problem.obstacles = node->inbox.obstacles;
+    problem.obstacle_count = node->inbox.obstacle_count;
+    problem.tracks = node->problem_tracks.tracks;
+    problem.track_count = node->problem_tracks.count;
+    problem.track_samples = node->problem_tracks.samples;
+
+    int64_t start = coa_node_stopwatch(c);
+    rc = coa_plan_centralised(node->planner, &problem, node->plan_out, result);
+    int64_t duration = coa_node_stopwatch(c) - start;
+    node->state.plans_run++;
+    node->last_plan_utime = now;
+    node->state.last_plan_duration_us = duration > 0 ? duration : 0;
+    if (rc != COA_OK) {
+        return rc;
+    }
+    node->state.last_outcome = (int)result->status;
+    node->state.last_nodes_expanded = result->nodes_expanded;
+    return COA_OK;
+}
+
+/* Plans for itself against obstacles, tracks, stale UAVs and every live UAV that is not a
+ * lower-priority member of its cluster (my = its cluster label), and adopts a solved
+ * plan. Returns COA_OK (whatever the outcome) or a negative error. */
+static int plan_self(coa_vehicle_node_t *node, int64_t now, uint32_t my)
+{
+    const coa_vehicle_t *self = &node->config.vehicle;
+    const coa_node_view_t *view = &node->view;
+    bool lower_outside = false;
+    for (size_t i = 0; i < view->live_count; i++) {
+        const coa_vehicle_t *peer = &view->live_vehicle[i];
+        bool lower = coa_node_outranks(self->priority, self->id, peer->priority, peer->id);
+        node->include[i] = !(lower && node->labels[i + 1u] == my);
+        lower_outside = lower_outside || (lower && node->include[i]);
+    }
+    coa_plan_result_t result;
+    int rc = search_self(node, now, &result);
+    /* Lower-priority UAVs outside its cluster are kept clear of while that is possible;
+     * when it is not (its way out of a conflict crosses their paths), it plans as
+     * coa_plan_decoupled orders it, around the higher priorities only: the others then
+     * see the conflict and plan around it. */
+    if (rc == COA_OK && result.status != COA_PLAN_SOLVED && lower_outside) {
+        for (size_t i = 0; i < view->live_count; i++) {
+            const coa_vehicle_t *peer = &view->live_vehicle[i];
+            node->include[i] = !coa_node_outranks(self->priority, self->id, peer->priority, peer->id);
+        }
+        rc = search_self(node, now, &result);
+    }
+    if (rc == COA_OK && result.status == COA_PLAN_SOLVED) {
+        adopt(node, node->plan_out, node->config.common.horizon + 1u);
+    }
+    return rc;
+}
+
+/* The decoupled step: predict with what it has; publish at once without a conflict;
+ * otherwise wait for the higher-priority members of its cluster (until the deadline),
+ * then plan and publish. Returns 1 when it published, 0 while it waits, or an error. */
+static int decide(coa_vehicle_node_t *node, int64_t now)
+{
+    const coa_node_common_t *c = &node->config.common;
+    const coa_vehicle_t *self = &node->config.vehicle;
+    coa_node_view_t *view = &node->view;
+    coa_node_view_build(view, &node->inbox, node->cycle_start, now);
+
+    coa_intent_plan_t *own = &node->plans[0];
+    memset(own, 0, sizeof *own);
+    own->id = self->id;
+    own->volume = self->volume;
+    own->t0 = 0;
+    own->step = c->dt;
+    own->samples = node->own_samples;
+    own->count = (size_t)c->horizon + 1u;
+    own->sigma_horizontal = node->config.sigma_horizontal;
+    own->sigma_vertical = node->config.sigma_vertical;
+    for (size_t i = 0; i < view->live_count; i++) {
+        node->plans[i + 1u] = view->live_plan[i];
+    }
+    const size_t n = view->live_count + 1u;
+    coa_predict_result_t result;
+    size_t clusters = 0;
+    int rc = coa_node_predict(node->predictor, c, node->plans, n, view, &node->inbox,
+                              node->conflicts, node->conflict_capacity, &result, node->labels,
+                              &clusters);
+    if (rc != COA_OK) {
+        node->fault = true;
+        int published = finish(node, now);
+        return published < 0 ? published : rc;
+    }
+    node->state.conflicts =
+        result.conflicts_found > UINT32_MAX ? UINT32_MAX : (uint32_t)result.conflicts_found;
+    const uint32_t my = node->labels[0];
+    if (my == COA_NO_CLUSTER) {
+        return finish(node, now);
+    }
+    bool pending = false;
+    for (size_t i = 0; i < view->live_count; i++) {
+        const coa_vehicle_t *peer = &view->live_vehicle[i];
+        if (node->labels[i + 1u] == my && !view->live_current[i] &&
+            coa_node_outranks(peer->priority, peer->id, self->priority, self->id)) {
+            pending = true;
+        }
+    }
+    if (pending && now < node->wait_deadline) {
+        node->state.waiting = true;
+        return 0;
+    }
+    /* Its own conflicts with lower-priority UAVs are theirs to solve (they plan around
+     * it, as coa_plan_decoupled orders it): it plans only for one that is its own. */
+    bool must = false;
+    for (size_t j = 0; j < result.conflict_count; j++) {
+        const coa_conflict_t *cf = &node->conflicts[j];
+        if (cf->a != 0u) {
+            continue;
+        }
+        if (cf->kind != COA_CONFLICT_VEHICLE) {
+            must = true;
+        } else if (cf->b >= 1u && cf->b < n) {
+            const coa_vehicle_t *peer = &view->live_vehicle[cf->b - 1u];
+            if (coa_node_outranks(peer->priority, peer->id, self->priority, self->id)) {
+                must = true;
+            }
+        }
+    }
+    if (must) {
+        rc = plan_self(node, now, my);
+        if (rc != COA_OK) {
+            node->fault = true;
+            int published = finish(node, now);
+            return published < 0 ? published : rc;
+        }
+    }
+    return finish(node, now);
+}
+
+static void reject(coa_vehicle_node_t *node, int code, const char *reason)
+{
+    coa_lcm_rx_count(&node->state.rx, code, reason);
+}
+
+/* Step 4 of node.h: a coordinator's plan that lists it. */
+static void on_plan(void *owner, const coavoid_plan_t *msg, const coa_lcm_plan_info_t *info,
+                    const coa_plan_result_t *result, const int32_t *offsets)
+{
+    coa_vehicle_node_t *node = owner;
+    const coa_vehicle_t *self = &node->config.vehicle;
+    const int64_t now = *node->config.common.clock;
+    size_t row = SIZE_MAX;
+    for (size_t i = 0; i < info->vehicle_count; i++) {
+        if (info->uav_ids[i] == self->id) {
+            row = i;
+        }
+    }
+    if (row == SIZE_MAX || result->status != COA_PLAN_SOLVED || row >= result->planned_count) {
+        coa_lcm_rx_count(&node->state.rx, COA_OK, NULL); /* not a plan for it */
+        return;
+    }
+    if (!node->started || msg->valid_from_utime != node->cycle_start) {
+        reject(node, COA_LCM_ERR_TIME, "plan: valid_from is not this cycle's start");
+        return;
+    }
+    if (now >= msg->valid_until_utime) {
+        reject(node, COA_LCM_ERR_TIME, "plan: arrived after valid_until");
+        return;
+    }
+    if (msg->dt != (double)node->config.common.dt) {
+        reject(node, COA_LCM_ERR_VALUE, "plan: dt is not this UAV's");
+        return;
+    }
+    const size_t samples = (size_t)info->horizon + 1u;
+    const int32_t *mine = offsets + row * samples;
+    if (mine[0] != node->state.offset) {
+        reject(node, COA_LCM_ERR_VALUE, "plan: does not start at the offset flown now");
+        return;
+    }
+    for (size_t j = 0; j < samples; j++) {
+        if (self->max_offset >= 0 && (mine[j] > self->max_offset || mine[j] < -self->max_offset)) {
+            reject(node, COA_LCM_ERR_VALUE, "plan: an offset beyond this UAV's max_offset");
+            return;
+        }
+        if (j > 0 && coa_action_between(mine[j - 1], mine[j], self->steep_factor) < 0) {
+            reject(node, COA_LCM_ERR_VALUE, "plan: a step this UAV cannot fly");
+            return;
+        }
+    }
+    adopt(node, mine, (uint32_t)samples);
+    coa_lcm_rx_count(&node->state.rx, COA_OK, NULL);
+}
+
+coa_vehicle_node_t *coa_vehicle_node_create(const coa_vehicle_node_config_t *config, lcm_t *lcm,
+                                            int *error)
+{
+    int dummy;
+    if (error == NULL) {
+        error = &dummy;
+    }
+    *error = COA_ERR_ARGUMENT;
+    if (config == NULL || lcm == NULL || coa_node_common_check(&config->common) != COA_OK ||
+        coa_vehicle_check(&config->vehicle) != COA_OK ||
+        (config->mode != COA_NODE_CENTRALISED && config->mode != COA_NODE_DECOUPLED) ||
+        config->coordinator_timeout_us < 0 || config->priority_wait_us < 0 ||
+        !isfinite((double)config->sigma_horizontal) || !isfinite((double)config->sigma_vertical) ||
+        config->sigma_horizontal < (coa_real_t)0 || config->sigma_vertical < (coa_real_t)0 ||
+        !(coa_climb_step(&config->vehicle, config->common.dt) > (coa_real_t)0)) {
+        return NULL;
+    }
+    const coa_node_common_t *c = &config->common;
+    const size_t pairs = coa_node_max_pairs();
+    const size_t predictor_size = coa_predictor_workspace_size(
+        COA_NODE_MAX_PEERS, COA_NODE_TRACK_CAPACITY, c->horizon, pairs);
+    const size_t planner_size = coa_planner_workspace_size(1u, c->beta);
+    if (predictor_size == 0u || planner_size == 0u) {
+        return NULL;
+    }
+    coa_vehicle_node_t *node = calloc(1, sizeof *node);
+    if (node == NULL) {
+        *error = COA_ERR_WORKSPACE;
+        return NULL;
+    }
+    node->config = *config;
+    if (node->config.coordinator_timeout_us == 0) {
+        node->config.coordinator_timeout_us = (int64_t)llround(2.5 * (double)c->dt_us);
+    }
+    if (node->config.priority_wait_us == 0) {
+        node->config.priority_wait_us = c->dt_us / 2 > 0 ? c->dt_us / 2 : 1;
+    }
+    node->dh = coa_climb_step(&node->config.vehicle, c->dt);
+    node->predictor_memory = malloc(predictor_size);
+    node->planner_memory = malloc(planner_size);
+    node->conflict_capacity = pairs;
+    node->conflicts = calloc(pairs, sizeof *node->conflicts);
+    if (node->predictor_memory == NULL || node->planner_memory == NULL || node->conflicts == NULL) {
+        coa_vehicle_node_destroy(node);
+        *error = COA_ERR_WORKSPACE;
+        return NULL;
+    }
+    node->predictor = coa_predictor_init(node->predictor_memory, predictor_size, COA_NODE_MAX_PEERS,
+                                         COA_NODE_TRACK_CAPACITY, c->horizon, pairs);
+    node->planner = coa_planner_init(node->planner_memory, planner_size, 1u, c->beta);
+    if (node->predictor == NULL || node->planner == NULL) {
+        coa_vehicle_node_destroy(node);
+        *error = COA_ERR_WORKSPACE;
+        return NULL;
+    }
+    node->plan_start = 0;
+    node->plan_count = 1;
+    node->plan_offsets[0] = node->config.vehicle.initial_offset;
+    node->state.cycle = -1;
+    node->state.offset = node->config.vehicle.initial_offset;
+    node->state.last_outcome = -1;
+    node->wait_deadline = INT64_MAX;
+    const bool centralised = node->config.mode == COA_NODE_CENTRALISED;
+    int rc = coa_node_inbox_init(&node->inbox, c, node->config.vehicle.id, node->config.vehicle.id,
+                                 COA_NODE_MAX_PEERS - 1u, node->config.coordinator_timeout_us, lcm,
+                                 &node->state.rx, centralised, centralised ? on_plan : NULL, node);
+    if (rc != COA_OK) {
+        free(node->predictor_memory);
+        free(node->planner_memory);
+        free(node->conflicts);
+        free(node);
+        *error = rc;
+        return NULL;
+    }
+    *error = COA_OK;
+    return node;
+}
+
+void coa_vehicle_node_destroy(coa_vehicle_node_t *node)
+{
+    if (node == NULL) {
+        return;
+    }
+    coa_node_inbox_fini(&node->inbox);
+    free(node->predictor_memory);
+    free(node->planner_memory);
+    free(node->conflicts);
+    free(node);
+}
+
+int coa_vehicle_node_cycle(coa_vehicle_node_t *node, int64_t now)
+{
+    if (node == NULL) {
+        return COA_ERR_ARGUMENT;
+    }
+    const coa_node_common_t *c = &node->config.common;
+    const int64_t k = coa_node_cycle_of(c, now);
+    if (k < 0) {
+        return COA_ERR_ARGUMENT;
+    }
+    if (node->started && k <= node->state.cycle) {
+        return COA_OK;
+    }
+    if (!node->started) {
+        node->started = true;
+        node->first_cycle_start = coa_node_cycle_utime(c, k);
+    }
+    node->fault = false;
+    node->state.cycle = k;
+    node->cycle_start = coa_node_cycle_utime(c, k);
+    coa_node_inbox_expire(&node->inbox, now);
+
+    build_own(node, k);
+    node->state.offset = node->own_offsets[0];
+    node->state.reference = node->own_reference[0];
+    node->state.position = node->own_samples[0];
+
+    const int64_t timeout = node->config.coordinator_timeout_us;
+    const bool coordinated =
+        node->config.mode == COA_NODE_CENTRALISED &&
+        ((node->inbox.heard_coordinator && now - node->inbox.coordinator_utime <= timeout) ||
+         now - node->first_cycle_start < timeout);
+    if (node->was_coordinated && !coordinated) {
+        node->state.fallbacks++;
+    }
+    node->was_coordinated = coordinated;
+    node->state.coordinated = coordinated;
+    node->state.published = false;
+    node->state.waiting = false;
+    node->wait_deadline = INT64_MAX;
+
+    int rc;
+    if (coordinated) {
+        rc = finish(node, now);
+    } else {
+        node->wait_deadline = node->cycle_start + node->config.priority_wait_us;
+        rc = decide(node, now);
+    }
+    return rc < 0 ? rc : COA_OK;
+}
+
+int coa_vehicle_node_poll(coa_vehicle_node_t *node, int64_t now)
+{
+    if (node == NULL) {
+        return COA_ERR_ARGUMENT;
+    }
+    if (!node->state.waiting) {
+        return 0;
+    }
+    int rc = decide(node, now);
+    return rc;
+}
+
+int64_t coa_vehicle_node_deadline(const coa_vehicle_node_t *node)
+{
+    return (node != NULL && node->state.waiting) ? node->wait_deadline : INT64_MAX;
+}
+
+const coa_vehicle_node_state_t *coa_vehicle_node_state(const coa_vehicle_node_t *node)
+{
+    return node != NULL ? &node->state : NULL;
+}
