@@ -28,19 +28,29 @@
  *        for itself alone (one-UAV A*) against obstacles, tracks and the intents of every
  *        UAV that is not a lower-priority member of its cluster (as moving obstacles, in
  *        the planner's track form), adopts the plan when solved, and publishes its intent.
- *        So a cluster plans in priority order, as coa_plan_decoupled does.
+ *        So a cluster plans in priority order, as coa_plan_decoupled does. It plans only
+ *        when one of its own conflicts is with something it must avoid (an obstacle, a
+ *        track, a higher-priority UAV): conflicts with lower priorities are theirs to
+ *        solve. When that search fails and lower-priority UAVs outside its cluster were
+ *        in it, it searches again around the higher priorities only (coa_plan_decoupled's
+ *        rule), and the others plan around it in turn.
  *   3. At cycle_utime(k) + collect_us the coordinator predicts over samples k..k+N from the
  *      intents for this cycle, plans each conflicting cluster in one centralised search
  *      (decoupled, in the coordinator, for a cluster larger than its workspace holds),
  *      clusters in ascending order, each later cluster treating the new plans of the
  *      earlier ones as moving obstacles; publishes one plan_t per cluster (valid_from =
  *      cycle_utime(k), valid_until = cycle_utime(k + 1)), the conflict report, and its
- *      heartbeat.
+ *      heartbeat. A cluster is only who conflicts now, and its way out can be blocked by
+ *      UAVs that do not (a UAV that must climb over terrain into the altitude of passing
+ *      traffic): when a cluster's plan fails, every clustered UAV is planned again as one
+ *      group, and failing that every UAV, from the intents as they came; that plan_t
+ *      (a newer plan_id) supersedes the cycle's earlier ones for its UAVs.
  *   4. A UAV adopts a plan_t that lists it among the planned rows, is solved, is newer
  *      than the last one adopted (plan_id), arrives before valid_until, has valid_from ==
  *      the current cycle's start, and starts at the offset the UAV flies now; anything
  *      else is not adopted (counted in status as rejected with the reason).
- * Every node publishes its heartbeat (status_t) once per cycle.
+ * Every node publishes its heartbeat (status_t) once per cycle; the world, a stand-in for
+ * external sources that status_t has no kind for, does not.
  *
  * A peer whose last intent is older than stale_after_us is no longer a co-operative UAV
  * to its receivers: they treat it as a non-cooperative track, extrapolated at constant
@@ -131,8 +141,10 @@ typedef struct {
     coa_node_common_t common;
     coa_vehicle_t vehicle;          /* its route is the caller's and must outlive the node */
     coa_node_mode_t mode;
-    int64_t coordinator_timeout_us; /* heartbeat silence before it plans for itself (default 2.5 dt) */
-    int64_t priority_wait_us;       /* bounded wait for higher-priority intents (default dt / 2) */
+    int64_t coordinator_timeout_us; /* heartbeat silence before it plans for itself (0: the
+                                       default, 2.5 dt) */
+    int64_t priority_wait_us;       /* bounded wait for higher-priority intents (0: the
+                                       default, dt / 2) */
     coa_real_t sigma_horizontal;    /* its own position uncertainty, published (default 0) */
     coa_real_t sigma_vertical;
 } coa_vehicle_node_config_t;
@@ -185,11 +197,12 @@ const coa_vehicle_node_state_t *coa_vehicle_node_state(const coa_vehicle_node_t 
 
 typedef struct {
     coa_node_common_t common;
-    uint16_t id;                     /* default COA_NODE_COORDINATOR_ID */
+    uint16_t id;                     /* 0: the default, COA_NODE_COORDINATOR_ID */
     size_t max_centralised;          /* largest cluster planned in one composite search
-                                        (1..COA_MAX_CENTRALISED; default 3); larger clusters
+                                        (1..COA_MAX_CENTRALISED; 0: the default, 3); larger clusters
                                         are planned decoupled by the coordinator */
-    int64_t collect_us;              /* after the cycle start, when it plans (default dt / 4) */
+    int64_t collect_us;              /* after the cycle start, when it plans, < dt (0: the
+                                        default, dt / 4) */
 } coa_coordinator_config_t;
 
 typedef struct {
@@ -218,7 +231,7 @@ const coa_coordinator_state_t *coa_coordinator_state(const coa_coordinator_t *no
 
 typedef struct {
     coa_node_common_t common;
-    uint16_t id;                      /* map_id and track source_id; default COA_NODE_WORLD_ID */
+    uint16_t id;                      /* map_id and track source_id; 0: COA_NODE_WORLD_ID */
     const coa_obstacle_t *obstacles;  /* the caller's, outliving the node */
     size_t obstacle_count;
     const coa_track_t *tracks;        /* positions at scenario t = 0 (epoch) */

@@ -1,0 +1,417 @@
+/*
+ * The coordinator node (node.h, step 3 of the cycle): the ground station that predicts
+ * from the intents of the cycle, plans each conflicting cluster in one composite search
+ * (decoupled for a cluster larger than its workspace), and publishes the plans, the
+ * conflict report and its heartbeat.
+ */
+#include "node_internal.h"
+
+#include <limits.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+struct coa_coordinator {
+    coa_coordinator_config_t config;
+    coa_coordinator_state_t state;
+    bool started;
+    bool degraded;                 /* a cluster's plan failed in this cycle */
+    bool fault;                    /* an internal error in this cycle */
+    int64_t plan_id;
+    int64_t report_sequence;
+    int64_t status_sequence;
+    int64_t last_plan_utime;
+
+    uint32_t labels[COA_NODE_MAX_PEERS];
+    bool include[COA_NODE_MAX_PEERS];
+    size_t member[COA_MAX_VEHICLES];            /* live indices of the cluster planned */
+    coa_vehicle_t vehicles[COA_MAX_VEHICLES];
+    const coa_vec3_t *references[COA_MAX_VEHICLES];
+    int32_t offsets[(size_t)COA_MAX_VEHICLES * COA_NODE_MAX_SAMPLES];
+    coavoid_plan_t tx_plan;
+    coavoid_conflict_report_t tx_report;
+    coavoid_status_t tx_status;
+
+    coa_conflict_t *conflicts;
+    size_t conflict_capacity;
+    void *predictor_memory;
+    coa_predictor_t *predictor;
+    void *planner_memory;
+    coa_planner_t *planner;
+
+    coa_node_inbox_t inbox;
+    coa_node_view_t view;
+    coa_node_problem_tracks_t problem_tracks;
+};
+
+coa_coordinator_t *coa_coordinator_create(const coa_coordinator_config_t *config, lcm_t *lcm,
+                                          int *error)
+{
+    int dummy;
+    if (error == NULL) {
+        error = &dummy;
+    }
+    *error = COA_ERR_ARGUMENT;
+    if (config == NULL || lcm == NULL || coa_node_common_check(&config->common) != COA_OK ||
+        config->max_centralised > COA_MAX_CENTRALISED || config->collect_us < 0 ||
+        config->collect_us >= config->common.dt_us) {
+        return NULL;
+    }
+    const coa_node_common_t *c = &config->common;
+    const size_t max_centralised = config->max_centralised == 0u ? 3u : config->max_centralised;
+    const size_t pairs = coa_node_max_pairs();
+    const size_t predictor_size = coa_predictor_workspace_size(
+        COA_NODE_MAX_PEERS, COA_NODE_TRACK_CAPACITY, c->horizon, pairs);
+    const size_t planner_size = coa_planner_workspace_size(max_centralised, c->beta);
+    if (predictor_size == 0u || planner_size == 0u) {
+        return NULL;
+    }
+    coa_coordinator_t *node = calloc(1, sizeof *node);
+    if (node == NULL) {
+        *error = COA_ERR_WORKSPACE;
+        return NULL;
+    }
+    node->config = *config;
+    node->config.max_centralised = max_centralised;
+    if (node->config.id == 0u) {
+        node->config.id = (uint16_t)COA_NODE_COORDINATOR_ID;
+    }
+    if (node->config.collect_us == 0) {
+        node->config.collect_us = c->dt_us / 4;
+    }
+    node->predictor_memory = malloc(predictor_size);
+    node->planner_memory = malloc(planner_size);
+    node->conflict_capacity = pairs;
+    node->conflicts = calloc(pairs, sizeof *node->conflicts);
+    if (node->predictor_memory != NULL) {
+        node->predictor = coa_predictor_init(node->predictor_memory, predictor_size,
+                                             COA_NODE_MAX_PEERS, COA_NODE_TRACK_CAPACITY,
+                                             c->horizon, pairs);
+    }
+    if (node->planner_memory != NULL) {
+        node->planner = coa_planner_init(node->planner_memory, planner_size, max_centralised,
+                                         c->beta);
+    }
+    if (node->predictor == NULL || node->planner == NULL || node->conflicts == NULL) {
+        free(node->predictor_memory);
+        free(node->planner_memory);
+        free(node->conflicts);
+        free(node);
+        *error = COA_ERR_WORKSPACE;
+        return NULL;
+    }
+    node->state.cycle = -1;
+    node->state.last_outcome = -1;
+    /* No UAV is its own: intents are all others'. */
+    int rc = coa_node_inbox_init(&node->inbox, c, 0u, node->config.id, COA_NODE_MAX_PEERS,
+                                 2 * c->stale_after_us, lcm, &node->state.rx, false, NULL, node);
+    if (rc != COA_OK) {
+        free(node->predictor_memory);
+        free(node->planner_memory);
+        free(node->conflicts);
+        free(node);
+        *error = rc;
+        return NULL;
+    }
+    *error = COA_OK;
+    return node;
+}
+
+void coa_coordinator_destroy(coa_coordinator_t *node)
+{
+    if (node == NULL) {
+        return;
+    }
+    coa_node_inbox_fini(&node->inbox);
+    free(node->predictor_memory);
+    free(node->planner_memory);
+    free(node->conflicts);
+    free(node);
+}
+
+const coa_coordinator_state_t *coa_coordinator_state(const coa_coordinator_t *node)
+{
+    return node != NULL ? &node->state : NULL;
+}
+
+static int publish_report(coa_coordinator_t *node, int64_t now, int64_t cycle_start,
+                          const coa_predict_result_t *result)
+{
+    const coa_node_common_t *c = &node->config.common;
+    const coa_node_view_t *view = &node->view;
+    coa_lcm_context_t ctx = coa_node_context(&node->inbox, now, cycle_start);
+    int rc = coa_lcm_conflict_report_from_core(
+        node->conflicts, result->conflict_count, result->conflicts_found, view->live_id,
+        view->live_count, view->track_ids, view->track_count,
+        view->live_count > 0u ? node->labels : NULL, now, node->config.id,
+        node->report_sequence++, cycle_start, c->dt, c->horizon, &ctx, &node->tx_report, NULL);
+    if (rc != COA_OK) {
+        return COA_ERR_ARGUMENT;
+    }
+    return coa_node_publish_conflicts(&node->inbox.tx, &node->tx_report);
+}
+
+static int publish_status(coa_coordinator_t *node, int64_t now, int64_t cycle_start)
+{
+    coavoid_status_t *m = &node->tx_status;
+    const coa_coordinator_state_t *s = &node->state;
+    memset(m, 0, sizeof *m);
+    m->utime = now;
+    m->node_id = node->config.id;
+    m->node_kind = COAVOID_STATUS_T_NODE_COORDINATOR;
+    m->sequence = node->status_sequence++;
+    if (node->fault) {
+        m->health = COAVOID_STATUS_T_HEALTH_FAULT;
+    } else if (node->degraded || node->view.stale_count > 0u) {
+        m->health = COAVOID_STATUS_T_HEALTH_DEGRADED;
+    } else {
+        m->health = COAVOID_STATUS_T_HEALTH_OK;
+    }
+    m->mode = COAVOID_STATUS_T_MODE_CENTRALISED;
+    m->last_plan_utime = node->last_plan_utime;
+    m->last_plan_duration_us = s->last_plan_duration_us;
+    m->nodes_expanded = s->last_nodes_expanded > (uint64_t)INT64_MAX ? INT64_MAX
+                                                                      : (int64_t)s->last_nodes_expanded;
+    m->outcome = s->last_outcome < 0 ? COAVOID_STATUS_T_OUTCOME_NONE : (int8_t)s->last_outcome;
+    m->conflicts = s->conflicts > (uint32_t)INT32_MAX ? INT32_MAX : (int32_t)s->conflicts;
+    m->messages_received = s->rx.received;
+    m->messages_rejected = s->rx.rejected;
+    m->last_reject_code = s->rx.last_reject_code;
+    coa_lcm_context_t ctx = coa_node_context(&node->inbox, now, cycle_start);
+    if (coa_lcm_status_check(m, &ctx, NULL) != COA_OK) {
+        return COA_ERR_ARGUMENT;
+    }
+    return coa_node_publish_status(&node->inbox.tx, m);
+}
+
+/* Which UAVs a planning call takes: one cluster, every clustered UAV, or every UAV. */
+#define GROUP_CLUSTERED (COA_NO_CLUSTER - 1u)
+#define GROUP_ALL COA_NO_CLUSTER
+
+/* The UAVs of `group` (a cluster label, GROUP_CLUSTERED or GROUP_ALL) with an intent for
+ * this cycle, ascending id; past COA_MAX_VEHICLES (a plan_t's rows) only the highest
+ * priorities are planned and the rest stay moving obstacles. Returns the count. */
+static size_t cluster_members(coa_coordinator_t *node, uint32_t group)
+{
+    const coa_node_view_t *view = &node->view;
+    size_t count = 0;
+    for (size_t i = 0; i < view->live_count; i++) {
+        bool in = group == GROUP_ALL ||
+                  (group == GROUP_CLUSTERED ? node->labels[i] != COA_NO_CLUSTER
+                                            : node->labels[i] == group);
+        if (!in || !view->live_current[i]) {
+            continue;
+        }
+        if (count < COA_MAX_VEHICLES) {
+            node->member[count++] = i;
+            continue;
+        }
+        /* Full: replace the lowest-ranked member if this one outranks it. */
+        size_t worst = 0;
+        for (size_t m = 1; m < count; m++) {
+            const coa_vehicle_t *a = &view->live_vehicle[node->member[m]];
+            const coa_vehicle_t *b = &view->live_vehicle[node->member[worst]];
+            if (coa_node_outranks(b->priority, b->id, a->priority, a->id)) {
+                worst = m;
+            }
+        }
+        const coa_vehicle_t *w = &view->live_vehicle[node->member[worst]];
+        const coa_vehicle_t *v = &view->live_vehicle[i];
+        if (coa_node_outranks(v->priority, v->id, w->priority, w->id)) {
+            node->member[worst] = i;
+        }
+    }
+    /* Keep ascending id (the order the plan's rows follow). */
+    for (size_t a = 1; a < count; a++) {
+        size_t x = node->member[a];
+        size_t b = a;
+        while (b > 0 && node->member[b - 1] > x) {
+            node->member[b] = node->member[b - 1];
+            b--;
+        }
+        node->member[b] = x;
+    }
+    return count;
+}
+
+/* Plans one cluster and publishes its plan; a solved plan replaces the members' positions
+ * in the view, so that later clusters plan around it. *solved says how it went. */
+static int plan_cluster(coa_coordinator_t *node, int64_t now, int64_t cycle_start, size_t count,
+                        bool *solved)
+{
+    const coa_node_common_t *c = &node->config.common;
+    coa_node_view_t *view = &node->view;
+    for (size_t i = 0; i < view->live_count; i++) {
+        node->include[i] = true;
+    }
+    for (size_t m = 0; m < count; m++) {
+        size_t i = node->member[m];
+        node->include[i] = false;
+        node->vehicles[m] = view->live_vehicle[i];
+        node->references[m] = view->live_arrays[i].reference;
+    }
+    int rc = coa_node_problem_tracks(&node->problem_tracks, view, node->include, c);
+    if (rc != COA_OK) {
+        return rc;
+    }
+    coa_problem_t problem;
+    memset(&problem, 0, sizeof problem);
+    problem.dt = c->dt;
+    problem.horizon = c->horizon;
+    problem.vehicles = node->vehicles;
+    problem.vehicle_count = count;
+    problem.references = node->references;
+    problem.obstacles = node->inbox.obstacles;
+    problem.obstacle_count = node->inbox.obstacle_count;
+    problem.tracks = node->problem_tracks.tracks;
+    problem.track_count = node->problem_tracks.count;
+    problem.track_samples = node->problem_tracks.samples;
+
+    const bool centralised = count <= node->config.max_centralised;
+    coa_plan_result_t result;
+    *solved = false;
+    int64_t start = coa_node_stopwatch(c);
+    if (centralised) {
+        rc = coa_plan_centralised(node->planner, &problem, node->offsets, &result);
+    } else {
+        rc = coa_plan_decoupled(node->planner, &problem, NULL, 1u, node->offsets, &result);
+    }
+    int64_t duration = coa_node_stopwatch(c) - start;
+    node->state.plans_run++;
+    node->state.clusters_planned++;
+    node->last_plan_utime = now;
+    node->state.last_plan_duration_us = duration > 0 ? duration : 0;
+    if (rc != COA_OK) {
+        return rc;
+    }
+    node->state.last_outcome = (int)result.status;
+    node->state.last_nodes_expanded = result.nodes_expanded;
+
+    coa_lcm_plan_info_t info;
+    memset(&info, 0, sizeof info);
+    info.utime = now;
+    info.coordinator_id = node->config.id;
+    info.plan_id = node->plan_id++;
+    info.valid_from = 0;
+    info.valid_until = c->dt;
+    info.dt = c->dt;
+    info.horizon = c->horizon;
+    info.mode = centralised ? COAVOID_PLAN_T_MODE_CENTRALISED : COAVOID_PLAN_T_MODE_DECOUPLED;
+    info.vehicle_count = count;
+    for (size_t m = 0; m < count; m++) {
+        info.uav_ids[m] = node->vehicles[m].id;
+    }
+    coa_lcm_context_t ctx = coa_node_context(&node->inbox, now, cycle_start);
+    rc = coa_lcm_plan_from_core(&info, &result, node->offsets, &ctx, &node->tx_plan, NULL);
+    if (rc == COA_OK) {
+        /* The validity window in exact microseconds, whatever the core's precision. */
+        node->tx_plan.valid_from_utime = cycle_start;
+        node->tx_plan.valid_until_utime = cycle_start + c->dt_us;
+        rc = coa_lcm_plan_check(&node->tx_plan, &ctx, NULL);
+    }
+    if (rc != COA_OK) {
+        return COA_ERR_ARGUMENT;
+    }
+    rc = coa_node_publish_plan(&node->inbox.tx, &node->tx_plan);
+    if (result.status != COA_PLAN_SOLVED) {
+        return rc;
+    }
+    *solved = true;
+    node->state.plans_published++;
+    const size_t samples = (size_t)c->horizon + 1u;
+    for (size_t m = 0; m < count; m++) {
+        size_t i = node->member[m];
+        coa_lcm_intent_arrays_t *a = &view->live_arrays[i];
+        coa_real_t dh = coa_climb_step(&view->live_vehicle[i], c->dt);
+        for (size_t j = 0; j < samples; j++) {
+            a->offsets[j] = node->offsets[m * samples + j];
+            a->samples[j] = a->reference[j];
+            a->samples[j].z += (coa_real_t)a->offsets[j] * dh;
+        }
+    }
+    return rc;
+}
+
+int coa_coordinator_cycle(coa_coordinator_t *node, int64_t now)
+{
+    if (node == NULL) {
+        return COA_ERR_ARGUMENT;
+    }
+    const coa_node_common_t *c = &node->config.common;
+    const int64_t k = coa_node_cycle_of(c, now);
+    if (k < 0) {
+        return COA_ERR_ARGUMENT;
+    }
+    if (node->started && k <= node->state.cycle) {
+        return COA_OK;
+    }
+    node->started = true;
+    node->state.cycle = k;
+    node->state.clusters_planned = 0;
+    node->degraded = false;
+    node->fault = false;
+    const int64_t cycle_start = coa_node_cycle_utime(c, k);
+    coa_node_inbox_expire(&node->inbox, now);
+    coa_node_view_t *view = &node->view;
+    coa_node_view_build(view, &node->inbox, cycle_start, now);
+
+    coa_predict_result_t result;
+    size_t clusters = 0;
+    int first_error = coa_node_predict(node->predictor, c, view->live_plan, view->live_count, view,
+                                       &node->inbox, node->conflicts, node->conflict_capacity,
+                                       &result, node->labels, &clusters);
+    if (first_error != COA_OK) {
+        memset(&result, 0, sizeof result);
+        clusters = 0;
+        node->fault = true;
+    }
+    node->state.conflicts =
+        result.conflicts_found > UINT32_MAX ? UINT32_MAX : (uint32_t)result.conflicts_found;
+    int rc = publish_report(node, now, cycle_start, &result);
+    if (first_error == COA_OK) {
+        first_error = rc;
+    }
+    /* Clusters in label order (by smallest id), each around the plans before it. */
+    size_t failed_size = 0;
+    for (uint32_t label = 0; label < clusters; label++) {
+        size_t count = cluster_members(node, label);
+        if (count == 0u) {
+            continue;
+        }
+        bool solved = false;
+        rc = plan_cluster(node, now, cycle_start, count, &solved);
+        if (rc != COA_OK) {
+            node->fault = true;
+            first_error = first_error != COA_OK ? first_error : rc;
+        }
+        if (!solved && count > failed_size) {
+            failed_size = count;
+        }
+    }
+    /* A cluster is only the UAVs that conflict now; its way out may be blocked by UAVs
+     * that do not (a UAV that must climb over terrain into traffic at the altitude it
+     * needs). Then the clusters are planned as one group, and failing that every UAV,
+     * each from the intents as they came (the plans just published are superseded by the
+     * newer plan_id, which every UAV of the group adopts). */
+    const uint32_t escalation[2] = {GROUP_CLUSTERED, GROUP_ALL};
+    for (size_t e = 0; e < 2u && failed_size > 0u && first_error == COA_OK; e++) {
+        size_t count = cluster_members(node, escalation[e]);
+        if (count <= failed_size) {
+            continue;
+        }
+        coa_node_view_build(view, &node->inbox, cycle_start, now);
+        bool solved = false;
+        rc = plan_cluster(node, now, cycle_start, count, &solved);
+        if (rc != COA_OK) {
+            node->fault = true;
+            first_error = rc;
+        }
+        failed_size = solved ? 0u : count;
+    }
+    node->degraded = failed_size > 0u;
+    rc = publish_status(node, now, cycle_start);
+    if (first_error == COA_OK) {
+        first_error = rc;
+    }
+    return first_error;
+}
