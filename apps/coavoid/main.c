@@ -7,6 +7,7 @@
  *   coavoid predict SCENARIO.json [--threshold P] [...]             predict_cmd.c
  *   coavoid bench predict --vehicles N --horizon H [...]            bench.c
  *   coavoid world SCENARIO.json [--lcm-url URL] [--epoch UTIME] [...] world_cmd.c
+ *   coavoid sim SCENARIO.json --mode centralised|decoupled [...]    sim_cmd.c
  *
  * Exit status: 0 success, 1 plan infeasible or budget exhausted, 2 invalid input or usage
  * (one line on stderr naming the input and why), 3 internal error.
@@ -24,6 +25,7 @@
     "  plan     plan collision-free altitude manoeuvres for a scenario\n"       \
     "  predict  predict the conflicts of a scenario's reference trajectories\n" \
     "  bench    time a core function on a random airspace (bench predict)\n"    \
+    "  sim      fly a scenario in closed loop over the nodes (deterministic)\n"  \
     "\n"                                                                        \
     "Run 'coavoid <command> --help' for the options of a command.\n"
 
@@ -48,6 +50,9 @@ int main(int argc, char **argv)
     }
     if (strcmp(command, "world") == 0) {
         return command_world(argc, argv);
+    }
+    if (strcmp(command, "sim") == 0) {
+        return command_sim(argc, argv);
     }
     if (command[0] == '-') {
         return cli_fail(CLI_EXIT_INVALID, "unknown option '%.40s' (see 'coavoid --help')", command);

@@ -1,0 +1,622 @@
+/*
+ * coavoid sim: the closed loop of SCENARIO_FORMAT.md ("Simulation result") in one
+ * process. The world, one vehicle node per UAV and (centralised) the coordinator are the
+ * nodes the real-time apps run (apps/node), here sharing LCM's in-process provider
+ * (memq) and a simulated clock, so a run is repeatable bit for bit. See SIM_USAGE.
+ */
+#define _POSIX_C_SOURCE 200809L
+
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+#include "commands.h"
+
+#ifdef COAVOID_HAVE_NODE
+
+#include <cjson/cJSON.h>
+#include <lcm/lcm.h>
+
+#include "flight.h"
+#include "node.h"
+#include "scenario.h"
+
+/* Cycle 0's utime: a fixed constant (2001-09-09), never the wall clock, so that every
+ * run stamps its messages alike and prints the same result. */
+#define SIM_EPOCH_UTIME INT64_C(1000000000000000)
+/* beta when the scenario gives none: `coavoid plan`'s default, lowered for a composite
+ * search until its workspace fits SIM_WORKSPACE_MAX (the workspace grows as beta * 5^n). */
+#define SIM_DEFAULT_BETA 20000u
+#define SIM_WORKSPACE_MAX ((size_t)1u << 30)
+/* More steps than this is more likely a typo than a simulation anyone waits for. */
+#define SIM_MAX_STEPS 1000000u
+
+#define SIM_USAGE                                                                              \
+    "usage: coavoid sim SCENARIO.json --mode centralised|decoupled [--steps K] [--json]\n"     \
+    "                   [--svg FILE] [--coordinator-stops STEP]\n"                             \
+    "\n"                                                                                       \
+    "Flies the scenario in closed loop: every step each UAV publishes its intent, conflicts\n" \
+    "are predicted and planned for (by the coordinator, or by each UAV in priority order),\n"  \
+    "and every UAV flies one step of its plan. The nodes are those of the real-time apps,\n"   \
+    "over LCM's in-process provider on a simulated clock: the output is repeatable.\n"         \
+    "\n"                                                                                       \
+    "options:\n"                                                                               \
+    "  --mode centralised   a coordinator plans each conflicting cluster; the UAVs follow\n"   \
+    "                       it, and plan for themselves when its heartbeat stops\n"            \
+    "  --mode decoupled     no coordinator: each UAV plans for itself in priority order\n"     \
+    "  --steps K            fly K steps (samples 0..K), K >= 1; default 2 * horizon\n"         \
+    "  --json               print the simulation result as JSON (default: text)\n"            \
+    "  --svg FILE           write the figure (top view, altitude profiles) to FILE\n"          \
+    "  --coordinator-stops STEP\n"                                                             \
+    "                       centralised: stop the coordinator before step STEP (0..K)\n"      \
+    "  -h, --help           show this help\n"                                                  \
+    "\n"                                                                                       \
+    "The scenario's horizon may be at most %u steps (an intent carries N + 1 samples) and\n"  \
+    "it may have at most %u UAVs.\n"                                                           \
+    "\n"                                                                                       \
+    "exit status: 0 no loss of separation, 1 a loss of separation, 2 invalid input or\n"       \
+    "usage (one line on stderr naming the input and why), 3 internal error\n"
+
+typedef struct {
+    const char *scenario_path;
+    const char *mode;
+    bool decoupled;
+    const char *steps_text;
+    uint32_t steps;
+    bool json;
+    const char *svg_path;
+    const char *stop_text;
+    uint32_t stop_step;
+} sim_options_t;
+
+/* A step number 0..max (cli_parse_count takes 1..max). */
+static bool parse_step(const char *text, uint32_t max, uint32_t *out)
+{
+    uint64_t value;
+    if (strcmp(text, "0") == 0) {
+        *out = 0;
+        return true;
+    }
+    if (!cli_parse_count(text, strlen(text), max, &value)) {
+        return false;
+    }
+    *out = (uint32_t)value;
+    return true;
+}
+
+static int parse_sim_options(int argc, char **argv, sim_options_t *o)
+{
+    bool options_done = false;
+    memset(o, 0, sizeof *o);
+    for (int i = 2; i < argc; i++) {
+        const char *arg = argv[i];
+        const char *value = NULL;
+        if (options_done || arg[0] != '-' || strcmp(arg, "-") == 0) {
+            if (o->scenario_path != NULL) {
+                return cli_fail(CLI_EXIT_INVALID,
+                                "sim: unexpected argument '%.80s' (one scenario only)", arg);
+            }
+            o->scenario_path = arg;
+        } else if (strcmp(arg, "--") == 0) {
+            options_done = true;
+        } else if (strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0) {
+            printf(SIM_USAGE, COA_NODE_MAX_HORIZON, COA_MAX_VEHICLES);
+            return CLI_EXIT_OK;
+        } else if (cli_option_is(arg, "--mode")) {
+            if (o->mode != NULL) {
+                return cli_fail(CLI_EXIT_INVALID, "--mode: given more than once");
+            }
+            if (!cli_option_value(argc, argv, &i, "--mode", &value)) {
+                return cli_fail(CLI_EXIT_INVALID,
+                                "--mode: missing value (centralised or decoupled)");
+            }
+            if (strcmp(value, "centralised") != 0 && strcmp(value, "decoupled") != 0) {
+                return cli_fail(CLI_EXIT_INVALID,
+                                "--mode: unknown mode '%.40s' (expected centralised or decoupled)",
+                                value);
+            }
+            o->mode = value;
+            o->decoupled = strcmp(value, "decoupled") == 0;
+        } else if (cli_option_is(arg, "--steps")) {
+            uint64_t steps;
+            if (o->steps_text != NULL) {
+                return cli_fail(CLI_EXIT_INVALID, "--steps: given more than once");
+            }
+            if (!cli_option_value(argc, argv, &i, "--steps", &value)) {
+                return cli_fail(CLI_EXIT_INVALID, "--steps: missing value (an integer >= 1)");
+            }
+            if (!cli_parse_count(value, strlen(value), SIM_MAX_STEPS, &steps)) {
+                return cli_fail(CLI_EXIT_INVALID,
+                                "--steps: must be an integer from 1 to %u, got '%.40s'",
+                                SIM_MAX_STEPS, value);
+            }
+            o->steps_text = value;
+            o->steps = (uint32_t)steps;
+        } else if (strcmp(arg, "--json") == 0) {
+            if (o->json) {
+                return cli_fail(CLI_EXIT_INVALID, "--json: given more than once");
+            }
+            o->json = true;
+        } else if (cli_option_is(arg, "--json")) {
+            return cli_fail(CLI_EXIT_INVALID, "--json: takes no value");
+        } else if (cli_option_is(arg, "--svg")) {
+            if (o->svg_path != NULL) {
+                return cli_fail(CLI_EXIT_INVALID, "--svg: given more than once");
+            }
+            if (!cli_option_value(argc, argv, &i, "--svg", &value) || value[0] == '\0') {
+                return cli_fail(CLI_EXIT_INVALID, "--svg: missing value (a file to write)");
+            }
+            o->svg_path = value;
+        } else if (cli_option_is(arg, "--coordinator-stops")) {
+            if (o->stop_text != NULL) {
+                return cli_fail(CLI_EXIT_INVALID, "--coordinator-stops: given more than once");
+            }
+            if (!cli_option_value(argc, argv, &i, "--coordinator-stops", &value)) {
+                return cli_fail(CLI_EXIT_INVALID,
+                                "--coordinator-stops: missing value (a step, 0 or more)");
+            }
+            if (!parse_step(value, SIM_MAX_STEPS, &o->stop_step)) {
+                return cli_fail(CLI_EXIT_INVALID,
+                                "--coordinator-stops: must be a step from 0 to %u, got '%.40s'",
+                                SIM_MAX_STEPS, value);
+            }
+            o->stop_text = value;
+        } else {
+            return cli_fail(CLI_EXIT_INVALID,
+                            "sim: unknown option '%.40s' (see 'coavoid sim --help')", arg);
+        }
+    }
+    if (o->scenario_path == NULL) {
+        return cli_fail(CLI_EXIT_INVALID, "sim: missing SCENARIO.json (see 'coavoid sim --help')");
+    }
+    if (o->mode == NULL) {
+        return cli_fail(CLI_EXIT_INVALID, "--mode: required (centralised or decoupled)");
+    }
+    if (o->decoupled && o->stop_text != NULL) {
+        return cli_fail(CLI_EXIT_INVALID,
+                        "--coordinator-stops: only valid with --mode centralised (decoupled "
+                        "runs without a coordinator)");
+    }
+    return CLI_CONTINUE;
+}
+
+/* The largest beta up to SIM_DEFAULT_BETA whose workspace for `searched` UAVs fits
+ * SIM_WORKSPACE_MAX (the size grows with beta: bisection), as `coavoid plan` chooses. */
+static uint32_t default_beta(size_t searched)
+{
+    uint32_t lo = 1u;
+    uint32_t hi = SIM_DEFAULT_BETA;
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo + 1u) / 2u;
+        size_t size = coa_planner_workspace_size(searched, mid);
+        if (size != 0u && size <= SIM_WORKSPACE_MAX) {
+            lo = mid;
+        } else {
+            hi = mid - 1u;
+        }
+    }
+    return lo;
+}
+
+static bool workspace_fits(size_t searched, uint32_t beta)
+{
+    size_t size = coa_planner_workspace_size(searched, beta);
+    return size != 0u && size <= SIM_WORKSPACE_MAX;
+}
+
+typedef struct {
+    lcm_t *lcm;
+    coa_world_t *world;
+    coa_coordinator_t *coordinator;
+    coa_vehicle_node_t **vehicles; /* in ascending id: the order they run in */
+    size_t *index;                 /* index[j]: scenario index of vehicles[j] */
+    coa_flight_vehicle_t *flown;   /* by scenario index */
+    coa_vec3_t *references;
+    int32_t *offsets;
+    double *vehicle_deviation;
+    uint32_t *vehicle_effort;
+    FILE *svg;
+} sim_run_t;
+
+static void sim_run_free(sim_run_t *r, size_t n)
+{
+    coa_coordinator_destroy(r->coordinator);
+    if (r->vehicles != NULL) {
+        for (size_t j = 0; j < n; j++) {
+            coa_vehicle_node_destroy(r->vehicles[j]);
+        }
+    }
+    coa_world_destroy(r->world);
+    if (r->lcm != NULL) {
+        lcm_destroy(r->lcm);
+    }
+    free(r->vehicles);
+    free(r->index);
+    free(r->flown);
+    free(r->references);
+    free(r->offsets);
+    free(r->vehicle_deviation);
+    free(r->vehicle_effort);
+    if (r->svg != NULL) {
+        fclose(r->svg);
+    }
+}
+
+/* Handles every queued message. false when LCM failed. */
+static bool drain(lcm_t *lcm)
+{
+    for (;;) {
+        int rc = lcm_handle_timeout(lcm, 0);
+        if (rc == 0) {
+            return true;
+        }
+        if (rc < 0) {
+            return false;
+        }
+    }
+}
+
+/* The simulation result with the extras only a simulation has (how often the UAVs fell
+ * back to planning for themselves), in the JSON coa_flight_json writes. */
+static int print_json(const coa_flight_t *flight, const coa_flight_eval_t *eval,
+                      uint32_t fallbacks, const sim_options_t *o)
+{
+    char *text = NULL;
+    size_t length = 0;
+    FILE *memory = open_memstream(&text, &length);
+    if (memory == NULL) {
+        return COA_ERR_WORKSPACE;
+    }
+    int rc = coa_flight_json(flight, eval, memory);
+    if (fclose(memory) != 0 && rc == COA_OK) {
+        rc = COA_ERR_WORKSPACE;
+    }
+    cJSON *root = rc == COA_OK ? cJSON_ParseWithLength(text, length) : NULL;
+    free(text);
+    if (rc != COA_OK) {
+        return rc;
+    }
+    if (root == NULL) {
+        return COA_ERR_WORKSPACE;
+    }
+    bool ok = cJSON_AddNumberToObject(root, "fallbacks", (double)fallbacks) != NULL;
+    if (ok && o->stop_text != NULL) {
+        ok = cJSON_AddNumberToObject(root, "coordinator_stopped_at", (double)o->stop_step) != NULL;
+    }
+    char *printed = ok ? cJSON_Print(root) : NULL;
+    cJSON_Delete(root);
+    if (printed == NULL) {
+        return COA_ERR_WORKSPACE;
+    }
+    ok = fputs(printed, stdout) >= 0 && fputc('\n', stdout) != EOF && fflush(stdout) == 0;
+    free(printed);
+    return ok ? COA_OK : COA_ERR_WORKSPACE;
+}
+
+static int sim(const sim_options_t *o, scenario_t *s)
+{
+    const char *file = o->scenario_path;
+    const size_t n = s->vehicle_count;
+    if (s->horizon > COA_NODE_MAX_HORIZON) {
+        return cli_fail(CLI_EXIT_INVALID,
+                        "%s: horizon: %lu steps, at most %u in a simulation (an intent carries "
+                        "N + 1 samples)",
+                        file, (unsigned long)s->horizon, COA_NODE_MAX_HORIZON);
+    }
+    if (n > COA_MAX_VEHICLES || n > COA_NODE_MAX_PEERS) {
+        return cli_fail(CLI_EXIT_INVALID, "%s: vehicles: %zu UAVs, at most %u in a simulation",
+                        file, n, COA_MAX_VEHICLES < COA_NODE_MAX_PEERS ? COA_MAX_VEHICLES
+                                                                       : COA_NODE_MAX_PEERS);
+    }
+    if (s->track_count > COA_NODE_MAX_TRACKS) {
+        return cli_fail(CLI_EXIT_INVALID, "%s: tracks: %zu tracks, at most %u in a simulation",
+                        file, s->track_count, COA_NODE_MAX_TRACKS);
+    }
+    const uint32_t steps = o->steps_text != NULL ? o->steps : 2u * s->horizon;
+    if (o->stop_text != NULL && o->stop_step > steps) {
+        return cli_fail(CLI_EXIT_INVALID, "--coordinator-stops: step %lu is after the last, %lu",
+                        (unsigned long)o->stop_step, (unsigned long)steps);
+    }
+    int rc = cli_sample_scenario(file, s);
+    if (rc != CLI_CONTINUE) {
+        return rc;
+    }
+
+    int64_t now = SIM_EPOCH_UTIME;
+    coa_node_common_t common;
+    if (coa_node_common_defaults(&common, SIM_EPOCH_UTIME, s->dt, s->horizon, &now) != COA_OK) {
+        return cli_fail(CLI_EXIT_INVALID,
+                        "%s: dt: %g s cannot be a cycle (whole microseconds, at most %g s)", file,
+                        (double)s->dt, COA_LCM_MAX_STEP);
+    }
+
+    /* Planner sizes: each UAV plans alone; the coordinator searches up to max_centralised
+     * UAVs together, fewer when the scenario's beta would not fit the cap otherwise. */
+    const uint32_t vehicle_beta = s->has_beta ? s->beta : default_beta(1u);
+    if (!workspace_fits(1u, vehicle_beta)) {
+        return cli_fail(CLI_EXIT_INVALID,
+                        "%s: beta: %lu is too large: a UAV's planner would not fit in 1 GiB", file,
+                        (unsigned long)vehicle_beta);
+    }
+    size_t max_centralised = n < COA_MAX_CENTRALISED ? n : COA_MAX_CENTRALISED;
+    uint32_t coordinator_beta = s->has_beta ? s->beta : default_beta(max_centralised);
+    while (max_centralised > 1u && !workspace_fits(max_centralised, coordinator_beta)) {
+        max_centralised--;
+    }
+
+    sim_run_t r;
+    memset(&r, 0, sizeof r);
+    const size_t samples = (size_t)steps + 1u;
+    r.vehicles = calloc(n, sizeof *r.vehicles);
+    r.index = calloc(n, sizeof *r.index);
+    r.flown = calloc(n, sizeof *r.flown);
+    r.references = calloc(n * samples, sizeof *r.references);
+    r.offsets = calloc(n * samples, sizeof *r.offsets);
+    r.vehicle_deviation = calloc(n, sizeof *r.vehicle_deviation);
+    r.vehicle_effort = calloc(n, sizeof *r.vehicle_effort);
+    if (r.vehicles == NULL || r.index == NULL || r.flown == NULL || r.references == NULL ||
+        r.offsets == NULL || r.vehicle_deviation == NULL || r.vehicle_effort == NULL) {
+        sim_run_free(&r, n);
+        return cli_fail(CLI_EXIT_INVALID, "%s: cannot allocate the record of %lu steps", file,
+                        (unsigned long)steps);
+    }
+    if (o->svg_path != NULL) {
+        r.svg = fopen(o->svg_path, "w");
+        if (r.svg == NULL) {
+            sim_run_free(&r, n);
+            return cli_fail(CLI_EXIT_INVALID, "--svg: cannot write '%.200s'", o->svg_path);
+        }
+    }
+    r.lcm = lcm_create("memq://");
+    if (r.lcm == NULL) {
+        sim_run_free(&r, n);
+        return cli_fail(CLI_EXIT_INTERNAL, "internal error: LCM's memq provider is unavailable");
+    }
+
+    int error = COA_OK;
+    coa_world_config_t world;
+    memset(&world, 0, sizeof world);
+    world.common = common;
+    world.id = COA_NODE_WORLD_ID;
+    world.obstacles = s->obstacles;
+    world.obstacle_count = s->obstacle_count;
+    world.tracks = s->tracks;
+    world.track_count = s->track_count;
+    r.world = coa_world_create(&world, r.lcm, &error);
+    if (r.world == NULL) {
+        sim_run_free(&r, n);
+        if (error == COA_ERR_ARGUMENT) {
+            return cli_fail(CLI_EXIT_INVALID,
+                            "%s: obstacles: more than an obstacle map message holds (%d boxes, "
+                            "%d polytopes of at most %d vertices)",
+                            file, COAVOID_OBSTACLE_MAP_T_MAX_BOXES,
+                            COAVOID_OBSTACLE_MAP_T_MAX_POLYTOPES,
+                            COAVOID_OBSTACLE_MAP_T_MAX_VERTICES);
+        }
+        return cli_fail(CLI_EXIT_INTERNAL, "internal error: out of memory for the world node");
+    }
+
+    /* UAVs run in ascending id, whatever the file's order. */
+    for (size_t i = 0; i < n; i++) {
+        size_t j = i;
+        while (j > 0 && s->vehicles[r.index[j - 1]].id > s->vehicles[i].id) {
+            r.index[j] = r.index[j - 1];
+            j--;
+        }
+        r.index[j] = i;
+    }
+    for (size_t j = 0; j < n; j++) {
+        size_t i = r.index[j];
+        coa_vehicle_node_config_t config;
+        memset(&config, 0, sizeof config);
+        config.common = common;
+        config.common.beta = vehicle_beta;
+        config.vehicle = s->vehicles[i];
+        config.mode = o->decoupled ? COA_NODE_DECOUPLED : COA_NODE_CENTRALISED;
+        r.vehicles[j] = coa_vehicle_node_create(&config, r.lcm, &error);
+        if (r.vehicles[j] == NULL) {
+            sim_run_free(&r, n);
+            if (error == COA_ERR_ARGUMENT) {
+                return cli_fail(CLI_EXIT_INVALID, "%s: vehicles[%zu]: cannot run as a node (%s)",
+                                file, i, coa_lcm_error_name(error));
+            }
+            return cli_fail(CLI_EXIT_INVALID,
+                            "%s: vehicles[%zu]: cannot allocate its node (beta %lu)", file, i,
+                            (unsigned long)vehicle_beta);
+        }
+    }
+    if (!o->decoupled) {
+        coa_coordinator_config_t config;
+        memset(&config, 0, sizeof config);
+        config.common = common;
+        config.common.beta = coordinator_beta;
+        config.id = COA_NODE_COORDINATOR_ID;
+        config.max_centralised = max_centralised;
+        config.collect_us = common.dt_us / 4 > 0 ? common.dt_us / 4 : 1;
+        if (config.collect_us >= common.dt_us) {
+            sim_run_free(&r, n);
+            return cli_fail(CLI_EXIT_INVALID,
+                            "%s: dt: %g s leaves the coordinator no time within a cycle", file,
+                            (double)s->dt);
+        }
+        r.coordinator = coa_coordinator_create(&config, r.lcm, &error);
+        if (r.coordinator == NULL) {
+            sim_run_free(&r, n);
+            if (error == COA_ERR_ARGUMENT) {
+                return cli_fail(CLI_EXIT_INVALID,
+                                "%s: beta: %lu cannot size the coordinator's planner", file,
+                                (unsigned long)coordinator_beta);
+            }
+            return cli_fail(CLI_EXIT_INVALID,
+                            "%s: cannot allocate the coordinator's planner (beta %lu, %zu UAVs "
+                            "together)",
+                            file, (unsigned long)coordinator_beta, max_centralised);
+        }
+    }
+
+    /* The loop of node.h: world, then the UAVs in ascending id, their waits, then the
+     * coordinator at cycle start + collect; each message is handled as soon as it is
+     * published, as on a quiet network. */
+    const int64_t collect_us = common.dt_us / 4 > 0 ? common.dt_us / 4 : 1;
+    uint32_t coordinator_plans = 0;
+    int node_error = COA_OK;
+    bool lcm_ok = true;
+    for (uint32_t k = 0; k <= steps && lcm_ok; k++) {
+        if (r.coordinator != NULL && o->stop_text != NULL && k == o->stop_step) {
+            coordinator_plans = coa_coordinator_state(r.coordinator)->plans_run;
+            coa_coordinator_destroy(r.coordinator);
+            r.coordinator = NULL;
+        }
+        const int64_t cycle_start = coa_node_cycle_utime(&common, (int64_t)k);
+        now = cycle_start;
+        rc = coa_world_cycle(r.world, now);
+        node_error = node_error != COA_OK ? node_error : rc;
+        lcm_ok = drain(r.lcm);
+        for (size_t j = 0; j < n && lcm_ok; j++) {
+            rc = coa_vehicle_node_cycle(r.vehicles[j], now);
+            node_error = node_error != COA_OK ? node_error : rc;
+            lcm_ok = drain(r.lcm);
+        }
+        /* Waits: poll until nobody moves on; then the clock jumps to the first deadline. */
+        for (;;) {
+            bool changed = true;
+            while (changed && lcm_ok) {
+                changed = false;
+                for (size_t j = 0; j < n && lcm_ok; j++) {
+                    rc = coa_vehicle_node_poll(r.vehicles[j], now);
+                    if (rc < 0) {
+                        node_error = node_error != COA_OK ? node_error : rc;
+                    } else if (rc > 0) {
+                        changed = true;
+                        lcm_ok = drain(r.lcm);
+                    }
+                }
+            }
+            int64_t deadline = INT64_MAX;
+            for (size_t j = 0; j < n; j++) {
+                int64_t d = coa_vehicle_node_deadline(r.vehicles[j]);
+                deadline = d < deadline ? d : deadline;
+            }
+            if (deadline == INT64_MAX || !lcm_ok) {
+                break;
+            }
+            now = deadline > now ? deadline : now;
+        }
+        /* The coordinator plans cycles 0..K-1: cycle K only flies the last sample. */
+        if (r.coordinator != NULL && k < steps && lcm_ok) {
+            now = cycle_start + collect_us > now ? cycle_start + collect_us : now;
+            rc = coa_coordinator_cycle(r.coordinator, now);
+            node_error = node_error != COA_OK ? node_error : rc;
+            lcm_ok = drain(r.lcm);
+        }
+        for (size_t j = 0; j < n; j++) {
+            const coa_vehicle_node_state_t *st = coa_vehicle_node_state(r.vehicles[j]);
+            size_t i = r.index[j];
+            r.references[i * samples + k] = st->reference;
+            r.offsets[i * samples + k] = st->offset;
+        }
+    }
+    if (r.coordinator != NULL) {
+        coordinator_plans = coa_coordinator_state(r.coordinator)->plans_run;
+    }
+    if (!lcm_ok) {
+        sim_run_free(&r, n);
+        return cli_fail(CLI_EXIT_INTERNAL, "internal error: LCM failed while handling messages");
+    }
+    if (node_error != COA_OK) {
+        sim_run_free(&r, n);
+        return cli_fail(CLI_EXIT_INTERNAL, "internal error: a node failed (%s)",
+                        coa_lcm_error_name(node_error));
+    }
+
+    uint32_t replans = coordinator_plans;
+    uint32_t fallbacks = 0;
+    for (size_t j = 0; j < n; j++) {
+        const coa_vehicle_node_state_t *st = coa_vehicle_node_state(r.vehicles[j]);
+        replans += st->plans_run;
+        fallbacks += st->fallbacks;
+    }
+    for (size_t i = 0; i < n; i++) {
+        r.flown[i].vehicle = s->vehicles[i];
+        r.flown[i].reference = r.references + i * samples;
+        r.flown[i].offsets = r.offsets + i * samples;
+        r.flown[i].known = NULL;
+    }
+    coa_flight_t flight;
+    memset(&flight, 0, sizeof flight);
+    flight.scenario = s->name;
+    flight.mode = o->mode;
+    flight.dt = s->dt;
+    flight.steps = steps;
+    flight.vehicles = r.flown;
+    flight.vehicle_count = n;
+    flight.obstacles = s->obstacles;
+    flight.obstacle_count = s->obstacle_count;
+    flight.tracks = s->tracks;
+    flight.track_count = s->track_count;
+    flight.replans = replans;
+    coa_flight_eval_t eval;
+    memset(&eval, 0, sizeof eval);
+    eval.vehicle_deviation = r.vehicle_deviation;
+    eval.vehicle_effort = r.vehicle_effort;
+    rc = coa_flight_evaluate(&flight, &eval);
+    if (rc != COA_OK) {
+        sim_run_free(&r, n);
+        return cli_fail(CLI_EXIT_INTERNAL, "internal error: the flight cannot be judged (%s)",
+                        coa_status_name(rc));
+    }
+    if (r.svg != NULL) {
+        rc = coa_flight_svg(&flight, &eval, r.svg);
+        int closed = fclose(r.svg);
+        r.svg = NULL;
+        if (rc != COA_OK || closed != 0) {
+            sim_run_free(&r, n);
+            return cli_fail(CLI_EXIT_INTERNAL, "--svg: writing '%.200s' failed", o->svg_path);
+        }
+    }
+    if (o->json) {
+        rc = print_json(&flight, &eval, fallbacks, o);
+    } else {
+        rc = coa_flight_text(&flight, &eval, stdout);
+        if (rc == COA_OK &&
+            (printf("fallbacks: %lu\n", (unsigned long)fallbacks) < 0 || fflush(stdout) != 0)) {
+            rc = COA_ERR_WORKSPACE;
+        }
+    }
+    sim_run_free(&r, n);
+    if (rc != COA_OK) {
+        return cli_fail(CLI_EXIT_INTERNAL, "internal error: the result could not be written");
+    }
+    return eval.loss_of_separation ? CLI_EXIT_NOT_SOLVED : CLI_EXIT_OK;
+}
+
+int command_sim(int argc, char **argv)
+{
+    sim_options_t options;
+    int status = parse_sim_options(argc, argv, &options);
+    if (status != CLI_CONTINUE) {
+        return status;
+    }
+    scenario_t scenario;
+    status = cli_load_scenario(options.scenario_path, &scenario);
+    if (status == CLI_CONTINUE) {
+        status = sim(&options, &scenario);
+    }
+    scenario_free(&scenario);
+    return status;
+}
+
+#else
+
+int command_sim(int argc, char **argv)
+{
+    (void)argc;
+    (void)argv;
+    return cli_fail(CLI_EXIT_INVALID,
+                    "sim: not built (this coavoid was built without LCM: COAVOID_BUILD_LCM)");
+}
+
+#endif
