@@ -8,6 +8,7 @@
  *   coavoid bench predict --vehicles N --horizon H [...]            bench.c
  *   coavoid world SCENARIO.json [--lcm-url URL] [--epoch UTIME] [...] world_cmd.c
  *   coavoid sim SCENARIO.json --mode centralised|decoupled [...]    sim_cmd.c
+ *   coavoid summary LOGFILE SCENARIO.json --mode MODE [...]         summary_cmd.c (LCM)
  *
  * Exit status: 0 success, 1 plan infeasible or budget exhausted, 2 invalid input or usage
  * (one line on stderr naming the input and why), 3 internal error.
@@ -18,6 +19,13 @@
 #include "cli.h"
 #include "commands.h"
 
+/* summary reads LCM logs: only with the node library (COAVOID_BUILD_LCM). */
+#ifdef COAVOID_HAVE_NODE
+#define USAGE_SUMMARY "  summary  judge a real-time run from its lcm-logger log (costs, figure)\n"
+#else
+#define USAGE_SUMMARY ""
+#endif
+
 #define USAGE                                                                   \
     "usage: coavoid <command> [options]\n"                                      \
     "\n"                                                                        \
@@ -26,6 +34,7 @@
     "  predict  predict the conflicts of a scenario's reference trajectories\n" \
     "  bench    time a core function on a random airspace (bench predict)\n"    \
     "  sim      fly a scenario in closed loop over the nodes (deterministic)\n"  \
+    USAGE_SUMMARY                                                               \
     "\n"                                                                        \
     "Run 'coavoid <command> --help' for the options of a command.\n"
 
@@ -54,6 +63,11 @@ int main(int argc, char **argv)
     if (strcmp(command, "sim") == 0) {
         return command_sim(argc, argv);
     }
+#ifdef COAVOID_HAVE_NODE
+    if (strcmp(command, "summary") == 0) {
+        return command_summary(argc, argv);
+    }
+#endif
     if (command[0] == '-') {
         return cli_fail(CLI_EXIT_INVALID, "unknown option '%.40s' (see 'coavoid --help')", command);
     }

@@ -251,9 +251,32 @@ int coa_flight_conflicts(const coa_flight_t *flight, coa_flight_trajectory_t whi
 
 /* ---- JSON ---- */
 
+/* A number as the shortest of %.15g, %.16g and %.17g that reads back to the same double.
+ * cJSON's own printer settles for %.15g when it reads back within a relative DBL_EPSILON,
+ * which is not always the same double, and positions must round-trip to the bit. */
+static cJSON *exact_number(double value)
+{
+    char text[40];
+    for (int digits = 15; digits <= 17; digits++) {
+        snprintf(text, sizeof text, "%.*g", digits, value);
+        if (strtod(text, NULL) == value) {
+            break;
+        }
+    }
+    return cJSON_CreateRaw(text);
+}
+
 static bool add_number(cJSON *obj, const char *key, double value)
 {
-    return cJSON_AddNumberToObject(obj, key, value) != NULL;
+    cJSON *item = exact_number(value);
+    if (item == NULL) {
+        return false;
+    }
+    if (!cJSON_AddItemToObject(obj, key, item)) {
+        cJSON_Delete(item);
+        return false;
+    }
+    return true;
 }
 
 static bool append(cJSON *array, cJSON *item)
@@ -288,8 +311,14 @@ static bool add_vehicle(cJSON *vehicles, const coa_flight_t *f, const coa_flight
     for (uint32_t k = 0; k <= f->steps; k++) {
         coa_vec3_t p = coa_flight_position(f, i, k, v->offsets[k]);
         double sample[4] = {sample_time(f, k), (double)p.x, (double)p.y, (double)p.z};
-        if (!append(flown, cJSON_CreateDoubleArray(sample, 4))) {
+        cJSON *point = cJSON_CreateArray();
+        if (!append(flown, point)) {
             return false;
+        }
+        for (int q = 0; q < 4; q++) {
+            if (!append(point, exact_number(sample[q]))) {
+                return false;
+            }
         }
     }
     if (eval->vehicle_deviation != NULL &&

@@ -110,7 +110,7 @@ int coa_flight_svg(const coa_flight_t *flight, const coa_flight_eval_t *eval, FI
  * flown (steps + 1 samples [t, x, y, z]). Extra fields, beyond the contract: when lost,
  * "first_loss": {"vehicle": id, "step": k, "t": s}; per UAV "deviation" and "effort" when
  * eval has the per-vehicle arrays, and "unknown_samples" (samples no intent covered) when
- * known is not NULL. Numbers round-trip (cJSON prints %.17g when %.15g does not). Returns
+ * known is not NULL. Numbers round-trip to the bit. Returns
  * COA_OK, COA_ERR_ARGUMENT (NULL, or an invalid record as coa_flight_conflicts) or
  * COA_ERR_WORKSPACE (out of memory, write failed). Allocates the document while printing. */
 int coa_flight_json(const coa_flight_t *flight, const coa_flight_eval_t *eval, FILE *out);

@@ -1,0 +1,1096 @@
+/*
+ * coavoid summary: what a real-time run flew, rebuilt from an lcm-logger log and judged
+ * exactly as `coavoid sim` judges its own runs (flight.h). See SUMMARY_USAGE below.
+ *
+ * What the log says, and how it becomes a flight record:
+ *   - Every UAV publishes an intent at each cycle's start: its reference and offsets for
+ *     samples from plan_utime on, sample 0 being where it is. The flown sample k of a UAV
+ *     is taken from the latest intent (largest plan_utime, later in the log on a tie) with
+ *     plan_utime <= cycle k's start that has a sample at exactly that time. Usually that
+ *     is the cycle's own intent; when it is missing (a dropped datagram, a late process)
+ *     an earlier plan that reaches k stands in for it. Where no intent covers k, the
+ *     scenario's reference is used with the offset held (the initial offset before the
+ *     first intent, the last covered one after): that sample is marked not known, counted,
+ *     and drawn as such.
+ *   - The epoch (cycle 0's start) is the earliest plan_utime of the scenario's UAVs unless
+ *     --epoch gives it; the step is the scenario's dt, which every intent must agree with.
+ *   - K, the last sample judged, is the last cycle for which the log holds every UAV's own
+ *     intent ("complete"), and at most the scenario's 2N (the default length of a sim).
+ *   - Replans: planning calls started at cycles 0..K-1. A node's heartbeat (status_t)
+ *     carries the time it last planned, so each distinct non-zero last_plan_utime of a
+ *     node is one call (a node plans at most once a cycle, and beats once a cycle, so
+ *     none is missed unless heartbeats are). A coordinator's calls are also counted by
+ *     its plan_t messages (one per cluster planned, distinct plan_id); for each
+ *     coordinator the larger of the two counts is taken, since either can miss some.
+ *
+ * The log is untrusted. LCM 1.3.1's reader skips anything until it finds an event's
+ * magic number, reports truncation as a normal end, prints its own complaints on stderr
+ * and, for a data length near 2^31, hands a failed allocation to fread. So each event's
+ * header is read and checked here first (magic exactly where the previous event ended,
+ * lengths within bounds and within the file) and only then is the event read with
+ * lcm_eventlog_read_next_event. Messages are decoded with the generated decoders and
+ * validated by src/lcm before anything is used; refused ones are counted and reported.
+ */
+#define _POSIX_C_SOURCE 200809L
+
+#include <errno.h>
+#include <inttypes.h>
+#include <math.h>
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/types.h>
+
+#include <cjson/cJSON.h>
+#include <lcm/eventlog.h>
+
+#include "cli.h"
+#include "coavoid/coavoid.h"
+#include "coavoid_lcm.h"
+#include "commands.h"
+#include "flight.h"
+#include "node.h"
+#include "scenario.h"
+
+#define SUMMARY_USAGE                                                                         \
+    "usage: coavoid summary LOGFILE SCENARIO.json --mode centralised|decoupled\n"             \
+    "                       [--json] [--svg FILE] [--epoch UTIME]\n"                          \
+    "\n"                                                                                      \
+    "Rebuilds what each UAV of the scenario flew from an lcm-logger log of a real-time\n"     \
+    "run (the intents on " COA_CHANNEL_INTENT "), judges it as 'coavoid sim' does (loss of\n" \
+    "separation, deviation, effort), and counts the planning calls (" COA_CHANNEL_STATUS     \
+    ",\n" COA_CHANNEL_PLAN ").\n"                                                             \
+    "\n"                                                                                      \
+    "options:\n"                                                                              \
+    "  --mode MODE     centralised or decoupled: the mode the run was started in\n"           \
+    "  --json          print the simulation result as JSON (with a \"log\" object)\n"         \
+    "  --svg FILE      write the figure (top view, altitude per UAV) to FILE\n"               \
+    "  --epoch UTIME   cycle 0's start, in microseconds; default: the earliest\n"             \
+    "                  plan_utime of the scenario's UAVs in the log\n"                        \
+    "  -h, --help      show this help\n"                                                      \
+    "\n"                                                                                      \
+    "Samples run from cycle 0 to the last cycle in which every UAV's own intent was\n"        \
+    "logged, at most twice the scenario's horizon. A sample no intent covers is taken\n"      \
+    "from the scenario's reference with the offset held, and reported.\n"                     \
+    "\n"                                                                                      \
+    "exit status: 0 no loss of separation, 1 loss of separation, 2 invalid input or usage\n"  \
+    "(one line on stderr naming the input and why), 3 internal error\n"
+
+/* An event's header in the file: magic, event number, time stamp, channel and data
+ * lengths, all big-endian. */
+#define LOG_MAGIC 0xEDA1DA01u
+#define LOG_HEADER_BYTES 28
+/* The reader's own bound on a channel name (1.3.1 refuses >= 1000). */
+#define LOG_MAX_CHANNEL 999
+/* Larger events are taken as corruption: the biggest message of ours is about 17 kB, and
+ * the reader allocates what the header claims before it reads. */
+#define LOG_MAX_DATA (64 * 1024 * 1024)
+
+/* ---- options ---- */
+
+typedef struct {
+    const char *log_path;
+    const char *scenario_path;
+    const char *mode;
+    bool json;
+    const char *svg_path;
+    const char *epoch_text;
+    int64_t epoch;
+} summary_options_t;
+
+static int parse_summary_options(int argc, char **argv, summary_options_t *o)
+{
+    bool options_done = false;
+    memset(o, 0, sizeof *o);
+    for (int i = 2; i < argc; i++) {
+        const char *arg = argv[i];
+        const char *value = NULL;
+        if (options_done || arg[0] != '-' || strcmp(arg, "-") == 0) {
+            if (o->log_path == NULL) {
+                o->log_path = arg;
+            } else if (o->scenario_path == NULL) {
+                o->scenario_path = arg;
+            } else {
+                return cli_fail(CLI_EXIT_INVALID,
+                                "summary: unexpected argument '%.80s' (one log and one scenario)",
+                                arg);
+            }
+        } else if (strcmp(arg, "--") == 0) {
+            options_done = true;
+        } else if (strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0) {
+            fputs(SUMMARY_USAGE, stdout);
+            return CLI_EXIT_OK;
+        } else if (cli_option_is(arg, "--mode")) {
+            if (o->mode != NULL) {
+                return cli_fail(CLI_EXIT_INVALID, "--mode: given more than once");
+            }
+            if (!cli_option_value(argc, argv, &i, "--mode", &value)) {
+                return cli_fail(CLI_EXIT_INVALID,
+                                "--mode: missing value (centralised or decoupled)");
+            }
+            if (strcmp(value, "centralised") != 0 && strcmp(value, "decoupled") != 0) {
+                return cli_fail(CLI_EXIT_INVALID,
+                                "--mode: unknown mode '%.40s' (expected centralised or decoupled)",
+                                value);
+            }
+            o->mode = value;
+        } else if (strcmp(arg, "--json") == 0) {
+            if (o->json) {
+                return cli_fail(CLI_EXIT_INVALID, "--json: given more than once");
+            }
+            o->json = true;
+        } else if (cli_option_is(arg, "--json")) {
+            return cli_fail(CLI_EXIT_INVALID, "--json: takes no value");
+        } else if (cli_option_is(arg, "--svg")) {
+            if (o->svg_path != NULL) {
+                return cli_fail(CLI_EXIT_INVALID, "--svg: given more than once");
+            }
+            if (!cli_option_value(argc, argv, &i, "--svg", &value) || value[0] == '\0') {
+                return cli_fail(CLI_EXIT_INVALID, "--svg: missing value (a file to write)");
+            }
+            o->svg_path = value;
+        } else if (cli_option_is(arg, "--epoch")) {
+            uint64_t epoch;
+            if (o->epoch_text != NULL) {
+                return cli_fail(CLI_EXIT_INVALID, "--epoch: given more than once");
+            }
+            if (!cli_option_value(argc, argv, &i, "--epoch", &value)) {
+                return cli_fail(CLI_EXIT_INVALID,
+                                "--epoch: missing value (microseconds, an integer >= 1)");
+            }
+            if (!cli_parse_count(value, strlen(value), (uint64_t)INT64_MAX / 2u, &epoch)) {
+                return cli_fail(CLI_EXIT_INVALID,
+                                "--epoch: must be an integer from 1 to %" PRIu64
+                                " (microseconds), got '%.40s'",
+                                (uint64_t)INT64_MAX / 2u, value);
+            }
+            o->epoch_text = value;
+            o->epoch = (int64_t)epoch;
+        } else {
+            return cli_fail(CLI_EXIT_INVALID,
+                            "summary: unknown option '%.40s' (see 'coavoid summary --help')", arg);
+        }
+    }
+    if (o->log_path == NULL) {
+        return cli_fail(CLI_EXIT_INVALID,
+                        "summary: missing LOGFILE (see 'coavoid summary --help')");
+    }
+    if (o->scenario_path == NULL) {
+        return cli_fail(CLI_EXIT_INVALID,
+                        "summary: missing SCENARIO.json (see 'coavoid summary --help')");
+    }
+    if (o->mode == NULL) {
+        return cli_fail(CLI_EXIT_INVALID, "--mode: required (centralised or decoupled)");
+    }
+    return CLI_CONTINUE;
+}
+
+/* ---- reading the log ---- */
+
+typedef struct {
+    const char *path;
+    lcm_eventlog_t *log;
+    int64_t size;   /* bytes to read: the file's size when opened */
+    int64_t offset; /* where the next event starts */
+    int64_t events; /* events read so far */
+} log_reader_t;
+
+static int log_open(log_reader_t *r, const char *path, int64_t limit)
+{
+    struct stat st;
+    memset(r, 0, sizeof *r);
+    r->path = path;
+    if (stat(path, &st) != 0) {
+        return cli_fail(CLI_EXIT_INVALID, "%s: cannot open: %s", path, strerror(errno));
+    }
+    if (!S_ISREG(st.st_mode)) {
+        return cli_fail(CLI_EXIT_INVALID, "%s: not a regular file (an lcm-logger log is one)",
+                        path);
+    }
+    errno = 0;
+    r->log = lcm_eventlog_create(path, "r");
+    if (r->log == NULL) {
+        return cli_fail(CLI_EXIT_INVALID, "%s: cannot open: %s", path,
+                        errno != 0 ? strerror(errno) : "lcm_eventlog_create failed");
+    }
+    /* The size of what was opened (the path may have been replaced since stat). */
+    if (fstat(fileno(r->log->f), &st) != 0) {
+        return cli_fail(CLI_EXIT_INVALID, "%s: cannot read: %s", path, strerror(errno));
+    }
+    r->size = (int64_t)st.st_size;
+    if (limit >= 0 && limit < r->size) {
+        r->size = limit;
+    }
+    if (r->size == 0) {
+        return cli_fail(CLI_EXIT_INVALID, "%s: empty file, not an LCM log", path);
+    }
+    return CLI_CONTINUE;
+}
+
+static void log_close(log_reader_t *r)
+{
+    if (r->log != NULL) {
+        lcm_eventlog_destroy(r->log);
+        r->log = NULL;
+    }
+}
+
+static uint32_t be32(const unsigned char *b)
+{
+    return (uint32_t)b[0] << 24 | (uint32_t)b[1] << 16 | (uint32_t)b[2] << 8 | (uint32_t)b[3];
+}
+
+/* The next event: 1 with *event (free it with lcm_eventlog_free_event), 0 at the end of
+ * the log, or the exit status after the message. */
+static int log_next(log_reader_t *r, lcm_eventlog_event_t **event)
+{
+    unsigned char header[LOG_HEADER_BYTES];
+    int64_t left = r->size - r->offset;
+    *event = NULL;
+    if (left <= 0) {
+        return 0;
+    }
+    if (fseeko(r->log->f, (off_t)r->offset, SEEK_SET) != 0) {
+        return cli_fail(CLI_EXIT_INVALID, "%s: cannot seek to byte %" PRId64 ": %s", r->path,
+                        r->offset, strerror(errno));
+    }
+    size_t want = left < LOG_HEADER_BYTES ? (size_t)left : (size_t)LOG_HEADER_BYTES;
+    size_t got = fread(header, 1, want, r->log->f);
+    if (got != want) {
+        return cli_fail(CLI_EXIT_INVALID, "%s: read error at byte %" PRId64, r->path, r->offset);
+    }
+    /* Whether the bytes there are (the start of) an event header. */
+    bool magic = true;
+    for (size_t j = 0; j < 4u && j < got; j++) {
+        magic = magic && header[j] == (unsigned char)(LOG_MAGIC >> (24u - 8u * j));
+    }
+    if (!magic) {
+        if (r->offset == 0) {
+            return cli_fail(CLI_EXIT_INVALID,
+                            "%s: not an LCM log (it does not start with an event header)", r->path);
+        }
+        return cli_fail(CLI_EXIT_INVALID,
+                        "%s: corrupt: no event header at byte %" PRId64 " (after %" PRId64
+                        " events)",
+                        r->path, r->offset, r->events);
+    }
+    if (got < (size_t)LOG_HEADER_BYTES) {
+        return cli_fail(CLI_EXIT_INVALID,
+                        "%s: truncated: event %" PRId64 " at byte %" PRId64
+                        " is cut off in its header (was the logger stopped mid-write?)",
+                        r->path, r->events, r->offset);
+    }
+    int32_t channel_length = (int32_t)be32(header + 20);
+    int32_t data_length = (int32_t)be32(header + 24);
+    if (channel_length < 1 || channel_length > LOG_MAX_CHANNEL || data_length < 0 ||
+        data_length > LOG_MAX_DATA) {
+        return cli_fail(CLI_EXIT_INVALID,
+                        "%s: corrupt: event %" PRId64 " at byte %" PRId64
+                        " claims a %ld-byte channel name and %ld bytes of data",
+                        r->path, r->events, r->offset, (long)channel_length, (long)data_length);
+    }
+    int64_t length = LOG_HEADER_BYTES + (int64_t)channel_length + (int64_t)data_length;
+    if (length > left) {
+        return cli_fail(CLI_EXIT_INVALID,
+                        "%s: truncated: event %" PRId64 " at byte %" PRId64 " needs %" PRId64
+                        " bytes, the file has %" PRId64 " left (was the logger stopped "
+                        "mid-write?)",
+                        r->path, r->events, r->offset, length, left);
+    }
+    if (fseeko(r->log->f, (off_t)r->offset, SEEK_SET) != 0) {
+        return cli_fail(CLI_EXIT_INVALID, "%s: cannot seek to byte %" PRId64 ": %s", r->path,
+                        r->offset, strerror(errno));
+    }
+    lcm_eventlog_event_t *e = lcm_eventlog_read_next_event(r->log);
+    if (e == NULL || e->channellen != channel_length || e->datalen != data_length) {
+        if (e != NULL) {
+            lcm_eventlog_free_event(e);
+        }
+        return cli_fail(CLI_EXIT_INVALID, "%s: cannot read event %" PRId64 " at byte %" PRId64,
+                        r->path, r->events, r->offset);
+    }
+    r->offset += length;
+    r->events++;
+    *event = e;
+    return 1;
+}
+
+/* ---- what the log says ---- */
+
+typedef struct {
+    uint32_t node;
+    int8_t kind;
+    int64_t utime; /* last_plan_utime, or a plan's valid_from */
+    int64_t id;    /* plan_id for plans, 0 for heartbeats */
+} planning_t;
+
+typedef struct {
+    planning_t *items;
+    size_t count;
+    size_t capacity;
+} planning_list_t;
+
+static bool planning_add(planning_list_t *list, planning_t item)
+{
+    if (list->count == list->capacity) {
+        size_t capacity = list->capacity > 0u ? list->capacity * 2u : 256u;
+        if (capacity > SIZE_MAX / sizeof *list->items) {
+            return false;
+        }
+        planning_t *grown = realloc(list->items, capacity * sizeof *grown);
+        if (grown == NULL) {
+            return false;
+        }
+        list->items = grown;
+        list->capacity = capacity;
+    }
+    list->items[list->count++] = item;
+    return true;
+}
+
+/* One accepted intent's place on the time line. */
+typedef struct {
+    size_t vehicle;
+    int64_t plan_utime;
+} intent_seen_t;
+
+typedef struct {
+    intent_seen_t *items;
+    size_t count;
+    size_t capacity;
+} intent_list_t;
+
+static bool intent_add(intent_list_t *list, intent_seen_t item)
+{
+    if (list->count == list->capacity) {
+        size_t capacity = list->capacity > 0u ? list->capacity * 2u : 256u;
+        if (capacity > SIZE_MAX / sizeof *list->items) {
+            return false;
+        }
+        intent_seen_t *grown = realloc(list->items, capacity * sizeof *grown);
+        if (grown == NULL) {
+            return false;
+        }
+        list->items = grown;
+        list->capacity = capacity;
+    }
+    list->items[list->count++] = item;
+    return true;
+}
+
+typedef struct {
+    const summary_options_t *o;
+    const scenario_t *s;
+    int64_t dt_us;
+
+    /* Decoding space (the plan type is 16.6 kB). */
+    coavoid_intent_t intent;
+    coavoid_status_t status;
+    coavoid_plan_t plan;
+
+    /* Counts over the whole log. */
+    int64_t events;
+    int64_t other_events;
+    int64_t intents;            /* on the intent channel */
+    int64_t intents_refused;    /* did not decode or failed validation */
+    const char *intent_reason;  /* the first refusal's reason */
+    int64_t intents_foreign;    /* valid, from a UAV that is not in the scenario */
+    int64_t statuses;
+    int64_t statuses_refused;
+    int64_t plans;
+    int64_t plans_refused;
+    const char *other_reason;   /* the first refusal of a status or plan */
+
+    intent_list_t seen;         /* accepted intents of the scenario's UAVs */
+    planning_list_t heartbeats; /* (node, last_plan_utime) of accepted heartbeats */
+    planning_list_t plan_list;  /* (coordinator, valid_from, plan_id) of accepted plans */
+    int64_t first_plan_utime[COA_MAX_VEHICLES];
+    int64_t intents_of[COA_MAX_VEHICLES];
+} log_summary_t;
+
+static const coa_lcm_context_t no_clock = {0, 0, 0, 0};
+
+/* Decodes and validates an intent. Returns the scenario's index of its UAV (>= 0), -1
+ * refused (counted), -2 a valid intent of another UAV (counted), or -3 after an error
+ * message (the log is not this scenario's run). */
+static long accept_intent(log_summary_t *ls, const lcm_eventlog_event_t *e, bool count)
+{
+    const char *reason = "intent: does not decode (wrong type or truncated)";
+    coavoid_intent_t *m = &ls->intent;
+    int used = coavoid_intent_t_decode(e->data, 0, e->datalen, m);
+    int rc = used == e->datalen ? coa_lcm_intent_check(m, &no_clock, &reason)
+                                : COA_LCM_ERR_DECODE;
+    if (used >= 0) {
+        coavoid_intent_t_decode_cleanup(m);
+    }
+    if (count) {
+        ls->intents++;
+    }
+    if (rc != COA_OK) {
+        if (count) {
+            ls->intents_refused++;
+            if (ls->intent_reason == NULL) {
+                ls->intent_reason = reason;
+            }
+        }
+        return -1;
+    }
+    long index = scenario_vehicle_index(ls->s, (long)m->uav_id);
+    if (index < 0) {
+        if (count) {
+            ls->intents_foreign++;
+        }
+        return -2;
+    }
+    /* Intents of another scenario (or another dt) cannot be judged against this one. */
+    const coa_vehicle_t *v = &ls->s->vehicles[index];
+    const char *field = NULL;
+    double theirs = 0.0;
+    double ours = 0.0;
+    if (llround(m->step * 1e6) != ls->dt_us) {
+        field = "step (the scenario's dt)";
+        theirs = m->step;
+        ours = (double)ls->s->dt;
+    } else if ((coa_real_t)m->climb_rate != v->climb_rate) {
+        field = "climb_rate";
+        theirs = m->climb_rate;
+        ours = (double)v->climb_rate;
+    } else if ((coa_real_t)m->cruise_speed != v->cruise_speed) {
+        field = "cruise_speed";
+        theirs = m->cruise_speed;
+        ours = (double)v->cruise_speed;
+    } else if ((coa_real_t)m->radius != v->volume.radius) {
+        field = "radius";
+        theirs = m->radius;
+        ours = (double)v->volume.radius;
+    } else if ((coa_real_t)m->half_height != v->volume.half_height) {
+        field = "half_height";
+        theirs = m->half_height;
+        ours = (double)v->volume.half_height;
+    } else if ((uint32_t)m->steep_factor != v->steep_factor) {
+        field = "steep_factor";
+        theirs = m->steep_factor;
+        ours = v->steep_factor;
+    }
+    if (field != NULL) {
+        cli_fail(CLI_EXIT_INVALID,
+                 "%s: UAV %ld's intents have %s %.17g, %s says %.17g: not a run of this "
+                 "scenario",
+                 ls->o->log_path, (long)m->uav_id, field, theirs, ls->o->scenario_path, ours);
+        return -3;
+    }
+    return index;
+}
+
+static void note_other(log_summary_t *ls, const char *reason)
+{
+    if (ls->other_reason == NULL) {
+        ls->other_reason = reason;
+    }
+}
+
+/* Pass 1: every event of the log. Returns CLI_CONTINUE or the exit status. */
+static int read_log(log_summary_t *ls, log_reader_t *r)
+{
+    for (size_t i = 0; i < ls->s->vehicle_count; i++) {
+        ls->first_plan_utime[i] = INT64_MAX;
+    }
+    for (;;) {
+        lcm_eventlog_event_t *e = NULL;
+        int rc = log_next(r, &e);
+        if (rc == 0) {
+            break;
+        }
+        if (rc != 1) {
+            return rc;
+        }
+        ls->events++;
+        bool ok = true;
+        if (strcmp(e->channel, COA_CHANNEL_INTENT) == 0) {
+            long index = accept_intent(ls, e, true);
+            if (index == -3) {
+                lcm_eventlog_free_event(e);
+                return CLI_EXIT_INVALID;
+            }
+            if (index >= 0) {
+                size_t i = (size_t)index;
+                int64_t p = ls->intent.plan_utime;
+                ls->intents_of[i]++;
+                if (p < ls->first_plan_utime[i]) {
+                    ls->first_plan_utime[i] = p;
+                }
+                intent_seen_t seen = {i, p};
+                ok = intent_add(&ls->seen, seen);
+            }
+        } else if (strcmp(e->channel, COA_CHANNEL_STATUS) == 0) {
+            const char *reason = "status: does not decode (wrong type or truncated)";
+            int used = coavoid_status_t_decode(e->data, 0, e->datalen, &ls->status);
+            int vrc = used == e->datalen ? coa_lcm_status_check(&ls->status, &no_clock, &reason)
+                                         : COA_LCM_ERR_DECODE;
+            if (used >= 0) {
+                coavoid_status_t_decode_cleanup(&ls->status);
+            }
+            ls->statuses++;
+            if (vrc != COA_OK) {
+                ls->statuses_refused++;
+                note_other(ls, reason);
+            } else if (ls->status.last_plan_utime > 0) {
+                planning_t item = {(uint32_t)ls->status.node_id, ls->status.node_kind,
+                                   ls->status.last_plan_utime, 0};
+                ok = planning_add(&ls->heartbeats, item);
+            }
+        } else if (strcmp(e->channel, COA_CHANNEL_PLAN) == 0) {
+            const char *reason = "plan: does not decode (wrong type or truncated)";
+            int used = coavoid_plan_t_decode(e->data, 0, e->datalen, &ls->plan);
+            int vrc = used == e->datalen ? coa_lcm_plan_check(&ls->plan, &no_clock, &reason)
+                                         : COA_LCM_ERR_DECODE;
+            if (used >= 0) {
+                coavoid_plan_t_decode_cleanup(&ls->plan);
+            }
+            ls->plans++;
+            if (vrc != COA_OK) {
+                ls->plans_refused++;
+                note_other(ls, reason);
+            } else {
+                planning_t item = {(uint32_t)ls->plan.coordinator_id,
+                                   COAVOID_STATUS_T_NODE_COORDINATOR, ls->plan.valid_from_utime,
+                                   ls->plan.plan_id};
+                ok = planning_add(&ls->plan_list, item);
+            }
+        } else {
+            ls->other_events++;
+        }
+        lcm_eventlog_free_event(e);
+        if (!ok) {
+            return cli_fail(CLI_EXIT_INTERNAL, "out of memory reading %s", r->path);
+        }
+    }
+    return CLI_CONTINUE;
+}
+
+static int planning_compare(const void *a, const void *b)
+{
+    const planning_t *p = a;
+    const planning_t *q = b;
+    if (p->node != q->node) {
+        return p->node < q->node ? -1 : 1;
+    }
+    if (p->id != q->id) {
+        return p->id < q->id ? -1 : 1;
+    }
+    if (p->utime != q->utime) {
+        return p->utime < q->utime ? -1 : 1;
+    }
+    return 0;
+}
+
+/* Planning calls in [from, to): heartbeats' distinct (node, last_plan_utime), and for a
+ * coordinator the larger of that and its distinct plan ids. */
+static uint32_t count_replans(log_summary_t *ls, int64_t from, int64_t to)
+{
+    planning_list_t *hb = &ls->heartbeats;
+    planning_list_t *pl = &ls->plan_list;
+    uint64_t total = 0;
+    if (hb->count > 0u) {
+        qsort(hb->items, hb->count, sizeof *hb->items, planning_compare);
+    }
+    if (pl->count > 0u) {
+        qsort(pl->items, pl->count, sizeof *pl->items, planning_compare);
+    }
+    size_t h = 0;
+    size_t p = 0;
+    /* Nodes in ascending id across both lists. */
+    while (h < hb->count || p < pl->count) {
+        uint32_t node = h < hb->count ? hb->items[h].node : UINT32_MAX;
+        if (p < pl->count && pl->items[p].node < node) {
+            node = pl->items[p].node;
+        }
+        uint64_t beats = 0;
+        uint64_t plans = 0;
+        bool have = false;
+        int64_t last = 0;
+        for (; h < hb->count && hb->items[h].node == node; h++) {
+            int64_t t = hb->items[h].utime;
+            if (t >= from && t < to && (!have || t != last)) {
+                beats++;
+                have = true;
+                last = t;
+            }
+        }
+        have = false;
+        for (; p < pl->count && pl->items[p].node == node; p++) {
+            int64_t t = pl->items[p].utime;
+            int64_t id = pl->items[p].id;
+            if (t >= from && t < to && (!have || id != last)) {
+                plans++;
+                have = true;
+                last = id;
+            }
+        }
+        total += beats > plans ? beats : plans;
+    }
+    return total > UINT32_MAX ? UINT32_MAX : (uint32_t)total;
+}
+
+/* ---- the flight ---- */
+
+typedef struct {
+    uint32_t steps;                 /* K */
+    coa_flight_vehicle_t vehicles[COA_MAX_VEHICLES];
+    int64_t *best;                  /* n rows of K + 1: plan_utime of the sample's source */
+    bool *own;                      /* n rows of K + 1: from the cycle's own intent */
+    bool *known;                    /* n rows of K + 1 */
+    coa_vec3_t *reference;          /* n rows */
+    int32_t *offsets;               /* n rows */
+    double vehicle_deviation[COA_MAX_VEHICLES];
+    uint32_t vehicle_effort[COA_MAX_VEHICLES];
+    int64_t own_samples;
+    int64_t earlier_samples;
+    int64_t missing_samples;
+    int64_t off_grid;               /* accepted intents whose plan_utime is not a cycle start */
+} rebuilt_t;
+
+static void rebuilt_free(rebuilt_t *b)
+{
+    free(b->best);
+    free(b->own);
+    free(b->known);
+    free(b->reference);
+    free(b->offsets);
+}
+
+/* The cycle whose start is utime, or -1 when utime is not a cycle start at or after the
+ * epoch. */
+static int64_t cycle_at(int64_t utime, int64_t epoch, int64_t dt_us)
+{
+    if (utime < epoch || (utime - epoch) % dt_us != 0) {
+        return -1;
+    }
+    return (utime - epoch) / dt_us;
+}
+
+/* K: the last cycle, at most cap, in which every UAV's own intent was logged; 0 when
+ * none after cycle 0 is. Returns -1 out of memory. */
+static int64_t last_complete_cycle(const log_summary_t *ls, int64_t epoch, uint32_t cap,
+                                   int64_t *off_grid)
+{
+    const size_t n = ls->s->vehicle_count;
+    const size_t row = (size_t)cap + 1u;
+    bool *own = calloc(n * row, sizeof *own);
+    if (own == NULL) {
+        return -1;
+    }
+    *off_grid = 0;
+    for (size_t q = 0; q < ls->seen.count; q++) {
+        int64_t c = cycle_at(ls->seen.items[q].plan_utime, epoch, ls->dt_us);
+        if (c < 0) {
+            /* Before the epoch is fine (--epoch later than the run's start); off the grid
+             * is worth reporting. */
+            if (ls->seen.items[q].plan_utime >= epoch ||
+                (epoch - ls->seen.items[q].plan_utime) % ls->dt_us != 0) {
+                (*off_grid)++;
+            }
+            continue;
+        }
+        if (c <= (int64_t)cap) {
+            own[ls->seen.items[q].vehicle * row + (size_t)c] = true;
+        }
+    }
+    int64_t k = cap;
+    for (; k > 0; k--) {
+        bool all = true;
+        for (size_t i = 0; i < n && all; i++) {
+            all = own[i * row + (size_t)k];
+        }
+        if (all) {
+            break;
+        }
+    }
+    free(own);
+    return k;
+}
+
+/* Pass 2: the samples of every accepted intent onto the cycles 0..K. */
+static int fill_samples(log_summary_t *ls, log_reader_t *r, rebuilt_t *b, int64_t epoch)
+{
+    const size_t row = (size_t)b->steps + 1u;
+    for (;;) {
+        lcm_eventlog_event_t *e = NULL;
+        int rc = log_next(r, &e);
+        if (rc == 0) {
+            break;
+        }
+        if (rc != 1) {
+            return rc;
+        }
+        if (strcmp(e->channel, COA_CHANNEL_INTENT) == 0) {
+            long index = accept_intent(ls, e, false);
+            if (index == -3) {
+                lcm_eventlog_free_event(e);
+                return CLI_EXIT_INVALID;
+            }
+            const coavoid_intent_t *m = &ls->intent;
+            for (int32_t j = 0; index >= 0 && j < m->sample_count; j++) {
+                /* The check bounds plan_utime to within an hour of a positive utime and j
+                 * below 128, so this cannot overflow. */
+                int64_t c = cycle_at(m->plan_utime + (int64_t)j * ls->dt_us, epoch, ls->dt_us);
+                if (c < 0 || c > (int64_t)b->steps) {
+                    continue;
+                }
+                size_t at = (size_t)index * row + (size_t)c;
+                if (b->known[at] && m->plan_utime < b->best[at]) {
+                    continue; /* a later plan already covers this sample */
+                }
+                b->known[at] = true;
+                b->best[at] = m->plan_utime;
+                b->own[at] = j == 0;
+                b->reference[at].x = (coa_real_t)m->reference[j][0];
+                b->reference[at].y = (coa_real_t)m->reference[j][1];
+                b->reference[at].z = (coa_real_t)m->reference[j][2];
+                b->offsets[at] = m->offsets[j];
+            }
+        }
+        lcm_eventlog_free_event(e);
+    }
+    return CLI_CONTINUE;
+}
+
+/* Samples no intent covered: the scenario's reference, the offset held. */
+static int fill_gaps(const scenario_t *s, rebuilt_t *b)
+{
+    const size_t row = (size_t)b->steps + 1u;
+    coa_vec3_t *scenario_reference = malloc(row * sizeof *scenario_reference);
+    if (scenario_reference == NULL) {
+        return COA_ERR_WORKSPACE;
+    }
+    for (size_t i = 0; i < s->vehicle_count; i++) {
+        int rc = coa_reference_sample(&s->vehicles[i], s->dt, b->steps, scenario_reference);
+        if (rc != COA_OK) {
+            free(scenario_reference);
+            return rc;
+        }
+        int32_t held = s->vehicles[i].initial_offset;
+        for (size_t k = 0; k < row; k++) {
+            size_t at = i * row + k;
+            if (b->known[at]) {
+                held = b->offsets[at];
+                if (b->own[at]) {
+                    b->own_samples++;
+                } else {
+                    b->earlier_samples++;
+                }
+                continue;
+            }
+            b->missing_samples++;
+            b->reference[at] = scenario_reference[k];
+            b->offsets[at] = held;
+        }
+    }
+    free(scenario_reference);
+    return COA_OK;
+}
+
+/* ---- output ---- */
+
+static void print_log_text(const log_summary_t *ls, const rebuilt_t *b, int64_t epoch)
+{
+    printf("log: %s: %" PRId64 " events; %" PRId64 " intents (%" PRId64 " refused, %" PRId64
+           " from UAVs not in the scenario, %" PRId64 " off the cycle grid); %" PRId64
+           " plans (%" PRId64 " refused); %" PRId64 " heartbeats (%" PRId64 " refused); %" PRId64
+           " on other channels\n",
+           ls->o->log_path, ls->events, ls->intents, ls->intents_refused, ls->intents_foreign,
+           b->off_grid, ls->plans, ls->plans_refused, ls->statuses, ls->statuses_refused,
+           ls->other_events);
+    if (ls->intent_reason != NULL) {
+        printf("first refused intent: %s\n", ls->intent_reason);
+    }
+    if (ls->other_reason != NULL) {
+        printf("first refused plan or heartbeat: %s\n", ls->other_reason);
+    }
+    printf("epoch: %" PRId64 " us (%s); cycles 0..%lu judged\n", epoch,
+           ls->o->epoch_text != NULL ? "--epoch" : "earliest plan_utime",
+           (unsigned long)b->steps);
+    printf("samples: %" PRId64 " from their cycle's own intent, %" PRId64
+           " from an earlier plan, %" PRId64 " not covered by any intent (scenario reference, "
+           "offset held)\n",
+           b->own_samples, b->earlier_samples, b->missing_samples);
+}
+
+/* An integer printed as one: cJSON would print a microsecond time as 1.7e+15. */
+static bool add_count(cJSON *obj, const char *key, int64_t value)
+{
+    char text[24];
+    snprintf(text, sizeof text, "%" PRId64, value);
+    return cJSON_AddRawToObject(obj, key, text) != NULL;
+}
+
+/* The flight's JSON with a "log" object added. coa_flight_json's document is spliced,
+ * not parsed and printed again: cJSON would print its numbers with its own, inexact,
+ * shortest form. The log object holds only integers and strings, which print exactly. */
+static int print_json(const log_summary_t *ls, const rebuilt_t *b, int64_t epoch,
+                      const coa_flight_t *flight, const coa_flight_eval_t *eval)
+{
+    char *text = NULL;
+    size_t size = 0;
+    FILE *mem = open_memstream(&text, &size);
+    if (mem == NULL) {
+        return cli_fail(CLI_EXIT_INTERNAL, "out of memory printing the result");
+    }
+    int rc = coa_flight_json(flight, eval, mem);
+    if (fclose(mem) != 0 || rc != COA_OK) {
+        free(text);
+        return cli_fail(CLI_EXIT_INTERNAL, "internal error: cannot print the result (%s)",
+                        coa_status_name(rc));
+    }
+    /* The document is one object: it ends with its closing brace and a newline. */
+    while (size > 0u && (text[size - 1u] == '\n' || text[size - 1u] == ' ')) {
+        size--;
+    }
+    if (size < 2u || text[size - 1u] != '}') {
+        free(text);
+        return cli_fail(CLI_EXIT_INTERNAL, "internal error: the result is not a JSON object");
+    }
+    size--;
+    cJSON *log = cJSON_CreateObject();
+    bool ok = log != NULL && cJSON_AddStringToObject(log, "file", ls->o->log_path) != NULL &&
+              add_count(log, "events", ls->events) && add_count(log, "intents", ls->intents) &&
+              add_count(log, "intents_refused", ls->intents_refused) &&
+              add_count(log, "intents_other_uavs", ls->intents_foreign) &&
+              add_count(log, "intents_off_grid", b->off_grid) &&
+              add_count(log, "plans", ls->plans) &&
+              add_count(log, "plans_refused", ls->plans_refused) &&
+              add_count(log, "heartbeats", ls->statuses) &&
+              add_count(log, "heartbeats_refused", ls->statuses_refused) &&
+              add_count(log, "epoch_utime", epoch) &&
+              add_count(log, "samples_own_intent", b->own_samples) &&
+              add_count(log, "samples_earlier_plan", b->earlier_samples) &&
+              add_count(log, "samples_missing", b->missing_samples) &&
+              (ls->intent_reason == NULL ||
+               cJSON_AddStringToObject(log, "first_refused_intent", ls->intent_reason) != NULL);
+    char *log_text = ok ? cJSON_PrintUnformatted(log) : NULL;
+    cJSON_Delete(log);
+    if (log_text == NULL) {
+        free(text);
+        return cli_fail(CLI_EXIT_INTERNAL, "out of memory printing the result");
+    }
+    errno = 0;
+    bool written = fwrite(text, 1, size, stdout) == size &&
+                   printf(",\n\t\"log\":\t%s\n}\n", log_text) > 0 && fflush(stdout) == 0;
+    free(text);
+    free(log_text);
+    if (!written) {
+        return cli_fail(CLI_EXIT_INTERNAL, "cannot write the result: %s",
+                        errno != 0 ? strerror(errno) : "write error");
+    }
+    return CLI_CONTINUE;
+}
+
+static int write_svg(const char *path, const coa_flight_t *flight, const coa_flight_eval_t *eval)
+{
+    FILE *out = fopen(path, "w");
+    if (out == NULL) {
+        return cli_fail(CLI_EXIT_INVALID, "--svg %s: cannot write: %s", path, strerror(errno));
+    }
+    int rc = coa_flight_svg(flight, eval, out);
+    if (fclose(out) != 0 && rc == COA_OK) {
+        rc = COA_ERR_WORKSPACE;
+    }
+    if (rc != COA_OK) {
+        return cli_fail(CLI_EXIT_INTERNAL, "--svg %s: cannot write the figure (%s)", path,
+                        coa_status_name(rc));
+    }
+    return CLI_CONTINUE;
+}
+
+/* The evaluation refused the record: name the step no action makes, if that is why. */
+static int refused_record(const summary_options_t *o, const coa_flight_t *f, const rebuilt_t *b)
+{
+    const size_t row = (size_t)f->steps + 1u;
+    for (size_t i = 0; i < f->vehicle_count; i++) {
+        const int32_t *offsets = f->vehicles[i].offsets;
+        for (uint32_t k = 0; k < f->steps; k++) {
+            if (coa_action_between(offsets[k], offsets[k + 1u],
+                                   f->vehicles[i].vehicle.steep_factor) < 0) {
+                bool gap = !b->own[i * row + k] || !b->own[i * row + k + 1u];
+                return cli_fail(CLI_EXIT_INVALID,
+                                "%s: UAV %u's offset goes from %ld at cycle %lu to %ld at cycle "
+                                "%lu, which no action does%s",
+                                o->log_path, (unsigned)f->vehicles[i].vehicle.id,
+                                (long)offsets[k], (unsigned long)k, (long)offsets[k + 1u],
+                                (unsigned long)k + 1ul,
+                                gap ? " (a cycle's own intent is missing from the log there)"
+                                    : "");
+            }
+        }
+    }
+    return cli_fail(CLI_EXIT_INTERNAL, "internal error: the flight record was refused");
+}
+
+/* Everything after the options and the scenario. Returns the exit status. */
+static int summarise(const summary_options_t *o, const scenario_t *s)
+{
+    log_summary_t *ls = calloc(1, sizeof *ls);
+    rebuilt_t b;
+    log_reader_t r;
+    int status = CLI_CONTINUE;
+    memset(&b, 0, sizeof b);
+    memset(&r, 0, sizeof r);
+    if (ls == NULL) {
+        return cli_fail(CLI_EXIT_INTERNAL, "out of memory");
+    }
+    ls->o = o;
+    ls->s = s;
+    double dt_us = (double)s->dt * 1e6;
+    if (!(dt_us >= 1.0) || dt_us > 3.6e9) {
+        free(ls);
+        return cli_fail(CLI_EXIT_INVALID, "%s: dt: %g s cannot be a cycle of whole microseconds "
+                                          "(1 us to 1 h)",
+                        o->scenario_path, (double)s->dt);
+    }
+    ls->dt_us = llround(dt_us);
+    if (s->vehicle_count > COA_MAX_VEHICLES) {
+        free(ls);
+        return cli_fail(CLI_EXIT_INVALID, "%s: %zu vehicles, at most %u", o->scenario_path,
+                        s->vehicle_count, COA_MAX_VEHICLES);
+    }
+
+    /* Pass 1: counts, the epoch, who was seen. */
+    status = log_open(&r, o->log_path, -1);
+    if (status == CLI_CONTINUE) {
+        status = read_log(ls, &r);
+    }
+    const int64_t size = r.size;
+    log_close(&r);
+    int64_t epoch = o->epoch;
+    uint32_t cap = s->horizon > COA_MAX_HORIZON / 2u ? COA_MAX_HORIZON : 2u * s->horizon;
+    if (status == CLI_CONTINUE) {
+        int64_t earliest = INT64_MAX;
+        for (size_t i = 0; i < s->vehicle_count && status == CLI_CONTINUE; i++) {
+            if (ls->intents_of[i] == 0) {
+                status = cli_fail(CLI_EXIT_INVALID,
+                                  "%s: UAV %u of %s never published an accepted intent "
+                                  "(%" PRId64 " intents in the log, %" PRId64 " refused)",
+                                  o->log_path, (unsigned)s->vehicles[i].id, o->scenario_path,
+                                  ls->intents, ls->intents_refused);
+            }
+            earliest = ls->first_plan_utime[i] < earliest ? ls->first_plan_utime[i] : earliest;
+        }
+        if (o->epoch_text == NULL) {
+            epoch = earliest;
+        }
+    }
+    int64_t k = 0;
+    if (status == CLI_CONTINUE) {
+        k = last_complete_cycle(ls, epoch, cap, &b.off_grid);
+        if (k < 0) {
+            status = cli_fail(CLI_EXIT_INTERNAL, "out of memory");
+        } else if (k == 0) {
+            status = cli_fail(CLI_EXIT_INVALID,
+                              "%s: no cycle after cycle 0 (epoch %" PRId64
+                              " us, dt %g s) has every UAV's own intent: nothing to judge",
+                              o->log_path, epoch, (double)s->dt);
+        }
+    }
+    const size_t n = s->vehicle_count;
+    if (status == CLI_CONTINUE) {
+        b.steps = (uint32_t)k;
+        size_t cells = n * ((size_t)k + 1u);
+        b.best = calloc(cells, sizeof *b.best);
+        b.own = calloc(cells, sizeof *b.own);
+        b.known = calloc(cells, sizeof *b.known);
+        b.reference = calloc(cells, sizeof *b.reference);
+        b.offsets = calloc(cells, sizeof *b.offsets);
+        if (b.best == NULL || b.own == NULL || b.known == NULL || b.reference == NULL ||
+            b.offsets == NULL) {
+            status = cli_fail(CLI_EXIT_INTERNAL, "out of memory");
+        }
+    }
+    /* Pass 2: the samples, from the same bytes pass 1 checked. */
+    if (status == CLI_CONTINUE) {
+        status = log_open(&r, o->log_path, size);
+        if (status == CLI_CONTINUE) {
+            status = fill_samples(ls, &r, &b, epoch);
+        }
+        log_close(&r);
+    }
+    if (status == CLI_CONTINUE && fill_gaps(s, &b) != COA_OK) {
+        status = cli_fail(CLI_EXIT_INVALID, "%s: a route cannot be sampled over %lu steps",
+                          o->scenario_path, (unsigned long)b.steps);
+    }
+
+    if (status == CLI_CONTINUE) {
+        const size_t row = (size_t)b.steps + 1u;
+        for (size_t i = 0; i < n; i++) {
+            b.vehicles[i].vehicle = s->vehicles[i];
+            b.vehicles[i].reference = &b.reference[i * row];
+            b.vehicles[i].offsets = &b.offsets[i * row];
+            b.vehicles[i].known = &b.known[i * row];
+        }
+        coa_flight_t flight;
+        memset(&flight, 0, sizeof flight);
+        flight.scenario = s->name;
+        flight.mode = o->mode;
+        flight.dt = s->dt;
+        flight.steps = b.steps;
+        flight.vehicles = b.vehicles;
+        flight.vehicle_count = n;
+        flight.obstacles = s->obstacles;
+        flight.obstacle_count = s->obstacle_count;
+        flight.tracks = s->tracks;
+        flight.track_count = s->track_count;
+        flight.replans = count_replans(ls, epoch, epoch + (int64_t)b.steps * ls->dt_us);
+
+        coa_flight_eval_t eval;
+        memset(&eval, 0, sizeof eval);
+        eval.vehicle_deviation = b.vehicle_deviation;
+        eval.vehicle_effort = b.vehicle_effort;
+        int rc = coa_flight_evaluate(&flight, &eval);
+        if (rc == COA_ERR_ARGUMENT) {
+            status = refused_record(o, &flight, &b);
+        } else if (rc != COA_OK) {
+            status = cli_fail(CLI_EXIT_INTERNAL, "cannot judge the flight (%s)",
+                              coa_status_name(rc));
+        }
+        if (status == CLI_CONTINUE) {
+            if (o->json) {
+                status = print_json(ls, &b, epoch, &flight, &eval);
+            } else {
+                print_log_text(ls, &b, epoch);
+                if (coa_flight_text(&flight, &eval, stdout) != COA_OK) {
+                    status = cli_fail(CLI_EXIT_INTERNAL, "cannot write the result");
+                }
+            }
+        }
+        if (status == CLI_CONTINUE && o->svg_path != NULL) {
+            status = write_svg(o->svg_path, &flight, &eval);
+        }
+        if (status == CLI_CONTINUE) {
+            status = eval.loss_of_separation ? CLI_EXIT_NOT_SOLVED : CLI_EXIT_OK;
+        }
+    }
+    rebuilt_free(&b);
+    free(ls->seen.items);
+    free(ls->heartbeats.items);
+    free(ls->plan_list.items);
+    free(ls);
+    return status;
+}
+
+int command_summary(int argc, char **argv)
+{
+    summary_options_t options;
+    int status = parse_summary_options(argc, argv, &options);
+    if (status != CLI_CONTINUE) {
+        return status;
+    }
+    scenario_t scenario;
+    status = cli_load_scenario(options.scenario_path, &scenario);
+    if (status == CLI_CONTINUE) {
+        status = summarise(&options, &scenario);
+    }
+    scenario_free(&scenario);
+    return status;
+}
