@@ -19,8 +19,11 @@
 
 #include <math.h>
 
+#include <time.h>
+
 #include <cjson/cJSON.h>
 #include <lcm/eventlog.h>
+#include <lcm/lcm.h>
 
 #include "coavoid_lcm.h"
 #include "flight.h"
@@ -644,6 +647,9 @@ static Suite *flight_suite(void)
 /*
  * test_flight --write-log OUT.log SCENARIO.json KIND [OPTION...]
  *
+ * or, to publish the same messages instead of writing them (for a real lcm-logger),
+ * test_flight --publish LCM_URL SCENARIO.json KIND [OPTION...]
+ *
  * Writes what a run of the scenario would have put in an lcm-logger log: every UAV's intent
  * at each cycle c = 0..2N (sample 0 at cycle c's start, N + 1 samples), heartbeats of each
  * UAV and of a coordinator, and with KIND "planned" one plan_t at cycle 0. KIND:
@@ -666,12 +672,16 @@ static Suite *flight_suite(void)
 #define LOG_EPOCH INT64_C(1700000000000000)
 
 typedef struct {
-    lcm_eventlog_t *log;
+    lcm_eventlog_t *log; /* --write-log */
+    lcm_t *lcm;          /* --publish */
     uint8_t buffer[20000];
 } log_writer_t;
 
 static int put_event(log_writer_t *w, int64_t utime, const char *channel, int size)
 {
+    if (w->lcm != NULL) {
+        return size < 0 ? -1 : lcm_publish(w->lcm, channel, w->buffer, (unsigned int)size);
+    }
     lcm_eventlog_event_t e;
     memset(&e, 0, sizeof e);
     e.timestamp = utime;
@@ -691,10 +701,11 @@ static int fail_writer(const char *what)
 static int write_log(int argc, char **argv)
 {
     if (argc < 5) {
-        return fail_writer("usage: test_flight --write-log OUT.log SCENARIO.json "
+        return fail_writer("usage: test_flight --write-log OUT.log|--publish URL SCENARIO.json "
                            "reference|planned [OPTION...]");
     }
     const char *out_path = argv[2];
+    const bool publish = strcmp(argv[1], "--publish") == 0;
     const char *kind = argv[4];
     bool planned = strcmp(kind, "planned") == 0;
     if (!planned && strcmp(kind, "reference") != 0) {
@@ -773,10 +784,18 @@ static int write_log(int argc, char **argv)
             goto done;
         }
     }
-    w->log = lcm_eventlog_create(out_path, "w");
-    if (w->log == NULL) {
-        status = fail_writer("cannot create the log");
-        goto done;
+    if (publish) {
+        w->lcm = lcm_create(out_path);
+        if (w->lcm == NULL) {
+            status = fail_writer("lcm_create failed (no multicast route?)");
+            goto done;
+        }
+    } else {
+        w->log = lcm_eventlog_create(out_path, "w");
+        if (w->log == NULL) {
+            status = fail_writer("cannot create the log");
+            goto done;
+        }
     }
     const long last_cycle = cycles > 0 ? cycles - 1 : 2L * (long)N;
     const coa_lcm_context_t ctx = {0, 0, 0, LOG_EPOCH};
@@ -874,6 +893,11 @@ static int write_log(int argc, char **argv)
                 status = fail_writer(reason);
             }
         }
+        if (publish) {
+            /* Paced like a (very fast) run, so that a logger's socket buffer keeps up. */
+            struct timespec pause = {0, 3000000};
+            nanosleep(&pause, NULL);
+        }
         if (junk && c == 1 && status == 0) {
             /* A copy of the last intent with a NaN position: refused. Then the same from a
              * UAV the scenario does not have: ignored. Then something else entirely. */
@@ -903,6 +927,9 @@ done:
     if (w != NULL && w->log != NULL) {
         lcm_eventlog_destroy(w->log);
     }
+    if (w != NULL && w->lcm != NULL) {
+        lcm_destroy(w->lcm);
+    }
     free(plan);
     free(reference);
     free(w);
@@ -915,7 +942,7 @@ done:
 
 int main(int argc, char **argv)
 {
-    if (argc >= 2 && strcmp(argv[1], "--write-log") == 0) {
+    if (argc >= 2 && (strcmp(argv[1], "--write-log") == 0 || strcmp(argv[1], "--publish") == 0)) {
         return write_log(argc, argv);
     }
     SRunner *sr = srunner_create(flight_suite());

@@ -25,9 +25,10 @@
  *
  * The log is untrusted. LCM 1.3.1's reader skips anything until it finds an event's
  * magic number, reports truncation as a normal end, prints its own complaints on stderr
- * and, for a data length near 2^31, hands a failed allocation to fread. So each event's
- * header is read and checked here first (magic exactly where the previous event ended,
- * lengths within bounds and within the file) and only then is the event read with
+ * (bad lengths; no magic right after an event) and, for a data length near 2^31, hands a
+ * failed allocation to fread. So each event's header is read and checked here first
+ * (magic exactly where the previous event ended and right after this one, lengths within
+ * bounds and within the file) and only then is the event read with
  * lcm_eventlog_read_next_event. Messages are decoded with the generated decoders and
  * validated by src/lcm before anything is used; refused ones are counted and reported.
  */
@@ -299,6 +300,23 @@ static int log_next(log_reader_t *r, lcm_eventlog_event_t **event)
                         " bytes, the file has %" PRId64 " left (was the logger stopped "
                         "mid-write?)",
                         r->path, r->events, r->offset, length, left);
+    }
+    /* Debian's 1.3.1 reader also looks at the 4 bytes after the event and, when they are
+     * not the next header's magic, prints a complaint and drops the event: judge them
+     * here first, so the message is ours and names the place. */
+    if (length + 4 <= left) {
+        unsigned char next[4];
+        if (fseeko(r->log->f, (off_t)(r->offset + length), SEEK_SET) != 0 ||
+            fread(next, 1, 4u, r->log->f) != 4u) {
+            return cli_fail(CLI_EXIT_INVALID, "%s: read error at byte %" PRId64, r->path,
+                            r->offset + length);
+        }
+        if (be32(next) != LOG_MAGIC) {
+            return cli_fail(CLI_EXIT_INVALID,
+                            "%s: corrupt: no event header at byte %" PRId64 " (after %" PRId64
+                            " events)",
+                            r->path, r->offset + length, r->events + 1);
+        }
     }
     if (fseeko(r->log->f, (off_t)r->offset, SEEK_SET) != 0) {
         return cli_fail(CLI_EXIT_INVALID, "%s: cannot seek to byte %" PRId64 ": %s", r->path,
@@ -1054,6 +1072,11 @@ static int summarise(const summary_options_t *o, const scenario_t *s)
             status = cli_fail(CLI_EXIT_INTERNAL, "cannot judge the flight (%s)",
                               coa_status_name(rc));
         }
+        /* The figure first: a file that cannot be written is a usage error, reported
+         * before anything is printed. */
+        if (status == CLI_CONTINUE && o->svg_path != NULL) {
+            status = write_svg(o->svg_path, &flight, &eval);
+        }
         if (status == CLI_CONTINUE) {
             if (o->json) {
                 status = print_json(ls, &b, epoch, &flight, &eval);
@@ -1063,9 +1086,6 @@ static int summarise(const summary_options_t *o, const scenario_t *s)
                     status = cli_fail(CLI_EXIT_INTERNAL, "cannot write the result");
                 }
             }
-        }
-        if (status == CLI_CONTINUE && o->svg_path != NULL) {
-            status = write_svg(o->svg_path, &flight, &eval);
         }
         if (status == CLI_CONTINUE) {
             status = eval.loss_of_separation ? CLI_EXIT_NOT_SOLVED : CLI_EXIT_OK;
