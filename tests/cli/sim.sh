@@ -1,0 +1,291 @@
+#!/bin/bash
+# `coavoid sim` follows SCENARIO_FORMAT.md ("Simulation result"): every shipped scenario
+# that `coavoid plan` solves in a mode flies without a loss of separation in that mode,
+# K = 2N steps by default, K + 1 samples per UAV at t = k dt, each on its reference raised
+# by a whole number of climb steps that change by actions; planning runs where there is a
+# conflict; the flown costs are at least the one-shot plan's; a run is repeatable byte for
+# byte; the UAVs fall back to planning for themselves when the coordinator stops, and stay
+# separated; a scenario already in conflict reports its loss (exit 1) instead of crashing;
+# bad arguments and inputs exit 2 with one line.
+#
+# usage: bash sim.sh <path-to-coavoid> <source-dir>   (VERBOSE=1 prints each result)
+set -u
+# shellcheck source=tests/cli/lib.bash
+. "$(dirname "${BASH_SOURCE[0]}")/lib.bash" "$@"
+scenarios=$src/scenarios
+
+# The contract, and the flight's geometry recomputed here from the scenario: x, y on the
+# reference at t = k dt and z the reference's raised by (offset * climb_rate * dt) with a
+# whole offset whose steps are actions (0, +-1, +-steep_factor). Then every line of the
+# extra assertions (Python; r is the result, s the scenario, offsets[id] the flown
+# offsets).
+cat >"$tmp/check.py" <<'PY'
+import json, math, sys
+
+r = json.load(open(sys.argv[1]))
+s = json.load(open(sys.argv[2]))
+mode = sys.argv[3]
+num = lambda x: isinstance(x, (int, float)) and not isinstance(x, bool)
+integer = lambda x: isinstance(x, int) and not isinstance(x, bool)
+
+for f in ("scenario", "mode", "steps", "replans", "loss_of_separation", "deviation",
+          "effort", "vehicles"):
+    assert f in r, f"no {f}"
+assert r["scenario"] == s["name"], "scenario is not the name"
+assert r["mode"] == mode, r["mode"]
+assert integer(r["steps"]) and r["steps"] >= 1
+assert integer(r["replans"]) and r["replans"] >= 0
+assert isinstance(r["loss_of_separation"], bool)
+assert num(r["deviation"]) and r["deviation"] >= 0
+assert integer(r["effort"]) and r["effort"] >= 0
+K = r["steps"]
+dt = s["dt"]
+
+def reference(v, t):
+    """The contract's reference: along the route at cruise_speed, z linear per leg, the
+    last leg extended."""
+    pts = v["route"]
+    d = v["cruise_speed"] * t
+    start = 0.0
+    for i in range(len(pts) - 1):
+        a, b = pts[i], pts[i + 1]
+        length = math.hypot(b[0] - a[0], b[1] - a[1])
+        if d < start + length or i == len(pts) - 2:
+            u = (d - start) / length
+            return [a[j] + u * (b[j] - a[j]) for j in range(3)]
+        start += length
+
+offsets = {}
+assert [v["id"] for v in r["vehicles"]] == [v["id"] for v in s["vehicles"]], "vehicle order"
+for v, sv in zip(r["vehicles"], s["vehicles"]):
+    flown = v["flown"]
+    assert isinstance(flown, list) and len(flown) == K + 1, f"{len(flown)} samples, K = {K}"
+    dh = sv["climb_rate"] * dt
+    steep = sv.get("steep_factor", 2)
+    row = []
+    for k, p in enumerate(flown):
+        assert len(p) == 4 and all(num(x) for x in p), p
+        assert abs(p[0] - k * dt) < 1e-9, f"sample {k} at t = {p[0]}"
+        ref = reference(sv, k * dt)
+        scale = 1e-9 * max(1.0, abs(ref[0]), abs(ref[1]), abs(ref[2]))
+        assert abs(p[1] - ref[0]) <= scale and abs(p[2] - ref[1]) <= scale, \
+            f"UAV {v['id']} off its reference horizontally at k = {k}: {p} vs {ref}"
+        o = (p[3] - ref[2]) / dh
+        assert abs(o - round(o)) < 1e-6, f"UAV {v['id']} z at k = {k} is {o} climb steps off"
+        row.append(round(o))
+    assert row[0] == sv.get("initial_offset", 0), f"UAV {v['id']} starts at {row[0]}"
+    for a, b in zip(row, row[1:]):
+        assert b - a in (0, 1, -1, steep, -steep), f"UAV {v['id']}: {a} -> {b} is no action"
+    offsets[v["id"]] = row
+
+for line in sys.argv[4].strip().splitlines():
+    if not eval(line):
+        sys.exit(f"assertion failed: {line}\n{json.dumps(r)[:600]}")
+PY
+
+# sim_json NAME SCENARIO MODE EXPECTED_EXIT ASSERTIONS [OPTIONS...]: `coavoid sim SCENARIO
+# --mode MODE --json OPTIONS` exits EXPECTED_EXIT with nothing on stderr, and its result
+# meets the contract, the geometry and ASSERTIONS. The result stays in $tmp/NAME.json.
+sim_json() {
+    local name=$1 scenario=$2 mode=$3 want=$4 asserts=$5
+    shift 5
+    "$bin" sim "$scenario" --mode "$mode" --json "$@" >"$tmp/$name.json" 2>"$tmp/err"
+    local rc=$?
+    if [ -n "${VERBOSE:-}" ]; then
+        python3 -c 'import json,sys; r=json.load(open(sys.argv[1])); r.pop("vehicles"); print(sys.argv[2], r)' \
+            "$tmp/$name.json" "$name" 2>/dev/null
+    fi
+    if [ "$rc" -ne "$want" ] || [ -s "$tmp/err" ]; then
+        fail "$name: exit $rc, expected $want: $(head -c 300 "$tmp/err")"
+    elif ! python3 "$tmp/check.py" "$tmp/$name.json" "$scenario" "$mode" "$asserts" \
+        >"$tmp/py" 2>&1; then
+        fail "$name: $(tail -n 5 "$tmp/py")"
+    else
+        pass
+    fi
+}
+
+# A field of a JSON file (python expression on r).
+field() { python3 -c 'import json,sys; r=json.load(open(sys.argv[1])); print(eval(sys.argv[2]))' "$@"; }
+
+# ---- every shipped scenario, in each mode its one-shot plan solves ----
+
+for scenario in "$scenarios"/*.json; do
+    base=$(basename "$scenario" .json)
+    horizon=$(field "$scenario" 'r["horizon"]')
+    "$bin" predict "$scenario" >"$tmp/predict.json" 2>/dev/null
+    conflicts=$(field "$tmp/predict.json" 'len(r["conflicts"])')
+    for mode in centralised decoupled; do
+        "$bin" plan "$scenario" --mode "$mode" >"$tmp/plan-$base-$mode.json" 2>/dev/null
+        plan_rc=$?
+        if [ "$plan_rc" -eq 0 ]; then
+            # Planning must have run where the references conflict.
+            sim_json "$base-$mode" "$scenario" "$mode" 0 "
+r['loss_of_separation'] is False
+r['steps'] == 2 * $horizon
+$conflicts == 0 or r['replans'] >= 1
+r['fallbacks'] == 0
+"
+        elif [ "$plan_rc" -eq 1 ]; then
+            # No plan from the start (a conflict at t = 0): the loss is reported, exit 1.
+            sim_json "$base-$mode" "$scenario" "$mode" 1 "
+r['loss_of_separation'] is True
+r['first_loss']['step'] == 0
+"
+        else
+            fail "$base: coavoid plan --mode $mode exits $plan_rc"
+        fi
+    done
+done
+
+# The shipped scenarios include both kinds, so neither branch above is vacuous.
+[ -s "$tmp/paper-centralised.json" ] && [ -s "$tmp/initial_conflict-decoupled.json" ] \
+    && pass || fail "the shipped scenarios changed: paper or initial_conflict is missing"
+
+# ---- what was flown against the one-shot plan ----
+
+# Closed loop against one-shot: the loop's first plan is the one-shot problem (everyone at
+# k = 0 over the same horizon), and the UAVs fly it; planning again later can only add
+# deviation (a plan holds its last offset past its end, and later plans start from where
+# the UAVs are). So the flown costs are at least the one-shot plan's, lexicographically.
+for mode in centralised decoupled; do
+    for base in paper headon; do
+        plan=$tmp/plan-$base-$mode.json
+        flown=$tmp/$base-$mode.json
+        dev=$(field "$plan" 'r["cost"]["deviation"]')
+        eff=$(field "$plan" 'r["cost"]["effort"]')
+        if python3 - "$flown" "$dev" "$eff" <<'PY'; then pass; else fail "$base $mode: flown costs below the one-shot plan's ($dev, $eff)"; fi
+import json, sys
+r = json.load(open(sys.argv[1]))
+dev, eff = float(sys.argv[2]), int(sys.argv[3])
+sys.exit(0 if (r["deviation"], r["effort"]) >= (dev, eff) else 1)
+PY
+    done
+done
+
+# Head-on, and the paper's three UAVs: nothing new enters the horizon after the first
+# plan, so the UAVs fly exactly the one-shot plan over its N steps (in the paper's case
+# centrally only because the coordinator plans all clustered UAVs together once UAV 1,
+# alone over the terrain, finds the others in its way).
+for mode in centralised decoupled; do
+    for base in paper headon; do
+        if python3 - "$tmp/$base-$mode.json" "$tmp/plan-$base-$mode.json" \
+            "$scenarios/$base.json" <<'PY'; then pass; else fail "$base $mode: the flown offsets are not the one-shot plan's"; fi
+import json, sys
+r, p, s = (json.load(open(f)) for f in sys.argv[1:4])
+n = s["horizon"]
+for v, pv, sv in zip(r["vehicles"], p["vehicles"], s["vehicles"]):
+    z0 = sv["route"][0][2]
+    dh = sv["climb_rate"] * s["dt"]
+    flown = [round((q[3] - z0) / dh) for q in v["flown"][: n + 1]]
+    if flown != pv["offsets"] or r["deviation"] != p["cost"]["deviation"]:
+        sys.exit(f"UAV {v['id']}: {flown} vs {pv['offsets']}")
+PY
+    done
+done
+
+# ---- determinism ----
+
+for args in "paper.json --mode centralised" "late_encounter.json --mode decoupled" \
+    "track_crossing.json --mode centralised --json" "late_encounter.json --mode centralised --coordinator-stops 13 --json"; do
+    read -r -a a <<<"$args"
+    "$bin" sim "$scenarios/${a[0]}" "${a[@]:1}" >"$tmp/run1" 2>&1
+    "$bin" sim "$scenarios/${a[0]}" "${a[@]:1}" >"$tmp/run2" 2>&1
+    if [ -s "$tmp/run1" ] && cmp -s "$tmp/run1" "$tmp/run2"; then pass; else fail "two runs of sim $args differ"; fi
+done
+
+# ---- the coordinator stops ----
+
+# Stopped before cycle 0: the UAVs wait out its heartbeat timeout from their start, then
+# plan the head-on encounter for themselves.
+sim_json headon-stop0 "$scenarios/headon.json" centralised 0 '
+r["loss_of_separation"] is False
+r["fallbacks"] == 2
+r["coordinator_stopped_at"] == 0
+r["replans"] >= 1
+' --coordinator-stops 0
+# Late encounter: the coordinator resolves the head-on pair at once and stops at step 13,
+# before UAV 3's crossing (which conflicts with UAV 1 around t = 35 s) has entered its
+# horizon; the UAVs fall back and solve the crossing themselves. Without the stop nobody
+# falls back.
+sim_json late-stop13 "$scenarios/late_encounter.json" centralised 0 '
+r["loss_of_separation"] is False
+r["fallbacks"] == 3
+r["replans"] >= 2
+any(offsets[1][k] != 0 or offsets[3][k] != 0 for k in range(30, 38))
+all(offsets[3][k] == 0 for k in range(0, 14))
+' --coordinator-stops 13
+sim_json late-alive "$scenarios/late_encounter.json" centralised 0 '
+r["loss_of_separation"] is False
+r["fallbacks"] == 0
+any(offsets[1][k] != 0 or offsets[3][k] != 0 for k in range(30, 38))
+'
+# The crossing needs a manoeuvre: flying their references, UAVs 1 and 3 meet at t = 35 s.
+if python3 - "$scenarios/late_encounter.json" <<'PY'; then pass; else fail "late_encounter: 1 and 3 do not meet on their references"; fi
+import json, math, sys
+s = json.load(open(sys.argv[1]))
+v = {u["id"]: u for u in s["vehicles"]}
+def at(u, t):
+    a, b = u["route"][0], u["route"][1]
+    L = math.hypot(b[0] - a[0], b[1] - a[1])
+    f = u["cruise_speed"] * t / L
+    return [a[j] + f * (b[j] - a[j]) for j in range(3)]
+p, q = at(v[1], 35.0), at(v[3], 35.0)
+sys.exit(0 if math.hypot(p[0] - q[0], p[1] - q[1]) < 30 and abs(p[2] - q[2]) < 10 else 1)
+PY
+
+# ---- steps, text output and the figure ----
+
+sim_json headon-steps5 "$scenarios/headon.json" decoupled 0 '
+r["steps"] == 5
+' --steps 5
+"$bin" sim "$scenarios/headon.json" --mode centralised --svg "$tmp/fig.svg" >"$tmp/text" 2>"$tmp/err"
+rc=$?
+if [ "$rc" -eq 0 ] && [ ! -s "$tmp/err" ] && grep -q '^loss of separation: no$' "$tmp/text" \
+    && grep -q '^fallbacks: 0$' "$tmp/text" && grep -q '^replans: 1$' "$tmp/text"; then
+    pass
+else
+    fail "text output: exit $rc: $(head -c 400 "$tmp/text") $(head -c 200 "$tmp/err")"
+fi
+if grep -q '<svg' "$tmp/fig.svg" && grep -q '</svg>' "$tmp/fig.svg"; then pass; else fail "--svg wrote no SVG document"; fi
+
+# ---- bad arguments and inputs ----
+
+h=$scenarios/headon.json
+expect_bad "no scenario" "missing SCENARIO" sim --mode centralised
+expect_bad "no mode" "--mode" sim "$h"
+expect_bad "bad mode" "--mode" sim "$h" --mode sideways
+expect_bad "mode twice" "--mode" sim "$h" --mode decoupled --mode decoupled
+expect_bad "steps 0" "--steps" sim "$h" --mode decoupled --steps 0
+expect_bad "steps word" "--steps" sim "$h" --mode decoupled --steps many
+expect_bad "steps negative" "--steps" sim "$h" --mode decoupled --steps=-3
+expect_bad "steps missing" "--steps" sim "$h" --mode decoupled --steps
+expect_bad "json value" "--json" sim "$h" --mode decoupled --json=yes
+expect_bad "svg missing" "--svg" sim "$h" --mode decoupled --svg
+expect_bad "svg unwritable" "--svg" sim "$h" --mode decoupled --svg "$tmp/no/such/dir/f.svg"
+expect_bad "stop decoupled" "--coordinator-stops" sim "$h" --mode decoupled --coordinator-stops 1
+expect_bad "stop after K" "--coordinator-stops" sim "$h" --mode centralised --steps 4 --coordinator-stops 5
+expect_bad "stop word" "--coordinator-stops" sim "$h" --mode centralised --coordinator-stops soon
+expect_bad "unknown option" "--fast" sim "$h" --mode decoupled --fast
+expect_bad "two scenarios" "unexpected argument" sim "$h" "$h" --mode decoupled
+expect_bad "missing file" "no-such.json" sim "$tmp/no-such.json" --mode decoupled
+printf '{"name": "x", "dt": 1' >"$tmp/truncated.json"
+expect_bad "truncated file" "truncated.json" sim "$tmp/truncated.json" --mode centralised
+python3 - "$h" "$tmp/long.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+s["horizon"] = 128
+json.dump(s, open(sys.argv[2], "w"))
+PY
+expect_bad "horizon 128" "horizon" sim "$tmp/long.json" --mode decoupled
+python3 - "$h" "$tmp/crowd.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+base = s["vehicles"][0]
+s["vehicles"] = [dict(base, id=i + 1, route=[[0, 100 * i, 100], [600, 100 * i, 100]])
+                 for i in range(33)]
+json.dump(s, open(sys.argv[2], "w"))
+PY
+expect_bad "33 vehicles" "vehicles" sim "$tmp/crowd.json" --mode decoupled
+
+finish

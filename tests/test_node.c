@@ -1,0 +1,636 @@
+/*
+ * test_node: the nodes of apps/node (node.h) over LCM's in-process provider, driven on a
+ * hand-set clock: what arrives is counted (undecodable bytes too) and never the node's own
+ * messages; a UAV that restarts its numbering is accepted once it has been silent; a
+ * coordinator's plan is adopted only under the rules of node.h (this cycle, from the
+ * offset flown, a newer plan_id, before valid_until); the UAV falls back to planning for
+ * itself when the heartbeat stops and returns when it comes back; a lower priority waits
+ * for the higher, up to its deadline; a silent UAV is avoided as a track; the world's
+ * track estimates reproduce the scenario's path over the horizon; bad configurations are
+ * refused.
+ */
+#include <check.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#ifdef COAVOID_HAVE_NODE
+
+#include <math.h>
+#include <string.h>
+
+#include <lcm/lcm.h>
+
+#include "node.h"
+#include "test_support.h"
+
+#define EPOCH INT64_C(1000000000000000)
+#define DT_US INT64_C(1000000)
+
+typedef struct {
+    lcm_t *lcm;
+    int64_t now;
+    coa_node_common_t common;
+} rig_t;
+
+static void rig_init(rig_t *r, uint32_t horizon)
+{
+    r->lcm = lcm_create("memq://");
+    ck_assert_ptr_nonnull(r->lcm);
+    r->now = EPOCH;
+    ck_assert_int_eq(coa_node_common_defaults(&r->common, EPOCH, (coa_real_t)1, horizon, &r->now),
+                     COA_OK);
+}
+
+static void drain(lcm_t *lcm)
+{
+    while (lcm_handle_timeout(lcm, 0) > 0) {
+    }
+}
+
+static int64_t cycle(int64_t k)
+{
+    return EPOCH + k * DT_US;
+}
+
+/* A UAV on a straight level route from (x0, y, z) towards x1 at 10 m/s. */
+static coa_vehicle_t uav(uint16_t id, uint32_t priority, coa_vec3_t *route, coa_real_t x0,
+                         coa_real_t x1, coa_real_t y, coa_real_t z)
+{
+    coa_vehicle_t v;
+    memset(&v, 0, sizeof v);
+    route[0].x = x0;
+    route[0].y = y;
+    route[0].z = z;
+    route[1].x = x1;
+    route[1].y = y;
+    route[1].z = z;
+    v.id = id;
+    v.priority = priority;
+    v.cruise_speed = 10;
+    v.climb_rate = 2;
+    v.steep_factor = 2;
+    v.volume.radius = 15;
+    v.volume.half_height = 5;
+    v.route = route;
+    v.route_count = 2;
+    v.initial_offset = 0;
+    v.max_offset = -1;
+    return v;
+}
+
+static coa_vehicle_node_t *vehicle_node(const rig_t *r, coa_vehicle_t v, coa_node_mode_t mode)
+{
+    coa_vehicle_node_config_t config;
+    memset(&config, 0, sizeof config);
+    config.common = r->common;
+    config.vehicle = v;
+    config.mode = mode;
+    int error = -99;
+    coa_vehicle_node_t *node = coa_vehicle_node_create(&config, r->lcm, &error);
+    ck_assert_ptr_nonnull(node);
+    ck_assert_int_eq(error, COA_OK);
+    return node;
+}
+
+static void heartbeat(lcm_t *lcm, int64_t now, int64_t sequence)
+{
+    coavoid_status_t m;
+    memset(&m, 0, sizeof m);
+    m.utime = now;
+    m.node_id = COA_NODE_COORDINATOR_ID;
+    m.node_kind = COAVOID_STATUS_T_NODE_COORDINATOR;
+    m.sequence = sequence;
+    m.health = COAVOID_STATUS_T_HEALTH_OK;
+    m.mode = COAVOID_STATUS_T_MODE_CENTRALISED;
+    m.outcome = COAVOID_STATUS_T_OUTCOME_NONE;
+    ck_assert_int_eq(coavoid_status_t_publish(lcm, COA_CHANNEL_STATUS, &m), 0);
+}
+
+/* A one-UAV plan_t from the coordinator: offsets 0, 1, 2, then level at 2, plus `shift`. */
+static void plan_msg(lcm_t *lcm, int64_t now, int64_t plan_id, int64_t valid_from, uint16_t id,
+                     int32_t horizon, int32_t shift)
+{
+    coavoid_plan_t m;
+    memset(&m, 0, sizeof m);
+    m.utime = now;
+    m.coordinator_id = COA_NODE_COORDINATOR_ID;
+    m.plan_id = plan_id;
+    m.valid_from_utime = valid_from;
+    m.valid_until_utime = valid_from + DT_US;
+    m.dt = 1.0;
+    m.horizon = horizon;
+    m.mode = COAVOID_PLAN_T_MODE_CENTRALISED;
+    m.status = COAVOID_PLAN_T_STATUS_SOLVED;
+    m.vehicle_count = 1;
+    m.planned_count = 1;
+    m.uav_ids[0] = id;
+    for (int32_t k = 0; k <= horizon; k++) {
+        m.offsets[0][k] = (k < 2 ? k : 2) + shift;
+    }
+    ck_assert_int_eq(coavoid_plan_t_publish(lcm, COA_CHANNEL_PLAN, &m), 0);
+}
+
+/* ---- counting ---- */
+
+START_TEST(test_undecodable_counted_own_ignored)
+{
+    rig_t r;
+    rig_init(&r, 10);
+    coa_vec3_t route[2];
+    coa_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, route, 0, 500, 0, 100), COA_NODE_CENTRALISED);
+    const coa_vehicle_node_state_t *s = coa_vehicle_node_state(a);
+    ck_assert_int_eq(s->cycle, -1);
+
+    /* Its own intent and heartbeat come back over memq: neither is counted. */
+    ck_assert_int_eq(coa_vehicle_node_cycle(a, r.now), COA_OK);
+    drain(r.lcm);
+    ck_assert(s->published);
+    ck_assert_int_eq(s->rx.received, 0);
+
+    const uint8_t junk[7] = {1, 2, 3, 4, 5, 6, 7};
+    const char *channels[] = {COA_CHANNEL_INTENT, COA_CHANNEL_TRACK, COA_CHANNEL_OBSTACLES,
+                              COA_CHANNEL_STATUS, COA_CHANNEL_PLAN};
+    for (size_t i = 0; i < 5; i++) {
+        ck_assert_int_eq(lcm_publish(r.lcm, channels[i], junk, sizeof junk), 0);
+    }
+    drain(r.lcm);
+    ck_assert_int_eq(s->rx.received, 5);
+    ck_assert_int_eq(s->rx.rejected, 5);
+    ck_assert_int_eq(s->rx.last_reject_code, COA_LCM_ERR_DECODE);
+
+    /* Another UAV's intent is counted and accepted. */
+    coa_vec3_t route2[2];
+    coa_vehicle_node_t *b = vehicle_node(&r, uav(2, 2, route2, 0, 500, 500, 100), COA_NODE_DECOUPLED);
+    ck_assert_int_eq(coa_vehicle_node_cycle(b, r.now), COA_OK);
+    drain(r.lcm);
+    ck_assert_int_eq(s->rx.received, 7); /* its intent and its heartbeat */
+    ck_assert_int_eq(s->rx.rejected, 5);
+    coa_vehicle_node_destroy(b);
+    coa_vehicle_node_destroy(a);
+    lcm_destroy(r.lcm);
+}
+END_TEST
+
+/* A peer that restarts numbers its intents from 0 again: refused while its old numbering
+ * is remembered, accepted once it has been silent past stale_after. */
+START_TEST(test_restarted_peer_accepted_after_silence)
+{
+    rig_t r;
+    rig_init(&r, 10);
+    coa_vec3_t r1[2], r2[2];
+    coa_vehicle_t v2 = uav(2, 2, r2, 0, 500, 800, 100);
+    coa_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, r1, 0, 500, 0, 100), COA_NODE_DECOUPLED);
+    coa_vehicle_node_t *b = vehicle_node(&r, v2, COA_NODE_DECOUPLED);
+    const coa_vehicle_node_state_t *s = coa_vehicle_node_state(a);
+    for (int64_t k = 0; k <= 3; k++) {
+        r.now = cycle(k);
+        coa_vehicle_node_cycle(a, r.now);
+        coa_vehicle_node_cycle(b, r.now);
+        drain(r.lcm);
+    }
+    ck_assert_int_eq(s->rx.rejected, 0);
+    coa_vehicle_node_destroy(b);
+    b = vehicle_node(&r, v2, COA_NODE_DECOUPLED); /* restarted: sequence 0 again */
+    int64_t rejected_at[10] = {0};
+    for (int64_t k = 4; k <= 9; k++) {
+        r.now = cycle(k);
+        coa_vehicle_node_cycle(a, r.now);
+        drain(r.lcm);
+        coa_vehicle_node_cycle(b, r.now);
+        drain(r.lcm);
+        rejected_at[k] = s->rx.rejected;
+    }
+    /* Last accepted at cycle 3; its numbering is forgotten once 2.5 cycles have passed,
+     * at cycle 6's expiry: the intents of cycles 4 and 5 (sequences 0, 1) are refused,
+     * those from cycle 6 on (2, 3, ...) are not. */
+    ck_assert_int_eq(rejected_at[4], 1);
+    ck_assert_int_eq(rejected_at[5], 2);
+    ck_assert_int_eq(rejected_at[6], 2);
+    ck_assert_int_eq(rejected_at[9], 2);
+    ck_assert_int_eq(s->rx.last_reject_code, COA_LCM_ERR_SEQUENCE);
+    coa_vehicle_node_destroy(b);
+    coa_vehicle_node_destroy(a);
+    lcm_destroy(r.lcm);
+}
+END_TEST
+
+/* ---- adoption of the coordinator's plans ---- */
+
+START_TEST(test_plan_adoption_rules)
+{
+    rig_t r;
+    rig_init(&r, 10);
+    coa_vec3_t route[2];
+    coa_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, route, 0, 500, 0, 100), COA_NODE_CENTRALISED);
+    const coa_vehicle_node_state_t *s = coa_vehicle_node_state(a);
+    ck_assert_int_eq(coa_vehicle_node_cycle(a, cycle(0)), COA_OK);
+    drain(r.lcm);
+    r.now = cycle(0) + DT_US / 4;
+    int64_t rejected = s->rx.rejected;
+
+    /* Not for it: received, neither rejected nor adopted. */
+    plan_msg(r.lcm, r.now, 1, cycle(0), 7, 10, 0);
+    drain(r.lcm);
+    ck_assert_int_eq(s->rx.rejected, rejected);
+    ck_assert_int_eq(s->plans_adopted, 0);
+    /* For the previous cycle: refused. */
+    plan_msg(r.lcm, r.now, 2, cycle(0) - DT_US, 1, 10, 0);
+    drain(r.lcm);
+    ck_assert_int_eq(s->rx.rejected, ++rejected);
+    ck_assert_int_eq(s->rx.last_reject_code, COA_LCM_ERR_TIME);
+    /* Not from the offset it flies (0): refused. */
+    plan_msg(r.lcm, r.now, 3, cycle(0), 1, 10, 3);
+    drain(r.lcm);
+    ck_assert_int_eq(s->rx.rejected, ++rejected);
+    ck_assert_int_eq(s->rx.last_reject_code, COA_LCM_ERR_VALUE);
+    /* Right: adopted. */
+    plan_msg(r.lcm, r.now, 4, cycle(0), 1, 10, 0);
+    drain(r.lcm);
+    ck_assert_int_eq(s->rx.rejected, rejected);
+    ck_assert_int_eq(s->plans_adopted, 1);
+    /* An older plan_id: refused. */
+    plan_msg(r.lcm, r.now, 4, cycle(0), 1, 10, 0);
+    drain(r.lcm);
+    ck_assert_int_eq(s->rx.rejected, ++rejected);
+    ck_assert_int_eq(s->rx.last_reject_code, COA_LCM_ERR_SEQUENCE);
+    /* Too late (valid_until has come): refused. */
+    r.now = cycle(1);
+    plan_msg(r.lcm, r.now, 5, cycle(0), 1, 10, 0);
+    drain(r.lcm);
+    ck_assert_int_eq(s->rx.rejected, ++rejected);
+    ck_assert_int_eq(s->rx.last_reject_code, COA_LCM_ERR_TIME);
+    ck_assert_int_eq(s->plans_adopted, 1);
+
+    /* It flies the adopted plan: 1 at sample 1, 2 from sample 2 on, 2 dh above. */
+    const int32_t want[4] = {0, 1, 2, 2};
+    for (int64_t k = 1; k <= 3; k++) {
+        ck_assert_int_eq(coa_vehicle_node_cycle(a, cycle(k)), COA_OK);
+        drain(r.lcm);
+        ck_assert_int_eq(s->offset, want[k]);
+        ck_assert(s->position.z == s->reference.z + (coa_real_t)want[k] * (coa_real_t)2);
+    }
+    coa_vehicle_node_destroy(a);
+    lcm_destroy(r.lcm);
+}
+END_TEST
+
+/* ---- fallback ---- */
+
+START_TEST(test_fallback_and_return)
+{
+    rig_t r;
+    rig_init(&r, 10);
+    coa_vec3_t route[2];
+    coa_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, route, 0, 500, 0, 100), COA_NODE_CENTRALISED);
+    const coa_vehicle_node_state_t *s = coa_vehicle_node_state(a);
+    int64_t sequence = 0;
+    /* Heartbeats at k + 1/4 for k in 0..4 and 10..14; timeout 2.5 cycles. */
+    const char *want = "CCCCCCCDDDDCCCCCCDDD";
+    const uint32_t fallbacks[20] = {0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 2, 2, 2};
+    for (int64_t k = 0; k < 20; k++) {
+        r.now = cycle(k);
+        ck_assert_int_eq(coa_vehicle_node_cycle(a, r.now), COA_OK);
+        drain(r.lcm);
+        ck_assert_msg(s->coordinated == (want[k] == 'C'), "cycle %d", (int)k);
+        ck_assert_uint_eq(s->fallbacks, fallbacks[k]);
+        ck_assert(s->published);
+        if (k <= 4 || (k >= 10 && k <= 14)) {
+            r.now = cycle(k) + DT_US / 4;
+            heartbeat(r.lcm, r.now, sequence++);
+            drain(r.lcm);
+        }
+    }
+    ck_assert_int_eq(s->rx.rejected, 0);
+    coa_vehicle_node_destroy(a);
+    lcm_destroy(r.lcm);
+}
+END_TEST
+
+/* ---- decoupled: waiting for higher priorities ---- */
+
+START_TEST(test_lower_priority_waits)
+{
+    rig_t r;
+    rig_init(&r, 24);
+    coa_vec3_t r1[2], r2[2];
+    /* Head-on, conflict around t = 13.5 s. 1 has priority. */
+    coa_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, r1, 0, 600, 0, 100), COA_NODE_DECOUPLED);
+    coa_vehicle_node_t *b = vehicle_node(&r, uav(2, 2, r2, 300, -300, 0, 100), COA_NODE_DECOUPLED);
+    const coa_vehicle_node_state_t *sa = coa_vehicle_node_state(a);
+    const coa_vehicle_node_state_t *sb = coa_vehicle_node_state(b);
+    /* Cycle 0: only 1 runs, so 2 knows 1's intent of cycle 0 and nothing newer. */
+    ck_assert_int_eq(coa_vehicle_node_cycle(a, cycle(0)), COA_OK);
+    drain(r.lcm);
+    /* Cycle 1: 2 first. It sees the conflict with a higher priority whose intent for this
+     * cycle has not come: it waits, until cycle start + dt / 2. */
+    r.now = cycle(1);
+    ck_assert_int_eq(coa_vehicle_node_cycle(b, r.now), COA_OK);
+    drain(r.lcm);
+    ck_assert(sb->waiting);
+    ck_assert(!sb->published);
+    ck_assert_int_eq(coa_vehicle_node_deadline(b), cycle(1) + DT_US / 2);
+    ck_assert_int_eq(coa_vehicle_node_poll(b, r.now), 0);
+    ck_assert_uint_eq(sb->plans_run, 0);
+    /* 1 publishes (its only conflict is with a lower priority: it does not plan). */
+    ck_assert_int_eq(coa_vehicle_node_cycle(a, r.now), COA_OK);
+    drain(r.lcm);
+    ck_assert_uint_eq(sa->plans_run, 0);
+    ck_assert(sa->published);
+    ck_assert_int_eq(coa_vehicle_node_poll(b, r.now), 1);
+    ck_assert(!sb->waiting);
+    ck_assert(sb->published);
+    ck_assert_uint_eq(sb->plans_run, 1);
+    ck_assert_uint_eq(sb->plans_adopted, 1);
+    ck_assert_int_eq(sb->last_outcome, COA_PLAN_SOLVED);
+    ck_assert_int_eq(coa_vehicle_node_deadline(b), INT64_MAX);
+    coa_vehicle_node_destroy(b);
+    coa_vehicle_node_destroy(a);
+    lcm_destroy(r.lcm);
+}
+END_TEST
+
+START_TEST(test_wait_ends_at_deadline)
+{
+    rig_t r;
+    rig_init(&r, 24);
+    coa_vec3_t r1[2], r2[2];
+    coa_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, r1, 0, 600, 0, 100), COA_NODE_DECOUPLED);
+    coa_vehicle_node_t *b = vehicle_node(&r, uav(2, 2, r2, 300, -300, 0, 100), COA_NODE_DECOUPLED);
+    const coa_vehicle_node_state_t *sb = coa_vehicle_node_state(b);
+    ck_assert_int_eq(coa_vehicle_node_cycle(a, cycle(0)), COA_OK);
+    drain(r.lcm);
+    /* 1 says nothing in cycle 1: 2 waits out its deadline, then plans around 1's intent of
+     * cycle 0, which still covers the encounter. */
+    r.now = cycle(1);
+    ck_assert_int_eq(coa_vehicle_node_cycle(b, r.now), COA_OK);
+    drain(r.lcm);
+    ck_assert(sb->waiting);
+    r.now = cycle(1) + DT_US / 2 - 1;
+    ck_assert_int_eq(coa_vehicle_node_poll(b, r.now), 0);
+    r.now = coa_vehicle_node_deadline(b);
+    ck_assert_int_eq(coa_vehicle_node_poll(b, r.now), 1);
+    ck_assert(sb->published);
+    ck_assert_uint_eq(sb->plans_adopted, 1);
+    /* Then both fly on: 1 on its reference, 2 on its plan; they stay separated. */
+    coa_vec3_t pa[31], pb[31];
+    for (int64_t k = 2; k <= 30; k++) {
+        r.now = cycle(k);
+        coa_vehicle_node_cycle(a, r.now);
+        drain(r.lcm);
+        coa_vehicle_node_cycle(b, r.now);
+        drain(r.lcm);
+        while (coa_vehicle_node_deadline(b) != INT64_MAX) {
+            r.now = coa_vehicle_node_deadline(b);
+            coa_vehicle_node_poll(b, r.now);
+            drain(r.lcm);
+        }
+        pa[k] = coa_vehicle_node_state(a)->position;
+        pb[k] = sb->position;
+    }
+    for (int64_t k = 2; k < 30; k++) {
+        coa_sweep_t x = {{15, 5}, pa[k], pa[k + 1]};
+        coa_sweep_t y = {{15, 5}, pb[k], pb[k + 1]};
+        ck_assert_msg(!coa_conflict_volumes(&x, &y), "conflict over step %d", (int)k);
+    }
+    coa_vehicle_node_destroy(b);
+    coa_vehicle_node_destroy(a);
+    lcm_destroy(r.lcm);
+}
+END_TEST
+
+/* ---- a silent UAV is a track ---- */
+
+START_TEST(test_silent_uav_avoided_as_track)
+{
+    rig_t r;
+    rig_init(&r, 24);
+    coa_vec3_t r1[2], r2[2];
+    /* 2 has priority and is 620 m away head-on: they would meet around t = 30 s, beyond
+     * the first horizon. 2 publishes once and falls silent. */
+    coa_vehicle_t v2 = uav(2, 1, r2, 620, -1380, 0, 100);
+    coa_vehicle_node_t *a = vehicle_node(&r, uav(1, 2, r1, 0, 2000, 0, 100), COA_NODE_DECOUPLED);
+    coa_vehicle_node_t *b = vehicle_node(&r, v2, COA_NODE_DECOUPLED);
+    const coa_vehicle_node_state_t *sa = coa_vehicle_node_state(a);
+    ck_assert_int_eq(coa_vehicle_node_cycle(a, cycle(0)), COA_OK);
+    ck_assert_int_eq(coa_vehicle_node_cycle(b, cycle(0)), COA_OK);
+    drain(r.lcm);
+    coa_vehicle_node_destroy(b);
+    coa_vec3_t pa[41];
+    pa[0] = sa->position;
+    uint32_t plans_before_stale = 0;
+    for (int64_t k = 1; k <= 40; k++) {
+        r.now = cycle(k);
+        coa_vehicle_node_cycle(a, r.now);
+        drain(r.lcm);
+        while (coa_vehicle_node_deadline(a) != INT64_MAX) {
+            r.now = coa_vehicle_node_deadline(a);
+            coa_vehicle_node_poll(a, r.now);
+            drain(r.lcm);
+        }
+        if (k == 2) {
+            plans_before_stale = sa->plans_run;
+        }
+        pa[k] = sa->position;
+    }
+    /* It planned only once 2 was a track (silent for more than 2.5 s). */
+    ck_assert_uint_eq(plans_before_stale, 0);
+    ck_assert_uint_gt(sa->plans_run, 0);
+    for (int64_t k = 0; k < 40; k++) {
+        coa_vec3_t q0 = coa_reference_at(&v2, (coa_real_t)k);
+        coa_vec3_t q1 = coa_reference_at(&v2, (coa_real_t)(k + 1));
+        coa_sweep_t x = {{15, 5}, pa[k], pa[k + 1]};
+        coa_sweep_t y = {{15, 5}, q0, q1};
+        ck_assert_msg(!coa_conflict_volumes(&x, &y), "conflict over step %d", (int)k);
+    }
+    ck_assert_int_eq(sa->rx.rejected, 0);
+    coa_vehicle_node_destroy(a);
+    lcm_destroy(r.lcm);
+}
+END_TEST
+
+/* ---- the world's track estimates ---- */
+
+typedef struct {
+    rig_t *rig;
+    coa_track_t original;
+    int count;
+    int truncated;
+    double worst;
+} track_probe_t;
+
+static void on_track(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
+{
+    track_probe_t *p = user;
+    (void)channel;
+    coavoid_track_t msg;
+    REQUIRE(coavoid_track_t_decode(rbuf->data, 0, (int)rbuf->data_size, &msg) >= 0);
+    const int64_t k = (p->rig->now - EPOCH) / DT_US;
+    coa_lcm_context_t ctx = {p->rig->now, 30 * DT_US, DT_US, cycle(k)};
+    coa_lcm_track_info_t info;
+    coa_track_t got;
+    coa_track_point_t path[COAVOID_TRACK_T_MAX_PATH];
+    REQUIRE(coa_lcm_track_to_core(&msg, &ctx, NULL, &info, &got, path, COAVOID_TRACK_T_MAX_PATH,
+                                  NULL) == COA_OK);
+    REQUIRE(got.path_count >= 2);
+    p->truncated += got.path_count == COAVOID_TRACK_T_MAX_PATH;
+    const coa_real_t covered = got.path[got.path_count - 1u].t;
+    for (int j = 0; j <= 20 && (coa_real_t)j <= covered; j++) {
+        coa_vec3_t a = coa_track_at(&got, (coa_real_t)j);
+        coa_vec3_t b = coa_track_at(&p->original, (coa_real_t)(k + j));
+        double e = fmax(fabs((double)(a.x - b.x)), fmax(fabs((double)(a.y - b.y)), fabs((double)(a.z - b.z))));
+        p->worst = fmax(p->worst, e);
+    }
+    /* The path reaches the horizon's end unless the message ran out of points. */
+    REQUIRE(covered >= (coa_real_t)20 || got.path_count == COAVOID_TRACK_T_MAX_PATH);
+    p->count++;
+}
+
+START_TEST(test_world_track_estimates)
+{
+    rig_t r;
+    rig_init(&r, 20);
+    coa_track_point_t path[24];
+    for (int j = 0; j < 24; j++) {
+        /* A zig-zag: every point a turn, some a second apart (more than a message holds
+         * within one horizon), some five. */
+        double t = j < 4 ? 5.0 * j : 15.0 + (j - 3);
+        path[j].t = (coa_real_t)t;
+        path[j].p.x = (coa_real_t)(150 + 3 * t);
+        path[j].p.y = (coa_real_t)((j % 2) ? 40 : -40);
+        path[j].p.z = (coa_real_t)(100 + j);
+    }
+    track_probe_t probe;
+    memset(&probe, 0, sizeof probe);
+    probe.rig = &r;
+    probe.original.id = 9;
+    probe.original.volume.radius = 20;
+    probe.original.volume.half_height = 8;
+    probe.original.path = path;
+    probe.original.path_count = 24;
+    coa_world_config_t config;
+    memset(&config, 0, sizeof config);
+    config.common = r.common;
+    config.tracks = &probe.original;
+    config.track_count = 1;
+    int error = -99;
+    coa_world_t *w = coa_world_create(&config, r.lcm, &error);
+    ck_assert_ptr_nonnull(w);
+    lcm_subscription_t *sub = lcm_subscribe(r.lcm, COA_CHANNEL_TRACK, on_track, &probe);
+    for (int64_t k = 0; k <= 45; k++) {
+        r.now = cycle(k);
+        ck_assert_int_eq(coa_world_cycle(w, r.now), COA_OK);
+        ck_assert_int_eq(coa_world_cycle(w, r.now), COA_OK); /* again: nothing */
+        drain(r.lcm);
+    }
+    ck_assert_int_eq(probe.count, 46);
+    ck_assert_int_gt(probe.truncated, 0);
+    ck_assert_msg(probe.worst < 1e-6, "worst error %g m", probe.worst);
+    lcm_unsubscribe(r.lcm, sub);
+    coa_world_destroy(w);
+    lcm_destroy(r.lcm);
+}
+END_TEST
+
+/* ---- configuration ---- */
+
+START_TEST(test_bad_configs_refused)
+{
+    rig_t r;
+    rig_init(&r, 10);
+    coa_node_common_t c;
+    ck_assert_int_eq(coa_node_common_defaults(&c, EPOCH, (coa_real_t)1, 128, &r.now), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coa_node_common_defaults(&c, EPOCH, (coa_real_t)0, 10, &r.now), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coa_node_common_defaults(&c, 0, (coa_real_t)1, 10, &r.now), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coa_node_common_defaults(&c, EPOCH, (coa_real_t)1, 10, NULL), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coa_node_cycle_of(&r.common, EPOCH - 1), -1);
+    ck_assert_int_eq(coa_node_cycle_of(&r.common, EPOCH + 2 * DT_US), 2);
+    ck_assert_int_eq(coa_node_cycle_utime(&r.common, 3), EPOCH + 3 * DT_US);
+
+    coa_vec3_t route[2];
+    coa_vehicle_node_config_t vc;
+    memset(&vc, 0, sizeof vc);
+    vc.common = r.common;
+    vc.vehicle = uav(1, 1, route, 0, 500, 0, 100);
+    vc.mode = COA_NODE_DECOUPLED;
+    int error = 0;
+    vc.vehicle.cruise_speed = -1;
+    ck_assert_ptr_null(coa_vehicle_node_create(&vc, r.lcm, &error));
+    ck_assert_int_eq(error, COA_ERR_ARGUMENT);
+    vc.vehicle.cruise_speed = 10;
+    vc.mode = (coa_node_mode_t)7;
+    ck_assert_ptr_null(coa_vehicle_node_create(&vc, r.lcm, &error));
+    vc.mode = COA_NODE_DECOUPLED;
+    vc.common.horizon = 128;
+    ck_assert_ptr_null(coa_vehicle_node_create(&vc, r.lcm, &error));
+    vc.common.horizon = 10;
+    ck_assert_ptr_null(coa_vehicle_node_create(&vc, NULL, &error));
+    vc.priority_wait_us = -1;
+    ck_assert_ptr_null(coa_vehicle_node_create(&vc, r.lcm, &error));
+
+    coa_coordinator_config_t cc;
+    memset(&cc, 0, sizeof cc);
+    cc.common = r.common;
+    cc.max_centralised = COA_MAX_CENTRALISED + 1u;
+    ck_assert_ptr_null(coa_coordinator_create(&cc, r.lcm, &error));
+    ck_assert_int_eq(error, COA_ERR_ARGUMENT);
+    cc.max_centralised = 2;
+    cc.collect_us = DT_US;
+    ck_assert_ptr_null(coa_coordinator_create(&cc, r.lcm, &error));
+
+    coa_world_config_t wc;
+    memset(&wc, 0, sizeof wc);
+    wc.common = r.common;
+    coa_obstacle_t boxes[65];
+    memset(boxes, 0, sizeof boxes);
+    wc.obstacles = boxes;
+    wc.obstacle_count = 65; /* one more than a map message holds */
+    ck_assert_ptr_null(coa_world_create(&wc, r.lcm, &error));
+    ck_assert_int_eq(error, COA_ERR_ARGUMENT);
+
+    ck_assert_int_eq(coa_vehicle_node_cycle(NULL, EPOCH), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coa_coordinator_cycle(NULL, EPOCH), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coa_world_cycle(NULL, EPOCH), COA_ERR_ARGUMENT);
+    coa_vehicle_node_destroy(NULL);
+    coa_coordinator_destroy(NULL);
+    coa_world_destroy(NULL);
+    lcm_destroy(r.lcm);
+}
+END_TEST
+
+static Suite *node_suite(void)
+{
+    Suite *s = suite_create("node");
+    TCase *tc = tcase_create("node");
+    tcase_set_timeout(tc, 120);
+    tcase_add_test(tc, test_undecodable_counted_own_ignored);
+    tcase_add_test(tc, test_restarted_peer_accepted_after_silence);
+    tcase_add_test(tc, test_plan_adoption_rules);
+    tcase_add_test(tc, test_fallback_and_return);
+    tcase_add_test(tc, test_lower_priority_waits);
+    tcase_add_test(tc, test_wait_ends_at_deadline);
+    tcase_add_test(tc, test_silent_uav_avoided_as_track);
+    tcase_add_test(tc, test_world_track_estimates);
+    tcase_add_test(tc, test_bad_configs_refused);
+    suite_add_tcase(s, tc);
+    return s;
+}
+
+int main(void)
+{
+    SRunner *sr = srunner_create(node_suite());
+    srunner_run_all(sr, CK_NORMAL);
+    int failed = srunner_ntests_failed(sr);
+    srunner_free(sr);
+    return failed == 0 ? EXIT_SUCCESS : EXIT_FAILURE;
+}
+
+#else /* !COAVOID_HAVE_NODE */
+
+/* Built without LCM (COAVOID_BUILD_LCM=OFF): nothing to test. */
+int main(void)
+{
+    puts("test_node: built without the node library, skipped");
+    return EXIT_SUCCESS;
+}
+
+#endif
