@@ -758,10 +758,13 @@ static void near_traffic(const svg_t *s, size_t i, const frame_t *fr, bool draw_
                 } else {
                     snprintf(label, sizeof label, "UAV %u (near)", (unsigned)f->vehicles[j].vehicle.id);
                 }
-                size_t at = (from + to) / 2u;
-                fprintf(out, "<text x=\"%.1f\" y=\"%.1f\" class=\"small\" fill=\"%s\">",
-                        px(fr, (double)at * (double)f->dt) + 4.0, py(fr, (double)row[at].z) - 6.0,
-                        colour);
+                /* Beside the run's start, outside it: conflict markers sit inside runs. */
+                double x = px(fr, (double)from * (double)f->dt);
+                bool left = x - fr->left > 90.0;
+                fprintf(out,
+                        "<text x=\"%.1f\" y=\"%.1f\" class=\"small\" fill=\"%s\"%s>",
+                        left ? x - 5.0 : x + 5.0, py(fr, (double)row[from].z) + 4.0, colour,
+                        left ? " text-anchor=\"end\"" : "");
                 put_text(out, label);
                 fputs("</text>\n", out);
                 labelled = true;

@@ -89,10 +89,13 @@ def check(result_path, scenario_path, expect):
         for k, (t, x, y, z) in enumerate(flown):
             assert t == k * dt, (k, t)
             d = sv["cruise_speed"] * t
-            assert abs(x - (x0 + ux * d)) < 1e-9 and abs(y - (y0 + uy * d)) < 1e-9, (k, x, y)
+            # Within float's precision too (COAVOID_SINGLE_PRECISION builds).
+            scale = max(1.0, abs(x0), abs(y0), abs(z0), abs(x1), abs(y1), abs(z1), d)
+            near = lambda a, b: abs(a - b) <= 1e-6 * scale
+            assert near(x, x0 + ux * d) and near(y, y0 + uy * d), (k, x, y)
             zr = z0 + (z1 - z0) * d / length
             o = (z - zr) / dh
-            assert abs(o - round(o)) < 1e-9, (k, z, zr)
+            assert abs(o - round(o)) < 1e-4, (k, z, zr)
             offsets.append(round(o))
         L = sv["cruise_speed"] * dt
         dev, eff = 0.0, 0
@@ -298,7 +301,9 @@ if command -v lcm-logger >/dev/null && [ -f "$tmp/paper.json" ]; then
         sleep 0.5
         kill -INT "$logger"
         wait "$logger"
-        if expect_status "lcm-logger log" 0 summary "$tmp/real.log" "$paper" --mode centralised --json; then
+        if [ ! -s "$tmp/real.log" ]; then
+            echo "lcm-logger part skipped: the logger heard nothing on $url (no multicast loopback?)"
+        elif expect_status "lcm-logger log" 0 summary "$tmp/real.log" "$paper" --mode centralised --json; then
             if python3 -c 'import json,sys
 a, b = (json.load(open(p)) for p in sys.argv[1:])
 for k in ("steps", "replans", "deviation", "effort", "loss_of_separation"):
