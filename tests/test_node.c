@@ -524,7 +524,9 @@ START_TEST(test_world_track_estimates)
     }
     ck_assert_int_eq(probe.count, 46);
     ck_assert_int_gt(probe.truncated, 0);
-    ck_assert_msg(probe.worst < 1e-6, "worst error %g m", probe.worst);
+    /* Rounding only: of the core's precision, on coordinates of a few hundred metres. */
+    const double tolerance = 100 * (sizeof(coa_real_t) == sizeof(float) ? 1.2e-7 : 2.3e-16) * 300;
+    ck_assert_msg(probe.worst < tolerance, "worst error %g m", probe.worst);
     lcm_unsubscribe(r.lcm, sub);
     coa_world_destroy(w);
     lcm_destroy(r.lcm);

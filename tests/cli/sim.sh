@@ -67,11 +67,13 @@ for v, sv in zip(r["vehicles"], s["vehicles"]):
         assert len(p) == 4 and all(num(x) for x in p), p
         assert abs(p[0] - k * dt) < 1e-9, f"sample {k} at t = {p[0]}"
         ref = reference(sv, k * dt)
-        scale = 1e-9 * max(1.0, abs(ref[0]), abs(ref[1]), abs(ref[2]))
-        assert abs(p[1] - ref[0]) <= scale and abs(p[2] - ref[1]) <= scale, \
+        # Rounding of the core's precision (float in a COAVOID_SINGLE_PRECISION build), far
+        # below a climb step.
+        tol = 1e-5 * max(1.0, abs(ref[0]), abs(ref[1]), abs(ref[2]))
+        assert abs(p[1] - ref[0]) <= tol and abs(p[2] - ref[1]) <= tol, \
             f"UAV {v['id']} off its reference horizontally at k = {k}: {p} vs {ref}"
         o = (p[3] - ref[2]) / dh
-        assert abs(o - round(o)) < 1e-6, f"UAV {v['id']} z at k = {k} is {o} climb steps off"
+        assert abs(o - round(o)) * dh <= tol, f"UAV {v['id']} z at k = {k} is {o} climb steps off"
         row.append(round(o))
     assert row[0] == sv.get("initial_offset", 0), f"UAV {v['id']} starts at {row[0]}"
     for a, b in zip(row, row[1:]):
