@@ -16,12 +16,14 @@
  *     --epoch gives it; the step is the scenario's dt, which every intent must agree with.
  *   - K, the last sample judged, is the last cycle for which the log holds every UAV's own
  *     intent ("complete"), and at most the scenario's 2N (the default length of a sim).
- *   - Replans: planning calls started at cycles 0..K-1. A node's heartbeat (status_t)
- *     carries the time it last planned, so each distinct non-zero last_plan_utime of a
- *     node is one call (a node plans at most once a cycle, and beats once a cycle, so
- *     none is missed unless heartbeats are). A coordinator's calls are also counted by
- *     its plan_t messages (one per cluster planned, distinct plan_id); for each
- *     coordinator the larger of the two counts is taken, since either can miss some.
+ *   - Replans: planning started at cycles 0..K-1. A node's heartbeat (status_t) carries
+ *     the time it last planned, so each distinct non-zero last_plan_utime of a node is
+ *     one occasion on which it planned. That is a lower bound on its search calls: the
+ *     heartbeat goes out once a cycle, so calls between two heartbeats show as one, and
+ *     a vehicle that searches again at the same instant (its decoupled retry around the
+ *     higher priorities only) shows as one as well, where `coavoid sim` counts both.
+ *     A coordinator's calls are also counted by its plan_t messages (one per cluster
+ *     planned, distinct plan_id); for each node the larger of the two counts is taken.
  *
  * The log is untrusted. LCM 1.3.1's reader skips anything until it finds an event's
  * magic number, reports truncation as a normal end, prints its own complaints on stderr
@@ -73,6 +75,8 @@
     "                  plan_utime of the scenario's UAVs in the log\n"                        \
     "  -h, --help      show this help\n"                                                      \
     "\n"                                                                                      \
+    "Replans are the occasions on which nodes planned, from their heartbeats' last\n"        \
+    "planning times and the coordinator's plans: a lower bound on the search calls.\n"      \
     "Samples run from cycle 0 to the last cycle in which every UAV's own intent was\n"        \
     "logged, at most twice the scenario's horizon. A sample no intent covers is taken\n"      \
     "from the scenario's reference with the offset held, and reported.\n"                     \
@@ -605,8 +609,8 @@ static int planning_compare(const void *a, const void *b)
     return 0;
 }
 
-/* Planning calls in [from, to): heartbeats' distinct (node, last_plan_utime), and for a
- * coordinator the larger of that and its distinct plan ids. */
+/* Planning in [from, to): heartbeats' distinct (node, last_plan_utime), and for each node
+ * the larger of that and its distinct plan ids (coordinators). */
 static uint32_t count_replans(log_summary_t *ls, int64_t from, int64_t to)
 {
     planning_list_t *hb = &ls->heartbeats;

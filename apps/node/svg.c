@@ -762,7 +762,7 @@ static void near_traffic(const svg_t *s, size_t i, const frame_t *fr, bool draw_
                 double x = px(fr, (double)from * (double)f->dt);
                 bool left = x - fr->left > 90.0;
                 fprintf(out,
-                        "<text x=\"%.1f\" y=\"%.1f\" class=\"small\" fill=\"%s\"%s>",
+                        "<text x=\"%.1f\" y=\"%.1f\" class=\"near\" fill=\"%s\"%s>",
                         left ? x - 5.0 : x + 5.0, py(fr, (double)row[from].z) + 4.0, colour,
                         left ? " text-anchor=\"end\"" : "");
                 put_text(out, label);
@@ -1075,6 +1075,7 @@ int coa_flight_svg(const coa_flight_t *flight, const coa_flight_eval_t *eval, FI
           ".legend{font-size:12px}\n"
           ".label{font-size:12px;font-weight:bold}\n"
           ".small{font-size:10.5px;fill:#333}\n"
+          ".near{font-size:10.5px;font-weight:bold}\n"
           ".tick{font-size:11px;fill:#333}\n"
           ".axis{font-size:12px}\n"
           "</style>\n"
