@@ -110,14 +110,20 @@ int coa_flight_svg(const coa_flight_t *flight, const coa_flight_eval_t *eval, FI
  * flown (steps + 1 samples [t, x, y, z]). Extra fields, beyond the contract: when lost,
  * "first_loss": {"vehicle": id, "step": k, "t": s}; per UAV "deviation" and "effort" when
  * eval has the per-vehicle arrays, and "unknown_samples" (samples no intent covered) when
- * known is not NULL. Numbers round-trip to the bit. Returns
- * COA_OK, COA_ERR_ARGUMENT (NULL, or an invalid record as coa_flight_conflicts) or
- * COA_ERR_WORKSPACE (out of memory, write failed). Allocates the document while printing. */
+ * known is not NULL. Numbers are printed in the shortest form that reads back to the same
+ * double (cJSON's own printer settles for one within an epsilon: parsing this document
+ * with cJSON and printing it again loses the exactness; splice text into it instead).
+ * Returns COA_OK, COA_ERR_ARGUMENT (NULL; counts, steps or dt out of range; NULL arrays;
+ * a loss without a valid first_vehicle) or COA_ERR_WORKSPACE (out of memory, write
+ * failed). Cost O(K n); allocates the document, O(K n), while printing. */
 int coa_flight_json(const coa_flight_t *flight, const coa_flight_eval_t *eval, FILE *out);
 
 /* Writes the result for a reader, one fact a line ("loss of separation: no", "deviation:
  * ... m^2", per UAV its costs), as `coavoid sim` and `coavoid summary` print it without
- * --json. Returns COA_OK, COA_ERR_ARGUMENT (NULL) or COA_ERR_WORKSPACE (write failed). */
+ * --json; a loss names both sides ("UAV 1 and obstacle 0") from coa_flight_conflicts.
+ * Returns COA_OK, COA_ERR_ARGUMENT (NULL, or counts out of range as coa_flight_json) or
+ * COA_ERR_WORKSPACE (write failed). Cost O(K n), plus the pairwise listing when lost,
+ * which it allocates and frees. */
 int coa_flight_text(const coa_flight_t *flight, const coa_flight_eval_t *eval, FILE *out);
 
 #endif /* COAVOID_APP_FLIGHT_H */
