@@ -12,7 +12,7 @@
 #include "cli.h"
 #include "commands.h"
 
-#ifdef COAVOID_HAVE_REALTIME /* TRANSITIONAL: COAVOID_HAVE_NODE */
+#ifdef COAVOID_HAVE_NODE
 
 #include "node.h"
 #include "realtime.h"
