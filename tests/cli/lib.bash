@@ -54,3 +54,33 @@ expect_bad() {
         pass
     fi
 }
+
+# in_multicast_netns ARGS...: runs the calling script in a private network namespace whose
+# loopback carries multicast (lo up with multicast on, 224.0.0.0/4 routed to it), so that
+# LCM's UDP multicast works where the host has no multicast route, and the test's traffic
+# never meets the host's network or another test's. Call it right after sourcing this
+# file, with the script's own arguments: outside a namespace it re-runs the script inside
+# one (`unshare --net` as root, `unshare -rn` otherwise: a user namespace) and exits with
+# its status; inside, it sets up lo and returns 0. Returns 1 after a message when it cannot
+# (no unshare permission, or no ip from iproute2).
+in_multicast_netns() {
+    if [ -n "${COAVOID_TEST_IN_NETNS:-}" ]; then
+        if ! ip link set lo up multicast on || ! ip route add 224.0.0.0/4 dev lo; then
+            echo "in_multicast_netns: cannot set up lo for multicast in the namespace"
+            return 1
+        fi
+        return 0
+    fi
+    if ! command -v ip >/dev/null; then
+        echo "in_multicast_netns: no 'ip' command (install iproute2)"
+        return 1
+    fi
+    local how=-rn
+    if [ "$(id -u)" -eq 0 ]; then how=--net; fi
+    if ! unshare "$how" true 2>/dev/null; then
+        echo "in_multicast_netns: 'unshare $how' is not permitted here"
+        return 1
+    fi
+    rm -rf "$tmp"
+    exec env COAVOID_TEST_IN_NETNS=1 unshare "$how" bash "$0" "$@"
+}
