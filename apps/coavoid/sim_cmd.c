@@ -216,6 +216,7 @@ typedef struct {
     coa_flight_vehicle_t *flown;   /* by scenario index */
     coa_vec3_t *references;
     int32_t *offsets;
+    coa_track_t *tracks;           /* the world's copy when the scenario's ids do not fit */
     double *vehicle_deviation;
     uint32_t *vehicle_effort;
     FILE *svg;
@@ -238,6 +239,7 @@ static void sim_run_free(sim_run_t *r, size_t n)
     free(r->flown);
     free(r->references);
     free(r->offsets);
+    free(r->tracks);
     free(r->vehicle_deviation);
     free(r->vehicle_effort);
     if (r->svg != NULL) {
@@ -376,6 +378,30 @@ static int sim(const sim_options_t *o, scenario_t *s)
         return cli_fail(CLI_EXIT_INTERNAL, "internal error: LCM's memq provider is unavailable");
     }
 
+    /* A track message numbers tracks 1..2^31-1, once each; the scenario may use any
+     * integer, so then the world's tracks are numbered by position instead (the ids only
+     * name tracks in the messages: the flight is judged on the scenario's own tracks). */
+    const coa_track_t *world_tracks = s->tracks;
+    bool ids_fit = true;
+    for (size_t i = 0; i < s->track_count; i++) {
+        ids_fit = ids_fit && s->tracks[i].id >= 1u && s->tracks[i].id <= (uint32_t)INT32_MAX;
+        for (size_t j = 0; j < i; j++) {
+            ids_fit = ids_fit && s->tracks[j].id != s->tracks[i].id;
+        }
+    }
+    if (!ids_fit) {
+        r.tracks = calloc(s->track_count, sizeof *r.tracks);
+        if (r.tracks == NULL) {
+            sim_run_free(&r, n);
+            return cli_fail(CLI_EXIT_INVALID, "%s: cannot allocate the tracks", file);
+        }
+        for (size_t i = 0; i < s->track_count; i++) {
+            r.tracks[i] = s->tracks[i];
+            r.tracks[i].id = (uint32_t)i + 1u;
+        }
+        world_tracks = r.tracks;
+    }
+
     int error = COA_OK;
     coa_world_config_t world;
     memset(&world, 0, sizeof world);
@@ -383,7 +409,7 @@ static int sim(const sim_options_t *o, scenario_t *s)
     world.id = COA_NODE_WORLD_ID;
     world.obstacles = s->obstacles;
     world.obstacle_count = s->obstacle_count;
-    world.tracks = s->tracks;
+    world.tracks = world_tracks;
     world.track_count = s->track_count;
     r.world = coa_world_create(&world, r.lcm, &error);
     if (r.world == NULL) {

@@ -461,16 +461,6 @@ static bool vec_finite(coa_vec3_t v)
     return isfinite((double)v.x) && isfinite((double)v.y) && isfinite((double)v.z);
 }
 
-long coa_node_view_find(const coa_node_view_t *view, uint16_t id)
-{
-    for (size_t i = 0; i < view->live_count; i++) {
-        if (view->live_id[i] == id) {
-            return (long)i;
-        }
-    }
-    return -1;
-}
-
 /* A stale UAV as a track: constant velocity from the state of its last intent, moved to
  * t = 0 at cycle_start, its sigma grown with the silence. */
 static bool stale_track(const coavoid_intent_t *msg, const coa_node_common_t *c,

@@ -171,24 +171,33 @@ typedef struct {
 typedef struct coa_vehicle_node coa_vehicle_node_t;
 
 /* Creates a vehicle node publishing and subscribing on lcm (not owned). Allocates the node,
- * its one-UAV planner (beta) and its predictor once. Returns NULL on bad config (invalid
- * vehicle, horizon > COA_NODE_MAX_HORIZON, ...) or out of memory, with *error set. */
+ * its one-UAV planner (beta) and its predictor once: about 1.4 MB of node, 1.2 MB of
+ * predictor and conflicts at N = 24, and coa_planner_workspace_size(1, beta) (6.3 MB at
+ * beta 20000). Returns NULL on bad config (invalid vehicle, horizon >
+ * COA_NODE_MAX_HORIZON, ...: COA_ERR_ARGUMENT, also when LCM refuses a subscription) or
+ * out of memory (COA_ERR_WORKSPACE), with *error set (error may be NULL). */
 coa_vehicle_node_t *coa_vehicle_node_create(const coa_vehicle_node_config_t *config, lcm_t *lcm,
                                             int *error);
 /* Unsubscribes and frees. NULL is fine. */
 void coa_vehicle_node_destroy(coa_vehicle_node_t *node);
 
 /* Starts cycle k = coa_node_cycle_of(now): flies to sample k, then step 2 of the file
- * comment. Calling it again within the same cycle does nothing. Returns COA_OK or a
- * negative error (publishing failed, internal). */
+ * comment. Calling it again within the same cycle (or an earlier one) does nothing.
+ * Returns COA_OK or a negative error (COA_ERR_ARGUMENT: NULL, now before the epoch, or an
+ * intent it cannot publish; a publishing or internal error); it publishes its intent and
+ * heartbeat even then, when it can. Cost: O(N + route) to fly; decoupled, one prediction
+ * over its peers, tracks and obstacles (coa_predict) and at most two one-UAV searches of
+ * beta expansions. No memory is allocated. */
 int coa_vehicle_node_cycle(coa_vehicle_node_t *node, int64_t now);
 
 /* Completes a decoupled wait once its condition holds at `now` (the intents arrived, or
  * priority_wait_us has passed since the cycle began). Returns 1 when it planned and
- * published, 0 when there was nothing to do or it still waits, negative on error. */
+ * published, 0 when there was nothing to do or it still waits, negative on error. Cost
+ * while waiting: one prediction (it looks again with the intents that came); then as
+ * coa_vehicle_node_cycle. No memory. */
 int coa_vehicle_node_poll(coa_vehicle_node_t *node, int64_t now);
 
-/* The utime by which poll must be called again (the end of a wait), or INT64_MAX. */
+/* The utime by which poll must be called again (the end of a wait), or INT64_MAX. O(1). */
 int64_t coa_vehicle_node_deadline(const coa_vehicle_node_t *node);
 
 const coa_vehicle_node_state_t *coa_vehicle_node_state(const coa_vehicle_node_t *node);
@@ -219,11 +228,20 @@ typedef struct {
 
 typedef struct coa_coordinator coa_coordinator_t;
 
+/* As coa_vehicle_node_create, with a planner for max_centralised UAVs at once
+ * (coa_planner_workspace_size(max_centralised, beta): 8.1 MB for 3 UAVs at beta 1000,
+ * 487 MB at beta 60000). Errors as there (collect_us >= dt, max_centralised >
+ * COA_MAX_CENTRALISED: COA_ERR_ARGUMENT). */
 coa_coordinator_t *coa_coordinator_create(const coa_coordinator_config_t *config, lcm_t *lcm,
                                           int *error);
+/* Unsubscribes and frees. NULL is fine. */
 void coa_coordinator_destroy(coa_coordinator_t *node);
 /* Step 3 of the file comment for the cycle `now` falls in (call it at cycle start +
- * collect_us). Once per cycle; again within one cycle does nothing. */
+ * collect_us). Once per cycle; again within one cycle does nothing. Returns COA_OK or the
+ * first negative error (NULL, before the epoch, a publishing or internal error); a plan
+ * that fails is not an error. Cost: one prediction, then per cluster one search of at
+ * most beta expansions (centralised: 5^n children each), and when one fails at most two
+ * more over larger groups. No memory is allocated. */
 int coa_coordinator_cycle(coa_coordinator_t *node, int64_t now);
 const coa_coordinator_state_t *coa_coordinator_state(const coa_coordinator_t *node);
 
@@ -240,11 +258,20 @@ typedef struct {
 
 typedef struct coa_world coa_world_t;
 
+/* Creates the world node (about 40 kB; it subscribes to nothing). NULL with
+ * COA_ERR_ARGUMENT when the obstacles do not fit one obstacle_map_t, there are more than
+ * COA_NODE_MAX_TRACKS tracks, or a track is invalid or its id not unique in
+ * 1..2^31-1; COA_ERR_WORKSPACE when out of memory. */
 coa_world_t *coa_world_create(const coa_world_config_t *config, lcm_t *lcm, int *error);
+/* Frees. NULL is fine. */
 void coa_world_destroy(coa_world_t *node);
 /* Step 1 of the file comment: the obstacle map (version 1, republished every cycle so that
  * late joiners get it) and every track's estimate at the cycle's start (its position and
- * velocity there; with the remaining path points of a path track). */
+ * velocity there; a path track also with its path over the next horizon: its position
+ * now, the path's points within N dt, and its position where the message's 16 points
+ * end or the horizon does). Once per cycle. Returns COA_OK or the first error (a message
+ * refused by its own check, or publishing failed). Cost O(obstacle vertices + tracks *
+ * path). No memory. */
 int coa_world_cycle(coa_world_t *node, int64_t now);
 
 #endif /* COAVOID_APP_NODE_H */

@@ -156,21 +156,24 @@ typedef struct {
     coa_track_point_t paths[COA_NODE_MAX_PEERS][COA_NODE_MAX_SAMPLES];
 } coa_node_problem_tracks_t;
 
-/* Checks a common configuration (node.h's ranges). COA_OK or COA_ERR_ARGUMENT. */
+/* Checks a common configuration (node.h's ranges). COA_OK or COA_ERR_ARGUMENT. O(1). */
 int coa_node_common_check(const coa_node_common_t *c);
 
-/* The validation context at `now` with t = 0 at `epoch`. */
+/* The validation context at `now` with t = 0 at `epoch`: messages up to a horizon and
+ * stale_after old, at most one cycle ahead. Cannot fail; O(1). */
 coa_lcm_context_t coa_node_context(const coa_node_inbox_t *in, int64_t now, int64_t epoch);
 
 /* Initialises the inbox and subscribes to intents, tracks and the obstacle map, and to
- * heartbeats (want_status) and plans (plan_handler non-NULL) when asked; counts into rx. Returns COA_OK, or COA_ERR_ARGUMENT when LCM refused a subscription
- * (everything subscribed so far is unsubscribed). */
+ * heartbeats (want_status) and plans (plan_handler non-NULL) when asked; counts into rx.
+ * Returns COA_OK, or COA_ERR_ARGUMENT when LCM refused a subscription (everything
+ * subscribed so far is unsubscribed). The handlers cost O(message) each (decoding and
+ * validation, O(senders) for the sequence rule) and allocate nothing. */
 int coa_node_inbox_init(coa_node_inbox_t *in, const coa_node_common_t *common, uint16_t self_uav,
                         uint16_t self_node, size_t peer_capacity, int64_t coordinator_timeout_us,
                         lcm_t *lcm, coa_lcm_rx_stats_t *rx, bool want_status,
                         coa_node_plan_handler_t plan_handler, void *owner);
 
-/* Unsubscribes everything. */
+/* Unsubscribes everything. O(subscriptions). */
 void coa_node_inbox_fini(coa_node_inbox_t *in);
 
 /* Forgets senders silent for too long (intents past stale_after, the coordinator past its
@@ -182,34 +185,35 @@ void coa_node_inbox_expire(coa_node_inbox_t *in, int64_t now);
 void coa_node_view_build(coa_node_view_t *view, const coa_node_inbox_t *in,
                          int64_t cycle_start, int64_t now);
 
-/* Index of a live UAV in the view, or -1. */
-long coa_node_view_find(const coa_node_view_t *view, uint16_t id);
-
-/* Whether a outranks b in the decoupled order (ascending priority, ties by ascending id). */
+/* Whether a outranks b in the decoupled order (ascending priority, ties by ascending id).
+ * O(1). */
 bool coa_node_outranks(uint32_t priority_a, uint16_t id_a, uint32_t priority_b, uint16_t id_b);
 
 /* Fills out with the planner's tracks: every real and stale track of the view and each
  * live UAV i with include[i] (its positions as a path; exactly its samples when the intent
  * is for this cycle), each sampled over samples 0..N. Returns COA_OK or COA_ERR_ARGUMENT
- * (a track that does not sample). */
+ * (a track that does not sample). Cost O(tracks * (N + path)). No memory. */
 int coa_node_problem_tracks(coa_node_problem_tracks_t *out, const coa_node_view_t *view,
                             const bool *include, const coa_node_common_t *c);
 
 /* Predicts over samples 0..N of the view's clock for plans[0..n) against the view's
- * tracks and the inbox's obstacles, then clusters. n == 0 gives no conflict. Returns
- * COA_OK or the predictor's error. */
+ * tracks and the inbox's obstacles, then clusters (labels[0..n)). n == 0 gives no
+ * conflict. Returns COA_OK, the predictor's or the clustering's error, or
+ * COA_ERR_WORKSPACE when the conflicts overflow `capacity`. Cost: coa_predict's. No
+ * memory beyond the predictor's workspace. */
 int coa_node_predict(coa_predictor_t *predictor, const coa_node_common_t *c,
                      const coa_intent_plan_t *plans, size_t n, const coa_node_view_t *view,
                      const coa_node_inbox_t *in, coa_conflict_t *conflicts, size_t capacity,
                      coa_predict_result_t *result, uint32_t *labels, size_t *cluster_count);
 
-/* The predictor's limits for a node: MAX_PEERS plans, TRACK_CAPACITY tracks, every pair
- * that can exist (so that the broad phase cannot run out). */
+/* The predictor's pair bound for a node: every pair that can exist among MAX_PEERS
+ * plans, TRACK_CAPACITY tracks and MAX_OBSTACLES obstacles, so that the broad phase
+ * cannot run out (13,280). O(1). */
 size_t coa_node_max_pairs(void);
 
 /* Publishing: encodes into tx->buf and publishes on the type's channel. COA_OK, or
  * COA_ERR_WORKSPACE (does not encode into the buffer) or COA_ERR_ARGUMENT (LCM refused
- * it). */
+ * it). O(message); our code allocates nothing (the provider may, inside lcm_publish). */
 int coa_node_publish_intent(coa_node_tx_t *tx, const coavoid_intent_t *msg);
 int coa_node_publish_plan(coa_node_tx_t *tx, const coavoid_plan_t *msg);
 int coa_node_publish_track(coa_node_tx_t *tx, const coavoid_track_t *msg);
@@ -217,7 +221,7 @@ int coa_node_publish_map(coa_node_tx_t *tx, const coavoid_obstacle_map_t *msg);
 int coa_node_publish_conflicts(coa_node_tx_t *tx, const coavoid_conflict_report_t *msg);
 int coa_node_publish_status(coa_node_tx_t *tx, const coavoid_status_t *msg);
 
-/* The common stopwatch's reading (us), 0 without one: durations are differences. */
+/* The common stopwatch's reading (us), 0 without one: durations are differences. O(1). */
 int64_t coa_node_stopwatch(const coa_node_common_t *c);
 
 #endif /* COAVOID_APP_NODE_INTERNAL_H */

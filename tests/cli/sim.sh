@@ -251,6 +251,20 @@ else
 fi
 if grep -q '<svg' "$tmp/fig.svg" && grep -q '</svg>' "$tmp/fig.svg"; then pass; else fail "--svg wrote no SVG document"; fi
 
+# Track ids a track message cannot carry (0, repeated) are the scenario's to choose: the
+# run goes on, and both tracks are avoided.
+python3 - "$scenarios/track_crossing.json" "$tmp/track_ids.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+t = s["tracks"][0]
+s["tracks"] = [dict(t, id=0), dict(t, id=0, position=[250, 250, 102], velocity=[0, -10, 0])]
+json.dump(s, open(sys.argv[2], "w"))
+PY
+sim_json track-ids "$tmp/track_ids.json" decoupled 0 '
+r["loss_of_separation"] is False
+r["replans"] >= 1
+'
+
 # ---- bad arguments and inputs ----
 
 h=$scenarios/headon.json
