@@ -23,7 +23,7 @@
 # paper scenario's heaviest plan (all three UAVs together, 48.5k nodes expanded) takes
 # about 240 ms in a RelWithDebInfo build: the default speed 2 gives it 375 ms; at speed 4
 # the first plan comes late, is refused by the vehicles and is planned again a cycle later.
-# Under the sanitizers the same plan takes about 900 ms: use --speed 0.5 there. Every
+# Under the sanitizers it takes 600 to 900 ms: use --speed 0.5 there (100 s). Every
 # process warns on stderr when its work overran its cycle.
 #
 # UDP multicast needs a multicast route. A host with a default route has one; otherwise

@@ -7,7 +7,6 @@
 #include "realtime.h"
 
 #include <errno.h>
-#include <limits.h>
 #include <math.h>
 #include <signal.h>
 #include <stdarg.h>
@@ -22,6 +21,9 @@
 /* Longest single wait: the stop flag is also looked at this often, whatever a signal's
  * delivery does to select. */
 #define RT_MAX_WAIT_US 100000
+
+/* Messages handled between two looks at the nodes' events. */
+#define RT_MAX_DRAIN 256
 
 /* Largest --steps: a day of 0.1 s cycles; more is a typo, not a run. */
 #define RT_MAX_STEPS 1000000u
@@ -66,8 +68,11 @@ int64_t coa_rt_scenario_utime(const coa_rt_clock_t *clock, int64_t wall_utime)
     if (wall_utime < clock->epoch_utime) {
         return wall_utime;
     }
-    double elapsed = (double)(wall_utime - clock->epoch_utime) * clock->speed;
-    return clock->epoch_utime + (int64_t)floor(elapsed);
+    double elapsed = floor((double)(wall_utime - clock->epoch_utime) * clock->speed);
+    if (elapsed >= (double)(INT64_MAX - clock->epoch_utime) - 2.0) {
+        return INT64_MAX;
+    }
+    return clock->epoch_utime + (int64_t)elapsed;
 }
 
 int64_t coa_rt_wall_at(const coa_rt_clock_t *clock, int64_t scenario_utime)
@@ -75,8 +80,12 @@ int64_t coa_rt_wall_at(const coa_rt_clock_t *clock, int64_t scenario_utime)
     if (scenario_utime <= clock->epoch_utime) {
         return scenario_utime;
     }
-    double elapsed = (double)(scenario_utime - clock->epoch_utime) / clock->speed;
-    int64_t wall = clock->epoch_utime + (int64_t)ceil(elapsed);
+    double elapsed = ceil((double)(scenario_utime - clock->epoch_utime) / clock->speed);
+    /* Slower than real time, a far scenario time (INT64_MAX: "never") lies beyond int64. */
+    if (elapsed >= (double)(INT64_MAX - clock->epoch_utime) - 2.0) {
+        return INT64_MAX;
+    }
+    int64_t wall = clock->epoch_utime + (int64_t)elapsed;
     /* Rounding in the division can leave it a microsecond short of the inverse. */
     while (coa_rt_scenario_utime(clock, wall) < scenario_utime) {
         wall++;
@@ -407,29 +416,31 @@ static int64_t rt_pending_deadline(const rt_run_t *r, size_t i, int64_t deadline
     return deadline == deadline_polled ? INT64_MAX : deadline;
 }
 
-/* Dispatches every message waiting, each with the clock set just before. Returns how
- * many, or COA_RT_ERR_LCM. */
+/* Dispatches the messages waiting, each with the clock set just before, at most
+ * RT_MAX_DRAIN at a time so that a flood cannot starve the nodes' own events. Returns
+ * how many, or COA_RT_ERR_LCM. */
 static int rt_drain(const rt_run_t *r)
 {
     int handled = 0;
-    for (;;) {
+    while (handled < RT_MAX_DRAIN) {
         *r->loop->now = rt_now(r);
+        errno = 0;
         int rc = lcm_handle_timeout(r->loop->lcm, 0);
         if (rc < 0) {
-            return COA_RT_ERR_LCM;
+            /* A signal during LCM's own select: the loop looks at the stop flag next. */
+            return errno == EINTR ? handled : COA_RT_ERR_LCM;
         }
         if (rc == 0) {
-            return handled;
+            break;
         }
-        if (handled < INT_MAX) {
-            handled++;
-        }
+        handled++;
     }
+    return handled;
 }
 
 /* Waits until wall time `wake` or a message, whichever is first. Returns 1 when LCM has a
  * message, 0 on time-out or a signal, COA_RT_ERR_LCM on failure. */
-static int rt_wait(const rt_run_t *r, int fd, int64_t wake_wall)
+static int rt_wait(int fd, int64_t wake_wall)
 {
     int64_t wait_us = wake_wall - coa_rt_wall_utime();
     if (wait_us < 0) {
@@ -438,7 +449,6 @@ static int rt_wait(const rt_run_t *r, int fd, int64_t wake_wall)
     if (wait_us > RT_MAX_WAIT_US) {
         wait_us = RT_MAX_WAIT_US;
     }
-    (void)r;
     fd_set fds;
     FD_ZERO(&fds);
     FD_SET(fd, &fds);
@@ -569,7 +579,7 @@ int coa_rt_run(const coa_rt_loop_t *loop, coa_rt_result_t *result)
             wake = t < wake ? t : wake;
         }
 
-        int rc = rt_wait(r, fd, coa_rt_wall_at(&loop->clock, wake));
+        int rc = rt_wait(fd, coa_rt_wall_at(&loop->clock, wake));
         if (rc < 0) {
             return rc;
         }
