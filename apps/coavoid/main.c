@@ -19,9 +19,12 @@
 #include "cli.h"
 #include "commands.h"
 
-/* summary reads LCM logs: only with the node library (COAVOID_BUILD_LCM). */
+/* summary reads LCM logs and world publishes over LCM: only with the node library
+ * (COAVOID_BUILD_LCM). */
 #ifdef COAVOID_HAVE_NODE
-#define USAGE_SUMMARY "  summary  judge a real-time run from its lcm-logger log (costs, figure)\n"
+#define USAGE_SUMMARY                                                              \
+    "  summary  judge a real-time run from its lcm-logger log (costs, figure)\n" \
+    "  world    publish a scenario's terrain and tracks to a real-time run\n"
 #else
 #define USAGE_SUMMARY ""
 #endif

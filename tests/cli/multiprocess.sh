@@ -246,6 +246,15 @@ else
     fail "--list-ids: $(cat "$tmp/ids")"
 fi
 
+# The drivers are listed where users look for them.
+if "$bin" --help | grep -q '^  world ' && "$bin" world --help | grep -q -- '--epoch UTIME' &&
+    "$vehicle" --help | grep -q -- '--coordinator-timeout S' &&
+    "$coordinator" --help | grep -q -- '--max-centralised N'; then
+    pass
+else
+    fail "--help: world is not listed, or a driver's help lacks its options"
+fi
+
 # ---- a) centralised: plans reach the vehicles, the encounters are resolved ----
 
 # A head-on pair in conflict from the start, and UAV 3 crossing UAV 1's path around
@@ -280,7 +289,7 @@ check stopped "
 rc == {'world': 0, 'coordinator': 0, 'vehicle-1': 0, 'vehicle-2': 0, 'vehicle-3': 0, 'summary': 0}
 'stopped by SIGTERM' in line['coordinator']
 num('coordinator', 'plans published') >= 1
-all(num(f'vehicle-{i}', 'fallbacks') == 1 for i in (1, 2, 3))
+all(num(f'vehicle-{i}', 'fallbacks') >= 1 for i in (1, 2, 3))
 sum(num(f'vehicle-{i}', 'plans run') for i in (1, 2, 3)) >= 1
 all(log['statuses'][str(i)][0] == 0 and log['statuses'][str(i)][-1] == 1 for i in (1, 2, 3))
 len(log['statuses']['65001']) in (12, 13)
