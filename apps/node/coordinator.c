@@ -267,12 +267,21 @@ static int plan_cluster(coa_coordinator_t *node, int64_t now, int64_t cycle_star
     problem.track_count = node->problem_tracks.count;
     problem.track_samples = node->problem_tracks.samples;
 
-    const bool centralised = count <= node->config.max_centralised;
+    bool centralised = count <= node->config.max_centralised;
     coa_plan_result_t result;
     *solved = false;
     int64_t start = coa_node_stopwatch(c);
     if (centralised) {
         rc = coa_plan_centralised(node->planner, &problem, node->offsets, &result);
+        /* The composite search grows as 5^n a node: when beta runs out before it proves
+         * anything, the cluster is planned decoupled (in priority order) rather than left
+         * to fly into its conflict. A proof of infeasibility stands: no order beats it. */
+        if (rc == COA_OK && result.status == COA_PLAN_BUDGET_EXHAUSTED && count > 1u) {
+            node->state.plans_run++;
+            node->state.clusters_planned++;
+            centralised = false;
+            rc = coa_plan_decoupled(node->planner, &problem, NULL, 1u, node->offsets, &result);
+        }
     } else {
         rc = coa_plan_decoupled(node->planner, &problem, NULL, 1u, node->offsets, &result);
     }

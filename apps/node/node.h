@@ -36,7 +36,8 @@
  *        rule), and the others plan around it in turn.
  *   3. At cycle_utime(k) + collect_us the coordinator predicts over samples k..k+N from the
  *      intents for this cycle, plans each conflicting cluster in one centralised search
- *      (decoupled, in the coordinator, for a cluster larger than its workspace holds),
+ *      (decoupled, in the coordinator, for a cluster larger than its workspace holds, or
+ *      when the composite search runs out of beta before proving anything),
  *      clusters in ascending order, each later cluster treating the new plans of the
  *      earlier ones as moving obstacles; publishes one plan_t per cluster (valid_from =
  *      cycle_utime(k), valid_until = cycle_utime(k + 1)), the conflict report, and its
