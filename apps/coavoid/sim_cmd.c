@@ -54,6 +54,10 @@
     "                       centralised: stop the coordinator before step STEP (0..K)\n"      \
     "  -h, --help           show this help\n"                                                  \
     "\n"                                                                                       \
+    "Beyond the contract's fields the result has \"fallbacks\" (times a UAV went from\n"      \
+    "following the coordinator to planning for itself) and, with --coordinator-stops,\n"      \
+    "\"coordinator_stopped_at\".\n"                                                            \
+    "\n"                                                                                       \
     "The scenario's horizon may be at most %u steps (an intent carries N + 1 samples) and\n"  \
     "it may have at most %u UAVs.\n"                                                           \
     "\n"                                                                                       \
