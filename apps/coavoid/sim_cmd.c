@@ -17,7 +17,6 @@
 
 #ifdef COAVOID_HAVE_NODE
 
-#include <cjson/cJSON.h>
 #include <lcm/lcm.h>
 
 #include "flight.h"
@@ -266,7 +265,8 @@ static bool drain(lcm_t *lcm)
 }
 
 /* The simulation result with the extras only a simulation has (how often the UAVs fell
- * back to planning for themselves), in the JSON coa_flight_json writes. */
+ * back to planning for themselves), spliced as text into the document coa_flight_json
+ * writes: parsing and printing it again through cJSON would round its exact numbers. */
 static int print_json(const coa_flight_t *flight, const coa_flight_eval_t *eval,
                       uint32_t fallbacks, const sim_options_t *o)
 {
@@ -280,26 +280,32 @@ static int print_json(const coa_flight_t *flight, const coa_flight_eval_t *eval,
     if (fclose(memory) != 0 && rc == COA_OK) {
         rc = COA_ERR_WORKSPACE;
     }
-    cJSON *root = rc == COA_OK ? cJSON_ParseWithLength(text, length) : NULL;
+    /* The object's closing brace, and the end of its last member before it. */
+    size_t close = length;
+    while (rc == COA_OK && close > 0 && text[close - 1] != '}') {
+        close--;
+    }
+    size_t member_end = close > 0 ? close - 1 : 0;
+    while (member_end > 0 && (text[member_end - 1] == '\n' || text[member_end - 1] == ' ' ||
+                              text[member_end - 1] == '\t' || text[member_end - 1] == '\r')) {
+        member_end--;
+    }
+    if (rc == COA_OK && (close == 0 || member_end == 0 || text[member_end - 1] == '{')) {
+        rc = COA_ERR_WORKSPACE; /* not the object coa_flight_json writes */
+    }
+    if (rc == COA_OK) {
+        bool ok = fwrite(text, 1, member_end, stdout) == member_end &&
+                  printf(",\n\t\"fallbacks\":\t%lu", (unsigned long)fallbacks) > 0;
+        if (ok && o->stop_text != NULL) {
+            ok = printf(",\n\t\"coordinator_stopped_at\":\t%lu", (unsigned long)o->stop_step) > 0;
+        }
+        ok = ok && fputs("\n}", stdout) >= 0 &&
+             fwrite(text + close, 1, length - close, stdout) == length - close &&
+             fflush(stdout) == 0;
+        rc = ok ? COA_OK : COA_ERR_WORKSPACE;
+    }
     free(text);
-    if (rc != COA_OK) {
-        return rc;
-    }
-    if (root == NULL) {
-        return COA_ERR_WORKSPACE;
-    }
-    bool ok = cJSON_AddNumberToObject(root, "fallbacks", (double)fallbacks) != NULL;
-    if (ok && o->stop_text != NULL) {
-        ok = cJSON_AddNumberToObject(root, "coordinator_stopped_at", (double)o->stop_step) != NULL;
-    }
-    char *printed = ok ? cJSON_Print(root) : NULL;
-    cJSON_Delete(root);
-    if (printed == NULL) {
-        return COA_ERR_WORKSPACE;
-    }
-    ok = fputs(printed, stdout) >= 0 && fputc('\n', stdout) != EOF && fflush(stdout) == 0;
-    free(printed);
-    return ok ? COA_OK : COA_ERR_WORKSPACE;
+    return rc;
 }
 
 static int sim(const sim_options_t *o, scenario_t *s)
