@@ -349,6 +349,41 @@ START_TEST(test_lower_priority_waits)
 }
 END_TEST
 
+/* A UAV waits for the intents of the higher priorities that pass near it horizontally,
+ * even with no conflict in sight: their plans for this cycle may climb into it. A far
+ * one is not waited for. */
+START_TEST(test_waits_for_near_higher_priority)
+{
+    rig_t r;
+    rig_init(&r, 24);
+    coa_vec3_t r1[2], r2[2], r3[2];
+    /* 1 and 2 meet head-on 30 m apart vertically (clear); 3 is 5 km away. */
+    coa_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, r1, 0, 600, 0, 100), COA_NODE_DECOUPLED);
+    coa_vehicle_node_t *b = vehicle_node(&r, uav(2, 2, r2, 300, -300, 0, 130), COA_NODE_DECOUPLED);
+    coa_vehicle_node_t *c = vehicle_node(&r, uav(3, 1, r3, 0, 600, 5000, 100), COA_NODE_DECOUPLED);
+    const coa_vehicle_node_state_t *sb = coa_vehicle_node_state(b);
+    ck_assert_int_eq(coa_vehicle_node_cycle(a, cycle(0)), COA_OK);
+    ck_assert_int_eq(coa_vehicle_node_cycle(c, cycle(0)), COA_OK);
+    drain(r.lcm);
+    r.now = cycle(1);
+    ck_assert_int_eq(coa_vehicle_node_cycle(b, r.now), COA_OK);
+    drain(r.lcm);
+    ck_assert(sb->waiting);
+    ck_assert(!sb->published);
+    ck_assert_uint_eq(sb->conflicts, 0);
+    ck_assert_int_eq(coa_vehicle_node_cycle(a, r.now), COA_OK);
+    drain(r.lcm);
+    /* 3 has not published for this cycle either, but it is far: 2 goes on. */
+    ck_assert_int_eq(coa_vehicle_node_poll(b, r.now), 1);
+    ck_assert(sb->published);
+    ck_assert_uint_eq(sb->plans_run, 0);
+    coa_vehicle_node_destroy(c);
+    coa_vehicle_node_destroy(b);
+    coa_vehicle_node_destroy(a);
+    lcm_destroy(r.lcm);
+}
+END_TEST
+
 START_TEST(test_wait_ends_at_deadline)
 {
     rig_t r;
@@ -609,6 +644,7 @@ static Suite *node_suite(void)
     tcase_add_test(tc, test_plan_adoption_rules);
     tcase_add_test(tc, test_fallback_and_return);
     tcase_add_test(tc, test_lower_priority_waits);
+    tcase_add_test(tc, test_waits_for_near_higher_priority);
     tcase_add_test(tc, test_wait_ends_at_deadline);
     tcase_add_test(tc, test_silent_uav_avoided_as_track);
     tcase_add_test(tc, test_world_track_estimates);

@@ -643,16 +643,8 @@ size_t coa_node_max_pairs(void)
     return n * (n - 1u) / 2u + n * COA_NODE_TRACK_CAPACITY + n * COA_NODE_MAX_OBSTACLES;
 }
 
-int coa_node_predict(coa_predictor_t *predictor, const coa_node_common_t *c,
-                     const coa_intent_plan_t *plans, size_t n, const coa_node_view_t *view,
-                     const coa_node_inbox_t *in, coa_conflict_t *conflicts, size_t capacity,
-                     coa_predict_result_t *result, uint32_t *labels, size_t *cluster_count)
+coa_predict_config_t coa_node_predict_config(const coa_node_common_t *c)
 {
-    memset(result, 0, sizeof *result);
-    *cluster_count = 0;
-    if (n == 0) {
-        return COA_OK;
-    }
     coa_predict_config_t config;
     memset(&config, 0, sizeof config);
     config.t0 = 0;
@@ -664,6 +656,20 @@ int coa_node_predict(coa_predictor_t *predictor, const coa_node_common_t *c,
     config.track_sigma_rate_vertical = c->track_sigma_rate_vertical;
     config.threshold = c->threshold;
     config.all_pairs = false;
+    return config;
+}
+
+int coa_node_predict(coa_predictor_t *predictor, const coa_node_common_t *c,
+                     const coa_intent_plan_t *plans, size_t n, const coa_node_view_t *view,
+                     const coa_node_inbox_t *in, coa_conflict_t *conflicts, size_t capacity,
+                     coa_predict_result_t *result, uint32_t *labels, size_t *cluster_count)
+{
+    memset(result, 0, sizeof *result);
+    *cluster_count = 0;
+    if (n == 0) {
+        return COA_OK;
+    }
+    coa_predict_config_t config = coa_node_predict_config(c);
     int rc = coa_predict(predictor, &config, plans, n, in->obstacles, in->obstacle_count,
                          view->tracks, view->track_count, conflicts, capacity, result);
     if (rc != COA_OK) {

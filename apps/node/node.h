@@ -14,14 +14,20 @@
  * which is scenario time t_k = k * dt (a UAV's reference is sampled at k * dt exactly).
  *
  * One cycle (the closed loop of SCENARIO_FORMAT.md, "Simulation result"):
- *   1. At cycle_utime(k) the world publishes the obstacle map and every track's estimate.
+ *   1. At cycle_utime(k) the world publishes the obstacle map and every track's estimate
+ *      (in real time a quarter cycle ahead, so that they are there when the UAVs decide).
  *   2. At cycle_utime(k) every UAV steps its simulated flight to sample k (the offset its
  *      adopted plan gives for k; a plan past its end holds its last offset).
  *      - centralised (a coordinator heartbeat heard within coordinator_timeout_us, or
  *        still inside that time since start): it publishes its intent at once (reference
  *        and offsets for samples k..k+N) and follows the coordinator;
- *      - decoupled: it predicts over samples k..k+N with its own plan and its peers'
- *        latest intents. With no conflict in its cluster (coa_predict_clusters over its
+ *      - decoupled: first it waits (until priority_wait_us has passed) for this cycle's
+ *        intents of the higher-priority UAVs whose paths pass near its own horizontally
+ *        within the horizon (the predictor's test with unbounded heights): only their
+ *        new plans can bring it a conflict it cannot see yet, since a UAV changes only
+ *        its altitude. So it decides on what they decided this cycle, whatever the order
+ *        in which the processes run, as in the simulation. Then it predicts over samples
+ *        k..k+N with its own plan and its peers' latest intents. With no conflict in its cluster (coa_predict_clusters over its
  *        view) it publishes its intent at once. Otherwise it waits until every
  *        higher-priority UAV of its cluster has published an intent for this cycle
  *        (plan_utime == cycle_utime(k)), or until priority_wait_us has passed, then plans

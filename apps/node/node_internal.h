@@ -196,6 +196,10 @@ bool coa_node_outranks(uint32_t priority_a, uint16_t id_a, uint32_t priority_b, 
 int coa_node_problem_tracks(coa_node_problem_tracks_t *out, const coa_node_view_t *view,
                             const bool *include, const coa_node_common_t *c);
 
+/* The predictor's configuration for one cycle of a node: t = 0 at the cycle's start,
+ * the common dt, horizon, sigma rates and threshold. Cannot fail; O(1). */
+coa_predict_config_t coa_node_predict_config(const coa_node_common_t *c);
+
 /* Predicts over samples 0..N of the view's clock for plans[0..n) against the view's
  * tracks and the inbox's obstacles, then clusters (labels[0..n)). n == 0 gives no
  * conflict. Returns COA_OK, the predictor's or the clustering's error, or

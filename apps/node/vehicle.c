@@ -37,6 +37,7 @@ struct coa_vehicle_node {
 
     int32_t plan_out[COA_NODE_MAX_SAMPLES];
     coa_intent_plan_t plans[COA_NODE_MAX_PEERS]; /* itself first, then the live peers */
+    coa_intent_plan_t tall[COA_NODE_MAX_PEERS];  /* the same, with unbounded height */
     uint32_t labels[COA_NODE_MAX_PEERS];
     bool include[COA_NODE_MAX_PEERS];
     coavoid_intent_t tx_intent;
@@ -140,6 +141,7 @@ static int publish_status(coa_vehicle_node_t *node, int64_t now)
                                                                       : (int64_t)s->last_nodes_expanded;
     m->outcome = s->last_outcome < 0 ? COAVOID_STATUS_T_OUTCOME_NONE : (int8_t)s->last_outcome;
     m->conflicts = s->conflicts > (uint32_t)INT32_MAX ? INT32_MAX : (int32_t)s->conflicts;
+    m->plans_run = s->plans_run > (uint32_t)INT32_MAX ? INT32_MAX : (int32_t)s->plans_run;
     m->messages_received = s->rx.received;
     m->messages_rejected = s->rx.rejected;
     m->last_reject_code = s->rx.last_reject_code;
@@ -271,6 +273,58 @@ static int plan_self(coa_vehicle_node_t *node, int64_t now, uint32_t my)
     return rc;
 }
 
+/* Whether a higher-priority UAV that may still publish this cycle's intent passes near it
+ * horizontally within the horizon. A UAV changes only its altitude, so such a UAV is the
+ * only one whose new plan can bring a conflict it does not see yet: it waits for those
+ * (until the deadline), as it would wait in a cluster. Without this it would decide on
+ * their previous intents and react a cycle late, which the simulation, where the intents
+ * of higher priorities happen to arrive first, would never show. The test is the
+ * predictor's own, with every volume made as tall as a message allows, so that only the
+ * horizontal distance (and its uncertainty) decides. Cost: one coa_predict over the live
+ * UAVs, no obstacles or tracks. */
+static bool near_pending(coa_vehicle_node_t *node, size_t n)
+{
+    const coa_node_common_t *c = &node->config.common;
+    const coa_vehicle_t *self = &node->config.vehicle;
+    const coa_node_view_t *view = &node->view;
+    bool any = false;
+    for (size_t i = 0; i < view->live_count; i++) {
+        const coa_vehicle_t *peer = &view->live_vehicle[i];
+        if (!view->live_current[i] &&
+            coa_node_outranks(peer->priority, peer->id, self->priority, self->id)) {
+            any = true;
+        }
+    }
+    if (!any) {
+        return false;
+    }
+    for (size_t i = 0; i < n; i++) {
+        node->tall[i] = node->plans[i];
+        node->tall[i].volume.half_height = (coa_real_t)COA_LCM_MAX_SIZE;
+    }
+    coa_predict_config_t config = coa_node_predict_config(c);
+    coa_predict_result_t result;
+    if (coa_predict(node->predictor, &config, node->tall, n, NULL, 0, NULL, 0, node->conflicts,
+                    node->conflict_capacity, &result) != COA_OK) {
+        return true; /* cannot tell: wait, bounded by the deadline */
+    }
+    /* Vehicle pairs come first in ascending (a, b), so its own (a == 0) survive an
+     * overflow of the array. */
+    for (size_t j = 0; j < result.conflict_count; j++) {
+        const coa_conflict_t *cf = &node->conflicts[j];
+        if (cf->kind != COA_CONFLICT_VEHICLE || cf->a != 0u) {
+            break;
+        }
+        size_t i = cf->b - 1u;
+        const coa_vehicle_t *peer = &view->live_vehicle[i];
+        if (!view->live_current[i] &&
+            coa_node_outranks(peer->priority, peer->id, self->priority, self->id)) {
+            return true;
+        }
+    }
+    return result.overflow && result.conflict_count == 0u;
+}
+
 /* The decoupled step: predict with what it has; publish at once without a conflict;
  * otherwise wait for the higher-priority members of its cluster (until the deadline),
  * then plan and publish. Returns 1 when it published, 0 while it waits, or an error. */
@@ -295,6 +349,10 @@ static int decide(coa_vehicle_node_t *node, int64_t now)
         node->plans[i + 1u] = view->live_plan[i];
     }
     const size_t n = view->live_count + 1u;
+    if (now < node->wait_deadline && near_pending(node, n)) {
+        node->state.waiting = true;
+        return 0;
+    }
     coa_predict_result_t result;
     size_t clusters = 0;
     int rc = coa_node_predict(node->predictor, c, node->plans, n, view, &node->inbox,
