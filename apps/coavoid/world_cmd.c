@@ -115,6 +115,7 @@ int command_world(int argc, char **argv)
     loop.common = &config.common;
     loop.steps = rt.steps;
     loop.world = node;
+    loop.world_lead_us = config.common.dt_us / 4;
     loop.name = "world";
     loop.warnings = stderr;
     coa_rt_result_t result;

@@ -370,7 +370,10 @@ static void rt_cycle_start(const rt_run_t *r, int64_t k)
     if (loop->world != NULL) {
         int64_t started = coa_rt_stopwatch_us(NULL);
         *loop->now = rt_now(r);
-        int rc = coa_world_cycle(loop->world, *loop->now);
+        /* Ahead of the cycle (world_lead_us), its messages still speak of the cycle. */
+        int64_t at = *loop->now > coa_node_cycle_utime(r->common, k) ? *loop->now
+                                                                      : coa_node_cycle_utime(r->common, k);
+        int rc = coa_world_cycle(loop->world, at);
         if (rc < 0) {
             rt_error(r, "the world's cycle", k, rc);
         }
@@ -495,6 +498,10 @@ int coa_rt_run(const coa_rt_loop_t *loop, coa_rt_result_t *result)
         first = 0;
     }
     bool has_starts = loop->world != NULL || loop->vehicle_count > 0;
+    const int64_t lead = (loop->world != NULL && loop->vehicle_count == 0 &&
+                          loop->world_lead_us > 0 && loop->world_lead_us < c->dt_us)
+                             ? loop->world_lead_us
+                             : 0;
     int64_t next_start = has_starts ? first : K + 1;
     int64_t next_collect = K;
     if (loop->coordinator != NULL) {
@@ -511,8 +518,8 @@ int coa_rt_run(const coa_rt_loop_t *loop, coa_rt_result_t *result)
         }
         now = rt_now(r);
 
-        if (next_start <= K && now >= coa_node_cycle_utime(c, next_start)) {
-            int64_t k = coa_node_cycle_of(c, now);
+        if (next_start <= K && now >= coa_node_cycle_utime(c, next_start) - lead) {
+            int64_t k = coa_node_cycle_of(c, now + lead);
             if (k > K) {
                 k = K;
             }
@@ -571,7 +578,7 @@ int coa_rt_run(const coa_rt_loop_t *loop, coa_rt_result_t *result)
             break;
         }
         if (next_start <= K) {
-            int64_t t = coa_node_cycle_utime(c, next_start);
+            int64_t t = coa_node_cycle_utime(c, next_start) - lead;
             wake = t < wake ? t : wake;
         }
         if (next_collect < K) {

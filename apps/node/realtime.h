@@ -16,7 +16,8 @@
  * The loop (coa_rt_run). Between events it waits on LCM's file descriptor and, for every
  * message, sets the clock variable the nodes read (common.clock) and lets LCM dispatch it
  * (lcm_handle_timeout). At its times it calls:
- *   - at cycle_utime(k), k = first..K: the world's cycle, then each vehicle's cycle;
+ *   - at cycle_utime(k), k = first..K: the world's cycle, then each vehicle's cycle (a
+ *     world alone in its process runs cycle k world_lead_us earlier);
  *   - at cycle_utime(k) + collect_us, k = first..K-1: the coordinator's cycle;
  *   - a vehicle's poll at its deadline, and after every message while it waits.
  * So a run of K cycles (--steps K) flies samples 0..K, as `coavoid sim --steps K` does:
@@ -141,6 +142,11 @@ typedef struct {
     const coa_node_common_t *common; /* any node's: epoch (as scenario time), dt_us */
     int64_t steps;                   /* K */
     int64_t collect_us;              /* the coordinator's, when there is one */
+    /* The world alone (no vehicle in the loop): how long before cycle k's start it
+     * publishes cycle k's map and track estimates (stamped with the cycle's start, at most
+     * one cycle ahead), so that they are in every vehicle's view when the cycle begins, as
+     * in `coavoid sim`, where the world's cycle runs first. 0: at the cycle's start. */
+    int64_t world_lead_us;
     coa_world_t *world;              /* each optional */
     coa_coordinator_t *coordinator;
     coa_vehicle_node_t *const *vehicles;
