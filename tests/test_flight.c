@@ -858,6 +858,7 @@ static int write_log(int argc, char **argv)
             if (i == n && planned) {
                 hb.last_plan_utime = LOG_EPOCH + 1000;
                 hb.outcome = COAVOID_STATUS_T_OUTCOME_SOLVED;
+                hb.plans_run = 1;
             }
             if (coa_lcm_status_check(&hb, &ctx, &reason) != COA_OK ||
                 put_event(w, hb.utime, COA_CHANNEL_STATUS,

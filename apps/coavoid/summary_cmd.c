@@ -16,14 +16,9 @@
  *     --epoch gives it; the step is the scenario's dt, which every intent must agree with.
  *   - K, the last sample judged, is the last cycle for which the log holds every UAV's own
  *     intent ("complete"), and at most the scenario's 2N (the default length of a sim).
- *   - Replans: planning started at cycles 0..K-1. A node's heartbeat (status_t) carries
- *     the time it last planned, so each distinct non-zero last_plan_utime of a node is
- *     one occasion on which it planned. That is a lower bound on its search calls: the
- *     heartbeat goes out once a cycle, so calls between two heartbeats show as one, and
- *     a vehicle that searches again at the same instant (its decoupled retry around the
- *     higher priorities only) shows as one as well, where `coavoid sim` counts both.
- *     A coordinator's calls are also counted by its plan_t messages (one per cluster
- *     planned, distinct plan_id); for each node the larger of the two counts is taken.
+ *   - Replans: every node's heartbeat (status_t) carries plans_run, its planning calls
+ *     since it started; the replans of a run are the sum over nodes of the largest
+ *     plans_run among their heartbeats up to cycle K, which is what `coavoid sim` counts.
  *
  * The log is untrusted. LCM 1.3.1's reader skips anything until it finds an event's
  * magic number, reports truncation as a normal end, prints its own complaints on stderr
@@ -75,8 +70,8 @@
     "                  plan_utime of the scenario's UAVs in the log\n"                        \
     "  -h, --help      show this help\n"                                                      \
     "\n"                                                                                      \
-    "Replans are the occasions on which nodes planned, from their heartbeats' last\n"        \
-    "planning times and the coordinator's plans: a lower bound on the search calls.\n"      \
+    "Replans are the planning calls of every node up to the last sample, from the\n"       \
+    "plans_run of their heartbeats (as coavoid sim counts them).\n"                          \
     "Samples run from cycle 0 to the last cycle in which every UAV's own intent was\n"        \
     "logged, at most twice the scenario's horizon. A sample no intent covers is taken\n"      \
     "from the scenario's reference with the offset held, and reported.\n"                     \
@@ -345,8 +340,8 @@ static int log_next(log_reader_t *r, lcm_eventlog_event_t **event)
 typedef struct {
     uint32_t node;
     int8_t kind;
-    int64_t utime; /* last_plan_utime, or a plan's valid_from */
-    int64_t id;    /* plan_id for plans, 0 for heartbeats */
+    int64_t utime; /* the heartbeat's utime, or a plan's valid_from */
+    int64_t id;    /* plan_id for plans, plans_run for heartbeats */
 } planning_t;
 
 typedef struct {
@@ -427,7 +422,7 @@ typedef struct {
     const char *other_reason;   /* the first refusal of a status or plan */
 
     intent_list_t seen;         /* accepted intents of the scenario's UAVs */
-    planning_list_t heartbeats; /* (node, last_plan_utime) of accepted heartbeats */
+    planning_list_t heartbeats; /* (node, utime, plans_run) of accepted heartbeats */
     planning_list_t plan_list;  /* (coordinator, valid_from, plan_id) of accepted plans */
     int64_t first_plan_utime[COA_MAX_VEHICLES];
     int64_t intents_of[COA_MAX_VEHICLES];
@@ -559,9 +554,9 @@ static int read_log(log_summary_t *ls, log_reader_t *r)
             if (vrc != COA_OK) {
                 ls->statuses_refused++;
                 note_other(ls, reason);
-            } else if (ls->status.last_plan_utime > 0) {
+            } else if (ls->status.plans_run > 0) {
                 planning_t item = {(uint32_t)ls->status.node_id, ls->status.node_kind,
-                                   ls->status.last_plan_utime, 0};
+                                   ls->status.utime, ls->status.plans_run};
                 ok = planning_add(&ls->heartbeats, item);
             }
         } else if (strcmp(e->channel, COA_CHANNEL_PLAN) == 0) {
@@ -609,50 +604,24 @@ static int planning_compare(const void *a, const void *b)
     return 0;
 }
 
-/* Planning in [from, to): heartbeats' distinct (node, last_plan_utime), and for each node
- * the larger of that and its distinct plan ids (coordinators). */
-static uint32_t count_replans(log_summary_t *ls, int64_t from, int64_t to)
+/* Planning calls up to `to`: per node, the largest plans_run of its heartbeats stamped
+ * before `to`, summed over the nodes. */
+static uint32_t count_replans(log_summary_t *ls, int64_t to)
 {
     planning_list_t *hb = &ls->heartbeats;
-    planning_list_t *pl = &ls->plan_list;
     uint64_t total = 0;
     if (hb->count > 0u) {
         qsort(hb->items, hb->count, sizeof *hb->items, planning_compare);
     }
-    if (pl->count > 0u) {
-        qsort(pl->items, pl->count, sizeof *pl->items, planning_compare);
-    }
-    size_t h = 0;
-    size_t p = 0;
-    /* Nodes in ascending id across both lists. */
-    while (h < hb->count || p < pl->count) {
-        uint32_t node = h < hb->count ? hb->items[h].node : UINT32_MAX;
-        if (p < pl->count && pl->items[p].node < node) {
-            node = pl->items[p].node;
-        }
-        uint64_t beats = 0;
-        uint64_t plans = 0;
-        bool have = false;
-        int64_t last = 0;
+    for (size_t h = 0; h < hb->count;) {
+        uint32_t node = hb->items[h].node;
+        int64_t most = 0;
         for (; h < hb->count && hb->items[h].node == node; h++) {
-            int64_t t = hb->items[h].utime;
-            if (t >= from && t < to && (!have || t != last)) {
-                beats++;
-                have = true;
-                last = t;
+            if (hb->items[h].utime < to && hb->items[h].id > most) {
+                most = hb->items[h].id;
             }
         }
-        have = false;
-        for (; p < pl->count && pl->items[p].node == node; p++) {
-            int64_t t = pl->items[p].utime;
-            int64_t id = pl->items[p].id;
-            if (t >= from && t < to && (!have || id != last)) {
-                plans++;
-                have = true;
-                last = id;
-            }
-        }
-        total += beats > plans ? beats : plans;
+        total += (uint64_t)most;
     }
     return total > UINT32_MAX ? UINT32_MAX : (uint32_t)total;
 }
@@ -1063,7 +1032,7 @@ static int summarise(const summary_options_t *o, const scenario_t *s)
         flight.obstacle_count = s->obstacle_count;
         flight.tracks = s->tracks;
         flight.track_count = s->track_count;
-        flight.replans = count_replans(ls, epoch, epoch + (int64_t)b.steps * ls->dt_us);
+        flight.replans = count_replans(ls, epoch + ((int64_t)b.steps + 1) * ls->dt_us);
 
         coa_flight_eval_t eval;
         memset(&eval, 0, sizeof eval);

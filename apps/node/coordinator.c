@@ -174,6 +174,7 @@ static int publish_status(coa_coordinator_t *node, int64_t now, int64_t cycle_st
                                                                       : (int64_t)s->last_nodes_expanded;
     m->outcome = s->last_outcome < 0 ? COAVOID_STATUS_T_OUTCOME_NONE : (int8_t)s->last_outcome;
     m->conflicts = s->conflicts > (uint32_t)INT32_MAX ? INT32_MAX : (int32_t)s->conflicts;
+    m->plans_run = s->plans_run > (uint32_t)INT32_MAX ? INT32_MAX : (int32_t)s->plans_run;
     m->messages_received = s->rx.received;
     m->messages_rejected = s->rx.rejected;
     m->last_reject_code = s->rx.last_reject_code;

@@ -1151,8 +1151,9 @@ int coa_lcm_status_check(const coavoid_status_t *msg, const coa_lcm_context_t *c
     if (msg->last_plan_utime < 0 || msg->last_plan_utime > msg->utime) {
         REJECT(COA_LCM_ERR_TIME, "status: last_plan_utime negative or after utime");
     }
-    if (msg->last_plan_duration_us < 0 || msg->nodes_expanded < 0 || msg->conflicts < 0) {
-        REJECT(COA_LCM_ERR_VALUE, "status: a negative duration, node count or conflict count");
+    if (msg->last_plan_duration_us < 0 || msg->nodes_expanded < 0 || msg->conflicts < 0 ||
+        msg->plans_run < 0) {
+        REJECT(COA_LCM_ERR_VALUE, "status: a negative duration, node count, conflict count or plans_run");
     }
     if (msg->messages_received < 0 || msg->messages_rejected < 0 ||
         msg->messages_rejected > msg->messages_received) {
