@@ -37,7 +37,7 @@
     "  --coordinator-timeout S  scenario seconds of coordinator silence after which it\n"     \
     "                      plans for itself; default 2.5 * dt\n"                               \
     "  --priority-wait S   decoupled: scenario seconds it waits for the intents of the\n"     \
-    "                      higher-priority UAVs of its cluster, 0 <= S < dt; default dt / 2\n" \
+    "                      higher-priority UAVs that pass near it, 0 <= S < dt; default dt / 2\n" \
     "  --list-ids          print the scenario's vehicle ids, one per line, and exit (for\n"   \
     "                      scripts that start one process per UAV)\n"                         \
     "  -h, --help          show this help\n"                                                   \
