@@ -960,7 +960,7 @@ int main(int argc, char **argv)
 int main(void)
 {
     puts("test_flight: built without the node library, skipped");
-    return EXIT_SUCCESS;
+    return 77; /* ctest: skipped */
 }
 
 #endif

@@ -1278,7 +1278,7 @@ int main(void)
 int main(void)
 {
     puts("test_lcm: built without LCM, skipped");
-    return EXIT_SUCCESS;
+    return 77; /* ctest: skipped */
 }
 
 #endif

@@ -668,7 +668,7 @@ int main(void)
 int main(void)
 {
     puts("test_node: built without the node library, skipped");
-    return EXIT_SUCCESS;
+    return 77; /* ctest: skipped */
 }
 
 #endif
