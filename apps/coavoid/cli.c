@@ -9,6 +9,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "coavoid/coavoid.h"
+
 int cli_fail(int status, const char *fmt, ...)
 {
     char line[1024];
@@ -98,6 +100,27 @@ bool cli_parse_real(const char *text, double *out)
     }
     *out = value;
     return true;
+}
+
+bool cli_workspace_fits(size_t searched, uint32_t beta)
+{
+    size_t size = coa_planner_workspace_size(searched, beta);
+    return size != 0u && size <= CLI_DEFAULT_WORKSPACE_MAX;
+}
+
+uint32_t cli_default_beta(size_t searched)
+{
+    uint32_t lo = 1u;
+    uint32_t hi = CLI_DEFAULT_BETA;
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo + 1u) / 2u;
+        if (cli_workspace_fits(searched, mid)) {
+            lo = mid;
+        } else {
+            hi = mid - 1u;
+        }
+    }
+    return lo;
 }
 
 int64_t cli_elapsed_us(const struct timespec *start, const struct timespec *end)

@@ -60,6 +60,23 @@ bool cli_parse_count(const char *text, size_t length, uint64_t max, uint64_t *ou
  * "inf" and hexadecimal, which in an option are more likely a mistake than meant. */
 bool cli_parse_real(const char *text, double *out);
 
+/* The closed-set bound beta of a planner when neither an option nor the scenario's "beta"
+ * gives one (`coavoid plan`, `coavoid sim`, coavoid-coordinator). */
+#define CLI_DEFAULT_BETA 20000u
+/* The default beta is lowered until the worst-case workspace fits this many bytes: the
+ * workspace grows as beta * 5^n, and a default that asks a laptop for 18 GB (6 UAVs
+ * centralised) is a trap. A beta that is given is taken as given. */
+#define CLI_DEFAULT_WORKSPACE_MAX ((size_t)1u << 30)
+
+/* Whether a planner for `searched` UAVs a search at `beta` fits CLI_DEFAULT_WORKSPACE_MAX.
+ * O(1), no memory, cannot fail. */
+bool cli_workspace_fits(size_t searched, uint32_t beta);
+
+/* The default beta for `searched` UAVs a search: CLI_DEFAULT_BETA, or the largest beta whose
+ * workspace fits CLI_DEFAULT_WORKSPACE_MAX when that is smaller (1 when none does). The
+ * size grows with beta, so a bisection finds it: O(log CLI_DEFAULT_BETA), no memory. */
+uint32_t cli_default_beta(size_t searched);
+
 /* Microseconds from start to end. */
 int64_t cli_elapsed_us(const struct timespec *start, const struct timespec *end);
 

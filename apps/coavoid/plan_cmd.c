@@ -17,13 +17,6 @@
 #include "output.h"
 #include "scenario.h"
 
-/* The closed-set bound beta when neither --beta nor the scenario's "beta" gives one. */
-#define COAVOID_DEFAULT_BETA 20000u
-/* The default beta is lowered until the worst-case workspace fits this many bytes: the
- * workspace grows as beta * 5^n, and a default that asks a laptop for 18 GB (6 UAVs
- * centralised) is a trap. An explicit --beta or scenario beta is taken as given. */
-#define COAVOID_DEFAULT_WORKSPACE_MAX ((size_t)1u << 30)
-
 /* How many priority orders --reorder tries unless --max-orders says otherwise. n UAVs have
  * n! orders and a failing order costs up to n searches, so an unbounded search can run for
  * hours (12! is 479 million); 7! tries every order of up to 7 UAVs, which is still well
@@ -91,7 +84,7 @@ static int parse_plan_options(int argc, char **argv, plan_options_t *o)
             options_done = true;
         } else if (strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0) {
             printf(PLAN_USAGE, SCENARIO_MAX_BYTES / (1024u * 1024u), COA_MAX_CENTRALISED,
-                   COAVOID_DEFAULT_BETA, COAVOID_DEFAULT_MAX_ORDERS,
+                   CLI_DEFAULT_BETA, COAVOID_DEFAULT_MAX_ORDERS,
                    COAVOID_DEFAULT_MAX_ORDERS_COVER);
             return CLI_EXIT_OK;
         } else if (cli_option_is(arg, "--mode")) {
@@ -249,25 +242,6 @@ static int range_error(const char *file, const scenario_t *s)
                     file, (unsigned long)s->horizon);
 }
 
-/* The default beta for `searched` vehicles a search: COAVOID_DEFAULT_BETA, or the largest
- * beta whose workspace fits COAVOID_DEFAULT_WORKSPACE_MAX when that is smaller (the size
- * grows with beta, so a bisection finds it). */
-static uint32_t default_beta(size_t searched)
-{
-    uint32_t lo = 1u;
-    uint32_t hi = COAVOID_DEFAULT_BETA;
-    while (lo < hi) {
-        uint32_t mid = lo + (hi - lo + 1u) / 2u;
-        size_t size = coa_planner_workspace_size(searched, mid);
-        if (size != 0u && size <= COAVOID_DEFAULT_WORKSPACE_MAX) {
-            lo = mid;
-        } else {
-            hi = mid - 1u;
-        }
-    }
-    return lo;
-}
-
 /* beta from --beta, else the scenario, else the default; *source names it for messages. */
 static uint32_t choose_beta(const plan_options_t *o, const scenario_t *s, size_t searched,
                             char *source, size_t source_size)
@@ -280,7 +254,7 @@ static uint32_t choose_beta(const plan_options_t *o, const scenario_t *s, size_t
         snprintf(source, source_size, "%.400s: beta %lu", o->scenario_path, (unsigned long)s->beta);
         return s->beta;
     }
-    uint32_t beta = default_beta(searched);
+    uint32_t beta = cli_default_beta(searched);
     snprintf(source, source_size, "default beta %lu", (unsigned long)beta);
     return beta;
 }

@@ -26,10 +26,6 @@
 /* Cycle 0's utime: a fixed constant (2001-09-09), never the wall clock, so that every
  * run stamps its messages alike and prints the same result. */
 #define SIM_EPOCH_UTIME INT64_C(1000000000000000)
-/* beta when the scenario gives none: `coavoid plan`'s default, lowered for a composite
- * search until its workspace fits SIM_WORKSPACE_MAX (the workspace grows as beta * 5^n). */
-#define SIM_DEFAULT_BETA 20000u
-#define SIM_WORKSPACE_MAX ((size_t)1u << 30)
 /* More steps than this is more likely a typo than a simulation anyone waits for. */
 #define SIM_MAX_STEPS 1000000u
 
@@ -186,30 +182,6 @@ static int parse_sim_options(int argc, char **argv, sim_options_t *o)
     return CLI_CONTINUE;
 }
 
-/* The largest beta up to SIM_DEFAULT_BETA whose workspace for `searched` UAVs fits
- * SIM_WORKSPACE_MAX (the size grows with beta: bisection), as `coavoid plan` chooses. */
-static uint32_t default_beta(size_t searched)
-{
-    uint32_t lo = 1u;
-    uint32_t hi = SIM_DEFAULT_BETA;
-    while (lo < hi) {
-        uint32_t mid = lo + (hi - lo + 1u) / 2u;
-        size_t size = coa_planner_workspace_size(searched, mid);
-        if (size != 0u && size <= SIM_WORKSPACE_MAX) {
-            lo = mid;
-        } else {
-            hi = mid - 1u;
-        }
-    }
-    return lo;
-}
-
-static bool workspace_fits(size_t searched, uint32_t beta)
-{
-    size_t size = coa_planner_workspace_size(searched, beta);
-    return size != 0u && size <= SIM_WORKSPACE_MAX;
-}
-
 typedef struct {
     lcm_t *lcm;
     coa_world_t *world;
@@ -347,15 +319,15 @@ static int sim(const sim_options_t *o, scenario_t *s)
 
     /* Planner sizes: each UAV plans alone; the coordinator searches up to max_centralised
      * UAVs together, fewer when the scenario's beta would not fit the cap otherwise. */
-    const uint32_t vehicle_beta = s->has_beta ? s->beta : default_beta(1u);
-    if (!workspace_fits(1u, vehicle_beta)) {
+    const uint32_t vehicle_beta = s->has_beta ? s->beta : cli_default_beta(1u);
+    if (!cli_workspace_fits(1u, vehicle_beta)) {
         return cli_fail(CLI_EXIT_INVALID,
                         "%s: beta: %lu is too large: a UAV's planner would not fit in 1 GiB", file,
                         (unsigned long)vehicle_beta);
     }
     size_t max_centralised = n < COA_MAX_CENTRALISED ? n : COA_MAX_CENTRALISED;
-    uint32_t coordinator_beta = s->has_beta ? s->beta : default_beta(max_centralised);
-    while (max_centralised > 1u && !workspace_fits(max_centralised, coordinator_beta)) {
+    uint32_t coordinator_beta = s->has_beta ? s->beta : cli_default_beta(max_centralised);
+    while (max_centralised > 1u && !cli_workspace_fits(max_centralised, coordinator_beta)) {
         max_centralised--;
     }
 

@@ -19,10 +19,6 @@
 #include "realtime.h"
 #include "scenario.h"
 
-/* The closed-set bound when neither --beta nor the scenario gives one: as `coavoid plan`,
- * lowered until the workspace for the largest cluster fits COORDINATOR_WORKSPACE_MAX. */
-#define COORDINATOR_DEFAULT_BETA 20000u
-#define COORDINATOR_WORKSPACE_MAX ((size_t)1u << 30)
 #define COORDINATOR_DEFAULT_MAX_CENTRALISED 3u
 
 #define COORDINATOR_USAGE                                                                      \
@@ -79,7 +75,7 @@ static int parse_options(int argc, char **argv, coordinator_options_t *o)
             return rc;
         }
         if (strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0) {
-            printf(COORDINATOR_USAGE, COORDINATOR_DEFAULT_BETA, COA_MAX_CENTRALISED,
+            printf(COORDINATOR_USAGE, CLI_DEFAULT_BETA, COA_MAX_CENTRALISED,
                    COORDINATOR_DEFAULT_MAX_CENTRALISED);
             return CLI_EXIT_OK;
         } else if (cli_option_is(arg, "--scenario")) {
@@ -151,24 +147,6 @@ static int parse_options(int argc, char **argv, coordinator_options_t *o)
     return CLI_CONTINUE;
 }
 
-/* The largest beta up to COORDINATOR_DEFAULT_BETA whose workspace for `searched` UAVs
- * fits COORDINATOR_WORKSPACE_MAX (the size grows with beta: bisection). */
-static uint32_t default_beta(size_t searched)
-{
-    uint32_t lo = 1u;
-    uint32_t hi = COORDINATOR_DEFAULT_BETA;
-    while (lo < hi) {
-        uint32_t mid = lo + (hi - lo + 1u) / 2u;
-        size_t size = coa_planner_workspace_size(searched, mid);
-        if (size != 0u && size <= COORDINATOR_WORKSPACE_MAX) {
-            lo = mid;
-        } else {
-            hi = mid - 1u;
-        }
-    }
-    return lo;
-}
-
 /* Everything after the options. Returns the exit status. */
 static int run(coordinator_options_t *o, scenario_t *s)
 {
@@ -195,7 +173,7 @@ static int run(coordinator_options_t *o, scenario_t *s)
     } else if (s->has_beta) {
         beta_source = "the scenario's beta";
     } else {
-        config.common.beta = default_beta(o->max_centralised);
+        config.common.beta = cli_default_beta(o->max_centralised);
         beta_source = "the default beta";
     }
     size_t size = coa_planner_workspace_size(o->max_centralised, config.common.beta);
