@@ -109,44 +109,6 @@ typedef struct {
     bool json;
 } bench_options_t;
 
-/* --name N for an integer option in lo..max; `seen` catches repetition. Returns
- * CLI_CONTINUE or the exit status. */
-static int count_option(int argc, char **argv, int *i, const char *name, uint64_t max,
-                        bool allow_zero, const char **seen, uint64_t *out)
-{
-    const char *value = NULL;
-    if (*seen != NULL) {
-        return cli_fail(CLI_EXIT_INVALID, "%s: given more than once", name);
-    }
-    if (!cli_option_value(argc, argv, i, name, &value)) {
-        return cli_fail(CLI_EXIT_INVALID, "%s: missing value (an integer from %d to %llu)", name,
-                        allow_zero ? 0 : 1, (unsigned long long)max);
-    }
-    bool zero = allow_zero && strcmp(value, "0") == 0;
-    if (!zero && !cli_parse_count(value, strlen(value), max, out)) {
-        return cli_fail(CLI_EXIT_INVALID, "%s: must be an integer from %d to %llu, got '%.40s'",
-                        name, allow_zero ? 0 : 1, (unsigned long long)max, value);
-    }
-    if (zero) {
-        *out = 0;
-    }
-    *seen = value;
-    return CLI_CONTINUE;
-}
-
-/* A flag without a value, at most once. Returns CLI_CONTINUE or the exit status. */
-static int flag_option(const char *arg, const char *name, bool *flag)
-{
-    if (strcmp(arg, name) != 0) {
-        return cli_fail(CLI_EXIT_INVALID, "%s: takes no value", name);
-    }
-    if (*flag) {
-        return cli_fail(CLI_EXIT_INVALID, "%s: given more than once", name);
-    }
-    *flag = true;
-    return CLI_CONTINUE;
-}
-
 /* Returns CLI_CONTINUE, or the exit status (help printed: 0; a usage error: 2). */
 static int parse_bench_options(int argc, char **argv, bench_options_t *o)
 {
@@ -160,40 +122,34 @@ static int parse_bench_options(int argc, char **argv, bench_options_t *o)
             print_usage();
             return CLI_EXIT_OK;
         } else if (cli_option_is(arg, "--vehicles")) {
-            status = count_option(argc, argv, &i, "--vehicles", BENCH_MAX_VEHICLES, false,
-                                  &o->vehicles_text, &value);
+            status = cli_count_option(argc, argv, &i, "--vehicles", NULL, false, BENCH_MAX_VEHICLES,
+                                      &o->vehicles_text, &value);
             o->vehicles = (uint32_t)value;
         } else if (cli_option_is(arg, "--horizon")) {
-            status = count_option(argc, argv, &i, "--horizon", COA_MAX_HORIZON, false,
-                                  &o->horizon_text, &value);
+            status = cli_count_option(argc, argv, &i, "--horizon", NULL, false, COA_MAX_HORIZON,
+                                      &o->horizon_text, &value);
             o->horizon = (uint32_t)value;
         } else if (cli_option_is(arg, "--seed")) {
-            status =
-                count_option(argc, argv, &i, "--seed", UINT64_MAX, true, &o->seed_text, &value);
+            status = cli_count_option(argc, argv, &i, "--seed", NULL, true, UINT64_MAX,
+                                      &o->seed_text, &value);
             o->seed = value;
         } else if (cli_option_is(arg, "--repeat")) {
-            status = count_option(argc, argv, &i, "--repeat", BENCH_MAX_REPEAT, false,
-                                  &o->repeat_text, &value);
+            status = cli_count_option(argc, argv, &i, "--repeat", NULL, false, BENCH_MAX_REPEAT,
+                                      &o->repeat_text, &value);
             o->repeat = (uint32_t)value;
         } else if (cli_option_is(arg, "--side-km")) {
-            const char *text = NULL;
-            if (o->side_text != NULL) {
-                return cli_fail(CLI_EXIT_INVALID, "--side-km: given more than once");
-            }
-            if (!cli_option_value(argc, argv, &i, "--side-km", &text)) {
-                return cli_fail(CLI_EXIT_INVALID, "--side-km: missing value (km, > 0)");
-            }
-            if (!cli_parse_real(text, &o->side_km) || !(o->side_km > 0) ||
-                o->side_km > BENCH_MAX_SIDE_KM) {
+            status = cli_text_option(argc, argv, &i, "--side-km", "km, > 0", true, &o->side_text);
+            if (status == CLI_CONTINUE &&
+                (!cli_parse_real(o->side_text, &o->side_km) || !(o->side_km > 0) ||
+                 o->side_km > BENCH_MAX_SIDE_KM)) {
                 return cli_fail(CLI_EXIT_INVALID,
                                 "--side-km: must be a number with 0 < L <= %g, got '%.40s'",
-                                BENCH_MAX_SIDE_KM, text);
+                                BENCH_MAX_SIDE_KM, o->side_text);
             }
-            o->side_text = text;
         } else if (cli_option_is(arg, "--all-pairs")) {
-            status = flag_option(arg, "--all-pairs", &o->all_pairs);
+            status = cli_flag_option(arg, "--all-pairs", &o->all_pairs);
         } else if (cli_option_is(arg, "--json")) {
-            status = flag_option(arg, "--json", &o->json);
+            status = cli_flag_option(arg, "--json", &o->json);
         } else {
             return cli_fail(CLI_EXIT_INVALID,
                             "bench predict: unexpected argument '%.40s' (see 'coavoid bench "

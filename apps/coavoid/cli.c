@@ -48,6 +48,69 @@ bool cli_option_value(int argc, char **argv, int *i, const char *name, const cha
     return true;
 }
 
+int cli_text_option(int argc, char **argv, int *i, const char *name, const char *hint,
+                    bool allow_empty, const char **text)
+{
+    const char *value = NULL;
+    if (*text != NULL) {
+        return cli_fail(CLI_EXIT_INVALID, "%s: given more than once", name);
+    }
+    if (!cli_option_value(argc, argv, i, name, &value) || (value[0] == '\0' && !allow_empty)) {
+        return cli_fail(CLI_EXIT_INVALID, "%s: missing value (%s)", name, hint);
+    }
+    *text = value;
+    return CLI_CONTINUE;
+}
+
+int cli_count_option(int argc, char **argv, int *i, const char *name, const char *hint,
+                     bool zero_ok, uint64_t max, const char **text, uint64_t *out)
+{
+    char range[64];
+    const char *value = *text;
+    snprintf(range, sizeof range, "an integer from %d to %llu", zero_ok ? 0 : 1,
+             (unsigned long long)max);
+    int status = cli_text_option(argc, argv, i, name, hint != NULL ? hint : range, true, &value);
+    if (status != CLI_CONTINUE) {
+        return status;
+    }
+    if (!(zero_ok ? cli_parse_index(value, max, out)
+                  : cli_parse_count(value, strlen(value), max, out))) {
+        return cli_fail(CLI_EXIT_INVALID, "%s: must be %s, got '%.40s'", name, range, value);
+    }
+    *text = value;
+    return CLI_CONTINUE;
+}
+
+int cli_flag_option(const char *arg, const char *name, bool *flag)
+{
+    if (strcmp(arg, name) != 0) {
+        return cli_fail(CLI_EXIT_INVALID, "%s: takes no value", name);
+    }
+    if (*flag) {
+        return cli_fail(CLI_EXIT_INVALID, "%s: given more than once", name);
+    }
+    *flag = true;
+    return CLI_CONTINUE;
+}
+
+int cli_mode_option(int argc, char **argv, int *i, const char **mode, bool *decoupled)
+{
+    const char *value = *mode;
+    int status = cli_text_option(argc, argv, i, "--mode", "centralised or decoupled", true, &value);
+    if (status != CLI_CONTINUE) {
+        return status;
+    }
+    if (strcmp(value, "centralised") != 0 && strcmp(value, "decoupled") != 0) {
+        return cli_fail(CLI_EXIT_INVALID,
+                        "--mode: unknown mode '%.40s' (expected centralised or decoupled)", value);
+    }
+    *mode = value;
+    if (decoupled != NULL) {
+        *decoupled = strcmp(value, "decoupled") == 0;
+    }
+    return CLI_CONTINUE;
+}
+
 bool cli_parse_count(const char *text, size_t length, uint64_t max, uint64_t *out)
 {
     uint64_t value = 0;
@@ -67,6 +130,15 @@ bool cli_parse_count(const char *text, size_t length, uint64_t max, uint64_t *ou
     }
     *out = value;
     return value >= 1;
+}
+
+bool cli_parse_index(const char *text, uint64_t max, uint64_t *out)
+{
+    if (strcmp(text, "0") == 0) {
+        *out = 0;
+        return true;
+    }
+    return cli_parse_count(text, strlen(text), max, out);
 }
 
 bool cli_parse_real(const char *text, double *out)
@@ -145,4 +217,58 @@ int cli_sample_scenario(const char *path, scenario_t *s)
         return cli_fail(CLI_EXIT_INVALID, "%s: %s", path, err);
     }
     return CLI_CONTINUE;
+}
+
+int cli_parse_args(const cli_command_t *c, int argc, char **argv, void *options,
+                   const char **args)
+{
+    size_t wanted = 0;
+    size_t given = 0;
+    bool options_done = false;
+    while (wanted < sizeof c->arguments / sizeof c->arguments[0] && c->arguments[wanted] != NULL) {
+        wanted++;
+    }
+    for (int i = c->first; i < argc; i++) {
+        const char *arg = argv[i];
+        if (options_done || arg[0] != '-' || (wanted > 0u && strcmp(arg, "-") == 0)) {
+            if (given == wanted) {
+                return cli_fail(CLI_EXIT_INVALID, "%s: unexpected argument '%.80s' (%s)", c->name,
+                                arg, c->too_many);
+            }
+            args[given++] = arg;
+            continue;
+        }
+        if (wanted > 0u && strcmp(arg, "--") == 0) {
+            options_done = true;
+            continue;
+        }
+        if (strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0) {
+            c->help();
+            return CLI_EXIT_OK;
+        }
+        int status = c->option(argc, argv, &i, options);
+        if (status == CLI_UNKNOWN_OPTION) {
+            return cli_fail(CLI_EXIT_INVALID, "%s: unknown option '%.40s' (see '%s --help')",
+                            c->name, arg, c->see);
+        }
+        if (status != CLI_CONTINUE) {
+            return status;
+        }
+    }
+    if (given < wanted) {
+        return cli_fail(CLI_EXIT_INVALID, "%s: missing %s (see '%s --help')", c->name,
+                        c->arguments[given], c->see);
+    }
+    return CLI_CONTINUE;
+}
+
+int cli_run_scenario(const char *path, int (*run)(void *options, scenario_t *s), void *options)
+{
+    scenario_t scenario;
+    int status = cli_load_scenario(path, &scenario);
+    if (status == CLI_CONTINUE) {
+        status = run(options, &scenario);
+    }
+    scenario_free(&scenario);
+    return status;
 }

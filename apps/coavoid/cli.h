@@ -51,9 +51,70 @@ bool cli_option_is(const char *arg, const char *name);
  * '=', or the next argument (consumed). false when there is none. */
 bool cli_option_value(int argc, char **argv, int *i, const char *name, const char **value);
 
+/* ---- a command's arguments ---- */
+
+/* A command's own options: argv[*i] starts with '-'. Returns CLI_CONTINUE when it was one
+ * of them (consumed with its value), CLI_UNKNOWN_OPTION when it is not, or the exit status
+ * after the one-line message. */
+#define CLI_UNKNOWN_OPTION (-2)
+typedef int (*cli_option_parser_t)(int argc, char **argv, int *i, void *options);
+
+typedef struct {
+    const char *name;          /* its messages' prefix: "plan", "coordinator" */
+    const char *see;           /* how its help is asked for: "coavoid plan" */
+    int first;                 /* argv index of its first argument: 2 for coavoid's commands */
+    const char *arguments[2];  /* its arguments in order ("LOGFILE", "SCENARIO.json"), NULL
+                                  after the last; none for the drivers, which take options */
+    const char *too_many;      /* why one more argument is refused: "one scenario only" */
+    void (*help)(void);        /* prints the usage on stdout */
+    cli_option_parser_t option;
+} cli_command_t;
+
+/* Walks argv[c->first..]: "-h" or "--help" prints the help and returns CLI_EXIT_OK; every
+ * other option goes to c->option; what is not an option is the next of c->arguments, and
+ * args[j] (room for each) is set to argument j. A command that takes arguments also takes
+ * "--" (the rest are arguments) and "-" (an argument). Returns CLI_CONTINUE, or
+ * CLI_EXIT_INVALID after one of "NAME: unexpected argument 'ARG' (TOO_MANY)", "NAME:
+ * unknown option 'ARG' (see 'SEE --help')", "NAME: missing ARGUMENT (see 'SEE --help')",
+ * or c->option's status. O(argc) plus the parser's, no memory. */
+int cli_parse_args(const cli_command_t *c, int argc, char **argv, void *options,
+                   const char **args);
+
+/* A command's step after its options: runs run(options, s) on the scenario at path, loaded
+ * (cli_load_scenario) and freed afterwards. Returns run's status, or CLI_EXIT_INVALID after
+ * the loader's message. Memory: the scenario's, until run returns. */
+int cli_run_scenario(const char *path, int (*run)(void *options, scenario_t *s), void *options);
+
+/* ---- one option's value ----
+ * Each takes the option `name` at argv[*i] (already matched by cli_option_is), consumes its
+ * value (cli_option_value), and returns CLI_CONTINUE, or CLI_EXIT_INVALID after one line:
+ * "NAME: given more than once" (each option at most once), "NAME: missing value (HINT)",
+ * or what each says of a bad value. O(length of the value), no memory. */
+
+/* Any text, which *text (NULL until given) is set to. An empty value is missing unless
+ * allow_empty (then the caller judges it). */
+int cli_text_option(int argc, char **argv, int *i, const char *name, const char *hint,
+                    bool allow_empty, const char **text);
+
+/* An integer from 1 (0 with zero_ok) to max: "NAME: must be an integer from 1 to MAX, got
+ * 'VALUE'". hint NULL: "an integer from 1 to MAX". Sets *text (NULL until given) and *out. */
+int cli_count_option(int argc, char **argv, int *i, const char *name, const char *hint,
+                     bool zero_ok, uint64_t max, const char **text, uint64_t *out);
+
+/* A flag, `arg` matched by cli_option_is(arg, name): "NAME: takes no value" for
+ * "NAME=...". Sets *flag. */
+int cli_flag_option(const char *arg, const char *name, bool *flag);
+
+/* --mode centralised|decoupled: "--mode: unknown mode 'VALUE' (expected centralised or
+ * decoupled)". Sets *mode (NULL until given) and, unless NULL, *decoupled. */
+int cli_mode_option(int argc, char **argv, int *i, const char **mode, bool *decoupled);
+
 /* `length` characters of decimal digits only (no sign, no spaces) whose value is in
  * 1..max. */
 bool cli_parse_count(const char *text, size_t length, uint64_t max, uint64_t *out);
+
+/* A whole string that is "0" or what cli_parse_count takes: a value in 0..max. */
+bool cli_parse_index(const char *text, uint64_t max, uint64_t *out);
 
 /* A whole string that is one finite decimal number (an optional sign, digits with at most
  * one point, an optional exponent): strtod alone would also take leading spaces, "nan",

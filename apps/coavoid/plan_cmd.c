@@ -66,96 +66,48 @@ typedef struct {
     uint32_t max_orders;
 } plan_options_t;
 
+static void plan_help(void)
+{
+    printf(PLAN_USAGE, SCENARIO_MAX_BYTES / (1024u * 1024u), COA_MAX_CENTRALISED,
+           CLI_DEFAULT_BETA, COAVOID_DEFAULT_MAX_ORDERS, COAVOID_DEFAULT_MAX_ORDERS_COVER);
+}
+
+static int plan_option(int argc, char **argv, int *i, void *options)
+{
+    plan_options_t *o = options;
+    const char *arg = argv[*i];
+    uint64_t value = 0;
+    int status = CLI_UNKNOWN_OPTION;
+    if (cli_option_is(arg, "--mode")) {
+        status = cli_mode_option(argc, argv, i, &o->mode, &o->decoupled);
+    } else if (cli_option_is(arg, "--priority")) {
+        status = cli_text_option(argc, argv, i, "--priority", "vehicle ids, e.g. 3,1,2", true,
+                                 &o->priority);
+    } else if (cli_option_is(arg, "--beta")) {
+        status = cli_count_option(argc, argv, i, "--beta", "an integer >= 1", false, UINT32_MAX,
+                                  &o->beta_text, &value);
+        o->beta = (uint32_t)value;
+    } else if (cli_option_is(arg, "--reorder")) {
+        status = cli_flag_option(arg, "--reorder", &o->reorder);
+    } else if (cli_option_is(arg, "--max-orders")) {
+        status = cli_count_option(argc, argv, i, "--max-orders", "an integer >= 1", false,
+                                  UINT32_MAX, &o->max_orders_text, &value);
+        o->max_orders = (uint32_t)value;
+    }
+    return status;
+}
+
+static const cli_command_t plan_command = {
+    "plan", "coavoid plan", 2, {"SCENARIO.json", NULL}, "one scenario only", plan_help,
+    plan_option};
+
 /* Returns CLI_CONTINUE, or the exit status (help printed: 0; a usage error: 2). */
 static int parse_plan_options(int argc, char **argv, plan_options_t *o)
 {
-    bool options_done = false;
     memset(o, 0, sizeof *o);
-    for (int i = 2; i < argc; i++) {
-        const char *arg = argv[i];
-        const char *value = NULL;
-        if (options_done || arg[0] != '-' || strcmp(arg, "-") == 0) {
-            if (o->scenario_path != NULL) {
-                return cli_fail(CLI_EXIT_INVALID,
-                                "plan: unexpected argument '%.80s' (one scenario only)", arg);
-            }
-            o->scenario_path = arg;
-        } else if (strcmp(arg, "--") == 0) {
-            options_done = true;
-        } else if (strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0) {
-            printf(PLAN_USAGE, SCENARIO_MAX_BYTES / (1024u * 1024u), COA_MAX_CENTRALISED,
-                   CLI_DEFAULT_BETA, COAVOID_DEFAULT_MAX_ORDERS,
-                   COAVOID_DEFAULT_MAX_ORDERS_COVER);
-            return CLI_EXIT_OK;
-        } else if (cli_option_is(arg, "--mode")) {
-            if (o->mode != NULL) {
-                return cli_fail(CLI_EXIT_INVALID, "--mode: given more than once");
-            }
-            if (!cli_option_value(argc, argv, &i, "--mode", &value)) {
-                return cli_fail(CLI_EXIT_INVALID,
-                                "--mode: missing value (centralised or decoupled)");
-            }
-            if (strcmp(value, "centralised") != 0 && strcmp(value, "decoupled") != 0) {
-                return cli_fail(CLI_EXIT_INVALID,
-                                "--mode: unknown mode '%.40s' (expected centralised or decoupled)",
-                                value);
-            }
-            o->mode = value;
-            o->decoupled = strcmp(value, "decoupled") == 0;
-        } else if (cli_option_is(arg, "--priority")) {
-            if (o->priority != NULL) {
-                return cli_fail(CLI_EXIT_INVALID, "--priority: given more than once");
-            }
-            if (!cli_option_value(argc, argv, &i, "--priority", &value)) {
-                return cli_fail(CLI_EXIT_INVALID,
-                                "--priority: missing value (vehicle ids, e.g. 3,1,2)");
-            }
-            o->priority = value;
-        } else if (cli_option_is(arg, "--beta")) {
-            uint64_t beta;
-            if (o->beta_text != NULL) {
-                return cli_fail(CLI_EXIT_INVALID, "--beta: given more than once");
-            }
-            if (!cli_option_value(argc, argv, &i, "--beta", &value)) {
-                return cli_fail(CLI_EXIT_INVALID, "--beta: missing value (an integer >= 1)");
-            }
-            if (!cli_parse_count(value, strlen(value), UINT32_MAX, &beta)) {
-                return cli_fail(CLI_EXIT_INVALID,
-                                "--beta: must be an integer from 1 to %lu, got '%.40s'",
-                                (unsigned long)UINT32_MAX, value);
-            }
-            o->beta_text = value;
-            o->beta = (uint32_t)beta;
-        } else if (strcmp(arg, "--reorder") == 0) {
-            if (o->reorder) {
-                return cli_fail(CLI_EXIT_INVALID, "--reorder: given more than once");
-            }
-            o->reorder = true;
-        } else if (cli_option_is(arg, "--reorder")) {
-            return cli_fail(CLI_EXIT_INVALID, "--reorder: takes no value");
-        } else if (cli_option_is(arg, "--max-orders")) {
-            uint64_t max_orders;
-            if (o->max_orders_text != NULL) {
-                return cli_fail(CLI_EXIT_INVALID, "--max-orders: given more than once");
-            }
-            if (!cli_option_value(argc, argv, &i, "--max-orders", &value)) {
-                return cli_fail(CLI_EXIT_INVALID, "--max-orders: missing value (an integer >= 1)");
-            }
-            if (!cli_parse_count(value, strlen(value), UINT32_MAX, &max_orders)) {
-                return cli_fail(CLI_EXIT_INVALID,
-                                "--max-orders: must be an integer from 1 to %lu, got '%.40s'",
-                                (unsigned long)UINT32_MAX, value);
-            }
-            o->max_orders_text = value;
-            o->max_orders = (uint32_t)max_orders;
-        } else {
-            return cli_fail(CLI_EXIT_INVALID,
-                            "plan: unknown option '%.40s' (see 'coavoid plan --help')", arg);
-        }
-    }
-    if (o->scenario_path == NULL) {
-        return cli_fail(CLI_EXIT_INVALID,
-                        "plan: missing SCENARIO.json (see 'coavoid plan --help')");
+    int status = cli_parse_args(&plan_command, argc, argv, o, &o->scenario_path);
+    if (status != CLI_CONTINUE) {
+        return status;
     }
     if (o->mode == NULL) {
         return cli_fail(CLI_EXIT_INVALID, "--mode: required (centralised or decoupled)");
@@ -260,8 +212,9 @@ static uint32_t choose_beta(const plan_options_t *o, const scenario_t *s, size_t
 }
 
 /* Everything after the scenario is loaded. Returns the exit status. */
-static int plan(const plan_options_t *o, scenario_t *s)
+static int plan(void *options, scenario_t *s)
 {
+    const plan_options_t *o = options;
     const char *file = o->scenario_path;
     char err[SCENARIO_ERROR_MAX];
     size_t order_storage[COA_MAX_VEHICLES];
@@ -364,11 +317,5 @@ int command_plan(int argc, char **argv)
     if (status != CLI_CONTINUE) {
         return status;
     }
-    scenario_t scenario;
-    status = cli_load_scenario(options.scenario_path, &scenario);
-    if (status == CLI_CONTINUE) {
-        status = plan(&options, &scenario);
-    }
-    scenario_free(&scenario);
-    return status;
+    return cli_run_scenario(options.scenario_path, plan, &options);
 }

@@ -75,62 +75,53 @@ static bool parse_growth(const char *text, double *horizontal, double *vertical)
            *horizontal >= 0 && *vertical >= 0;
 }
 
+static void predict_help(void)
+{
+    printf(PREDICT_USAGE, SCENARIO_MAX_BYTES / (1024u * 1024u), COAVOID_DEFAULT_THRESHOLD);
+}
+
+static int predict_option(int argc, char **argv, int *i, void *options)
+{
+    predict_options_t *o = options;
+    const char *arg = argv[*i];
+    if (cli_option_is(arg, "--threshold")) {
+        int status = cli_text_option(argc, argv, i, "--threshold", "a probability, 0 < P <= 1",
+                                     true, &o->threshold_text);
+        if (status == CLI_CONTINUE &&
+            (!cli_parse_real(o->threshold_text, &o->threshold) || !(o->threshold > 0) ||
+             o->threshold > 1)) {
+            status = cli_fail(CLI_EXIT_INVALID,
+                              "--threshold: must be a number with 0 < P <= 1, got '%.40s'",
+                              o->threshold_text);
+        }
+        return status;
+    }
+    if (cli_option_is(arg, "--sigma-growth")) {
+        int status = cli_text_option(argc, argv, i, "--sigma-growth",
+                                     "H,V in m/s, e.g. 0.5,0.1", true, &o->growth_text);
+        if (status == CLI_CONTINUE &&
+            !parse_growth(o->growth_text, &o->growth_horizontal, &o->growth_vertical)) {
+            status = cli_fail(CLI_EXIT_INVALID,
+                              "--sigma-growth: must be two numbers >= 0 as H,V (m/s), "
+                              "got '%.40s'",
+                              o->growth_text);
+        }
+        return status;
+    }
+    return CLI_UNKNOWN_OPTION;
+}
+
+static const cli_command_t predict_command = {
+    "predict", "coavoid predict", 2, {"SCENARIO.json", NULL}, "one scenario only", predict_help,
+    predict_option};
+
 /* Returns CLI_CONTINUE, or the exit status (help printed: 0; a usage error: 2). */
 static int parse_predict_options(int argc, char **argv, predict_options_t *o)
 {
-    bool options_done = false;
     memset(o, 0, sizeof *o);
-    for (int i = 2; i < argc; i++) {
-        const char *arg = argv[i];
-        const char *value = NULL;
-        if (options_done || arg[0] != '-' || strcmp(arg, "-") == 0) {
-            if (o->scenario_path != NULL) {
-                return cli_fail(CLI_EXIT_INVALID,
-                                "predict: unexpected argument '%.80s' (one scenario only)", arg);
-            }
-            o->scenario_path = arg;
-        } else if (strcmp(arg, "--") == 0) {
-            options_done = true;
-        } else if (strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0) {
-            printf(PREDICT_USAGE, SCENARIO_MAX_BYTES / (1024u * 1024u), COAVOID_DEFAULT_THRESHOLD);
-            return CLI_EXIT_OK;
-        } else if (cli_option_is(arg, "--threshold")) {
-            if (o->threshold_text != NULL) {
-                return cli_fail(CLI_EXIT_INVALID, "--threshold: given more than once");
-            }
-            if (!cli_option_value(argc, argv, &i, "--threshold", &value)) {
-                return cli_fail(CLI_EXIT_INVALID,
-                                "--threshold: missing value (a probability, 0 < P <= 1)");
-            }
-            if (!cli_parse_real(value, &o->threshold) || !(o->threshold > 0) || o->threshold > 1) {
-                return cli_fail(CLI_EXIT_INVALID,
-                                "--threshold: must be a number with 0 < P <= 1, got '%.40s'",
-                                value);
-            }
-            o->threshold_text = value;
-        } else if (cli_option_is(arg, "--sigma-growth")) {
-            if (o->growth_text != NULL) {
-                return cli_fail(CLI_EXIT_INVALID, "--sigma-growth: given more than once");
-            }
-            if (!cli_option_value(argc, argv, &i, "--sigma-growth", &value)) {
-                return cli_fail(CLI_EXIT_INVALID,
-                                "--sigma-growth: missing value (H,V in m/s, e.g. 0.5,0.1)");
-            }
-            if (!parse_growth(value, &o->growth_horizontal, &o->growth_vertical)) {
-                return cli_fail(CLI_EXIT_INVALID,
-                                "--sigma-growth: must be two numbers >= 0 as H,V (m/s), "
-                                "got '%.40s'",
-                                value);
-            }
-            o->growth_text = value;
-        } else {
-            return cli_fail(CLI_EXIT_INVALID,
-                            "predict: unknown option '%.40s' (see 'coavoid predict --help')", arg);
-        }
-    }
-    if (o->scenario_path == NULL) {
-        return cli_fail(CLI_EXIT_INVALID,
-                        "predict: missing SCENARIO.json (see 'coavoid predict --help')");
+    int status = cli_parse_args(&predict_command, argc, argv, o, &o->scenario_path);
+    if (status != CLI_CONTINUE) {
+        return status;
     }
     if (o->threshold_text == NULL) {
         o->threshold = COAVOID_DEFAULT_THRESHOLD;
@@ -342,8 +333,9 @@ static int build_plans(const char *file, const scenario_t *s, predict_memory_t *
 }
 
 /* Everything after the scenario is loaded. Returns the exit status. */
-static int predict(const predict_options_t *o, scenario_t *s)
+static int predict(void *options, scenario_t *s)
 {
+    const predict_options_t *o = options;
     const char *file = o->scenario_path;
     const size_t n = s->vehicle_count;
     const size_t tracks = s->track_count;
@@ -471,11 +463,5 @@ int command_predict(int argc, char **argv)
     if (status != CLI_CONTINUE) {
         return status;
     }
-    scenario_t scenario;
-    status = cli_load_scenario(options.scenario_path, &scenario);
-    if (status == CLI_CONTINUE) {
-        status = predict(&options, &scenario);
-    }
-    scenario_free(&scenario);
-    return status;
+    return cli_run_scenario(options.scenario_path, predict, &options);
 }

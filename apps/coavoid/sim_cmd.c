@@ -71,105 +71,49 @@ typedef struct {
     uint32_t stop_step;
 } sim_options_t;
 
-/* A step number 0..max (cli_parse_count takes 1..max). */
-static bool parse_step(const char *text, uint32_t max, uint32_t *out)
+static void sim_help(void)
 {
-    uint64_t value;
-    if (strcmp(text, "0") == 0) {
-        *out = 0;
-        return true;
-    }
-    if (!cli_parse_count(text, strlen(text), max, &value)) {
-        return false;
-    }
-    *out = (uint32_t)value;
-    return true;
+    printf(SIM_USAGE, COA_NODE_MAX_HORIZON, COA_MAX_VEHICLES);
 }
+
+static int sim_option(int argc, char **argv, int *i, void *options)
+{
+    sim_options_t *o = options;
+    const char *arg = argv[*i];
+    uint64_t value = 0;
+    int status = CLI_UNKNOWN_OPTION;
+    if (cli_option_is(arg, "--mode")) {
+        status = cli_mode_option(argc, argv, i, &o->mode, &o->decoupled);
+    } else if (cli_option_is(arg, "--steps")) {
+        status = cli_count_option(argc, argv, i, "--steps", "an integer >= 1", false,
+                                  SIM_MAX_STEPS, &o->steps_text, &value);
+        o->steps = (uint32_t)value;
+    } else if (cli_option_is(arg, "--json")) {
+        status = cli_flag_option(arg, "--json", &o->json);
+    } else if (cli_option_is(arg, "--svg")) {
+        status = cli_text_option(argc, argv, i, "--svg", "a file to write", false, &o->svg_path);
+    } else if (cli_option_is(arg, "--coordinator-stops")) {
+        status = cli_text_option(argc, argv, i, "--coordinator-stops", "a step, 0 or more", true,
+                                 &o->stop_text);
+        if (status == CLI_CONTINUE && !cli_parse_index(o->stop_text, SIM_MAX_STEPS, &value)) {
+            status = cli_fail(CLI_EXIT_INVALID,
+                              "--coordinator-stops: must be a step from 0 to %u, got '%.40s'",
+                              SIM_MAX_STEPS, o->stop_text);
+        }
+        o->stop_step = (uint32_t)value;
+    }
+    return status;
+}
+
+static const cli_command_t sim_command = {
+    "sim", "coavoid sim", 2, {"SCENARIO.json", NULL}, "one scenario only", sim_help, sim_option};
 
 static int parse_sim_options(int argc, char **argv, sim_options_t *o)
 {
-    bool options_done = false;
     memset(o, 0, sizeof *o);
-    for (int i = 2; i < argc; i++) {
-        const char *arg = argv[i];
-        const char *value = NULL;
-        if (options_done || arg[0] != '-' || strcmp(arg, "-") == 0) {
-            if (o->scenario_path != NULL) {
-                return cli_fail(CLI_EXIT_INVALID,
-                                "sim: unexpected argument '%.80s' (one scenario only)", arg);
-            }
-            o->scenario_path = arg;
-        } else if (strcmp(arg, "--") == 0) {
-            options_done = true;
-        } else if (strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0) {
-            printf(SIM_USAGE, COA_NODE_MAX_HORIZON, COA_MAX_VEHICLES);
-            return CLI_EXIT_OK;
-        } else if (cli_option_is(arg, "--mode")) {
-            if (o->mode != NULL) {
-                return cli_fail(CLI_EXIT_INVALID, "--mode: given more than once");
-            }
-            if (!cli_option_value(argc, argv, &i, "--mode", &value)) {
-                return cli_fail(CLI_EXIT_INVALID,
-                                "--mode: missing value (centralised or decoupled)");
-            }
-            if (strcmp(value, "centralised") != 0 && strcmp(value, "decoupled") != 0) {
-                return cli_fail(CLI_EXIT_INVALID,
-                                "--mode: unknown mode '%.40s' (expected centralised or decoupled)",
-                                value);
-            }
-            o->mode = value;
-            o->decoupled = strcmp(value, "decoupled") == 0;
-        } else if (cli_option_is(arg, "--steps")) {
-            uint64_t steps;
-            if (o->steps_text != NULL) {
-                return cli_fail(CLI_EXIT_INVALID, "--steps: given more than once");
-            }
-            if (!cli_option_value(argc, argv, &i, "--steps", &value)) {
-                return cli_fail(CLI_EXIT_INVALID, "--steps: missing value (an integer >= 1)");
-            }
-            if (!cli_parse_count(value, strlen(value), SIM_MAX_STEPS, &steps)) {
-                return cli_fail(CLI_EXIT_INVALID,
-                                "--steps: must be an integer from 1 to %u, got '%.40s'",
-                                SIM_MAX_STEPS, value);
-            }
-            o->steps_text = value;
-            o->steps = (uint32_t)steps;
-        } else if (strcmp(arg, "--json") == 0) {
-            if (o->json) {
-                return cli_fail(CLI_EXIT_INVALID, "--json: given more than once");
-            }
-            o->json = true;
-        } else if (cli_option_is(arg, "--json")) {
-            return cli_fail(CLI_EXIT_INVALID, "--json: takes no value");
-        } else if (cli_option_is(arg, "--svg")) {
-            if (o->svg_path != NULL) {
-                return cli_fail(CLI_EXIT_INVALID, "--svg: given more than once");
-            }
-            if (!cli_option_value(argc, argv, &i, "--svg", &value) || value[0] == '\0') {
-                return cli_fail(CLI_EXIT_INVALID, "--svg: missing value (a file to write)");
-            }
-            o->svg_path = value;
-        } else if (cli_option_is(arg, "--coordinator-stops")) {
-            if (o->stop_text != NULL) {
-                return cli_fail(CLI_EXIT_INVALID, "--coordinator-stops: given more than once");
-            }
-            if (!cli_option_value(argc, argv, &i, "--coordinator-stops", &value)) {
-                return cli_fail(CLI_EXIT_INVALID,
-                                "--coordinator-stops: missing value (a step, 0 or more)");
-            }
-            if (!parse_step(value, SIM_MAX_STEPS, &o->stop_step)) {
-                return cli_fail(CLI_EXIT_INVALID,
-                                "--coordinator-stops: must be a step from 0 to %u, got '%.40s'",
-                                SIM_MAX_STEPS, value);
-            }
-            o->stop_text = value;
-        } else {
-            return cli_fail(CLI_EXIT_INVALID,
-                            "sim: unknown option '%.40s' (see 'coavoid sim --help')", arg);
-        }
-    }
-    if (o->scenario_path == NULL) {
-        return cli_fail(CLI_EXIT_INVALID, "sim: missing SCENARIO.json (see 'coavoid sim --help')");
+    int status = cli_parse_args(&sim_command, argc, argv, o, &o->scenario_path);
+    if (status != CLI_CONTINUE) {
+        return status;
     }
     if (o->mode == NULL) {
         return cli_fail(CLI_EXIT_INVALID, "--mode: required (centralised or decoupled)");
@@ -280,8 +224,9 @@ static int print_json(const coa_flight_t *flight, const coa_flight_eval_t *eval,
     return rc;
 }
 
-static int sim(const sim_options_t *o, scenario_t *s)
+static int sim(void *options, scenario_t *s)
 {
+    const sim_options_t *o = options;
     const char *file = o->scenario_path;
     const size_t n = s->vehicle_count;
     if (s->horizon > COA_NODE_MAX_HORIZON) {
@@ -608,13 +553,7 @@ int command_sim(int argc, char **argv)
     if (status != CLI_CONTINUE) {
         return status;
     }
-    scenario_t scenario;
-    status = cli_load_scenario(options.scenario_path, &scenario);
-    if (status == CLI_CONTINUE) {
-        status = sim(&options, &scenario);
-    }
-    scenario_free(&scenario);
-    return status;
+    return cli_run_scenario(options.scenario_path, sim, &options);
 }
 
 #else

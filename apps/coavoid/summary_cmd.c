@@ -101,87 +101,52 @@ typedef struct {
     int64_t epoch;
 } summary_options_t;
 
+static void summary_help(void)
+{
+    fputs(SUMMARY_USAGE, stdout);
+}
+
+static int summary_option(int argc, char **argv, int *i, void *options)
+{
+    summary_options_t *o = options;
+    const char *arg = argv[*i];
+    int status = CLI_UNKNOWN_OPTION;
+    if (cli_option_is(arg, "--mode")) {
+        status = cli_mode_option(argc, argv, i, &o->mode, NULL);
+    } else if (cli_option_is(arg, "--json")) {
+        status = cli_flag_option(arg, "--json", &o->json);
+    } else if (cli_option_is(arg, "--svg")) {
+        status = cli_text_option(argc, argv, i, "--svg", "a file to write", false, &o->svg_path);
+    } else if (cli_option_is(arg, "--epoch")) {
+        uint64_t epoch = 0;
+        status = cli_text_option(argc, argv, i, "--epoch", "microseconds, an integer >= 1", true,
+                                 &o->epoch_text);
+        if (status == CLI_CONTINUE && !cli_parse_count(o->epoch_text, strlen(o->epoch_text),
+                                                       (uint64_t)INT64_MAX / 2u, &epoch)) {
+            return cli_fail(CLI_EXIT_INVALID,
+                            "--epoch: must be an integer from 1 to %" PRIu64
+                            " (microseconds), got '%.40s'",
+                            (uint64_t)INT64_MAX / 2u, o->epoch_text);
+        }
+        o->epoch = (int64_t)epoch;
+    }
+    return status;
+}
+
+static const cli_command_t summary_command = {
+    "summary", "coavoid summary", 2, {"LOGFILE", "SCENARIO.json"}, "one log and one scenario",
+    summary_help, summary_option};
+
 static int parse_summary_options(int argc, char **argv, summary_options_t *o)
 {
-    bool options_done = false;
+    const char *args[2] = {NULL, NULL};
     memset(o, 0, sizeof *o);
-    for (int i = 2; i < argc; i++) {
-        const char *arg = argv[i];
-        const char *value = NULL;
-        if (options_done || arg[0] != '-' || strcmp(arg, "-") == 0) {
-            if (o->log_path == NULL) {
-                o->log_path = arg;
-            } else if (o->scenario_path == NULL) {
-                o->scenario_path = arg;
-            } else {
-                return cli_fail(CLI_EXIT_INVALID,
-                                "summary: unexpected argument '%.80s' (one log and one scenario)",
-                                arg);
-            }
-        } else if (strcmp(arg, "--") == 0) {
-            options_done = true;
-        } else if (strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0) {
-            fputs(SUMMARY_USAGE, stdout);
-            return CLI_EXIT_OK;
-        } else if (cli_option_is(arg, "--mode")) {
-            if (o->mode != NULL) {
-                return cli_fail(CLI_EXIT_INVALID, "--mode: given more than once");
-            }
-            if (!cli_option_value(argc, argv, &i, "--mode", &value)) {
-                return cli_fail(CLI_EXIT_INVALID,
-                                "--mode: missing value (centralised or decoupled)");
-            }
-            if (strcmp(value, "centralised") != 0 && strcmp(value, "decoupled") != 0) {
-                return cli_fail(CLI_EXIT_INVALID,
-                                "--mode: unknown mode '%.40s' (expected centralised or decoupled)",
-                                value);
-            }
-            o->mode = value;
-        } else if (strcmp(arg, "--json") == 0) {
-            if (o->json) {
-                return cli_fail(CLI_EXIT_INVALID, "--json: given more than once");
-            }
-            o->json = true;
-        } else if (cli_option_is(arg, "--json")) {
-            return cli_fail(CLI_EXIT_INVALID, "--json: takes no value");
-        } else if (cli_option_is(arg, "--svg")) {
-            if (o->svg_path != NULL) {
-                return cli_fail(CLI_EXIT_INVALID, "--svg: given more than once");
-            }
-            if (!cli_option_value(argc, argv, &i, "--svg", &value) || value[0] == '\0') {
-                return cli_fail(CLI_EXIT_INVALID, "--svg: missing value (a file to write)");
-            }
-            o->svg_path = value;
-        } else if (cli_option_is(arg, "--epoch")) {
-            uint64_t epoch;
-            if (o->epoch_text != NULL) {
-                return cli_fail(CLI_EXIT_INVALID, "--epoch: given more than once");
-            }
-            if (!cli_option_value(argc, argv, &i, "--epoch", &value)) {
-                return cli_fail(CLI_EXIT_INVALID,
-                                "--epoch: missing value (microseconds, an integer >= 1)");
-            }
-            if (!cli_parse_count(value, strlen(value), (uint64_t)INT64_MAX / 2u, &epoch)) {
-                return cli_fail(CLI_EXIT_INVALID,
-                                "--epoch: must be an integer from 1 to %" PRIu64
-                                " (microseconds), got '%.40s'",
-                                (uint64_t)INT64_MAX / 2u, value);
-            }
-            o->epoch_text = value;
-            o->epoch = (int64_t)epoch;
-        } else {
-            return cli_fail(CLI_EXIT_INVALID,
-                            "summary: unknown option '%.40s' (see 'coavoid summary --help')", arg);
-        }
+    int status = cli_parse_args(&summary_command, argc, argv, o, args);
+    if (status != CLI_CONTINUE) {
+        return status;
     }
-    if (o->log_path == NULL) {
-        return cli_fail(CLI_EXIT_INVALID,
-                        "summary: missing LOGFILE (see 'coavoid summary --help')");
-    }
-    if (o->scenario_path == NULL) {
-        return cli_fail(CLI_EXIT_INVALID,
-                        "summary: missing SCENARIO.json (see 'coavoid summary --help')");
-    }
+    o->log_path = args[0];
+    o->scenario_path = args[1];
     if (o->mode == NULL) {
         return cli_fail(CLI_EXIT_INVALID, "--mode: required (centralised or decoupled)");
     }
@@ -921,8 +886,9 @@ static int refused_record(const summary_options_t *o, const coa_flight_t *f, con
 }
 
 /* Everything after the options and the scenario. Returns the exit status. */
-static int summarise(const summary_options_t *o, const scenario_t *s)
+static int summarise(void *options, scenario_t *s)
 {
+    const summary_options_t *o = options;
     log_summary_t *ls = calloc(1, sizeof *ls);
     rebuilt_t b;
     log_reader_t r;
@@ -1079,11 +1045,5 @@ int command_summary(int argc, char **argv)
     if (status != CLI_CONTINUE) {
         return status;
     }
-    scenario_t scenario;
-    status = cli_load_scenario(options.scenario_path, &scenario);
-    if (status == CLI_CONTINUE) {
-        status = summarise(&options, &scenario);
-    }
-    scenario_free(&scenario);
-    return status;
+    return cli_run_scenario(options.scenario_path, summarise, &options);
 }
