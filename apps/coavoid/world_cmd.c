@@ -31,107 +31,82 @@
     "\n"                                                                                      \
     "exit status: 0 done, 2 invalid input or usage (one line on stderr), 3 internal error\n"
 
-int command_world(int argc, char **argv)
+static void world_help(void)
 {
-    const char *path = NULL;
-    coa_rt_options_t rt;
-    coa_rt_options_init(&rt);
-    bool options_done = false;
-    for (int i = 2; i < argc; i++) {
-        const char *arg = argv[i];
-        if (options_done || arg[0] != '-' || strcmp(arg, "-") == 0) {
-            if (path != NULL) {
-                return cli_fail(CLI_EXIT_INVALID,
-                                "world: unexpected argument '%.80s' (one scenario only)", arg);
-            }
-            path = arg;
-            continue;
-        }
-        if (strcmp(arg, "--") == 0) {
-            options_done = true;
-            continue;
-        }
-        if (strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0) {
-            fputs(WORLD_USAGE, stdout);
-            return CLI_EXIT_OK;
-        }
-        int rc = coa_rt_parse_option(argc, argv, &i, &rt);
-        if (rc == 0) {
-            return cli_fail(CLI_EXIT_INVALID,
-                            "world: unknown option '%.40s' (see 'coavoid world --help')", arg);
-        }
-        if (rc != 1) {
-            return rc;
-        }
-    }
-    if (path == NULL) {
-        return cli_fail(CLI_EXIT_INVALID,
-                        "world: missing SCENARIO.json (see 'coavoid world --help')");
-    }
+    fputs(WORLD_USAGE, stdout);
+}
 
+static int world_option(int argc, char **argv, int *i, void *options)
+{
+    return coa_rt_parse_option(argc, argv, i, options);
+}
+
+static const cli_command_t world_command = {
+    "world", "coavoid world", 2, {"SCENARIO.json", NULL}, "one scenario only", world_help,
+    world_option};
+
+typedef struct {
+    const char *path;
+    coa_rt_options_t rt;
+} world_options_t;
+
+static void world_report(void *user, const char *name, const coa_rt_result_t *result,
+                         const char *tail)
+{
+    const scenario_t *s = user;
+    fprintf(stderr, "%s: %lld cycles, %zu obstacles and %zu tracks published each%s\n", name,
+            (long long)result->cycles, s->obstacle_count, s->track_count, tail);
+}
+
+/* Everything after the scenario is loaded. Returns the exit status. */
+static int world(void *options, scenario_t *s)
+{
+    world_options_t *o = options;
     int64_t now = 0; /* the node's clock (common.clock), written by the loop */
-    scenario_t s;
-    memset(&s, 0, sizeof s);
     coa_world_config_t config;
     memset(&config, 0, sizeof config);
-    int status = coa_rt_setup(path, &s, &rt, &now, &config.common);
+    int status = coa_rt_setup(o->path, s, &o->rt, &now, &config.common);
     if (status != CLI_CONTINUE) {
-        scenario_free(&s);
         return status;
     }
     config.id = COA_NODE_WORLD_ID;
-    config.obstacles = s.obstacles;
-    config.obstacle_count = s.obstacle_count;
-    config.tracks = s.tracks;
-    config.track_count = s.track_count;
+    config.obstacles = s->obstacles;
+    config.obstacle_count = s->obstacle_count;
+    config.tracks = s->tracks;
+    config.track_count = s->track_count;
 
     char err[512];
-    lcm_t *lcm = coa_rt_lcm_create(rt.lcm_url, err, sizeof err);
+    lcm_t *lcm = coa_rt_lcm_create(o->rt.lcm_url, err, sizeof err);
     if (lcm == NULL) {
-        scenario_free(&s);
         return cli_fail(CLI_EXIT_INVALID, "%s", err);
     }
     int error = COA_OK;
     coa_world_t *node = coa_world_create(&config, lcm, &error);
     if (node == NULL) {
         lcm_destroy(lcm);
-        scenario_free(&s);
         return cli_fail(error == COA_ERR_ARGUMENT ? CLI_EXIT_INVALID : CLI_EXIT_INTERNAL,
-                        "world: %s: cannot publish it (%s)", path, coa_lcm_error_name(error));
+                        "world: %s: cannot publish it (%s)", o->path, coa_lcm_error_name(error));
     }
-    if (coa_rt_install_signal_handlers() != 0) {
-        coa_world_destroy(node);
-        lcm_destroy(lcm);
-        scenario_free(&s);
-        return cli_fail(CLI_EXIT_INTERNAL, "world: cannot handle SIGINT/SIGTERM");
-    }
-
     coa_rt_loop_t loop;
-    memset(&loop, 0, sizeof loop);
-    loop.clock.epoch_utime = rt.epoch_utime;
-    loop.clock.speed = rt.speed;
-    loop.lcm = lcm;
-    loop.now = &now;
-    loop.common = &config.common;
-    loop.steps = rt.steps;
+    coa_rt_loop_init(&loop, &o->rt, lcm, &now, &config.common, "world");
     loop.world = node;
     loop.world_lead_us = config.common.dt_us / 4;
-    loop.name = "world";
-    loop.warnings = stderr;
-    coa_rt_result_t result;
-    int rc = coa_rt_run(&loop, &result);
-
-    char tail[256];
-    coa_rt_result_text(&result, tail, sizeof tail);
-    fprintf(stderr, "world: %lld cycles, %zu obstacles and %zu tracks published each%s\n",
-            (long long)result.cycles, s.obstacle_count, s.track_count, tail);
+    status = coa_rt_drive(&loop, o->rt.lcm_url, world_report, s);
     coa_world_destroy(node);
     lcm_destroy(lcm);
-    scenario_free(&s);
-    if (rc != COA_OK) {
-        return cli_fail(CLI_EXIT_INTERNAL, "world: LCM failed while running (%s)", rt.lcm_url);
+    return status;
+}
+
+int command_world(int argc, char **argv)
+{
+    world_options_t options;
+    options.path = NULL;
+    coa_rt_options_init(&options.rt);
+    int status = cli_parse_args(&world_command, argc, argv, &options.rt, &options.path);
+    if (status != CLI_CONTINUE) {
+        return status;
     }
-    return result.errors > 0 ? CLI_EXIT_INTERNAL : CLI_EXIT_OK;
+    return cli_run_scenario(options.path, world, &options);
 }
 
 #else

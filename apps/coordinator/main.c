@@ -59,87 +59,57 @@ typedef struct {
     coa_rt_options_t rt;
 } coordinator_options_t;
 
+static void coordinator_help(void)
+{
+    printf(COORDINATOR_USAGE, CLI_DEFAULT_BETA, COA_MAX_CENTRALISED,
+           COORDINATOR_DEFAULT_MAX_CENTRALISED);
+}
+
+static int coordinator_option(int argc, char **argv, int *i, void *options)
+{
+    coordinator_options_t *o = options;
+    const char *arg = argv[*i];
+    uint64_t value = 0;
+    int status = coa_rt_parse_option(argc, argv, i, &o->rt);
+    if (status != CLI_UNKNOWN_OPTION) {
+        return status;
+    }
+    if (cli_option_is(arg, "--scenario")) {
+        status = cli_text_option(argc, argv, i, "--scenario", "a scenario file", false,
+                                 &o->scenario_path);
+    } else if (cli_option_is(arg, "--beta")) {
+        status = cli_count_option(argc, argv, i, "--beta", "an integer >= 1", false, UINT32_MAX,
+                                  &o->beta_text, &value);
+        o->beta = (uint32_t)value;
+    } else if (cli_option_is(arg, "--max-centralised")) {
+        status = cli_count_option(argc, argv, i, "--max-centralised", NULL, false,
+                                  COA_MAX_CENTRALISED, &o->max_text, &value);
+        o->max_centralised = (size_t)value;
+    } else if (cli_option_is(arg, "--collect")) {
+        status = cli_text_option(argc, argv, i, "--collect", "scenario seconds", true,
+                                 &o->collect_text);
+        if (status == CLI_CONTINUE && (!cli_parse_real(o->collect_text, &o->collect) ||
+                                       !(o->collect > 0))) {
+            status = cli_fail(CLI_EXIT_INVALID,
+                              "--collect: must be a number of seconds > 0, got '%.40s'",
+                              o->collect_text);
+        }
+    }
+    return status;
+}
+
+static const cli_command_t coordinator_command = {
+    "coordinator", "coavoid-coordinator", 1, {NULL, NULL}, "the scenario is --scenario FILE",
+    coordinator_help, coordinator_option};
+
 static int parse_options(int argc, char **argv, coordinator_options_t *o)
 {
     memset(o, 0, sizeof *o);
     coa_rt_options_init(&o->rt);
     o->max_centralised = COORDINATOR_DEFAULT_MAX_CENTRALISED;
-    for (int i = 1; i < argc; i++) {
-        const char *arg = argv[i];
-        const char *value = NULL;
-        int rc = coa_rt_parse_option(argc, argv, &i, &o->rt);
-        if (rc == 1) {
-            continue;
-        }
-        if (rc != 0) {
-            return rc;
-        }
-        if (strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0) {
-            printf(COORDINATOR_USAGE, CLI_DEFAULT_BETA, COA_MAX_CENTRALISED,
-                   COORDINATOR_DEFAULT_MAX_CENTRALISED);
-            return CLI_EXIT_OK;
-        } else if (cli_option_is(arg, "--scenario")) {
-            if (o->scenario_path != NULL) {
-                return cli_fail(CLI_EXIT_INVALID, "--scenario: given more than once");
-            }
-            if (!cli_option_value(argc, argv, &i, "--scenario", &value) || value[0] == '\0') {
-                return cli_fail(CLI_EXIT_INVALID, "--scenario: missing value (a scenario file)");
-            }
-            o->scenario_path = value;
-        } else if (cli_option_is(arg, "--beta")) {
-            uint64_t beta;
-            if (o->beta_text != NULL) {
-                return cli_fail(CLI_EXIT_INVALID, "--beta: given more than once");
-            }
-            if (!cli_option_value(argc, argv, &i, "--beta", &value)) {
-                return cli_fail(CLI_EXIT_INVALID, "--beta: missing value (an integer >= 1)");
-            }
-            if (!cli_parse_count(value, strlen(value), UINT32_MAX, &beta)) {
-                return cli_fail(CLI_EXIT_INVALID,
-                                "--beta: must be an integer from 1 to %lu, got '%.40s'",
-                                (unsigned long)UINT32_MAX, value);
-            }
-            o->beta_text = value;
-            o->beta = (uint32_t)beta;
-        } else if (cli_option_is(arg, "--max-centralised")) {
-            uint64_t max;
-            if (o->max_text != NULL) {
-                return cli_fail(CLI_EXIT_INVALID, "--max-centralised: given more than once");
-            }
-            if (!cli_option_value(argc, argv, &i, "--max-centralised", &value)) {
-                return cli_fail(CLI_EXIT_INVALID,
-                                "--max-centralised: missing value (an integer from 1 to %u)",
-                                COA_MAX_CENTRALISED);
-            }
-            if (!cli_parse_count(value, strlen(value), COA_MAX_CENTRALISED, &max)) {
-                return cli_fail(CLI_EXIT_INVALID,
-                                "--max-centralised: must be an integer from 1 to %u, got '%.40s'",
-                                COA_MAX_CENTRALISED, value);
-            }
-            o->max_text = value;
-            o->max_centralised = (size_t)max;
-        } else if (cli_option_is(arg, "--collect")) {
-            if (o->collect_text != NULL) {
-                return cli_fail(CLI_EXIT_INVALID, "--collect: given more than once");
-            }
-            if (!cli_option_value(argc, argv, &i, "--collect", &value)) {
-                return cli_fail(CLI_EXIT_INVALID, "--collect: missing value (scenario seconds)");
-            }
-            if (!cli_parse_real(value, &o->collect) || !(o->collect > 0)) {
-                return cli_fail(CLI_EXIT_INVALID,
-                                "--collect: must be a number of seconds > 0, got '%.40s'", value);
-            }
-            o->collect_text = value;
-        } else if (arg[0] != '-') {
-            return cli_fail(CLI_EXIT_INVALID,
-                            "coordinator: unexpected argument '%.80s' (the scenario is "
-                            "--scenario FILE)",
-                            arg);
-        } else {
-            return cli_fail(CLI_EXIT_INVALID,
-                            "coordinator: unknown option '%.40s' (see 'coavoid-coordinator --help')",
-                            arg);
-        }
+    int status = cli_parse_args(&coordinator_command, argc, argv, o, NULL);
+    if (status != CLI_CONTINUE) {
+        return status;
     }
     if (o->scenario_path == NULL) {
         return cli_fail(CLI_EXIT_INVALID, "--scenario: required (a scenario file)");
@@ -147,9 +117,24 @@ static int parse_options(int argc, char **argv, coordinator_options_t *o)
     return CLI_CONTINUE;
 }
 
-/* Everything after the options. Returns the exit status. */
-static int run(coordinator_options_t *o, scenario_t *s)
+static void coordinator_report(void *user, const char *name, const coa_rt_result_t *result,
+                               const char *tail)
 {
+    const coa_coordinator_state_t *st = coa_coordinator_state(user);
+    fprintf(stderr,
+            "%s: %lld cycles, plans run %u, plans published %u, last plan %.1f ms "
+            "(%llu nodes expanded), messages received %lld, rejected %lld (last: %s)%s\n",
+            name, (long long)result->cycles, (unsigned)st->plans_run, (unsigned)st->plans_published,
+            (double)st->last_plan_duration_us * 1e-3,
+            (unsigned long long)st->last_nodes_expanded, (long long)st->rx.received,
+            (long long)st->rx.rejected, st->rx.last_reason != NULL ? st->rx.last_reason : "none",
+            tail);
+}
+
+/* Everything after the options. Returns the exit status. */
+static int run(void *options, scenario_t *s)
+{
+    coordinator_options_t *o = options;
     int64_t now = 0; /* the node's clock (common.clock), written by the loop */
     coa_coordinator_config_t config;
     memset(&config, 0, sizeof config);
@@ -203,45 +188,14 @@ static int run(coordinator_options_t *o, scenario_t *s)
         return cli_fail(error == COA_ERR_ARGUMENT ? CLI_EXIT_INVALID : CLI_EXIT_INTERNAL,
                         "coordinator: cannot start (%s)", coa_lcm_error_name(error));
     }
-    if (coa_rt_install_signal_handlers() != 0) {
-        coa_coordinator_destroy(node);
-        lcm_destroy(lcm);
-        return cli_fail(CLI_EXIT_INTERNAL, "coordinator: cannot handle SIGINT/SIGTERM");
-    }
-
     coa_rt_loop_t loop;
-    memset(&loop, 0, sizeof loop);
-    loop.clock.epoch_utime = o->rt.epoch_utime;
-    loop.clock.speed = o->rt.speed;
-    loop.lcm = lcm;
-    loop.now = &now;
-    loop.common = &config.common;
-    loop.steps = o->rt.steps;
+    coa_rt_loop_init(&loop, &o->rt, lcm, &now, &config.common, "coordinator");
     loop.collect_us = config.collect_us;
     loop.coordinator = node;
-    loop.name = "coordinator";
-    loop.warnings = stderr;
-    coa_rt_result_t result;
-    int rc = coa_rt_run(&loop, &result);
-
-    const coa_coordinator_state_t *st = coa_coordinator_state(node);
-    char tail[256];
-    coa_rt_result_text(&result, tail, sizeof tail);
-    fprintf(stderr,
-            "coordinator: %lld cycles, plans run %u, plans published %u, last plan %.1f ms "
-            "(%llu nodes expanded), messages received %lld, rejected %lld (last: %s)%s\n",
-            (long long)result.cycles, (unsigned)st->plans_run, (unsigned)st->plans_published,
-            (double)st->last_plan_duration_us * 1e-3,
-            (unsigned long long)st->last_nodes_expanded, (long long)st->rx.received,
-            (long long)st->rx.rejected, st->rx.last_reason != NULL ? st->rx.last_reason : "none",
-            tail);
+    status = coa_rt_drive(&loop, o->rt.lcm_url, coordinator_report, node);
     coa_coordinator_destroy(node);
     lcm_destroy(lcm);
-    if (rc != COA_OK) {
-        return cli_fail(CLI_EXIT_INTERNAL, "coordinator: LCM failed while running (%s)",
-                        o->rt.lcm_url);
-    }
-    return result.errors > 0 ? CLI_EXIT_INTERNAL : CLI_EXIT_OK;
+    return status;
 }
 
 int main(int argc, char **argv)
@@ -251,9 +205,5 @@ int main(int argc, char **argv)
     if (status != CLI_CONTINUE) {
         return status;
     }
-    scenario_t scenario;
-    memset(&scenario, 0, sizeof scenario);
-    status = run(&options, &scenario);
-    scenario_free(&scenario);
-    return status;
+    return cli_run_scenario(options.scenario_path, run, &options);
 }

@@ -104,73 +104,37 @@ void coa_rt_options_init(coa_rt_options_t *o)
 int coa_rt_parse_option(int argc, char **argv, int *i, coa_rt_options_t *o)
 {
     const char *arg = argv[*i];
-    const char *value = NULL;
+    uint64_t value = 0;
+    int status = CLI_UNKNOWN_OPTION;
     if (cli_option_is(arg, "--lcm-url")) {
-        if (o->lcm_url != NULL) {
-            return cli_fail(CLI_EXIT_INVALID, "--lcm-url: given more than once");
+        status = cli_text_option(argc, argv, i, "--lcm-url",
+                                 "an LCM URL, e.g. " COA_RT_DEFAULT_LCM_URL, false, &o->lcm_url);
+    } else if (cli_option_is(arg, "--epoch")) {
+        status = cli_text_option(argc, argv, i, "--epoch", "wall-clock microseconds since 1970",
+                                 true, &o->epoch_text);
+        if (status == CLI_CONTINUE &&
+            !cli_parse_count(o->epoch_text, strlen(o->epoch_text), (uint64_t)INT64_MAX, &value)) {
+            status = cli_fail(CLI_EXIT_INVALID,
+                              "--epoch: must be a positive integer (wall-clock microseconds "
+                              "since 1970), got '%.40s'",
+                              o->epoch_text);
         }
-        if (!cli_option_value(argc, argv, i, "--lcm-url", &value) || value[0] == '\0') {
-            return cli_fail(CLI_EXIT_INVALID,
-                            "--lcm-url: missing value (an LCM URL, e.g. %s)",
-                            COA_RT_DEFAULT_LCM_URL);
+        o->epoch_utime = (int64_t)value;
+    } else if (cli_option_is(arg, "--speed")) {
+        status = cli_text_option(argc, argv, i, "--speed", "scenario seconds per wall second",
+                                 true, &o->speed_text);
+        if (status == CLI_CONTINUE && (!cli_parse_real(o->speed_text, &o->speed) ||
+                                       !(o->speed > 0) || o->speed > COA_RT_MAX_SPEED)) {
+            status = cli_fail(CLI_EXIT_INVALID,
+                              "--speed: must be a number with 0 < S <= %g, got '%.40s'",
+                              COA_RT_MAX_SPEED, o->speed_text);
         }
-        o->lcm_url = value;
-        return 1;
+    } else if (cli_option_is(arg, "--steps")) {
+        status = cli_count_option(argc, argv, i, "--steps", "an integer >= 1", false, RT_MAX_STEPS,
+                                  &o->steps_text, &value);
+        o->steps = (int64_t)value;
     }
-    if (cli_option_is(arg, "--epoch")) {
-        uint64_t epoch;
-        if (o->have_epoch) {
-            return cli_fail(CLI_EXIT_INVALID, "--epoch: given more than once");
-        }
-        if (!cli_option_value(argc, argv, i, "--epoch", &value)) {
-            return cli_fail(CLI_EXIT_INVALID,
-                            "--epoch: missing value (wall-clock microseconds since 1970)");
-        }
-        if (!cli_parse_count(value, strlen(value), (uint64_t)INT64_MAX, &epoch)) {
-            return cli_fail(CLI_EXIT_INVALID,
-                            "--epoch: must be a positive integer (wall-clock microseconds "
-                            "since 1970), got '%.40s'",
-                            value);
-        }
-        o->have_epoch = true;
-        o->epoch_utime = (int64_t)epoch;
-        return 1;
-    }
-    if (cli_option_is(arg, "--speed")) {
-        double speed;
-        if (o->speed_text != NULL) {
-            return cli_fail(CLI_EXIT_INVALID, "--speed: given more than once");
-        }
-        if (!cli_option_value(argc, argv, i, "--speed", &value)) {
-            return cli_fail(CLI_EXIT_INVALID,
-                            "--speed: missing value (scenario seconds per wall second)");
-        }
-        if (!cli_parse_real(value, &speed) || !(speed > 0) || speed > COA_RT_MAX_SPEED) {
-            return cli_fail(CLI_EXIT_INVALID,
-                            "--speed: must be a number with 0 < S <= %g, got '%.40s'",
-                            COA_RT_MAX_SPEED, value);
-        }
-        o->speed_text = value;
-        o->speed = speed;
-        return 1;
-    }
-    if (cli_option_is(arg, "--steps")) {
-        uint64_t steps;
-        if (o->steps_text != NULL) {
-            return cli_fail(CLI_EXIT_INVALID, "--steps: given more than once");
-        }
-        if (!cli_option_value(argc, argv, i, "--steps", &value)) {
-            return cli_fail(CLI_EXIT_INVALID, "--steps: missing value (an integer >= 1)");
-        }
-        if (!cli_parse_count(value, strlen(value), RT_MAX_STEPS, &steps)) {
-            return cli_fail(CLI_EXIT_INVALID, "--steps: must be an integer from 1 to %u, got '%.40s'",
-                            RT_MAX_STEPS, value);
-        }
-        o->steps_text = value;
-        o->steps = (int64_t)steps;
-        return 1;
-    }
-    return 0;
+    return status;
 }
 
 int coa_rt_options_finish(coa_rt_options_t *o, int64_t dt_us, uint32_t horizon)
@@ -182,7 +146,7 @@ int coa_rt_options_finish(coa_rt_options_t *o, int64_t dt_us, uint32_t horizon)
         o->steps = 2 * (int64_t)horizon;
     }
     int64_t now = coa_rt_wall_utime();
-    if (!o->have_epoch) {
+    if (o->epoch_text == NULL) {
         o->epoch_utime = now;
         return CLI_CONTINUE;
     }
@@ -208,11 +172,7 @@ int coa_rt_options_finish(coa_rt_options_t *o, int64_t dt_us, uint32_t horizon)
 int coa_rt_setup(const char *path, scenario_t *s, coa_rt_options_t *o, const int64_t *now,
                  coa_node_common_t *common)
 {
-    int status = cli_load_scenario(path, s);
-    if (status != CLI_CONTINUE) {
-        return status;
-    }
-    status = cli_sample_scenario(path, s);
+    int status = cli_sample_scenario(path, s);
     if (status != CLI_CONTINUE) {
         return status;
     }
@@ -308,6 +268,38 @@ lcm_t *coa_rt_lcm_create(const char *url, char *err, size_t err_size)
 }
 
 /* ---- the loop ---- */
+
+void coa_rt_loop_init(coa_rt_loop_t *loop, const coa_rt_options_t *o, lcm_t *lcm, int64_t *now,
+                      const coa_node_common_t *common, const char *name)
+{
+    memset(loop, 0, sizeof *loop);
+    loop->clock.epoch_utime = o->epoch_utime;
+    loop->clock.speed = o->speed;
+    loop->lcm = lcm;
+    loop->now = now;
+    loop->common = common;
+    loop->steps = o->steps;
+    loop->name = name;
+    loop->warnings = stderr;
+}
+
+int coa_rt_drive(const coa_rt_loop_t *loop, const char *lcm_url, coa_rt_report_t report,
+                 void *user)
+{
+    if (coa_rt_install_signal_handlers() != 0) {
+        return cli_fail(CLI_EXIT_INTERNAL, "%s: cannot handle SIGINT/SIGTERM", loop->name);
+    }
+    coa_rt_result_t result;
+    int rc = coa_rt_run(loop, &result);
+    char tail[256];
+    coa_rt_result_text(&result, tail, sizeof tail);
+    report(user, loop->name, &result, tail);
+    if (rc != COA_OK) {
+        return cli_fail(CLI_EXIT_INTERNAL, "%s: LCM failed while running (%s)", loop->name,
+                        lcm_url);
+    }
+    return result.errors > 0 ? CLI_EXIT_INTERNAL : CLI_EXIT_OK;
+}
 
 typedef struct {
     const coa_rt_loop_t *loop;

@@ -85,7 +85,7 @@ int64_t coa_rt_wall_at(const coa_rt_clock_t *clock, int64_t scenario_utime);
 
 typedef struct {
     const char *lcm_url;      /* NULL until given; then COA_RT_DEFAULT_LCM_URL */
-    bool have_epoch;
+    const char *epoch_text;   /* NULL until given */
     int64_t epoch_utime;      /* --epoch; when not given, coa_rt_options_finish sets now */
     const char *speed_text;   /* NULL: 1 */
     double speed;
@@ -97,8 +97,9 @@ typedef struct {
 void coa_rt_options_init(coa_rt_options_t *o);
 
 /* Whether argv[*i] is one of --lcm-url, --epoch, --speed, --steps; if so consumes it
- * (and its value) and returns 1, or returns CLI_EXIT_INVALID after the one-line error
- * (missing or bad value, given twice). Returns 0 for any other argument. */
+ * (and its value) and returns CLI_CONTINUE, or returns CLI_EXIT_INVALID after the one-line
+ * error (missing or bad value, given twice). Returns CLI_UNKNOWN_OPTION for any other
+ * argument (cli.h's option parser contract). */
 int coa_rt_parse_option(int argc, char **argv, int *i, coa_rt_options_t *o);
 
 /* After the scenario is loaded: steps defaults to 2 * horizon; the epoch defaults to now
@@ -108,13 +109,13 @@ int coa_rt_parse_option(int argc, char **argv, int *i, coa_rt_options_t *o);
  * CLI_EXIT_INVALID after the one-line error. */
 int coa_rt_options_finish(coa_rt_options_t *o, int64_t dt_us, uint32_t horizon);
 
-/* What every driver does once its options are parsed: loads and samples the scenario at
- * `path` into *s (the caller calls scenario_free afterwards, whatever the result),
- * refuses a horizon beyond COA_NODE_MAX_HORIZON, finishes the options
- * (coa_rt_options_finish), and fills *common with the node defaults on the scenario's dt
- * and horizon, the epoch, `now` as the clock, the monotonic stopwatch, and the scenario's
- * beta when it gives one. Returns CLI_CONTINUE, or CLI_EXIT_INVALID after the one-line
- * error. */
+/* What every driver does once its options are parsed and the scenario at `path` is loaded
+ * into *s (cli_run_scenario): samples it, refuses a horizon beyond COA_NODE_MAX_HORIZON,
+ * finishes the options (coa_rt_options_finish), and fills *common with the node defaults
+ * on the scenario's dt and horizon, the epoch, `now` as the clock, the monotonic
+ * stopwatch, and the scenario's beta when it gives one. Returns CLI_CONTINUE, or
+ * CLI_EXIT_INVALID after the one-line error. Cost: sampling the scenario; no memory
+ * beyond the scenario's samples. */
 int coa_rt_setup(const char *path, scenario_t *s, coa_rt_options_t *o, const int64_t *now,
                  coa_node_common_t *common);
 
@@ -171,6 +172,25 @@ int coa_rt_install_signal_handlers(void);
 /* LCM itself failed: waiting on its descriptor or lcm_handle returned an error, so the
  * provider is unusable. */
 #define COA_RT_ERR_LCM (-200)
+
+/* Sets the loop's fields every driver sets alike: the clock (epoch, speed) and steps from
+ * the finished options, lcm, now, common, name, and warnings on stderr; the rest (the
+ * nodes, collect_us, world_lead_us) is zero for the caller to set. O(1). */
+void coa_rt_loop_init(coa_rt_loop_t *loop, const coa_rt_options_t *o, lcm_t *lcm, int64_t *now,
+                      const coa_node_common_t *common, const char *name);
+
+/* Prints a driver's summary line on stderr from its node's state, starting with the
+ * loop's name and ending with `tail` (coa_rt_result_text). */
+typedef void (*coa_rt_report_t)(void *user, const char *name, const coa_rt_result_t *result,
+                                const char *tail);
+
+/* What every driver does once its node is in the loop: installs the signal handlers, runs
+ * the loop and calls report. Returns CLI_EXIT_OK, or CLI_EXIT_INTERNAL when a node call
+ * failed, or after the line "NAME: cannot handle SIGINT/SIGTERM" (nothing ran) or "NAME:
+ * LCM failed while running (URL)". The caller destroys its node and the LCM afterwards.
+ * Cost and memory: coa_rt_run's. */
+int coa_rt_drive(const coa_rt_loop_t *loop, const char *lcm_url, coa_rt_report_t report,
+                 void *user);
 
 /* Runs the loop until cycle K is done or a signal asks it to stop. Returns COA_OK,
  * COA_ERR_ARGUMENT (no node, NULL lcm/now/common, steps < 1) or COA_RT_ERR_LCM. Node

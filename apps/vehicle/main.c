@@ -66,109 +66,72 @@ typedef struct {
 static int parse_seconds(int argc, char **argv, int *i, const char *name, bool zero_ok,
                          const char **text, double *out)
 {
-    const char *value = NULL;
-    if (*text != NULL) {
-        return cli_fail(CLI_EXIT_INVALID, "%s: given more than once", name);
+    int status = cli_text_option(argc, argv, i, name, "scenario seconds", true, text);
+    if (status == CLI_CONTINUE && (!cli_parse_real(*text, out) || *out < 0 ||
+                                   (*out == 0 && !zero_ok) || *out > COA_LCM_MAX_STEP)) {
+        status = cli_fail(CLI_EXIT_INVALID, "%s: must be a number of seconds, %s %g, got '%.40s'",
+                          name, zero_ok ? "0 <= S <=" : "0 < S <=", COA_LCM_MAX_STEP, *text);
     }
-    if (!cli_option_value(argc, argv, i, name, &value)) {
-        return cli_fail(CLI_EXIT_INVALID, "%s: missing value (scenario seconds)", name);
-    }
-    if (!cli_parse_real(value, out) || *out < 0 || (*out == 0 && !zero_ok) ||
-        *out > COA_LCM_MAX_STEP) {
-        return cli_fail(CLI_EXIT_INVALID, "%s: must be a number of seconds, %s %g, got '%.40s'",
-                        name, zero_ok ? "0 <= S <=" : "0 < S <=", COA_LCM_MAX_STEP, value);
-    }
-    *text = value;
-    return CLI_CONTINUE;
+    return status;
 }
+
+static void vehicle_help(void)
+{
+    fputs(VEHICLE_USAGE, stdout);
+}
+
+static int vehicle_option(int argc, char **argv, int *i, void *options)
+{
+    vehicle_options_t *o = options;
+    const char *arg = argv[*i];
+    uint64_t value = 0;
+    int status = coa_rt_parse_option(argc, argv, i, &o->rt);
+    if (status != CLI_UNKNOWN_OPTION) {
+        return status;
+    }
+    if (cli_option_is(arg, "--scenario")) {
+        status = cli_text_option(argc, argv, i, "--scenario", "a scenario file", false,
+                                 &o->scenario_path);
+    } else if (cli_option_is(arg, "--id")) {
+        status = cli_text_option(argc, argv, i, "--id", "a vehicle id", true, &o->id_text);
+        if (status == CLI_CONTINUE &&
+            !cli_parse_count(o->id_text, strlen(o->id_text), 65535u, &value)) {
+            status = cli_fail(CLI_EXIT_INVALID,
+                              "--id: must be a vehicle id from 1 to 65535, got '%.40s'",
+                              o->id_text);
+        }
+        o->id = (uint16_t)value;
+    } else if (cli_option_is(arg, "--list-ids")) {
+        status = cli_flag_option(arg, "--list-ids", &o->list_ids);
+    } else if (cli_option_is(arg, "--mode")) {
+        status = cli_mode_option(argc, argv, i, &o->mode, &o->decoupled);
+    } else if (cli_option_is(arg, "--coordinator-timeout")) {
+        status = parse_seconds(argc, argv, i, "--coordinator-timeout", false, &o->timeout_text,
+                               &o->timeout);
+    } else if (cli_option_is(arg, "--priority-wait")) {
+        status = parse_seconds(argc, argv, i, "--priority-wait", true, &o->wait_text, &o->wait);
+    }
+    return status;
+}
+
+static const cli_command_t vehicle_command = {
+    "vehicle", "coavoid-vehicle", 1, {NULL, NULL}, "the scenario is --scenario FILE",
+    vehicle_help, vehicle_option};
 
 static int parse_options(int argc, char **argv, vehicle_options_t *o)
 {
     memset(o, 0, sizeof *o);
     coa_rt_options_init(&o->rt);
-    for (int i = 1; i < argc; i++) {
-        const char *arg = argv[i];
-        const char *value = NULL;
-        int rc = coa_rt_parse_option(argc, argv, &i, &o->rt);
-        if (rc == 1) {
-            continue;
-        }
-        if (rc != 0) {
-            return rc;
-        }
-        if (strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0) {
-            fputs(VEHICLE_USAGE, stdout);
-            return CLI_EXIT_OK;
-        } else if (cli_option_is(arg, "--scenario")) {
-            if (o->scenario_path != NULL) {
-                return cli_fail(CLI_EXIT_INVALID, "--scenario: given more than once");
-            }
-            if (!cli_option_value(argc, argv, &i, "--scenario", &value) || value[0] == '\0') {
-                return cli_fail(CLI_EXIT_INVALID, "--scenario: missing value (a scenario file)");
-            }
-            o->scenario_path = value;
-        } else if (cli_option_is(arg, "--id")) {
-            uint64_t id;
-            if (o->id_text != NULL) {
-                return cli_fail(CLI_EXIT_INVALID, "--id: given more than once");
-            }
-            if (!cli_option_value(argc, argv, &i, "--id", &value)) {
-                return cli_fail(CLI_EXIT_INVALID, "--id: missing value (a vehicle id)");
-            }
-            if (!cli_parse_count(value, strlen(value), 65535u, &id)) {
-                return cli_fail(CLI_EXIT_INVALID,
-                                "--id: must be a vehicle id from 1 to 65535, got '%.40s'", value);
-            }
-            o->id_text = value;
-            o->id = (uint16_t)id;
-        } else if (strcmp(arg, "--list-ids") == 0) {
-            if (o->list_ids) {
-                return cli_fail(CLI_EXIT_INVALID, "--list-ids: given more than once");
-            }
-            o->list_ids = true;
-        } else if (cli_option_is(arg, "--list-ids")) {
-            return cli_fail(CLI_EXIT_INVALID, "--list-ids: takes no value");
-        } else if (cli_option_is(arg, "--mode")) {
-            if (o->mode != NULL) {
-                return cli_fail(CLI_EXIT_INVALID, "--mode: given more than once");
-            }
-            if (!cli_option_value(argc, argv, &i, "--mode", &value)) {
-                return cli_fail(CLI_EXIT_INVALID,
-                                "--mode: missing value (centralised or decoupled)");
-            }
-            if (strcmp(value, "centralised") != 0 && strcmp(value, "decoupled") != 0) {
-                return cli_fail(CLI_EXIT_INVALID,
-                                "--mode: unknown mode '%.40s' (expected centralised or decoupled)",
-                                value);
-            }
-            o->mode = value;
-            o->decoupled = strcmp(value, "decoupled") == 0;
-        } else if (cli_option_is(arg, "--coordinator-timeout")) {
-            rc = parse_seconds(argc, argv, &i, "--coordinator-timeout", false, &o->timeout_text,
-                               &o->timeout);
-            if (rc != CLI_CONTINUE) {
-                return rc;
-            }
-        } else if (cli_option_is(arg, "--priority-wait")) {
-            rc = parse_seconds(argc, argv, &i, "--priority-wait", true, &o->wait_text, &o->wait);
-            if (rc != CLI_CONTINUE) {
-                return rc;
-            }
-        } else if (arg[0] != '-') {
-            return cli_fail(CLI_EXIT_INVALID,
-                            "vehicle: unexpected argument '%.80s' (the scenario is --scenario FILE)",
-                            arg);
-        } else {
-            return cli_fail(CLI_EXIT_INVALID,
-                            "vehicle: unknown option '%.40s' (see 'coavoid-vehicle --help')", arg);
-        }
+    int status = cli_parse_args(&vehicle_command, argc, argv, o, NULL);
+    if (status != CLI_CONTINUE) {
+        return status;
     }
     if (o->scenario_path == NULL) {
         return cli_fail(CLI_EXIT_INVALID, "--scenario: required (a scenario file)");
     }
     if (o->list_ids) {
         if (o->id_text != NULL || o->mode != NULL || o->timeout_text != NULL ||
-            o->wait_text != NULL || o->rt.lcm_url != NULL || o->rt.have_epoch ||
+            o->wait_text != NULL || o->rt.lcm_url != NULL || o->rt.epoch_text != NULL ||
             o->rt.speed_text != NULL || o->rt.steps_text != NULL) {
             return cli_fail(CLI_EXIT_INVALID, "--list-ids: takes only --scenario FILE");
         }
@@ -184,9 +147,36 @@ static int parse_options(int argc, char **argv, vehicle_options_t *o)
     return CLI_CONTINUE;
 }
 
-/* Everything after the options. Returns the exit status. */
-static int run(vehicle_options_t *o, scenario_t *s)
+/* The scenario's vehicle ids, one a line (--list-ids). */
+static int list_ids(const scenario_t *s)
 {
+    for (size_t i = 0; i < s->vehicle_count; i++) {
+        printf("%u\n", (unsigned)s->vehicles[i].id);
+    }
+    return fflush(stdout) == 0 ? CLI_EXIT_OK
+                               : cli_fail(CLI_EXIT_INTERNAL, "--list-ids: cannot write");
+}
+
+static void vehicle_report(void *user, const char *name, const coa_rt_result_t *result,
+                           const char *tail)
+{
+    const coa_vehicle_node_state_t *st = coa_vehicle_node_state(user);
+    fprintf(stderr,
+            "%s: %lld cycles, plans run %u, plans adopted %u, fallbacks %u, messages received "
+            "%lld, rejected %lld (last: %s)%s\n",
+            name, (long long)result->cycles, (unsigned)st->plans_run,
+            (unsigned)st->plans_adopted, (unsigned)st->fallbacks, (long long)st->rx.received,
+            (long long)st->rx.rejected, st->rx.last_reason != NULL ? st->rx.last_reason : "none",
+            tail);
+}
+
+/* Everything after the options and the scenario. Returns the exit status. */
+static int run(void *options, scenario_t *s)
+{
+    vehicle_options_t *o = options;
+    if (o->list_ids) {
+        return list_ids(s);
+    }
     int64_t now = 0; /* the nodes' clock (common.clock), written by the loop */
     coa_vehicle_node_config_t config;
     memset(&config, 0, sizeof config);
@@ -228,47 +218,17 @@ static int run(vehicle_options_t *o, scenario_t *s)
                         "vehicle %u: cannot start (%s)", (unsigned)o->id,
                         coa_lcm_error_name(error));
     }
-    if (coa_rt_install_signal_handlers() != 0) {
-        coa_vehicle_node_destroy(node);
-        lcm_destroy(lcm);
-        return cli_fail(CLI_EXIT_INTERNAL, "vehicle %u: cannot handle SIGINT/SIGTERM",
-                        (unsigned)o->id);
-    }
-
     char name[32];
     snprintf(name, sizeof name, "vehicle %u", (unsigned)o->id);
     coa_vehicle_node_t *const vehicles[1] = {node};
     coa_rt_loop_t loop;
-    memset(&loop, 0, sizeof loop);
-    loop.clock.epoch_utime = o->rt.epoch_utime;
-    loop.clock.speed = o->rt.speed;
-    loop.lcm = lcm;
-    loop.now = &now;
-    loop.common = &config.common;
-    loop.steps = o->rt.steps;
+    coa_rt_loop_init(&loop, &o->rt, lcm, &now, &config.common, name);
     loop.vehicles = vehicles;
     loop.vehicle_count = 1;
-    loop.name = name;
-    loop.warnings = stderr;
-    coa_rt_result_t result;
-    int rc = coa_rt_run(&loop, &result);
-
-    const coa_vehicle_node_state_t *st = coa_vehicle_node_state(node);
-    char tail[256];
-    coa_rt_result_text(&result, tail, sizeof tail);
-    fprintf(stderr,
-            "%s: %lld cycles, plans run %u, plans adopted %u, fallbacks %u, messages received "
-            "%lld, rejected %lld (last: %s)%s\n",
-            name, (long long)result.cycles, (unsigned)st->plans_run, (unsigned)st->plans_adopted,
-            (unsigned)st->fallbacks, (long long)st->rx.received, (long long)st->rx.rejected,
-            st->rx.last_reason != NULL ? st->rx.last_reason : "none", tail);
+    status = coa_rt_drive(&loop, o->rt.lcm_url, vehicle_report, node);
     coa_vehicle_node_destroy(node);
     lcm_destroy(lcm);
-    if (rc != COA_OK) {
-        return cli_fail(CLI_EXIT_INTERNAL, "%s: LCM failed while running (%s)", name,
-                        o->rt.lcm_url);
-    }
-    return result.errors > 0 ? CLI_EXIT_INTERNAL : CLI_EXIT_OK;
+    return status;
 }
 
 int main(int argc, char **argv)
@@ -278,21 +238,5 @@ int main(int argc, char **argv)
     if (status != CLI_CONTINUE) {
         return status;
     }
-    scenario_t scenario;
-    memset(&scenario, 0, sizeof scenario);
-    if (options.list_ids) {
-        status = cli_load_scenario(options.scenario_path, &scenario);
-        if (status == CLI_CONTINUE) {
-            for (size_t i = 0; i < scenario.vehicle_count; i++) {
-                printf("%u\n", (unsigned)scenario.vehicles[i].id);
-            }
-            status = fflush(stdout) == 0 ? CLI_EXIT_OK
-                                         : cli_fail(CLI_EXIT_INTERNAL, "--list-ids: cannot write");
-        }
-        scenario_free(&scenario);
-        return status;
-    }
-    status = run(&options, &scenario);
-    scenario_free(&scenario);
-    return status;
+    return cli_run_scenario(options.scenario_path, run, &options);
 }
