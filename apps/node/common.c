@@ -7,6 +7,7 @@
 
 #include <limits.h>
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* A generous queue per subscription: a cycle publishes one intent and one heartbeat per
@@ -679,6 +680,72 @@ int coa_node_predict(coa_predictor_t *predictor, const coa_node_common_t *c,
         return COA_ERR_WORKSPACE;
     }
     return coa_predict_clusters(conflicts, result->conflict_count, n, labels, cluster_count);
+}
+
+int coa_node_solver_init(coa_node_solver_t *s, uint32_t horizon, size_t searched, uint32_t beta)
+{
+    memset(s, 0, sizeof *s);
+    const size_t pairs = coa_node_max_pairs();
+    const size_t predictor_size = coa_predictor_workspace_size(
+        COA_NODE_MAX_PEERS, COA_NODE_TRACK_CAPACITY, horizon, pairs);
+    const size_t planner_size = coa_planner_workspace_size(searched, beta);
+    if (predictor_size == 0u || planner_size == 0u) {
+        return COA_ERR_ARGUMENT;
+    }
+    s->predictor_memory = malloc(predictor_size);
+    s->planner_memory = malloc(planner_size);
+    s->conflict_capacity = pairs;
+    s->conflicts = calloc(pairs, sizeof *s->conflicts);
+    if (s->predictor_memory != NULL) {
+        s->predictor = coa_predictor_init(s->predictor_memory, predictor_size, COA_NODE_MAX_PEERS,
+                                          COA_NODE_TRACK_CAPACITY, horizon, pairs);
+    }
+    if (s->planner_memory != NULL) {
+        s->planner = coa_planner_init(s->planner_memory, planner_size, searched, beta);
+    }
+    if (s->predictor == NULL || s->planner == NULL || s->conflicts == NULL) {
+        coa_node_solver_fini(s);
+        return COA_ERR_WORKSPACE;
+    }
+    return COA_OK;
+}
+
+void coa_node_solver_fini(coa_node_solver_t *s)
+{
+    free(s->predictor_memory);
+    free(s->planner_memory);
+    free(s->conflicts);
+    memset(s, 0, sizeof *s);
+}
+
+int coa_node_publish_heartbeat(coa_node_inbox_t *in, coavoid_status_t *m, int64_t now,
+                               int64_t cycle_start, const coa_node_heartbeat_t *h)
+{
+    memset(m, 0, sizeof *m);
+    m->utime = now;
+    m->node_id = h->node_id;
+    m->node_kind = h->node_kind;
+    m->sequence = h->sequence;
+    m->health = h->fault      ? COAVOID_STATUS_T_HEALTH_FAULT
+                : h->degraded ? COAVOID_STATUS_T_HEALTH_DEGRADED
+                              : COAVOID_STATUS_T_HEALTH_OK;
+    m->mode = h->mode;
+    m->last_plan_utime = h->last_plan_utime;
+    m->last_plan_duration_us = h->last_plan_duration_us;
+    m->nodes_expanded = h->last_nodes_expanded > (uint64_t)INT64_MAX
+                            ? INT64_MAX
+                            : (int64_t)h->last_nodes_expanded;
+    m->outcome = h->last_outcome < 0 ? COAVOID_STATUS_T_OUTCOME_NONE : (int8_t)h->last_outcome;
+    m->conflicts = h->conflicts > (uint32_t)INT32_MAX ? INT32_MAX : (int32_t)h->conflicts;
+    m->plans_run = h->plans_run > (uint32_t)INT32_MAX ? INT32_MAX : (int32_t)h->plans_run;
+    m->messages_received = h->rx->received;
+    m->messages_rejected = h->rx->rejected;
+    m->last_reject_code = h->rx->last_reject_code;
+    coa_lcm_context_t ctx = coa_node_context(in, now, cycle_start);
+    if (coa_lcm_status_check(m, &ctx, NULL) != COA_OK) {
+        return COA_ERR_ARGUMENT;
+    }
+    return coa_node_publish_status(&in->tx, m);
 }
 
 /* ---- publishing ---- */

@@ -32,13 +32,7 @@ struct coa_coordinator {
     coavoid_conflict_report_t tx_report;
     coavoid_status_t tx_status;
 
-    coa_conflict_t *conflicts;
-    size_t conflict_capacity;
-    void *predictor_memory;
-    coa_predictor_t *predictor;
-    void *planner_memory;
-    coa_planner_t *planner;
-
+    coa_node_solver_t solver;
     coa_node_inbox_t inbox;
     coa_node_view_t view;
     coa_node_problem_tracks_t problem_tracks;
@@ -59,18 +53,19 @@ coa_coordinator_t *coa_coordinator_create(const coa_coordinator_config_t *config
     }
     const coa_node_common_t *c = &config->common;
     const size_t max_centralised = config->max_centralised == 0u ? 3u : config->max_centralised;
-    const size_t pairs = coa_node_max_pairs();
-    const size_t predictor_size = coa_predictor_workspace_size(
-        COA_NODE_MAX_PEERS, COA_NODE_TRACK_CAPACITY, c->horizon, pairs);
-    const size_t planner_size = coa_planner_workspace_size(max_centralised, c->beta);
-    if (predictor_size == 0u || planner_size == 0u) {
+    coa_node_solver_t solver;
+    int rc = coa_node_solver_init(&solver, c->horizon, max_centralised, c->beta);
+    if (rc != COA_OK) {
+        *error = rc;
         return NULL;
     }
     coa_coordinator_t *node = calloc(1, sizeof *node);
     if (node == NULL) {
+        coa_node_solver_fini(&solver);
         *error = COA_ERR_WORKSPACE;
         return NULL;
     }
+    node->solver = solver;
     node->config = *config;
     node->config.max_centralised = max_centralised;
     if (node->config.id == 0u) {
@@ -79,36 +74,13 @@ coa_coordinator_t *coa_coordinator_create(const coa_coordinator_config_t *config
     if (node->config.collect_us == 0) {
         node->config.collect_us = c->dt_us / 4;
     }
-    node->predictor_memory = malloc(predictor_size);
-    node->planner_memory = malloc(planner_size);
-    node->conflict_capacity = pairs;
-    node->conflicts = calloc(pairs, sizeof *node->conflicts);
-    if (node->predictor_memory != NULL) {
-        node->predictor = coa_predictor_init(node->predictor_memory, predictor_size,
-                                             COA_NODE_MAX_PEERS, COA_NODE_TRACK_CAPACITY,
-                                             c->horizon, pairs);
-    }
-    if (node->planner_memory != NULL) {
-        node->planner = coa_planner_init(node->planner_memory, planner_size, max_centralised,
-                                         c->beta);
-    }
-    if (node->predictor == NULL || node->planner == NULL || node->conflicts == NULL) {
-        free(node->predictor_memory);
-        free(node->planner_memory);
-        free(node->conflicts);
-        free(node);
-        *error = COA_ERR_WORKSPACE;
-        return NULL;
-    }
     node->state.cycle = -1;
     node->state.last_outcome = -1;
     /* No UAV is its own: intents are all others'. */
-    int rc = coa_node_inbox_init(&node->inbox, c, 0u, node->config.id, COA_NODE_MAX_PEERS,
-                                 2 * c->stale_after_us, lcm, &node->state.rx, false, NULL, node);
+    rc = coa_node_inbox_init(&node->inbox, c, 0u, node->config.id, COA_NODE_MAX_PEERS,
+                             2 * c->stale_after_us, lcm, &node->state.rx, false, NULL, node);
     if (rc != COA_OK) {
-        free(node->predictor_memory);
-        free(node->planner_memory);
-        free(node->conflicts);
+        coa_node_solver_fini(&node->solver);
         free(node);
         *error = rc;
         return NULL;
@@ -123,9 +95,7 @@ void coa_coordinator_destroy(coa_coordinator_t *node)
         return;
     }
     coa_node_inbox_fini(&node->inbox);
-    free(node->predictor_memory);
-    free(node->planner_memory);
-    free(node->conflicts);
+    coa_node_solver_fini(&node->solver);
     free(node);
 }
 
@@ -141,7 +111,7 @@ static int publish_report(coa_coordinator_t *node, int64_t now, int64_t cycle_st
     const coa_node_view_t *view = &node->view;
     coa_lcm_context_t ctx = coa_node_context(&node->inbox, now, cycle_start);
     int rc = coa_lcm_conflict_report_from_core(
-        node->conflicts, result->conflict_count, result->conflicts_found, view->live_id,
+        node->solver.conflicts, result->conflict_count, result->conflicts_found, view->live_id,
         view->live_count, view->track_ids, view->track_count,
         view->live_count > 0u ? node->labels : NULL, now, node->config.id,
         node->report_sequence++, cycle_start, c->dt, c->horizon, &ctx, &node->tx_report, NULL);
@@ -153,36 +123,21 @@ static int publish_report(coa_coordinator_t *node, int64_t now, int64_t cycle_st
 
 static int publish_status(coa_coordinator_t *node, int64_t now, int64_t cycle_start)
 {
-    coavoid_status_t *m = &node->tx_status;
     const coa_coordinator_state_t *s = &node->state;
-    memset(m, 0, sizeof *m);
-    m->utime = now;
-    m->node_id = node->config.id;
-    m->node_kind = COAVOID_STATUS_T_NODE_COORDINATOR;
-    m->sequence = node->status_sequence++;
-    if (node->fault) {
-        m->health = COAVOID_STATUS_T_HEALTH_FAULT;
-    } else if (node->degraded || node->view.stale_count > 0u) {
-        m->health = COAVOID_STATUS_T_HEALTH_DEGRADED;
-    } else {
-        m->health = COAVOID_STATUS_T_HEALTH_OK;
-    }
-    m->mode = COAVOID_STATUS_T_MODE_CENTRALISED;
-    m->last_plan_utime = node->last_plan_utime;
-    m->last_plan_duration_us = s->last_plan_duration_us;
-    m->nodes_expanded = s->last_nodes_expanded > (uint64_t)INT64_MAX ? INT64_MAX
-                                                                      : (int64_t)s->last_nodes_expanded;
-    m->outcome = s->last_outcome < 0 ? COAVOID_STATUS_T_OUTCOME_NONE : (int8_t)s->last_outcome;
-    m->conflicts = s->conflicts > (uint32_t)INT32_MAX ? INT32_MAX : (int32_t)s->conflicts;
-    m->plans_run = s->plans_run > (uint32_t)INT32_MAX ? INT32_MAX : (int32_t)s->plans_run;
-    m->messages_received = s->rx.received;
-    m->messages_rejected = s->rx.rejected;
-    m->last_reject_code = s->rx.last_reject_code;
-    coa_lcm_context_t ctx = coa_node_context(&node->inbox, now, cycle_start);
-    if (coa_lcm_status_check(m, &ctx, NULL) != COA_OK) {
-        return COA_ERR_ARGUMENT;
-    }
-    return coa_node_publish_status(&node->inbox.tx, m);
+    const coa_node_heartbeat_t h = {node->config.id,
+                                    COAVOID_STATUS_T_NODE_COORDINATOR,
+                                    node->status_sequence++,
+                                    node->fault,
+                                    node->degraded || node->view.stale_count > 0u,
+                                    COAVOID_STATUS_T_MODE_CENTRALISED,
+                                    node->last_plan_utime,
+                                    s->last_plan_duration_us,
+                                    s->last_nodes_expanded,
+                                    s->last_outcome,
+                                    s->conflicts,
+                                    s->plans_run,
+                                    &s->rx};
+    return coa_node_publish_heartbeat(&node->inbox, &node->tx_status, now, cycle_start, &h);
 }
 
 /* Which UAVs a planning call takes: one cluster, every clustered UAV, or every UAV. */
@@ -269,11 +224,12 @@ static int plan_cluster(coa_coordinator_t *node, int64_t now, int64_t cycle_star
     problem.track_samples = node->problem_tracks.samples;
 
     bool centralised = count <= node->config.max_centralised;
+    coa_planner_t *planner = node->solver.planner;
     coa_plan_result_t result;
     *solved = false;
     int64_t start = coa_node_stopwatch(c);
     if (centralised) {
-        rc = coa_plan_centralised(node->planner, &problem, node->offsets, &result);
+        rc = coa_plan_centralised(planner, &problem, node->offsets, &result);
         /* The composite search grows as 5^n a node: when beta runs out before it proves
          * anything, the cluster is planned decoupled (in priority order) rather than left
          * to fly into its conflict. A proof of infeasibility stands: no order beats it. */
@@ -281,10 +237,10 @@ static int plan_cluster(coa_coordinator_t *node, int64_t now, int64_t cycle_star
             node->state.plans_run++;
             node->state.clusters_planned++;
             centralised = false;
-            rc = coa_plan_decoupled(node->planner, &problem, NULL, 1u, node->offsets, &result);
+            rc = coa_plan_decoupled(planner, &problem, NULL, 1u, node->offsets, &result);
         }
     } else {
-        rc = coa_plan_decoupled(node->planner, &problem, NULL, 1u, node->offsets, &result);
+        rc = coa_plan_decoupled(planner, &problem, NULL, 1u, node->offsets, &result);
     }
     int64_t duration = coa_node_stopwatch(c) - start;
     node->state.plans_run++;
@@ -367,9 +323,10 @@ int coa_coordinator_cycle(coa_coordinator_t *node, int64_t now)
 
     coa_predict_result_t result;
     size_t clusters = 0;
-    int first_error = coa_node_predict(node->predictor, c, view->live_plan, view->live_count, view,
-                                       &node->inbox, node->conflicts, node->conflict_capacity,
-                                       &result, node->labels, &clusters);
+    coa_node_solver_t *sv = &node->solver;
+    int first_error = coa_node_predict(sv->predictor, c, view->live_plan, view->live_count, view,
+                                       &node->inbox, sv->conflicts, sv->conflict_capacity, &result,
+                                       node->labels, &clusters);
     if (first_error != COA_OK) {
         memset(&result, 0, sizeof result);
         clusters = 0;

@@ -156,6 +156,36 @@ typedef struct {
     coa_track_point_t paths[COA_NODE_MAX_PEERS][COA_NODE_MAX_SAMPLES];
 } coa_node_problem_tracks_t;
 
+/* A node's prediction and planning memory, allocated once when it is created: room for
+ * every pair coa_node_max_pairs allows, a predictor over MAX_PEERS plans and
+ * TRACK_CAPACITY tracks, and a planner of `searched` UAVs a search. */
+typedef struct {
+    coa_conflict_t *conflicts;
+    size_t conflict_capacity;
+    void *predictor_memory;
+    coa_predictor_t *predictor;
+    void *planner_memory;
+    coa_planner_t *planner;
+} coa_node_solver_t;
+
+/* What a node's heartbeat (status_t) says: who it is and how it is, as the node judges,
+ * and the counters its state keeps (saturated to the message's types when sent). */
+typedef struct {
+    uint16_t node_id;
+    int8_t node_kind;               /* COAVOID_STATUS_T_NODE_* */
+    int64_t sequence;
+    bool fault;                     /* an internal error: HEALTH_FAULT */
+    bool degraded;                  /* otherwise HEALTH_DEGRADED, else HEALTH_OK */
+    int8_t mode;                    /* COAVOID_STATUS_T_MODE_* */
+    int64_t last_plan_utime;
+    int64_t last_plan_duration_us;
+    uint64_t last_nodes_expanded;
+    int last_outcome;               /* coa_plan_status_t, -1 none */
+    uint32_t conflicts;
+    uint32_t plans_run;
+    const coa_lcm_rx_stats_t *rx;
+} coa_node_heartbeat_t;
+
 /* Checks a common configuration (node.h's ranges). COA_OK or COA_ERR_ARGUMENT. O(1). */
 int coa_node_common_check(const coa_node_common_t *c);
 
@@ -214,6 +244,21 @@ int coa_node_predict(coa_predictor_t *predictor, const coa_node_common_t *c,
  * plans, TRACK_CAPACITY tracks and MAX_OBSTACLES obstacles, so that the broad phase
  * cannot run out (13,280). O(1). */
 size_t coa_node_max_pairs(void);
+
+/* Allocates *s for a horizon of N steps and a planner of `searched` UAVs at beta. Returns
+ * COA_OK, COA_ERR_ARGUMENT (sizes the core refuses; nothing allocated) or COA_ERR_WORKSPACE
+ * (out of memory; nothing kept). Memory: the predictor's and planner's workspaces
+ * (coa_predictor_workspace_size, coa_planner_workspace_size) and the conflict array. */
+int coa_node_solver_init(coa_node_solver_t *s, uint32_t horizon, size_t searched, uint32_t beta);
+
+/* Frees what coa_node_solver_init allocated; a zeroed *s is fine. */
+void coa_node_solver_fini(coa_node_solver_t *s);
+
+/* Fills *m from h at `now`, validates it on the clock whose t = 0 is cycle_start
+ * (coa_node_context) and publishes it. Returns COA_OK, COA_ERR_ARGUMENT (it does not
+ * validate) or coa_node_publish_status's error. O(1); no memory. */
+int coa_node_publish_heartbeat(coa_node_inbox_t *in, coavoid_status_t *m, int64_t now,
+                               int64_t cycle_start, const coa_node_heartbeat_t *h);
 
 /* Publishing: encodes into tx->buf and publishes on the type's channel. COA_OK, or
  * COA_ERR_WORKSPACE (does not encode into the buffer) or COA_ERR_ARGUMENT (LCM refused

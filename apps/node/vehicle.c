@@ -43,13 +43,7 @@ struct coa_vehicle_node {
     coavoid_intent_t tx_intent;
     coavoid_status_t tx_status;
 
-    coa_conflict_t *conflicts;
-    size_t conflict_capacity;
-    void *predictor_memory;
-    coa_predictor_t *predictor;
-    void *planner_memory;
-    coa_planner_t *planner;
-
+    coa_node_solver_t solver;
     coa_node_inbox_t inbox;
     coa_node_view_t view;
     coa_node_problem_tracks_t problem_tracks;
@@ -119,38 +113,23 @@ static bool stale_inputs(const coa_vehicle_node_t *node, int64_t now)
 
 static int publish_status(coa_vehicle_node_t *node, int64_t now)
 {
-    coavoid_status_t *m = &node->tx_status;
     const coa_vehicle_node_state_t *s = &node->state;
-    memset(m, 0, sizeof *m);
-    m->utime = now;
-    m->node_id = node->config.vehicle.id;
-    m->node_kind = COAVOID_STATUS_T_NODE_VEHICLE;
-    m->sequence = node->status_sequence++;
-    if (node->fault) {
-        m->health = COAVOID_STATUS_T_HEALTH_FAULT;
-    } else if (s->last_outcome > 0 || stale_inputs(node, now) ||
-               (node->config.mode == COA_NODE_CENTRALISED && !s->coordinated)) {
-        m->health = COAVOID_STATUS_T_HEALTH_DEGRADED;
-    } else {
-        m->health = COAVOID_STATUS_T_HEALTH_OK;
-    }
-    m->mode = s->coordinated ? COAVOID_STATUS_T_MODE_CENTRALISED : COAVOID_STATUS_T_MODE_DECOUPLED;
-    m->last_plan_utime = node->last_plan_utime;
-    m->last_plan_duration_us = s->last_plan_duration_us;
-    m->nodes_expanded = s->last_nodes_expanded > (uint64_t)INT64_MAX ? INT64_MAX
-                                                                      : (int64_t)s->last_nodes_expanded;
-    m->outcome = s->last_outcome < 0 ? COAVOID_STATUS_T_OUTCOME_NONE : (int8_t)s->last_outcome;
-    m->conflicts = s->conflicts > (uint32_t)INT32_MAX ? INT32_MAX : (int32_t)s->conflicts;
-    m->plans_run = s->plans_run > (uint32_t)INT32_MAX ? INT32_MAX : (int32_t)s->plans_run;
-    m->messages_received = s->rx.received;
-    m->messages_rejected = s->rx.rejected;
-    m->last_reject_code = s->rx.last_reject_code;
-    coa_lcm_context_t ctx = coa_node_context(&node->inbox, now, node->cycle_start);
-    int rc = coa_lcm_status_check(m, &ctx, NULL);
-    if (rc != COA_OK) {
-        return COA_ERR_ARGUMENT;
-    }
-    return coa_node_publish_status(&node->inbox.tx, m);
+    const coa_node_heartbeat_t h = {
+        node->config.vehicle.id,
+        COAVOID_STATUS_T_NODE_VEHICLE,
+        node->status_sequence++,
+        node->fault,
+        s->last_outcome > 0 || stale_inputs(node, now) ||
+            (node->config.mode == COA_NODE_CENTRALISED && !s->coordinated),
+        s->coordinated ? COAVOID_STATUS_T_MODE_CENTRALISED : COAVOID_STATUS_T_MODE_DECOUPLED,
+        node->last_plan_utime,
+        s->last_plan_duration_us,
+        s->last_nodes_expanded,
+        s->last_outcome,
+        s->conflicts,
+        s->plans_run,
+        &s->rx};
+    return coa_node_publish_heartbeat(&node->inbox, &node->tx_status, now, node->cycle_start, &h);
 }
 
 /* Publishes this cycle's intent and heartbeat; the wait, if any, is over. Returns 1 or a
@@ -227,7 +206,7 @@ static int search_self(coa_vehicle_node_t *node, int64_t now, coa_plan_result_t 
     problem.track_samples = node->problem_tracks.samples;
 
     int64_t start = coa_node_stopwatch(c);
-    rc = coa_plan_centralised(node->planner, &problem, node->plan_out, result);
+    rc = coa_plan_centralised(node->solver.planner, &problem, node->plan_out, result);
     int64_t duration = coa_node_stopwatch(c) - start;
     node->state.plans_run++;
     node->last_plan_utime = now;
@@ -304,14 +283,15 @@ static bool near_pending(coa_vehicle_node_t *node, size_t n)
     }
     coa_predict_config_t config = coa_node_predict_config(c);
     coa_predict_result_t result;
-    if (coa_predict(node->predictor, &config, node->tall, n, NULL, 0, NULL, 0, node->conflicts,
-                    node->conflict_capacity, &result) != COA_OK) {
+    coa_node_solver_t *sv = &node->solver;
+    if (coa_predict(sv->predictor, &config, node->tall, n, NULL, 0, NULL, 0, sv->conflicts,
+                    sv->conflict_capacity, &result) != COA_OK) {
         return true; /* cannot tell: wait, bounded by the deadline */
     }
     /* Vehicle pairs come first in ascending (a, b), so its own (a == 0) survive an
      * overflow of the array. */
     for (size_t j = 0; j < result.conflict_count; j++) {
-        const coa_conflict_t *cf = &node->conflicts[j];
+        const coa_conflict_t *cf = &node->solver.conflicts[j];
         if (cf->kind != COA_CONFLICT_VEHICLE || cf->a != 0u) {
             break;
         }
@@ -355,9 +335,9 @@ static int decide(coa_vehicle_node_t *node, int64_t now)
     }
     coa_predict_result_t result;
     size_t clusters = 0;
-    int rc = coa_node_predict(node->predictor, c, node->plans, n, view, &node->inbox,
-                              node->conflicts, node->conflict_capacity, &result, node->labels,
-                              &clusters);
+    coa_node_solver_t *sv = &node->solver;
+    int rc = coa_node_predict(sv->predictor, c, node->plans, n, view, &node->inbox, sv->conflicts,
+                              sv->conflict_capacity, &result, node->labels, &clusters);
     if (rc != COA_OK) {
         node->fault = true;
         int published = finish(node, now);
@@ -385,7 +365,7 @@ static int decide(coa_vehicle_node_t *node, int64_t now)
      * it, as coa_plan_decoupled orders it): it plans only for one that is its own. */
     bool must = false;
     for (size_t j = 0; j < result.conflict_count; j++) {
-        const coa_conflict_t *cf = &node->conflicts[j];
+        const coa_conflict_t *cf = &node->solver.conflicts[j];
         if (cf->a != 0u) {
             continue;
         }
@@ -481,18 +461,19 @@ coa_vehicle_node_t *coa_vehicle_node_create(const coa_vehicle_node_config_t *con
         return NULL;
     }
     const coa_node_common_t *c = &config->common;
-    const size_t pairs = coa_node_max_pairs();
-    const size_t predictor_size = coa_predictor_workspace_size(
-        COA_NODE_MAX_PEERS, COA_NODE_TRACK_CAPACITY, c->horizon, pairs);
-    const size_t planner_size = coa_planner_workspace_size(1u, c->beta);
-    if (predictor_size == 0u || planner_size == 0u) {
+    coa_node_solver_t solver;
+    int rc = coa_node_solver_init(&solver, c->horizon, 1u, c->beta);
+    if (rc != COA_OK) {
+        *error = rc;
         return NULL;
     }
     coa_vehicle_node_t *node = calloc(1, sizeof *node);
     if (node == NULL) {
+        coa_node_solver_fini(&solver);
         *error = COA_ERR_WORKSPACE;
         return NULL;
     }
+    node->solver = solver;
     node->config = *config;
     if (node->config.coordinator_timeout_us == 0) {
         node->config.coordinator_timeout_us = (int64_t)llround(2.5 * (double)c->dt_us);
@@ -501,23 +482,6 @@ coa_vehicle_node_t *coa_vehicle_node_create(const coa_vehicle_node_config_t *con
         node->config.priority_wait_us = c->dt_us / 2 > 0 ? c->dt_us / 2 : 1;
     }
     node->dh = coa_climb_step(&node->config.vehicle, c->dt);
-    node->predictor_memory = malloc(predictor_size);
-    node->planner_memory = malloc(planner_size);
-    node->conflict_capacity = pairs;
-    node->conflicts = calloc(pairs, sizeof *node->conflicts);
-    if (node->predictor_memory == NULL || node->planner_memory == NULL || node->conflicts == NULL) {
-        coa_vehicle_node_destroy(node);
-        *error = COA_ERR_WORKSPACE;
-        return NULL;
-    }
-    node->predictor = coa_predictor_init(node->predictor_memory, predictor_size, COA_NODE_MAX_PEERS,
-                                         COA_NODE_TRACK_CAPACITY, c->horizon, pairs);
-    node->planner = coa_planner_init(node->planner_memory, planner_size, 1u, c->beta);
-    if (node->predictor == NULL || node->planner == NULL) {
-        coa_vehicle_node_destroy(node);
-        *error = COA_ERR_WORKSPACE;
-        return NULL;
-    }
     node->plan_start = 0;
     node->plan_count = 1;
     node->plan_offsets[0] = node->config.vehicle.initial_offset;
@@ -526,13 +490,11 @@ coa_vehicle_node_t *coa_vehicle_node_create(const coa_vehicle_node_config_t *con
     node->state.last_outcome = -1;
     node->wait_deadline = INT64_MAX;
     const bool centralised = node->config.mode == COA_NODE_CENTRALISED;
-    int rc = coa_node_inbox_init(&node->inbox, c, node->config.vehicle.id, node->config.vehicle.id,
-                                 COA_NODE_MAX_PEERS - 1u, node->config.coordinator_timeout_us, lcm,
-                                 &node->state.rx, centralised, centralised ? on_plan : NULL, node);
+    rc = coa_node_inbox_init(&node->inbox, c, node->config.vehicle.id, node->config.vehicle.id,
+                             COA_NODE_MAX_PEERS - 1u, node->config.coordinator_timeout_us, lcm,
+                             &node->state.rx, centralised, centralised ? on_plan : NULL, node);
     if (rc != COA_OK) {
-        free(node->predictor_memory);
-        free(node->planner_memory);
-        free(node->conflicts);
+        coa_node_solver_fini(&node->solver);
         free(node);
         *error = rc;
         return NULL;
@@ -547,9 +509,7 @@ void coa_vehicle_node_destroy(coa_vehicle_node_t *node)
         return;
     }
     coa_node_inbox_fini(&node->inbox);
-    free(node->predictor_memory);
-    free(node->planner_memory);
-    free(node->conflicts);
+    coa_node_solver_fini(&node->solver);
     free(node);
 }
 
