@@ -20,6 +20,7 @@
 #include <lcm/lcm.h>
 
 #include "flight.h"
+#include "judge.h"
 #include "node.h"
 #include "scenario.h"
 
@@ -132,12 +133,10 @@ typedef struct {
     coa_coordinator_t *coordinator;
     coa_vehicle_node_t **vehicles; /* in ascending id: the order they run in */
     size_t *index;                 /* index[j]: scenario index of vehicles[j] */
-    coa_flight_vehicle_t *flown;   /* by scenario index */
-    coa_vec3_t *references;
+    coa_vec3_t *references;        /* by scenario index, rows of K + 1 */
     int32_t *offsets;
     coa_track_t *tracks;           /* the world's copy when the scenario's ids do not fit */
-    double *vehicle_deviation;
-    uint32_t *vehicle_effort;
+    judged_t judged;
     FILE *svg;
 } sim_run_t;
 
@@ -155,12 +154,9 @@ static void sim_run_free(sim_run_t *r, size_t n)
     }
     free(r->vehicles);
     free(r->index);
-    free(r->flown);
     free(r->references);
     free(r->offsets);
     free(r->tracks);
-    free(r->vehicle_deviation);
-    free(r->vehicle_effort);
     if (r->svg != NULL) {
         fclose(r->svg);
     }
@@ -178,50 +174,6 @@ static bool drain(lcm_t *lcm)
             return false;
         }
     }
-}
-
-/* The simulation result with the extras only a simulation has (how often the UAVs fell
- * back to planning for themselves), spliced as text into the document coa_flight_json
- * writes: parsing and printing it again through cJSON would round its exact numbers. */
-static int print_json(const coa_flight_t *flight, const coa_flight_eval_t *eval,
-                      uint32_t fallbacks, const sim_options_t *o)
-{
-    char *text = NULL;
-    size_t length = 0;
-    FILE *memory = open_memstream(&text, &length);
-    if (memory == NULL) {
-        return COA_ERR_WORKSPACE;
-    }
-    int rc = coa_flight_json(flight, eval, memory);
-    if (fclose(memory) != 0 && rc == COA_OK) {
-        rc = COA_ERR_WORKSPACE;
-    }
-    /* The object's closing brace, and the end of its last member before it. */
-    size_t close = length;
-    while (rc == COA_OK && close > 0 && text[close - 1] != '}') {
-        close--;
-    }
-    size_t member_end = close > 0 ? close - 1 : 0;
-    while (member_end > 0 && (text[member_end - 1] == '\n' || text[member_end - 1] == ' ' ||
-                              text[member_end - 1] == '\t' || text[member_end - 1] == '\r')) {
-        member_end--;
-    }
-    if (rc == COA_OK && (close == 0 || member_end == 0 || text[member_end - 1] == '{')) {
-        rc = COA_ERR_WORKSPACE; /* not the object coa_flight_json writes */
-    }
-    if (rc == COA_OK) {
-        bool ok = fwrite(text, 1, member_end, stdout) == member_end &&
-                  printf(",\n\t\"fallbacks\":\t%lu", (unsigned long)fallbacks) > 0;
-        if (ok && o->stop_text != NULL) {
-            ok = printf(",\n\t\"coordinator_stopped_at\":\t%lu", (unsigned long)o->stop_step) > 0;
-        }
-        ok = ok && fputs("\n}", stdout) >= 0 &&
-             fwrite(text + close, 1, length - close, stdout) == length - close &&
-             fflush(stdout) == 0;
-        rc = ok ? COA_OK : COA_ERR_WORKSPACE;
-    }
-    free(text);
-    return rc;
 }
 
 static int sim(void *options, scenario_t *s)
@@ -281,13 +233,9 @@ static int sim(void *options, scenario_t *s)
     const size_t samples = (size_t)steps + 1u;
     r.vehicles = calloc(n, sizeof *r.vehicles);
     r.index = calloc(n, sizeof *r.index);
-    r.flown = calloc(n, sizeof *r.flown);
     r.references = calloc(n * samples, sizeof *r.references);
     r.offsets = calloc(n * samples, sizeof *r.offsets);
-    r.vehicle_deviation = calloc(n, sizeof *r.vehicle_deviation);
-    r.vehicle_effort = calloc(n, sizeof *r.vehicle_effort);
-    if (r.vehicles == NULL || r.index == NULL || r.flown == NULL || r.references == NULL ||
-        r.offsets == NULL || r.vehicle_deviation == NULL || r.vehicle_effort == NULL) {
+    if (r.vehicles == NULL || r.index == NULL || r.references == NULL || r.offsets == NULL) {
         sim_run_free(&r, n);
         return cli_fail(CLI_EXIT_INVALID, "%s: cannot allocate the record of %lu steps", file,
                         (unsigned long)steps);
@@ -492,37 +440,16 @@ static int sim(void *options, scenario_t *s)
         replans += st->plans_run;
         fallbacks += st->fallbacks;
     }
-    for (size_t i = 0; i < n; i++) {
-        r.flown[i].vehicle = s->vehicles[i];
-        r.flown[i].reference = r.references + i * samples;
-        r.flown[i].offsets = r.offsets + i * samples;
-        r.flown[i].known = NULL;
-    }
-    coa_flight_t flight;
-    memset(&flight, 0, sizeof flight);
-    flight.scenario = s->name;
-    flight.mode = o->mode;
-    flight.dt = s->dt;
-    flight.steps = steps;
-    flight.vehicles = r.flown;
-    flight.vehicle_count = n;
-    flight.obstacles = s->obstacles;
-    flight.obstacle_count = s->obstacle_count;
-    flight.tracks = s->tracks;
-    flight.track_count = s->track_count;
-    flight.replans = replans;
-    coa_flight_eval_t eval;
-    memset(&eval, 0, sizeof eval);
-    eval.vehicle_deviation = r.vehicle_deviation;
-    eval.vehicle_effort = r.vehicle_effort;
-    rc = coa_flight_evaluate(&flight, &eval);
+    rc = judge_run(&r.judged, s, o->mode, steps, replans, r.references, r.offsets, NULL);
+    const coa_flight_t *flight = &r.judged.flight;
+    const coa_flight_eval_t *eval = &r.judged.eval;
     if (rc != COA_OK) {
         sim_run_free(&r, n);
         return cli_fail(CLI_EXIT_INTERNAL, "internal error: the flight cannot be judged (%s)",
                         coa_status_name(rc));
     }
     if (r.svg != NULL) {
-        rc = coa_flight_svg(&flight, &eval, r.svg);
+        rc = coa_flight_svg(flight, eval, r.svg);
         int closed = fclose(r.svg);
         r.svg = NULL;
         if (rc != COA_OK || closed != 0) {
@@ -531,9 +458,15 @@ static int sim(void *options, scenario_t *s)
         }
     }
     if (o->json) {
-        rc = print_json(&flight, &eval, fallbacks, o);
+        char fallbacks_text[16];
+        char stopped_text[16];
+        snprintf(fallbacks_text, sizeof fallbacks_text, "%lu", (unsigned long)fallbacks);
+        snprintf(stopped_text, sizeof stopped_text, "%lu", (unsigned long)o->stop_step);
+        const coa_flight_extra_t extra[2] = {{"fallbacks", fallbacks_text},
+                                             {"coordinator_stopped_at", stopped_text}};
+        rc = coa_flight_json_extra(flight, eval, extra, o->stop_text != NULL ? 2u : 1u, stdout);
     } else {
-        rc = coa_flight_text(&flight, &eval, stdout);
+        rc = coa_flight_text(flight, eval, stdout);
         if (rc == COA_OK &&
             (printf("fallbacks: %lu\n", (unsigned long)fallbacks) < 0 || fflush(stdout) != 0)) {
             rc = COA_ERR_WORKSPACE;
@@ -543,7 +476,7 @@ static int sim(void *options, scenario_t *s)
     if (rc != COA_OK) {
         return cli_fail(CLI_EXIT_INTERNAL, "internal error: the result could not be written");
     }
-    return eval.loss_of_separation ? CLI_EXIT_NOT_SOLVED : CLI_EXIT_OK;
+    return eval->loss_of_separation ? CLI_EXIT_NOT_SOLVED : CLI_EXIT_OK;
 }
 
 int command_sim(int argc, char **argv)

@@ -50,6 +50,7 @@
 #include "coavoid_lcm.h"
 #include "commands.h"
 #include "flight.h"
+#include "judge.h"
 #include "node.h"
 #include "scenario.h"
 
@@ -595,14 +596,11 @@ static uint32_t count_replans(log_summary_t *ls, int64_t to)
 
 typedef struct {
     uint32_t steps;                 /* K */
-    coa_flight_vehicle_t vehicles[COA_MAX_VEHICLES];
     int64_t *best;                  /* n rows of K + 1: plan_utime of the sample's source */
     bool *own;                      /* n rows of K + 1: from the cycle's own intent */
     bool *known;                    /* n rows of K + 1 */
     coa_vec3_t *reference;          /* n rows */
     int32_t *offsets;               /* n rows */
-    double vehicle_deviation[COA_MAX_VEHICLES];
-    uint32_t vehicle_effort[COA_MAX_VEHICLES];
     int64_t own_samples;
     int64_t earlier_samples;
     int64_t missing_samples;
@@ -783,33 +781,11 @@ static bool add_count(cJSON *obj, const char *key, int64_t value)
     return cJSON_AddRawToObject(obj, key, text) != NULL;
 }
 
-/* The flight's JSON with a "log" object added. coa_flight_json's document is spliced,
- * not parsed and printed again: cJSON would print its numbers with its own, inexact,
- * shortest form. The log object holds only integers and strings, which print exactly. */
+/* The flight's JSON with a "log" object added. The log object holds only integers and
+ * strings, which cJSON prints exactly. */
 static int print_json(const log_summary_t *ls, const rebuilt_t *b, int64_t epoch,
                       const coa_flight_t *flight, const coa_flight_eval_t *eval)
 {
-    char *text = NULL;
-    size_t size = 0;
-    FILE *mem = open_memstream(&text, &size);
-    if (mem == NULL) {
-        return cli_fail(CLI_EXIT_INTERNAL, "out of memory printing the result");
-    }
-    int rc = coa_flight_json(flight, eval, mem);
-    if (fclose(mem) != 0 || rc != COA_OK) {
-        free(text);
-        return cli_fail(CLI_EXIT_INTERNAL, "internal error: cannot print the result (%s)",
-                        coa_status_name(rc));
-    }
-    /* The document is one object: it ends with its closing brace and a newline. */
-    while (size > 0u && (text[size - 1u] == '\n' || text[size - 1u] == ' ')) {
-        size--;
-    }
-    if (size < 2u || text[size - 1u] != '}') {
-        free(text);
-        return cli_fail(CLI_EXIT_INTERNAL, "internal error: the result is not a JSON object");
-    }
-    size--;
     cJSON *log = cJSON_CreateObject();
     bool ok = log != NULL && cJSON_AddStringToObject(log, "file", ls->o->log_path) != NULL &&
               add_count(log, "events", ls->events) && add_count(log, "intents", ls->intents) &&
@@ -829,15 +805,17 @@ static int print_json(const log_summary_t *ls, const rebuilt_t *b, int64_t epoch
     char *log_text = ok ? cJSON_PrintUnformatted(log) : NULL;
     cJSON_Delete(log);
     if (log_text == NULL) {
-        free(text);
         return cli_fail(CLI_EXIT_INTERNAL, "out of memory printing the result");
     }
+    const coa_flight_extra_t extra = {"log", log_text};
     errno = 0;
-    bool written = fwrite(text, 1, size, stdout) == size &&
-                   printf(",\n\t\"log\":\t%s\n}\n", log_text) > 0 && fflush(stdout) == 0;
-    free(text);
+    int rc = coa_flight_json_extra(flight, eval, &extra, 1u, stdout);
     free(log_text);
-    if (!written) {
+    if (rc == COA_ERR_ARGUMENT) {
+        return cli_fail(CLI_EXIT_INTERNAL, "internal error: cannot print the result (%s)",
+                        coa_status_name(rc));
+    }
+    if (rc != COA_OK) {
         return cli_fail(CLI_EXIT_INTERNAL, "cannot write the result: %s",
                         errno != 0 ? strerror(errno) : "write error");
     }
@@ -978,35 +956,15 @@ static int summarise(void *options, scenario_t *s)
                           o->scenario_path, (unsigned long)b.steps);
     }
 
+    judged_t judged;
+    const coa_flight_t *flight = &judged.flight;
+    const coa_flight_eval_t *eval = &judged.eval;
     if (status == CLI_CONTINUE) {
-        const size_t row = (size_t)b.steps + 1u;
-        for (size_t i = 0; i < n; i++) {
-            b.vehicles[i].vehicle = s->vehicles[i];
-            b.vehicles[i].reference = &b.reference[i * row];
-            b.vehicles[i].offsets = &b.offsets[i * row];
-            b.vehicles[i].known = &b.known[i * row];
-        }
-        coa_flight_t flight;
-        memset(&flight, 0, sizeof flight);
-        flight.scenario = s->name;
-        flight.mode = o->mode;
-        flight.dt = s->dt;
-        flight.steps = b.steps;
-        flight.vehicles = b.vehicles;
-        flight.vehicle_count = n;
-        flight.obstacles = s->obstacles;
-        flight.obstacle_count = s->obstacle_count;
-        flight.tracks = s->tracks;
-        flight.track_count = s->track_count;
-        flight.replans = count_replans(ls, epoch + ((int64_t)b.steps + 1) * ls->dt_us);
-
-        coa_flight_eval_t eval;
-        memset(&eval, 0, sizeof eval);
-        eval.vehicle_deviation = b.vehicle_deviation;
-        eval.vehicle_effort = b.vehicle_effort;
-        int rc = coa_flight_evaluate(&flight, &eval);
+        uint32_t replans = count_replans(ls, epoch + ((int64_t)b.steps + 1) * ls->dt_us);
+        int rc = judge_run(&judged, s, o->mode, b.steps, replans, b.reference, b.offsets,
+                           b.known);
         if (rc == COA_ERR_ARGUMENT) {
-            status = refused_record(o, &flight, &b);
+            status = refused_record(o, flight, &b);
         } else if (rc != COA_OK) {
             status = cli_fail(CLI_EXIT_INTERNAL, "cannot judge the flight (%s)",
                               coa_status_name(rc));
@@ -1014,20 +972,20 @@ static int summarise(void *options, scenario_t *s)
         /* The figure first: a file that cannot be written is a usage error, reported
          * before anything is printed. */
         if (status == CLI_CONTINUE && o->svg_path != NULL) {
-            status = write_svg(o->svg_path, &flight, &eval);
+            status = write_svg(o->svg_path, flight, eval);
         }
         if (status == CLI_CONTINUE) {
             if (o->json) {
-                status = print_json(ls, &b, epoch, &flight, &eval);
+                status = print_json(ls, &b, epoch, flight, eval);
             } else {
                 print_log_text(ls, &b, epoch);
-                if (coa_flight_text(&flight, &eval, stdout) != COA_OK) {
+                if (coa_flight_text(flight, eval, stdout) != COA_OK) {
                     status = cli_fail(CLI_EXIT_INTERNAL, "cannot write the result");
                 }
             }
         }
         if (status == CLI_CONTINUE) {
-            status = eval.loss_of_separation ? CLI_EXIT_NOT_SOLVED : CLI_EXIT_OK;
+            status = eval->loss_of_separation ? CLI_EXIT_NOT_SOLVED : CLI_EXIT_OK;
         }
     }
     rebuilt_free(&b);

@@ -379,13 +379,31 @@ fail:
 
 int coa_flight_json(const coa_flight_t *flight, const coa_flight_eval_t *eval, FILE *out)
 {
+    return coa_flight_json_extra(flight, eval, NULL, 0u, out);
+}
+
+int coa_flight_json_extra(const coa_flight_t *flight, const coa_flight_eval_t *eval,
+                          const coa_flight_extra_t *extra, size_t extra_count, FILE *out)
+{
     if (eval == NULL || out == NULL || check_record(flight) != COA_OK ||
-        (eval->loss_of_separation && eval->first_vehicle >= flight->vehicle_count)) {
+        (eval->loss_of_separation && eval->first_vehicle >= flight->vehicle_count) ||
+        (extra_count > 0u && extra == NULL)) {
         return COA_ERR_ARGUMENT;
+    }
+    for (size_t i = 0; i < extra_count; i++) {
+        if (extra[i].key == NULL || extra[i].json == NULL) {
+            return COA_ERR_ARGUMENT;
+        }
     }
     cJSON *root = build_json(flight, eval);
     if (root == NULL) {
         return COA_ERR_WORKSPACE;
+    }
+    for (size_t i = 0; i < extra_count; i++) {
+        if (cJSON_AddRawToObject(root, extra[i].key, extra[i].json) == NULL) {
+            cJSON_Delete(root);
+            return COA_ERR_WORKSPACE;
+        }
     }
     char *text = cJSON_Print(root);
     cJSON_Delete(root);

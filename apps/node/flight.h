@@ -118,6 +118,21 @@ int coa_flight_svg(const coa_flight_t *flight, const coa_flight_eval_t *eval, FI
  * failed). Cost O(K n); allocates the document, O(K n), while printing. */
 int coa_flight_json(const coa_flight_t *flight, const coa_flight_eval_t *eval, FILE *out);
 
+/* A member a command adds to the result beyond the record's: its key and its value as
+ * JSON text, written as given (e.g. "3", or an object printed by cJSON). */
+typedef struct {
+    const char *key;
+    const char *json;
+} coa_flight_extra_t;
+
+/* coa_flight_json with extra[0..extra_count) appended to the object, in order, the way
+ * `coavoid sim` adds "fallbacks" and `coavoid summary` its "log": so no command has to
+ * parse the document and print it again. The json texts are not checked. Returns, costs
+ * and allocates as coa_flight_json; COA_ERR_ARGUMENT also for an extra without a key or
+ * text. */
+int coa_flight_json_extra(const coa_flight_t *flight, const coa_flight_eval_t *eval,
+                          const coa_flight_extra_t *extra, size_t extra_count, FILE *out);
+
 /* Writes the result for a reader, one fact a line ("loss of separation: no", "deviation:
  * ... m^2", per UAV its costs), as `coavoid sim` and `coavoid summary` print it without
  * --json; a loss names both sides ("UAV 1 and obstacle 0") from coa_flight_conflicts.
