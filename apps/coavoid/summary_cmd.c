@@ -316,20 +316,31 @@ typedef struct {
     size_t capacity;
 } planning_list_t;
 
+/* items, of *capacity items of item_size bytes, holding count, with room for one more:
+ * doubled (from 256) when full. NULL out of memory, items then unchanged. */
+static void *room_for_one(void *items, size_t count, size_t *capacity, size_t item_size)
+{
+    if (count < *capacity) {
+        return items;
+    }
+    size_t grown = *capacity > 0u ? *capacity * 2u : 256u;
+    if (grown > SIZE_MAX / item_size) {
+        return NULL;
+    }
+    void *moved = realloc(items, grown * item_size);
+    if (moved != NULL) {
+        *capacity = grown;
+    }
+    return moved;
+}
+
 static bool planning_add(planning_list_t *list, planning_t item)
 {
-    if (list->count == list->capacity) {
-        size_t capacity = list->capacity > 0u ? list->capacity * 2u : 256u;
-        if (capacity > SIZE_MAX / sizeof *list->items) {
-            return false;
-        }
-        planning_t *grown = realloc(list->items, capacity * sizeof *grown);
-        if (grown == NULL) {
-            return false;
-        }
-        list->items = grown;
-        list->capacity = capacity;
+    planning_t *items = room_for_one(list->items, list->count, &list->capacity, sizeof item);
+    if (items == NULL) {
+        return false;
     }
+    list->items = items;
     list->items[list->count++] = item;
     return true;
 }
@@ -348,18 +359,11 @@ typedef struct {
 
 static bool intent_add(intent_list_t *list, intent_seen_t item)
 {
-    if (list->count == list->capacity) {
-        size_t capacity = list->capacity > 0u ? list->capacity * 2u : 256u;
-        if (capacity > SIZE_MAX / sizeof *list->items) {
-            return false;
-        }
-        intent_seen_t *grown = realloc(list->items, capacity * sizeof *grown);
-        if (grown == NULL) {
-            return false;
-        }
-        list->items = grown;
-        list->capacity = capacity;
+    intent_seen_t *items = room_for_one(list->items, list->count, &list->capacity, sizeof item);
+    if (items == NULL) {
+        return false;
     }
+    list->items = items;
     list->items[list->count++] = item;
     return true;
 }
