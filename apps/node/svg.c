@@ -707,6 +707,29 @@ static double horizontal_distance(coa_vec3_t a, coa_vec3_t b)
     return hypot((double)a.x - (double)b.x, (double)a.y - (double)b.y);
 }
 
+/* Traffic q as UAV i's panel sees it: UAV q when q < vehicle_count, else track
+ * q - vehicle_count. */
+typedef struct {
+    bool is_track;
+    size_t j;                  /* its index among the UAVs or among the tracks */
+    const coa_vec3_t *row;     /* its samples 0..K */
+    const coa_volume_t *vol;
+    double near;               /* horizontal distance to UAV i within which it is drawn */
+} svg_other_t;
+
+static svg_other_t other_traffic(const svg_t *s, size_t i, size_t q)
+{
+    const coa_flight_t *f = s->f;
+    svg_other_t o;
+    o.is_track = q >= f->vehicle_count;
+    o.j = o.is_track ? q - f->vehicle_count : q;
+    o.row = o.is_track ? &s->tracks[o.j * s->row] : &s->flown[o.j * s->row];
+    o.vol = o.is_track ? &f->tracks[o.j].volume : &f->vehicles[o.j].vehicle.volume;
+    o.near = SVG_NEAR_RADII *
+             ((double)f->vehicles[i].vehicle.volume.radius + (double)o.vol->radius);
+    return o;
+}
+
 /* Traffic near UAV i: other UAVs' and tracks' altitudes over the runs of samples where they
  * are within SVG_NEAR_RADII summed radii horizontally. */
 static void near_traffic(const svg_t *s, size_t i, const frame_t *fr, bool draw_labels)
@@ -714,56 +737,54 @@ static void near_traffic(const svg_t *s, size_t i, const frame_t *fr, bool draw_
     FILE *out = s->out;
     const coa_flight_t *f = s->f;
     const coa_vec3_t *me = &s->flown[i * s->row];
-    const double ri = (double)f->vehicles[i].vehicle.volume.radius;
     const size_t others = f->vehicle_count + f->track_count;
     for (size_t q = 0; q < others; q++) {
         if (q == i) {
             continue;
         }
-        bool is_track = q >= f->vehicle_count;
-        size_t j = is_track ? q - f->vehicle_count : q;
-        const coa_vec3_t *row = is_track ? &s->tracks[j * s->row] : &s->flown[j * s->row];
-        const coa_volume_t *vol = is_track ? &f->tracks[j].volume : &f->vehicles[j].vehicle.volume;
-        const char *colour = is_track ? TRACK_COLOUR : colour_of(j);
-        double near = SVG_NEAR_RADII * (ri + (double)vol->radius);
+        const svg_other_t o = other_traffic(s, i, q);
+        const char *colour = o.is_track ? TRACK_COLOUR : colour_of(o.j);
         size_t k = 0;
         bool labelled = false;
         while (k < s->row) {
-            if (horizontal_distance(me[k], row[k]) >= near) {
+            if (horizontal_distance(me[k], o.row[k]) >= o.near) {
                 k++;
                 continue;
             }
             size_t from = k;
-            while (k + 1u < s->row && horizontal_distance(me[k + 1u], row[k + 1u]) < near) {
+            while (k + 1u < s->row && horizontal_distance(me[k + 1u], o.row[k + 1u]) < o.near) {
                 k++;
             }
             size_t to = k;
             char attrs[160];
             snprintf(attrs, sizeof attrs, "fill=\"%s\" fill-opacity=\"0.10\" stroke=\"none\"",
                      colour);
-            band_tz(out, fr, row, (double)f->dt, from, to, (double)vol->half_height, attrs);
+            band_tz(out, fr, o.row, (double)f->dt, from, to, (double)o.vol->half_height, attrs);
             if (to > from) {
                 snprintf(attrs, sizeof attrs,
                          "stroke=\"%s\" stroke-width=\"1.4\"%s", colour,
-                         is_track ? " stroke-dasharray=\"2 3\"" : "");
-                polyline_tz(out, fr, row, (double)f->dt, from, to, 0.0, attrs);
+                         o.is_track ? " stroke-dasharray=\"2 3\"" : "");
+                polyline_tz(out, fr, o.row, (double)f->dt, from, to, 0.0, attrs);
             } else {
                 fprintf(out, "<circle cx=\"%.2f\" cy=\"%.2f\" r=\"2.5\" fill=\"%s\"/>\n",
-                        px(fr, (double)from * (double)f->dt), py(fr, (double)row[from].z), colour);
+                        px(fr, (double)from * (double)f->dt), py(fr, (double)o.row[from].z),
+                        colour);
             }
             if (draw_labels && !labelled) {
                 char label[48];
-                if (is_track) {
-                    snprintf(label, sizeof label, "track %lu (near)", (unsigned long)f->tracks[j].id);
+                if (o.is_track) {
+                    snprintf(label, sizeof label, "track %lu (near)",
+                             (unsigned long)f->tracks[o.j].id);
                 } else {
-                    snprintf(label, sizeof label, "UAV %u (near)", (unsigned)f->vehicles[j].vehicle.id);
+                    snprintf(label, sizeof label, "UAV %u (near)",
+                             (unsigned)f->vehicles[o.j].vehicle.id);
                 }
                 /* Beside the run's start, outside it: conflict markers sit inside runs. */
                 double x = px(fr, (double)from * (double)f->dt);
                 bool left = x - fr->left > 90.0;
                 fprintf(out,
                         "<text x=\"%.1f\" y=\"%.1f\" class=\"near\" fill=\"%s\"%s>",
-                        left ? x - 5.0 : x + 5.0, py(fr, (double)row[from].z) + 4.0, colour,
+                        left ? x - 5.0 : x + 5.0, py(fr, (double)o.row[from].z) + 4.0, colour,
                         left ? " text-anchor=\"end\"" : "");
                 put_text(out, label);
                 fputs("</text>\n", out);
@@ -781,24 +802,20 @@ static void near_extent(const svg_t *s, size_t i, double lo_own, double hi_own, 
 {
     const coa_flight_t *f = s->f;
     const coa_vec3_t *me = &s->flown[i * s->row];
-    const double ri = (double)f->vehicles[i].vehicle.volume.radius;
     const double hi_vol = (double)f->vehicles[i].vehicle.volume.half_height;
     for (size_t q = 0; q < f->vehicle_count + f->track_count; q++) {
         if (q == i) {
             continue;
         }
-        bool is_track = q >= f->vehicle_count;
-        size_t j = is_track ? q - f->vehicle_count : q;
-        const coa_vec3_t *row = is_track ? &s->tracks[j * s->row] : &s->flown[j * s->row];
-        const coa_volume_t *vol = is_track ? &f->tracks[j].volume : &f->vehicles[j].vehicle.volume;
-        double near = SVG_NEAR_RADII * (ri + (double)vol->radius);
-        double reach = 6.0 * (hi_vol + (double)vol->half_height);
+        const svg_other_t o = other_traffic(s, i, q);
+        const double h = (double)o.vol->half_height;
+        const double reach = 6.0 * (hi_vol + h);
         for (size_t k = 0; k < s->row; k++) {
-            double z = (double)row[k].z;
-            if (horizontal_distance(me[k], row[k]) < near && z > lo_own - reach &&
+            double z = (double)o.row[k].z;
+            if (horizontal_distance(me[k], o.row[k]) < o.near && z > lo_own - reach &&
                 z < hi_own + reach) {
-                *lo = fmin(*lo, z - (double)vol->half_height);
-                *hi = fmax(*hi, z + (double)vol->half_height);
+                *lo = fmin(*lo, z - h);
+                *hi = fmax(*hi, z + h);
             }
         }
     }
