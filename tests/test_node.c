@@ -3,7 +3,9 @@
  * hand-set clock: what arrives is counted (undecodable bytes too) and never the node's own
  * messages; a UAV that restarts its numbering is accepted once it has been silent; a
  * coordinator's plan is adopted only under the rules of node.h (this cycle, from the
- * offset flown, a newer plan_id, before valid_until); the UAV falls back to planning for
+ * offset flown, a plan_id newer than the last adopted in the cycle, before valid_until),
+ * and no plan_id, forged or from a restarted coordinator, locks later cycles out; the
+ * UAV falls back to planning for
  * itself when the heartbeat stops and returns when it comes back; a lower priority waits
  * for the higher, up to its deadline; a silent UAV is avoided as a track; the world's
  * track estimates reproduce the scenario's path over the horizon; bad configurations are
@@ -268,6 +270,57 @@ START_TEST(test_plan_adoption_rules)
         drain(r.lcm);
         ck_assert_int_eq(s->offset, want[k]);
         ck_assert(s->position.z == s->reference.z + (coa_real_t)want[k] * (coa_real_t)2);
+    }
+    coa_vehicle_node_destroy(a);
+    lcm_destroy(r.lcm);
+}
+END_TEST
+
+/* Plans are ordered within a cycle only: valid_from already ties a plan to one cycle. A
+ * forged plan_id INT64_MAX (for another UAV, or for this one) does not lock out the real
+ * coordinator, whose heartbeats keep coming, and a restarted coordinator's numbering
+ * from 0 is adopted at once. */
+START_TEST(test_plan_ids_do_not_lock_out)
+{
+    rig_t r;
+    rig_init(&r, 10);
+    coa_vec3_t route[2];
+    coa_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, route, 0, 500, 0, 100), COA_NODE_CENTRALISED);
+    const coa_vehicle_node_state_t *s = coa_vehicle_node_state(a);
+    int64_t sequence = 0;
+    ck_assert_int_eq(coa_vehicle_node_cycle(a, cycle(0)), COA_OK);
+    drain(r.lcm);
+    r.now = cycle(0) + DT_US / 4;
+    heartbeat(r.lcm, r.now, sequence++);
+    /* A forged plan for a UAV that does not exist, then the real one for this UAV. */
+    plan_msg(r.lcm, r.now, INT64_MAX, cycle(0), 999, 10, 0);
+    plan_msg(r.lcm, r.now, 0, cycle(0), 1, 10, 0);
+    drain(r.lcm);
+    ck_assert_int_eq(s->plans_adopted, 1);
+    ck_assert_int_eq(s->rx.rejected, 0);
+    /* A forged plan for this UAV: within this cycle it supersedes, and the real
+     * coordinator's next plan of this cycle is not newer. */
+    plan_msg(r.lcm, r.now, INT64_MAX, cycle(0), 1, 10, 0);
+    drain(r.lcm);
+    ck_assert_int_eq(s->plans_adopted, 2);
+    plan_msg(r.lcm, r.now, 1, cycle(0), 1, 10, 0);
+    drain(r.lcm);
+    ck_assert_int_eq(s->plans_adopted, 2);
+    ck_assert_int_eq(s->rx.last_reject_code, COA_LCM_ERR_SEQUENCE);
+    /* From the next cycle on the real coordinator's plans are adopted again, and so are a
+     * restarted coordinator's, numbered from 0. */
+    const int64_t ids[4] = {2, 3, 0, 1};
+    for (int64_t k = 1; k <= 4; k++) {
+        r.now = cycle(k);
+        ck_assert_int_eq(coa_vehicle_node_cycle(a, r.now), COA_OK);
+        drain(r.lcm);
+        ck_assert(s->coordinated);
+        r.now = cycle(k) + DT_US / 4;
+        heartbeat(r.lcm, r.now, sequence++);
+        plan_msg(r.lcm, r.now, ids[k - 1], cycle(k), 1, 10, s->offset);
+        drain(r.lcm);
+        ck_assert_msg(s->plans_adopted == (uint32_t)(2 + k), "cycle %d: %s", (int)k,
+                      s->rx.last_reason);
     }
     coa_vehicle_node_destroy(a);
     lcm_destroy(r.lcm);
@@ -642,6 +695,7 @@ static Suite *node_suite(void)
     tcase_add_test(tc, test_undecodable_counted_own_ignored);
     tcase_add_test(tc, test_restarted_peer_accepted_after_silence);
     tcase_add_test(tc, test_plan_adoption_rules);
+    tcase_add_test(tc, test_plan_ids_do_not_lock_out);
     tcase_add_test(tc, test_fallback_and_return);
     tcase_add_test(tc, test_lower_priority_waits);
     tcase_add_test(tc, test_waits_for_near_higher_priority);

@@ -315,8 +315,6 @@ static void on_status(const lcm_recv_buf_t *rbuf, const char *channel, void *use
     if (msg->node_kind == COAVOID_STATUS_T_NODE_COORDINATOR) {
         in->heard_coordinator = true;
         in->coordinator_utime = now;
-        /* Its plan numbering lives as long as its heartbeat does. */
-        senders_heard(&in->plan_seq, (uint32_t)msg->node_id, now);
     }
 }
 
@@ -338,13 +336,16 @@ static void on_plan(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
     coa_lcm_plan_info_t info;
     coa_plan_result_t result;
     const char *reason = NULL;
-    int rc = coa_lcm_plan_to_core(msg, &ctx, &in->plan_seq.table, &info, &result, in->rx_offsets,
+    /* No sequence rule across cycles: a plan is only ever adopted in the cycle its
+     * valid_from names, and the vehicle orders the plans of one cycle itself. A table
+     * remembering plan_ids would let one forged INT64_MAX, or a coordinator restarted
+     * while its heartbeat kept the entry alive, lock every later plan out. */
+    int rc = coa_lcm_plan_to_core(msg, &ctx, NULL, &info, &result, in->rx_offsets,
                                   sizeof in->rx_offsets / sizeof in->rx_offsets[0], &reason);
     if (rc != COA_OK) {
         coa_lcm_rx_count(in->rx, rc, reason);
         return;
     }
-    senders_heard(&in->plan_seq, (uint32_t)msg->coordinator_id, now);
     in->on_plan(in->owner, msg, &info, &result, in->rx_offsets);
 }
 
@@ -360,8 +361,7 @@ static int subscribe(coa_node_inbox_t *in, const char *channel, lcm_msg_handler_
 }
 
 int coa_node_inbox_init(coa_node_inbox_t *in, const coa_node_common_t *common, uint16_t self_uav,
-                        uint16_t self_node, size_t peer_capacity, int64_t coordinator_timeout_us,
-                        lcm_t *lcm, coa_lcm_rx_stats_t *rx, bool want_status,
+                        uint16_t self_node, size_t peer_capacity, lcm_t *lcm, coa_lcm_rx_stats_t *rx, bool want_status,
                         coa_node_plan_handler_t plan_handler, void *owner)
 {
     in->common = *common;
@@ -373,7 +373,6 @@ int coa_node_inbox_init(coa_node_inbox_t *in, const coa_node_common_t *common, u
      * track's path and a plan's samples around their stamps. */
     int64_t horizon_us = ((int64_t)common->horizon + 2) * common->dt_us;
     in->max_age_us = common->stale_after_us + horizon_us;
-    in->coordinator_timeout_us = coordinator_timeout_us;
     in->tx.lcm = lcm;
     in->sub_count = 0;
     coa_lcm_rx_init(in->rx);
@@ -381,7 +380,6 @@ int coa_node_inbox_init(coa_node_inbox_t *in, const coa_node_common_t *common, u
     senders_init(&in->track_seq);
     senders_init(&in->map_seq);
     senders_init(&in->status_seq);
-    senders_init(&in->plan_seq);
     memset(in->peers, 0, sizeof in->peers);
     memset(in->tracks, 0, sizeof in->tracks);
     in->have_map = false;
@@ -451,8 +449,6 @@ void coa_node_inbox_expire(coa_node_inbox_t *in, int64_t now)
     senders_expire(&in->track_seq, now, stale);
     senders_expire(&in->map_seq, now, stale);
     senders_expire(&in->status_seq, now, stale);
-    senders_expire(&in->plan_seq, now,
-                   in->coordinator_timeout_us > stale ? in->coordinator_timeout_us : stale);
 }
 
 /* ---- the view ---- */

@@ -52,10 +52,14 @@
  *      traffic): when a cluster's plan fails, every clustered UAV is planned again as one
  *      group, and failing that every UAV, from the intents as they came; that plan_t
  *      (a newer plan_id) supersedes the cycle's earlier ones for its UAVs.
- *   4. A UAV adopts a plan_t that lists it among the planned rows, is solved, is newer
- *      than the last one adopted (plan_id), arrives before valid_until, has valid_from ==
- *      the current cycle's start, and starts at the offset the UAV flies now; anything
- *      else is not adopted (counted in status as rejected with the reason).
+ *   4. A UAV adopts a plan_t that lists it among the planned rows, is solved, arrives
+ *      before valid_until, has valid_from == the current cycle's start, has a plan_id
+ *      greater than that of any plan it adopted in this cycle (so that a later plan of
+ *      the cycle supersedes), and starts at the offset the UAV flies now; anything else
+ *      is not adopted (counted in status as rejected with the reason). Plan ids are not
+ *      compared across cycles: valid_from already ties a plan to its cycle, and a rule
+ *      across cycles would let one forged plan_id INT64_MAX, or a coordinator restarted
+ *      with its numbering at 0, lock every later plan out.
  * Every node publishes its heartbeat (status_t) once per cycle; the world, a stand-in for
  * external sources that status_t has no kind for, does not.
  *

@@ -76,8 +76,9 @@ typedef struct {
 
 typedef struct coa_node_inbox coa_node_inbox_t;
 
-/* Called for a plan_t that decoded, is not the node's own and passed validation and the
- * sequence rule (vehicle.c decides on adoption and counts the outcome itself). */
+/* Called for a plan_t that decoded, is not the node's own and passed validation; no
+ * sequence rule is applied to plans (vehicle.c orders those of one cycle, decides on
+ * adoption and counts the outcome itself). */
 typedef void (*coa_node_plan_handler_t)(void *owner, const coavoid_plan_t *msg,
                                         const coa_lcm_plan_info_t *info,
                                         const coa_plan_result_t *result, const int32_t *offsets);
@@ -88,7 +89,6 @@ struct coa_node_inbox {
     uint16_t self_node;             /* status and plans from this node id are its own */
     size_t peer_capacity;           /* other UAVs it keeps (vehicle: MAX_PEERS - 1) */
     int64_t max_age_us;             /* validation window (context max_age) */
-    int64_t coordinator_timeout_us; /* when a silent coordinator is forgotten */
     lcm_subscription_t *subs[6];
     size_t sub_count;
     coa_lcm_rx_stats_t *rx;         /* the owner's counters (its state's rx) */
@@ -97,7 +97,6 @@ struct coa_node_inbox {
     coa_node_senders_t track_seq;
     coa_node_senders_t map_seq;
     coa_node_senders_t status_seq;
-    coa_node_senders_t plan_seq;
 
     coa_node_peer_t peers[COA_NODE_MAX_PEERS];
     coa_node_track_slot_t tracks[COA_NODE_MAX_TRACKS];
@@ -199,15 +198,14 @@ coa_lcm_context_t coa_node_context(const coa_node_inbox_t *in, int64_t now, int6
  * subscribed so far is unsubscribed). The handlers cost O(message) each (decoding and
  * validation, O(senders) for the sequence rule) and allocate nothing. */
 int coa_node_inbox_init(coa_node_inbox_t *in, const coa_node_common_t *common, uint16_t self_uav,
-                        uint16_t self_node, size_t peer_capacity, int64_t coordinator_timeout_us,
-                        lcm_t *lcm, coa_lcm_rx_stats_t *rx, bool want_status,
+                        uint16_t self_node, size_t peer_capacity, lcm_t *lcm, coa_lcm_rx_stats_t *rx, bool want_status,
                         coa_node_plan_handler_t plan_handler, void *owner);
 
 /* Unsubscribes everything. O(subscriptions). */
 void coa_node_inbox_fini(coa_node_inbox_t *in);
 
-/* Forgets senders silent for too long (intents past stale_after, the coordinator past its
- * timeout, ...) and drops intents and tracks too old to be of use. Cost O(senders). */
+/* Forgets senders silent past stale_after (a restarted one numbers from 0 again) and
+ * drops intents and tracks too old to be of use. Cost O(senders). */
 void coa_node_inbox_expire(coa_node_inbox_t *in, int64_t now);
 
 /* Builds the view of the cycle starting at cycle_start, at `now`. Cost O(peers * samples +

@@ -23,6 +23,10 @@ struct coa_vehicle_node {
     int64_t intent_sequence;
     int64_t status_sequence;
     int64_t last_plan_utime;
+    /* The coordinator's plans of this cycle: whether one was adopted, and the plan_id of
+     * the last one. Plans are ordered within a cycle only (node.h, step 4). */
+    bool cycle_plan_adopted;
+    int64_t cycle_plan_id;
 
     /* The adopted plan: offsets of samples plan_start .. plan_start + plan_count - 1; past
      * its end the last offset holds. */
@@ -419,6 +423,10 @@ static void on_plan(void *owner, const coavoid_plan_t *msg, const coa_lcm_plan_i
         reject(node, COA_LCM_ERR_TIME, "plan: arrived after valid_until");
         return;
     }
+    if (node->cycle_plan_adopted && msg->plan_id <= node->cycle_plan_id) {
+        reject(node, COA_LCM_ERR_SEQUENCE, "plan: plan_id not after the one adopted this cycle");
+        return;
+    }
     if (msg->dt != (double)node->config.common.dt) {
         reject(node, COA_LCM_ERR_VALUE, "plan: dt is not this UAV's");
         return;
@@ -440,6 +448,8 @@ static void on_plan(void *owner, const coavoid_plan_t *msg, const coa_lcm_plan_i
         }
     }
     adopt(node, mine, (uint32_t)samples);
+    node->cycle_plan_adopted = true;
+    node->cycle_plan_id = msg->plan_id;
     coa_lcm_rx_count(&node->state.rx, COA_OK, NULL);
 }
 
@@ -491,8 +501,8 @@ coa_vehicle_node_t *coa_vehicle_node_create(const coa_vehicle_node_config_t *con
     node->wait_deadline = INT64_MAX;
     const bool centralised = node->config.mode == COA_NODE_CENTRALISED;
     rc = coa_node_inbox_init(&node->inbox, c, node->config.vehicle.id, node->config.vehicle.id,
-                             COA_NODE_MAX_PEERS - 1u, node->config.coordinator_timeout_us, lcm,
-                             &node->state.rx, centralised, centralised ? on_plan : NULL, node);
+                             COA_NODE_MAX_PEERS - 1u, lcm, &node->state.rx, centralised,
+                             centralised ? on_plan : NULL, node);
     if (rc != COA_OK) {
         coa_node_solver_fini(&node->solver);
         free(node);
@@ -531,6 +541,7 @@ int coa_vehicle_node_cycle(coa_vehicle_node_t *node, int64_t now)
         node->first_cycle_start = coa_node_cycle_utime(c, k);
     }
     node->fault = false;
+    node->cycle_plan_adopted = false;
     node->state.cycle = k;
     node->cycle_start = coa_node_cycle_utime(c, k);
     coa_node_inbox_expire(&node->inbox, now);
