@@ -1,15 +1,18 @@
 /*
  * test_node: the nodes of apps/node (node.h) over LCM's in-process provider, driven on a
- * hand-set clock: what arrives is counted (undecodable bytes too) and never the node's own
- * messages; a UAV that restarts its numbering is accepted once it has been silent; a
- * coordinator's plan is adopted only under the rules of node.h (this cycle, from the
- * offset flown, a plan_id newer than the last adopted in the cycle, before valid_until),
- * and no plan_id, forged or from a restarted coordinator, locks later cycles out; the
- * UAV falls back to planning for
- * itself when the heartbeat stops and returns when it comes back; a lower priority waits
- * for the higher, up to its deadline; a silent UAV is avoided as a track; the world's
- * track estimates reproduce the scenario's path over the horizon; bad configurations are
- * refused.
+ * hand-set clock:
+ *   - what arrives is counted (undecodable bytes too) and never the node's own messages;
+ *   - a UAV that restarts its numbering is accepted once it has been silent;
+ *   - a coordinator's plan is adopted only under the rules of node.h (this cycle, from
+ *     the offset flown, a plan_id newer than the last adopted in the cycle, before
+ *     valid_until), no plan_id (forged, or from a restarted coordinator) locks later
+ *     cycles out, and a plan into the terrain the UAV knows is refused;
+ *   - the UAV falls back to planning for itself when the heartbeat stops and returns
+ *     when it comes back;
+ *   - a lower priority waits for the higher, up to its deadline;
+ *   - a silent UAV is avoided as a track;
+ *   - the world's track estimates reproduce the scenario's path over the horizon;
+ *   - bad configurations are refused.
  */
 #include <check.h>
 #include <stdio.h>
@@ -323,6 +326,83 @@ START_TEST(test_plan_ids_do_not_lock_out)
                       s->rx.last_reason);
     }
     coa_vehicle_node_destroy(a);
+    lcm_destroy(r.lcm);
+}
+END_TEST
+
+/* A plan is checked against the terrain (and tracks) the UAV knows before it is adopted:
+ * a forged plan that dives into a box below is refused, the real one is adopted. */
+START_TEST(test_plan_into_terrain_refused)
+{
+    rig_t r;
+    rig_init(&r, 10);
+    coa_obstacle_t box;
+    memset(&box, 0, sizeof box);
+    box.kind = COA_OBSTACLE_BOX;
+    box.box.min.x = -1000;
+    box.box.min.y = -1000;
+    box.box.min.z = 0;
+    box.box.max.x = 1000;
+    box.box.max.y = 1000;
+    box.box.max.z = 90;
+    coa_world_config_t wc;
+    memset(&wc, 0, sizeof wc);
+    wc.common = r.common;
+    wc.obstacles = &box;
+    wc.obstacle_count = 1;
+    int error = -99;
+    coa_world_t *w = coa_world_create(&wc, r.lcm, &error);
+    ck_assert_ptr_nonnull(w);
+    coa_vec3_t route[2];
+    coa_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, route, 0, 500, 0, 100), COA_NODE_CENTRALISED);
+    const coa_vehicle_node_state_t *s = coa_vehicle_node_state(a);
+    ck_assert_int_eq(coa_world_cycle(w, r.now), COA_OK);
+    drain(r.lcm);
+    ck_assert_int_eq(coa_vehicle_node_cycle(a, r.now), COA_OK);
+    drain(r.lcm);
+    r.now = cycle(0) + DT_US / 4;
+    heartbeat(r.lcm, r.now, 0);
+    drain(r.lcm);
+    /* Steep dives from 100 m: its bottom is below the box's top (90 m) from sample 3 on. */
+    coavoid_plan_t m;
+    memset(&m, 0, sizeof m);
+    m.utime = r.now;
+    m.coordinator_id = COA_NODE_COORDINATOR_ID;
+    m.plan_id = INT64_MAX - 5;
+    m.valid_from_utime = cycle(0);
+    m.valid_until_utime = cycle(1);
+    m.dt = 1.0;
+    m.horizon = 10;
+    m.mode = COAVOID_PLAN_T_MODE_CENTRALISED;
+    m.status = COAVOID_PLAN_T_STATUS_SOLVED;
+    m.vehicle_count = 1;
+    m.planned_count = 1;
+    m.uav_ids[0] = 1;
+    for (int32_t k = 0; k <= 10; k++) {
+        m.offsets[0][k] = -2 * k;
+    }
+    const int64_t rejected = s->rx.rejected;
+    ck_assert_int_eq(coavoid_plan_t_publish(r.lcm, COA_CHANNEL_PLAN, &m), 0);
+    drain(r.lcm);
+    ck_assert_int_eq(s->plans_adopted, 0);
+    ck_assert_int_eq(s->rx.rejected, rejected + 1);
+    ck_assert_int_eq(s->rx.last_reject_code, COA_LCM_ERR_VALUE);
+    ck_assert_str_eq(s->rx.last_reason, "plan: flies this UAV into an obstacle or track it knows");
+    /* The real coordinator's plan (a climb) is adopted, although its plan_id is lower. */
+    plan_msg(r.lcm, r.now, 0, cycle(0), 1, 10, 0);
+    drain(r.lcm);
+    ck_assert_int_eq(s->plans_adopted, 1);
+    ck_assert_int_eq(s->rx.rejected, rejected + 1);
+    for (int64_t k = 1; k <= 10; k++) {
+        r.now = cycle(k);
+        ck_assert_int_eq(coa_world_cycle(w, r.now), COA_OK);
+        drain(r.lcm);
+        ck_assert_int_eq(coa_vehicle_node_cycle(a, r.now), COA_OK);
+        drain(r.lcm);
+        ck_assert(s->position.z >= (coa_real_t)100);
+    }
+    coa_vehicle_node_destroy(a);
+    coa_world_destroy(w);
     lcm_destroy(r.lcm);
 }
 END_TEST
@@ -696,6 +776,7 @@ static Suite *node_suite(void)
     tcase_add_test(tc, test_restarted_peer_accepted_after_silence);
     tcase_add_test(tc, test_plan_adoption_rules);
     tcase_add_test(tc, test_plan_ids_do_not_lock_out);
+    tcase_add_test(tc, test_plan_into_terrain_refused);
     tcase_add_test(tc, test_fallback_and_return);
     tcase_add_test(tc, test_lower_priority_waits);
     tcase_add_test(tc, test_waits_for_near_higher_priority);

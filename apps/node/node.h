@@ -55,8 +55,10 @@
  *   4. A UAV adopts a plan_t that lists it among the planned rows, is solved, arrives
  *      before valid_until, has valid_from == the current cycle's start, has a plan_id
  *      greater than that of any plan it adopted in this cycle (so that a later plan of
- *      the cycle supersedes), and starts at the offset the UAV flies now; anything else
- *      is not adopted (counted in status as rejected with the reason). Plan ids are not
+ *      the cycle supersedes), starts at the offset the UAV flies now, and over this
+ *      cycle's samples k..k+N runs into none of the obstacles and tracks (silent UAVs
+ *      included) the UAV knows (coa_plan_find_conflict: a coordinator may know less
+ *      terrain, or be an impostor); anything else is not adopted (counted in status as rejected with the reason). Plan ids are not
  *      compared across cycles: valid_from already ties a plan to its cycle, and a rule
  *      across cycles would let one forged plan_id INT64_MAX, or a coordinator restarted
  *      with its numbering at 0, lock every later plan out.

@@ -40,6 +40,7 @@ struct coa_vehicle_node {
     coa_vec3_t own_samples[COA_NODE_MAX_SAMPLES];
 
     int32_t plan_out[COA_NODE_MAX_SAMPLES];
+    int32_t checked[COA_NODE_MAX_SAMPLES];      /* a coordinator's plan over this window */
     coa_intent_plan_t plans[COA_NODE_MAX_PEERS]; /* itself first, then the live peers */
     coa_intent_plan_t tall[COA_NODE_MAX_PEERS];  /* the same, with unbounded height */
     uint32_t labels[COA_NODE_MAX_PEERS];
@@ -398,6 +399,44 @@ static void reject(coa_vehicle_node_t *node, int code, const char *reason)
     coa_lcm_rx_count(&node->state.rx, code, reason);
 }
 
+/* Whether flying `offsets` (a plan's row from this cycle's start, `count` samples; past its
+ * end the last offset holds) over this cycle's window runs into an obstacle or a track it
+ * knows (real tracks and silent UAVs; the live UAVs are the coordinator's to plan around,
+ * with plans this UAV has not seen). A coordinator may know less terrain than the UAV, or
+ * be an impostor: what the UAV knows it can check before it flies. Returns 0 (clear), 1
+ * (a conflict) or a negative error (it cannot tell). */
+static int plan_hits_known(coa_vehicle_node_t *node, const int32_t *offsets, size_t count,
+                           int64_t now)
+{
+    const coa_node_common_t *c = &node->config.common;
+    const size_t n = (size_t)c->horizon + 1u;
+    for (size_t j = 0; j < n; j++) {
+        node->checked[j] = offsets[j < count ? j : count - 1u];
+    }
+    coa_node_view_build(&node->view, &node->inbox, node->cycle_start, now);
+    int rc = coa_node_problem_tracks(&node->problem_tracks, &node->view, NULL, c);
+    if (rc != COA_OK) {
+        return rc;
+    }
+    coa_vehicle_t vehicle = node->config.vehicle;
+    vehicle.initial_offset = node->state.offset;
+    const coa_vec3_t *references[1] = {node->own_reference};
+    coa_problem_t problem;
+    memset(&problem, 0, sizeof problem);
+    problem.dt = c->dt;
+    problem.horizon = c->horizon;
+    problem.vehicles = &vehicle;
+    problem.vehicle_count = 1;
+    problem.references = references;
+    problem.obstacles = node->inbox.obstacles;
+    problem.obstacle_count = node->inbox.obstacle_count;
+    problem.tracks = node->problem_tracks.tracks;
+    problem.track_count = node->problem_tracks.count;
+    problem.track_samples = node->problem_tracks.samples;
+    const size_t which[1] = {0};
+    return coa_plan_find_conflict(&problem, node->checked, which, 1, NULL, NULL);
+}
+
 /* Step 4 of node.h: a coordinator's plan that lists it. */
 static void on_plan(void *owner, const coavoid_plan_t *msg, const coa_lcm_plan_info_t *info,
                     const coa_plan_result_t *result, const int32_t *offsets)
@@ -446,6 +485,13 @@ static void on_plan(void *owner, const coavoid_plan_t *msg, const coa_lcm_plan_i
             reject(node, COA_LCM_ERR_VALUE, "plan: a step this UAV cannot fly");
             return;
         }
+    }
+    int hit = plan_hits_known(node, mine, samples, now);
+    if (hit != 0) {
+        reject(node, hit > 0 ? COA_LCM_ERR_VALUE : hit,
+               hit > 0 ? "plan: flies this UAV into an obstacle or track it knows"
+                       : "plan: cannot be checked against the obstacles and tracks it knows");
+        return;
     }
     adopt(node, mine, (uint32_t)samples);
     node->cycle_plan_adopted = true;
