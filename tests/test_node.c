@@ -2,6 +2,7 @@
  * test_node: the nodes of apps/node (node.h) over LCM's in-process provider, driven on a
  * hand-set clock:
  *   - what arrives is counted (undecodable bytes too) and never the node's own messages;
+ *     another UAV's intents under the node's id are refused and reported as a fault;
  *   - a UAV that restarts its numbering is accepted once it has been silent;
  *   - a coordinator's plan is adopted only under the rules of node.h (this cycle, from
  *     the offset flown, a plan_id newer than the last adopted in the cycle, before
@@ -407,6 +408,66 @@ START_TEST(test_plan_into_terrain_refused)
 }
 END_TEST
 
+/* The heartbeats of one node id, as its receivers see them. */
+typedef struct {
+    int32_t node_id;
+    int count;
+    int8_t health;
+} health_probe_t;
+
+static void on_status_probe(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
+{
+    health_probe_t *p = user;
+    (void)channel;
+    coavoid_status_t m;
+    REQUIRE(coavoid_status_t_decode(rbuf->data, 0, (int)rbuf->data_size, &m) >= 0);
+    if (m.node_id == p->node_id) {
+        p->count++;
+        p->health = m.health;
+    }
+}
+
+/* Another UAV with this node's id: its intents are not this node's own looped back, even
+ * at the same times and sequence numbers; they are refused and the node reports a fault
+ * while they come. */
+START_TEST(test_duplicate_id_reported)
+{
+    rig_t r;
+    rig_init(&r, 10);
+    health_probe_t probe = {1, 0, -1};
+    lcm_subscription_t *sub = lcm_subscribe(r.lcm, COA_CHANNEL_STATUS, on_status_probe, &probe);
+    coa_vec3_t r1[2], r2[2];
+    coa_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, r1, 0, 500, 0, 100), COA_NODE_DECOUPLED);
+    const coa_vehicle_node_state_t *s = coa_vehicle_node_state(a);
+    ck_assert_int_eq(coa_vehicle_node_cycle(a, r.now), COA_OK);
+    drain(r.lcm);
+    ck_assert_int_eq(probe.health, COAVOID_STATUS_T_HEALTH_OK);
+    ck_assert_int_eq(s->rx.received, 0); /* its own intent came back: not counted */
+    /* Its twin starts in the same cycle, on the same clock: the same utime and sequence. */
+    coa_vehicle_node_t *b = vehicle_node(&r, uav(1, 1, r2, 0, 500, 800, 100), COA_NODE_DECOUPLED);
+    ck_assert_int_eq(coa_vehicle_node_cycle(b, r.now), COA_OK);
+    drain(r.lcm);
+    coa_vehicle_node_destroy(b);
+    ck_assert_int_eq(s->rx.received, 1);
+    ck_assert_int_eq(s->rx.rejected, 1);
+    ck_assert_int_eq(s->rx.last_reject_code, COA_LCM_ERR_ID);
+    ck_assert_str_eq(s->rx.last_reason, "intent: another UAV uses this node's id");
+    r.now = cycle(1);
+    ck_assert_int_eq(coa_vehicle_node_cycle(a, r.now), COA_OK);
+    drain(r.lcm);
+    ck_assert_int_eq(probe.health, COAVOID_STATUS_T_HEALTH_FAULT);
+    /* The twin is gone: no fault any more. */
+    r.now = cycle(2);
+    ck_assert_int_eq(coa_vehicle_node_cycle(a, r.now), COA_OK);
+    drain(r.lcm);
+    ck_assert_int_ne(probe.health, COAVOID_STATUS_T_HEALTH_FAULT);
+    ck_assert_int_eq(s->rx.received, 1);
+    lcm_unsubscribe(r.lcm, sub);
+    coa_vehicle_node_destroy(a);
+    lcm_destroy(r.lcm);
+}
+END_TEST
+
 /* ---- fallback ---- */
 
 START_TEST(test_fallback_and_return)
@@ -777,6 +838,7 @@ static Suite *node_suite(void)
     tcase_add_test(tc, test_plan_adoption_rules);
     tcase_add_test(tc, test_plan_ids_do_not_lock_out);
     tcase_add_test(tc, test_plan_into_terrain_refused);
+    tcase_add_test(tc, test_duplicate_id_reported);
     tcase_add_test(tc, test_fallback_and_return);
     tcase_add_test(tc, test_lower_priority_waits);
     tcase_add_test(tc, test_waits_for_near_higher_priority);

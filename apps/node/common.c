@@ -159,6 +159,28 @@ static void count_undecodable(coa_node_inbox_t *in, const char *reason)
     coa_lcm_rx_count(in->rx, COA_LCM_ERR_DECODE, reason);
 }
 
+/* FNV-1a (64 bits) of a message's bytes. */
+static uint64_t fingerprint(const void *data, size_t size)
+{
+    const uint8_t *p = data;
+    uint64_t h = UINT64_C(14695981039346656037);
+    for (size_t i = 0; i < size; i++) {
+        h = (h ^ p[i]) * UINT64_C(1099511628211);
+    }
+    return h;
+}
+
+static bool sent_by_self(const coa_node_inbox_t *in, const void *data, size_t size)
+{
+    const uint64_t h = fingerprint(data, size);
+    for (size_t i = 0; i < COA_NODE_OWN_INTENTS; i++) {
+        if (in->own_size[i] > 0 && (size_t)in->own_size[i] == size && in->own_hash[i] == h) {
+            return true;
+        }
+    }
+    return false;
+}
+
 static void on_intent(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
 {
     coa_node_inbox_t *in = user;
@@ -169,8 +191,16 @@ static void on_intent(const lcm_recv_buf_t *rbuf, const char *channel, void *use
         count_undecodable(in, "intent: does not decode");
         return;
     }
-    if (msg->uav_id == (int32_t)in->self_uav) {
-        return; /* its own, looped back */
+    if (in->self_uav != 0u && msg->uav_id == (int32_t)in->self_uav) {
+        if (sent_by_self(in, rbuf->data, (size_t)size)) {
+            return; /* its own, looped back */
+        }
+        /* Two UAVs flying under one id: each would ignore the other as its own echo. */
+        if (in->foreign_intents < UINT32_MAX) {
+            in->foreign_intents++;
+        }
+        coa_lcm_rx_count(in->rx, COA_LCM_ERR_ID, "intent: another UAV uses this node's id");
+        return;
     }
     const int64_t now = *in->common.clock;
     /* A place to keep it before the sequence rule, so that a full table does not
@@ -384,6 +414,10 @@ int coa_node_inbox_init(coa_node_inbox_t *in, const coa_node_common_t *common, u
     memset(in->tracks, 0, sizeof in->tracks);
     in->have_map = false;
     in->obstacle_count = 0;
+    memset(in->own_hash, 0, sizeof in->own_hash);
+    memset(in->own_size, 0, sizeof in->own_size);
+    in->own_next = 0;
+    in->foreign_intents = 0;
     in->heard_coordinator = false;
     in->coordinator_utime = 0;
     in->on_plan = plan_handler;
@@ -759,10 +793,26 @@ int coa_node_publish_heartbeat(coa_node_inbox_t *in, coavoid_status_t *m, int64_
                    : COA_ERR_ARGUMENT;                                                      \
     }
 
-COA_NODE_DEFINE_PUBLISH(coa_node_publish_intent, coavoid_intent_t, COA_CHANNEL_INTENT)
 COA_NODE_DEFINE_PUBLISH(coa_node_publish_plan, coavoid_plan_t, COA_CHANNEL_PLAN)
 COA_NODE_DEFINE_PUBLISH(coa_node_publish_track, coavoid_track_t, COA_CHANNEL_TRACK)
 COA_NODE_DEFINE_PUBLISH(coa_node_publish_map, coavoid_obstacle_map_t, COA_CHANNEL_OBSTACLES)
 COA_NODE_DEFINE_PUBLISH(coa_node_publish_conflicts, coavoid_conflict_report_t,
                         COA_CHANNEL_CONFLICTS)
 COA_NODE_DEFINE_PUBLISH(coa_node_publish_status, coavoid_status_t, COA_CHANNEL_STATUS)
+
+int coa_node_publish_intent(coa_node_inbox_t *in, const coavoid_intent_t *msg)
+{
+    coa_node_tx_t *tx = &in->tx;
+    int size = coavoid_intent_t_encoded_size(msg);
+    if (size <= 0 || (size_t)size > sizeof tx->buf ||
+        coavoid_intent_t_encode(tx->buf, 0, size, msg) != size) {
+        return COA_ERR_WORKSPACE;
+    }
+    /* Remembered before it is sent: a provider may hand it back within lcm_publish. */
+    in->own_hash[in->own_next] = fingerprint(tx->buf, (size_t)size);
+    in->own_size[in->own_next] = size;
+    in->own_next = (in->own_next + 1u) % COA_NODE_OWN_INTENTS;
+    return lcm_publish(tx->lcm, COA_CHANNEL_INTENT, tx->buf, (unsigned int)size) == 0
+               ? COA_OK
+               : COA_ERR_ARGUMENT;
+}

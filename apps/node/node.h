@@ -73,7 +73,10 @@
  * Messages arrive through LCM subscriptions made at init; each is decoded and validated
  * (src/lcm) with the driver's clock, counted, and stored (the latest intent per UAV, per
  * track, the obstacle map, the coordinator's heartbeat); a refused message is counted in
- * the node's status and otherwise ignored, never fatal.
+ * the node's status and otherwise ignored, never fatal. A node's own messages come back
+ * to it and are not counted; but an intent with a UAV's own id that it did not publish
+ * (not byte for byte one of its latest) is another UAV using the same id: refused
+ * (COA_LCM_ERR_ID), and the UAV's next heartbeat says HEALTH_FAULT.
  *
  * Memory: a node is one struct of fixed size plus the planner and predictor workspaces,
  * allocated once by init and released by fini: nothing is allocated per cycle.

@@ -47,6 +47,9 @@ _Static_assert(COA_NODE_MAX_SAMPLES == (unsigned)COAVOID_INTENT_T_MAX_SAMPLES &&
  * about 16.6 kB. */
 #define COA_NODE_TX_BYTES 20000u
 
+/* How many of its latest intents a node remembers, to tell them when they come back. */
+#define COA_NODE_OWN_INTENTS 4u
+
 /* Where a node encodes what it publishes. */
 typedef struct {
     lcm_t *lcm;
@@ -105,6 +108,14 @@ struct coa_node_inbox {
     coa_obstacle_t obstacles[COA_NODE_MAX_OBSTACLES];
     size_t obstacle_count;
     coa_vec3_t vertices[COA_NODE_MAX_VERTICES];
+
+    /* Its latest published intents (FNV-1a of the encoded bytes, and their size): an
+     * intent with its own UAV id that is none of these was sent by another UAV using the
+     * same id, even when the times and sequence numbers happen to agree. */
+    uint64_t own_hash[COA_NODE_OWN_INTENTS];
+    int own_size[COA_NODE_OWN_INTENTS];
+    size_t own_next;
+    uint32_t foreign_intents;       /* such intents since the owner last cleared it */
 
     bool heard_coordinator;         /* a coordinator's status_t was received */
     int64_t coordinator_utime;      /* when (driver clock) */
@@ -261,12 +272,15 @@ int coa_node_publish_heartbeat(coa_node_inbox_t *in, coavoid_status_t *m, int64_
 /* Publishing: encodes into tx->buf and publishes on the type's channel. COA_OK, or
  * COA_ERR_WORKSPACE (does not encode into the buffer) or COA_ERR_ARGUMENT (LCM refused
  * it). O(message); our code allocates nothing (the provider may, inside lcm_publish). */
-int coa_node_publish_intent(coa_node_tx_t *tx, const coavoid_intent_t *msg);
 int coa_node_publish_plan(coa_node_tx_t *tx, const coavoid_plan_t *msg);
 int coa_node_publish_track(coa_node_tx_t *tx, const coavoid_track_t *msg);
 int coa_node_publish_map(coa_node_tx_t *tx, const coavoid_obstacle_map_t *msg);
 int coa_node_publish_conflicts(coa_node_tx_t *tx, const coavoid_conflict_report_t *msg);
 int coa_node_publish_status(coa_node_tx_t *tx, const coavoid_status_t *msg);
+
+/* Publishes the node's own intent as the functions above do, and remembers it so that the
+ * inbox knows it when it comes back (node_internal.h, own_hash). Same returns and cost. */
+int coa_node_publish_intent(coa_node_inbox_t *in, const coavoid_intent_t *msg);
 
 /* The common stopwatch's reading (us), 0 without one: durations are differences. O(1). */
 int64_t coa_node_stopwatch(const coa_node_common_t *c);

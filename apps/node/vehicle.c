@@ -119,11 +119,15 @@ static bool stale_inputs(const coa_vehicle_node_t *node, int64_t now)
 static int publish_status(coa_vehicle_node_t *node, int64_t now)
 {
     const coa_vehicle_node_state_t *s = &node->state;
+    /* Another UAV using its id makes every peer's view of it wrong: a fault for as long
+     * as that UAV's intents keep coming. */
+    const bool twin = node->inbox.foreign_intents > 0u;
+    node->inbox.foreign_intents = 0;
     const coa_node_heartbeat_t h = {
         node->config.vehicle.id,
         COAVOID_STATUS_T_NODE_VEHICLE,
         node->status_sequence++,
-        node->fault,
+        node->fault || twin,
         s->last_outcome > 0 || stale_inputs(node, now) ||
             (node->config.mode == COA_NODE_CENTRALISED && !s->coordinated),
         s->coordinated ? COAVOID_STATUS_T_MODE_CENTRALISED : COAVOID_STATUS_T_MODE_DECOUPLED,
@@ -168,7 +172,7 @@ static int finish(coa_vehicle_node_t *node, int64_t now)
                                       node->own_offsets, (size_t)c->horizon + 1u, &ctx,
                                       &node->tx_intent, NULL);
     if (rc == COA_OK) {
-        rc = coa_node_publish_intent(&node->inbox.tx, &node->tx_intent);
+        rc = coa_node_publish_intent(&node->inbox, &node->tx_intent);
     } else {
         rc = COA_ERR_ARGUMENT; /* its own reference left the range a message can carry */
     }
