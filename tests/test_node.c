@@ -3,6 +3,7 @@
  * hand-set clock:
  *   - what arrives is counted (undecodable bytes too) and never the node's own messages;
  *     another UAV's intents under the node's id are refused and reported as a fault;
+ *     a node that refused messages since its last heartbeat says it is degraded;
  *   - a UAV that restarts its numbering is accepted once it has been silent;
  *   - a coordinator's plan is adopted only under the rules of node.h (this cycle, from
  *     the offset flown, a plan_id newer than the last adopted in the cycle, before
@@ -468,6 +469,69 @@ START_TEST(test_duplicate_id_reported)
 }
 END_TEST
 
+/* A node whose messages are being refused (a peer's clock running ahead, bytes that do
+ * not decode) says so in its next heartbeat: HEALTH_DEGRADED, then OK again once nothing
+ * more is refused. */
+START_TEST(test_refusals_degrade_health)
+{
+    rig_t r;
+    rig_init(&r, 10);
+    health_probe_t pa = {1, 0, -1};
+    health_probe_t pc = {(int32_t)COA_NODE_COORDINATOR_ID, 0, -1};
+    lcm_subscription_t *sa = lcm_subscribe(r.lcm, COA_CHANNEL_STATUS, on_status_probe, &pa);
+    lcm_subscription_t *sc = lcm_subscribe(r.lcm, COA_CHANNEL_STATUS, on_status_probe, &pc);
+    coa_vec3_t r1[2], r2[2];
+    coa_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, r1, 0, 500, 0, 100), COA_NODE_DECOUPLED);
+    const coa_vehicle_node_state_t *s = coa_vehicle_node_state(a);
+    coa_coordinator_config_t cc;
+    memset(&cc, 0, sizeof cc);
+    cc.common = r.common;
+    cc.common.beta = 1000;
+    int error = -99;
+    coa_coordinator_t *co = coa_coordinator_create(&cc, r.lcm, &error);
+    ck_assert_ptr_nonnull(co);
+    /* A peer whose clock runs 1.5 cycles ahead: its intents come from the future. */
+    int64_t ahead = r.now + 3 * DT_US / 2;
+    coa_vehicle_node_config_t config;
+    memset(&config, 0, sizeof config);
+    config.common = r.common;
+    config.common.clock = &ahead;
+    config.vehicle = uav(2, 2, r2, 0, 500, 800, 100);
+    config.mode = COA_NODE_DECOUPLED;
+    coa_vehicle_node_t *b = coa_vehicle_node_create(&config, r.lcm, &error);
+    ck_assert_ptr_nonnull(b);
+    const char junk[3] = {1, 2, 3};
+    for (int64_t k = 0; k <= 3; k++) {
+        r.now = cycle(k);
+        ck_assert_int_eq(coa_vehicle_node_cycle(a, r.now), COA_OK);
+        drain(r.lcm);
+        ck_assert_int_eq(coa_coordinator_cycle(co, r.now + DT_US / 4), COA_OK);
+        drain(r.lcm);
+        const int8_t want = k == 0 || k == 3 ? COAVOID_STATUS_T_HEALTH_OK
+                                             : COAVOID_STATUS_T_HEALTH_DEGRADED;
+        ck_assert_msg(pa.health == want, "cycle %d: vehicle health %d", (int)k, pa.health);
+        ck_assert_msg(pc.health == want, "cycle %d: coordinator health %d", (int)k, pc.health);
+        if (k == 0) {
+            ahead = r.now + 3 * DT_US / 2;
+            ck_assert_int_eq(coa_vehicle_node_cycle(b, ahead), COA_OK);
+            drain(r.lcm);
+            ck_assert_int_eq(s->rx.last_reject_code, COA_LCM_ERR_TIME);
+        } else if (k == 1) {
+            ck_assert_int_eq(lcm_publish(r.lcm, COA_CHANNEL_INTENT, junk, sizeof junk), 0);
+            drain(r.lcm);
+            ck_assert_int_eq(s->rx.last_reject_code, COA_LCM_ERR_DECODE);
+        }
+    }
+    ck_assert_int_eq(pa.count, 4);
+    lcm_unsubscribe(r.lcm, sa);
+    lcm_unsubscribe(r.lcm, sc);
+    coa_vehicle_node_destroy(b);
+    coa_coordinator_destroy(co);
+    coa_vehicle_node_destroy(a);
+    lcm_destroy(r.lcm);
+}
+END_TEST
+
 /* ---- fallback ---- */
 
 START_TEST(test_fallback_and_return)
@@ -839,6 +903,7 @@ static Suite *node_suite(void)
     tcase_add_test(tc, test_plan_ids_do_not_lock_out);
     tcase_add_test(tc, test_plan_into_terrain_refused);
     tcase_add_test(tc, test_duplicate_id_reported);
+    tcase_add_test(tc, test_refusals_degrade_health);
     tcase_add_test(tc, test_fallback_and_return);
     tcase_add_test(tc, test_lower_priority_waits);
     tcase_add_test(tc, test_waits_for_near_higher_priority);

@@ -418,6 +418,7 @@ int coa_node_inbox_init(coa_node_inbox_t *in, const coa_node_common_t *common, u
     memset(in->own_size, 0, sizeof in->own_size);
     in->own_next = 0;
     in->foreign_intents = 0;
+    in->rejected_at_heartbeat = 0;
     in->heard_coordinator = false;
     in->coordinator_utime = 0;
     in->on_plan = plan_handler;
@@ -756,9 +757,11 @@ int coa_node_publish_heartbeat(coa_node_inbox_t *in, coavoid_status_t *m, int64_
     m->node_id = h->node_id;
     m->node_kind = h->node_kind;
     m->sequence = h->sequence;
-    m->health = h->fault      ? COAVOID_STATUS_T_HEALTH_FAULT
-                : h->degraded ? COAVOID_STATUS_T_HEALTH_DEGRADED
-                              : COAVOID_STATUS_T_HEALTH_OK;
+    const bool refused = h->rx->rejected > in->rejected_at_heartbeat;
+    in->rejected_at_heartbeat = h->rx->rejected;
+    m->health = h->fault                 ? COAVOID_STATUS_T_HEALTH_FAULT
+                : h->degraded || refused ? COAVOID_STATUS_T_HEALTH_DEGRADED
+                                         : COAVOID_STATUS_T_HEALTH_OK;
     m->mode = h->mode;
     m->last_plan_utime = h->last_plan_utime;
     m->last_plan_duration_us = h->last_plan_duration_us;

@@ -63,7 +63,11 @@
  *      across cycles would let one forged plan_id INT64_MAX, or a coordinator restarted
  *      with its numbering at 0, lock every later plan out.
  * Every node publishes its heartbeat (status_t) once per cycle; the world, a stand-in for
- * external sources that status_t has no kind for, does not.
+ * external sources that status_t has no kind for, does not. Its health is HEALTH_FAULT
+ * after an internal error (a UAV: also while another UAV uses its id), else
+ * HEALTH_DEGRADED when messages were refused since its previous heartbeat (a clock that
+ * disagrees, more peers than it holds, a bad sender), a planning call failed, a peer is
+ * stale, or (a centralised UAV) it is not following the coordinator; else HEALTH_OK.
  *
  * A peer whose last intent is older than stale_after_us is no longer a co-operative UAV
  * to its receivers: they treat it as a non-cooperative track, extrapolated at constant
