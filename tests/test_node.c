@@ -10,7 +10,7 @@
  *     valid_until), no plan_id (forged, or from a restarted coordinator) locks later
  *     cycles out, and a plan into the terrain the UAV knows is refused;
  *   - the UAV falls back to planning for itself when the heartbeat stops and returns
- *     when it comes back;
+ *     when it comes back; it follows only the coordinator it is configured with;
  *   - a lower priority waits for the higher, up to its deadline;
  *   - a silent UAV is avoided as a track;
  *   - the world's track estimates reproduce the scenario's path over the horizon;
@@ -99,6 +99,21 @@ static coa_vehicle_node_t *vehicle_node(const rig_t *r, coa_vehicle_t v, coa_nod
     return node;
 }
 
+static void heartbeat_from(lcm_t *lcm, int64_t now, int64_t sequence, int32_t node_id,
+                           int8_t health)
+{
+    coavoid_status_t m;
+    memset(&m, 0, sizeof m);
+    m.utime = now;
+    m.node_id = node_id;
+    m.node_kind = COAVOID_STATUS_T_NODE_COORDINATOR;
+    m.sequence = sequence;
+    m.health = health;
+    m.mode = COAVOID_STATUS_T_MODE_CENTRALISED;
+    m.outcome = COAVOID_STATUS_T_OUTCOME_NONE;
+    ck_assert_int_eq(coavoid_status_t_publish(lcm, COA_CHANNEL_STATUS, &m), 0);
+}
+
 static void heartbeat(lcm_t *lcm, int64_t now, int64_t sequence)
 {
     coavoid_status_t m;
@@ -113,14 +128,15 @@ static void heartbeat(lcm_t *lcm, int64_t now, int64_t sequence)
     ck_assert_int_eq(coavoid_status_t_publish(lcm, COA_CHANNEL_STATUS, &m), 0);
 }
 
-/* A one-UAV plan_t from the coordinator: offsets 0, 1, 2, then level at 2, plus `shift`. */
-static void plan_msg(lcm_t *lcm, int64_t now, int64_t plan_id, int64_t valid_from, uint16_t id,
-                     int32_t horizon, int32_t shift)
+/* A one-UAV plan_t from coordinator `from`: offsets 0, 1, 2, then level at 2, plus
+ * `shift`. */
+static void plan_msg_from(lcm_t *lcm, int64_t now, int32_t from, int64_t plan_id,
+                          int64_t valid_from, uint16_t id, int32_t horizon, int32_t shift)
 {
     coavoid_plan_t m;
     memset(&m, 0, sizeof m);
     m.utime = now;
-    m.coordinator_id = COA_NODE_COORDINATOR_ID;
+    m.coordinator_id = from;
     m.plan_id = plan_id;
     m.valid_from_utime = valid_from;
     m.valid_until_utime = valid_from + DT_US;
@@ -135,6 +151,14 @@ static void plan_msg(lcm_t *lcm, int64_t now, int64_t plan_id, int64_t valid_fro
         m.offsets[0][k] = (k < 2 ? k : 2) + shift;
     }
     ck_assert_int_eq(coavoid_plan_t_publish(lcm, COA_CHANNEL_PLAN, &m), 0);
+}
+
+/* The same from the default coordinator. */
+static void plan_msg(lcm_t *lcm, int64_t now, int64_t plan_id, int64_t valid_from, uint16_t id,
+                     int32_t horizon, int32_t shift)
+{
+    plan_msg_from(lcm, now, (int32_t)COA_NODE_COORDINATOR_ID, plan_id, valid_from, id, horizon,
+                  shift);
 }
 
 /* ---- counting ---- */
@@ -564,6 +588,60 @@ START_TEST(test_fallback_and_return)
 }
 END_TEST
 
+/* A UAV follows the coordinator it is configured with: heartbeats and plans from any other
+ * node id are refused (here the default id's, the UAV being configured with 700). */
+START_TEST(test_configured_coordinator_only)
+{
+    rig_t r;
+    rig_init(&r, 10);
+    coa_vec3_t route[2];
+    coa_vehicle_node_config_t config;
+    memset(&config, 0, sizeof config);
+    config.common = r.common;
+    config.vehicle = uav(1, 1, route, 0, 500, 0, 100);
+    config.mode = COA_NODE_CENTRALISED;
+    config.coordinator_id = 1;
+    int error = -99;
+    ck_assert_ptr_null(coa_vehicle_node_create(&config, r.lcm, &error)); /* its own id */
+    ck_assert_int_eq(error, COA_ERR_ARGUMENT);
+    config.coordinator_id = 700;
+    coa_vehicle_node_t *a = coa_vehicle_node_create(&config, r.lcm, &error);
+    ck_assert_ptr_nonnull(a);
+    const coa_vehicle_node_state_t *s = coa_vehicle_node_state(a);
+    /* Cycles 0..5: only the default id speaks. After 2.5 cycles without its own
+     * coordinator the UAV plans for itself. */
+    const char *want = "CCCDDDDC";
+    for (int64_t k = 0; k < 8; k++) {
+        r.now = cycle(k);
+        ck_assert_int_eq(coa_vehicle_node_cycle(a, r.now), COA_OK);
+        drain(r.lcm);
+        ck_assert_msg(s->coordinated == (want[k] == 'C'), "cycle %d", (int)k);
+        r.now = cycle(k) + DT_US / 4;
+        const int32_t from = k <= 5 ? (int32_t)COA_NODE_COORDINATOR_ID : 700;
+        const int64_t rejected = s->rx.rejected;
+        heartbeat_from(r.lcm, r.now, k, from, COAVOID_STATUS_T_HEALTH_OK);
+        drain(r.lcm);
+        if (k <= 5) {
+            ck_assert_int_eq(s->rx.rejected, rejected + 1);
+            ck_assert_int_eq(s->rx.last_reject_code, COA_LCM_ERR_ID);
+            ck_assert_str_eq(s->rx.last_reason, "status: a coordinator that is not this UAV's");
+        } else {
+            ck_assert_int_eq(s->rx.rejected, rejected);
+        }
+        plan_msg_from(r.lcm, r.now, from, k, cycle(k), 1, 10, s->offset);
+        drain(r.lcm);
+        if (k <= 5) {
+            ck_assert_int_eq(s->rx.rejected, rejected + 2);
+            ck_assert_str_eq(s->rx.last_reason, "plan: from a coordinator that is not this UAV's");
+            ck_assert_int_eq(s->plans_adopted, 0);
+        }
+    }
+    ck_assert_int_eq(s->plans_adopted, 2);
+    coa_vehicle_node_destroy(a);
+    lcm_destroy(r.lcm);
+}
+END_TEST
+
 /* ---- decoupled: waiting for higher priorities ---- */
 
 START_TEST(test_lower_priority_waits)
@@ -905,6 +983,7 @@ static Suite *node_suite(void)
     tcase_add_test(tc, test_duplicate_id_reported);
     tcase_add_test(tc, test_refusals_degrade_health);
     tcase_add_test(tc, test_fallback_and_return);
+    tcase_add_test(tc, test_configured_coordinator_only);
     tcase_add_test(tc, test_lower_priority_waits);
     tcase_add_test(tc, test_waits_for_near_higher_priority);
     tcase_add_test(tc, test_wait_ends_at_deadline);

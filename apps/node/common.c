@@ -333,6 +333,12 @@ static void on_status(const lcm_recv_buf_t *rbuf, const char *channel, void *use
     if (msg->node_id == (int32_t)in->self_node) {
         return;
     }
+    /* Before the sequence rule, so that impostors take no room in its table. */
+    if (msg->node_kind == COAVOID_STATUS_T_NODE_COORDINATOR &&
+        msg->node_id != (int32_t)in->coordinator_id) {
+        coa_lcm_rx_count(in->rx, COA_LCM_ERR_ID, "status: a coordinator that is not this UAV's");
+        return;
+    }
     const int64_t now = *in->common.clock;
     coa_lcm_context_t ctx = coa_node_context(in, now, now);
     const char *reason = NULL;
@@ -358,7 +364,8 @@ static void on_plan(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
         count_undecodable(in, "plan: does not decode");
         return;
     }
-    if (msg->coordinator_id == (int32_t)in->self_node) {
+    if (msg->coordinator_id != (int32_t)in->coordinator_id) {
+        coa_lcm_rx_count(in->rx, COA_LCM_ERR_ID, "plan: from a coordinator that is not this UAV's");
         return;
     }
     const int64_t now = *in->common.clock;
@@ -391,12 +398,14 @@ static int subscribe(coa_node_inbox_t *in, const char *channel, lcm_msg_handler_
 }
 
 int coa_node_inbox_init(coa_node_inbox_t *in, const coa_node_common_t *common, uint16_t self_uav,
-                        uint16_t self_node, size_t peer_capacity, lcm_t *lcm, coa_lcm_rx_stats_t *rx, bool want_status,
+                        uint16_t self_node, uint16_t coordinator_id, size_t peer_capacity,
+                        lcm_t *lcm, coa_lcm_rx_stats_t *rx, bool want_status,
                         coa_node_plan_handler_t plan_handler, void *owner)
 {
     in->common = *common;
     in->self_uav = self_uav;
     in->self_node = self_node;
+    in->coordinator_id = coordinator_id;
     in->rx = rx;
     in->peer_capacity = peer_capacity > COA_NODE_MAX_PEERS ? COA_NODE_MAX_PEERS : peer_capacity;
     /* Old enough to still extrapolate a silent UAV for a horizon, and wide enough for a

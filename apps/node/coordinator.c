@@ -77,7 +77,7 @@ coa_coordinator_t *coa_coordinator_create(const coa_coordinator_config_t *config
     node->state.cycle = -1;
     node->state.last_outcome = -1;
     /* No UAV is its own: intents are all others'. */
-    rc = coa_node_inbox_init(&node->inbox, c, 0u, node->config.id, COA_NODE_MAX_PEERS, lcm,
+    rc = coa_node_inbox_init(&node->inbox, c, 0u, node->config.id, 0u, COA_NODE_MAX_PEERS, lcm,
                              &node->state.rx, false, NULL, node);
     if (rc != COA_OK) {
         coa_node_solver_fini(&node->solver);

@@ -18,9 +18,11 @@
  *      (in real time a quarter cycle ahead, so that they are there when the UAVs decide).
  *   2. At cycle_utime(k) every UAV steps its simulated flight to sample k (the offset its
  *      adopted plan gives for k; a plan past its end holds its last offset).
- *      - centralised (a coordinator heartbeat heard within coordinator_timeout_us, or
- *        still inside that time since start): it publishes its intent at once (reference
- *        and offsets for samples k..k+N) and follows the coordinator;
+ *      - centralised (a heartbeat of its coordinator heard within
+ *        coordinator_timeout_us, or still inside that time since start): it publishes its
+ *        intent at once (reference and offsets for samples k..k+N) and follows the
+ *        coordinator. Its coordinator is the node id it is configured with: heartbeats
+ *        of a coordinator and plans from any other id are refused (COA_LCM_ERR_ID);
  *      - decoupled: first it waits (until priority_wait_us has passed) for this cycle's
  *        intents of the higher-priority UAVs whose paths pass near its own horizontally
  *        within the horizon (the predictor's test with unbounded heights): only their
@@ -167,6 +169,9 @@ typedef struct {
                                        default, dt / 2) */
     coa_real_t sigma_horizontal;    /* its own position uncertainty, published (default 0) */
     coa_real_t sigma_vertical;
+    uint16_t coordinator_id;        /* the only node whose heartbeats and plans it follows
+                                       (0: the default, COA_NODE_COORDINATOR_ID); not its
+                                       own id */
 } coa_vehicle_node_config_t;
 
 /* What a vehicle did; read by drivers, the simulation and tests. */

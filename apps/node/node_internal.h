@@ -90,6 +90,7 @@ struct coa_node_inbox {
     coa_node_common_t common;
     uint16_t self_uav;              /* intents from this UAV are the node's own (0: none) */
     uint16_t self_node;             /* status and plans from this node id are its own */
+    uint16_t coordinator_id;        /* the only coordinator it hears (0: none) */
     size_t peer_capacity;           /* other UAVs it keeps (vehicle: MAX_PEERS - 1) */
     int64_t max_age_us;             /* validation window (context max_age) */
     lcm_subscription_t *subs[6];
@@ -207,11 +208,14 @@ coa_lcm_context_t coa_node_context(const coa_node_inbox_t *in, int64_t now, int6
 
 /* Initialises the inbox and subscribes to intents, tracks and the obstacle map, and to
  * heartbeats (want_status) and plans (plan_handler non-NULL) when asked; counts into rx.
+ * A coordinator's heartbeat or a plan from another node than coordinator_id is refused
+ * (COA_LCM_ERR_ID).
  * Returns COA_OK, or COA_ERR_ARGUMENT when LCM refused a subscription (everything
  * subscribed so far is unsubscribed). The handlers cost O(message) each (decoding and
  * validation, O(senders) for the sequence rule) and allocate nothing. */
 int coa_node_inbox_init(coa_node_inbox_t *in, const coa_node_common_t *common, uint16_t self_uav,
-                        uint16_t self_node, size_t peer_capacity, lcm_t *lcm, coa_lcm_rx_stats_t *rx, bool want_status,
+                        uint16_t self_node, uint16_t coordinator_id, size_t peer_capacity,
+                        lcm_t *lcm, coa_lcm_rx_stats_t *rx, bool want_status,
                         coa_node_plan_handler_t plan_handler, void *owner);
 
 /* Unsubscribes everything. O(subscriptions). */

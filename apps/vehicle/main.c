@@ -21,7 +21,8 @@
 #define VEHICLE_USAGE                                                                          \
     "usage: coavoid-vehicle --scenario FILE --id ID [--mode centralised|decoupled]\n"          \
     "                       [--lcm-url URL] [--epoch UTIME] [--speed S] [--steps K]\n"         \
-    "                       [--coordinator-timeout S] [--priority-wait S]\n"                   \
+    "                       [--coordinator-timeout S] [--coordinator-id ID]\n"                 \
+    "                       [--priority-wait S]\n"                                              \
     "       coavoid-vehicle --scenario FILE --list-ids\n"                                      \
     "\n"                                                                                       \
     "Flies the UAV with this id from the scenario in real time, exchanging intents and\n"     \
@@ -36,6 +37,9 @@
     COA_RT_OPTIONS_USAGE                                                                       \
     "  --coordinator-timeout S  scenario seconds of coordinator silence after which it\n"     \
     "                      plans for itself; default 2.5 * dt\n"                               \
+    "  --coordinator-id ID the node id of the coordinator it follows (1 to 65535, not its\n" \
+    "                      own); heartbeats and plans from any other are refused; default\n"   \
+    "                      65001, coavoid-coordinator's\n"                                       \
     "  --priority-wait S   decoupled: scenario seconds it waits for the intents of the\n"     \
     "                      higher-priority UAVs that pass near it, 0 <= S < dt; default dt / 2\n" \
     "  --list-ids          print the scenario's vehicle ids, one per line, and exit (for\n"   \
@@ -57,6 +61,8 @@ typedef struct {
     bool decoupled;
     const char *timeout_text;
     double timeout;
+    const char *coordinator_text;
+    uint16_t coordinator_id;
     const char *wait_text;
     double wait;
     coa_rt_options_t rt;
@@ -108,6 +114,16 @@ static int vehicle_option(int argc, char **argv, int *i, void *options)
     } else if (cli_option_is(arg, "--coordinator-timeout")) {
         status = parse_seconds(argc, argv, i, "--coordinator-timeout", false, &o->timeout_text,
                                &o->timeout);
+    } else if (cli_option_is(arg, "--coordinator-id")) {
+        status = cli_text_option(argc, argv, i, "--coordinator-id", "a node id", true,
+                                 &o->coordinator_text);
+        if (status == CLI_CONTINUE &&
+            !cli_parse_count(o->coordinator_text, strlen(o->coordinator_text), 65535u, &value)) {
+            status = cli_fail(CLI_EXIT_INVALID,
+                              "--coordinator-id: must be a node id from 1 to 65535, got '%.40s'",
+                              o->coordinator_text);
+        }
+        o->coordinator_id = (uint16_t)value;
     } else if (cli_option_is(arg, "--priority-wait")) {
         status = parse_seconds(argc, argv, i, "--priority-wait", true, &o->wait_text, &o->wait);
     }
@@ -131,7 +147,7 @@ static int parse_options(int argc, char **argv, vehicle_options_t *o)
     }
     if (o->list_ids) {
         if (o->id_text != NULL || o->mode != NULL || o->timeout_text != NULL ||
-            o->wait_text != NULL || o->rt.lcm_url != NULL || o->rt.epoch_text != NULL ||
+            o->coordinator_text != NULL || o->wait_text != NULL || o->rt.lcm_url != NULL || o->rt.epoch_text != NULL ||
             o->rt.speed_text != NULL || o->rt.steps_text != NULL) {
             return cli_fail(CLI_EXIT_INVALID, "--list-ids: takes only --scenario FILE");
         }
@@ -143,6 +159,13 @@ static int parse_options(int argc, char **argv, vehicle_options_t *o)
     /* The coordinator timeout only decides when a centralised vehicle plans for itself. */
     if (o->decoupled && o->timeout_text != NULL) {
         return cli_fail(CLI_EXIT_INVALID, "--coordinator-timeout: only valid with --mode centralised");
+    }
+    if (o->decoupled && o->coordinator_text != NULL) {
+        return cli_fail(CLI_EXIT_INVALID, "--coordinator-id: only valid with --mode centralised");
+    }
+    if (o->coordinator_text != NULL && o->coordinator_id == o->id) {
+        return cli_fail(CLI_EXIT_INVALID, "--coordinator-id: %u is this vehicle's own id",
+                        (unsigned)o->id);
     }
     return CLI_CONTINUE;
 }
@@ -192,6 +215,7 @@ static int run(void *options, scenario_t *s)
     const int64_t dt_us = config.common.dt_us;
     config.vehicle = s->vehicles[index];
     config.mode = o->decoupled ? COA_NODE_DECOUPLED : COA_NODE_CENTRALISED;
+    config.coordinator_id = o->coordinator_id; /* 0: the default */
     config.coordinator_timeout_us =
         o->timeout_text != NULL ? llround(o->timeout * 1e6) : llround(2.5 * (double)dt_us);
     config.priority_wait_us = o->wait_text != NULL ? llround(o->wait * 1e6) : dt_us / 2;
