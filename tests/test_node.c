@@ -10,7 +10,9 @@
  *     valid_until), no plan_id (forged, or from a restarted coordinator) locks later
  *     cycles out, and a plan into the terrain the UAV knows is refused;
  *   - the UAV falls back to planning for itself when the heartbeat stops and returns
- *     when it comes back; it follows only the coordinator it is configured with;
+ *     when it comes back; it follows only the coordinator it is configured with, not
+ *     one that reports a fault, and not one whose plans do not come while it has a
+ *     conflict; the coordinator plans no UAV that plans for itself;
  *   - a lower priority waits for the higher, up to its deadline;
  *   - a silent UAV is avoided as a track;
  *   - the world's track estimates reproduce the scenario's path over the horizon;
@@ -642,6 +644,164 @@ START_TEST(test_configured_coordinator_only)
 }
 END_TEST
 
+/* A coordinator that reports a fault is not followed: its heartbeats do not keep the UAV
+ * coordinated. */
+START_TEST(test_faulty_coordinator_not_followed)
+{
+    rig_t r;
+    rig_init(&r, 10);
+    coa_vec3_t route[2];
+    coa_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, route, 0, 500, 0, 100), COA_NODE_CENTRALISED);
+    const coa_vehicle_node_state_t *s = coa_vehicle_node_state(a);
+    /* Heartbeats every cycle, HEALTH_FAULT from cycle 2 on: the last one that counts is
+     * at 1.25, so from cycle 4 (2.75 s later) the UAV plans for itself. */
+    const char *want = "CCCCDDDD";
+    for (int64_t k = 0; k < 8; k++) {
+        r.now = cycle(k);
+        ck_assert_int_eq(coa_vehicle_node_cycle(a, r.now), COA_OK);
+        drain(r.lcm);
+        ck_assert_msg(s->coordinated == (want[k] == 'C'), "cycle %d", (int)k);
+        r.now = cycle(k) + DT_US / 4;
+        heartbeat_from(r.lcm, r.now, k, (int32_t)COA_NODE_COORDINATOR_ID,
+                       k < 2 ? COAVOID_STATUS_T_HEALTH_OK : COAVOID_STATUS_T_HEALTH_FAULT);
+        drain(r.lcm);
+    }
+    ck_assert_uint_eq(s->fallbacks, 1);
+    ck_assert_int_eq(s->rx.rejected, 0);
+    coa_vehicle_node_destroy(a);
+    lcm_destroy(r.lcm);
+}
+END_TEST
+
+/* Whether two UAVs' flown positions (samples 0..n) conflict over any step. */
+static bool flown_conflict(const coa_vec3_t *pa, const coa_vec3_t *pb, int64_t n)
+{
+    for (int64_t k = 0; k < n; k++) {
+        coa_sweep_t x = {{15, 5}, pa[k], pa[k + 1]};
+        coa_sweep_t y = {{15, 5}, pb[k], pb[k + 1]};
+        if (coa_conflict_volumes(&x, &y)) {
+            return true;
+        }
+    }
+    return false;
+}
+
+/* A heartbeat alone does not keep a UAV following the coordinator: here the coordinator's
+ * plans always come a cycle late (valid_from the cycle before), its heartbeats in time.
+ * A UAV that followed it, had a conflict and adopted no plan in that cycle plans for
+ * itself in the next one, and the head-on pair stays separated. */
+START_TEST(test_late_plans_fall_back)
+{
+    rig_t r;
+    rig_init(&r, 24);
+    coa_vec3_t r1[2], r2[2];
+    coa_vehicle_node_t *v[2];
+    v[0] = vehicle_node(&r, uav(1, 1, r1, 0, 600, 0, 100), COA_NODE_CENTRALISED);
+    v[1] = vehicle_node(&r, uav(2, 2, r2, 300, -300, 0, 100), COA_NODE_CENTRALISED);
+    const coa_vehicle_node_state_t *s[2] = {coa_vehicle_node_state(v[0]),
+                                            coa_vehicle_node_state(v[1])};
+    coa_coordinator_config_t cc;
+    memset(&cc, 0, sizeof cc);
+    cc.common = r.common;
+    cc.common.beta = 5000;
+    int error = -99;
+    coa_coordinator_t *co = coa_coordinator_create(&cc, r.lcm, &error);
+    ck_assert_ptr_nonnull(co);
+    coa_vec3_t p[2][31];
+    for (int64_t k = 0; k <= 30; k++) {
+        /* The coordinator's messages of cycle k - 1, still queued, reach the UAVs with
+         * the first message of cycle k, after the cycle has begun. */
+        r.now = cycle(k);
+        for (int i = 0; i < 2; i++) {
+            ck_assert_int_eq(coa_vehicle_node_cycle(v[i], r.now), COA_OK);
+            drain(r.lcm);
+        }
+        while (coa_vehicle_node_deadline(v[1]) != INT64_MAX) {
+            r.now = coa_vehicle_node_deadline(v[1]);
+            ck_assert_int_ge(coa_vehicle_node_poll(v[1], r.now), 0);
+            drain(r.lcm);
+        }
+        if (k == 1) {
+            /* In the first cycle after the conflict showed, both plan for themselves. */
+            ck_assert(!s[0]->coordinated && !s[1]->coordinated);
+            ck_assert_uint_ge(s[1]->plans_run, 1);
+        }
+        r.now = cycle(k) + DT_US / 4;
+        ck_assert_int_eq(coa_coordinator_cycle(co, r.now), COA_OK);
+        for (int i = 0; i < 2; i++) {
+            p[i][k] = s[i]->position;
+        }
+    }
+    ck_assert_msg(!flown_conflict(p[0], p[1], 30), "loss of separation");
+    for (int i = 0; i < 2; i++) {
+        ck_assert_uint_ge(s[i]->fallbacks, 1);
+        ck_assert_int_eq(s[i]->rx.last_reject_code, COA_LCM_ERR_TIME);
+    }
+    coa_coordinator_destroy(co);
+    coa_vehicle_node_destroy(v[1]);
+    coa_vehicle_node_destroy(v[0]);
+    lcm_destroy(r.lcm);
+}
+END_TEST
+
+/* The UAV rows of the plans a coordinator publishes. */
+typedef struct {
+    int plans;
+    int32_t rows;
+    int32_t ids[4];
+} plan_probe_t;
+
+static void on_plan_probe(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
+{
+    plan_probe_t *p = user;
+    (void)channel;
+    coavoid_plan_t m;
+    REQUIRE(coavoid_plan_t_decode(rbuf->data, 0, (int)rbuf->data_size, &m) >= 0);
+    p->plans++;
+    p->rows = m.vehicle_count;
+    for (int32_t i = 0; i < m.vehicle_count && i < 4; i++) {
+        p->ids[i] = m.uav_ids[i];
+    }
+}
+
+/* The coordinator does not plan a UAV that says it plans for itself (a decoupled intent):
+ * the others' plans would rely on a move it does not make. It plans the others around it. */
+START_TEST(test_coordinator_skips_decoupled_uav)
+{
+    rig_t r;
+    rig_init(&r, 24);
+    plan_probe_t probe;
+    memset(&probe, 0, sizeof probe);
+    lcm_subscription_t *sub = lcm_subscribe(r.lcm, COA_CHANNEL_PLAN, on_plan_probe, &probe);
+    coa_vec3_t r1[2], r2[2];
+    coa_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, r1, 0, 600, 0, 100), COA_NODE_DECOUPLED);
+    coa_vehicle_node_t *b = vehicle_node(&r, uav(2, 2, r2, 300, -300, 0, 100), COA_NODE_CENTRALISED);
+    coa_coordinator_config_t cc;
+    memset(&cc, 0, sizeof cc);
+    cc.common = r.common;
+    cc.common.beta = 5000;
+    int error = -99;
+    coa_coordinator_t *co = coa_coordinator_create(&cc, r.lcm, &error);
+    ck_assert_ptr_nonnull(co);
+    ck_assert_int_eq(coa_vehicle_node_cycle(a, r.now), COA_OK);
+    drain(r.lcm);
+    ck_assert_int_eq(coa_vehicle_node_cycle(b, r.now), COA_OK);
+    drain(r.lcm);
+    r.now = cycle(0) + DT_US / 4;
+    ck_assert_int_eq(coa_coordinator_cycle(co, r.now), COA_OK);
+    drain(r.lcm);
+    ck_assert_int_eq(probe.plans, 1);
+    ck_assert_int_eq(probe.rows, 1);
+    ck_assert_int_eq(probe.ids[0], 2);
+    ck_assert_uint_eq(coa_vehicle_node_state(b)->plans_adopted, 1);
+    lcm_unsubscribe(r.lcm, sub);
+    coa_coordinator_destroy(co);
+    coa_vehicle_node_destroy(b);
+    coa_vehicle_node_destroy(a);
+    lcm_destroy(r.lcm);
+}
+END_TEST
+
 /* ---- decoupled: waiting for higher priorities ---- */
 
 START_TEST(test_lower_priority_waits)
@@ -984,6 +1144,9 @@ static Suite *node_suite(void)
     tcase_add_test(tc, test_refusals_degrade_health);
     tcase_add_test(tc, test_fallback_and_return);
     tcase_add_test(tc, test_configured_coordinator_only);
+    tcase_add_test(tc, test_faulty_coordinator_not_followed);
+    tcase_add_test(tc, test_late_plans_fall_back);
+    tcase_add_test(tc, test_coordinator_skips_decoupled_uav);
     tcase_add_test(tc, test_lower_priority_waits);
     tcase_add_test(tc, test_waits_for_near_higher_priority);
     tcase_add_test(tc, test_wait_ends_at_deadline);

@@ -348,7 +348,9 @@ static void on_status(const lcm_recv_buf_t *rbuf, const char *channel, void *use
         return;
     }
     senders_heard(&in->status_seq, (uint32_t)msg->node_id, now);
-    if (msg->node_kind == COAVOID_STATUS_T_NODE_COORDINATOR) {
+    /* A coordinator that reports a fault is not one to follow. */
+    if (msg->node_kind == COAVOID_STATUS_T_NODE_COORDINATOR &&
+        msg->health != COAVOID_STATUS_T_HEALTH_FAULT) {
         in->heard_coordinator = true;
         in->coordinator_utime = now;
     }

@@ -145,7 +145,7 @@ static int publish_status(coa_coordinator_t *node, int64_t now, int64_t cycle_st
 #define GROUP_ALL COA_NO_CLUSTER
 
 /* The UAVs of `group` (a cluster label, GROUP_CLUSTERED or GROUP_ALL) with an intent for
- * this cycle, ascending id; past COA_MAX_VEHICLES (a plan_t's rows) only the highest
+ * this cycle that follow the coordinator, ascending id; past COA_MAX_VEHICLES (a plan_t's rows) only the highest
  * priorities are planned and the rest stay moving obstacles. Returns the count. */
 static size_t cluster_members(coa_coordinator_t *node, uint32_t group)
 {
@@ -155,7 +155,11 @@ static size_t cluster_members(coa_coordinator_t *node, uint32_t group)
         bool in = group == GROUP_ALL ||
                   (group == GROUP_CLUSTERED ? node->labels[i] != COA_NO_CLUSTER
                                             : node->labels[i] == group);
-        if (!in || !view->live_current[i]) {
+        /* A UAV that says it plans for itself (decoupled intent) will not fly a plan of
+         * the coordinator's: planning it jointly would leave the others' plans relying on
+         * a move it does not make. It stays a moving obstacle. */
+        if (!in || !view->live_current[i] ||
+            view->live_info[i].mode != COAVOID_INTENT_T_MODE_CENTRALISED) {
             continue;
         }
         if (count < COA_MAX_VEHICLES) {

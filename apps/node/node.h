@@ -19,10 +19,20 @@
  *   2. At cycle_utime(k) every UAV steps its simulated flight to sample k (the offset its
  *      adopted plan gives for k; a plan past its end holds its last offset).
  *      - centralised (a heartbeat of its coordinator heard within
- *        coordinator_timeout_us, or still inside that time since start): it publishes its
- *        intent at once (reference and offsets for samples k..k+N) and follows the
- *        coordinator. Its coordinator is the node id it is configured with: heartbeats
- *        of a coordinator and plans from any other id are refused (COA_LCM_ERR_ID);
+ *        coordinator_timeout_us, or still inside that time since start, and the
+ *        coordinator not found wanting, below): it publishes its intent at once
+ *        (reference and offsets for samples k..k+N) and follows the coordinator. Its
+ *        coordinator is the node id it is configured with: heartbeats of a coordinator
+ *        and plans from any other id are refused (COA_LCM_ERR_ID), and a heartbeat with
+ *        HEALTH_FAULT does not count. A heartbeat alone does not keep a UAV safe (plans
+ *        that come late, an impostor): so at the start of cycle k + 1, a UAV that
+ *        followed the coordinator in cycle k and adopted none of its plans there runs
+ *        its own prediction (as decoupled, without waiting: its intent of k + 1 and its
+ *        peers' latest), and when it has a conflict of its own that begins within cycle
+ *        k's horizon (first step < N - 1 on the new clock; one that only now enters the
+ *        horizon is the coordinator's to plan in k + 1), it plans for itself as in
+ *        decoupled mode from cycle k + 1 on (counted in fallbacks), until a cycle in
+ *        which it adopts a coordinator's plan or has no conflict of its own;
  *      - decoupled: first it waits (until priority_wait_us has passed) for this cycle's
  *        intents of the higher-priority UAVs whose paths pass near its own horizontally
  *        within the horizon (the predictor's test with unbounded heights): only their
@@ -43,7 +53,9 @@
  *        in it, it searches again around the higher priorities only (coa_plan_decoupled's
  *        rule), and the others plan around it in turn.
  *   3. At cycle_utime(k) + collect_us the coordinator predicts over samples k..k+N from the
- *      intents for this cycle, plans each conflicting cluster in one centralised search
+ *      intents for this cycle, plans each conflicting cluster (of the UAVs whose intent
+ *      says they follow it: one that plans for itself is a moving obstacle, since the
+ *      others' plans must not rely on a move it will not make) in one centralised search
  *      (decoupled, in the coordinator, for a cluster larger than its workspace holds, or
  *      when the composite search runs out of beta before proving anything),
  *      clusters in ascending order, each later cluster treating the new plans of the
@@ -210,9 +222,10 @@ void coa_vehicle_node_destroy(coa_vehicle_node_t *node);
  * comment. Calling it again within the same cycle (or an earlier one) does nothing.
  * Returns COA_OK or a negative error (COA_ERR_ARGUMENT: NULL, now before the epoch, or an
  * intent it cannot publish; a publishing or internal error); it publishes its intent and
- * heartbeat even then, when it can. Cost: O(N + route) to fly; decoupled, one prediction
- * over its peers, tracks and obstacles (coa_predict) and at most two one-UAV searches of
- * beta expansions. No memory is allocated. */
+ * heartbeat even then, when it can. Cost: O(N + route) to fly; after a coordinated cycle
+ * without an adopted plan, one prediction over its peers, tracks and obstacles
+ * (coa_predict); decoupled, one more and at most two one-UAV searches of beta
+ * expansions. No memory is allocated. */
 int coa_vehicle_node_cycle(coa_vehicle_node_t *node, int64_t now);
 
 /* Completes a decoupled wait once its condition holds at `now` (the intents arrived, or

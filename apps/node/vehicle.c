@@ -1,7 +1,8 @@
 /*
  * The vehicle node (node.h): one simulated UAV that flies its adopted plan, publishes its
- * intent, follows the coordinator while its heartbeat lasts, and otherwise plans for
- * itself in priority order (steps 2 and 4 of node.h's cycle).
+ * intent, follows the coordinator while its heartbeat lasts and its plans come when they
+ * are needed, and otherwise plans for itself in priority order (steps 2 and 4 of node.h's
+ * cycle).
  */
 #include "node_internal.h"
 
@@ -19,6 +20,8 @@ struct coa_vehicle_node {
     int64_t cycle_start;
     int64_t wait_deadline;
     bool was_coordinated;
+    bool cycle_conflict;             /* a conflict of its own in this cycle's prediction */
+    bool distrust;                   /* not following a coordinator it hears (cycle()) */
     bool fault;                      /* an internal error in this cycle */
     int64_t intent_sequence;
     int64_t status_sequence;
@@ -261,6 +264,75 @@ static int plan_self(coa_vehicle_node_t *node, int64_t now, uint32_t my)
     return rc;
 }
 
+/* Builds the cycle's view at `now` and the plans to predict: its own intent first, then
+ * the live UAVs' (view order). Returns their count. */
+static size_t gather(coa_vehicle_node_t *node, int64_t now)
+{
+    const coa_node_common_t *c = &node->config.common;
+    const coa_vehicle_t *self = &node->config.vehicle;
+    coa_node_view_t *view = &node->view;
+    coa_node_view_build(view, &node->inbox, node->cycle_start, now);
+    coa_intent_plan_t *own = &node->plans[0];
+    memset(own, 0, sizeof *own);
+    own->id = self->id;
+    own->volume = self->volume;
+    own->t0 = 0;
+    own->step = c->dt;
+    own->samples = node->own_samples;
+    own->count = (size_t)c->horizon + 1u;
+    own->sigma_horizontal = node->config.sigma_horizontal;
+    own->sigma_vertical = node->config.sigma_vertical;
+    for (size_t i = 0; i < view->live_count; i++) {
+        node->plans[i + 1u] = view->live_plan[i];
+    }
+    return view->live_count + 1u;
+}
+
+/* Predicts over the n gathered plans with the view's tracks and the known obstacles:
+ * node->labels and the solver's conflicts, state.conflicts, and whether it has a conflict
+ * of its own in this cycle. Returns COA_OK or the prediction's error. */
+static int predict(coa_vehicle_node_t *node, size_t n, coa_predict_result_t *result)
+{
+    size_t clusters = 0;
+    coa_node_solver_t *sv = &node->solver;
+    int rc = coa_node_predict(sv->predictor, &node->config.common, node->plans, n, &node->view,
+                              &node->inbox, sv->conflicts, sv->conflict_capacity, result,
+                              node->labels, &clusters);
+    if (rc != COA_OK) {
+        return rc;
+    }
+    node->state.conflicts =
+        result->conflicts_found > UINT32_MAX ? UINT32_MAX : (uint32_t)result->conflicts_found;
+    return COA_OK;
+}
+
+/* At the start of a cycle, after following the coordinator in the one before without
+ * adopting a plan: whether it had a conflict of its own there that the coordinator
+ * left open. It predicts as decoupled, on this cycle's clock with its own intent of this
+ * cycle (the last one flown on) and its peers' latest, and counts only conflicts that
+ * begin within the previous cycle's horizon (first step below N - 1 here): one that
+ * only now enters the horizon is the coordinator's to plan in this cycle. Predicting at
+ * the previous cycle's start instead would have seen some peers' intents of the cycle
+ * before it, without the plans they adopted since, and taken a solved conflict for an
+ * open one. Returns COA_OK or the prediction's error. */
+static int missed_conflict(coa_vehicle_node_t *node, int64_t now, bool *conflict)
+{
+    coa_predict_result_t result;
+    *conflict = false;
+    int rc = predict(node, gather(node, now), &result);
+    if (rc != COA_OK) {
+        return rc;
+    }
+    const uint32_t horizon = node->config.common.horizon;
+    for (size_t j = 0; j < result.conflict_count; j++) {
+        const coa_conflict_t *cf = &node->solver.conflicts[j];
+        if (cf->a == 0u && cf->first_step + 1u < horizon) {
+            *conflict = true;
+        }
+    }
+    return COA_OK;
+}
+
 /* Whether a higher-priority UAV that may still publish this cycle's intent passes near it
  * horizontally within the horizon. A UAV changes only its altitude, so such a UAV is the
  * only one whose new plan can bring a conflict it does not see yet: it waits for those
@@ -319,42 +391,22 @@ static bool near_pending(coa_vehicle_node_t *node, size_t n)
  * then plan and publish. Returns 1 when it published, 0 while it waits, or an error. */
 static int decide(coa_vehicle_node_t *node, int64_t now)
 {
-    const coa_node_common_t *c = &node->config.common;
     const coa_vehicle_t *self = &node->config.vehicle;
-    coa_node_view_t *view = &node->view;
-    coa_node_view_build(view, &node->inbox, node->cycle_start, now);
-
-    coa_intent_plan_t *own = &node->plans[0];
-    memset(own, 0, sizeof *own);
-    own->id = self->id;
-    own->volume = self->volume;
-    own->t0 = 0;
-    own->step = c->dt;
-    own->samples = node->own_samples;
-    own->count = (size_t)c->horizon + 1u;
-    own->sigma_horizontal = node->config.sigma_horizontal;
-    own->sigma_vertical = node->config.sigma_vertical;
-    for (size_t i = 0; i < view->live_count; i++) {
-        node->plans[i + 1u] = view->live_plan[i];
-    }
-    const size_t n = view->live_count + 1u;
+    const coa_node_view_t *view = &node->view;
+    const size_t n = gather(node, now);
     if (now < node->wait_deadline && near_pending(node, n)) {
         node->state.waiting = true;
         return 0;
     }
     coa_predict_result_t result;
-    size_t clusters = 0;
-    coa_node_solver_t *sv = &node->solver;
-    int rc = coa_node_predict(sv->predictor, c, node->plans, n, view, &node->inbox, sv->conflicts,
-                              sv->conflict_capacity, &result, node->labels, &clusters);
+    int rc = predict(node, n, &result);
     if (rc != COA_OK) {
         node->fault = true;
         int published = finish(node, now);
         return published < 0 ? published : rc;
     }
-    node->state.conflicts =
-        result.conflicts_found > UINT32_MAX ? UINT32_MAX : (uint32_t)result.conflicts_found;
     const uint32_t my = node->labels[0];
+    node->cycle_conflict = my != COA_NO_CLUSTER;
     if (my == COA_NO_CLUSTER) {
         return finish(node, now);
     }
@@ -600,6 +652,7 @@ int coa_vehicle_node_cycle(coa_vehicle_node_t *node, int64_t now)
         node->first_cycle_start = coa_node_cycle_utime(c, k);
     }
     node->fault = false;
+    const bool previous_adopted = node->cycle_plan_adopted;
     node->cycle_plan_adopted = false;
     node->state.cycle = k;
     node->cycle_start = coa_node_cycle_utime(c, k);
@@ -610,9 +663,31 @@ int coa_vehicle_node_cycle(coa_vehicle_node_t *node, int64_t now)
     node->state.reference = node->own_reference[0];
     node->state.position = node->own_samples[0];
 
+    /* A coordinator answers, within its cycle, for the conflicts of the UAVs that follow
+     * it. One that followed it, had a conflict of its own and adopted none of its plans
+     * in that cycle (plans late, an impostor's or a dead coordinator's heartbeat, a plan
+     * that failed) plans for itself instead, until a cycle in which it adopts one of the
+     * coordinator's plans or has no conflict of its own: a heartbeat alone keeps no UAV
+     * safe. Decoupled cycles tell their conflicts in decide(). */
+    int predicted = COA_OK;
+    bool conflict = node->cycle_conflict;
+    if (node->was_coordinated && !previous_adopted) {
+        predicted = missed_conflict(node, now, &conflict);
+        if (predicted != COA_OK) {
+            node->fault = true;
+            conflict = false; /* cannot tell: the error is reported */
+        }
+    }
+    if (node->was_coordinated && conflict && !previous_adopted) {
+        node->distrust = true;
+    } else if (node->distrust && (previous_adopted || !conflict)) {
+        node->distrust = false;
+    }
+    node->cycle_conflict = false;
+
     const int64_t timeout = node->config.coordinator_timeout_us;
     const bool coordinated =
-        node->config.mode == COA_NODE_CENTRALISED &&
+        node->config.mode == COA_NODE_CENTRALISED && !node->distrust &&
         ((node->inbox.heard_coordinator && now - node->inbox.coordinator_utime <= timeout) ||
          now - node->first_cycle_start < timeout);
     if (node->was_coordinated && !coordinated) {
@@ -630,6 +705,9 @@ int coa_vehicle_node_cycle(coa_vehicle_node_t *node, int64_t now)
     } else {
         node->wait_deadline = node->cycle_start + node->config.priority_wait_us;
         rc = decide(node, now);
+    }
+    if (rc >= 0 && predicted != COA_OK) {
+        rc = predicted;
     }
     return rc < 0 ? rc : COA_OK;
 }
