@@ -13,7 +13,8 @@
  *     when it comes back; it follows only the coordinator it is configured with, not
  *     one that reports a fault, and not one whose plans do not come while it has a
  *     conflict; the coordinator plans no UAV that plans for itself;
- *   - a lower priority waits for the higher, up to its deadline;
+ *   - a lower priority waits for the higher, up to its deadline; every member of a
+ *     cluster in conflict plans, the highest priority too;
  *   - a silent UAV is avoided as a track;
  *   - the world's track estimates reproduce the scenario's path over the horizon;
  *   - bad configurations are refused.
@@ -827,7 +828,7 @@ START_TEST(test_lower_priority_waits)
     ck_assert_int_eq(coa_vehicle_node_deadline(b), cycle(1) + DT_US / 2);
     ck_assert_int_eq(coa_vehicle_node_poll(b, r.now), 0);
     ck_assert_uint_eq(sb->plans_run, 0);
-    /* 1 publishes (its only conflict is with a lower priority: it does not plan). */
+    /* 1 publishes (2 has published nothing yet: 1 sees no conflict and does not plan). */
     ck_assert_int_eq(coa_vehicle_node_cycle(a, r.now), COA_OK);
     drain(r.lcm);
     ck_assert_uint_eq(sa->plans_run, 0);
@@ -925,6 +926,51 @@ START_TEST(test_wait_ends_at_deadline)
     }
     coa_vehicle_node_destroy(b);
     coa_vehicle_node_destroy(a);
+    lcm_destroy(r.lcm);
+}
+END_TEST
+
+/* Every member of a cluster in conflict plans, the highest priority too: 1 holds an offset
+ * (6 steps, 12 m up) that puts it at 2's altitude head-on, and 2 may deviate by one step
+ * only, which is not enough. 1, planning around what it must avoid and ignoring 2,
+ * returns to its reference, which frees 2. Before, 1 never planned for a conflict with a
+ * lower priority, and they met. */
+START_TEST(test_higher_priority_replans_in_cluster)
+{
+    rig_t r;
+    rig_init(&r, 24);
+    coa_vec3_t r1[2], r2[2];
+    coa_vehicle_t v1 = uav(1, 1, r1, 0, 800, 0, 100);
+    v1.initial_offset = 6;
+    coa_vehicle_t v2 = uav(2, 2, r2, 600, -200, 0, 112);
+    v2.max_offset = 1;
+    coa_vehicle_node_t *v[2] = {vehicle_node(&r, v1, COA_NODE_DECOUPLED),
+                                vehicle_node(&r, v2, COA_NODE_DECOUPLED)};
+    const coa_vehicle_node_state_t *sa = coa_vehicle_node_state(v[0]);
+    const coa_vehicle_node_state_t *sb = coa_vehicle_node_state(v[1]);
+    coa_vec3_t p[2][41];
+    for (int64_t k = 0; k <= 40; k++) {
+        r.now = cycle(k);
+        for (int i = 0; i < 2; i++) {
+            ck_assert_int_eq(coa_vehicle_node_cycle(v[i], r.now), COA_OK);
+            drain(r.lcm);
+        }
+        for (int i = 0; i < 2; i++) {
+            while (coa_vehicle_node_deadline(v[i]) != INT64_MAX) {
+                r.now = coa_vehicle_node_deadline(v[i]);
+                ck_assert_int_ge(coa_vehicle_node_poll(v[i], r.now), 0);
+                drain(r.lcm);
+            }
+        }
+        p[0][k] = sa->position;
+        p[1][k] = sb->position;
+    }
+    ck_assert_uint_ge(sa->plans_run, 1);
+    ck_assert_int_eq(sa->offset, 0);
+    ck_assert_msg(!flown_conflict(p[0], p[1], 40), "loss of separation");
+    for (int i = 0; i < 2; i++) {
+        coa_vehicle_node_destroy(v[i]);
+    }
     lcm_destroy(r.lcm);
 }
 END_TEST
@@ -1150,6 +1196,7 @@ static Suite *node_suite(void)
     tcase_add_test(tc, test_lower_priority_waits);
     tcase_add_test(tc, test_waits_for_near_higher_priority);
     tcase_add_test(tc, test_wait_ends_at_deadline);
+    tcase_add_test(tc, test_higher_priority_replans_in_cluster);
     tcase_add_test(tc, test_silent_uav_avoided_as_track);
     tcase_add_test(tc, test_world_track_estimates);
     tcase_add_test(tc, test_bad_configs_refused);

@@ -39,19 +39,21 @@
  *        new plans can bring it a conflict it cannot see yet, since a UAV changes only
  *        its altitude. So it decides on what they decided this cycle, whatever the order
  *        in which the processes run, as in the simulation. Then it predicts over samples
- *        k..k+N with its own plan and its peers' latest intents. With no conflict in its cluster (coa_predict_clusters over its
- *        view) it publishes its intent at once. Otherwise it waits until every
- *        higher-priority UAV of its cluster has published an intent for this cycle
- *        (plan_utime == cycle_utime(k)), or until priority_wait_us has passed, then plans
- *        for itself alone (one-UAV A*) against obstacles, tracks and the intents of every
- *        UAV that is not a lower-priority member of its cluster (as moving obstacles, in
- *        the planner's track form), adopts the plan when solved, and publishes its intent.
- *        So a cluster plans in priority order, as coa_plan_decoupled does. It plans only
- *        when one of its own conflicts is with something it must avoid (an obstacle, a
- *        track, a higher-priority UAV): conflicts with lower priorities are theirs to
- *        solve. When that search fails and lower-priority UAVs outside its cluster were
- *        in it, it searches again around the higher priorities only (coa_plan_decoupled's
- *        rule), and the others plan around it in turn.
+ *        k..k+N with its own plan and its peers' latest intents. With no conflict in its
+ *        cluster (coa_predict_clusters over its view) it publishes its intent at once.
+ *        Otherwise it waits until every higher-priority UAV of its cluster has published
+ *        an intent for this cycle (plan_utime == cycle_utime(k)), or until
+ *        priority_wait_us has passed, then plans for itself alone (one-UAV A*) against
+ *        obstacles, tracks and the intents of every UAV that is not a lower-priority
+ *        member of its cluster (as moving obstacles, in the planner's track form), adopts
+ *        the plan when solved, and publishes its intent.
+ *        So a cluster plans in priority order, as coa_plan_decoupled does: every member
+ *        plans, the highest priority too when its only conflicts are with lower ones
+ *        (ignoring them, it returns towards its reference where it can: an offset it
+ *        merely kept could leave a lower priority no way out). When that search fails
+ *        and lower-priority UAVs outside its cluster were in it, it searches again
+ *        around the higher priorities only (coa_plan_decoupled's rule), and the others
+ *        plan around it in turn.
  *   3. At cycle_utime(k) + collect_us the coordinator predicts over samples k..k+N from the
  *      intents for this cycle, plans each conflicting cluster (of the UAVs whose intent
  *      says they follow it: one that plans for itself is a moving obstacle, since the

@@ -422,30 +422,16 @@ static int decide(coa_vehicle_node_t *node, int64_t now)
         node->state.waiting = true;
         return 0;
     }
-    /* Its own conflicts with lower-priority UAVs are theirs to solve (they plan around
-     * it, as coa_plan_decoupled orders it): it plans only for one that is its own. */
-    bool must = false;
-    for (size_t j = 0; j < result.conflict_count; j++) {
-        const coa_conflict_t *cf = &node->solver.conflicts[j];
-        if (cf->a != 0u) {
-            continue;
-        }
-        if (cf->kind != COA_CONFLICT_VEHICLE) {
-            must = true;
-        } else if (cf->b >= 1u && cf->b < n) {
-            const coa_vehicle_t *peer = &view->live_vehicle[cf->b - 1u];
-            if (coa_node_outranks(peer->priority, peer->id, self->priority, self->id)) {
-                must = true;
-            }
-        }
-    }
-    if (must) {
-        rc = plan_self(node, now, my);
-        if (rc != COA_OK) {
-            node->fault = true;
-            int published = finish(node, now);
-            return published < 0 ? published : rc;
-        }
+    /* Every member of a cluster in conflict plans, in priority order, as
+     * coa_plan_decoupled orders it, even one whose only conflicts are with lower
+     * priorities: ignoring them, it plans around what it must avoid and returns towards
+     * its reference where it can. Holding an old offset instead can leave a lower
+     * priority no way out. */
+    rc = plan_self(node, now, my);
+    if (rc != COA_OK) {
+        node->fault = true;
+        int published = finish(node, now);
+        return published < 0 ? published : rc;
     }
     return finish(node, now);
 }
