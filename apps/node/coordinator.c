@@ -145,8 +145,9 @@ static int publish_status(coa_coordinator_t *node, int64_t now, int64_t cycle_st
 #define GROUP_ALL COA_NO_CLUSTER
 
 /* The UAVs of `group` (a cluster label, GROUP_CLUSTERED or GROUP_ALL) with an intent for
- * this cycle that follow the coordinator, ascending id; past COA_MAX_VEHICLES (a plan_t's rows) only the highest
- * priorities are planned and the rest stay moving obstacles. Returns the count. */
+ * this cycle that follow the coordinator, ascending id; past COA_MAX_VEHICLES (a plan_t's
+ * rows) only the highest priorities are planned and the rest stay moving obstacles.
+ * Returns the count. */
 static size_t cluster_members(coa_coordinator_t *node, uint32_t group)
 {
     const coa_node_view_t *view = &node->view;

@@ -74,10 +74,11 @@
  *      the cycle supersedes), starts at the offset the UAV flies now, and over this
  *      cycle's samples k..k+N runs into none of the obstacles and tracks (silent UAVs
  *      included) the UAV knows (coa_plan_find_conflict: a coordinator may know less
- *      terrain, or be an impostor); anything else is not adopted (counted in status as rejected with the reason). Plan ids are not
- *      compared across cycles: valid_from already ties a plan to its cycle, and a rule
- *      across cycles would let one forged plan_id INT64_MAX, or a coordinator restarted
- *      with its numbering at 0, lock every later plan out.
+ *      terrain, or be an impostor); anything else is not adopted (counted in status as
+ *      rejected with the reason). Plan ids are not compared across cycles: valid_from
+ *      already ties a plan to its cycle, and a rule across cycles would let one forged
+ *      plan_id INT64_MAX, or a coordinator restarted with its numbering at 0, lock every
+ *      later plan out.
  * Every node publishes its heartbeat (status_t) once per cycle; the world, a stand-in for
  * external sources that status_t has no kind for, does not. Its health is HEALTH_FAULT
  * after an internal error (a UAV: also while another UAV uses its id), else

@@ -272,8 +272,9 @@ void coa_node_solver_fini(coa_node_solver_t *s);
 /* Fills *m from h at `now`, validates it on the clock whose t = 0 is cycle_start
  * (coa_node_context) and publishes it. Its health is HEALTH_DEGRADED (unless a fault)
  * also when messages were refused since the previous heartbeat: a clock that disagrees,
- * more peers than the node holds or a bad sender show in the heartbeat as they happen. Returns COA_OK, COA_ERR_ARGUMENT (it does not
- * validate) or coa_node_publish_status's error. O(1); no memory. */
+ * more peers than the node holds or a bad sender show in the heartbeat as they happen.
+ * Returns COA_OK, COA_ERR_ARGUMENT (it does not validate) or coa_node_publish_status's
+ * error. O(1); no memory. */
 int coa_node_publish_heartbeat(coa_node_inbox_t *in, coavoid_status_t *m, int64_t now,
                                int64_t cycle_start, const coa_node_heartbeat_t *h);
 

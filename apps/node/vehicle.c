@@ -289,8 +289,8 @@ static size_t gather(coa_vehicle_node_t *node, int64_t now)
 }
 
 /* Predicts over the n gathered plans with the view's tracks and the known obstacles:
- * node->labels and the solver's conflicts, state.conflicts, and whether it has a conflict
- * of its own in this cycle. Returns COA_OK or the prediction's error. */
+ * node->labels, the solver's conflicts and state.conflicts. Returns COA_OK or the
+ * prediction's error. */
 static int predict(coa_vehicle_node_t *node, size_t n, coa_predict_result_t *result)
 {
     size_t clusters = 0;
@@ -555,9 +555,14 @@ coa_vehicle_node_t *coa_vehicle_node_create(const coa_vehicle_node_config_t *con
         config->coordinator_timeout_us < 0 || config->priority_wait_us < 0 ||
         !isfinite((double)config->sigma_horizontal) || !isfinite((double)config->sigma_vertical) ||
         config->sigma_horizontal < (coa_real_t)0 || config->sigma_vertical < (coa_real_t)0 ||
-        !(coa_climb_step(&config->vehicle, config->common.dt) > (coa_real_t)0) ||
-        config->coordinator_id == config->vehicle.id) {
+        !(coa_climb_step(&config->vehicle, config->common.dt) > (coa_real_t)0)) {
         return NULL;
+    }
+    const uint16_t coordinator_id = config->coordinator_id != 0u
+                                        ? config->coordinator_id
+                                        : (uint16_t)COA_NODE_COORDINATOR_ID;
+    if (coordinator_id == config->vehicle.id) {
+        return NULL; /* its own heartbeats and plans would be taken for its coordinator's */
     }
     const coa_node_common_t *c = &config->common;
     coa_node_solver_t solver;
@@ -577,14 +582,7 @@ coa_vehicle_node_t *coa_vehicle_node_create(const coa_vehicle_node_config_t *con
     if (node->config.coordinator_timeout_us == 0) {
         node->config.coordinator_timeout_us = (int64_t)llround(2.5 * (double)c->dt_us);
     }
-    if (node->config.coordinator_id == 0u) {
-        node->config.coordinator_id = (uint16_t)COA_NODE_COORDINATOR_ID;
-    }
-    if (node->config.coordinator_id == node->config.vehicle.id) {
-        coa_node_solver_fini(&node->solver);
-        free(node);
-        return NULL;
-    }
+    node->config.coordinator_id = coordinator_id;
     if (node->config.priority_wait_us == 0) {
         node->config.priority_wait_us = c->dt_us / 2 > 0 ? c->dt_us / 2 : 1;
     }
@@ -598,8 +596,8 @@ coa_vehicle_node_t *coa_vehicle_node_create(const coa_vehicle_node_config_t *con
     node->wait_deadline = INT64_MAX;
     const bool centralised = node->config.mode == COA_NODE_CENTRALISED;
     rc = coa_node_inbox_init(&node->inbox, c, node->config.vehicle.id, node->config.vehicle.id,
-                             node->config.coordinator_id, COA_NODE_MAX_PEERS - 1u, lcm, &node->state.rx, centralised,
-                             centralised ? on_plan : NULL, node);
+                             coordinator_id, COA_NODE_MAX_PEERS - 1u, lcm, &node->state.rx,
+                             centralised, centralised ? on_plan : NULL, node);
     if (rc != COA_OK) {
         coa_node_solver_fini(&node->solver);
         free(node);

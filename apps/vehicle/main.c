@@ -147,8 +147,8 @@ static int parse_options(int argc, char **argv, vehicle_options_t *o)
     }
     if (o->list_ids) {
         if (o->id_text != NULL || o->mode != NULL || o->timeout_text != NULL ||
-            o->coordinator_text != NULL || o->wait_text != NULL || o->rt.lcm_url != NULL || o->rt.epoch_text != NULL ||
-            o->rt.speed_text != NULL || o->rt.steps_text != NULL) {
+            o->coordinator_text != NULL || o->wait_text != NULL || o->rt.lcm_url != NULL ||
+            o->rt.epoch_text != NULL || o->rt.speed_text != NULL || o->rt.steps_text != NULL) {
             return cli_fail(CLI_EXIT_INVALID, "--list-ids: takes only --scenario FILE");
         }
         return CLI_CONTINUE;
