@@ -131,7 +131,7 @@ typedef struct {
     lcm_t *lcm;
     coa_world_t *world;
     coa_coordinator_t *coordinator;
-    coa_vehicle_node_t **vehicles; /* in ascending id: the order they run in */
+    coa_vehicle_node_t **vehicles; /* in priority order: the order they run in */
     size_t *index;                 /* index[j]: scenario index of vehicles[j] */
     coa_vec3_t *references;        /* by scenario index, rows of K + 1 */
     int32_t *offsets;
@@ -300,14 +300,13 @@ static int sim(void *options, scenario_t *s)
         return cli_fail(CLI_EXIT_INTERNAL, "internal error: out of memory for the world node");
     }
 
-    /* UAVs run in ascending id, whatever the file's order. */
-    for (size_t i = 0; i < n; i++) {
-        size_t j = i;
-        while (j > 0 && s->vehicles[r.index[j - 1]].id > s->vehicles[i].id) {
-            r.index[j] = r.index[j - 1];
-            j--;
-        }
-        r.index[j] = i;
+    /* UAVs run in priority order (ascending priority, ties by ascending id), whatever
+     * the file's order or their ids: the order in which a real fleet's decisions settle.
+     * A UAV that has not yet heard a peer cannot wait for it (cycle 0, before anyone has
+     * published), so a lower priority stepped first would decide around nothing there. */
+    if (coa_priority_order(s->vehicles, n, r.index) != COA_OK) {
+        sim_run_free(&r, n);
+        return cli_fail(CLI_EXIT_INTERNAL, "internal error: no priority order of %zu UAVs", n);
     }
     for (size_t j = 0; j < n; j++) {
         size_t i = r.index[j];
@@ -358,7 +357,7 @@ static int sim(void *options, scenario_t *s)
         }
     }
 
-    /* The loop of node.h: world, then the UAVs in ascending id, their waits, then the
+    /* The loop of node.h: world, then the UAVs in priority order, their waits, then the
      * coordinator at cycle start + collect; each message is handled as soon as it is
      * published, as on a quiet network. */
     const int64_t collect_us = common.dt_us / 4 > 0 ? common.dt_us / 4 : 1;

@@ -6,7 +6,8 @@
 # conflict; the flown costs are at least the one-shot plan's; a run is repeatable byte for
 # byte; the UAVs fall back to planning for themselves when the coordinator stops, and stay
 # separated; a scenario already in conflict reports its loss (exit 1) instead of crashing;
-# bad arguments and inputs exit 2 with one line.
+# UAVs decide in priority order whatever their ids; bad arguments and inputs exit 2 with
+# one line.
 #
 # usage: bash sim.sh <path-to-coavoid> <source-dir>   (VERBOSE=1 prints each result)
 set -u
@@ -285,6 +286,25 @@ sim_json track-ids "$tmp/track_ids.json" decoupled 0 '
 r["loss_of_separation"] is False
 r["replans"] >= 1
 '
+
+# Ids against priorities: UAV 1 (priority 2) and UAV 2 (priority 1) cross at the same
+# altitude and meet within the first step, so the lower priority must climb at cycle 0,
+# knowing the higher priority's intent. The UAVs are stepped in priority order, not by
+# id (stepped by id, UAV 1 decided before it had heard UAV 2 and flew into it over step 0),
+# so the loop flies what the one-shot decoupled plan gives: UAV 1 climbs, UAV 2 does not.
+python3 - "$tmp/ids_against_priorities.json" <<'PY'
+import json, sys
+uav = {"cruise_speed": 20.0, "climb_rate": 10.0, "radius": 15.0, "half_height": 5.0}
+json.dump({"name": "crossing, ids against priorities", "dt": 1.0, "horizon": 10, "vehicles": [
+    dict(uav, id=1, priority=2, route=[[0, -40, 100], [0, 400, 100]]),
+    dict(uav, id=2, priority=1, route=[[-40, 0, 100], [400, 0, 100]])]}, open(sys.argv[1], "w"))
+PY
+"$bin" plan "$tmp/ids_against_priorities.json" --mode decoupled >"$tmp/plan_ids.json" 2>/dev/null
+sim_json ids-against-priorities "$tmp/ids_against_priorities.json" decoupled 0 "
+r['loss_of_separation'] is False
+offsets[1][1] != 0 and all(o == 0 for o in offsets[2])
+(r['deviation'], r['effort']) == ($(field "$tmp/plan_ids.json" 'r["cost"]["deviation"]'), $(field "$tmp/plan_ids.json" 'r["cost"]["effort"]'))
+"
 
 # ---- bad arguments and inputs ----
 
