@@ -6,6 +6,7 @@
  */
 #define _POSIX_C_SOURCE 200809L
 
+#include <math.h>
 #include <stdbool.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -55,7 +56,9 @@
     "\"coordinator_stopped_at\".\n"                                                            \
     "\n"                                                                                       \
     "The scenario's horizon may be at most %u steps (an intent carries N + 1 samples) and\n"  \
-    "it may have at most %u UAVs.\n"                                                           \
+    "it may have at most %u UAVs. What its messages carry over the run (references and\n"     \
+    "tracks up to t = (K + N) dt, with the climbs a UAV can make) must stay within their\n"   \
+    "bounds: positions %g m, speeds %g m/s, sizes and sigmas %g m.\n"                         \
     "\n"                                                                                       \
     "exit status: 0 no loss of separation, 1 a loss of separation, 2 invalid input or\n"       \
     "usage (one line on stderr naming the input and why), 3 internal error\n"
@@ -74,7 +77,8 @@ typedef struct {
 
 static void sim_help(void)
 {
-    printf(SIM_USAGE, COA_NODE_MAX_HORIZON, COA_MAX_VEHICLES);
+    printf(SIM_USAGE, COA_NODE_MAX_HORIZON, COA_MAX_VEHICLES, COA_LCM_MAX_COORDINATE,
+           COA_LCM_MAX_SPEED, COA_LCM_MAX_SIZE);
 }
 
 static int sim_option(int argc, char **argv, int *i, void *options)
@@ -162,6 +166,284 @@ static void sim_run_free(sim_run_t *r, size_t n)
     }
 }
 
+/* ---- what the messages can carry ----
+ *
+ * The nodes talk in messages whose numbers have bounds (coavoid_lcm.h, COA_LCM_MAX_*) that
+ * a scenario's do not: coavoid plan takes a radius of 1e300 m. A node that cannot publish
+ * its intent, or a world that cannot publish a track, would stop the run as a failed node,
+ * so the whole run is checked before it starts, and the field is named. "The whole run":
+ * every sample a message of it carries, t_0 .. t_{K+N} (the intent of cycle K reaches N
+ * samples beyond the last flown one), as the nodes compute them. */
+
+#define SIM_INTENT "an intent"
+#define SIM_TRACK "a track message"
+#define SIM_MAP "an obstacle map"
+
+static bool beyond(double x, double limit)
+{
+    return !isfinite(x) || fabs(x) > limit;
+}
+
+/* The first coordinate of p that is beyond COA_LCM_MAX_COORDINATE, as 'x', 'y' or 'z'
+ * with *value set; or 0. */
+static char far_axis(coa_vec3_t p, double *value)
+{
+    const double c[3] = {(double)p.x, (double)p.y, (double)p.z};
+    for (int a = 0; a < 3; a++) {
+        if (beyond(c[a], COA_LCM_MAX_COORDINATE)) {
+            *value = c[a];
+            return (char)('x' + a);
+        }
+    }
+    return 0;
+}
+
+/* A vehicle's intents over samples 0..last: its volume, speeds and priority, and every
+ * reference point and the positions and velocities its offsets can give there. An offset
+ * at sample j is at most initial_offset + steep_factor * j climb steps from the reference
+ * (and within max_offset), whatever is planned. */
+static int check_vehicle_limits(const char *file, size_t i, const coa_vehicle_t *v,
+                                coa_real_t dt, uint64_t last)
+{
+    if (beyond((double)v->volume.radius, COA_LCM_MAX_SIZE)) {
+        return cli_fail(CLI_EXIT_INVALID,
+                        "%s: vehicles[%zu].radius: %g m is beyond what " SIM_INTENT
+                        " carries (%g m)",
+                        file, i, (double)v->volume.radius, COA_LCM_MAX_SIZE);
+    }
+    if (beyond((double)v->volume.half_height, COA_LCM_MAX_SIZE)) {
+        return cli_fail(CLI_EXIT_INVALID,
+                        "%s: vehicles[%zu].half_height: %g m is beyond what " SIM_INTENT
+                        " carries (%g m)",
+                        file, i, (double)v->volume.half_height, COA_LCM_MAX_SIZE);
+    }
+    if (beyond((double)v->cruise_speed, COA_LCM_MAX_SPEED)) {
+        return cli_fail(CLI_EXIT_INVALID,
+                        "%s: vehicles[%zu].cruise_speed: %g m/s is beyond what " SIM_INTENT
+                        " carries (%g m/s)",
+                        file, i, (double)v->cruise_speed, COA_LCM_MAX_SPEED);
+    }
+    /* The largest change of offset in one step, and the vertical speed it adds. */
+    uint32_t max_change = v->steep_factor;
+    if (v->max_offset >= 0 && (uint64_t)2u * (uint32_t)v->max_offset < max_change) {
+        max_change = 2u * (uint32_t)v->max_offset;
+    }
+    const double climb = (double)max_change * (double)v->climb_rate;
+    if (beyond(climb, COA_LCM_MAX_SPEED)) {
+        return cli_fail(CLI_EXIT_INVALID,
+                        "%s: vehicles[%zu].climb_rate: %g m/s, %g m/s in a steep climb, is "
+                        "beyond what " SIM_INTENT " carries (%g m/s)",
+                        file, i, (double)v->climb_rate, climb, COA_LCM_MAX_SPEED);
+    }
+    if (v->priority > (uint32_t)INT32_MAX) {
+        return cli_fail(CLI_EXIT_INVALID,
+                        "%s: vehicles[%zu].priority: %lu is beyond what " SIM_INTENT
+                        " carries (%ld)",
+                        file, i, (unsigned long)v->priority, (long)INT32_MAX);
+    }
+    const double dh = (double)coa_climb_step(v, dt);
+    const int64_t bound = v->max_offset >= 0 ? v->max_offset : COA_MAX_OFFSET;
+    const int64_t initial = v->initial_offset < 0 ? -(int64_t)v->initial_offset
+                                                  : (int64_t)v->initial_offset;
+    coa_vec3_t previous = coa_reference_at(v, (coa_real_t)0);
+    for (uint64_t j = 0; j <= last; j++) {
+        const coa_real_t t = (coa_real_t)j * dt;
+        const coa_vec3_t r = j == 0u ? previous : coa_reference_at(v, t);
+        double value = 0.0;
+        char axis = far_axis(r, &value);
+        if (axis != 0) {
+            return cli_fail(CLI_EXIT_INVALID,
+                            "%s: vehicles[%zu].route: its reference reaches %c = %.10g m at t "
+                            "= %g s, beyond what " SIM_INTENT " carries (%g m; this run's "
+                            "intents reach t = %g s)",
+                            file, i, axis, value, (double)t, COA_LCM_MAX_COORDINATE,
+                            (double)last * (double)dt);
+        }
+        const int64_t reach_steps = initial + (int64_t)v->steep_factor * (int64_t)j;
+        const int64_t reach = reach_steps < bound ? reach_steps : bound;
+        const double top = fabs((double)r.z) + (double)reach * dh;
+        if (beyond(top, COA_LCM_MAX_COORDINATE)) {
+            return cli_fail(CLI_EXIT_INVALID,
+                            "%s: vehicles[%zu]: at t = %g s its reference is at z = %.10g m, "
+                            "and the %lld climb steps of %g m it may have taken by then take "
+                            "|z| to %.10g m: beyond what " SIM_INTENT " carries (%g m)",
+                            file, i, (double)t, (double)r.z, (long long)reach, dh, top,
+                            COA_LCM_MAX_COORDINATE);
+        }
+        if (j == 0u) {
+            continue;
+        }
+        /* The intent's velocity is the step from one sample to the next. */
+        const double vx = (double)((r.x - previous.x) / dt);
+        const double vy = (double)((r.y - previous.y) / dt);
+        const double vz = fabs((double)((r.z - previous.z) / dt)) + climb;
+        if (beyond(vx, COA_LCM_MAX_SPEED) || beyond(vy, COA_LCM_MAX_SPEED) ||
+            beyond(vz, COA_LCM_MAX_SPEED)) {
+            return cli_fail(CLI_EXIT_INVALID,
+                            "%s: vehicles[%zu].route: its reference moves at (%g, %g) m/s "
+                            "horizontally and %g m/s vertically with its steepest climb at t = "
+                            "%g s, beyond what " SIM_INTENT " carries (%g m/s each)",
+                            file, i, vx, vy, vz, (double)t, COA_LCM_MAX_SPEED);
+        }
+        /* Consecutive reference points must differ horizontally in the core's precision,
+         * as the intent's check judges them (a route far out flown very slowly does not). */
+        const coa_vec3_t leg[2] = {previous, r};
+        coa_vehicle_t probe = *v;
+        probe.route = leg;
+        probe.route_count = 2u;
+        probe.initial_offset = 0;
+        if (coa_vehicle_check(&probe) != COA_OK) {
+            return cli_fail(CLI_EXIT_INVALID,
+                            "%s: vehicles[%zu].cruise_speed: %g m/s moves it too little in a "
+                            "step to tell its position at t = %g s from the one before "
+                            "(%.10g, %.10g m), as " SIM_INTENT " must",
+                            file, i, (double)v->cruise_speed, (double)t, (double)r.x,
+                            (double)r.y);
+        }
+        previous = r;
+    }
+    return CLI_CONTINUE;
+}
+
+/* A track's messages over cycles 0..steps (world.c): its volume and sigmas, and at each
+ * cycle its velocity (a path track's: that of the leg in use) and position; a path track's
+ * message also carries its path over the next horizon, so its points and positions up to
+ * sample `last` too. */
+static int check_track_limits(const char *file, size_t i, const coa_track_t *tr, coa_real_t dt,
+                              uint64_t steps, uint64_t last)
+{
+    const struct {
+        const char *name;
+        coa_real_t value;
+    } sizes[4] = {{"radius", tr->volume.radius},
+                  {"half_height", tr->volume.half_height},
+                  {"sigma[0]", tr->sigma_horizontal},
+                  {"sigma[1]", tr->sigma_vertical}};
+    for (size_t f = 0; f < 4u; f++) {
+        if (beyond((double)sizes[f].value, COA_LCM_MAX_SIZE)) {
+            return cli_fail(CLI_EXIT_INVALID,
+                            "%s: tracks[%zu].%s: %g m is beyond what " SIM_TRACK
+                            " carries (%g m)",
+                            file, i, sizes[f].name, (double)sizes[f].value, COA_LCM_MAX_SIZE);
+        }
+    }
+    if (tr->path_count == 0u) {
+        double value = 0.0;
+        const coa_vec3_t v = tr->velocity;
+        if (beyond((double)v.x, COA_LCM_MAX_SPEED) || beyond((double)v.y, COA_LCM_MAX_SPEED) ||
+            beyond((double)v.z, COA_LCM_MAX_SPEED)) {
+            value = beyond((double)v.x, COA_LCM_MAX_SPEED)   ? (double)v.x
+                    : beyond((double)v.y, COA_LCM_MAX_SPEED) ? (double)v.y
+                                                              : (double)v.z;
+            return cli_fail(CLI_EXIT_INVALID,
+                            "%s: tracks[%zu].velocity: %g m/s is beyond what " SIM_TRACK
+                            " carries (%g m/s)",
+                            file, i, value, COA_LCM_MAX_SPEED);
+        }
+    } else if (tr->path_count > 1u) {
+        /* The leg in use at t_k, as coa_track_at and the world choose it: the first one
+         * before path[1], the last one from path[last - 1] on. */
+        const size_t final = tr->path_count - 1u;
+        size_t leg = 0;
+        for (uint64_t k = 0; k <= steps; k++) {
+            const coa_real_t t = (coa_real_t)k * dt;
+            while (leg + 1u < final && !(t < tr->path[leg + 1u].t)) {
+                leg++;
+            }
+            const coa_track_point_t *a = &tr->path[leg];
+            const coa_track_point_t *b = &tr->path[leg + 1u];
+            const coa_real_t span = b->t - a->t;
+            const double v[3] = {(double)((b->p.x - a->p.x) / span),
+                                 (double)((b->p.y - a->p.y) / span),
+                                 (double)((b->p.z - a->p.z) / span)};
+            for (int c = 0; c < 3; c++) {
+                if (beyond(v[c], COA_LCM_MAX_SPEED)) {
+                    return cli_fail(CLI_EXIT_INVALID,
+                                    "%s: tracks[%zu].path[%zu]: the leg to it is flown at %g m/s, "
+                                    "beyond what " SIM_TRACK " carries (%g m/s)",
+                                    file, i, leg + 1u, v[c], COA_LCM_MAX_SPEED);
+                }
+            }
+        }
+    }
+    const uint64_t sampled = tr->path_count > 0u ? last : steps;
+    const coa_real_t end = (coa_real_t)sampled * dt;
+    for (size_t j = 0; j < tr->path_count; j++) {
+        double value = 0.0;
+        char axis = far_axis(tr->path[j].p, &value);
+        if (axis != 0 && tr->path[j].t > (coa_real_t)0 && tr->path[j].t < end) {
+            return cli_fail(CLI_EXIT_INVALID,
+                            "%s: tracks[%zu].path[%zu]: %c = %.10g m is beyond what " SIM_TRACK
+                            " carries (%g m)",
+                            file, i, j, axis, value, COA_LCM_MAX_COORDINATE);
+        }
+    }
+    for (uint64_t j = 0; j <= sampled; j++) {
+        const coa_real_t t = (coa_real_t)j * dt;
+        double value = 0.0;
+        char axis = far_axis(coa_track_at(tr, t), &value);
+        if (axis != 0) {
+            return cli_fail(CLI_EXIT_INVALID,
+                            "%s: tracks[%zu]: at t = %g s it is at %c = %.10g m, beyond what "
+                            SIM_TRACK " carries (%g m; this run's track messages reach t = %g "
+                            "s)",
+                            file, i, (double)t, axis, value, COA_LCM_MAX_COORDINATE,
+                            (double)end);
+        }
+    }
+    return CLI_CONTINUE;
+}
+
+static int check_obstacle_limits(const char *file, size_t i, const coa_obstacle_t *o)
+{
+    double value = 0.0;
+    char axis = 0;
+    if (o->kind == COA_OBSTACLE_BOX) {
+        const char *corner = "min";
+        axis = far_axis(o->box.min, &value);
+        if (axis == 0) {
+            corner = "max";
+            axis = far_axis(o->box.max, &value);
+        }
+        if (axis != 0) {
+            return cli_fail(CLI_EXIT_INVALID,
+                            "%s: obstacles[%zu].%s: %c = %.10g m is beyond what " SIM_MAP
+                            " carries (%g m)",
+                            file, i, corner, axis, value, COA_LCM_MAX_COORDINATE);
+        }
+        return CLI_CONTINUE;
+    }
+    for (size_t j = 0; j < o->polytope.count; j++) {
+        axis = far_axis(o->polytope.vertices[j], &value);
+        if (axis != 0) {
+            return cli_fail(CLI_EXIT_INVALID,
+                            "%s: obstacles[%zu].vertices[%zu]: %c = %.10g m is beyond what "
+                            SIM_MAP
+                            " carries (%g m)",
+                            file, i, j, axis, value, COA_LCM_MAX_COORDINATE);
+        }
+    }
+    return CLI_CONTINUE;
+}
+
+/* Every check above, over a run of `steps` cycles. Cost O((steps + N) * (vehicles * route +
+ * tracks * path) + obstacle vertices), no memory. */
+static int check_message_limits(const char *file, const scenario_t *s, uint32_t steps)
+{
+    const uint64_t last = (uint64_t)steps + s->horizon;
+    int rc = CLI_CONTINUE;
+    for (size_t i = 0; i < s->vehicle_count && rc == CLI_CONTINUE; i++) {
+        rc = check_vehicle_limits(file, i, &s->vehicles[i], s->dt, last);
+    }
+    for (size_t i = 0; i < s->track_count && rc == CLI_CONTINUE; i++) {
+        rc = check_track_limits(file, i, &s->tracks[i], s->dt, steps, last);
+    }
+    for (size_t i = 0; i < s->obstacle_count && rc == CLI_CONTINUE; i++) {
+        rc = check_obstacle_limits(file, i, &s->obstacles[i]);
+    }
+    return rc;
+}
+
 /* Handles every queued message. false when LCM failed. */
 static bool drain(lcm_t *lcm)
 {
@@ -212,6 +494,10 @@ static int sim(void *options, scenario_t *s)
         return cli_fail(CLI_EXIT_INVALID,
                         "%s: dt: %g s cannot be a cycle (whole microseconds, at most %g s)", file,
                         (double)s->dt, COA_LCM_MAX_STEP);
+    }
+    rc = check_message_limits(file, s, steps);
+    if (rc != CLI_CONTINUE) {
+        return rc;
     }
 
     /* Planner sizes: each UAV plans alone; the coordinator searches up to max_centralised

@@ -6,8 +6,8 @@
 # conflict; the flown costs are at least the one-shot plan's; a run is repeatable byte for
 # byte; the UAVs fall back to planning for themselves when the coordinator stops, and stay
 # separated; a scenario already in conflict reports its loss (exit 1) instead of crashing;
-# UAVs decide in priority order whatever their ids; bad arguments and inputs exit 2 with
-# one line.
+# UAVs decide in priority order whatever their ids; bad arguments and inputs, and numbers
+# beyond what a message carries anywhere in the run, exit 2 with one line.
 #
 # usage: bash sim.sh <path-to-coavoid> <source-dir>   (VERBOSE=1 prints each result)
 set -u
@@ -344,5 +344,66 @@ s["vehicles"] = [dict(base, id=i + 1, route=[[0, 100 * i, 100], [600, 100 * i, 1
 json.dump(s, open(sys.argv[2], "w"))
 PY
 expect_bad "33 vehicles" "vehicles" sim "$tmp/crowd.json" --mode decoupled
+
+# Scenarios that `coavoid plan` takes but whose numbers a message cannot carry
+# (COA_LCM_MAX_* in coavoid_lcm.h), at the start or somewhere in the run: refused before
+# the run, naming the field, instead of a node failing in it (exit 3).
+python3 - "$h" "$scenarios/track_crossing.json" "$tmp" <<'PY'
+import copy, json, sys
+h, tc = (json.load(open(f)) for f in sys.argv[1:3])
+def write(name, base, part, index, **fields):
+    s = copy.deepcopy(base)
+    item = s[part][index]
+    for k, v in fields.items():
+        if v is None:
+            del item[k]
+        else:
+            item[k] = v
+    json.dump(s, open(f"{sys.argv[3]}/limit_{name}.json", "w"))
+# (1e30, not the 1e300 that double takes: a COAVOID_SINGLE_PRECISION build's loader refuses
+# what float cannot hold before sim sees it.)
+write("radius", h, "vehicles", 1, radius=1e30)
+write("half_height", h, "vehicles", 1, half_height=2e5)
+write("cruise", h, "vehicles", 1, cruise_speed=2e4)
+write("steep", h, "vehicles", 1, climb_rate=3000.0, steep_factor=4)
+write("priority", h, "vehicles", 1, priority=3000000000)
+write("far", h, "vehicles", 1, route=[[1e15, 0, 0], [1e15 + 1e9, 0, 0]])
+# 9.9e6 m at t = 0, 1e7 m at t = 50 s: within the run's 48 steps and last horizon of 24.
+write("runaway", h, "vehicles", 1, route=[[9.9e6, 0, 100], [9.9e6 + 1000, 0, 100]],
+      cruise_speed=2000.0)
+write("slope", h, "vehicles", 1, route=[[0, 500, 0], [1, 500, 1e5]], cruise_speed=1.0)
+write("track_velocity", tc, "tracks", 0, velocity=[1e30, 0, 0])
+write("track_sigma", tc, "tracks", 0, sigma=[1.0, 2e5])
+write("track_runaway", tc, "tracks", 0, position=[9.99e6, 0, 100], velocity=[1000, 0, 0])
+write("track_leg", tc, "tracks", 0, position=None, velocity=None,
+      path=[[0, 0, 0, 100], [1, 5e4, 0, 100], [2, 5e4, 1, 100]])
+s = copy.deepcopy(h)
+s["obstacles"] = [{"type": "box", "min": [0, 1000, 0], "max": [10, 2e7, 10]}]
+json.dump(s, open(f"{sys.argv[3]}/limit_box.json", "w"))
+PY
+for name in radius far runaway track_velocity track_runaway box; do
+    "$bin" plan "$tmp/limit_$name.json" --mode decoupled >/dev/null 2>&1
+    rc=$?
+    if [ "$rc" -le 1 ]; then pass; else fail "limit_$name: coavoid plan refuses it too (exit $rc), so it tests nothing of sim's own"; fi
+done
+also="beyond what"
+expect_bad "radius 1e30" "vehicles[1].radius: 1e+30 m" sim "$tmp/limit_radius.json" --mode decoupled
+expect_bad "half-height 2e5" "vehicles[1].half_height" sim "$tmp/limit_half_height.json" --mode centralised
+expect_bad "cruise speed 2e4" "vehicles[1].cruise_speed" sim "$tmp/limit_cruise.json" --mode decoupled
+expect_bad "steep climb of 12000 m/s" "vehicles[1].climb_rate" sim "$tmp/limit_steep.json" --mode decoupled
+expect_bad "priority 3e9" "vehicles[1].priority" sim "$tmp/limit_priority.json" --mode decoupled
+expect_bad "route at 1e15 m" "vehicles[1].route" sim "$tmp/limit_far.json" --mode decoupled
+expect_bad "route leaving the range in the run" "t = 51 s" sim "$tmp/limit_runaway.json" --mode decoupled
+expect_bad "route climbing at 1e5 m/s" "vehicles[1].route" sim "$tmp/limit_slope.json" --mode decoupled
+expect_bad "track velocity 1e30" "tracks[0].velocity" sim "$tmp/limit_track_velocity.json" --mode decoupled
+expect_bad "track sigma 2e5" "tracks[0].sigma[1]" sim "$tmp/limit_track_sigma.json" --mode decoupled
+expect_bad "track leaving the range in the run" "tracks[0]: at t = 11 s" sim "$tmp/limit_track_runaway.json" --mode centralised
+expect_bad "track path leg at 5e4 m/s" "tracks[0].path[1]" sim "$tmp/limit_track_leg.json" --mode decoupled
+expect_bad "box at 2e7 m" "obstacles[0].max" sim "$tmp/limit_box.json" --mode decoupled
+also=
+# A shorter run that stays in range is flown: the check is over this run, not any run.
+sim_json runaway-short "$tmp/limit_runaway.json" decoupled 0 '
+r["steps"] == 20
+' --steps 20
 
 finish
