@@ -12,7 +12,8 @@
  *   - the UAV falls back to planning for itself when the heartbeat stops and returns
  *     when it comes back; it follows only the coordinator it is configured with, not
  *     one that reports a fault, and not one whose plans do not come while it has a
- *     conflict; the coordinator plans no UAV that plans for itself;
+ *     conflict (a plan that says its search failed is an answer); the coordinator plans
+ *     no UAV that plans for itself;
  *   - a lower priority waits for the higher, up to its deadline; every member of a
  *     cluster in conflict plans, the highest priority too;
  *   - a silent UAV is avoided as a track;
@@ -745,6 +746,54 @@ START_TEST(test_late_plans_fall_back)
 }
 END_TEST
 
+/* A plan that lists the UAV in time but was not solved is the coordinator's answer: its
+ * search found nothing for the cluster this cycle. The UAV keeps following it (planning
+ * for itself would take it out of the coordinator's next, larger searches). */
+START_TEST(test_failed_plan_is_an_answer)
+{
+    rig_t r;
+    rig_init(&r, 24);
+    coa_vec3_t r1[2], r2[2];
+    coa_vehicle_node_t *v[2];
+    v[0] = vehicle_node(&r, uav(1, 1, r1, 0, 600, 0, 100), COA_NODE_CENTRALISED);
+    v[1] = vehicle_node(&r, uav(2, 2, r2, 300, -300, 0, 100), COA_NODE_CENTRALISED);
+    for (int64_t k = 0; k < 6; k++) {
+        r.now = cycle(k);
+        for (int i = 0; i < 2; i++) {
+            ck_assert_int_eq(coa_vehicle_node_cycle(v[i], r.now), COA_OK);
+            drain(r.lcm);
+            ck_assert_msg(coa_vehicle_node_state(v[i])->coordinated, "cycle %d", (int)k);
+        }
+        r.now = cycle(k) + DT_US / 4;
+        heartbeat(r.lcm, r.now, k);
+        coavoid_plan_t m;
+        memset(&m, 0, sizeof m);
+        m.utime = r.now;
+        m.coordinator_id = COA_NODE_COORDINATOR_ID;
+        m.plan_id = k;
+        m.valid_from_utime = cycle(k);
+        m.valid_until_utime = cycle(k + 1);
+        m.dt = 1.0;
+        m.horizon = 24;
+        m.mode = COAVOID_PLAN_T_MODE_CENTRALISED;
+        m.status = COAVOID_PLAN_T_STATUS_INFEASIBLE;
+        m.vehicle_count = 2;
+        m.planned_count = 0;
+        m.uav_ids[0] = 1;
+        m.uav_ids[1] = 2;
+        ck_assert_int_eq(coavoid_plan_t_publish(r.lcm, COA_CHANNEL_PLAN, &m), 0);
+        drain(r.lcm);
+    }
+    for (int i = 0; i < 2; i++) {
+        const coa_vehicle_node_state_t *s = coa_vehicle_node_state(v[i]);
+        ck_assert_uint_eq(s->fallbacks, 0);
+        ck_assert_int_eq(s->rx.rejected, 0);
+        coa_vehicle_node_destroy(v[i]);
+    }
+    lcm_destroy(r.lcm);
+}
+END_TEST
+
 /* The UAV rows of the plans a coordinator publishes. */
 typedef struct {
     int plans;
@@ -1192,6 +1241,7 @@ static Suite *node_suite(void)
     tcase_add_test(tc, test_configured_coordinator_only);
     tcase_add_test(tc, test_faulty_coordinator_not_followed);
     tcase_add_test(tc, test_late_plans_fall_back);
+    tcase_add_test(tc, test_failed_plan_is_an_answer);
     tcase_add_test(tc, test_coordinator_skips_decoupled_uav);
     tcase_add_test(tc, test_lower_priority_waits);
     tcase_add_test(tc, test_waits_for_near_higher_priority);

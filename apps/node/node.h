@@ -26,13 +26,15 @@
  *        and plans from any other id are refused (COA_LCM_ERR_ID), and a heartbeat with
  *        HEALTH_FAULT does not count. A heartbeat alone does not keep a UAV safe (plans
  *        that come late, an impostor): so at the start of cycle k + 1, a UAV that
- *        followed the coordinator in cycle k and adopted none of its plans there runs
- *        its own prediction (as decoupled, without waiting: its intent of k + 1 and its
- *        peers' latest), and when it has a conflict of its own that begins within cycle
- *        k's horizon (first step < N - 1 on the new clock; one that only now enters the
- *        horizon is the coordinator's to plan in k + 1), it plans for itself as in
- *        decoupled mode from cycle k + 1 on (counted in fallbacks), until a cycle in
- *        which it adopts a coordinator's plan or has no conflict of its own;
+ *        followed the coordinator in cycle k and got no answer from it there (it adopted
+ *        none of its plans, and no plan for it came in time saying the search failed:
+ *        the coordinator tried, and planning alone would not do better) runs its own
+ *        prediction (as decoupled, without waiting: its intent of k + 1 and its peers'
+ *        latest). When it has a conflict of its own that begins within cycle k's horizon
+ *        (first step < N - 1 on the new clock; one that only now enters the horizon is
+ *        the coordinator's to plan in k + 1), it plans for itself as in decoupled mode
+ *        from cycle k + 1 on (counted in fallbacks), until a cycle in which it adopts a
+ *        coordinator's plan or has no conflict of its own;
  *      - decoupled: first it waits (until priority_wait_us has passed) for this cycle's
  *        intents of the higher-priority UAVs whose paths pass near its own horizontally
  *        within the horizon (the predictor's test with unbounded heights): only their

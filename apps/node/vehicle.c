@@ -30,6 +30,7 @@ struct coa_vehicle_node {
      * the last one. Plans are ordered within a cycle only (node.h, step 4). */
     bool cycle_plan_adopted;
     int64_t cycle_plan_id;
+    bool cycle_plan_failed;          /* one listed it, in time, but was not solved */
 
     /* The adopted plan: offsets of samples plan_start .. plan_start + plan_count - 1; past
      * its end the last offset holds. */
@@ -492,6 +493,13 @@ static void on_plan(void *owner, const coavoid_plan_t *msg, const coa_lcm_plan_i
             row = i;
         }
     }
+    if (row != SIZE_MAX && result->status != COA_PLAN_SOLVED && node->started &&
+        msg->valid_from_utime == node->cycle_start && now < msg->valid_until_utime) {
+        /* The coordinator tried this cycle and found nothing: it answered. Planning for
+         * itself would not do better than the coordinator's search over the same UAVs,
+         * and would take it out of the coordinator's next, larger ones. */
+        node->cycle_plan_failed = true;
+    }
     if (row == SIZE_MAX || result->status != COA_PLAN_SOLVED || row >= result->planned_count) {
         coa_lcm_rx_count(&node->state.rx, COA_OK, NULL); /* not a plan for it */
         return;
@@ -637,7 +645,9 @@ int coa_vehicle_node_cycle(coa_vehicle_node_t *node, int64_t now)
     }
     node->fault = false;
     const bool previous_adopted = node->cycle_plan_adopted;
+    const bool previous_answered = previous_adopted || node->cycle_plan_failed;
     node->cycle_plan_adopted = false;
+    node->cycle_plan_failed = false;
     node->state.cycle = k;
     node->cycle_start = coa_node_cycle_utime(c, k);
     coa_node_inbox_expire(&node->inbox, now);
@@ -648,21 +658,22 @@ int coa_vehicle_node_cycle(coa_vehicle_node_t *node, int64_t now)
     node->state.position = node->own_samples[0];
 
     /* A coordinator answers, within its cycle, for the conflicts of the UAVs that follow
-     * it. One that followed it, had a conflict of its own and adopted none of its plans
-     * in that cycle (plans late, an impostor's or a dead coordinator's heartbeat, a plan
-     * that failed) plans for itself instead, until a cycle in which it adopts one of the
-     * coordinator's plans or has no conflict of its own: a heartbeat alone keeps no UAV
-     * safe. Decoupled cycles tell their conflicts in decide(). */
+     * it. One that followed it, had a conflict of its own and got no answer in that cycle
+     * (no plan for it adopted, nor one that says the coordinator's search failed: plans
+     * late, an impostor's or a dead coordinator's heartbeat, a plan it refused) plans
+     * for itself instead, until a cycle in which it adopts one of the coordinator's plans
+     * or has no conflict of its own: a heartbeat alone keeps no UAV safe. Decoupled
+     * cycles tell their conflicts in decide(). */
     int predicted = COA_OK;
     bool conflict = node->cycle_conflict;
-    if (node->was_coordinated && !previous_adopted) {
+    if (node->was_coordinated && !previous_answered) {
         predicted = missed_conflict(node, now, &conflict);
         if (predicted != COA_OK) {
             node->fault = true;
             conflict = false; /* cannot tell: the error is reported */
         }
     }
-    if (node->was_coordinated && conflict && !previous_adopted) {
+    if (node->was_coordinated && conflict && !previous_answered) {
         node->distrust = true;
     } else if (node->distrust && (previous_adopted || !conflict)) {
         node->distrust = false;
