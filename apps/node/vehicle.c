@@ -193,6 +193,31 @@ static int finish(coa_vehicle_node_t *node, int64_t now)
     return status_rc != COA_OK ? status_rc : 1;
 }
 
+/* The one-UAV problem of this cycle: itself from the offset it flies now along its
+ * reference window, the known obstacles and node->problem_tracks (filled by the caller).
+ * vehicle and references are the caller's storage the problem points to. */
+static coa_problem_t own_problem(const coa_vehicle_node_t *node, coa_vehicle_t *vehicle,
+                                 const coa_vec3_t **references)
+{
+    const coa_node_common_t *c = &node->config.common;
+    *vehicle = node->config.vehicle;
+    vehicle->initial_offset = node->state.offset;
+    references[0] = node->own_reference;
+    coa_problem_t problem;
+    memset(&problem, 0, sizeof problem);
+    problem.dt = c->dt;
+    problem.horizon = c->horizon;
+    problem.vehicles = vehicle;
+    problem.vehicle_count = 1;
+    problem.references = references;
+    problem.obstacles = node->inbox.obstacles;
+    problem.obstacle_count = node->inbox.obstacle_count;
+    problem.tracks = node->problem_tracks.tracks;
+    problem.track_count = node->problem_tracks.count;
+    problem.track_samples = node->problem_tracks.samples;
+    return problem;
+}
+
 /* One one-UAV A* search for itself around the view's tracks and the live UAVs marked in
  * node->include. Returns COA_OK with *result, or a negative error. */
 static int search_self(coa_vehicle_node_t *node, int64_t now, coa_plan_result_t *result)
@@ -202,21 +227,9 @@ static int search_self(coa_vehicle_node_t *node, int64_t now, coa_plan_result_t 
     if (rc != COA_OK) {
         return rc;
     }
-    coa_vehicle_t vehicle = node->config.vehicle;
-    vehicle.initial_offset = node->state.offset;
-    const coa_vec3_t *references[1] = {node->own_reference};
-    coa_problem_t problem;
-    memset(&problem, 0, sizeof problem);
-    problem.dt = c->dt;
-    problem.horizon = c->horizon;
-    problem.vehicles = &vehicle;
-    problem.vehicle_count = 1;
-    problem.references = references;
-    problem.obstacles = node->inbox.obstacles;
-    problem.obstacle_count = node->inbox.obstacle_count;
-    problem.tracks = node->problem_tracks.tracks;
-    problem.track_count = node->problem_tracks.count;
-    problem.track_samples = node->problem_tracks.samples;
+    coa_vehicle_t vehicle;
+    const coa_vec3_t *references[1];
+    coa_problem_t problem = own_problem(node, &vehicle, references);
 
     int64_t start = coa_node_stopwatch(c);
     rc = coa_plan_centralised(node->solver.planner, &problem, node->plan_out, result);
@@ -461,21 +474,9 @@ static int plan_hits_known(coa_vehicle_node_t *node, const int32_t *offsets, siz
     if (rc != COA_OK) {
         return rc;
     }
-    coa_vehicle_t vehicle = node->config.vehicle;
-    vehicle.initial_offset = node->state.offset;
-    const coa_vec3_t *references[1] = {node->own_reference};
-    coa_problem_t problem;
-    memset(&problem, 0, sizeof problem);
-    problem.dt = c->dt;
-    problem.horizon = c->horizon;
-    problem.vehicles = &vehicle;
-    problem.vehicle_count = 1;
-    problem.references = references;
-    problem.obstacles = node->inbox.obstacles;
-    problem.obstacle_count = node->inbox.obstacle_count;
-    problem.tracks = node->problem_tracks.tracks;
-    problem.track_count = node->problem_tracks.count;
-    problem.track_samples = node->problem_tracks.samples;
+    coa_vehicle_t vehicle;
+    const coa_vec3_t *references[1];
+    coa_problem_t problem = own_problem(node, &vehicle, references);
     const size_t which[1] = {0};
     return coa_plan_find_conflict(&problem, node->checked, which, 1, NULL, NULL);
 }
