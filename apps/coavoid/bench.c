@@ -603,7 +603,7 @@ int command_bench(int argc, char **argv)
 {
     if (argc < 3) {
         return cli_fail(CLI_EXIT_INVALID,
-                        "bench: missing benchmark (predict; see 'coavoid bench --help')");
+                        "bench: missing benchmark (predict or plan; see 'coavoid bench --help')");
     }
     const char *name = argv[2];
     if (strcmp(name, "-h") == 0 || strcmp(name, "--help") == 0) {
@@ -613,8 +613,11 @@ int command_bench(int argc, char **argv)
     if (strcmp(name, "predict") == 0) {
         return bench_predict(argc, argv);
     }
+    if (strcmp(name, "plan") == 0) {
+        return bench_plan(argc, argv);
+    }
     return cli_fail(CLI_EXIT_INVALID,
-                    "bench: unknown benchmark '%.40s' (expected predict; see 'coavoid bench "
+                    "bench: unknown benchmark '%.40s' (expected predict or plan; see 'coavoid bench "
                     "--help')",
                     name);
 }

@@ -6,6 +6,7 @@
  *   coavoid plan SCENARIO.json --mode centralised|decoupled [...]   plan_cmd.c
  *   coavoid predict SCENARIO.json [--threshold P] [...]             predict_cmd.c
  *   coavoid bench predict --vehicles N --horizon H [...]            bench.c
+ *   coavoid bench plan [--vehicles N] [--count C] [...]              bench_plan.c
  *   coavoid world SCENARIO.json [--lcm-url URL] [--epoch UTIME] [...] world_cmd.c
  *   coavoid sim SCENARIO.json --mode centralised|decoupled [...]    sim_cmd.c
  *   coavoid summary LOGFILE SCENARIO.json --mode MODE [...]         summary_cmd.c (LCM)
@@ -35,7 +36,7 @@
     "commands:\n"                                                               \
     "  plan     plan collision-free altitude manoeuvres for a scenario\n"       \
     "  predict  predict the conflicts of a scenario's reference trajectories\n" \
-    "  bench    time a core function on a random airspace (bench predict)\n"    \
+    "  bench    time the core: bench predict, bench plan\n"    \
     "  sim      fly a scenario in closed loop over the nodes (deterministic)\n"  \
     USAGE_SUMMARY                                                               \
     "\n"                                                                        \
