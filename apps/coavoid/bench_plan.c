@@ -48,6 +48,7 @@
 #define BP_MAX_COUNT 10000u
 #define BP_MIN_VEHICLES 2u
 #define BP_MAX_VEHICLES 5u
+_Static_assert(BP_MIN_VEHICLES == 2u && BP_MAX_VEHICLES == 5u, "--vehicles' hint says 2 to 5");
 #define BP_DEFAULT_SCENARIO "scenarios/paper.json"
 #define BP_HORIZON 20u
 #define BP_DT 1.0
@@ -117,13 +118,17 @@ static int bp_option(int argc, char **argv, int *i, void *options)
     uint64_t value = 0;
     int status = CLI_UNKNOWN_OPTION;
     if (cli_option_is(arg, "--vehicles")) {
-        status = cli_count_option(argc, argv, i, "--vehicles", NULL, false, BP_MAX_VEHICLES,
-                                  &o->vehicles_text, &value);
-        o->vehicles = (uint32_t)value;
-        if (status == CLI_CONTINUE && value < BP_MIN_VEHICLES) {
+        /* 2..5, which cli_count_option (1..max) cannot say. */
+        status = cli_text_option(argc, argv, i, "--vehicles", "an integer from 2 to 5", true,
+                                 &o->vehicles_text);
+        if (status == CLI_CONTINUE &&
+            (!cli_parse_count(o->vehicles_text, strlen(o->vehicles_text), BP_MAX_VEHICLES,
+                              &value) ||
+             value < BP_MIN_VEHICLES)) {
             status = cli_fail(CLI_EXIT_INVALID, "--vehicles: must be an integer from %u to %u, "
                               "got '%.40s'", BP_MIN_VEHICLES, BP_MAX_VEHICLES, o->vehicles_text);
         }
+        o->vehicles = (uint32_t)value;
     } else if (cli_option_is(arg, "--count")) {
         status = cli_count_option(argc, argv, i, "--count", NULL, false, BP_MAX_COUNT,
                                   &o->count_text, &value);

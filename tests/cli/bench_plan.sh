@@ -1,0 +1,147 @@
+#!/bin/bash
+# `coavoid bench plan` runs on tiny sets and prints every field, in the table and in JSON;
+# the same seed gives the same work; a beta too small to solve anything is reported as
+# budget exhausted, not hidden; bad options exit 2 with one line naming the option. Never
+# its times: a benchmark is not a timed test.
+#
+# usage: bash bench_plan.sh <path-to-coavoid> <source-dir>   (VERBOSE=1 shows each message)
+set -u
+# shellcheck source=tests/cli/lib.bash
+. "$(dirname "${BASH_SOURCE[0]}")/lib.bash" "$@"
+
+# run NAME ARGS...: `coavoid bench plan ARGS` exits 0 with nothing on stderr; the output
+# is left in $tmp/out.
+run() {
+    local name=$1
+    shift
+    "$bin" bench plan "$@" >"$tmp/out" 2>"$tmp/err"
+    local rc=$?
+    if [ "$rc" -ne 0 ] || [ -s "$tmp/err" ]; then
+        fail "$name: exit $rc, expected 0: $(head -c 300 "$tmp/err")"
+        return 1
+    fi
+    return 0
+}
+
+# check NAME ASSERTIONS: the JSON in $tmp/out is well formed (every field of every row,
+# counts adding up, min <= median <= max); ASSERTIONS see it as b and its rows as rows.
+check() {
+    local name=$1 asserts=$2
+    if python3 - "$tmp/out" "$asserts" >"$tmp/py" 2>&1 <<'PY'; then pass; else fail "$name: $(tail -n 5 "$tmp/py")"; fi
+import json, sys
+b = json.load(open(sys.argv[1]))
+assert list(b) == ["benchmark", "seed", "repeat", "count", "results"], list(b)
+assert b["benchmark"] == "plan"
+rows = b["results"]
+keys = ["set", "mode", "vehicles", "problems", "beta", "beta_lowered", "median_ms", "min_ms",
+        "max_ms", "nodes_expanded", "nodes_generated", "nodes_per_s", "workspace_bytes",
+        "solved", "infeasible", "budget_exhausted"]
+for r in rows:
+    assert list(r) == keys, f"keys {list(r)}"
+    assert r["mode"] in ("centralised", "decoupled"), r
+    assert isinstance(r["beta_lowered"], bool), r
+    for k in keys[2:]:
+        if k != "beta_lowered":
+            assert isinstance(r[k], (int, float)) and not isinstance(r[k], bool) and r[k] >= 0, (k, r)
+    assert r["min_ms"] <= r["median_ms"] <= r["max_ms"], r
+    assert r["solved"] + r["infeasible"] + r["budget_exhausted"] == r["problems"], r
+    assert r["workspace_bytes"] > 0 and r["beta"] >= 1, r
+    assert r["workspace_bytes"] <= 1 << 30, r
+# Each set in both modes, centralised first.
+assert [r["mode"] for r in rows] == ["centralised", "decoupled"] * (len(rows) // 2), rows
+for line in sys.argv[2].strip().splitlines():
+    assert eval(line), f"assertion failed: {line}: {rows}"
+with open(sys.argv[1] + ".last", "w") as f:
+    json.dump(b, f)
+PY
+}
+
+# The table: the header, the column names, one row per mode, the footnote.
+if run table --vehicles 2 --count 2 --repeat 1; then
+    if python3 - "$tmp/out" >"$tmp/py" 2>&1 <<'PY'; then pass; else fail "table: $(tail -n 5 "$tmp/py")"; fi
+import sys
+lines = open(sys.argv[1]).read().splitlines()
+assert lines[:4] == ["benchmark: plan", "seed: 1", "repeat: 1", "count: 2"], lines[:4]
+cols = lines[4].split()
+assert cols == ["set", "mode", "problems", "solved", "infeasible", "budget", "uavs", "beta",
+                "median_ms", "min_ms", "max_ms", "nodes_expanded", "nodes_per_s",
+                "workspace_bytes"], cols
+rows = [l.split() for l in lines[5:7]]
+assert [r[:3] for r in rows] == [["2", "UAVs", "centralised"], ["2", "UAVs", "decoupled"]], rows
+for r in rows:
+    assert len(r) == len(cols) + 1, r  # "2 UAVs" is two words
+    assert r[3] == "2" and int(r[4]) + int(r[5]) + int(r[6]) == 2 and r[7] == "2", r
+assert lines[7].startswith("times: "), lines[7:]
+assert len(lines) == 8, lines
+PY
+fi
+
+if run json --vehicles 2 --count 2 --repeat 1 --json; then
+    check json '
+len(rows) == 2 and all(r["set"] == "2 UAVs" and r["vehicles"] == 2 and r["problems"] == 2 for r in rows)
+b["seed"] == 1 and b["repeat"] == 1 and b["count"] == 2
+all(r["nodes_expanded"] > 0 and r["beta"] == 20000 and not r["beta_lowered"] for r in rows)
+'
+    cp "$tmp/out.last" "$tmp/first"
+fi
+# The same seed gives the same problems: the same work.
+if run same_seed --json --vehicles=2 --count=2 --repeat=2; then
+    check same_seed 'True'
+    if python3 - "$tmp/first" "$tmp/out.last" <<'PY'; then pass; else fail "same seed, different work"; fi
+import json, sys
+a, b = (json.load(open(p))["results"] for p in sys.argv[1:])
+work = lambda rows: [(r["nodes_expanded"], r["nodes_generated"], r["solved"]) for r in rows]
+sys.exit(0 if work(a) == work(b) else f"{work(a)} vs {work(b)}")
+PY
+fi
+# A beta too small to finish is counted as budget exhausted (and the run still exits 0).
+if run small_beta --vehicles 5 --count 1 --repeat 1 --beta 2 --seed 3 --json; then
+    check small_beta '
+rows[0]["budget_exhausted"] == 1 and rows[0]["nodes_expanded"] == 2 and rows[0]["beta"] == 2
+rows[0]["vehicles"] == 5 and not rows[0]["beta_lowered"]
+'
+fi
+# A beta whose centralised workspace would pass 1 GiB is lowered, and says so.
+if run lowered_beta --vehicles 5 --count 1 --repeat 1 --beta 1000000 --json; then
+    check lowered_beta '
+rows[0]["beta_lowered"] and rows[0]["beta"] < 20000
+not rows[1]["beta_lowered"] and rows[1]["beta"] == 1000000
+'
+fi
+# Without --vehicles: the paper scenario, then 2, 3, 4 and 5 UAVs (a small beta keeps it
+# cheap).
+if run all_sets --scenario "$src/scenarios/paper.json" --count 1 --repeat 1 --beta 30 --json; then
+    check all_sets '
+[r["set"] for r in rows] == [s for s in ("paper", "2 UAVs", "3 UAVs", "4 UAVs", "5 UAVs") for _ in (0, 1)]
+rows[0]["vehicles"] == 3 and rows[0]["problems"] == 1 and rows[0]["beta"] == 30
+'
+fi
+
+if "$bin" bench plan --help >"$tmp/help" 2>&1 && grep -q -- '--vehicles N' "$tmp/help"; then
+    pass
+else
+    fail "bench plan --help: $(head -c 300 "$tmp/help")"
+fi
+
+also="from 2 to 5"
+expect_bad "vehicles 1" "--vehicles" bench plan --vehicles 1
+expect_bad "vehicles 6" "--vehicles" bench plan --vehicles 6
+expect_bad "vehicles 0" "--vehicles" bench plan --vehicles 0
+expect_bad "vehicles abc" "--vehicles" bench plan --vehicles abc
+expect_bad "vehicles missing" "--vehicles" bench plan --vehicles
+also=
+expect_bad "vehicles twice" "--vehicles" bench plan --vehicles 2 --vehicles 3
+expect_bad "count 0" "--count" bench plan --vehicles 2 --count 0
+expect_bad "count huge" "--count" bench plan --vehicles 2 --count 99999999999999999999
+expect_bad "repeat 0" "--repeat" bench plan --vehicles 2 --repeat 0
+expect_bad "seed negative" "--seed" bench plan --vehicles 2 --seed -1
+expect_bad "seed 2^64" "--seed" bench plan --vehicles 2 --seed 18446744073709551616
+expect_bad "beta 0" "--beta" bench plan --vehicles 2 --beta 0
+expect_bad "json value" "--json" bench plan --vehicles 2 --json=yes
+expect_bad "unknown option" "--bogus" bench plan --vehicles 2 --bogus
+expect_bad "argument" "'extra'" bench plan --vehicles 2 extra
+expect_bad "scenario with vehicles" "--scenario" bench plan --vehicles 2 --scenario "$src/scenarios/paper.json"
+expect_bad "scenario missing" "$tmp/none.json" bench plan --scenario "$tmp/none.json"
+expect_bad "scenario empty" "--scenario" bench plan --scenario=
+
+finish
