@@ -37,6 +37,7 @@
 
 #include <cjson/cJSON.h>
 
+#include "bench_support.h"
 #include "cli.h"
 #include "coavoid/coavoid.h"
 #include "coavoid/predict.h"
@@ -181,31 +182,6 @@ static int parse_bench_options(int argc, char **argv, bench_options_t *o)
 }
 
 /* ---- the airspace ---- */
-
-typedef struct {
-    uint64_t state;
-} prng_t;
-
-/* splitmix64 (Steele, Lea, Flood 2014): tiny, fast and the same everywhere. */
-static uint64_t prng_next(prng_t *r)
-{
-    uint64_t z = (r->state += 0x9e3779b97f4a7c15u);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9u;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebu;
-    return z ^ (z >> 31);
-}
-
-/* Uniform in [lo, hi). */
-static double prng_uniform(prng_t *r, double lo, double hi)
-{
-    double u = (double)(prng_next(r) >> 11) * (1.0 / 9007199254740992.0);
-    return lo + (hi - lo) * u;
-}
-
-static uint32_t prng_below(prng_t *r, uint32_t n)
-{
-    return (uint32_t)(prng_next(r) % n);
-}
 
 #define BENCH_PI 3.14159265358979323846
 #define BENCH_LAYER_COUNT 4u
@@ -360,19 +336,6 @@ typedef struct {
     size_t max_pairs;
 } bench_result_t;
 
-static int compare_doubles(const void *pa, const void *pb)
-{
-    double a = *(const double *)pa;
-    double b = *(const double *)pb;
-    return a < b ? -1 : (a > b ? 1 : 0);
-}
-
-static double elapsed_ms(const struct timespec *start, const struct timespec *end)
-{
-    return (double)(end->tv_sec - start->tv_sec) * 1e3 +
-           (double)(end->tv_nsec - start->tv_nsec) * 1e-6;
-}
-
 typedef struct {
     void *workspace;
     coa_predictor_t *predictor;
@@ -483,7 +446,7 @@ static int run(const bench_options_t *o, const airspace_t *a, bench_result_t *ou
         clock_gettime(CLOCK_MONOTONIC, &start);
         int rc = predict_once(a, &config, &m, &result);
         clock_gettime(CLOCK_MONOTONIC, &end);
-        times[k] = elapsed_ms(&start, &end);
+        times[k] = bench_elapsed_ms(&start, &end);
         /* The same input must give the same answer every cycle. */
         if (rc != COA_OK || result.overflow || result.pair_tests != first.pair_tests ||
             result.candidate_pairs != first.candidate_pairs ||
@@ -494,11 +457,7 @@ static int run(const bench_options_t *o, const airspace_t *a, bench_result_t *ou
         }
     }
     if (status == CLI_CONTINUE) {
-        qsort(times, o->repeat, sizeof *times, compare_doubles);
-        uint32_t r = o->repeat;
-        out->median_ms = r % 2u == 1u ? times[r / 2u] : 0.5 * (times[r / 2u - 1u] + times[r / 2u]);
-        out->min_ms = times[0];
-        out->max_ms = times[r - 1u];
+        bench_summarise(times, o->repeat, &out->median_ms, &out->min_ms, &out->max_ms);
         out->result = first;
         out->workspace_bytes = m.size;
         out->max_pairs = m.max_pairs;

@@ -36,6 +36,7 @@
 
 #include <cjson/cJSON.h>
 
+#include "bench_support.h"
 #include "cli.h"
 #include "coavoid/coavoid.h"
 #include "commands.h"
@@ -188,30 +189,6 @@ static int parse_bp_options(int argc, char **argv, bp_options_t *o)
 
 /* ---- the encounters ---- */
 
-typedef struct {
-    uint64_t state;
-} bp_prng_t;
-
-/* splitmix64 (Steele, Lea, Flood 2014), as in bench predict: the same everywhere. */
-static uint64_t bp_next(bp_prng_t *r)
-{
-    uint64_t z = (r->state += 0x9e3779b97f4a7c15u);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9u;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebu;
-    return z ^ (z >> 31);
-}
-
-static double bp_uniform(bp_prng_t *r, double lo, double hi)
-{
-    double u = (double)(bp_next(r) >> 11) * (1.0 / 9007199254740992.0);
-    return lo + (hi - lo) * u;
-}
-
-static uint32_t bp_below(bp_prng_t *r, uint32_t n)
-{
-    return (uint32_t)(bp_next(r) % n);
-}
-
 /* Appends to buf; false when it would not fit (a bug: BP_JSON_MAX bounds a problem). */
 static bool bp_append(char *buf, size_t size, size_t *used, const char *fmt, ...)
     CLI_PRINTF_LIKE(4, 5);
@@ -233,23 +210,23 @@ static bool bp_append(char *buf, size_t size, size_t *used, const char *fmt, ...
  * counts does not change the others. */
 static bool encounter_json(uint64_t seed, uint32_t n, uint32_t index, char *buf, size_t size)
 {
-    bp_prng_t r = {seed ^ ((uint64_t)n << 56) ^ ((uint64_t)index * 0x9e3779b97f4a7c15u)};
-    bp_next(&r);
+    prng_t r = {seed ^ ((uint64_t)n << 56) ^ ((uint64_t)index * 0x9e3779b97f4a7c15u)};
+    prng_next(&r);
     size_t used = 0;
     const double horizon_s = BP_HORIZON * BP_DT;
     bool ok = bp_append(buf, size, &used,
                         "{\"name\": \"bench encounter %u of %u UAVs\", \"dt\": %g, "
                         "\"horizon\": %u, \"vehicles\": [",
                         index, n, BP_DT, BP_HORIZON);
-    double heading0 = bp_uniform(&r, 0.0, 2.0 * BP_PI);
+    double heading0 = prng_uniform(&r, 0.0, 2.0 * BP_PI);
     double lowest = 1e300;
     for (uint32_t i = 0; ok && i < n; i++) {
-        double heading = heading0 + 2.0 * BP_PI * i / n + bp_uniform(&r, -0.3, 0.3);
-        double speed = bp_uniform(&r, 8.0, 12.0);
-        double climb = bp_uniform(&r, 1.5, 3.0);
-        double arrive = bp_uniform(&r, 8.0, 12.0);
+        double heading = heading0 + 2.0 * BP_PI * i / n + prng_uniform(&r, -0.3, 0.3);
+        double speed = prng_uniform(&r, 8.0, 12.0);
+        double climb = prng_uniform(&r, 1.5, 3.0);
+        double arrive = prng_uniform(&r, 8.0, 12.0);
         double z = BP_BASE_ALTITUDE +
-                   BP_ALTITUDE_GRID * ((double)bp_below(&r, 2u * BP_MAX_STAGGER + 1u) -
+                   BP_ALTITUDE_GRID * ((double)prng_below(&r, 2u * BP_MAX_STAGGER + 1u) -
                                        (double)BP_MAX_STAGGER);
         lowest = z < lowest ? z : lowest;
         double ux = cos(heading), uy = sin(heading);
@@ -264,7 +241,7 @@ static bool encounter_json(uint64_t seed, uint32_t n, uint32_t index, char *buf,
                        -before * uy, z, after * ux, after * uy, z);
     }
     ok = ok && bp_append(buf, size, &used, "]");
-    if (ok && bp_below(&r, 2u) == 0) {
+    if (ok && prng_below(&r, 2u) == 0) {
         ok = bp_append(buf, size, &used,
                        ", \"obstacles\": [{\"type\": \"box\", \"min\": [-40, -40, 0], "
                        "\"max\": [40, 40, %.1f]}]",
@@ -351,19 +328,6 @@ typedef struct {
     uint32_t solved, infeasible, budget_exhausted;
 } bp_row_t;
 
-static int compare_doubles(const void *pa, const void *pb)
-{
-    double a = *(const double *)pa;
-    double b = *(const double *)pb;
-    return a < b ? -1 : (a > b ? 1 : 0);
-}
-
-static double elapsed_ms(const struct timespec *start, const struct timespec *end)
-{
-    return (double)(end->tv_sec - start->tv_sec) * 1e3 +
-           (double)(end->tv_nsec - start->tv_nsec) * 1e-6;
-}
-
 /* One run over the set: adds the time (ms) and fills the tallies of row. */
 static int run_once(coa_planner_t *planner, const bp_set_t *set, bool decoupled, int32_t *offsets,
                     double *ms, bp_row_t *row)
@@ -385,7 +349,7 @@ static int run_once(coa_planner_t *planner, const bp_set_t *set, bool decoupled,
                             "%s, problem %u: the planner failed (%s)", set->label, j,
                             coa_status_name(rc));
         }
-        *ms += elapsed_ms(&start, &end);
+        *ms += bench_elapsed_ms(&start, &end);
         row->nodes_expanded += result.nodes_expanded;
         row->nodes_generated += result.nodes_generated;
         row->solved += result.status == COA_PLAN_SOLVED;
@@ -440,11 +404,7 @@ static int run_set(const bp_options_t *o, const bp_set_t *set, bool decoupled, b
         }
     }
     if (status == CLI_CONTINUE) {
-        uint32_t r = o->repeat;
-        qsort(times, r, sizeof *times, compare_doubles);
-        row->median_ms = r % 2u == 1u ? times[r / 2u] : 0.5 * (times[r / 2u - 1u] + times[r / 2u]);
-        row->min_ms = times[0];
-        row->max_ms = times[r - 1u];
+        bench_summarise(times, o->repeat, &row->median_ms, &row->min_ms, &row->max_ms);
     }
     free(times);
     free(offsets);
