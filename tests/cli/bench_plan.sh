@@ -123,6 +123,14 @@ else
     fail "bench plan --help: $(head -c 300 "$tmp/help")"
 fi
 
+# `coavoid bench --help` names both benchmarks (it used to show only predict's usage).
+if "$bin" bench --help >"$tmp/help" 2>&1 && grep -q "coavoid bench plan" "$tmp/help" &&
+    grep -q "coavoid bench predict" "$tmp/help"; then
+    pass
+else
+    fail "bench --help: $(head -c 300 "$tmp/help")"
+fi
+
 also="from 2 to 5"
 expect_bad "vehicles 1" "--vehicles" bench plan --vehicles 1
 expect_bad "vehicles 6" "--vehicles" bench plan --vehicles 6
