@@ -1,0 +1,4 @@
+# Injected into libccd's project (CMAKE_PROJECT_libccd_INCLUDE, cmake/libccd_arm.cmake):
+# a .su file beside each object, for the firmware test's worst stack frame. Added to the
+# toolchain file's flags rather than replacing them, as -DCMAKE_C_FLAGS would.
+add_compile_options(-fstack-usage)
