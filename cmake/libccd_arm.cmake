@@ -17,13 +17,15 @@ if(NOT coavoid_ccd_src)
   set(coavoid_ccd_fetch_dir ${CMAKE_BINARY_DIR}/libccd-source)
   file(GLOB coavoid_ccd_found LIST_DIRECTORIES true ${coavoid_ccd_fetch_dir}/libccd-*/src/ccd)
   if(NOT coavoid_ccd_found)
+    # The commands on lines of their own, indented: CMake does not re-wrap those.
     set(coavoid_ccd_howto
       "libccd's source is needed for the firmware build: pass -DCOAVOID_CCD_SOURCE_DIR=<dir> "
       "(an unpacked `apt-get source libccd`), or let this step fetch it, which needs the "
-      "package dpkg-dev and a deb-src line for Debian, e.g. as root: "
-      "printf 'Types: deb-src\\nURIs: http://deb.debian.org/debian\\nSuites: bookworm\\n"
+      "package dpkg-dev and a deb-src line for Debian. As root:\n"
+      "  printf 'Types: deb-src\\nURIs: http://deb.debian.org/debian\\nSuites: bookworm\\n"
       "Components: main\\nSigned-By: /usr/share/keyrings/debian-archive-keyring.gpg\\n' "
-      "> /etc/apt/sources.list.d/deb-src.sources && apt-get update && apt-get install dpkg-dev")
+      "> /etc/apt/sources.list.d/deb-src.sources\n"
+      "  apt-get update && apt-get install -y dpkg-dev\n")
     find_program(COAVOID_APT_GET apt-get)
     find_program(COAVOID_DPKG_SOURCE dpkg-source)
     if(NOT COAVOID_APT_GET)
