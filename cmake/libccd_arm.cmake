@@ -83,6 +83,9 @@ ExternalProject_Add(libccd_arm
     -DBUILD_SHARED_LIBS=OFF
     -DLIBM_LIBRARY:STRING=m
   BUILD_BYPRODUCTS ${coavoid_ccd_lib})
+# Reconfigure libccd when the flags injected into it change.
+ExternalProject_Add_StepDependencies(libccd_arm configure
+  ${CMAKE_CURRENT_LIST_DIR}/stack_usage.cmake)
 
 # The imported target's include directory must exist when the project is configured.
 file(MAKE_DIRECTORY ${coavoid_ccd_prefix}/include)

@@ -4,8 +4,9 @@
 #   - fails if the ARM core archive or the linked firmware ELF references a heap or stdio
 #     function (tests/check_core_symbols.cmake, the list the host's core_symbols uses),
 #     or if a core or firmware function has an unbounded (dynamic) stack frame;
-#   - prints text, data and bss of the ELF, the core and libccd, and the largest stack
-#     frames (-fstack-usage: per function, not per call chain).
+#   - prints text, data and bss of the ELF, the core and libccd, the largest stack frames
+#     (-fstack-usage) and the deepest call chains (-fcallgraph-info=su, callgraph.awk),
+#     failing on recursion or a dynamic frame.
 # Usage: run.sh SRC BUILD [CCD_SOURCE_DIR]. A missing toolchain, newlib or libccd source
 # is a failure with the packages to install, not a skip: CI must run this.
 set -euo pipefail
@@ -77,6 +78,16 @@ echo "== stack (largest single frame; a call chain adds its callers' frames)"
 report_frames core "$arm/CMakeFiles/coavoid_core.dir" || die "unbounded stack frame in the core"
 report_frames firmware "$arm/apps/firmware" || die "unbounded stack frame in the firmware"
 report_frames libccd "$arm/libccd-arm-build/src" || true
+# Call chains: the deepest sum of frames below each entry point, over the core's,
+# libccd's and the firmware's call graphs; libccd's only indirect calls are to the
+# callbacks geometry.c hands it. Recursion or a dynamic frame fails the test.
+echo "== stack (deepest call chain: frames summed, library leaves not included)"
+mapfile -t graphs < <(find "$arm/CMakeFiles/coavoid_core.dir" "$arm/apps/firmware" \
+  "$arm/libccd-arm-build/src" -name '*.ci' | sort)
+[ "${#graphs[@]}" -gt 0 ] || die "no .ci files (-fcallgraph-info=su missing?)"
+awk -v roots="main,fw_systick_handler,fw_task_cycle,coa_plan_decoupled,coa_plan_centralised,coa_predict" \
+  -v indirect="sweep_support,poly_support,sweep_centre,poly_centre" \
+  -f "$src/tests/firmware/callgraph.awk" "${graphs[@]}" || die "unbounded call chain"
 echo "== firmware sections (flash: .isr_vector .text .ARM.exidx + .data's image; SRAM: .data .bss; CCM: .stack)"
 "${prefix}size" -A "$elf" | awk '$1 ~ /^\.(isr_vector|text|ARM\.exidx|data|bss|stack)/ { printf "%-12s %7d bytes at 0x%08x\n", $1, $2, $3 }'
 echo "firmware: ARM core and firmware link without heap or stdio"
