@@ -88,6 +88,8 @@ mapfile -t graphs < <(find "$arm/CMakeFiles/coavoid_core.dir" "$arm/apps/firmwar
 awk -v roots="main,fw_systick_handler,fw_task_cycle,coa_plan_decoupled,coa_plan_centralised,coa_predict" \
   -v indirect="sweep_support,poly_support,sweep_centre,poly_centre" \
   -f "$src/tests/firmware/callgraph.awk" "${graphs[@]}" || die "unbounded call chain"
+echo "== firmware ELF by origin (input sections from the map; flash = code + constants)"
+awk -f "$src/tests/firmware/mapsizes.awk" "$map"
 echo "== firmware sections (flash: .isr_vector .text .ARM.exidx + .data's image; SRAM: .data .bss; CCM: .stack)"
 "${prefix}size" -A "$elf" | awk '$1 ~ /^\.(isr_vector|text|ARM\.exidx|data|bss|stack)/ { printf "%-12s %7d bytes at 0x%08x\n", $1, $2, $3 }'
 echo "firmware: ARM core and firmware link without heap or stdio"
