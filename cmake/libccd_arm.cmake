@@ -82,6 +82,8 @@ ExternalProject_Add(libccd_arm
     -DBUILD_TESTING=OFF
     -DBUILD_SHARED_LIBS=OFF
     -DLIBM_LIBRARY:STRING=m
+    # libccd asks for CMake 2.8.11; the deprecation notice is upstream's, not ours.
+    -DCMAKE_WARN_DEPRECATED=OFF
   BUILD_BYPRODUCTS ${coavoid_ccd_lib})
 # Reconfigure libccd when the flags injected into it change.
 ExternalProject_Add_StepDependencies(libccd_arm configure
