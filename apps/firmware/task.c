@@ -1,7 +1,6 @@
 /*
  * task.c: one UAV's collision-avoidance task (see firmware.h and docs/embedded.md). Plain
- * C on the core: the same file links into the Cortex-M4F firmware and, for a check of its
- * logic, into a host program.
+ * C on the core, nothing board-specific (that is main.c and startup.c).
  *
  * A cycle: our intent is our reference plus the plan in force; the predictor looks at it
  * together with the neighbours' intents and the tracks; when a conflict of ours is
