@@ -1302,6 +1302,52 @@ START_TEST(workspace_size_is_exact)
 }
 END_TEST
 
+/* coa_planner_max_beta inverts the size function: the beta it gives fits, one more does
+ * not, and a buffer of exactly the size for beta gives beta back. */
+START_TEST(max_beta_inverts_workspace_size)
+{
+    static const uint32_t betas[] = {1u, 2u, 3u, 24u, 100u, 255u, 1000u, 4097u, 100000u};
+    size_t n;
+    size_t i;
+
+    for (n = 1u; n <= COA_MAX_CENTRALISED; ++n) {
+        uint32_t pow5 = 1u;
+        uint32_t top;
+        size_t j;
+        for (j = 0; j < n; ++j) {
+            pow5 *= 5u;
+        }
+        top = ((UINT32_C(1) << 30) - 1u) / pow5; /* the node pool's limit */
+        ck_assert_uint_gt(coa_planner_workspace_size(n, top), 0u);
+        ck_assert_uint_eq(coa_planner_workspace_size(n, top + 1u), 0u);
+        for (i = 0; i < sizeof betas / sizeof betas[0]; ++i) {
+            uint32_t beta = betas[i];
+            size_t bytes;
+            uint32_t got;
+            if (beta > top) {
+                continue;
+            }
+            bytes = coa_planner_workspace_size(n, beta);
+            ck_assert_uint_gt(bytes, 0u);
+            ck_assert_uint_eq(coa_planner_max_beta(n, bytes), beta);
+            ck_assert_uint_eq(coa_planner_max_beta(n, bytes - 1u), beta - 1u);
+            /* Between two sizes: the smaller beta, which fits. */
+            got = coa_planner_max_beta(n, bytes + 7u);
+            ck_assert_uint_ge(got, beta);
+            ck_assert_uint_le(coa_planner_workspace_size(n, got), bytes + 7u);
+            ck_assert_uint_gt(coa_planner_workspace_size(n, got + 1u), bytes + 7u);
+        }
+        /* Room beyond the pool's limit: the limit, not more. */
+        ck_assert_uint_eq(coa_planner_max_beta(n, SIZE_MAX), top);
+        /* Less than the header and one expansion: nothing fits. */
+        ck_assert_uint_eq(coa_planner_max_beta(n, coa_planner_workspace_size(n, 1u) - 1u), 0u);
+        ck_assert_uint_eq(coa_planner_max_beta(n, 0u), 0u);
+    }
+    ck_assert_uint_eq(coa_planner_max_beta(0u, SIZE_MAX), 0u);
+    ck_assert_uint_eq(coa_planner_max_beta(COA_MAX_CENTRALISED + 1u, SIZE_MAX), 0u);
+}
+END_TEST
+
 START_TEST(initial_conflict_is_infeasible_without_expanding)
 {
     static fx_t f;
@@ -1731,6 +1777,7 @@ static Suite *plan_suite(void)
     TCase *tc = tcase_create("plan");
     tcase_set_timeout(tc, 300);
     tcase_add_test(tc, workspace_size_is_exact);
+    tcase_add_test(tc, max_beta_inverts_workspace_size);
     tcase_add_test(tc, initial_conflict_is_infeasible_without_expanding);
     tcase_add_test(tc, tiny_beta_is_budget_exhausted);
     tcase_add_test(tc, max_offset_is_respected);

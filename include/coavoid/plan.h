@@ -147,6 +147,16 @@ typedef struct coa_planner coa_planner_t;
  * fit in size_t. Cost O(n), no memory. The size is exact: one byte less is refused. */
 size_t coa_planner_workspace_size(size_t max_vehicles, uint32_t beta);
 
+/* The inverse, for a buffer whose size is fixed first (a static array in firmware): the
+ * largest beta with coa_planner_workspace_size(max_vehicles, beta) <= bytes, so that
+ * coa_planner_init(buffer, bytes, max_vehicles, coa_planner_max_beta(max_vehicles, bytes))
+ * succeeds on any suitably aligned buffer of `bytes` bytes. Returns 0 when max_vehicles is
+ * 0 or > COA_MAX_CENTRALISED or `bytes` is smaller than the workspace for beta = 1; at
+ * most the largest beta whose node pool 1 + beta * 5^max_vehicles fits 2^30. Exact: with
+ * b = coa_planner_max_beta(n, coa_planner_workspace_size(n, beta)), b == beta. Cost
+ * O(n log beta) (a bisection over the size function), no memory. */
+uint32_t coa_planner_max_beta(size_t max_vehicles, size_t bytes);
+
 /* Builds a planner inside `buffer`. Returns the handle (which points into the buffer, so
  * the buffer must not move while it is used), or NULL when buffer is NULL or not aligned
  * to COA_WORKSPACE_ALIGNMENT, the arguments are refused by coa_planner_workspace_size, or

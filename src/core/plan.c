@@ -181,6 +181,36 @@ size_t coa_planner_workspace_size(size_t max_vehicles, uint32_t beta)
     return layout_compute(max_vehicles, beta, &lo) ? lo.total : 0u;
 }
 
+uint32_t coa_planner_max_beta(size_t max_vehicles, size_t bytes)
+{
+    plan_layout_t lo;
+    uint32_t pow5 = 1u;
+    uint32_t lo_beta = 0u; /* fits (0 stands for "nothing fits") */
+    uint32_t hi_beta;      /* the largest beta the node pool allows */
+    size_t i;
+
+    if (max_vehicles == 0u || max_vehicles > MAXM) {
+        return 0u;
+    }
+    for (i = 0; i < max_vehicles; ++i) {
+        pow5 *= ACTIONS;
+    }
+    hi_beta = (MAX_NODES - 1u) / pow5;
+    if (layout_compute(max_vehicles, hi_beta, &lo) && lo.total <= bytes) {
+        return hi_beta;
+    }
+    /* The size grows strictly with beta: invariant size(lo_beta) <= bytes < size(hi_beta). */
+    while (hi_beta - lo_beta > 1u) {
+        uint32_t mid = lo_beta + (hi_beta - lo_beta) / 2u;
+        if (layout_compute(max_vehicles, mid, &lo) && lo.total <= bytes) {
+            lo_beta = mid;
+        } else {
+            hi_beta = mid;
+        }
+    }
+    return lo_beta;
+}
+
 coa_planner_t *coa_planner_init(void *buffer, size_t size, size_t max_vehicles, uint32_t beta)
 {
     plan_layout_t lo;

@@ -1,0 +1,95 @@
+#!/usr/bin/env bash
+# The Cortex-M4F firmware build (docs/embedded.md), as CI runs it: configures and builds
+# the cross tree with cmake/arm-none-eabi-cortex-m4f.cmake in BUILD/firmware-arm, then
+#   - fails if the ARM core archive or the linked firmware ELF references a heap or stdio
+#     function (tests/check_core_symbols.cmake, the list the host's core_symbols uses),
+#     or if a core or firmware function has an unbounded (dynamic) stack frame;
+#   - prints text, data and bss of the ELF, the core and libccd, the largest stack frames
+#     (-fstack-usage) and the deepest call chains (-fcallgraph-info=su, callgraph.awk),
+#     failing on recursion or a dynamic frame.
+# Usage: run.sh SRC BUILD [CCD_SOURCE_DIR]. A missing toolchain, newlib or libccd source
+# is a failure with the packages to install, not a skip: CI must run this.
+set -euo pipefail
+src=${1:?usage: run.sh SRC BUILD [CCD_SOURCE_DIR]}
+build=${2:?usage: run.sh SRC BUILD [CCD_SOURCE_DIR]}
+ccd_src=${3:-}
+arm=$build/firmware-arm
+cmake=${CMAKE:-cmake}
+prefix=arm-none-eabi-
+
+die() { echo "firmware: FAIL: $*" >&2; exit 1; }
+
+command -v "${prefix}gcc" >/dev/null ||
+  die "${prefix}gcc not found: apt-get install gcc-arm-none-eabi libnewlib-arm-none-eabi"
+libc=$("${prefix}gcc" -mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard \
+  -print-file-name=libc.a)
+[ -f "$libc" ] || die "newlib for Cortex-M4F hard float not found: apt-get install libnewlib-arm-none-eabi"
+
+args=(-S "$src" -B "$arm" -DCMAKE_TOOLCHAIN_FILE="$src/cmake/arm-none-eabi-cortex-m4f.cmake")
+if [ -n "$ccd_src" ]; then
+  args+=(-DCOAVOID_CCD_SOURCE_DIR="$ccd_src")
+fi
+# Configure output only when it fails (it says what is missing: a deb-src line, dpkg-dev).
+if ! log=$("$cmake" "${args[@]}" 2>&1); then
+  echo "$log" >&2
+  die "configuring the ARM build failed (see above)"
+fi
+if ! log=$("$cmake" --build "$arm" -j2 2>&1); then
+  echo "$log" >&2
+  die "building the ARM tree failed (see above)"
+fi
+
+core=$arm/libcoavoid_core.a
+elf=$arm/apps/firmware/coavoid-firmware.elf
+ccd=$arm/libccd-arm/lib/libccd.a
+map=$arm/apps/firmware/coavoid-firmware.map
+for f in "$core" "$elf" "$ccd" "$map"; do
+  [ -f "$f" ] || die "$f was not built"
+done
+grep -q '^#define CCD_SINGLE' "$arm/libccd-arm/include/ccd/config.h" ||
+  die "the ARM libccd is not single precision"
+
+# Heap and stdio: what the core archive needs from outside it, and everything the ELF
+# contains after --gc-sections.
+"$cmake" -DLIB="$core" -DNM="${prefix}nm" -P "$src/tests/check_core_symbols.cmake" ||
+  die "the ARM core archive references a forbidden function"
+"$cmake" -DLINKED=ON -DLIB="$elf" -DNM="${prefix}nm" -P "$src/tests/check_core_symbols.cmake" ||
+  die "the firmware ELF contains a forbidden function"
+
+echo "== size (bytes; an archive's total is every function, the ELF only what it links)"
+"${prefix}size" -t "$core" | tail -n 1 | sed 's/(TOTALS)/core (libcoavoid_core.a)/'
+"${prefix}size" -t "$ccd" | tail -n 1 | sed 's/(TOTALS)/libccd (libccd.a)/'
+"${prefix}size" "$elf" | tail -n 1 | sed "s|$elf|firmware ELF|"
+
+# Stack frames: file:line:col:function <TAB> bytes <TAB> static|dynamic[,bounded].
+report_frames() { # NAME DIR
+  local name=$1 dir=$2 files
+  mapfile -t files < <(find "$dir" -name '*.su' | sort)
+  [ "${#files[@]}" -gt 0 ] || die "no .su files under $dir (-fstack-usage missing?)"
+  cat "${files[@]}" | awk -F'\t' -v name="$name" '
+    { n = split($1, p, ":"); fn = p[n]; file = p[1]; sub(/.*\//, "", file)
+      if ($2 + 0 > best) { best = $2 + 0; where = fn " (" file ")"; q = $3 }
+      if ($3 == "dynamic") { dyn = dyn " " fn }
+      total++ }
+    END { printf "%-9s worst frame %5d bytes  %s [%s], %d functions\n", name, best, where, q, total
+          if (dyn != "") { printf "%s: unbounded stack frames:%s\n", name, dyn; exit 1 } }'
+}
+echo "== stack (largest single frame; a call chain adds its callers' frames)"
+report_frames core "$arm/CMakeFiles/coavoid_core.dir" || die "unbounded stack frame in the core"
+report_frames firmware "$arm/apps/firmware" || die "unbounded stack frame in the firmware"
+report_frames libccd "$arm/libccd-arm-build/src" || true
+# Call chains: the deepest sum of frames below each entry point, over the core's,
+# libccd's and the firmware's call graphs; libccd's only indirect calls are to the
+# callbacks geometry.c hands it. Recursion or a dynamic frame fails the test.
+echo "== stack (deepest call chain: frames summed, library leaves not included)"
+mapfile -t graphs < <(find "$arm/CMakeFiles/coavoid_core.dir" "$arm/apps/firmware" \
+  "$arm/libccd-arm-build/src" -name '*.ci' | sort)
+[ "${#graphs[@]}" -gt 0 ] || die "no .ci files (-fcallgraph-info=su missing?)"
+awk -v roots="main,fw_systick_handler,fw_task_cycle,coa_plan_decoupled,coa_plan_centralised,coa_predict" \
+  -v indirect="sweep_support,poly_support,sweep_centre,poly_centre" \
+  -f "$src/tests/firmware/callgraph.awk" "${graphs[@]}" || die "unbounded call chain"
+echo "== firmware ELF by origin (input sections from the map; flash = code + constants)"
+awk -f "$src/tests/firmware/mapsizes.awk" "$map"
+echo "== firmware sections (flash: .isr_vector .text .ARM.exidx + .data's image; SRAM: .data .bss; CCM: .stack)"
+"${prefix}size" -A "$elf" | awk '$1 ~ /^\.(isr_vector|text|ARM\.exidx|data|bss|stack)/ { printf "%-12s %7d bytes at 0x%08x\n", $1, $2, $3 }'
+echo "firmware: ARM core and firmware link without heap or stdio"
