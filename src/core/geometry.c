@@ -11,15 +11,7 @@
 
 #include <ccd/ccd.h>
 
-#ifdef COA_SINGLE_PRECISION
-#define coa_sqrt(x) sqrtf(x)
-#define coa_fabs(x) fabsf(x)
-#define coa_hypot(x, y) hypotf((x), (y))
-#else
-#define coa_sqrt(x) sqrt(x)
-#define coa_fabs(x) fabs(x)
-#define coa_hypot(x, y) hypot((x), (y))
-#endif
+#include "internal.h"
 
 /* MPR works in ccd_real_t whatever coa_real_t is; these follow libccd's precision. */
 #ifdef CCD_SINGLE
@@ -119,18 +111,18 @@ static coa_span_t span_disc(coa_real_t qx, coa_real_t qy, coa_real_t wx, coa_rea
     coa_real_t u2;
     coa_span_t s;
 
-    qn = coa_hypot(qx, qy);
+    qn = real_norm2(qx, qy);
     c = (qn - radius) * (qn + radius);
     if (a == (coa_real_t)0) {
         return c < (coa_real_t)0 ? span_all() : span_empty();
     }
-    cross = coa_fabs(qx * wy - qy * wx);
-    ra = radius * coa_sqrt(a);
+    cross = real_fabs(qx * wy - qy * wx);
+    ra = radius * real_sqrt(a);
     disc = (ra - cross) * (ra + cross);
     if (!(disc > (coa_real_t)0)) {
         return span_empty();
     }
-    sd = coa_sqrt(disc);
+    sd = real_sqrt(disc);
     b = qx * wx + qy * wy;
     t = b >= (coa_real_t)0 ? -(b + sd) : sd - b;
     u1 = t / a;
