@@ -2,7 +2,7 @@
 """Single and double precision must give the same plans: runs both builds of coavoid on
 each scenario and compares what they print.
 
-Usage: compare.py DOUBLE_COAVOID SINGLE_COAVOID SCENARIO.json...
+Usage: compare.py [--exact] DOUBLE_COAVOID SINGLE_COAVOID SCENARIO.json...
 
 Plans (`coavoid plan`, centralised, decoupled, and decoupled --reorder): the exit status
 and the whole result must be equal, every field of it, numbers compared exactly, except
@@ -20,11 +20,20 @@ positions rounded to the build's precision, so they may differ by rounding, with
 and a pair with uncertainty may be listed by one build only when its probability is
 within that tolerance of the threshold.
 
-Prints one line per difference and a summary; exits 1 when anything differed.
+With --exact (scenarios from random_scenarios.py --exact), the double build's predicted
+conflict steps must also equal the exact ones (exact_oracle.py), so that agreeing is not
+enough: both must be right.
+
+The two builds run side by side (two processes at a time), which halves the wall time on
+two cores. Prints one line per difference and a summary; exits 1 when anything differed.
 """
 import json
+import os
 import subprocess
 import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import exact_oracle  # noqa: E402
 
 IGNORED = {"time_us", "workspace_bytes"}
 MODES = (["--mode", "centralised"], ["--mode", "decoupled"],
@@ -35,13 +44,15 @@ TOL_REL = 2.0 ** -14
 THRESHOLD = 0.01  # coavoid predict's default
 
 
-def run(binary, args):
-    p = subprocess.run([binary] + args, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                       text=True, check=False)
-    out = None
-    if p.stdout.strip():
-        out = json.loads(p.stdout)
-    return p.returncode, out, p.stderr.strip()
+def run_both(double, single, args):
+    """(exit status, parsed stdout or None, stderr) of each build, run concurrently."""
+    procs = [subprocess.Popen([b] + args, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                              text=True) for b in (double, single)]
+    results = []
+    for p in procs:
+        out, err = p.communicate()
+        results.append((p.returncode, json.loads(out) if out.strip() else None, err.strip()))
+    return results
 
 
 def strip(x):
@@ -136,9 +147,14 @@ def compare_predict(d, s, scenario):
 
 
 def main():
-    if len(sys.argv) < 4:
-        sys.exit("usage: compare.py DOUBLE_COAVOID SINGLE_COAVOID SCENARIO.json...")
-    double, single, files = sys.argv[1], sys.argv[2], sys.argv[3:]
+    args = sys.argv[1:]
+    exact = bool(args) and args[0] == "--exact"
+    if exact:
+        args = args[1:]
+    if len(args) < 3:
+        sys.exit("usage: compare.py [--exact] DOUBLE_COAVOID SINGLE_COAVOID SCENARIO.json...")
+    double, single, files = args[0], args[1], args[2:]
+    exact_conflicts = 0
     compared = 0
     differed = 0
     statuses = {}
@@ -147,8 +163,7 @@ def main():
             scenario = json.load(f)
         for mode in MODES:
             args = ["plan", path] + mode
-            rd, od, ed = run(double, args)
-            rs, os_, es = run(single, args)
+            (rd, od, ed), (rs, os_, es) = run_both(double, single, args)
             compared += 1
             what = f"{path} {' '.join(mode)}"
             status = od.get("status") if od else f"exit {rd}"
@@ -162,15 +177,23 @@ def main():
             if diff:
                 differed += 1
                 print(f"DIFF plan {what}: {diff}")
-        rd, od, ed = run(double, ["predict", path])
-        rs, os_, es = run(single, ["predict", path])
+        (rd, od, ed), (rs, os_, es) = run_both(double, single, ["predict", path])
         compared += 1
         diff = f"exit {rd} != {rs}" if rd != rs else compare_predict(od, os_, scenario)
         if diff:
             differed += 1
             print(f"DIFF predict {path}: {diff}")
+        if exact and od is not None:
+            want = exact_oracle.first_steps(scenario)
+            got = exact_oracle.reported_steps(scenario, od)
+            exact_conflicts += len(want)
+            if got != want:
+                differed += 1
+                print(f"DIFF exact {path}: coavoid {sorted(got.items())} != "
+                      f"exact {sorted(want.items())}")
     summary = ", ".join(f"{k} {v}" for k, v in sorted(statuses.items()))
-    print(f"{len(files)} scenarios, {compared} results compared ({summary}), "
+    checked = f", {exact_conflicts} exact conflict steps checked" if exact else ""
+    print(f"{len(files)} scenarios, {compared} results compared ({summary}){checked}, "
           f"{differed} differed")
     return 1 if differed else 0
 

@@ -146,6 +146,14 @@ def first_steps(s):
     return out
 
 
+def reported_steps(s, result):
+    """The first steps a `coavoid predict` result reports for the pairs first_steps
+    covers (UAV pairs, and UAV-track pairs without sigma)."""
+    exact_tracks = {t["id"] for t in s.get("tracks", []) if "sigma" not in t}
+    return {(c["kind"], c["a"], c["b"]): c["first_step"] for c in result["conflicts"]
+            if c["kind"] == "vehicle" or (c["kind"] == "track" and c["b"] in exact_tracks)}
+
+
 def main():
     if len(sys.argv) < 3:
         sys.exit("usage: exact_oracle.py COAVOID SCENARIO.json...")
@@ -157,10 +165,7 @@ def main():
         want = first_steps(s)
         p = subprocess.run([binary, "predict", path], stdout=subprocess.PIPE, text=True,
                            check=False)
-        r = json.loads(p.stdout)
-        exact_tracks = {t["id"] for t in s.get("tracks", []) if "sigma" not in t}
-        got = {(c["kind"], c["a"], c["b"]): c["first_step"] for c in r["conflicts"]
-               if c["kind"] == "vehicle" or (c["kind"] == "track" and c["b"] in exact_tracks)}
+        got = reported_steps(s, json.loads(p.stdout))
         n = len(s["vehicles"])
         pairs += n * (n - 1) // 2 + n * sum(1 for t in s.get("tracks", []) if "sigma" not in t)
         conflicts += len(want)
