@@ -15,6 +15,7 @@ import json
 import subprocess
 import sys
 from fractions import Fraction as F
+from math import isqrt
 
 
 def route_at(route, d):
@@ -53,7 +54,6 @@ def track_samples(s, t):
 def sqrt_bounds(x):
     """Rationals lo <= sqrt(x) <= hi, exact (lo == hi) when x is a perfect square."""
     num, den = x.numerator, x.denominator
-    from math import isqrt
     rn, rd = isqrt(num), isqrt(den)
     if rn * rn == num and rd * rd == den:
         r = F(rn, rd)
@@ -83,7 +83,6 @@ def step_conflict(a0, a1, b0, b1, rsum, hsum):
         if not c < 0:
             return False
         hlo = hhi = None
-        hlo_b = hhi_b = None
     else:
         disc = b * b - a * c
         if disc <= 0:
@@ -92,37 +91,28 @@ def step_conflict(a0, a1, b0, b1, rsum, hsum):
         # Roots (-b -+ sqrt(disc)) / a, bracketed by rationals.
         hlo = ((-b - shi) / a, (-b - slo) / a)
         hhi = ((-b + slo) / a, (-b + shi) / a)
-    # The set meets [0, 1] iff max(lower ends, 0-) < min(upper ends, 1+) with the step
-    # closed: compare max(vlo, hlo) < min(vhi, hhi), max(...) < 1 and min(...) > 0.
-    lo_cands = []
-    hi_cands = []
+    # Ends as (lower, upper) rational brackets: exact when lower == upper; an irrational
+    # root's bracket is 1e-40 wide and never holds a rational end of these sizes.
+    lows, highs = [], []
     if vlo is not None:
-        lo_cands.append((vlo, vlo))
-        hi_cands.append((vhi, vhi))
+        lows.append((vlo, vlo))
+        highs.append((vhi, vhi))
     if hlo is not None:
-        lo_cands.append(hlo)
-        hi_cands.append(hhi)
-    lo = max(lo_cands, key=lambda x: x[0]) if lo_cands else None
-    hi = min(hi_cands, key=lambda x: x[1]) if hi_cands else None
-    # An irrational end is bracketed 1e-40 wide; an exact comparison is needed only when
-    # brackets overlap, which for an irrational end against a rational one cannot hold.
-    def less(x, y):  # x < y for bracketed x, y
+        lows.append(hlo)
+        highs.append(hhi)
+
+    def less(x, y):
         if x[1] < y[0]:
             return True
-        if x[0] >= y[1] and not (x[0] == x[1] == y[0] == y[1]):
+        if x[0] >= y[1]:
             return False
-        if x[0] == x[1] and y[0] == y[1]:
-            return x[0] < y[0]
         raise AssertionError("exact oracle: cannot separate two interval ends")
-    for x in lo_cands:
-        for y in hi_cands:
-            if not less(x, y):
-                return False
-    if lo is not None and not less(lo, (F(1), F(1))):
-        return False
-    if hi is not None and not less((F(0), F(0)), hi):
-        return False
-    return True
+
+    # The open intervals meet each other and the closed step [0, 1] iff every lower end
+    # is below every upper end, below 1, and every upper end is above 0.
+    one, zero = (F(1), F(1)), (F(0), F(0))
+    return (all(less(x, y) for x in lows for y in highs) and
+            all(less(x, one) for x in lows) and all(less(zero, y) for y in highs))
 
 
 def first_steps(s):
