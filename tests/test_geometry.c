@@ -705,6 +705,41 @@ START_TEST(test_box_touching)
 }
 END_TEST
 
+/* Contact reached or left exactly at a step end by relative motion off the axes, as
+ * tests/precision/random_scenarios.py --exact found in planning problems: the answer must
+ * be exact, and so the same in float and in double, on inputs with few significant bits.
+ * Here |w|^2 = 320 is not a square, so a test that took sqrt(|w|^2) (or the norm of q)
+ * before the discriminant rounded the root at u = 1 and reported the touch as a conflict
+ * (double) or the conflict one step early (float). The same cases scaled by powers of two,
+ * far beyond where fourth powers would overflow or underflow, give the same answers. */
+START_TEST(test_volumes_touching_off_axis)
+{
+    const double scales[] = {1.0, 0x1p60, 0x1p-60, 0x1p100, 0x1p-100};
+    size_t i;
+
+    for (i = 0; i < sizeof scales / sizeof scales[0]; ++i) {
+        double k = scales[i];
+        coa_sweep_t a = still(5 * k, 2 * k, 0, 0, 0);
+        coa_box_t corner = box(vec(-100 * k, -100 * k, -10 * k), vec(0, 0, 10 * k));
+        /* q = a - b goes (0, -22) -> (8, -6): |q| = 10 = r_a + r_b only at u = 1. */
+        ck_assert(!vols(a, sweep(5 * k, 2 * k, vec(0, 22 * k, 0), vec(-8 * k, 6 * k, 0))));
+        /* ... and on from there, inside for u in (0, 0.2). */
+        ck_assert(vols(a, sweep(5 * k, 2 * k, vec(-8 * k, 6 * k, 0), vec(-16 * k, -10 * k, 0))));
+        /* The same closing speed along y, 9 apart in x: contact (9, 12, 15) at u = 1. */
+        ck_assert(!vols(still(5 * k, 2.5 * k, 0, 0, 0),
+                        sweep(10 * k, 2 * k, vec(9 * k, 21 * k, 4.375 * k),
+                              vec(9 * k, 12 * k, 4.375 * k))));
+        ck_assert(vols(still(5 * k, 2.5 * k, 0, 0, 0),
+                       sweep(10 * k, 2 * k, vec(9 * k, 12 * k, 4.375 * k),
+                             vec(9 * k, 3 * k, 4.375 * k))));
+        /* A box's rounded corner (its max x, max y edge), reached at u = 1. */
+        ck_assert(!boxc(sweep(10 * k, 1 * k, vec(22 * k, 0, 0), vec(6 * k, 8 * k, 0)), corner));
+        ck_assert(boxc(sweep(10 * k, 1 * k, vec(6 * k, 8 * k, 0), vec(-10 * k, 16 * k, 0)),
+                       corner));
+    }
+}
+END_TEST
+
 START_TEST(test_box_motion)
 {
     coa_box_t c = cube10();
@@ -1131,6 +1166,7 @@ static Suite *geometry_suite(void)
 
     tcase_add_test(hand, test_volumes_touching);
     tcase_add_test(hand, test_obstacle_check);
+    tcase_add_test(hand, test_volumes_touching_off_axis);
     tcase_add_test(hand, test_volumes_crossing);
     tcase_add_test(hand, test_volumes_step_ends);
     tcase_add_test(hand, test_volumes_degenerate_motion);

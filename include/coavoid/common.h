@@ -24,7 +24,30 @@ extern "C" {
 #endif
 
 /* Geometry precision. Double by default; define COA_SINGLE_PRECISION for float (firmware
- * on an FPU that only does single precision). Costs never depend on it: they are integers. */
+ * on an FPU that only does single precision). Costs never depend on it: they are integers.
+ *
+ * Same plans in both precisions. Fed the same numbers (so numbers representable in float,
+ * as everything a float build receives is), the two builds give the same plan result -
+ * status, every offset, deviation, effort, nodes expanded and generated, priority order -
+ * whenever the numbers the conflict tests form are exact in float: every sampled position
+ * representable (reference legs along the axes whose fractions flown are dyadic, such as
+ * legs 2^j m long; tracks by position and velocity at such times), and relative positions
+ * and displacements over a step with few significant bits (coordinates on a grid of 1/8 m
+ * within a few hundred metres, say). The conflict tests form sums of products of their
+ * inputs, with no square root or quotient before the discriminant's, so there an exact
+ * touch (no conflict, by the contract) at a step's end or a tangency comes out exact in
+ * both, and both decide it as the contract does. Where a position rounds (a leg 17 m
+ * long, a leg off the axes, a dt of 0.1) or the products need more bits than float has,
+ * a pair within rounding of an exact touch (a few float ulps of the coordinates: 1e-4 m
+ * at 1 km) may be decided differently by the two builds, and by neither exactly (double
+ * has the same limit, further out), and the plans may then differ. Predictions
+ * (predict.h) agree on conflict sets and first steps under the same rule; the real numbers
+ * they report (times, least separations, probabilities) differ by rounding, and a pair
+ * with uncertainty within rounding of the threshold may be listed by one build only.
+ * Other differences: the planner's workspace is 2,112 bytes smaller in float (its fixed
+ * header holds 62 sweeps and 32 climb steps of coa_real_t); the polytope test runs
+ * libccd's MPR in libccd's own precision (double on the host whatever this is).
+ * tests/precision checks this (README, "Precision"). */
 #ifdef COA_SINGLE_PRECISION
 typedef float coa_real_t;
 #else

@@ -11,15 +11,7 @@
 
 #include <ccd/ccd.h>
 
-#ifdef COA_SINGLE_PRECISION
-#define coa_sqrt(x) sqrtf(x)
-#define coa_fabs(x) fabsf(x)
-#define coa_hypot(x, y) hypotf((x), (y))
-#else
-#define coa_sqrt(x) sqrt(x)
-#define coa_fabs(x) fabs(x)
-#define coa_hypot(x, y) hypot((x), (y))
-#endif
+#include "internal.h"
 
 /* MPR works in ccd_real_t whatever coa_real_t is; these follow libccd's precision. */
 #ifdef CCD_SINGLE
@@ -99,19 +91,29 @@ static coa_span_t span_linear(coa_real_t p, coa_real_t v, coa_real_t bmin, coa_r
     return s;
 }
 
-/* The open set of u with |q + u*w| < radius in the plane: a quadratic inequality.
- * Its discriminant is written as radius^2*|w|^2 - (q x w)^2, the squared margin between
- * the radius and the line's closest approach, which keeps tangency (no conflict) exact
- * where b^2 - 4ac would cancel; the roots use the cancellation-free pair t/a, c/t. */
+/* Outside [2^-DISC_RANGE, 2^DISC_RANGE] span_disc rescales its inputs: within it, the
+ * fourth powers it forms stay inside even float's normal range (2^-126 to 2^128). */
+#define DISC_RANGE 24
+
+/* The open set of u with |q + u*w| < radius in the plane: a*u^2 + 2*b*u + c < 0 with
+ * a = |w|^2, b = q.w, c = |q|^2 - radius^2. Its discriminant b^2 - a*c is written as
+ * radius^2*|w|^2 - (q x w)^2 (Lagrange's identity), the squared margin between the radius
+ * and the line's closest approach, which does not cancel as b^2 - a*c would when q is far;
+ * the roots use the cancellation-free pair t/a, c/t.
+ *
+ * Every quantity is a sum of products of the inputs, with no square root before the
+ * discriminant's: on inputs with few significant bits (coordinates on a grid of 1/8 m,
+ * say, near a touch) each one is then exact in float as in double, so an exact touch (a
+ * root at exactly u = 0 or 1, a zero discriminant) is found exact in both precisions and
+ * the two builds agree on it. A norm by sqrt (or radius * sqrt(a)) would round first. */
 static coa_span_t span_disc(coa_real_t qx, coa_real_t qy, coa_real_t wx, coa_real_t wy,
                             coa_real_t radius)
 {
-    coa_real_t a = wx * wx + wy * wy;
-    coa_real_t qn;
+    coa_real_t m;
+    coa_real_t a;
     coa_real_t c;
     coa_real_t b;
     coa_real_t cross;
-    coa_real_t ra;
     coa_real_t disc;
     coa_real_t sd;
     coa_real_t t;
@@ -119,18 +121,36 @@ static coa_span_t span_disc(coa_real_t qx, coa_real_t qy, coa_real_t wx, coa_rea
     coa_real_t u2;
     coa_span_t s;
 
-    qn = coa_hypot(qx, qy);
-    c = (qn - radius) * (qn + radius);
+    /* The roots do not change when every input is scaled by one power of two, and such
+     * a scaling rounds nothing (short of underflow): it keeps squares of squares finite
+     * whatever the coordinates' range, and costs a comparison in a local frame. */
+    m = real_fabs(qx) > real_fabs(qy) ? real_fabs(qx) : real_fabs(qy);
+    m = real_fabs(wx) > m ? real_fabs(wx) : m;
+    m = real_fabs(wy) > m ? real_fabs(wy) : m;
+    m = radius > m ? radius : m;
+    if (m > real_ldexp((coa_real_t)1, DISC_RANGE) ||
+        m < real_ldexp((coa_real_t)1, -DISC_RANGE)) {
+        int e = 0;
+        coa_real_t k;
+        (void)real_frexp(m, &e);
+        k = real_ldexp((coa_real_t)1, -e);
+        qx *= k;
+        qy *= k;
+        wx *= k;
+        wy *= k;
+        radius *= k;
+    }
+    a = wx * wx + wy * wy;
+    c = (qx * qx + qy * qy) - radius * radius;
     if (a == (coa_real_t)0) {
         return c < (coa_real_t)0 ? span_all() : span_empty();
     }
-    cross = coa_fabs(qx * wy - qy * wx);
-    ra = radius * coa_sqrt(a);
-    disc = (ra - cross) * (ra + cross);
+    cross = qx * wy - qy * wx;
+    disc = radius * radius * a - cross * cross;
     if (!(disc > (coa_real_t)0)) {
         return span_empty();
     }
-    sd = coa_sqrt(disc);
+    sd = real_sqrt(disc);
     b = qx * wx + qy * wy;
     t = b >= (coa_real_t)0 ? -(b + sd) : sd - b;
     u1 = t / a;

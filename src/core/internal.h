@@ -52,6 +52,31 @@ static inline bool reserve(size_t *cursor, size_t count, size_t elem, size_t *at
     return size_add(*cursor, bytes, cursor);
 }
 
+/* The precision-dependent libm calls, named once for every module. Only correctly rounded
+ * operations are used (sqrt and fabs are, by IEEE 754, and frexp and ldexp are exact;
+ * hypot is not, and its error
+ * differs between libms), so the host and a firmware's libm give the same bits for the
+ * same inputs in the same precision. */
+#ifdef COA_SINGLE_PRECISION
+#define real_sqrt(x) sqrtf(x)
+#define real_fabs(x) fabsf(x)
+#define real_frexp(x, e) frexpf((x), (e))
+#define real_ldexp(x, e) ldexpf((x), (e))
+#else
+#define real_sqrt(x) sqrt(x)
+#define real_fabs(x) fabs(x)
+#define real_frexp(x, e) frexp((x), (e))
+#define real_ldexp(x, e) ldexp((x), (e))
+#endif
+
+/* sqrt(x^2 + y^2), the length of a horizontal vector, rather than hypot (see above).
+ * Coordinates in a local ENU frame are far from the range where the squares would
+ * overflow or underflow. */
+static inline coa_real_t real_norm2(coa_real_t x, coa_real_t y)
+{
+    return real_sqrt(x * x + y * y);
+}
+
 static inline bool real_ok(coa_real_t x)
 {
     return isfinite(x) != 0;

@@ -30,12 +30,8 @@
 #include "internal.h"
 
 #ifdef COA_SINGLE_PRECISION
-#define coa_sqrt(x) sqrtf(x)
-#define coa_fabs(x) fabsf(x)
 #define REAL_EPSILON FLT_EPSILON
 #else
-#define coa_sqrt(x) sqrt(x)
-#define coa_fabs(x) fabs(x)
 #define REAL_EPSILON DBL_EPSILON
 #endif
 
@@ -611,9 +607,9 @@ static coa_vec3_t plan_at(const coa_intent_plan_t *p, coa_real_t u)
 
 static coa_real_t max_abs3(const coa_vec3_t *p, coa_real_t m)
 {
-    coa_real_t x = coa_fabs(p->x);
-    coa_real_t y = coa_fabs(p->y);
-    coa_real_t z = coa_fabs(p->z);
+    coa_real_t x = real_fabs(p->x);
+    coa_real_t y = real_fabs(p->y);
+    coa_real_t z = real_fabs(p->z);
     m = x > m ? x : m;
     m = y > m ? y : m;
     return z > m ? z : m;
@@ -1249,11 +1245,11 @@ static bool evaluate_movers(const coa_predictor_t *pr, uint32_t a, uint32_t b,
             (r.d0z >= (coa_real_t)0 && d1z <= (coa_real_t)0)) {
             vmin = (coa_real_t)0;
             uv = r.d0z == d1z ? (coa_real_t)0 : r.d0z / (r.d0z - d1z);
-        } else if (coa_fabs(r.d0z) <= coa_fabs(d1z)) {
-            vmin = coa_fabs(r.d0z);
+        } else if (real_fabs(r.d0z) <= real_fabs(d1z)) {
+            vmin = real_fabs(r.d0z);
             uv = (coa_real_t)0;
         } else {
-            vmin = coa_fabs(d1z);
+            vmin = real_fabs(d1z);
             uv = (coa_real_t)1;
         }
         best_h2 = h2 < best_h2 ? h2 : best_h2;
@@ -1284,7 +1280,7 @@ static bool evaluate_movers(const coa_predictor_t *pr, uint32_t a, uint32_t b,
             double sh1 = pair_sigma(ma->sigma_h, ma->rate_h, mb->sigma_h, mb->rate_h, tau1);
             double sv1 = pair_sigma(ma->sigma_v, ma->rate_v, mb->sigma_v, mb->rate_v, tau1);
 
-            double gap_h = (double)coa_sqrt(h2) - (double)near_h;
+            double gap_h = (double)real_sqrt(h2) - (double)near_h;
             double gap_v = (double)vmin - (double)near_v;
             coa_real_t instants[7];
             size_t count = 0u;
@@ -1312,7 +1308,7 @@ static bool evaluate_movers(const coa_predictor_t *pr, uint32_t a, uint32_t b,
                 coa_real_t u = instants[i];
                 coa_real_t x = r.d0x + u * r.wx;
                 coa_real_t y = r.d0y + u * r.wy;
-                coa_real_t d = coa_sqrt(x * x + y * y);
+                coa_real_t d = real_norm2(x, y);
                 coa_real_t dz = r.d0z + u * r.wz;
                 double tau = (double)(((coa_real_t)k + u) * c->dt);
                 double sh = pair_sigma(ma->sigma_h, ma->rate_h, mb->sigma_h, mb->rate_h, tau);
@@ -1320,7 +1316,7 @@ static bool evaluate_movers(const coa_predictor_t *pr, uint32_t a, uint32_t b,
                 double p;
                 if (!real_ok(d) || !real_ok(dz) ||
                     log_probability_bound((double)d - (double)rsum, sh,
-                                          (double)coa_fabs(dz) - (double)hsum, sv) +
+                                          (double)real_fabs(dz) - (double)hsum, sv) +
                             PRUNE_MARGIN <
                         log_cut) {
                     continue;
@@ -1343,7 +1339,7 @@ static bool evaluate_movers(const coa_predictor_t *pr, uint32_t a, uint32_t b,
     }
     out->first_step = first;
     out->first_time = c->t0 + (coa_real_t)first * c->dt;
-    out->min_horizontal = coa_sqrt(best_h2);
+    out->min_horizontal = real_sqrt(best_h2);
     out->min_vertical = best_v;
     out->probability = uncertain ? pmax : 1.0;
     return true;
@@ -1500,7 +1496,7 @@ static bool evaluate_obstacle(const coa_predictor_t *pr, uint32_t a, uint32_t o,
             best_h2 = h2 < best_h2 ? h2 : best_h2;
             best_v = v < best_v ? v : best_v;
         }
-        out->min_horizontal = coa_sqrt(best_h2);
+        out->min_horizontal = real_sqrt(best_h2);
         out->min_vertical = best_v;
     }
     return true;

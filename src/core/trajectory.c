@@ -7,11 +7,7 @@
 #include <float.h>
 #include <math.h>
 
-#ifdef COA_SINGLE_PRECISION
-#define coa_sqrt(x) sqrtf(x)
-#else
-#define coa_sqrt(x) sqrt(x)
-#endif
+#include "internal.h"
 
 #define INT64_LIMIT ((uint64_t)INT64_MAX)
 
@@ -43,14 +39,9 @@ static coa_vec3_t vec_lerp(const coa_vec3_t *p0, const coa_vec3_t *p1, coa_real_
     return r;
 }
 
-/* sqrt of the sum of squares rather than hypot: sqrt is correctly rounded everywhere, so
- * the host and the firmware's libm compute the same leg lengths. Coordinates in a local
- * ENU frame are far from the range where the squares would overflow or underflow. */
 static coa_real_t horizontal_length(const coa_vec3_t *p0, const coa_vec3_t *p1)
 {
-    coa_real_t dx = p1->x - p0->x;
-    coa_real_t dy = p1->y - p0->y;
-    return coa_sqrt(dx * dx + dy * dy);
+    return real_norm2(p1->x - p0->x, p1->y - p0->y);
 }
 
 static uint64_t magnitude(int32_t a)
