@@ -590,15 +590,21 @@ static void csv_rows(FILE *f, uint64_t seed, const mc_result_t *r)
 {
     for (int m = 0; m < MC_METHODS; m++) {
         const mc_outcome_t *o = &r->m[m];
-        char units[48];
-        cost_text(o->units, units, sizeof units);
-        fprintf(f, "%llu,%lu,%lu,%lu,%lu,%lu,%lu,%s,%s,%.6f,%s,%lu,%llu,%llu,%lu,%.1f\n",
+        /* Costs only of a plan: a failed decoupled attempt's partial costs are not one. */
+        char costs[128] = ",,";
+        if (o->status == COA_PLAN_SOLVED) {
+            char units[48];
+            cost_text(o->units, units, sizeof units);
+            snprintf(costs, sizeof costs, "%.6f,%s,%lu", o->deviation, units,
+                     (unsigned long)o->effort);
+        }
+        fprintf(f, "%llu,%lu,%lu,%lu,%lu,%lu,%lu,%s,%s,%s,%llu,%llu,%lu,%.1f\n",
                 (unsigned long long)seed, (unsigned long)r->vehicles, (unsigned long)r->index,
                 (unsigned long)r->redraws, (unsigned long)r->info.hills,
                 (unsigned long)r->info.tracks, (unsigned long)r->first_conflict_step,
-                method_names[m], status_name(o->status), o->deviation, units,
-                (unsigned long)o->effort, (unsigned long long)o->expanded,
-                (unsigned long long)o->generated, (unsigned long)o->orders_tried, o->time_us);
+                method_names[m], status_name(o->status), costs,
+                (unsigned long long)o->expanded, (unsigned long long)o->generated,
+                (unsigned long)o->orders_tried, o->time_us);
     }
 }
 
@@ -779,8 +785,9 @@ static void wilson(uint32_t k, uint32_t n, double *rate, double *low, double *hi
     double centre = (p + z2 / (2.0 * nn)) / (1.0 + z2 / nn);
     double half = MC_Z95 * sqrt(p * (1.0 - p) / nn + z2 / (4.0 * nn * nn)) / (1.0 + z2 / nn);
     *rate = p;
-    *low = centre - half < 0 ? 0 : centre - half;
-    *high = centre + half > 1 ? 1 : centre + half;
+    /* Exactly 0 and 1 at the ends, where rounding would leave a few ulps. */
+    *low = k == 0 || centre - half < 0 ? 0 : centre - half;
+    *high = k == n || centre + half > 1 ? 1 : centre + half;
 }
 
 /* Summarises the count results of one size; x: room for count doubles. */
