@@ -194,12 +194,12 @@ bool encounter_json(const encounter_design_t *d, uint64_t seed, uint32_t n, uint
                     lowest - d->half_height - 4.0);
     }
     if (ok && d->terrain_hills) {
-        /* Tops from 6 m below the lowest UAV's volume to 2 m into it: diving over a hill
-         * is limited or impossible, and the lowest UAV may have to climb over one. */
+        /* Tops from 8 m below the lowest UAV's volume up to touching it: diving over a
+         * hill is limited or impossible. */
         drawn.hills = 1u + prng_below(&r, 3u);
         ok = append(buf, size, &used, ", \"obstacles\": [");
         for (uint32_t h = 0; ok && h < drawn.hills; h++) {
-            double top = lowest - d->half_height - prng_uniform(&r, -2.0, 6.0);
+            double top = lowest - d->half_height - prng_uniform(&r, 0.0, 8.0);
             ok = append(buf, size, &used, "%s", h == 0 ? "" : ", ") &&
                  hill_json(d, &r, top, buf, size, &used);
         }

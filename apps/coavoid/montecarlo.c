@@ -14,7 +14,9 @@
  *
  * The centralised plan is optimal, so wherever both solve, a decoupled plan's exact
  * deviation must be at least the centralised one's, lexicographically with the effort;
- * and every solved plan must be conflict-free by coa_plan_find_conflict. A violation is a
+ * a decoupled plan is a plan for the group, so the centralised search cannot have proven
+ * one absent (infeasible); every solved plan must be conflict-free by
+ * coa_plan_find_conflict, and must move someone (the reference conflicts). A violation is a
  * defect of the planner: it is printed on stderr and the command exits 3 after writing
  * everything else.
  *
@@ -59,7 +61,7 @@ static const char *const method_names[MC_METHODS] = {"centralised", "decoupled_f
 #define MONTECARLO_USAGE                                                                     \
     "usage: coavoid montecarlo --vehicles N[,N...] [--count C] [--seed S] [--beta B]\n"     \
     "                          [--max-orders M] [--csv FILE] [--svg FILE] [--json]\n"      \
-    "                          [--save DIR] [--jobs J] [--quiet]\n"                                     \
+    "                          [--save DIR] [--jobs J] [--quiet]\n"                        \
     "\n"                                                                                   \
     "Draws C random encounters of N UAVs (for each N listed) converging on a point over\n" \
     "hills, with 0 to 2 non-cooperative tracks crossing (%u steps of %g s), and solves\n"  \
@@ -90,9 +92,9 @@ static const char *const method_names[MC_METHODS] = {"centralised", "decoupled_f
     "A seed gives the same encounters and results on every machine, except the times.\n"  \
     "\n"                                                                                   \
     "exit status: 0 done (whatever the plans' outcomes), 2 invalid usage (one line on\n"  \
-    "stderr naming the option and why), 3 internal error, or a defect: a decoupled plan\n" \
-    "cheaper than the optimal centralised one, or a solved plan in conflict (each one\n"   \
-    "line on stderr)\n"
+    "stderr naming the option and why), 3 internal error or a defect of the planner (a\n" \
+    "decoupled plan cheaper than the optimal centralised one or where it proved none, a\n" \
+    "solved plan in conflict or with no deviation: one line each on stderr)\n"
 
 static void montecarlo_help(void)
 {
@@ -479,6 +481,13 @@ static int solve_encounter(uint64_t seed, const mc_size_t *size, uint32_t index,
     }
     for (int m = MC_FIXED; status == 0 && m < MC_METHODS && r->defect[0] == '\0'; m++) {
         const mc_outcome_t *d = &r->m[m];
+        /* A decoupled plan is a plan for the whole group, which the centralised search
+         * cannot have proven absent. */
+        if (c->status == COA_PLAN_INFEASIBLE && d->status == COA_PLAN_SOLVED) {
+            snprintf(r->defect, sizeof r->defect, "%s solved an encounter the centralised "
+                     "search proved infeasible", method_names[m]);
+            continue;
+        }
         if (c->status != COA_PLAN_SOLVED || d->status != COA_PLAN_SOLVED) {
             continue;
         }

@@ -113,6 +113,9 @@ for s in b["sizes"]:
             assert close(r["mean"], sum(ratios) / len(ratios)), r
             eq = sum(1 for e in both if e[m["method"]]["deviation_units"] == e["centralised"]["deviation_units"])
             assert close(r["equal_share"], eq / len(both)), r
+        # A decoupled plan is a plan: the centralised search cannot have proven none.
+        assert not any(e["centralised"]["status"] == "infeasible" and e[m["method"]]["status"] == "solved"
+                       for e in enc.values()), m
         cs = lambda e: e["centralised"]["status"] == "solved"
         ds = lambda e: e[m["method"]]["status"] == "solved"
         assert m["fails_where_centralised_solves"] == sum(1 for e in enc.values() if cs(e) and not ds(e)), m
