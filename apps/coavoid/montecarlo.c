@@ -1051,9 +1051,17 @@ static int write_svg(const char *path, const mc_options_t *o, const mc_run_t *ru
                "viewBox=\"0 0 %.0f %.0f\" font-family=\"sans-serif\" font-size=\"13\">\n"
                "<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n",
             SVG_W, SVG_H, SVG_W, SVG_H);
+    char betas[64] = "";
+    for (uint32_t k = 0, used = 0; k < sizes && used < sizeof betas; k++) {
+        if (k == 0 || s[k].size.beta != s[k - 1].size.beta) {
+            int w = snprintf(betas + used, sizeof betas - used, "%s%lu", k == 0 ? "" : "/",
+                             (unsigned long)s[k].size.beta);
+            used += w > 0 ? (uint32_t)w : 0u;
+        }
+    }
     fprintf(f, "<text x=\"%.0f\" y=\"24\" font-size=\"15\" font-weight=\"bold\">coavoid "
-               "montecarlo: seed %llu, %lu encounters per UAV count</text>\n",
-            SVG_BAR_LEFT, (unsigned long long)o->seed, (unsigned long)o->count);
+               "montecarlo: seed %llu, %lu encounters per UAV count, beta %s</text>\n",
+            SVG_BAR_LEFT, (unsigned long long)o->seed, (unsigned long)o->count, betas);
 
     /* Left: success rates, a group of three bars per UAV count, with Wilson intervals. */
     fprintf(f, "<text x=\"%.0f\" y=\"%.0f\" font-weight=\"bold\">success rate (95%% Wilson "
@@ -1071,6 +1079,12 @@ static int write_svg(const char *path, const mc_options_t *o, const mc_run_t *ru
             const mc_method_summary_t *ms = &s[k].m[m];
             double bx = gx + m * bar, top = y0 - ms->rate * SVG_PANEL_H;
             double cx = bx + 0.45 * bar;
+            if (ms->budget > 0) { /* above the bar, pale: unknown, not failed */
+                double h = (double)ms->budget / s[k].encounters * SVG_PANEL_H;
+                fprintf(f, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" "
+                           "fill=\"%s\" fill-opacity=\"0.3\"/>\n",
+                        bx, top - h, 0.9 * bar, h, method_colours[m]);
+            }
             fprintf(f, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" "
                        "fill=\"%s\"/>\n"
                        "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"black\"/>\n",
@@ -1089,6 +1103,8 @@ static int write_svg(const char *path, const mc_options_t *o, const mc_run_t *ru
                 SVG_BAR_LEFT, ly - 10, method_colours[m], SVG_BAR_LEFT + 18, ly,
                 method_names[m]);
     }
+    fprintf(f, "<text x=\"%.0f\" y=\"%.0f\">pale above a bar: budget exhausted</text>\n",
+            SVG_BAR_LEFT + 170, y0 + 44);
 
     /* Right: the CDF of the deviation ratio per UAV count, fixed solid, reordered dashed. */
     double right = cdf_right(s, sizes);
