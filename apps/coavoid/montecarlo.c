@@ -48,7 +48,7 @@
 
 #define MC_DEFAULT_SEED 1u
 #define MC_DEFAULT_COUNT 100u
-#define MC_MAX_COUNT 1000000u
+#define MC_MAX_COUNT 100000u
 #define MC_MAX_JOBS 64u
 #define MC_MAX_ATTEMPTS 1000u /* draws per encounter before giving up (a design bug) */
 #define MC_SIZES (ENCOUNTER_MAX_VEHICLES - ENCOUNTER_MIN_VEHICLES + 1u)
