@@ -10,8 +10,9 @@
  * climb steps): against 10 m of combined half-heights most pairs conflict unless someone
  * moves, and some pairs already clear each other. Half the encounters have a terrain box
  * under the point whose top is 4 m below the lowest UAV's volume, so diving is limited
- * there. The problems are written as scenario JSON and go through the scenario loader,
- * so they are checked like any file.
+ * there. The problems (encounter.h, design encounter_bench, shared with coavoid
+ * montecarlo) are written as scenario JSON and go through the scenario loader, so they are
+ * checked like any file.
  *
  * Everything comes from our own PRNG (splitmix64) seeded by --seed, so a seed gives the
  * same problems on every machine; only the times differ.
@@ -25,8 +26,6 @@
  */
 #define _POSIX_C_SOURCE 200809L
 
-#include <math.h>
-#include <stdarg.h>
 #include <stdbool.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -40,6 +39,7 @@
 #include "cli.h"
 #include "coavoid/coavoid.h"
 #include "commands.h"
+#include "encounter.h"
 #include "scenario.h"
 
 #define BP_DEFAULT_SEED 1u
@@ -47,18 +47,12 @@
 #define BP_DEFAULT_COUNT 5u
 #define BP_MAX_REPEAT 10000u
 #define BP_MAX_COUNT 10000u
-#define BP_MIN_VEHICLES 2u
-#define BP_MAX_VEHICLES 5u
+#define BP_MIN_VEHICLES ENCOUNTER_MIN_VEHICLES
+#define BP_MAX_VEHICLES ENCOUNTER_MAX_VEHICLES
 _Static_assert(BP_MIN_VEHICLES == 2u && BP_MAX_VEHICLES == 5u, "--vehicles' hint says 2 to 5");
 #define BP_DEFAULT_SCENARIO "scenarios/paper.json"
-#define BP_HORIZON 20u
-#define BP_DT 1.0
-#define BP_BASE_ALTITUDE 100.0
-#define BP_ALTITUDE_GRID 2.0 /* m per stagger step */
-#define BP_MAX_STAGGER 3u    /* steps either side of the base */
-#define BP_PI 3.14159265358979323846
-/* One problem's JSON: 5 vehicles of about 300 characters and a box. */
-#define BP_JSON_MAX 4096u
+#define BP_HORIZON encounter_bench.horizon
+#define BP_DT encounter_bench.dt
 #define BP_SET_MAX (1u + BP_MAX_VEHICLES - BP_MIN_VEHICLES + 1u)
 
 #define BENCH_PLAN_USAGE                                                                    \
@@ -189,67 +183,6 @@ static int parse_bp_options(int argc, char **argv, bp_options_t *o)
 
 /* ---- the encounters ---- */
 
-/* Appends to buf; false when it would not fit (a bug: BP_JSON_MAX bounds a problem). */
-static bool bp_append(char *buf, size_t size, size_t *used, const char *fmt, ...)
-    CLI_PRINTF_LIKE(4, 5);
-
-static bool bp_append(char *buf, size_t size, size_t *used, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    int n = vsnprintf(buf + *used, size - *used, fmt, ap);
-    va_end(ap);
-    if (n < 0 || (size_t)n >= size - *used) {
-        return false;
-    }
-    *used += (size_t)n;
-    return true;
-}
-
-/* The JSON of encounter `index` of n UAVs: its own PRNG stream, so adding problems or UAV
- * counts does not change the others. */
-static bool encounter_json(uint64_t seed, uint32_t n, uint32_t index, char *buf, size_t size)
-{
-    prng_t r = {seed ^ ((uint64_t)n << 56) ^ ((uint64_t)index * 0x9e3779b97f4a7c15u)};
-    prng_next(&r);
-    size_t used = 0;
-    const double horizon_s = BP_HORIZON * BP_DT;
-    bool ok = bp_append(buf, size, &used,
-                        "{\"name\": \"bench encounter %u of %u UAVs\", \"dt\": %g, "
-                        "\"horizon\": %u, \"vehicles\": [",
-                        index, n, BP_DT, BP_HORIZON);
-    double heading0 = prng_uniform(&r, 0.0, 2.0 * BP_PI);
-    double lowest = 1e300;
-    for (uint32_t i = 0; ok && i < n; i++) {
-        double heading = heading0 + 2.0 * BP_PI * i / n + prng_uniform(&r, -0.3, 0.3);
-        double speed = prng_uniform(&r, 8.0, 12.0);
-        double climb = prng_uniform(&r, 1.5, 3.0);
-        double arrive = prng_uniform(&r, 8.0, 12.0);
-        double z = BP_BASE_ALTITUDE +
-                   BP_ALTITUDE_GRID * ((double)prng_below(&r, 2u * BP_MAX_STAGGER + 1u) -
-                                       (double)BP_MAX_STAGGER);
-        lowest = z < lowest ? z : lowest;
-        double ux = cos(heading), uy = sin(heading);
-        /* Flying along (ux, uy) through the point at t = arrive, and on past the horizon. */
-        double before = speed * arrive;
-        double after = speed * (horizon_s - arrive + 10.0);
-        ok = bp_append(buf, size, &used,
-                       "%s{\"id\": %u, \"priority\": %u, \"cruise_speed\": %.3f, "
-                       "\"climb_rate\": %.3f, \"steep_factor\": 2, \"radius\": 15, "
-                       "\"half_height\": 5, \"route\": [[%.3f, %.3f, %.1f], [%.3f, %.3f, %.1f]]}",
-                       i == 0 ? "" : ", ", i + 1u, i + 1u, speed, climb, -before * ux,
-                       -before * uy, z, after * ux, after * uy, z);
-    }
-    ok = ok && bp_append(buf, size, &used, "]");
-    if (ok && prng_below(&r, 2u) == 0) {
-        ok = bp_append(buf, size, &used,
-                       ", \"obstacles\": [{\"type\": \"box\", \"min\": [-40, -40, 0], "
-                       "\"max\": [40, 40, %.1f]}]",
-                       lowest - 5.0 - 4.0);
-    }
-    return ok && bp_append(buf, size, &used, "}");
-}
-
 /* ---- the sets ---- */
 
 typedef struct {
@@ -278,12 +211,12 @@ static int build_random_set(const bp_options_t *o, uint32_t n, bp_set_t *set)
                         (unsigned long)o->count);
     }
     for (uint32_t j = 0; j < o->count; j++) {
-        char json[BP_JSON_MAX];
+        char json[ENCOUNTER_JSON_MAX];
         char err[SCENARIO_ERROR_MAX];
         set->count = j + 1u; /* so set_free frees this one too */
-        if (!encounter_json(o->seed, n, j, json, sizeof json)) {
+        if (!encounter_json(&encounter_bench, o->seed, n, j, 0u, json, sizeof json, NULL)) {
             return cli_fail(CLI_EXIT_INTERNAL, "internal error: encounter %u of %u UAVs does "
-                            "not fit %u bytes", j, n, BP_JSON_MAX);
+                            "not fit %u bytes", j, n, ENCOUNTER_JSON_MAX);
         }
         if (scenario_parse(json, strlen(json), &set->problems[j], err, sizeof err) != 0 ||
             scenario_sample(&set->problems[j], err, sizeof err) != 0) {

@@ -7,6 +7,7 @@
  *   coavoid predict SCENARIO.json [--threshold P] [...]             predict_cmd.c
  *   coavoid bench predict --vehicles N --horizon H [...]            bench.c
  *   coavoid bench plan [--vehicles N] [--count C] [...]              bench_plan.c
+ *   coavoid montecarlo --vehicles N[,N...] [--count C] [...]        montecarlo.c
  *   coavoid world SCENARIO.json [--lcm-url URL] [--epoch UTIME] [...] world_cmd.c
  *   coavoid sim SCENARIO.json --mode centralised|decoupled [...]    sim_cmd.c
  *   coavoid summary LOGFILE SCENARIO.json --mode MODE [...]         summary_cmd.c (LCM)
@@ -37,6 +38,7 @@
     "  plan     plan collision-free altitude manoeuvres for a scenario\n"       \
     "  predict  predict the conflicts of a scenario's reference trajectories\n" \
     "  bench    time the core: bench predict, bench plan\n"    \
+    "  montecarlo  compare the planners over random encounters\n"           \
     "  sim      fly a scenario in closed loop over the nodes (deterministic)\n"  \
     USAGE_SUMMARY                                                               \
     "\n"                                                                        \
@@ -60,6 +62,9 @@ int main(int argc, char **argv)
     }
     if (strcmp(command, "bench") == 0) {
         return command_bench(argc, argv);
+    }
+    if (strcmp(command, "montecarlo") == 0) {
+        return command_montecarlo(argc, argv);
     }
     if (strcmp(command, "world") == 0) {
         return command_world(argc, argv);

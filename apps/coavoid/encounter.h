@@ -1,0 +1,74 @@
+/*
+ * encounter.h: seeded random encounters of n UAVs converging on one point, written as
+ * scenario JSON (SCENARIO_FORMAT.md) so that they go through the scenario loader and are
+ * checked like any file. `coavoid bench plan` times the planner on them and `coavoid
+ * montecarlo` evaluates the planners over thousands of them; one generator serves both so
+ * that "an encounter" means the same thing in docs/benchmarks.md and docs/evaluation.md.
+ *
+ * The shape. UAV i's heading is heading0 + 2 pi i / n plus jitter; it flies a straight
+ * level route through the origin, reaching it `arrive` seconds into the window, at an
+ * altitude staggered on a grid around a base altitude. A design (encounter_design_t) sets
+ * the ranges; with terrain_hills it adds hills under the crossing area, with max_tracks
+ * non-cooperative aircraft crossing it, and with max_offset_max a vertical band per UAV.
+ *
+ * Everything comes from splitmix64 (bench_support.h), one stream per (seed, n, index,
+ * attempt), so a seed gives the same problems on every machine, and adding problems or UAV
+ * counts changes none of the others. The draws are made in a fixed order and a design's
+ * optional parts draw nothing when they are off, so encounter_bench (no quantum, one box
+ * half the time) gives exactly the problems bench plan gave before this file existed.
+ */
+#ifndef COAVOID_APP_ENCOUNTER_H
+#define COAVOID_APP_ENCOUNTER_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+/* One problem's JSON: 5 vehicles of about 330 characters, 3 hills of about 250, 2 tracks. */
+#define ENCOUNTER_JSON_MAX 6144u
+#define ENCOUNTER_MIN_VEHICLES 2u
+#define ENCOUNTER_MAX_VEHICLES 5u
+
+typedef struct {
+    const char *name;        /* "bench encounter", in each problem's name */
+    uint32_t horizon;        /* steps */
+    double dt;               /* s */
+    double speed_min, speed_max;   /* cruise speed, m/s */
+    double climb_min, climb_max;   /* climb rate, m/s */
+    double arrive_min, arrive_max; /* when each reaches the origin, s */
+    double jitter;           /* heading jitter, rad either side */
+    double base_altitude;    /* m */
+    double altitude_grid;    /* m per stagger step */
+    uint32_t max_stagger;    /* stagger steps either side of the base */
+    double radius, half_height; /* every UAV's protected volume, m */
+    /* 0: numbers as drawn (printed to 3 decimals); otherwise every coordinate, speed and
+     * rate is rounded to a multiple of it. A power of two such as 1/8 makes each one a
+     * float exactly, so single- and double-precision builds read the same problem. */
+    double quantum;
+    bool box_half;           /* bench: half the encounters get a box under the origin */
+    bool terrain_hills;      /* montecarlo: 1-3 hills (boxes or pyramids) near the origin */
+    uint32_t max_tracks;     /* 0..max_tracks non-cooperative tracks crossing near the origin */
+    double track_radius, track_half_height; /* their protected volumes, m */
+    /* 0: unbounded; otherwise each UAV's max_offset is drawn from min..max. */
+    uint32_t max_offset_min, max_offset_max;
+} encounter_design_t;
+
+/* bench plan's encounters (docs/benchmarks.md, "The encounters"). */
+extern const encounter_design_t encounter_bench;
+/* montecarlo's encounters (docs/evaluation.md, "The encounters"). */
+extern const encounter_design_t encounter_montecarlo;
+
+/* What encounter_json drew beyond the vehicles, for reports. */
+typedef struct {
+    uint32_t hills;
+    uint32_t tracks;
+} encounter_info_t;
+
+/* Writes encounter `index` of n UAVs (ENCOUNTER_MIN_VEHICLES..ENCOUNTER_MAX_VEHICLES) of
+ * design d, draw `attempt` (0 first; a caller that rejects a draw asks for the next), as
+ * scenario JSON into buf[size]. info may be NULL. Returns false when it does not fit (a
+ * bug: ENCOUNTER_JSON_MAX bounds a problem). O(n + hills + tracks), no memory. */
+bool encounter_json(const encounter_design_t *d, uint64_t seed, uint32_t n, uint32_t index,
+                    uint32_t attempt, char *buf, size_t size, encounter_info_t *info);
+
+#endif /* COAVOID_APP_ENCOUNTER_H */

@@ -1,0 +1,270 @@
+#!/bin/bash
+# `coavoid montecarlo` on small runs: the CSV, the JSON summary and the SVG are well formed;
+# the summary is what the CSV says (recomputed here); a seed gives the same rows (times
+# aside) twice and with --jobs 1 or 2; every plan the centralised planner solves is at most
+# as costly as a decoupled one (lexicographically, in exact units), which the command also
+# checks itself and would exit 3 on; a saved encounter replays to the same plan with
+# `coavoid plan`; progress goes to stderr; bad options exit 2 with one line naming them.
+#
+# usage: bash montecarlo.sh <path-to-coavoid> <source-dir>   (VERBOSE=1 shows each message)
+set -u
+# shellcheck source=tests/cli/lib.bash
+. "$(dirname "${BASH_SOURCE[0]}")/lib.bash" "$@"
+
+# run NAME ARGS...: `coavoid montecarlo ARGS` exits 0 with nothing on stderr; stdout is
+# left in $tmp/out.
+run() {
+    local name=$1
+    shift
+    "$bin" montecarlo "$@" >"$tmp/out" 2>"$tmp/err"
+    local rc=$?
+    if [ "$rc" -ne 0 ] || [ -s "$tmp/err" ]; then
+        fail "$name: exit $rc, expected 0: $(head -c 300 "$tmp/err")"
+        return 1
+    fi
+    return 0
+}
+
+# check NAME CSV JSON SVG: the files are well formed and agree.
+check() {
+    local name=$1
+    shift
+    if python3 - "$@" >"$tmp/py" 2>&1 <<'PY'; then pass; else fail "$name: $(tail -n 5 "$tmp/py")"; fi
+import csv, json, math, sys
+import xml.etree.ElementTree as ET
+
+csv_path, json_path, svg_path = sys.argv[1:4]
+header = ["seed", "vehicles", "index", "redraws", "hills", "tracks", "first_conflict_step",
+          "method", "status", "deviation", "deviation_units", "effort", "expanded",
+          "generated", "orders_tried", "time_us"]
+methods = ["centralised", "decoupled_fixed", "decoupled_reordered"]
+with open(csv_path, newline="") as f:
+    reader = csv.reader(f)
+    assert next(reader) == header
+    rows = [dict(zip(header, r)) for r in reader]
+b = json.load(open(json_path))
+assert b["command"] == "montecarlo" and b["horizon"] >= 1 and b["dt"] > 0, b
+count = b["count"]
+sizes = [s["vehicles"] for s in b["sizes"]]
+# Every encounter once per method, in order: sizes as given, then index, then method.
+expect = [(n, j, m) for n in sizes for j in range(count) for m in methods]
+got = [(int(r["vehicles"]), int(r["index"]), r["method"]) for r in rows]
+assert got == expect, (got[:6], expect[:6])
+for r in rows:
+    assert r["status"] in ("solved", "infeasible", "budget_exhausted"), r
+    assert int(r["seed"]) == int(b["seed"]), r
+    assert 1 <= int(r["first_conflict_step"]) < b["horizon"], r
+    assert 1 <= int(r["hills"]) <= 3 and 0 <= int(r["tracks"]) <= 2, r
+    assert float(r["time_us"]) >= 0 and int(r["expanded"]) >= 0, r
+    solved = r["status"] == "solved"
+    if solved:  # the reference conflicts: every plan moves someone
+        assert float(r["deviation"]) > 0 and int(r["deviation_units"]) > 0 and int(r["effort"]) > 0, r
+    else:
+        assert r["deviation"] == r["deviation_units"] == r["effort"] == "", r
+    assert int(r["orders_tried"]) >= 1, r
+    if r["method"] != "decoupled_reordered":
+        assert int(r["orders_tried"]) == 1, r
+
+def quantile(x, p):  # numpy's default (linear), as the command's
+    h = (len(x) - 1) * p
+    lo = math.floor(h)
+    return x[lo] + (h - lo) * (x[lo + 1] - x[lo]) if lo + 1 < len(x) else x[-1]
+
+def close(a, b):
+    return abs(a - b) <= 1e-9 * max(1.0, abs(a), abs(b))
+
+for s in b["sizes"]:
+    n = s["vehicles"]
+    assert s["encounters"] == count and s["beta"] >= 1 and s["max_orders"] >= 1, s
+    enc = {}
+    for r in rows:
+        if int(r["vehicles"]) == n:
+            enc.setdefault(int(r["index"]), {})[r["method"]] = r
+    assert s["redraws"] == sum(int(e["centralised"]["redraws"]) for e in enc.values()), s
+    assert [m["method"] for m in s["methods"]] == methods, s
+    for m in s["methods"]:
+        st = [e[m["method"]]["status"] for e in enc.values()]
+        assert (m["solved"], m["infeasible"], m["budget_exhausted"]) == (
+            st.count("solved"), st.count("infeasible"), st.count("budget_exhausted")), m
+        assert close(m["success_rate"], m["solved"] / count), m
+        assert 0 <= m["wilson_low"] <= m["success_rate"] <= m["wilson_high"] <= 1, m
+        times = sorted(float(e[m["method"]]["time_us"]) / 1000 for e in enc.values())
+        # the CSV rounds times to 0.1 us
+        assert abs(m["time_ms"]["max"] - times[-1]) < 1e-3, (m["time_ms"], times[-1])
+        nodes = sorted(int(e[m["method"]]["expanded"]) for e in enc.values())
+        assert close(m["nodes_expanded"]["median"], quantile(nodes, 0.5)), m
+        if m["method"] == "centralised":
+            continue
+        both = [e for e in enc.values()
+                if e["centralised"]["status"] == "solved" and e[m["method"]]["status"] == "solved"]
+        for e in both:
+            c, d = e["centralised"], e[m["method"]]
+            # Centralised is optimal: never beaten, lexicographically in exact units.
+            assert (int(d["deviation_units"]), int(d["effort"])) >= (
+                int(c["deviation_units"]), int(c["effort"])), (c, d)
+        ratios = sorted(int(e[m["method"]]["deviation_units"]) / int(e["centralised"]["deviation_units"])
+                        for e in both)
+        r = m["deviation_ratio"]
+        assert r["count"] == len(both), (r, len(both))
+        if both:
+            for key, p in (("min", 0), ("p25", 0.25), ("median", 0.5), ("p75", 0.75),
+                           ("p90", 0.9), ("max", 1)):
+                assert close(r[key], quantile(ratios, p)), (key, r[key], quantile(ratios, p))
+            assert close(r["mean"], sum(ratios) / len(ratios)), r
+            eq = sum(1 for e in both if e[m["method"]]["deviation_units"] == e["centralised"]["deviation_units"])
+            assert close(r["equal_share"], eq / len(both)), r
+        # A decoupled plan is a plan: the centralised search cannot have proven none.
+        assert not any(e["centralised"]["status"] == "infeasible" and e[m["method"]]["status"] == "solved"
+                       for e in enc.values()), m
+        cs = lambda e: e["centralised"]["status"] == "solved"
+        ds = lambda e: e[m["method"]]["status"] == "solved"
+        assert m["fails_where_centralised_solves"] == sum(1 for e in enc.values() if cs(e) and not ds(e)), m
+        assert m["solves_where_centralised_fails"] == sum(1 for e in enc.values() if ds(e) and not cs(e)), m
+    # Reordering tries the fixed order first: it solves whatever the fixed order solves.
+    for e in enc.values():
+        if e["decoupled_fixed"]["status"] == "solved":
+            assert e["decoupled_reordered"]["deviation_units"] == e["decoupled_fixed"]["deviation_units"], e
+
+root = ET.parse(svg_path).getroot()
+assert root.tag == "{http://www.w3.org/2000/svg}svg", root.tag
+texts = " ".join(t.text or "" for t in root.iter("{http://www.w3.org/2000/svg}text"))
+for n in sizes:
+    assert f"{n} UAVs" in texts, texts
+bars = [r for r in root.iter("{http://www.w3.org/2000/svg}rect") if r.get("fill") not in ("white", "none")]
+assert len(bars) >= 3 * len(sizes), len(bars)
+PY
+}
+
+# rows_equal NAME A B: two CSVs are the same but for their times (the last column).
+rows_equal() {
+    if diff <(cut -d, -f1-15 "$2") <(cut -d, -f1-15 "$3") >"$tmp/diff"; then
+        pass
+    else
+        fail "$1: the rows differ: $(head -c 400 "$tmp/diff")"
+    fi
+}
+
+# 2, 3 and 4 UAVs; a small beta keeps the 4-UAV centralised searches cheap (and some run
+# out of it, which must be reported as budget exhausted, not hidden).
+set_a=(--vehicles 2,3,4 --count 5 --seed 7 --beta 2000 --quiet)
+if run first "${set_a[@]}" --csv "$tmp/a.csv" --svg "$tmp/a.svg" --json; then
+    cp "$tmp/out" "$tmp/a.json"
+    check first "$tmp/a.csv" "$tmp/a.json" "$tmp/a.svg"
+fi
+if run again "${set_a[@]}" --csv "$tmp/b.csv" --json; then
+    rows_equal "same seed" "$tmp/a.csv" "$tmp/b.csv"
+    if python3 - "$tmp/a.json" "$tmp/out" <<'PY'; then pass; else fail "same seed: different summary"; fi
+import json, sys
+def strip(b):  # times aside
+    for s in b["sizes"]:
+        for m in s["methods"]:
+            m.pop("time_ms")
+    return b
+a, b = (strip(json.load(open(p))) for p in sys.argv[1:])
+sys.exit(0 if a == b else "summaries differ")
+PY
+fi
+if run jobs "${set_a[@]}" --jobs 2 --csv "$tmp/c.csv"; then
+    rows_equal "--jobs 2" "$tmp/a.csv" "$tmp/c.csv"
+fi
+# Another seed draws other encounters.
+if run other_seed --vehicles 2 --count 5 --seed 8 --quiet --csv "$tmp/d.csv"; then
+    if [ "$(grep -c '^8,2,' "$tmp/d.csv")" -eq 15 ] &&
+        ! diff -q <(cut -d, -f2-15 "$tmp/d.csv") <(grep -E '^(seed|7,2,)' "$tmp/a.csv" | cut -d, -f2-15) >/dev/null; then
+        pass
+    else
+        fail "seed 8 gave the rows of seed 7, or not 15 rows"
+    fi
+fi
+# beta 1 cannot solve a conflict: every centralised search runs out of it, and says so.
+if run budget --vehicles 3 --count 3 --beta 1 --quiet --csv "$tmp/e.csv" --svg "$tmp/e.svg" --json; then
+    cp "$tmp/out" "$tmp/e.json"
+    check budget "$tmp/e.csv" "$tmp/e.json" "$tmp/e.svg"
+    if python3 -c '
+import json, sys
+m = json.load(open(sys.argv[1]))["sizes"][0]["methods"][0]
+sys.exit(0 if m["budget_exhausted"] == 3 and m["solved"] == 0 else m)' "$tmp/e.json"; then
+        pass
+    else
+        fail "beta 1: centralised not reported as budget exhausted"
+    fi
+fi
+
+# The text summary: one block per UAV count with a row per method.
+if run text --vehicles 2,3 --count 3 --quiet; then
+    if grep -q '^2 UAVs: 3 encounters' "$tmp/out" && grep -q '^3 UAVs: 3 encounters' "$tmp/out" &&
+        [ "$(grep -c '^  decoupled_reordered ' "$tmp/out")" -eq 4 ]; then
+        pass
+    else
+        fail "text summary: $(head -c 400 "$tmp/out")"
+    fi
+fi
+
+# A saved encounter is a scenario file that `coavoid plan` plans the same way.
+mkdir "$tmp/saved"
+if run save --vehicles 3 --count 2 --seed 7 --quiet --save "$tmp/saved" --csv "$tmp/f.csv"; then
+    file="$tmp/saved/montecarlo-7-3-1.json"
+    "$bin" plan "$file" --mode centralised >"$tmp/plan.json" 2>"$tmp/err"
+    if python3 - "$tmp/plan.json" "$tmp/f.csv" <<'PY'; then pass; else fail "replay of $file: $(cat "$tmp/err")"; fi
+import csv, json, sys
+plan = json.load(open(sys.argv[1]))
+row = [r for r in csv.DictReader(open(sys.argv[2]))
+       if r["index"] == "1" and r["method"] == "centralised"][0]
+assert plan["status"] == row["status"], (plan["status"], row["status"])
+assert plan["stats"]["nodes_expanded"] == int(row["expanded"]), (plan["stats"], row)
+if row["status"] == "solved":
+    assert abs(plan["cost"]["deviation"] - float(row["deviation"])) < 1e-5, (plan["cost"], row)
+    assert plan["cost"]["effort"] == int(row["effort"]), (plan["cost"], row)
+PY
+    [ "$(ls "$tmp/saved" | wc -l)" -eq 2 ] && pass || fail "--save: $(ls "$tmp/saved")"
+fi
+
+# Progress: without --quiet and with stderr not a terminal, a line per 10 % and the last.
+if "$bin" montecarlo --vehicles 2 --count 20 >"$tmp/out" 2>"$tmp/err"; then
+    if grep -q '^montecarlo: 20/20 encounters (100%), ' "$tmp/err" &&
+        ! grep -qv '^montecarlo: [0-9]*/20 encounters ' "$tmp/err"; then
+        pass
+    else
+        fail "progress: $(head -c 400 "$tmp/err")"
+    fi
+else
+    fail "progress: exit status $?"
+fi
+
+if "$bin" montecarlo --help >"$tmp/help" 2>&1 && grep -q -- '--vehicles N' "$tmp/help"; then
+    pass
+else
+    fail "montecarlo --help: $(head -c 300 "$tmp/help")"
+fi
+
+expect_bad "vehicles missing" "--vehicles: required" montecarlo --count 2
+also="from 2 to 5"
+expect_bad "vehicles 1" "--vehicles" montecarlo --vehicles 1
+expect_bad "vehicles 6" "--vehicles" montecarlo --vehicles 2,6
+expect_bad "vehicles empty entry" "--vehicles" montecarlo --vehicles 2,,3
+expect_bad "vehicles trailing comma" "--vehicles" montecarlo --vehicles 2,
+expect_bad "vehicles abc" "--vehicles" montecarlo --vehicles abc
+also=
+expect_bad "vehicles twice in the list" "listed twice" montecarlo --vehicles 3,2,3
+expect_bad "vehicles given twice" "--vehicles" montecarlo --vehicles 2 --vehicles 3
+expect_bad "vehicles no value" "--vehicles" montecarlo --vehicles
+expect_bad "count 0" "--count" montecarlo --vehicles 2 --count 0
+expect_bad "count huge" "--count" montecarlo --vehicles 2 --count 99999999999999999999
+expect_bad "seed negative" "--seed" montecarlo --vehicles 2 --seed -1
+expect_bad "beta 0" "--beta" montecarlo --vehicles 2 --beta 0
+expect_bad "beta too large" "--beta" montecarlo --vehicles 5 --beta 4000000000
+expect_bad "max orders 0" "--max-orders" montecarlo --vehicles 2 --max-orders 0
+expect_bad "jobs 0" "--jobs" montecarlo --vehicles 2 --jobs 0
+expect_bad "jobs 65" "--jobs" montecarlo --vehicles 2 --jobs 65
+expect_bad "json value" "--json" montecarlo --vehicles 2 --json=yes
+expect_bad "quiet value" "--quiet" montecarlo --vehicles 2 --quiet=1
+expect_bad "csv unwritable" "--csv" montecarlo --vehicles 2 --csv "$tmp/none/x.csv"
+expect_bad "csv empty" "--csv" montecarlo --vehicles 2 --csv=
+expect_bad "svg unwritable" "--svg" montecarlo --vehicles 2 --svg "$tmp/none/x.svg"
+expect_bad "svg same as csv" "--svg" montecarlo --vehicles 2 --csv "$tmp/x" --svg "$tmp/x"
+expect_bad "save not a directory" "--save" montecarlo --vehicles 2 --save "$tmp/a.csv"
+expect_bad "save missing" "--save" montecarlo --vehicles 2 --save "$tmp/none"
+expect_bad "unknown option" "--bogus" montecarlo --vehicles 2 --bogus
+expect_bad "argument" "'extra'" montecarlo --vehicles 2 extra
+
+finish
