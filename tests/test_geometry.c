@@ -9,6 +9,7 @@
  * cannot pass by skipping everything.
  */
 #include <check.h>
+#include <float.h>
 #include <math.h>
 #include <string.h>
 #include <stdint.h>
@@ -711,10 +712,18 @@ END_TEST
  * Here |w|^2 = 320 is not a square, so a test that took sqrt(|w|^2) (or the norm of q)
  * before the discriminant rounded the root at u = 1 and reported the touch as a conflict
  * (double) or the conflict one step early (float). The same cases scaled by powers of two,
- * far beyond where fourth powers would overflow or underflow, give the same answers. */
+ * far beyond where fourth powers would overflow or underflow, give the same answers, and
+ * so do they scaled into the subnormals (where 2^-e for the inputs' exponent e is not a
+ * number of the type: a rescaling by multiplying with it gave inf and NaN, and no
+ * conflict even for volumes that overlap throughout). */
+#ifdef COA_SINGLE_PRECISION
+#define REAL_SUBNORMAL_SCALE ((double)FLT_MIN * 0x1p-8)
+#else
+#define REAL_SUBNORMAL_SCALE (DBL_MIN * 0x1p-8)
+#endif
 START_TEST(test_volumes_touching_off_axis)
 {
-    const double scales[] = {1.0, 0x1p60, 0x1p-60, 0x1p100, 0x1p-100};
+    const double scales[] = {1.0, 0x1p60, 0x1p-60, 0x1p100, 0x1p-100, REAL_SUBNORMAL_SCALE};
     size_t i;
 
     for (i = 0; i < sizeof scales / sizeof scales[0]; ++i) {
