@@ -749,6 +749,27 @@ START_TEST(test_volumes_touching_off_axis)
 }
 END_TEST
 
+/* Two volumes that coincide at the start conflict however little they then move. With a
+ * displacement whose square is the type's least subnormal, radius^2 * |w|^2 underflows to
+ * 0, and the discriminant with it: the disc test reported no conflict. */
+#ifdef COA_SINGLE_PRECISION
+#define REAL_TINY_STEP 0x1.8p-75
+#else
+#define REAL_TINY_STEP 0x1.8p-538
+#endif
+START_TEST(test_volumes_coincident_tiny_step)
+{
+    coa_sweep_t a = still(0.25, 1, 0, 0, 0);
+    coa_real_t w = (coa_real_t)REAL_TINY_STEP;
+
+    ck_assert(w * w > 0);
+    ck_assert(vols(a, sweep(0.25, 1, vec(0, 0, 0), vec(REAL_TINY_STEP, 0, 0))));
+    ck_assert(vols(a, sweep(0.25, 1, vec(0.125, 0, 0), vec(0.125, REAL_TINY_STEP, 0))));
+    /* Apart by more than the radii: still no conflict. */
+    ck_assert(!vols(a, sweep(0.25, 1, vec(0.5, 0, 0), vec(0.5, REAL_TINY_STEP, 0))));
+}
+END_TEST
+
 START_TEST(test_box_motion)
 {
     coa_box_t c = cube10();
@@ -1176,6 +1197,7 @@ static Suite *geometry_suite(void)
     tcase_add_test(hand, test_volumes_touching);
     tcase_add_test(hand, test_obstacle_check);
     tcase_add_test(hand, test_volumes_touching_off_axis);
+    tcase_add_test(hand, test_volumes_coincident_tiny_step);
     tcase_add_test(hand, test_volumes_crossing);
     tcase_add_test(hand, test_volumes_step_ends);
     tcase_add_test(hand, test_volumes_degenerate_motion);

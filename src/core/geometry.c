@@ -152,7 +152,12 @@ static coa_span_t span_disc(coa_real_t qx, coa_real_t qy, coa_real_t wx, coa_rea
     cross = qx * wy - qy * wx;
     disc = radius * radius * a - cross * cross;
     if (!(disc > (coa_real_t)0)) {
-        return span_empty();
+        /* c < 0 (the start inside) makes the true discriminant positive; a computed one
+         * that is not has underflowed (|w| so far below radius that radius^2*|w|^2 does)
+         * or rounded at a tangency through the start. Inside at the start is a conflict
+         * either way: the whole step, which is right for a step that short and errs on
+         * the safe side at the tangency. */
+        return c < (coa_real_t)0 ? span_all() : span_empty();
     }
     sd = real_sqrt(disc);
     b = qx * wx + qy * wy;
