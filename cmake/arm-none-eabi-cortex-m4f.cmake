@@ -3,7 +3,7 @@
 #
 #   cmake -S . -B build-arm -DCMAKE_TOOLCHAIN_FILE=cmake/arm-none-eabi-cortex-m4f.cmake
 #
-# The same file builds libccd from its source package (cmake/firmware.cmake passes it on),
+# The same file builds libccd from its source package (cmake/libccd_arm.cmake passes it on),
 # so the core and libccd share one ABI: objects built for another float ABI would refuse to
 # link rather than misbehave.
 set(CMAKE_SYSTEM_NAME Generic)

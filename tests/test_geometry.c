@@ -9,6 +9,7 @@
  * cannot pass by skipping everything.
  */
 #include <check.h>
+#include <float.h>
 #include <math.h>
 #include <string.h>
 #include <stdint.h>
@@ -711,10 +712,18 @@ END_TEST
  * Here |w|^2 = 320 is not a square, so a test that took sqrt(|w|^2) (or the norm of q)
  * before the discriminant rounded the root at u = 1 and reported the touch as a conflict
  * (double) or the conflict one step early (float). The same cases scaled by powers of two,
- * far beyond where fourth powers would overflow or underflow, give the same answers. */
+ * far beyond where fourth powers would overflow or underflow, give the same answers, and
+ * so do they scaled into the subnormals (where 2^-e for the inputs' exponent e is not a
+ * number of the type: a rescaling by multiplying with it gave inf and NaN, and no
+ * conflict even for volumes that overlap throughout). */
+#ifdef COA_SINGLE_PRECISION
+#define REAL_SUBNORMAL_SCALE ((double)FLT_MIN * 0x1p-8)
+#else
+#define REAL_SUBNORMAL_SCALE (DBL_MIN * 0x1p-8)
+#endif
 START_TEST(test_volumes_touching_off_axis)
 {
-    const double scales[] = {1.0, 0x1p60, 0x1p-60, 0x1p100, 0x1p-100};
+    const double scales[] = {1.0, 0x1p60, 0x1p-60, 0x1p100, 0x1p-100, REAL_SUBNORMAL_SCALE};
     size_t i;
 
     for (i = 0; i < sizeof scales / sizeof scales[0]; ++i) {
@@ -737,6 +746,27 @@ START_TEST(test_volumes_touching_off_axis)
         ck_assert(boxc(sweep(10 * k, 1 * k, vec(6 * k, 8 * k, 0), vec(-10 * k, 16 * k, 0)),
                        corner));
     }
+}
+END_TEST
+
+/* Two volumes that coincide at the start conflict however little they then move. With a
+ * displacement whose square is the type's least subnormal, radius^2 * |w|^2 underflows to
+ * 0, and the discriminant with it: the disc test reported no conflict. */
+#ifdef COA_SINGLE_PRECISION
+#define REAL_TINY_STEP 0x1.8p-75
+#else
+#define REAL_TINY_STEP 0x1.8p-538
+#endif
+START_TEST(test_volumes_coincident_tiny_step)
+{
+    coa_sweep_t a = still(0.25, 1, 0, 0, 0);
+    coa_real_t w = (coa_real_t)REAL_TINY_STEP;
+
+    ck_assert(w * w > 0);
+    ck_assert(vols(a, sweep(0.25, 1, vec(0, 0, 0), vec(REAL_TINY_STEP, 0, 0))));
+    ck_assert(vols(a, sweep(0.25, 1, vec(0.125, 0, 0), vec(0.125, REAL_TINY_STEP, 0))));
+    /* Apart by more than the radii: still no conflict. */
+    ck_assert(!vols(a, sweep(0.25, 1, vec(0.5, 0, 0), vec(0.5, REAL_TINY_STEP, 0))));
 }
 END_TEST
 
@@ -1167,6 +1197,7 @@ static Suite *geometry_suite(void)
     tcase_add_test(hand, test_volumes_touching);
     tcase_add_test(hand, test_obstacle_check);
     tcase_add_test(hand, test_volumes_touching_off_axis);
+    tcase_add_test(hand, test_volumes_coincident_tiny_step);
     tcase_add_test(hand, test_volumes_crossing);
     tcase_add_test(hand, test_volumes_step_ends);
     tcase_add_test(hand, test_volumes_degenerate_motion);

@@ -874,12 +874,19 @@ static void text_summary(FILE *f, const mc_options_t *o, const mc_summary_t *s, 
         for (int m = MC_FIXED; m < MC_METHODS; m++) {
             const mc_method_summary_t *ms = &z->m[m];
             const mc_dist_t *r = &ms->ratio;
+            double fails = 100.0 * ms->fails_where_central_solves / z->encounters;
+            double solves = 100.0 * ms->solves_where_central_fails / z->encounters;
+            if (r->count == 0) {
+                /* No ratio at all, not ratios of 0 (a ratio is at least 1). */
+                fprintf(f, "  %-20s %6lu %7s %7s %7s %7s %7s %7s %7s %7s %8.1f%% %8.1f%%\n",
+                        method_names[m], 0ul, "-", "-", "-", "-", "-", "-", "-", "-", fails,
+                        solves);
+                continue;
+            }
             fprintf(f, "  %-20s %6lu %7.3f %7.3f %7.3f %7.3f %7.3f %7.3f %7.3f %6.1f%% %8.1f%% "
                        "%8.1f%%\n",
                     method_names[m], (unsigned long)r->count, r->min, r->p25, r->median, r->p75,
-                    r->p90, r->max, r->mean, 100 * r->equal_share,
-                    100.0 * ms->fails_where_central_solves / z->encounters,
-                    100.0 * ms->solves_where_central_fails / z->encounters);
+                    r->p90, r->max, r->mean, 100 * r->equal_share, fails, solves);
         }
     }
     fprintf(f, "\nbudget: beta exhausted (nothing proven); =1: the same exact deviation as "

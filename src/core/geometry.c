@@ -123,22 +123,26 @@ static coa_span_t span_disc(coa_real_t qx, coa_real_t qy, coa_real_t wx, coa_rea
 
     /* The roots do not change when every input is scaled by one power of two, and such
      * a scaling rounds nothing (short of underflow): it keeps squares of squares finite
-     * whatever the coordinates' range, and costs a comparison in a local frame. */
+     * whatever the coordinates' range, and costs a comparison in a local frame. It
+     * cannot help inputs far smaller than the largest: a product such as radius^2*|w|^2
+     * still underflows when radius*|w| is below about 2^-63 of m^2 in float (2^-511 in
+     * double), e.g. a 1e-20 m step against a 1 m radius, and the answer then follows
+     * the rounding (a conflict may be missed); no local frame comes near that. */
     m = real_fabs(qx) > real_fabs(qy) ? real_fabs(qx) : real_fabs(qy);
     m = real_fabs(wx) > m ? real_fabs(wx) : m;
     m = real_fabs(wy) > m ? real_fabs(wy) : m;
     m = radius > m ? radius : m;
     if (m > real_ldexp((coa_real_t)1, DISC_RANGE) ||
         m < real_ldexp((coa_real_t)1, -DISC_RANGE)) {
+        /* Each input by ldexp rather than times 2^-e: for a subnormal m, 2^-e itself
+         * overflows (float's 2^-e for m < 2^-127) and the product would be inf or NaN. */
         int e = 0;
-        coa_real_t k;
         (void)real_frexp(m, &e);
-        k = real_ldexp((coa_real_t)1, -e);
-        qx *= k;
-        qy *= k;
-        wx *= k;
-        wy *= k;
-        radius *= k;
+        qx = real_ldexp(qx, -e);
+        qy = real_ldexp(qy, -e);
+        wx = real_ldexp(wx, -e);
+        wy = real_ldexp(wy, -e);
+        radius = real_ldexp(radius, -e);
     }
     a = wx * wx + wy * wy;
     c = (qx * qx + qy * qy) - radius * radius;
@@ -148,7 +152,12 @@ static coa_span_t span_disc(coa_real_t qx, coa_real_t qy, coa_real_t wx, coa_rea
     cross = qx * wy - qy * wx;
     disc = radius * radius * a - cross * cross;
     if (!(disc > (coa_real_t)0)) {
-        return span_empty();
+        /* c < 0 (the start inside) makes the true discriminant positive; a computed one
+         * that is not has underflowed (|w| so far below radius that radius^2*|w|^2 does)
+         * or rounded at a tangency through the start. Inside at the start is a conflict
+         * either way: the whole step, which is right for a step that short and errs on
+         * the safe side at the tangency. */
+        return c < (coa_real_t)0 ? span_all() : span_empty();
     }
     sd = real_sqrt(disc);
     b = qx * wx + qy * wy;

@@ -200,6 +200,18 @@ if run text --vehicles 2,3 --count 3 --quiet; then
     fi
 fi
 
+# With beta 1 nothing is solved: the ratio rows have no numbers (a ratio is at least 1,
+# so 0.000 there would be a made-up value), but still the shares.
+if run text_empty --vehicles 3 --count 2 --beta 1 --quiet; then
+    rows=$(grep -E '^  decoupled_(fixed|reordered) +0 ' "$tmp/out")
+    if [ "$(printf '%s\n' "$rows" | grep -c -- ' -  *- ')" -eq 2 ] &&
+        ! printf '%s\n' "$rows" | grep -q '0\.000'; then
+        pass
+    else
+        fail "text summary without ratios: $(head -c 600 "$tmp/out")"
+    fi
+fi
+
 # A saved encounter is a scenario file that `coavoid plan` plans the same way.
 mkdir "$tmp/saved"
 if run save --vehicles 3 --count 2 --seed 7 --quiet --save "$tmp/saved" --csv "$tmp/f.csv"; then
