@@ -15,7 +15,8 @@
  * checked like any file.
  *
  * Everything comes from our own PRNG (splitmix64) seeded by --seed, so a seed gives the
- * same problems on every machine; only the times differ.
+ * same problems on every machine with the same libm (headings use cos and sin); only the
+ * times differ.
  *
  * What is timed: the planning call alone (clock_gettime around it). One run plans every
  * problem of a set once; a set's time is the sum over its problems, reported as the

@@ -12,8 +12,9 @@
  * non-cooperative aircraft crossing it, and with max_offset_max a vertical band per UAV.
  *
  * Everything comes from splitmix64 (bench_support.h), one stream per (seed, n, index,
- * attempt), so a seed gives the same problems on every machine, and adding problems or UAV
- * counts changes none of the others. The draws are made in a fixed order and a design's
+ * attempt), so a seed gives the same problems on every machine with the same libm
+ * (headings go through cos and sin, which C does not require to round correctly), and
+ * adding problems or UAV counts changes none of the others. The draws are made in a fixed order and a design's
  * optional parts draw nothing when they are off, so encounter_bench (no quantum, one box
  * half the time) gives exactly the problems bench plan gave before this file existed.
  */

@@ -89,7 +89,8 @@ static const char *const method_names[MC_METHODS] = {"centralised", "decoupled_f
     "                    on a terminal, a line every 10%% when stderr is not one)\n"       \
     "  -h, --help        show this help\n"                                                 \
     "\n"                                                                                   \
-    "A seed gives the same encounters and results on every machine, except the times.\n"  \
+    "A seed gives the same encounters and results on every machine with the same C\n"     \
+    "maths library (headings use cos and sin), except the times.\n"                      \
     "\n"                                                                                   \
     "exit status: 0 done (whatever the plans' outcomes), 2 invalid usage (one line on\n"  \
     "stderr naming the option and why), 3 internal error or a defect of the planner (a\n" \
