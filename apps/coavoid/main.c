@@ -24,24 +24,24 @@
 /* summary reads LCM logs and world publishes over LCM: only with the node library
  * (COAVOID_BUILD_LCM). */
 #ifdef COAVOID_HAVE_NODE
-#define USAGE_SUMMARY                                                              \
-    "  summary  judge a real-time run from its lcm-logger log (costs, figure)\n" \
-    "  world    publish a scenario's terrain and tracks to a real-time run\n"
+#define USAGE_SUMMARY                                                                \
+    "  summary     judge a real-time run from its lcm-logger log (costs, figure)\n" \
+    "  world       publish a scenario's terrain and tracks to a real-time run\n"
 #else
 #define USAGE_SUMMARY ""
 #endif
 
-#define USAGE                                                                   \
-    "usage: coavoid <command> [options]\n"                                      \
-    "\n"                                                                        \
-    "commands:\n"                                                               \
-    "  plan     plan collision-free altitude manoeuvres for a scenario\n"       \
-    "  predict  predict the conflicts of a scenario's reference trajectories\n" \
-    "  bench    time the core: bench predict, bench plan\n"    \
-    "  montecarlo  compare the planners over random encounters\n"           \
-    "  sim      fly a scenario in closed loop over the nodes (deterministic)\n"  \
-    USAGE_SUMMARY                                                               \
-    "\n"                                                                        \
+#define USAGE                                                                         \
+    "usage: coavoid <command> [options]\n"                                            \
+    "\n"                                                                              \
+    "commands:\n"                                                                     \
+    "  plan        plan collision-free altitude manoeuvres for a scenario\n"          \
+    "  predict     predict the conflicts of a scenario's reference trajectories\n"    \
+    "  bench       time the core: bench predict, bench plan\n"                        \
+    "  montecarlo  compare centralised and decoupled planning over random encounters\n" \
+    "  sim         fly a scenario in closed loop over the nodes (deterministic)\n"    \
+    USAGE_SUMMARY                                                                     \
+    "\n"                                                                              \
     "Run 'coavoid <command> --help' for the options of a command.\n"
 
 int main(int argc, char **argv)
