@@ -4,13 +4,18 @@
  * target, as the task does (coa_reference_sample, coa_track_sample, coa_plan_decoupled,
  * coa_plan_centralised), and reports every result over ARM semihosting, so that
  * tests/firmware/qemu.sh can run it on an emulated STM32F405 and compare it with the
- * host's `coavoid plan` on the same scenarios. Same start-up and linker script as the
+ * host's `coavoid plan` on the same scenarios. Each problem is also predicted
+ * (coa_predict) as `coavoid predict` does with its defaults. Same start-up and linker script as the
  * example firmware; no newlib stdio: the semihosting calls are written here.
  *
  * Output, one line per run (tokens separated by spaces, integers in decimal):
  *   run NAME MODE rc RC status S expanded E generated G effort F deviation_bits HEX
  *       units HI:LO order I,J,.. planned P failed V
  *   offsets NAME MODE VEHICLE_ID o0 o1 ... oN      (one line per planned vehicle)
+ *   predict NAME rc RC conflicts C
+ *   conflict NAME KIND A_ID B FIRST_STEP FIRST_TIME MIN_H MIN_V PROBABILITY
+ *       (B an id, or an obstacle's index; the reals as the hexadecimal bits of the float,
+ *       or of the double for the probability)
  * then `done` and an exit through SYS_EXIT (status 0; 1 when a problem could not run).
  */
 #include <ccd/config.h>
@@ -53,6 +58,11 @@ static const coa_vec3_t *reference_rows[FWC_MAX_VEHICLES];
 static coa_vec3_t track_samples[FWC_MAX_TRACKS][FWC_SAMPLES];
 static const coa_vec3_t *track_rows[FWC_MAX_TRACKS];
 static int32_t offsets[FWC_MAX_VEHICLES * FWC_SAMPLES];
+static coa_vec3_t intent_samples[FWC_MAX_VEHICLES][FWC_SAMPLES];
+static coa_intent_plan_t intents[FWC_MAX_VEHICLES];
+/* Every pair can conflict: n(n-1)/2 + n (tracks + obstacles), as `coavoid predict` sizes. */
+#define FWC_MAX_PAIRS 32u
+static coa_conflict_t conflicts[FWC_MAX_PAIRS];
 
 /* ARM semihosting (the "Angel" interface): operation in r0, argument in r1, bkpt 0xAB in
  * Thumb state; the debugger or emulator does the operation and resumes. */
@@ -183,6 +193,14 @@ static void report(const fwc_problem_t *p, const char *mode, int rc, const coa_p
     }
 }
 
+static void put_real_bits(coa_real_t x)
+{
+    uint32_t bits;
+    memcpy(&bits, &x, sizeof bits);
+    put(" ");
+    put_hex64(bits);
+}
+
 static void fail(const fwc_problem_t *p, const char *why)
 {
     put("error ");
@@ -190,6 +208,83 @@ static void fail(const fwc_problem_t *p, const char *why)
     put(": ");
     put(why);
     end_line();
+}
+
+/* One prediction cycle as `coavoid predict` runs it with its defaults (predict_cmd.c):
+ * each UAV's plan its reference at initial_offset, no sigma on the UAVs, the tracks' own,
+ * no sigma growth, threshold 0.01, every pair sized for. The planner's buffer serves the
+ * predictor first: the two never run at once. */
+static bool run_predict(const fwc_problem_t *p)
+{
+    static const char *const kinds[] = {"vehicle", "track", "obstacle"};
+    const size_t n = p->vehicle_count;
+    size_t pairs = n * (n - 1u) / 2u + n * (p->track_count + p->obstacle_count);
+    coa_predict_config_t config = {.t0 = 0.0f, .dt = p->dt, .horizon = p->horizon,
+                                   .threshold = 0.01, .all_pairs = false};
+    coa_predict_result_t result;
+    coa_predictor_t *predictor;
+    size_t i;
+    size_t k;
+    int rc;
+
+    pairs = pairs == 0u ? 1u : pairs;
+    if (pairs > FWC_MAX_PAIRS) {
+        fail(p, "more pairs than the check's conflict array");
+        return false;
+    }
+    predictor = coa_predictor_init(planner_buffer, sizeof planner_buffer, n, p->track_count,
+                                   p->horizon, pairs);
+    if (predictor == NULL) {
+        fail(p, "the predictor refused its workspace");
+        return false;
+    }
+    for (i = 0; i < n; ++i) {
+        const coa_vehicle_t *v = &p->vehicles[i];
+        const coa_real_t lift = (coa_real_t)v->initial_offset * coa_climb_step(v, p->dt);
+        for (k = 0; k <= p->horizon; ++k) {
+            intent_samples[i][k] = references[i][k];
+            intent_samples[i][k].z += lift;
+        }
+        intents[i] = (coa_intent_plan_t){.id = v->id, .volume = v->volume, .t0 = 0.0f,
+                                         .step = p->dt, .samples = intent_samples[i],
+                                         .count = p->horizon + 1u};
+    }
+    rc = coa_predict(predictor, &config, intents, n, p->obstacles, p->obstacle_count,
+                     p->tracks, p->track_count, conflicts, pairs, &result);
+    put("predict ");
+    put(p->name);
+    put(" rc ");
+    put_i64(rc);
+    put_field("conflicts", rc == COA_OK ? result.conflict_count : 0u);
+    end_line();
+    for (i = 0; rc == COA_OK && i < result.conflict_count; ++i) {
+        const coa_conflict_t *cf = &conflicts[i];
+        uint64_t bits;
+        put("conflict ");
+        put(p->name);
+        put(" ");
+        put(kinds[cf->kind <= COA_CONFLICT_OBSTACLE ? cf->kind : 0]);
+        put(" ");
+        put_u64(p->vehicles[cf->a < n ? cf->a : 0u].id);
+        put(" ");
+        if (cf->kind == COA_CONFLICT_VEHICLE) {
+            put_u64(p->vehicles[cf->b < n ? cf->b : 0u].id);
+        } else if (cf->kind == COA_CONFLICT_TRACK) {
+            put_u64(p->tracks[cf->b < p->track_count ? cf->b : 0u].id);
+        } else {
+            put_u64(cf->b);
+        }
+        put(" ");
+        put_u64(cf->first_step);
+        put_real_bits(cf->first_time);
+        put_real_bits(cf->min_horizontal);
+        put_real_bits(cf->min_vertical);
+        memcpy(&bits, &cf->probability, sizeof bits);
+        put(" ");
+        put_hex64(bits);
+        end_line();
+    }
+    return rc == COA_OK;
 }
 
 /* Samples the problem as `coavoid plan` does (scenario.c), then plans it in each mode. */
@@ -218,6 +313,9 @@ static bool run_problem(const fwc_problem_t *p)
             return false;
         }
         track_rows[i] = track_samples[i];
+    }
+    if (!run_predict(p)) {
+        return false;
     }
     problem = (coa_problem_t){.dt = p->dt, .horizon = p->horizon, .vehicles = p->vehicles,
                               .vehicle_count = p->vehicle_count, .references = reference_rows,

@@ -59,9 +59,9 @@ static const coa_vehicle_t p3_vehicles[] = {
     {.id = 1u, .priority = 1u, .cruise_speed = 10.0f, .climb_rate = 2.0f, .steep_factor = 2u,
      .volume = {15.0f, 5.0f}, .route = p3_v0_route, .route_count = 2u, .initial_offset = 0, .max_offset = 12}};
 static const coa_track_point_t p3_t1_path[] = {
-    {0.0f, {260.0f, 40.0f, 90.0f}},
-    {8.0f, {260.0f, 8.0f, 92.5f}},
-    {16.0f, {260.0f, -24.0f, 95.0f}}};
+    {0.0f, {260.0f, 104.0f, 98.0f}},
+    {8.0f, {260.0f, 72.0f, 100.5f}},
+    {16.0f, {260.0f, 40.0f, 103.0f}}};
 static const coa_track_t p3_tracks[] = {
 {.id = 901u, .volume = {20.0f, 8.0f},
      .position = {150.0f, -150.0f, 102.0f}, .velocity = {0.0f, 10.0f, 0.0f},

@@ -3,15 +3,16 @@
 # runs coavoid-firmware-check.elf (apps/firmware/check.c, built by the `firmware` test's
 # cross build in BUILD/firmware-arm) in qemu's netduinoplus2 machine (Cortex-M4F, FPU)
 # with ARM semihosting, then qemu_compare.py compares every result with `coavoid plan` on
-# the same scenarios (tests/firmware/qemu/*.json) in each host build given, exactly.
+# the same scenarios (tests/firmware/qemu/*.json) in both host builds (double and single).
 # Also fails when apps/firmware/check_problems.h is not what gen_check_problems.py makes
 # of those scenarios. A missing qemu-system-arm is a failure, not a skip.
-# Usage: qemu.sh SRC BUILD COAVOID...
+# Usage: qemu.sh SRC BUILD DOUBLE_COAVOID SINGLE_COAVOID
 set -uo pipefail
-src=${1:?usage: qemu.sh SRC BUILD COAVOID...}
-build=${2:?usage: qemu.sh SRC BUILD COAVOID...}
-shift 2
-[ "$#" -ge 1 ] || { echo "usage: qemu.sh SRC BUILD COAVOID..." >&2; exit 2; }
+usage="usage: qemu.sh SRC BUILD DOUBLE_COAVOID SINGLE_COAVOID"
+src=${1:?$usage}
+build=${2:?$usage}
+double=${3:?$usage}
+single=${4:?$usage}
 arm=$build/firmware-arm
 elf=$arm/apps/firmware/coavoid-firmware-check.elf
 cmake=${CMAKE:-cmake}
@@ -48,5 +49,5 @@ rc=$?
 echo "== firmware check on qemu netduinoplus2 (exit $rc)"
 cat "$out"
 [ "$rc" -eq 0 ] || { echo "firmware_qemu: FAIL: the firmware check exited with $rc" >&2; failed=1; }
-python3 "$here/qemu_compare.py" "$out" "$@" -- "$here"/qemu/*.json || failed=1
+python3 "$here/qemu_compare.py" "$out" "$double" "$single" -- "$here"/qemu/*.json || failed=1
 exit "$failed"

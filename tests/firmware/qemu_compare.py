@@ -2,7 +2,7 @@
 """Compares the firmware check's results (its semihosting output, apps/firmware/check.c)
 with the host's `coavoid plan` on the same scenarios, exactly.
 
-Usage: qemu_compare.py FIRMWARE_OUTPUT COAVOID... -- SCENARIO.json...
+Usage: qemu_compare.py FIRMWARE_OUTPUT DOUBLE_COAVOID SINGLE_COAVOID -- SCENARIO.json...
 
 For every scenario and every mode of its "qemu_modes", each host binary (double and
 single precision) is run as `coavoid plan SCENARIO --mode MODE` (decoupled: the priority
@@ -12,7 +12,14 @@ the effort and the deviation in m^2 (the same double, bit for bit). The planner'
 deviation_units, which `coavoid plan` does not print, is checked against the offsets:
 sum_i W_i * S * A(a, b) over the planned vehicles' steps, computed here in rational
 arithmetic from the contract (trajectory.h: w_i = fl(fl(v dt) fl(c dt)) = W_i 2^E, S the
-lcm of 2 s_i). Prints one line per difference; exits 1 when anything differed.
+lcm of 2 s_i).
+
+Predictions: `coavoid predict SCENARIO` (defaults) in each build must list the same
+conflicts in the same order as the firmware's coa_predict: kind, a, b and first_step.
+The real numbers (first_time, min_horizontal, min_vertical as floats, probability as a
+double) must equal the single-precision build's bit for bit; the double build computes
+them from unrounded positions, so only its conflict set is compared (as tests/precision
+does). Prints one line per difference; exits 1 when anything differed.
 """
 import json
 import os
@@ -27,6 +34,7 @@ STATUS = {0: "solved", 1: "infeasible", 2: "budget_exhausted"}
 
 def parse(path):
     runs, offsets, errors = {}, {}, []
+    predicts, conflicts = {}, {}
     done = False
     with open(path) as f:
         for raw in f:
@@ -38,11 +46,15 @@ def parse(path):
                 runs[(t[1], t[2])] = kv
             elif t[0] == "offsets":
                 offsets.setdefault((t[1], t[2]), {})[int(t[3])] = [int(x) for x in t[4:]]
+            elif t[0] == "predict":
+                predicts[t[1]] = t[3]
+            elif t[0] == "conflict":
+                conflicts.setdefault(t[1], []).append(t[2:])
             elif t[0] == "error":
                 errors.append(raw.strip())
             elif t[0] == "done":
                 done = True
-    return runs, offsets, errors, done
+    return runs, offsets, errors, done, predicts, conflicts
 
 
 def area_scaled(a, b, scale):
@@ -78,13 +90,49 @@ def expected_units(scenario, rows):
     return int(total)
 
 
+def float_bits(x):
+    return struct.pack(">f", x).hex()
+
+
+def double_bits(x):
+    return struct.pack(">d", x).hex()
+
+
+def compare_predict(name, path, fw_rc, fw_conflicts, binary, single, bad):
+    where = f"{name} predict"
+    if fw_rc != "0":
+        bad.append(f"{where}: firmware: coa_predict returned {fw_rc}")
+        return
+    p = subprocess.run([binary, "predict", path], capture_output=True, text=True)
+    if p.returncode != 0:
+        bad.append(f"{where}: host {binary}: exit {p.returncode}: {p.stderr.strip()}")
+        return
+    host = json.loads(p.stdout)["conflicts"]
+    if len(host) != len(fw_conflicts):
+        bad.append(f"{where}: firmware {len(fw_conflicts)} conflicts != host {len(host)} ({binary})")
+        return
+    for j, (f, h) in enumerate(zip(fw_conflicts, host)):
+        kind, a, b, step, t, dh, dv, prob = f
+        checks = [("kind", kind, h["kind"]), ("a", int(a), h["a"]), ("b", int(b), h["b"]),
+                  ("first_step", int(step), h["first_step"])]
+        if single:
+            checks += [("first_time", t.zfill(16)[8:], float_bits(h["first_time"])),
+                       ("min_horizontal", dh.zfill(16)[8:], float_bits(h["min_horizontal"])),
+                       ("min_vertical", dv.zfill(16)[8:], float_bits(h["min_vertical"])),
+                       ("probability", prob, double_bits(h["probability"]))]
+        for what, got, want in checks:
+            if got != want:
+                bad.append(f"{where}: conflicts[{j}].{what}: firmware {got} != host {want} "
+                           f"({binary})")
+
+
 def main():
     argv = sys.argv[1:]
-    if "--" not in argv or argv.index("--") < 2:
-        sys.exit("usage: qemu_compare.py FIRMWARE_OUTPUT COAVOID... -- SCENARIO.json...")
-    cut = argv.index("--")
-    out, binaries, scenarios = argv[0], argv[1:cut], argv[cut + 1:]
-    runs, fw_offsets, errors, done = parse(out)
+    if "--" not in argv or argv.index("--") != 3:
+        sys.exit("usage: qemu_compare.py FIRMWARE_OUTPUT DOUBLE_COAVOID SINGLE_COAVOID -- "
+                 "SCENARIO.json...")
+    out, binaries, scenarios = argv[0], argv[1:3], argv[4:]
+    runs, fw_offsets, errors, done, predicts, fw_conflicts = parse(out)
     bad = []
     for e in errors:
         bad.append(f"firmware: {e}")
@@ -95,6 +143,13 @@ def main():
         name = os.path.splitext(os.path.basename(path))[0]
         with open(path) as f:
             scenario = json.load(f)
+        if name not in predicts:
+            bad.append(f"{name} predict: the firmware reported no prediction")
+        else:
+            for b, single in zip(binaries, (False, True)):
+                compare_predict(name, path, predicts[name], fw_conflicts.get(name, []), b,
+                                single, bad)
+                compared += 1
         for mode in scenario.get("qemu_modes", ["decoupled"]):
             fw = runs.get((name, mode))
             if fw is None:
@@ -138,7 +193,7 @@ def main():
                 compared += 1
     for line in bad:
         print(f"firmware_qemu: DIFFERENT: {line}")
-    print(f"firmware_qemu: {compared} comparisons (scenario x mode x host build), "
+    print(f"firmware_qemu: {compared} comparisons (scenario x (prediction + modes) x host build), "
           f"{len(bad)} differences")
     return 1 if bad else 0
 
