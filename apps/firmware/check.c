@@ -17,6 +17,13 @@
  *       (B an id, or an obstacle's index; the reals as the hexadecimal bits of the float,
  *       or of the double for the probability)
  * then `done` and an exit through SYS_EXIT (status 0; 1 when a problem could not run).
+ *
+ * Each `run` and `predict` line ends with `ticks T`: SysTick ticks of the processor clock
+ * around the call. Under qemu -icount shift=0 (virtual time advances 1 ns per guest
+ * instruction executed) they count instructions, not time; the first line, `calibrate
+ * INSNS TICKS`, times a loop of a known instruction count so that the ratio comes from
+ * the run itself rather than from qemu's clock settings. Not cycles: qemu is not
+ * cycle-accurate (no wait states, no pipeline).
  */
 #include <ccd/config.h>
 #include <stdint.h>
@@ -63,6 +70,38 @@ static coa_intent_plan_t intents[FWC_MAX_VEHICLES];
 /* Every pair can conflict: n(n-1)/2 + n (tracks + obstacles), as `coavoid predict` sizes. */
 #define FWC_MAX_PAIRS 32u
 static coa_conflict_t conflicts[FWC_MAX_PAIRS];
+
+/* SysTick, free-running on the processor clock: 24 bits, the wraps counted in the
+ * interrupt. */
+#define SYST_CSR (*(volatile uint32_t *)0xE000E010u)
+#define SYST_RVR (*(volatile uint32_t *)0xE000E014u)
+#define SYST_CVR (*(volatile uint32_t *)0xE000E018u)
+#define SYST_PERIOD 0x1000000u
+
+static volatile uint32_t systick_wraps;
+
+void fw_systick_handler(void)
+{
+    systick_wraps = systick_wraps + 1u;
+}
+
+static uint64_t ticks_now(void)
+{
+    uint32_t wraps;
+    uint32_t value;
+    do {
+        wraps = systick_wraps;
+        value = SYST_CVR;
+    } while (wraps != systick_wraps);
+    return (uint64_t)wraps * SYST_PERIOD + (SYST_PERIOD - 1u - value);
+}
+
+/* A loop of exactly 2 * n + 1 instructions (subs and a taken bne per round, the last bne
+ * not taken, plus the mov), for the calibration. */
+static void spin(uint32_t n)
+{
+    __asm__ volatile("mov r0, %0\n1:\n\tsubs r0, #1\n\tbne 1b" : : "r"(n) : "r0", "cc");
+}
 
 /* ARM semihosting (the "Angel" interface): operation in r0, argument in r1, bkpt 0xAB in
  * Thumb state; the debugger or emulator does the operation and resumes. */
@@ -141,7 +180,8 @@ static void put_field(const char *key, uint64_t v)
     put_u64(v);
 }
 
-static void report(const fwc_problem_t *p, const char *mode, int rc, const coa_plan_result_t *r)
+static void report(const fwc_problem_t *p, const char *mode, int rc, const coa_plan_result_t *r,
+                   uint64_t ticks)
 {
     uint64_t bits;
     size_t j;
@@ -175,6 +215,7 @@ static void report(const fwc_problem_t *p, const char *mode, int rc, const coa_p
     if (r->failed_vehicle < p->vehicle_count) {
         put_u64(p->vehicles[r->failed_vehicle].id);
     }
+    put_field("ticks", ticks);
     end_line();
     /* The rows the result says are a plan: the first planned_count of `order`. */
     for (j = 0; j < r->planned_count && j < p->vehicle_count; ++j) {
@@ -223,6 +264,7 @@ static bool run_predict(const fwc_problem_t *p)
                                    .threshold = 0.01, .all_pairs = false};
     coa_predict_result_t result;
     coa_predictor_t *predictor;
+    uint64_t start;
     size_t i;
     size_t k;
     int rc;
@@ -249,13 +291,16 @@ static bool run_predict(const fwc_problem_t *p)
                                          .step = p->dt, .samples = intent_samples[i],
                                          .count = p->horizon + 1u};
     }
+    start = ticks_now();
     rc = coa_predict(predictor, &config, intents, n, p->obstacles, p->obstacle_count,
                      p->tracks, p->track_count, conflicts, pairs, &result);
+    start = ticks_now() - start;
     put("predict ");
     put(p->name);
     put(" rc ");
     put_i64(rc);
     put_field("conflicts", rc == COA_OK ? result.conflict_count : 0u);
+    put_field("ticks", start);
     end_line();
     for (i = 0; rc == COA_OK && i < result.conflict_count; ++i) {
         const coa_conflict_t *cf = &conflicts[i];
@@ -292,6 +337,7 @@ static bool run_problem(const fwc_problem_t *p)
 {
     coa_problem_t problem;
     coa_plan_result_t result;
+    uint64_t start;
     size_t i;
     int rc;
 
@@ -330,8 +376,9 @@ static bool run_problem(const fwc_problem_t *p)
             return false;
         }
         memset(offsets, 0, sizeof offsets);
+        start = ticks_now();
         rc = coa_plan_decoupled(planner, &problem, NULL, 1u, offsets, &result);
-        report(p, "decoupled", rc, &result);
+        report(p, "decoupled", rc, &result, ticks_now() - start);
     }
     if (p->centralised) {
         coa_planner_t *planner = coa_planner_init(planner_buffer, sizeof planner_buffer,
@@ -341,25 +388,34 @@ static bool run_problem(const fwc_problem_t *p)
             return false;
         }
         memset(offsets, 0, sizeof offsets);
+        start = ticks_now();
         rc = coa_plan_centralised(planner, &problem, offsets, &result);
-        report(p, "centralised", rc, &result);
+        report(p, "centralised", rc, &result, ticks_now() - start);
     }
     return true;
-}
-
-/* startup.c's vector table names it; the check uses no interrupt. */
-void fw_systick_handler(void)
-{
 }
 
 int main(void)
 {
     bool ok = true;
+    uint64_t start;
     size_t p;
 
     put("coavoid firmware check: ");
     put_u64(FWC_PROBLEM_COUNT);
     put(" problems");
+    end_line();
+    SYST_RVR = SYST_PERIOD - 1u;
+    SYST_CVR = 0u;
+    SYST_CSR = 7u; /* processor clock, interrupt, enable */
+    spin(1000u);   /* past the first reload from the 0 written above */
+    start = ticks_now();
+    spin(1000000u);
+    start = ticks_now() - start;
+    put("calibrate ");
+    put_u64(2u * 1000000u + 1u);
+    put(" ");
+    put_u64(start);
     end_line();
     for (p = 0; p < FWC_PROBLEM_COUNT; ++p) {
         ok = run_problem(&fwc_problems[p]) && ok;

@@ -40,8 +40,10 @@ if ! diff -u "$src/apps/firmware/check_problems.h" "$tmp/check_problems.h" >&2; 
 fi
 
 # Semihosting output to a file of its own: nothing else of qemu's (monitor, UART) mixes in.
+# -icount shift=0: virtual time is the guest instruction count (1 ns each), so the check's
+# SysTick readings count instructions, the same on every run and every host.
 out=$tmp/firmware.txt
-timeout 60 qemu-system-arm -M netduinoplus2 -display none -monitor none -serial null \
+timeout 60 qemu-system-arm -M netduinoplus2 -icount shift=0 -display none -monitor none -serial null \
   -chardev file,id=semihosting,path="$out" \
   -semihosting-config enable=on,target=native,chardev=semihosting -kernel "$elf"
 rc=$?

@@ -20,6 +20,11 @@ The real numbers (first_time, min_horizontal, min_vertical as floats, probabilit
 double) must equal the single-precision build's bit for bit; the double build computes
 them from unrounded positions, so only its conflict set is compared (as tests/precision
 does). Prints one line per difference; exits 1 when anything differed.
+
+Also prints the instructions each call executed on the emulated Cortex-M4F, when the
+firmware was run under qemu -icount shift=0: its SysTick ticks times the ratio of its
+calibration loop (a known instruction count over its ticks). Guest instructions, not
+cycles or time (qemu is not cycle-accurate); printed, never compared.
 """
 import json
 import os
@@ -35,6 +40,7 @@ STATUS = {0: "solved", 1: "infeasible", 2: "budget_exhausted"}
 def parse(path):
     runs, offsets, errors = {}, {}, []
     predicts, conflicts = {}, {}
+    calibration = None
     done = False
     with open(path) as f:
         for raw in f:
@@ -46,15 +52,18 @@ def parse(path):
                 runs[(t[1], t[2])] = kv
             elif t[0] == "offsets":
                 offsets.setdefault((t[1], t[2]), {})[int(t[3])] = [int(x) for x in t[4:]]
+            elif t[0] == "calibrate":
+                calibration = (int(t[1]), int(t[2]))
             elif t[0] == "predict":
                 predicts[t[1]] = t[3]
+                runs[(t[1], "predict")] = dict(zip(t[2::2], t[3::2]))
             elif t[0] == "conflict":
                 conflicts.setdefault(t[1], []).append(t[2:])
             elif t[0] == "error":
                 errors.append(raw.strip())
             elif t[0] == "done":
                 done = True
-    return runs, offsets, errors, done, predicts, conflicts
+    return runs, offsets, errors, done, predicts, conflicts, calibration
 
 
 def area_scaled(a, b, scale):
@@ -132,7 +141,7 @@ def main():
         sys.exit("usage: qemu_compare.py FIRMWARE_OUTPUT DOUBLE_COAVOID SINGLE_COAVOID -- "
                  "SCENARIO.json...")
     out, binaries, scenarios = argv[0], argv[1:3], argv[4:]
-    runs, fw_offsets, errors, done, predicts, fw_conflicts = parse(out)
+    runs, fw_offsets, errors, done, predicts, fw_conflicts, calibration = parse(out)
     bad = []
     for e in errors:
         bad.append(f"firmware: {e}")
@@ -191,6 +200,20 @@ def main():
                     if got != want:
                         bad.append(f"{where}: {what}: firmware {got} != host {want} ({b})")
                 compared += 1
+    if calibration and calibration[1] > 0:
+        per_tick = calibration[0] / calibration[1]
+        print(f"== instructions on the emulated Cortex-M4F (qemu -icount shift=0: "
+              f"{per_tick:.4f} instructions per SysTick tick, from {calibration[0]} "
+              f"instructions in {calibration[1]} ticks; not cycles, not time)")
+        print(f"{'scenario':10} {'call':12} {'expanded':>9} {'instructions':>13} "
+              f"{'per expansion':>14}")
+        for (name, mode), kv in sorted(runs.items()):
+            if "ticks" not in kv:
+                continue
+            insns = int(kv["ticks"]) * per_tick
+            expanded = int(kv.get("expanded", 0))
+            per = f"{insns / expanded:14,.0f}" if expanded else f"{'-':>14}"
+            print(f"{name:10} {mode:12} {expanded:9} {insns:13,.0f} {per}")
     for line in bad:
         print(f"firmware_qemu: DIFFERENT: {line}")
     print(f"firmware_qemu: {compared} comparisons (scenario x (prediction + modes) x host build), "
