@@ -42,6 +42,7 @@
 #include "coavoid/coavoid.h"
 #include "coavoid/predict.h"
 #include "commands.h"
+#include "output.h"
 
 #define BENCH_DEFAULT_SEED 1u
 #define BENCH_DEFAULT_REPEAT 21u
@@ -524,14 +525,11 @@ static int report(FILE *f, const bench_options_t *o, const airspace_t *a, const 
             ok = cJSON_AddNumberToObject(root, rows[i].key, rows[i].value) != NULL;
         }
     }
-    char *text = ok ? cJSON_Print(root) : NULL;
-    cJSON_Delete(root);
-    if (text == NULL) {
+    if (!ok) {
+        cJSON_Delete(root);
         return -1;
     }
-    ok = fputs(text, f) >= 0 && fputc('\n', f) != EOF && fflush(f) == 0;
-    free(text);
-    return ok ? 0 : -1;
+    return output_json(f, root, NULL, 0);
 }
 
 static int bench_predict(int argc, char **argv)

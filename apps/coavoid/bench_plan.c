@@ -41,6 +41,7 @@
 #include "coavoid/coavoid.h"
 #include "commands.h"
 #include "encounter.h"
+#include "output.h"
 #include "scenario.h"
 
 #define BP_DEFAULT_SEED 1u
@@ -412,14 +413,11 @@ static int report_json(FILE *f, const bp_options_t *o, const bp_row_t *rows, siz
              cJSON_AddNumberToObject(row, "infeasible", r->infeasible) != NULL &&
              cJSON_AddNumberToObject(row, "budget_exhausted", r->budget_exhausted) != NULL;
     }
-    char *text = ok ? cJSON_Print(root) : NULL;
-    cJSON_Delete(root);
-    if (text == NULL) {
+    if (!ok) {
+        cJSON_Delete(root);
         return -1;
     }
-    ok = fputs(text, f) >= 0 && fputc('\n', f) != EOF && fflush(f) == 0;
-    free(text);
-    return ok ? 0 : -1;
+    return output_json(f, root, NULL, 0);
 }
 
 int bench_plan(int argc, char **argv)

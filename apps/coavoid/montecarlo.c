@@ -44,6 +44,7 @@
 #include "coavoid/coavoid.h"
 #include "commands.h"
 #include "encounter.h"
+#include "output.h"
 #include "scenario.h"
 
 #define MC_DEFAULT_SEED 1u
@@ -963,14 +964,11 @@ static int json_summary(FILE *f, const mc_options_t *o, const mc_summary_t *s, u
             }
         }
     }
-    char *text = ok ? cJSON_Print(root) : NULL;
-    cJSON_Delete(root);
-    if (text == NULL) {
+    if (!ok) {
+        cJSON_Delete(root);
         return -1;
     }
-    ok = fputs(text, f) >= 0 && fputc('\n', f) != EOF;
-    free(text);
-    return ok ? 0 : -1;
+    return output_json(f, root, NULL, 0);
 }
 
 /* ---- the figure ---- */

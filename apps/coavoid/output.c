@@ -200,8 +200,7 @@ fail:
     return NULL;
 }
 
-/* Prints and frees `root`. Returns 0, or -1 with err set. */
-static int print_object(FILE *out, cJSON *root, char *err, size_t err_size)
+int output_json(FILE *out, cJSON *root, char *err, size_t err_size)
 {
     char *text = cJSON_Print(root);
     cJSON_Delete(root);
@@ -224,7 +223,7 @@ int output_plan(FILE *out, const output_plan_t *plan, char *err, size_t err_size
     if (root == NULL) {
         return -1;
     }
-    return print_object(out, root, err, err_size);
+    return output_json(out, root, err, err_size);
 }
 
 const char *output_conflict_kind_name(coa_conflict_kind_t kind)
@@ -296,5 +295,5 @@ int output_predict(FILE *out, const output_predict_t *prediction, char *err, siz
     if (root == NULL) {
         return set_error(err, err_size, "out of memory printing the result");
     }
-    return print_object(out, root, err, err_size);
+    return output_json(out, root, err, err_size);
 }

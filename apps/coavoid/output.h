@@ -10,6 +10,8 @@
 #include <stdint.h>
 #include <stdio.h>
 
+#include <cjson/cJSON.h>
+
 #include "coavoid/coavoid.h"
 #include "coavoid/predict.h"
 #include "scenario.h"
@@ -59,5 +61,11 @@ int output_predict(FILE *out, const output_predict_t *prediction, char *err, siz
 
 /* The contract's name of a conflict kind ("vehicle", "track", "obstacle"). */
 const char *output_conflict_kind_name(coa_conflict_kind_t kind);
+
+/* Prints `root` (cJSON's indented form) and a newline to `out`, flushes, and deletes root
+ * whatever happens: every JSON report of the commands ends here. Returns 0, or -1 with the
+ * reason in err (out of memory, a write error and its errno text); err may be NULL with
+ * err_size 0 when the caller words its own message. */
+int output_json(FILE *out, cJSON *root, char *err, size_t err_size);
 
 #endif /* COAVOID_APP_OUTPUT_H */

@@ -19,6 +19,8 @@
 
 #include <cjson/cJSON.h>
 
+#include "output.h"
+
 /* The checks every entry point shares before it reads the arrays. The core's own checks
  * (vehicles, obstacles, tracks, finite samples) come later through the problem. */
 static int check_record(const coa_flight_t *f)
@@ -405,14 +407,7 @@ int coa_flight_json_extra(const coa_flight_t *flight, const coa_flight_eval_t *e
             return COA_ERR_WORKSPACE;
         }
     }
-    char *text = cJSON_Print(root);
-    cJSON_Delete(root);
-    if (text == NULL) {
-        return COA_ERR_WORKSPACE;
-    }
-    bool written = fputs(text, out) >= 0 && fputc('\n', out) != EOF && fflush(out) == 0;
-    free(text);
-    return written ? COA_OK : COA_ERR_WORKSPACE;
+    return output_json(out, root, NULL, 0) == 0 ? COA_OK : COA_ERR_WORKSPACE;
 }
 
 /* ---- text ---- */
