@@ -43,7 +43,7 @@ static bool add_number(cJSON *obj, const char *key, double value)
     return cJSON_AddNumberToObject(obj, key, value) != NULL;
 }
 
-static bool append(cJSON *array, cJSON *item)
+bool output_append(cJSON *array, cJSON *item)
 {
     if (item == NULL) {
         return false;
@@ -69,7 +69,7 @@ static int add_vehicle(cJSON *array, const scenario_t *s, size_t index, const in
         return -2;
     }
     cJSON *entry = cJSON_CreateObject();
-    if (!append(array, entry) || !add_number(entry, "id", v->id)) {
+    if (!output_append(array, entry) || !add_number(entry, "id", v->id)) {
         return -1;
     }
     cJSON *offsets = cJSON_AddArrayToObject(entry, "offsets");
@@ -78,7 +78,7 @@ static int add_vehicle(cJSON *array, const scenario_t *s, size_t index, const in
         return -1;
     }
     for (uint32_t k = 0; k <= s->horizon; k++) {
-        if (!append(offsets, cJSON_CreateNumber(row[k]))) {
+        if (!output_append(offsets, cJSON_CreateNumber(row[k]))) {
             return -1;
         }
     }
@@ -90,7 +90,7 @@ static int add_vehicle(cJSON *array, const scenario_t *s, size_t index, const in
                       (unsigned)v->id, (long)row[k], (long)row[k + 1], (unsigned long)k);
             return -2;
         }
-        if (!append(actions, cJSON_CreateString(coa_action_name((coa_action_t)action)))) {
+        if (!output_append(actions, cJSON_CreateString(coa_action_name((coa_action_t)action)))) {
             return -1;
         }
     }
@@ -131,7 +131,7 @@ static cJSON *build(const output_plan_t *plan, char *err, size_t err_size)
             set_error(err, err_size, "internal error: planning order names vehicle index %zu", i);
             goto fail;
         }
-        if (!append(order, cJSON_CreateNumber(s->vehicles[i].id))) {
+        if (!output_append(order, cJSON_CreateNumber(s->vehicles[i].id))) {
             goto out_of_memory;
         }
     }
@@ -242,7 +242,7 @@ const char *output_conflict_kind_name(coa_conflict_kind_t kind)
 static bool add_conflict(cJSON *array, const output_conflict_t *c)
 {
     cJSON *entry = cJSON_CreateObject();
-    return append(array, entry) &&
+    return output_append(array, entry) &&
            cJSON_AddStringToObject(entry, "kind", output_conflict_kind_name(c->kind)) != NULL &&
            add_number(entry, "a", c->a) && add_number(entry, "b", c->b) &&
            add_number(entry, "first_step", c->first_step) &&
@@ -273,11 +273,11 @@ static cJSON *build_prediction(const output_predict_t *p)
     }
     for (size_t c = 0; c < p->cluster_count; c++) {
         cJSON *cluster = cJSON_CreateArray();
-        if (!append(clusters, cluster)) {
+        if (!output_append(clusters, cluster)) {
             goto fail;
         }
         for (size_t j = p->cluster_start[c]; j < p->cluster_start[c + 1]; j++) {
-            if (!append(cluster, cJSON_CreateNumber(p->cluster_ids[j]))) {
+            if (!output_append(cluster, cJSON_CreateNumber(p->cluster_ids[j]))) {
                 goto fail;
             }
         }

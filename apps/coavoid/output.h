@@ -62,6 +62,10 @@ int output_predict(FILE *out, const output_predict_t *prediction, char *err, siz
 /* The contract's name of a conflict kind ("vehicle", "track", "obstacle"). */
 const char *output_conflict_kind_name(coa_conflict_kind_t kind);
 
+/* Adds `item` to `array`; an item that is NULL (a failed cJSON_Create*) or cannot be added
+ * is deleted and false returned, so a builder can chain creations without leaking. */
+bool output_append(cJSON *array, cJSON *item);
+
 /* Prints `root` (cJSON's indented form) and a newline to `out`, flushes, and deletes root
  * whatever happens: every JSON report of the commands ends here. Returns 0, or -1 with the
  * reason in err (out of memory, a write error and its errno text); err may be NULL with

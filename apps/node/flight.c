@@ -281,18 +281,6 @@ static bool add_number(cJSON *obj, const char *key, double value)
     return true;
 }
 
-static bool append(cJSON *array, cJSON *item)
-{
-    if (item == NULL) {
-        return false;
-    }
-    if (!cJSON_AddItemToArray(array, item)) {
-        cJSON_Delete(item);
-        return false;
-    }
-    return true;
-}
-
 static double sample_time(const coa_flight_t *f, uint32_t k)
 {
     return (double)k * (double)f->dt;
@@ -303,7 +291,7 @@ static bool add_vehicle(cJSON *vehicles, const coa_flight_t *f, const coa_flight
 {
     const coa_flight_vehicle_t *v = &f->vehicles[i];
     cJSON *entry = cJSON_CreateObject();
-    if (!append(vehicles, entry) || !add_number(entry, "id", v->vehicle.id)) {
+    if (!output_append(vehicles, entry) || !add_number(entry, "id", v->vehicle.id)) {
         return false;
     }
     cJSON *flown = cJSON_AddArrayToObject(entry, "flown");
@@ -314,11 +302,11 @@ static bool add_vehicle(cJSON *vehicles, const coa_flight_t *f, const coa_flight
         coa_vec3_t p = coa_flight_position(f, i, k, v->offsets[k]);
         double sample[4] = {sample_time(f, k), (double)p.x, (double)p.y, (double)p.z};
         cJSON *point = cJSON_CreateArray();
-        if (!append(flown, point)) {
+        if (!output_append(flown, point)) {
             return false;
         }
         for (int q = 0; q < 4; q++) {
-            if (!append(point, exact_number(sample[q]))) {
+            if (!output_append(point, exact_number(sample[q]))) {
                 return false;
             }
         }
