@@ -54,9 +54,8 @@ static inline bool reserve(size_t *cursor, size_t count, size_t elem, size_t *at
 
 /* The precision-dependent libm calls, named once for every module. Only correctly rounded
  * operations are used (sqrt and fabs are, by IEEE 754, and frexp and ldexp are exact;
- * hypot is not, and its error
- * differs between libms), so the host and a firmware's libm give the same bits for the
- * same inputs in the same precision. */
+ * hypot is not, and its error differs between libms), so the host and a firmware's libm
+ * give the same bits for the same inputs in the same precision. */
 #ifdef COA_SINGLE_PRECISION
 #define real_sqrt(x) sqrtf(x)
 #define real_fabs(x) fabsf(x)
