@@ -40,6 +40,7 @@
 
 #include <cjson/cJSON.h>
 
+#include "bench_support.h"
 #include "cli.h"
 #include "coavoid/coavoid.h"
 #include "commands.h"
@@ -459,8 +460,7 @@ static int solve_encounter(uint64_t seed, const mc_size_t *size, uint32_t index,
         o->expanded = result.nodes_expanded;
         o->generated = result.nodes_generated;
         o->orders_tried = result.orders_tried;
-        o->time_us = (double)(end.tv_sec - start.tv_sec) * 1e6 +
-                     (double)(end.tv_nsec - start.tv_nsec) * 1e-3;
+        o->time_us = bench_elapsed_ms(&start, &end) * 1e3;
         if (result.status == COA_PLAN_SOLVED && r->defect[0] == '\0') {
             size_t vehicle = 0;
             uint32_t step = 0;
@@ -587,12 +587,6 @@ static void cost_text(coa_cost_t c, char *buf, size_t size)
     buf[j] = '\0';
 }
 
-static const char *status_name(coa_plan_status_t s)
-{
-    return s == COA_PLAN_SOLVED ? "solved" : s == COA_PLAN_INFEASIBLE ? "infeasible"
-                                                                      : "budget_exhausted";
-}
-
 #define MC_CSV_HEADER                                                                    \
     "seed,vehicles,index,redraws,hills,tracks,first_conflict_step,method,status,"         \
     "deviation,deviation_units,effort,expanded,generated,orders_tried,time_us\n"
@@ -613,7 +607,7 @@ static void csv_rows(FILE *f, uint64_t seed, const mc_result_t *r)
                 (unsigned long long)seed, (unsigned long)r->vehicles, (unsigned long)r->index,
                 (unsigned long)r->redraws, (unsigned long)r->info.hills,
                 (unsigned long)r->info.tracks, (unsigned long)r->first_conflict_step,
-                method_names[m], status_name(o->status), costs,
+                method_names[m], output_status_name(o->status), costs,
                 (unsigned long long)o->expanded, (unsigned long long)o->generated,
                 (unsigned long)o->orders_tried, o->time_us);
     }
@@ -623,7 +617,7 @@ static double seconds_since(const struct timespec *start)
 {
     struct timespec now;
     clock_gettime(CLOCK_MONOTONIC, &now);
-    return (double)(now.tv_sec - start->tv_sec) + (double)(now.tv_nsec - start->tv_nsec) * 1e-9;
+    return bench_elapsed_ms(start, &now) * 1e-3;
 }
 
 typedef struct {
@@ -732,12 +726,6 @@ typedef struct {
     double equal_share; /* ratio exactly 1 (the same exact deviation) */
 } mc_dist_t;
 
-static int compare_doubles(const void *pa, const void *pb)
-{
-    double a = *(const double *)pa, b = *(const double *)pb;
-    return a < b ? -1 : (a > b ? 1 : 0);
-}
-
 /* The p-quantile of sorted x[0..m-1] (m >= 1), interpolating linearly between order
  * statistics (numpy's default, "type 7"), so scripts can recompute it. */
 static double quantile(const double *x, uint32_t m, double p)
@@ -757,7 +745,7 @@ static mc_dist_t distribution(double *x, uint32_t m, uint32_t equal)
     if (m == 0) {
         return d;
     }
-    qsort(x, m, sizeof *x, compare_doubles);
+    qsort(x, m, sizeof *x, bench_compare_doubles);
     double sum = 0;
     for (uint32_t k = 0; k < m; k++) {
         sum += x[k];
@@ -1021,7 +1009,7 @@ static void svg_cdf(FILE *f, const mc_result_t *results, uint32_t count, int m, 
     if (both == 0) {
         return;
     }
-    qsort(x, both, sizeof *x, compare_doubles);
+    qsort(x, both, sizeof *x, bench_compare_doubles);
     const double y0 = SVG_PANEL_TOP + SVG_PANEL_H;
     fprintf(f, "<polyline fill=\"none\" stroke=\"%s\" stroke-width=\"1.8\"%s points=\"", colour,
             dashed ? " stroke-dasharray=\"6 4\"" : "");
