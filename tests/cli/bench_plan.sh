@@ -9,20 +9,6 @@ set -u
 # shellcheck source=tests/cli/lib.bash
 . "$(dirname "${BASH_SOURCE[0]}")/lib.bash" "$@"
 
-# run NAME ARGS...: `coavoid bench plan ARGS` exits 0 with nothing on stderr; the output
-# is left in $tmp/out.
-run() {
-    local name=$1
-    shift
-    "$bin" bench plan "$@" >"$tmp/out" 2>"$tmp/err"
-    local rc=$?
-    if [ "$rc" -ne 0 ] || [ -s "$tmp/err" ]; then
-        fail "$name: exit $rc, expected 0: $(head -c 300 "$tmp/err")"
-        return 1
-    fi
-    return 0
-}
-
 # check NAME ASSERTIONS: the JSON in $tmp/out is well formed (every field of every row,
 # counts adding up, min <= median <= max); ASSERTIONS see it as b and its rows as rows.
 check() {
@@ -57,7 +43,7 @@ PY
 }
 
 # The table: the header, the column names, one row per mode, the footnote.
-if run table --vehicles 2 --count 2 --repeat 1; then
+if expect_ok table bench plan --vehicles 2 --count 2 --repeat 1; then
     if python3 - "$tmp/out" >"$tmp/py" 2>&1 <<'PY'; then pass; else fail "table: $(tail -n 5 "$tmp/py")"; fi
 import sys
 lines = open(sys.argv[1]).read().splitlines()
@@ -76,7 +62,7 @@ assert len(lines) == 8, lines
 PY
 fi
 
-if run json --vehicles 2 --count 2 --repeat 1 --json; then
+if expect_ok json bench plan --vehicles 2 --count 2 --repeat 1 --json; then
     check json '
 len(rows) == 2 and all(r["set"] == "2 UAVs" and r["vehicles"] == 2 and r["problems"] == 2 for r in rows)
 b["seed"] == 1 and b["repeat"] == 1 and b["count"] == 2
@@ -85,7 +71,7 @@ all(r["nodes_expanded"] > 0 and r["beta"] == 20000 and not r["beta_lowered"] for
     cp "$tmp/out.last" "$tmp/first"
 fi
 # The same seed gives the same problems: the same work.
-if run same_seed --json --vehicles=2 --count=2 --repeat=2; then
+if expect_ok same_seed bench plan --json --vehicles=2 --count=2 --repeat=2; then
     check same_seed 'True'
     if python3 - "$tmp/first" "$tmp/out.last" <<'PY'; then pass; else fail "same seed, different work"; fi
 import json, sys
@@ -95,14 +81,14 @@ sys.exit(0 if work(a) == work(b) else f"{work(a)} vs {work(b)}")
 PY
 fi
 # A beta too small to finish is counted as budget exhausted (and the run still exits 0).
-if run small_beta --vehicles 5 --count 1 --repeat 1 --beta 2 --seed 3 --json; then
+if expect_ok small_beta bench plan --vehicles 5 --count 1 --repeat 1 --beta 2 --seed 3 --json; then
     check small_beta '
 rows[0]["budget_exhausted"] == 1 and rows[0]["nodes_expanded"] == 2 and rows[0]["beta"] == 2
 rows[0]["vehicles"] == 5 and not rows[0]["beta_lowered"]
 '
 fi
 # A beta whose centralised workspace would pass 1 GiB is lowered, and says so.
-if run lowered_beta --vehicles 5 --count 1 --repeat 1 --beta 1000000 --json; then
+if expect_ok lowered_beta bench plan --vehicles 5 --count 1 --repeat 1 --beta 1000000 --json; then
     check lowered_beta '
 rows[0]["beta_lowered"] and rows[0]["beta"] < 20000
 not rows[1]["beta_lowered"] and rows[1]["beta"] == 1000000
@@ -110,7 +96,7 @@ not rows[1]["beta_lowered"] and rows[1]["beta"] == 1000000
 fi
 # Without --vehicles: the paper scenario, then 2, 3, 4 and 5 UAVs (a small beta keeps it
 # cheap).
-if run all_sets --scenario "$src/scenarios/paper.json" --count 1 --repeat 1 --beta 30 --json; then
+if expect_ok all_sets bench plan --scenario "$src/scenarios/paper.json" --count 1 --repeat 1 --beta 30 --json; then
     check all_sets '
 [r["set"] for r in rows] == [s for s in ("paper", "2 UAVs", "3 UAVs", "4 UAVs", "5 UAVs") for _ in (0, 1)]
 rows[0]["vehicles"] == 3 and rows[0]["problems"] == 1 and rows[0]["beta"] == 30

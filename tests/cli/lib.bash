@@ -26,6 +26,21 @@ finish() {
     [ "$failed" -eq 0 ]
 }
 
+# expect_ok NAME ARGS...: coavoid ARGS exits 0 with nothing on stderr; its stdout is left in
+# $tmp/out. Returns 1 after counting a failure, so `if expect_ok ...; then check ...` reads
+# the output only when there is one to read.
+expect_ok() {
+    local name=$1
+    shift
+    "$bin" "$@" >"$tmp/out" 2>"$tmp/err"
+    local rc=$?
+    if [ "$rc" -ne 0 ] || [ -s "$tmp/err" ]; then
+        fail "$name: exit $rc, expected 0: $(head -c 300 "$tmp/err")"
+        return 1
+    fi
+    return 0
+}
+
 # expect_bad DESCRIPTION PATTERN ARGS...: coavoid ARGS exits 2, prints nothing on stdout
 # and exactly one stderr line that starts with "coavoid: " and contains PATTERN (and the
 # text in $also, when set).

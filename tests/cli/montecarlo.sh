@@ -11,20 +11,6 @@ set -u
 # shellcheck source=tests/cli/lib.bash
 . "$(dirname "${BASH_SOURCE[0]}")/lib.bash" "$@"
 
-# run NAME ARGS...: `coavoid montecarlo ARGS` exits 0 with nothing on stderr; stdout is
-# left in $tmp/out.
-run() {
-    local name=$1
-    shift
-    "$bin" montecarlo "$@" >"$tmp/out" 2>"$tmp/err"
-    local rc=$?
-    if [ "$rc" -ne 0 ] || [ -s "$tmp/err" ]; then
-        fail "$name: exit $rc, expected 0: $(head -c 300 "$tmp/err")"
-        return 1
-    fi
-    return 0
-}
-
 # check NAME CSV JSON SVG: the files are well formed and agree.
 check() {
     local name=$1
@@ -147,11 +133,11 @@ rows_equal() {
 # 2, 3 and 4 UAVs; a small beta keeps the 4-UAV centralised searches cheap (and some run
 # out of it, which must be reported as budget exhausted, not hidden).
 set_a=(--vehicles 2,3,4 --count 5 --seed 7 --beta 2000 --quiet)
-if run first "${set_a[@]}" --csv "$tmp/a.csv" --svg "$tmp/a.svg" --json; then
+if expect_ok first montecarlo "${set_a[@]}" --csv "$tmp/a.csv" --svg "$tmp/a.svg" --json; then
     cp "$tmp/out" "$tmp/a.json"
     check first "$tmp/a.csv" "$tmp/a.json" "$tmp/a.svg"
 fi
-if run again "${set_a[@]}" --csv "$tmp/b.csv" --json; then
+if expect_ok again montecarlo "${set_a[@]}" --csv "$tmp/b.csv" --json; then
     rows_equal "same seed" "$tmp/a.csv" "$tmp/b.csv"
     if python3 - "$tmp/a.json" "$tmp/out" <<'PY'; then pass; else fail "same seed: different summary"; fi
 import json, sys
@@ -164,11 +150,11 @@ a, b = (strip(json.load(open(p))) for p in sys.argv[1:])
 sys.exit(0 if a == b else "summaries differ")
 PY
 fi
-if run jobs "${set_a[@]}" --jobs 2 --csv "$tmp/c.csv"; then
+if expect_ok jobs montecarlo "${set_a[@]}" --jobs 2 --csv "$tmp/c.csv"; then
     rows_equal "--jobs 2" "$tmp/a.csv" "$tmp/c.csv"
 fi
 # Another seed draws other encounters.
-if run other_seed --vehicles 2 --count 5 --seed 8 --quiet --csv "$tmp/d.csv"; then
+if expect_ok other_seed montecarlo --vehicles 2 --count 5 --seed 8 --quiet --csv "$tmp/d.csv"; then
     if [ "$(grep -c '^8,2,' "$tmp/d.csv")" -eq 15 ] &&
         ! diff -q <(cut -d, -f2-15 "$tmp/d.csv") <(grep -E '^(seed|7,2,)' "$tmp/a.csv" | cut -d, -f2-15) >/dev/null; then
         pass
@@ -177,7 +163,7 @@ if run other_seed --vehicles 2 --count 5 --seed 8 --quiet --csv "$tmp/d.csv"; th
     fi
 fi
 # beta 1 cannot solve a conflict: every centralised search runs out of it, and says so.
-if run budget --vehicles 3 --count 3 --beta 1 --quiet --csv "$tmp/e.csv" --svg "$tmp/e.svg" --json; then
+if expect_ok budget montecarlo --vehicles 3 --count 3 --beta 1 --quiet --csv "$tmp/e.csv" --svg "$tmp/e.svg" --json; then
     cp "$tmp/out" "$tmp/e.json"
     check budget "$tmp/e.csv" "$tmp/e.json" "$tmp/e.svg"
     if python3 -c '
@@ -191,7 +177,7 @@ sys.exit(0 if m["budget_exhausted"] == 3 and m["solved"] == 0 else m)' "$tmp/e.j
 fi
 
 # The text summary: one block per UAV count with a row per method.
-if run text --vehicles 2,3 --count 3 --quiet; then
+if expect_ok text montecarlo --vehicles 2,3 --count 3 --quiet; then
     if grep -q '^2 UAVs: 3 encounters' "$tmp/out" && grep -q '^3 UAVs: 3 encounters' "$tmp/out" &&
         [ "$(grep -c '^  decoupled_reordered ' "$tmp/out")" -eq 4 ]; then
         pass
@@ -202,7 +188,7 @@ fi
 
 # With beta 1 nothing is solved: the ratio rows have no numbers (a ratio is at least 1,
 # so 0.000 there would be a made-up value), but still the shares.
-if run text_empty --vehicles 3 --count 2 --beta 1 --quiet; then
+if expect_ok text_empty montecarlo --vehicles 3 --count 2 --beta 1 --quiet; then
     rows=$(grep -E '^  decoupled_(fixed|reordered) +0 ' "$tmp/out")
     if [ "$(printf '%s\n' "$rows" | grep -c -- ' -  *- ')" -eq 2 ] &&
         ! printf '%s\n' "$rows" | grep -q '0\.000'; then
@@ -214,7 +200,7 @@ fi
 
 # A saved encounter is a scenario file that `coavoid plan` plans the same way.
 mkdir "$tmp/saved"
-if run save --vehicles 3 --count 2 --seed 7 --quiet --save "$tmp/saved" --csv "$tmp/f.csv"; then
+if expect_ok save montecarlo --vehicles 3 --count 2 --seed 7 --quiet --save "$tmp/saved" --csv "$tmp/f.csv"; then
     file="$tmp/saved/montecarlo-7-3-1.json"
     "$bin" plan "$file" --mode centralised >"$tmp/plan.json" 2>"$tmp/err"
     if python3 - "$tmp/plan.json" "$tmp/f.csv" <<'PY'; then pass; else fail "replay of $file: $(cat "$tmp/err")"; fi
