@@ -26,19 +26,29 @@ finish() {
     [ "$failed" -eq 0 ]
 }
 
-# expect_ok NAME ARGS...: coavoid ARGS exits 0 with nothing on stderr; its stdout is left in
-# $tmp/out. Returns 1 after counting a failure, so `if expect_ok ...; then check ...` reads
-# the output only when there is one to read.
-expect_ok() {
-    local name=$1
-    shift
+# expect_status DESCRIPTION STATUS ARGS...: coavoid ARGS exits STATUS with nothing on
+# stderr; its stdout is left in $tmp/out. Counts a pass, or a failure and returns 1, so
+# `if expect_status ...; then check ...` reads the output only when there is one to read.
+expect_status() {
+    local what=$1 want=$2
+    shift 2
     "$bin" "$@" >"$tmp/out" 2>"$tmp/err"
     local rc=$?
-    if [ "$rc" -ne 0 ] || [ -s "$tmp/err" ]; then
-        fail "$name: exit $rc, expected 0: $(head -c 300 "$tmp/err")"
+    if [ "$rc" -ne "$want" ]; then
+        fail "$what: exit $rc, expected $want (stderr: $(head -c 300 "$tmp/err"))"
+        return 1
+    elif [ -s "$tmp/err" ]; then
+        fail "$what: stderr not empty: $(head -c 300 "$tmp/err")"
         return 1
     fi
-    return 0
+    pass
+}
+
+# expect_ok DESCRIPTION ARGS...: expect_status with exit 0.
+expect_ok() {
+    local what=$1
+    shift
+    expect_status "$what" 0 "$@"
 }
 
 # expect_bad DESCRIPTION PATTERN ARGS...: coavoid ARGS exits 2, prints nothing on stdout

@@ -38,23 +38,6 @@ write() {
     fi
 }
 
-# expect_status DESCRIPTION STATUS ARGS...: coavoid ARGS exits STATUS with nothing on
-# stderr; its stdout is left in $tmp/out.
-expect_status() {
-    local what=$1 want=$2
-    shift 2
-    "$bin" "$@" >"$tmp/out" 2>"$tmp/err"
-    local rc=$?
-    if [ "$rc" -ne "$want" ]; then
-        fail "$what: exit $rc, expected $want (stderr: $(head -c 300 "$tmp/err"))"
-        return 1
-    elif [ -s "$tmp/err" ]; then
-        fail "$what: stderr not empty: $(head -c 300 "$tmp/err")"
-        return 1
-    fi
-    pass
-}
-
 # The contract's fields in order, then ours; numbers recomputed from the scenario: the
 # flown x, y on the reference (straight routes at cruise speed), offsets (z - z_ref) / dh
 # whole numbers moving by actions, and deviation and effort from those offsets by the
