@@ -89,9 +89,7 @@ bad_text() {
 }
 
 # The base must be good, or every case below would pass for the wrong reason.
-"$bin" plan "$tmp/good.json" --mode decoupled >"$tmp/out" 2>"$tmp/err"
-rc=$?
-if [ "$rc" -eq 0 ] && [ ! -s "$tmp/err" ]; then pass; else fail "good scenario: exit $rc: $(cat "$tmp/err")"; fi
+expect_ok "good scenario" plan "$tmp/good.json" --mode decoupled
 
 # Which precision the core was built with: 1e39 is out of range only for float.
 mutate precision_probe 's["obstacles"][0]["max"][0] = 1e39'
