@@ -131,23 +131,28 @@ static inline int cost_compare(coa_cost_t a, coa_cost_t b)
 /* Sizes                                                                                 */
 
 
+/* Children of one expansion of n searched UAVs at most: 5^n (n <= MAXM, so below 2^14). */
+static uint32_t children_per_node(size_t n)
+{
+    uint32_t pow5 = 1u;
+    for (size_t i = 0; i < n; ++i) {
+        pow5 *= ACTIONS;
+    }
+    return pow5;
+}
+
 static bool layout_compute(size_t max_vehicles, uint32_t beta, plan_layout_t *lo)
 {
-    uint64_t pow5 = 1u;
     uint64_t nodes;
     uint64_t table = 1u;
     size_t cursor;
     size_t c;
-    size_t i;
 
     if (max_vehicles == 0u || max_vehicles > MAXM || beta == 0u) {
         return false;
     }
-    for (i = 0; i < max_vehicles; ++i) {
-        pow5 *= ACTIONS;
-    }
     /* beta < 2^32 and 5^6 < 2^14: the product cannot overflow 64 bits. */
-    nodes = 1u + (uint64_t)beta * pow5;
+    nodes = 1u + (uint64_t)beta * children_per_node(max_vehicles);
     if (nodes > MAX_NODES) {
         return false;
     }
@@ -184,18 +189,13 @@ size_t coa_planner_workspace_size(size_t max_vehicles, uint32_t beta)
 uint32_t coa_planner_max_beta(size_t max_vehicles, size_t bytes)
 {
     plan_layout_t lo;
-    uint32_t pow5 = 1u;
     uint32_t lo_beta = 0u; /* fits (0 stands for "nothing fits") */
     uint32_t hi_beta;      /* the largest beta the node pool allows */
-    size_t i;
 
     if (max_vehicles == 0u || max_vehicles > MAXM) {
         return 0u;
     }
-    for (i = 0; i < max_vehicles; ++i) {
-        pow5 *= ACTIONS;
-    }
-    hi_beta = (MAX_NODES - 1u) / pow5;
+    hi_beta = (MAX_NODES - 1u) / children_per_node(max_vehicles);
     if (layout_compute(max_vehicles, hi_beta, &lo) && lo.total <= bytes) {
         return hi_beta;
     }
