@@ -424,6 +424,17 @@ START_TEST(test_volumes_random)
             coa_box_t ba = coa_sweep_bounds(&a), bb = coa_sweep_bounds(&b);
             ck_assert(coa_boxes_touch(&ba, &bb));
         }
+        /* The horizontal half: implied by a conflict, and exactly the conflict of b moved to
+         * a's altitudes (where the vertical overlap holds throughout). */
+        {
+            coa_sweep_t level = b;
+            bool horizontal = coa_conflict_horizontal(&a, &b);
+            level.p0.z = a.p0.z;
+            level.p1.z = a.p1.z;
+            ck_assert(!got || horizontal);
+            ck_assert(horizontal == coa_conflict_horizontal(&b, &a));
+            ck_assert(horizontal == coa_conflict_volumes(&a, &level));
+        }
     }
     tally_check(&t);
 }

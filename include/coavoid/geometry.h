@@ -78,6 +78,12 @@ typedef struct {
  * Cost O(1), no memory. Preconditions as in the file comment. */
 bool coa_conflict_volumes(const coa_sweep_t *a, const coa_sweep_t *b);
 
+/* Whether two moving volumes' horizontal discs come within r_a + r_b of each other
+ * (strictly) at some instant of the step, whatever their altitudes: the horizontal half of
+ * coa_conflict_volumes, by the same arithmetic, so that coa_conflict_volumes(a, b) implies
+ * it. A planner uses it to know where two vehicles can meet at all. Cost O(1), no memory. */
+bool coa_conflict_horizontal(const coa_sweep_t *a, const coa_sweep_t *b);
+
 /* Conflict between a moving volume and a static box over one step (closed form).
  * Returns true when some u in [0,1] has the volume overlapping the box (strictly).
  * Cost O(1), no memory. */
@@ -108,6 +114,11 @@ int coa_conflict_obstacle(const coa_sweep_t *a, const coa_obstacle_t *obstacle);
 /* The axis-aligned bounding box of everything a sweep covers over its step (for broad
  * phases and cheap rejection). Cost O(1); cannot fail. */
 coa_box_t coa_sweep_bounds(const coa_sweep_t *a);
+
+/* The axis-aligned box of an obstacle: the box itself, or the box of a polytope's
+ * vertices. Precondition: coa_obstacle_check(o) == COA_OK. Cost O(1) for a box,
+ * O(vertices) for a polytope; cannot fail. */
+coa_box_t coa_obstacle_bounds(const coa_obstacle_t *o);
 
 /* Whether two closed boxes share any point (touching counts: a broad phase must never
  * reject a pair the exact test would accept). Cost O(1). */

@@ -204,6 +204,15 @@ bool coa_conflict_volumes(const coa_sweep_t *a, const coa_sweep_t *b)
     return span_meets_step(span_meet(horiz, vert));
 }
 
+bool coa_conflict_horizontal(const coa_sweep_t *a, const coa_sweep_t *b)
+{
+    coa_real_t d0x = a->p0.x - b->p0.x;
+    coa_real_t d0y = a->p0.y - b->p0.y;
+    coa_real_t vx = (a->p1.x - b->p1.x) - d0x;
+    coa_real_t vy = (a->p1.y - b->p1.y) - d0y;
+    return span_meets_step(span_disc(d0x, d0y, vx, vy, a->volume.radius + b->volume.radius));
+}
+
 /* The open rounded rectangle {distance to the closed rectangle < r} is convex, so its
  * u-set is one open interval: the inf and sup over the pieces that cover it (two open
  * slabs crossed with closed strips, four open corner discs). Pieces that are a single
@@ -269,6 +278,28 @@ coa_box_t coa_sweep_bounds(const coa_sweep_t *a)
     b.max.x = (a->p0.x > a->p1.x ? a->p0.x : a->p1.x) + r;
     b.max.y = (a->p0.y > a->p1.y ? a->p0.y : a->p1.y) + r;
     b.max.z = (a->p0.z > a->p1.z ? a->p0.z : a->p1.z) + h;
+    return b;
+}
+
+coa_box_t coa_obstacle_bounds(const coa_obstacle_t *o)
+{
+    coa_box_t b;
+    size_t v;
+
+    if (o->kind == COA_OBSTACLE_BOX) {
+        return o->box;
+    }
+    b.min = o->polytope.vertices[0];
+    b.max = o->polytope.vertices[0];
+    for (v = 1; v < o->polytope.count; ++v) {
+        const coa_vec3_t *q = &o->polytope.vertices[v];
+        b.min.x = q->x < b.min.x ? q->x : b.min.x;
+        b.min.y = q->y < b.min.y ? q->y : b.min.y;
+        b.min.z = q->z < b.min.z ? q->z : b.min.z;
+        b.max.x = q->x > b.max.x ? q->x : b.max.x;
+        b.max.y = q->y > b.max.y ? q->y : b.max.y;
+        b.max.z = q->z > b.max.z ? q->z : b.max.z;
+    }
     return b;
 }
 

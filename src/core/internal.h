@@ -8,9 +8,11 @@
 #ifndef COAVOID_CORE_INTERNAL_H
 #define COAVOID_CORE_INTERNAL_H
 
+#include <float.h>
 #include <math.h>
 
 #include "coavoid/common.h"
+#include "coavoid/geometry.h"
 
 #define WS_ALIGN ((size_t)COA_WORKSPACE_ALIGNMENT)
 
@@ -74,6 +76,27 @@ static inline bool reserve(size_t *cursor, size_t count, size_t elem, size_t *at
 static inline coa_real_t real_norm2(coa_real_t x, coa_real_t y)
 {
     return real_sqrt(x * x + y * y);
+}
+
+/* Boxes and cheap rejections in front of an exact conflict test are widened by this many
+ * ulps of the scene's largest coordinate, so that no rounding in them can reject a step
+ * that the exact tests (whose own rounding is a few ulps) would accept. */
+#ifdef COA_SINGLE_PRECISION
+#define REAL_EPSILON FLT_EPSILON
+#else
+#define REAL_EPSILON DBL_EPSILON
+#endif
+#define SLACK_ULPS 64
+
+/* The largest of m and |p|'s coordinates. */
+static inline coa_real_t real_max_abs3(const coa_vec3_t *p, coa_real_t m)
+{
+    coa_real_t x = real_fabs(p->x);
+    coa_real_t y = real_fabs(p->y);
+    coa_real_t z = real_fabs(p->z);
+    m = x > m ? x : m;
+    m = y > m ? y : m;
+    return z > m ? z : m;
 }
 
 static inline bool real_ok(coa_real_t x)

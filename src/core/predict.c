@@ -24,16 +24,9 @@
  */
 #include "coavoid/predict.h"
 
-#include <float.h>
 #include <math.h>
 
 #include "internal.h"
-
-#ifdef COA_SINGLE_PRECISION
-#define REAL_EPSILON FLT_EPSILON
-#else
-#define REAL_EPSILON DBL_EPSILON
-#endif
 
 #define PREDICT_MAGIC 0x434f5052u /* marks a buffer built by coa_predictor_init */
 #define NONE UINT32_MAX
@@ -45,10 +38,6 @@
  * and mover indices in uint32 with NONE reserved. */
 #define MAX_MOVERS ((size_t)1 << 30)
 #define MAX_PAIRS ((size_t)1 << 30)
-/* Boxes and the narrow phase's cheap rejections are widened by this many ulps of the
- * scene's largest coordinate, so that no rounding in them can reject a step that the
- * exact tests (whose own rounding is a few ulps) would accept. */
-#define SLACK_ULPS 64
 /* The broad phase's grid has at most this many cells per mover. */
 #define GRID_CELLS_PER_MOVER 4u
 
@@ -605,16 +594,6 @@ static coa_vec3_t plan_at(const coa_intent_plan_t *p, coa_real_t u)
     return r;
 }
 
-static coa_real_t max_abs3(const coa_vec3_t *p, coa_real_t m)
-{
-    coa_real_t x = real_fabs(p->x);
-    coa_real_t y = real_fabs(p->y);
-    coa_real_t z = real_fabs(p->z);
-    m = x > m ? x : m;
-    m = y > m ? y : m;
-    return z > m ? z : m;
-}
-
 /* Fills the samples, the movers and the UAVs' reach. Returns COA_ERR_ARGUMENT when a
  * position or a sigma over the horizon is not finite. */
 static int align(coa_predictor_t *pr, const coa_intent_plan_t *plans, const coa_track_t *tracks)
@@ -671,7 +650,7 @@ static int align(coa_predictor_t *pr, const coa_intent_plan_t *plans, const coa_
             if (!vec_ok(&row[k])) {
                 return COA_ERR_ARGUMENT;
             }
-            scale = max_abs3(&row[k], scale);
+            scale = real_max_abs3(&row[k], scale);
         }
         /* The widest a box gets: the volume plus the margin at the horizon's end. */
         worst_h = mv->volume.radius +
@@ -762,29 +741,6 @@ static void set_clear(coa_predictor_t *pr, size_t count)
     for (i = 0; i < count; ++i) {
         pr->table[pr->slot[i]] = EMPTY_KEY;
     }
-}
-
-/* An obstacle's axis-aligned box: itself, or the box of a polytope's vertices. */
-static coa_box_t obstacle_bounds(const coa_obstacle_t *o)
-{
-    coa_box_t b;
-    size_t v;
-
-    if (o->kind == COA_OBSTACLE_BOX) {
-        return o->box;
-    }
-    b.min = o->polytope.vertices[0];
-    b.max = o->polytope.vertices[0];
-    for (v = 1; v < o->polytope.count; ++v) {
-        const coa_vec3_t *q = &o->polytope.vertices[v];
-        b.min.x = q->x < b.min.x ? q->x : b.min.x;
-        b.min.y = q->y < b.min.y ? q->y : b.min.y;
-        b.min.z = q->z < b.min.z ? q->z : b.min.z;
-        b.max.x = q->x > b.max.x ? q->x : b.max.x;
-        b.max.y = q->y > b.max.y ? q->y : b.max.y;
-        b.max.z = q->z > b.max.z ? q->z : b.max.z;
-    }
-    return b;
 }
 
 /* A pair of this step's boxes: a candidate when they overlap in x, y and z and are not
@@ -1116,7 +1072,7 @@ static int broad_phase(coa_predictor_t *pr, size_t obstacle_count, size_t *count
         return rc;
     }
     for (o = 0; o < obstacle_count; ++o) {
-        coa_box_t ob = obstacle_bounds(&pr->obstacles[o]);
+        coa_box_t ob = coa_obstacle_bounds(&pr->obstacles[o]);
         for (p = 0; p < n; ++p) {
             if (coa_boxes_touch(&pr->reach[p], &ob)) {
                 if (*count == pr->max_pairs) {
@@ -1456,7 +1412,7 @@ static bool evaluate_obstacle(const coa_predictor_t *pr, uint32_t a, uint32_t o,
     const coa_obstacle_t *obs = &pr->obstacles[o];
     const mover_t *ma = &pr->mover[a];
     const coa_vec3_t *pa = &pr->pos[(size_t)a * pr->stride];
-    coa_box_t ob = obstacle_bounds(obs);
+    coa_box_t ob = coa_obstacle_bounds(obs);
     uint32_t first = NONE;
     uint32_t k;
 
