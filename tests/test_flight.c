@@ -774,9 +774,12 @@ static int write_log(int argc, char **argv)
     if (planned) {
         coa_problem_t problem = scenario_problem(&s);
         uint32_t beta = s.has_beta ? s.beta : 20000u;
-        size_t size = coa_planner_workspace_size(n, beta);
+        coa_planner_config_t config;
+        size_t size = coa_planner_config_of(&problem, n, beta, &config) == COA_OK
+                          ? coa_planner_workspace_size(&config)
+                          : 0u;
         void *buffer = size > 0u ? malloc(size) : NULL;
-        coa_planner_t *planner = buffer != NULL ? coa_planner_init(buffer, size, n, beta) : NULL;
+        coa_planner_t *planner = buffer != NULL ? coa_planner_init(buffer, size, &config) : NULL;
         int rc = planner != NULL ? coa_plan_centralised(planner, &problem, plan, &result) : -1;
         free(buffer);
         if (rc != COA_OK || result.status != COA_PLAN_SOLVED) {

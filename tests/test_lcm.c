@@ -424,14 +424,19 @@ typedef struct {
     coa_planner_t *planner;
 } workspace_t;
 
+/* A planner for one UAV that takes any intent a coordinator can receive: the longest
+ * horizon a message holds, the steepest steep factor and no offset bound. The intents a
+ * test plans differ in all three, and one workspace serves them all. */
 static workspace_t workspace(uint32_t beta)
 {
+    const coa_planner_config_t config = {1u, beta, COAVOID_INTENT_T_MAX_SAMPLES - 1u,
+                                         COA_MAX_STEEP_FACTOR, -1};
     workspace_t ws;
-    size_t bytes = coa_planner_workspace_size(1u, beta);
+    size_t bytes = coa_planner_workspace_size(&config);
     ck_assert_uint_gt(bytes, 0u);
     ws.mem = malloc(bytes);
     ck_assert_ptr_nonnull(ws.mem);
-    ws.planner = coa_planner_init(ws.mem, bytes, 1u, beta);
+    ws.planner = coa_planner_init(ws.mem, bytes, &config);
     ck_assert_ptr_nonnull(ws.planner);
     return ws;
 }

@@ -97,6 +97,7 @@ START_TEST(planner_makes_no_heap_call)
     coa_plan_result_t central;
     coa_plan_result_t decoupled;
     coa_plan_result_t at_start;
+    coa_planner_config_t cfg;
     coa_planner_t *pl;
     void *mem;
     size_t bytes;
@@ -163,14 +164,15 @@ START_TEST(planner_makes_no_heap_call)
     p.track_count = 1u;
     p.track_samples = trackp;
 
-    bytes = coa_planner_workspace_size(2u, 2000u);
+    ck_assert_int_eq(coa_planner_config_of(&p, 2u, 2000u, &cfg), COA_OK);
+    bytes = coa_planner_workspace_size(&cfg);
     ck_assert_uint_gt(bytes, 0u);
     mem = malloc(bytes);
     ck_assert_ptr_nonnull(mem);
 
     heap_calls = 0u;
     armed = true;
-    pl = coa_planner_init(mem, bytes, 2u, 2000u);
+    pl = coa_planner_init(mem, bytes, &cfg);
     rc_central = coa_plan_centralised(pl, &p, rows, &central);
     rc_decoupled = coa_plan_decoupled(pl, &p, NULL, 2u, rows, &decoupled);
     rc_weights = coa_deviation_weights(veh, 2u, p.dt, weights, &exponent);
@@ -185,6 +187,10 @@ START_TEST(planner_makes_no_heap_call)
     ck_assert_ptr_nonnull(pl);
     ck_assert_int_eq(rc_central, COA_OK);
     ck_assert_int_eq(central.status, COA_PLAN_SOLVED);
+    /* A and B could not go around each other at their own costs: they were merged and
+     * searched jointly, so the joint search and its pair tables ran under the wrappers too. */
+    ck_assert_uint_eq(central.largest_group, 2u);
+    ck_assert_uint_gt(central.nodes_generated, 0u);
     ck_assert_int_eq(rc_decoupled, COA_OK);
     ck_assert_int_eq(decoupled.status, COA_PLAN_SOLVED);
     ck_assert_uint_eq(decoupled.orders_tried, 2u);

@@ -680,13 +680,14 @@ static dp_out_t dp_solve(const fx_t *f, const size_t *sv, size_t m, const int32_
     return out;
 }
 
-/* States with k < N the search could ever close: beta above this never interferes. */
+/* States (k = 0..N, the goal layer included) a joint search could ever store: it never
+ * stores one state twice, so beta above this never interferes. */
 static uint32_t state_bound(const fx_t *f, const size_t *sv, size_t m)
 {
     uint64_t total = 0u;
     uint32_t k;
     size_t i;
-    for (k = 0; k < f->p.horizon; ++k) {
+    for (k = 0; k <= f->p.horizon; ++k) {
         uint64_t layer = 1u;
         for (i = 0; i < m; ++i) {
             const coa_vehicle_t *v = &f->veh[sv[i]];
@@ -708,16 +709,25 @@ typedef struct {
     size_t bytes;
 } ws_t;
 
-static ws_t ws_make(size_t m, uint32_t beta)
+static ws_t ws_make_config(const coa_planner_config_t *c)
 {
     ws_t w;
-    w.bytes = coa_planner_workspace_size(m, beta);
+    w.bytes = coa_planner_workspace_size(c);
     ck_assert_uint_gt(w.bytes, 0u);
     w.mem = malloc(w.bytes);
     ck_assert_ptr_nonnull(w.mem);
-    w.pl = coa_planner_init(w.mem, w.bytes, m, beta);
+    w.pl = coa_planner_init(w.mem, w.bytes, c);
     ck_assert_ptr_nonnull(w.pl);
     return w;
+}
+
+/* Up to m UAVs searched together, at most beta nodes a joint search. The rest of the
+ * config fits every problem this file plans with such a planner (horizons up to MAXN,
+ * steep factors up to 3, any offset), so that one planner serves a whole random series. */
+static ws_t ws_make(size_t m, uint32_t beta)
+{
+    const coa_planner_config_t c = {m, beta, MAXN, 3u, -1};
+    return ws_make_config(&c);
 }
 
 static void ws_free(ws_t *w)
@@ -782,13 +792,16 @@ START_TEST(centralised_matches_exhaustive_search)
 {
     static fx_t f;
     static int32_t rows[MAXV * (MAXN + 1u)];
-    const uint32_t beta = 9500u;
+    /* Above every state_bound drawn here (three UAVs, four steps, s = 3: 25025), so that
+     * no search can run out of nodes and every answer is a proof. */
+    const uint32_t beta = 30000u;
     ws_t w = ws_make(3u, beta);
     uint64_t rng = 0x5eed0001u;
     unsigned solved = 0u;
     unsigned infeasible = 0u;
     unsigned moved = 0u;
     unsigned ties = 0u;
+    unsigned joint = 0u;
     unsigned trial;
 
     for (trial = 0; trial < 600u; ++trial) {
@@ -808,7 +821,15 @@ START_TEST(centralised_matches_exhaustive_search)
                       best.found ? "found a plan" : "found none");
         ck_assert_uint_eq(r.workspace_bytes, w.bytes);
         ck_assert_uint_eq(r.orders_tried, 1u);
-        ck_assert_uint_le(r.nodes_expanded, beta);
+        /* Single UAVs (alone, re-planned around a group) walk their tables and store no
+         * node: only a merged group's joint search does. */
+        ck_assert_uint_le(r.largest_group, n);
+        if (r.largest_group < 2u) {
+            ck_assert_uint_eq(r.nodes_generated, 0u);
+        }
+        if (r.nodes_generated > 0u) {
+            ++joint;
+        }
         if (best.found) {
             char b1[40];
             char b2[40];
@@ -817,6 +838,9 @@ START_TEST(centralised_matches_exhaustive_search)
                           u128_str(to_u128(r.deviation_units), b1), r.effort,
                           u128_str(best.dev, b2), best.eff);
             check_solved_plan(&f, rows, &r);
+            /* Every UAV was planned alone first. */
+            ck_assert_uint_ge(r.searches, n);
+            ck_assert_uint_ge(r.largest_group, 1u);
             ++solved;
             if (best.tie) {
                 ++ties;
@@ -841,6 +865,9 @@ START_TEST(centralised_matches_exhaustive_search)
     ck_assert_uint_ge(moved, 150u);
     /* ... and least-deviation plans that only the effort tells apart. */
     ck_assert_uint_ge(ties, 40u);
+    /* ... and groups that independence detection had to merge and search jointly, or the
+     * joint search would go unchecked. */
+    ck_assert_uint_ge(joint, 150u);
     ws_free(&w);
 }
 END_TEST
@@ -917,7 +944,9 @@ START_TEST(decoupled_each_vehicle_optimal_given_earlier)
 {
     static fx_t f;
     static int32_t rows[MAXV * (MAXN + 1u)];
-    const uint32_t beta = 2000u;
+    /* The smallest beta: a decoupled plan reads each UAV's plan off its exact cost-to-go
+     * table and stores no search node, so beta can never cut it short. */
+    const uint32_t beta = 1u;
     ws_t w = ws_make(1u, beta);
     uint64_t rng = 0x5eed0002u;
     unsigned solved = 0u;
@@ -940,6 +969,10 @@ START_TEST(decoupled_each_vehicle_optimal_given_earlier)
         ck_assert_uint_eq(r.orders_tried, 1u);
         ck_assert_uint_eq(r.workspace_bytes, w.bytes);
         ck_assert(r.status != COA_PLAN_BUDGET_EXHAUSTED);
+        ck_assert_uint_eq(r.nodes_generated, 0u);
+        /* One search per UAV planned, the one that failed included. */
+        ck_assert_uint_eq(r.searches,
+                          r.planned_count + (r.status == COA_PLAN_SOLVED ? 0u : 1u));
         for (i = 0; i < n; ++i) {
             ck_assert_uint_eq(r.order[i], prio[i]);
         }
@@ -1198,6 +1231,9 @@ static void fx_head_on(fx_t *f, uint32_t horizon, double half)
     fx_vehicle(f, 2u, 1u, 10.0, 4.0, 2u, 5.0, half, V(60, 0, 100), V(-60, 0, 100));
 }
 
+/* Head-on, each UAV's plan alone goes through the other and neither can go around the
+ * other at its own optimal cost, so independence detection merges the two and only a
+ * joint search finds the optimum (which shares the manoeuvre: head_on_is_separated). */
 START_TEST(tiny_beta_is_budget_exhausted)
 {
     static fx_t f;
@@ -1210,83 +1246,203 @@ START_TEST(tiny_beta_is_budget_exhausted)
     w = ws_make(2u, 3u);
     ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
     ck_assert_int_eq(r.status, COA_PLAN_BUDGET_EXHAUSTED);
-    ck_assert_uint_eq(r.nodes_expanded, 3u);
+    ck_assert_uint_eq(r.largest_group, 2u);
+    /* The one joint search stopped when its pool of beta nodes was full, not before. */
+    ck_assert_uint_eq(r.nodes_generated, 3u);
+    ck_assert(to_u128(r.deviation_units) == 0u); /* nothing proven, no costs */
     ws_free(&w);
 
     /* With room, the same problem is solved: the budget was the only obstacle. */
     w = ws_make(2u, 20000u);
     ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
     ck_assert_int_eq(r.status, COA_PLAN_SOLVED);
-    ck_assert_uint_gt(r.nodes_expanded, 3u);
+    ck_assert_uint_eq(r.largest_group, 2u);
+    ck_assert_uint_gt(r.nodes_generated, 3u);
+    ck_assert_uint_le(r.nodes_generated, 20000u);
+    check_solved_plan(&f, rows, &r);
     ws_free(&w);
 
-    /* Decoupled: B has to move around A, which takes more than a few expansions. */
-    w = ws_make(1u, 14u);
+    /* Decoupled: B has to move around A, but it reads that off its table against A's
+     * plan and stores no node, so even the smallest beta is enough. */
+    w = ws_make(1u, 1u);
     ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, NULL, 2u, rows, &r), COA_OK);
-    ck_assert_int_eq(r.status, COA_PLAN_BUDGET_EXHAUSTED);
-    ck_assert_uint_eq(r.failed_vehicle, r.order[r.planned_count]);
+    ck_assert_int_eq(r.status, COA_PLAN_SOLVED);
+    ck_assert_uint_eq(r.nodes_generated, 0u);
+    ck_assert_uint_eq(r.orders_tried, 1u);
+    ck_assert_int_gt(r.effort, 0u);
+    check_decoupled_attempt(&f, rows, &r);
     ws_free(&w);
 }
 END_TEST
 
+/* The node pool's bytes per node for a config shape, checked to be a constant: the size
+ * is exactly linear in beta (betas that are multiples of 8 leave every array on its
+ * 8-byte boundary without padding). */
+static size_t node_bytes(size_t m, uint32_t horizon, uint32_t steep, int32_t max_offset)
+{
+    coa_planner_config_t c = {m, 1000u, horizon, steep, max_offset};
+    size_t a = coa_planner_workspace_size(&c);
+    size_t b;
+    size_t d;
+    c.beta = 2000u;
+    b = coa_planner_workspace_size(&c);
+    c.beta = 3000u;
+    d = coa_planner_workspace_size(&c);
+    ck_assert_uint_gt(a, 0u);
+    ck_assert_uint_gt(b, a);
+    ck_assert_uint_eq(d - b, b - a);
+    ck_assert_uint_eq((b - a) % 1000u, 0u);
+    return (b - a) / 1000u;
+}
+
 START_TEST(workspace_size_is_exact)
 {
-    size_t bytes = coa_planner_workspace_size(2u, 50u);
-    size_t bytes1 = coa_planner_workspace_size(1u, 50u);
+    /* Head-on below: 2 UAVs, 12 steps, steep factor 2, unbounded; beta too small for it. */
+    const coa_planner_config_t c2 = {2u, 20u, 12u, 2u, -1};
+    const coa_planner_config_t c1 = {1u, 20u, 12u, 2u, -1};
+    /* A bounded config, and configs that each need more in one field. */
+    const coa_planner_config_t cb = {2u, 20u, 12u, 2u, 5};
+    const coa_planner_config_t more[6] = {
+        {3u, 20u, 12u, 2u, 5}, {2u, 21u, 12u, 2u, 5}, {2u, 20u, 13u, 2u, 5},
+        {2u, 20u, 12u, 3u, 5}, {2u, 20u, 12u, 2u, 6}, {2u, 20u, 12u, 2u, -1},
+    };
+    size_t bytes = coa_planner_workspace_size(&c2);
+    size_t bytes1 = coa_planner_workspace_size(&c1);
+    size_t bytesb = coa_planner_workspace_size(&cb);
+    coa_planner_config_t c;
     unsigned char *mem;
     unsigned char *guard;
     coa_planner_t *pl;
     static fx_t f;
     static int32_t rows[MAXV * (MAXN + 1u)];
     coa_plan_result_t r;
+    size_t per_node;
+    size_t m;
     size_t i;
 
     ck_assert_uint_gt(bytes, 0u);
     ck_assert_uint_gt(bytes, bytes1);
-    ck_assert_uint_gt(coa_planner_workspace_size(2u, 51u), bytes);
-    ck_assert_uint_eq(coa_planner_workspace_size(0u, 50u), 0u);
-    ck_assert_uint_eq(coa_planner_workspace_size(COA_MAX_CENTRALISED + 1u, 50u), 0u);
-    ck_assert_uint_eq(coa_planner_workspace_size(2u, 0u), 0u);
-    ck_assert_uint_gt(coa_planner_workspace_size(COA_MAX_CENTRALISED, 1u), 0u);
-    ck_assert_uint_eq(coa_planner_workspace_size(COA_MAX_CENTRALISED, UINT32_MAX), 0u);
-    ck_assert_uint_eq(coa_planner_workspace_size(1u, UINT32_MAX), 0u);
-    /* Bytes per node as plan.h states them, 50 + 2m: between these betas the pool grows
-     * by 3000 nodes and the hash table keeps its 16384 slots. */
-    ck_assert_uint_eq(coa_planner_workspace_size(1u, 1600u) - coa_planner_workspace_size(1u, 1000u),
-                      3000u * (50u + 2u));
-    ck_assert_uint_eq(coa_planner_workspace_size(2u, 320u) - coa_planner_workspace_size(2u, 200u),
-                      3000u * (50u + 4u));
+    ck_assert_uint_gt(bytes, bytesb);
+    c = c2;
+    c.beta = 21u;
+    ck_assert_uint_gt(coa_planner_workspace_size(&c), bytes);
+
+    /* Every field out of its range is refused. */
+    ck_assert_uint_eq(coa_planner_workspace_size(NULL), 0u);
+    c = c2;
+    c.vehicles = 0u;
+    ck_assert_uint_eq(coa_planner_workspace_size(&c), 0u);
+    c.vehicles = COA_MAX_CENTRALISED + 1u;
+    ck_assert_uint_eq(coa_planner_workspace_size(&c), 0u);
+    c.vehicles = COA_MAX_CENTRALISED;
+    ck_assert_uint_gt(coa_planner_workspace_size(&c), 0u);
+    c = c2;
+    c.beta = 0u;
+    ck_assert_uint_eq(coa_planner_workspace_size(&c), 0u);
+    c.beta = UINT32_C(1) << 30; /* a pool of 1 + beta nodes past 2^30 */
+    ck_assert_uint_eq(coa_planner_workspace_size(&c), 0u);
+    c.beta = UINT32_MAX;
+    ck_assert_uint_eq(coa_planner_workspace_size(&c), 0u);
+    c = c2;
+    c.horizon = 0u;
+    ck_assert_uint_eq(coa_planner_workspace_size(&c), 0u);
+    c.horizon = COA_MAX_HORIZON + 1u;
+    ck_assert_uint_eq(coa_planner_workspace_size(&c), 0u);
+    c.horizon = COA_MAX_HORIZON;
+    ck_assert_uint_gt(coa_planner_workspace_size(&c), 0u);
+    c = c2;
+    c.steep_factor = 1u;
+    ck_assert_uint_eq(coa_planner_workspace_size(&c), 0u);
+    c.steep_factor = COA_MAX_STEEP_FACTOR + 1u;
+    ck_assert_uint_eq(coa_planner_workspace_size(&c), 0u);
+    c.steep_factor = COA_MAX_STEEP_FACTOR;
+    ck_assert_uint_gt(coa_planner_workspace_size(&c), 0u);
+    /* Any negative bound is unbounded, and so is COA_MAX_OFFSET itself. */
+    c = c2;
+    c.max_offset = INT32_MIN;
+    ck_assert_uint_eq(coa_planner_workspace_size(&c), bytes);
+    c.max_offset = COA_MAX_OFFSET;
+    ck_assert_uint_eq(coa_planner_workspace_size(&c), bytes);
+
+    /* The tables (plan.h, "Memory"): a single-UAV planner is its header and one table of
+     * T = sum over k of min(2 k s + 1, 2 L + 1) cells of 8 bytes, so the size differs
+     * between horizons by the cells alone: 1,225 for N = 24 and s = 2, 6 for N = 1; with
+     * L = 3, 1 + 5 + 23 * 7 = 167; a bound beyond reach (2 L + 1 = 2 N s + 1) changes
+     * nothing. */
+    {
+        coa_planner_config_t a = {1u, 20u, 1u, 2u, -1};
+        coa_planner_config_t b = {1u, 20u, 24u, 2u, -1};
+        ck_assert_uint_eq(coa_planner_workspace_size(&b) - coa_planner_workspace_size(&a),
+                          8u * (1225u - 6u));
+        a.max_offset = 3;
+        b.max_offset = 3;
+        ck_assert_uint_eq(coa_planner_workspace_size(&b) - coa_planner_workspace_size(&a),
+                          8u * (167u - 6u));
+        b.max_offset = 48;
+        a.max_offset = -1;
+        ck_assert_uint_eq(coa_planner_workspace_size(&b) - coa_planner_workspace_size(&a),
+                          8u * (1225u - 6u));
+    }
+    /* A single-UAV planner never searches jointly: it has no node pool, and beta does not
+     * change its size. */
+    c = c1;
+    c.beta = 1u;
+    ck_assert_uint_eq(coa_planner_workspace_size(&c), bytes1);
+    c.beta = (UINT32_C(1) << 30) - 1u;
+    ck_assert_uint_eq(coa_planner_workspace_size(&c), bytes1);
+    /* The node pool: linear in beta, its bytes per node independent of the horizon, the
+     * steep factor and the offset bound, and one int16 offset more per UAV searched
+     * together (the composite search's pool grew by 5^n a node). */
+    per_node = node_bytes(2u, 12u, 2u, -1);
+    for (m = 2u; m <= COA_MAX_CENTRALISED; ++m) {
+        size_t here = node_bytes(m, 12u, 2u, -1);
+        ck_assert_uint_eq(node_bytes(m, 24u, 3u, 5), here);
+        ck_assert_uint_eq(node_bytes(m, 1u, COA_MAX_STEEP_FACTOR, 0), here);
+        ck_assert_uint_eq(here, per_node + (m - 2u) * sizeof(int16_t));
+    }
 
     /* 16 spare bytes: 8 for a misaligned start, 8 of guard after the workspace. */
     mem = malloc(bytes + 16u);
     ck_assert_ptr_nonnull(mem);
-    ck_assert_ptr_null(coa_planner_init(NULL, bytes, 2u, 50u));
-    ck_assert_ptr_null(coa_planner_init(mem, bytes - 1u, 2u, 50u));
-    ck_assert_ptr_null(coa_planner_init(mem + 1, bytes, 2u, 50u));
-    ck_assert_ptr_null(coa_planner_init(mem + 4, bytes, 2u, 50u));
-    ck_assert_ptr_null(coa_planner_init(mem, bytes, 0u, 50u));
-    ck_assert_ptr_null(coa_planner_init(mem, bytes, 3u, 50u));
-    ck_assert_ptr_null(coa_planner_init(mem, bytes, 2u, 51u));
+    ck_assert_ptr_null(coa_planner_init(NULL, bytes, &c2));
+    ck_assert_ptr_null(coa_planner_init(mem, bytes - 1u, &c2));
+    ck_assert_ptr_null(coa_planner_init(mem + 1, bytes, &c2));
+    ck_assert_ptr_null(coa_planner_init(mem + 4, bytes, &c2));
+    ck_assert_ptr_null(coa_planner_init(mem, bytes, NULL));
+    c = c2;
+    c.vehicles = 0u;
+    ck_assert_ptr_null(coa_planner_init(mem, bytes, &c));
+    /* A size exact for one config is one byte short (at least) for any config that needs
+     * more in any field. */
+    ck_assert_ptr_nonnull(coa_planner_init(mem, bytesb, &cb));
+    ck_assert_ptr_null(coa_planner_init(mem, bytesb - 1u, &cb));
+    for (i = 0; i < 6u; ++i) {
+        ck_assert_uint_gt(coa_planner_workspace_size(&more[i]), bytesb);
+        ck_assert_ptr_null(coa_planner_init(mem, bytesb, &more[i]));
+    }
 
     guard = mem + bytes;
     memset(guard, 0xA5, 16u);
-    pl = coa_planner_init(mem, bytes, 2u, 50u);
+    pl = coa_planner_init(mem, bytes, &c2);
     ck_assert_ptr_eq((void *)pl, (void *)mem);
 
-    /* Run it to its budget and then solve: it never writes past its size. */
+    /* Run it to its budget (the joint search fills its whole pool) and then solve: it
+     * never writes past its size. */
     fx_head_on(&f, 12u, 3.0);
     fx_finish(&f);
     ck_assert_int_eq(coa_plan_centralised(pl, &f.p, rows, &r), COA_OK);
     ck_assert_int_eq(r.status, COA_PLAN_BUDGET_EXHAUSTED);
+    ck_assert_uint_eq(r.nodes_generated, c2.beta);
     ck_assert_uint_eq(r.workspace_bytes, bytes);
     ck_assert_int_eq(coa_plan_decoupled(pl, &f.p, NULL, 2u, rows, &r), COA_OK);
     ck_assert_int_eq(r.status, COA_PLAN_SOLVED);
+    ck_assert_uint_eq(r.workspace_bytes, bytes);
     for (i = 0; i < 16u; ++i) {
         ck_assert_uint_eq(guard[i], 0xA5u);
     }
 
     /* A planner for one vehicle refuses a centralised search of two. */
-    pl = coa_planner_init(mem, bytes1, 1u, 50u);
+    pl = coa_planner_init(mem, bytes1, &c1);
     ck_assert_ptr_nonnull(pl);
     ck_assert_int_eq(coa_plan_centralised(pl, &f.p, rows, &r), COA_ERR_WORKSPACE);
     ck_assert_int_eq(coa_plan_decoupled(pl, &f.p, NULL, 1u, rows, &r), COA_OK);
@@ -1303,48 +1459,77 @@ START_TEST(workspace_size_is_exact)
 END_TEST
 
 /* coa_planner_max_beta inverts the size function: the beta it gives fits, one more does
- * not, and a buffer of exactly the size for beta gives beta back. */
+ * not, and a buffer of exactly the size for beta gives beta back. config->beta plays no
+ * part. A single-UAV planner's size does not depend on beta, so there any beta fits once
+ * the header and the table do. */
 START_TEST(max_beta_inverts_workspace_size)
 {
     static const uint32_t betas[] = {1u, 2u, 3u, 24u, 100u, 255u, 1000u, 4097u, 100000u};
+    /* Two shapes: beta's inverse must not depend on the tables. */
+    static const coa_planner_config_t shapes[2] = {{1u, 0u, 12u, 2u, -1}, {1u, 0u, 24u, 3u, 5}};
+    const uint32_t top = (UINT32_C(1) << 30) - 1u; /* the node pool's limit */
+    size_t sh;
     size_t n;
     size_t i;
 
-    for (n = 1u; n <= COA_MAX_CENTRALISED; ++n) {
-        uint32_t pow5 = 1u;
-        uint32_t top;
-        size_t j;
-        for (j = 0; j < n; ++j) {
-            pow5 *= 5u;
-        }
-        top = ((UINT32_C(1) << 30) - 1u) / pow5; /* the node pool's limit */
-        ck_assert_uint_gt(coa_planner_workspace_size(n, top), 0u);
-        ck_assert_uint_eq(coa_planner_workspace_size(n, top + 1u), 0u);
-        for (i = 0; i < sizeof betas / sizeof betas[0]; ++i) {
-            uint32_t beta = betas[i];
-            size_t bytes;
-            uint32_t got;
-            if (beta > top) {
-                continue;
+    for (sh = 0; sh < 2u; ++sh) {
+        for (n = 1u; n <= COA_MAX_CENTRALISED; ++n) {
+            coa_planner_config_t c = shapes[sh];
+            coa_planner_config_t q;
+            size_t floor_bytes;
+            c.vehicles = n;
+            c.beta = top;
+            ck_assert_uint_gt(coa_planner_workspace_size(&c), 0u);
+            c.beta = top + 1u;
+            ck_assert_uint_eq(coa_planner_workspace_size(&c), 0u);
+            c.beta = 1u;
+            floor_bytes = coa_planner_workspace_size(&c);
+            for (i = 0; i < sizeof betas / sizeof betas[0]; ++i) {
+                size_t bytes;
+                uint32_t got;
+                c.beta = betas[i];
+                bytes = coa_planner_workspace_size(&c);
+                ck_assert_uint_gt(bytes, 0u);
+                /* Whatever beta the config carries. */
+                q = c;
+                q.beta = 77u;
+                if (n == 1u) {
+                    ck_assert_uint_eq(bytes, floor_bytes);
+                    ck_assert_uint_eq(coa_planner_max_beta(&q, bytes), top);
+                    ck_assert_uint_eq(coa_planner_max_beta(&q, bytes - 1u), 0u);
+                    continue;
+                }
+                ck_assert_uint_eq(coa_planner_max_beta(&q, bytes), betas[i]);
+                ck_assert_uint_eq(coa_planner_max_beta(&q, bytes - 1u), betas[i] - 1u);
+                /* Between two sizes: the smaller beta, which fits. */
+                got = coa_planner_max_beta(&q, bytes + 7u);
+                ck_assert_uint_ge(got, betas[i]);
+                q.beta = got;
+                ck_assert_uint_le(coa_planner_workspace_size(&q), bytes + 7u);
+                q.beta = got + 1u;
+                ck_assert_uint_gt(coa_planner_workspace_size(&q), bytes + 7u);
             }
-            bytes = coa_planner_workspace_size(n, beta);
-            ck_assert_uint_gt(bytes, 0u);
-            ck_assert_uint_eq(coa_planner_max_beta(n, bytes), beta);
-            ck_assert_uint_eq(coa_planner_max_beta(n, bytes - 1u), beta - 1u);
-            /* Between two sizes: the smaller beta, which fits. */
-            got = coa_planner_max_beta(n, bytes + 7u);
-            ck_assert_uint_ge(got, beta);
-            ck_assert_uint_le(coa_planner_workspace_size(n, got), bytes + 7u);
-            ck_assert_uint_gt(coa_planner_workspace_size(n, got + 1u), bytes + 7u);
+            /* Room beyond the pool's limit: the limit, not more. */
+            ck_assert_uint_eq(coa_planner_max_beta(&c, SIZE_MAX), top);
+            /* Less than the workspace for beta = 1: nothing fits. */
+            ck_assert_uint_eq(coa_planner_max_beta(&c, floor_bytes - 1u), 0u);
+            ck_assert_uint_eq(coa_planner_max_beta(&c, 0u), 0u);
         }
-        /* Room beyond the pool's limit: the limit, not more. */
-        ck_assert_uint_eq(coa_planner_max_beta(n, SIZE_MAX), top);
-        /* Less than the header and one expansion: nothing fits. */
-        ck_assert_uint_eq(coa_planner_max_beta(n, coa_planner_workspace_size(n, 1u) - 1u), 0u);
-        ck_assert_uint_eq(coa_planner_max_beta(n, 0u), 0u);
     }
-    ck_assert_uint_eq(coa_planner_max_beta(0u, SIZE_MAX), 0u);
-    ck_assert_uint_eq(coa_planner_max_beta(COA_MAX_CENTRALISED + 1u, SIZE_MAX), 0u);
+    {
+        coa_planner_config_t c = shapes[0];
+        ck_assert_uint_eq(coa_planner_max_beta(NULL, SIZE_MAX), 0u);
+        c.vehicles = 0u;
+        ck_assert_uint_eq(coa_planner_max_beta(&c, SIZE_MAX), 0u);
+        c.vehicles = COA_MAX_CENTRALISED + 1u;
+        ck_assert_uint_eq(coa_planner_max_beta(&c, SIZE_MAX), 0u);
+        c.vehicles = 2u;
+        c.horizon = 0u;
+        ck_assert_uint_eq(coa_planner_max_beta(&c, SIZE_MAX), 0u);
+        c.horizon = 12u;
+        c.steep_factor = COA_MAX_STEEP_FACTOR + 1u;
+        ck_assert_uint_eq(coa_planner_max_beta(&c, SIZE_MAX), 0u);
+    }
 }
 END_TEST
 
@@ -1364,11 +1549,14 @@ START_TEST(initial_conflict_is_infeasible_without_expanding)
     ck_assert_int_eq(r.status, COA_PLAN_INFEASIBLE);
     ck_assert_uint_eq(r.nodes_expanded, 0u);
     ck_assert_uint_eq(r.nodes_generated, 0u);
+    ck_assert_uint_eq(r.searches, 0u); /* not even the UAVs alone */
+    ck_assert_uint_eq(r.largest_group, 0u);
     ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, NULL, 1u, rows, &r), COA_OK);
     ck_assert_int_eq(r.status, COA_PLAN_INFEASIBLE);
     ck_assert_uint_eq(r.planned_count, 1u);
     ck_assert_uint_eq(r.failed_vehicle, 1u);
     ck_assert_uint_eq(r.nodes_expanded, 6u); /* vehicle 0 alone: one expansion a step */
+    ck_assert_uint_eq(r.nodes_generated, 0u);
 
     /* One UAV starting inside a box; a track sitting on the other at t = 0. */
     fx_init(&f, 6u);
@@ -1548,11 +1736,24 @@ START_TEST(problem_check_and_helpers)
     {
         static int32_t big_rows[9 * (COA_MAX_HORIZON + 1u)];
         coa_plan_result_t r;
-        ws_t w = ws_make(1u, 10u);
+        coa_planner_config_t c;
+        ws_t w;
+        /* A planner that takes the problem, so that only the weights can refuse it: its
+         * offsets bounded to 1 (unbounded, the table of steep factor 10 over 10,000 steps
+         * would take gigabytes), which the range check does not depend on. */
+        for (i = 0; i < 9u; ++i) {
+            many[i].max_offset = 1;
+        }
+        ck_assert_int_eq(coa_planner_config_of(&p, 1u, 10u, &c), COA_OK);
+        w = ws_make_config(&c);
         ck_assert_int_eq(coa_plan_decoupled(w.pl, &p, NULL, 1u, big_rows, &r), COA_ERR_RANGE);
         ck_assert_int_eq(r.status, COA_PLAN_INFEASIBLE); /* cleared */
         ck_assert_uint_eq(r.orders_tried, 0u);
+        ck_assert_uint_eq(r.searches, 0u);
         ws_free(&w);
+        for (i = 0; i < 9u; ++i) {
+            many[i].max_offset = -1;
+        }
     }
     many[1].cruise_speed = R(1.1 * 512.0);
     ck_assert_int_eq(coa_problem_check(&p), COA_OK);
@@ -1634,46 +1835,98 @@ START_TEST(tie_between_vehicles_goes_to_lower_effort)
 }
 END_TEST
 
-/* A goal on top of the open list is taken even when beta states have been closed. */
-START_TEST(goal_on_top_is_taken_at_the_budget)
+/* A single UAV never needs a search node: alone (centralised) or in turn (decoupled), its
+ * plan is read off its exact cost-to-go table in N expansions, so the smallest beta plans
+ * any number of UAVs whose plans never meet. (The old planner needed beta = N here, and
+ * ran out with N - 1.) */
+START_TEST(single_vehicle_plans_need_no_budget)
 {
     static fx_t f;
     static int32_t rows[MAXV * (MAXN + 1u)];
     coa_plan_result_t r;
+    ws_t w = ws_make(2u, 1u);
     uint32_t n;
 
     for (n = 1u; n <= 7u; n += 3u) {
-        ws_t w;
-        /* One UAV with nothing around: the search closes k = 0..N-1 and then sees the
-         * goal at k = N on top. */
         fx_init(&f, n);
         fx_vehicle(&f, 1u, 1u, 10.0, 2.0, 2u, 5.0, 2.0, V(0, 0, 100), V(100, 0, 100));
         fx_finish(&f);
-        w = ws_make(1u, n);
         ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
         ck_assert_int_eq(r.status, COA_PLAN_SOLVED);
         ck_assert_uint_eq(r.nodes_expanded, n);
+        ck_assert_uint_eq(r.nodes_generated, 0u);
+        ck_assert_uint_eq(r.searches, 1u);
+        ck_assert_uint_eq(r.largest_group, 1u);
         ck_assert_uint_eq(r.effort, 0u);
         ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, NULL, 1u, rows, &r), COA_OK);
         ck_assert_int_eq(r.status, COA_PLAN_SOLVED);
         ck_assert_uint_eq(r.nodes_expanded, n);
-        /* A second UAV far away: each single-UAV search fits the same beta. */
+        ck_assert_uint_eq(r.nodes_generated, 0u);
+        ck_assert_uint_eq(r.searches, 1u);
+        /* A second UAV far away: one more table each, still no node. */
         fx_vehicle(&f, 2u, 2u, 10.0, 2.0, 2u, 5.0, 2.0, V(0, 500, 100), V(100, 500, 100));
         fx_finish(&f);
         ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, NULL, 1u, rows, &r), COA_OK);
         ck_assert_int_eq(r.status, COA_PLAN_SOLVED);
         ck_assert_uint_eq(r.nodes_expanded, 2u * n);
-        ws_free(&w);
-        if (n > 1u) {
-            w = ws_make(1u, n - 1u);
-            ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, NULL, 1u, rows, &r), COA_OK);
-            ck_assert_int_eq(r.status, COA_PLAN_BUDGET_EXHAUSTED);
-            ck_assert_uint_eq(r.nodes_expanded, n - 1u);
-            ck_assert_uint_eq(r.failed_vehicle, 0u);
-            ck_assert(!r.all_orders_covered);
-            ws_free(&w);
-        }
+        ck_assert_uint_eq(r.nodes_generated, 0u);
+        ck_assert_uint_eq(r.searches, 2u);
+        ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
+        ck_assert_int_eq(r.status, COA_PLAN_SOLVED);
+        ck_assert_uint_eq(r.nodes_expanded, 2u * n);
+        ck_assert_uint_eq(r.nodes_generated, 0u);
+        ck_assert_uint_eq(r.searches, 2u);
+        ck_assert_uint_eq(r.largest_group, 1u); /* never searched together */
+        check_solved_plan(&f, rows, &r);
     }
+    ws_free(&w);
+}
+END_TEST
+
+/* A goal on top of the open list is taken even when the pool is full. Head-on needs a
+ * joint search (tiny_beta_is_budget_exhausted). Over a range of betas, each run either
+ * runs out with exactly beta nodes stored (running out of room is the only way to run
+ * out) or finds the same optimum with at most beta stored; and some run solves it with
+ * all beta stored: the goal was the last node the pool took, and it was still taken. */
+START_TEST(goal_on_top_is_taken_at_the_budget)
+{
+    static fx_t f;
+    static int32_t rows[MAXV * (MAXN + 1u)];
+    coa_plan_result_t r;
+    u128_t optimum;
+    uint32_t effort;
+    uint32_t beta;
+    unsigned exhausted = 0u;
+    unsigned full_and_solved = 0u;
+    ws_t w = ws_make(2u, 20000u);
+
+    fx_head_on(&f, 12u, 3.0);
+    fx_finish(&f);
+    ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
+    ck_assert_int_eq(r.status, COA_PLAN_SOLVED);
+    optimum = to_u128(r.deviation_units);
+    effort = r.effort;
+    ws_free(&w);
+
+    for (beta = 1u; beta <= 64u; ++beta) {
+        w = ws_make(2u, beta);
+        ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
+        ck_assert_uint_eq(r.largest_group, 2u);
+        if (r.status == COA_PLAN_BUDGET_EXHAUSTED) {
+            ck_assert_uint_eq(r.nodes_generated, beta);
+            ++exhausted;
+        } else {
+            ck_assert_int_eq(r.status, COA_PLAN_SOLVED);
+            ck_assert_uint_le(r.nodes_generated, beta);
+            ck_assert(to_u128(r.deviation_units) == optimum);
+            ck_assert_uint_eq(r.effort, effort);
+            check_solved_plan(&f, rows, &r);
+            full_and_solved += r.nodes_generated == beta ? 1u : 0u;
+        }
+        ws_free(&w);
+    }
+    ck_assert_uint_gt(exhausted, 0u);
+    ck_assert_uint_gt(full_and_solved, 0u);
 }
 END_TEST
 
@@ -1728,15 +1981,19 @@ START_TEST(conflict_at_start_rules_out_every_order)
 }
 END_TEST
 
-/* A proof that every order fails outranks an attempt that ran out of beta. A (priority
- * 1) is free but needs 6 expansions and beta is 3, so the first attempt ends with A's
- * budget exhausted; then either B flies into a wall, which it cannot survive even alone
- * (tried first in the second order), or B and C overlap at t = 0. */
+/* A proof that no plan exists ends the call whatever beta is. A (priority 1) is free;
+ * then either B flies into a wall, which it cannot survive even alone (tried first in the
+ * second order), or B and C overlap at t = 0. Decoupled, no beta can cut a plan short
+ * any more (each UAV's plan is read off its table), so even beta = 1 leaves the proofs
+ * to decide, where the old planner's first attempt ran out of beta on A and this test
+ * checked that the proof outranked that. Centralised, a UAV with no plan even alone is
+ * infeasible before any joint search, so a beta too small for the search that two
+ * other UAVs' encounter needs does not matter either. */
 START_TEST(proof_for_every_order_outranks_budget)
 {
     static fx_t f;
     static int32_t rows[MAXV * (MAXN + 1u)];
-    ws_t w = ws_make(1u, 3u);
+    ws_t w = ws_make(1u, 1u);
     coa_plan_result_t r;
     int variant;
 
@@ -1756,17 +2013,149 @@ START_TEST(proof_for_every_order_outranks_budget)
         ck_assert_int_eq(r.status, COA_PLAN_INFEASIBLE);
         ck_assert(r.all_orders_covered);
         ck_assert_uint_eq(r.orders_tried, variant == 0 ? 2u : 1u);
-        /* The report is still the first order's attempt: A failed first, through beta. */
-        ck_assert_uint_eq(r.planned_count, 0u);
-        ck_assert_uint_eq(r.failed_vehicle, 0u);
+        ck_assert_uint_eq(r.nodes_generated, 0u);
+        /* The report is the first order's attempt: A planned, then B (variant 0) or C
+         * (variant 1, against B) failed. */
         ck_assert_uint_eq(r.order[0], 0u);
-        /* Without the proof it stays budget exhausted. */
+        ck_assert_uint_eq(r.planned_count, variant == 0 ? 1u : 2u);
+        ck_assert_uint_eq(r.failed_vehicle, variant == 0 ? 1u : 2u);
+        check_decoupled_attempt(&f, rows, &r);
+        /* One order: the same failure, covering every order only through the t = 0 proof. */
         ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, (const size_t[]){0u, 1u, 2u}, 1u, rows,
                                             &r),
                          COA_OK);
-        ck_assert_int_eq(r.status, variant == 0 ? COA_PLAN_BUDGET_EXHAUSTED : COA_PLAN_INFEASIBLE);
+        ck_assert_int_eq(r.status, COA_PLAN_INFEASIBLE);
         ck_assert(r.all_orders_covered == (variant == 1));
     }
+    ws_free(&w);
+
+    /* Head-on, which needs more than one node of joint search, plus B into its wall. */
+    w = ws_make(3u, 1u);
+    fx_head_on(&f, 12u, 3.0);
+    fx_vehicle(&f, 3u, 2u, 10.0, 2.0, 2u, 3.0, 2.0, V(0, 500, 100), V(100, 500, 100));
+    fx_box(&f, V(11, 400, 0), V(20, 600, 300));
+    fx_finish(&f);
+    ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
+    ck_assert_int_eq(r.status, COA_PLAN_INFEASIBLE);
+    ck_assert_uint_eq(r.nodes_generated, 0u);
+    /* Without the wall, beta is what stops it. */
+    f.p.obstacle_count = 0u;
+    ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
+    ck_assert_int_eq(r.status, COA_PLAN_BUDGET_EXHAUSTED);
+    ck_assert_uint_eq(r.nodes_generated, 1u);
+    ws_free(&w);
+}
+END_TEST
+
+/* coa_planner_config_of fits a problem exactly, and a planner takes a problem just when it
+ * fits its config (plan.h, coa_planner_config_t): centralised, at most `vehicles` UAVs;
+ * a horizon at most the config's; each UAV's table no larger than the config's. Beyond
+ * that it refuses with COA_ERR_WORKSPACE and a cleared result; within it, it plans as a
+ * planner with room to spare does. */
+START_TEST(planner_takes_problems_within_its_config)
+{
+    static fx_t f;
+    static int32_t rows[MAXV * (MAXN + 1u)];
+    static int32_t roomy_rows[MAXV * (MAXN + 1u)];
+    coa_planner_config_t c;
+    coa_planner_config_t exact;
+    coa_plan_result_t r;
+    coa_plan_result_t roomy;
+    ws_t w;
+    size_t i;
+
+    /* A: steep factor 2, offsets within 2; B: steep factor 3, within 5. */
+    fx_head_on(&f, 12u, 3.0);
+    f.veh[0].max_offset = 2;
+    f.veh[1].steep_factor = 3u;
+    f.veh[1].max_offset = 5;
+    fx_finish(&f);
+    ck_assert_int_eq(coa_planner_config_of(&f.p, 2u, 20000u, &exact), COA_OK);
+    ck_assert_uint_eq(exact.vehicles, 2u);
+    ck_assert_uint_eq(exact.beta, 20000u);
+    ck_assert_uint_eq(exact.horizon, 12u);
+    ck_assert_uint_eq(exact.steep_factor, 3u);
+    ck_assert_int_eq(exact.max_offset, 5);
+    /* One unbounded UAV makes the config unbounded, wherever it is. */
+    f.veh[0].max_offset = -1;
+    ck_assert_int_eq(coa_planner_config_of(&f.p, 2u, 20000u, &c), COA_OK);
+    ck_assert_int_lt(c.max_offset, 0);
+    f.veh[0].max_offset = 2;
+    f.veh[1].max_offset = -1;
+    ck_assert_int_eq(coa_planner_config_of(&f.p, 2u, 20000u, &c), COA_OK);
+    ck_assert_int_lt(c.max_offset, 0);
+    f.veh[1].max_offset = 5;
+    /* What it refuses. */
+    ck_assert_int_eq(coa_planner_config_of(NULL, 2u, 100u, &c), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coa_planner_config_of(&f.p, 2u, 100u, NULL), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coa_planner_config_of(&f.p, 0u, 100u, &c), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coa_planner_config_of(&f.p, COA_MAX_CENTRALISED + 1u, 100u, &c),
+                     COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coa_planner_config_of(&f.p, 2u, 0u, &c), COA_ERR_ARGUMENT);
+    f.p.vehicle_count = 0u;
+    ck_assert_int_eq(coa_planner_config_of(&f.p, 2u, 100u, &c), COA_ERR_ARGUMENT);
+    f.p.vehicle_count = 2u;
+
+    /* The exact config plans as a roomy planner does. */
+    w = ws_make(2u, 20000u);
+    ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, roomy_rows, &roomy), COA_OK);
+    ck_assert_int_eq(roomy.status, COA_PLAN_SOLVED);
+    ws_free(&w);
+    w = ws_make_config(&exact);
+    ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
+    ck_assert_int_eq(r.status, COA_PLAN_SOLVED);
+    ck_assert(to_u128(r.deviation_units) == to_u128(roomy.deviation_units));
+    ck_assert_uint_eq(r.effort, roomy.effort);
+    ck_assert_mem_eq(rows, roomy_rows, 2u * ROW(&f) * sizeof rows[0]);
+    check_solved_plan(&f, rows, &r);
+    ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, NULL, 1u, rows, &r), COA_OK);
+    ws_free(&w);
+
+    /* One short in any field: refused, and the result cleared. Decoupled needs room for
+     * one UAV only. */
+    for (i = 0; i < 4u; ++i) {
+        coa_planner_config_t d = exact;
+        int want_decoupled = COA_ERR_WORKSPACE;
+        switch (i) {
+        case 0u:
+            d.vehicles = 1u;
+            want_decoupled = COA_OK;
+            break;
+        case 1u:
+            d.horizon = 11u;
+            break;
+        case 2u:
+            d.steep_factor = 2u; /* B's table: 1 + 7 + 11 * 11 cells, not 1 + 5 + 9 + 10 * 11 */
+            break;
+        default:
+            d.max_offset = 4; /* B's table: 1 + 7 + 11 * 9 cells */
+            break;
+        }
+        w = ws_make_config(&d);
+        ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_ERR_WORKSPACE);
+        ck_assert_int_eq(r.status, COA_PLAN_INFEASIBLE);
+        ck_assert_uint_eq(r.workspace_bytes, 0u);
+        ck_assert_uint_eq(r.orders_tried, 0u);
+        ck_assert_uint_eq(r.searches, 0u);
+        ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, NULL, 1u, rows, &r), want_decoupled);
+        if (want_decoupled != COA_OK) {
+            ck_assert_uint_eq(r.orders_tried, 0u);
+        }
+        ws_free(&w);
+    }
+
+    /* What must fit is each table, not each field: B (steep factor 3, within 5) has fewer
+     * cells (129) than a UAV of steep factor 2 unbounded (13 * 25), so a config of steep
+     * factor 2, unbounded, takes it although its steep factor is larger. */
+    c.vehicles = 2u;
+    c.beta = 20000u;
+    c.horizon = 12u;
+    c.steep_factor = 2u;
+    c.max_offset = -1;
+    w = ws_make_config(&c);
+    ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
+    ck_assert_int_eq(r.status, COA_PLAN_SOLVED);
+    ck_assert(to_u128(r.deviation_units) == to_u128(roomy.deviation_units));
     ws_free(&w);
 }
 END_TEST
@@ -1778,12 +2167,14 @@ static Suite *plan_suite(void)
     tcase_set_timeout(tc, 300);
     tcase_add_test(tc, workspace_size_is_exact);
     tcase_add_test(tc, max_beta_inverts_workspace_size);
+    tcase_add_test(tc, planner_takes_problems_within_its_config);
     tcase_add_test(tc, initial_conflict_is_infeasible_without_expanding);
     tcase_add_test(tc, tiny_beta_is_budget_exhausted);
     tcase_add_test(tc, max_offset_is_respected);
     tcase_add_test(tc, head_on_is_separated);
     tcase_add_test(tc, problem_check_and_helpers);
     tcase_add_test(tc, tie_between_vehicles_goes_to_lower_effort);
+    tcase_add_test(tc, single_vehicle_plans_need_no_budget);
     tcase_add_test(tc, goal_on_top_is_taken_at_the_budget);
     tcase_add_test(tc, conflict_at_start_rules_out_every_order);
     tcase_add_test(tc, proof_for_every_order_outranks_budget);

@@ -2,6 +2,7 @@
 
 #include "cli.h"
 
+#include <assert.h>
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>
@@ -174,25 +175,39 @@ bool cli_parse_real(const char *text, double *out)
     return true;
 }
 
-bool cli_workspace_fits(size_t searched, uint32_t beta)
+coa_planner_config_t cli_planner_config(const scenario_t *s, size_t searched, uint32_t beta)
 {
-    size_t size = coa_planner_workspace_size(searched, beta);
+    coa_planner_config_t config;
+    coa_problem_t problem = scenario_problem(s);
+    int rc = coa_planner_config_of(&problem, searched, beta, &config);
+    assert(rc == COA_OK);
+    (void)rc;
+    return config;
+}
+
+void cli_planner_config_widen(coa_planner_config_t *into, const coa_planner_config_t *with)
+{
+    if (with->horizon > into->horizon) {
+        into->horizon = with->horizon;
+    }
+    if (with->steep_factor > into->steep_factor) {
+        into->steep_factor = with->steep_factor;
+    }
+    if (into->max_offset >= 0 && (with->max_offset < 0 || with->max_offset > into->max_offset)) {
+        into->max_offset = with->max_offset;
+    }
+}
+
+bool cli_workspace_fits(const coa_planner_config_t *config)
+{
+    size_t size = coa_planner_workspace_size(config);
     return size != 0u && size <= CLI_DEFAULT_WORKSPACE_MAX;
 }
 
-uint32_t cli_default_beta(size_t searched)
+uint32_t cli_default_beta(const coa_planner_config_t *config)
 {
-    uint32_t lo = 1u;
-    uint32_t hi = CLI_DEFAULT_BETA;
-    while (lo < hi) {
-        uint32_t mid = lo + (hi - lo + 1u) / 2u;
-        if (cli_workspace_fits(searched, mid)) {
-            lo = mid;
-        } else {
-            hi = mid - 1u;
-        }
-    }
-    return lo;
+    uint32_t fits = coa_planner_max_beta(config, CLI_DEFAULT_WORKSPACE_MAX);
+    return fits < CLI_DEFAULT_BETA ? fits : CLI_DEFAULT_BETA;
 }
 
 int64_t cli_elapsed_us(const struct timespec *start, const struct timespec *end)

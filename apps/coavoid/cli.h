@@ -16,6 +16,7 @@
 #include <time.h>
 
 #include "coavoid/common.h"
+#include "coavoid/plan.h"
 #include "scenario.h"
 
 /* malloc's alignment is what every workspace buffer (planner, predictor) relies on. */
@@ -121,22 +122,31 @@ bool cli_parse_index(const char *text, uint64_t max, uint64_t *out);
  * "inf" and hexadecimal, which in an option are more likely a mistake than meant. */
 bool cli_parse_real(const char *text, double *out);
 
-/* The closed-set bound beta of a planner when neither an option nor the scenario's "beta"
- * gives one (`coavoid plan`, `coavoid sim`, coavoid-coordinator). */
+/* The bound beta on each search's expansions when neither an option nor the scenario's
+ * "beta" gives one (`coavoid plan`, `coavoid sim`, coavoid-coordinator). */
 #define CLI_DEFAULT_BETA 20000u
-/* The default beta is lowered until the worst-case workspace fits this many bytes: the
- * workspace grows as beta * 5^n, and a default that asks a laptop for 18 GB (6 UAVs
- * centralised) is a trap. A beta that is given is taken as given. */
+/* The default beta is lowered until the workspace fits this many bytes (a default that
+ * asks a laptop for gigabytes is a trap). A beta that is given is taken as given. */
 #define CLI_DEFAULT_WORKSPACE_MAX ((size_t)1u << 30)
 
-/* Whether a planner for `searched` UAVs a search at `beta` fits CLI_DEFAULT_WORKSPACE_MAX.
- * O(1), no memory, cannot fail. */
-bool cli_workspace_fits(size_t searched, uint32_t beta);
+/* The planner config of a scenario (coa_planner_config_of: its horizon, largest steep
+ * factor and offset bound) for `searched` UAVs a search and `beta`. The scenario need not
+ * be sampled. Cannot fail for a scenario that scenario_load accepted and searched in
+ * 1..COA_MAX_CENTRALISED, beta >= 1 (asserted). */
+coa_planner_config_t cli_planner_config(const scenario_t *s, size_t searched, uint32_t beta);
 
-/* The default beta for `searched` UAVs a search: CLI_DEFAULT_BETA, or the largest beta whose
- * workspace fits CLI_DEFAULT_WORKSPACE_MAX when that is smaller (1 when none does). The
- * size grows with beta, so a bisection finds it: O(log CLI_DEFAULT_BETA), no memory. */
-uint32_t cli_default_beta(size_t searched);
+/* Widens *into so that it also takes every problem `with` takes: the longer horizon, the
+ * larger steep factor and offset bound (unbounded when either is). */
+void cli_planner_config_widen(coa_planner_config_t *into, const coa_planner_config_t *with);
+
+/* Whether a planner of this config has a size and fits CLI_DEFAULT_WORKSPACE_MAX.
+ * O(1), no memory, cannot fail. */
+bool cli_workspace_fits(const coa_planner_config_t *config);
+
+/* The default beta for planners of this config (its beta ignored): CLI_DEFAULT_BETA, or
+ * the largest beta whose workspace fits CLI_DEFAULT_WORKSPACE_MAX when that is smaller;
+ * 0 when none does (the cost-to-go tables alone are too large: a very long horizon). */
+uint32_t cli_default_beta(const coa_planner_config_t *config);
 
 /* Microseconds from start to end. */
 int64_t cli_elapsed_us(const struct timespec *start, const struct timespec *end);

@@ -129,7 +129,7 @@ typedef struct {
     bool quiet;
 } mc_options_t;
 
-/* "2,3,4": each 2..5, each once. */
+/* "2,3,4": each 2..6, each once. */
 static int parse_sizes(mc_options_t *o)
 {
     const char *token = o->vehicles_text;
@@ -166,7 +166,7 @@ static int mc_option(int argc, char **argv, int *i, void *options)
     uint64_t value = 0;
     int status = CLI_UNKNOWN_OPTION;
     if (cli_option_is(arg, "--vehicles")) {
-        status = cli_text_option(argc, argv, i, "--vehicles", "UAV counts from 2 to 5, e.g. 2,3,4",
+        status = cli_text_option(argc, argv, i, "--vehicles", "UAV counts from 2 to 6, e.g. 2,3,4",
                                  false, &o->vehicles_text);
         if (status == CLI_CONTINUE) {
             status = parse_sizes(o);
@@ -262,6 +262,20 @@ typedef struct {
     uint32_t max_orders;
 } mc_size_t;
 
+/* A planner for every encounter of the design: its horizon, steep factor 2 (the
+ * generator's) and its offset band (unbounded when it draws none). */
+static coa_planner_config_t mc_config(uint32_t searched, uint32_t beta)
+{
+    const encounter_design_t *d = &encounter_montecarlo;
+    coa_planner_config_t c;
+    c.vehicles = searched;
+    c.beta = beta;
+    c.horizon = d->horizon;
+    c.steep_factor = 2u;
+    c.max_offset = d->max_offset_max > 0u ? (int32_t)d->max_offset_max : -1;
+    return c;
+}
+
 static uint32_t factorial(uint32_t n)
 {
     uint32_t f = 1u;
@@ -306,8 +320,10 @@ static int planners_ready(mc_planners_t *p, const mc_size_t *size, char *err, si
         p->offsets = calloc(rows, sizeof *p->offsets);
         p->zeros = calloc(rows, sizeof *p->zeros);
     }
-    size_t central = coa_planner_workspace_size(size->n, size->beta);
-    size_t decoupled = coa_planner_workspace_size(1u, size->beta);
+    coa_planner_config_t central_config = mc_config(size->n, size->beta);
+    coa_planner_config_t decoupled_config = mc_config(1u, size->beta);
+    size_t central = coa_planner_workspace_size(&central_config);
+    size_t decoupled = coa_planner_workspace_size(&decoupled_config);
     if (central == 0 || decoupled == 0) {
         snprintf(err, err_size, "--beta: %lu is too large for %lu UAVs centralised (the node "
                  "pool would pass 2^30)", (unsigned long)size->beta, (unsigned long)size->n);
@@ -322,8 +338,8 @@ static int planners_ready(mc_planners_t *p, const mc_size_t *size, char *err, si
                  (unsigned long)size->beta);
         return -1;
     }
-    p->central = coa_planner_init(p->central_buffer, central, size->n, size->beta);
-    p->decoupled = coa_planner_init(p->decoupled_buffer, decoupled, 1u, size->beta);
+    p->central = coa_planner_init(p->central_buffer, central, &central_config);
+    p->decoupled = coa_planner_init(p->decoupled_buffer, decoupled, &decoupled_config);
     if (p->central == NULL || p->decoupled == NULL) {
         snprintf(err, err_size, "internal error: the planner refused its workspace");
         return -1;
@@ -971,7 +987,8 @@ static int json_summary(FILE *f, const mc_options_t *o, const mc_summary_t *s, u
 #define SVG_CDF_W 400.0
 
 static const char *const method_colours[MC_METHODS] = {"#1f77b4", "#ff7f0e", "#2ca02c"};
-static const char *const size_colours[MC_SIZES] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd"};
+static const char *const size_colours[MC_SIZES] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd",
+                                                   "#8c564b"};
 
 /* The ratio axis, logarithmic: from 1 to the largest ratio seen, at least 2 and at most
  * 10 (a longer tail is drawn against the edge and said in the caption). */
@@ -1160,9 +1177,11 @@ int command_montecarlo(int argc, char **argv)
     for (uint32_t k = 0; k < o.size_count; k++) {
         uint32_t n = o.sizes[k];
         sizes[k].n = n;
-        sizes[k].beta = o.beta_text != NULL ? o.beta : cli_default_beta(n);
+        coa_planner_config_t shape = mc_config(n, CLI_DEFAULT_BETA);
+        sizes[k].beta = o.beta_text != NULL ? o.beta : cli_default_beta(&shape);
         sizes[k].max_orders = o.max_orders_text != NULL ? o.max_orders : factorial(n);
-        if (coa_planner_workspace_size(n, sizes[k].beta) == 0) {
+        shape.beta = sizes[k].beta;
+        if (coa_planner_workspace_size(&shape) == 0) {
             return cli_fail(CLI_EXIT_INVALID, "--beta: %lu is too large for %lu UAVs "
                             "centralised (the node pool would pass 2^30)",
                             (unsigned long)sizes[k].beta, (unsigned long)n);

@@ -206,7 +206,8 @@ static uint32_t choose_beta(const plan_options_t *o, const scenario_t *s, size_t
         snprintf(source, source_size, "%.400s: beta %lu", o->scenario_path, (unsigned long)s->beta);
         return s->beta;
     }
-    uint32_t beta = cli_default_beta(searched);
+    coa_planner_config_t shape = cli_planner_config(s, searched, CLI_DEFAULT_BETA);
+    uint32_t beta = cli_default_beta(&shape);
     snprintf(source, source_size, "default beta %lu", (unsigned long)beta);
     return beta;
 }
@@ -229,16 +230,15 @@ static int plan(void *options, scenario_t *s)
         order = order_storage;
     }
 
-    const size_t searched = o->decoupled ? 1u : n;
-    char beta_source[SCENARIO_ERROR_MAX];
-    uint32_t beta = choose_beta(o, s, searched, beta_source, sizeof beta_source);
-
     if (!o->decoupled && n > COA_MAX_CENTRALISED) {
         return cli_fail(CLI_EXIT_INVALID,
                         "--mode centralised: %zu vehicles, at most %u (COA_MAX_CENTRALISED) can be "
                         "planned together",
                         n, COA_MAX_CENTRALISED);
     }
+    const size_t searched = o->decoupled ? 1u : n;
+    char beta_source[SCENARIO_ERROR_MAX];
+    uint32_t beta = choose_beta(o, s, searched, beta_source, sizeof beta_source);
 
     int rc = cli_sample_scenario(file, s);
     if (rc != CLI_CONTINUE) {
@@ -254,12 +254,21 @@ static int plan(void *options, scenario_t *s)
                         coa_status_name(rc));
     }
 
-    size_t size = coa_planner_workspace_size(searched, beta);
+    coa_planner_config_t config = cli_planner_config(s, searched, beta);
+    /* The tables alone (every reachable step and offset) do not depend on beta: when they
+     * pass the limit no beta helps, whatever --beta or the scenario say. */
+    if (beta == 0 || coa_planner_max_beta(&config, CLI_DEFAULT_WORKSPACE_MAX) == 0) {
+        return cli_fail(CLI_EXIT_INVALID,
+                        "%s: too large: the cost-to-go tables of a %lu-step horizon would not "
+                        "fit in %zu MiB of workspace (shorten the horizon or bound max_offset)",
+                        file, (unsigned long)s->horizon, CLI_DEFAULT_WORKSPACE_MAX >> 20);
+    }
+    size_t size = coa_planner_workspace_size(&config);
     if (size == 0) {
         return cli_fail(CLI_EXIT_INVALID,
-                        "%s: too large: the workspace for %zu vehicle(s) would not fit in memory "
-                        "(lower it with --beta)",
-                        beta_source, searched);
+                        "%s: too large: the workspace for %zu vehicle(s) over %lu steps would "
+                        "not fit in memory (lower it with --beta)",
+                        beta_source, searched, (unsigned long)s->horizon);
     }
     void *workspace = malloc(size);
     if (workspace == NULL) {
@@ -268,7 +277,7 @@ static int plan(void *options, scenario_t *s)
                         "(lower it with --beta)",
                         beta_source, size, searched);
     }
-    coa_planner_t *planner = coa_planner_init(workspace, size, searched, beta);
+    coa_planner_t *planner = coa_planner_init(workspace, size, &config);
     int32_t *offsets = calloc(n * ((size_t)s->horizon + 1u), sizeof *offsets);
     if (planner == NULL || offsets == NULL) {
         free(workspace);

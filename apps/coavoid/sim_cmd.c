@@ -502,16 +502,21 @@ static int sim(void *options, scenario_t *s)
 
     /* Planner sizes: each UAV plans alone; the coordinator searches up to max_centralised
      * UAVs together, fewer when the scenario's beta would not fit the cap otherwise. */
-    const uint32_t vehicle_beta = s->has_beta ? s->beta : cli_default_beta(1u);
-    if (!cli_workspace_fits(1u, vehicle_beta)) {
+    coa_planner_config_t vehicle_shape = coa_node_planner_config(s->horizon, 1u, CLI_DEFAULT_BETA);
+    const uint32_t vehicle_beta = s->has_beta ? s->beta : cli_default_beta(&vehicle_shape);
+    vehicle_shape.beta = vehicle_beta;
+    if (vehicle_beta == 0 || !cli_workspace_fits(&vehicle_shape)) {
         return cli_fail(CLI_EXIT_INVALID,
                         "%s: beta: %lu is too large: a UAV's planner would not fit in 1 GiB", file,
                         (unsigned long)vehicle_beta);
     }
     size_t max_centralised = n < COA_MAX_CENTRALISED ? n : COA_MAX_CENTRALISED;
-    uint32_t coordinator_beta = s->has_beta ? s->beta : cli_default_beta(max_centralised);
-    while (max_centralised > 1u && !cli_workspace_fits(max_centralised, coordinator_beta)) {
-        max_centralised--;
+    coa_planner_config_t coordinator_shape =
+        coa_node_planner_config(s->horizon, max_centralised, CLI_DEFAULT_BETA);
+    uint32_t coordinator_beta = s->has_beta ? s->beta : cli_default_beta(&coordinator_shape);
+    coordinator_shape.beta = coordinator_beta;
+    while (max_centralised > 1u && !cli_workspace_fits(&coordinator_shape)) {
+        coordinator_shape.vehicles = --max_centralised;
     }
 
     sim_run_t r;

@@ -158,10 +158,14 @@ static int run(void *options, scenario_t *s)
     } else if (s->has_beta) {
         beta_source = "the scenario's beta";
     } else {
-        config.common.beta = cli_default_beta(o->max_centralised);
+        coa_planner_config_t shape = coa_node_planner_config(config.common.horizon,
+                                                             o->max_centralised, CLI_DEFAULT_BETA);
+        config.common.beta = cli_default_beta(&shape);
         beta_source = "the default beta";
     }
-    size_t size = coa_planner_workspace_size(o->max_centralised, config.common.beta);
+    coa_planner_config_t planner_config =
+        coa_node_planner_config(config.common.horizon, o->max_centralised, config.common.beta);
+    size_t size = coa_planner_workspace_size(&planner_config);
     if (size == 0) {
         return cli_fail(CLI_EXIT_INVALID,
                         "%s %lu: the workspace for %zu vehicles would not fit in memory (lower "

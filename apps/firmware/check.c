@@ -369,8 +369,11 @@ static bool run_problem(const fwc_problem_t *p)
                               .tracks = p->tracks, .track_count = p->track_count,
                               .track_samples = track_rows};
     if (p->decoupled) {
-        coa_planner_t *planner =
-            coa_planner_init(planner_buffer, sizeof planner_buffer, 1u, p->beta);
+        coa_planner_config_t config;
+        coa_planner_t *planner = NULL;
+        if (coa_planner_config_of(&problem, 1u, p->beta, &config) == COA_OK) {
+            planner = coa_planner_init(planner_buffer, sizeof planner_buffer, &config);
+        }
         if (planner == NULL) {
             fail(p, "decoupled: the planner buffer is too small for this beta");
             return false;
@@ -381,8 +384,11 @@ static bool run_problem(const fwc_problem_t *p)
         report(p, "decoupled", rc, &result, ticks_now() - start);
     }
     if (p->centralised) {
-        coa_planner_t *planner = coa_planner_init(planner_buffer, sizeof planner_buffer,
-                                                  p->vehicle_count, p->beta);
+        coa_planner_config_t config;
+        coa_planner_t *planner = NULL;
+        if (coa_planner_config_of(&problem, p->vehicle_count, p->beta, &config) == COA_OK) {
+            planner = coa_planner_init(planner_buffer, sizeof planner_buffer, &config);
+        }
         if (planner == NULL) {
             fail(p, "centralised: the planner buffer is too small for this beta");
             return false;

@@ -55,16 +55,20 @@ static int32_t new_offsets[FW_SAMPLES];
 
 int fw_task_init(void)
 {
-    uint32_t beta = coa_planner_max_beta(1u, sizeof planner_buffer);
+    coa_planner_config_t config = {.vehicles = 1u,
+                                   .horizon = FW_HORIZON,
+                                   .steep_factor = self_template.steep_factor,
+                                   .max_offset = self_template.max_offset};
     uint32_t k;
 
-    planner = coa_planner_init(planner_buffer, sizeof planner_buffer, 1u, beta);
+    config.beta = coa_planner_max_beta(&config, sizeof planner_buffer);
+    planner = coa_planner_init(planner_buffer, sizeof planner_buffer, &config);
     predictor = coa_predictor_init(predictor_buffer, sizeof predictor_buffer, FW_PLANS,
                                    FW_TRACKS, FW_HORIZON, FW_MAX_PAIRS);
     if (planner == NULL || predictor == NULL) {
         return COA_ERR_WORKSPACE;
     }
-    fw_outputs.beta = beta;
+    fw_outputs.beta = config.beta;
     for (k = 0; k < FW_SAMPLES; ++k) {
         fw_outputs.offsets[k] = 0;
     }

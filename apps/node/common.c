@@ -724,13 +724,25 @@ int coa_node_predict(coa_predictor_t *predictor, const coa_node_common_t *c,
     return coa_predict_clusters(conflicts, result->conflict_count, n, labels, cluster_count);
 }
 
+coa_planner_config_t coa_node_planner_config(uint32_t horizon, size_t searched, uint32_t beta)
+{
+    coa_planner_config_t c;
+    c.vehicles = searched;
+    c.beta = beta;
+    c.horizon = horizon;
+    c.steep_factor = COA_MAX_STEEP_FACTOR;
+    c.max_offset = -1;
+    return c;
+}
+
 int coa_node_solver_init(coa_node_solver_t *s, uint32_t horizon, size_t searched, uint32_t beta)
 {
     memset(s, 0, sizeof *s);
     const size_t pairs = coa_node_max_pairs();
     const size_t predictor_size = coa_predictor_workspace_size(
         COA_NODE_MAX_PEERS, COA_NODE_TRACK_CAPACITY, horizon, pairs);
-    const size_t planner_size = coa_planner_workspace_size(searched, beta);
+    const coa_planner_config_t config = coa_node_planner_config(horizon, searched, beta);
+    const size_t planner_size = coa_planner_workspace_size(&config);
     if (predictor_size == 0u || planner_size == 0u) {
         return COA_ERR_ARGUMENT;
     }
@@ -743,7 +755,7 @@ int coa_node_solver_init(coa_node_solver_t *s, uint32_t horizon, size_t searched
                                           COA_NODE_TRACK_CAPACITY, horizon, pairs);
     }
     if (s->planner_memory != NULL) {
-        s->planner = coa_planner_init(s->planner_memory, planner_size, searched, beta);
+        s->planner = coa_planner_init(s->planner_memory, planner_size, &config);
     }
     if (s->predictor == NULL || s->planner == NULL || s->conflicts == NULL) {
         coa_node_solver_fini(s);

@@ -212,10 +212,15 @@ typedef struct {
 
 typedef struct coa_vehicle_node coa_vehicle_node_t;
 
+/* The planner config of a node planning `searched` UAVs at once over a horizon of N
+ * steps: any UAV an intent may describe (steep factor up to COA_MAX_STEEP_FACTOR, offsets
+ * unbounded), so that no valid intent meets a planner too small for it. */
+coa_planner_config_t coa_node_planner_config(uint32_t horizon, size_t searched, uint32_t beta);
+
 /* Creates a vehicle node publishing and subscribing on lcm (not owned). Allocates the node,
  * its one-UAV planner (beta) and its predictor once: about 1.4 MB of node, 1.2 MB of
- * predictor and conflicts at N = 24, and coa_planner_workspace_size(1, beta) (6.3 MB at
- * beta 20000). Returns NULL on bad config (invalid vehicle, horizon >
+ * predictor and conflicts at N = 24, and the workspace of coa_node_planner_config(N, 1,
+ * beta) (1.1 MB at N = 24 and beta 20000). Returns NULL on bad config (invalid vehicle, horizon >
  * COA_NODE_MAX_HORIZON, ...: COA_ERR_ARGUMENT, also when LCM refuses a subscription) or
  * out of memory (COA_ERR_WORKSPACE), with *error set (error may be NULL). */
 coa_vehicle_node_t *coa_vehicle_node_create(const coa_vehicle_node_config_t *config, lcm_t *lcm,
@@ -272,8 +277,8 @@ typedef struct {
 typedef struct coa_coordinator coa_coordinator_t;
 
 /* As coa_vehicle_node_create, with a planner for max_centralised UAVs at once
- * (coa_planner_workspace_size(max_centralised, beta): 8.1 MB for 3 UAVs at beta 1000,
- * 487 MB at beta 60000). Errors as there (collect_us >= dt, max_centralised >
+ * (the workspace of coa_node_planner_config(N, max_centralised, beta): 1.3 MB for 3 UAVs
+ * at N = 24 and beta 20,000). Errors as there (collect_us >= dt, max_centralised >
  * COA_MAX_CENTRALISED: COA_ERR_ARGUMENT). */
 coa_coordinator_t *coa_coordinator_create(const coa_coordinator_config_t *config, lcm_t *lcm,
                                           int *error);
@@ -283,7 +288,7 @@ void coa_coordinator_destroy(coa_coordinator_t *node);
  * collect_us). Once per cycle; again within one cycle does nothing. Returns COA_OK or the
  * first negative error (NULL, before the epoch, a publishing or internal error); a plan
  * that fails is not an error. Cost: one prediction, then per cluster one search of at
- * most beta expansions (centralised: 5^n children each), and when one fails at most two
+ * most beta expansions each (centralised: independence detection's searches), and when one fails at most two
  * more over larger groups. No memory is allocated. */
 int coa_coordinator_cycle(coa_coordinator_t *node, int64_t now);
 const coa_coordinator_state_t *coa_coordinator_state(const coa_coordinator_t *node);

@@ -69,7 +69,7 @@ typedef struct {
 
 /* Limits of the core. They bound every loop and every fixed array. */
 #define COA_MAX_VEHICLES 32u       /* co-operative UAVs in one problem */
-#define COA_MAX_CENTRALISED 6u     /* UAVs in one composite (centralised) search: 5^6 children a node */
+#define COA_MAX_CENTRALISED 6u     /* UAVs in one centralised problem: each has a cost-to-go table */
 #define COA_MAX_STEEP_FACTOR 10u   /* largest steep_factor; keeps the integer cost scale small */
 #define COA_MAX_HORIZON 10000u     /* N: samples k = 0..N */
 #define COA_MAX_OFFSET 32767       /* |altitude offset| in climb steps at any sample */

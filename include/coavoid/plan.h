@@ -6,76 +6,112 @@
  * samples k = 0..N. A plan gives every UAV an altitude offset at every sample; it is
  * conflict-free when no step of it conflicts (geometry.h) with another UAV's step, an
  * obstacle or a track's step. Its cost is lexicographic: the deviation area first, then
- * the effort (trajectory.h).
+ * the effort (trajectory.h). Both front ends return an optimal plan (for decoupled:
+ * optimal for each UAV given the ones before it) or prove there is none, on one engine:
  *
- * One A* engine solves both front ends. A search state is (k, offsets of the searched
- * UAVs); the goal is any state with k = N. The open list is a binary heap ordered by
- * f-deviation, then f-effort, then larger k first (as the paper orders it), then by the
- * order nodes were generated, so results are deterministic. Duplicate states are found
- * by a hash table: a better path to an open state updates it; closed states are final
- * (the heuristic is consistent). The search looks at the top of the open list before
- * each expansion: a goal there is optimal and ends the search (solved), even when beta
- * states have already been closed; otherwise the search stops when beta states have been
- * closed (budget exhausted: nothing proven) or when the open list empties (infeasible:
- * the space is exhausted). So a problem whose plan needs exactly beta expansions is
- * solved: a free single UAV over N steps needs beta = N.
- *
- *   - Centralised: one search over the composite state of all UAVs, with the composite
- *     action space (every combination of five actions per UAV, 5^n children a node).
- *     Optimal for the whole group.
+ *   - Centralised: optimal for the whole group. Every UAV is first planned alone; while
+ *     the plans of two groups of UAVs conflict, one group is re-planned around the
+ *     other's plan at its own optimal cost (and then the other around the first), and
+ *     only if neither can do that do the two merge into one group planned jointly:
+ *     independence detection (Standley 2010). Each group's plan is optimal for the group
+ *     alone and no two groups conflict at the end, so the sum of the groups' costs, a
+ *     lower bound for the whole, is met: the plan is optimal. UAVs whose optimal plans
+ *     never interact are never searched together.
  *   - Decoupled: UAVs plan one at a time in priority order; each treats the plans of the
  *     UAVs before it as moving obstacles and ignores those after it. Optionally, when one
  *     fails, other orders are tried, the failing UAV earlier first.
  *
- * Children. Each UAV's actions come in coa_action_t order (level, climb, dive, steep climb,
- * steep dive); a composite child combines them with UAV 0 varying slowest. An action is
- * not generated when it would take |offset| past the UAV's max_offset or past
- * COA_MAX_OFFSET. A child is valid when each UAV's step (its protected volume swept from
- * its position at k to k+1) conflicts with no obstacle, no track's step, no fixed UAV's
- * step (decoupled: the UAVs planned before it) and no other searched UAV's step in the
- * same composite action. Each expansion tests every (UAV, action) against the environment
- * once and every pair of UAVs' actions once, then combines the results over the 5^m
- * children. The root is checked at t = 0 (positions at k = 0) the same way; a conflict
- * there is infeasible with nothing expanded.
+ * Tables. Before planning, each UAV gets a table of its exact cost to go alone: a
+ * backward pass over every (k, offset) it can reach from its initial offset, keeping for
+ * each the least (deviation, effort) over its actions that stay within max_offset,
+ * conflict with no obstacle and no track (decoupled: and no UAV planned before it) and
+ * lead to a state from which k = N can be reached; states with no such action are dead.
+ * A single UAV's optimal plan is then read off its table (walk from the start, taking
+ * at each step the cheapest live action, ties in coa_action_t order and towards the
+ * larger k as the paper orders them): no search, N steps. That is the whole decoupled
+ * front end, one table per UAV against the plans before it, and how the centralised one
+ * plans each UAV alone. A centralised planner also keeps each UAV's cost from the start
+ * (the forward pass) for the joint searches.
  *
+ * The joint search of a group. A member takes part only between the first and the last
+ * step where it can come horizontally near another member or a fixed UAV (its span);
+ * before, it flies its cheapest way to the offset it enters at, after, its cheapest way
+ * on from where it leaves: both exact from its tables. A search state is (k, offsets of
+ * the members in their span at k). Before searching, the members are planned in turn
+ * (each around those before it): a plan of the group whose cost caps the search (nothing
+ * dearer is stored), and which is already optimal when it costs no more than the members
+ * alone. The heuristic (doubled so that halves stay integers) is twice the sum of the
+ * members' own costs to go (or costs alone, for members not yet entered) plus the
+ * largest half-integral fractional matching of the pairs' surcharges, a surcharge being
+ * a pair's exact joint cost to go (a table over the pair's common span, within the cap's
+ * corridor) less the two own costs. Each matching is a sum of exact pair costs to go and
+ * own costs over disjoint sets, so it is admissible and consistent; so is their maximum.
+ * Expansion is partial (EPEA*, Goldenberg et al. 2014): the members' moves and the
+ * entering members' offsets are enumerated depth first, each member's options in the
+ * order of the increase of f they cause, cutting branches that cannot reach the
+ * expansion's threshold; the node goes back to the open list under the least f it left,
+ * so no expansion stores 5^n children. The threshold is the node's key plus a window (a
+ * quarter of the gap between the root and the cap, at least a quarter of the key): with
+ * costs as fine-grained as (deviation, effort) almost every child has an f of its own,
+ * and a node would otherwise come back once per child. The open list orders f's
+ * deviation, then its effort, then the later sample first, then the order nodes were
+ * stored, so results are deterministic. States are found again by a hash table; a
+ * better path to one not yet expanded updates it, expanded ones are final (the
+ * heuristic is consistent). A goal at the top of the open list ends the search (solved);
+ * an empty open list, or one whose least f is above the cap or the wanted bound, proves
+ * there is no plan (infeasible); a pool with no room for a new state ends it with
+ * nothing proven (budget exhausted).
+ *
+ * What beta counts. beta bounds the states each joint search stores (its node pool):
+ * every state generated and kept, expanded or still open, the root included. Single UAVs
+ * and decoupled plans store none (they walk tables), so the decoupled front end is never
+ * budget exhausted and a one-UAV planner's workspace does not depend on beta. The
+ * centralised front end runs at most one joint search per re-plan and per merge; beta
+ * bounds each of them. An initial conflict (t = 0), or a UAV whose table is dead at its
+ * initial offset, is infeasible with nothing expanded. nodes_expanded counts expansions,
+ * a node taken back off the open list for more children counting again.
+
  * Costs. The search minimises, lexicographically, the integer deviation
  * sum_i W_i * coa_area_scaled(a, b, S) (S = coa_area_scale and W_i 2^E =
  * coa_deviation_weights over all the problem's UAVs, whichever are searched), one unit
- * being 2^E / S m^2, and then the effort; the heuristic is
- * sum_i W_i * coa_heuristic_scaled(offset_i, N - k, s_i, S) for the deviation and 0 for
- * the effort. Deviations are exact 128-bit integers (coa_cost_t): the worst f = g + h,
- * 2 N sum_i W_i S B_i with B_i the largest |offset| vehicle i can reach, is below
- * 2^64 * 2^13 * 2^15 * 2^15 * 2^5 = 2^112 by the limits of common.h (W_i < 2^64,
- * S <= 5040, B_i <= 32767, 2N <= 20000, n <= 32), so no sum the search forms can wrap.
+ * being 2^E / S m^2, and then the effort. Deviations are exact 128-bit integers
+ * (coa_cost_t): the worst f = g + h, 2 N sum_i W_i S B_i with B_i the largest |offset|
+ * vehicle i can reach, is below 2^64 * 2^13 * 2^15 * 2^15 * 2^5 = 2^112 by the limits of
+ * common.h (W_i < 2^64, S <= 5040, B_i <= 32767, 2N <= 20000, n <= 32), so no sum the
+ * search forms can wrap. The tables hold each UAV's own deviation in units of 1/(2 s_i)
+ * of its L_i dh_i, below 2^35.
  *
- * Memory. The planner lives in a buffer the caller provides, as in o1heap: ask
- * coa_planner_workspace_size(n, beta) for the byte count, hand coa_planner_init a buffer
- * of that size aligned to COA_WORKSPACE_ALIGNMENT, and use the returned handle. Nothing
- * is allocated, nothing needs freeing; the buffer can be reused for any number of plans
- * with at most n searched UAVs and beta closed states. Node storage is sized for the worst
- * case (1 + beta * 5^n nodes), so running out of room can only happen through beta and is
- * always reported as COA_PLAN_BUDGET_EXHAUSTED, never as infeasible.
+ * Memory. The planner lives in a buffer the caller provides, as in o1heap: describe the
+ * largest problems it must take in a coa_planner_config_t, ask coa_planner_workspace_size
+ * for the byte count, hand coa_planner_init a buffer of that size aligned to
+ * COA_WORKSPACE_ALIGNMENT, and use the returned handle. Nothing is allocated, nothing
+ * needs freeing; the buffer can be reused for any number of plans within the config. It
+ * holds:
+ *   - the tables: one for vehicles == 1, else 2 * vehicles + 1 (cost to go and from the
+ *     start of each, one for re-plans around fixed UAVs), each of
+ *     T = sum over k = 0..N of min(2 k s + 1, 2 L + 1) cells of 8 bytes (N, s and L the
+ *     config's horizon, steep factor and offset bound): every offset reachable in k
+ *     steps, within the bound; 1,225 cells (9.8 kB) for N = 24 and s = 2;
+ *   - for vehicles > 1: per member an entry list of one table row and its saved plan row,
+ *     and the node pool of beta nodes of 70 + 2 * vehicles bytes: key and g 16 each
+ *     (128-bit packed costs), parent, heap entry and position 4 each, 2 hash slots of 4,
+ *     sample 2, offsets 2 per UAV, and 16 bytes of pair-table arena (a pair table that
+ *     does not fit is left out: a weaker heuristic, never a wrong one);
+ *   - a fixed header (the per-call context, a few kB).
+ * Running out of room can only happen through beta and is always reported as
+ * COA_PLAN_BUDGET_EXHAUSTED, never as infeasible. docs/embedded.md has the bytes for
+ * each vehicle count on the host and on a Cortex-M4F. The planner keeps state between
+ * calls in its buffer: one planner serves one thread at a time.
  *
- * A node takes 50 + 2n bytes (k 2, parent 4, g and f deviation 16 + 16, g effort 4, heap
- * position 4, heap entry 4, offsets 2 per UAV) plus 8 to 16 bytes of hash table (a power
- * of two of at least two slots per node, 4 bytes a slot): 60 to 68 bytes for n = 1, 70 to
- * 78 for n = 6 (16 more than with 64-bit costs, the price of exact ties between any
- * vehicles). Add a fixed header of about 6.9 kB (the per-expansion validity tables and
- * sweeps live there, not on the stack; 2,112 bytes less with COA_SINGLE_PRECISION, whose
- * 62 sweeps and 32 climb steps there are float). For example n = 1, beta = 10000: 3.1 MB; n = 3,
- * beta = 1000: 8.1 MB; n = 4, beta = 1000: 45 MB. The planner keeps state between calls
- * in its buffer: one planner serves one thread at a time.
- *
- * Time. One expansion costs 25 n(n-1)/2 pairwise volume checks among the searched UAVs,
- * 5 n (obstacles + tracks + fixed UAVs) environment checks (polytopes cost MPR support
- * calls past a bounding-box test), and O(5^n * n) to combine them into children, each
- * with an expected O(n) hash look-up and O(log pool) heap work; a search does at most
- * beta expansions. Measured (x86-64, -O2): two UAVs head-on over 12 steps take 121
- * expansions (0.24 ms); four UAVs converging on one point over 20 steps take 72k
- * expansions and 36M children (2.4 s), against 271 expansions (0.2 ms) decoupled. Exact
- * 128-bit costs make large searches about 8% slower: the paper scenario's centralised plan
- * (three UAVs, 24 steps, 48.5k expansions, 4.2M children) went from 0.215 s to 0.233 s
- * (medians of seven runs, coavoid plan, RelWithDebInfo).
+ * Time. A table costs one pass over its cells with a conflict test for each action whose
+ * step comes near (box test) an obstacle, a track or a fixed UAV; a pair table one pass
+ * over its corridor with the pair's conflict tests. A joint expansion enumerates at most
+ * 5^m move combinations of the m members in their span (times their entry offsets),
+ * usually far fewer thanks to the cuts, with O(m^2) conflict tests per combination tried
+ * and O(log beta) heap work per child; a search stores at most beta nodes, and a node is
+ * expanded at most once per distinct f among its children. Independence detection
+ * checks the groups' plans for conflicts after every search (O(N n^2) volume tests) and
+ * runs fewer than n^2 re-plans and merges. docs/benchmarks.md has the figures.
  */
 #ifndef COAVOID_PLAN_H
 #define COAVOID_PLAN_H
@@ -107,7 +143,7 @@ typedef struct {
 typedef enum {
     COA_PLAN_SOLVED = 0,           /* a plan was found and it is optimal */
     COA_PLAN_INFEASIBLE = 1,       /* the search space is exhausted: no plan exists (decoupled: for this order) */
-    COA_PLAN_BUDGET_EXHAUSTED = 2  /* beta states were closed before an answer: nothing proven */
+    COA_PLAN_BUDGET_EXHAUSTED = 2  /* a joint search filled its beta nodes: nothing proven */
 } coa_plan_status_t;
 
 #define COA_NO_VEHICLE ((size_t)-1)
@@ -121,7 +157,9 @@ typedef struct {
                                    2^E / S m^2 (file comment, "Costs") */
     uint32_t effort;
     uint64_t nodes_expanded;   /* over every search this call ran */
-    uint64_t nodes_generated;  /* children that passed the conflict checks */
+    uint64_t nodes_generated;  /* states the joint searches stored (at most beta a
+                                  search; 0 when none ran): duplicates of stored states,
+                                  dead ones and those above the cap are not stored */
     size_t workspace_bytes;    /* size of the workspace the planner ran in */
     /* Planning order as vehicle indices: decoupled, the order of the reported attempt;
      * centralised, 0..n-1. */
@@ -137,34 +175,64 @@ typedef struct {
                                   infeasible, no order has a plan; with budget exhausted,
                                   some order failed only through beta. false when solved,
                                   centralised, or when max_orders ended the search first */
+    uint32_t searches;         /* plans this call made: each table built and walked
+                                  against fixed UAVs (decoupled: one per UAV planned)
+                                  and each joint search of a group */
+    size_t largest_group;      /* centralised: the most UAVs searched together (0 when
+                                  nothing was searched) */
 } coa_plan_result_t;
 
 typedef struct coa_planner coa_planner_t;
 
-/* Bytes of workspace for searches over at most `max_vehicles` UAVs at once (n for
- * centralised, 1 is enough for decoupled) with closed-set bound beta (see the file comment
- * for the bytes per node). Returns 0 when max_vehicles is 0 or > COA_MAX_CENTRALISED,
- * beta is 0, the node pool 1 + beta * 5^max_vehicles exceeds 2^30, or the size would not
- * fit in size_t. Cost O(n), no memory. The size is exact: one byte less is refused. */
-size_t coa_planner_workspace_size(size_t max_vehicles, uint32_t beta);
+/* The largest problems a planner must take. A problem fits when it has at most
+ * `vehicles` UAVs (centralised; decoupled plans any number with vehicles >= 1), its
+ * horizon is at most `horizon`, and each UAV's table (file comment, "Memory"), computed
+ * with its own steep factor and offset bound, holds no more cells than one computed with
+ * `steep_factor` and `max_offset`: so any UAV with a steep factor <= steep_factor and
+ * |max_offset| <= max_offset (unbounded only when max_offset < 0). */
+typedef struct {
+    size_t vehicles;       /* UAVs searched together: 1..COA_MAX_CENTRALISED */
+    uint32_t beta;         /* nodes a joint search stores, >= 1 */
+    uint32_t horizon;      /* longest N, 1..COA_MAX_HORIZON */
+    uint32_t steep_factor; /* largest steep factor, 2..COA_MAX_STEEP_FACTOR */
+    int32_t max_offset;    /* largest offset bound; negative: unbounded (COA_MAX_OFFSET) */
+} coa_planner_config_t;
+
+/* The config that fits `problem` exactly: its horizon, its largest steep factor and
+ * offset bound (negative when a UAV is unbounded), with the given vehicles and beta.
+ * Returns COA_OK, or COA_ERR_ARGUMENT when a pointer is NULL, the problem has no UAVs or
+ * more than COA_MAX_VEHICLES, or the resulting config is not one the size function
+ * accepts (vehicles or beta out of range, horizon 0 or too long, steep factor > 10).
+ * Reads the problem's counts and vehicles only. Cost O(vehicles), no memory. */
+int coa_planner_config_of(const coa_problem_t *problem, size_t vehicles, uint32_t beta,
+                          coa_planner_config_t *config);
+
+/* Bytes of workspace for a config (file comment, "Memory"). Returns 0 when config is
+ * NULL, a field is out of its range, beta reaches 2^30 nodes, or the
+ * size would not fit in size_t. Cost O(1), no memory. The size is exact: one byte less is
+ * refused by coa_planner_init. */
+size_t coa_planner_workspace_size(const coa_planner_config_t *config);
 
 /* The inverse, for a buffer whose size is fixed first (a static array in firmware): the
- * largest beta with coa_planner_workspace_size(max_vehicles, beta) <= bytes, so that
- * coa_planner_init(buffer, bytes, max_vehicles, coa_planner_max_beta(max_vehicles, bytes))
- * succeeds on any suitably aligned buffer of `bytes` bytes. Returns 0 when max_vehicles is
- * 0 or > COA_MAX_CENTRALISED or `bytes` is smaller than the workspace for beta = 1; at
- * most the largest beta whose node pool 1 + beta * 5^max_vehicles fits 2^30. Exact: with
- * b = coa_planner_max_beta(n, coa_planner_workspace_size(n, beta)), b == beta. Cost
- * O(n log beta) (a bisection over the size function), no memory. */
-uint32_t coa_planner_max_beta(size_t max_vehicles, size_t bytes);
+ * largest beta with coa_planner_workspace_size(config with that beta) <= bytes, so that
+ * coa_planner_init succeeds on any suitably aligned buffer of `bytes` bytes with it.
+ * config->beta is ignored. Returns 0 when config is NULL or out of range, or `bytes` is
+ * smaller than the workspace for beta = 1; at most 2^30 - 1. Exact: with b =
+ * coa_planner_max_beta(c, coa_planner_workspace_size(c)), b == c->beta when c->vehicles
+ * > 1; a one-vehicle planner stores no nodes, its size does not depend on beta, and any
+ * `bytes` that hold it give 2^30 - 1. Cost O(log beta) (a bisection over the size
+ * function), no memory. Note that beta also sizes the arena of the joint searches' pair
+ * tables (file comment, "Memory"): a pair table that does not fit is left out, so a
+ * search at a small beta can store more nodes than the same search with room. */
+uint32_t coa_planner_max_beta(const coa_planner_config_t *config, size_t bytes);
 
 /* Builds a planner inside `buffer`. Returns the handle (which points into the buffer, so
  * the buffer must not move while it is used), or NULL when buffer is NULL or not aligned
- * to COA_WORKSPACE_ALIGNMENT, the arguments are refused by coa_planner_workspace_size, or
+ * to COA_WORKSPACE_ALIGNMENT, the config is refused by coa_planner_workspace_size, or
  * size is smaller than it says. Writes only the first coa_planner_workspace_size bytes.
- * Cost O(hash table) to clear it; each later search first clears the entries the one
- * before it used (entry by entry, or the whole table when that is cheaper). */
-coa_planner_t *coa_planner_init(void *buffer, size_t size, size_t max_vehicles, uint32_t beta);
+ * Cost O(hash slots) to clear them; each later search first clears the slots the one
+ * before it used (one by one, or all when that is cheaper). */
+coa_planner_t *coa_planner_init(void *buffer, size_t size, const coa_planner_config_t *config);
 
 /* Checks a problem in full (counts, finite numbers, every vehicle and track, unique ids,
  * obstacles, non-NULL and finite samples) before a search trusts it. Returns COA_OK,
@@ -176,22 +244,28 @@ coa_planner_t *coa_planner_init(void *buffer, size_t size, size_t max_vehicles, 
  * vehicles) + tracks * (path + N) + polytope vertices), no memory. */
 int coa_problem_check(const coa_problem_t *problem);
 
-/* Centralised plan of every vehicle of the problem in one composite search.
+/* Centralised plan of every vehicle of the problem, optimal for the whole group
+ * (independence detection over searches of groups: file comment).
  * offsets: vehicle_count * (horizon+1) int32, row i is vehicle i; filled when solved,
- * untouched otherwise. Returns COA_OK with the outcome in *result, or COA_ERR_ARGUMENT
- * (NULL, problem check failed), COA_ERR_RANGE, or COA_ERR_WORKSPACE (planner built for
- * fewer vehicles, or not a planner). On an error *result is cleared (when not NULL).
- * An initial conflict (t = 0) is COA_PLAN_INFEASIBLE with no node expanded. The result's
+ * unspecified otherwise (the searches of groups write their rows as they go). Returns
+ * COA_OK with the outcome in *result, or COA_ERR_ARGUMENT (NULL, problem check failed),
+ * COA_ERR_RANGE, or COA_ERR_WORKSPACE (planner built for fewer vehicles, a horizon, steep
+ * factor or offset bound beyond its config, or not a planner). On an error *result is
+ * cleared (when not NULL). An initial conflict (t = 0) is COA_PLAN_INFEASIBLE with no
+ * node expanded; so is a vehicle that cannot reach k = N alone. A group without a plan
+ * makes the call infeasible, a group out of beta makes it budget exhausted. The result's
  * order is 0..n-1, orders_tried 1, failed_vehicle COA_NO_VEHICLE; the costs are 0 unless
- * solved. Cost: the problem check, then at most beta expansions (see the file comment);
- * no memory beyond the workspace and O(1) stack. */
+ * solved. Cost: the problem check, 2n tables, then fewer than n^2 joint searches (each
+ * with its pair tables) of at most beta stored nodes each (see the file comment); no
+ * memory beyond the workspace and O(1) stack. */
 int coa_plan_centralised(coa_planner_t *planner, const coa_problem_t *problem,
                          int32_t *offsets, coa_plan_result_t *result);
 
 /* Decoupled plan: vehicles plan one at a time in `order` (vehicle indices, a permutation
  * of 0..n-1; NULL: ascending priority, ties by ascending id), each against obstacles,
  * tracks and the plans of the vehicles before it. With max_orders == 1 the first failure
- * ends the call (status infeasible or budget exhausted, failed_vehicle set). With
+ * ends the call (status infeasible, failed_vehicle set: a table walk cannot run out of
+ * beta, so decoupled is never budget exhausted). With
  * max_orders > 1, other orders are tried depth-first over their prefixes, reusing the
  * plans of the prefix they share: after a failure at position F the search goes back to
  * the deepest position P <= F that still has a vehicle not yet tried there under the
@@ -214,8 +288,8 @@ int coa_plan_centralised(coa_planner_t *planner, const coa_problem_t *problem,
  * planned_count vehicles of the reported order. Rows of other vehicles are unspecified.
  * Errors as coa_plan_centralised (the planner needs room for one vehicle), and
  * COA_ERR_ARGUMENT when max_orders is 0 or `order` is not a permutation.
- * Cost: in the worst case min(max_orders, n!) attempts of at most n single-UAV searches
- * each (fewer when attempts share a prefix), each search at most beta expansions, then
+ * Cost: in the worst case min(max_orders, n!) attempts of at most n single-UAV tables and
+ * walks each (fewer when attempts share a prefix), then
  * at most n re-plans of the first order; plus, after a failed first attempt,
  * n (obstacles + tracks) + n(n-1)/2 volume checks at t = 0. The rules above only cut
  * this short in the cases they name: two UAVs that can never pass each other (but are

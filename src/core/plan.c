@@ -1,251 +1,245 @@
 /*
- * plan.c: the A* engine inside a caller-provided workspace, and its centralised and
- * decoupled front ends (see plan.h for the contract).
+ * plan.c: the planner's public entry points (see plan.h for the contract): workspace
+ * sizing, problem checks, the decoupled front end, the entry of the centralised one
+ * (independence detection is plan_group.c), and the costs and conflicts of finished rows.
  *
- * Workspace layout (every array starts on an 8-byte boundary):
+ * Workspace layout (every array starts on an 8-byte boundary), with T cells per table,
+ * W the widest row of a table and C = beta nodes:
  *
- *   coa_planner_t header (limits, per-call context, per-expansion scratch)
- *   coa_cost_t g_dev[C], f_dev[C]    (16 bytes each: exact 128-bit deviation units)
- *   uint32_t parent[C], g_eff[C], heap_pos[C], heap[C]
- *   uint32_t table[T]                (T = power of two >= 2C, open addressing)
+ *   coa_planner_t header (limits, per-call context, independence detection's state)
+ *   uint64_t cells[tables * T]       (1 table for one vehicle; else each vehicle's cost to
+ *                                     go and cost from the start, and one more)
+ *   int16_t  entries[vehicles * W]   (joint searches only, as everything below)
+ *   int32_t  saved_rows[vehicles * (N + 1)]
+ *   coa_cost_t pair_arena[C]         (pair tables: 16-byte cells)
+ *   coa_cost_t key[C], g[C]          (packed 128-bit costs)
+ *   uint32_t parent[C], heap_pos[C], heap[C]
+ *   uint32_t slot[2C]                (open addressing over the states)
  *   uint16_t k[C]
- *   int16_t  off[C * max_vehicles]   (offsets of node i at off[i*m .. i*m+m-1])
- *
- * with C = 1 + beta * 5^max_vehicles: each of at most beta expansions adds at most 5^m
- * new nodes, so the pool can never run out before the budget does.
+ *   int16_t  off[C * vehicles]
  */
 #include "coavoid/plan.h"
 
 #include <math.h>
 
-#include "internal.h"
+#include "plan_internal.h"
 
-#define PLAN_MAGIC 0x434f4150u      /* marks a buffer built by coa_planner_init */
-#define NONE UINT32_MAX             /* no node, empty table slot, not in the heap */
-#define ACTIONS COA_ACTION_COUNT
-#define MAXM COA_MAX_CENTRALISED
-/* Node indices, heap positions and table slots are uint32 with NONE reserved; a pool of
- * at most 2^30 nodes keeps the table (>= 2C slots, a power of two) below 2^32 too. */
+#define PLAN_MAGIC 0x434f4151u /* marks a buffer built by coa_planner_init */
+/* Node indices, heap positions and slots are uint32 with PLAN_NONE reserved; a pool of
+ * at most 2^30 nodes keeps the 2C slots below 2^32 too. */
 #define MAX_NODES (UINT32_C(1) << 30)
-
-struct coa_planner {
-    uint32_t magic;
-    uint32_t beta;
-    size_t max_vehicles;
-    size_t bytes;
-    uint32_t capacity;
-    uint32_t table_mask;
-
-    coa_cost_t *g_dev;
-    coa_cost_t *f_dev;
-    uint32_t *parent;
-    uint32_t *g_eff;
-    uint32_t *heap_pos;
-    uint32_t *heap;
-    uint32_t *table;
-    uint16_t *node_k;
-    int16_t *off;
-
-    /* The last search's nodes stay until the next one starts (results are rebuilt from
-     * them); their table entries are cleared then, with the stride they were stored at. */
-    uint32_t used;
-    uint32_t heap_count;
-    size_t m;
-
-    /* Per call: the problem and its exact cost parameters. */
-    const coa_problem_t *problem;
-    uint32_t scale;
-    uint64_t weight[COA_MAX_VEHICLES];
-    coa_real_t dh[COA_MAX_VEHICLES];
-    int32_t limit[COA_MAX_VEHICLES];
-
-    /* Per search: who moves, who is fixed (rows of `rows`), where results go. */
-    size_t searched[MAXM];
-    const size_t *fixed;
-    size_t fixed_count;
-    int32_t *rows;
-    uint32_t fixed_k0;
-    uint32_t fixed_k1;
-    bool fixed_ready;
-
-    /* Per expansion: each (vehicle, action) once, each pair of them once. */
-    coa_sweep_t fixed_sweep[COA_MAX_VEHICLES];
-    coa_sweep_t sweep[MAXM][ACTIONS];
-    int32_t next[MAXM][ACTIONS];
-    coa_cost_t dev[MAXM][ACTIONS];
-    coa_cost_t heur[MAXM][ACTIONS];
-    bool env_ok[MAXM][ACTIONS];
-    bool pair_ok[MAXM][MAXM][ACTIONS][ACTIONS];
-};
+#define PAIR_CELLS_PER_NODE 1u
 
 typedef struct {
+    size_t tables;
+    size_t table_cells;
+    size_t row_width;
     uint32_t capacity;
-    uint32_t table_size;
-    size_t at_g_dev;
-    size_t at_f_dev;
+    uint32_t slot_count;
+    size_t pair_cells;
+    size_t at_cells;
+    size_t at_entries;
+    size_t at_saved;
+    size_t at_pairs;
+    size_t at_key;
+    size_t at_g;
     size_t at_parent;
-    size_t at_g_eff;
     size_t at_heap_pos;
     size_t at_heap;
-    size_t at_table;
+    size_t at_slot;
     size_t at_k;
     size_t at_off;
     size_t total;
 } plan_layout_t;
 
-typedef struct {
-    coa_plan_status_t status;
-    uint64_t expanded;
-    uint64_t generated;
-} search_out_t;
-
-/* ------------------------------------------------------------------------------------ */
-/* Exact costs on the hot path                                                           */
-
-/* The same arithmetic as coa_cost_add and coa_cost_compare (trajectory.c), repeated for
- * the search loop so that the compiler can inline it: the open list compares costs
- * O(log pool) times per child, and the out-of-line calls made the paper scenario's
- * centralised search about a quarter slower. Colder code calls the public pair.
- * test_trajectory pins the public pair and test_plan checks the planner's costs against
- * an independent exact oracle, so the copies cannot drift unnoticed. */
-static inline coa_cost_t cost_add(coa_cost_t a, coa_cost_t b)
-{
-    coa_cost_t r;
-    r.lo = a.lo + b.lo;
-    r.hi = a.hi + b.hi + (r.lo < a.lo ? 1u : 0u);
-    return r;
-}
-
-static inline int cost_compare(coa_cost_t a, coa_cost_t b)
-{
-    if (a.hi != b.hi) {
-        return a.hi < b.hi ? -1 : 1;
-    }
-    if (a.lo != b.lo) {
-        return a.lo < b.lo ? -1 : 1;
-    }
-    return 0;
-}
-
 /* ------------------------------------------------------------------------------------ */
 /* Sizes                                                                                 */
 
-
-/* Children of one expansion of n searched UAVs at most: 5^n (n <= MAXM, so below 2^14). */
-static uint32_t children_per_node(size_t n)
+/* The offset bound a table is sized for: a vehicle's max_offset, or COA_MAX_OFFSET. */
+static int32_t bound_of(int32_t max_offset)
 {
-    uint32_t pow5 = 1u;
-    for (size_t i = 0; i < n; ++i) {
-        pow5 *= ACTIONS;
-    }
-    return pow5;
+    return (max_offset >= 0 && max_offset < COA_MAX_OFFSET) ? max_offset : COA_MAX_OFFSET;
 }
 
-static bool layout_compute(size_t max_vehicles, uint32_t beta, plan_layout_t *lo)
+static bool config_ok(const coa_planner_config_t *c)
 {
-    uint64_t nodes;
-    uint64_t table = 1u;
-    size_t cursor;
-    size_t c;
+    return c != NULL && c->vehicles >= 1u && c->vehicles <= PLAN_MAXM && c->beta >= 1u &&
+           c->beta < MAX_NODES && c->horizon >= 1u && c->horizon <= COA_MAX_HORIZON &&
+           c->steep_factor >= 2u && c->steep_factor <= COA_MAX_STEEP_FACTOR;
+}
 
-    if (max_vehicles == 0u || max_vehicles > MAXM || beta == 0u) {
+/* The node pool and what goes with it, for a planner that searches jointly. */
+static bool layout_nodes(const coa_planner_config_t *c, size_t *cursor, plan_layout_t *lo)
+{
+    size_t n = c->beta;
+    size_t off;
+    lo->capacity = c->beta;
+    lo->slot_count = 2u * c->beta;
+    lo->pair_cells = (size_t)PAIR_CELLS_PER_NODE * n;
+    size_t rows;
+    return size_mul(c->vehicles, lo->row_width, &off) &&
+           reserve(cursor, off, sizeof(int16_t), &lo->at_entries) &&
+           size_mul(c->vehicles, (size_t)c->horizon + 1u, &rows) &&
+           reserve(cursor, rows, sizeof(int32_t), &lo->at_saved) &&
+           reserve(cursor, lo->pair_cells, sizeof(coa_cost_t), &lo->at_pairs) &&
+           reserve(cursor, n, sizeof(coa_cost_t), &lo->at_key) &&
+           reserve(cursor, n, sizeof(coa_cost_t), &lo->at_g) &&
+           reserve(cursor, n, sizeof(uint32_t), &lo->at_parent) &&
+           reserve(cursor, n, sizeof(uint32_t), &lo->at_heap_pos) &&
+           reserve(cursor, n, sizeof(uint32_t), &lo->at_heap) &&
+           reserve(cursor, lo->slot_count, sizeof(uint32_t), &lo->at_slot) &&
+           reserve(cursor, n, sizeof(uint16_t), &lo->at_k) && size_mul(n, c->vehicles, &off) &&
+           reserve(cursor, off, sizeof(int16_t), &lo->at_off);
+}
+
+static bool layout_compute(const coa_planner_config_t *c, plan_layout_t *lo)
+{
+    uint64_t cells;
+    uint64_t width;
+    size_t cursor;
+    size_t all;
+
+    if (!config_ok(c)) {
         return false;
     }
-    /* beta < 2^32 and 5^6 < 2^14: the product cannot overflow 64 bits. */
-    nodes = 1u + (uint64_t)beta * children_per_node(max_vehicles);
-    if (nodes > MAX_NODES) {
+    *lo = (plan_layout_t){0};
+    cells = plan_table_cells(c->horizon, c->steep_factor, bound_of(c->max_offset));
+    width = plan_table_row_width(c->horizon, c->steep_factor, bound_of(c->max_offset));
+    if (cells == 0u || cells > SIZE_MAX || width > SIZE_MAX) {
         return false;
     }
-    while (table < 2u * nodes) {
-        table <<= 1;
-    }
-    lo->capacity = (uint32_t)nodes;
-    lo->table_size = (uint32_t)table;
-    c = (size_t)nodes;
-    if (!size_round(sizeof(coa_planner_t), &cursor)) {
+    lo->table_cells = (size_t)cells;
+    lo->row_width = (size_t)width;
+    lo->tables = c->vehicles == 1u ? 1u : 2u * c->vehicles + 1u;
+    if (!size_round(sizeof(coa_planner_t), &cursor) ||
+        !size_mul(lo->table_cells, lo->tables, &all) ||
+        !reserve(&cursor, all, sizeof(uint64_t), &lo->at_cells)) {
         return false;
     }
-    if (!reserve(&cursor, c, sizeof(coa_cost_t), &lo->at_g_dev) ||
-        !reserve(&cursor, c, sizeof(coa_cost_t), &lo->at_f_dev) ||
-        !reserve(&cursor, c, sizeof(uint32_t), &lo->at_parent) ||
-        !reserve(&cursor, c, sizeof(uint32_t), &lo->at_g_eff) ||
-        !reserve(&cursor, c, sizeof(uint32_t), &lo->at_heap_pos) ||
-        !reserve(&cursor, c, sizeof(uint32_t), &lo->at_heap) ||
-        !reserve(&cursor, (size_t)table, sizeof(uint32_t), &lo->at_table) ||
-        !reserve(&cursor, c, sizeof(uint16_t), &lo->at_k) || !size_mul(c, max_vehicles, &c) ||
-        !reserve(&cursor, c, sizeof(int16_t), &lo->at_off)) {
+    if (c->vehicles > 1u && !layout_nodes(c, &cursor, lo)) {
         return false;
     }
     lo->total = cursor;
     return true;
 }
 
-size_t coa_planner_workspace_size(size_t max_vehicles, uint32_t beta)
+size_t coa_planner_workspace_size(const coa_planner_config_t *config)
 {
     plan_layout_t lo;
-    return layout_compute(max_vehicles, beta, &lo) ? lo.total : 0u;
+    return layout_compute(config, &lo) ? lo.total : 0u;
 }
 
-uint32_t coa_planner_max_beta(size_t max_vehicles, size_t bytes)
+uint32_t coa_planner_max_beta(const coa_planner_config_t *config, size_t bytes)
 {
+    coa_planner_config_t c;
     plan_layout_t lo;
     uint32_t lo_beta = 0u; /* fits (0 stands for "nothing fits") */
-    uint32_t hi_beta;      /* the largest beta the node pool allows */
+    uint32_t hi_beta = MAX_NODES - 1u;
 
-    if (max_vehicles == 0u || max_vehicles > MAXM) {
+    if (config == NULL) {
         return 0u;
     }
-    hi_beta = (MAX_NODES - 1u) / children_per_node(max_vehicles);
-    if (layout_compute(max_vehicles, hi_beta, &lo) && lo.total <= bytes) {
+    c = *config;
+    c.beta = hi_beta;
+    if (layout_compute(&c, &lo) && lo.total <= bytes) {
         return hi_beta;
     }
-    /* The size grows strictly with beta: invariant size(lo_beta) <= bytes < size(hi_beta). */
+    /* The size grows strictly with beta (vehicles > 1; with one vehicle it does not
+     * depend on beta and the test above answered): size(lo_beta) <= bytes < size(hi_beta). */
     while (hi_beta - lo_beta > 1u) {
-        uint32_t mid = lo_beta + (hi_beta - lo_beta) / 2u;
-        if (layout_compute(max_vehicles, mid, &lo) && lo.total <= bytes) {
-            lo_beta = mid;
+        c.beta = lo_beta + (hi_beta - lo_beta) / 2u;
+        if (layout_compute(&c, &lo) && lo.total <= bytes) {
+            lo_beta = c.beta;
         } else {
-            hi_beta = mid;
+            hi_beta = c.beta;
         }
     }
     return lo_beta;
 }
 
-coa_planner_t *coa_planner_init(void *buffer, size_t size, size_t max_vehicles, uint32_t beta)
+static void point_into(coa_planner_t *pl, unsigned char *base, const plan_layout_t *lo)
+{
+    pl->cells = (uint64_t *)(void *)(base + lo->at_cells);
+    if (pl->config.vehicles == 1u) {
+        return;
+    }
+    pl->entries = (int16_t *)(void *)(base + lo->at_entries);
+    pl->saved_rows = (int32_t *)(void *)(base + lo->at_saved);
+    pl->pair_arena = (coa_cost_t *)(void *)(base + lo->at_pairs);
+    pl->key = (coa_cost_t *)(void *)(base + lo->at_key);
+    pl->g = (coa_cost_t *)(void *)(base + lo->at_g);
+    pl->parent = (uint32_t *)(void *)(base + lo->at_parent);
+    pl->heap_pos = (uint32_t *)(void *)(base + lo->at_heap_pos);
+    pl->heap = (uint32_t *)(void *)(base + lo->at_heap);
+    pl->slot = (uint32_t *)(void *)(base + lo->at_slot);
+    pl->node_k = (uint16_t *)(void *)(base + lo->at_k);
+    pl->off = (int16_t *)(void *)(base + lo->at_off);
+}
+
+coa_planner_t *coa_planner_init(void *buffer, size_t size, const coa_planner_config_t *config)
 {
     plan_layout_t lo;
     coa_planner_t *pl;
-    unsigned char *base = (unsigned char *)buffer;
     uint32_t i;
+    size_t t;
 
     if (buffer == NULL || (uintptr_t)buffer % WS_ALIGN != 0u) {
         return NULL;
     }
-    if (!layout_compute(max_vehicles, beta, &lo) || size < lo.total) {
+    if (!layout_compute(config, &lo) || size < lo.total) {
         return NULL;
     }
     pl = (coa_planner_t *)buffer;
     *pl = (coa_planner_t){0};
-    pl->beta = beta;
-    pl->max_vehicles = max_vehicles;
+    pl->config = *config;
     pl->bytes = lo.total;
+    pl->table_cells = lo.table_cells;
+    pl->table_count = lo.tables;
+    pl->row_width = lo.row_width;
     pl->capacity = lo.capacity;
-    pl->table_mask = lo.table_size - 1u;
-    pl->g_dev = (coa_cost_t *)(void *)(base + lo.at_g_dev);
-    pl->f_dev = (coa_cost_t *)(void *)(base + lo.at_f_dev);
-    pl->parent = (uint32_t *)(void *)(base + lo.at_parent);
-    pl->g_eff = (uint32_t *)(void *)(base + lo.at_g_eff);
-    pl->heap_pos = (uint32_t *)(void *)(base + lo.at_heap_pos);
-    pl->heap = (uint32_t *)(void *)(base + lo.at_heap);
-    pl->table = (uint32_t *)(void *)(base + lo.at_table);
-    pl->node_k = (uint16_t *)(void *)(base + lo.at_k);
-    pl->off = (int16_t *)(void *)(base + lo.at_off);
-    for (i = 0; i <= pl->table_mask; ++i) {
-        pl->table[i] = NONE;
+    pl->slot_count = lo.slot_count;
+    pl->pair_cells = lo.pair_cells;
+    point_into(pl, (unsigned char *)buffer, &lo);
+    for (i = 0; i < pl->slot_count; ++i) {
+        pl->slot[i] = PLAN_NONE;
     }
+    /* Tables 0..v-1 are the vehicles' costs to go, v..2v-1 their costs from the start,
+     * the last one is for plans against fixed vehicles. */
+    for (t = 0; t < PLAN_MAXM; ++t) {
+        pl->to_go[t].cells = &pl->cells[(t % pl->table_count) * pl->table_cells];
+        pl->from_start[t].cells =
+            &pl->cells[((config->vehicles + t) % pl->table_count) * pl->table_cells];
+    }
+    pl->scratch.cells = &pl->cells[(pl->table_count - 1u) * pl->table_cells];
     pl->m = 1u;
     pl->magic = PLAN_MAGIC;
     return pl;
+}
+
+int coa_planner_config_of(const coa_problem_t *problem, size_t vehicles, uint32_t beta,
+                          coa_planner_config_t *config)
+{
+    size_t i;
+
+    if (problem == NULL || config == NULL || problem->vehicles == NULL ||
+        problem->vehicle_count == 0u || problem->vehicle_count > COA_MAX_VEHICLES) {
+        return COA_ERR_ARGUMENT;
+    }
+    config->vehicles = vehicles;
+    config->beta = beta;
+    config->horizon = problem->horizon;
+    config->steep_factor = 2u;
+    config->max_offset = 0;
+    for (i = 0; i < problem->vehicle_count; ++i) {
+        const coa_vehicle_t *v = &problem->vehicles[i];
+        if (v->steep_factor > config->steep_factor) {
+            config->steep_factor = v->steep_factor;
+        }
+        if (config->max_offset >= 0 && (v->max_offset < 0 || v->max_offset > config->max_offset)) {
+            config->max_offset = v->max_offset;
+        }
+    }
+    return config_ok(config) ? COA_OK : COA_ERR_ARGUMENT;
 }
 
 /* ------------------------------------------------------------------------------------ */
@@ -402,10 +396,6 @@ int coa_priority_order(const coa_vehicle_t *vehicles, size_t n, size_t *order)
 /* ------------------------------------------------------------------------------------ */
 /* Costs of a finished row                                                               */
 
-static int32_t abs_i32(int32_t a)
-{
-    return a < 0 ? -a : a;
-}
 
 int coa_plan_vehicle_cost(const coa_vehicle_t *vehicle, coa_real_t dt, uint32_t horizon,
                           const int32_t *offsets, double *deviation, uint32_t *effort)
@@ -440,37 +430,11 @@ int coa_plan_vehicle_cost(const coa_vehicle_t *vehicle, coa_real_t dt, uint32_t 
     return COA_OK;
 }
 
-/* The exact deviation of one step in the search's units. Areas and heuristics are never
- * negative, so the casts below are exact. */
-static coa_cost_t step_units(const coa_planner_t *pl, size_t v, int32_t a, int32_t b)
-{
-    return coa_cost_mul(pl->weight[v], (uint64_t)coa_area_scaled(a, b, pl->scale));
-}
-
-/* The heuristic for vehicle v at offset a with `left` steps to go, in the same units. */
-static coa_cost_t heuristic_units(const coa_planner_t *pl, size_t v, int32_t a, uint32_t left)
-{
-    const coa_vehicle_t *veh = &pl->problem->vehicles[v];
-    return coa_cost_mul(pl->weight[v],
-                        (uint64_t)coa_heuristic_scaled(a, left, veh->steep_factor, pl->scale));
-}
-
-/* The exact integer deviation of a row, as the search counts it. */
-static coa_cost_t row_units(const coa_planner_t *pl, size_t v, const int32_t *row)
-{
-    coa_cost_t units = {0u, 0u};
-    uint32_t k;
-    for (k = 0; k < pl->problem->horizon; ++k) {
-        units = coa_cost_add(units, step_units(pl, v, row[k], row[k + 1u]));
-    }
-    return units;
-}
-
 /* ------------------------------------------------------------------------------------ */
-/* Geometry of the problem                                                               */
+/* Geometry and costs of rows                                                            */
 
-static coa_sweep_t vehicle_sweep(const coa_problem_t *pr, const coa_real_t *dh, size_t v,
-                                 uint32_t k0, int32_t a, uint32_t k1, int32_t b)
+coa_sweep_t plan_vehicle_sweep(const coa_problem_t *pr, const coa_real_t *dh, size_t v,
+                               uint32_t k0, int32_t a, uint32_t k1, int32_t b)
 {
     coa_sweep_t s;
     s.volume = pr->vehicles[v].volume;
@@ -481,8 +445,7 @@ static coa_sweep_t vehicle_sweep(const coa_problem_t *pr, const coa_real_t *dh, 
     return s;
 }
 
-/* Obstacles and tracks over samples k0 -> k1 (k0 == k1: the instant t_k0). */
-static bool static_clear(const coa_problem_t *pr, const coa_sweep_t *s, uint32_t k0, uint32_t k1)
+bool plan_static_clear(const coa_problem_t *pr, const coa_sweep_t *s, uint32_t k0, uint32_t k1)
 {
     size_t j;
     for (j = 0; j < pr->obstacle_count; ++j) {
@@ -504,416 +467,16 @@ static bool static_clear(const coa_problem_t *pr, const coa_sweep_t *s, uint32_t
     return true;
 }
 
-static void prepare_fixed(coa_planner_t *pl, uint32_t k0, uint32_t k1)
+/* The exact integer deviation of a row, as the search counts it. */
+static coa_cost_t row_units(const coa_planner_t *pl, size_t v, const int32_t *row)
 {
-    size_t i;
-    if (pl->fixed_ready && pl->fixed_k0 == k0 && pl->fixed_k1 == k1) {
-        return;
+    const uint32_t own_scale = 2u * pl->problem->vehicles[v].steep_factor;
+    uint64_t own = 0u;
+    uint32_t k;
+    for (k = 0; k < pl->problem->horizon; ++k) {
+        own += (uint64_t)coa_area_scaled(row[k], row[k + 1u], own_scale);
     }
-    for (i = 0; i < pl->fixed_count; ++i) {
-        size_t u = pl->fixed[i];
-        const int32_t *row = &pl->rows[u * ((size_t)pl->problem->horizon + 1u)];
-        pl->fixed_sweep[i] = vehicle_sweep(pl->problem, pl->dh, u, k0, row[k0], k1, row[k1]);
-    }
-    pl->fixed_k0 = k0;
-    pl->fixed_k1 = k1;
-    pl->fixed_ready = true;
-}
-
-/* Obstacles, tracks and the fixed vehicles: everything but the other searched vehicles. */
-static bool env_clear(coa_planner_t *pl, const coa_sweep_t *s, uint32_t k0, uint32_t k1)
-{
-    size_t i;
-    if (!static_clear(pl->problem, s, k0, k1)) {
-        return false;
-    }
-    prepare_fixed(pl, k0, k1);
-    for (i = 0; i < pl->fixed_count; ++i) {
-        if (coa_conflict_volumes(s, &pl->fixed_sweep[i])) {
-            return false;
-        }
-    }
-    return true;
-}
-
-/* ------------------------------------------------------------------------------------ */
-/* Node table and open list                                                              */
-
-static uint32_t key_hash(uint16_t k, const int16_t *off, size_t m)
-{
-    uint64_t h = 0x9e3779b97f4a7c15u ^ (uint64_t)k;
-    size_t i;
-    for (i = 0; i < m; ++i) {
-        h = (h ^ (uint64_t)(uint16_t)off[i]) * 0xff51afd7ed558ccdu;
-        h ^= h >> 32;
-    }
-    h ^= h >> 29;
-    h *= 0xc4ceb9fe1a85ec53u;
-    h ^= h >> 32;
-    return (uint32_t)h;
-}
-
-static const int16_t *node_off(const coa_planner_t *pl, uint32_t n)
-{
-    return &pl->off[(size_t)n * pl->m];
-}
-
-/* The node with this key, or NONE and the empty slot where it would go. The table is at
- * most half full, so the probe always ends within table_mask + 1 steps. */
-static uint32_t table_find(const coa_planner_t *pl, uint16_t k, const int16_t *key,
-                           uint32_t *slot_out)
-{
-    uint32_t slot = key_hash(k, key, pl->m) & pl->table_mask;
-    uint32_t probe;
-    size_t i;
-
-    for (probe = 0; probe <= pl->table_mask; ++probe) {
-        uint32_t n = pl->table[slot];
-        if (n == NONE) {
-            break;
-        }
-        if (pl->node_k[n] == k) {
-            const int16_t *o = node_off(pl, n);
-            for (i = 0; i < pl->m && o[i] == key[i]; ++i) {
-            }
-            if (i == pl->m) {
-                return n;
-            }
-        }
-        slot = (slot + 1u) & pl->table_mask;
-    }
-    *slot_out = slot;
-    return NONE;
-}
-
-/* Empties the table of the previous search's nodes: wholesale when they filled a good
- * part of it, else entry by entry so a small search does not pay for a large table. */
-static void table_reset(coa_planner_t *pl)
-{
-    uint32_t n;
-    if ((uint64_t)pl->used * 4u >= (uint64_t)pl->table_mask + 1u) {
-        for (n = 0; n <= pl->table_mask; ++n) {
-            pl->table[n] = NONE;
-        }
-    } else {
-        for (n = 0; n < pl->used; ++n) {
-            uint32_t slot = key_hash(pl->node_k[n], node_off(pl, n), pl->m) & pl->table_mask;
-            uint32_t probe;
-            /* Entries cleared before this one may have left holes in its probe run, so
-             * walk past empty slots: the entry is known to be present. */
-            for (probe = 0; probe <= pl->table_mask; ++probe) {
-                if (pl->table[slot] == n) {
-                    pl->table[slot] = NONE;
-                    break;
-                }
-                slot = (slot + 1u) & pl->table_mask;
-            }
-        }
-    }
-    pl->used = 0u;
-    pl->heap_count = 0u;
-}
-
-/* Open-list order: f_dev, then f_eff (= g_eff), then larger k, then generation order. */
-static bool node_before(const coa_planner_t *pl, uint32_t a, uint32_t b)
-{
-    int c = cost_compare(pl->f_dev[a], pl->f_dev[b]);
-    if (c != 0) {
-        return c < 0;
-    }
-    if (pl->g_eff[a] != pl->g_eff[b]) {
-        return pl->g_eff[a] < pl->g_eff[b];
-    }
-    if (pl->node_k[a] != pl->node_k[b]) {
-        return pl->node_k[a] > pl->node_k[b];
-    }
-    return a < b;
-}
-
-static void heap_place(coa_planner_t *pl, uint32_t pos, uint32_t n)
-{
-    pl->heap[pos] = n;
-    pl->heap_pos[n] = pos;
-}
-
-static void sift_up(coa_planner_t *pl, uint32_t pos)
-{
-    uint32_t n = pl->heap[pos];
-    while (pos > 0u) {
-        uint32_t up = (pos - 1u) / 2u;
-        if (!node_before(pl, n, pl->heap[up])) {
-            break;
-        }
-        heap_place(pl, pos, pl->heap[up]);
-        pos = up;
-    }
-    heap_place(pl, pos, n);
-}
-
-static void sift_down(coa_planner_t *pl, uint32_t pos)
-{
-    uint32_t n = pl->heap[pos];
-    for (;;) {
-        uint32_t child = 2u * pos + 1u;
-        if (child >= pl->heap_count) {
-            break;
-        }
-        if (child + 1u < pl->heap_count && node_before(pl, pl->heap[child + 1u], pl->heap[child])) {
-            ++child;
-        }
-        if (!node_before(pl, pl->heap[child], n)) {
-            break;
-        }
-        heap_place(pl, pos, pl->heap[child]);
-        pos = child;
-    }
-    heap_place(pl, pos, n);
-}
-
-static void heap_push(coa_planner_t *pl, uint32_t n)
-{
-    pl->heap[pl->heap_count] = n;
-    pl->heap_pos[n] = pl->heap_count;
-    ++pl->heap_count;
-    sift_up(pl, pl->heap_count - 1u);
-}
-
-static uint32_t heap_pop(coa_planner_t *pl)
-{
-    uint32_t top = pl->heap[0];
-    --pl->heap_count;
-    if (pl->heap_count > 0u) {
-        heap_place(pl, 0u, pl->heap[pl->heap_count]);
-        sift_down(pl, 0u);
-    }
-    pl->heap_pos[top] = NONE; /* closed from now on */
-    return top;
-}
-
-/* ------------------------------------------------------------------------------------ */
-/* The search                                                                            */
-
-/* A new child, or a better path to an open one. Returns false only if the pool is full,
- * which the sizing makes impossible; the caller then reports the budget as exhausted. */
-static bool add_child(coa_planner_t *pl, uint32_t parent, uint16_t k, const int16_t *key,
-                      coa_cost_t g, coa_cost_t f, uint32_t eff)
-{
-    uint32_t slot = 0u;
-    uint32_t n = table_find(pl, k, key, &slot);
-    size_t i;
-
-    if (n != NONE) {
-        if (pl->heap_pos[n] == NONE) {
-            return true; /* closed: final, the heuristic is consistent */
-        }
-        int c = cost_compare(g, pl->g_dev[n]);
-        if (c < 0 || (c == 0 && eff < pl->g_eff[n])) {
-            pl->parent[n] = parent;
-            pl->g_dev[n] = g;
-            pl->f_dev[n] = f;
-            pl->g_eff[n] = eff;
-            sift_up(pl, pl->heap_pos[n]);
-        }
-        return true;
-    }
-    if (pl->used >= pl->capacity) {
-        return false;
-    }
-    n = pl->used++;
-    pl->node_k[n] = k;
-    pl->parent[n] = parent;
-    pl->g_dev[n] = g;
-    pl->f_dev[n] = f;
-    pl->g_eff[n] = eff;
-    for (i = 0; i < pl->m; ++i) {
-        pl->off[(size_t)n * pl->m + i] = key[i];
-    }
-    pl->table[slot] = n;
-    heap_push(pl, n);
-    return true;
-}
-
-static bool expand(coa_planner_t *pl, uint32_t n, search_out_t *out)
-{
-    const coa_problem_t *pr = pl->problem;
-    const size_t m = pl->m;
-    const uint32_t k = pl->node_k[n];
-    const uint32_t k1 = k + 1u;
-    const uint32_t left = pr->horizon - k1;
-    int16_t key[MAXM];
-    int act[MAXM];
-    size_t i;
-    size_t j;
-    int a;
-    int b;
-    long d;
-
-    /* Copy the parent's offsets: adding children never moves them, but this keeps the
-     * inner loops free of repeated index arithmetic. */
-    for (i = 0; i < m; ++i) {
-        key[i] = node_off(pl, n)[i];
-    }
-    for (i = 0; i < m; ++i) {
-        size_t v = pl->searched[i];
-        const coa_vehicle_t *veh = &pr->vehicles[v];
-        int32_t from = key[i];
-        for (a = 0; a < (int)ACTIONS; ++a) {
-            int32_t to = from + coa_action_delta((coa_action_t)a, veh->steep_factor);
-            bool ok = abs_i32(to) <= pl->limit[v];
-            if (ok) {
-                pl->sweep[i][a] = vehicle_sweep(pr, pl->dh, v, k, from, k1, to);
-                ok = env_clear(pl, &pl->sweep[i][a], k, k1);
-            }
-            pl->env_ok[i][a] = ok;
-            if (ok) {
-                pl->next[i][a] = to;
-                pl->dev[i][a] = step_units(pl, v, from, to);
-                pl->heur[i][a] = heuristic_units(pl, v, to, left);
-            }
-        }
-    }
-    for (i = 0; i < m; ++i) {
-        for (j = i + 1u; j < m; ++j) {
-            for (a = 0; a < (int)ACTIONS; ++a) {
-                for (b = 0; b < (int)ACTIONS; ++b) {
-                    pl->pair_ok[i][j][a][b] = pl->env_ok[i][a] && pl->env_ok[j][b] &&
-                                              !coa_conflict_volumes(&pl->sweep[i][a],
-                                                                    &pl->sweep[j][b]);
-                }
-            }
-        }
-    }
-
-    /* Depth-first over the composite actions, vehicle 0 outermost, each vehicle's actions
-     * in coa_action_t order; a prefix that fails a table entry is cut at once. At most
-     * 5 + 25 + ... + 5^m steps. */
-    d = 0;
-    act[0] = -1;
-    while (d >= 0) {
-        size_t di = (size_t)d;
-        bool ok;
-        ++act[di];
-        if (act[di] >= (int)ACTIONS) {
-            --d;
-            continue;
-        }
-        ok = pl->env_ok[di][act[di]];
-        for (j = 0; ok && j < di; ++j) {
-            ok = pl->pair_ok[j][di][act[j]][act[di]];
-        }
-        if (!ok) {
-            continue;
-        }
-        if (di + 1u < m) {
-            ++d;
-            act[di + 1u] = -1;
-            continue;
-        }
-        {
-            int16_t child[MAXM];
-            coa_cost_t g = pl->g_dev[n];
-            coa_cost_t h = {0u, 0u};
-            uint32_t eff = pl->g_eff[n];
-            for (i = 0; i < m; ++i) {
-                child[i] = (int16_t)pl->next[i][act[i]];
-                g = cost_add(g, pl->dev[i][act[i]]);
-                h = cost_add(h, pl->heur[i][act[i]]);
-                eff += coa_action_effort((coa_action_t)act[i]);
-            }
-            ++out->generated;
-            if (!add_child(pl, n, (uint16_t)k1, child, g, cost_add(g, h), eff)) {
-                return false;
-            }
-        }
-    }
-    return true;
-}
-
-/* Whether the searched vehicles are clear of everything at t = 0. */
-static bool root_clear(coa_planner_t *pl)
-{
-    const coa_problem_t *pr = pl->problem;
-    coa_sweep_t at0[MAXM];
-    size_t i;
-    size_t j;
-
-    for (i = 0; i < pl->m; ++i) {
-        size_t v = pl->searched[i];
-        int32_t o = pr->vehicles[v].initial_offset;
-        at0[i] = vehicle_sweep(pr, pl->dh, v, 0u, o, 0u, o);
-        if (!env_clear(pl, &at0[i], 0u, 0u)) {
-            return false;
-        }
-        for (j = 0; j < i; ++j) {
-            if (coa_conflict_volumes(&at0[i], &at0[j])) {
-                return false;
-            }
-        }
-    }
-    return true;
-}
-
-/* One A* search over pl->searched[0..m-1] against the fixed rows. When solved, writes
- * the searched vehicles' rows of pl->rows. */
-static void search(coa_planner_t *pl, size_t m, search_out_t *out)
-{
-    const coa_problem_t *pr = pl->problem;
-    const uint32_t horizon = pr->horizon;
-    int16_t key[MAXM];
-    uint32_t closed = 0u;
-    coa_cost_t h = {0u, 0u};
-    coa_cost_t zero = {0u, 0u};
-    size_t i;
-
-    out->status = COA_PLAN_INFEASIBLE;
-    out->expanded = 0u;
-    out->generated = 0u;
-    table_reset(pl);
-    pl->m = m;
-    pl->fixed_ready = false;
-
-    if (!root_clear(pl)) {
-        return;
-    }
-    for (i = 0; i < m; ++i) {
-        const coa_vehicle_t *v = &pr->vehicles[pl->searched[i]];
-        key[i] = (int16_t)v->initial_offset;
-        h = coa_cost_add(h, heuristic_units(pl, pl->searched[i], v->initial_offset, horizon));
-    }
-    if (!add_child(pl, NONE, 0u, key, zero, h, 0u)) {
-        out->status = COA_PLAN_BUDGET_EXHAUSTED;
-        return;
-    }
-
-    /* The goal test comes before the budget test: a goal on top of the open list is
-     * optimal however many states were closed to get there, and closing it costs nothing. */
-    while (pl->heap_count > 0u) {
-        uint32_t n = pl->heap[0];
-        if (pl->node_k[n] == horizon) {
-            uint32_t step;
-            for (step = 0; step <= horizon && n != NONE; ++step) {
-                const int16_t *o = node_off(pl, n);
-                for (i = 0; i < m; ++i) {
-                    pl->rows[pl->searched[i] * ((size_t)horizon + 1u) + pl->node_k[n]] = o[i];
-                }
-                n = pl->parent[n];
-            }
-            out->status = COA_PLAN_SOLVED;
-            return;
-        }
-        if (closed >= pl->beta) {
-            out->status = COA_PLAN_BUDGET_EXHAUSTED;
-            return;
-        }
-        (void)heap_pop(pl);
-        if (!expand(pl, n, out)) {
-            out->status = COA_PLAN_BUDGET_EXHAUSTED;
-            return;
-        }
-        ++closed;
-        ++out->expanded;
-    }
-    out->status = COA_PLAN_INFEASIBLE;
+    return plan_units(pl, v, own);
 }
 
 /* ------------------------------------------------------------------------------------ */
@@ -937,6 +500,8 @@ static void result_clear(coa_plan_result_t *r)
     r->failed_vehicle = COA_NO_VEHICLE;
     r->orders_tried = 0u;
     r->all_orders_covered = false;
+    r->searches = 0u;
+    r->largest_group = 0u;
 }
 
 /* Validates the call and loads the problem's cost parameters into the planner. */
@@ -960,17 +525,31 @@ static int load(coa_planner_t *pl, const coa_problem_t *problem, const int32_t *
     if (rc != COA_OK) {
         return rc;
     }
+    if (problem->horizon > pl->config.horizon) {
+        return COA_ERR_WORKSPACE;
+    }
+    for (i = 0; i < problem->vehicle_count; ++i) {
+        const coa_vehicle_t *v = &problem->vehicles[i];
+        if (plan_table_cells(problem->horizon, v->steep_factor, offset_limit(v)) >
+                pl->table_cells ||
+            plan_table_row_width(problem->horizon, v->steep_factor, offset_limit(v)) >
+                pl->row_width) {
+            return COA_ERR_WORKSPACE;
+        }
+    }
+    plan_search_release(pl);
     pl->problem = problem;
+    pl->rows = (int32_t *)(uintptr_t)offsets;
     for (i = 0; i < problem->vehicle_count; ++i) {
         pl->dh[i] = coa_climb_step(&problem->vehicles[i], problem->dt);
         pl->limit[i] = offset_limit(&problem->vehicles[i]);
+        pl->unit[i] = pl->scale / (2u * problem->vehicles[i].steep_factor);
     }
     return COA_OK;
 }
 
-/* Totals of the rows of vehicles[which[0..count-1]]. */
-static void fill_costs(const coa_planner_t *pl, const size_t *which, size_t count,
-                       coa_plan_result_t *r)
+void plan_fill_costs(const coa_planner_t *pl, const size_t *which, size_t count,
+                     coa_plan_result_t *r)
 {
     const coa_problem_t *pr = pl->problem;
     size_t i;
@@ -982,7 +561,7 @@ static void fill_costs(const coa_planner_t *pl, const size_t *which, size_t coun
         const int32_t *row = &pl->rows[which[i] * ((size_t)pr->horizon + 1u)];
         double dev = 0.0;
         uint32_t eff = 0u;
-        /* Rows come from the search, so every step is an action and this cannot fail. */
+        /* Rows come from the planner, so every step is an action and this cannot fail. */
         (void)coa_plan_vehicle_cost(&pr->vehicles[which[i]], pr->dt, pr->horizon, row, &dev, &eff);
         r->deviation += dev;
         r->effort += eff;
@@ -990,10 +569,54 @@ static void fill_costs(const coa_planner_t *pl, const size_t *which, size_t coun
     }
 }
 
+bool plan_any_initial_conflict(const coa_planner_t *pl)
+{
+    const coa_problem_t *pr = pl->problem;
+    coa_sweep_t at0[COA_MAX_VEHICLES];
+    size_t i;
+    size_t j;
+
+    for (i = 0; i < pr->vehicle_count; ++i) {
+        int32_t o = pr->vehicles[i].initial_offset;
+        at0[i] = plan_vehicle_sweep(pr, pl->dh, i, 0u, o, 0u, o);
+        if (!plan_static_clear(pr, &at0[i], 0u, 0u)) {
+            return true;
+        }
+        for (j = 0; j < i; ++j) {
+            if (coa_conflict_volumes(&at0[i], &at0[j])) {
+                return true;
+            }
+        }
+    }
+    return false;
+}
+
+/* The packed worst case of a joint search must leave the doubled keys below 2^128: the
+ * worst deviation check_range allows (2^127) is far above what the packing leaves room
+ * for (2^(127 - PLAN_EFF_BITS - 1)), so a centralised problem of more than one vehicle is
+ * checked again here. The limits of common.h keep every real problem far below. */
+static bool packed_range_ok(const coa_planner_t *pl)
+{
+    const coa_problem_t *p = pl->problem;
+    coa_cost_t total = {0u, 0u};
+    size_t i;
+    for (i = 0; i < p->vehicle_count; ++i) {
+        const coa_vehicle_t *v = &p->vehicles[i];
+        uint64_t init = (uint64_t)(v->initial_offset < 0 ? -(int64_t)v->initial_offset
+                                                         : (int64_t)v->initial_offset);
+        uint64_t bound = init + (uint64_t)p->horizon * v->steep_factor;
+        if (bound > (uint64_t)pl->limit[i]) {
+            bound = (uint64_t)pl->limit[i];
+        }
+        total = coa_cost_add(total, coa_cost_mul(pl->weight[i],
+                                                 (uint64_t)pl->scale * bound * 2u * p->horizon));
+    }
+    return total.hi < (UINT64_C(1) << (64u - PLAN_EFF_BITS - 2u));
+}
+
 int coa_plan_centralised(coa_planner_t *planner, const coa_problem_t *problem,
                          int32_t *offsets, coa_plan_result_t *result)
 {
-    search_out_t out;
     size_t i;
     int rc;
 
@@ -1004,68 +627,43 @@ int coa_plan_centralised(coa_planner_t *planner, const coa_problem_t *problem,
     if (rc != COA_OK) {
         return rc;
     }
-    if (problem->vehicle_count > planner->max_vehicles) {
+    if (problem->vehicle_count > planner->config.vehicles) {
         return COA_ERR_WORKSPACE;
     }
-    for (i = 0; i < problem->vehicle_count; ++i) {
-        planner->searched[i] = i;
+    if (problem->vehicle_count > 1u && !packed_range_ok(planner)) {
+        return COA_ERR_RANGE;
     }
-    planner->fixed = NULL;
-    planner->fixed_count = 0u;
-    planner->rows = offsets;
-    search(planner, problem->vehicle_count, &out);
-
-    result->status = out.status;
-    result->nodes_expanded = out.expanded;
-    result->nodes_generated = out.generated;
     result->workspace_bytes = planner->bytes;
     result->orders_tried = 1u;
-    if (out.status == COA_PLAN_SOLVED) {
+    if (plan_any_initial_conflict(planner)) {
+        return COA_OK; /* infeasible, nothing expanded */
+    }
+    result->status = plan_independence(planner, result);
+    if (result->status == COA_PLAN_SOLVED) {
+        for (i = 0; i < problem->vehicle_count; ++i) {
+            result->order[i] = i;
+        }
         result->planned_count = problem->vehicle_count;
-        fill_costs(planner, planner->searched, problem->vehicle_count, result);
+        plan_fill_costs(planner, result->order, problem->vehicle_count, result);
     }
     return COA_OK;
 }
 
-/* Plans order[level] against the plans of order[0..level-1]. */
+/* Plans order[level] against the plans of order[0..level-1]: its table knows them, so
+ * its plan is read off the table (infeasible when its start is dead there). */
 static coa_plan_status_t plan_one(coa_planner_t *pl, const size_t *order, size_t level,
                                   coa_plan_result_t *r)
 {
-    search_out_t out;
-    pl->searched[0] = order[level];
-    pl->fixed = order;
-    pl->fixed_count = level;
-    search(pl, 1u, &out);
-    r->nodes_expanded += out.expanded;
-    r->nodes_generated += out.generated;
-    return out.status;
-}
-
-/* Whether some vehicle meets an obstacle, a track or another vehicle at t = 0 (positions
- * at k = 0 with the initial offsets). Every order then fails: the root of whichever
- * vehicle of the pair is planned second (or of the vehicle itself) is in conflict.
- * Uses the planner's fixed-vehicle scratch, which the next search rebuilds anyway. */
-static bool any_initial_conflict(coa_planner_t *pl)
-{
-    const coa_problem_t *pr = pl->problem;
-    coa_sweep_t *at0 = pl->fixed_sweep;
-    size_t i;
-    size_t j;
-
-    pl->fixed_ready = false;
-    for (i = 0; i < pr->vehicle_count; ++i) {
-        int32_t o = pr->vehicles[i].initial_offset;
-        at0[i] = vehicle_sweep(pr, pl->dh, i, 0u, o, 0u, o);
-        if (!static_clear(pr, &at0[i], 0u, 0u)) {
-            return true;
-        }
-        for (j = 0; j < i; ++j) {
-            if (coa_conflict_volumes(&at0[i], &at0[j])) {
-                return true;
-            }
-        }
+    const size_t v = order[level];
+    const int32_t start = pl->problem->vehicles[v].initial_offset;
+    plan_table_build(pl, &pl->scratch, v, order, level);
+    ++r->searches;
+    if (cell_dead(plan_table_at(&pl->scratch, 0u, start))) {
+        return COA_PLAN_INFEASIBLE;
     }
-    return false;
+    plan_table_walk(pl, &pl->scratch, 0u, start);
+    r->nodes_expanded += pl->problem->horizon;
+    return COA_PLAN_SOLVED;
 }
 
 /* order without the vehicle at `from`, that vehicle re-inserted at `to` <= from. */
@@ -1125,7 +723,6 @@ int coa_plan_decoupled(coa_planner_t *planner, const coa_problem_t *problem,
         tried[i] = 0u;
     }
     keep = n;
-    planner->rows = offsets;
     result->workspace_bytes = planner->bytes;
 
     while (result->orders_tried < max_orders) {
@@ -1154,7 +751,7 @@ int coa_plan_decoupled(coa_planner_t *planner, const coa_problem_t *problem,
                 result->order[i] = cur[i];
             }
             result->planned_count = n;
-            fill_costs(planner, cur, n, result);
+            plan_fill_costs(planner, cur, n, result);
             return COA_OK;
         }
         if (st == COA_PLAN_BUDGET_EXHAUSTED) {
@@ -1169,7 +766,7 @@ int coa_plan_decoupled(coa_planner_t *planner, const coa_problem_t *problem,
             /* Checked only once an order has failed, so a solved call never pays for it;
              * without it, two vehicles in conflict at t = 0 among n would cost up to n!
              * attempts before the order space ran out. */
-            if (!proven && any_initial_conflict(planner)) {
+            if (!proven && plan_any_initial_conflict(planner)) {
                 proven = true;
             }
         }
@@ -1223,7 +820,7 @@ int coa_plan_decoupled(coa_planner_t *planner, const coa_problem_t *problem,
         }
     }
     result->failed_vehicle = first[result->planned_count];
-    fill_costs(planner, first, result->planned_count, result);
+    plan_fill_costs(planner, first, result->planned_count, result);
     return COA_OK;
 }
 
@@ -1264,12 +861,12 @@ int coa_plan_find_conflict(const coa_problem_t *problem, const int32_t *offsets,
         for (i = 0; i < count; ++i) {
             size_t v = which[i];
             const int32_t *ov = &offsets[v * row];
-            coa_sweep_t s = vehicle_sweep(problem, dh, v, k, ov[k], k + 1u, ov[k + 1u]);
-            bool hit = !static_clear(problem, &s, k, k + 1u);
+            coa_sweep_t s = plan_vehicle_sweep(problem, dh, v, k, ov[k], k + 1u, ov[k + 1u]);
+            bool hit = !plan_static_clear(problem, &s, k, k + 1u);
             for (j = 0; !hit && j < count; ++j) {
                 if (j != i) {
                     const int32_t *ou = &offsets[which[j] * row];
-                    coa_sweep_t t = vehicle_sweep(problem, dh, which[j], k, ou[k], k + 1u,
+                    coa_sweep_t t = plan_vehicle_sweep(problem, dh, which[j], k, ou[k], k + 1u,
                                                   ou[k + 1u]);
                     hit = coa_conflict_volumes(&s, &t);
                 }

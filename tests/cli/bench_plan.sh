@@ -83,15 +83,17 @@ fi
 # A beta too small to finish is counted as budget exhausted (and the run still exits 0).
 if expect_ok small_beta bench plan --vehicles 5 --count 1 --repeat 1 --beta 2 --seed 3 --json; then
     check small_beta '
-rows[0]["budget_exhausted"] == 1 and rows[0]["nodes_expanded"] == 2 and rows[0]["beta"] == 2
+rows[0]["budget_exhausted"] == 1 and rows[0]["nodes_generated"] == 2 and rows[0]["beta"] == 2
 rows[0]["vehicles"] == 5 and not rows[0]["beta_lowered"]
 '
 fi
-# A beta whose centralised workspace would pass 1 GiB is lowered, and says so.
-if expect_ok lowered_beta bench plan --vehicles 5 --count 1 --repeat 1 --beta 1000000 --json; then
+# A beta whose centralised workspace would pass 1 GiB (74 bytes a node for two UAVs) is
+# lowered to the default (which fits), and says so; a decoupled planner stores no nodes, so its beta is never lowered.
+if expect_ok lowered_beta bench plan --vehicles 2 --count 1 --repeat 1 --beta 20000000 --json; then
     check lowered_beta '
-rows[0]["beta_lowered"] and rows[0]["beta"] < 20000
-not rows[1]["beta_lowered"] and rows[1]["beta"] == 1000000
+rows[0]["beta_lowered"] and rows[0]["beta"] == 20000
+rows[0]["workspace_bytes"] <= 2 ** 30
+not rows[1]["beta_lowered"] and rows[1]["beta"] == 20000000
 '
 fi
 # Without --vehicles: the paper scenario, then 2, 3, 4 and 5 UAVs (a small beta keeps it
@@ -117,9 +119,9 @@ else
     fail "bench --help: $(head -c 300 "$tmp/help")"
 fi
 
-also="from 2 to 5"
+also="from 2 to 6"
 expect_bad "vehicles 1" "--vehicles" bench plan --vehicles 1
-expect_bad "vehicles 6" "--vehicles" bench plan --vehicles 6
+expect_bad "vehicles 7" "--vehicles" bench plan --vehicles 7
 expect_bad "vehicles 0" "--vehicles" bench plan --vehicles 0
 expect_bad "vehicles abc" "--vehicles" bench plan --vehicles abc
 expect_bad "vehicles missing" "--vehicles" bench plan --vehicles

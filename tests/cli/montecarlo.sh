@@ -236,9 +236,9 @@ else
 fi
 
 expect_bad "vehicles missing" "--vehicles: required" montecarlo --count 2
-also="from 2 to 5"
+also="from 2 to 6"
 expect_bad "vehicles 1" "--vehicles" montecarlo --vehicles 1
-expect_bad "vehicles 6" "--vehicles" montecarlo --vehicles 2,6
+expect_bad "vehicles 7" "--vehicles" montecarlo --vehicles 2,7
 expect_bad "vehicles empty entry" "--vehicles" montecarlo --vehicles 2,,3
 expect_bad "vehicles trailing comma" "--vehicles" montecarlo --vehicles 2,
 expect_bad "vehicles abc" "--vehicles" montecarlo --vehicles abc

@@ -335,7 +335,9 @@ expect_stats stuck_max1 'st["orders_tried"] == 1 and st["all_orders_covered"] is
 
 # ---- budget exhausted: beta 1 cannot reach k = 10 ----
 expect_result budget_central 1 budget_exhausted centralised "$h" "" "" plan "$h" --mode centralised --beta 1
-expect_result budget_decoupled 1 budget_exhausted decoupled "$h" 1,2 1 plan "$h" --mode decoupled --beta 1
+# decoupled reads each UAV's plan off its exact table and stores no search node: beta 1 is
+# enough, and a decoupled plan never runs out of beta
+expect_result beta1_decoupled 0 solved decoupled "$h" 1,2 "" plan "$h" --mode decoupled --beta 1
 python3 -c 'import json,sys; s=json.load(open(sys.argv[1])); s["beta"]=1; json.dump(s, open(sys.argv[2], "w"))' "$h" "$tmp/beta1.json"
 expect_result scenario_beta 1 budget_exhausted centralised "$tmp/beta1.json" "" "" plan "$tmp/beta1.json" --mode centralised
 expect_result beta_overrides 0 solved centralised "$tmp/beta1.json" "" "" plan "$tmp/beta1.json" --mode centralised --beta 20000

@@ -241,18 +241,19 @@ p, q = at(v[1], 35.0), at(v[3], 35.0)
 sys.exit(0 if math.hypot(p[0] - q[0], p[1] - q[1]) < 30 and abs(p[2] - q[2]) < 10 else 1)
 PY
 
-# A composite search that runs out of beta is not the end: the coordinator plans the
-# cluster decoupled instead. Head-on needs 1,900 centralised expansions but only ~230
-# decoupled, so with beta 500 the one-shot centralised plan gives up and the loop does not.
+# A joint search that runs out of beta is not the end: the coordinator plans the cluster
+# decoupled instead. Head-on's joint search stores more than 20 nodes, while decoupled
+# plans store none, so with beta 20 the one-shot centralised plan gives up and the loop
+# does not.
 python3 - "$scenarios/headon.json" "$tmp/headon_beta.json" <<'PY'
 import json, sys
 s = json.load(open(sys.argv[1]))
-s["beta"] = 500
+s["beta"] = 20
 json.dump(s, open(sys.argv[2], "w"))
 PY
 "$bin" plan "$tmp/headon_beta.json" --mode centralised >"$tmp/plan_beta.json" 2>/dev/null
-if [ "$(field "$tmp/plan_beta.json" 'r["status"]')" = budget_exhausted ]; then pass; else fail "headon with beta 500: the one-shot centralised plan did not run out of beta"; fi
-sim_json headon-beta500 "$tmp/headon_beta.json" centralised 0 '
+if [ "$(field "$tmp/plan_beta.json" 'r["status"]')" = budget_exhausted ]; then pass; else fail "headon with beta 20: the one-shot centralised plan did not run out of beta"; fi
+sim_json headon-beta20 "$tmp/headon_beta.json" centralised 0 '
 r["loss_of_separation"] is False
 r["replans"] >= 2
 r["deviation"] == 580

@@ -26,12 +26,16 @@ int main(void)
         return 1;
     }
     const coa_problem_t problem = {1.0, HORIZON, vehicles, 2, refs, NULL, 0, NULL, 0, NULL};
-    const size_t need = coa_planner_workspace_size(2, BETA);
+    coa_planner_config_t config;
+    if (coa_planner_config_of(&problem, 2, BETA, &config) != COA_OK) {
+        return 1;
+    }
+    const size_t need = coa_planner_workspace_size(&config);
     if (need == 0 || need > sizeof workspace) {
         fprintf(stderr, "workspace: need %zu bytes\n", need);
         return 1;
     }
-    coa_planner_t *planner = coa_planner_init(workspace, need, 2, BETA);
+    coa_planner_t *planner = coa_planner_init(workspace, need, &config);
     if (planner == NULL) {
         return 1;
     }

@@ -13,6 +13,7 @@
 #include "scenario.h"
 
 #define FUZZ_BETA 40u
+#define FUZZ_MAX_WORKSPACE ((size_t)64u << 20)
 
 static void plan_both(const coa_problem_t *problem)
 {
@@ -25,11 +26,18 @@ static void plan_both(const coa_problem_t *problem)
     for (size_t m = 1; m <= 2; ++m) {
         const size_t searched = (m == 1) ? 1u : n;
         if (searched > 3u) {
-            continue; /* 5^n children a node: keep each fuzz run fast */
+            continue; /* joint searches of more: keep each fuzz run fast */
         }
-        const size_t size = coa_planner_workspace_size(searched, FUZZ_BETA);
+        coa_planner_config_t config;
+        size_t size = 0u;
+        if (coa_planner_config_of(problem, searched, FUZZ_BETA, &config) == COA_OK) {
+            size = coa_planner_workspace_size(&config);
+        }
+        if (size > FUZZ_MAX_WORKSPACE) {
+            continue; /* tables of a long unbounded horizon: gigabytes, not a bug */
+        }
         void *buffer = size ? aligned_alloc(COA_WORKSPACE_ALIGNMENT, (size + 7u) & ~(size_t)7u) : NULL;
-        coa_planner_t *planner = buffer ? coa_planner_init(buffer, size, searched, FUZZ_BETA) : NULL;
+        coa_planner_t *planner = buffer ? coa_planner_init(buffer, size, &config) : NULL;
         if (planner != NULL) {
             const int rc = (m == 1) ? coa_plan_decoupled(planner, problem, NULL, 4u, offsets, &result)
                                     : coa_plan_centralised(planner, problem, offsets, &result);

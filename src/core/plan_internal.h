@@ -1,0 +1,414 @@
+/*
+ * plan_internal.h: what the planner's sources share (private, not installed).
+ *
+ *   plan.c        the public entry points: sizing, problem checks, the centralised front
+ *                 end (independence detection) and the decoupled one, costs of rows;
+ *   plan_table.c  each vehicle's exact cost-to-go and cost-from-start tables, and the
+ *                 plans read off them;
+ *   plan_pair.c   the exact cost-to-go of pairs of vehicles over their encounters;
+ *   plan_search.c the joint search of a group of vehicles.
+ *
+ * Exact arithmetic. A vehicle's own deviation is counted in units of 1/(2s) of its
+ * L*dh (s its steep factor), where every step's area is an integer (trajectory.h); the
+ * problem's unit is 2^E / S m^2 with S = lcm(2 s_i) (coa_area_scale), so a vehicle's own
+ * units convert exactly by W_i * (S / 2s_i). Tables hold the vehicle's own units (below
+ * 2^35 by the limits of common.h: N * 32767 * 2s <= 6.6e9). The joint search packs a
+ * cost into one 128-bit integer, deviation * 2^PLAN_EFF_BITS + effort (coa_cost_t used
+ * as a plain 128-bit integer), so that comparing two packed costs compares them
+ * lexicographically, and sums and differences of packed costs are exact as long as the
+ * effort part of every result stays in range (it is a sum of efforts of at most
+ * COA_MAX_CENTRALISED vehicles over N steps, below 2^18).
+ */
+#ifndef COAVOID_CORE_PLAN_INTERNAL_H
+#define COAVOID_CORE_PLAN_INTERNAL_H
+
+#include "coavoid/plan.h"
+
+#include "internal.h"
+
+#define PLAN_ACTIONS COA_ACTION_COUNT
+#define PLAN_MAXM COA_MAX_CENTRALISED
+#define PLAN_NONE UINT32_MAX   /* no node, an empty slot, not in the heap */
+#define PLAN_EFF_BITS 18u      /* effort bits of a packed cost */
+#define PLAN_PAIRS (PLAN_MAXM * (PLAN_MAXM - 1u) / 2u)
+#define PLAN_OUT INT16_MIN     /* a group member's offset while it is not in the search */
+
+/* ------------------------------------------------------------------------------------ */
+/* Tables                                                                                */
+
+/* A table cell packs a state's exact cost (to go, or from the start) and, in a cost-to-go
+ * table, the actions that leave it:
+ *   bits 63..29  deviation, the vehicle's own units (all ones: dead or unreachable)
+ *   bits 28..14  effort (at most 3N < 2^15)
+ *   bits  4..0   cost-to-go tables: actions (bit a for coa_action_t a) that stay within
+ *                the offset bound, conflict with nothing the table was built against and
+ *                lead to a live state. A dead state has none; a state at k = N has none
+ *                and is live.
+ * cell >> CELL_EFF_SHIFT orders two cells' costs lexicographically. */
+#define CELL_DEV_SHIFT 29u
+#define CELL_EFF_SHIFT 14u
+#define CELL_DEV_DEAD ((UINT64_C(1) << 35) - 1u)
+#define CELL_MASK_BITS 0x1fu
+#define CELL_DEAD (CELL_DEV_DEAD << CELL_DEV_SHIFT)
+
+static inline uint64_t cell_dev(uint64_t c)
+{
+    return c >> CELL_DEV_SHIFT;
+}
+
+static inline uint32_t cell_eff(uint64_t c)
+{
+    return (uint32_t)((c >> CELL_EFF_SHIFT) & 0x7fffu);
+}
+
+static inline uint32_t cell_mask(uint64_t c)
+{
+    return (uint32_t)(c & CELL_MASK_BITS);
+}
+
+static inline bool cell_dead(uint64_t c)
+{
+    return cell_dev(c) == CELL_DEV_DEAD;
+}
+
+/* One vehicle's table: the reachable offsets [plan_row_lo(k), plan_row_hi(k)] of every
+ * sample k, stored row after row. Rows are laid out by their widest possible width,
+ * min(2ks + 1, 2L + 1), so that a row's start has a closed form. */
+typedef struct {
+    size_t vehicle;  /* index into the problem */
+    int32_t origin;  /* initial offset */
+    int32_t limit;   /* L: the largest |offset| */
+    uint32_t steep;  /* s */
+    uint32_t horizon;
+    uint64_t *cells;
+} plan_table_t;
+
+/* The moves out of one state of one vehicle, in the order a plan takes them: by the
+ * increase of f they cause (deviation, then effort), then by action. */
+typedef struct {
+    uint32_t count;
+    uint8_t action[PLAN_ACTIONS];
+    int32_t to[PLAN_ACTIONS];
+    uint64_t dev[PLAN_ACTIONS]; /* f's deviation increase, the vehicle's own units */
+    int32_t eff[PLAN_ACTIONS];  /* f's effort increase (negative when dev's is positive) */
+} plan_moves_t;
+
+/* ------------------------------------------------------------------------------------ */
+/* Groups and pairs                                                                      */
+
+/* A joint search over group members m_0..m_{count-1} (problem indices, ascending). A
+ * member takes part in the search from sample `first` to sample `last` (the steps
+ * first..last are the only ones where it can meet another member or a fixed vehicle);
+ * before, it flies its cheapest way to whatever offset it enters at, after, its cheapest
+ * way on: both exact from its tables. */
+typedef struct {
+    size_t count;
+    size_t vehicle[PLAN_MAXM];
+    uint32_t first[PLAN_MAXM];
+    uint32_t last[PLAN_MAXM];
+    uint32_t end;             /* 1 + the largest `last`: the search's goal sample */
+    coa_cost_t alone[PLAN_MAXM]; /* each member's cost alone, packed */
+    uint32_t entry_count[PLAN_MAXM]; /* offsets in its entry list (pl->entries) */
+    /* Pairs (a, b) of members, a < b, in the order (0,1), (0,2), .., (1,2), ..: the steps
+     * where they can meet (near_first > near_last: never). */
+    uint32_t near_first[PLAN_PAIRS];
+    uint32_t near_last[PLAN_PAIRS];
+    /* Fixed vehicles (independence detection's re-plans): problem indices, and the steps
+     * each member can meet each. */
+    size_t fixed[COA_MAX_VEHICLES];
+    size_t fixed_count;
+    bool bounded;             /* plans that cost more than bound are not wanted */
+    coa_cost_t bound;         /* packed */
+    bool capped;              /* a plan is known that costs `cap` (packed): prune above */
+    coa_cost_t cap;
+} plan_group_t;
+
+/* The exact joint cost-to-go of members a and b over rows first..last (sample `last`+1 is
+ * the boundary, where it is the sum of their own), over the offsets each can take at a
+ * cost within the group's slack (a corridor: every offset whose cheapest plan through it
+ * costs at most the cap's slack over its cost alone). Cells outside are dead. */
+typedef struct {
+    bool present;
+    uint32_t first;
+    uint32_t last;
+    int16_t *row_lo; /* per row (first..last): corridor of a, then of b: lo_a, hi_a, lo_b, hi_b */
+    uint32_t *row_base;
+    coa_cost_t *cells; /* packed; PLAN_COST_DEAD when dead */
+} plan_pair_t;
+
+static const coa_cost_t PLAN_COST_DEAD = {UINT64_MAX, UINT64_MAX};
+
+static inline bool plan_cost_dead(coa_cost_t c)
+{
+    return c.hi == UINT64_MAX && c.lo == UINT64_MAX;
+}
+
+/* ------------------------------------------------------------------------------------ */
+/* The planner                                                                           */
+
+typedef struct {
+    coa_plan_status_t status;
+    uint64_t expanded;
+    uint64_t stored;
+} plan_search_out_t;
+
+#define PLAN_MAX_TRIED 64u /* pairs of groups independence detection tried to re-plan */
+
+struct coa_planner {
+    uint32_t magic;
+    coa_planner_config_t config;
+    size_t bytes;
+    size_t table_cells;   /* cells one table holds */
+    size_t table_count;   /* tables in the workspace */
+    size_t row_width;     /* the widest row a table can have */
+    uint32_t capacity;    /* nodes: beta (0: no joint search, vehicles == 1) */
+    uint32_t slot_count;  /* hash slots: 2 * capacity */
+    size_t pair_cells;    /* cells of the pair arena */
+
+    uint64_t *cells;      /* table_count tables of table_cells */
+    int16_t *entries;     /* per member: its entry offsets, cheapest first (row_width) */
+    coa_cost_t *pair_arena;
+
+    /* Node pool (one array per field). key: the packed, doubled f of the node's next
+     * children; g: its packed cost from the start; k: the sample (bit 15: expanded). */
+    coa_cost_t *key;
+    coa_cost_t *g;
+    uint32_t *parent;
+    uint32_t *heap_pos;
+    uint32_t *heap;
+    uint32_t *slot;
+    uint16_t *node_k;
+    int16_t *off;
+
+    /* The last search's nodes stay until the next one starts (rows are rebuilt from
+     * them); its hash entries are cleared then. */
+    uint32_t used;
+    uint32_t heap_count;
+    size_t m;
+    coa_cost_t batch;     /* doubled f beyond its key an expansion also generates */
+
+    /* Per call: the problem and its exact cost parameters. */
+    const coa_problem_t *problem;
+    int32_t *rows;
+    uint32_t scale;
+    uint64_t weight[COA_MAX_VEHICLES];
+    uint32_t unit[COA_MAX_VEHICLES]; /* S / (2 s_i) */
+    coa_real_t dh[COA_MAX_VEHICLES];
+    int32_t limit[COA_MAX_VEHICLES];
+
+    /* Tables: cost-to-go and cost-from-start of each vehicle (centralised), and one more
+     * cost-to-go table for plans against fixed vehicles. */
+    plan_table_t to_go[PLAN_MAXM];
+    plan_table_t from_start[PLAN_MAXM];
+    plan_table_t scratch;
+
+    /* Steps where two vehicles can meet at all (first > last: never), per call. */
+    uint32_t near_first[PLAN_MAXM][PLAN_MAXM];
+    uint32_t near_last[PLAN_MAXM][PLAN_MAXM];
+
+    /* The current joint search, and the rows its members had before it (a search that
+     * fails must leave them as they were). */
+    plan_group_t group;
+    int32_t *saved_rows;
+    plan_pair_t pair[PLAN_PAIRS];
+    size_t pair_used;     /* arena cells taken */
+
+    /* Independence detection: pairs of groups (member bit masks) it tried to re-plan. */
+    uint32_t tried[PLAN_MAX_TRIED][2];
+    size_t tried_count;
+};
+
+/* ------------------------------------------------------------------------------------ */
+/* Packed costs                                                                          */
+
+static inline coa_cost_t plan_cost_add(coa_cost_t a, coa_cost_t b)
+{
+    coa_cost_t r;
+    r.lo = a.lo + b.lo;
+    r.hi = a.hi + b.hi + (r.lo < a.lo ? 1u : 0u);
+    return r;
+}
+
+/* a - b for a >= b. */
+static inline coa_cost_t plan_cost_sub(coa_cost_t a, coa_cost_t b)
+{
+    coa_cost_t r;
+    r.lo = a.lo - b.lo;
+    r.hi = a.hi - b.hi - (a.lo < b.lo ? 1u : 0u);
+    return r;
+}
+
+static inline int plan_cost_compare(coa_cost_t a, coa_cost_t b)
+{
+    if (a.hi != b.hi) {
+        return a.hi < b.hi ? -1 : 1;
+    }
+    if (a.lo != b.lo) {
+        return a.lo < b.lo ? -1 : 1;
+    }
+    return 0;
+}
+
+static inline coa_cost_t plan_cost_twice(coa_cost_t a)
+{
+    coa_cost_t r;
+    r.hi = (a.hi << 1) | (a.lo >> 63);
+    r.lo = a.lo << 1;
+    return r;
+}
+
+/* A deviation in the problem's units (coa_cost_t) with an effort, packed. */
+static inline coa_cost_t plan_pack(coa_cost_t dev, uint64_t eff)
+{
+    coa_cost_t r;
+    r.hi = (dev.hi << PLAN_EFF_BITS) | (dev.lo >> (64u - PLAN_EFF_BITS));
+    r.lo = dev.lo << PLAN_EFF_BITS;
+    return plan_cost_add(r, (coa_cost_t){0u, eff});
+}
+
+/* a * b in 128 bits: the compiler's when it has a 128-bit type (the search calls this
+ * for every cost it forms), else coa_cost_mul's 32-bit schedule (Cortex-M). */
+#ifdef __SIZEOF_INT128__
+__extension__ typedef unsigned __int128 plan_u128_t;
+static inline coa_cost_t plan_mul(uint64_t a, uint64_t b)
+{
+    plan_u128_t p = (plan_u128_t)a * b;
+    coa_cost_t r;
+    r.hi = (uint64_t)(p >> 64);
+    r.lo = (uint64_t)p;
+    return r;
+}
+#else
+static inline coa_cost_t plan_mul(uint64_t a, uint64_t b)
+{
+    return coa_cost_mul(a, b);
+}
+#endif
+
+/* A vehicle's own deviation units as the problem's: W_i * (S / 2s_i) * units. */
+static inline coa_cost_t plan_units(const coa_planner_t *pl, size_t v, uint64_t own)
+{
+    return plan_mul(pl->weight[v], own * pl->unit[v]);
+}
+
+/* A table cell's cost as a packed cost of vehicle v. */
+static inline coa_cost_t plan_cell_cost(const coa_planner_t *pl, size_t v, uint64_t c)
+{
+    return plan_pack(plan_units(pl, v, cell_dev(c)), cell_eff(c));
+}
+
+/* Group member i's tables. */
+static inline const plan_table_t *plan_to_go(const coa_planner_t *pl, size_t i)
+{
+    return &pl->to_go[pl->group.vehicle[i]];
+}
+
+static inline const plan_table_t *plan_from_start(const coa_planner_t *pl, size_t i)
+{
+    return &pl->from_start[pl->group.vehicle[i]];
+}
+
+/* ------------------------------------------------------------------------------------ */
+/* Shared functions                                                                      */
+
+/* The swept volume of vehicle v from offset a at sample k0 to offset b at k1. */
+coa_sweep_t plan_vehicle_sweep(const coa_problem_t *pr, const coa_real_t *dh, size_t v,
+                               uint32_t k0, int32_t a, uint32_t k1, int32_t b);
+
+/* Whether a sweep over samples k0 -> k1 is clear of every obstacle and track (k0 == k1:
+ * the instant t_k0). */
+bool plan_static_clear(const coa_problem_t *pr, const coa_sweep_t *s, uint32_t k0, uint32_t k1);
+
+/* Cells of a table for horizon N, steep factor s and offset bound L (0 when it would not
+ * fit 64 bits, which the limits of common.h rule out). */
+uint64_t plan_table_cells(uint32_t horizon, uint32_t steep, int32_t limit);
+
+/* Widest row of such a table: min(2Ns + 1, 2L + 1). */
+uint64_t plan_table_row_width(uint32_t horizon, uint32_t steep, int32_t limit);
+
+int32_t plan_row_lo(const plan_table_t *t, uint32_t k);
+int32_t plan_row_hi(const plan_table_t *t, uint32_t k);
+
+/* The cell of (k, offset) in a table. Precondition: the offset is in row k. */
+uint64_t plan_table_at(const plan_table_t *t, uint32_t k, int32_t offset);
+
+/* Builds cost-to-go table t for vehicle v against the obstacles, the tracks and the
+ * vehicles fixed[0..nfixed-1] flying their rows of pl->rows. */
+void plan_table_build(coa_planner_t *pl, plan_table_t *t, size_t v, const size_t *fixed,
+                      size_t nfixed);
+
+/* Builds cost-from-start table f of the vehicle of cost-to-go table t, over t's moves. */
+void plan_table_build_from_start(plan_table_t *f, const plan_table_t *t);
+
+/* The moves out of offset `from` at sample k of cost-to-go table t, sorted (see
+ * plan_moves_t). */
+void plan_table_moves(const plan_table_t *t, uint32_t k, int32_t from, plan_moves_t *mv);
+
+/* Writes t's vehicle's row of pl->rows from sample k on, from `offset`, along its
+ * cheapest plan (each step the first of plan_table_moves). Precondition: live. */
+void plan_table_walk(coa_planner_t *pl, const plan_table_t *t, uint32_t k, int32_t offset);
+
+/* Writes t's vehicle's row of pl->rows up to sample k, ending at `offset`, along a
+ * cheapest plan from its initial offset (cost-from-start table f). Precondition: f's
+ * cell there is reachable. */
+void plan_table_walk_back(coa_planner_t *pl, const plan_table_t *t, const plan_table_t *f,
+                          uint32_t k, int32_t offset);
+
+/* Builds the pair tables of the current group within the arena (pairs that do not fit
+ * are left out). */
+void plan_pairs_build(coa_planner_t *pl);
+
+/* The surcharge of members a < b at sample k (packed: their joint cost-to-go less the sum
+ * of their own), 0 where the pair has no table or the sample is outside it, or
+ * PLAN_COST_DEAD. */
+coa_cost_t plan_pair_surcharge(const coa_planner_t *pl, size_t a, size_t b, uint32_t k,
+                               int32_t oa, int32_t ob, coa_cost_t to_go_a, coa_cost_t to_go_b);
+
+/* Index of pair (a, b), a < b < m. */
+static inline size_t plan_pair_index(size_t a, size_t b, size_t m)
+{
+    return a * m - a * (a + 1u) / 2u + (b - a - 1u);
+}
+
+/* Totals of the rows of vehicles which[0..count-1] into r's costs. */
+void plan_fill_costs(const coa_planner_t *pl, const size_t *which, size_t count,
+                     coa_plan_result_t *r);
+
+/* Whether some vehicle meets an obstacle, a track or another vehicle at t = 0 (positions
+ * at k = 0 with the initial offsets): then no plan and no order avoids it. */
+bool plan_any_initial_conflict(const coa_planner_t *pl);
+
+/* Independence detection over the loaded problem (plan_group.c): the centralised plan's
+ * status; the rows of every vehicle when solved. */
+coa_plan_status_t plan_independence(coa_planner_t *pl, coa_plan_result_t *r);
+
+/* One joint search over pl->group. When solved, writes the members' rows of pl->rows.
+ * Precondition: plan_search_release since the last search. */
+void plan_search(coa_planner_t *pl, plan_search_out_t *out);
+
+/* Empties the hash table of the last search's nodes (wholesale when they filled a good
+ * part of it, else one by one so that a small search does not pay for a large table).
+ * Call it before pl->group changes: the states' hashes depend on the group. */
+void plan_search_release(coa_planner_t *pl);
+
+/* ------------------------------------------------------------------------------------ */
+/* Test hooks (tests/test_heuristic.c): not used by the planner itself.                  */
+
+/* Sets up pl->group as a joint search of `members` (a bit mask of vehicles) with nothing
+ * fixed, no bound and no cap (so the pair tables' corridors are every live offset):
+ * rebuilds every vehicle's cost-to-go and cost-from-start tables, the steps where
+ * vehicles can meet, the spans, the entry lists and the pair tables. Precondition: the
+ * problem is loaded (a coa_plan_* call on it returned COA_OK) and the planner has room
+ * for a joint search of all its vehicles. */
+void plan_test_group_setup(coa_planner_t *pl, uint32_t members);
+
+/* The joint search's doubled heuristic (plan_search.c) of the state at sample k with
+ * member offsets off[0..count-1] (read only for the members in the search at k): false
+ * when a pair is dead there. */
+bool plan_test_heuristic(const coa_planner_t *pl, uint32_t k, const int16_t *off, coa_cost_t *h2);
+
+/* The doubled matching the heuristic adds (plan_search.c) of surcharges s[] (pairs of m
+ * members in plan_pair_index order) among the members of mask. */
+coa_cost_t plan_test_matching(const coa_cost_t *s, size_t m, uint32_t mask);
+
+#endif /* COAVOID_CORE_PLAN_INTERNAL_H */

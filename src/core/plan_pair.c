@@ -1,0 +1,299 @@
+/*
+ * plan_pair.c: the exact joint cost-to-go of pairs of group members over their encounter
+ * (plan.h, "Heuristic").
+ *
+ * Members a and b can only meet at the steps near_first..near_last of the group's pair
+ * table; after the last of them their joint cost-to-go is the sum of their own. Before
+ * it, a backward pass over the pair's states (k, offset of a, offset of b), from the last
+ * step they can meet back to the first sample both are in the search, takes the least
+ * cost over both members' moves (each valid for its own table) that do not conflict with
+ * each other. The difference between that and the sum of their own costs to go is the
+ * pair's surcharge: what avoiding each other costs them at least.
+ *
+ * Only offsets within the group's corridor are kept when a plan of the group is known
+ * (its cost, the cap): the plans worth finding cost at most the cap, and every offset a
+ * member takes on such a plan has a cheapest plan through it (cost from the start plus
+ * cost to go) within the cap's slack over its cost alone; a pair's two slacks within it
+ * together. Pair states outside the corridor are dead for the search, which drops them.
+ */
+#include "plan_internal.h"
+
+/* The slack of member i's offset o at sample k: its cheapest cost through (k, o) less its
+ * cost alone, packed; PLAN_COST_DEAD when no plan goes through it. */
+static coa_cost_t slack_of(const coa_planner_t *pl, size_t i, uint32_t k, int32_t o)
+{
+    const plan_group_t *g = &pl->group;
+    size_t v = g->vehicle[i];
+    uint64_t from = plan_table_at(plan_from_start(pl, i), k, o);
+    uint64_t to = plan_table_at(plan_to_go(pl, i), k, o);
+    if (cell_dead(from) || cell_dead(to)) {
+        return PLAN_COST_DEAD;
+    }
+    return plan_cost_sub(plan_cost_add(plan_cell_cost(pl, v, from), plan_cell_cost(pl, v, to)),
+                         g->alone[i]);
+}
+
+/* The group's slack: the cap less the sum of the members' costs alone. */
+static coa_cost_t group_slack(const plan_group_t *g)
+{
+    coa_cost_t sum = {0u, 0u};
+    size_t i;
+    for (i = 0; i < g->count; ++i) {
+        sum = plan_cost_add(sum, g->alone[i]);
+    }
+    return plan_cost_sub(g->cap, sum);
+}
+
+/* Member i's corridor at sample k: the smallest range holding every offset whose slack
+ * is within `slack` (all live offsets when uncapped). Empty: lo > hi. */
+static void corridor(const coa_planner_t *pl, size_t i, uint32_t k, const coa_cost_t *slack,
+                     int16_t *lo, int16_t *hi)
+{
+    const plan_table_t *t = plan_to_go(pl, i);
+    int32_t o;
+    *lo = INT16_MAX;
+    *hi = INT16_MIN;
+    for (o = plan_row_lo(t, k); o <= plan_row_hi(t, k); ++o) {
+        coa_cost_t s = slack_of(pl, i, k, o);
+        if (plan_cost_dead(s) || (slack != NULL && plan_cost_compare(s, *slack) > 0)) {
+            continue;
+        }
+        *lo = (int16_t)(o < *lo ? o : *lo);
+        *hi = (int16_t)(o > *hi ? o : *hi);
+    }
+}
+
+static size_t width(int16_t lo, int16_t hi)
+{
+    return lo > hi ? 0u : (size_t)(hi - lo) + 1u;
+}
+
+/* Carves `bytes` from the arena (whole cells); NULL when it is full. */
+static void *arena_take(coa_planner_t *pl, size_t bytes)
+{
+    size_t cells = (bytes + sizeof(coa_cost_t) - 1u) / sizeof(coa_cost_t);
+    void *p;
+    if (cells > pl->pair_cells - pl->pair_used) {
+        return NULL;
+    }
+    p = &pl->pair_arena[pl->pair_used];
+    pl->pair_used += cells;
+    return p;
+}
+
+/* Lays out pair p's rows first..last; false when the arena cannot hold it. */
+static bool pair_layout(coa_planner_t *pl, plan_pair_t *p, size_t a, size_t b,
+                        const coa_cost_t *slack)
+{
+    const size_t rows = (size_t)(p->last - p->first) + 1u;
+    size_t cells = 0u;
+    size_t r;
+    size_t mark = pl->pair_used;
+
+    p->row_lo = arena_take(pl, rows * 4u * sizeof(int16_t));
+    p->row_base = arena_take(pl, rows * sizeof(uint32_t));
+    if (p->row_lo == NULL || p->row_base == NULL) {
+        pl->pair_used = mark;
+        return false;
+    }
+    for (r = 0; r < rows; ++r) {
+        int16_t *c = &p->row_lo[4u * r];
+        uint32_t k = p->first + (uint32_t)r;
+        corridor(pl, a, k, slack, &c[0], &c[1]);
+        corridor(pl, b, k, slack, &c[2], &c[3]);
+        if (cells > UINT32_MAX) {
+            pl->pair_used = mark;
+            return false;
+        }
+        p->row_base[r] = (uint32_t)cells;
+        cells += width(c[0], c[1]) * width(c[2], c[3]);
+    }
+    if (cells > pl->pair_cells || (p->cells = arena_take(pl, cells * sizeof(coa_cost_t))) == NULL) {
+        pl->pair_used = mark;
+        return false;
+    }
+    return true;
+}
+
+/* The pair's cell at (k, oa, ob): NULL outside its rows or corridor. */
+static coa_cost_t *pair_cell(const plan_pair_t *p, uint32_t k, int32_t oa, int32_t ob)
+{
+    const int16_t *c;
+    size_t r;
+    if (k < p->first || k > p->last) {
+        return NULL;
+    }
+    r = (size_t)(k - p->first);
+    c = &p->row_lo[4u * r];
+    if (oa < c[0] || oa > c[1] || ob < c[2] || ob > c[3]) {
+        return NULL;
+    }
+    return &p->cells[p->row_base[r] + (size_t)(oa - c[0]) * width(c[2], c[3]) +
+                     (size_t)(ob - c[2])];
+}
+
+/* One member's moves out of (k, o) as packed step costs and targets. */
+typedef struct {
+    uint32_t count;
+    int32_t to[PLAN_ACTIONS];
+    coa_cost_t step[PLAN_ACTIONS];
+    coa_sweep_t sweep[PLAN_ACTIONS];
+} pair_moves_t;
+
+static void pair_moves(const coa_planner_t *pl, size_t i, uint32_t k, int32_t o, bool sweeps,
+                       pair_moves_t *mv)
+{
+    const plan_table_t *t = plan_to_go(pl, i);
+    const size_t v = pl->group.vehicle[i];
+    uint32_t mask = cell_mask(plan_table_at(t, k, o));
+    uint32_t a;
+    mv->count = 0u;
+    for (a = 0; a < PLAN_ACTIONS; ++a) {
+        int32_t to;
+        if ((mask & (1u << a)) == 0u) {
+            continue;
+        }
+        to = o + coa_action_delta((coa_action_t)a, t->steep);
+        mv->to[mv->count] = to;
+        mv->step[mv->count] =
+            plan_pack(plan_units(pl, v, (uint64_t)coa_area_scaled(o, to, 2u * t->steep)),
+                      coa_action_effort((coa_action_t)a));
+        if (sweeps) {
+            mv->sweep[mv->count] = plan_vehicle_sweep(pl->problem, pl->dh, v, k, o, k + 1u, to);
+        }
+        ++mv->count;
+    }
+}
+
+/* The cost to go after the pair's moves to (k + 1, a2, b2): from the next row, or past
+ * the last the sum of their own. */
+static coa_cost_t pair_next(const coa_planner_t *pl, const plan_pair_t *p, size_t a, size_t b,
+                            uint32_t k, int32_t a2, int32_t b2)
+{
+    const coa_cost_t *c;
+    if (k == p->last) {
+        uint64_t ca = plan_table_at(plan_to_go(pl, a), k + 1u, a2);
+        uint64_t cb = plan_table_at(plan_to_go(pl, b), k + 1u, b2);
+        return plan_cost_add(plan_cell_cost(pl, pl->group.vehicle[a], ca),
+                             plan_cell_cost(pl, pl->group.vehicle[b], cb));
+    }
+    c = pair_cell(p, k + 1u, a2, b2);
+    return c == NULL ? PLAN_COST_DEAD : *c;
+}
+
+/* The pair's cell at (k, oa, ob) from the cells of row k + 1. */
+static coa_cost_t pair_value(const coa_planner_t *pl, const plan_pair_t *p, size_t a, size_t b,
+                             uint32_t k, int32_t ob, const pair_moves_t *ma, bool near)
+{
+    coa_cost_t best = PLAN_COST_DEAD;
+    pair_moves_t mb;
+    uint32_t x;
+    uint32_t y;
+
+    pair_moves(pl, b, k, ob, near, &mb);
+    for (x = 0; x < ma->count; ++x) {
+        for (y = 0; y < mb.count; ++y) {
+            coa_cost_t c = pair_next(pl, p, a, b, k, ma->to[x], mb.to[y]);
+            if (plan_cost_dead(c)) {
+                continue;
+            }
+            c = plan_cost_add(c, plan_cost_add(ma->step[x], mb.step[y]));
+            if (plan_cost_compare(c, best) >= 0) {
+                continue;
+            }
+            if (near && coa_conflict_volumes(&ma->sweep[x], &mb.sweep[y])) {
+                continue;
+            }
+            best = c;
+        }
+    }
+    return best;
+}
+
+/* Fills row k of pair p. */
+static void pair_row(coa_planner_t *pl, plan_pair_t *p, size_t a, size_t b, uint32_t k,
+                     const coa_cost_t *slack)
+{
+    const size_t pi = plan_pair_index(a, b, pl->group.count);
+    const bool near = k >= pl->group.near_first[pi] && k <= pl->group.near_last[pi];
+    const int16_t *c = &p->row_lo[4u * (size_t)(k - p->first)];
+    int32_t oa;
+    int32_t ob;
+
+    for (oa = c[0]; oa <= c[1]; ++oa) {
+        coa_cost_t sa = slack_of(pl, a, k, oa);
+        pair_moves_t ma;
+        ma.count = 0u;
+        if (!plan_cost_dead(sa)) {
+            pair_moves(pl, a, k, oa, near, &ma);
+        }
+        for (ob = c[2]; ob <= c[3]; ++ob) {
+            coa_cost_t *cell = pair_cell(p, k, oa, ob);
+            coa_cost_t sb = slack_of(pl, b, k, ob);
+            *cell = PLAN_COST_DEAD;
+            if (plan_cost_dead(sa) || plan_cost_dead(sb) ||
+                (slack != NULL && plan_cost_compare(plan_cost_add(sa, sb), *slack) > 0)) {
+                continue;
+            }
+            *cell = pair_value(pl, p, a, b, k, ob, &ma, near);
+        }
+    }
+}
+
+/* Pair (a, b): rows from the first sample both are in the search to the last step they
+ * can meet. */
+static void pair_build(coa_planner_t *pl, size_t a, size_t b, const coa_cost_t *slack)
+{
+    const plan_group_t *g = &pl->group;
+    const size_t pi = plan_pair_index(a, b, g->count);
+    plan_pair_t *p = &pl->pair[pi];
+    uint32_t k;
+
+    p->present = false;
+    if (g->near_first[pi] > g->near_last[pi]) {
+        return;
+    }
+    p->first = g->first[a] > g->first[b] ? g->first[a] : g->first[b];
+    p->last = g->near_last[pi];
+    if (!pair_layout(pl, p, a, b, slack)) {
+        return;
+    }
+    for (k = p->last + 1u; k-- > p->first;) {
+        pair_row(pl, p, a, b, k, slack);
+    }
+    p->present = true;
+}
+
+void plan_pairs_build(coa_planner_t *pl)
+{
+    const plan_group_t *g = &pl->group;
+    coa_cost_t slack;
+    size_t a;
+    size_t b;
+
+    pl->pair_used = 0u;
+    if (g->capped) {
+        slack = group_slack(g);
+    }
+    for (a = 0; a < g->count; ++a) {
+        for (b = a + 1u; b < g->count; ++b) {
+            pair_build(pl, a, b, g->capped ? &slack : NULL);
+        }
+    }
+}
+
+coa_cost_t plan_pair_surcharge(const coa_planner_t *pl, size_t a, size_t b, uint32_t k,
+                               int32_t oa, int32_t ob, coa_cost_t to_go_a, coa_cost_t to_go_b)
+{
+    const plan_pair_t *p = &pl->pair[plan_pair_index(a, b, pl->group.count)];
+    const coa_cost_t *c;
+    coa_cost_t zero = {0u, 0u};
+    if (!p->present || k < p->first || k > p->last) {
+        return zero;
+    }
+    c = pair_cell(p, k, oa, ob);
+    if (c == NULL || plan_cost_dead(*c)) {
+        return PLAN_COST_DEAD;
+    }
+    return plan_cost_sub(*c, plan_cost_add(to_go_a, to_go_b));
+}

@@ -1,0 +1,418 @@
+/*
+ * plan_table.c: the exact cost-to-go and cost-from-start of each vehicle alone (plan.h,
+ * "Heuristic"), and the plans read off them.
+ *
+ * A backward pass over the states (k, offset) the vehicle can reach from its initial
+ * offset: at k = N every state costs nothing more; at k < N a state's cost to go is the
+ * least, lexicographically (deviation, then effort), over its actions that stay within the
+ * offset bound, conflict with no obstacle, track or vehicle the table is built against
+ * and reach a live state, of the step's cost plus the cost to go from there. A state with
+ * no such action is dead. The pass visits each reachable state once and each of its five
+ * actions once.
+ *
+ * Conflict tests dominate, so they are filtered twice before the exact test runs: per row
+ * and obstacle (or track, or fixed vehicle), by the box that holds every step of the row,
+ * and per step, by the step's own box; both widened by SLACK_ULPS so that rounding in the
+ * boxes can never skip a step that the exact test would find in conflict. The exact tests
+ * themselves say no conflict for boxes that do not touch (geometry.h), so the filters
+ * change no decision, only what it costs.
+ */
+#include "plan_internal.h"
+
+/* Where row k starts: rows 0..q (q = L / s) are 2ks + 1 wide, the others 2L + 1. */
+static uint64_t row_base(uint32_t k, uint32_t steep, int32_t limit)
+{
+    uint64_t s = steep;
+    uint64_t q = (uint64_t)limit / s;
+    uint64_t kk = k;
+
+    if (kk <= q + 1u) {
+        return s * kk * (kk - 1u) + kk;
+    }
+    return s * (q + 1u) * q + (q + 1u) + (kk - q - 1u) * (2u * (uint64_t)limit + 1u);
+}
+
+uint64_t plan_table_cells(uint32_t horizon, uint32_t steep, int32_t limit)
+{
+    return row_base(horizon + 1u, steep, limit);
+}
+
+uint64_t plan_table_row_width(uint32_t horizon, uint32_t steep, int32_t limit)
+{
+    uint64_t reach = 2u * (uint64_t)horizon * steep + 1u;
+    uint64_t bound = 2u * (uint64_t)limit + 1u;
+    return reach < bound ? reach : bound;
+}
+
+int32_t plan_row_lo(const plan_table_t *t, uint32_t k)
+{
+    int64_t lo = (int64_t)t->origin - (int64_t)k * t->steep;
+    return lo < -(int64_t)t->limit ? -t->limit : (int32_t)lo;
+}
+
+int32_t plan_row_hi(const plan_table_t *t, uint32_t k)
+{
+    int64_t hi = (int64_t)t->origin + (int64_t)k * t->steep;
+    return hi > (int64_t)t->limit ? t->limit : (int32_t)hi;
+}
+
+static uint64_t *row_of(const plan_table_t *t, uint32_t k)
+{
+    return &t->cells[row_base(k, t->steep, t->limit)];
+}
+
+static uint64_t *cell_of(const plan_table_t *t, uint32_t k, int32_t offset)
+{
+    return &row_of(t, k)[offset - plan_row_lo(t, k)];
+}
+
+uint64_t plan_table_at(const plan_table_t *t, uint32_t k, int32_t offset)
+{
+    return *cell_of(t, k, offset);
+}
+
+/* ------------------------------------------------------------------------------------ */
+/* Conflicts of one row                                                                  */
+
+static coa_box_t widened(coa_box_t b, coa_real_t slack)
+{
+    b.min.x -= slack;
+    b.min.y -= slack;
+    b.min.z -= slack;
+    b.max.x += slack;
+    b.max.y += slack;
+    b.max.z += slack;
+    return b;
+}
+
+static coa_real_t box_scale(const coa_box_t *b)
+{
+    return real_max_abs3(&b->max, real_max_abs3(&b->min, (coa_real_t)0));
+}
+
+static coa_box_t box_union(coa_box_t a, const coa_box_t *b)
+{
+    a.min.x = b->min.x < a.min.x ? b->min.x : a.min.x;
+    a.min.y = b->min.y < a.min.y ? b->min.y : a.min.y;
+    a.min.z = b->min.z < a.min.z ? b->min.z : a.min.z;
+    a.max.x = b->max.x > a.max.x ? b->max.x : a.max.x;
+    a.max.y = b->max.y > a.max.y ? b->max.y : a.max.y;
+    a.max.z = b->max.z > a.max.z ? b->max.z : a.max.z;
+    return a;
+}
+
+/* What a row's steps are tested against: one obstacle, or one moving volume. */
+typedef struct {
+    const coa_obstacle_t *obstacle; /* NULL: `moving` */
+    coa_sweep_t moving;
+    coa_box_t bounds;
+} row_item_t;
+
+typedef struct {
+    const coa_planner_t *pl;
+    const plan_table_t *t;
+    uint32_t k;
+    int32_t lo;
+    int32_t hi;
+    uint64_t *row;      /* row k: only the action bits are set while conflicts are cleared */
+    coa_box_t bounds;   /* every step of the row lies in it */
+} row_ctx_t;
+
+static bool item_conflict(const row_item_t *it, const coa_sweep_t *s)
+{
+    if (it->obstacle != NULL) {
+        /* The problem check ruled out the polytope test's errors; were one to happen
+         * anyway, counting it as a conflict is the safe side. */
+        return coa_conflict_obstacle(s, it->obstacle) != 0;
+    }
+    return coa_conflict_volumes(s, &it->moving);
+}
+
+/* Clears, in row k, the actions whose step conflicts with the item. */
+static void row_clear_item(const row_ctx_t *r, const row_item_t *it)
+{
+    const coa_planner_t *pl = r->pl;
+    const plan_table_t *t = r->t;
+    coa_real_t slack =
+        (box_scale(&r->bounds) + box_scale(&it->bounds)) * (coa_real_t)(SLACK_ULPS * REAL_EPSILON);
+    coa_box_t item = widened(it->bounds, slack);
+    int32_t o;
+
+    if (!coa_boxes_touch(&r->bounds, &item)) {
+        return;
+    }
+    for (o = r->lo; o <= r->hi; ++o) {
+        uint64_t *c = &r->row[o - r->lo];
+        uint32_t a;
+        for (a = 0; a < PLAN_ACTIONS; ++a) {
+            coa_sweep_t s;
+            coa_box_t sb;
+            if ((*c & (UINT64_C(1) << a)) == 0u) {
+                continue;
+            }
+            s = plan_vehicle_sweep(pl->problem, pl->dh, t->vehicle, r->k, o, r->k + 1u,
+                                   o + coa_action_delta((coa_action_t)a, t->steep));
+            sb = coa_sweep_bounds(&s);
+            if (coa_boxes_touch(&sb, &item) && item_conflict(it, &s)) {
+                *c &= ~(UINT64_C(1) << a);
+            }
+        }
+    }
+}
+
+/* Clears, in row k, every action whose step conflicts with an obstacle, a track or a
+ * fixed vehicle. */
+static void row_clear_conflicts(const row_ctx_t *r, const size_t *fixed, size_t nfixed)
+{
+    const coa_problem_t *pr = r->pl->problem;
+    row_item_t it;
+    size_t j;
+
+    for (j = 0; j < pr->obstacle_count; ++j) {
+        it.obstacle = &pr->obstacles[j];
+        it.bounds = coa_obstacle_bounds(it.obstacle);
+        row_clear_item(r, &it);
+    }
+    it.obstacle = NULL;
+    for (j = 0; j < pr->track_count; ++j) {
+        it.moving.volume = pr->tracks[j].volume;
+        it.moving.p0 = pr->track_samples[j][r->k];
+        it.moving.p1 = pr->track_samples[j][r->k + 1u];
+        it.bounds = coa_sweep_bounds(&it.moving);
+        row_clear_item(r, &it);
+    }
+    for (j = 0; j < nfixed; ++j) {
+        const int32_t *row = &r->pl->rows[fixed[j] * ((size_t)pr->horizon + 1u)];
+        it.moving = plan_vehicle_sweep(pr, r->pl->dh, fixed[j], r->k, row[r->k], r->k + 1u,
+                                       row[r->k + 1u]);
+        it.bounds = coa_sweep_bounds(&it.moving);
+        row_clear_item(r, &it);
+    }
+}
+
+/* ------------------------------------------------------------------------------------ */
+/* The backward pass                                                                     */
+
+static uint64_t cell_pack(uint64_t dev, uint32_t eff, uint32_t mask)
+{
+    return (dev << CELL_DEV_SHIFT) | ((uint64_t)eff << CELL_EFF_SHIFT) | mask;
+}
+
+/* Row k's actions that stay within the bound and reach a live state of row k + 1. */
+static void row_moves(const plan_table_t *t, uint32_t k, int32_t lo, int32_t hi, uint64_t *row)
+{
+    int32_t o;
+    for (o = lo; o <= hi; ++o) {
+        uint32_t mask = 0u;
+        uint32_t a;
+        for (a = 0; a < PLAN_ACTIONS; ++a) {
+            int32_t b = o + coa_action_delta((coa_action_t)a, t->steep);
+            /* b is within row k + 1 whenever |b| <= L: rows widen by s a step. */
+            if (b >= -t->limit && b <= t->limit && !cell_dead(*cell_of(t, k + 1u, b))) {
+                mask |= 1u << a;
+            }
+        }
+        row[o - lo] = mask;
+    }
+}
+
+/* Row k's costs to go from its remaining actions. */
+static void row_costs(const plan_table_t *t, uint32_t k, int32_t lo, int32_t hi, uint64_t *row)
+{
+    const uint32_t scale = 2u * t->steep;
+    int32_t o;
+    for (o = lo; o <= hi; ++o) {
+        uint32_t mask = cell_mask(row[o - lo]);
+        uint64_t best = UINT64_MAX;
+        uint32_t a;
+        for (a = 0; a < PLAN_ACTIONS; ++a) {
+            if ((mask & (1u << a)) != 0u) {
+                int32_t b = o + coa_action_delta((coa_action_t)a, t->steep);
+                uint64_t next = *cell_of(t, k + 1u, b);
+                /* Own units: an area times 2s is an integer (trajectory.h). */
+                uint64_t dev = cell_dev(next) + (uint64_t)coa_area_scaled(o, b, scale);
+                uint64_t eff = cell_eff(next) + coa_action_effort((coa_action_t)a);
+                uint64_t cost = (dev << (CELL_DEV_SHIFT - CELL_EFF_SHIFT)) | eff;
+                best = cost < best ? cost : best;
+            }
+        }
+        row[o - lo] = mask == 0u ? cell_pack(CELL_DEV_DEAD, 0u, 0u)
+                                 : (best << CELL_EFF_SHIFT) | mask;
+    }
+}
+
+/* The box that holds every step of row k: its lowest and highest steps span it. */
+static coa_box_t row_bounds(const coa_planner_t *pl, const plan_table_t *t, uint32_t k)
+{
+    coa_sweep_t low = plan_vehicle_sweep(pl->problem, pl->dh, t->vehicle, k, plan_row_lo(t, k),
+                                         k + 1u, plan_row_lo(t, k + 1u));
+    coa_sweep_t high = plan_vehicle_sweep(pl->problem, pl->dh, t->vehicle, k, plan_row_hi(t, k),
+                                          k + 1u, plan_row_hi(t, k + 1u));
+    coa_box_t b = coa_sweep_bounds(&low);
+    coa_box_t h = coa_sweep_bounds(&high);
+    return box_union(b, &h);
+}
+
+void plan_table_build(coa_planner_t *pl, plan_table_t *tb, size_t v, const size_t *fixed,
+                      size_t nfixed)
+{
+    const coa_vehicle_t *veh = &pl->problem->vehicles[v];
+    const uint32_t horizon = pl->problem->horizon;
+    uint32_t k;
+    int32_t o;
+
+    tb->vehicle = v;
+    tb->origin = veh->initial_offset;
+    tb->limit = pl->limit[v];
+    tb->steep = veh->steep_factor;
+    tb->horizon = horizon;
+    for (o = plan_row_lo(tb, horizon); o <= plan_row_hi(tb, horizon); ++o) {
+        *cell_of(tb, horizon, o) = cell_pack(0u, 0u, 0u);
+    }
+    for (k = horizon; k-- > 0u;) {
+        row_ctx_t r;
+        r.pl = pl;
+        r.t = tb;
+        r.k = k;
+        r.lo = plan_row_lo(tb, k);
+        r.hi = plan_row_hi(tb, k);
+        r.row = row_of(tb, k);
+        r.bounds = row_bounds(pl, tb, k);
+        row_moves(tb, k, r.lo, r.hi, r.row);
+        row_clear_conflicts(&r, fixed, nfixed);
+        row_costs(tb, k, r.lo, r.hi, r.row);
+    }
+}
+
+/* ------------------------------------------------------------------------------------ */
+/* Moves in search order                                                                 */
+
+void plan_table_moves(const plan_table_t *t, uint32_t k, int32_t from, plan_moves_t *mv)
+{
+    const uint64_t here = *cell_of(t, k, from);
+    const uint32_t mask = cell_mask(here);
+    const uint32_t scale = 2u * t->steep;
+    uint32_t a;
+
+    mv->count = 0u;
+    for (a = 0; a < PLAN_ACTIONS; ++a) {
+        int32_t b;
+        uint64_t next;
+        uint32_t i;
+        uint64_t dev;
+        int32_t eff;
+        if ((mask & (1u << a)) == 0u) {
+            continue;
+        }
+        b = from + coa_action_delta((coa_action_t)a, t->steep);
+        next = *cell_of(t, k + 1u, b);
+        /* The table's minimum makes both increases lexicographically >= 0. */
+        dev = cell_dev(next) + (uint64_t)coa_area_scaled(from, b, scale) - cell_dev(here);
+        eff = (int32_t)(cell_eff(next) + coa_action_effort((coa_action_t)a)) -
+              (int32_t)cell_eff(here);
+        /* Insertion: stable for equal increases, so ties keep coa_action_t order. */
+        for (i = mv->count; i > 0u && (mv->dev[i - 1u] > dev ||
+                                       (mv->dev[i - 1u] == dev && mv->eff[i - 1u] > eff));
+             --i) {
+            mv->action[i] = mv->action[i - 1u];
+            mv->to[i] = mv->to[i - 1u];
+            mv->dev[i] = mv->dev[i - 1u];
+            mv->eff[i] = mv->eff[i - 1u];
+        }
+        mv->action[i] = (uint8_t)a;
+        mv->to[i] = b;
+        mv->dev[i] = dev;
+        mv->eff[i] = eff;
+        ++mv->count;
+    }
+}
+
+/* ------------------------------------------------------------------------------------ */
+/* Cost from the start, and plans                                                        */
+
+void plan_table_build_from_start(plan_table_t *f, const plan_table_t *t)
+{
+    const uint32_t scale = 2u * t->steep;
+    uint32_t k;
+    int32_t o;
+
+    f->vehicle = t->vehicle;
+    f->origin = t->origin;
+    f->limit = t->limit;
+    f->steep = t->steep;
+    f->horizon = t->horizon;
+    for (k = 0; k <= t->horizon; ++k) {
+        for (o = plan_row_lo(t, k); o <= plan_row_hi(t, k); ++o) {
+            *cell_of(f, k, o) = CELL_DEAD;
+        }
+    }
+    *cell_of(f, 0u, t->origin) = cell_pack(0u, 0u, 0u);
+    for (k = 0; k < t->horizon; ++k) {
+        for (o = plan_row_lo(t, k); o <= plan_row_hi(t, k); ++o) {
+            uint64_t here = *cell_of(f, k, o);
+            uint32_t mask = cell_mask(*cell_of(t, k, o));
+            uint32_t a;
+            if (cell_dead(here)) {
+                continue;
+            }
+            for (a = 0; a < PLAN_ACTIONS; ++a) {
+                int32_t b;
+                uint64_t cand;
+                uint64_t *there;
+                if ((mask & (1u << a)) == 0u) {
+                    continue;
+                }
+                b = o + coa_action_delta((coa_action_t)a, t->steep);
+                cand = cell_pack(cell_dev(here) + (uint64_t)coa_area_scaled(o, b, scale),
+                                 cell_eff(here) + coa_action_effort((coa_action_t)a), 0u);
+                there = cell_of(f, k + 1u, b);
+                if (cand < *there) {
+                    *there = cand;
+                }
+            }
+        }
+    }
+}
+
+void plan_table_walk(coa_planner_t *pl, const plan_table_t *t, uint32_t k, int32_t offset)
+{
+    int32_t *row = &pl->rows[t->vehicle * ((size_t)t->horizon + 1u)];
+    row[k] = offset;
+    for (; k < t->horizon; ++k) {
+        plan_moves_t mv;
+        plan_table_moves(t, k, offset, &mv);
+        offset = mv.to[0];
+        row[k + 1u] = offset;
+    }
+}
+
+void plan_table_walk_back(coa_planner_t *pl, const plan_table_t *t, const plan_table_t *f,
+                          uint32_t k, int32_t offset)
+{
+    const uint32_t scale = 2u * t->steep;
+    int32_t *row = &pl->rows[t->vehicle * ((size_t)t->horizon + 1u)];
+
+    row[k] = offset;
+    /* Each step back, the first predecessor (in coa_action_t order of the step that
+     * leaves it) on a cheapest path: the one whose cost plus the step's is this cost. */
+    for (; k > 0u; --k) {
+        uint64_t here = *cell_of(f, k, offset);
+        uint32_t a;
+        for (a = 0; a < PLAN_ACTIONS; ++a) {
+            int32_t from = offset - coa_action_delta((coa_action_t)a, t->steep);
+            uint64_t prev;
+            if (from < plan_row_lo(t, k - 1u) || from > plan_row_hi(t, k - 1u) ||
+                (cell_mask(*cell_of(t, k - 1u, from)) & (1u << a)) == 0u) {
+                continue;
+            }
+            prev = *cell_of(f, k - 1u, from);
+            if (!cell_dead(prev) &&
+                cell_pack(cell_dev(prev) + (uint64_t)coa_area_scaled(from, offset, scale),
+                          cell_eff(prev) + coa_action_effort((coa_action_t)a), 0u) == here) {
+                offset = from;
+                break;
+            }
+        }
+        row[k - 1u] = offset;
+    }
+}
