@@ -6,7 +6,7 @@
 #define FWC_MAX_VEHICLES 3u
 #define FWC_MAX_TRACKS 2u
 #define FWC_MAX_HORIZON 30u
-#define FWC_PROBLEM_COUNT 4u
+#define FWC_PROBLEM_COUNT 5u
 
 static const coa_vec3_t p0_v0_route[] = {
     {0.0f, 0.0f, 100.0f},
@@ -69,6 +69,22 @@ static const coa_track_t p3_tracks[] = {
 {.id = 902u, .volume = {10.0f, 4.0f},
      .path = p3_t1_path, .path_count = 3u,
      .sigma_horizontal = 0.0f, .sigma_vertical = 0.0f}};
+static const coa_vec3_t p4_v0_route[] = {
+    {0.0f, 0.0f, 100.0f},
+    {256.0f, 0.0f, 100.0f}};
+static const coa_vec3_t p4_v1_route[] = {
+    {200.0f, 0.0f, 104.0f},
+    {-56.0f, 0.0f, 104.0f}};
+static const coa_vec3_t p4_v2_route[] = {
+    {100.0f, -130.0f, 112.0f},
+    {100.0f, 156.0f, 112.0f}};
+static const coa_vehicle_t p4_vehicles[] = {
+    {.id = 1u, .priority = 1u, .cruise_speed = 10.0f, .climb_rate = 2.0f, .steep_factor = 2u,
+     .volume = {15.0f, 5.0f}, .route = p4_v0_route, .route_count = 2u, .initial_offset = 0, .max_offset = 8},
+    {.id = 2u, .priority = 2u, .cruise_speed = 10.0f, .climb_rate = 2.0f, .steep_factor = 2u,
+     .volume = {15.0f, 5.0f}, .route = p4_v1_route, .route_count = 2u, .initial_offset = 0, .max_offset = 8},
+    {.id = 3u, .priority = 3u, .cruise_speed = 10.0f, .climb_rate = 1.5f, .steep_factor = 3u,
+     .volume = {15.0f, 5.0f}, .route = p4_v2_route, .route_count = 2u, .initial_offset = 0, .max_offset = 8}};
 
 static const fwc_problem_t fwc_problems[FWC_PROBLEM_COUNT] = {
     {.name = "headon", .dt = 1.0f, .horizon = 5u, .beta = 60u,
@@ -90,6 +106,11 @@ static const fwc_problem_t fwc_problems[FWC_PROBLEM_COUNT] = {
      .decoupled = true, .centralised = true,
      .vehicles = p3_vehicles, .vehicle_count = 1u,
      .obstacles = NULL, .obstacle_count = 0u,
-     .tracks = p3_tracks, .track_count = 2u}};
+     .tracks = p3_tracks, .track_count = 2u},
+    {.name = "triple", .dt = 1.0f, .horizon = 16u, .beta = 1000u,
+     .decoupled = true, .centralised = true,
+     .vehicles = p4_vehicles, .vehicle_count = 3u,
+     .obstacles = NULL, .obstacle_count = 0u,
+     .tracks = NULL, .track_count = 0u}};
 
 #endif /* COAVOID_CHECK_PROBLEMS_H */

@@ -25,7 +25,7 @@
 /* Workspaces (bytes). The predictor's must hold coa_predictor_workspace_size(FW_PLANS,
  * FW_TRACKS, FW_HORIZON, FW_MAX_PAIRS), checked once at start-up; the planner takes the
  * largest beta that fits its buffer (coa_planner_max_beta). */
-#define FW_PLANNER_BYTES (96u * 1024u)
+#define FW_PLANNER_BYTES (32u * 1024u)
 #define FW_PREDICTOR_BYTES (8u * 1024u)
 
 /* A neighbour's intent as the radio delivers it (times on the mission clock). */
