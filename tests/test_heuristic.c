@@ -53,19 +53,10 @@ __extension__ typedef unsigned __int128 u128_t;
 #define INF (~(u128_t)0)
 #define EFF_BITS 18u                       /* the planner's packing (plan_internal.h) */
 
-static coa_real_t R(double x)
-{
-    return (coa_real_t)x;
-}
-
-static coa_vec3_t V(double x, double y, double z)
-{
-    coa_vec3_t v;
-    v.x = R(x);
-    v.y = R(y);
-    v.z = R(z);
-    return v;
-}
+/* The problem holder, sized to these problems. */
+#define FX_MAXV MAXM
+#define FX_MAXN MAXN
+#include "plan_fixture.h"
 
 static u128_t from_cost(coa_cost_t c)
 {
@@ -108,91 +99,29 @@ static const char *pk(u128_t x)
 /* ------------------------------------------------------------------------------------ */
 /* Problems                                                                              */
 
-typedef struct {
-    coa_vehicle_t veh[MAXM];
-    coa_vec3_t route[MAXM][2];
-    coa_vec3_t ref[MAXM][MAXN + 1u];
-    const coa_vec3_t *refp[MAXM];
-    coa_obstacle_t obs[2];
-    coa_track_t tr[1];
-    coa_vec3_t trs[1][MAXN + 1u];
-    const coa_vec3_t *trp[1];
-    coa_problem_t p;
-} fx_t;
-
-static void fx_init(fx_t *f, double dt, uint32_t horizon)
-{
-    memset(f, 0, sizeof *f);
-    f->p.dt = R(dt);
-    f->p.horizon = horizon;
-    f->p.vehicles = f->veh;
-    f->p.references = f->refp;
-    f->p.obstacles = f->obs;
-    f->p.tracks = f->tr;
-    f->p.track_samples = f->trp;
-}
-
 /* A UAV flying straight at `speed` along heading th, over (cx, cy, cz) at time tm. */
-static coa_vehicle_t *fx_vehicle(fx_t *f, double speed, double climb, uint32_t steep,
-                                 double radius, double half, double th, double tm, double cx,
-                                 double cy, double cz, double slope)
+static coa_vehicle_t *fx_flyby(fx_t *f, double speed, double climb, uint32_t steep,
+                               double radius, double half, double th, double tm, double cx,
+                               double cy, double cz, double slope)
 {
-    size_t i = f->p.vehicle_count++;
-    coa_vehicle_t *v = &f->veh[i];
+    size_t i = f->p.vehicle_count;
     double span = (double)f->p.dt * (double)f->p.horizon;
     double ux = cos(th);
     double uy = sin(th);
-    ck_assert_uint_lt(i, MAXM);
-    f->route[i][0] = V(cx - ux * speed * tm, cy - uy * speed * tm, cz - slope * speed * tm);
-    f->route[i][1] = V(cx + ux * speed * (span + 1.0), cy + uy * speed * (span + 1.0),
-                       cz + slope * speed * (span + 1.0));
-    v->id = (uint16_t)(1u + i);
-    v->priority = 1u;
-    v->cruise_speed = R(speed);
-    v->climb_rate = R(climb);
-    v->steep_factor = steep;
-    v->volume.radius = R(radius);
-    v->volume.half_height = R(half);
-    v->route = f->route[i];
-    v->route_count = 2u;
-    v->initial_offset = 0;
-    v->max_offset = -1;
-    return v;
+    return fx_vehicle(f, (uint16_t)(1u + i), 1u, speed, climb, steep, radius, half,
+                      V(cx - ux * speed * tm, cy - uy * speed * tm, cz - slope * speed * tm),
+                      V(cx + ux * speed * (span + 1.0), cy + uy * speed * (span + 1.0),
+                        cz + slope * speed * (span + 1.0)));
 }
 
-static void fx_box(fx_t *f, coa_vec3_t min, coa_vec3_t max)
+/* A level track at `speed` along heading th, over (cx, cy, cz) at time tm. */
+static void fx_crossing(fx_t *f, double speed, double th, double tm, double cx, double cy,
+                        double cz, double radius, double half)
 {
-    coa_obstacle_t *o = &f->obs[f->p.obstacle_count++];
-    o->kind = COA_OBSTACLE_BOX;
-    o->box.min = min;
-    o->box.max = max;
-}
-
-static void fx_track(fx_t *f, double speed, double th, double tm, double cx, double cy,
-                     double cz, double radius, double half)
-{
-    coa_track_t *t = &f->tr[f->p.track_count++];
     coa_vec3_t vel = V(speed * cos(th), speed * sin(th), 0.0);
+    coa_track_t *t = fx_track(f, V(cx - (double)vel.x * tm, cy - (double)vel.y * tm, cz), vel,
+                              radius, half);
     t->id = 100u;
-    t->volume.radius = R(radius);
-    t->volume.half_height = R(half);
-    t->position = V(cx - (double)vel.x * tm, cy - (double)vel.y * tm, cz);
-    t->velocity = vel;
-}
-
-static void fx_finish(fx_t *f)
-{
-    size_t i;
-    for (i = 0; i < f->p.vehicle_count; ++i) {
-        ck_assert_int_eq(coa_reference_sample(&f->veh[i], f->p.dt, f->p.horizon, f->ref[i]),
-                         COA_OK);
-        f->refp[i] = f->ref[i];
-    }
-    for (i = 0; i < f->p.track_count; ++i) {
-        ck_assert_int_eq(coa_track_sample(&f->tr[i], f->p.dt, f->p.horizon, f->trs[i]), COA_OK);
-        f->trp[i] = f->trs[i];
-    }
-    ck_assert_int_eq(coa_problem_check(&f->p), COA_OK);
 }
 
 /* Initial offset and bound of a random vehicle: 0 mostly, up to +-2, sometimes a bound
@@ -234,8 +163,8 @@ static void fx_single(fx_t *f, uint64_t *rng, uint32_t horizon, uint32_t steep)
     coa_vehicle_t *v;
 
     fx_init(f, dt, horizon);
-    v = fx_vehicle(f, speed, climb, steep, speed * dt * unif(rng, 0.2, 0.5),
-                   dh * unif(rng, 0.6, 1.6), 0.0, 0.0, 0.0, 0.0, cz, 0.0);
+    v = fx_flyby(f, speed, climb, steep, speed * dt * unif(rng, 0.2, 0.5),
+                 dh * unif(rng, 0.6, 1.6), 0.0, 0.0, 0.0, 0.0, cz, 0.0);
     random_offsets(rng, v);
     if (pick(rng, 6u) != 0u) {
         double t0 = unif(rng, -0.2, 0.8) * span;
@@ -259,9 +188,9 @@ static void fx_single(fx_t *f, uint64_t *rng, uint32_t horizon, uint32_t steep)
         fx_box(f, V(speed * t0, -unif(rng, 1, 20), cz + lo), V(speed * t1, unif(rng, 1, 20), cz + hi));
     }
     if (pick(rng, 3u) == 0u) {
-        fx_track(f, unif(rng, 5, 20), unif(rng, 0.5, 2.6), unif(rng, 0.1, 1.0) * span,
-                 speed * unif(rng, 0.1, 1.0) * span, 0.0, cz + unif(rng, -4, 4) * dh,
-                 unif(rng, 2, 8), unif(rng, 0.5, 2.0) * dh);
+        fx_crossing(f, unif(rng, 5, 20), unif(rng, 0.5, 2.6), unif(rng, 0.1, 1.0) * span,
+                    speed * unif(rng, 0.1, 1.0) * span, 0.0, cz + unif(rng, -4, 4) * dh,
+                    unif(rng, 2, 8), unif(rng, 0.5, 2.0) * dh);
     }
     fx_finish(f);
 }
@@ -287,7 +216,7 @@ static void fx_group(fx_t *f, uint64_t *rng, size_t m, uint32_t horizon, uint32_
         double climb = (double)(1u + pick(rng, 3u));
         double dh = climb * dt;
         double th = base + 6.283185307179586 * (double)i / (double)m + unif(rng, -0.5, 0.5);
-        coa_vehicle_t *v = fx_vehicle(
+        coa_vehicle_t *v = fx_flyby(
             f, speed, climb, 2u + pick(rng, max_steep - 1u), speed * dt * unif(rng, 0.25, 0.6),
             dh * unif(rng, 0.6, 1.6), th,
             (together ? common + unif(rng, -0.1, 0.1) : unif(rng, 0.15, 0.95)) * span,
@@ -305,9 +234,9 @@ static void fx_group(fx_t *f, uint64_t *rng, size_t m, uint32_t horizon, uint32_
                V(a, a, s > 0 ? cz + near + 50.0 : cz - near));
     }
     if (pick(rng, 4u) == 0u) {
-        fx_track(f, unif(rng, 5, 20), unif(rng, 0, 6.283185307179586), unif(rng, 0.1, 1.0) * span,
-                 unif(rng, -5, 5), unif(rng, -5, 5), cz + unif(rng, -3, 3) * dhmin,
-                 unif(rng, 2, 6), unif(rng, 0.5, 2.0) * dhmin);
+        fx_crossing(f, unif(rng, 5, 20), unif(rng, 0, 6.283185307179586),
+                    unif(rng, 0.1, 1.0) * span, unif(rng, -5, 5), unif(rng, -5, 5),
+                    cz + unif(rng, -3, 3) * dhmin, unif(rng, 2, 6), unif(rng, 0.5, 2.0) * dhmin);
     }
     fx_finish(f);
 }

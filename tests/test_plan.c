@@ -26,111 +26,16 @@
 __extension__ typedef unsigned __int128 u128_t;
 
 #define MAXV 10u
-#define MAXPTS 4u   /* route points of a random vehicle */
-#define MAXTRPTS 3u /* path points of a random track */
 #define MAXN 24u
-#define MAXOBS 4u
-#define MAXTR 2u
-#define ROW(f) ((size_t)(f)->p.horizon + 1u)
 
-static coa_real_t R(double x)
-{
-    return (coa_real_t)x;
-}
-
-static coa_vec3_t V(double x, double y, double z)
-{
-    coa_vec3_t v;
-    v.x = R(x);
-    v.y = R(y);
-    v.z = R(z);
-    return v;
-}
+/* The problem holder, sized to this file's limits (the other capacities' defaults are
+ * this file's). */
+#define FX_MAXV MAXV
+#define FX_MAXN MAXN
+#include "plan_fixture.h"
 
 /* ------------------------------------------------------------------------------------ */
 /* Problems                                                                              */
-
-typedef struct {
-    coa_vehicle_t veh[MAXV];
-    coa_vec3_t route[MAXV][MAXPTS];
-    coa_vec3_t ref[MAXV][MAXN + 1u];
-    const coa_vec3_t *refp[MAXV];
-    coa_obstacle_t obs[MAXOBS];
-    coa_vec3_t poly[MAXOBS][8];
-    coa_track_t tr[MAXTR];
-    coa_track_point_t trpath[MAXTR][MAXTRPTS];
-    coa_vec3_t trs[MAXTR][MAXN + 1u];
-    const coa_vec3_t *trp[MAXTR];
-    coa_problem_t p;
-} fx_t;
-
-static void fx_init(fx_t *f, uint32_t horizon)
-{
-    memset(f, 0, sizeof *f);
-    f->p.dt = R(1.0);
-    f->p.horizon = horizon;
-    f->p.vehicles = f->veh;
-    f->p.references = f->refp;
-    f->p.obstacles = f->obs;
-    f->p.tracks = f->tr;
-    f->p.track_samples = f->trp;
-}
-
-static coa_vehicle_t *fx_vehicle(fx_t *f, uint16_t id, uint32_t priority, double speed,
-                                 double climb, uint32_t steep, double radius, double half,
-                                 coa_vec3_t start, coa_vec3_t end)
-{
-    size_t i = f->p.vehicle_count++;
-    coa_vehicle_t *v = &f->veh[i];
-    ck_assert_uint_lt(i, MAXV);
-    f->route[i][0] = start;
-    f->route[i][1] = end;
-    v->id = id;
-    v->priority = priority;
-    v->cruise_speed = R(speed);
-    v->climb_rate = R(climb);
-    v->steep_factor = steep;
-    v->volume.radius = R(radius);
-    v->volume.half_height = R(half);
-    v->route = f->route[i];
-    v->route_count = 2u;
-    v->initial_offset = 0;
-    v->max_offset = -1;
-    return v;
-}
-
-static void fx_box(fx_t *f, coa_vec3_t min, coa_vec3_t max)
-{
-    coa_obstacle_t *o = &f->obs[f->p.obstacle_count++];
-    o->kind = COA_OBSTACLE_BOX;
-    o->box.min = min;
-    o->box.max = max;
-}
-
-static void fx_track(fx_t *f, coa_vec3_t pos, coa_vec3_t vel, double radius, double half)
-{
-    coa_track_t *t = &f->tr[f->p.track_count++];
-    t->id = (uint32_t)(100u + f->p.track_count);
-    t->volume.radius = R(radius);
-    t->volume.half_height = R(half);
-    t->position = pos;
-    t->velocity = vel;
-}
-
-static void fx_finish(fx_t *f)
-{
-    size_t i;
-    for (i = 0; i < f->p.vehicle_count; ++i) {
-        ck_assert_int_eq(coa_reference_sample(&f->veh[i], f->p.dt, f->p.horizon, f->ref[i]),
-                         COA_OK);
-        f->refp[i] = f->ref[i];
-    }
-    for (i = 0; i < f->p.track_count; ++i) {
-        ck_assert_int_eq(coa_track_sample(&f->tr[i], f->p.dt, f->p.horizon, f->trs[i]), COA_OK);
-        f->trp[i] = f->trs[i];
-    }
-    ck_assert_int_eq(coa_problem_check(&f->p), COA_OK);
-}
 
 /* UAVs converging on one point at random times, so that conflicts are common, with
  * obstacles and tracks around that point. dt is 0.5, 1 or 2 s. Two problems in three draw
@@ -166,8 +71,7 @@ static void fx_random(fx_t *f, uint64_t *rng, size_t n, uint32_t horizon, uint32
     size_t j;
     uint32_t count;
 
-    fx_init(f, horizon);
-    f->p.dt = R(dt);
+    fx_init(f, dt, horizon);
     gen.dt_half += dt == 0.5 ? 1u : 0u;
     gen.dt_two += dt == 2.0 ? 1u : 0u;
     for (i = 0; i < n; ++i) {
@@ -254,12 +158,12 @@ static void fx_random(fx_t *f, uint64_t *rng, size_t n, uint32_t horizon, uint32
             size_t o = f->p.obstacle_count++;
             double rad = unif(rng, 4, 8);
             f->obs[o].kind = COA_OBSTACLE_POLYTOPE;
-            for (j = 0; j < 8u; ++j) {
+            for (j = 0; j < FX_POLYV; ++j) {
                 f->poly[o][j] = V(ox + unif(rng, -rad, rad), oy + unif(rng, -rad, rad),
                                   oz + unif(rng, -rad, rad));
             }
             f->obs[o].polytope.vertices = f->poly[o];
-            f->obs[o].polytope.count = 8u;
+            f->obs[o].polytope.count = FX_POLYV;
         }
     }
     if (pick(rng, 5u) < 2u) {
@@ -1120,7 +1024,7 @@ END_TEST
  * level, so B fails; planned first, B stays level and A goes around. */
 static void fx_tunnel(fx_t *f)
 {
-    fx_init(f, 16u);
+    fx_init(f, 1.0, 16u);
     fx_vehicle(f, 1u, 1u, 20.0, 4.0, 2u, 10.0, 5.0, V(-200, 0, 100), V(200, 0, 100));
     fx_vehicle(f, 2u, 2u, 10.0, 4.0, 2u, 10.0, 5.0, V(0, -100, 100), V(0, 100, 100));
     fx_box(f, V(-11, -160, 105.5), V(11, 160, 106.5));
@@ -1226,7 +1130,7 @@ END_TEST
 /* Two identical UAVs head-on at the same altitude. */
 static void fx_head_on(fx_t *f, uint32_t horizon, double half)
 {
-    fx_init(f, horizon);
+    fx_init(f, 1.0, horizon);
     fx_vehicle(f, 1u, 1u, 10.0, 4.0, 2u, 5.0, half, V(-60, 0, 100), V(60, 0, 100));
     fx_vehicle(f, 2u, 1u, 10.0, 4.0, 2u, 5.0, half, V(60, 0, 100), V(-60, 0, 100));
 }
@@ -1541,7 +1445,7 @@ START_TEST(initial_conflict_is_infeasible_without_expanding)
     coa_plan_result_t r;
 
     /* Two UAVs overlapping at t = 0, diverging at once. */
-    fx_init(&f, 6u);
+    fx_init(&f, 1.0, 6u);
     fx_vehicle(&f, 1u, 1u, 10.0, 4.0, 2u, 5.0, 3.0, V(0, 0, 100), V(100, 0, 100));
     fx_vehicle(&f, 2u, 2u, 10.0, 4.0, 2u, 5.0, 3.0, V(2, 0, 101), V(-100, 0, 101));
     fx_finish(&f);
@@ -1559,14 +1463,14 @@ START_TEST(initial_conflict_is_infeasible_without_expanding)
     ck_assert_uint_eq(r.nodes_generated, 0u);
 
     /* One UAV starting inside a box; a track sitting on the other at t = 0. */
-    fx_init(&f, 6u);
+    fx_init(&f, 1.0, 6u);
     fx_vehicle(&f, 1u, 1u, 10.0, 4.0, 2u, 5.0, 3.0, V(0, 0, 100), V(100, 0, 100));
     fx_box(&f, V(-3, -3, 90), V(3, 3, 98));
     fx_finish(&f);
     ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
     ck_assert_int_eq(r.status, COA_PLAN_INFEASIBLE);
     ck_assert_uint_eq(r.nodes_expanded, 0u);
-    fx_init(&f, 6u);
+    fx_init(&f, 1.0, 6u);
     fx_vehicle(&f, 1u, 1u, 10.0, 4.0, 2u, 5.0, 3.0, V(0, 0, 100), V(100, 0, 100));
     fx_track(&f, V(-3, 3, 104), V(0, -30, 0), 3.0, 2.0);
     fx_finish(&f);
@@ -1810,7 +1714,7 @@ START_TEST(tie_between_vehicles_goes_to_lower_effort)
     dp_out_t best;
     uint32_t k;
 
-    fx_init(&f, 3u);
+    fx_init(&f, 1.0, 3u);
     fx_vehicle(&f, 1u, 1u, 10.0, 3.0, 3u, 2.5, 1.4, V(-15, 0, 100), V(100, 0, 100));
     fx_vehicle(&f, 2u, 2u, 10.0, 1.0, 3u, 2.5, 1.4, V(0, -15, 100), V(0, 100, 100));
     fx_finish(&f);
@@ -1848,7 +1752,7 @@ START_TEST(single_vehicle_plans_need_no_budget)
     uint32_t n;
 
     for (n = 1u; n <= 7u; n += 3u) {
-        fx_init(&f, n);
+        fx_init(&f, 1.0, n);
         fx_vehicle(&f, 1u, 1u, 10.0, 2.0, 2u, 5.0, 2.0, V(0, 0, 100), V(100, 0, 100));
         fx_finish(&f);
         ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
@@ -1945,7 +1849,7 @@ START_TEST(conflict_at_start_rules_out_every_order)
     unsigned m;
 
     for (variant = 0; variant < 3; ++variant) {
-        fx_init(&f, 6u);
+        fx_init(&f, 1.0, 6u);
         for (i = 0; i < 10u; ++i) {
             double y = 1000.0 * (double)i;
             fx_vehicle(&f, (uint16_t)(i + 1u), (uint32_t)(i + 1u), 10.0, 2.0, 2u, 5.0, 2.0,
@@ -1998,7 +1902,7 @@ START_TEST(proof_for_every_order_outranks_budget)
     int variant;
 
     for (variant = 0; variant < 2; ++variant) {
-        fx_init(&f, 6u);
+        fx_init(&f, 1.0, 6u);
         fx_vehicle(&f, 1u, 1u, 10.0, 2.0, 2u, 3.0, 2.0, V(0, 0, 100), V(100, 0, 100));
         fx_vehicle(&f, 2u, 2u, 10.0, 2.0, 2u, 3.0, 2.0, V(0, 500, 100), V(100, 500, 100));
         if (variant == 0) {

@@ -32,7 +32,6 @@
 #define MAXN 14u
 #define MAXSTEEP 4u  /* steep factors 2..MAXSTEEP */
 #define TRIALS 2500u /* encounters; at least 2000 must be compared */
-#define ROW(e) ((size_t)(e)->p.horizon + 1u)
 
 /* REQUIRE (test_support.h) with a message. */
 #define REQUIRE_MSG(cond, ...)                                                              \
@@ -48,83 +47,13 @@
 static const uint32_t OLD_BETA[MAXV + 1u] = {0u, 0u, 20000u, 3000u, 1000u};
 #define NEW_BETA 200000u
 
-static coa_real_t R(double x)
-{
-    return (coa_real_t)x;
-}
-
-static coa_vec3_t V(double x, double y, double z)
-{
-    coa_vec3_t v;
-    v.x = R(x);
-    v.y = R(y);
-    v.z = R(z);
-    return v;
-}
+/* The problem holder, sized to an encounter. */
+#define FX_MAXV MAXV
+#define FX_MAXN MAXN
+#include "plan_fixture.h"
 
 /* ------------------------------------------------------------------------------------ */
 /* Encounters                                                                            */
-
-typedef struct {
-    coa_vehicle_t veh[MAXV];
-    coa_vec3_t route[MAXV][2];
-    coa_vec3_t ref[MAXV][MAXN + 1u];
-    const coa_vec3_t *refp[MAXV];
-    coa_obstacle_t obs[1];
-    coa_track_t tr[1];
-    coa_vec3_t trs[1][MAXN + 1u];
-    const coa_vec3_t *trp[1];
-    coa_problem_t p;
-} enc_t;
-
-static void enc_init(enc_t *e, double dt, uint32_t horizon)
-{
-    memset(e, 0, sizeof *e);
-    e->p.dt = R(dt);
-    e->p.horizon = horizon;
-    e->p.vehicles = e->veh;
-    e->p.references = e->refp;
-    e->p.obstacles = e->obs;
-    e->p.tracks = e->tr;
-    e->p.track_samples = e->trp;
-}
-
-static coa_vehicle_t *enc_vehicle(enc_t *e, uint16_t id, uint32_t priority, double speed,
-                                  double climb, uint32_t steep, double radius, double half,
-                                  coa_vec3_t start, coa_vec3_t end)
-{
-    size_t i = e->p.vehicle_count++;
-    coa_vehicle_t *v = &e->veh[i];
-    ck_assert_uint_lt(i, MAXV);
-    e->route[i][0] = start;
-    e->route[i][1] = end;
-    v->id = id;
-    v->priority = priority;
-    v->cruise_speed = R(speed);
-    v->climb_rate = R(climb);
-    v->steep_factor = steep;
-    v->volume.radius = R(radius);
-    v->volume.half_height = R(half);
-    v->route = e->route[i];
-    v->route_count = 2u;
-    v->initial_offset = 0;
-    v->max_offset = -1;
-    return v;
-}
-
-static void enc_finish(enc_t *e)
-{
-    size_t i;
-    for (i = 0; i < e->p.vehicle_count; ++i) {
-        REQUIRE(coa_reference_sample(&e->veh[i], e->p.dt, e->p.horizon, e->ref[i]) == COA_OK);
-        e->refp[i] = e->ref[i];
-    }
-    for (i = 0; i < e->p.track_count; ++i) {
-        REQUIRE(coa_track_sample(&e->tr[i], e->p.dt, e->p.horizon, e->trs[i]) == COA_OK);
-        e->trp[i] = e->trs[i];
-    }
-    REQUIRE(coa_problem_check(&e->p) == COA_OK);
-}
 
 /* What the generator produced, so that the test can show it covers what it claims. */
 static struct {
@@ -156,7 +85,7 @@ static const struct {
     uint32_t scenery[MAXV + 1u]; /* per UAV count: 1 in `scenery` has a box, 1 a track */
 } shape = {3.0, 0.8, 1.2, {0u, 0u, MAXN, 12u, 10u}, {0u, 0u, 4u, 5u, 12u}};
 
-static void enc_random(enc_t *e, uint64_t *rng, size_t n)
+static void enc_random(fx_t *e, uint64_t *rng, size_t n)
 {
     static const double dts[3] = {0.5, 1.0, 1.0};
     static const double tie_speed[2] = {10.0, 20.0};
@@ -176,7 +105,7 @@ static void enc_random(enc_t *e, uint64_t *rng, size_t n)
     bool offset = false;
     size_t i;
 
-    enc_init(e, dt, horizon);
+    fx_init(e, dt, horizon);
     /* The stack: a random order of the UAVs from the bottom up. */
     for (i = 0; i < n; ++i) {
         size_t j = pick(rng, (uint32_t)i + 1u);
@@ -191,10 +120,10 @@ static void enc_random(enc_t *e, uint64_t *rng, size_t n)
         double tm = t0 + dt * shape.spread * unif(rng, -0.5, 0.5);
         coa_vehicle_t *v;
         half[i] = dh * unif(rng, 0.7, 1.5);
-        v = enc_vehicle(e, (uint16_t)(10u + 10u * pick(rng, 4u) + i), 1u + pick(rng, 3u), speed,
-                        climb, 2u + pick(rng, MAXSTEEP - 1u), speed * dt * unif(rng, 0.3, 0.6),
-                        half[i], V(-cos(th) * speed * tm, -sin(th) * speed * tm, 0),
-                        V(cos(th) * speed * 2.0 * span, sin(th) * speed * 2.0 * span, 0));
+        v = fx_vehicle(e, (uint16_t)(10u + 10u * pick(rng, 4u) + i), 1u + pick(rng, 3u), speed,
+                       climb, 2u + pick(rng, MAXSTEEP - 1u), speed * dt * unif(rng, 0.3, 0.6),
+                       half[i], V(-cos(th) * speed * tm, -sin(th) * speed * tm, 0),
+                       V(cos(th) * speed * 2.0 * span, sin(th) * speed * 2.0 * span, 0));
         switch (pick(rng, 6u)) {
         case 0u:
             v->initial_offset = pick(rng, 2u) == 0u ? 1 : -1;
@@ -243,16 +172,12 @@ static void enc_random(enc_t *e, uint64_t *rng, size_t n)
         double sy = unif(rng, 4, 15);
         double gap = unif(rng, 3, 8);
         double h = unif(rng, 2, 10);
-        coa_obstacle_t *o = &e->obs[e->p.obstacle_count++];
         double ox = cx + unif(rng, -8, 8);
         double oy = cy + unif(rng, -8, 8);
-        o->kind = COA_OBSTACLE_BOX;
         if (pick(rng, 2u) == 0u) {
-            o->box.min = V(ox - sx, oy - sy, cz + gap);
-            o->box.max = V(ox + sx, oy + sy, cz + gap + h);
+            fx_box(e, V(ox - sx, oy - sy, cz + gap), V(ox + sx, oy + sy, cz + gap + h));
         } else {
-            o->box.min = V(ox - sx, oy - sy, cz - gap - h);
-            o->box.max = V(ox + sx, oy + sy, cz - gap);
+            fx_box(e, V(ox - sx, oy - sy, cz - gap - h), V(ox + sx, oy + sy, cz - gap));
         }
         ++gen.with_box;
         break;
@@ -264,20 +189,21 @@ static void enc_random(enc_t *e, uint64_t *rng, size_t n)
         double tm = unif(rng, 0.3 * span, span);
         double vz = unif(rng, -0.5, 0.5);
         double bz = cz + unif(rng, -6, 6);
-        coa_track_t *t = &e->tr[e->p.track_count++];
         coa_vec3_t vel = V(speed * cos(th), speed * sin(th), vz);
+        /* Radius, then half-height: drawn before the call, as C leaves the order in which
+         * a call's arguments are evaluated open. */
+        double radius = speed * dt * unif(rng, 0.3, 0.6);
+        double half_height = unif(rng, 1.5, 3.5);
+        coa_vec3_t start = V(cx - (double)vel.x * tm, cy - (double)vel.y * tm, bz - vz * tm);
+        coa_track_t *t = fx_track(e, start, vel, radius, half_height);
         t->id = 900u;
-        t->volume.radius = R(speed * dt * unif(rng, 0.3, 0.6));
-        t->volume.half_height = R(unif(rng, 1.5, 3.5));
-        t->position = V(cx - (double)vel.x * tm, cy - (double)vel.y * tm, bz - vz * tm);
-        t->velocity = vel;
         ++gen.with_track;
         break;
     }
     default:
         break;
     }
-    enc_finish(e);
+    fx_finish(e);
 }
 
 /* ------------------------------------------------------------------------------------ */
@@ -347,7 +273,7 @@ static const char *status_name(coa_plan_status_t s)
 
 /* Rows start at the initial offset, move by actions (coa_plan_vehicle_cost checks that)
  * and respect max_offset. */
-static bool rows_well_formed(const enc_t *e, const int32_t *rows, const size_t *which,
+static bool rows_well_formed(const fx_t *e, const int32_t *rows, const size_t *which,
                              size_t count)
 {
     size_t i;
@@ -373,7 +299,7 @@ static bool rows_well_formed(const enc_t *e, const int32_t *rows, const size_t *
 
 /* Vehicle v's own exact cost: its deviation in units of L*dh / (2s) (every step's area is
  * an integer there) and its effort. */
-static void own_cost(const enc_t *e, size_t v, const int32_t *rows, int64_t *units,
+static void own_cost(const fx_t *e, size_t v, const int32_t *rows, int64_t *units,
                      uint32_t *effort)
 {
     const int32_t *r = &rows[v * ROW(e)];
@@ -389,7 +315,7 @@ static void own_cost(const enc_t *e, size_t v, const int32_t *rows, int64_t *uni
     }
 }
 
-static bool same_row(const enc_t *e, size_t v, const int32_t *a, const int32_t *b)
+static bool same_row(const fx_t *e, size_t v, const int32_t *a, const int32_t *b)
 {
     return memcmp(&a[v * ROW(e)], &b[v * ROW(e)], ROW(e) * sizeof a[0]) == 0;
 }
@@ -410,7 +336,7 @@ typedef enum {
  * agree nothing may differ; the first row that differs must be a tie. `tie_before`: this
  * encounter already showed a tie in an attempt that the result does not report (the first
  * attempt, when reordering reports a later one), after which the attempts may differ. */
-static dec_verdict_t decoupled_compare(const enc_t *e, const coa_plan_result_t *o,
+static dec_verdict_t decoupled_compare(const fx_t *e, const coa_plan_result_t *o,
                                        const int32_t *orows, const coa_plan_result_t *nw,
                                        const int32_t *nrows, bool tie_before, char *why,
                                        size_t why_size)
@@ -460,7 +386,7 @@ static dec_verdict_t decoupled_compare(const enc_t *e, const coa_plan_result_t *
 
 START_TEST(new_planner_matches_old_on_random_encounters)
 {
-    static enc_t e;
+    static fx_t e;
     static int32_t orows[MAXV * (MAXN + 1u)];
     static int32_t nrows[MAXV * (MAXN + 1u)];
     static const uint32_t max_orders[2] = {1u, 6u};
@@ -639,7 +565,7 @@ END_TEST
  * plan, and its cost against the old planner's joint search. */
 static int32_t checked_rows[MAXV * (MAXN + 1u)]; /* plan_checked's plan */
 
-static coa_plan_result_t plan_checked(const enc_t *e)
+static coa_plan_result_t plan_checked(const fx_t *e)
 {
     static int32_t orows[MAXV * (MAXN + 1u)];
     int32_t *nrows = checked_rows;
@@ -667,7 +593,7 @@ static coa_plan_result_t plan_checked(const enc_t *e)
 }
 
 /* The level plan (every UAV on its reference) conflicts or not. */
-static bool level_conflicts(const enc_t *e)
+static bool level_conflicts(const fx_t *e)
 {
     static const int32_t zero[MAXV * (MAXN + 1u)];
     return coa_plan_find_conflict(&e->p, zero, ALL, e->p.vehicle_count, NULL, NULL) == 1;
@@ -675,7 +601,7 @@ static bool level_conflicts(const enc_t *e)
 
 /* Whether the references of u and v come within r_u + r_v horizontally at some step,
  * whatever their altitudes: the steps independence detection checks them at. */
-static bool meet_horizontally(const enc_t *e, size_t u, size_t v)
+static bool meet_horizontally(const fx_t *e, size_t u, size_t v)
 {
     uint32_t k;
     for (k = 0; k < e->p.horizon; ++k) {
@@ -696,11 +622,11 @@ static bool meet_horizontally(const enc_t *e, size_t u, size_t v)
 
 /* Two identical UAVs head-on at 100 m (they meet at t = 6: 120 m apart closing at
  * 20 m/s), 5 m radius, 3 m half-height, dh = 4 m. */
-static void head_on_pair(enc_t *e)
+static void head_on_pair(fx_t *e)
 {
-    enc_init(e, 1.0, 12u);
-    enc_vehicle(e, 1u, 1u, 10.0, 4.0, 2u, 5.0, 3.0, V(-60, 0, 100), V(60, 0, 100));
-    enc_vehicle(e, 2u, 1u, 10.0, 4.0, 2u, 5.0, 3.0, V(60, 0, 100), V(-60, 0, 100));
+    fx_init(e, 1.0, 12u);
+    fx_vehicle(e, 1u, 1u, 10.0, 4.0, 2u, 5.0, 3.0, V(-60, 0, 100), V(60, 0, 100));
+    fx_vehicle(e, 2u, 1u, 10.0, 4.0, 2u, 5.0, 3.0, V(60, 0, 100), V(-60, 0, 100));
 }
 
 /* The reasoning below follows plan_independence (src/core/plan_group.c): every UAV is
@@ -719,18 +645,18 @@ static void head_on_pair(enc_t *e)
  * read off its table counts N expansions), and no other; the plan is level, cost 0. */
 START_TEST(independent_uavs_are_never_merged)
 {
-    static enc_t e;
+    static fx_t e;
     int variant;
     for (variant = 0; variant < 2; ++variant) {
         coa_plan_result_t r;
-        enc_init(&e, 1.0, 12u);
-        enc_vehicle(&e, 1u, 1u, 10.0, 4.0, 2u, 5.0, 3.0, V(-60, 0, 100), V(60, 0, 100));
+        fx_init(&e, 1.0, 12u);
+        fx_vehicle(&e, 1u, 1u, 10.0, 4.0, 2u, 5.0, 3.0, V(-60, 0, 100), V(60, 0, 100));
         if (variant == 0) {
-            enc_vehicle(&e, 2u, 1u, 10.0, 4.0, 2u, 5.0, 3.0, V(60, 500, 100), V(-60, 500, 100));
+            fx_vehicle(&e, 2u, 1u, 10.0, 4.0, 2u, 5.0, 3.0, V(60, 500, 100), V(-60, 500, 100));
         } else {
-            enc_vehicle(&e, 2u, 1u, 10.0, 4.0, 2u, 5.0, 3.0, V(0, -60, 150), V(0, 60, 150));
+            fx_vehicle(&e, 2u, 1u, 10.0, 4.0, 2u, 5.0, 3.0, V(0, -60, 150), V(0, 60, 150));
         }
-        enc_finish(&e);
+        fx_finish(&e);
         ck_assert(!level_conflicts(&e));
         ck_assert(meet_horizontally(&e, 0u, 1u) == (variant == 1));
         r = plan_checked(&e);
@@ -752,7 +678,7 @@ END_TEST
  * searches jointly unless that already costs no more than alone, which it cannot). */
 START_TEST(head_on_pair_is_merged)
 {
-    static enc_t e;
+    static fx_t e;
     static int32_t rows[MAXV * (MAXN + 1u)];
     static const size_t orders[2][2] = {{0u, 1u}, {1u, 0u}};
     coa_planner_config_t cfg;
@@ -761,7 +687,7 @@ START_TEST(head_on_pair_is_merged)
     int i;
 
     head_on_pair(&e);
-    enc_finish(&e);
+    fx_finish(&e);
     ck_assert(level_conflicts(&e));
     ck_assert_int_eq(coa_planner_config_of(&e.p, 1u, 1000u, &cfg), COA_OK);
     w = new_make(&cfg);
@@ -793,18 +719,18 @@ END_TEST
  * merge no conflict is left, and the third is neither re-planned nor searched with them. */
 START_TEST(only_interacting_uavs_are_merged)
 {
-    static enc_t e;
+    static fx_t e;
     int variant;
     uint32_t k;
     for (variant = 0; variant < 2; ++variant) {
         coa_plan_result_t r;
         head_on_pair(&e);
         if (variant == 0) {
-            enc_vehicle(&e, 3u, 1u, 10.0, 4.0, 2u, 5.0, 3.0, V(-60, 500, 100), V(60, 500, 100));
+            fx_vehicle(&e, 3u, 1u, 10.0, 4.0, 2u, 5.0, 3.0, V(-60, 500, 100), V(60, 500, 100));
         } else {
-            enc_vehicle(&e, 3u, 1u, 10.0, 4.0, 2u, 5.0, 3.0, V(0, -60, 140), V(0, 60, 140));
+            fx_vehicle(&e, 3u, 1u, 10.0, 4.0, 2u, 5.0, 3.0, V(0, -60, 140), V(0, 60, 140));
         }
-        enc_finish(&e);
+        fx_finish(&e);
         ck_assert(level_conflicts(&e));
         ck_assert(meet_horizontally(&e, 0u, 2u) == (variant == 1));
         ck_assert(meet_horizontally(&e, 1u, 2u) == (variant == 1));
