@@ -747,7 +747,7 @@ static void dp_rec(dp_ctx_t *c, size_t i, u128_t cost)
     if (cost >= c->best) {
         return;
     }
-    if (i == o->m) {
+    if (i == o->m || i >= MAXM) { /* o->m <= MAXM: the second says so to the compiler */
         u128_t nx = c->next[layer_index(c->next_layer, c->to)];
         if (nx != INF && cost + nx < c->best) {
             c->best = cost + nx;
@@ -867,6 +867,9 @@ static void edges_rec(edge_ctx_t *e, size_t c, u128_t cost)
         return;
     }
     i = e->who[c];
+    if (i >= MAXM) { /* never: who[] holds members; says so to the compiler's bounds check */
+        return;
+    }
     if (e->enters[c]) {
         int32_t x;
         for (x = lo_of(o, i, k + 1u); x <= hi_of(o, i, k + 1u); ++x) {

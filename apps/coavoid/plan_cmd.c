@@ -35,12 +35,12 @@ _Static_assert(COAVOID_DEFAULT_MAX_ORDERS == 7u * 6u * 5u * 4u * 3u * 2u * 1u &&
     "Reads a scenario (JSON, at most %u MiB) and prints the plan result as JSON.\n"         \
     "\n"                                                                                    \
     "options:\n"                                                                            \
-    "  --mode centralised  one search over all UAVs together (at most %u UAVs)\n"           \
+    "  --mode centralised  optimal for all UAVs together (at most %u UAVs)\n"               \
     "  --mode decoupled    each UAV in turn, in priority order\n"                           \
     "  --priority ID,...   decoupled: plan in this order (every vehicle id exactly once)\n" \
-    "  --beta N            closed-set bound, N >= 1; overrides the scenario's \"beta\";\n"  \
-    "                      default %u, lowered so the workspace stays within 1 GiB;\n"      \
-    "                      the centralised workspace grows as beta * 5^UAVs\n"              \
+    "  --beta N            nodes a joint search may store, N >= 1; overrides the\n"        \
+    "                      scenario's \"beta\"; default %u, lowered so the workspace stays\n" \
+    "                      within 1 GiB (a node is 70 + 2 bytes per UAV)\n"                \
     "  --reorder           decoupled: when a UAV fails, try other priority orders\n"        \
     "  --max-orders N      with --reorder: try at most N orders, N >= 1; default %u\n"      \
     "                      (every order of up to %u UAVs); stats.all_orders_covered\n"      \

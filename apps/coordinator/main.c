@@ -32,10 +32,10 @@
     "options:\n"                                                                               \
     "  --scenario FILE     the scenario (SCENARIO_FORMAT.md)\n"                                \
     COA_RT_OPTIONS_USAGE                                                                       \
-    "  --beta B            closed-set bound of its planner, B >= 1; default the scenario's\n"  \
-    "                      \"beta\", else %u lowered so the workspace fits 1 GiB\n"            \
-    "  --max-centralised N largest cluster planned in one search, 1..%u (default %u);\n"      \
-    "                      the workspace grows as beta * 5^N; a larger cluster is planned\n"  \
+    "  --beta B            nodes a joint search of its planner stores, B >= 1; default the\n" \
+    "                      scenario's \"beta\", else %u lowered so the workspace fits 1 GiB\n" \
+    "  --max-centralised N largest cluster planned centrally, 1..%u (default %u); the\n"     \
+    "                      workspace grows by about 20 kB per UAV; a larger cluster is planned\n" \
     "                      decoupled by the coordinator\n"                                     \
     "  --collect S         scenario seconds after each cycle start at which it plans,\n"       \
     "                      0 < S < dt; default dt / 4. Its plans must reach the vehicles\n"    \

@@ -235,7 +235,7 @@ static int plan_cluster(coa_coordinator_t *node, int64_t now, int64_t cycle_star
     int64_t start = coa_node_stopwatch(c);
     if (centralised) {
         rc = coa_plan_centralised(planner, &problem, node->offsets, &result);
-        /* The composite search grows as 5^n a node: when beta runs out before it proves
+        /* A joint search can fill its beta nodes: when beta runs out before it proves
          * anything, the cluster is planned decoupled (in priority order) rather than left
          * to fly into its conflict. A proof of infeasibility stands: no order beats it. */
         if (rc == COA_OK && result.status == COA_PLAN_BUDGET_EXHAUSTED && count > 1u) {
