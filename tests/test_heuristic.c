@@ -1583,6 +1583,9 @@ static Suite *suite(void)
 {
     Suite *s = suite_create("heuristic");
     TCase *tc = tcase_create("brute force");
+    /* Seconds each: Check's default of 4 is for unit tests, not brute force on a loaded
+     * 2-core machine under the sanitizers. */
+    tcase_set_timeout(tc, 300);
     tcase_add_test(tc, table_exact);
     tcase_add_test(tc, joint_two);
     tcase_add_test(tc, joint_three);
