@@ -20,7 +20,8 @@ objs=$arm/CMakeFiles/coavoid_core.dir/src/core
 arm_planner=$(struct_size arm-none-eabi-readelf "$objs/plan.c.obj" coa_planner)
 arm_predictor=$(struct_size arm-none-eabi-readelf "$objs/predict.c.obj" coa_predictor)
 
-for f in common geometry trajectory plan predict; do
+core="common geometry trajectory plan plan_table plan_pair plan_group plan_search predict"
+for f in $core; do
   cc -std=c11 -g -O1 -DCOA_SINGLE_PRECISION -I"$src/include" -c "$src/src/core/$f.c" -o "$work/$f.o"
 done
 host_planner=$(struct_size readelf "$work/plan.o" coa_planner)
@@ -37,19 +38,29 @@ int main(int argc, char **argv)
 {
     size_t hp = strtoul(argv[1], NULL, 10), ap = strtoul(argv[2], NULL, 10);
     size_t hq = strtoul(argv[3], NULL, 10), aq = strtoul(argv[4], NULL, 10);
-    static const struct { size_t n; uint32_t beta; } pl[] = {
-        {1, 24}, {1, 100}, {1, 300}, {1, 1000}, {1, 10000},
-        {2, 50}, {2, 200}, {2, 1000}, {3, 20}, {3, 100}, {3, 1000}};
+    /* N = 24 and steep factor 2 (the paper's and the firmware's), offsets unbounded. */
+    static const uint32_t betas[] = {1000, 10000, 60000};
     static const struct { size_t v, t; uint32_t n; } pr[] = {
         {4, 0, 24}, {8, 0, 24}, {16, 0, 24}, {8, 2, 24}, {4, 0, 60}, {8, 0, 60}, {16, 0, 60}};
     size_t i;
     (void)argc;
-    printf("planner: n, beta, host (x86-64, float) bytes, Cortex-M4F bytes, per closed node\n");
-    for (i = 0; i < sizeof pl / sizeof pl[0]; ++i) {
-        size_t h = coa_planner_workspace_size(pl[i].n, pl[i].beta);
-        size_t a = h - round8(hp) + round8(ap);
-        printf("%zu %u %zu %zu %.0f\n", pl[i].n, pl[i].beta, h, a,
-               (double)(a - round8(ap)) / pl[i].beta);
+    printf("planner (N 24, s 2, unbounded): n, beta, host (x86-64, float) bytes, Cortex-M4F "
+           "bytes, tables, bytes per stored node\n");
+    for (size_t n = 1; n <= COA_MAX_CENTRALISED; ++n) {
+        for (i = 0; i < sizeof betas / sizeof betas[0]; ++i) {
+            coa_planner_config_t c = {n, betas[i], 24u, 2u, -1};
+            size_t h = coa_planner_workspace_size(&c);
+            size_t a = h - round8(hp) + round8(ap);
+            size_t tables = (n == 1u ? 1u : 2u * n + 1u) * 1225u * 8u;
+            /* Per stored node: the slope over 59,000 nodes (one more node can cost up to
+             * 8 bytes more than the slope: every array starts on an 8-byte boundary). */
+            coa_planner_config_t lo = c, hi = c;
+            lo.beta = 1000u;
+            hi.beta = 60000u;
+            printf("%zu %u %zu %zu %zu %.2f\n", n, betas[i], h, a, tables,
+                   (double)(coa_planner_workspace_size(&hi) - coa_planner_workspace_size(&lo)) /
+                       59000.0);
+        }
     }
     printf("predictor: UAVs, tracks, N, pairs (4 per UAV), host bytes, Cortex-M4F bytes\n");
     for (i = 0; i < sizeof pr / sizeof pr[0]; ++i) {
@@ -59,13 +70,20 @@ int main(int argc, char **argv)
     }
     printf("headers: planner host %zu ARM %zu; predictor host %zu ARM %zu\n", hp, ap, hq, aq);
     /* The ARM header is smaller: the same buffer holds what the host's would with
-     * that much more room. */
-    printf("firmware planner buffer 96 KiB: beta %u on the host, %u on the Cortex-M4F\n",
-           coa_planner_max_beta(1u, 96u * 1024u),
-           coa_planner_max_beta(1u, 96u * 1024u + round8(hp) - round8(ap)));
+     * that much more room. The firmware plans one UAV (N 24, s 2, max_offset 40). */
+    {
+        coa_planner_config_t c = {1u, 1u, 24u, 2u, 40};
+        printf("firmware planner buffer 32 KiB, n = 1: %zu bytes used on the Cortex-M4F\n",
+               coa_planner_workspace_size(&c) - round8(hp) + round8(ap));
+        c.vehicles = 3u;
+        printf("firmware check triple (N 16, s 3, L 8), n = 3, beta 1000: %zu on the Cortex-M4F\n",
+               (c.horizon = 16u, c.steep_factor = 3u, c.max_offset = 8, c.beta = 1000u,
+                coa_planner_workspace_size(&c) - round8(hp) + round8(ap)));
+    }
     return 0;
 }
 C
-cc -std=c11 -DCOA_SINGLE_PRECISION -I"$src/include" "$work/sizes.c" "$work"/{common,geometry,trajectory,plan,predict}.o \
+objs_host=(); for f in $core; do objs_host+=("$work/$f.o"); done
+cc -std=c11 -DCOA_SINGLE_PRECISION -I"$src/include" "$work/sizes.c" "${objs_host[@]}" \
   -lccd -lm -o "$work/sizes"
 "$work/sizes" "$host_planner" "$arm_planner" "$host_predictor" "$arm_predictor"
