@@ -4,7 +4,7 @@
  *
  * The exhaustive search (layered dynamic programming over every reachable offset vector)
  * shares no code with plan.c and none with the core's cost code: it uses only the geometry
- * conflict tests, and it prices plans itself, exactly, from the contract (SCENARIO_FORMAT
+ * conflict tests, and it prices plans itself, exactly, from the contract (docs/scenario-format.md
  * "Costs"): each w_i = fl(fl(v dt) fl(c dt)) taken apart with frexp, the areas as exact
  * rationals, everything summed in the compiler's 128-bit integers (this test runs on
  * 64-bit hosts only). So an error in the engine's duplicate handling, ordering, validity

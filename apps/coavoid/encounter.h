@@ -1,6 +1,6 @@
 /*
  * encounter.h: seeded random encounters of n UAVs converging on one point, written as
- * scenario JSON (SCENARIO_FORMAT.md) so that they go through the scenario loader and are
+ * scenario JSON (docs/scenario-format.md) so that they go through the scenario loader and are
  * checked like any file. `coavoid bench plan` times the planner on them and `coavoid
  * montecarlo` evaluates the planners over thousands of them; one generator serves both so
  * that "an encounter" means the same thing in docs/benchmarks.md and docs/evaluation.md.

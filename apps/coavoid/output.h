@@ -1,5 +1,5 @@
 /*
- * output.h: the result objects of SCENARIO_FORMAT.md ("Plan result", "Prediction result"),
+ * output.h: the result objects of docs/scenario-format.md ("Plan result", "Prediction result"),
  * printed as JSON.
  */
 #ifndef COAVOID_APP_OUTPUT_H

@@ -1,5 +1,5 @@
 /*
- * coavoid plan: reads a scenario (SCENARIO_FORMAT.md), plans altitude manoeuvres
+ * coavoid plan: reads a scenario (docs/scenario-format.md), plans altitude manoeuvres
  * centrally or decoupled, and prints the plan result as JSON. See PLAN_USAGE below.
  */
 #define _POSIX_C_SOURCE 200809L

@@ -1,6 +1,6 @@
 /*
  * coavoid predict: one prediction cycle of the core (predict.h) over a scenario, printed
- * as SCENARIO_FORMAT.md's "Prediction result". See PREDICT_USAGE below.
+ * as docs/scenario-format.md's "Prediction result". See PREDICT_USAGE below.
  *
  * A scenario has no published plans, so each UAV's plan is taken to be its reference at
  * its initial_offset, sampled on the scenario's own grid (t0 = 0, step dt, N+1 samples):

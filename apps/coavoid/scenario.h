@@ -1,5 +1,5 @@
 /*
- * scenario.h: reading a scenario file (SCENARIO_FORMAT.md, "Scenario") into core types.
+ * scenario.h: reading a scenario file (docs/scenario-format.md, "Scenario file") into core types.
  *
  * The file is untrusted. Every field of the contract is checked for its JSON type and its
  * range before anything reaches the core, and the first problem is reported as one line

@@ -1,5 +1,5 @@
 /*
- * coavoid sim: the closed loop of SCENARIO_FORMAT.md ("Simulation result") in one
+ * coavoid sim: the closed loop of docs/scenario-format.md ("Simulation result") in one
  * process. The world, one vehicle node per UAV and (centralised) the coordinator are the
  * nodes the real-time apps run (apps/node), here sharing LCM's in-process provider
  * (memq) and a simulated clock, so a run is repeatable bit for bit. See SIM_USAGE.

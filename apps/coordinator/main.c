@@ -30,7 +30,7 @@
     "the horizon and the default beta; the vehicles and obstacles come from the messages.\n" \
     "\n"                                                                                       \
     "options:\n"                                                                               \
-    "  --scenario FILE     the scenario (SCENARIO_FORMAT.md)\n"                                \
+    "  --scenario FILE     the scenario (docs/scenario-format.md)\n"                          \
     COA_RT_OPTIONS_USAGE                                                                       \
     "  --beta B            nodes a joint search of its planner stores, B >= 1; default the\n" \
     "                      scenario's \"beta\", else %u lowered so the workspace fits 1 GiB\n" \

@@ -105,7 +105,7 @@ int coa_flight_conflicts(const coa_flight_t *flight, coa_flight_trajectory_t whi
  * a write failed). Cost O(K n (n + obstacles + tracks)); allocates O(K (n + tracks)). */
 int coa_flight_svg(const coa_flight_t *flight, const coa_flight_eval_t *eval, FILE *out);
 
-/* Writes the simulation result of SCENARIO_FORMAT.md ("Simulation result") as JSON:
+/* Writes the simulation result of docs/scenario-format.md ("Simulation result") as JSON:
  * scenario, mode, steps, replans, loss_of_separation, deviation, effort, and per UAV id and
  * flown (steps + 1 samples [t, x, y, z]). Extra fields, beyond the contract: when lost,
  * "first_loss": {"vehicle": id, "step": k, "t": s}; per UAV "deviation" and "effort" when

@@ -13,7 +13,7 @@
  *     cycle_utime(k) = epoch_utime + k * dt_us,   dt_us = llround(dt * 1e6),
  * which is scenario time t_k = k * dt (a UAV's reference is sampled at k * dt exactly).
  *
- * One cycle (the closed loop of SCENARIO_FORMAT.md, "Simulation result"):
+ * One cycle (the closed loop of docs/scenario-format.md, "Simulation result"):
  *   1. At cycle_utime(k) the world publishes the obstacle map and every track's estimate
  *      (in real time a quarter cycle ahead, so that they are there when the UAVs decide).
  *   2. At cycle_utime(k) every UAV steps its simulated flight to sample k (the offset its

@@ -29,7 +29,7 @@
     "plans over LCM with the other vehicles, the coordinator and `coavoid world`.\n"          \
     "\n"                                                                                       \
     "options:\n"                                                                               \
-    "  --scenario FILE     the scenario (SCENARIO_FORMAT.md): route, dt, horizon, beta\n"      \
+    "  --scenario FILE     the scenario (docs/scenario-format.md): route, dt, horizon, beta\n" \
     "  --id ID             which of its vehicles this process flies\n"                         \
     "  --mode centralised  follow the coordinator; plan for itself while the coordinator\n"    \
     "                      is silent (default)\n"                                              \

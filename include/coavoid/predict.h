@@ -11,7 +11,7 @@
  *      length; none is aligned with the predictor's clock. Each is resampled onto the
  *      predictor's grid t_k = t0 + k*dt, k = 0..N, by linear interpolation between its
  *      samples and, outside them, by the constant velocity of its nearest leg (one sample:
- *      stationary) - the semantics SCENARIO_FORMAT.md gives track paths. Tracks are
+ *      stationary) - the semantics docs/scenario-format.md gives track paths. Tracks are
  *      sampled with coa_track_at at the same t_k: a track's time is the predictor's
  *      clock. Between grid samples everything moves in a straight line.
  *   2. Broad phase. For every step, the swept bounding boxes of all UAVs and tracks

@@ -562,7 +562,7 @@ static bool plan_ok(const coa_intent_plan_t *p)
 /* Alignment                                                                             */
 
 /* A plan's position at u sample steps after its first sample (u may be negative or past
- * the last sample): the track-path semantics of SCENARIO_FORMAT.md. Anchored at a sample
+ * the last sample): the track-path semantics of docs/scenario-format.md. Anchored at a sample
  * so that a whole u gives that sample exactly. */
 static coa_vec3_t plan_at(const coa_intent_plan_t *p, coa_real_t u)
 {

@@ -1,5 +1,5 @@
 #!/bin/bash
-# The result of `coavoid plan` follows SCENARIO_FORMAT.md ("Plan result") exactly: every
+# The result of `coavoid plan` follows docs/scenario-format.md ("Plan result") exactly: every
 # field with its type, offsets and actions that agree with each other and with the
 # scenario, per-vehicle costs that add up to the totals, and exit status 0 / 1 for
 # solved / not solved (infeasible, budget exhausted) in both modes.

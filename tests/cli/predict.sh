@@ -1,5 +1,5 @@
 #!/bin/bash
-# `coavoid predict` follows SCENARIO_FORMAT.md ("Prediction result") exactly on the shipped
+# `coavoid predict` follows docs/scenario-format.md ("Prediction result") exactly on the shipped
 # scenarios and on a few written here (ids out of input order, initial offsets, tracks with
 # uncertainty); bad arguments exit 2 with one line naming the argument; and `coavoid bench
 # predict` runs and prints its keys (never its times: a benchmark is not a timed test).

@@ -1,5 +1,5 @@
 #!/bin/bash
-# `coavoid sim` follows SCENARIO_FORMAT.md ("Simulation result"): every shipped scenario
+# `coavoid sim` follows docs/scenario-format.md ("Simulation result"): every shipped scenario
 # that `coavoid plan` solves in a mode flies without a loss of separation in that mode,
 # K = 2N steps by default, K + 1 samples per UAV at t = k dt, each on its reference raised
 # by a whole number of climb steps that change by actions; planning runs where there is a

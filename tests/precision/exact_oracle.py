@@ -2,7 +2,7 @@
 """The exact answer that `coavoid predict` must give on a scenario whose sampled
 positions are all exactly representable (random_scenarios.py --exact): for every pair of
 UAVs, and every UAV and track without sigma, the first step that holds a conflict, by the
-contract (SCENARIO_FORMAT.md: straight lines between samples, strict inequalities, an
+contract (docs/scenario-format.md: straight lines between samples, strict inequalities, an
 exact touch is no conflict), in rational arithmetic.
 
 Usage: exact_oracle.py COAVOID SCENARIO.json...
