@@ -155,46 +155,38 @@ static bool entry_before(const coa_planner_t *pl, size_t i, int16_t a, int16_t b
     return c < 0 || (c == 0 && a < b);
 }
 
+/* Moves e[root] down the max-heap e[0..n-1] (ordered by entry_before) to its place. */
+static void entries_sift(const coa_planner_t *pl, size_t i, int16_t *e, size_t root, size_t n)
+{
+    while (2u * root + 1u < n) {
+        size_t child = 2u * root + 1u;
+        int16_t t;
+        if (child + 1u < n && entry_before(pl, i, e[child], e[child + 1u])) {
+            ++child;
+        }
+        if (!entry_before(pl, i, e[root], e[child])) {
+            break;
+        }
+        t = e[root];
+        e[root] = e[child];
+        e[child] = t;
+        root = child;
+    }
+}
+
 /* Heapsort of member i's entry list by (slack, offset): in place, no recursion. */
 static void entries_sort(const coa_planner_t *pl, size_t i, int16_t *e, size_t n)
 {
     size_t end;
     size_t start;
     for (start = n / 2u; start-- > 0u;) {
-        size_t root = start;
-        while (2u * root + 1u < n) {
-            size_t child = 2u * root + 1u;
-            int16_t t;
-            if (child + 1u < n && entry_before(pl, i, e[child], e[child + 1u])) {
-                ++child;
-            }
-            if (!entry_before(pl, i, e[root], e[child])) {
-                break;
-            }
-            t = e[root];
-            e[root] = e[child];
-            e[child] = t;
-            root = child;
-        }
+        entries_sift(pl, i, e, start, n);
     }
     for (end = n; end-- > 1u;) {
         int16_t t = e[0];
-        size_t root = 0u;
         e[0] = e[end];
         e[end] = t;
-        while (2u * root + 1u < end) {
-            size_t child = 2u * root + 1u;
-            if (child + 1u < end && entry_before(pl, i, e[child], e[child + 1u])) {
-                ++child;
-            }
-            if (!entry_before(pl, i, e[root], e[child])) {
-                break;
-            }
-            t = e[root];
-            e[root] = e[child];
-            e[child] = t;
-            root = child;
-        }
+        entries_sift(pl, i, e, 0u, end);
     }
 }
 
