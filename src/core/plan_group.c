@@ -274,18 +274,12 @@ static void rows_save(coa_planner_t *pl, bool back)
     }
 }
 
-/* Everything a joint search of `members` around the rows of `fixed` (at most `bound`,
- * when not NULL) needs. Returns true when the members' plan in turn is already optimal
- * (or, with a bound, meets it), with their rows written: no search is needed. Otherwise
- * the members' rows are as they were. */
-static bool group_setup(coa_planner_t *pl, uint32_t members, uint32_t fixed,
-                        const coa_cost_t *bound, coa_plan_result_t *r)
+/* Starts a group: the last search's nodes released, the members (bit mask of vehicles)
+ * with their costs alone, and the fixed vehicles. */
+static void group_collect(coa_planner_t *pl, uint32_t members, uint32_t fixed)
 {
     plan_group_t *g = &pl->group;
-    coa_cost_t cap;
-    coa_cost_t slack;
     size_t v;
-    size_t i;
 
     plan_search_release(pl);
     g->count = 0u;
@@ -300,6 +294,21 @@ static bool group_setup(coa_planner_t *pl, uint32_t members, uint32_t fixed,
             g->fixed[g->fixed_count++] = v;
         }
     }
+}
+
+/* Everything a joint search of `members` around the rows of `fixed` (at most `bound`,
+ * when not NULL) needs. Returns true when the members' plan in turn is already optimal
+ * (or, with a bound, meets it), with their rows written: no search is needed. Otherwise
+ * the members' rows are as they were. */
+static bool group_setup(coa_planner_t *pl, uint32_t members, uint32_t fixed,
+                        const coa_cost_t *bound, coa_plan_result_t *r)
+{
+    plan_group_t *g = &pl->group;
+    coa_cost_t cap;
+    coa_cost_t slack;
+    size_t i;
+
+    group_collect(pl, members, fixed);
     g->bounded = bound != NULL;
     if (bound != NULL) {
         g->bound = *bound;
@@ -546,17 +555,7 @@ void plan_test_group_setup(coa_planner_t *pl, uint32_t members)
         plan_table_build_from_start(&pl->from_start[v], &pl->to_go[v]);
     }
     near_all(pl);
-    plan_search_release(pl);
-    g->count = 0u;
-    g->fixed_count = 0u;
-    for (v = 0; v < pl->problem->vehicle_count; ++v) {
-        if ((members & (UINT32_C(1) << v)) != 0u) {
-            g->vehicle[g->count] = v;
-            g->alone[g->count] = plan_cell_cost(
-                pl, v, plan_table_at(&pl->to_go[v], 0u, pl->problem->vehicles[v].initial_offset));
-            ++g->count;
-        }
-    }
+    group_collect(pl, members, 0u);
     g->bounded = false;
     g->capped = false;
     group_spans(pl, members, 0u);
