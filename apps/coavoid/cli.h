@@ -122,9 +122,12 @@ bool cli_parse_index(const char *text, uint64_t max, uint64_t *out);
  * "inf" and hexadecimal, which in an option are more likely a mistake than meant. */
 bool cli_parse_real(const char *text, double *out);
 
-/* The bound beta on each search's expansions when neither an option nor the scenario's
- * "beta" gives one (`coavoid plan`, `coavoid sim`, coavoid-coordinator). */
-#define CLI_DEFAULT_BETA 20000u
+/* The bound beta on the nodes each joint search stores when neither an option nor the
+ * scenario's "beta" gives one (`coavoid plan`, `coavoid sim`, coavoid-coordinator,
+ * bench plan, montecarlo). 200,000 nodes are 15-17 MB for 2-6 UAVs; at 20,000 a quarter
+ * of bench plan's 4-UAV encounters and 14 % of montecarlo's 5-UAV ones ran out of beta,
+ * at 200,000 none of either (docs/benchmarks.md, docs/evaluation.md). */
+#define CLI_DEFAULT_BETA 200000u
 /* The default beta is lowered until the workspace fits this many bytes (a default that
  * asks a laptop for gigabytes is a trap). A beta that is given is taken as given. */
 #define CLI_DEFAULT_WORKSPACE_MAX ((size_t)1u << 30)

@@ -347,7 +347,7 @@ for args in "--help" "-h" "plan --help" "plan -h"; do
         fail "coavoid $args: exit $rc, expected usage on stdout and exit 0"
     fi
 done
-if grep -q 'default 20000' <("$bin" plan --help); then pass; else fail "plan --help does not state the default beta"; fi
+if grep -q 'default 200000' <("$bin" plan --help); then pass; else fail "plan --help does not state the default beta"; fi
 if grep -q -- '--max-orders N .*default 5040' <("$bin" plan --help); then pass; else fail "plan --help does not state the default --max-orders"; fi
 
 finish

@@ -66,7 +66,7 @@ if expect_ok json bench plan --vehicles 2 --count 2 --repeat 1 --json; then
     check json '
 len(rows) == 2 and all(r["set"] == "2 UAVs" and r["vehicles"] == 2 and r["problems"] == 2 for r in rows)
 b["seed"] == 1 and b["repeat"] == 1 and b["count"] == 2
-all(r["nodes_expanded"] > 0 and r["beta"] == 20000 and not r["beta_lowered"] for r in rows)
+all(r["nodes_expanded"] > 0 and r["beta"] == 200000 and not r["beta_lowered"] for r in rows)
 '
     cp "$tmp/out.last" "$tmp/first"
 fi
@@ -91,7 +91,7 @@ fi
 # lowered to the default (which fits), and says so; a decoupled planner stores no nodes, so its beta is never lowered.
 if expect_ok lowered_beta bench plan --vehicles 2 --count 1 --repeat 1 --beta 20000000 --json; then
     check lowered_beta '
-rows[0]["beta_lowered"] and rows[0]["beta"] == 20000
+rows[0]["beta_lowered"] and rows[0]["beta"] == 200000
 rows[0]["workspace_bytes"] <= 2 ** 30
 not rows[1]["beta_lowered"] and rows[1]["beta"] == 20000000
 '
