@@ -88,6 +88,18 @@ static inline coa_real_t real_norm2(coa_real_t x, coa_real_t y)
 #endif
 #define SLACK_ULPS 64
 
+/* b grown by `slack` on every side (the widening of SLACK_ULPS above). */
+static inline coa_box_t box_widened(coa_box_t b, coa_real_t slack)
+{
+    b.min.x -= slack;
+    b.min.y -= slack;
+    b.min.z -= slack;
+    b.max.x += slack;
+    b.max.y += slack;
+    b.max.z += slack;
+    return b;
+}
+
 /* The largest of m and |p|'s coordinates. */
 static inline coa_real_t real_max_abs3(const coa_vec3_t *p, coa_real_t m)
 {

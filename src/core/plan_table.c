@@ -74,17 +74,6 @@ uint64_t plan_table_at(const plan_table_t *t, uint32_t k, int32_t offset)
 /* ------------------------------------------------------------------------------------ */
 /* Conflicts of one row                                                                  */
 
-static coa_box_t widened(coa_box_t b, coa_real_t slack)
-{
-    b.min.x -= slack;
-    b.min.y -= slack;
-    b.min.z -= slack;
-    b.max.x += slack;
-    b.max.y += slack;
-    b.max.z += slack;
-    return b;
-}
-
 static coa_real_t box_scale(const coa_box_t *b)
 {
     return real_max_abs3(&b->max, real_max_abs3(&b->min, (coa_real_t)0));
@@ -135,7 +124,7 @@ static void row_clear_item(const row_ctx_t *r, const row_item_t *it)
     const plan_table_t *t = r->t;
     coa_real_t slack =
         (box_scale(&r->bounds) + box_scale(&it->bounds)) * (coa_real_t)(SLACK_ULPS * REAL_EPSILON);
-    coa_box_t item = widened(it->bounds, slack);
+    coa_box_t item = box_widened(it->bounds, slack);
     int32_t o;
 
     if (!coa_boxes_touch(&r->bounds, &item)) {

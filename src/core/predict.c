@@ -1422,13 +1422,7 @@ static bool evaluate_obstacle(const coa_predictor_t *pr, uint32_t a, uint32_t o,
         s.volume = ma->volume;
         s.p0 = pa[k];
         s.p1 = pa[k + 1u];
-        sb = coa_sweep_bounds(&s);
-        sb.min.x -= pr->slack;
-        sb.min.y -= pr->slack;
-        sb.min.z -= pr->slack;
-        sb.max.x += pr->slack;
-        sb.max.y += pr->slack;
-        sb.max.z += pr->slack;
+        sb = box_widened(coa_sweep_bounds(&s), pr->slack);
         /* An error of the polytope test (a scene no floating-point frame holds) counts
          * as a conflict, as in the planner: the safe side. */
         if (coa_boxes_touch(&sb, &ob) && coa_conflict_obstacle(&s, obs) != 0) {
