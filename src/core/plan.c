@@ -55,7 +55,8 @@ typedef struct {
 /* ------------------------------------------------------------------------------------ */
 /* Sizes                                                                                 */
 
-/* The offset bound a table is sized for: a vehicle's max_offset, or COA_MAX_OFFSET. */
+/* The largest |offset| a max_offset allows: itself, or COA_MAX_OFFSET (the int16 node
+ * storage) when unbounded (negative) or above it. Tables and vehicles both use it. */
 static int32_t bound_of(int32_t max_offset)
 {
     return (max_offset >= 0 && max_offset < COA_MAX_OFFSET) ? max_offset : COA_MAX_OFFSET;
@@ -245,7 +246,6 @@ int coa_planner_config_of(const coa_problem_t *problem, size_t vehicles, uint32_
 /* ------------------------------------------------------------------------------------ */
 /* Problem validation                                                                    */
 
-
 static bool samples_ok(const coa_vec3_t *s, uint32_t horizon)
 {
     uint32_t k;
@@ -259,7 +259,6 @@ static bool samples_ok(const coa_vec3_t *s, uint32_t horizon)
     }
     return true;
 }
-
 
 /* Everything but the integer range: what a conflict check needs to be safe to run. */
 static int check_arguments(const coa_problem_t *p)
@@ -303,27 +302,45 @@ static int check_arguments(const coa_problem_t *p)
     return COA_OK;
 }
 
-/* The largest |offset| a vehicle may take: its own bound, and the int16 node storage. */
 static int32_t offset_limit(const coa_vehicle_t *v)
 {
-    return (v->max_offset >= 0 && v->max_offset < COA_MAX_OFFSET) ? v->max_offset
-                                                                   : COA_MAX_OFFSET;
+    return bound_of(v->max_offset);
 }
 
-/* Whether the worst case f = g + h of any node stays below 2^127, which leaves every sum
- * the search forms (g + one step, g + h) far from the 2^128 wrap. One step costs at most
- * W * S * max(|a|, |b|) <= W * S * B and the heuristic at most W * S * R * B, so
- * f <= 2 N * sum_i W_i S B_i. With the limits of common.h that is below 2^64 * 2^13 *
- * 2^15 * 2^15 * 2^5 = 2^112, so only coa_deviation_weights' own COA_ERR_RANGE (weights
- * that do not fit 64 bits) can refuse a problem today; the check stays so that raising a
- * limit cannot silently break exactness. Fills the weights and the scale on success. */
-static int check_range(const coa_problem_t *p, uint64_t *weights, uint32_t *scale)
+/* The worst case f = g + h of any node, 2 N * sum_i W_i S B_i: one step costs at most
+ * W * S * max(|a|, |b|) <= W * S * B and the heuristic at most W * S * N * B, with B_i =
+ * min(|initial offset| + N s_i, the vehicle's offset bound). With the limits of common.h
+ * it is below 2^64 * 2^13 * 2^15 * 2^15 * 2^5 = 2^112: each term is below 2^106 and there
+ * are at most 32, so the sum cannot wrap. */
+static coa_cost_t worst_f(const coa_problem_t *p, const uint64_t *weights, uint32_t s)
 {
     coa_cost_t total = {0u, 0u};
+    size_t i;
+    for (i = 0; i < p->vehicle_count; ++i) {
+        const coa_vehicle_t *v = &p->vehicles[i];
+        uint64_t init = (uint64_t)(v->initial_offset < 0 ? -(int64_t)v->initial_offset
+                                                         : (int64_t)v->initial_offset);
+        uint64_t bound = init + (uint64_t)p->horizon * v->steep_factor;
+        if (bound > (uint64_t)offset_limit(v)) {
+            bound = (uint64_t)offset_limit(v);
+        }
+        /* S <= 5040, B <= 32767, 2N <= 20000: the factor is below 2^42. */
+        total = coa_cost_add(total,
+                             coa_cost_mul(weights[i], (uint64_t)s * bound * 2u * p->horizon));
+    }
+    return total;
+}
+
+/* Whether worst_f stays below 2^127, which leaves every sum the search forms (g + one
+ * step, g + h) far from the 2^128 wrap. Only coa_deviation_weights' own COA_ERR_RANGE
+ * (weights that do not fit 64 bits) can refuse a problem today; the check stays so that
+ * raising a limit cannot silently break exactness. Fills the weights and the scale on
+ * success. */
+static int check_range(const coa_problem_t *p, uint64_t *weights, uint32_t *scale)
+{
     uint32_t s;
     int exponent;
     int rc;
-    size_t i;
 
     s = coa_area_scale(p->vehicles, p->vehicle_count);
     if (s == 0u) {
@@ -333,23 +350,8 @@ static int check_range(const coa_problem_t *p, uint64_t *weights, uint32_t *scal
     if (rc != COA_OK) {
         return rc;
     }
-    for (i = 0; i < p->vehicle_count; ++i) {
-        const coa_vehicle_t *v = &p->vehicles[i];
-        uint64_t init = (uint64_t)(v->initial_offset < 0 ? -(int64_t)v->initial_offset
-                                                         : (int64_t)v->initial_offset);
-        uint64_t bound = init + (uint64_t)p->horizon * v->steep_factor;
-        uint64_t factor;
-        if (bound > (uint64_t)offset_limit(v)) {
-            bound = (uint64_t)offset_limit(v);
-        }
-        /* S <= 5040, B <= 32767, 2N <= 20000: the factor is below 2^42. */
-        factor = (uint64_t)s * bound * 2u * (uint64_t)p->horizon;
-        /* Each term is below 2^106 and there are at most 32: the sum cannot wrap before
-         * the test. */
-        total = coa_cost_add(total, coa_cost_mul(weights[i], factor));
-        if (total.hi >= (UINT64_C(1) << 63)) {
-            return COA_ERR_RANGE;
-        }
+    if (worst_f(p, weights, s).hi >= (UINT64_C(1) << 63)) {
+        return COA_ERR_RANGE;
     }
     *scale = s;
     return COA_OK;
@@ -395,7 +397,6 @@ int coa_priority_order(const coa_vehicle_t *vehicles, size_t n, size_t *order)
 
 /* ------------------------------------------------------------------------------------ */
 /* Costs of a finished row                                                               */
-
 
 int coa_plan_vehicle_cost(const coa_vehicle_t *vehicle, coa_real_t dt, uint32_t horizon,
                           const int32_t *offsets, double *deviation, uint32_t *effort)
@@ -467,14 +468,20 @@ bool plan_static_clear(const coa_problem_t *pr, const coa_sweep_t *s, uint32_t k
     return true;
 }
 
-/* The exact integer deviation of a row, as the search counts it. */
-static coa_cost_t row_units(const coa_planner_t *pl, size_t v, const int32_t *row)
+coa_cost_t plan_row_units(const coa_planner_t *pl, size_t v, const int32_t *row,
+                          uint64_t *effort)
 {
-    const uint32_t own_scale = 2u * pl->problem->vehicles[v].steep_factor;
+    const uint32_t steep = pl->problem->vehicles[v].steep_factor;
     uint64_t own = 0u;
+    uint64_t eff = 0u;
     uint32_t k;
     for (k = 0; k < pl->problem->horizon; ++k) {
-        own += (uint64_t)coa_area_scaled(row[k], row[k + 1u], own_scale);
+        int act = coa_action_between(row[k], row[k + 1u], steep);
+        own += (uint64_t)coa_area_scaled(row[k], row[k + 1u], 2u * steep);
+        eff += coa_action_effort((coa_action_t)(act < 0 ? 0 : act));
+    }
+    if (effort != NULL) {
+        *effort = eff;
     }
     return plan_units(pl, v, own);
 }
@@ -565,7 +572,8 @@ void plan_fill_costs(const coa_planner_t *pl, const size_t *which, size_t count,
         (void)coa_plan_vehicle_cost(&pr->vehicles[which[i]], pr->dt, pr->horizon, row, &dev, &eff);
         r->deviation += dev;
         r->effort += eff;
-        r->deviation_units = coa_cost_add(r->deviation_units, row_units(pl, which[i], row));
+        r->deviation_units =
+            coa_cost_add(r->deviation_units, plan_row_units(pl, which[i], row, NULL));
     }
 }
 
@@ -597,21 +605,8 @@ bool plan_any_initial_conflict(const coa_planner_t *pl)
  * checked again here. The limits of common.h keep every real problem far below. */
 static bool packed_range_ok(const coa_planner_t *pl)
 {
-    const coa_problem_t *p = pl->problem;
-    coa_cost_t total = {0u, 0u};
-    size_t i;
-    for (i = 0; i < p->vehicle_count; ++i) {
-        const coa_vehicle_t *v = &p->vehicles[i];
-        uint64_t init = (uint64_t)(v->initial_offset < 0 ? -(int64_t)v->initial_offset
-                                                         : (int64_t)v->initial_offset);
-        uint64_t bound = init + (uint64_t)p->horizon * v->steep_factor;
-        if (bound > (uint64_t)pl->limit[i]) {
-            bound = (uint64_t)pl->limit[i];
-        }
-        total = coa_cost_add(total, coa_cost_mul(pl->weight[i],
-                                                 (uint64_t)pl->scale * bound * 2u * p->horizon));
-    }
-    return total.hi < (UINT64_C(1) << (64u - PLAN_EFF_BITS - 2u));
+    return worst_f(pl->problem, pl->weight, pl->scale).hi <
+           (UINT64_C(1) << (64u - PLAN_EFF_BITS - 2u));
 }
 
 int coa_plan_centralised(coa_planner_t *planner, const coa_problem_t *problem,

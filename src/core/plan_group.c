@@ -28,18 +28,10 @@
 /* The packed cost of vehicle v's row. */
 static coa_cost_t row_cost(const coa_planner_t *pl, size_t v)
 {
-    const coa_problem_t *pr = pl->problem;
-    const int32_t *row = &pl->rows[v * ((size_t)pr->horizon + 1u)];
-    const uint32_t s = pr->vehicles[v].steep_factor;
-    uint64_t dev = 0u;
-    uint64_t eff = 0u;
-    uint32_t k;
-    for (k = 0; k < pr->horizon; ++k) {
-        int act = coa_action_between(row[k], row[k + 1u], s);
-        dev += (uint64_t)coa_area_scaled(row[k], row[k + 1u], 2u * s);
-        eff += coa_action_effort((coa_action_t)(act < 0 ? 0 : act));
-    }
-    return plan_pack(plan_units(pl, v, dev), eff);
+    uint64_t eff;
+    coa_cost_t dev =
+        plan_row_units(pl, v, &pl->rows[v * ((size_t)pl->problem->horizon + 1u)], &eff);
+    return plan_pack(dev, eff);
 }
 
 static coa_cost_t rows_cost(const coa_planner_t *pl, uint32_t members)
