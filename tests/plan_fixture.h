@@ -150,4 +150,29 @@ static inline void fx_finish(fx_t *f)
     ck_assert_int_eq(coa_problem_check(&f->p), COA_OK);
 }
 
+/* Whether one step's sweep s (over samples k -> k + 1) is clear of the problem's obstacles
+ * and tracks, by the public conflict tests: the suites' own oracles use it instead of the
+ * planner's tables. The polytope test may only answer clear or conflict here. */
+static inline bool fx_static_clear(const fx_t *f, const coa_sweep_t *s, uint32_t k)
+{
+    size_t j;
+    for (j = 0; j < f->p.obstacle_count; ++j) {
+        int rc = coa_conflict_obstacle(s, &f->obs[j]);
+        ck_assert_msg(rc == 0 || rc == 1, "coa_conflict_obstacle returned %d", rc);
+        if (rc != 0) {
+            return false;
+        }
+    }
+    for (j = 0; j < f->p.track_count; ++j) {
+        coa_sweep_t t;
+        t.volume = f->tr[j].volume;
+        t.p0 = f->trs[j][k];
+        t.p1 = f->trs[j][k + 1u];
+        if (coa_conflict_volumes(s, &t)) {
+            return false;
+        }
+    }
+    return true;
+}
+
 #endif /* COAVOID_PLAN_FIXTURE_H */

@@ -311,29 +311,6 @@ static coa_sweep_t sweep_of(const oracle_t *o, size_t i, uint32_t k, int32_t a, 
     return s;
 }
 
-static bool static_clear(const oracle_t *o, const coa_sweep_t *s, uint32_t k)
-{
-    const fx_t *f = o->f;
-    size_t j;
-    for (j = 0; j < f->p.obstacle_count; ++j) {
-        int rc = coa_conflict_obstacle(s, &f->obs[j]);
-        REQUIRE(rc == 0 || rc == 1);
-        if (rc != 0) {
-            return false;
-        }
-    }
-    for (j = 0; j < f->p.track_count; ++j) {
-        coa_sweep_t t;
-        t.volume = f->tr[j].volume;
-        t.p0 = f->trs[j][k];
-        t.p1 = f->trs[j][k + 1u];
-        if (coa_conflict_volumes(s, &t)) {
-            return false;
-        }
-    }
-    return true;
-}
-
 static uint32_t gcd32(uint32_t a, uint32_t b)
 {
     while (b != 0u) {
@@ -381,7 +358,8 @@ static void oracle_init(oracle_t *o, const fx_t *f)
                         continue;
                     }
                     s = sweep_of(o, i, k, x, b);
-                    o->ok[i][k][x - lo_of(o, i, k)][a] = static_clear(o, &s, k) ? 1u : 0u;
+                    o->ok[i][k][x - lo_of(o, i, k)][a] =
+                        fx_static_clear(o->f, &s, k) ? 1u : 0u;
                 }
             }
         }

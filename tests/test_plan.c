@@ -218,29 +218,6 @@ static coa_sweep_t sweep_of(const fx_t *f, size_t v, uint32_t k, int32_t a, int3
     return s;
 }
 
-/* A sweep against obstacles and tracks over step k. */
-static bool static_ok(const fx_t *f, const coa_sweep_t *s, uint32_t k)
-{
-    size_t j;
-    for (j = 0; j < f->p.obstacle_count; ++j) {
-        int rc = coa_conflict_obstacle(s, &f->obs[j]);
-        REQUIRE(rc >= 0);
-        if (rc != 0) {
-            return false;
-        }
-    }
-    for (j = 0; j < f->p.track_count; ++j) {
-        coa_sweep_t t;
-        t.volume = f->tr[j].volume;
-        t.p0 = f->trs[j][k];
-        t.p1 = f->trs[j][k + 1u];
-        if (coa_conflict_volumes(s, &t)) {
-            return false;
-        }
-    }
-    return true;
-}
-
 /* Rows start at the initial offset, move by actions, respect max_offset. */
 static bool rows_well_formed(const fx_t *f, const int32_t *rows, const size_t *which, size_t count)
 {
@@ -278,7 +255,7 @@ static bool plan_conflict_free(const fx_t *f, const int32_t *rows, const size_t 
         for (i = 0; i < count; ++i) {
             const int32_t *ri = &rows[which[i] * ROW(f)];
             coa_sweep_t si = sweep_of(f, which[i], k, ri[k], ri[k + 1u]);
-            if (!static_ok(f, &si, k)) {
+            if (!fx_static_clear(f, &si, k)) {
                 return false;
             }
             for (j = i + 1u; j < count; ++j) {
@@ -516,7 +493,7 @@ static dp_out_t dp_solve(const fx_t *f, const size_t *sv, size_t m, const int32_
                     cell[i] = oc * 5u + (size_t)a[i];
                     if (dp_env[i][oc][a[i]] == 0) {
                         coa_sweep_t s = sweep_of(f, sv[i], k, o[i], to[i]);
-                        bool clear = static_ok(f, &s, k);
+                        bool clear = fx_static_clear(f, &s, k);
                         for (j = 0; clear && j < nfixed; ++j) {
                             const int32_t *r = &rows[fixed[j] * ROW(f)];
                             coa_sweep_t t = sweep_of(f, fixed[j], k, r[k], r[k + 1u]);
