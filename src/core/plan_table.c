@@ -117,6 +117,40 @@ static bool item_conflict(const row_item_t *it, const coa_sweep_t *s)
     return coa_conflict_volumes(s, &it->moving);
 }
 
+/* The offsets of row k whose steps can reach the (widened) item box vertically. A step
+ * from offset o climbs or dives at most s offsets, so its volume stays within o dh plus
+ * the lower reference altitude less s dh and the half height, and o dh plus the higher
+ * one plus s dh and the half height; offsets whose band misses the box are skipped
+ * before their five sweeps are built (on the paper they were most of the table's
+ * conflict work). Two offsets of margin on each side cover the rounding of this
+ * arithmetic, far below dh; the steps kept still go through the box and exact tests. */
+static void row_item_range(const row_ctx_t *r, const coa_box_t *item, int32_t *lo, int32_t *hi)
+{
+    const coa_problem_t *pr = r->pl->problem;
+    const size_t v = r->t->vehicle;
+    const coa_real_t dh = r->pl->dh[v];
+    const coa_real_t z0 = pr->references[v][r->k].z;
+    const coa_real_t z1 = pr->references[v][r->k + 1u].z;
+    const coa_real_t reach = (coa_real_t)r->t->steep * dh + pr->vehicles[v].volume.half_height;
+    coa_real_t below = (item->min.z - reach - (z0 > z1 ? z0 : z1)) / dh - (coa_real_t)2;
+    coa_real_t above = (item->max.z + reach - (z0 < z1 ? z0 : z1)) / dh + (coa_real_t)2;
+
+    *lo = r->lo;
+    *hi = r->hi;
+    /* Comparisons first, so that only values within the row are converted (and NaN,
+     * which no comparison passes, restricts nothing). */
+    if (below > (coa_real_t)r->hi || above < (coa_real_t)r->lo) {
+        *hi = *lo - 1;
+        return;
+    }
+    if (below > (coa_real_t)r->lo) {
+        *lo = (int32_t)below; /* truncation moves it down, or up by less than the margin */
+    }
+    if (above < (coa_real_t)r->hi) {
+        *hi = (int32_t)above;
+    }
+}
+
 /* Clears, in row k, the actions whose step conflicts with the item. */
 static void row_clear_item(const row_ctx_t *r, const row_item_t *it)
 {
@@ -127,10 +161,14 @@ static void row_clear_item(const row_ctx_t *r, const row_item_t *it)
     coa_box_t item = box_widened(it->bounds, slack);
     int32_t o;
 
+    int32_t lo;
+    int32_t hi;
+
     if (!coa_boxes_touch(&r->bounds, &item)) {
         return;
     }
-    for (o = r->lo; o <= r->hi; ++o) {
+    row_item_range(r, &item, &lo, &hi);
+    for (o = lo; o <= hi; ++o) {
         uint64_t *c = &r->row[o - r->lo];
         uint32_t a;
         for (a = 0; a < PLAN_ACTIONS; ++a) {
