@@ -431,6 +431,7 @@ typedef struct {
     bool enters[PLAN_MAXM];
     uint32_t options[PLAN_MAXM];
     plan_moves_t moves[PLAN_MAXM];         /* movers */
+    coa_cost_t move_inc[PLAN_MAXM][PLAN_ACTIONS]; /* movers: increase() of each move */
     coa_cost_t rest_min[PLAN_MAXM + 1u];   /* least increase of choosers c.. */
     coa_sweep_t sweep[PLAN_MAXM][PLAN_ACTIONS];
     uint8_t pair_ok[PLAN_MAXM][PLAN_MAXM][PLAN_ACTIONS][PLAN_ACTIONS]; /* 0 ?, 1 ok, 2 no */
@@ -440,8 +441,8 @@ typedef struct {
  * a mover, its move's increase (W * unit * dev, and the effort's, which may be negative
  * when the deviation's is positive); for a member entering at k + 1, the slack of its
  * entry offset (its cheapest cost through it less its cost alone). */
-static coa_cost_t increase(const coa_planner_t *pl, const choosers_t *ch, size_t c, uint32_t k,
-                           uint32_t t)
+static coa_cost_t increase_of(const coa_planner_t *pl, const choosers_t *ch, size_t c,
+                              uint32_t k, uint32_t t)
 {
     const size_t i = ch->member[c];
     const size_t v = pl->group.vehicle[i];
@@ -462,6 +463,13 @@ static coa_cost_t increase(const coa_planner_t *pl, const choosers_t *ch, size_t
     }
 }
 
+/* increase_of, from the movers' cache (the enumeration asks again for each branch above). */
+static coa_cost_t increase(const coa_planner_t *pl, const choosers_t *ch, size_t c, uint32_t k,
+                           uint32_t t)
+{
+    return ch->enters[c] ? increase_of(pl, ch, c, k, t) : ch->move_inc[c][t];
+}
+
 static void choosers_make(const coa_planner_t *pl, uint32_t n, choosers_t *ch)
 {
     const plan_group_t *g = &pl->group;
@@ -477,8 +485,12 @@ static void choosers_make(const coa_planner_t *pl, uint32_t n, choosers_t *ch)
         if (in_search(g, i, k)) {
             ch->member[c] = i;
             ch->enters[c] = false;
+            uint32_t t;
             plan_table_moves(plan_to_go(pl, i), k, off[i], &ch->moves[c]);
             ch->options[c] = ch->moves[c].count;
+            for (t = 0; t < ch->options[c]; ++t) {
+                ch->move_inc[c][t] = increase_of(pl, ch, c, k, t);
+            }
             ++ch->count;
         } else if (g->first[i] == k + 1u) {
             ch->member[c] = i;
