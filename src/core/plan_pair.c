@@ -132,13 +132,36 @@ static coa_cost_t *pair_cell(const plan_pair_t *p, uint32_t k, int32_t oa, int32
                      (size_t)(ob - c[2])];
 }
 
-/* One member's moves out of (k, o) as packed step costs and targets. */
+/* One member's moves out of (k, o) as packed step costs and targets, cheapest first by
+ * `alone`: the step plus the member's own cost to go after it, a lower bound of what the
+ * move costs the pair (a pair's cost to go is at least the sum of its members' own). */
 typedef struct {
     uint32_t count;
     int32_t to[PLAN_ACTIONS];
     coa_cost_t step[PLAN_ACTIONS];
+    coa_cost_t alone[PLAN_ACTIONS];
     coa_sweep_t sweep[PLAN_ACTIONS];
 } pair_moves_t;
+
+/* Inserts move n (the last) in `alone` order; ties keep action order. */
+static void pair_moves_sort(pair_moves_t *mv, uint32_t n)
+{
+    while (n > 0u && plan_cost_compare(mv->alone[n], mv->alone[n - 1u]) < 0) {
+        int32_t to = mv->to[n];
+        coa_cost_t step = mv->step[n];
+        coa_cost_t alone = mv->alone[n];
+        coa_sweep_t sweep = mv->sweep[n];
+        mv->to[n] = mv->to[n - 1u];
+        mv->step[n] = mv->step[n - 1u];
+        mv->alone[n] = mv->alone[n - 1u];
+        mv->sweep[n] = mv->sweep[n - 1u];
+        mv->to[n - 1u] = to;
+        mv->step[n - 1u] = step;
+        mv->alone[n - 1u] = alone;
+        mv->sweep[n - 1u] = sweep;
+        --n;
+    }
+}
 
 static void pair_moves(const coa_planner_t *pl, size_t i, uint32_t k, int32_t o, bool sweeps,
                        pair_moves_t *mv)
@@ -149,65 +172,127 @@ static void pair_moves(const coa_planner_t *pl, size_t i, uint32_t k, int32_t o,
     uint32_t a;
     mv->count = 0u;
     for (a = 0; a < PLAN_ACTIONS; ++a) {
+        const uint32_t n = mv->count;
         int32_t to;
         if ((mask & (1u << a)) == 0u) {
             continue;
         }
         to = o + coa_action_delta((coa_action_t)a, t->steep);
-        mv->to[mv->count] = to;
-        mv->step[mv->count] =
+        mv->to[n] = to;
+        mv->step[n] =
             plan_pack(plan_units(pl, v, (uint64_t)coa_area_scaled(o, to, 2u * t->steep)),
                       coa_action_effort((coa_action_t)a));
+        mv->alone[n] = plan_cost_add(mv->step[n],
+                                     plan_cell_cost(pl, v, plan_table_at(t, k + 1u, to)));
         if (sweeps) {
-            mv->sweep[mv->count] = plan_vehicle_sweep(pl->problem, pl->dh, v, k, o, k + 1u, to);
+            mv->sweep[n] = plan_vehicle_sweep(pl->problem, pl->dh, v, k, o, k + 1u, to);
         }
+        pair_moves_sort(mv, n);
         ++mv->count;
     }
 }
 
-/* The cost to go after the pair's moves to (k + 1, a2, b2): from the next row, or past
- * the last the sum of their own. */
-static coa_cost_t pair_next(const coa_planner_t *pl, const plan_pair_t *p, size_t a, size_t b,
-                            uint32_t k, int32_t a2, int32_t b2)
+/* Row k + 1 of a pair, as pair_value reads it for every combination of moves: NULL
+ * cells past the pair's last row, where the pair's cost to go is the sum of its members'
+ * own (so a combination costs exactly its two moves' `alone`). */
+typedef struct {
+    const coa_cost_t *cells;
+    int16_t a_lo, a_hi, b_lo, b_hi;
+    size_t b_width;
+} pair_next_t;
+
+static pair_next_t pair_next_row(const plan_pair_t *p, uint32_t k)
 {
-    const coa_cost_t *c;
-    if (k == p->last) {
-        uint64_t ca = plan_table_at(plan_to_go(pl, a), k + 1u, a2);
-        uint64_t cb = plan_table_at(plan_to_go(pl, b), k + 1u, b2);
-        return plan_cost_add(plan_cell_cost(pl, pl->group.vehicle[a], ca),
-                             plan_cell_cost(pl, pl->group.vehicle[b], cb));
+    pair_next_t n = {NULL, 0, -1, 0, -1, 0u};
+    if (k < p->last) {
+        const size_t r = (size_t)(k + 1u - p->first);
+        const int16_t *c = &p->row_lo[4u * r];
+        n.cells = &p->cells[p->row_base[r]];
+        n.a_lo = c[0];
+        n.a_hi = c[1];
+        n.b_lo = c[2];
+        n.b_hi = c[3];
+        n.b_width = width(c[2], c[3]);
     }
-    c = pair_cell(p, k + 1u, a2, b2);
-    return c == NULL ? PLAN_COST_DEAD : *c;
+    return n;
 }
 
-/* The pair's cell at (k, oa, ob) from the cells of row k + 1. */
-static coa_cost_t pair_value(const coa_planner_t *pl, const plan_pair_t *p, size_t a, size_t b,
-                             uint32_t k, int32_t ob, const pair_moves_t *ma, bool near)
+/* What moves x of a and y of b cost the pair from (k, ., .) on, conflicts aside. */
+static coa_cost_t pair_next(const pair_next_t *n, const pair_moves_t *ma, uint32_t x,
+                            const pair_moves_t *mb, uint32_t y)
+{
+    const int32_t a2 = ma->to[x];
+    const int32_t b2 = mb->to[y];
+    if (n->cells == NULL) {
+        return plan_cost_add(ma->alone[x], mb->alone[y]);
+    }
+    if (a2 < n->a_lo || a2 > n->a_hi || b2 < n->b_lo || b2 > n->b_hi) {
+        return PLAN_COST_DEAD;
+    }
+    {
+        coa_cost_t c = n->cells[(size_t)(a2 - n->a_lo) * n->b_width + (size_t)(b2 - n->b_lo)];
+        return plan_cost_dead(c) ? c : plan_cost_add(c, plan_cost_add(ma->step[x], mb->step[y]));
+    }
+}
+
+/* The pair's cell at (k, oa, ob) from the cells of row k + 1, given both members' moves
+ * out of it. */
+static coa_cost_t pair_value(const pair_next_t *next, const pair_moves_t *ma,
+                             const pair_moves_t *mb, bool near)
 {
     coa_cost_t best = PLAN_COST_DEAD;
-    pair_moves_t mb;
     uint32_t x;
     uint32_t y;
 
-    pair_moves(pl, b, k, ob, near, &mb);
+    /* Moves come cheapest alone first and a combination costs at least the sum of its
+     * two `alone`, so the loops stop once that sum cannot beat the best found: at once
+     * where the members cannot meet (the first combination costs just that). */
     for (x = 0; x < ma->count; ++x) {
-        for (y = 0; y < mb.count; ++y) {
-            coa_cost_t c = pair_next(pl, p, a, b, k, ma->to[x], mb.to[y]);
-            if (plan_cost_dead(c)) {
+        if (mb->count == 0u ||
+            plan_cost_compare(plan_cost_add(ma->alone[x], mb->alone[0]), best) >= 0) {
+            break;
+        }
+        for (y = 0; y < mb->count; ++y) {
+            coa_cost_t c;
+            if (plan_cost_compare(plan_cost_add(ma->alone[x], mb->alone[y]), best) >= 0) {
+                break;
+            }
+            c = pair_next(next, ma, x, mb, y);
+            if (plan_cost_dead(c) || plan_cost_compare(c, best) >= 0) {
                 continue;
             }
-            c = plan_cost_add(c, plan_cost_add(ma->step[x], mb.step[y]));
-            if (plan_cost_compare(c, best) >= 0) {
-                continue;
-            }
-            if (near && coa_conflict_volumes(&ma->sweep[x], &mb.sweep[y])) {
+            if (near && coa_conflict_volumes(&ma->sweep[x], &mb->sweep[y])) {
                 continue;
             }
             best = c;
         }
     }
     return best;
+}
+
+/* Offsets of b whose moves (and sweeps) are built once per row rather than once per cell:
+ * the sweeps were a fifth of the paper's planning time. A block, not the whole row, keeps
+ * the stack bounded (a few KiB on the firmware's 8 KiB); a's moves are built once per
+ * block. */
+#define PAIR_BLOCK 8
+
+/* A member's slack at (k, o) and, when live, its moves out of it. */
+static coa_cost_t pair_side(const coa_planner_t *pl, size_t i, uint32_t k, int32_t o, bool near,
+                            pair_moves_t *mv)
+{
+    coa_cost_t s = slack_of(pl, i, k, o);
+    mv->count = 0u;
+    if (!plan_cost_dead(s)) {
+        pair_moves(pl, i, k, o, near, mv);
+    }
+    return s;
+}
+
+/* Whether a pair state whose members have these slacks can be on a plan within the cap. */
+static bool pair_live(coa_cost_t sa, coa_cost_t sb, const coa_cost_t *slack)
+{
+    return !plan_cost_dead(sa) && !plan_cost_dead(sb) &&
+           (slack == NULL || plan_cost_compare(plan_cost_add(sa, sb), *slack) <= 0);
 }
 
 /* Fills row k of pair p. */
@@ -217,25 +302,27 @@ static void pair_row(coa_planner_t *pl, plan_pair_t *p, size_t a, size_t b, uint
     const size_t pi = plan_pair_index(a, b, pl->group.count);
     const bool near = k >= pl->group.near_first[pi] && k <= pl->group.near_last[pi];
     const int16_t *c = &p->row_lo[4u * (size_t)(k - p->first)];
-    int32_t oa;
-    int32_t ob;
+    const pair_next_t next = pair_next_row(p, k);
+    pair_moves_t mb[PAIR_BLOCK];
+    coa_cost_t sb[PAIR_BLOCK];
+    int32_t ob0;
 
-    for (oa = c[0]; oa <= c[1]; ++oa) {
-        coa_cost_t sa = slack_of(pl, a, k, oa);
-        pair_moves_t ma;
-        ma.count = 0u;
-        if (!plan_cost_dead(sa)) {
-            pair_moves(pl, a, k, oa, near, &ma);
+    for (ob0 = c[2]; ob0 <= c[3]; ob0 += PAIR_BLOCK) {
+        const int32_t n = c[3] - ob0 + 1 < PAIR_BLOCK ? c[3] - ob0 + 1 : PAIR_BLOCK;
+        int32_t oa;
+        int32_t j;
+        for (j = 0; j < n; ++j) {
+            sb[j] = pair_side(pl, b, k, ob0 + j, near, &mb[j]);
         }
-        for (ob = c[2]; ob <= c[3]; ++ob) {
-            coa_cost_t *cell = pair_cell(p, k, oa, ob);
-            coa_cost_t sb = slack_of(pl, b, k, ob);
-            *cell = PLAN_COST_DEAD;
-            if (plan_cost_dead(sa) || plan_cost_dead(sb) ||
-                (slack != NULL && plan_cost_compare(plan_cost_add(sa, sb), *slack) > 0)) {
-                continue;
+        for (oa = c[0]; oa <= c[1]; ++oa) {
+            pair_moves_t ma;
+            coa_cost_t sa = pair_side(pl, a, k, oa, near, &ma);
+            coa_cost_t *cell = pair_cell(p, k, oa, ob0);
+            for (j = 0; j < n; ++j) {
+                cell[j] = pair_live(sa, sb[j], slack)
+                              ? pair_value(&next, &ma, &mb[j], near)
+                              : PLAN_COST_DEAD;
             }
-            *cell = pair_value(pl, p, a, b, k, ob, &ma, near);
         }
     }
 }
