@@ -80,6 +80,7 @@ typedef struct {
     int32_t limit;   /* L: the largest |offset| */
     uint32_t steep;  /* s */
     uint32_t horizon;
+    uint32_t growing; /* q = L / s: rows 0..q are 2ks + 1 wide, the later ones 2L + 1 */
     uint64_t *cells;
 } plan_table_t;
 
@@ -331,11 +332,38 @@ uint64_t plan_table_cells(uint32_t horizon, uint32_t steep, int32_t limit);
 /* Widest row of such a table: min(2Ns + 1, 2L + 1). */
 uint64_t plan_table_row_width(uint32_t horizon, uint32_t steep, int32_t limit);
 
-int32_t plan_row_lo(const plan_table_t *t, uint32_t k);
-int32_t plan_row_hi(const plan_table_t *t, uint32_t k);
+/* Where row k starts in a table of steep factor s, offset bound L and q = L / s. Inline,
+ * with q kept in the table, because every search step and pair cell reads table cells
+ * (a division and a call per read were a tenth of the paper's planning time). */
+static inline uint64_t plan_row_base(uint32_t k, uint32_t steep, uint32_t q, int32_t limit)
+{
+    const uint64_t s = steep;
+    const uint64_t kk = k;
+    if (kk <= (uint64_t)q + 1u) {
+        return s * kk * (kk - 1u) + kk;
+    }
+    return s * ((uint64_t)q + 1u) * q + ((uint64_t)q + 1u) +
+           (kk - q - 1u) * (2u * (uint64_t)limit + 1u);
+}
+
+static inline int32_t plan_row_lo(const plan_table_t *t, uint32_t k)
+{
+    int64_t lo = (int64_t)t->origin - (int64_t)k * t->steep;
+    return lo < -(int64_t)t->limit ? -t->limit : (int32_t)lo;
+}
+
+static inline int32_t plan_row_hi(const plan_table_t *t, uint32_t k)
+{
+    int64_t hi = (int64_t)t->origin + (int64_t)k * t->steep;
+    return hi > (int64_t)t->limit ? t->limit : (int32_t)hi;
+}
 
 /* The cell of (k, offset) in a table. Precondition: the offset is in row k. */
-uint64_t plan_table_at(const plan_table_t *t, uint32_t k, int32_t offset);
+static inline uint64_t plan_table_at(const plan_table_t *t, uint32_t k, int32_t offset)
+{
+    return t->cells[plan_row_base(k, t->steep, t->growing, t->limit) +
+                    (uint64_t)(offset - plan_row_lo(t, k))];
+}
 
 /* Builds cost-to-go table t for vehicle v against the obstacles, the tracks and the
  * vehicles fixed[0..nfixed-1] flying their rows of pl->rows. */

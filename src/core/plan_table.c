@@ -19,22 +19,9 @@
  */
 #include "plan_internal.h"
 
-/* Where row k starts: rows 0..q (q = L / s) are 2ks + 1 wide, the others 2L + 1. */
-static uint64_t row_base(uint32_t k, uint32_t steep, int32_t limit)
-{
-    uint64_t s = steep;
-    uint64_t q = (uint64_t)limit / s;
-    uint64_t kk = k;
-
-    if (kk <= q + 1u) {
-        return s * kk * (kk - 1u) + kk;
-    }
-    return s * (q + 1u) * q + (q + 1u) + (kk - q - 1u) * (2u * (uint64_t)limit + 1u);
-}
-
 uint64_t plan_table_cells(uint32_t horizon, uint32_t steep, int32_t limit)
 {
-    return row_base(horizon + 1u, steep, limit);
+    return plan_row_base(horizon + 1u, steep, (uint32_t)limit / steep, limit);
 }
 
 uint64_t plan_table_row_width(uint32_t horizon, uint32_t steep, int32_t limit)
@@ -44,31 +31,14 @@ uint64_t plan_table_row_width(uint32_t horizon, uint32_t steep, int32_t limit)
     return reach < bound ? reach : bound;
 }
 
-int32_t plan_row_lo(const plan_table_t *t, uint32_t k)
-{
-    int64_t lo = (int64_t)t->origin - (int64_t)k * t->steep;
-    return lo < -(int64_t)t->limit ? -t->limit : (int32_t)lo;
-}
-
-int32_t plan_row_hi(const plan_table_t *t, uint32_t k)
-{
-    int64_t hi = (int64_t)t->origin + (int64_t)k * t->steep;
-    return hi > (int64_t)t->limit ? t->limit : (int32_t)hi;
-}
-
 static uint64_t *row_of(const plan_table_t *t, uint32_t k)
 {
-    return &t->cells[row_base(k, t->steep, t->limit)];
+    return &t->cells[plan_row_base(k, t->steep, t->growing, t->limit)];
 }
 
 static uint64_t *cell_of(const plan_table_t *t, uint32_t k, int32_t offset)
 {
     return &row_of(t, k)[offset - plan_row_lo(t, k)];
-}
-
-uint64_t plan_table_at(const plan_table_t *t, uint32_t k, int32_t offset)
-{
-    return *cell_of(t, k, offset);
 }
 
 /* ------------------------------------------------------------------------------------ */
@@ -292,6 +262,7 @@ void plan_table_build(coa_planner_t *pl, plan_table_t *tb, size_t v, const size_
     tb->origin = veh->initial_offset;
     tb->limit = pl->limit[v];
     tb->steep = veh->steep_factor;
+    tb->growing = (uint32_t)tb->limit / tb->steep;
     tb->horizon = horizon;
     for (o = plan_row_lo(tb, horizon); o <= plan_row_hi(tb, horizon); ++o) {
         *cell_of(tb, horizon, o) = cell_pack(0u, 0u, 0u);
@@ -367,6 +338,7 @@ void plan_table_build_from_start(plan_table_t *f, const plan_table_t *t)
     f->origin = t->origin;
     f->limit = t->limit;
     f->steep = t->steep;
+    f->growing = t->growing;
     f->horizon = t->horizon;
     for (k = 0; k <= t->horizon; ++k) {
         for (o = plan_row_lo(t, k); o <= plan_row_hi(t, k); ++o) {
