@@ -32,12 +32,6 @@
 /* ---------------------------------------------------------------------------------- */
 /* Intervals of the step parameter u.                                                  */
 
-/* An interval of u whose ends are open or closed as its constructor says; it is empty
- * unless lo < hi, so a single point never counts (see union_pieces for why that is safe). */
-typedef struct {
-    coa_real_t lo;
-    coa_real_t hi;
-} coa_span_t;
 
 static coa_span_t span_all(void)
 {
@@ -183,34 +177,51 @@ static bool span_meets_step(coa_span_t s)
 /* ---------------------------------------------------------------------------------- */
 /* Closed-form tests.                                                                  */
 
-bool coa_conflict_volumes(const coa_sweep_t *a, const coa_sweep_t *b)
+coa_span_t coa_conflict_horizontal_span(const coa_sweep_t *a, const coa_sweep_t *b)
 {
     coa_real_t d0x = a->p0.x - b->p0.x;
     coa_real_t d0y = a->p0.y - b->p0.y;
-    coa_real_t d0z = a->p0.z - b->p0.z;
     coa_real_t vx = (a->p1.x - b->p1.x) - d0x;
     coa_real_t vy = (a->p1.y - b->p1.y) - d0y;
-    coa_real_t vz = (a->p1.z - b->p1.z) - d0z;
-    coa_real_t rsum = a->volume.radius + b->volume.radius;
-    coa_real_t hsum = a->volume.half_height + b->volume.half_height;
-    coa_span_t vert;
-    coa_span_t horiz;
+    return span_disc(d0x, d0y, vx, vy, a->volume.radius + b->volume.radius);
+}
 
-    vert = span_linear(d0z, vz, -hsum, hsum, false);
+/* The vertical half of coa_conflict_volumes, met with its horizontal span: the vertical
+ * test first because it is the cheap one and rules out most pairs. */
+static bool conflict_vertical(const coa_sweep_t *a, const coa_sweep_t *b,
+                              const coa_span_t *horizontal)
+{
+    coa_real_t d0z = a->p0.z - b->p0.z;
+    coa_real_t vz = (a->p1.z - b->p1.z) - d0z;
+    coa_real_t hsum = a->volume.half_height + b->volume.half_height;
+    coa_span_t vert = span_linear(d0z, vz, -hsum, hsum, false);
     if (!span_meets_step(vert)) {
         return false;
     }
-    horiz = span_disc(d0x, d0y, vx, vy, rsum);
-    return span_meets_step(span_meet(horiz, vert));
+    return span_meets_step(span_meet(horizontal != NULL ? *horizontal
+                                                        : coa_conflict_horizontal_span(a, b),
+                                     vert));
+}
+
+bool coa_conflict_volumes(const coa_sweep_t *a, const coa_sweep_t *b)
+{
+    return conflict_vertical(a, b, NULL);
+}
+
+bool coa_conflict_volumes_given(const coa_sweep_t *a, const coa_sweep_t *b,
+                                coa_span_t horizontal)
+{
+    return conflict_vertical(a, b, &horizontal);
+}
+
+bool coa_conflict_span_in_step(coa_span_t s)
+{
+    return span_meets_step(s);
 }
 
 bool coa_conflict_horizontal(const coa_sweep_t *a, const coa_sweep_t *b)
 {
-    coa_real_t d0x = a->p0.x - b->p0.x;
-    coa_real_t d0y = a->p0.y - b->p0.y;
-    coa_real_t vx = (a->p1.x - b->p1.x) - d0x;
-    coa_real_t vy = (a->p1.y - b->p1.y) - d0y;
-    return span_meets_step(span_disc(d0x, d0y, vx, vy, a->volume.radius + b->volume.radius));
+    return span_meets_step(coa_conflict_horizontal_span(a, b));
 }
 
 /* The open rounded rectangle {distance to the closed rectangle < r} is convex, so its

@@ -16,6 +16,26 @@
 
 #define WS_ALIGN ((size_t)COA_WORKSPACE_ALIGNMENT)
 
+/* An interval of a step's parameter u (geometry.c): empty unless lo < hi, so a single
+ * point never counts. */
+typedef struct {
+    coa_real_t lo;
+    coa_real_t hi;
+} coa_span_t;
+
+/* coa_conflict_volumes in two halves, for callers that test many pairs of sweeps whose
+ * horizontal paths are the same and only their altitudes differ (every offset of two
+ * vehicles at one step): the u where the discs come within r_a + r_b, computed once, then
+ * per pair the vertical test met with it. coa_conflict_volumes_given(a, b,
+ * coa_conflict_horizontal_span(a', b')) is exactly coa_conflict_volumes(a, b) when a', b'
+ * have a's and b's x, y and radii (the same arithmetic on the same numbers). */
+coa_span_t coa_conflict_horizontal_span(const coa_sweep_t *a, const coa_sweep_t *b);
+bool coa_conflict_volumes_given(const coa_sweep_t *a, const coa_sweep_t *b, coa_span_t horizontal);
+
+/* Whether some u of the closed step [0, 1] is in the span: false means no pair of sweeps
+ * with these horizontal paths can conflict, whatever their altitudes. */
+bool coa_conflict_span_in_step(coa_span_t s);
+
 /* a * b, false when it would overflow size_t. */
 static inline bool size_mul(size_t a, size_t b, size_t *out)
 {

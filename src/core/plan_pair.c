@@ -238,7 +238,7 @@ static coa_cost_t pair_next(const pair_next_t *n, const pair_moves_t *ma, uint32
 /* The pair's cell at (k, oa, ob) from the cells of row k + 1, given both members' moves
  * out of it. */
 static coa_cost_t pair_value(const pair_next_t *next, const pair_moves_t *ma,
-                             const pair_moves_t *mb, bool near)
+                             const pair_moves_t *mb, const coa_span_t *near)
 {
     coa_cost_t best = PLAN_COST_DEAD;
     uint32_t x;
@@ -261,7 +261,7 @@ static coa_cost_t pair_value(const pair_next_t *next, const pair_moves_t *ma,
             if (plan_cost_dead(c) || plan_cost_compare(c, best) >= 0) {
                 continue;
             }
-            if (near && coa_conflict_volumes(&ma->sweep[x], &mb->sweep[y])) {
+            if (near != NULL && coa_conflict_volumes_given(&ma->sweep[x], &mb->sweep[y], *near)) {
                 continue;
             }
             best = c;
@@ -295,14 +295,33 @@ static bool pair_live(coa_cost_t sa, coa_cost_t sb, const coa_cost_t *slack)
            (slack == NULL || plan_cost_compare(plan_cost_add(sa, sb), *slack) <= 0);
 }
 
+/* Whether a and b can meet at step k: one of the steps they can meet at (near_first..
+ * near_last), with horizontal paths that come close within it. Every pair of their sweeps
+ * at k has the same horizontal paths (offsets move them vertically only), so the
+ * horizontal half of the conflict test is computed here once for the row. */
+static bool pair_near(const coa_planner_t *pl, size_t a, size_t b, uint32_t k,
+                      coa_span_t *horizontal)
+{
+    const size_t pi = plan_pair_index(a, b, pl->group.count);
+    coa_sweep_t sa;
+    coa_sweep_t sb;
+    if (k < pl->group.near_first[pi] || k > pl->group.near_last[pi]) {
+        return false;
+    }
+    sa = plan_vehicle_sweep(pl->problem, pl->dh, pl->group.vehicle[a], k, 0, k + 1u, 0);
+    sb = plan_vehicle_sweep(pl->problem, pl->dh, pl->group.vehicle[b], k, 0, k + 1u, 0);
+    *horizontal = coa_conflict_horizontal_span(&sa, &sb);
+    return coa_conflict_span_in_step(*horizontal);
+}
+
 /* Fills row k of pair p. */
 static void pair_row(coa_planner_t *pl, plan_pair_t *p, size_t a, size_t b, uint32_t k,
                      const coa_cost_t *slack)
 {
-    const size_t pi = plan_pair_index(a, b, pl->group.count);
-    const bool near = k >= pl->group.near_first[pi] && k <= pl->group.near_last[pi];
     const int16_t *c = &p->row_lo[4u * (size_t)(k - p->first)];
     const pair_next_t next = pair_next_row(p, k);
+    coa_span_t horizontal;
+    const bool near = pair_near(pl, a, b, k, &horizontal);
     pair_moves_t mb[PAIR_BLOCK];
     coa_cost_t sb[PAIR_BLOCK];
     int32_t ob0;
@@ -320,7 +339,7 @@ static void pair_row(coa_planner_t *pl, plan_pair_t *p, size_t a, size_t b, uint
             coa_cost_t *cell = pair_cell(p, k, oa, ob0);
             for (j = 0; j < n; ++j) {
                 cell[j] = pair_live(sa, sb[j], slack)
-                              ? pair_value(&next, &ma, &mb[j], near)
+                              ? pair_value(&next, &ma, &mb[j], near ? &horizontal : NULL)
                               : PLAN_COST_DEAD;
             }
         }
