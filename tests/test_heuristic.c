@@ -1557,6 +1557,30 @@ START_TEST(matching_exact)
 }
 END_TEST
 
+/* The planner's step area (plan_area, the library's formula without its divisions where
+ * a step does not cross the reference) against coa_area_scaled, on every step of every
+ * steep factor near the reference, where the crossing cases are, and at the offset
+ * bound. */
+START_TEST(area_exact)
+{
+    uint32_t s;
+    for (s = 1u; s <= COA_MAX_STEEP_FACTOR; ++s) {
+        int32_t a;
+        for (a = -40; a <= 40; ++a) {
+            int32_t d;
+            for (d = -(int32_t)s; d <= (int32_t)s; ++d) {
+                int32_t far = a < 0 ? -COA_MAX_OFFSET - a : COA_MAX_OFFSET - a;
+                ck_assert_uint_eq(plan_area(a, a + d, s), (uint64_t)coa_area_scaled(a, a + d, 2u * s));
+                if (far + d >= -COA_MAX_OFFSET && far + d <= COA_MAX_OFFSET) {
+                    ck_assert_uint_eq(plan_area(far, far + d, s),
+                                      (uint64_t)coa_area_scaled(far, far + d, 2u * s));
+                }
+            }
+        }
+    }
+}
+END_TEST
+
 static Suite *suite(void)
 {
     Suite *s = suite_create("heuristic");
@@ -1568,6 +1592,7 @@ static Suite *suite(void)
     tcase_add_test(tc, joint_two);
     tcase_add_test(tc, joint_three);
     tcase_add_test(tc, matching_exact);
+    tcase_add_test(tc, area_exact);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -477,7 +477,7 @@ coa_cost_t plan_row_units(const coa_planner_t *pl, size_t v, const int32_t *row,
     uint32_t k;
     for (k = 0; k < pl->problem->horizon; ++k) {
         int act = coa_action_between(row[k], row[k + 1u], steep);
-        own += (uint64_t)coa_area_scaled(row[k], row[k + 1u], 2u * steep);
+        own += plan_area(row[k], row[k + 1u], steep);
         eff += coa_action_effort((coa_action_t)(act < 0 ? 0 : act));
     }
     if (effort != NULL) {

@@ -325,6 +325,18 @@ coa_sweep_t plan_vehicle_sweep(const coa_problem_t *pr, const coa_real_t *dh, si
  * the instant t_k0). */
 bool plan_static_clear(const coa_problem_t *pr, const coa_sweep_t *s, uint32_t k0, uint32_t k1);
 
+/* A step's area in the planner's own units, coa_area_scaled(a, b, 2s) exactly, whose
+ * divisions were a tenth of a plan's time: a step that does not cross the reference is
+ * the trapezoid (|a| + |b|) / 2 times 2s, an integer; only a crossing one (|a|, |b| <= s)
+ * takes the library's general path. */
+static inline uint64_t plan_area(int32_t a, int32_t b, uint32_t steep)
+{
+    if ((a < 0 && b > 0) || (a > 0 && b < 0)) {
+        return (uint64_t)coa_area_scaled(a, b, 2u * steep);
+    }
+    return ((uint64_t)(a < 0 ? -(int64_t)a : a) + (uint64_t)(b < 0 ? -(int64_t)b : b)) * steep;
+}
+
 /* Cells of a table for horizon N, steep factor s and offset bound L (0 when it would not
  * fit 64 bits, which the limits of common.h rule out). */
 uint64_t plan_table_cells(uint32_t horizon, uint32_t steep, int32_t limit);

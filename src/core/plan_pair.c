@@ -180,7 +180,7 @@ static void pair_moves(const coa_planner_t *pl, size_t i, uint32_t k, int32_t o,
         to = o + coa_action_delta((coa_action_t)a, t->steep);
         mv->to[n] = to;
         mv->step[n] =
-            plan_pack(plan_units(pl, v, (uint64_t)coa_area_scaled(o, to, 2u * t->steep)),
+            plan_pack(plan_units(pl, v, plan_area(o, to, t->steep)),
                       coa_action_effort((coa_action_t)a));
         mv->alone[n] = plan_cost_add(mv->step[n],
                                      plan_cell_cost(pl, v, plan_table_at(t, k + 1u, to)));

@@ -683,8 +683,8 @@ static bool child_add(coa_planner_t *pl, const expansion_t *e, coa_cost_t f2, ui
             continue;
         }
         in.g = plan_cost_add(
-            in.g, plan_pack(plan_units(pl, v, (uint64_t)coa_area_scaled(
-                                                  from[i], e->off[i], 2u * plan_to_go(pl, i)->steep)),
+            in.g, plan_pack(plan_units(pl, v, plan_area(
+                                                  from[i], e->off[i], plan_to_go(pl, i)->steep)),
                             coa_action_effort((coa_action_t)e->ch.moves[c].action[t])));
         if (g->last[i] == e->k) { /* leaves the search: its cost to go is exact */
             in.g = plan_cost_add(in.g, own_to_go(pl, i, k1, e->off[i]));

@@ -216,7 +216,6 @@ static void row_moves(const plan_table_t *t, uint32_t k, int32_t lo, int32_t hi,
 /* Row k's costs to go from its remaining actions. */
 static void row_costs(const plan_table_t *t, uint32_t k, int32_t lo, int32_t hi, uint64_t *row)
 {
-    const uint32_t scale = 2u * t->steep;
     int32_t o;
     for (o = lo; o <= hi; ++o) {
         uint32_t mask = cell_mask(row[o - lo]);
@@ -227,7 +226,7 @@ static void row_costs(const plan_table_t *t, uint32_t k, int32_t lo, int32_t hi,
                 int32_t b = o + coa_action_delta((coa_action_t)a, t->steep);
                 uint64_t next = *cell_of(t, k + 1u, b);
                 /* Own units: an area times 2s is an integer (trajectory.h). */
-                uint64_t dev = cell_dev(next) + (uint64_t)coa_area_scaled(o, b, scale);
+                uint64_t dev = cell_dev(next) + plan_area(o, b, t->steep);
                 uint64_t eff = cell_eff(next) + coa_action_effort((coa_action_t)a);
                 uint64_t cost = (dev << (CELL_DEV_SHIFT - CELL_EFF_SHIFT)) | eff;
                 best = cost < best ? cost : best;
@@ -289,7 +288,6 @@ void plan_table_moves(const plan_table_t *t, uint32_t k, int32_t from, plan_move
 {
     const uint64_t here = *cell_of(t, k, from);
     const uint32_t mask = cell_mask(here);
-    const uint32_t scale = 2u * t->steep;
     uint32_t a;
 
     mv->count = 0u;
@@ -305,7 +303,7 @@ void plan_table_moves(const plan_table_t *t, uint32_t k, int32_t from, plan_move
         b = from + coa_action_delta((coa_action_t)a, t->steep);
         next = *cell_of(t, k + 1u, b);
         /* The table's minimum makes both increases lexicographically >= 0. */
-        dev = cell_dev(next) + (uint64_t)coa_area_scaled(from, b, scale) - cell_dev(here);
+        dev = cell_dev(next) + plan_area(from, b, t->steep) - cell_dev(here);
         eff = (int32_t)(cell_eff(next) + coa_action_effort((coa_action_t)a)) -
               (int32_t)cell_eff(here);
         /* Insertion: stable for equal increases, so ties keep coa_action_t order. */
@@ -330,7 +328,6 @@ void plan_table_moves(const plan_table_t *t, uint32_t k, int32_t from, plan_move
 
 void plan_table_build_from_start(plan_table_t *f, const plan_table_t *t)
 {
-    const uint32_t scale = 2u * t->steep;
     uint32_t k;
     int32_t o;
 
@@ -362,7 +359,7 @@ void plan_table_build_from_start(plan_table_t *f, const plan_table_t *t)
                     continue;
                 }
                 b = o + coa_action_delta((coa_action_t)a, t->steep);
-                cand = cell_pack(cell_dev(here) + (uint64_t)coa_area_scaled(o, b, scale),
+                cand = cell_pack(cell_dev(here) + plan_area(o, b, t->steep),
                                  cell_eff(here) + coa_action_effort((coa_action_t)a), 0u);
                 there = cell_of(f, k + 1u, b);
                 if (cand < *there) {
@@ -388,7 +385,6 @@ void plan_table_walk(coa_planner_t *pl, const plan_table_t *t, uint32_t k, int32
 void plan_table_walk_back(coa_planner_t *pl, const plan_table_t *t, const plan_table_t *f,
                           uint32_t k, int32_t offset)
 {
-    const uint32_t scale = 2u * t->steep;
     int32_t *row = &pl->rows[t->vehicle * ((size_t)t->horizon + 1u)];
 
     row[k] = offset;
@@ -406,7 +402,7 @@ void plan_table_walk_back(coa_planner_t *pl, const plan_table_t *t, const plan_t
             }
             prev = *cell_of(f, k - 1u, from);
             if (!cell_dead(prev) &&
-                cell_pack(cell_dev(prev) + (uint64_t)coa_area_scaled(from, offset, scale),
+                cell_pack(cell_dev(prev) + plan_area(from, offset, t->steep),
                           cell_eff(prev) + coa_action_effort((coa_action_t)a), 0u) == here) {
                 offset = from;
                 break;
