@@ -60,7 +60,7 @@ static coa_span_t span_meet(coa_span_t a, coa_span_t b)
 
 /* The u with p + u*v in (bmin, bmax) (open) or [bmin, bmax] (closed). Only the numbers
  * differ between the two: which ends belong to the set matters only when v == 0. */
-static coa_span_t span_linear(coa_real_t p, coa_real_t v, coa_real_t bmin, coa_real_t bmax,
+static inline coa_span_t span_linear(coa_real_t p, coa_real_t v, coa_real_t bmin, coa_real_t bmax,
                               bool closed)
 {
     coa_real_t t1;

@@ -31,12 +31,12 @@ uint64_t plan_table_row_width(uint32_t horizon, uint32_t steep, int32_t limit)
     return reach < bound ? reach : bound;
 }
 
-static uint64_t *row_of(const plan_table_t *t, uint32_t k)
+static inline uint64_t *row_of(const plan_table_t *t, uint32_t k)
 {
     return &t->cells[plan_row_base(k, t->steep, t->growing, t->limit)];
 }
 
-static uint64_t *cell_of(const plan_table_t *t, uint32_t k, int32_t offset)
+static inline uint64_t *cell_of(const plan_table_t *t, uint32_t k, int32_t offset)
 {
     return &row_of(t, k)[offset - plan_row_lo(t, k)];
 }
