@@ -21,7 +21,7 @@
 # Speed: the coordinator's plans must reach the vehicles before the next cycle starts, so
 # its planning gets (dt - collect) / speed wall seconds: 0.75 s / speed for dt = 1 s. The
 # paper scenario's heaviest plan (all three UAVs together, 1,331 nodes expanded) takes
-# about 4.6 ms in a RelWithDebInfo build and 20 ms under the sanitizers: --speed 20 (37.5 ms)
+# about 4.6 ms in a RelWithDebInfo build and 13 ms under the sanitizers: --speed 20 (37.5 ms)
 # flies without a late plan. A plan that comes late is refused by the vehicles and planned
 # again a cycle later. Every process warns on stderr when its work overran its cycle.
 #
