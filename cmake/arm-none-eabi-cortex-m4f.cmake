@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # Toolchain file: bare-metal Cortex-M4F with the single-precision FPU in hard-float ABI
 # (Debian: gcc-arm-none-eabi, libnewlib-arm-none-eabi).
 #

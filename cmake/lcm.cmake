@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # LCM messaging: the generated message types (lcmtypes/) and the validation and
 # conversion library coavoid_lcm (src/lcm/). Included from the top-level CMakeLists.txt
 # after coavoid_core is defined.

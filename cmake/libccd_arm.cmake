@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # libccd for the cross build (included from the top-level CMakeLists.txt when
 # cross-compiling). Debian's libccd-dev is a 64-bit, double-precision host library, so
 # libccd is built here from Debian's source package, in single precision, with the same

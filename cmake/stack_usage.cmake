@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # Injected into libccd's project (CMAKE_PROJECT_libccd_INCLUDE, cmake/libccd_arm.cmake):
 # a .su and a .ci file beside each object, for the firmware test's worst stack frame and
 # deepest call chain. Added to the

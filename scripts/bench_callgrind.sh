@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # A repeatable cost of planning the paper scenario: the instructions executed (callgrind's
 # Ir) by `coavoid plan scenarios/paper.json`, centralised and decoupled. Unlike times, the
 # count does not depend on the machine's load or clock, so it compares commits exactly
@@ -23,7 +24,7 @@ while [ $# -gt 0 ]; do
     case $1 in
     --build) build=${2:?--build: missing value}; shift 2 ;;
     --scenario) scenario=${2:?--scenario: missing value}; shift 2 ;;
-    -h | --help) sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h | --help) sed -n '3,18p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "bench_callgrind.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
     esac
 done

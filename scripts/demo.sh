@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # The coavoid demo: the ground coordinator, the world (terrain and tracks) and one vehicle
 # process per UAV of a scenario, exchanging intents and plans over LCM's UDP multicast on
 # this host, recorded by lcm-logger; then `coavoid summary` of the log: loss of

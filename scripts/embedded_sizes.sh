@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # Workspace sizes on the Cortex-M4F build, for docs/embedded.md. The firmware cannot run
 # here (no board, no emulator), so the size functions run on the host, built from the same
 # sources in single precision, and each result is moved to the target by one term: every

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
 """Builds the paper's illustrative encounter and checks it shows what the paper's figures do.
 
 Three UAVs in the vertical plane y = 0 (ids: 1 red, 2 blue, 3 green):

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # Fails when the core references a heap, stdio, clock, thread or LCM function.
 #   cmake -DLIB=<archive> -DNM=<nm> -P check_core_symbols.cmake
 # checks an archive's undefined symbols (what it needs from elsewhere); with -DLINKED=ON,

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * plan_fixture.h: a planner problem held in fixed arrays, and the calls that fill it, for
  * the suites that build problems (test_plan, test_plan_oracle, test_heuristic). Included,

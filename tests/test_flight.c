@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * test_flight.c: the flight record (apps/node/flight.h): loss of separation by the
  * contract's semantics on hand-made flights whose answers are known (an exact touch is

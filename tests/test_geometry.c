@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * test_geometry.c: the exact conflict tests against dense time sampling.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * test_heuristic.c: the planner's exact tables and the joint search's heuristic against
  * brute force on small random problems.

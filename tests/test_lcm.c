@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * LCM messages: every type round-trips through encode/decode and through the core
  * types; each validation rule refuses its bad message; an accepted intent is one the

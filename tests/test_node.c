@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * test_node: the nodes of apps/node (node.h) over LCM's in-process provider, driven on a
  * hand-set clock:

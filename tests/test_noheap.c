@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * test_noheap.c: the planner and the predictor never touch the heap.
  *

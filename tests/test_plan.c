@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * test_plan.c: the A* planner against exhaustive searches written here, plus the budget,
  * workspace, reordering and edge-case contracts of plan.h.

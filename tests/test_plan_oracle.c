@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * test_plan_oracle.c: the planner of src/core against the planner it replaced.
  *

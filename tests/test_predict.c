@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * test_predict.c: collision prediction (predict.h) against independent references.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * test_support.h: helpers the Check suites share (included, not a suite of its own: the
  * tests' glob only picks up test_*.c).

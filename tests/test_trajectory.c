@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * test_trajectory.c: the trajectory module against hand-computed values, independent
  * oracles and a brute-force cost-to-go.

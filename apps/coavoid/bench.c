@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * coavoid bench predict: times the core's prediction cycle (coa_predict) on a random but
  * realistic airspace. See BENCH_PREDICT_USAGE below and docs/benchmarks.md.

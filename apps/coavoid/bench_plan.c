@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * coavoid bench plan: times the core's planner (coa_plan_centralised and
  * coa_plan_decoupled) on the paper scenario and on seeded random encounters of 2 to 5 UAVs.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * bench_support.h: what `coavoid bench predict` and `coavoid bench plan` share: the seeded
  * PRNG that makes a seed give the same airspace or encounters everywhere, and the timing

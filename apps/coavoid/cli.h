@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * cli.h: what every coavoid command shares: exit statuses, the one-line error report,
  * option parsing in one style ("--opt value" or "--opt=value", each option at most once),

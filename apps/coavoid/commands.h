@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * commands.h: the coavoid subcommands main() dispatches to. Each takes main's argc and
  * argv unchanged (argv[1] is the command's name, its arguments start at argv[2]; bench

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * encounter.c: the seeded random encounters of bench plan and montecarlo (encounter.h).
  */

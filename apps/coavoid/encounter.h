@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * encounter.h: seeded random encounters of n UAVs converging on one point, written as
  * scenario JSON (docs/scenario-format.md) so that they go through the scenario loader and are

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * judge.c: a scenario's closed-loop run as a flight record, judged (judge.h).
  */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * judge.h: a closed-loop run of a scenario as a flight record (flight.h), judged. What
  * `coavoid sim` (from its nodes' states) and `coavoid summary` (from a log's intents) both

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * coavoid: the command-line front end of the core. main() only dispatches; each command
  * lives in its own file (commands.h) and shares option parsing, error reporting and

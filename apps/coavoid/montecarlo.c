@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * coavoid montecarlo: the paper's question (does centralised planning succeed more often
  * and more cheaply than decoupled planning?) asked of thousands of seeded random

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * output.h: the result objects of docs/scenario-format.md ("Plan result", "Prediction result"),
  * printed as JSON.

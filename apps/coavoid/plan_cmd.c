@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * coavoid plan: reads a scenario (docs/scenario-format.md), plans altitude manoeuvres
  * centrally or decoupled, and prints the plan result as JSON. See PLAN_USAGE below.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * coavoid predict: one prediction cycle of the core (predict.h) over a scenario, printed
  * as docs/scenario-format.md's "Prediction result". See PREDICT_USAGE below.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * scenario.h: reading a scenario file (docs/scenario-format.md, "Scenario file") into core types.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * coavoid sim: the closed loop of docs/scenario-format.md ("Simulation result") in one
  * process. The world, one vehicle node per UAV and (centralised) the coordinator are the

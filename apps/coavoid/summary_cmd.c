@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * coavoid summary: what a real-time run flew, rebuilt from an lcm-logger log and judged
  * exactly as `coavoid sim` judges its own runs (flight.h). See SUMMARY_USAGE below.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * coavoid world: the terrain database and the tracker of a real-time run, standing in for
  * the ground station's sources: every cycle it publishes the scenario's obstacle map and

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * coavoid-coordinator: the ground station as a process of its own. Every cycle, a
  * collection time after the cycle starts, it predicts from the intents the vehicles

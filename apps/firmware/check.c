@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * check.c: the firmware check (coavoid-firmware-check.elf). Runs fixed planning problems
  * (check_problems.h, generated from the scenarios in tests/firmware/qemu/) through the core on the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * firmware.h: the example firmware's collision-avoidance task (task.c), which is plain C
  * on the core, and the board glue that drives it (main.c, startup.c).

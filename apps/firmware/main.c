@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * main.c: the example firmware's board side (STM32F405-class, 168 MHz): a SysTick
  * interrupt counts time, and the main loop runs the collision-avoidance task once per

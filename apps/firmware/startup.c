@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * startup.c: the C runtime of the example firmware (no crt0, no libc start-up code):
  * the vector table, and a reset handler that turns the FPU on, copies .data, clears .bss

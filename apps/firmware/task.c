@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * task.c: one UAV's collision-avoidance task (see firmware.h and docs/embedded.md). Plain
  * C on the core, nothing board-specific (that is main.c and startup.c).

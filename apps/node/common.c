@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * What the nodes share (node.h, node_internal.h): the clock arithmetic, the inbox that
  * decodes, validates, counts and stores what arrives, the view of one cycle, the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * The coordinator node (node.h, step 3 of the cycle): the ground station that predicts
  * from the intents of the cycle, plans each conflicting cluster in one composite search

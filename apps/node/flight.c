@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * flight.c: judging a flight record (flight.h) by the contract's conflict semantics and
  * printing it as the "Simulation result" JSON or as text.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * flight.h: what a closed loop flew, judged and drawn. Filled by `coavoid sim` from its
  * nodes, and by `coavoid summary` from an lcm-logger log of a real-time run (the intents

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # Included from apps/CMakeLists.txt when the messaging library is built.
 # Sources of the node library are listed here by the people who write them.
 set(COAVOID_NODE_SOURCES "")

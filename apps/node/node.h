@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * node.h: the coavoid nodes (a UAV, the ground coordinator, and the "world" that stands
  * in for the terrain database and the tracker), written once and driven two ways:

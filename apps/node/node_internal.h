@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * node_internal.h: what the vehicle and the coordinator share beyond node.h (common.c):
  *   - the inbox: the LCM subscriptions, decoding and validation of what arrives, the

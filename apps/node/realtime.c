@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * realtime.c: the scenario clock, the options every real-time driver shares, and the
  * loop that calls the nodes at their times (realtime.h).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * realtime.h: running the nodes of node.h in real time, one process each (apps/vehicle,
  * apps/coordinator, `coavoid world`), over an LCM provider such as UDP multicast.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * svg.c: the figure of a flight record (flight.h), after the paper's figures: a top view
  * of the run, then one altitude-against-time panel per UAV with its reference dashed and

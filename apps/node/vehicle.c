@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * The vehicle node (node.h): one simulated UAV that flies its adopted plan, publishes its
  * intent, follows the coordinator while its heartbeat lasts and its plans come when they

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * The world node (node.h): a scenario's terrain database and tracker. Every cycle it
  * republishes the obstacle map (so that a node that joins late gets it) and each track's

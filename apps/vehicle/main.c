@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * coavoid-vehicle: one simulated UAV of a scenario as a process of its own. It flies its
  * route, publishes its intent every cycle, follows the coordinator's plans while the

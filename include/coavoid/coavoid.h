@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * coavoid.h: the whole core API in one include. See each module header for its contract:
  *   common.h     types, limits, status codes

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * coavoid: co-operative collision avoidance for UAVs with vertical manoeuvres.
  *

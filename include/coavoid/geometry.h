@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * geometry.h: protected volumes, obstacles and exact continuous-time conflict tests.
  *

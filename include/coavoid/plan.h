@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * plan.h: the A* planner, its fixed workspace, and the centralised and decoupled front ends.
  *

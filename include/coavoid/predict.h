@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * predict.h: collision prediction over the horizon, with probability of conflict, at
  * fleet scale, in caller-provided memory.

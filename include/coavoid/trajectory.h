@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * trajectory.h: vehicles, reference trajectories, tracks, the altitude-offset lattice and
  * the exact integer step costs.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 #include "coavoid/common.h"
 
 const char *coa_status_name(int status)

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * geometry.c: exact continuous-time conflict tests over one step.
  *

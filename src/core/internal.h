@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * internal.h: helpers the core's modules share. Private: not installed, not API.
  *

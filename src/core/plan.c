@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * plan.c: the planner's public entry points (see plan.h for the contract): workspace
  * sizing, problem checks, the decoupled front end, the entry of the centralised one

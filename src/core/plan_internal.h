@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * plan_internal.h: what the planner's sources share (private, not installed).
  *

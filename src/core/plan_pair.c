@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * plan_pair.c: the exact joint cost-to-go of pairs of group members over their encounter
  * (plan.h, "Heuristic").

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * plan_search.c: the joint A* search of a group of vehicles (plan.h, "The joint search").
  *

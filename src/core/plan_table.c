@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * plan_table.c: the exact cost-to-go and cost-from-start of each vehicle alone (plan.h,
  * "Heuristic"), and the plans read off them.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * predict.c: collision prediction over the horizon in a caller-provided workspace (see
  * predict.h for the contract and the probability model).

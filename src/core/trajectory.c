@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * trajectory.c: vehicle and track validation, reference and track sampling, the action
  * lattice and the exact integer step costs (see trajectory.h for the contract).

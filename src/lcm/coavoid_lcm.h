@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * coavoid_lcm.h: validation of LCM messages and conversion between them and core types.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * Validation of LCM messages and conversion to and from core types (coavoid_lcm.h).
  * Every rule is a REJECT(code, reason) with a reason naming the field, so a refusal

@@ -1,4 +1,5 @@
 #!/bin/bash
+# SPDX-License-Identifier: MIT
 # Every kind of bad input to `coavoid plan` must exit 2 with exactly one line on stderr,
 # starting "coavoid: " and naming the offending field or option, and print nothing on
 # stdout. Bad scenarios are derived from one good scenario written below.

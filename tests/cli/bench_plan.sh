@@ -1,4 +1,5 @@
 #!/bin/bash
+# SPDX-License-Identifier: MIT
 # `coavoid bench plan` runs on tiny sets and prints every field, in the table and in JSON;
 # the same seed gives the same work; a beta too small to solve anything is reported as
 # budget exhausted, not hidden; bad options exit 2 with one line naming the option. Never

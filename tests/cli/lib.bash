@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # Shared set-up of the command-line tests, sourced by tests/cli/*.sh as
 #   . "$(dirname "${BASH_SOURCE[0]}")/lib.bash" "$@"
 # It is named .bash, not .sh, because tests/CMakeLists.txt runs every tests/cli/*.sh as a

@@ -1,4 +1,5 @@
 #!/bin/bash
+# SPDX-License-Identifier: MIT
 # `coavoid montecarlo` on small runs: the CSV, the JSON summary and the SVG are well formed;
 # the summary is what the CSV says (recomputed here); a seed gives the same rows (times
 # aside) twice and with --jobs 1 or 2; every plan the centralised planner solves is at most

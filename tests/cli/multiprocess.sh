@@ -1,4 +1,5 @@
 #!/bin/bash
+# SPDX-License-Identifier: MIT
 # The real-time drivers as separate processes over LCM's UDP multicast, recorded by
 # lcm-logger, in a private network namespace (so the test works where the host has no
 # multicast route and never touches the host's network):

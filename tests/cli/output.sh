@@ -1,4 +1,5 @@
 #!/bin/bash
+# SPDX-License-Identifier: MIT
 # The result of `coavoid plan` follows docs/scenario-format.md ("Plan result") exactly: every
 # field with its type, offsets and actions that agree with each other and with the
 # scenario, per-vehicle costs that add up to the totals, and exit status 0 / 1 for

@@ -1,4 +1,5 @@
 #!/bin/bash
+# SPDX-License-Identifier: MIT
 # `coavoid predict` follows docs/scenario-format.md ("Prediction result") exactly on the shipped
 # scenarios and on a few written here (ids out of input order, initial offsets, tracks with
 # uncertainty); bad arguments exit 2 with one line naming the argument; and `coavoid bench

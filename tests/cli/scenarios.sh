@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # The shipped scenarios' outcomes, as issue 2 and the paper's figures state them.
 # Usage: scenarios.sh COAVOID SRC
 set -uo pipefail

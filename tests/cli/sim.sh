@@ -1,4 +1,5 @@
 #!/bin/bash
+# SPDX-License-Identifier: MIT
 # `coavoid sim` follows docs/scenario-format.md ("Simulation result"): every shipped scenario
 # that `coavoid plan` solves in a mode flies without a loss of separation in that mode,
 # K = 2N steps by default, K + 1 samples per UAV at t = k dt, each on its reference raised

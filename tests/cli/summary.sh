@@ -1,4 +1,5 @@
 #!/bin/bash
+# SPDX-License-Identifier: MIT
 # `coavoid summary` rebuilds a run from an lcm-logger log and judges it: on logs written by
 # test_flight --write-log (the paper scenario planned, a head-on encounter flown without
 # manoeuvre, logs with intents missing, an abandoned plan logged late, refused and foreign

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* A downstream user of the installed core: plans a head-on encounter of two UAVs in a
  * statically allocated workspace and exits 0 only when it is solved conflict-free. */
 #include <coavoid/coavoid.h>

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # Installs the build tree into a scratch prefix, then builds a consumer against it twice:
 # with find_package(coavoid) (CMake) and with pkg-config. Usage: run.sh SRC BUILD
 set -euo pipefail

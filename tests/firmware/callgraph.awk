@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # Worst stack depth of call chains from GCC's -fcallgraph-info=su graphs (.ci files, VCG).
 #   awk -v roots="main,coa_predict" -v indirect="f,g" -f callgraph.awk *.ci
 # For each root: the largest sum of frames along a call chain below it, and that chain.

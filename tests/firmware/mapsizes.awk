@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # Flash and RAM of a GNU ld map file by origin: the core, libccd, the firmware's own
 # objects, and newlib with libgcc (everything else). Input sections only: the linker's
 # alignment padding is not counted (the ELF's totals include it).

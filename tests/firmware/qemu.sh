@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # The firmware's planning on an emulated STM32F405 against the host's (docs/embedded.md):
 # runs coavoid-firmware-check.elf (apps/firmware/check.c, built by the `firmware` test's
 # cross build in BUILD/firmware-arm) in qemu's netduinoplus2 machine (Cortex-M4F, FPU)

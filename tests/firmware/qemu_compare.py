@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
 """Compares the firmware check's results (its semihosting output, apps/firmware/check.c)
 with the host's `coavoid plan` on the same scenarios, exactly.
 

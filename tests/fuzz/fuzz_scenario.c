@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * libFuzzer harness for the untrusted input of `coavoid plan`: scenario JSON text.
  *

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # Builds the scenario fuzzer with clang (libFuzzer + ASan + UBSan) and runs it for a fixed
 # number of inputs from the shipped scenarios. Usage: run.sh SRC [RUNS]
 # A fixed run count, not a time limit, keeps the test's verdict independent of machine load.

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
 """Single and double precision must give the same plans: runs both builds of coavoid on
 each scenario and compares what they print.
 

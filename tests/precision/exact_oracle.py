@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
 """The exact answer that `coavoid predict` must give on a scenario whose sampled
 positions are all exactly representable (random_scenarios.py --exact): for every pair of
 UAVs, and every UAV and track without sigma, the first step that holds a conflict, by the

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
 """Seeded random encounters built to make float and double disagree if they can.
 
 Usage: random_scenarios.py [--exact] SEED COUNT OUTDIR

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # Single and double precision plan identically: the shipped scenarios and seeded random
 # encounters aimed at exact touches, planned by both builds (compare.py), and the exact
 # conflict steps of the random ones checked in rational arithmetic (exact_oracle.py).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * plan_v1.c: the planner as it was before issue 11 (test-only reference).
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /*
  * plan_v1.h: the planner as it was before issue 11, kept as a test-only reference
  * (plan_v1.c). Same contract as plan.h's coa_planner_workspace_size, coa_planner_init,
