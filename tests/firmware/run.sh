@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # The Cortex-M4F firmware build (docs/embedded.md), as CI runs it: configures and builds
 # the cross tree with cmake/arm-none-eabi-cortex-m4f.cmake in BUILD/firmware-arm, then
 #   - fails if the ARM core archive or the linked firmware ELF references a heap or stdio
@@ -7,12 +8,13 @@
 #   - prints text, data and bss of the ELF, the core and libccd, the largest stack frames
 #     (-fstack-usage) and the deepest call chains (-fcallgraph-info=su, callgraph.awk),
 #     failing on recursion or a dynamic frame.
-# Usage: run.sh SRC BUILD [CCD_SOURCE_DIR]. A missing toolchain, newlib or libccd source
-# is a failure with the packages to install, not a skip: CI must run this.
+# Usage: run.sh SRC BUILD CCD_SOURCE_DIR (libccd's unpacked source, fetched beforehand by
+# scripts/fetch_libccd_source.sh: a test never downloads). A missing toolchain, newlib or
+# libccd source is a failure with what to install, not a skip: CI must run this.
 set -euo pipefail
-src=${1:?usage: run.sh SRC BUILD [CCD_SOURCE_DIR]}
-build=${2:?usage: run.sh SRC BUILD [CCD_SOURCE_DIR]}
-ccd_src=${3:-}
+src=${1:?usage: run.sh SRC BUILD CCD_SOURCE_DIR}
+build=${2:?usage: run.sh SRC BUILD CCD_SOURCE_DIR}
+ccd_src=${3:?usage: run.sh SRC BUILD CCD_SOURCE_DIR}
 arm=$build/firmware-arm
 cmake=${CMAKE:-cmake}
 prefix=arm-none-eabi-
@@ -25,10 +27,19 @@ libc=$("${prefix}gcc" -mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard
   -print-file-name=libc.a)
 [ -f "$libc" ] || die "newlib for Cortex-M4F hard float not found: apt-get install libnewlib-arm-none-eabi"
 
-args=(-S "$src" -B "$arm" -DCMAKE_TOOLCHAIN_FILE="$src/cmake/arm-none-eabi-cortex-m4f.cmake")
-if [ -n "$ccd_src" ]; then
-  args+=(-DCOAVOID_CCD_SOURCE_DIR="$ccd_src")
+[ -f "$ccd_src/src/ccd/config.h.cmake.in" ] ||
+  die "$ccd_src is not libccd's unpacked source: scripts/fetch_libccd_source.sh DIR, then -DCOAVOID_CCD_SOURCE_DIR=DIR/source"
+# The ARM tree is this test's own: one built from another libccd source (an earlier
+# configure, or the configure step's own fetch: libccd's ExternalProject cannot switch
+# sources) starts again. $arm/ccd-source names the source it was built from.
+if [ -d "$arm" ] && [ "$(cat "$arm/ccd-source" 2>/dev/null)" != "$ccd_src" ]; then
+  echo "firmware: $arm was not built from $ccd_src: rebuilding it"
+  rm -rf "$arm"
 fi
+mkdir -p "$arm"
+echo "$ccd_src" > "$arm/ccd-source"
+args=(-S "$src" -B "$arm" -DCMAKE_TOOLCHAIN_FILE="$src/cmake/arm-none-eabi-cortex-m4f.cmake"
+  -DCOAVOID_CCD_SOURCE_DIR="$ccd_src")
 # Configure output only when it fails (it says what is missing: a deb-src line, dpkg-dev).
 if ! log=$("$cmake" "${args[@]}" 2>&1); then
   echo "$log" >&2
