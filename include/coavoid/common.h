@@ -48,7 +48,7 @@ extern "C" {
  * Other differences: the planner's workspace is 2,112 bytes smaller in float (its fixed
  * header holds 62 sweeps and 32 climb steps of coa_real_t); the polytope test runs
  * libccd's MPR in libccd's own precision (double on the host whatever this is).
- * tests/precision checks this (README, "Precision"). */
+ * tests/precision checks this (docs/library.md, "Precision"). */
 #ifdef COA_SINGLE_PRECISION
 typedef float coa_real_t;
 #else

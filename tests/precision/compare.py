@@ -8,7 +8,7 @@ Usage: compare.py [--exact] DOUBLE_COAVOID SINGLE_COAVOID SCENARIO.json...
 Plans (`coavoid plan`, centralised, decoupled, and decoupled --reorder): the exit status
 and the whole result must be equal, every field of it, numbers compared exactly, except
 stats.time_us (a clock) and stats.workspace_bytes (the planner's fixed header holds
-per-step sweeps of coa_real_t, so it is smaller in float; see README, "Precision").
+per-step sweeps of coa_real_t, so it is smaller in float; see docs/library.md, "Precision").
 
 Predictions (`coavoid predict`): the exit status, the clusters and each conflict's kind,
 a, b and first_step must be equal; the real numbers a conflict reports are measured on

@@ -10,7 +10,7 @@ along the axes, 2^j m long; so every position the core computes from them is exa
 both precisions), the case where single and double precision must plan identically and
 where exact_oracle.py knows the right answer. Without it, routes also run along
 directions whose samples round (their lengths or fractions are not dyadic), where the two
-precisions may legitimately decide a touch differently (README, "Precision").
+precisions may legitimately decide a touch differently (docs/library.md, "Precision").
 
 Every number written is a multiple of 1/8 below 2^16 in magnitude (so exactly the same
 value in float and in double), and the encounters are aimed at the edges of the conflict
