@@ -20,13 +20,4 @@ endif()
 
 add_subdirectory(${PROJECT_SOURCE_DIR}/lcmtypes ${PROJECT_BINARY_DIR}/lcmtypes)
 
-add_library(coavoid_lcm STATIC
-  ${PROJECT_SOURCE_DIR}/src/lcm/convert.c)
-target_include_directories(coavoid_lcm PUBLIC ${PROJECT_SOURCE_DIR}/src/lcm)
-target_link_libraries(coavoid_lcm PUBLIC coavoid_core coavoid_lcmtypes)
-# The generated headers must exist before coavoid_lcm's sources compile, whatever the
-# generator's ordering between static libraries.
-add_dependencies(coavoid_lcm coavoid_lcmtypes_gen)
-# Lets tests/test_lcm.c (picked up by the tests' glob whatever the options) know that
-# the messaging library is there.
-target_compile_definitions(coavoid_lcm PUBLIC COAVOID_HAVE_LCM)
+add_subdirectory(${PROJECT_SOURCE_DIR}/src/lcm ${PROJECT_BINARY_DIR}/src/lcm)

@@ -17,7 +17,7 @@ struct_size() { # READELF OBJECT STRUCT
   "$1" --debug-dump=info "$2" | grep -A3 "DW_AT_name.*: $3\$" |
     sed -n 's/.*DW_AT_byte_size *: *//p' | head -n 1
 }
-objs=$arm/CMakeFiles/coavoid_core.dir/src/core
+objs=$arm/src/core/CMakeFiles/coavoid_core.dir
 arm_planner=$(struct_size arm-none-eabi-readelf "$objs/plan.c.obj" coa_planner)
 arm_predictor=$(struct_size arm-none-eabi-readelf "$objs/predict.c.obj" coa_predictor)
 

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * test_flight.c: the flight record (apps/node/flight.h): loss of separation by the
+ * test_flight.c: the flight record (src/flight/flight.h): loss of separation by the
  * contract's semantics on hand-made flights whose answers are known (an exact touch is
  * not a loss, a centimetre closer is, at the step where it happens), costs against hand
  * values and coa_plan_vehicle_cost, the pairwise listing against the core's answer on

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * test_node: the nodes of apps/node (node.h) over LCM's in-process provider, driven on a
+ * test_node: the nodes of src/node (node.h) over LCM's in-process provider, driven on a
  * hand-set clock:
  *   - what arrives is counted (undecodable bytes too) and never the node's own messages;
  *     another UAV's intents under the node's id are refused and reported as a fault;

@@ -2,7 +2,7 @@
 /*
  * coavoid sim: the closed loop of docs/scenario-format.md ("Simulation result") in one
  * process. The world, one vehicle node per UAV and (centralised) the coordinator are the
- * nodes the real-time apps run (apps/node), here sharing LCM's in-process provider
+ * nodes the real-time apps run (src/node), here sharing LCM's in-process provider
  * (memq) and a simulated clock, so a run is repeatable bit for bit. See SIM_USAGE.
  */
 #define _POSIX_C_SOURCE 200809L

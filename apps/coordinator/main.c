@@ -3,7 +3,7 @@
  * coavoid-coordinator: the ground station as a process of its own. Every cycle, a
  * collection time after the cycle starts, it predicts from the intents the vehicles
  * published, plans each conflicting cluster in one centralised search, and publishes the
- * plans, the conflict report and its heartbeat. The node is apps/node/coordinator.c; this
+ * plans, the conflict report and its heartbeat. The node is src/node/coordinator.c; this
  * file only reads the options and runs it in real time (realtime.h). See
  * COORDINATOR_USAGE below.
  */

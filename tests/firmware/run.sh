@@ -50,7 +50,7 @@ if ! log=$("$cmake" --build "$arm" -j2 2>&1); then
   die "building the ARM tree failed (see above)"
 fi
 
-core=$arm/libcoavoid_core.a
+core=$arm/src/core/libcoavoid_core.a
 elf=$arm/apps/firmware/coavoid-firmware.elf
 ccd=$arm/libccd-arm/lib/libccd.a
 map=$arm/apps/firmware/coavoid-firmware.map
@@ -91,7 +91,7 @@ report_frames() { # NAME DIR
           if (dyn != "") { printf "%s: unbounded stack frames:%s\n", name, dyn; exit 1 } }'
 }
 echo "== stack (largest single frame; a call chain adds its callers' frames)"
-report_frames core "$arm/CMakeFiles/coavoid_core.dir" || die "unbounded stack frame in the core"
+report_frames core "$arm/src/core/CMakeFiles/coavoid_core.dir" || die "unbounded stack frame in the core"
 # The example firmware's objects only: the check ELF (check.c) has a main of its own.
 fw_objs=$arm/apps/firmware/CMakeFiles/coavoid_firmware.dir
 report_frames firmware "$fw_objs" || die "unbounded stack frame in the firmware"
@@ -102,7 +102,7 @@ report_frames libccd "$arm/libccd-arm-build/src" || true
 # libccd's and the firmware's call graphs; libccd's only indirect calls are to the
 # callbacks geometry.c hands it. Recursion or a dynamic frame fails the test.
 echo "== stack (deepest call chain: frames summed, library leaves not included)"
-mapfile -t graphs < <(find "$arm/CMakeFiles/coavoid_core.dir" "$fw_objs" \
+mapfile -t graphs < <(find "$arm/src/core/CMakeFiles/coavoid_core.dir" "$fw_objs" \
   "$arm/libccd-arm-build/src" -name '*.ci' | sort)
 [ "${#graphs[@]}" -gt 0 ] || die "no .ci files (-fcallgraph-info=su missing?)"
 awk -v roots="main,fw_systick_handler,fw_task_cycle,coa_plan_decoupled,coa_plan_centralised,coa_predict" \

@@ -10,8 +10,8 @@ trap 'rm -rf "$work"' EXIT
 command -v clang >/dev/null || { echo "fuzz: clang is not installed" >&2; exit 1; }
 # shellcheck disable=SC2046
 clang -std=c11 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all \
-  -I"$src/include" -I"$src/apps/coavoid" $(pkg-config --cflags libcjson) \
-  "$src/tests/fuzz/fuzz_scenario.c" "$src/apps/coavoid/scenario.c" "$src"/src/core/*.c \
+  -I"$src/include" -I"$src/src/scenario" $(pkg-config --cflags libcjson) \
+  "$src/tests/fuzz/fuzz_scenario.c" "$src/src/scenario/scenario.c" "$src"/src/core/*.c \
   $(pkg-config --libs libcjson) -lccd -lm -o "$work/fuzz_scenario"
 mkdir -p "$work/corpus"
 cp "$src"/scenarios/*.json "$work/corpus/"
