@@ -16,7 +16,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#ifdef COAVOID_HAVE_NODE
 
 #include <math.h>
 
@@ -957,14 +956,3 @@ int main(int argc, char **argv)
     srunner_free(sr);
     return failed == 0 ? EXIT_SUCCESS : EXIT_FAILURE;
 }
-
-#else /* !COAVOID_HAVE_NODE */
-
-/* Built without the node library (COAVOID_BUILD_LCM=OFF): nothing to test. */
-int main(void)
-{
-    puts("test_flight: built without the node library, skipped");
-    return 77; /* ctest: skipped */
-}
-
-#endif

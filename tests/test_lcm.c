@@ -11,7 +11,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#ifdef COAVOID_HAVE_LCM
 
 #include "coavoid_lcm.h"
 #include "test_support.h"
@@ -1277,14 +1276,3 @@ int main(void)
     srunner_free(sr);
     return failed == 0 ? EXIT_SUCCESS : EXIT_FAILURE;
 }
-
-#else /* !COAVOID_HAVE_LCM */
-
-/* Built without LCM (COAVOID_BUILD_LCM=OFF): nothing to test. */
-int main(void)
-{
-    puts("test_lcm: built without LCM, skipped");
-    return 77; /* ctest: skipped */
-}
-
-#endif

@@ -25,7 +25,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#ifdef COAVOID_HAVE_NODE
 
 #include <math.h>
 #include <string.h>
@@ -1263,14 +1262,3 @@ int main(void)
     srunner_free(sr);
     return failed == 0 ? EXIT_SUCCESS : EXIT_FAILURE;
 }
-
-#else /* !COAVOID_HAVE_NODE */
-
-/* Built without LCM (COAVOID_BUILD_LCM=OFF): nothing to test. */
-int main(void)
-{
-    puts("test_node: built without the node library, skipped");
-    return 77; /* ctest: skipped */
-}
-
-#endif

@@ -22,14 +22,17 @@
 #include "cli.h"
 #include "commands.h"
 
-/* summary reads LCM logs and world publishes over LCM: only with the node library
- * (COAVOID_BUILD_LCM). */
+/* sim, summary and world run the nodes over LCM: they are built, and listed, only with
+ * the node library (COAVOID_BUILD_LCM, which gives this program COAVOID_HAVE_NODE). This is
+ * the one place where that option reaches the code: their sources are left out of the
+ * build otherwise, not replaced by stubs. */
 #ifdef COAVOID_HAVE_NODE
-#define USAGE_SUMMARY                                                                \
+#define USAGE_NODES                                                                  \
+    "  sim         fly a scenario in closed loop over the nodes (deterministic)\n"  \
     "  summary     judge a real-time run from its lcm-logger log (costs, figure)\n" \
     "  world       publish a scenario's terrain and tracks to a real-time run\n"
 #else
-#define USAGE_SUMMARY ""
+#define USAGE_NODES ""
 #endif
 
 #define USAGE                                                                         \
@@ -40,8 +43,7 @@
     "  predict     predict the conflicts of a scenario's reference trajectories\n"    \
     "  bench       time the core: bench predict, bench plan\n"                        \
     "  montecarlo  compare centralised and decoupled planning over random encounters\n" \
-    "  sim         fly a scenario in closed loop over the nodes (deterministic)\n"    \
-    USAGE_SUMMARY                                                                     \
+    USAGE_NODES                                                                       \
     "\n"                                                                              \
     "Run 'coavoid <command> --help' for the options of a command.\n"
 
@@ -67,15 +69,15 @@ int main(int argc, char **argv)
     if (strcmp(command, "montecarlo") == 0) {
         return command_montecarlo(argc, argv);
     }
-    if (strcmp(command, "world") == 0) {
-        return command_world(argc, argv);
-    }
+#ifdef COAVOID_HAVE_NODE
     if (strcmp(command, "sim") == 0) {
         return command_sim(argc, argv);
     }
-#ifdef COAVOID_HAVE_NODE
     if (strcmp(command, "summary") == 0) {
         return command_summary(argc, argv);
+    }
+    if (strcmp(command, "world") == 0) {
+        return command_world(argc, argv);
     }
 #endif
     if (command[0] == '-') {

@@ -17,7 +17,6 @@
 #include "cli.h"
 #include "commands.h"
 
-#ifdef COAVOID_HAVE_NODE
 
 #include <lcm/lcm.h>
 
@@ -779,15 +778,3 @@ int command_sim(int argc, char **argv)
     }
     return cli_run_scenario(options.scenario_path, sim, &options);
 }
-
-#else
-
-int command_sim(int argc, char **argv)
-{
-    (void)argc;
-    (void)argv;
-    return cli_fail(CLI_EXIT_INVALID,
-                    "sim: not built (this coavoid was built without LCM: COAVOID_BUILD_LCM)");
-}
-
-#endif

@@ -13,7 +13,6 @@
 #include "cli.h"
 #include "commands.h"
 
-#ifdef COAVOID_HAVE_NODE
 
 #include "node.h"
 #include "realtime.h"
@@ -109,15 +108,3 @@ int command_world(int argc, char **argv)
     }
     return cli_run_scenario(options.path, world, &options);
 }
-
-#else
-
-int command_world(int argc, char **argv)
-{
-    (void)argc;
-    (void)argv;
-    return cli_fail(CLI_EXIT_INVALID,
-                    "world: not built (this coavoid was built without LCM: COAVOID_BUILD_LCM)");
-}
-
-#endif
