@@ -39,13 +39,13 @@ typedef struct {
     coa_vec3_t route[COA_MAX_VEHICLES][2];
     coa_vec3_t reference[COA_MAX_VEHICLES][MAX_K + 1u];
     int32_t offsets[COA_MAX_VEHICLES][MAX_K + 1u];
-    coa_flight_vehicle_t vehicles[COA_MAX_VEHICLES];
+    coavoid_flight_vehicle_t vehicles[COA_MAX_VEHICLES];
     coa_obstacle_t obstacles[4];
     coa_track_t tracks[4];
-    coa_flight_t flight;
+    coavoid_flight_t flight;
     double vehicle_deviation[COA_MAX_VEHICLES];
     uint32_t vehicle_effort[COA_MAX_VEHICLES];
-    coa_flight_eval_t eval;
+    coavoid_flight_eval_t eval;
 } fixture_t;
 
 static void fixture_init(fixture_t *f, uint32_t steps)
@@ -119,20 +119,20 @@ START_TEST(test_exact_touch_is_not_a_loss)
     fixture_init(&f, 30u);
     add_uav(&f, vec(0, 0, 100), vec(600, 0, 100));
     add_uav(&f, vec(305, 30, 100), vec(-295, 30, 100));
-    ck_assert_int_eq(coa_flight_evaluate(&f.flight, &f.eval), COA_OK);
+    ck_assert_int_eq(coavoid_flight_evaluate(&f.flight, &f.eval), COA_OK);
     ck_assert(!f.eval.loss_of_separation);
     ck_assert_uint_eq(f.eval.first_vehicle, COA_NO_VEHICLE);
     ck_assert(f.eval.deviation == 0.0);
     ck_assert_uint_eq(f.eval.effort, 0u);
     size_t found = 99;
-    ck_assert_int_eq(coa_flight_conflicts(&f.flight, COA_FLIGHT_FLOWN, NULL, 0u, &found), COA_OK);
+    ck_assert_int_eq(coavoid_flight_conflicts(&f.flight, COAVOID_FLIGHT_FLOWN, NULL, 0u, &found), COA_OK);
     ck_assert_uint_eq(found, 0u);
 
     /* Vertically as well: one above the other by exactly h_a + h_b = 10 m, on one line. */
     fixture_init(&f, 30u);
     add_uav(&f, vec(0, 0, 100), vec(600, 0, 100));
     add_uav(&f, vec(305, 0, 110), vec(-295, 0, 110));
-    ck_assert_int_eq(coa_flight_evaluate(&f.flight, &f.eval), COA_OK);
+    ck_assert_int_eq(coavoid_flight_evaluate(&f.flight, &f.eval), COA_OK);
     ck_assert(!f.eval.loss_of_separation);
 }
 END_TEST
@@ -142,16 +142,16 @@ END_TEST
 START_TEST(test_a_centimetre_closer_is_a_loss)
 {
     fixture_t f;
-    coa_flight_conflict_t list[8];
+    coavoid_flight_conflict_t list[8];
     size_t found = 0;
     fixture_init(&f, 30u);
     add_uav(&f, vec(0, 0, 100), vec(600, 0, 100));
     add_uav(&f, vec(305, 29.99, 100), vec(-295, 29.99, 100));
-    ck_assert_int_eq(coa_flight_evaluate(&f.flight, &f.eval), COA_OK);
+    ck_assert_int_eq(coavoid_flight_evaluate(&f.flight, &f.eval), COA_OK);
     ck_assert(f.eval.loss_of_separation);
     ck_assert_uint_eq(f.eval.first_vehicle, 0u);
     ck_assert_uint_eq(f.eval.first_step, 15u);
-    ck_assert_int_eq(coa_flight_conflicts(&f.flight, COA_FLIGHT_FLOWN, list, 8u, &found), COA_OK);
+    ck_assert_int_eq(coavoid_flight_conflicts(&f.flight, COAVOID_FLIGHT_FLOWN, list, 8u, &found), COA_OK);
     /* Within 0.77 m of the meeting point only: one step. */
     ck_assert_uint_eq(found, 1u);
     ck_assert_int_eq(list[0].kind, COA_CONFLICT_VEHICLE);
@@ -162,7 +162,7 @@ START_TEST(test_a_centimetre_closer_is_a_loss)
     fixture_init(&f, 30u);
     add_uav(&f, vec(0, 0, 100), vec(600, 0, 100));
     add_uav(&f, vec(305, 0, 109.99), vec(-295, 0, 109.99));
-    ck_assert_int_eq(coa_flight_evaluate(&f.flight, &f.eval), COA_OK);
+    ck_assert_int_eq(coavoid_flight_evaluate(&f.flight, &f.eval), COA_OK);
     ck_assert(f.eval.loss_of_separation);
     /* Horizontal distance 30 is reached at t = 13.75 (x 137.5 and 167.5): step 13. */
     ck_assert_uint_eq(f.eval.first_step, 13u);
@@ -171,9 +171,9 @@ START_TEST(test_a_centimetre_closer_is_a_loss)
      * what is judged, not the references. */
     int32_t climb[] = {0, 1, 2, 3, 4, 5, 6};
     set_offsets(&f, 1, climb, sizeof climb / sizeof climb[0]);
-    ck_assert_int_eq(coa_flight_evaluate(&f.flight, &f.eval), COA_OK);
+    ck_assert_int_eq(coavoid_flight_evaluate(&f.flight, &f.eval), COA_OK);
     ck_assert(!f.eval.loss_of_separation);
-    ck_assert_int_eq(coa_flight_conflicts(&f.flight, COA_FLIGHT_REFERENCE, list, 8u, &found),
+    ck_assert_int_eq(coavoid_flight_conflicts(&f.flight, COAVOID_FLIGHT_REFERENCE, list, 8u, &found),
                      COA_OK);
     ck_assert_uint_ge(found, 1u); /* the references still would have */
 }
@@ -185,16 +185,16 @@ END_TEST
 START_TEST(test_through_a_box)
 {
     fixture_t f;
-    coa_flight_conflict_t list[64];
+    coavoid_flight_conflict_t list[64];
     size_t found = 0;
     fixture_init(&f, 30u);
     add_uav(&f, vec(0, 0, 100), vec(600, 0, 100));
     add_box(&f, vec(100, -60, 0), vec(200, 60, 104));
-    ck_assert_int_eq(coa_flight_evaluate(&f.flight, &f.eval), COA_OK);
+    ck_assert_int_eq(coavoid_flight_evaluate(&f.flight, &f.eval), COA_OK);
     ck_assert(f.eval.loss_of_separation);
     ck_assert_uint_eq(f.eval.first_vehicle, 0u);
     ck_assert_uint_eq(f.eval.first_step, 8u);
-    ck_assert_int_eq(coa_flight_conflicts(&f.flight, COA_FLIGHT_FLOWN, list, 64u, &found), COA_OK);
+    ck_assert_int_eq(coavoid_flight_conflicts(&f.flight, COAVOID_FLIGHT_FLOWN, list, 64u, &found), COA_OK);
     /* Steps 8..21: x from 80 to 220 overlaps 85..215 in each. */
     ck_assert_uint_eq(found, 14u);
     for (size_t c = 0; c < found; c++) {
@@ -207,7 +207,7 @@ START_TEST(test_through_a_box)
     int32_t over[] = {0, 1, 2, 3, 4, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5,
                       5, 5, 5, 5, 5, 5, 4, 3, 2, 1, 0};
     set_offsets(&f, 0, over, sizeof over / sizeof over[0]);
-    ck_assert_int_eq(coa_flight_evaluate(&f.flight, &f.eval), COA_OK);
+    ck_assert_int_eq(coavoid_flight_evaluate(&f.flight, &f.eval), COA_OK);
     ck_assert(!f.eval.loss_of_separation);
     /* One step too late down (offset 4 at k = 21, x = 210 < 215): a loss at step 20. */
     over[21] = 4;
@@ -216,7 +216,7 @@ START_TEST(test_through_a_box)
     over[24] = 1;
     over[25] = 0;
     set_offsets(&f, 0, over, 26u);
-    ck_assert_int_eq(coa_flight_evaluate(&f.flight, &f.eval), COA_OK);
+    ck_assert_int_eq(coavoid_flight_evaluate(&f.flight, &f.eval), COA_OK);
     ck_assert(f.eval.loss_of_separation);
     ck_assert_uint_eq(f.eval.first_step, 20u);
 }
@@ -227,7 +227,7 @@ END_TEST
 START_TEST(test_track_crossing)
 {
     fixture_t f;
-    coa_flight_conflict_t list[32];
+    coavoid_flight_conflict_t list[32];
     size_t found = 0;
     fixture_init(&f, 30u);
     add_uav(&f, vec(0, 0, 100), vec(400, 0, 100));
@@ -237,10 +237,10 @@ START_TEST(test_track_crossing)
     t->volume.half_height = (coa_real_t)8;
     t->position = vec(150, -150, 102);
     t->velocity = vec(0, 10, 0);
-    ck_assert_int_eq(coa_flight_evaluate(&f.flight, &f.eval), COA_OK);
+    ck_assert_int_eq(coavoid_flight_evaluate(&f.flight, &f.eval), COA_OK);
     ck_assert(f.eval.loss_of_separation);
     ck_assert_uint_eq(f.eval.first_step, 12u);
-    ck_assert_int_eq(coa_flight_conflicts(&f.flight, COA_FLIGHT_FLOWN, list, 32u, &found), COA_OK);
+    ck_assert_int_eq(coavoid_flight_conflicts(&f.flight, COAVOID_FLIGHT_FLOWN, list, 32u, &found), COA_OK);
     ck_assert_uint_ge(found, 1u);
     ck_assert_int_eq(list[0].kind, COA_CONFLICT_TRACK);
     ck_assert_uint_eq(list[0].other, 0u);
@@ -250,11 +250,11 @@ START_TEST(test_track_crossing)
      * from t = 8 on clears it; offset 7 (z 114) does not. */
     int32_t up8[] = {0, 1, 2, 3, 4, 5, 6, 7, 8};
     set_offsets(&f, 0, up8, 9u);
-    ck_assert_int_eq(coa_flight_evaluate(&f.flight, &f.eval), COA_OK);
+    ck_assert_int_eq(coavoid_flight_evaluate(&f.flight, &f.eval), COA_OK);
     ck_assert(!f.eval.loss_of_separation);
     int32_t up7[] = {0, 1, 2, 3, 4, 5, 6, 7};
     set_offsets(&f, 0, up7, 8u);
-    ck_assert_int_eq(coa_flight_evaluate(&f.flight, &f.eval), COA_OK);
+    ck_assert_int_eq(coavoid_flight_evaluate(&f.flight, &f.eval), COA_OK);
     ck_assert(f.eval.loss_of_separation);
 }
 END_TEST
@@ -275,7 +275,7 @@ START_TEST(test_costs_by_hand)
     int32_t b[] = {0, -1};
     set_offsets(&f, 0, a, sizeof a / sizeof a[0]);
     set_offsets(&f, 1, b, sizeof b / sizeof b[0]);
-    ck_assert_int_eq(coa_flight_evaluate(&f.flight, &f.eval), COA_OK);
+    ck_assert_int_eq(coavoid_flight_evaluate(&f.flight, &f.eval), COA_OK);
     ck_assert(!f.eval.loss_of_separation);
     ck_assert(f.vehicle_deviation[0] == 190.0);
     ck_assert_uint_eq(f.vehicle_effort[0], 11u);
@@ -295,7 +295,7 @@ START_TEST(test_costs_by_hand)
     /* The per-vehicle arrays are optional. */
     f.eval.vehicle_deviation = NULL;
     f.eval.vehicle_effort = NULL;
-    ck_assert_int_eq(coa_flight_evaluate(&f.flight, &f.eval), COA_OK);
+    ck_assert_int_eq(coavoid_flight_evaluate(&f.flight, &f.eval), COA_OK);
     ck_assert(f.eval.deviation == 380.0);
 }
 END_TEST
@@ -308,38 +308,38 @@ START_TEST(test_refusals)
     /* 0 -> 3 with steep factor 2: no action does that. */
     int32_t jump[] = {0, 0, 3};
     set_offsets(&f, 0, jump, 3u);
-    ck_assert_int_eq(coa_flight_evaluate(&f.flight, &f.eval), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coavoid_flight_evaluate(&f.flight, &f.eval), COA_ERR_ARGUMENT);
     /* The figure and the listing judge geometry only: they still work. */
     size_t found = 0;
-    ck_assert_int_eq(coa_flight_conflicts(&f.flight, COA_FLIGHT_FLOWN, NULL, 0u, &found), COA_OK);
+    ck_assert_int_eq(coavoid_flight_conflicts(&f.flight, COAVOID_FLIGHT_FLOWN, NULL, 0u, &found), COA_OK);
     int32_t ok[] = {0, 1, 3};
     set_offsets(&f, 0, ok, 3u);
-    ck_assert_int_eq(coa_flight_evaluate(&f.flight, &f.eval), COA_OK);
+    ck_assert_int_eq(coavoid_flight_evaluate(&f.flight, &f.eval), COA_OK);
 
-    ck_assert_int_eq(coa_flight_evaluate(NULL, &f.eval), COA_ERR_ARGUMENT);
-    ck_assert_int_eq(coa_flight_evaluate(&f.flight, NULL), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coavoid_flight_evaluate(NULL, &f.eval), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coavoid_flight_evaluate(&f.flight, NULL), COA_ERR_ARGUMENT);
     f.flight.steps = 0u;
-    ck_assert_int_eq(coa_flight_evaluate(&f.flight, &f.eval), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coavoid_flight_evaluate(&f.flight, &f.eval), COA_ERR_ARGUMENT);
     f.flight.steps = COA_MAX_HORIZON + 1u;
-    ck_assert_int_eq(coa_flight_evaluate(&f.flight, &f.eval), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coavoid_flight_evaluate(&f.flight, &f.eval), COA_ERR_ARGUMENT);
     f.flight.steps = 10u;
     f.flight.dt = (coa_real_t)0;
-    ck_assert_int_eq(coa_flight_evaluate(&f.flight, &f.eval), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coavoid_flight_evaluate(&f.flight, &f.eval), COA_ERR_ARGUMENT);
     f.flight.dt = (coa_real_t)1;
     f.vehicles[0].offsets = NULL;
-    ck_assert_int_eq(coa_flight_evaluate(&f.flight, &f.eval), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coavoid_flight_evaluate(&f.flight, &f.eval), COA_ERR_ARGUMENT);
     f.vehicles[0].offsets = f.offsets[0];
     /* A non-finite flown reference: what the core refuses. */
     f.reference[0][4].z = (coa_real_t)NAN;
-    ck_assert_int_eq(coa_flight_evaluate(&f.flight, &f.eval), COA_ERR_ARGUMENT);
-    ck_assert_int_eq(coa_flight_conflicts(&f.flight, COA_FLIGHT_FLOWN, NULL, 0u, &found),
+    ck_assert_int_eq(coavoid_flight_evaluate(&f.flight, &f.eval), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coavoid_flight_conflicts(&f.flight, COAVOID_FLIGHT_FLOWN, NULL, 0u, &found),
                      COA_ERR_ARGUMENT);
-    ck_assert_int_eq(coa_flight_svg(&f.flight, NULL, stderr), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coavoid_flight_svg(&f.flight, NULL, stderr), COA_ERR_ARGUMENT);
     f.reference[0][4].z = (coa_real_t)100;
     /* Two UAVs with one id. */
     add_uav(&f, vec(0, 500, 100), vec(600, 500, 100));
     f.vehicles[1].vehicle.id = f.vehicles[0].vehicle.id;
-    ck_assert_int_eq(coa_flight_evaluate(&f.flight, &f.eval), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coavoid_flight_evaluate(&f.flight, &f.eval), COA_ERR_ARGUMENT);
 }
 END_TEST
 
@@ -381,10 +381,10 @@ START_TEST(test_listing_agrees_with_the_core)
             t->position = vec(unif(&seed, -150, 150), unif(&seed, -150, 150), unif(&seed, 90, 110));
             t->velocity = vec(unif(&seed, -15, 15), unif(&seed, -15, 15), unif(&seed, -1, 1));
         }
-        REQUIRE(coa_flight_evaluate(&f.flight, &f.eval) == COA_OK);
-        coa_flight_conflict_t list[512];
+        REQUIRE(coavoid_flight_evaluate(&f.flight, &f.eval) == COA_OK);
+        coavoid_flight_conflict_t list[512];
         size_t found = 0;
-        REQUIRE(coa_flight_conflicts(&f.flight, COA_FLIGHT_FLOWN, list, 512u, &found) == COA_OK);
+        REQUIRE(coavoid_flight_conflicts(&f.flight, COAVOID_FLIGHT_FLOWN, list, 512u, &found) == COA_OK);
         REQUIRE((found > 0u) == f.eval.loss_of_separation);
         if (found > 0u) {
             lost++;
@@ -400,8 +400,8 @@ END_TEST
 
 /* ---- JSON ---- */
 
-static char *capture(int (*writer)(const coa_flight_t *, const coa_flight_eval_t *, FILE *),
-                     const coa_flight_t *flight, const coa_flight_eval_t *eval, int *rc)
+static char *capture(int (*writer)(const coavoid_flight_t *, const coavoid_flight_eval_t *, FILE *),
+                     const coavoid_flight_t *flight, const coavoid_flight_eval_t *eval, int *rc)
 {
     char *text = NULL;
     size_t size = 0;
@@ -437,9 +437,9 @@ START_TEST(test_json_fields)
     }
     f.vehicles[0].known = known[0];
     f.vehicles[1].known = known[1];
-    ck_assert_int_eq(coa_flight_evaluate(&f.flight, &f.eval), COA_OK);
+    ck_assert_int_eq(coavoid_flight_evaluate(&f.flight, &f.eval), COA_OK);
     ck_assert(f.eval.loss_of_separation);
-    char *text = capture(coa_flight_json, &f.flight, &f.eval, &rc);
+    char *text = capture(coavoid_flight_json, &f.flight, &f.eval, &rc);
     ck_assert_int_eq(rc, COA_OK);
     cJSON *root = cJSON_Parse(text);
     ck_assert_ptr_nonnull(root);
@@ -467,7 +467,7 @@ START_TEST(test_json_fields)
         for (int k = 0; k <= 12; k++) {
             const cJSON *s = cJSON_GetArrayItem(flown, k);
             ck_assert_int_eq(cJSON_GetArraySize(s), 4);
-            coa_vec3_t p = coa_flight_position(&f.flight, (size_t)i, (uint32_t)k, f.offsets[i][k]);
+            coa_vec3_t p = coavoid_flight_position(&f.flight, (size_t)i, (uint32_t)k, f.offsets[i][k]);
             /* Round trip: exactly the planner's positions. */
             ck_assert(cJSON_GetArrayItem(s, 0)->valuedouble == (double)k * 0.5);
             ck_assert(cJSON_GetArrayItem(s, 1)->valuedouble == (double)p.x);
@@ -488,9 +488,9 @@ START_TEST(test_json_fields)
     add_uav(&f, vec(0, 900, 100), vec(600, 900, 100));
     f.eval.vehicle_deviation = NULL;
     f.eval.vehicle_effort = NULL;
-    ck_assert_int_eq(coa_flight_evaluate(&f.flight, &f.eval), COA_OK);
+    ck_assert_int_eq(coavoid_flight_evaluate(&f.flight, &f.eval), COA_OK);
     ck_assert(!f.eval.loss_of_separation);
-    text = capture(coa_flight_json, &f.flight, &f.eval, &rc);
+    text = capture(coavoid_flight_json, &f.flight, &f.eval, &rc);
     ck_assert_int_eq(rc, COA_OK);
     root = cJSON_Parse(text);
     ck_assert_ptr_nonnull(root);
@@ -503,7 +503,7 @@ START_TEST(test_json_fields)
     cJSON_Delete(root);
     free(text);
 
-    ck_assert_int_eq(coa_flight_json(&f.flight, NULL, stdout), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coavoid_flight_json(&f.flight, NULL, stdout), COA_ERR_ARGUMENT);
 }
 END_TEST
 
@@ -576,9 +576,9 @@ START_TEST(test_svg_shape)
         known[k] = k < 20;
     }
     f.vehicles[1].known = known;
-    ck_assert_int_eq(coa_flight_evaluate(&f.flight, &f.eval), COA_OK);
+    ck_assert_int_eq(coavoid_flight_evaluate(&f.flight, &f.eval), COA_OK);
     ck_assert(f.eval.loss_of_separation);
-    char *doc = capture(coa_flight_svg, &f.flight, &f.eval, &rc);
+    char *doc = capture(coavoid_flight_svg, &f.flight, &f.eval, &rc);
     ck_assert_int_eq(rc, COA_OK);
     ck_assert_msg(strncmp(doc, "<svg", 4) == 0, "starts with %.20s", doc);
     size_t length = strlen(doc);
@@ -599,7 +599,7 @@ START_TEST(test_svg_shape)
     free(doc);
 
     /* Without an evaluation: no result line, still a document. */
-    doc = capture(coa_flight_svg, &f.flight, NULL, &rc);
+    doc = capture(coavoid_flight_svg, &f.flight, NULL, &rc);
     ck_assert_int_eq(rc, COA_OK);
     ck_assert(balanced(doc));
     ck_assert_ptr_null(strstr(doc, "LOSS OF SEPARATION"));
@@ -614,8 +614,8 @@ START_TEST(test_text)
     fixture_init(&f, 30u);
     add_uav(&f, vec(0, 0, 100), vec(600, 0, 100));
     add_box(&f, vec(100, -60, 0), vec(200, 60, 104));
-    ck_assert_int_eq(coa_flight_evaluate(&f.flight, &f.eval), COA_OK);
-    char *text = capture(coa_flight_text, &f.flight, &f.eval, &rc);
+    ck_assert_int_eq(coavoid_flight_evaluate(&f.flight, &f.eval), COA_OK);
+    char *text = capture(coavoid_flight_text, &f.flight, &f.eval, &rc);
     ck_assert_int_eq(rc, COA_OK);
     ck_assert_ptr_nonnull(strstr(text, "loss of separation: yes, first over step 8 (t = 8 s): "
                                        "UAV 1 and obstacle 0"));
@@ -733,10 +733,10 @@ static int write_log(int argc, char **argv)
         return fail_writer("unknown option");
     }
 
-    scenario_t s;
+    coavoid_scenario_t s;
     char err[SCENARIO_ERROR_MAX];
-    if (scenario_load(argv[3], &s, err, sizeof err) != 0 || scenario_sample(&s, err, sizeof err) != 0) {
-        scenario_free(&s);
+    if (coavoid_scenario_load(argv[3], &s, err, sizeof err) != 0 || coavoid_scenario_sample(&s, err, sizeof err) != 0) {
+        coavoid_scenario_free(&s);
         return fail_writer(err);
     }
     const size_t n = s.vehicle_count;
@@ -744,7 +744,7 @@ static int write_log(int argc, char **argv)
     const int64_t dt_us = llround((double)s.dt * 1e6);
     const size_t row = (size_t)N + 1u;
     if (N + 1u > (uint32_t)COAVOID_INTENT_T_MAX_SAMPLES) {
-        scenario_free(&s);
+        coavoid_scenario_free(&s);
         return fail_writer("horizon too long for an intent");
     }
     int32_t *plan = calloc(n * row, sizeof *plan);
@@ -772,7 +772,7 @@ static int write_log(int argc, char **argv)
     coa_plan_result_t result;
     memset(&result, 0, sizeof result);
     if (planned) {
-        coa_problem_t problem = scenario_problem(&s);
+        coa_problem_t problem = coavoid_scenario_problem(&s);
         uint32_t beta = s.has_beta ? s.beta : 20000u;
         coa_planner_config_t config;
         size_t size = coa_planner_config_of(&problem, n, beta, &config) == COA_OK
@@ -801,7 +801,7 @@ static int write_log(int argc, char **argv)
         }
     }
     const long last_cycle = cycles > 0 ? cycles - 1 : 2L * (long)N;
-    const coa_lcm_context_t ctx = {0, 0, 0, LOG_EPOCH};
+    const coavoid_lcm_context_t ctx = {0, 0, 0, LOG_EPOCH};
     const char *reason = "";
     for (long c = 0; c <= last_cycle && status == 0; c++) {
         const int64_t start = LOG_EPOCH + c * dt_us;
@@ -820,7 +820,7 @@ static int write_log(int argc, char **argv)
                 size_t k = (size_t)c + j;
                 offsets[j] = plan[i * row + (k < row ? k : row - 1u)];
             }
-            coa_lcm_intent_info_t info;
+            coavoid_lcm_intent_info_t info;
             memset(&info, 0, sizeof info);
             info.utime = start + 100 * (int64_t)(i + 1u);
             info.sequence = c;
@@ -829,7 +829,7 @@ static int write_log(int argc, char **argv)
             info.position.z += (coa_real_t)offsets[0] * coa_climb_step(v, s.dt);
             info.plan_utime = start;
             info.step = s.dt;
-            if (coa_lcm_intent_from_core(v, &info, ref, offsets, row, &ctx, msg, &reason) != COA_OK) {
+            if (coavoid_lcm_intent_from_core(v, &info, ref, offsets, row, &ctx, msg, &reason) != COA_OK) {
                 status = fail_writer(reason);
                 break;
             }
@@ -844,7 +844,7 @@ static int write_log(int argc, char **argv)
                 }
                 have_stale = true;
             }
-            if (put_event(w, info.utime, COA_CHANNEL_INTENT,
+            if (put_event(w, info.utime, COAVOID_CHANNEL_INTENT,
                           coavoid_intent_t_encode(w->buffer, 0, (int)sizeof w->buffer, msg)) != 0) {
                 status = fail_writer("cannot write an intent");
             }
@@ -854,7 +854,7 @@ static int write_log(int argc, char **argv)
             coavoid_status_t hb;
             memset(&hb, 0, sizeof hb);
             hb.utime = start + 5000;
-            hb.node_id = i < n ? s.vehicles[i].id : (int32_t)COA_NODE_COORDINATOR_ID;
+            hb.node_id = i < n ? s.vehicles[i].id : (int32_t)COAVOID_NODE_COORDINATOR_ID;
             hb.node_kind = i < n ? COAVOID_STATUS_T_NODE_VEHICLE : COAVOID_STATUS_T_NODE_COORDINATOR;
             hb.sequence = c;
             hb.outcome = COAVOID_STATUS_T_OUTCOME_NONE;
@@ -863,8 +863,8 @@ static int write_log(int argc, char **argv)
                 hb.outcome = COAVOID_STATUS_T_OUTCOME_SOLVED;
                 hb.plans_run = 1;
             }
-            if (coa_lcm_status_check(&hb, &ctx, &reason) != COA_OK ||
-                put_event(w, hb.utime, COA_CHANNEL_STATUS,
+            if (coavoid_lcm_status_check(&hb, &ctx, &reason) != COA_OK ||
+                put_event(w, hb.utime, COAVOID_CHANNEL_STATUS,
                           coavoid_status_t_encode(w->buffer, 0, (int)sizeof w->buffer, &hb)) != 0) {
                 status = fail_writer(reason);
             }
@@ -872,7 +872,7 @@ static int write_log(int argc, char **argv)
         if (c == 0 && planned && status == 0) {
             memset(plan_msg, 0, sizeof *plan_msg);
             plan_msg->utime = start + 1500;
-            plan_msg->coordinator_id = (int32_t)COA_NODE_COORDINATOR_ID;
+            plan_msg->coordinator_id = (int32_t)COAVOID_NODE_COORDINATOR_ID;
             plan_msg->plan_id = 0;
             plan_msg->valid_from_utime = start;
             plan_msg->valid_until_utime = start + dt_us;
@@ -891,8 +891,8 @@ static int write_log(int argc, char **argv)
                     plan_msg->offsets[i][k] = plan[i * row + k];
                 }
             }
-            if (coa_lcm_plan_check(plan_msg, &ctx, &reason) != COA_OK ||
-                put_event(w, plan_msg->utime, COA_CHANNEL_PLAN,
+            if (coavoid_lcm_plan_check(plan_msg, &ctx, &reason) != COA_OK ||
+                put_event(w, plan_msg->utime, COAVOID_CHANNEL_PLAN,
                           coavoid_plan_t_encode(w->buffer, 0, (int)sizeof w->buffer, plan_msg)) != 0) {
                 status = fail_writer(reason);
             }
@@ -906,13 +906,13 @@ static int write_log(int argc, char **argv)
             /* A copy of the last intent with a NaN position: refused. Then the same from a
              * UAV the scenario does not have: ignored. Then something else entirely. */
             msg->position[0] = NAN;
-            if (put_event(w, start + 3000, COA_CHANNEL_INTENT,
+            if (put_event(w, start + 3000, COAVOID_CHANNEL_INTENT,
                           coavoid_intent_t_encode(w->buffer, 0, (int)sizeof w->buffer, msg)) != 0) {
                 status = fail_writer("cannot write");
             }
             msg->position[0] = 0.0;
             msg->uav_id = 4242;
-            if (put_event(w, start + 3001, COA_CHANNEL_INTENT,
+            if (put_event(w, start + 3001, COAVOID_CHANNEL_INTENT,
                           coavoid_intent_t_encode(w->buffer, 0, (int)sizeof w->buffer, msg)) != 0) {
                 status = fail_writer("cannot write");
             }
@@ -923,7 +923,7 @@ static int write_log(int argc, char **argv)
         }
     }
     if (have_stale && status == 0 &&
-        put_event(w, LOG_EPOCH + (last_cycle + 1) * dt_us, COA_CHANNEL_INTENT,
+        put_event(w, LOG_EPOCH + (last_cycle + 1) * dt_us, COAVOID_CHANNEL_INTENT,
                   coavoid_intent_t_encode(w->buffer, 0, (int)sizeof w->buffer, stale)) != 0) {
         status = fail_writer("cannot write");
     }
@@ -940,7 +940,7 @@ done:
     free(msg);
     free(plan_msg);
     free(stale);
-    scenario_free(&s);
+    coavoid_scenario_free(&s);
     return status;
 }
 

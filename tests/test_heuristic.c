@@ -8,7 +8,7 @@
  *     over every action sequence from that (k, offset) to the horizon.
  *   - The joint search's heuristic (plan_search.c), on 2 and 3 UAVs: a group of all of
  *     them is set up as the centralised front end sets one up, but with no cap and no
- *     bound (plan_test_group_setup). Checked on the set-up: each member's cost-to-go and
+ *     bound (coa_plan_test_group_setup). Checked on the set-up: each member's cost-to-go and
  *     cost-from-start tables; each pair table present where the pair can meet, its
  *     corridor every offset live both ways (the full reachable range, as there is no
  *     cap), and every cell equal to the exact cost to go of the two alone. Then every
@@ -511,7 +511,7 @@ static void check_table(uint64_t seed, table_stats_t *st)
     if (res.searches == 0u) {
         /* A conflict at t = 0: the front end stops before building the table. */
         ck_assert_int_eq(res.status, COA_PLAN_INFEASIBLE);
-        plan_table_build(pl, &pl->to_go[0], 0u, NULL, 0u);
+        coa_plan_table_build(pl, &pl->to_go[0], 0u, NULL, 0u);
         ++st->initial_conflicts;
     }
     ck_assert_uint_eq(t->vehicle, 0u);
@@ -1041,7 +1041,7 @@ static unsigned check_pair_table(const oracle_t *o, const coa_planner_t *pl, siz
                     }
                 }
                 exact[k & 1u][x - lo_of(o, i, k)][y - lo_of(o, j, k)] = best;
-                sur = plan_pair_surcharge(pl, i, j, k, x, y, to_cost(live ? ti : 0u),
+                sur = coa_plan_pair_surcharge(pl, i, j, k, x, y, to_cost(live ? ti : 0u),
                                           to_cost(live ? tj : 0u));
                 if (!live || best == INF) {
                     if (!plan_cost_dead(sur)) {
@@ -1111,7 +1111,7 @@ static void check_joint(uint64_t seed, size_t m, joint_stats_t *st, coa_planner_
 
     rc = coa_plan_centralised(pl, &f.p, rows, &res);
     ck_assert_int_eq(rc, COA_OK);
-    plan_test_group_setup(pl, (1u << m) - 1u);
+    coa_plan_test_group_setup(pl, (1u << m) - 1u);
     g = &pl->group;
     ck_assert_uint_eq(g->count, m);
     ck_assert(!g->capped && !g->bounded && g->fixed_count == 0u);
@@ -1305,7 +1305,7 @@ static void check_joint(uint64_t seed, size_t m, joint_stats_t *st, coa_planner_
                                  fail_seed_msg, (unsigned long long)seed, k, at[0], at[1], at[2],
                                  pk(gr.ha[k][idx]), pk(exact));
                 }
-                live = plan_test_heuristic(pl, k, o16, &h2);
+                live = coa_plan_test_heuristic(pl, k, o16, &h2);
                 gr.hlive[k][idx] = live ? 1u : 0u;
                 if (!live) {
                     ++st->dead_by_h;
@@ -1357,7 +1357,7 @@ static void check_joint(uint64_t seed, size_t m, joint_stats_t *st, coa_planner_
                         if (!in_span(g, pa[j], k) || !in_span(g, pb[j], k)) {
                             continue;
                         }
-                        c = plan_pair_surcharge(pl, pa[j], pb[j], k, at[pa[j]], at[pb[j]],
+                        c = coa_plan_pair_surcharge(pl, pa[j], pb[j], k, at[pa[j]], at[pb[j]],
                                                 to_cost(tg_at(&o, pa[j], k, at[pa[j]])),
                                                 to_cost(tg_at(&o, pb[j], k, at[pb[j]])));
                         REQUIRE(!plan_cost_dead(c)); /* the heuristic said live */
@@ -1403,7 +1403,7 @@ static void check_joint(uint64_t seed, size_t m, joint_stats_t *st, coa_planner_
         /* The search on the uncapped group finds the optimum. */
         {
             plan_search_out_t out;
-            plan_search(pl, &out);
+            coa_plan_search(pl, &out);
             if (out.status == COA_PLAN_BUDGET_EXHAUSTED) {
                 ++st->search_budget;
             } else if (opt == INF) {
@@ -1423,7 +1423,7 @@ static void check_joint(uint64_t seed, size_t m, joint_stats_t *st, coa_planner_
                 }
                 ++st->searched;
             }
-            plan_search_release(pl);
+            coa_plan_search_release(pl);
         }
     }
 
@@ -1547,7 +1547,7 @@ START_TEST(matching_exact)
             sur[p].lo = (r & 12u) == 0u ? 0u : ((r & 16u) != 0u ? r : (r >> 58));
         }
         for (mask = 0u; mask < (1u << m); ++mask) {
-            coa_cost_t got = plan_test_matching(sur, m, mask);
+            coa_cost_t got = coa_plan_test_matching(sur, m, mask);
             coa_cost_t want = matching_brute(sur, m, mask);
             ck_assert_msg(plan_cost_compare(got, want) == 0,
                           "m %zu mask %x: got %llx:%llx, want %llx:%llx", m, (unsigned)mask,

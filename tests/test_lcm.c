@@ -19,9 +19,9 @@
 
 #define T0 INT64_C(1700000000000000) /* a plausible utime */
 
-static coa_lcm_context_t ctx_now(void)
+static coavoid_lcm_context_t ctx_now(void)
 {
-    coa_lcm_context_t c;
+    coavoid_lcm_context_t c;
     c.now_utime = T0;
     c.max_age_us = INT64_C(10000000);
     c.max_future_us = INT64_C(1000000);
@@ -210,7 +210,7 @@ static coavoid_status_t good_status(void)
     m.conflicts = 2;
     m.messages_received = 1000;
     m.messages_rejected = 3;
-    m.last_reject_code = COA_LCM_ERR_NONFINITE;
+    m.last_reject_code = COAVOID_LCM_ERR_NONFINITE;
     return m;
 }
 
@@ -238,14 +238,14 @@ START_TEST(test_round_trip_wire)
     coavoid_obstacle_map_t o = good_map();
     coavoid_conflict_report_t c = good_report();
     coavoid_status_t s = good_status();
-    coa_lcm_context_t ctx = ctx_now();
+    coavoid_lcm_context_t ctx = ctx_now();
     const char *why = NULL;
-    ck_assert_int_eq(coa_lcm_intent_check(&i, &ctx, &why), COA_OK);
-    ck_assert_int_eq(coa_lcm_plan_check(&p, &ctx, &why), COA_OK);
-    ck_assert_int_eq(coa_lcm_track_check(&t, &ctx, &why), COA_OK);
-    ck_assert_int_eq(coa_lcm_obstacle_map_check(&o, &ctx, &why), COA_OK);
-    ck_assert_int_eq(coa_lcm_conflict_report_check(&c, &ctx, &why), COA_OK);
-    ck_assert_int_eq(coa_lcm_status_check(&s, &ctx, &why), COA_OK);
+    ck_assert_int_eq(coavoid_lcm_intent_check(&i, &ctx, &why), COA_OK);
+    ck_assert_int_eq(coavoid_lcm_plan_check(&p, &ctx, &why), COA_OK);
+    ck_assert_int_eq(coavoid_lcm_track_check(&t, &ctx, &why), COA_OK);
+    ck_assert_int_eq(coavoid_lcm_obstacle_map_check(&o, &ctx, &why), COA_OK);
+    ck_assert_int_eq(coavoid_lcm_conflict_report_check(&c, &ctx, &why), COA_OK);
+    ck_assert_int_eq(coavoid_lcm_status_check(&s, &ctx, &why), COA_OK);
     ck_assert_str_eq(why, "ok");
     ROUND_TRIP(coavoid_intent_t, i);
     ROUND_TRIP(coavoid_plan_t, p);
@@ -258,17 +258,17 @@ END_TEST
 
 /* The core's views of an intent, as a receiver holds them. */
 typedef struct {
-    coa_lcm_intent_info_t info;
+    coavoid_lcm_intent_info_t info;
     coa_vehicle_t vehicle;
     coa_intent_plan_t plan;
-    coa_lcm_intent_arrays_t arrays;
+    coavoid_lcm_intent_arrays_t arrays;
 } intent_view_t;
 
 static int intent_view(const coavoid_intent_t *m, intent_view_t *v, const char **why)
 {
-    coa_lcm_context_t ctx = ctx_now();
+    coavoid_lcm_context_t ctx = ctx_now();
     memset(v, 0, sizeof *v);
-    return coa_lcm_intent_to_core(m, &ctx, NULL, &v->info, &v->vehicle, &v->plan, &v->arrays, why);
+    return coavoid_lcm_intent_to_core(m, &ctx, NULL, &v->info, &v->vehicle, &v->plan, &v->arrays, why);
 }
 
 /* Bits, not values: -0.0 == 0.0 and the test is about the last bit. */
@@ -304,7 +304,7 @@ START_TEST(test_round_trip_intent_core)
 {
     coavoid_intent_t m = good_intent();
     coavoid_intent_t back;
-    coa_lcm_context_t ctx = ctx_now();
+    coavoid_lcm_context_t ctx = ctx_now();
     intent_view_t *v = malloc(sizeof *v);
     intent_view_t *w = malloc(sizeof *w);
     coa_real_t dh;
@@ -363,7 +363,7 @@ START_TEST(test_round_trip_intent_core)
     }
     /* And back: the sender's message, bit for bit in double; in float, a message that
      * gives the same core views again. */
-    ck_assert_int_eq(coa_lcm_intent_from_core(&v->vehicle, &v->info, v->arrays.reference,
+    ck_assert_int_eq(coavoid_lcm_intent_from_core(&v->vehicle, &v->info, v->arrays.reference,
                                               v->arrays.offsets, v->plan.count, &ctx, &back, &why),
                      COA_OK);
 #ifndef COA_SINGLE_PRECISION
@@ -392,26 +392,26 @@ START_TEST(test_round_trip_intent_core)
     /* An unbounded vehicle publishes max_offset -1 whatever negative number it holds. */
     unbounded = v->vehicle;
     unbounded.max_offset = -5;
-    ck_assert_int_eq(coa_lcm_intent_from_core(&unbounded, &v->info, v->arrays.reference,
+    ck_assert_int_eq(coavoid_lcm_intent_from_core(&unbounded, &v->info, v->arrays.reference,
                                               v->arrays.offsets, v->plan.count, &ctx, &back, &why),
                      COA_OK);
     ck_assert_int_eq(back.max_offset, -1);
 
     /* What from_core and to_core refuse themselves. */
-    ck_assert_int_eq(coa_lcm_intent_from_core(&v->vehicle, &v->info, v->arrays.reference,
+    ck_assert_int_eq(coavoid_lcm_intent_from_core(&v->vehicle, &v->info, v->arrays.reference,
                                               v->arrays.offsets, 1, &ctx, &back, &why),
-                     COA_LCM_ERR_COUNT);
-    ck_assert_int_eq(coa_lcm_intent_from_core(&v->vehicle, &v->info, v->arrays.reference,
+                     COAVOID_LCM_ERR_COUNT);
+    ck_assert_int_eq(coavoid_lcm_intent_from_core(&v->vehicle, &v->info, v->arrays.reference,
                                               v->arrays.offsets, 129, &ctx, &back, &why),
-                     COA_LCM_ERR_COUNT);
-    ck_assert_int_eq(coa_lcm_intent_from_core(&v->vehicle, &v->info, NULL, v->arrays.offsets, 61,
+                     COAVOID_LCM_ERR_COUNT);
+    ck_assert_int_eq(coavoid_lcm_intent_from_core(&v->vehicle, &v->info, NULL, v->arrays.offsets, 61,
                                               &ctx, &back, &why),
                      COA_ERR_ARGUMENT);
     unbounded.id = 0;
-    ck_assert_int_eq(coa_lcm_intent_from_core(&unbounded, &v->info, v->arrays.reference,
+    ck_assert_int_eq(coavoid_lcm_intent_from_core(&unbounded, &v->info, v->arrays.reference,
                                               v->arrays.offsets, v->plan.count, &ctx, &back, &why),
-                     COA_LCM_ERR_ID);
-    ck_assert_int_eq(coa_lcm_intent_to_core(&m, &ctx, NULL, &v->info, &v->vehicle, &v->plan, NULL,
+                     COAVOID_LCM_ERR_ID);
+    ck_assert_int_eq(coavoid_lcm_intent_to_core(&m, &ctx, NULL, &v->info, &v->vehicle, &v->plan, NULL,
                                             &why),
                      COA_ERR_ARGUMENT);
     free(v);
@@ -455,7 +455,7 @@ START_TEST(test_plan_from_intent)
 {
     coavoid_intent_t m = good_intent();
     coavoid_intent_t replanned;
-    coa_lcm_context_t ctx = ctx_now();
+    coavoid_lcm_context_t ctx = ctx_now();
     intent_view_t *v = malloc(sizeof *v);
     workspace_t ws = workspace(2000u);
     int32_t offsets[COAVOID_INTENT_T_MAX_SAMPLES];
@@ -480,7 +480,7 @@ START_TEST(test_plan_from_intent)
     ck_assert_int_eq(offsets[0], -2);
     ck_assert_int_eq(offsets[60], 0);
     ck_assert(result.deviation > 0.0);
-    ck_assert_int_eq(coa_lcm_intent_from_core(&v->vehicle, &v->info, v->arrays.reference, offsets,
+    ck_assert_int_eq(coavoid_lcm_intent_from_core(&v->vehicle, &v->info, v->arrays.reference, offsets,
                                               v->plan.count, &ctx, &replanned, &why),
                      COA_OK);
 
@@ -585,7 +585,7 @@ START_TEST(test_accepted_intent_is_plannable)
     rng_state = UINT64_C(0xC0A1D);
     for (i = 0; i < 4000; ++i) {
         coavoid_intent_t m = good_intent();
-        coa_lcm_context_t ctx = ctx_now();
+        coavoid_lcm_context_t ctx = ctx_now();
         int changes = 1 + (int)pick(&rng_state, 3u);
         int c;
         const char *why = NULL;
@@ -603,7 +603,7 @@ START_TEST(test_accepted_intent_is_plannable)
                 break;
             }
         }
-        if (coa_lcm_intent_check(&m, &ctx, &why) == COA_OK) {
+        if (coavoid_lcm_intent_check(&m, &ctx, &why) == COA_OK) {
             require_usable_intent(&m);
             accepted++;
         } else {
@@ -619,20 +619,20 @@ START_TEST(test_round_trip_plan_core)
 {
     coavoid_plan_t m = good_plan();
     coavoid_plan_t back;
-    coa_lcm_context_t ctx = ctx_now();
-    coa_lcm_plan_info_t info;
+    coavoid_lcm_context_t ctx = ctx_now();
+    coavoid_lcm_plan_info_t info;
     coa_plan_result_t result;
     int32_t offsets[COAVOID_PLAN_T_MAX_VEHICLES * COAVOID_PLAN_T_MAX_SAMPLES];
     const char *why = NULL;
-    ck_assert_int_eq(coa_lcm_plan_to_core(&m, &ctx, NULL, &info, &result, offsets,
+    ck_assert_int_eq(coavoid_lcm_plan_to_core(&m, &ctx, NULL, &info, &result, offsets,
                                           sizeof offsets / sizeof offsets[0], &why), COA_OK);
     ck_assert_int_eq(result.status, COA_PLAN_SOLVED);
     ck_assert_uint_eq(result.planned_count, 3u);
     ck_assert_int_eq(offsets[2 * 61 + 60], 9);
-    ck_assert_int_eq(coa_lcm_plan_from_core(&info, &result, offsets, &ctx, &back, &why), COA_OK);
+    ck_assert_int_eq(coavoid_lcm_plan_from_core(&info, &result, offsets, &ctx, &back, &why), COA_OK);
     ck_assert_int_eq(memcmp(&back, &m, sizeof m), 0);
-    ck_assert_int_eq(coa_lcm_plan_to_core(&m, &ctx, NULL, &info, &result, offsets, 3 * 61 - 1, &why),
-                     COA_LCM_ERR_CAPACITY);
+    ck_assert_int_eq(coavoid_lcm_plan_to_core(&m, &ctx, NULL, &info, &result, offsets, 3 * 61 - 1, &why),
+                     COAVOID_LCM_ERR_CAPACITY);
 }
 END_TEST
 
@@ -640,18 +640,18 @@ START_TEST(test_round_trip_track_core)
 {
     coavoid_track_t m = good_track();
     coavoid_track_t back;
-    coa_lcm_context_t ctx = ctx_now();
-    coa_lcm_track_info_t info;
+    coavoid_lcm_context_t ctx = ctx_now();
+    coavoid_lcm_track_info_t info;
     coa_track_t track;
     coa_track_point_t path[COAVOID_TRACK_T_MAX_PATH];
     const char *why = NULL;
-    ck_assert_int_eq(coa_lcm_track_to_core(&m, &ctx, NULL, &info, &track, path,
+    ck_assert_int_eq(coavoid_lcm_track_to_core(&m, &ctx, NULL, &info, &track, path,
                                            COAVOID_TRACK_T_MAX_PATH, &why), COA_OK);
     ck_assert_int_eq(coa_track_check(&track), COA_OK);
     /* Estimated at t = 4.8 s of the core clock: at t = 0 it was 4.8 s * 30 m/s east. */
     ck_assert(fabs((double)track.position.x - (500.0 + 30.0 * 4.8)) < 1e-3);
     ck_assert(fabs((double)path[1].t - 6.0) < 1e-6);
-    ck_assert_int_eq(coa_lcm_track_from_core(&track, &info, &ctx, &back, &why), COA_OK);
+    ck_assert_int_eq(coavoid_lcm_track_from_core(&track, &info, &ctx, &back, &why), COA_OK);
     ck_assert_int_eq(back.track_id, 77);
     ck_assert_int_eq(back.path_count, 3);
     ck_assert_int_eq((int)(back.path_utime[2] - m.path_utime[2]), 0);
@@ -664,25 +664,25 @@ START_TEST(test_round_trip_map_core)
 {
     coavoid_obstacle_map_t m = good_map();
     coavoid_obstacle_map_t back;
-    coa_lcm_context_t ctx = ctx_now();
+    coavoid_lcm_context_t ctx = ctx_now();
     coa_obstacle_t obstacles[COAVOID_OBSTACLE_MAP_T_MAX_BOXES + COAVOID_OBSTACLE_MAP_T_MAX_POLYTOPES];
     coa_vec3_t vertices[COAVOID_OBSTACLE_MAP_T_MAX_POLYTOPES * COAVOID_OBSTACLE_MAP_T_MAX_VERTICES];
     size_t n = 0;
     size_t i;
     const char *why = NULL;
-    ck_assert_int_eq(coa_lcm_obstacle_map_to_core(&m, &ctx, NULL, obstacles, 80, &n, vertices, 512,
+    ck_assert_int_eq(coavoid_lcm_obstacle_map_to_core(&m, &ctx, NULL, obstacles, 80, &n, vertices, 512,
                                                   &why), COA_OK);
     ck_assert_uint_eq(n, 3u);
     for (i = 0; i < n; ++i) {
         ck_assert_int_eq(coa_obstacle_check(&obstacles[i]), COA_OK);
     }
-    ck_assert_int_eq(coa_lcm_obstacle_map_from_core(obstacles, n, m.utime, 2, 4, &ctx, &back, &why),
+    ck_assert_int_eq(coavoid_lcm_obstacle_map_from_core(obstacles, n, m.utime, 2, 4, &ctx, &back, &why),
                      COA_OK);
     ck_assert_int_eq(memcmp(&back, &m, sizeof m), 0);
-    ck_assert_int_eq(coa_lcm_obstacle_map_to_core(&m, &ctx, NULL, obstacles, 2, &n, vertices, 512,
-                                                  &why), COA_LCM_ERR_CAPACITY);
-    ck_assert_int_eq(coa_lcm_obstacle_map_to_core(&m, &ctx, NULL, obstacles, 80, &n, vertices, 4,
-                                                  &why), COA_LCM_ERR_CAPACITY);
+    ck_assert_int_eq(coavoid_lcm_obstacle_map_to_core(&m, &ctx, NULL, obstacles, 2, &n, vertices, 512,
+                                                  &why), COAVOID_LCM_ERR_CAPACITY);
+    ck_assert_int_eq(coavoid_lcm_obstacle_map_to_core(&m, &ctx, NULL, obstacles, 80, &n, vertices, 4,
+                                                  &why), COAVOID_LCM_ERR_CAPACITY);
 }
 END_TEST
 
@@ -690,7 +690,7 @@ START_TEST(test_round_trip_report_core)
 {
     coavoid_conflict_report_t m = good_report();
     coavoid_conflict_report_t back;
-    coa_lcm_context_t ctx = ctx_now();
+    coavoid_lcm_context_t ctx = ctx_now();
     coa_conflict_t c[2];
     uint16_t plan_ids[3] = {10, 11, 12};
     uint32_t track_ids[1] = {77};
@@ -711,7 +711,7 @@ START_TEST(test_round_trip_report_core)
     c[1].min_horizontal = 40.0;
     c[1].min_vertical = 5.0;
     c[1].probability = 0.25;
-    ck_assert_int_eq(coa_lcm_conflict_report_from_core(c, 2, 2, plan_ids, 3, track_ids, 1, cluster,
+    ck_assert_int_eq(coavoid_lcm_conflict_report_from_core(c, 2, 2, plan_ids, 3, track_ids, 1, cluster,
                                                        T0, 1, 100, T0, 1.0, 60, &ctx, &back, &why),
                      COA_OK);
     ck_assert_int_eq(memcmp(&back, &m, sizeof m), 0);
@@ -724,9 +724,9 @@ END_TEST
     do {                                                              \
         type m_ = good_##checker##_msg();                             \
         const char *why_ = NULL;                                      \
-        coa_lcm_context_t ctx_ = ctx_now();                           \
+        coavoid_lcm_context_t ctx_ = ctx_now();                           \
         mutate;                                                       \
-        ck_assert_int_eq(coa_lcm_##checker##_check(&m_, &ctx_, &why_), (code)); \
+        ck_assert_int_eq(coavoid_lcm_##checker##_check(&m_, &ctx_, &why_), (code)); \
         ck_assert_ptr_nonnull(why_);                                  \
     } while (0)
 
@@ -738,14 +738,14 @@ END_TEST
 #define good_status_msg good_status
 
 /* An intent mutation refused with `code`, by the rule whose reason contains `field`: many
- * rules share COA_LCM_ERR_VALUE, and the reason shows which one fired. */
+ * rules share COAVOID_LCM_ERR_VALUE, and the reason shows which one fired. */
 #define EXPECT_INTENT(mutate, code, field)                                                 \
     do {                                                                                   \
         coavoid_intent_t m_ = good_intent();                                               \
         const char *why_ = NULL;                                                           \
-        coa_lcm_context_t ctx_ = ctx_now();                                                \
+        coavoid_lcm_context_t ctx_ = ctx_now();                                                \
         mutate;                                                                            \
-        ck_assert_int_eq(coa_lcm_intent_check(&m_, &ctx_, &why_), (code));                 \
+        ck_assert_int_eq(coavoid_lcm_intent_check(&m_, &ctx_, &why_), (code));                 \
         ck_assert_ptr_nonnull(why_);                                                       \
         ck_assert_msg(strstr(why_, (field)) != NULL, "reason \"%s\" does not name %s", why_, \
                       (field));                                                            \
@@ -753,142 +753,142 @@ END_TEST
 
 START_TEST(test_reject_intent)
 {
-    EXPECT_INTENT(m_.utime = 0, COA_LCM_ERR_TIME, "utime");
-    EXPECT_INTENT(m_.utime = T0 - 20000000, COA_LCM_ERR_TIME, "utime");
-    EXPECT_INTENT(m_.utime = T0 + 2000000, COA_LCM_ERR_TIME, "utime");
-    EXPECT_INTENT(m_.uav_id = 0, COA_LCM_ERR_ID, "uav_id");
-    EXPECT_INTENT(m_.uav_id = 65536, COA_LCM_ERR_ID, "uav_id");
-    EXPECT_INTENT(m_.sequence = -1, COA_LCM_ERR_VALUE, "sequence");
-    EXPECT_INTENT(m_.priority = 0, COA_LCM_ERR_VALUE, "priority");
-    EXPECT_INTENT(m_.mode = 3, COA_LCM_ERR_ENUM, "mode");
-    EXPECT_INTENT(m_.position[1] = NAN, COA_LCM_ERR_NONFINITE, "position");
-    EXPECT_INTENT(m_.position[2] = 1e300, COA_LCM_ERR_VALUE, "position");
-    EXPECT_INTENT(m_.velocity[0] = INFINITY, COA_LCM_ERR_NONFINITE, "velocity");
-    EXPECT_INTENT(m_.velocity[0] = 2e4, COA_LCM_ERR_VALUE, "velocity");
-    EXPECT_INTENT(m_.radius = 0.0, COA_LCM_ERR_VALUE, "radius");
-    EXPECT_INTENT(m_.half_height = -1.0, COA_LCM_ERR_VALUE, "half_height");
-    EXPECT_INTENT(m_.half_height = NAN, COA_LCM_ERR_NONFINITE, "half_height");
+    EXPECT_INTENT(m_.utime = 0, COAVOID_LCM_ERR_TIME, "utime");
+    EXPECT_INTENT(m_.utime = T0 - 20000000, COAVOID_LCM_ERR_TIME, "utime");
+    EXPECT_INTENT(m_.utime = T0 + 2000000, COAVOID_LCM_ERR_TIME, "utime");
+    EXPECT_INTENT(m_.uav_id = 0, COAVOID_LCM_ERR_ID, "uav_id");
+    EXPECT_INTENT(m_.uav_id = 65536, COAVOID_LCM_ERR_ID, "uav_id");
+    EXPECT_INTENT(m_.sequence = -1, COAVOID_LCM_ERR_VALUE, "sequence");
+    EXPECT_INTENT(m_.priority = 0, COAVOID_LCM_ERR_VALUE, "priority");
+    EXPECT_INTENT(m_.mode = 3, COAVOID_LCM_ERR_ENUM, "mode");
+    EXPECT_INTENT(m_.position[1] = NAN, COAVOID_LCM_ERR_NONFINITE, "position");
+    EXPECT_INTENT(m_.position[2] = 1e300, COAVOID_LCM_ERR_VALUE, "position");
+    EXPECT_INTENT(m_.velocity[0] = INFINITY, COAVOID_LCM_ERR_NONFINITE, "velocity");
+    EXPECT_INTENT(m_.velocity[0] = 2e4, COAVOID_LCM_ERR_VALUE, "velocity");
+    EXPECT_INTENT(m_.radius = 0.0, COAVOID_LCM_ERR_VALUE, "radius");
+    EXPECT_INTENT(m_.half_height = -1.0, COAVOID_LCM_ERR_VALUE, "half_height");
+    EXPECT_INTENT(m_.half_height = NAN, COAVOID_LCM_ERR_NONFINITE, "half_height");
 
     /* Performance. */
-    EXPECT_INTENT(m_.cruise_speed = 0.0, COA_LCM_ERR_VALUE, "cruise_speed");
-    EXPECT_INTENT(m_.cruise_speed = -18.0, COA_LCM_ERR_VALUE, "cruise_speed");
-    EXPECT_INTENT(m_.cruise_speed = NAN, COA_LCM_ERR_NONFINITE, "cruise_speed");
-    EXPECT_INTENT(m_.cruise_speed = 1.0001e4, COA_LCM_ERR_VALUE, "cruise_speed");
-    EXPECT_INTENT(m_.climb_rate = 0.0, COA_LCM_ERR_VALUE, "climb_rate");
-    EXPECT_INTENT(m_.climb_rate = -1.7, COA_LCM_ERR_VALUE, "climb_rate");
-    EXPECT_INTENT(m_.climb_rate = NAN, COA_LCM_ERR_NONFINITE, "climb_rate");
-    EXPECT_INTENT(m_.climb_rate = -INFINITY, COA_LCM_ERR_NONFINITE, "climb_rate");
-    EXPECT_INTENT(m_.climb_rate = 1.0001e4, COA_LCM_ERR_VALUE, "climb_rate");
-    EXPECT_INTENT(m_.steep_factor = 1, COA_LCM_ERR_VALUE, "steep_factor");
-    EXPECT_INTENT(m_.steep_factor = 11, COA_LCM_ERR_VALUE, "steep_factor");
-    EXPECT_INTENT(m_.max_offset = -2, COA_LCM_ERR_VALUE, "max_offset");
-    EXPECT_INTENT(m_.max_offset = 32768, COA_LCM_ERR_VALUE, "max_offset");
+    EXPECT_INTENT(m_.cruise_speed = 0.0, COAVOID_LCM_ERR_VALUE, "cruise_speed");
+    EXPECT_INTENT(m_.cruise_speed = -18.0, COAVOID_LCM_ERR_VALUE, "cruise_speed");
+    EXPECT_INTENT(m_.cruise_speed = NAN, COAVOID_LCM_ERR_NONFINITE, "cruise_speed");
+    EXPECT_INTENT(m_.cruise_speed = 1.0001e4, COAVOID_LCM_ERR_VALUE, "cruise_speed");
+    EXPECT_INTENT(m_.climb_rate = 0.0, COAVOID_LCM_ERR_VALUE, "climb_rate");
+    EXPECT_INTENT(m_.climb_rate = -1.7, COAVOID_LCM_ERR_VALUE, "climb_rate");
+    EXPECT_INTENT(m_.climb_rate = NAN, COAVOID_LCM_ERR_NONFINITE, "climb_rate");
+    EXPECT_INTENT(m_.climb_rate = -INFINITY, COAVOID_LCM_ERR_NONFINITE, "climb_rate");
+    EXPECT_INTENT(m_.climb_rate = 1.0001e4, COAVOID_LCM_ERR_VALUE, "climb_rate");
+    EXPECT_INTENT(m_.steep_factor = 1, COAVOID_LCM_ERR_VALUE, "steep_factor");
+    EXPECT_INTENT(m_.steep_factor = 11, COAVOID_LCM_ERR_VALUE, "steep_factor");
+    EXPECT_INTENT(m_.max_offset = -2, COAVOID_LCM_ERR_VALUE, "max_offset");
+    EXPECT_INTENT(m_.max_offset = 32768, COAVOID_LCM_ERR_VALUE, "max_offset");
     /* The bounds themselves are accepted. */
     EXPECT_INTENT((m_.cruise_speed = 1e4, m_.climb_rate = 1e4), COA_OK, "ok");
     EXPECT_INTENT((m_.steep_factor = 10, memset(m_.offsets, 0, sizeof m_.offsets)), COA_OK, "ok");
-    EXPECT_INTENT(m_.steep_factor = 2, COA_LCM_ERR_VALUE, "no action");
+    EXPECT_INTENT(m_.steep_factor = 2, COAVOID_LCM_ERR_VALUE, "no action");
     EXPECT_INTENT(m_.max_offset = 32767, COA_OK, "ok");
     EXPECT_INTENT(m_.max_offset = -1, COA_OK, "ok");
     /* Positive in double but nothing in the core: two tiny factors whose product (the
      * climb step, the planner's deviation weight) is 0 in either precision; and a volume
      * that is 0 once in float. */
-    EXPECT_INTENT((m_.climb_rate = 1e-200, m_.step = 1e-200), COA_LCM_ERR_VALUE, "core's precision");
-    EXPECT_INTENT((m_.cruise_speed = 1e-200, m_.climb_rate = 1e-200), COA_LCM_ERR_VALUE,
+    EXPECT_INTENT((m_.climb_rate = 1e-200, m_.step = 1e-200), COAVOID_LCM_ERR_VALUE, "core's precision");
+    EXPECT_INTENT((m_.cruise_speed = 1e-200, m_.climb_rate = 1e-200), COAVOID_LCM_ERR_VALUE,
                   "core's precision");
 #ifdef COA_SINGLE_PRECISION
-    EXPECT_INTENT(m_.radius = 1e-300, COA_LCM_ERR_VALUE, "core's precision");
-    EXPECT_INTENT(m_.cruise_speed = 1e-50, COA_LCM_ERR_VALUE, "core's precision");
+    EXPECT_INTENT(m_.radius = 1e-300, COAVOID_LCM_ERR_VALUE, "core's precision");
+    EXPECT_INTENT(m_.cruise_speed = 1e-50, COAVOID_LCM_ERR_VALUE, "core's precision");
 #else
     EXPECT_INTENT(m_.radius = 1e-300, COA_OK, "ok");
     EXPECT_INTENT(m_.cruise_speed = 1e-50, COA_OK, "ok");
 #endif
 
     /* The plan's time and step. */
-    EXPECT_INTENT(m_.plan_utime = 0, COA_LCM_ERR_TIME, "plan_utime");
-    EXPECT_INTENT(m_.plan_utime = T0 + 20000000, COA_LCM_ERR_TIME, "plan_utime");
-    EXPECT_INTENT(m_.step = 0.0, COA_LCM_ERR_VALUE, "step");
-    EXPECT_INTENT(m_.step = NAN, COA_LCM_ERR_NONFINITE, "step");
-    EXPECT_INTENT(m_.step = 3601.0, COA_LCM_ERR_VALUE, "step");
+    EXPECT_INTENT(m_.plan_utime = 0, COAVOID_LCM_ERR_TIME, "plan_utime");
+    EXPECT_INTENT(m_.plan_utime = T0 + 20000000, COAVOID_LCM_ERR_TIME, "plan_utime");
+    EXPECT_INTENT(m_.step = 0.0, COAVOID_LCM_ERR_VALUE, "step");
+    EXPECT_INTENT(m_.step = NAN, COAVOID_LCM_ERR_NONFINITE, "step");
+    EXPECT_INTENT(m_.step = 3601.0, COAVOID_LCM_ERR_VALUE, "step");
 
     /* Sample count. */
-    EXPECT_INTENT(m_.sample_count = 1, COA_LCM_ERR_COUNT, "sample_count");
-    EXPECT_INTENT(m_.sample_count = 129, COA_LCM_ERR_COUNT, "sample_count");
-    EXPECT_INTENT(m_.sample_count = 0, COA_LCM_ERR_COUNT, "sample_count");
-    EXPECT_INTENT(m_.sample_count = -5, COA_LCM_ERR_COUNT, "sample_count");
+    EXPECT_INTENT(m_.sample_count = 1, COAVOID_LCM_ERR_COUNT, "sample_count");
+    EXPECT_INTENT(m_.sample_count = 129, COAVOID_LCM_ERR_COUNT, "sample_count");
+    EXPECT_INTENT(m_.sample_count = 0, COAVOID_LCM_ERR_COUNT, "sample_count");
+    EXPECT_INTENT(m_.sample_count = -5, COAVOID_LCM_ERR_COUNT, "sample_count");
     EXPECT_INTENT(m_.sample_count = 2, COA_OK, "ok");
 
     /* The reference. */
-    EXPECT_INTENT(m_.reference[60][0] = NAN, COA_LCM_ERR_NONFINITE, "reference point");
-    EXPECT_INTENT(m_.reference[0][2] = INFINITY, COA_LCM_ERR_NONFINITE, "reference point");
-    EXPECT_INTENT(m_.reference[10][1] = -2e7, COA_LCM_ERR_VALUE, "reference point");
+    EXPECT_INTENT(m_.reference[60][0] = NAN, COAVOID_LCM_ERR_NONFINITE, "reference point");
+    EXPECT_INTENT(m_.reference[0][2] = INFINITY, COAVOID_LCM_ERR_NONFINITE, "reference point");
+    EXPECT_INTENT(m_.reference[10][1] = -2e7, COAVOID_LCM_ERR_VALUE, "reference point");
     EXPECT_INTENT((m_.reference[5][0] = m_.reference[4][0], m_.reference[5][1] = m_.reference[4][1]),
-                  COA_LCM_ERR_VALUE, "horizontal separation");
+                  COAVOID_LCM_ERR_VALUE, "horizontal separation");
     /* Only z differs: a vertical leg, which no cruise speed flies. */
     EXPECT_INTENT((m_.reference[5][0] = m_.reference[4][0], m_.reference[5][1] = m_.reference[4][1],
                    m_.reference[5][2] += 50.0),
-                  COA_LCM_ERR_VALUE, "horizontal separation");
+                  COAVOID_LCM_ERR_VALUE, "horizontal separation");
     /* Different numbers, but the horizontal length squares to 0 (in float they are equal
      * once converted). */
     EXPECT_INTENT((m_.reference[4][0] = 0.0, m_.reference[4][1] = 0.0, m_.reference[5][0] = 1e-200,
                    m_.reference[5][1] = 0.0),
-                  COA_LCM_ERR_VALUE, "horizontal separation");
+                  COAVOID_LCM_ERR_VALUE, "horizontal separation");
     /* A point past sample_count is not part of the message. */
     EXPECT_INTENT(m_.reference[61][0] = NAN, COA_OK, "ok");
     EXPECT_INTENT(m_.offsets[61] = 99999, COA_OK, "ok");
 
     /* Offsets. The good intent's offsets reach -5. */
-    EXPECT_INTENT(m_.max_offset = 4, COA_LCM_ERR_VALUE, "offset beyond max_offset");
+    EXPECT_INTENT(m_.max_offset = 4, COAVOID_LCM_ERR_VALUE, "offset beyond max_offset");
     EXPECT_INTENT(m_.max_offset = 5, COA_OK, "ok");
     EXPECT_INTENT((m_.max_offset = -1, m_.offsets[0] = 32768, m_.offsets[1] = 32768),
-                  COA_LCM_ERR_VALUE, "offset beyond max_offset");
-    EXPECT_INTENT((m_.max_offset = -1, m_.offsets[0] = -32768), COA_LCM_ERR_VALUE,
+                  COAVOID_LCM_ERR_VALUE, "offset beyond max_offset");
+    EXPECT_INTENT((m_.max_offset = -1, m_.offsets[0] = -32768), COAVOID_LCM_ERR_VALUE,
                   "offset beyond max_offset");
     /* +3 is a steep climb for steep factor 3, no action for 2; +2 is none for 3. */
-    EXPECT_INTENT(m_.steep_factor = 2, COA_LCM_ERR_VALUE, "no action");
-    EXPECT_INTENT(m_.offsets[1] = m_.offsets[0] + 2, COA_LCM_ERR_VALUE, "no action");
-    EXPECT_INTENT(m_.offsets[60] = m_.offsets[59] - 4, COA_LCM_ERR_VALUE, "no action");
+    EXPECT_INTENT(m_.steep_factor = 2, COAVOID_LCM_ERR_VALUE, "no action");
+    EXPECT_INTENT(m_.offsets[1] = m_.offsets[0] + 2, COAVOID_LCM_ERR_VALUE, "no action");
+    EXPECT_INTENT(m_.offsets[60] = m_.offsets[59] - 4, COAVOID_LCM_ERR_VALUE, "no action");
 
     /* A planned position out of range although its reference point is in range: offset 3
      * at sample 6 climbs 3 * 1e4 * 0.9 m above 9.99e6 m; offset -5 at sample 1 dives
      * 45 km below -9.99e6 m. */
     ck_assert_int_eq(good_intent().offsets[6], 3);
     ck_assert_int_eq(good_intent().offsets[1], -5);
-    EXPECT_INTENT((m_.climb_rate = 1e4, m_.reference[6][2] = 9.99e6), COA_LCM_ERR_VALUE,
+    EXPECT_INTENT((m_.climb_rate = 1e4, m_.reference[6][2] = 9.99e6), COAVOID_LCM_ERR_VALUE,
                   "planned position out of range");
-    EXPECT_INTENT((m_.climb_rate = 1e4, m_.reference[1][2] = -9.99e6), COA_LCM_ERR_VALUE,
+    EXPECT_INTENT((m_.climb_rate = 1e4, m_.reference[1][2] = -9.99e6), COAVOID_LCM_ERR_VALUE,
                   "planned position out of range");
     EXPECT_INTENT((m_.climb_rate = 1e4, m_.reference[6][2] = 9.97e6), COA_OK, "ok");
 
-    EXPECT_INTENT(m_.sigma_horizontal = -0.1, COA_LCM_ERR_VALUE, "sigma_horizontal");
-    EXPECT_INTENT(m_.sigma_vertical = INFINITY, COA_LCM_ERR_NONFINITE, "sigma_vertical");
+    EXPECT_INTENT(m_.sigma_horizontal = -0.1, COAVOID_LCM_ERR_VALUE, "sigma_horizontal");
+    EXPECT_INTENT(m_.sigma_vertical = INFINITY, COAVOID_LCM_ERR_NONFINITE, "sigma_vertical");
 }
 END_TEST
 
 START_TEST(test_reject_plan)
 {
-    EXPECT(coavoid_plan_t, plan, m_.utime = -1, COA_LCM_ERR_TIME);
-    EXPECT(coavoid_plan_t, plan, m_.coordinator_id = 0, COA_LCM_ERR_ID);
-    EXPECT(coavoid_plan_t, plan, m_.plan_id = -3, COA_LCM_ERR_VALUE);
-    EXPECT(coavoid_plan_t, plan, m_.valid_from_utime = 0, COA_LCM_ERR_TIME);
-    EXPECT(coavoid_plan_t, plan, m_.valid_until_utime = m_.valid_from_utime, COA_LCM_ERR_TIME);
-    EXPECT(coavoid_plan_t, plan, m_.dt = -1.0, COA_LCM_ERR_VALUE);
-    EXPECT(coavoid_plan_t, plan, m_.dt = NAN, COA_LCM_ERR_NONFINITE);
-    EXPECT(coavoid_plan_t, plan, m_.horizon = 0, COA_LCM_ERR_COUNT);
-    EXPECT(coavoid_plan_t, plan, m_.horizon = 128, COA_LCM_ERR_COUNT);
-    EXPECT(coavoid_plan_t, plan, m_.mode = 2, COA_LCM_ERR_ENUM);
-    EXPECT(coavoid_plan_t, plan, m_.status = 3, COA_LCM_ERR_ENUM);
-    EXPECT(coavoid_plan_t, plan, m_.deviation = -1.0, COA_LCM_ERR_VALUE);
-    EXPECT(coavoid_plan_t, plan, m_.deviation = NAN, COA_LCM_ERR_NONFINITE);
-    EXPECT(coavoid_plan_t, plan, m_.effort = -1, COA_LCM_ERR_VALUE);
-    EXPECT(coavoid_plan_t, plan, m_.nodes_expanded = -1, COA_LCM_ERR_VALUE);
-    EXPECT(coavoid_plan_t, plan, m_.vehicle_count = 0, COA_LCM_ERR_COUNT);
-    EXPECT(coavoid_plan_t, plan, m_.vehicle_count = 33, COA_LCM_ERR_COUNT);
-    EXPECT(coavoid_plan_t, plan, m_.planned_count = 2, COA_LCM_ERR_COUNT);
-    EXPECT(coavoid_plan_t, plan, m_.planned_count = -1, COA_LCM_ERR_COUNT);
-    EXPECT(coavoid_plan_t, plan, m_.uav_ids[2] = 0, COA_LCM_ERR_ID);
-    EXPECT(coavoid_plan_t, plan, m_.uav_ids[2] = m_.uav_ids[0], COA_LCM_ERR_ID);
-    EXPECT(coavoid_plan_t, plan, m_.offsets[1][5] = 40000, COA_LCM_ERR_VALUE);
-    EXPECT(coavoid_plan_t, plan, m_.offsets[1][5] = 11, COA_LCM_ERR_VALUE);
+    EXPECT(coavoid_plan_t, plan, m_.utime = -1, COAVOID_LCM_ERR_TIME);
+    EXPECT(coavoid_plan_t, plan, m_.coordinator_id = 0, COAVOID_LCM_ERR_ID);
+    EXPECT(coavoid_plan_t, plan, m_.plan_id = -3, COAVOID_LCM_ERR_VALUE);
+    EXPECT(coavoid_plan_t, plan, m_.valid_from_utime = 0, COAVOID_LCM_ERR_TIME);
+    EXPECT(coavoid_plan_t, plan, m_.valid_until_utime = m_.valid_from_utime, COAVOID_LCM_ERR_TIME);
+    EXPECT(coavoid_plan_t, plan, m_.dt = -1.0, COAVOID_LCM_ERR_VALUE);
+    EXPECT(coavoid_plan_t, plan, m_.dt = NAN, COAVOID_LCM_ERR_NONFINITE);
+    EXPECT(coavoid_plan_t, plan, m_.horizon = 0, COAVOID_LCM_ERR_COUNT);
+    EXPECT(coavoid_plan_t, plan, m_.horizon = 128, COAVOID_LCM_ERR_COUNT);
+    EXPECT(coavoid_plan_t, plan, m_.mode = 2, COAVOID_LCM_ERR_ENUM);
+    EXPECT(coavoid_plan_t, plan, m_.status = 3, COAVOID_LCM_ERR_ENUM);
+    EXPECT(coavoid_plan_t, plan, m_.deviation = -1.0, COAVOID_LCM_ERR_VALUE);
+    EXPECT(coavoid_plan_t, plan, m_.deviation = NAN, COAVOID_LCM_ERR_NONFINITE);
+    EXPECT(coavoid_plan_t, plan, m_.effort = -1, COAVOID_LCM_ERR_VALUE);
+    EXPECT(coavoid_plan_t, plan, m_.nodes_expanded = -1, COAVOID_LCM_ERR_VALUE);
+    EXPECT(coavoid_plan_t, plan, m_.vehicle_count = 0, COAVOID_LCM_ERR_COUNT);
+    EXPECT(coavoid_plan_t, plan, m_.vehicle_count = 33, COAVOID_LCM_ERR_COUNT);
+    EXPECT(coavoid_plan_t, plan, m_.planned_count = 2, COAVOID_LCM_ERR_COUNT);
+    EXPECT(coavoid_plan_t, plan, m_.planned_count = -1, COAVOID_LCM_ERR_COUNT);
+    EXPECT(coavoid_plan_t, plan, m_.uav_ids[2] = 0, COAVOID_LCM_ERR_ID);
+    EXPECT(coavoid_plan_t, plan, m_.uav_ids[2] = m_.uav_ids[0], COAVOID_LCM_ERR_ID);
+    EXPECT(coavoid_plan_t, plan, m_.offsets[1][5] = 40000, COAVOID_LCM_ERR_VALUE);
+    EXPECT(coavoid_plan_t, plan, m_.offsets[1][5] = 11, COAVOID_LCM_ERR_VALUE);
     /* Not solved: fewer rows are plans. */
     EXPECT(coavoid_plan_t, plan, (m_.status = 2, m_.planned_count = 1), COA_OK);
 }
@@ -896,92 +896,92 @@ END_TEST
 
 START_TEST(test_reject_track)
 {
-    EXPECT(coavoid_track_t, track, m_.utime = T0 + 5000000, COA_LCM_ERR_TIME);
-    EXPECT(coavoid_track_t, track, m_.source_id = -4, COA_LCM_ERR_ID);
-    EXPECT(coavoid_track_t, track, m_.sequence = -1, COA_LCM_ERR_VALUE);
-    EXPECT(coavoid_track_t, track, m_.track_id = 0, COA_LCM_ERR_ID);
-    EXPECT(coavoid_track_t, track, m_.estimate_utime = 0, COA_LCM_ERR_TIME);
-    EXPECT(coavoid_track_t, track, m_.position[0] = NAN, COA_LCM_ERR_NONFINITE);
-    EXPECT(coavoid_track_t, track, m_.velocity[1] = -1e5, COA_LCM_ERR_VALUE);
-    EXPECT(coavoid_track_t, track, m_.radius = -1.0, COA_LCM_ERR_VALUE);
-    EXPECT(coavoid_track_t, track, m_.half_height = 1e6, COA_LCM_ERR_VALUE);
-    EXPECT(coavoid_track_t, track, m_.path_count = 17, COA_LCM_ERR_COUNT);
-    EXPECT(coavoid_track_t, track, m_.path_count = -1, COA_LCM_ERR_COUNT);
-    EXPECT(coavoid_track_t, track, m_.path_utime[2] = m_.path_utime[1], COA_LCM_ERR_TIME);
-    EXPECT(coavoid_track_t, track, m_.path_utime[0] = -1, COA_LCM_ERR_TIME);
-    EXPECT(coavoid_track_t, track, m_.path[1][2] = INFINITY, COA_LCM_ERR_NONFINITE);
-    EXPECT(coavoid_track_t, track, m_.sigma_horizontal = NAN, COA_LCM_ERR_NONFINITE);
-    EXPECT(coavoid_track_t, track, m_.sigma_vertical = -2.0, COA_LCM_ERR_VALUE);
+    EXPECT(coavoid_track_t, track, m_.utime = T0 + 5000000, COAVOID_LCM_ERR_TIME);
+    EXPECT(coavoid_track_t, track, m_.source_id = -4, COAVOID_LCM_ERR_ID);
+    EXPECT(coavoid_track_t, track, m_.sequence = -1, COAVOID_LCM_ERR_VALUE);
+    EXPECT(coavoid_track_t, track, m_.track_id = 0, COAVOID_LCM_ERR_ID);
+    EXPECT(coavoid_track_t, track, m_.estimate_utime = 0, COAVOID_LCM_ERR_TIME);
+    EXPECT(coavoid_track_t, track, m_.position[0] = NAN, COAVOID_LCM_ERR_NONFINITE);
+    EXPECT(coavoid_track_t, track, m_.velocity[1] = -1e5, COAVOID_LCM_ERR_VALUE);
+    EXPECT(coavoid_track_t, track, m_.radius = -1.0, COAVOID_LCM_ERR_VALUE);
+    EXPECT(coavoid_track_t, track, m_.half_height = 1e6, COAVOID_LCM_ERR_VALUE);
+    EXPECT(coavoid_track_t, track, m_.path_count = 17, COAVOID_LCM_ERR_COUNT);
+    EXPECT(coavoid_track_t, track, m_.path_count = -1, COAVOID_LCM_ERR_COUNT);
+    EXPECT(coavoid_track_t, track, m_.path_utime[2] = m_.path_utime[1], COAVOID_LCM_ERR_TIME);
+    EXPECT(coavoid_track_t, track, m_.path_utime[0] = -1, COAVOID_LCM_ERR_TIME);
+    EXPECT(coavoid_track_t, track, m_.path[1][2] = INFINITY, COAVOID_LCM_ERR_NONFINITE);
+    EXPECT(coavoid_track_t, track, m_.sigma_horizontal = NAN, COAVOID_LCM_ERR_NONFINITE);
+    EXPECT(coavoid_track_t, track, m_.sigma_vertical = -2.0, COAVOID_LCM_ERR_VALUE);
 }
 END_TEST
 
 START_TEST(test_reject_obstacle_map)
 {
-    EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.utime = 0, COA_LCM_ERR_TIME);
-    EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.utime = T0 + 5000000, COA_LCM_ERR_TIME);
+    EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.utime = 0, COAVOID_LCM_ERR_TIME);
+    EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.utime = T0 + 5000000, COAVOID_LCM_ERR_TIME);
     /* A latched map may be old. */
     EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.utime = T0 - 3600000000, COA_OK);
-    EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.map_id = 70000, COA_LCM_ERR_ID);
-    EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.version = -1, COA_LCM_ERR_VALUE);
-    EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.box_count = 65, COA_LCM_ERR_COUNT);
-    EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.box_count = -1, COA_LCM_ERR_COUNT);
-    EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.box_min[1][2] = NAN, COA_LCM_ERR_NONFINITE);
-    EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.box_max[0][0] = 1e8, COA_LCM_ERR_VALUE);
-    EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.box_min[0][1] = 200.0, COA_LCM_ERR_VALUE);
-    EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.polytope_count = 17, COA_LCM_ERR_COUNT);
-    EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.vertex_count[0] = 3, COA_LCM_ERR_COUNT);
-    EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.vertex_count[0] = 33, COA_LCM_ERR_COUNT);
-    EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.vertices[0][4][1] = -INFINITY, COA_LCM_ERR_NONFINITE);
+    EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.map_id = 70000, COAVOID_LCM_ERR_ID);
+    EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.version = -1, COAVOID_LCM_ERR_VALUE);
+    EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.box_count = 65, COAVOID_LCM_ERR_COUNT);
+    EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.box_count = -1, COAVOID_LCM_ERR_COUNT);
+    EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.box_min[1][2] = NAN, COAVOID_LCM_ERR_NONFINITE);
+    EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.box_max[0][0] = 1e8, COAVOID_LCM_ERR_VALUE);
+    EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.box_min[0][1] = 200.0, COAVOID_LCM_ERR_VALUE);
+    EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.polytope_count = 17, COAVOID_LCM_ERR_COUNT);
+    EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.vertex_count[0] = 3, COAVOID_LCM_ERR_COUNT);
+    EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.vertex_count[0] = 33, COAVOID_LCM_ERR_COUNT);
+    EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.vertices[0][4][1] = -INFINITY, COAVOID_LCM_ERR_NONFINITE);
 }
 END_TEST
 
 START_TEST(test_reject_conflict_report)
 {
-    EXPECT(coavoid_conflict_report_t, conflict_report, m_.utime = 0, COA_LCM_ERR_TIME);
-    EXPECT(coavoid_conflict_report_t, conflict_report, m_.reporter_id = 0, COA_LCM_ERR_ID);
-    EXPECT(coavoid_conflict_report_t, conflict_report, m_.sequence = -1, COA_LCM_ERR_VALUE);
-    EXPECT(coavoid_conflict_report_t, conflict_report, m_.prediction_utime = 0, COA_LCM_ERR_TIME);
-    EXPECT(coavoid_conflict_report_t, conflict_report, m_.dt = 0.0, COA_LCM_ERR_VALUE);
-    EXPECT(coavoid_conflict_report_t, conflict_report, m_.horizon = 0, COA_LCM_ERR_COUNT);
-    EXPECT(coavoid_conflict_report_t, conflict_report, m_.conflict_count = 65, COA_LCM_ERR_COUNT);
-    EXPECT(coavoid_conflict_report_t, conflict_report, m_.conflicts_found = 1, COA_LCM_ERR_COUNT);
-    EXPECT(coavoid_conflict_report_t, conflict_report, m_.kind[1] = 3, COA_LCM_ERR_ENUM);
-    EXPECT(coavoid_conflict_report_t, conflict_report, m_.a_id[0] = 0, COA_LCM_ERR_ID);
-    EXPECT(coavoid_conflict_report_t, conflict_report, m_.b_id[0] = m_.a_id[0], COA_LCM_ERR_ID);
-    EXPECT(coavoid_conflict_report_t, conflict_report, m_.b_id[1] = -1, COA_LCM_ERR_ID);
-    EXPECT(coavoid_conflict_report_t, conflict_report, m_.first_step[0] = 60, COA_LCM_ERR_VALUE);
-    EXPECT(coavoid_conflict_report_t, conflict_report, m_.min_horizontal[0] = NAN, COA_LCM_ERR_NONFINITE);
-    EXPECT(coavoid_conflict_report_t, conflict_report, m_.min_vertical[1] = -1.0, COA_LCM_ERR_VALUE);
-    EXPECT(coavoid_conflict_report_t, conflict_report, m_.probability[1] = 1.5, COA_LCM_ERR_VALUE);
-    EXPECT(coavoid_conflict_report_t, conflict_report, m_.probability[1] = NAN, COA_LCM_ERR_NONFINITE);
-    EXPECT(coavoid_conflict_report_t, conflict_report, m_.cluster[0] = -2, COA_LCM_ERR_VALUE);
+    EXPECT(coavoid_conflict_report_t, conflict_report, m_.utime = 0, COAVOID_LCM_ERR_TIME);
+    EXPECT(coavoid_conflict_report_t, conflict_report, m_.reporter_id = 0, COAVOID_LCM_ERR_ID);
+    EXPECT(coavoid_conflict_report_t, conflict_report, m_.sequence = -1, COAVOID_LCM_ERR_VALUE);
+    EXPECT(coavoid_conflict_report_t, conflict_report, m_.prediction_utime = 0, COAVOID_LCM_ERR_TIME);
+    EXPECT(coavoid_conflict_report_t, conflict_report, m_.dt = 0.0, COAVOID_LCM_ERR_VALUE);
+    EXPECT(coavoid_conflict_report_t, conflict_report, m_.horizon = 0, COAVOID_LCM_ERR_COUNT);
+    EXPECT(coavoid_conflict_report_t, conflict_report, m_.conflict_count = 65, COAVOID_LCM_ERR_COUNT);
+    EXPECT(coavoid_conflict_report_t, conflict_report, m_.conflicts_found = 1, COAVOID_LCM_ERR_COUNT);
+    EXPECT(coavoid_conflict_report_t, conflict_report, m_.kind[1] = 3, COAVOID_LCM_ERR_ENUM);
+    EXPECT(coavoid_conflict_report_t, conflict_report, m_.a_id[0] = 0, COAVOID_LCM_ERR_ID);
+    EXPECT(coavoid_conflict_report_t, conflict_report, m_.b_id[0] = m_.a_id[0], COAVOID_LCM_ERR_ID);
+    EXPECT(coavoid_conflict_report_t, conflict_report, m_.b_id[1] = -1, COAVOID_LCM_ERR_ID);
+    EXPECT(coavoid_conflict_report_t, conflict_report, m_.first_step[0] = 60, COAVOID_LCM_ERR_VALUE);
+    EXPECT(coavoid_conflict_report_t, conflict_report, m_.min_horizontal[0] = NAN, COAVOID_LCM_ERR_NONFINITE);
+    EXPECT(coavoid_conflict_report_t, conflict_report, m_.min_vertical[1] = -1.0, COAVOID_LCM_ERR_VALUE);
+    EXPECT(coavoid_conflict_report_t, conflict_report, m_.probability[1] = 1.5, COAVOID_LCM_ERR_VALUE);
+    EXPECT(coavoid_conflict_report_t, conflict_report, m_.probability[1] = NAN, COAVOID_LCM_ERR_NONFINITE);
+    EXPECT(coavoid_conflict_report_t, conflict_report, m_.cluster[0] = -2, COAVOID_LCM_ERR_VALUE);
 }
 END_TEST
 
 START_TEST(test_reject_status)
 {
-    EXPECT(coavoid_status_t, status, m_.utime = T0 - 11000000, COA_LCM_ERR_TIME);
-    EXPECT(coavoid_status_t, status, m_.node_id = 65536, COA_LCM_ERR_ID);
-    EXPECT(coavoid_status_t, status, m_.node_kind = 2, COA_LCM_ERR_ENUM);
-    EXPECT(coavoid_status_t, status, m_.sequence = -1, COA_LCM_ERR_VALUE);
-    EXPECT(coavoid_status_t, status, m_.health = 3, COA_LCM_ERR_ENUM);
-    EXPECT(coavoid_status_t, status, m_.mode = -1, COA_LCM_ERR_ENUM);
-    EXPECT(coavoid_status_t, status, m_.outcome = 4, COA_LCM_ERR_ENUM);
-    EXPECT(coavoid_status_t, status, m_.last_plan_utime = T0 + 1, COA_LCM_ERR_TIME);
-    EXPECT(coavoid_status_t, status, m_.last_plan_duration_us = -1, COA_LCM_ERR_VALUE);
-    EXPECT(coavoid_status_t, status, m_.nodes_expanded = -1, COA_LCM_ERR_VALUE);
-    EXPECT(coavoid_status_t, status, m_.conflicts = -1, COA_LCM_ERR_VALUE);
-    EXPECT(coavoid_status_t, status, m_.messages_rejected = 1001, COA_LCM_ERR_COUNT);
-    EXPECT(coavoid_status_t, status, m_.messages_received = -1, COA_LCM_ERR_COUNT);
-    EXPECT(coavoid_status_t, status, m_.last_reject_code = 1, COA_LCM_ERR_VALUE);
+    EXPECT(coavoid_status_t, status, m_.utime = T0 - 11000000, COAVOID_LCM_ERR_TIME);
+    EXPECT(coavoid_status_t, status, m_.node_id = 65536, COAVOID_LCM_ERR_ID);
+    EXPECT(coavoid_status_t, status, m_.node_kind = 2, COAVOID_LCM_ERR_ENUM);
+    EXPECT(coavoid_status_t, status, m_.sequence = -1, COAVOID_LCM_ERR_VALUE);
+    EXPECT(coavoid_status_t, status, m_.health = 3, COAVOID_LCM_ERR_ENUM);
+    EXPECT(coavoid_status_t, status, m_.mode = -1, COAVOID_LCM_ERR_ENUM);
+    EXPECT(coavoid_status_t, status, m_.outcome = 4, COAVOID_LCM_ERR_ENUM);
+    EXPECT(coavoid_status_t, status, m_.last_plan_utime = T0 + 1, COAVOID_LCM_ERR_TIME);
+    EXPECT(coavoid_status_t, status, m_.last_plan_duration_us = -1, COAVOID_LCM_ERR_VALUE);
+    EXPECT(coavoid_status_t, status, m_.nodes_expanded = -1, COAVOID_LCM_ERR_VALUE);
+    EXPECT(coavoid_status_t, status, m_.conflicts = -1, COAVOID_LCM_ERR_VALUE);
+    EXPECT(coavoid_status_t, status, m_.messages_rejected = 1001, COAVOID_LCM_ERR_COUNT);
+    EXPECT(coavoid_status_t, status, m_.messages_received = -1, COAVOID_LCM_ERR_COUNT);
+    EXPECT(coavoid_status_t, status, m_.last_reject_code = 1, COAVOID_LCM_ERR_VALUE);
 }
 END_TEST
 
 START_TEST(test_sequence_rules)
 {
-    coa_lcm_sender_t entries[2];
-    coa_lcm_sequence_table_t table;
-    coa_lcm_context_t ctx = ctx_now();
+    coavoid_lcm_sender_t entries[2];
+    coavoid_lcm_sequence_table_t table;
+    coavoid_lcm_context_t ctx = ctx_now();
     coavoid_intent_t m = good_intent();
     intent_view_t *v = malloc(sizeof *v);
     coavoid_obstacle_map_t map = good_map();
@@ -991,19 +991,19 @@ START_TEST(test_sequence_rules)
     const char *why = NULL;
     ck_assert_ptr_nonnull(v);
 #define INTENT_IN() \
-    coa_lcm_intent_to_core(&m, &ctx, &table, &v->info, &v->vehicle, &v->plan, &v->arrays, &why)
-    coa_lcm_sequence_init(&table, entries, 2);
+    coavoid_lcm_intent_to_core(&m, &ctx, &table, &v->info, &v->vehicle, &v->plan, &v->arrays, &why)
+    coavoid_lcm_sequence_init(&table, entries, 2);
     ck_assert_int_eq(INTENT_IN(), COA_OK);
     /* The same sequence again, and an older one: refused, nothing recorded. */
-    ck_assert_int_eq(INTENT_IN(), COA_LCM_ERR_SEQUENCE);
+    ck_assert_int_eq(INTENT_IN(), COAVOID_LCM_ERR_SEQUENCE);
     m.sequence = 41;
-    ck_assert_int_eq(INTENT_IN(), COA_LCM_ERR_SEQUENCE);
+    ck_assert_int_eq(INTENT_IN(), COAVOID_LCM_ERR_SEQUENCE);
     m.sequence = 43;
     ck_assert_int_eq(INTENT_IN(), COA_OK);
     /* An invalid message does not advance the sequence. */
     m.sequence = 100;
     m.steep_factor = 2;
-    ck_assert_int_eq(INTENT_IN(), COA_LCM_ERR_VALUE);
+    ck_assert_int_eq(INTENT_IN(), COAVOID_LCM_ERR_VALUE);
     m.steep_factor = 3;
     m.sequence = 44;
     ck_assert_int_eq(INTENT_IN(), COA_OK);
@@ -1012,19 +1012,19 @@ START_TEST(test_sequence_rules)
     m.sequence = 0;
     ck_assert_int_eq(INTENT_IN(), COA_OK);
     m.uav_id = 9;
-    ck_assert_int_eq(INTENT_IN(), COA_LCM_ERR_SENDERS);
-    coa_lcm_sequence_forget(&table, 8);
+    ck_assert_int_eq(INTENT_IN(), COAVOID_LCM_ERR_SENDERS);
+    coavoid_lcm_sequence_forget(&table, 8);
     ck_assert_int_eq(INTENT_IN(), COA_OK);
 #undef INTENT_IN
     free(v);
     /* A map may be republished with the same version, never an older one. */
-    coa_lcm_sequence_init(&table, entries, 2);
-    ck_assert_int_eq(coa_lcm_obstacle_map_to_core(&map, &ctx, &table, obstacles, 80, &n, vertices, 512, &why), COA_OK);
-    ck_assert_int_eq(coa_lcm_obstacle_map_to_core(&map, &ctx, &table, obstacles, 80, &n, vertices, 512, &why), COA_OK);
+    coavoid_lcm_sequence_init(&table, entries, 2);
+    ck_assert_int_eq(coavoid_lcm_obstacle_map_to_core(&map, &ctx, &table, obstacles, 80, &n, vertices, 512, &why), COA_OK);
+    ck_assert_int_eq(coavoid_lcm_obstacle_map_to_core(&map, &ctx, &table, obstacles, 80, &n, vertices, 512, &why), COA_OK);
     map.version = 3;
-    ck_assert_int_eq(coa_lcm_obstacle_map_to_core(&map, &ctx, &table, obstacles, 80, &n, vertices, 512, &why),
-                     COA_LCM_ERR_SEQUENCE);
-    ck_assert_str_eq(coa_lcm_error_name(COA_LCM_ERR_SEQUENCE), "sequence went backwards");
+    ck_assert_int_eq(coavoid_lcm_obstacle_map_to_core(&map, &ctx, &table, obstacles, 80, &n, vertices, 512, &why),
+                     COAVOID_LCM_ERR_SEQUENCE);
+    ck_assert_str_eq(coavoid_lcm_error_name(COAVOID_LCM_ERR_SEQUENCE), "sequence went backwards");
 }
 END_TEST
 
@@ -1032,70 +1032,70 @@ END_TEST
 
 START_TEST(test_rx_count)
 {
-    coa_lcm_rx_stats_t rx;
+    coavoid_lcm_rx_stats_t rx;
     coavoid_status_t st = good_status();
-    coa_lcm_context_t ctx = ctx_now();
+    coavoid_lcm_context_t ctx = ctx_now();
     const char *why = "untouched";
     coavoid_intent_t bad = good_intent();
     int rc;
-    coa_lcm_rx_init(&rx);
+    coavoid_lcm_rx_init(&rx);
     ck_assert(rx.received == 0 && rx.rejected == 0);
     ck_assert_int_eq(rx.last_reject_code, 0);
     ck_assert_str_eq(rx.last_reason, "none");
 
-    coa_lcm_rx_count(&rx, COA_OK, "ok");
+    coavoid_lcm_rx_count(&rx, COA_OK, "ok");
     ck_assert(rx.received == 1 && rx.rejected == 0);
     ck_assert_str_eq(rx.last_reason, "none");
     /* A refusal as a node meets it: the check's code and its reason string. */
     bad.climb_rate = NAN;
-    rc = coa_lcm_intent_check(&bad, &ctx, &why); /* before reading why: argument order */
-    coa_lcm_rx_count(&rx, rc, why);
+    rc = coavoid_lcm_intent_check(&bad, &ctx, &why); /* before reading why: argument order */
+    coavoid_lcm_rx_count(&rx, rc, why);
     ck_assert(rx.received == 2 && rx.rejected == 1);
-    ck_assert_int_eq(rx.last_reject_code, COA_LCM_ERR_NONFINITE);
+    ck_assert_int_eq(rx.last_reject_code, COAVOID_LCM_ERR_NONFINITE);
     ck_assert_ptr_eq(rx.last_reason, why);
     ck_assert_ptr_nonnull(strstr(rx.last_reason, "climb_rate"));
     /* An acceptance leaves the last refusal as it was. */
-    coa_lcm_rx_count(&rx, COA_OK, "ok");
+    coavoid_lcm_rx_count(&rx, COA_OK, "ok");
     ck_assert(rx.received == 3 && rx.rejected == 1);
-    ck_assert_int_eq(rx.last_reject_code, COA_LCM_ERR_NONFINITE);
+    ck_assert_int_eq(rx.last_reject_code, COAVOID_LCM_ERR_NONFINITE);
     /* No reason given: the code's name. */
-    coa_lcm_rx_count(&rx, COA_LCM_ERR_DECODE, NULL);
+    coavoid_lcm_rx_count(&rx, COAVOID_LCM_ERR_DECODE, NULL);
     ck_assert(rx.received == 4 && rx.rejected == 2);
-    ck_assert_int_eq(rx.last_reject_code, COA_LCM_ERR_DECODE);
+    ck_assert_int_eq(rx.last_reject_code, COAVOID_LCM_ERR_DECODE);
     ck_assert_str_eq(rx.last_reason, "message does not decode");
     /* A decoder's byte count is a success, not a positive reject code (which would make
      * the status message itself refused). */
-    coa_lcm_rx_count(&rx, 3791, NULL);
+    coavoid_lcm_rx_count(&rx, 3791, NULL);
     ck_assert(rx.received == 5 && rx.rejected == 2);
-    ck_assert_int_eq(rx.last_reject_code, COA_LCM_ERR_DECODE);
+    ck_assert_int_eq(rx.last_reject_code, COAVOID_LCM_ERR_DECODE);
 
     /* What the status message carries passes the status check. */
     st.messages_received = rx.received;
     st.messages_rejected = rx.rejected;
     st.last_reject_code = rx.last_reject_code;
-    ck_assert_int_eq(coa_lcm_status_check(&st, &ctx, &why), COA_OK);
+    ck_assert_int_eq(coavoid_lcm_status_check(&st, &ctx, &why), COA_OK);
 
     /* Saturation: neither counter wraps, and rejected never passes received. */
     rx.received = INT64_MAX - 1;
     rx.rejected = INT64_MAX - 2;
-    coa_lcm_rx_count(&rx, COA_LCM_ERR_TIME, "t");
+    coavoid_lcm_rx_count(&rx, COAVOID_LCM_ERR_TIME, "t");
     ck_assert(rx.received == INT64_MAX && rx.rejected == INT64_MAX - 1);
-    coa_lcm_rx_count(&rx, COA_LCM_ERR_ID, "i");
+    coavoid_lcm_rx_count(&rx, COAVOID_LCM_ERR_ID, "i");
     ck_assert(rx.received == INT64_MAX && rx.rejected == INT64_MAX);
-    coa_lcm_rx_count(&rx, COA_LCM_ERR_COUNT, "c");
+    coavoid_lcm_rx_count(&rx, COAVOID_LCM_ERR_COUNT, "c");
     ck_assert(rx.received == INT64_MAX && rx.rejected == INT64_MAX);
-    ck_assert_int_eq(rx.last_reject_code, COA_LCM_ERR_COUNT);
+    ck_assert_int_eq(rx.last_reject_code, COAVOID_LCM_ERR_COUNT);
     ck_assert_str_eq(rx.last_reason, "c");
-    coa_lcm_rx_count(&rx, COA_OK, NULL);
+    coavoid_lcm_rx_count(&rx, COA_OK, NULL);
     ck_assert(rx.received == INT64_MAX && rx.rejected == INT64_MAX);
     st.messages_received = rx.received;
     st.messages_rejected = rx.rejected;
     st.last_reject_code = rx.last_reject_code;
-    ck_assert_int_eq(coa_lcm_status_check(&st, &ctx, &why), COA_OK);
+    ck_assert_int_eq(coavoid_lcm_status_check(&st, &ctx, &why), COA_OK);
 
     /* NULL is harmless. */
-    coa_lcm_rx_init(NULL);
-    coa_lcm_rx_count(NULL, COA_LCM_ERR_TIME, "t");
+    coavoid_lcm_rx_init(NULL);
+    coavoid_lcm_rx_count(NULL, COAVOID_LCM_ERR_TIME, "t");
 }
 END_TEST
 
@@ -1107,11 +1107,11 @@ END_TEST
     do {                                                                                    \
         type m_;                                                                            \
         const char *why_ = NULL;                                                            \
-        coa_lcm_context_t ctx_ = ctx_now();                                                 \
+        coavoid_lcm_context_t ctx_ = ctx_now();                                                 \
         memset(&m_, 0, sizeof m_);                                                          \
         if (type##_decode((buf), 0, (int)(len), &m_) >= 0) {                                \
             decoded++;                                                                      \
-            if (coa_lcm_##checker##_check(&m_, &ctx_, &why_) == COA_OK) {                    \
+            if (coavoid_lcm_##checker##_check(&m_, &ctx_, &why_) == COA_OK) {                    \
                 accepted++;                                                                 \
                 usable;                                                                     \
             }                                                                               \

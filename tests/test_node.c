@@ -40,7 +40,7 @@
 typedef struct {
     lcm_t *lcm;
     int64_t now;
-    coa_node_common_t common;
+    coavoid_node_common_t common;
 } rig_t;
 
 static void rig_init(rig_t *r, uint32_t horizon)
@@ -48,7 +48,7 @@ static void rig_init(rig_t *r, uint32_t horizon)
     r->lcm = lcm_create("memq://");
     ck_assert_ptr_nonnull(r->lcm);
     r->now = EPOCH;
-    ck_assert_int_eq(coa_node_common_defaults(&r->common, EPOCH, (coa_real_t)1, horizon, &r->now),
+    ck_assert_int_eq(coavoid_node_common_defaults(&r->common, EPOCH, (coa_real_t)1, horizon, &r->now),
                      COA_OK);
 }
 
@@ -89,15 +89,15 @@ static coa_vehicle_t uav(uint16_t id, uint32_t priority, coa_vec3_t *route, coa_
     return v;
 }
 
-static coa_vehicle_node_t *vehicle_node(const rig_t *r, coa_vehicle_t v, coa_node_mode_t mode)
+static coavoid_vehicle_node_t *vehicle_node(const rig_t *r, coa_vehicle_t v, coavoid_node_mode_t mode)
 {
-    coa_vehicle_node_config_t config;
+    coavoid_vehicle_node_config_t config;
     memset(&config, 0, sizeof config);
     config.common = r->common;
     config.vehicle = v;
     config.mode = mode;
     int error = -99;
-    coa_vehicle_node_t *node = coa_vehicle_node_create(&config, r->lcm, &error);
+    coavoid_vehicle_node_t *node = coavoid_vehicle_node_create(&config, r->lcm, &error);
     ck_assert_ptr_nonnull(node);
     ck_assert_int_eq(error, COA_OK);
     return node;
@@ -115,7 +115,7 @@ static void heartbeat_from(lcm_t *lcm, int64_t now, int64_t sequence, int32_t no
     m.health = health;
     m.mode = COAVOID_STATUS_T_MODE_CENTRALISED;
     m.outcome = COAVOID_STATUS_T_OUTCOME_NONE;
-    ck_assert_int_eq(coavoid_status_t_publish(lcm, COA_CHANNEL_STATUS, &m), 0);
+    ck_assert_int_eq(coavoid_status_t_publish(lcm, COAVOID_CHANNEL_STATUS, &m), 0);
 }
 
 static void heartbeat(lcm_t *lcm, int64_t now, int64_t sequence)
@@ -123,13 +123,13 @@ static void heartbeat(lcm_t *lcm, int64_t now, int64_t sequence)
     coavoid_status_t m;
     memset(&m, 0, sizeof m);
     m.utime = now;
-    m.node_id = COA_NODE_COORDINATOR_ID;
+    m.node_id = COAVOID_NODE_COORDINATOR_ID;
     m.node_kind = COAVOID_STATUS_T_NODE_COORDINATOR;
     m.sequence = sequence;
     m.health = COAVOID_STATUS_T_HEALTH_OK;
     m.mode = COAVOID_STATUS_T_MODE_CENTRALISED;
     m.outcome = COAVOID_STATUS_T_OUTCOME_NONE;
-    ck_assert_int_eq(coavoid_status_t_publish(lcm, COA_CHANNEL_STATUS, &m), 0);
+    ck_assert_int_eq(coavoid_status_t_publish(lcm, COAVOID_CHANNEL_STATUS, &m), 0);
 }
 
 /* A one-UAV plan_t from coordinator `from`: offsets 0, 1, 2, then level at 2, plus
@@ -154,14 +154,14 @@ static void plan_msg_from(lcm_t *lcm, int64_t now, int32_t from, int64_t plan_id
     for (int32_t k = 0; k <= horizon; k++) {
         m.offsets[0][k] = (k < 2 ? k : 2) + shift;
     }
-    ck_assert_int_eq(coavoid_plan_t_publish(lcm, COA_CHANNEL_PLAN, &m), 0);
+    ck_assert_int_eq(coavoid_plan_t_publish(lcm, COAVOID_CHANNEL_PLAN, &m), 0);
 }
 
 /* The same from the default coordinator. */
 static void plan_msg(lcm_t *lcm, int64_t now, int64_t plan_id, int64_t valid_from, uint16_t id,
                      int32_t horizon, int32_t shift)
 {
-    plan_msg_from(lcm, now, (int32_t)COA_NODE_COORDINATOR_ID, plan_id, valid_from, id, horizon,
+    plan_msg_from(lcm, now, (int32_t)COAVOID_NODE_COORDINATOR_ID, plan_id, valid_from, id, horizon,
                   shift);
 }
 
@@ -172,36 +172,36 @@ START_TEST(test_undecodable_counted_own_ignored)
     rig_t r;
     rig_init(&r, 10);
     coa_vec3_t route[2];
-    coa_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, route, 0, 500, 0, 100), COA_NODE_CENTRALISED);
-    const coa_vehicle_node_state_t *s = coa_vehicle_node_state(a);
+    coavoid_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, route, 0, 500, 0, 100), COAVOID_NODE_CENTRALISED);
+    const coavoid_vehicle_node_state_t *s = coavoid_vehicle_node_state(a);
     ck_assert_int_eq(s->cycle, -1);
 
     /* Its own intent and heartbeat come back over memq: neither is counted. */
-    ck_assert_int_eq(coa_vehicle_node_cycle(a, r.now), COA_OK);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
     drain(r.lcm);
     ck_assert(s->published);
     ck_assert_int_eq(s->rx.received, 0);
 
     const uint8_t junk[7] = {1, 2, 3, 4, 5, 6, 7};
-    const char *channels[] = {COA_CHANNEL_INTENT, COA_CHANNEL_TRACK, COA_CHANNEL_OBSTACLES,
-                              COA_CHANNEL_STATUS, COA_CHANNEL_PLAN};
+    const char *channels[] = {COAVOID_CHANNEL_INTENT, COAVOID_CHANNEL_TRACK, COAVOID_CHANNEL_OBSTACLES,
+                              COAVOID_CHANNEL_STATUS, COAVOID_CHANNEL_PLAN};
     for (size_t i = 0; i < 5; i++) {
         ck_assert_int_eq(lcm_publish(r.lcm, channels[i], junk, sizeof junk), 0);
     }
     drain(r.lcm);
     ck_assert_int_eq(s->rx.received, 5);
     ck_assert_int_eq(s->rx.rejected, 5);
-    ck_assert_int_eq(s->rx.last_reject_code, COA_LCM_ERR_DECODE);
+    ck_assert_int_eq(s->rx.last_reject_code, COAVOID_LCM_ERR_DECODE);
 
     /* Another UAV's intent is counted and accepted. */
     coa_vec3_t route2[2];
-    coa_vehicle_node_t *b = vehicle_node(&r, uav(2, 2, route2, 0, 500, 500, 100), COA_NODE_DECOUPLED);
-    ck_assert_int_eq(coa_vehicle_node_cycle(b, r.now), COA_OK);
+    coavoid_vehicle_node_t *b = vehicle_node(&r, uav(2, 2, route2, 0, 500, 500, 100), COAVOID_NODE_DECOUPLED);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(b, r.now), COA_OK);
     drain(r.lcm);
     ck_assert_int_eq(s->rx.received, 7); /* its intent and its heartbeat */
     ck_assert_int_eq(s->rx.rejected, 5);
-    coa_vehicle_node_destroy(b);
-    coa_vehicle_node_destroy(a);
+    coavoid_vehicle_node_destroy(b);
+    coavoid_vehicle_node_destroy(a);
     lcm_destroy(r.lcm);
 }
 END_TEST
@@ -214,24 +214,24 @@ START_TEST(test_restarted_peer_accepted_after_silence)
     rig_init(&r, 10);
     coa_vec3_t r1[2], r2[2];
     coa_vehicle_t v2 = uav(2, 2, r2, 0, 500, 800, 100);
-    coa_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, r1, 0, 500, 0, 100), COA_NODE_DECOUPLED);
-    coa_vehicle_node_t *b = vehicle_node(&r, v2, COA_NODE_DECOUPLED);
-    const coa_vehicle_node_state_t *s = coa_vehicle_node_state(a);
+    coavoid_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, r1, 0, 500, 0, 100), COAVOID_NODE_DECOUPLED);
+    coavoid_vehicle_node_t *b = vehicle_node(&r, v2, COAVOID_NODE_DECOUPLED);
+    const coavoid_vehicle_node_state_t *s = coavoid_vehicle_node_state(a);
     for (int64_t k = 0; k <= 3; k++) {
         r.now = cycle(k);
-        coa_vehicle_node_cycle(a, r.now);
-        coa_vehicle_node_cycle(b, r.now);
+        coavoid_vehicle_node_cycle(a, r.now);
+        coavoid_vehicle_node_cycle(b, r.now);
         drain(r.lcm);
     }
     ck_assert_int_eq(s->rx.rejected, 0);
-    coa_vehicle_node_destroy(b);
-    b = vehicle_node(&r, v2, COA_NODE_DECOUPLED); /* restarted: sequence 0 again */
+    coavoid_vehicle_node_destroy(b);
+    b = vehicle_node(&r, v2, COAVOID_NODE_DECOUPLED); /* restarted: sequence 0 again */
     int64_t rejected_at[10] = {0};
     for (int64_t k = 4; k <= 9; k++) {
         r.now = cycle(k);
-        coa_vehicle_node_cycle(a, r.now);
+        coavoid_vehicle_node_cycle(a, r.now);
         drain(r.lcm);
-        coa_vehicle_node_cycle(b, r.now);
+        coavoid_vehicle_node_cycle(b, r.now);
         drain(r.lcm);
         rejected_at[k] = s->rx.rejected;
     }
@@ -242,9 +242,9 @@ START_TEST(test_restarted_peer_accepted_after_silence)
     ck_assert_int_eq(rejected_at[5], 2);
     ck_assert_int_eq(rejected_at[6], 2);
     ck_assert_int_eq(rejected_at[9], 2);
-    ck_assert_int_eq(s->rx.last_reject_code, COA_LCM_ERR_SEQUENCE);
-    coa_vehicle_node_destroy(b);
-    coa_vehicle_node_destroy(a);
+    ck_assert_int_eq(s->rx.last_reject_code, COAVOID_LCM_ERR_SEQUENCE);
+    coavoid_vehicle_node_destroy(b);
+    coavoid_vehicle_node_destroy(a);
     lcm_destroy(r.lcm);
 }
 END_TEST
@@ -256,9 +256,9 @@ START_TEST(test_plan_adoption_rules)
     rig_t r;
     rig_init(&r, 10);
     coa_vec3_t route[2];
-    coa_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, route, 0, 500, 0, 100), COA_NODE_CENTRALISED);
-    const coa_vehicle_node_state_t *s = coa_vehicle_node_state(a);
-    ck_assert_int_eq(coa_vehicle_node_cycle(a, cycle(0)), COA_OK);
+    coavoid_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, route, 0, 500, 0, 100), COAVOID_NODE_CENTRALISED);
+    const coavoid_vehicle_node_state_t *s = coavoid_vehicle_node_state(a);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, cycle(0)), COA_OK);
     drain(r.lcm);
     r.now = cycle(0) + DT_US / 4;
     int64_t rejected = s->rx.rejected;
@@ -272,12 +272,12 @@ START_TEST(test_plan_adoption_rules)
     plan_msg(r.lcm, r.now, 2, cycle(0) - DT_US, 1, 10, 0);
     drain(r.lcm);
     ck_assert_int_eq(s->rx.rejected, ++rejected);
-    ck_assert_int_eq(s->rx.last_reject_code, COA_LCM_ERR_TIME);
+    ck_assert_int_eq(s->rx.last_reject_code, COAVOID_LCM_ERR_TIME);
     /* Not from the offset it flies (0): refused. */
     plan_msg(r.lcm, r.now, 3, cycle(0), 1, 10, 3);
     drain(r.lcm);
     ck_assert_int_eq(s->rx.rejected, ++rejected);
-    ck_assert_int_eq(s->rx.last_reject_code, COA_LCM_ERR_VALUE);
+    ck_assert_int_eq(s->rx.last_reject_code, COAVOID_LCM_ERR_VALUE);
     /* Right: adopted. */
     plan_msg(r.lcm, r.now, 4, cycle(0), 1, 10, 0);
     drain(r.lcm);
@@ -287,24 +287,24 @@ START_TEST(test_plan_adoption_rules)
     plan_msg(r.lcm, r.now, 4, cycle(0), 1, 10, 0);
     drain(r.lcm);
     ck_assert_int_eq(s->rx.rejected, ++rejected);
-    ck_assert_int_eq(s->rx.last_reject_code, COA_LCM_ERR_SEQUENCE);
+    ck_assert_int_eq(s->rx.last_reject_code, COAVOID_LCM_ERR_SEQUENCE);
     /* Too late (valid_until has come): refused. */
     r.now = cycle(1);
     plan_msg(r.lcm, r.now, 5, cycle(0), 1, 10, 0);
     drain(r.lcm);
     ck_assert_int_eq(s->rx.rejected, ++rejected);
-    ck_assert_int_eq(s->rx.last_reject_code, COA_LCM_ERR_TIME);
+    ck_assert_int_eq(s->rx.last_reject_code, COAVOID_LCM_ERR_TIME);
     ck_assert_int_eq(s->plans_adopted, 1);
 
     /* It flies the adopted plan: 1 at sample 1, 2 from sample 2 on, 2 dh above. */
     const int32_t want[4] = {0, 1, 2, 2};
     for (int64_t k = 1; k <= 3; k++) {
-        ck_assert_int_eq(coa_vehicle_node_cycle(a, cycle(k)), COA_OK);
+        ck_assert_int_eq(coavoid_vehicle_node_cycle(a, cycle(k)), COA_OK);
         drain(r.lcm);
         ck_assert_int_eq(s->offset, want[k]);
         ck_assert(s->position.z == s->reference.z + (coa_real_t)want[k] * (coa_real_t)2);
     }
-    coa_vehicle_node_destroy(a);
+    coavoid_vehicle_node_destroy(a);
     lcm_destroy(r.lcm);
 }
 END_TEST
@@ -318,10 +318,10 @@ START_TEST(test_plan_ids_do_not_lock_out)
     rig_t r;
     rig_init(&r, 10);
     coa_vec3_t route[2];
-    coa_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, route, 0, 500, 0, 100), COA_NODE_CENTRALISED);
-    const coa_vehicle_node_state_t *s = coa_vehicle_node_state(a);
+    coavoid_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, route, 0, 500, 0, 100), COAVOID_NODE_CENTRALISED);
+    const coavoid_vehicle_node_state_t *s = coavoid_vehicle_node_state(a);
     int64_t sequence = 0;
-    ck_assert_int_eq(coa_vehicle_node_cycle(a, cycle(0)), COA_OK);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, cycle(0)), COA_OK);
     drain(r.lcm);
     r.now = cycle(0) + DT_US / 4;
     heartbeat(r.lcm, r.now, sequence++);
@@ -339,13 +339,13 @@ START_TEST(test_plan_ids_do_not_lock_out)
     plan_msg(r.lcm, r.now, 1, cycle(0), 1, 10, 0);
     drain(r.lcm);
     ck_assert_int_eq(s->plans_adopted, 2);
-    ck_assert_int_eq(s->rx.last_reject_code, COA_LCM_ERR_SEQUENCE);
+    ck_assert_int_eq(s->rx.last_reject_code, COAVOID_LCM_ERR_SEQUENCE);
     /* From the next cycle on the real coordinator's plans are adopted again, and so are a
      * restarted coordinator's, numbered from 0. */
     const int64_t ids[4] = {2, 3, 0, 1};
     for (int64_t k = 1; k <= 4; k++) {
         r.now = cycle(k);
-        ck_assert_int_eq(coa_vehicle_node_cycle(a, r.now), COA_OK);
+        ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
         drain(r.lcm);
         ck_assert(s->coordinated);
         r.now = cycle(k) + DT_US / 4;
@@ -355,7 +355,7 @@ START_TEST(test_plan_ids_do_not_lock_out)
         ck_assert_msg(s->plans_adopted == (uint32_t)(2 + k), "cycle %d: %s", (int)k,
                       s->rx.last_reason);
     }
-    coa_vehicle_node_destroy(a);
+    coavoid_vehicle_node_destroy(a);
     lcm_destroy(r.lcm);
 }
 END_TEST
@@ -375,20 +375,20 @@ START_TEST(test_plan_into_terrain_refused)
     box.box.max.x = 1000;
     box.box.max.y = 1000;
     box.box.max.z = 90;
-    coa_world_config_t wc;
+    coavoid_world_config_t wc;
     memset(&wc, 0, sizeof wc);
     wc.common = r.common;
     wc.obstacles = &box;
     wc.obstacle_count = 1;
     int error = -99;
-    coa_world_t *w = coa_world_create(&wc, r.lcm, &error);
+    coavoid_world_t *w = coavoid_world_create(&wc, r.lcm, &error);
     ck_assert_ptr_nonnull(w);
     coa_vec3_t route[2];
-    coa_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, route, 0, 500, 0, 100), COA_NODE_CENTRALISED);
-    const coa_vehicle_node_state_t *s = coa_vehicle_node_state(a);
-    ck_assert_int_eq(coa_world_cycle(w, r.now), COA_OK);
+    coavoid_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, route, 0, 500, 0, 100), COAVOID_NODE_CENTRALISED);
+    const coavoid_vehicle_node_state_t *s = coavoid_vehicle_node_state(a);
+    ck_assert_int_eq(coavoid_world_cycle(w, r.now), COA_OK);
     drain(r.lcm);
-    ck_assert_int_eq(coa_vehicle_node_cycle(a, r.now), COA_OK);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
     drain(r.lcm);
     r.now = cycle(0) + DT_US / 4;
     heartbeat(r.lcm, r.now, 0);
@@ -397,7 +397,7 @@ START_TEST(test_plan_into_terrain_refused)
     coavoid_plan_t m;
     memset(&m, 0, sizeof m);
     m.utime = r.now;
-    m.coordinator_id = COA_NODE_COORDINATOR_ID;
+    m.coordinator_id = COAVOID_NODE_COORDINATOR_ID;
     m.plan_id = INT64_MAX - 5;
     m.valid_from_utime = cycle(0);
     m.valid_until_utime = cycle(1);
@@ -412,11 +412,11 @@ START_TEST(test_plan_into_terrain_refused)
         m.offsets[0][k] = -2 * k;
     }
     const int64_t rejected = s->rx.rejected;
-    ck_assert_int_eq(coavoid_plan_t_publish(r.lcm, COA_CHANNEL_PLAN, &m), 0);
+    ck_assert_int_eq(coavoid_plan_t_publish(r.lcm, COAVOID_CHANNEL_PLAN, &m), 0);
     drain(r.lcm);
     ck_assert_int_eq(s->plans_adopted, 0);
     ck_assert_int_eq(s->rx.rejected, rejected + 1);
-    ck_assert_int_eq(s->rx.last_reject_code, COA_LCM_ERR_VALUE);
+    ck_assert_int_eq(s->rx.last_reject_code, COAVOID_LCM_ERR_VALUE);
     ck_assert_str_eq(s->rx.last_reason, "plan: flies this UAV into an obstacle or track it knows");
     /* The real coordinator's plan (a climb) is adopted, although its plan_id is lower. */
     plan_msg(r.lcm, r.now, 0, cycle(0), 1, 10, 0);
@@ -425,14 +425,14 @@ START_TEST(test_plan_into_terrain_refused)
     ck_assert_int_eq(s->rx.rejected, rejected + 1);
     for (int64_t k = 1; k <= 10; k++) {
         r.now = cycle(k);
-        ck_assert_int_eq(coa_world_cycle(w, r.now), COA_OK);
+        ck_assert_int_eq(coavoid_world_cycle(w, r.now), COA_OK);
         drain(r.lcm);
-        ck_assert_int_eq(coa_vehicle_node_cycle(a, r.now), COA_OK);
+        ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
         drain(r.lcm);
         ck_assert(s->position.z >= (coa_real_t)100);
     }
-    coa_vehicle_node_destroy(a);
-    coa_world_destroy(w);
+    coavoid_vehicle_node_destroy(a);
+    coavoid_world_destroy(w);
     lcm_destroy(r.lcm);
 }
 END_TEST
@@ -464,35 +464,35 @@ START_TEST(test_duplicate_id_reported)
     rig_t r;
     rig_init(&r, 10);
     health_probe_t probe = {1, 0, -1};
-    lcm_subscription_t *sub = lcm_subscribe(r.lcm, COA_CHANNEL_STATUS, on_status_probe, &probe);
+    lcm_subscription_t *sub = lcm_subscribe(r.lcm, COAVOID_CHANNEL_STATUS, on_status_probe, &probe);
     coa_vec3_t r1[2], r2[2];
-    coa_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, r1, 0, 500, 0, 100), COA_NODE_DECOUPLED);
-    const coa_vehicle_node_state_t *s = coa_vehicle_node_state(a);
-    ck_assert_int_eq(coa_vehicle_node_cycle(a, r.now), COA_OK);
+    coavoid_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, r1, 0, 500, 0, 100), COAVOID_NODE_DECOUPLED);
+    const coavoid_vehicle_node_state_t *s = coavoid_vehicle_node_state(a);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
     drain(r.lcm);
     ck_assert_int_eq(probe.health, COAVOID_STATUS_T_HEALTH_OK);
     ck_assert_int_eq(s->rx.received, 0); /* its own intent came back: not counted */
     /* Its twin starts in the same cycle, on the same clock: the same utime and sequence. */
-    coa_vehicle_node_t *b = vehicle_node(&r, uav(1, 1, r2, 0, 500, 800, 100), COA_NODE_DECOUPLED);
-    ck_assert_int_eq(coa_vehicle_node_cycle(b, r.now), COA_OK);
+    coavoid_vehicle_node_t *b = vehicle_node(&r, uav(1, 1, r2, 0, 500, 800, 100), COAVOID_NODE_DECOUPLED);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(b, r.now), COA_OK);
     drain(r.lcm);
-    coa_vehicle_node_destroy(b);
+    coavoid_vehicle_node_destroy(b);
     ck_assert_int_eq(s->rx.received, 1);
     ck_assert_int_eq(s->rx.rejected, 1);
-    ck_assert_int_eq(s->rx.last_reject_code, COA_LCM_ERR_ID);
+    ck_assert_int_eq(s->rx.last_reject_code, COAVOID_LCM_ERR_ID);
     ck_assert_str_eq(s->rx.last_reason, "intent: another UAV uses this node's id");
     r.now = cycle(1);
-    ck_assert_int_eq(coa_vehicle_node_cycle(a, r.now), COA_OK);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
     drain(r.lcm);
     ck_assert_int_eq(probe.health, COAVOID_STATUS_T_HEALTH_FAULT);
     /* The twin is gone: no fault any more. */
     r.now = cycle(2);
-    ck_assert_int_eq(coa_vehicle_node_cycle(a, r.now), COA_OK);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
     drain(r.lcm);
     ck_assert_int_ne(probe.health, COAVOID_STATUS_T_HEALTH_FAULT);
     ck_assert_int_eq(s->rx.received, 1);
     lcm_unsubscribe(r.lcm, sub);
-    coa_vehicle_node_destroy(a);
+    coavoid_vehicle_node_destroy(a);
     lcm_destroy(r.lcm);
 }
 END_TEST
@@ -505,35 +505,35 @@ START_TEST(test_refusals_degrade_health)
     rig_t r;
     rig_init(&r, 10);
     health_probe_t pa = {1, 0, -1};
-    health_probe_t pc = {(int32_t)COA_NODE_COORDINATOR_ID, 0, -1};
-    lcm_subscription_t *sa = lcm_subscribe(r.lcm, COA_CHANNEL_STATUS, on_status_probe, &pa);
-    lcm_subscription_t *sc = lcm_subscribe(r.lcm, COA_CHANNEL_STATUS, on_status_probe, &pc);
+    health_probe_t pc = {(int32_t)COAVOID_NODE_COORDINATOR_ID, 0, -1};
+    lcm_subscription_t *sa = lcm_subscribe(r.lcm, COAVOID_CHANNEL_STATUS, on_status_probe, &pa);
+    lcm_subscription_t *sc = lcm_subscribe(r.lcm, COAVOID_CHANNEL_STATUS, on_status_probe, &pc);
     coa_vec3_t r1[2], r2[2];
-    coa_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, r1, 0, 500, 0, 100), COA_NODE_DECOUPLED);
-    const coa_vehicle_node_state_t *s = coa_vehicle_node_state(a);
-    coa_coordinator_config_t cc;
+    coavoid_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, r1, 0, 500, 0, 100), COAVOID_NODE_DECOUPLED);
+    const coavoid_vehicle_node_state_t *s = coavoid_vehicle_node_state(a);
+    coavoid_coordinator_config_t cc;
     memset(&cc, 0, sizeof cc);
     cc.common = r.common;
     cc.common.beta = 1000;
     int error = -99;
-    coa_coordinator_t *co = coa_coordinator_create(&cc, r.lcm, &error);
+    coavoid_coordinator_t *co = coavoid_coordinator_create(&cc, r.lcm, &error);
     ck_assert_ptr_nonnull(co);
     /* A peer whose clock runs 1.5 cycles ahead: its intents come from the future. */
     int64_t ahead = r.now + 3 * DT_US / 2;
-    coa_vehicle_node_config_t config;
+    coavoid_vehicle_node_config_t config;
     memset(&config, 0, sizeof config);
     config.common = r.common;
     config.common.clock = &ahead;
     config.vehicle = uav(2, 2, r2, 0, 500, 800, 100);
-    config.mode = COA_NODE_DECOUPLED;
-    coa_vehicle_node_t *b = coa_vehicle_node_create(&config, r.lcm, &error);
+    config.mode = COAVOID_NODE_DECOUPLED;
+    coavoid_vehicle_node_t *b = coavoid_vehicle_node_create(&config, r.lcm, &error);
     ck_assert_ptr_nonnull(b);
     const char junk[3] = {1, 2, 3};
     for (int64_t k = 0; k <= 3; k++) {
         r.now = cycle(k);
-        ck_assert_int_eq(coa_vehicle_node_cycle(a, r.now), COA_OK);
+        ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
         drain(r.lcm);
-        ck_assert_int_eq(coa_coordinator_cycle(co, r.now + DT_US / 4), COA_OK);
+        ck_assert_int_eq(coavoid_coordinator_cycle(co, r.now + DT_US / 4), COA_OK);
         drain(r.lcm);
         const int8_t want = k == 0 || k == 3 ? COAVOID_STATUS_T_HEALTH_OK
                                              : COAVOID_STATUS_T_HEALTH_DEGRADED;
@@ -541,21 +541,21 @@ START_TEST(test_refusals_degrade_health)
         ck_assert_msg(pc.health == want, "cycle %d: coordinator health %d", (int)k, pc.health);
         if (k == 0) {
             ahead = r.now + 3 * DT_US / 2;
-            ck_assert_int_eq(coa_vehicle_node_cycle(b, ahead), COA_OK);
+            ck_assert_int_eq(coavoid_vehicle_node_cycle(b, ahead), COA_OK);
             drain(r.lcm);
-            ck_assert_int_eq(s->rx.last_reject_code, COA_LCM_ERR_TIME);
+            ck_assert_int_eq(s->rx.last_reject_code, COAVOID_LCM_ERR_TIME);
         } else if (k == 1) {
-            ck_assert_int_eq(lcm_publish(r.lcm, COA_CHANNEL_INTENT, junk, sizeof junk), 0);
+            ck_assert_int_eq(lcm_publish(r.lcm, COAVOID_CHANNEL_INTENT, junk, sizeof junk), 0);
             drain(r.lcm);
-            ck_assert_int_eq(s->rx.last_reject_code, COA_LCM_ERR_DECODE);
+            ck_assert_int_eq(s->rx.last_reject_code, COAVOID_LCM_ERR_DECODE);
         }
     }
     ck_assert_int_eq(pa.count, 4);
     lcm_unsubscribe(r.lcm, sa);
     lcm_unsubscribe(r.lcm, sc);
-    coa_vehicle_node_destroy(b);
-    coa_coordinator_destroy(co);
-    coa_vehicle_node_destroy(a);
+    coavoid_vehicle_node_destroy(b);
+    coavoid_coordinator_destroy(co);
+    coavoid_vehicle_node_destroy(a);
     lcm_destroy(r.lcm);
 }
 END_TEST
@@ -567,15 +567,15 @@ START_TEST(test_fallback_and_return)
     rig_t r;
     rig_init(&r, 10);
     coa_vec3_t route[2];
-    coa_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, route, 0, 500, 0, 100), COA_NODE_CENTRALISED);
-    const coa_vehicle_node_state_t *s = coa_vehicle_node_state(a);
+    coavoid_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, route, 0, 500, 0, 100), COAVOID_NODE_CENTRALISED);
+    const coavoid_vehicle_node_state_t *s = coavoid_vehicle_node_state(a);
     int64_t sequence = 0;
     /* Heartbeats at k + 1/4 for k in 0..4 and 10..14; timeout 2.5 cycles. */
     const char *want = "CCCCCCCDDDDCCCCCCDDD";
     const uint32_t fallbacks[20] = {0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 2, 2, 2};
     for (int64_t k = 0; k < 20; k++) {
         r.now = cycle(k);
-        ck_assert_int_eq(coa_vehicle_node_cycle(a, r.now), COA_OK);
+        ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
         drain(r.lcm);
         ck_assert_msg(s->coordinated == (want[k] == 'C'), "cycle %d", (int)k);
         ck_assert_uint_eq(s->fallbacks, fallbacks[k]);
@@ -587,7 +587,7 @@ START_TEST(test_fallback_and_return)
         }
     }
     ck_assert_int_eq(s->rx.rejected, 0);
-    coa_vehicle_node_destroy(a);
+    coavoid_vehicle_node_destroy(a);
     lcm_destroy(r.lcm);
 }
 END_TEST
@@ -599,35 +599,35 @@ START_TEST(test_configured_coordinator_only)
     rig_t r;
     rig_init(&r, 10);
     coa_vec3_t route[2];
-    coa_vehicle_node_config_t config;
+    coavoid_vehicle_node_config_t config;
     memset(&config, 0, sizeof config);
     config.common = r.common;
     config.vehicle = uav(1, 1, route, 0, 500, 0, 100);
-    config.mode = COA_NODE_CENTRALISED;
+    config.mode = COAVOID_NODE_CENTRALISED;
     config.coordinator_id = 1;
     int error = -99;
-    ck_assert_ptr_null(coa_vehicle_node_create(&config, r.lcm, &error)); /* its own id */
+    ck_assert_ptr_null(coavoid_vehicle_node_create(&config, r.lcm, &error)); /* its own id */
     ck_assert_int_eq(error, COA_ERR_ARGUMENT);
     config.coordinator_id = 700;
-    coa_vehicle_node_t *a = coa_vehicle_node_create(&config, r.lcm, &error);
+    coavoid_vehicle_node_t *a = coavoid_vehicle_node_create(&config, r.lcm, &error);
     ck_assert_ptr_nonnull(a);
-    const coa_vehicle_node_state_t *s = coa_vehicle_node_state(a);
+    const coavoid_vehicle_node_state_t *s = coavoid_vehicle_node_state(a);
     /* Cycles 0..5: only the default id speaks. After 2.5 cycles without its own
      * coordinator the UAV plans for itself. */
     const char *want = "CCCDDDDC";
     for (int64_t k = 0; k < 8; k++) {
         r.now = cycle(k);
-        ck_assert_int_eq(coa_vehicle_node_cycle(a, r.now), COA_OK);
+        ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
         drain(r.lcm);
         ck_assert_msg(s->coordinated == (want[k] == 'C'), "cycle %d", (int)k);
         r.now = cycle(k) + DT_US / 4;
-        const int32_t from = k <= 5 ? (int32_t)COA_NODE_COORDINATOR_ID : 700;
+        const int32_t from = k <= 5 ? (int32_t)COAVOID_NODE_COORDINATOR_ID : 700;
         const int64_t rejected = s->rx.rejected;
         heartbeat_from(r.lcm, r.now, k, from, COAVOID_STATUS_T_HEALTH_OK);
         drain(r.lcm);
         if (k <= 5) {
             ck_assert_int_eq(s->rx.rejected, rejected + 1);
-            ck_assert_int_eq(s->rx.last_reject_code, COA_LCM_ERR_ID);
+            ck_assert_int_eq(s->rx.last_reject_code, COAVOID_LCM_ERR_ID);
             ck_assert_str_eq(s->rx.last_reason, "status: a coordinator that is not this UAV's");
         } else {
             ck_assert_int_eq(s->rx.rejected, rejected);
@@ -641,7 +641,7 @@ START_TEST(test_configured_coordinator_only)
         }
     }
     ck_assert_int_eq(s->plans_adopted, 2);
-    coa_vehicle_node_destroy(a);
+    coavoid_vehicle_node_destroy(a);
     lcm_destroy(r.lcm);
 }
 END_TEST
@@ -653,24 +653,24 @@ START_TEST(test_faulty_coordinator_not_followed)
     rig_t r;
     rig_init(&r, 10);
     coa_vec3_t route[2];
-    coa_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, route, 0, 500, 0, 100), COA_NODE_CENTRALISED);
-    const coa_vehicle_node_state_t *s = coa_vehicle_node_state(a);
+    coavoid_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, route, 0, 500, 0, 100), COAVOID_NODE_CENTRALISED);
+    const coavoid_vehicle_node_state_t *s = coavoid_vehicle_node_state(a);
     /* Heartbeats every cycle, HEALTH_FAULT from cycle 2 on: the last one that counts is
      * at 1.25, so from cycle 4 (2.75 s later) the UAV plans for itself. */
     const char *want = "CCCCDDDD";
     for (int64_t k = 0; k < 8; k++) {
         r.now = cycle(k);
-        ck_assert_int_eq(coa_vehicle_node_cycle(a, r.now), COA_OK);
+        ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
         drain(r.lcm);
         ck_assert_msg(s->coordinated == (want[k] == 'C'), "cycle %d", (int)k);
         r.now = cycle(k) + DT_US / 4;
-        heartbeat_from(r.lcm, r.now, k, (int32_t)COA_NODE_COORDINATOR_ID,
+        heartbeat_from(r.lcm, r.now, k, (int32_t)COAVOID_NODE_COORDINATOR_ID,
                        k < 2 ? COAVOID_STATUS_T_HEALTH_OK : COAVOID_STATUS_T_HEALTH_FAULT);
         drain(r.lcm);
     }
     ck_assert_uint_eq(s->fallbacks, 1);
     ck_assert_int_eq(s->rx.rejected, 0);
-    coa_vehicle_node_destroy(a);
+    coavoid_vehicle_node_destroy(a);
     lcm_destroy(r.lcm);
 }
 END_TEST
@@ -697,17 +697,17 @@ START_TEST(test_late_plans_fall_back)
     rig_t r;
     rig_init(&r, 24);
     coa_vec3_t r1[2], r2[2];
-    coa_vehicle_node_t *v[2];
-    v[0] = vehicle_node(&r, uav(1, 1, r1, 0, 600, 0, 100), COA_NODE_CENTRALISED);
-    v[1] = vehicle_node(&r, uav(2, 2, r2, 300, -300, 0, 100), COA_NODE_CENTRALISED);
-    const coa_vehicle_node_state_t *s[2] = {coa_vehicle_node_state(v[0]),
-                                            coa_vehicle_node_state(v[1])};
-    coa_coordinator_config_t cc;
+    coavoid_vehicle_node_t *v[2];
+    v[0] = vehicle_node(&r, uav(1, 1, r1, 0, 600, 0, 100), COAVOID_NODE_CENTRALISED);
+    v[1] = vehicle_node(&r, uav(2, 2, r2, 300, -300, 0, 100), COAVOID_NODE_CENTRALISED);
+    const coavoid_vehicle_node_state_t *s[2] = {coavoid_vehicle_node_state(v[0]),
+                                            coavoid_vehicle_node_state(v[1])};
+    coavoid_coordinator_config_t cc;
     memset(&cc, 0, sizeof cc);
     cc.common = r.common;
     cc.common.beta = 5000;
     int error = -99;
-    coa_coordinator_t *co = coa_coordinator_create(&cc, r.lcm, &error);
+    coavoid_coordinator_t *co = coavoid_coordinator_create(&cc, r.lcm, &error);
     ck_assert_ptr_nonnull(co);
     coa_vec3_t p[2][31];
     for (int64_t k = 0; k <= 30; k++) {
@@ -715,12 +715,12 @@ START_TEST(test_late_plans_fall_back)
          * the first message of cycle k, after the cycle has begun. */
         r.now = cycle(k);
         for (int i = 0; i < 2; i++) {
-            ck_assert_int_eq(coa_vehicle_node_cycle(v[i], r.now), COA_OK);
+            ck_assert_int_eq(coavoid_vehicle_node_cycle(v[i], r.now), COA_OK);
             drain(r.lcm);
         }
-        while (coa_vehicle_node_deadline(v[1]) != INT64_MAX) {
-            r.now = coa_vehicle_node_deadline(v[1]);
-            ck_assert_int_ge(coa_vehicle_node_poll(v[1], r.now), 0);
+        while (coavoid_vehicle_node_deadline(v[1]) != INT64_MAX) {
+            r.now = coavoid_vehicle_node_deadline(v[1]);
+            ck_assert_int_ge(coavoid_vehicle_node_poll(v[1], r.now), 0);
             drain(r.lcm);
         }
         if (k == 1) {
@@ -729,7 +729,7 @@ START_TEST(test_late_plans_fall_back)
             ck_assert_uint_ge(s[1]->plans_run, 1);
         }
         r.now = cycle(k) + DT_US / 4;
-        ck_assert_int_eq(coa_coordinator_cycle(co, r.now), COA_OK);
+        ck_assert_int_eq(coavoid_coordinator_cycle(co, r.now), COA_OK);
         for (int i = 0; i < 2; i++) {
             p[i][k] = s[i]->position;
         }
@@ -737,11 +737,11 @@ START_TEST(test_late_plans_fall_back)
     ck_assert_msg(!flown_conflict(p[0], p[1], 30), "loss of separation");
     for (int i = 0; i < 2; i++) {
         ck_assert_uint_ge(s[i]->fallbacks, 1);
-        ck_assert_int_eq(s[i]->rx.last_reject_code, COA_LCM_ERR_TIME);
+        ck_assert_int_eq(s[i]->rx.last_reject_code, COAVOID_LCM_ERR_TIME);
     }
-    coa_coordinator_destroy(co);
-    coa_vehicle_node_destroy(v[1]);
-    coa_vehicle_node_destroy(v[0]);
+    coavoid_coordinator_destroy(co);
+    coavoid_vehicle_node_destroy(v[1]);
+    coavoid_vehicle_node_destroy(v[0]);
     lcm_destroy(r.lcm);
 }
 END_TEST
@@ -754,22 +754,22 @@ START_TEST(test_failed_plan_is_an_answer)
     rig_t r;
     rig_init(&r, 24);
     coa_vec3_t r1[2], r2[2];
-    coa_vehicle_node_t *v[2];
-    v[0] = vehicle_node(&r, uav(1, 1, r1, 0, 600, 0, 100), COA_NODE_CENTRALISED);
-    v[1] = vehicle_node(&r, uav(2, 2, r2, 300, -300, 0, 100), COA_NODE_CENTRALISED);
+    coavoid_vehicle_node_t *v[2];
+    v[0] = vehicle_node(&r, uav(1, 1, r1, 0, 600, 0, 100), COAVOID_NODE_CENTRALISED);
+    v[1] = vehicle_node(&r, uav(2, 2, r2, 300, -300, 0, 100), COAVOID_NODE_CENTRALISED);
     for (int64_t k = 0; k < 6; k++) {
         r.now = cycle(k);
         for (int i = 0; i < 2; i++) {
-            ck_assert_int_eq(coa_vehicle_node_cycle(v[i], r.now), COA_OK);
+            ck_assert_int_eq(coavoid_vehicle_node_cycle(v[i], r.now), COA_OK);
             drain(r.lcm);
-            ck_assert_msg(coa_vehicle_node_state(v[i])->coordinated, "cycle %d", (int)k);
+            ck_assert_msg(coavoid_vehicle_node_state(v[i])->coordinated, "cycle %d", (int)k);
         }
         r.now = cycle(k) + DT_US / 4;
         heartbeat(r.lcm, r.now, k);
         coavoid_plan_t m;
         memset(&m, 0, sizeof m);
         m.utime = r.now;
-        m.coordinator_id = COA_NODE_COORDINATOR_ID;
+        m.coordinator_id = COAVOID_NODE_COORDINATOR_ID;
         m.plan_id = k;
         m.valid_from_utime = cycle(k);
         m.valid_until_utime = cycle(k + 1);
@@ -781,14 +781,14 @@ START_TEST(test_failed_plan_is_an_answer)
         m.planned_count = 0;
         m.uav_ids[0] = 1;
         m.uav_ids[1] = 2;
-        ck_assert_int_eq(coavoid_plan_t_publish(r.lcm, COA_CHANNEL_PLAN, &m), 0);
+        ck_assert_int_eq(coavoid_plan_t_publish(r.lcm, COAVOID_CHANNEL_PLAN, &m), 0);
         drain(r.lcm);
     }
     for (int i = 0; i < 2; i++) {
-        const coa_vehicle_node_state_t *s = coa_vehicle_node_state(v[i]);
+        const coavoid_vehicle_node_state_t *s = coavoid_vehicle_node_state(v[i]);
         ck_assert_uint_eq(s->fallbacks, 0);
         ck_assert_int_eq(s->rx.rejected, 0);
-        coa_vehicle_node_destroy(v[i]);
+        coavoid_vehicle_node_destroy(v[i]);
     }
     lcm_destroy(r.lcm);
 }
@@ -822,32 +822,32 @@ START_TEST(test_coordinator_skips_decoupled_uav)
     rig_init(&r, 24);
     plan_probe_t probe;
     memset(&probe, 0, sizeof probe);
-    lcm_subscription_t *sub = lcm_subscribe(r.lcm, COA_CHANNEL_PLAN, on_plan_probe, &probe);
+    lcm_subscription_t *sub = lcm_subscribe(r.lcm, COAVOID_CHANNEL_PLAN, on_plan_probe, &probe);
     coa_vec3_t r1[2], r2[2];
-    coa_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, r1, 0, 600, 0, 100), COA_NODE_DECOUPLED);
-    coa_vehicle_node_t *b = vehicle_node(&r, uav(2, 2, r2, 300, -300, 0, 100), COA_NODE_CENTRALISED);
-    coa_coordinator_config_t cc;
+    coavoid_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, r1, 0, 600, 0, 100), COAVOID_NODE_DECOUPLED);
+    coavoid_vehicle_node_t *b = vehicle_node(&r, uav(2, 2, r2, 300, -300, 0, 100), COAVOID_NODE_CENTRALISED);
+    coavoid_coordinator_config_t cc;
     memset(&cc, 0, sizeof cc);
     cc.common = r.common;
     cc.common.beta = 5000;
     int error = -99;
-    coa_coordinator_t *co = coa_coordinator_create(&cc, r.lcm, &error);
+    coavoid_coordinator_t *co = coavoid_coordinator_create(&cc, r.lcm, &error);
     ck_assert_ptr_nonnull(co);
-    ck_assert_int_eq(coa_vehicle_node_cycle(a, r.now), COA_OK);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
     drain(r.lcm);
-    ck_assert_int_eq(coa_vehicle_node_cycle(b, r.now), COA_OK);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(b, r.now), COA_OK);
     drain(r.lcm);
     r.now = cycle(0) + DT_US / 4;
-    ck_assert_int_eq(coa_coordinator_cycle(co, r.now), COA_OK);
+    ck_assert_int_eq(coavoid_coordinator_cycle(co, r.now), COA_OK);
     drain(r.lcm);
     ck_assert_int_eq(probe.plans, 1);
     ck_assert_int_eq(probe.rows, 1);
     ck_assert_int_eq(probe.ids[0], 2);
-    ck_assert_uint_eq(coa_vehicle_node_state(b)->plans_adopted, 1);
+    ck_assert_uint_eq(coavoid_vehicle_node_state(b)->plans_adopted, 1);
     lcm_unsubscribe(r.lcm, sub);
-    coa_coordinator_destroy(co);
-    coa_vehicle_node_destroy(b);
-    coa_vehicle_node_destroy(a);
+    coavoid_coordinator_destroy(co);
+    coavoid_vehicle_node_destroy(b);
+    coavoid_vehicle_node_destroy(a);
     lcm_destroy(r.lcm);
 }
 END_TEST
@@ -860,37 +860,37 @@ START_TEST(test_lower_priority_waits)
     rig_init(&r, 24);
     coa_vec3_t r1[2], r2[2];
     /* Head-on, conflict around t = 13.5 s. 1 has priority. */
-    coa_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, r1, 0, 600, 0, 100), COA_NODE_DECOUPLED);
-    coa_vehicle_node_t *b = vehicle_node(&r, uav(2, 2, r2, 300, -300, 0, 100), COA_NODE_DECOUPLED);
-    const coa_vehicle_node_state_t *sa = coa_vehicle_node_state(a);
-    const coa_vehicle_node_state_t *sb = coa_vehicle_node_state(b);
+    coavoid_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, r1, 0, 600, 0, 100), COAVOID_NODE_DECOUPLED);
+    coavoid_vehicle_node_t *b = vehicle_node(&r, uav(2, 2, r2, 300, -300, 0, 100), COAVOID_NODE_DECOUPLED);
+    const coavoid_vehicle_node_state_t *sa = coavoid_vehicle_node_state(a);
+    const coavoid_vehicle_node_state_t *sb = coavoid_vehicle_node_state(b);
     /* Cycle 0: only 1 runs, so 2 knows 1's intent of cycle 0 and nothing newer. */
-    ck_assert_int_eq(coa_vehicle_node_cycle(a, cycle(0)), COA_OK);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, cycle(0)), COA_OK);
     drain(r.lcm);
     /* Cycle 1: 2 first. It sees the conflict with a higher priority whose intent for this
      * cycle has not come: it waits, until cycle start + dt / 2. */
     r.now = cycle(1);
-    ck_assert_int_eq(coa_vehicle_node_cycle(b, r.now), COA_OK);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(b, r.now), COA_OK);
     drain(r.lcm);
     ck_assert(sb->waiting);
     ck_assert(!sb->published);
-    ck_assert_int_eq(coa_vehicle_node_deadline(b), cycle(1) + DT_US / 2);
-    ck_assert_int_eq(coa_vehicle_node_poll(b, r.now), 0);
+    ck_assert_int_eq(coavoid_vehicle_node_deadline(b), cycle(1) + DT_US / 2);
+    ck_assert_int_eq(coavoid_vehicle_node_poll(b, r.now), 0);
     ck_assert_uint_eq(sb->plans_run, 0);
     /* 1 publishes (2 has published nothing yet: 1 sees no conflict and does not plan). */
-    ck_assert_int_eq(coa_vehicle_node_cycle(a, r.now), COA_OK);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
     drain(r.lcm);
     ck_assert_uint_eq(sa->plans_run, 0);
     ck_assert(sa->published);
-    ck_assert_int_eq(coa_vehicle_node_poll(b, r.now), 1);
+    ck_assert_int_eq(coavoid_vehicle_node_poll(b, r.now), 1);
     ck_assert(!sb->waiting);
     ck_assert(sb->published);
     ck_assert_uint_eq(sb->plans_run, 1);
     ck_assert_uint_eq(sb->plans_adopted, 1);
     ck_assert_int_eq(sb->last_outcome, COA_PLAN_SOLVED);
-    ck_assert_int_eq(coa_vehicle_node_deadline(b), INT64_MAX);
-    coa_vehicle_node_destroy(b);
-    coa_vehicle_node_destroy(a);
+    ck_assert_int_eq(coavoid_vehicle_node_deadline(b), INT64_MAX);
+    coavoid_vehicle_node_destroy(b);
+    coavoid_vehicle_node_destroy(a);
     lcm_destroy(r.lcm);
 }
 END_TEST
@@ -904,28 +904,28 @@ START_TEST(test_waits_for_near_higher_priority)
     rig_init(&r, 24);
     coa_vec3_t r1[2], r2[2], r3[2];
     /* 1 and 2 meet head-on 30 m apart vertically (clear); 3 is 5 km away. */
-    coa_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, r1, 0, 600, 0, 100), COA_NODE_DECOUPLED);
-    coa_vehicle_node_t *b = vehicle_node(&r, uav(2, 2, r2, 300, -300, 0, 130), COA_NODE_DECOUPLED);
-    coa_vehicle_node_t *c = vehicle_node(&r, uav(3, 1, r3, 0, 600, 5000, 100), COA_NODE_DECOUPLED);
-    const coa_vehicle_node_state_t *sb = coa_vehicle_node_state(b);
-    ck_assert_int_eq(coa_vehicle_node_cycle(a, cycle(0)), COA_OK);
-    ck_assert_int_eq(coa_vehicle_node_cycle(c, cycle(0)), COA_OK);
+    coavoid_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, r1, 0, 600, 0, 100), COAVOID_NODE_DECOUPLED);
+    coavoid_vehicle_node_t *b = vehicle_node(&r, uav(2, 2, r2, 300, -300, 0, 130), COAVOID_NODE_DECOUPLED);
+    coavoid_vehicle_node_t *c = vehicle_node(&r, uav(3, 1, r3, 0, 600, 5000, 100), COAVOID_NODE_DECOUPLED);
+    const coavoid_vehicle_node_state_t *sb = coavoid_vehicle_node_state(b);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, cycle(0)), COA_OK);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(c, cycle(0)), COA_OK);
     drain(r.lcm);
     r.now = cycle(1);
-    ck_assert_int_eq(coa_vehicle_node_cycle(b, r.now), COA_OK);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(b, r.now), COA_OK);
     drain(r.lcm);
     ck_assert(sb->waiting);
     ck_assert(!sb->published);
     ck_assert_uint_eq(sb->conflicts, 0);
-    ck_assert_int_eq(coa_vehicle_node_cycle(a, r.now), COA_OK);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
     drain(r.lcm);
     /* 3 has not published for this cycle either, but it is far: 2 goes on. */
-    ck_assert_int_eq(coa_vehicle_node_poll(b, r.now), 1);
+    ck_assert_int_eq(coavoid_vehicle_node_poll(b, r.now), 1);
     ck_assert(sb->published);
     ck_assert_uint_eq(sb->plans_run, 0);
-    coa_vehicle_node_destroy(c);
-    coa_vehicle_node_destroy(b);
-    coa_vehicle_node_destroy(a);
+    coavoid_vehicle_node_destroy(c);
+    coavoid_vehicle_node_destroy(b);
+    coavoid_vehicle_node_destroy(a);
     lcm_destroy(r.lcm);
 }
 END_TEST
@@ -935,37 +935,37 @@ START_TEST(test_wait_ends_at_deadline)
     rig_t r;
     rig_init(&r, 24);
     coa_vec3_t r1[2], r2[2];
-    coa_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, r1, 0, 600, 0, 100), COA_NODE_DECOUPLED);
-    coa_vehicle_node_t *b = vehicle_node(&r, uav(2, 2, r2, 300, -300, 0, 100), COA_NODE_DECOUPLED);
-    const coa_vehicle_node_state_t *sb = coa_vehicle_node_state(b);
-    ck_assert_int_eq(coa_vehicle_node_cycle(a, cycle(0)), COA_OK);
+    coavoid_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, r1, 0, 600, 0, 100), COAVOID_NODE_DECOUPLED);
+    coavoid_vehicle_node_t *b = vehicle_node(&r, uav(2, 2, r2, 300, -300, 0, 100), COAVOID_NODE_DECOUPLED);
+    const coavoid_vehicle_node_state_t *sb = coavoid_vehicle_node_state(b);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, cycle(0)), COA_OK);
     drain(r.lcm);
     /* 1 says nothing in cycle 1: 2 waits out its deadline, then plans around 1's intent of
      * cycle 0, which still covers the encounter. */
     r.now = cycle(1);
-    ck_assert_int_eq(coa_vehicle_node_cycle(b, r.now), COA_OK);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(b, r.now), COA_OK);
     drain(r.lcm);
     ck_assert(sb->waiting);
     r.now = cycle(1) + DT_US / 2 - 1;
-    ck_assert_int_eq(coa_vehicle_node_poll(b, r.now), 0);
-    r.now = coa_vehicle_node_deadline(b);
-    ck_assert_int_eq(coa_vehicle_node_poll(b, r.now), 1);
+    ck_assert_int_eq(coavoid_vehicle_node_poll(b, r.now), 0);
+    r.now = coavoid_vehicle_node_deadline(b);
+    ck_assert_int_eq(coavoid_vehicle_node_poll(b, r.now), 1);
     ck_assert(sb->published);
     ck_assert_uint_eq(sb->plans_adopted, 1);
     /* Then both fly on: 1 on its reference, 2 on its plan; they stay separated. */
     coa_vec3_t pa[31], pb[31];
     for (int64_t k = 2; k <= 30; k++) {
         r.now = cycle(k);
-        coa_vehicle_node_cycle(a, r.now);
+        coavoid_vehicle_node_cycle(a, r.now);
         drain(r.lcm);
-        coa_vehicle_node_cycle(b, r.now);
+        coavoid_vehicle_node_cycle(b, r.now);
         drain(r.lcm);
-        while (coa_vehicle_node_deadline(b) != INT64_MAX) {
-            r.now = coa_vehicle_node_deadline(b);
-            coa_vehicle_node_poll(b, r.now);
+        while (coavoid_vehicle_node_deadline(b) != INT64_MAX) {
+            r.now = coavoid_vehicle_node_deadline(b);
+            coavoid_vehicle_node_poll(b, r.now);
             drain(r.lcm);
         }
-        pa[k] = coa_vehicle_node_state(a)->position;
+        pa[k] = coavoid_vehicle_node_state(a)->position;
         pb[k] = sb->position;
     }
     for (int64_t k = 2; k < 30; k++) {
@@ -973,8 +973,8 @@ START_TEST(test_wait_ends_at_deadline)
         coa_sweep_t y = {{15, 5}, pb[k], pb[k + 1]};
         ck_assert_msg(!coa_conflict_volumes(&x, &y), "conflict over step %d", (int)k);
     }
-    coa_vehicle_node_destroy(b);
-    coa_vehicle_node_destroy(a);
+    coavoid_vehicle_node_destroy(b);
+    coavoid_vehicle_node_destroy(a);
     lcm_destroy(r.lcm);
 }
 END_TEST
@@ -993,21 +993,21 @@ START_TEST(test_higher_priority_replans_in_cluster)
     v1.initial_offset = 6;
     coa_vehicle_t v2 = uav(2, 2, r2, 600, -200, 0, 112);
     v2.max_offset = 1;
-    coa_vehicle_node_t *v[2] = {vehicle_node(&r, v1, COA_NODE_DECOUPLED),
-                                vehicle_node(&r, v2, COA_NODE_DECOUPLED)};
-    const coa_vehicle_node_state_t *sa = coa_vehicle_node_state(v[0]);
-    const coa_vehicle_node_state_t *sb = coa_vehicle_node_state(v[1]);
+    coavoid_vehicle_node_t *v[2] = {vehicle_node(&r, v1, COAVOID_NODE_DECOUPLED),
+                                vehicle_node(&r, v2, COAVOID_NODE_DECOUPLED)};
+    const coavoid_vehicle_node_state_t *sa = coavoid_vehicle_node_state(v[0]);
+    const coavoid_vehicle_node_state_t *sb = coavoid_vehicle_node_state(v[1]);
     coa_vec3_t p[2][41];
     for (int64_t k = 0; k <= 40; k++) {
         r.now = cycle(k);
         for (int i = 0; i < 2; i++) {
-            ck_assert_int_eq(coa_vehicle_node_cycle(v[i], r.now), COA_OK);
+            ck_assert_int_eq(coavoid_vehicle_node_cycle(v[i], r.now), COA_OK);
             drain(r.lcm);
         }
         for (int i = 0; i < 2; i++) {
-            while (coa_vehicle_node_deadline(v[i]) != INT64_MAX) {
-                r.now = coa_vehicle_node_deadline(v[i]);
-                ck_assert_int_ge(coa_vehicle_node_poll(v[i], r.now), 0);
+            while (coavoid_vehicle_node_deadline(v[i]) != INT64_MAX) {
+                r.now = coavoid_vehicle_node_deadline(v[i]);
+                ck_assert_int_ge(coavoid_vehicle_node_poll(v[i], r.now), 0);
                 drain(r.lcm);
             }
         }
@@ -1018,7 +1018,7 @@ START_TEST(test_higher_priority_replans_in_cluster)
     ck_assert_int_eq(sa->offset, 0);
     ck_assert_msg(!flown_conflict(p[0], p[1], 40), "loss of separation");
     for (int i = 0; i < 2; i++) {
-        coa_vehicle_node_destroy(v[i]);
+        coavoid_vehicle_node_destroy(v[i]);
     }
     lcm_destroy(r.lcm);
 }
@@ -1034,23 +1034,23 @@ START_TEST(test_silent_uav_avoided_as_track)
     /* 2 has priority and is 620 m away head-on: they would meet around t = 30 s, beyond
      * the first horizon. 2 publishes once and falls silent. */
     coa_vehicle_t v2 = uav(2, 1, r2, 620, -1380, 0, 100);
-    coa_vehicle_node_t *a = vehicle_node(&r, uav(1, 2, r1, 0, 2000, 0, 100), COA_NODE_DECOUPLED);
-    coa_vehicle_node_t *b = vehicle_node(&r, v2, COA_NODE_DECOUPLED);
-    const coa_vehicle_node_state_t *sa = coa_vehicle_node_state(a);
-    ck_assert_int_eq(coa_vehicle_node_cycle(a, cycle(0)), COA_OK);
-    ck_assert_int_eq(coa_vehicle_node_cycle(b, cycle(0)), COA_OK);
+    coavoid_vehicle_node_t *a = vehicle_node(&r, uav(1, 2, r1, 0, 2000, 0, 100), COAVOID_NODE_DECOUPLED);
+    coavoid_vehicle_node_t *b = vehicle_node(&r, v2, COAVOID_NODE_DECOUPLED);
+    const coavoid_vehicle_node_state_t *sa = coavoid_vehicle_node_state(a);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, cycle(0)), COA_OK);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(b, cycle(0)), COA_OK);
     drain(r.lcm);
-    coa_vehicle_node_destroy(b);
+    coavoid_vehicle_node_destroy(b);
     coa_vec3_t pa[41];
     pa[0] = sa->position;
     uint32_t plans_before_stale = 0;
     for (int64_t k = 1; k <= 40; k++) {
         r.now = cycle(k);
-        coa_vehicle_node_cycle(a, r.now);
+        coavoid_vehicle_node_cycle(a, r.now);
         drain(r.lcm);
-        while (coa_vehicle_node_deadline(a) != INT64_MAX) {
-            r.now = coa_vehicle_node_deadline(a);
-            coa_vehicle_node_poll(a, r.now);
+        while (coavoid_vehicle_node_deadline(a) != INT64_MAX) {
+            r.now = coavoid_vehicle_node_deadline(a);
+            coavoid_vehicle_node_poll(a, r.now);
             drain(r.lcm);
         }
         if (k == 2) {
@@ -1069,7 +1069,7 @@ START_TEST(test_silent_uav_avoided_as_track)
         ck_assert_msg(!coa_conflict_volumes(&x, &y), "conflict over step %d", (int)k);
     }
     ck_assert_int_eq(sa->rx.rejected, 0);
-    coa_vehicle_node_destroy(a);
+    coavoid_vehicle_node_destroy(a);
     lcm_destroy(r.lcm);
 }
 END_TEST
@@ -1091,11 +1091,11 @@ static void on_track(const lcm_recv_buf_t *rbuf, const char *channel, void *user
     coavoid_track_t msg;
     REQUIRE(coavoid_track_t_decode(rbuf->data, 0, (int)rbuf->data_size, &msg) >= 0);
     const int64_t k = (p->rig->now - EPOCH) / DT_US;
-    coa_lcm_context_t ctx = {p->rig->now, 30 * DT_US, DT_US, cycle(k)};
-    coa_lcm_track_info_t info;
+    coavoid_lcm_context_t ctx = {p->rig->now, 30 * DT_US, DT_US, cycle(k)};
+    coavoid_lcm_track_info_t info;
     coa_track_t got;
     coa_track_point_t path[COAVOID_TRACK_T_MAX_PATH];
-    REQUIRE(coa_lcm_track_to_core(&msg, &ctx, NULL, &info, &got, path, COAVOID_TRACK_T_MAX_PATH,
+    REQUIRE(coavoid_lcm_track_to_core(&msg, &ctx, NULL, &info, &got, path, COAVOID_TRACK_T_MAX_PATH,
                                   NULL) == COA_OK);
     REQUIRE(got.path_count >= 2);
     p->truncated += got.path_count == COAVOID_TRACK_T_MAX_PATH;
@@ -1133,19 +1133,19 @@ START_TEST(test_world_track_estimates)
     probe.original.volume.half_height = 8;
     probe.original.path = path;
     probe.original.path_count = 24;
-    coa_world_config_t config;
+    coavoid_world_config_t config;
     memset(&config, 0, sizeof config);
     config.common = r.common;
     config.tracks = &probe.original;
     config.track_count = 1;
     int error = -99;
-    coa_world_t *w = coa_world_create(&config, r.lcm, &error);
+    coavoid_world_t *w = coavoid_world_create(&config, r.lcm, &error);
     ck_assert_ptr_nonnull(w);
-    lcm_subscription_t *sub = lcm_subscribe(r.lcm, COA_CHANNEL_TRACK, on_track, &probe);
+    lcm_subscription_t *sub = lcm_subscribe(r.lcm, COAVOID_CHANNEL_TRACK, on_track, &probe);
     for (int64_t k = 0; k <= 45; k++) {
         r.now = cycle(k);
-        ck_assert_int_eq(coa_world_cycle(w, r.now), COA_OK);
-        ck_assert_int_eq(coa_world_cycle(w, r.now), COA_OK); /* again: nothing */
+        ck_assert_int_eq(coavoid_world_cycle(w, r.now), COA_OK);
+        ck_assert_int_eq(coavoid_world_cycle(w, r.now), COA_OK); /* again: nothing */
         drain(r.lcm);
     }
     ck_assert_int_eq(probe.count, 46);
@@ -1154,7 +1154,7 @@ START_TEST(test_world_track_estimates)
     const double tolerance = 100 * (sizeof(coa_real_t) == sizeof(float) ? 1.2e-7 : 2.3e-16) * 300;
     ck_assert_msg(probe.worst < tolerance, "worst error %g m", probe.worst);
     lcm_unsubscribe(r.lcm, sub);
-    coa_world_destroy(w);
+    coavoid_world_destroy(w);
     lcm_destroy(r.lcm);
 }
 END_TEST
@@ -1165,62 +1165,62 @@ START_TEST(test_bad_configs_refused)
 {
     rig_t r;
     rig_init(&r, 10);
-    coa_node_common_t c;
-    ck_assert_int_eq(coa_node_common_defaults(&c, EPOCH, (coa_real_t)1, 128, &r.now), COA_ERR_ARGUMENT);
-    ck_assert_int_eq(coa_node_common_defaults(&c, EPOCH, (coa_real_t)0, 10, &r.now), COA_ERR_ARGUMENT);
-    ck_assert_int_eq(coa_node_common_defaults(&c, 0, (coa_real_t)1, 10, &r.now), COA_ERR_ARGUMENT);
-    ck_assert_int_eq(coa_node_common_defaults(&c, EPOCH, (coa_real_t)1, 10, NULL), COA_ERR_ARGUMENT);
-    ck_assert_int_eq(coa_node_cycle_of(&r.common, EPOCH - 1), -1);
-    ck_assert_int_eq(coa_node_cycle_of(&r.common, EPOCH + 2 * DT_US), 2);
-    ck_assert_int_eq(coa_node_cycle_utime(&r.common, 3), EPOCH + 3 * DT_US);
+    coavoid_node_common_t c;
+    ck_assert_int_eq(coavoid_node_common_defaults(&c, EPOCH, (coa_real_t)1, 128, &r.now), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coavoid_node_common_defaults(&c, EPOCH, (coa_real_t)0, 10, &r.now), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coavoid_node_common_defaults(&c, 0, (coa_real_t)1, 10, &r.now), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coavoid_node_common_defaults(&c, EPOCH, (coa_real_t)1, 10, NULL), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coavoid_node_cycle_of(&r.common, EPOCH - 1), -1);
+    ck_assert_int_eq(coavoid_node_cycle_of(&r.common, EPOCH + 2 * DT_US), 2);
+    ck_assert_int_eq(coavoid_node_cycle_utime(&r.common, 3), EPOCH + 3 * DT_US);
 
     coa_vec3_t route[2];
-    coa_vehicle_node_config_t vc;
+    coavoid_vehicle_node_config_t vc;
     memset(&vc, 0, sizeof vc);
     vc.common = r.common;
     vc.vehicle = uav(1, 1, route, 0, 500, 0, 100);
-    vc.mode = COA_NODE_DECOUPLED;
+    vc.mode = COAVOID_NODE_DECOUPLED;
     int error = 0;
     vc.vehicle.cruise_speed = -1;
-    ck_assert_ptr_null(coa_vehicle_node_create(&vc, r.lcm, &error));
+    ck_assert_ptr_null(coavoid_vehicle_node_create(&vc, r.lcm, &error));
     ck_assert_int_eq(error, COA_ERR_ARGUMENT);
     vc.vehicle.cruise_speed = 10;
-    vc.mode = (coa_node_mode_t)7;
-    ck_assert_ptr_null(coa_vehicle_node_create(&vc, r.lcm, &error));
-    vc.mode = COA_NODE_DECOUPLED;
+    vc.mode = (coavoid_node_mode_t)7;
+    ck_assert_ptr_null(coavoid_vehicle_node_create(&vc, r.lcm, &error));
+    vc.mode = COAVOID_NODE_DECOUPLED;
     vc.common.horizon = 128;
-    ck_assert_ptr_null(coa_vehicle_node_create(&vc, r.lcm, &error));
+    ck_assert_ptr_null(coavoid_vehicle_node_create(&vc, r.lcm, &error));
     vc.common.horizon = 10;
-    ck_assert_ptr_null(coa_vehicle_node_create(&vc, NULL, &error));
+    ck_assert_ptr_null(coavoid_vehicle_node_create(&vc, NULL, &error));
     vc.priority_wait_us = -1;
-    ck_assert_ptr_null(coa_vehicle_node_create(&vc, r.lcm, &error));
+    ck_assert_ptr_null(coavoid_vehicle_node_create(&vc, r.lcm, &error));
 
-    coa_coordinator_config_t cc;
+    coavoid_coordinator_config_t cc;
     memset(&cc, 0, sizeof cc);
     cc.common = r.common;
     cc.max_centralised = COA_MAX_CENTRALISED + 1u;
-    ck_assert_ptr_null(coa_coordinator_create(&cc, r.lcm, &error));
+    ck_assert_ptr_null(coavoid_coordinator_create(&cc, r.lcm, &error));
     ck_assert_int_eq(error, COA_ERR_ARGUMENT);
     cc.max_centralised = 2;
     cc.collect_us = DT_US;
-    ck_assert_ptr_null(coa_coordinator_create(&cc, r.lcm, &error));
+    ck_assert_ptr_null(coavoid_coordinator_create(&cc, r.lcm, &error));
 
-    coa_world_config_t wc;
+    coavoid_world_config_t wc;
     memset(&wc, 0, sizeof wc);
     wc.common = r.common;
     coa_obstacle_t boxes[65];
     memset(boxes, 0, sizeof boxes);
     wc.obstacles = boxes;
     wc.obstacle_count = 65; /* one more than a map message holds */
-    ck_assert_ptr_null(coa_world_create(&wc, r.lcm, &error));
+    ck_assert_ptr_null(coavoid_world_create(&wc, r.lcm, &error));
     ck_assert_int_eq(error, COA_ERR_ARGUMENT);
 
-    ck_assert_int_eq(coa_vehicle_node_cycle(NULL, EPOCH), COA_ERR_ARGUMENT);
-    ck_assert_int_eq(coa_coordinator_cycle(NULL, EPOCH), COA_ERR_ARGUMENT);
-    ck_assert_int_eq(coa_world_cycle(NULL, EPOCH), COA_ERR_ARGUMENT);
-    coa_vehicle_node_destroy(NULL);
-    coa_coordinator_destroy(NULL);
-    coa_world_destroy(NULL);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(NULL, EPOCH), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coavoid_coordinator_cycle(NULL, EPOCH), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coavoid_world_cycle(NULL, EPOCH), COA_ERR_ARGUMENT);
+    coavoid_vehicle_node_destroy(NULL);
+    coavoid_coordinator_destroy(NULL);
+    coavoid_world_destroy(NULL);
     lcm_destroy(r.lcm);
 }
 END_TEST

@@ -630,7 +630,7 @@ static void head_on_pair(fx_t *e)
     fx_vehicle(e, 2u, 1u, 10.0, 4.0, 2u, 5.0, 3.0, V(60, 0, 100), V(-60, 0, 100));
 }
 
-/* The reasoning below follows plan_independence (src/core/plan_group.c): every UAV is
+/* The reasoning below follows coa_plan_independence (src/core/plan_group.c): every UAV is
  * first planned alone off its table (alone(): one search each, largest_group 1); then,
  * while groups_conflict finds two vehicles of different groups whose rows conflict (only
  * at steps where their references come within r_a + r_b horizontally: near_steps), the

@@ -13,7 +13,7 @@
 
 #include "coavoid/coavoid.h"
 
-int cli_fail(int status, const char *fmt, ...)
+int coavoid_cli_fail(int status, const char *fmt, ...)
 {
     char line[1024];
     va_list ap;
@@ -29,13 +29,13 @@ int cli_fail(int status, const char *fmt, ...)
     return status;
 }
 
-bool cli_option_is(const char *arg, const char *name)
+bool coavoid_cli_option_is(const char *arg, const char *name)
 {
     size_t length = strlen(name);
     return strncmp(arg, name, length) == 0 && (arg[length] == '\0' || arg[length] == '=');
 }
 
-bool cli_option_value(int argc, char **argv, int *i, const char *name, const char **value)
+bool coavoid_cli_option_value(int argc, char **argv, int *i, const char *name, const char **value)
 {
     const char *arg = argv[*i];
     size_t length = strlen(name);
@@ -50,60 +50,60 @@ bool cli_option_value(int argc, char **argv, int *i, const char *name, const cha
     return true;
 }
 
-int cli_text_option(int argc, char **argv, int *i, const char *name, const char *hint,
+int coavoid_cli_text_option(int argc, char **argv, int *i, const char *name, const char *hint,
                     bool allow_empty, const char **text)
 {
     const char *value = NULL;
     if (*text != NULL) {
-        return cli_fail(CLI_EXIT_INVALID, "%s: given more than once", name);
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: given more than once", name);
     }
-    if (!cli_option_value(argc, argv, i, name, &value) || (value[0] == '\0' && !allow_empty)) {
-        return cli_fail(CLI_EXIT_INVALID, "%s: missing value (%s)", name, hint);
+    if (!coavoid_cli_option_value(argc, argv, i, name, &value) || (value[0] == '\0' && !allow_empty)) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: missing value (%s)", name, hint);
     }
     *text = value;
     return CLI_CONTINUE;
 }
 
-int cli_count_option(int argc, char **argv, int *i, const char *name, const char *hint,
+int coavoid_cli_count_option(int argc, char **argv, int *i, const char *name, const char *hint,
                      bool zero_ok, uint64_t max, const char **text, uint64_t *out)
 {
     char range[64];
     const char *value = *text;
     snprintf(range, sizeof range, "an integer from %d to %llu", zero_ok ? 0 : 1,
              (unsigned long long)max);
-    int status = cli_text_option(argc, argv, i, name, hint != NULL ? hint : range, true, &value);
+    int status = coavoid_cli_text_option(argc, argv, i, name, hint != NULL ? hint : range, true, &value);
     if (status != CLI_CONTINUE) {
         return status;
     }
-    if (!(zero_ok ? cli_parse_index(value, max, out)
-                  : cli_parse_count(value, strlen(value), max, out))) {
-        return cli_fail(CLI_EXIT_INVALID, "%s: must be %s, got '%.40s'", name, range, value);
+    if (!(zero_ok ? coavoid_cli_parse_index(value, max, out)
+                  : coavoid_cli_parse_count(value, strlen(value), max, out))) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: must be %s, got '%.40s'", name, range, value);
     }
     *text = value;
     return CLI_CONTINUE;
 }
 
-int cli_flag_option(const char *arg, const char *name, bool *flag)
+int coavoid_cli_flag_option(const char *arg, const char *name, bool *flag)
 {
     if (strcmp(arg, name) != 0) {
-        return cli_fail(CLI_EXIT_INVALID, "%s: takes no value", name);
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: takes no value", name);
     }
     if (*flag) {
-        return cli_fail(CLI_EXIT_INVALID, "%s: given more than once", name);
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: given more than once", name);
     }
     *flag = true;
     return CLI_CONTINUE;
 }
 
-int cli_mode_option(int argc, char **argv, int *i, const char **mode, bool *decoupled)
+int coavoid_cli_mode_option(int argc, char **argv, int *i, const char **mode, bool *decoupled)
 {
     const char *value = *mode;
-    int status = cli_text_option(argc, argv, i, "--mode", "centralised or decoupled", true, &value);
+    int status = coavoid_cli_text_option(argc, argv, i, "--mode", "centralised or decoupled", true, &value);
     if (status != CLI_CONTINUE) {
         return status;
     }
     if (strcmp(value, "centralised") != 0 && strcmp(value, "decoupled") != 0) {
-        return cli_fail(CLI_EXIT_INVALID,
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
                         "--mode: unknown mode '%.40s' (expected centralised or decoupled)", value);
     }
     *mode = value;
@@ -113,7 +113,7 @@ int cli_mode_option(int argc, char **argv, int *i, const char **mode, bool *deco
     return CLI_CONTINUE;
 }
 
-bool cli_parse_count(const char *text, size_t length, uint64_t max, uint64_t *out)
+bool coavoid_cli_parse_count(const char *text, size_t length, uint64_t max, uint64_t *out)
 {
     uint64_t value = 0;
     if (length == 0) {
@@ -134,16 +134,16 @@ bool cli_parse_count(const char *text, size_t length, uint64_t max, uint64_t *ou
     return value >= 1;
 }
 
-bool cli_parse_index(const char *text, uint64_t max, uint64_t *out)
+bool coavoid_cli_parse_index(const char *text, uint64_t max, uint64_t *out)
 {
     if (strcmp(text, "0") == 0) {
         *out = 0;
         return true;
     }
-    return cli_parse_count(text, strlen(text), max, out);
+    return coavoid_cli_parse_count(text, strlen(text), max, out);
 }
 
-bool cli_parse_real(const char *text, double *out)
+bool coavoid_cli_parse_real(const char *text, double *out)
 {
     const char *c = text;
     bool digits = false;
@@ -176,17 +176,17 @@ bool cli_parse_real(const char *text, double *out)
     return true;
 }
 
-coa_planner_config_t cli_planner_config(const scenario_t *s, size_t searched, uint32_t beta)
+coa_planner_config_t coavoid_cli_planner_config(const coavoid_scenario_t *s, size_t searched, uint32_t beta)
 {
     coa_planner_config_t config;
-    coa_problem_t problem = scenario_problem(s);
+    coa_problem_t problem = coavoid_scenario_problem(s);
     int rc = coa_planner_config_of(&problem, searched, beta, &config);
     assert(rc == COA_OK);
     (void)rc;
     return config;
 }
 
-void cli_planner_config_widen(coa_planner_config_t *into, const coa_planner_config_t *with)
+void coavoid_cli_planner_config_widen(coa_planner_config_t *into, const coa_planner_config_t *with)
 {
     if (with->horizon > into->horizon) {
         into->horizon = with->horizon;
@@ -199,43 +199,43 @@ void cli_planner_config_widen(coa_planner_config_t *into, const coa_planner_conf
     }
 }
 
-bool cli_workspace_fits(const coa_planner_config_t *config)
+bool coavoid_cli_workspace_fits(const coa_planner_config_t *config)
 {
     size_t size = coa_planner_workspace_size(config);
     return size != 0u && size <= CLI_DEFAULT_WORKSPACE_MAX;
 }
 
-uint32_t cli_default_beta(const coa_planner_config_t *config)
+uint32_t coavoid_cli_default_beta(const coa_planner_config_t *config)
 {
     uint32_t fits = coa_planner_max_beta(config, CLI_DEFAULT_WORKSPACE_MAX);
     return fits < CLI_DEFAULT_BETA ? fits : CLI_DEFAULT_BETA;
 }
 
-int64_t cli_elapsed_us(const struct timespec *start, const struct timespec *end)
+int64_t coavoid_cli_elapsed_us(const struct timespec *start, const struct timespec *end)
 {
     return (int64_t)(end->tv_sec - start->tv_sec) * 1000000 +
            (int64_t)(end->tv_nsec - start->tv_nsec) / 1000;
 }
 
-int cli_load_scenario(const char *path, scenario_t *s)
+int coavoid_cli_load_scenario(const char *path, coavoid_scenario_t *s)
 {
     char err[SCENARIO_ERROR_MAX];
-    if (scenario_load(path, s, err, sizeof err) != 0) {
-        return cli_fail(CLI_EXIT_INVALID, "%s: %s", path, err);
+    if (coavoid_scenario_load(path, s, err, sizeof err) != 0) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: %s", path, err);
     }
     return CLI_CONTINUE;
 }
 
-int cli_sample_scenario(const char *path, scenario_t *s)
+int coavoid_cli_sample_scenario(const char *path, coavoid_scenario_t *s)
 {
     char err[SCENARIO_ERROR_MAX];
-    if (scenario_sample(s, err, sizeof err) != 0) {
-        return cli_fail(CLI_EXIT_INVALID, "%s: %s", path, err);
+    if (coavoid_scenario_sample(s, err, sizeof err) != 0) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: %s", path, err);
     }
     return CLI_CONTINUE;
 }
 
-int cli_parse_args(const cli_command_t *c, int argc, char **argv, void *options,
+int coavoid_cli_parse_args(const coavoid_cli_command_t *c, int argc, char **argv, void *options,
                    const char **args)
 {
     size_t wanted = 0;
@@ -248,7 +248,7 @@ int cli_parse_args(const cli_command_t *c, int argc, char **argv, void *options,
         const char *arg = argv[i];
         if (options_done || arg[0] != '-' || (wanted > 0u && strcmp(arg, "-") == 0)) {
             if (given == wanted) {
-                return cli_fail(CLI_EXIT_INVALID, "%s: unexpected argument '%.80s' (%s)", c->name,
+                return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: unexpected argument '%.80s' (%s)", c->name,
                                 arg, c->too_many);
             }
             args[given++] = arg;
@@ -264,7 +264,7 @@ int cli_parse_args(const cli_command_t *c, int argc, char **argv, void *options,
         }
         int status = c->option(argc, argv, &i, options);
         if (status == CLI_UNKNOWN_OPTION) {
-            return cli_fail(CLI_EXIT_INVALID, "%s: unknown option '%.40s' (see '%s --help')",
+            return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: unknown option '%.40s' (see '%s --help')",
                             c->name, arg, c->see);
         }
         if (status != CLI_CONTINUE) {
@@ -272,19 +272,19 @@ int cli_parse_args(const cli_command_t *c, int argc, char **argv, void *options,
         }
     }
     if (given < wanted) {
-        return cli_fail(CLI_EXIT_INVALID, "%s: missing %s (see '%s --help')", c->name,
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: missing %s (see '%s --help')", c->name,
                         c->arguments[given], c->see);
     }
     return CLI_CONTINUE;
 }
 
-int cli_run_scenario(const char *path, int (*run)(void *options, scenario_t *s), void *options)
+int coavoid_cli_run_scenario(const char *path, int (*run)(void *options, coavoid_scenario_t *s), void *options)
 {
-    scenario_t scenario;
-    int status = cli_load_scenario(path, &scenario);
+    coavoid_scenario_t scenario;
+    int status = coavoid_cli_load_scenario(path, &scenario);
     if (status == CLI_CONTINUE) {
         status = run(options, &scenario);
     }
-    scenario_free(&scenario);
+    coavoid_scenario_free(&scenario);
     return status;
 }

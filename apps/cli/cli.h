@@ -43,15 +43,15 @@ enum {
 
 /* Prints "coavoid: <message>" as exactly one line (control characters that came from the
  * input, such as a file name or an option value, are replaced so they cannot split it) and
- * returns `status`, so that every check reads `return cli_fail(...)`. */
-int cli_fail(int status, const char *fmt, ...) CLI_PRINTF_LIKE(2, 3);
+ * returns `status`, so that every check reads `return coavoid_cli_fail(...)`. */
+int coavoid_cli_fail(int status, const char *fmt, ...) CLI_PRINTF_LIKE(2, 3);
 
 /* Whether `arg` is the option `name`, alone or as "name=value". */
-bool cli_option_is(const char *arg, const char *name);
+bool coavoid_cli_option_is(const char *arg, const char *name);
 
-/* The value of option `name` (argv[*i], already matched by cli_option_is): the text after
+/* The value of option `name` (argv[*i], already matched by coavoid_cli_option_is): the text after
  * '=', or the next argument (consumed). false when there is none. */
-bool cli_option_value(int argc, char **argv, int *i, const char *name, const char **value);
+bool coavoid_cli_option_value(int argc, char **argv, int *i, const char *name, const char **value);
 
 /* ---- a command's arguments ---- */
 
@@ -70,7 +70,7 @@ typedef struct {
     const char *too_many;      /* why one more argument is refused: "one scenario only" */
     void (*help)(void);        /* prints the usage on stdout */
     cli_option_parser_t option;
-} cli_command_t;
+} coavoid_cli_command_t;
 
 /* Walks argv[c->first..]: "-h" or "--help" prints the help and returns CLI_EXIT_OK; every
  * other option goes to c->option; what is not an option is the next of c->arguments, and
@@ -79,49 +79,49 @@ typedef struct {
  * CLI_EXIT_INVALID after one of "NAME: unexpected argument 'ARG' (TOO_MANY)", "NAME:
  * unknown option 'ARG' (see 'SEE --help')", "NAME: missing ARGUMENT (see 'SEE --help')",
  * or c->option's status. O(argc) plus the parser's, no memory. */
-int cli_parse_args(const cli_command_t *c, int argc, char **argv, void *options,
+int coavoid_cli_parse_args(const coavoid_cli_command_t *c, int argc, char **argv, void *options,
                    const char **args);
 
 /* A command's step after its options: runs run(options, s) on the scenario at path, loaded
- * (cli_load_scenario) and freed afterwards. Returns run's status, or CLI_EXIT_INVALID after
+ * (coavoid_cli_load_scenario) and freed afterwards. Returns run's status, or CLI_EXIT_INVALID after
  * the loader's message. Memory: the scenario's, until run returns. */
-int cli_run_scenario(const char *path, int (*run)(void *options, scenario_t *s), void *options);
+int coavoid_cli_run_scenario(const char *path, int (*run)(void *options, coavoid_scenario_t *s), void *options);
 
 /* ---- one option's value ----
- * Each takes the option `name` at argv[*i] (already matched by cli_option_is), consumes its
- * value (cli_option_value), and returns CLI_CONTINUE, or CLI_EXIT_INVALID after one line:
+ * Each takes the option `name` at argv[*i] (already matched by coavoid_cli_option_is), consumes its
+ * value (coavoid_cli_option_value), and returns CLI_CONTINUE, or CLI_EXIT_INVALID after one line:
  * "NAME: given more than once" (each option at most once), "NAME: missing value (HINT)",
  * or what each says of a bad value. O(length of the value), no memory. */
 
 /* Any text, which *text (NULL until given) is set to. An empty value is missing unless
  * allow_empty (then the caller judges it). */
-int cli_text_option(int argc, char **argv, int *i, const char *name, const char *hint,
+int coavoid_cli_text_option(int argc, char **argv, int *i, const char *name, const char *hint,
                     bool allow_empty, const char **text);
 
 /* An integer from 1 (0 with zero_ok) to max: "NAME: must be an integer from 1 to MAX, got
  * 'VALUE'". hint NULL: "an integer from 1 to MAX". Sets *text (NULL until given) and *out. */
-int cli_count_option(int argc, char **argv, int *i, const char *name, const char *hint,
+int coavoid_cli_count_option(int argc, char **argv, int *i, const char *name, const char *hint,
                      bool zero_ok, uint64_t max, const char **text, uint64_t *out);
 
-/* A flag, `arg` matched by cli_option_is(arg, name): "NAME: takes no value" for
+/* A flag, `arg` matched by coavoid_cli_option_is(arg, name): "NAME: takes no value" for
  * "NAME=...". Sets *flag. */
-int cli_flag_option(const char *arg, const char *name, bool *flag);
+int coavoid_cli_flag_option(const char *arg, const char *name, bool *flag);
 
 /* --mode centralised|decoupled: "--mode: unknown mode 'VALUE' (expected centralised or
  * decoupled)". Sets *mode (NULL until given) and, unless NULL, *decoupled. */
-int cli_mode_option(int argc, char **argv, int *i, const char **mode, bool *decoupled);
+int coavoid_cli_mode_option(int argc, char **argv, int *i, const char **mode, bool *decoupled);
 
 /* `length` characters of decimal digits only (no sign, no spaces) whose value is in
  * 1..max. */
-bool cli_parse_count(const char *text, size_t length, uint64_t max, uint64_t *out);
+bool coavoid_cli_parse_count(const char *text, size_t length, uint64_t max, uint64_t *out);
 
-/* A whole string that is "0" or what cli_parse_count takes: a value in 0..max. */
-bool cli_parse_index(const char *text, uint64_t max, uint64_t *out);
+/* A whole string that is "0" or what coavoid_cli_parse_count takes: a value in 0..max. */
+bool coavoid_cli_parse_index(const char *text, uint64_t max, uint64_t *out);
 
 /* A whole string that is one finite decimal number (an optional sign, digits with at most
  * one point, an optional exponent): strtod alone would also take leading spaces, "nan",
  * "inf" and hexadecimal, which in an option are more likely a mistake than meant. */
-bool cli_parse_real(const char *text, double *out);
+bool coavoid_cli_parse_real(const char *text, double *out);
 
 /* The bound beta on the nodes each joint search stores when neither an option nor the
  * scenario's "beta" gives one (`coavoid plan`, `coavoid sim`, coavoid-coordinator,
@@ -135,34 +135,34 @@ bool cli_parse_real(const char *text, double *out);
 
 /* The planner config of a scenario (coa_planner_config_of: its horizon, largest steep
  * factor and offset bound) for `searched` UAVs a search and `beta`. The scenario need not
- * be sampled. Cannot fail for a scenario that scenario_load accepted and searched in
+ * be sampled. Cannot fail for a scenario that coavoid_scenario_load accepted and searched in
  * 1..COA_MAX_CENTRALISED, beta >= 1 (asserted). */
-coa_planner_config_t cli_planner_config(const scenario_t *s, size_t searched, uint32_t beta);
+coa_planner_config_t coavoid_cli_planner_config(const coavoid_scenario_t *s, size_t searched, uint32_t beta);
 
 /* Widens *into so that it also takes every problem `with` takes: the longer horizon, the
  * larger steep factor and offset bound (unbounded when either is). */
-void cli_planner_config_widen(coa_planner_config_t *into, const coa_planner_config_t *with);
+void coavoid_cli_planner_config_widen(coa_planner_config_t *into, const coa_planner_config_t *with);
 
 /* Whether a planner of this config has a size and fits CLI_DEFAULT_WORKSPACE_MAX.
  * O(1), no memory, cannot fail. */
-bool cli_workspace_fits(const coa_planner_config_t *config);
+bool coavoid_cli_workspace_fits(const coa_planner_config_t *config);
 
 /* The default beta for planners of this config (its beta ignored): CLI_DEFAULT_BETA, or
  * the largest beta whose workspace fits CLI_DEFAULT_WORKSPACE_MAX when that is smaller;
  * 0 when none does (the cost-to-go tables alone are too large: a very long horizon). */
-uint32_t cli_default_beta(const coa_planner_config_t *config);
+uint32_t coavoid_cli_default_beta(const coa_planner_config_t *config);
 
 /* Microseconds from start to end. */
-int64_t cli_elapsed_us(const struct timespec *start, const struct timespec *end);
+int64_t coavoid_cli_elapsed_us(const struct timespec *start, const struct timespec *end);
 
-/* Loads and validates the scenario at `path` (scenario_load). Returns CLI_CONTINUE, or
+/* Loads and validates the scenario at `path` (coavoid_scenario_load). Returns CLI_CONTINUE, or
  * CLI_EXIT_INVALID after the loader's one-line message ("coavoid: FILE: field: reason").
- * Either way the caller calls scenario_free(s) afterwards. */
-int cli_load_scenario(const char *path, scenario_t *s);
+ * Either way the caller calls coavoid_scenario_free(s) afterwards. */
+int coavoid_cli_load_scenario(const char *path, coavoid_scenario_t *s);
 
 /* Samples every reference and track of a loaded scenario over its horizon
- * (scenario_sample). Returns CLI_CONTINUE, or CLI_EXIT_INVALID after the one-line message
+ * (coavoid_scenario_sample). Returns CLI_CONTINUE, or CLI_EXIT_INVALID after the one-line message
  * naming `path` and the field. */
-int cli_sample_scenario(const char *path, scenario_t *s);
+int coavoid_cli_sample_scenario(const char *path, coavoid_scenario_t *s);
 
 #endif /* COAVOID_APP_CLI_H */

@@ -11,7 +11,7 @@
  * climb steps): against 10 m of combined half-heights most pairs conflict unless someone
  * moves, and some pairs already clear each other. Half the encounters have a terrain box
  * under the point whose top is 4 m below the lowest UAV's volume, so diving is limited
- * there. The problems (encounter.h, design encounter_bench, shared with coavoid
+ * there. The problems (encounter.h, design coavoid_encounter_bench, shared with coavoid
  * montecarlo) are written as scenario JSON and go through the scenario loader, so they are
  * checked like any file.
  *
@@ -57,8 +57,8 @@
 #define BP_DEFAULT_MAX_VEHICLES 5u
 _Static_assert(BP_MIN_VEHICLES == 2u && BP_MAX_VEHICLES == 6u, "--vehicles' hint says 2 to 6");
 #define BP_DEFAULT_SCENARIO "scenarios/paper.json"
-#define BP_HORIZON encounter_bench.horizon
-#define BP_DT encounter_bench.dt
+#define BP_HORIZON coavoid_encounter_bench.horizon
+#define BP_DT coavoid_encounter_bench.dt
 #define BP_SET_MAX (1u + BP_MAX_VEHICLES - BP_MIN_VEHICLES + 1u)
 
 #define BENCH_PLAN_USAGE                                                                    \
@@ -119,57 +119,57 @@ static int bp_option(int argc, char **argv, int *i, void *options)
     const char *arg = argv[*i];
     uint64_t value = 0;
     int status = CLI_UNKNOWN_OPTION;
-    if (cli_option_is(arg, "--vehicles")) {
-        /* 2..6, which cli_count_option (1..max) cannot say. */
-        status = cli_text_option(argc, argv, i, "--vehicles", "an integer from 2 to 6", true,
+    if (coavoid_cli_option_is(arg, "--vehicles")) {
+        /* 2..6, which coavoid_cli_count_option (1..max) cannot say. */
+        status = coavoid_cli_text_option(argc, argv, i, "--vehicles", "an integer from 2 to 6", true,
                                  &o->vehicles_text);
         if (status == CLI_CONTINUE &&
-            (!cli_parse_count(o->vehicles_text, strlen(o->vehicles_text), BP_MAX_VEHICLES,
+            (!coavoid_cli_parse_count(o->vehicles_text, strlen(o->vehicles_text), BP_MAX_VEHICLES,
                               &value) ||
              value < BP_MIN_VEHICLES)) {
-            status = cli_fail(CLI_EXIT_INVALID, "--vehicles: must be an integer from %u to %u, "
+            status = coavoid_cli_fail(CLI_EXIT_INVALID, "--vehicles: must be an integer from %u to %u, "
                               "got '%.40s'", BP_MIN_VEHICLES, BP_MAX_VEHICLES, o->vehicles_text);
         }
         o->vehicles = (uint32_t)value;
-    } else if (cli_option_is(arg, "--count")) {
-        status = cli_count_option(argc, argv, i, "--count", NULL, false, BP_MAX_COUNT,
+    } else if (coavoid_cli_option_is(arg, "--count")) {
+        status = coavoid_cli_count_option(argc, argv, i, "--count", NULL, false, BP_MAX_COUNT,
                                   &o->count_text, &value);
         o->count = (uint32_t)value;
-    } else if (cli_option_is(arg, "--seed")) {
-        status = cli_count_option(argc, argv, i, "--seed", NULL, true, UINT64_MAX, &o->seed_text,
+    } else if (coavoid_cli_option_is(arg, "--seed")) {
+        status = coavoid_cli_count_option(argc, argv, i, "--seed", NULL, true, UINT64_MAX, &o->seed_text,
                                   &value);
         o->seed = value;
-    } else if (cli_option_is(arg, "--repeat")) {
-        status = cli_count_option(argc, argv, i, "--repeat", NULL, false, BP_MAX_REPEAT,
+    } else if (coavoid_cli_option_is(arg, "--repeat")) {
+        status = coavoid_cli_count_option(argc, argv, i, "--repeat", NULL, false, BP_MAX_REPEAT,
                                   &o->repeat_text, &value);
         o->repeat = (uint32_t)value;
-    } else if (cli_option_is(arg, "--beta")) {
-        status = cli_count_option(argc, argv, i, "--beta", "an integer >= 1", false, UINT32_MAX,
+    } else if (coavoid_cli_option_is(arg, "--beta")) {
+        status = coavoid_cli_count_option(argc, argv, i, "--beta", "an integer >= 1", false, UINT32_MAX,
                                   &o->beta_text, &value);
         o->beta = (uint32_t)value;
-    } else if (cli_option_is(arg, "--scenario")) {
-        status = cli_text_option(argc, argv, i, "--scenario", "a scenario file", false,
+    } else if (coavoid_cli_option_is(arg, "--scenario")) {
+        status = coavoid_cli_text_option(argc, argv, i, "--scenario", "a scenario file", false,
                                  &o->scenario);
-    } else if (cli_option_is(arg, "--json")) {
-        status = cli_flag_option(arg, "--json", &o->json);
+    } else if (coavoid_cli_option_is(arg, "--json")) {
+        status = coavoid_cli_flag_option(arg, "--json", &o->json);
     }
     return status;
 }
 
 /* bench's argv[2] is the benchmark's name, so options start at argv[3]. */
-static const cli_command_t bench_plan_command = {
+static const coavoid_cli_command_t bench_plan_command = {
     "bench plan", "coavoid bench plan", 3, {NULL, NULL}, "it takes options only",
     bench_plan_help, bp_option};
 
 static int parse_bp_options(int argc, char **argv, bp_options_t *o)
 {
     memset(o, 0, sizeof *o);
-    int status = cli_parse_args(&bench_plan_command, argc, argv, o, NULL);
+    int status = coavoid_cli_parse_args(&bench_plan_command, argc, argv, o, NULL);
     if (status != CLI_CONTINUE) {
         return status;
     }
     if (o->scenario != NULL && o->vehicles_text != NULL) {
-        return cli_fail(CLI_EXIT_INVALID,
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
                         "--scenario: only without --vehicles (which times random encounters "
                         "only)");
     }
@@ -195,14 +195,14 @@ static int parse_bp_options(int argc, char **argv, bp_options_t *o)
 typedef struct {
     char label[16];       /* "paper", "2 UAVs" */
     uint32_t vehicles;    /* per problem (the paper: its own) */
-    scenario_t *problems; /* sampled */
+    coavoid_scenario_t *problems; /* sampled */
     uint32_t count;
 } bp_set_t;
 
 static void set_free(bp_set_t *set)
 {
     for (uint32_t j = 0; set->problems != NULL && j < set->count; j++) {
-        scenario_free(&set->problems[j]);
+        coavoid_scenario_free(&set->problems[j]);
     }
     free(set->problems);
     memset(set, 0, sizeof *set);
@@ -214,20 +214,20 @@ static int build_random_set(const bp_options_t *o, uint32_t n, bp_set_t *set)
     set->vehicles = n;
     set->problems = calloc(o->count, sizeof *set->problems);
     if (set->problems == NULL) {
-        return cli_fail(CLI_EXIT_INVALID, "--count: out of memory for %lu problems",
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "--count: out of memory for %lu problems",
                         (unsigned long)o->count);
     }
     for (uint32_t j = 0; j < o->count; j++) {
         char json[ENCOUNTER_JSON_MAX];
         char err[SCENARIO_ERROR_MAX];
         set->count = j + 1u; /* so set_free frees this one too */
-        if (!encounter_json(&encounter_bench, o->seed, n, j, 0u, json, sizeof json, NULL)) {
-            return cli_fail(CLI_EXIT_INTERNAL, "internal error: encounter %u of %u UAVs does "
+        if (!coavoid_encounter_json(&coavoid_encounter_bench, o->seed, n, j, 0u, json, sizeof json, NULL)) {
+            return coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: encounter %u of %u UAVs does "
                             "not fit %u bytes", j, n, ENCOUNTER_JSON_MAX);
         }
-        if (scenario_parse(json, strlen(json), &set->problems[j], err, sizeof err) != 0 ||
-            scenario_sample(&set->problems[j], err, sizeof err) != 0) {
-            return cli_fail(CLI_EXIT_INTERNAL, "internal error: encounter %u of %u UAVs: %s", j,
+        if (coavoid_scenario_parse(json, strlen(json), &set->problems[j], err, sizeof err) != 0 ||
+            coavoid_scenario_sample(&set->problems[j], err, sizeof err) != 0) {
+            return coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: encounter %u of %u UAVs: %s", j,
                             n, err);
         }
     }
@@ -239,15 +239,15 @@ static int build_paper_set(const bp_options_t *o, bp_set_t *set)
     snprintf(set->label, sizeof set->label, "paper");
     set->problems = calloc(1u, sizeof *set->problems);
     if (set->problems == NULL) {
-        return cli_fail(CLI_EXIT_INVALID, "--scenario: out of memory");
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "--scenario: out of memory");
     }
     set->count = 1u;
-    int status = cli_load_scenario(o->scenario, &set->problems[0]);
+    int status = coavoid_cli_load_scenario(o->scenario, &set->problems[0]);
     if (status == CLI_CONTINUE) {
-        status = cli_sample_scenario(o->scenario, &set->problems[0]);
+        status = coavoid_cli_sample_scenario(o->scenario, &set->problems[0]);
     }
     if (status == CLI_CONTINUE && set->problems[0].vehicle_count > COA_MAX_CENTRALISED) {
-        status = cli_fail(CLI_EXIT_INVALID, "%s: %zu vehicles, at most %u can be planned "
+        status = coavoid_cli_fail(CLI_EXIT_INVALID, "%s: %zu vehicles, at most %u can be planned "
                           "centrally", o->scenario, set->problems[0].vehicle_count,
                           COA_MAX_CENTRALISED);
     }
@@ -276,7 +276,7 @@ static int run_once(coa_planner_t *planner, const bp_set_t *set, bool decoupled,
     row->nodes_expanded = row->nodes_generated = 0;
     row->solved = row->infeasible = row->budget_exhausted = 0;
     for (uint32_t j = 0; j < set->count; j++) {
-        coa_problem_t problem = scenario_problem(&set->problems[j]);
+        coa_problem_t problem = coavoid_scenario_problem(&set->problems[j]);
         coa_plan_result_t result;
         memset(&result, 0, sizeof result);
         struct timespec start, end;
@@ -285,7 +285,7 @@ static int run_once(coa_planner_t *planner, const bp_set_t *set, bool decoupled,
                            : coa_plan_centralised(planner, &problem, offsets, &result);
         clock_gettime(CLOCK_MONOTONIC, &end);
         if (rc != COA_OK) {
-            return cli_fail(rc == COA_ERR_RANGE ? CLI_EXIT_INVALID : CLI_EXIT_INTERNAL,
+            return coavoid_cli_fail(rc == COA_ERR_RANGE ? CLI_EXIT_INVALID : CLI_EXIT_INTERNAL,
                             "%s, problem %u: the planner failed (%s)", set->label, j,
                             coa_status_name(rc));
         }
@@ -310,13 +310,13 @@ static int run_set(const bp_options_t *o, const bp_set_t *set, bool decoupled, b
     uint32_t wanted = o->beta_text != NULL                          ? o->beta
                       : set->count == 1u && set->problems[0].has_beta ? set->problems[0].beta
                                                                       : CLI_DEFAULT_BETA;
-    coa_planner_config_t config = cli_planner_config(&set->problems[0], searched, wanted);
+    coa_planner_config_t config = coavoid_cli_planner_config(&set->problems[0], searched, wanted);
     for (uint32_t j = 1; j < set->count; j++) {
-        coa_planner_config_t other = cli_planner_config(&set->problems[j], searched, wanted);
-        cli_planner_config_widen(&config, &other);
+        coa_planner_config_t other = coavoid_cli_planner_config(&set->problems[j], searched, wanted);
+        coavoid_cli_planner_config_widen(&config, &other);
     }
-    if (!cli_workspace_fits(&config)) {
-        config.beta = cli_default_beta(&config);
+    if (!coavoid_cli_workspace_fits(&config)) {
+        config.beta = coavoid_cli_default_beta(&config);
     }
     row->beta_lowered = config.beta != wanted;
     row->beta = config.beta;
@@ -327,10 +327,10 @@ static int run_set(const bp_options_t *o, const bp_set_t *set, bool decoupled, b
     int status = CLI_CONTINUE;
     coa_planner_t *planner = NULL;
     if (workspace == NULL || offsets == NULL || times == NULL) {
-        status = cli_fail(CLI_EXIT_INVALID, "%s: out of memory for %zu bytes of workspace",
+        status = coavoid_cli_fail(CLI_EXIT_INVALID, "%s: out of memory for %zu bytes of workspace",
                           set->label, size);
     } else if ((planner = coa_planner_init(workspace, size, &config)) == NULL) {
-        status = cli_fail(CLI_EXIT_INTERNAL, "internal error: the planner refused its workspace");
+        status = coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: the planner refused its workspace");
     }
     row->workspace_bytes = size;
     bp_row_t first;
@@ -346,7 +346,7 @@ static int run_set(const bp_options_t *o, const bp_set_t *set, bool decoupled, b
             (row->nodes_expanded != first.nodes_expanded ||
              row->nodes_generated != first.nodes_generated || row->solved != first.solved ||
              row->budget_exhausted != first.budget_exhausted)) {
-            status = cli_fail(CLI_EXIT_INTERNAL, "internal error: %s, run %lu differs from the "
+            status = coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: %s, run %lu differs from the "
                               "first", set->label, (unsigned long)k + 1u);
         }
     }
@@ -429,10 +429,10 @@ static int report_json(FILE *f, const bp_options_t *o, const bp_row_t *rows, siz
         cJSON_Delete(root);
         return -1;
     }
-    return output_json(f, root, NULL, 0);
+    return coavoid_output_json(f, root, NULL, 0);
 }
 
-int bench_plan(int argc, char **argv)
+int coavoid_bench_plan(int argc, char **argv)
 {
     bp_options_t o;
     int status = parse_bp_options(argc, argv, &o);
@@ -460,7 +460,7 @@ int bench_plan(int argc, char **argv)
     if (status == CLI_CONTINUE) {
         int rc = o.json ? report_json(stdout, &o, rows, row_count)
                         : report_text(stdout, &o, rows, row_count);
-        status = rc == 0 ? CLI_EXIT_OK : cli_fail(CLI_EXIT_INTERNAL, "cannot write the result");
+        status = rc == 0 ? CLI_EXIT_OK : coavoid_cli_fail(CLI_EXIT_INTERNAL, "cannot write the result");
     }
     for (size_t i = 0; i < set_count; i++) {
         set_free(&sets[i]);

@@ -15,7 +15,7 @@
 
 /* bench plan's design, as it was when bench_plan.c held the generator: its figures in
  * docs/benchmarks.md are for exactly these problems. */
-const encounter_design_t encounter_bench = {
+const coavoid_encounter_design_t coavoid_encounter_bench = {
     .name = "bench encounter",
     .horizon = 20u,
     .dt = 1.0,
@@ -40,7 +40,7 @@ const encounter_design_t encounter_bench = {
 };
 
 /* montecarlo's design; docs/evaluation.md ("The encounters") says why each number. */
-const encounter_design_t encounter_montecarlo = {
+const coavoid_encounter_design_t coavoid_encounter_montecarlo = {
     .name = "montecarlo encounter",
     .horizon = 12u,
     .dt = 1.0,
@@ -84,14 +84,14 @@ static bool append(char *buf, size_t size, size_t *used, const char *fmt, ...)
 }
 
 /* x on the design's grid. Printed with %.3f, a multiple of 1/8 is written exactly. */
-static double quantise(const encounter_design_t *d, double x)
+static double quantise(const coavoid_encounter_design_t *d, double x)
 {
     return d->quantum > 0 ? round(x / d->quantum) * d->quantum : x;
 }
 
 /* A hill near the origin: a box, or a pyramid (a square base on the ground turned by a
  * random angle, its apex over a point near the centre), its top `top` m high. */
-static bool hill_json(const encounter_design_t *d, prng_t *r, double top, char *buf,
+static bool hill_json(const coavoid_encounter_design_t *d, prng_t *r, double top, char *buf,
                       size_t size, size_t *used)
 {
     bool pyramid = prng_below(r, 2u) == 1u;
@@ -120,7 +120,7 @@ static bool hill_json(const encounter_design_t *d, prng_t *r, double top, char *
 
 /* A non-cooperative aircraft flying level and straight through a point near the origin
  * at a time when the UAVs are about there, at an altitude within or near their stagger. */
-static bool track_json(const encounter_design_t *d, prng_t *r, uint32_t id, char *buf,
+static bool track_json(const coavoid_encounter_design_t *d, prng_t *r, uint32_t id, char *buf,
                        size_t size, size_t *used)
 {
     double heading = prng_uniform(r, 0.0, 2.0 * ENC_PI);
@@ -142,14 +142,14 @@ static bool track_json(const encounter_design_t *d, prng_t *r, uint32_t id, char
                   quantise(d, py - vy * when), quantise(d, z), vx, vy);
 }
 
-bool encounter_json(const encounter_design_t *d, uint64_t seed, uint32_t n, uint32_t index,
-                    uint32_t attempt, char *buf, size_t size, encounter_info_t *info)
+bool coavoid_encounter_json(const coavoid_encounter_design_t *d, uint64_t seed, uint32_t n, uint32_t index,
+                    uint32_t attempt, char *buf, size_t size, coavoid_encounter_info_t *info)
 {
     /* Attempt 0 is bench plan's original stream; a redraw moves to another. */
     prng_t r = {seed ^ ((uint64_t)n << 56) ^ ((uint64_t)index * 0x9e3779b97f4a7c15u) ^
                 ((uint64_t)attempt * 0xd1b54a32d192ed03u)};
     prng_next(&r);
-    encounter_info_t drawn = {0u, 0u};
+    coavoid_encounter_info_t drawn = {0u, 0u};
     size_t used = 0;
     const double horizon_s = d->horizon * d->dt;
     bool ok = append(buf, size, &used,

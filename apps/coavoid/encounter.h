@@ -8,7 +8,7 @@
  *
  * The shape. UAV i's heading is heading0 + 2 pi i / n plus jitter; it flies a straight
  * level route through the origin, reaching it `arrive` seconds into the window, at an
- * altitude staggered on a grid around a base altitude. A design (encounter_design_t) sets
+ * altitude staggered on a grid around a base altitude. A design (coavoid_encounter_design_t) sets
  * the ranges; with terrain_hills it adds hills under the crossing area, with max_tracks
  * non-cooperative aircraft crossing it, and with max_offset_max a vertical band per UAV.
  *
@@ -16,7 +16,7 @@
  * attempt), so a seed gives the same problems on every machine with the same libm
  * (headings go through cos and sin, which C does not require to round correctly), and
  * adding problems or UAV counts changes none of the others. The draws are made in a fixed order and a design's
- * optional parts draw nothing when they are off, so encounter_bench (no quantum, one box
+ * optional parts draw nothing when they are off, so coavoid_encounter_bench (no quantum, one box
  * half the time) gives exactly the problems bench plan gave before this file existed.
  */
 #ifndef COAVOID_APP_ENCOUNTER_H
@@ -53,24 +53,24 @@ typedef struct {
     double track_radius, track_half_height; /* their protected volumes, m */
     /* 0: unbounded; otherwise each UAV's max_offset is drawn from min..max. */
     uint32_t max_offset_min, max_offset_max;
-} encounter_design_t;
+} coavoid_encounter_design_t;
 
 /* bench plan's encounters (docs/benchmarks.md, "The encounters"). */
-extern const encounter_design_t encounter_bench;
+extern const coavoid_encounter_design_t coavoid_encounter_bench;
 /* montecarlo's encounters (docs/evaluation.md, "The encounters"). */
-extern const encounter_design_t encounter_montecarlo;
+extern const coavoid_encounter_design_t coavoid_encounter_montecarlo;
 
-/* What encounter_json drew beyond the vehicles, for reports. */
+/* What coavoid_encounter_json drew beyond the vehicles, for reports. */
 typedef struct {
     uint32_t hills;
     uint32_t tracks;
-} encounter_info_t;
+} coavoid_encounter_info_t;
 
 /* Writes encounter `index` of n UAVs (ENCOUNTER_MIN_VEHICLES..ENCOUNTER_MAX_VEHICLES) of
  * design d, draw `attempt` (0 first; a caller that rejects a draw asks for the next), as
  * scenario JSON into buf[size]. info may be NULL. Returns false when it does not fit (a
  * bug: ENCOUNTER_JSON_MAX bounds a problem). O(n + hills + tracks), no memory. */
-bool encounter_json(const encounter_design_t *d, uint64_t seed, uint32_t n, uint32_t index,
-                    uint32_t attempt, char *buf, size_t size, encounter_info_t *info);
+bool coavoid_encounter_json(const coavoid_encounter_design_t *d, uint64_t seed, uint32_t n, uint32_t index,
+                    uint32_t attempt, char *buf, size_t size, coavoid_encounter_info_t *info);
 
 #endif /* COAVOID_APP_ENCOUNTER_H */

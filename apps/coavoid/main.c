@@ -50,7 +50,7 @@
 int main(int argc, char **argv)
 {
     if (argc < 2) {
-        return cli_fail(CLI_EXIT_INVALID, "missing command (see 'coavoid --help')");
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "missing command (see 'coavoid --help')");
     }
     const char *command = argv[1];
     if (strcmp(command, "-h") == 0 || strcmp(command, "--help") == 0) {
@@ -58,30 +58,30 @@ int main(int argc, char **argv)
         return CLI_EXIT_OK;
     }
     if (strcmp(command, "plan") == 0) {
-        return command_plan(argc, argv);
+        return coavoid_command_plan(argc, argv);
     }
     if (strcmp(command, "predict") == 0) {
-        return command_predict(argc, argv);
+        return coavoid_command_predict(argc, argv);
     }
     if (strcmp(command, "bench") == 0) {
-        return command_bench(argc, argv);
+        return coavoid_command_bench(argc, argv);
     }
     if (strcmp(command, "montecarlo") == 0) {
-        return command_montecarlo(argc, argv);
+        return coavoid_command_montecarlo(argc, argv);
     }
 #ifdef COAVOID_HAVE_NODE
     if (strcmp(command, "sim") == 0) {
-        return command_sim(argc, argv);
+        return coavoid_command_sim(argc, argv);
     }
     if (strcmp(command, "summary") == 0) {
-        return command_summary(argc, argv);
+        return coavoid_command_summary(argc, argv);
     }
     if (strcmp(command, "world") == 0) {
-        return command_world(argc, argv);
+        return coavoid_command_world(argc, argv);
     }
 #endif
     if (command[0] == '-') {
-        return cli_fail(CLI_EXIT_INVALID, "unknown option '%.40s' (see 'coavoid --help')", command);
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "unknown option '%.40s' (see 'coavoid --help')", command);
     }
-    return cli_fail(CLI_EXIT_INVALID, "unknown command '%.40s' (see 'coavoid --help')", command);
+    return coavoid_cli_fail(CLI_EXIT_INVALID, "unknown command '%.40s' (see 'coavoid --help')", command);
 }

@@ -5,7 +5,7 @@
  * encounters instead of a few illustrations. See MONTECARLO_USAGE below and
  * docs/evaluation.md.
  *
- * Each encounter (encounter.h, design encounter_montecarlo: UAVs converging on a point
+ * Each encounter (encounter.h, design coavoid_encounter_montecarlo: UAVs converging on a point
  * over hills, with non-cooperative tracks crossing) is solved three ways on the same
  * problem: centralised (coa_plan_centralised), decoupled in the fixed priority order
  * (coa_plan_decoupled, max_orders 1) and decoupled with reordering (max_orders M). A draw
@@ -102,7 +102,7 @@ static const char *const method_names[MC_METHODS] = {"centralised", "decoupled_f
 
 static void montecarlo_help(void)
 {
-    printf(MONTECARLO_USAGE, encounter_montecarlo.horizon, encounter_montecarlo.dt,
+    printf(MONTECARLO_USAGE, coavoid_encounter_montecarlo.horizon, coavoid_encounter_montecarlo.dt,
            ENCOUNTER_MIN_VEHICLES, ENCOUNTER_MAX_VEHICLES, MC_MAX_COUNT, MC_DEFAULT_COUNT,
            MC_DEFAULT_SEED, CLI_DEFAULT_BETA, MC_MAX_JOBS);
 }
@@ -138,9 +138,9 @@ static int parse_sizes(mc_options_t *o)
         const char *comma = strchr(token, ',');
         size_t length = comma != NULL ? (size_t)(comma - token) : strlen(token);
         uint64_t n = 0;
-        if (!cli_parse_count(token, length, ENCOUNTER_MAX_VEHICLES, &n) ||
+        if (!coavoid_cli_parse_count(token, length, ENCOUNTER_MAX_VEHICLES, &n) ||
             n < ENCOUNTER_MIN_VEHICLES) {
-            return cli_fail(CLI_EXIT_INVALID,
+            return coavoid_cli_fail(CLI_EXIT_INVALID,
                             "--vehicles: each entry must be an integer from %u to %u, got "
                             "'%.*s'",
                             ENCOUNTER_MIN_VEHICLES, ENCOUNTER_MAX_VEHICLES,
@@ -148,7 +148,7 @@ static int parse_sizes(mc_options_t *o)
         }
         for (uint32_t k = 0; k < o->size_count; k++) {
             if (o->sizes[k] == n) {
-                return cli_fail(CLI_EXIT_INVALID, "--vehicles: %lu is listed twice",
+                return coavoid_cli_fail(CLI_EXIT_INVALID, "--vehicles: %lu is listed twice",
                                 (unsigned long)n);
             }
         }
@@ -166,63 +166,63 @@ static int mc_option(int argc, char **argv, int *i, void *options)
     const char *arg = argv[*i];
     uint64_t value = 0;
     int status = CLI_UNKNOWN_OPTION;
-    if (cli_option_is(arg, "--vehicles")) {
-        status = cli_text_option(argc, argv, i, "--vehicles", "UAV counts from 2 to 6, e.g. 2,3,4",
+    if (coavoid_cli_option_is(arg, "--vehicles")) {
+        status = coavoid_cli_text_option(argc, argv, i, "--vehicles", "UAV counts from 2 to 6, e.g. 2,3,4",
                                  false, &o->vehicles_text);
         if (status == CLI_CONTINUE) {
             status = parse_sizes(o);
         }
-    } else if (cli_option_is(arg, "--count")) {
-        status = cli_count_option(argc, argv, i, "--count", NULL, false, MC_MAX_COUNT,
+    } else if (coavoid_cli_option_is(arg, "--count")) {
+        status = coavoid_cli_count_option(argc, argv, i, "--count", NULL, false, MC_MAX_COUNT,
                                   &o->count_text, &value);
         o->count = (uint32_t)value;
-    } else if (cli_option_is(arg, "--seed")) {
-        status = cli_count_option(argc, argv, i, "--seed", NULL, true, UINT64_MAX, &o->seed_text,
+    } else if (coavoid_cli_option_is(arg, "--seed")) {
+        status = coavoid_cli_count_option(argc, argv, i, "--seed", NULL, true, UINT64_MAX, &o->seed_text,
                                   &value);
         o->seed = value;
-    } else if (cli_option_is(arg, "--beta")) {
-        status = cli_count_option(argc, argv, i, "--beta", "an integer >= 1", false, UINT32_MAX,
+    } else if (coavoid_cli_option_is(arg, "--beta")) {
+        status = coavoid_cli_count_option(argc, argv, i, "--beta", "an integer >= 1", false, UINT32_MAX,
                                   &o->beta_text, &value);
         o->beta = (uint32_t)value;
-    } else if (cli_option_is(arg, "--max-orders")) {
-        status = cli_count_option(argc, argv, i, "--max-orders", "an integer >= 1", false,
+    } else if (coavoid_cli_option_is(arg, "--max-orders")) {
+        status = coavoid_cli_count_option(argc, argv, i, "--max-orders", "an integer >= 1", false,
                                   UINT32_MAX, &o->max_orders_text, &value);
         o->max_orders = (uint32_t)value;
-    } else if (cli_option_is(arg, "--csv")) {
-        status = cli_text_option(argc, argv, i, "--csv", "a file to write", false, &o->csv);
-    } else if (cli_option_is(arg, "--svg")) {
-        status = cli_text_option(argc, argv, i, "--svg", "a file to write", false, &o->svg);
-    } else if (cli_option_is(arg, "--save")) {
-        status = cli_text_option(argc, argv, i, "--save", "a directory", false, &o->save);
-    } else if (cli_option_is(arg, "--json")) {
-        status = cli_flag_option(arg, "--json", &o->json);
-    } else if (cli_option_is(arg, "--jobs")) {
-        status = cli_count_option(argc, argv, i, "--jobs", NULL, false, MC_MAX_JOBS,
+    } else if (coavoid_cli_option_is(arg, "--csv")) {
+        status = coavoid_cli_text_option(argc, argv, i, "--csv", "a file to write", false, &o->csv);
+    } else if (coavoid_cli_option_is(arg, "--svg")) {
+        status = coavoid_cli_text_option(argc, argv, i, "--svg", "a file to write", false, &o->svg);
+    } else if (coavoid_cli_option_is(arg, "--save")) {
+        status = coavoid_cli_text_option(argc, argv, i, "--save", "a directory", false, &o->save);
+    } else if (coavoid_cli_option_is(arg, "--json")) {
+        status = coavoid_cli_flag_option(arg, "--json", &o->json);
+    } else if (coavoid_cli_option_is(arg, "--jobs")) {
+        status = coavoid_cli_count_option(argc, argv, i, "--jobs", NULL, false, MC_MAX_JOBS,
                                   &o->jobs_text, &value);
         o->jobs = (uint32_t)value;
-    } else if (cli_option_is(arg, "--quiet")) {
-        status = cli_flag_option(arg, "--quiet", &o->quiet);
+    } else if (coavoid_cli_option_is(arg, "--quiet")) {
+        status = coavoid_cli_flag_option(arg, "--quiet", &o->quiet);
     }
     return status;
 }
 
-static const cli_command_t montecarlo_command = {
+static const coavoid_cli_command_t montecarlo_command = {
     "montecarlo", "coavoid montecarlo", 2, {NULL, NULL}, "it takes options only",
     montecarlo_help, mc_option};
 
 static int parse_mc_options(int argc, char **argv, mc_options_t *o)
 {
     memset(o, 0, sizeof *o);
-    int status = cli_parse_args(&montecarlo_command, argc, argv, o, NULL);
+    int status = coavoid_cli_parse_args(&montecarlo_command, argc, argv, o, NULL);
     if (status != CLI_CONTINUE) {
         return status;
     }
     if (o->vehicles_text == NULL) {
-        return cli_fail(CLI_EXIT_INVALID, "--vehicles: required (UAV counts from %u to %u, "
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "--vehicles: required (UAV counts from %u to %u, "
                         "e.g. 2,3,4)", ENCOUNTER_MIN_VEHICLES, ENCOUNTER_MAX_VEHICLES);
     }
     if (o->csv != NULL && o->svg != NULL && strcmp(o->csv, o->svg) == 0) {
-        return cli_fail(CLI_EXIT_INVALID, "--svg: the same file as --csv ('%.200s')", o->csv);
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "--svg: the same file as --csv ('%.200s')", o->csv);
     }
     if (o->count_text == NULL) {
         o->count = MC_DEFAULT_COUNT;
@@ -251,7 +251,7 @@ typedef struct {
 typedef struct {
     uint32_t vehicles, index;
     uint32_t redraws;
-    encounter_info_t info;
+    coavoid_encounter_info_t info;
     uint32_t first_conflict_step;
     mc_outcome_t m[MC_METHODS];
     char defect[256]; /* empty unless a check failed */
@@ -267,7 +267,7 @@ typedef struct {
  * generator's) and its offset band (unbounded when it draws none). */
 static coa_planner_config_t mc_config(uint32_t searched, uint32_t beta)
 {
-    const encounter_design_t *d = &encounter_montecarlo;
+    const coavoid_encounter_design_t *d = &coavoid_encounter_montecarlo;
     coa_planner_config_t c;
     c.vehicles = searched;
     c.beta = beta;
@@ -369,7 +369,7 @@ static int save_encounter(const char *dir, uint64_t seed, uint32_t n, uint32_t i
 /* The accepted draw of encounter (n, index), sampled, in *s; saved in save_dir unless
  * NULL. Returns 0 or -1 with err. */
 static int draw_encounter(uint64_t seed, const mc_size_t *size, uint32_t index,
-                          const char *save_dir, mc_planners_t *p, scenario_t *s,
+                          const char *save_dir, mc_planners_t *p, coavoid_scenario_t *s,
                           mc_result_t *r, char *err, size_t err_size)
 {
     const uint32_t n = size->n;
@@ -380,26 +380,26 @@ static int draw_encounter(uint64_t seed, const mc_size_t *size, uint32_t index,
     for (uint32_t attempt = 0; attempt < MC_MAX_ATTEMPTS; attempt++) {
         char json[ENCOUNTER_JSON_MAX];
         char why[SCENARIO_ERROR_MAX];
-        if (!encounter_json(&encounter_montecarlo, seed, n, index, attempt, json, sizeof json,
+        if (!coavoid_encounter_json(&coavoid_encounter_montecarlo, seed, n, index, attempt, json, sizeof json,
                             &r->info)) {
             snprintf(err, err_size, "internal error: encounter %lu of %lu UAVs does not fit %u "
                      "bytes", (unsigned long)index, (unsigned long)n, ENCOUNTER_JSON_MAX);
             return -1;
         }
         memset(s, 0, sizeof *s);
-        if (scenario_parse(json, strlen(json), s, why, sizeof why) != 0 ||
-            scenario_sample(s, why, sizeof why) != 0) {
-            scenario_free(s);
+        if (coavoid_scenario_parse(json, strlen(json), s, why, sizeof why) != 0 ||
+            coavoid_scenario_sample(s, why, sizeof why) != 0) {
+            coavoid_scenario_free(s);
             snprintf(err, err_size, "internal error: encounter %lu of %lu UAVs: %s",
                      (unsigned long)index, (unsigned long)n, why);
             return -1;
         }
-        coa_problem_t problem = scenario_problem(s);
+        coa_problem_t problem = coavoid_scenario_problem(s);
         size_t vehicle = 0;
         uint32_t step = 0;
         int rc = coa_plan_find_conflict(&problem, p->zeros, which, n, &vehicle, &step);
         if (rc < 0) {
-            scenario_free(s);
+            coavoid_scenario_free(s);
             snprintf(err, err_size, "internal error: encounter %lu of %lu UAVs: the conflict "
                      "check failed (%s)", (unsigned long)index, (unsigned long)n,
                      coa_status_name(rc));
@@ -407,7 +407,7 @@ static int draw_encounter(uint64_t seed, const mc_size_t *size, uint32_t index,
         }
         if (rc == 1 && step > 0) {
             if (save_dir != NULL && save_encounter(save_dir, seed, n, index, json) != 0) {
-                scenario_free(s);
+                coavoid_scenario_free(s);
                 snprintf(err, err_size, "--save: cannot write encounter %lu of %lu UAVs in "
                          "'%.200s'", (unsigned long)index, (unsigned long)n, save_dir);
                 return -1;
@@ -416,7 +416,7 @@ static int draw_encounter(uint64_t seed, const mc_size_t *size, uint32_t index,
             r->first_conflict_step = step;
             return 0;
         }
-        scenario_free(s);
+        coavoid_scenario_free(s);
     }
     snprintf(err, err_size, "internal error: encounter %lu of %lu UAVs: no draw in %u has a "
              "conflict after its first step", (unsigned long)index, (unsigned long)n,
@@ -441,11 +441,11 @@ static int solve_encounter(uint64_t seed, const mc_size_t *size, uint32_t index,
     if (planners_ready(p, size, err, err_size) != 0) {
         return -1;
     }
-    scenario_t s;
+    coavoid_scenario_t s;
     if (draw_encounter(seed, size, index, save_dir, p, &s, r, err, err_size) != 0) {
         return -1;
     }
-    coa_problem_t problem = scenario_problem(&s);
+    coa_problem_t problem = coavoid_scenario_problem(&s);
     size_t which[ENCOUNTER_MAX_VEHICLES];
     for (size_t i = 0; i < size->n; i++) {
         which[i] = i;
@@ -488,7 +488,7 @@ static int solve_encounter(uint64_t seed, const mc_size_t *size, uint32_t index,
             }
         }
     }
-    scenario_free(&s);
+    coavoid_scenario_free(&s);
     const mc_outcome_t *c = &r->m[MC_CENTRALISED];
     /* The reference plan conflicts, so every plan moves someone: a deviation of 0 would
      * be wrong (and the ratios divide by it). */
@@ -624,7 +624,7 @@ static void csv_rows(FILE *f, uint64_t seed, const mc_result_t *r)
                 (unsigned long long)seed, (unsigned long)r->vehicles, (unsigned long)r->index,
                 (unsigned long)r->redraws, (unsigned long)r->info.hills,
                 (unsigned long)r->info.tracks, (unsigned long)r->first_conflict_step,
-                method_names[m], output_status_name(o->status), costs,
+                method_names[m], coavoid_output_status_name(o->status), costs,
                 (unsigned long long)o->expanded, (unsigned long long)o->generated,
                 (unsigned long)o->orders_tried, o->time_us);
     }
@@ -680,7 +680,7 @@ static int run_all(mc_run_t *run, FILE *csv)
     }
     if (started == 0) {
         pthread_mutex_destroy(&run->lock);
-        return cli_fail(CLI_EXIT_INTERNAL, "cannot start a worker thread");
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "cannot start a worker thread");
     }
     mc_progress_t prog = {isatty(STDERR_FILENO) == 1, o->quiet, 0u, 0.0, false};
     struct timespec start;
@@ -704,7 +704,7 @@ static int run_all(mc_run_t *run, FILE *csv)
                     fputc('\n', stderr);
                     prog.line_open = false;
                 }
-                cli_fail(CLI_EXIT_INTERNAL, "montecarlo: defect: seed %llu, %lu UAVs, "
+                coavoid_cli_fail(CLI_EXIT_INTERNAL, "montecarlo: defect: seed %llu, %lu UAVs, "
                          "encounter %lu: %s", (unsigned long long)o->seed,
                          (unsigned long)run->results[written].vehicles,
                          (unsigned long)run->results[written].index,
@@ -728,7 +728,7 @@ static int run_all(mc_run_t *run, FILE *csv)
     }
     pthread_mutex_destroy(&run->lock);
     if (run->stop) {
-        return cli_fail(strncmp(run->error, "internal error", 14) == 0 ? CLI_EXIT_INTERNAL
+        return coavoid_cli_fail(strncmp(run->error, "internal error", 14) == 0 ? CLI_EXIT_INTERNAL
                                                                         : CLI_EXIT_INVALID,
                         "montecarlo: %s", run->error);
     }
@@ -856,7 +856,7 @@ static void summarise(const mc_result_t *results, uint32_t count, const mc_size_
 
 static void text_summary(FILE *f, const mc_options_t *o, const mc_summary_t *s, uint32_t sizes)
 {
-    const encounter_design_t *d = &encounter_montecarlo;
+    const coavoid_encounter_design_t *d = &coavoid_encounter_montecarlo;
     fprintf(f, "montecarlo: seed %llu, %lu encounters per UAV count, %u steps of %g s\n",
             (unsigned long long)o->seed, (unsigned long)o->count, d->horizon, d->dt);
     for (uint32_t k = 0; k < sizes; k++) {
@@ -929,8 +929,8 @@ static int json_summary(FILE *f, const mc_options_t *o, const mc_summary_t *s, u
     bool ok = root != NULL && cJSON_AddStringToObject(root, "command", "montecarlo") != NULL &&
               cJSON_AddRawToObject(root, "seed", seed) != NULL &&
               cJSON_AddNumberToObject(root, "count", o->count) != NULL &&
-              cJSON_AddNumberToObject(root, "horizon", encounter_montecarlo.horizon) != NULL &&
-              cJSON_AddNumberToObject(root, "dt", encounter_montecarlo.dt) != NULL &&
+              cJSON_AddNumberToObject(root, "horizon", coavoid_encounter_montecarlo.horizon) != NULL &&
+              cJSON_AddNumberToObject(root, "dt", coavoid_encounter_montecarlo.dt) != NULL &&
               (list = cJSON_AddArrayToObject(root, "sizes")) != NULL;
     for (uint32_t k = 0; ok && k < sizes; k++) {
         const mc_summary_t *z = &s[k];
@@ -973,7 +973,7 @@ static int json_summary(FILE *f, const mc_options_t *o, const mc_summary_t *s, u
         cJSON_Delete(root);
         return -1;
     }
-    return output_json(f, root, NULL, 0);
+    return coavoid_output_json(f, root, NULL, 0);
 }
 
 /* ---- the figure ---- */
@@ -1167,7 +1167,7 @@ static int write_svg(const char *path, const mc_options_t *o, const mc_run_t *ru
 
 /* ---- the command ---- */
 
-int command_montecarlo(int argc, char **argv)
+int coavoid_command_montecarlo(int argc, char **argv)
 {
     mc_options_t o;
     int status = parse_mc_options(argc, argv, &o);
@@ -1179,11 +1179,11 @@ int command_montecarlo(int argc, char **argv)
         uint32_t n = o.sizes[k];
         sizes[k].n = n;
         coa_planner_config_t shape = mc_config(n, CLI_DEFAULT_BETA);
-        sizes[k].beta = o.beta_text != NULL ? o.beta : cli_default_beta(&shape);
+        sizes[k].beta = o.beta_text != NULL ? o.beta : coavoid_cli_default_beta(&shape);
         sizes[k].max_orders = o.max_orders_text != NULL ? o.max_orders : factorial(n);
         shape.beta = sizes[k].beta;
         if (coa_planner_workspace_size(&shape) == 0) {
-            return cli_fail(CLI_EXIT_INVALID, "--beta: %lu is too large for %lu UAVs "
+            return coavoid_cli_fail(CLI_EXIT_INVALID, "--beta: %lu is too large for %lu UAVs "
                             "centralised (the node pool would pass 2^30)",
                             (unsigned long)sizes[k].beta, (unsigned long)n);
         }
@@ -1191,12 +1191,12 @@ int command_montecarlo(int argc, char **argv)
     struct stat info;
     if (o.save != NULL && (stat(o.save, &info) != 0 || !S_ISDIR(info.st_mode) ||
                            access(o.save, W_OK | X_OK) != 0)) {
-        return cli_fail(CLI_EXIT_INVALID, "--save: '%.200s' is not a directory we can write in",
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "--save: '%.200s' is not a directory we can write in",
                         o.save);
     }
     FILE *csv = NULL;
     if (o.csv != NULL && (csv = fopen(o.csv, "w")) == NULL) {
-        return cli_fail(CLI_EXIT_INVALID, "--csv: cannot write '%.200s'", o.csv);
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "--csv: cannot write '%.200s'", o.csv);
     }
     if (o.svg != NULL) { /* refused now rather than after an hour's run */
         FILE *probe = fopen(o.svg, "w");
@@ -1204,7 +1204,7 @@ int command_montecarlo(int argc, char **argv)
             if (csv != NULL) {
                 fclose(csv);
             }
-            return cli_fail(CLI_EXIT_INVALID, "--svg: cannot write '%.200s'", o.svg);
+            return coavoid_cli_fail(CLI_EXIT_INVALID, "--svg: cannot write '%.200s'", o.svg);
         }
         fclose(probe);
     }
@@ -1217,11 +1217,11 @@ int command_montecarlo(int argc, char **argv)
     run.done = calloc(run.total, sizeof *run.done);
     double *x = calloc(o.count, sizeof *x);
     if (run.results == NULL || run.done == NULL || x == NULL) {
-        status = cli_fail(CLI_EXIT_INVALID, "--count: out of memory for %lu encounters",
+        status = coavoid_cli_fail(CLI_EXIT_INVALID, "--count: out of memory for %lu encounters",
                           (unsigned long)run.total);
     }
     if (status == CLI_CONTINUE && csv != NULL && fputs(MC_CSV_HEADER, csv) < 0) {
-        status = cli_fail(CLI_EXIT_INTERNAL, "--csv: cannot write '%.200s'", o.csv);
+        status = coavoid_cli_fail(CLI_EXIT_INTERNAL, "--csv: cannot write '%.200s'", o.csv);
     }
     if (status == CLI_CONTINUE) {
         status = run_all(&run, csv);
@@ -1230,7 +1230,7 @@ int command_montecarlo(int argc, char **argv)
         bool ok = !ferror(csv);
         if (fclose(csv) != 0 || !ok) {
             status = status == CLI_CONTINUE
-                         ? cli_fail(CLI_EXIT_INTERNAL, "--csv: cannot write '%.200s'", o.csv)
+                         ? coavoid_cli_fail(CLI_EXIT_INTERNAL, "--csv: cannot write '%.200s'", o.csv)
                          : status;
         }
     }
@@ -1244,7 +1244,7 @@ int command_montecarlo(int argc, char **argv)
     }
     if (status == CLI_CONTINUE && o.svg != NULL &&
         write_svg(o.svg, &o, &run, summary, o.size_count, x) != 0) {
-        status = cli_fail(CLI_EXIT_INTERNAL, "--svg: cannot write '%.200s'", o.svg);
+        status = coavoid_cli_fail(CLI_EXIT_INTERNAL, "--svg: cannot write '%.200s'", o.svg);
     }
     if (status == CLI_CONTINUE) {
         int rc = 0;
@@ -1254,8 +1254,8 @@ int command_montecarlo(int argc, char **argv)
             text_summary(stdout, &o, summary, o.size_count);
         }
         rc = rc == 0 && fflush(stdout) == 0 && !ferror(stdout) ? 0 : -1;
-        status = rc != 0 ? cli_fail(CLI_EXIT_INTERNAL, "cannot write the summary")
-                 : defects ? cli_fail(CLI_EXIT_INTERNAL, "montecarlo: defects found (above)")
+        status = rc != 0 ? coavoid_cli_fail(CLI_EXIT_INTERNAL, "cannot write the summary")
+                 : defects ? coavoid_cli_fail(CLI_EXIT_INTERNAL, "montecarlo: defects found (above)")
                            : CLI_EXIT_OK;
     }
     free(x);

@@ -79,26 +79,26 @@ static int plan_option(int argc, char **argv, int *i, void *options)
     const char *arg = argv[*i];
     uint64_t value = 0;
     int status = CLI_UNKNOWN_OPTION;
-    if (cli_option_is(arg, "--mode")) {
-        status = cli_mode_option(argc, argv, i, &o->mode, &o->decoupled);
-    } else if (cli_option_is(arg, "--priority")) {
-        status = cli_text_option(argc, argv, i, "--priority", "vehicle ids, e.g. 3,1,2", true,
+    if (coavoid_cli_option_is(arg, "--mode")) {
+        status = coavoid_cli_mode_option(argc, argv, i, &o->mode, &o->decoupled);
+    } else if (coavoid_cli_option_is(arg, "--priority")) {
+        status = coavoid_cli_text_option(argc, argv, i, "--priority", "vehicle ids, e.g. 3,1,2", true,
                                  &o->priority);
-    } else if (cli_option_is(arg, "--beta")) {
-        status = cli_count_option(argc, argv, i, "--beta", "an integer >= 1", false, UINT32_MAX,
+    } else if (coavoid_cli_option_is(arg, "--beta")) {
+        status = coavoid_cli_count_option(argc, argv, i, "--beta", "an integer >= 1", false, UINT32_MAX,
                                   &o->beta_text, &value);
         o->beta = (uint32_t)value;
-    } else if (cli_option_is(arg, "--reorder")) {
-        status = cli_flag_option(arg, "--reorder", &o->reorder);
-    } else if (cli_option_is(arg, "--max-orders")) {
-        status = cli_count_option(argc, argv, i, "--max-orders", "an integer >= 1", false,
+    } else if (coavoid_cli_option_is(arg, "--reorder")) {
+        status = coavoid_cli_flag_option(arg, "--reorder", &o->reorder);
+    } else if (coavoid_cli_option_is(arg, "--max-orders")) {
+        status = coavoid_cli_count_option(argc, argv, i, "--max-orders", "an integer >= 1", false,
                                   UINT32_MAX, &o->max_orders_text, &value);
         o->max_orders = (uint32_t)value;
     }
     return status;
 }
 
-static const cli_command_t plan_command = {
+static const coavoid_cli_command_t plan_command = {
     "plan", "coavoid plan", 2, {"SCENARIO.json", NULL}, "one scenario only", plan_help,
     plan_option};
 
@@ -106,24 +106,24 @@ static const cli_command_t plan_command = {
 static int parse_plan_options(int argc, char **argv, plan_options_t *o)
 {
     memset(o, 0, sizeof *o);
-    int status = cli_parse_args(&plan_command, argc, argv, o, &o->scenario_path);
+    int status = coavoid_cli_parse_args(&plan_command, argc, argv, o, &o->scenario_path);
     if (status != CLI_CONTINUE) {
         return status;
     }
     if (o->mode == NULL) {
-        return cli_fail(CLI_EXIT_INVALID, "--mode: required (centralised or decoupled)");
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "--mode: required (centralised or decoupled)");
     }
     /* Centralised plans everyone in one search: an order would mean nothing, so asking
      * for one is more likely a mistake than something to ignore. */
     if (!o->decoupled && o->priority != NULL) {
-        return cli_fail(CLI_EXIT_INVALID, "--priority: only valid with --mode decoupled");
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "--priority: only valid with --mode decoupled");
     }
     if (!o->decoupled && o->reorder) {
-        return cli_fail(CLI_EXIT_INVALID, "--reorder: only valid with --mode decoupled");
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "--reorder: only valid with --mode decoupled");
     }
     /* Without --reorder exactly one order is planned: a bound on orders would do nothing. */
     if (o->max_orders_text != NULL && !o->reorder) {
-        return cli_fail(CLI_EXIT_INVALID,
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
                         "--max-orders: only valid with --reorder (and --mode decoupled)");
     }
     if (o->max_orders_text == NULL) {
@@ -134,7 +134,7 @@ static int parse_plan_options(int argc, char **argv, plan_options_t *o)
 
 /* --priority as vehicle indices into order[0..n-1]: a permutation of the ids. Returns
  * CLI_CONTINUE when valid, else the exit status after the message. */
-static int parse_priority(const char *text, const scenario_t *s, size_t *order)
+static int parse_priority(const char *text, const coavoid_scenario_t *s, size_t *order)
 {
     bool listed[COA_MAX_VEHICLES] = {false};
     size_t count = 0;
@@ -143,28 +143,28 @@ static int parse_priority(const char *text, const scenario_t *s, size_t *order)
         const char *comma = strchr(token, ',');
         size_t length = comma != NULL ? (size_t)(comma - token) : strlen(token);
         uint64_t id;
-        if (!cli_parse_count(token, length, 65535u, &id)) {
+        if (!coavoid_cli_parse_count(token, length, 65535u, &id)) {
             if (text[0] == '\0') {
-                return cli_fail(CLI_EXIT_INVALID,
+                return coavoid_cli_fail(CLI_EXIT_INVALID,
                                 "--priority: empty (expected vehicle ids separated "
                                 "by commas)");
             }
             if (length == 0) {
-                return cli_fail(CLI_EXIT_INVALID,
+                return coavoid_cli_fail(CLI_EXIT_INVALID,
                                 "--priority: empty entry in '%.80s' "
                                 "(expected vehicle ids separated by commas)",
                                 text);
             }
-            return cli_fail(CLI_EXIT_INVALID, "--priority: '%.*s' is not a vehicle id",
+            return coavoid_cli_fail(CLI_EXIT_INVALID, "--priority: '%.*s' is not a vehicle id",
                             (int)(length > 40 ? 40 : length), token);
         }
-        long index = scenario_vehicle_index(s, (long)id);
+        long index = coavoid_scenario_vehicle_index(s, (long)id);
         if (index < 0) {
-            return cli_fail(CLI_EXIT_INVALID, "--priority: %lu is not a vehicle id",
+            return coavoid_cli_fail(CLI_EXIT_INVALID, "--priority: %lu is not a vehicle id",
                             (unsigned long)id);
         }
         if (listed[index]) {
-            return cli_fail(CLI_EXIT_INVALID, "--priority: %lu is listed twice", (unsigned long)id);
+            return coavoid_cli_fail(CLI_EXIT_INVALID, "--priority: %lu is listed twice", (unsigned long)id);
         }
         listed[index] = true;
         order[count++] = (size_t)index;
@@ -175,7 +175,7 @@ static int parse_priority(const char *text, const scenario_t *s, size_t *order)
     }
     for (size_t i = 0; i < s->vehicle_count; i++) {
         if (!listed[i]) {
-            return cli_fail(CLI_EXIT_INVALID,
+            return coavoid_cli_fail(CLI_EXIT_INVALID,
                             "--priority: vehicle %u is missing (list every id once)",
                             (unsigned)s->vehicles[i].id);
         }
@@ -187,16 +187,16 @@ static int parse_priority(const char *text, const scenario_t *s, size_t *order)
  * exact (the only cause the current limits allow) are named by the parser first, so what
  * is left is the worst-case cost over the horizon outgrowing the core's exact integers:
  * horizon is what the user is most likely to change. A backstop. */
-static int range_error(const char *file, const scenario_t *s)
+static int range_error(const char *file, const coavoid_scenario_t *s)
 {
-    return cli_fail(CLI_EXIT_INVALID,
+    return coavoid_cli_fail(CLI_EXIT_INVALID,
                     "%s: horizon: %lu steps is too long for these vehicles' offsets and costs "
                     "(beyond the core's integer range; shorten it or bound max_offset)",
                     file, (unsigned long)s->horizon);
 }
 
 /* beta from --beta, else the scenario, else the default; *source names it for messages. */
-static uint32_t choose_beta(const plan_options_t *o, const scenario_t *s, size_t searched,
+static uint32_t choose_beta(const plan_options_t *o, const coavoid_scenario_t *s, size_t searched,
                             char *source, size_t source_size)
 {
     if (o->beta_text != NULL) {
@@ -207,14 +207,14 @@ static uint32_t choose_beta(const plan_options_t *o, const scenario_t *s, size_t
         snprintf(source, source_size, "%.400s: beta %lu", o->scenario_path, (unsigned long)s->beta);
         return s->beta;
     }
-    coa_planner_config_t shape = cli_planner_config(s, searched, CLI_DEFAULT_BETA);
-    uint32_t beta = cli_default_beta(&shape);
+    coa_planner_config_t shape = coavoid_cli_planner_config(s, searched, CLI_DEFAULT_BETA);
+    uint32_t beta = coavoid_cli_default_beta(&shape);
     snprintf(source, source_size, "default beta %lu", (unsigned long)beta);
     return beta;
 }
 
 /* Everything after the scenario is loaded. Returns the exit status. */
-static int plan(void *options, scenario_t *s)
+static int plan(void *options, coavoid_scenario_t *s)
 {
     const plan_options_t *o = options;
     const char *file = o->scenario_path;
@@ -232,7 +232,7 @@ static int plan(void *options, scenario_t *s)
     }
 
     if (!o->decoupled && n > COA_MAX_CENTRALISED) {
-        return cli_fail(CLI_EXIT_INVALID,
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
                         "--mode centralised: %zu vehicles, at most %u (COA_MAX_CENTRALISED) can be "
                         "planned together",
                         n, COA_MAX_CENTRALISED);
@@ -241,39 +241,39 @@ static int plan(void *options, scenario_t *s)
     char beta_source[SCENARIO_ERROR_MAX];
     uint32_t beta = choose_beta(o, s, searched, beta_source, sizeof beta_source);
 
-    int rc = cli_sample_scenario(file, s);
+    int rc = coavoid_cli_sample_scenario(file, s);
     if (rc != CLI_CONTINUE) {
         return rc;
     }
-    coa_problem_t problem = scenario_problem(s);
+    coa_problem_t problem = coavoid_scenario_problem(s);
     rc = coa_problem_check(&problem);
     if (rc == COA_ERR_RANGE) {
         return range_error(file, s);
     }
     if (rc != COA_OK) {
-        return cli_fail(CLI_EXIT_INVALID, "%s: rejected by the core's problem check (%s)", file,
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: rejected by the core's problem check (%s)", file,
                         coa_status_name(rc));
     }
 
-    coa_planner_config_t config = cli_planner_config(s, searched, beta);
+    coa_planner_config_t config = coavoid_cli_planner_config(s, searched, beta);
     /* The tables alone (every reachable step and offset) do not depend on beta: when they
      * pass the limit no beta helps, whatever --beta or the scenario say. */
     if (beta == 0 || coa_planner_max_beta(&config, CLI_DEFAULT_WORKSPACE_MAX) == 0) {
-        return cli_fail(CLI_EXIT_INVALID,
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
                         "%s: too large: the cost-to-go tables of a %lu-step horizon would not "
                         "fit in %zu MiB of workspace (shorten the horizon or bound max_offset)",
                         file, (unsigned long)s->horizon, CLI_DEFAULT_WORKSPACE_MAX >> 20);
     }
     size_t size = coa_planner_workspace_size(&config);
     if (size == 0) {
-        return cli_fail(CLI_EXIT_INVALID,
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
                         "%s: too large: the workspace for %zu vehicle(s) over %lu steps would "
                         "not fit in memory (lower it with --beta)",
                         beta_source, searched, (unsigned long)s->horizon);
     }
     void *workspace = malloc(size);
     if (workspace == NULL) {
-        return cli_fail(CLI_EXIT_INVALID,
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
                         "%s: cannot allocate %zu bytes of workspace for %zu vehicle(s) "
                         "(lower it with --beta)",
                         beta_source, size, searched);
@@ -283,7 +283,7 @@ static int plan(void *options, scenario_t *s)
     if (planner == NULL || offsets == NULL) {
         free(workspace);
         free(offsets);
-        return cli_fail(CLI_EXIT_INTERNAL, "%s",
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "%s",
                         planner == NULL ? "internal error: the planner refused its workspace"
                                         : "out of memory for the plan");
     }
@@ -305,13 +305,13 @@ static int plan(void *options, scenario_t *s)
     if (rc == COA_ERR_RANGE) {
         status = range_error(file, s);
     } else if (rc != COA_OK) {
-        status = cli_fail(CLI_EXIT_INTERNAL, "internal error: the planner failed (%s)",
+        status = coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: the planner failed (%s)",
                           coa_status_name(rc));
     } else {
-        output_plan_t view = {s,   o->decoupled, &result, offsets, cli_elapsed_us(&start, &end),
+        coavoid_output_plan_t view = {s,   o->decoupled, &result, offsets, coavoid_cli_elapsed_us(&start, &end),
                               beta};
-        if (output_plan(stdout, &view, err, sizeof err) != 0) {
-            status = cli_fail(CLI_EXIT_INTERNAL, "%s", err);
+        if (coavoid_output_plan(stdout, &view, err, sizeof err) != 0) {
+            status = coavoid_cli_fail(CLI_EXIT_INTERNAL, "%s", err);
         } else {
             status = result.status == COA_PLAN_SOLVED ? CLI_EXIT_OK : CLI_EXIT_NOT_SOLVED;
         }
@@ -320,12 +320,12 @@ static int plan(void *options, scenario_t *s)
     return status;
 }
 
-int command_plan(int argc, char **argv)
+int coavoid_command_plan(int argc, char **argv)
 {
     plan_options_t options;
     int status = parse_plan_options(argc, argv, &options);
     if (status != CLI_CONTINUE) {
         return status;
     }
-    return cli_run_scenario(options.scenario_path, plan, &options);
+    return coavoid_cli_run_scenario(options.scenario_path, plan, &options);
 }

@@ -72,7 +72,7 @@ static bool parse_growth(const char *text, double *horizontal, double *vertical)
     }
     memcpy(first, text, length);
     first[length] = '\0';
-    return cli_parse_real(first, horizontal) && cli_parse_real(comma + 1, vertical) &&
+    return coavoid_cli_parse_real(first, horizontal) && coavoid_cli_parse_real(comma + 1, vertical) &&
            *horizontal >= 0 && *vertical >= 0;
 }
 
@@ -85,24 +85,24 @@ static int predict_option(int argc, char **argv, int *i, void *options)
 {
     predict_options_t *o = options;
     const char *arg = argv[*i];
-    if (cli_option_is(arg, "--threshold")) {
-        int status = cli_text_option(argc, argv, i, "--threshold", "a probability, 0 < P <= 1",
+    if (coavoid_cli_option_is(arg, "--threshold")) {
+        int status = coavoid_cli_text_option(argc, argv, i, "--threshold", "a probability, 0 < P <= 1",
                                      true, &o->threshold_text);
         if (status == CLI_CONTINUE &&
-            (!cli_parse_real(o->threshold_text, &o->threshold) || !(o->threshold > 0) ||
+            (!coavoid_cli_parse_real(o->threshold_text, &o->threshold) || !(o->threshold > 0) ||
              o->threshold > 1)) {
-            status = cli_fail(CLI_EXIT_INVALID,
+            status = coavoid_cli_fail(CLI_EXIT_INVALID,
                               "--threshold: must be a number with 0 < P <= 1, got '%.40s'",
                               o->threshold_text);
         }
         return status;
     }
-    if (cli_option_is(arg, "--sigma-growth")) {
-        int status = cli_text_option(argc, argv, i, "--sigma-growth",
+    if (coavoid_cli_option_is(arg, "--sigma-growth")) {
+        int status = coavoid_cli_text_option(argc, argv, i, "--sigma-growth",
                                      "H,V in m/s, e.g. 0.5,0.1", true, &o->growth_text);
         if (status == CLI_CONTINUE &&
             !parse_growth(o->growth_text, &o->growth_horizontal, &o->growth_vertical)) {
-            status = cli_fail(CLI_EXIT_INVALID,
+            status = coavoid_cli_fail(CLI_EXIT_INVALID,
                               "--sigma-growth: must be two numbers >= 0 as H,V (m/s), "
                               "got '%.40s'",
                               o->growth_text);
@@ -112,7 +112,7 @@ static int predict_option(int argc, char **argv, int *i, void *options)
     return CLI_UNKNOWN_OPTION;
 }
 
-static const cli_command_t predict_command = {
+static const coavoid_cli_command_t predict_command = {
     "predict", "coavoid predict", 2, {"SCENARIO.json", NULL}, "one scenario only", predict_help,
     predict_option};
 
@@ -120,7 +120,7 @@ static const cli_command_t predict_command = {
 static int parse_predict_options(int argc, char **argv, predict_options_t *o)
 {
     memset(o, 0, sizeof *o);
-    int status = cli_parse_args(&predict_command, argc, argv, o, &o->scenario_path);
+    int status = coavoid_cli_parse_args(&predict_command, argc, argv, o, &o->scenario_path);
     if (status != CLI_CONTINUE) {
         return status;
     }
@@ -142,8 +142,8 @@ static bool size_mul_add(size_t a, size_t b, size_t c, size_t *out)
 
 static int compare_conflicts(const void *pa, const void *pb)
 {
-    const output_conflict_t *a = pa;
-    const output_conflict_t *b = pb;
+    const coavoid_output_conflict_t *a = pa;
+    const coavoid_output_conflict_t *b = pb;
     if (a->kind != b->kind) {
         return a->kind < b->kind ? -1 : 1;
     }
@@ -158,12 +158,12 @@ static int compare_conflicts(const void *pa, const void *pb)
 
 /* The core's conflicts (plan, track and obstacle indices) in the contract's terms (ids),
  * sorted by kind, a, b. Returns false when the core named an index out of range. */
-static bool map_conflicts(const scenario_t *s, const coa_conflict_t *in, size_t count,
-                          output_conflict_t *out)
+static bool map_conflicts(const coavoid_scenario_t *s, const coa_conflict_t *in, size_t count,
+                          coavoid_output_conflict_t *out)
 {
     for (size_t i = 0; i < count; i++) {
         const coa_conflict_t *c = &in[i];
-        output_conflict_t *o = &out[i];
+        coavoid_output_conflict_t *o = &out[i];
         if (c->a >= s->vehicle_count) {
             return false;
         }
@@ -221,7 +221,7 @@ static int compare_labelled(const void *pa, const void *pb)
  * the contract's clusters: ids ascending within each, clusters by their smallest id.
  * `ids` and `start` have room for n and n + 1 entries; `scratch` for n. Returns false
  * when a label is out of range or names no UAV, or out of memory. */
-static bool build_clusters(const scenario_t *s, const uint32_t *label, size_t label_count,
+static bool build_clusters(const coavoid_scenario_t *s, const uint32_t *label, size_t label_count,
                            labelled_t *scratch, uint32_t *ids, size_t *start, size_t *cluster_count)
 {
     const size_t n = s->vehicle_count;
@@ -282,7 +282,7 @@ typedef struct {
     coa_intent_plan_t *plans;
     void *workspace;
     coa_conflict_t *conflicts;
-    output_conflict_t *listed;
+    coavoid_output_conflict_t *listed;
     uint32_t *label;
     labelled_t *scratch;
     uint32_t *cluster_ids;
@@ -303,7 +303,7 @@ static void predict_memory_free(predict_memory_t *m)
 }
 
 /* Each UAV's plan: its sampled reference raised by initial_offset climb steps. */
-static int build_plans(const char *file, const scenario_t *s, predict_memory_t *m)
+static int build_plans(const char *file, const coavoid_scenario_t *s, predict_memory_t *m)
 {
     const size_t per_row = (size_t)s->horizon + 1u;
     for (size_t i = 0; i < s->vehicle_count; i++) {
@@ -314,7 +314,7 @@ static int build_plans(const char *file, const scenario_t *s, predict_memory_t *
             row[k] = s->references[i][k];
             row[k].z += lift;
             if (!isfinite(row[k].z)) {
-                return cli_fail(CLI_EXIT_INVALID,
+                return coavoid_cli_fail(CLI_EXIT_INVALID,
                                 "%s: vehicles[%zu]: initial_offset: the altitude it gives is "
                                 "not finite",
                                 file, i);
@@ -334,13 +334,13 @@ static int build_plans(const char *file, const scenario_t *s, predict_memory_t *
 }
 
 /* Everything after the scenario is loaded. Returns the exit status. */
-static int predict(void *options, scenario_t *s)
+static int predict(void *options, coavoid_scenario_t *s)
 {
     const predict_options_t *o = options;
     const char *file = o->scenario_path;
     const size_t n = s->vehicle_count;
     const size_t tracks = s->track_count;
-    int status = cli_sample_scenario(file, s);
+    int status = coavoid_cli_sample_scenario(file, s);
     if (status != CLI_CONTINUE) {
         return status;
     }
@@ -352,7 +352,7 @@ static int predict(void *options, scenario_t *s)
     size_t with_tracks, max_pairs;
     if (!size_mul_add(n, tracks, vehicle_pairs, &with_tracks) ||
         !size_mul_add(n, s->obstacle_count, with_tracks, &max_pairs)) {
-        return cli_fail(CLI_EXIT_INVALID, "%s: too many tracks and obstacles to size for", file);
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: too many tracks and obstacles to size for", file);
     }
     if (max_pairs == 0) {
         max_pairs = 1; /* one UAV alone: the size function refuses a limit of 0 */
@@ -360,7 +360,7 @@ static int predict(void *options, scenario_t *s)
     const size_t capacity = max_pairs;
     size_t size = coa_predictor_workspace_size(n, tracks, s->horizon, max_pairs);
     if (size == 0) {
-        return cli_fail(CLI_EXIT_INVALID,
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
                         "%s: too large: the predictor's workspace for %zu vehicles, %zu tracks, "
                         "%zu obstacles and %lu steps is beyond its limits",
                         file, n, tracks, s->obstacle_count, (unsigned long)s->horizon);
@@ -381,7 +381,7 @@ static int predict(void *options, scenario_t *s)
         m.listed == NULL || m.label == NULL || m.scratch == NULL || m.cluster_ids == NULL ||
         m.cluster_start == NULL) {
         predict_memory_free(&m);
-        return cli_fail(CLI_EXIT_INVALID,
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
                         "%s: cannot allocate %zu bytes of predictor workspace and %zu "
                         "conflicts",
                         file, size, capacity);
@@ -396,7 +396,7 @@ static int predict(void *options, scenario_t *s)
         coa_predictor_init(m.workspace, size, n, tracks, s->horizon, max_pairs);
     if (predictor == NULL) {
         predict_memory_free(&m);
-        return cli_fail(CLI_EXIT_INTERNAL, "internal error: the predictor refused its workspace");
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: the predictor refused its workspace");
     }
 
     coa_predict_config_t config;
@@ -418,26 +418,26 @@ static int predict(void *options, scenario_t *s)
     if (rc == COA_ERR_ARGUMENT) {
         /* The loader checked every field the contract defines; what is left is a
          * combination the core refuses (like plan's problem check). */
-        status = cli_fail(CLI_EXIT_INVALID, "%s: rejected by the core's predictor (%s)", file,
+        status = coavoid_cli_fail(CLI_EXIT_INVALID, "%s: rejected by the core's predictor (%s)", file,
                           coa_status_name(rc));
     } else if (rc != COA_OK) {
-        status = cli_fail(CLI_EXIT_INTERNAL, "internal error: the predictor failed (%s)",
+        status = coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: the predictor failed (%s)",
                           coa_status_name(rc));
     } else if (result.overflow || result.conflict_count > capacity ||
                result.conflicts_found != result.conflict_count) {
-        status = cli_fail(CLI_EXIT_INTERNAL,
+        status = coavoid_cli_fail(CLI_EXIT_INTERNAL,
                           "internal error: the predictor found %zu conflicts, room for %zu",
                           result.conflicts_found, capacity);
     } else if (coa_predict_clusters(m.conflicts, result.conflict_count, n, m.label,
                                     &cluster_labels) != COA_OK ||
                cluster_labels > n) {
-        status = cli_fail(CLI_EXIT_INTERNAL, "internal error: the conflicts do not cluster");
+        status = coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: the conflicts do not cluster");
     } else if (!map_conflicts(s, m.conflicts, result.conflict_count, m.listed)) {
-        status = cli_fail(CLI_EXIT_INTERNAL,
+        status = coavoid_cli_fail(CLI_EXIT_INTERNAL,
                           "internal error: the predictor named a vehicle, track or obstacle "
                           "out of range");
     } else {
-        output_predict_t view;
+        coavoid_output_predict_t view;
         memset(&view, 0, sizeof view);
         view.scenario = s->name;
         view.conflicts = m.listed;
@@ -446,9 +446,9 @@ static int predict(void *options, scenario_t *s)
         view.cluster_start = m.cluster_start;
         if (!build_clusters(s, m.label, cluster_labels, m.scratch, m.cluster_ids, m.cluster_start,
                             &view.cluster_count)) {
-            status = cli_fail(CLI_EXIT_INTERNAL, "internal error: bad cluster labels");
-        } else if (output_predict(stdout, &view, err, sizeof err) != 0) {
-            status = cli_fail(CLI_EXIT_INTERNAL, "%s", err);
+            status = coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: bad cluster labels");
+        } else if (coavoid_output_predict(stdout, &view, err, sizeof err) != 0) {
+            status = coavoid_cli_fail(CLI_EXIT_INTERNAL, "%s", err);
         } else {
             status = CLI_EXIT_OK;
         }
@@ -457,12 +457,12 @@ static int predict(void *options, scenario_t *s)
     return status;
 }
 
-int command_predict(int argc, char **argv)
+int coavoid_command_predict(int argc, char **argv)
 {
     predict_options_t options;
     int status = parse_predict_options(argc, argv, &options);
     if (status != CLI_CONTINUE) {
         return status;
     }
-    return cli_run_scenario(options.scenario_path, predict, &options);
+    return coavoid_cli_run_scenario(options.scenario_path, predict, &options);
 }

@@ -77,8 +77,8 @@ typedef struct {
 
 static void sim_help(void)
 {
-    printf(SIM_USAGE, COA_NODE_MAX_HORIZON, COA_MAX_VEHICLES, COA_LCM_MAX_COORDINATE,
-           COA_LCM_MAX_SPEED, COA_LCM_MAX_SIZE);
+    printf(SIM_USAGE, COAVOID_NODE_MAX_HORIZON, COA_MAX_VEHICLES, COAVOID_LCM_MAX_COORDINATE,
+           COAVOID_LCM_MAX_SPEED, COAVOID_LCM_MAX_SIZE);
 }
 
 static int sim_option(int argc, char **argv, int *i, void *options)
@@ -87,21 +87,21 @@ static int sim_option(int argc, char **argv, int *i, void *options)
     const char *arg = argv[*i];
     uint64_t value = 0;
     int status = CLI_UNKNOWN_OPTION;
-    if (cli_option_is(arg, "--mode")) {
-        status = cli_mode_option(argc, argv, i, &o->mode, &o->decoupled);
-    } else if (cli_option_is(arg, "--steps")) {
-        status = cli_count_option(argc, argv, i, "--steps", "an integer >= 1", false,
+    if (coavoid_cli_option_is(arg, "--mode")) {
+        status = coavoid_cli_mode_option(argc, argv, i, &o->mode, &o->decoupled);
+    } else if (coavoid_cli_option_is(arg, "--steps")) {
+        status = coavoid_cli_count_option(argc, argv, i, "--steps", "an integer >= 1", false,
                                   SIM_MAX_STEPS, &o->steps_text, &value);
         o->steps = (uint32_t)value;
-    } else if (cli_option_is(arg, "--json")) {
-        status = cli_flag_option(arg, "--json", &o->json);
-    } else if (cli_option_is(arg, "--svg")) {
-        status = cli_text_option(argc, argv, i, "--svg", "a file to write", false, &o->svg_path);
-    } else if (cli_option_is(arg, "--coordinator-stops")) {
-        status = cli_text_option(argc, argv, i, "--coordinator-stops", "a step, 0 or more", true,
+    } else if (coavoid_cli_option_is(arg, "--json")) {
+        status = coavoid_cli_flag_option(arg, "--json", &o->json);
+    } else if (coavoid_cli_option_is(arg, "--svg")) {
+        status = coavoid_cli_text_option(argc, argv, i, "--svg", "a file to write", false, &o->svg_path);
+    } else if (coavoid_cli_option_is(arg, "--coordinator-stops")) {
+        status = coavoid_cli_text_option(argc, argv, i, "--coordinator-stops", "a step, 0 or more", true,
                                  &o->stop_text);
-        if (status == CLI_CONTINUE && !cli_parse_index(o->stop_text, SIM_MAX_STEPS, &value)) {
-            status = cli_fail(CLI_EXIT_INVALID,
+        if (status == CLI_CONTINUE && !coavoid_cli_parse_index(o->stop_text, SIM_MAX_STEPS, &value)) {
+            status = coavoid_cli_fail(CLI_EXIT_INVALID,
                               "--coordinator-stops: must be a step from 0 to %u, got '%.40s'",
                               SIM_MAX_STEPS, o->stop_text);
         }
@@ -110,21 +110,21 @@ static int sim_option(int argc, char **argv, int *i, void *options)
     return status;
 }
 
-static const cli_command_t sim_command = {
+static const coavoid_cli_command_t sim_command = {
     "sim", "coavoid sim", 2, {"SCENARIO.json", NULL}, "one scenario only", sim_help, sim_option};
 
 static int parse_sim_options(int argc, char **argv, sim_options_t *o)
 {
     memset(o, 0, sizeof *o);
-    int status = cli_parse_args(&sim_command, argc, argv, o, &o->scenario_path);
+    int status = coavoid_cli_parse_args(&sim_command, argc, argv, o, &o->scenario_path);
     if (status != CLI_CONTINUE) {
         return status;
     }
     if (o->mode == NULL) {
-        return cli_fail(CLI_EXIT_INVALID, "--mode: required (centralised or decoupled)");
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "--mode: required (centralised or decoupled)");
     }
     if (o->decoupled && o->stop_text != NULL) {
-        return cli_fail(CLI_EXIT_INVALID,
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
                         "--coordinator-stops: only valid with --mode centralised (decoupled "
                         "runs without a coordinator)");
     }
@@ -133,26 +133,26 @@ static int parse_sim_options(int argc, char **argv, sim_options_t *o)
 
 typedef struct {
     lcm_t *lcm;
-    coa_world_t *world;
-    coa_coordinator_t *coordinator;
-    coa_vehicle_node_t **vehicles; /* in priority order: the order they run in */
+    coavoid_world_t *world;
+    coavoid_coordinator_t *coordinator;
+    coavoid_vehicle_node_t **vehicles; /* in priority order: the order they run in */
     size_t *index;                 /* index[j]: scenario index of vehicles[j] */
     coa_vec3_t *references;        /* by scenario index, rows of K + 1 */
     int32_t *offsets;
     coa_track_t *tracks;           /* the world's copy when the scenario's ids do not fit */
-    judged_t judged;
+    coavoid_judged_t judged;
     FILE *svg;
 } sim_run_t;
 
 static void sim_run_free(sim_run_t *r, size_t n)
 {
-    coa_coordinator_destroy(r->coordinator);
+    coavoid_coordinator_destroy(r->coordinator);
     if (r->vehicles != NULL) {
         for (size_t j = 0; j < n; j++) {
-            coa_vehicle_node_destroy(r->vehicles[j]);
+            coavoid_vehicle_node_destroy(r->vehicles[j]);
         }
     }
-    coa_world_destroy(r->world);
+    coavoid_world_destroy(r->world);
     if (r->lcm != NULL) {
         lcm_destroy(r->lcm);
     }
@@ -168,7 +168,7 @@ static void sim_run_free(sim_run_t *r, size_t n)
 
 /* ---- what the messages can carry ----
  *
- * The nodes talk in messages whose numbers have bounds (coavoid_lcm.h, COA_LCM_MAX_*) that
+ * The nodes talk in messages whose numbers have bounds (coavoid_lcm.h, COAVOID_LCM_MAX_*) that
  * a scenario's do not: coavoid plan takes a radius of 1e300 m. A node that cannot publish
  * its intent, or a world that cannot publish a track, would stop the run as a failed node,
  * so the whole run is checked before it starts, and the field is named. "The whole run":
@@ -184,13 +184,13 @@ static bool beyond(double x, double limit)
     return !isfinite(x) || fabs(x) > limit;
 }
 
-/* The first coordinate of p that is beyond COA_LCM_MAX_COORDINATE, as 'x', 'y' or 'z'
+/* The first coordinate of p that is beyond COAVOID_LCM_MAX_COORDINATE, as 'x', 'y' or 'z'
  * with *value set; or 0. */
 static char far_axis(coa_vec3_t p, double *value)
 {
     const double c[3] = {(double)p.x, (double)p.y, (double)p.z};
     for (int a = 0; a < 3; a++) {
-        if (beyond(c[a], COA_LCM_MAX_COORDINATE)) {
+        if (beyond(c[a], COAVOID_LCM_MAX_COORDINATE)) {
             *value = c[a];
             return (char)('x' + a);
         }
@@ -205,23 +205,23 @@ static char far_axis(coa_vec3_t p, double *value)
 static int check_vehicle_limits(const char *file, size_t i, const coa_vehicle_t *v,
                                 coa_real_t dt, uint64_t last)
 {
-    if (beyond((double)v->volume.radius, COA_LCM_MAX_SIZE)) {
-        return cli_fail(CLI_EXIT_INVALID,
+    if (beyond((double)v->volume.radius, COAVOID_LCM_MAX_SIZE)) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
                         "%s: vehicles[%zu].radius: %g m is beyond what " SIM_INTENT
                         " carries (%g m)",
-                        file, i, (double)v->volume.radius, COA_LCM_MAX_SIZE);
+                        file, i, (double)v->volume.radius, COAVOID_LCM_MAX_SIZE);
     }
-    if (beyond((double)v->volume.half_height, COA_LCM_MAX_SIZE)) {
-        return cli_fail(CLI_EXIT_INVALID,
+    if (beyond((double)v->volume.half_height, COAVOID_LCM_MAX_SIZE)) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
                         "%s: vehicles[%zu].half_height: %g m is beyond what " SIM_INTENT
                         " carries (%g m)",
-                        file, i, (double)v->volume.half_height, COA_LCM_MAX_SIZE);
+                        file, i, (double)v->volume.half_height, COAVOID_LCM_MAX_SIZE);
     }
-    if (beyond((double)v->cruise_speed, COA_LCM_MAX_SPEED)) {
-        return cli_fail(CLI_EXIT_INVALID,
+    if (beyond((double)v->cruise_speed, COAVOID_LCM_MAX_SPEED)) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
                         "%s: vehicles[%zu].cruise_speed: %g m/s is beyond what " SIM_INTENT
                         " carries (%g m/s)",
-                        file, i, (double)v->cruise_speed, COA_LCM_MAX_SPEED);
+                        file, i, (double)v->cruise_speed, COAVOID_LCM_MAX_SPEED);
     }
     /* The largest change of offset in one step, and the vertical speed it adds. */
     uint32_t max_change = v->steep_factor;
@@ -229,14 +229,14 @@ static int check_vehicle_limits(const char *file, size_t i, const coa_vehicle_t 
         max_change = 2u * (uint32_t)v->max_offset;
     }
     const double climb = (double)max_change * (double)v->climb_rate;
-    if (beyond(climb, COA_LCM_MAX_SPEED)) {
-        return cli_fail(CLI_EXIT_INVALID,
+    if (beyond(climb, COAVOID_LCM_MAX_SPEED)) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
                         "%s: vehicles[%zu].climb_rate: %g m/s, %g m/s in a steep climb, is "
                         "beyond what " SIM_INTENT " carries (%g m/s)",
-                        file, i, (double)v->climb_rate, climb, COA_LCM_MAX_SPEED);
+                        file, i, (double)v->climb_rate, climb, COAVOID_LCM_MAX_SPEED);
     }
     if (v->priority > (uint32_t)INT32_MAX) {
-        return cli_fail(CLI_EXIT_INVALID,
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
                         "%s: vehicles[%zu].priority: %lu is beyond what " SIM_INTENT
                         " carries (%ld)",
                         file, i, (unsigned long)v->priority, (long)INT32_MAX);
@@ -252,23 +252,23 @@ static int check_vehicle_limits(const char *file, size_t i, const coa_vehicle_t 
         double value = 0.0;
         char axis = far_axis(r, &value);
         if (axis != 0) {
-            return cli_fail(CLI_EXIT_INVALID,
+            return coavoid_cli_fail(CLI_EXIT_INVALID,
                             "%s: vehicles[%zu].route: its reference reaches %c = %.10g m at t "
                             "= %g s, beyond what " SIM_INTENT " carries (%g m; this run's "
                             "intents reach t = %g s)",
-                            file, i, axis, value, (double)t, COA_LCM_MAX_COORDINATE,
+                            file, i, axis, value, (double)t, COAVOID_LCM_MAX_COORDINATE,
                             (double)last * (double)dt);
         }
         const int64_t reach_steps = initial + (int64_t)v->steep_factor * (int64_t)j;
         const int64_t reach = reach_steps < bound ? reach_steps : bound;
         const double top = fabs((double)r.z) + (double)reach * dh;
-        if (beyond(top, COA_LCM_MAX_COORDINATE)) {
-            return cli_fail(CLI_EXIT_INVALID,
+        if (beyond(top, COAVOID_LCM_MAX_COORDINATE)) {
+            return coavoid_cli_fail(CLI_EXIT_INVALID,
                             "%s: vehicles[%zu]: at t = %g s its reference is at z = %.10g m, "
                             "and the %lld climb steps of %g m it may have taken by then take "
                             "|z| to %.10g m: beyond what " SIM_INTENT " carries (%g m)",
                             file, i, (double)t, (double)r.z, (long long)reach, dh, top,
-                            COA_LCM_MAX_COORDINATE);
+                            COAVOID_LCM_MAX_COORDINATE);
         }
         if (j == 0u) {
             continue;
@@ -277,13 +277,13 @@ static int check_vehicle_limits(const char *file, size_t i, const coa_vehicle_t 
         const double vx = (double)((r.x - previous.x) / dt);
         const double vy = (double)((r.y - previous.y) / dt);
         const double vz = fabs((double)((r.z - previous.z) / dt)) + climb;
-        if (beyond(vx, COA_LCM_MAX_SPEED) || beyond(vy, COA_LCM_MAX_SPEED) ||
-            beyond(vz, COA_LCM_MAX_SPEED)) {
-            return cli_fail(CLI_EXIT_INVALID,
+        if (beyond(vx, COAVOID_LCM_MAX_SPEED) || beyond(vy, COAVOID_LCM_MAX_SPEED) ||
+            beyond(vz, COAVOID_LCM_MAX_SPEED)) {
+            return coavoid_cli_fail(CLI_EXIT_INVALID,
                             "%s: vehicles[%zu].route: its reference moves at (%g, %g) m/s "
                             "horizontally and %g m/s vertically with its steepest climb at t = "
                             "%g s, beyond what " SIM_INTENT " carries (%g m/s each)",
-                            file, i, vx, vy, vz, (double)t, COA_LCM_MAX_SPEED);
+                            file, i, vx, vy, vz, (double)t, COAVOID_LCM_MAX_SPEED);
         }
         /* Consecutive reference points must differ horizontally in the core's precision,
          * as the intent's check judges them (a route far out flown very slowly does not). */
@@ -293,7 +293,7 @@ static int check_vehicle_limits(const char *file, size_t i, const coa_vehicle_t 
         probe.route_count = 2u;
         probe.initial_offset = 0;
         if (coa_vehicle_check(&probe) != COA_OK) {
-            return cli_fail(CLI_EXIT_INVALID,
+            return coavoid_cli_fail(CLI_EXIT_INVALID,
                             "%s: vehicles[%zu].cruise_speed: %g m/s moves it too little in a "
                             "step to tell its position at t = %g s from the one before "
                             "(%.10g, %.10g m), as " SIM_INTENT " must",
@@ -320,25 +320,25 @@ static int check_track_limits(const char *file, size_t i, const coa_track_t *tr,
                   {"sigma[0]", tr->sigma_horizontal},
                   {"sigma[1]", tr->sigma_vertical}};
     for (size_t f = 0; f < 4u; f++) {
-        if (beyond((double)sizes[f].value, COA_LCM_MAX_SIZE)) {
-            return cli_fail(CLI_EXIT_INVALID,
+        if (beyond((double)sizes[f].value, COAVOID_LCM_MAX_SIZE)) {
+            return coavoid_cli_fail(CLI_EXIT_INVALID,
                             "%s: tracks[%zu].%s: %g m is beyond what " SIM_TRACK
                             " carries (%g m)",
-                            file, i, sizes[f].name, (double)sizes[f].value, COA_LCM_MAX_SIZE);
+                            file, i, sizes[f].name, (double)sizes[f].value, COAVOID_LCM_MAX_SIZE);
         }
     }
     if (tr->path_count == 0u) {
         double value = 0.0;
         const coa_vec3_t v = tr->velocity;
-        if (beyond((double)v.x, COA_LCM_MAX_SPEED) || beyond((double)v.y, COA_LCM_MAX_SPEED) ||
-            beyond((double)v.z, COA_LCM_MAX_SPEED)) {
-            value = beyond((double)v.x, COA_LCM_MAX_SPEED)   ? (double)v.x
-                    : beyond((double)v.y, COA_LCM_MAX_SPEED) ? (double)v.y
+        if (beyond((double)v.x, COAVOID_LCM_MAX_SPEED) || beyond((double)v.y, COAVOID_LCM_MAX_SPEED) ||
+            beyond((double)v.z, COAVOID_LCM_MAX_SPEED)) {
+            value = beyond((double)v.x, COAVOID_LCM_MAX_SPEED)   ? (double)v.x
+                    : beyond((double)v.y, COAVOID_LCM_MAX_SPEED) ? (double)v.y
                                                               : (double)v.z;
-            return cli_fail(CLI_EXIT_INVALID,
+            return coavoid_cli_fail(CLI_EXIT_INVALID,
                             "%s: tracks[%zu].velocity: %g m/s is beyond what " SIM_TRACK
                             " carries (%g m/s)",
-                            file, i, value, COA_LCM_MAX_SPEED);
+                            file, i, value, COAVOID_LCM_MAX_SPEED);
         }
     } else if (tr->path_count > 1u) {
         /* The leg in use at t_k, as coa_track_at and the world choose it: the first one
@@ -357,11 +357,11 @@ static int check_track_limits(const char *file, size_t i, const coa_track_t *tr,
                                  (double)((b->p.y - a->p.y) / span),
                                  (double)((b->p.z - a->p.z) / span)};
             for (int c = 0; c < 3; c++) {
-                if (beyond(v[c], COA_LCM_MAX_SPEED)) {
-                    return cli_fail(CLI_EXIT_INVALID,
+                if (beyond(v[c], COAVOID_LCM_MAX_SPEED)) {
+                    return coavoid_cli_fail(CLI_EXIT_INVALID,
                                     "%s: tracks[%zu].path[%zu]: the leg to it is flown at %g m/s, "
                                     "beyond what " SIM_TRACK " carries (%g m/s)",
-                                    file, i, leg + 1u, v[c], COA_LCM_MAX_SPEED);
+                                    file, i, leg + 1u, v[c], COAVOID_LCM_MAX_SPEED);
                 }
             }
         }
@@ -372,10 +372,10 @@ static int check_track_limits(const char *file, size_t i, const coa_track_t *tr,
         double value = 0.0;
         char axis = far_axis(tr->path[j].p, &value);
         if (axis != 0 && tr->path[j].t > (coa_real_t)0 && tr->path[j].t < end) {
-            return cli_fail(CLI_EXIT_INVALID,
+            return coavoid_cli_fail(CLI_EXIT_INVALID,
                             "%s: tracks[%zu].path[%zu]: %c = %.10g m is beyond what " SIM_TRACK
                             " carries (%g m)",
-                            file, i, j, axis, value, COA_LCM_MAX_COORDINATE);
+                            file, i, j, axis, value, COAVOID_LCM_MAX_COORDINATE);
         }
     }
     for (uint64_t j = 0; j <= sampled; j++) {
@@ -383,11 +383,11 @@ static int check_track_limits(const char *file, size_t i, const coa_track_t *tr,
         double value = 0.0;
         char axis = far_axis(coa_track_at(tr, t), &value);
         if (axis != 0) {
-            return cli_fail(CLI_EXIT_INVALID,
+            return coavoid_cli_fail(CLI_EXIT_INVALID,
                             "%s: tracks[%zu]: at t = %g s it is at %c = %.10g m, beyond what "
                             SIM_TRACK " carries (%g m; this run's track messages reach t = %g "
                             "s)",
-                            file, i, (double)t, axis, value, COA_LCM_MAX_COORDINATE,
+                            file, i, (double)t, axis, value, COAVOID_LCM_MAX_COORDINATE,
                             (double)end);
         }
     }
@@ -406,21 +406,21 @@ static int check_obstacle_limits(const char *file, size_t i, const coa_obstacle_
             axis = far_axis(o->box.max, &value);
         }
         if (axis != 0) {
-            return cli_fail(CLI_EXIT_INVALID,
+            return coavoid_cli_fail(CLI_EXIT_INVALID,
                             "%s: obstacles[%zu].%s: %c = %.10g m is beyond what " SIM_MAP
                             " carries (%g m)",
-                            file, i, corner, axis, value, COA_LCM_MAX_COORDINATE);
+                            file, i, corner, axis, value, COAVOID_LCM_MAX_COORDINATE);
         }
         return CLI_CONTINUE;
     }
     for (size_t j = 0; j < o->polytope.count; j++) {
         axis = far_axis(o->polytope.vertices[j], &value);
         if (axis != 0) {
-            return cli_fail(CLI_EXIT_INVALID,
+            return coavoid_cli_fail(CLI_EXIT_INVALID,
                             "%s: obstacles[%zu].vertices[%zu]: %c = %.10g m is beyond what "
                             SIM_MAP
                             " carries (%g m)",
-                            file, i, j, axis, value, COA_LCM_MAX_COORDINATE);
+                            file, i, j, axis, value, COAVOID_LCM_MAX_COORDINATE);
         }
     }
     return CLI_CONTINUE;
@@ -428,7 +428,7 @@ static int check_obstacle_limits(const char *file, size_t i, const coa_obstacle_
 
 /* Every check above, over a run of `steps` cycles. Cost O((steps + N) * (vehicles * route +
  * tracks * path) + obstacle vertices), no memory. */
-static int check_message_limits(const char *file, const scenario_t *s, uint32_t steps)
+static int check_message_limits(const char *file, const coavoid_scenario_t *s, uint32_t steps)
 {
     const uint64_t last = (uint64_t)steps + s->horizon;
     int rc = CLI_CONTINUE;
@@ -458,42 +458,42 @@ static bool drain(lcm_t *lcm)
     }
 }
 
-static int sim(void *options, scenario_t *s)
+static int sim(void *options, coavoid_scenario_t *s)
 {
     const sim_options_t *o = options;
     const char *file = o->scenario_path;
     const size_t n = s->vehicle_count;
-    if (s->horizon > COA_NODE_MAX_HORIZON) {
-        return cli_fail(CLI_EXIT_INVALID,
+    if (s->horizon > COAVOID_NODE_MAX_HORIZON) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
                         "%s: horizon: %lu steps, at most %u in a simulation (an intent carries "
                         "N + 1 samples)",
-                        file, (unsigned long)s->horizon, COA_NODE_MAX_HORIZON);
+                        file, (unsigned long)s->horizon, COAVOID_NODE_MAX_HORIZON);
     }
-    if (n > COA_MAX_VEHICLES || n > COA_NODE_MAX_PEERS) {
-        return cli_fail(CLI_EXIT_INVALID, "%s: vehicles: %zu UAVs, at most %u in a simulation",
-                        file, n, COA_MAX_VEHICLES < COA_NODE_MAX_PEERS ? COA_MAX_VEHICLES
-                                                                       : COA_NODE_MAX_PEERS);
+    if (n > COA_MAX_VEHICLES || n > COAVOID_NODE_MAX_PEERS) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: vehicles: %zu UAVs, at most %u in a simulation",
+                        file, n, COA_MAX_VEHICLES < COAVOID_NODE_MAX_PEERS ? COA_MAX_VEHICLES
+                                                                       : COAVOID_NODE_MAX_PEERS);
     }
-    if (s->track_count > COA_NODE_MAX_TRACKS) {
-        return cli_fail(CLI_EXIT_INVALID, "%s: tracks: %zu tracks, at most %u in a simulation",
-                        file, s->track_count, COA_NODE_MAX_TRACKS);
+    if (s->track_count > COAVOID_NODE_MAX_TRACKS) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: tracks: %zu tracks, at most %u in a simulation",
+                        file, s->track_count, COAVOID_NODE_MAX_TRACKS);
     }
     const uint32_t steps = o->steps_text != NULL ? o->steps : 2u * s->horizon;
     if (o->stop_text != NULL && o->stop_step > steps) {
-        return cli_fail(CLI_EXIT_INVALID, "--coordinator-stops: step %lu is after the last, %lu",
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "--coordinator-stops: step %lu is after the last, %lu",
                         (unsigned long)o->stop_step, (unsigned long)steps);
     }
-    int rc = cli_sample_scenario(file, s);
+    int rc = coavoid_cli_sample_scenario(file, s);
     if (rc != CLI_CONTINUE) {
         return rc;
     }
 
     int64_t now = SIM_EPOCH_UTIME;
-    coa_node_common_t common;
-    if (coa_node_common_defaults(&common, SIM_EPOCH_UTIME, s->dt, s->horizon, &now) != COA_OK) {
-        return cli_fail(CLI_EXIT_INVALID,
+    coavoid_node_common_t common;
+    if (coavoid_node_common_defaults(&common, SIM_EPOCH_UTIME, s->dt, s->horizon, &now) != COA_OK) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
                         "%s: dt: %g s cannot be a cycle (whole microseconds, at most %g s)", file,
-                        (double)s->dt, COA_LCM_MAX_STEP);
+                        (double)s->dt, COAVOID_LCM_MAX_STEP);
     }
     rc = check_message_limits(file, s, steps);
     if (rc != CLI_CONTINUE) {
@@ -502,20 +502,20 @@ static int sim(void *options, scenario_t *s)
 
     /* Planner sizes: each UAV plans alone; the coordinator searches up to max_centralised
      * UAVs together, fewer when the scenario's beta would not fit the cap otherwise. */
-    coa_planner_config_t vehicle_shape = coa_node_planner_config(s->horizon, 1u, CLI_DEFAULT_BETA);
-    const uint32_t vehicle_beta = s->has_beta ? s->beta : cli_default_beta(&vehicle_shape);
+    coa_planner_config_t vehicle_shape = coavoid_node_planner_config(s->horizon, 1u, CLI_DEFAULT_BETA);
+    const uint32_t vehicle_beta = s->has_beta ? s->beta : coavoid_cli_default_beta(&vehicle_shape);
     vehicle_shape.beta = vehicle_beta;
-    if (vehicle_beta == 0 || !cli_workspace_fits(&vehicle_shape)) {
-        return cli_fail(CLI_EXIT_INVALID,
+    if (vehicle_beta == 0 || !coavoid_cli_workspace_fits(&vehicle_shape)) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
                         "%s: beta: %lu is too large: a UAV's planner would not fit in 1 GiB", file,
                         (unsigned long)vehicle_beta);
     }
     size_t max_centralised = n < COA_MAX_CENTRALISED ? n : COA_MAX_CENTRALISED;
     coa_planner_config_t coordinator_shape =
-        coa_node_planner_config(s->horizon, max_centralised, CLI_DEFAULT_BETA);
-    uint32_t coordinator_beta = s->has_beta ? s->beta : cli_default_beta(&coordinator_shape);
+        coavoid_node_planner_config(s->horizon, max_centralised, CLI_DEFAULT_BETA);
+    uint32_t coordinator_beta = s->has_beta ? s->beta : coavoid_cli_default_beta(&coordinator_shape);
     coordinator_shape.beta = coordinator_beta;
-    while (max_centralised > 1u && !cli_workspace_fits(&coordinator_shape)) {
+    while (max_centralised > 1u && !coavoid_cli_workspace_fits(&coordinator_shape)) {
         coordinator_shape.vehicles = --max_centralised;
     }
 
@@ -528,20 +528,20 @@ static int sim(void *options, scenario_t *s)
     r.offsets = calloc(n * samples, sizeof *r.offsets);
     if (r.vehicles == NULL || r.index == NULL || r.references == NULL || r.offsets == NULL) {
         sim_run_free(&r, n);
-        return cli_fail(CLI_EXIT_INVALID, "%s: cannot allocate the record of %lu steps", file,
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: cannot allocate the record of %lu steps", file,
                         (unsigned long)steps);
     }
     if (o->svg_path != NULL) {
         r.svg = fopen(o->svg_path, "w");
         if (r.svg == NULL) {
             sim_run_free(&r, n);
-            return cli_fail(CLI_EXIT_INVALID, "--svg: cannot write '%.200s'", o->svg_path);
+            return coavoid_cli_fail(CLI_EXIT_INVALID, "--svg: cannot write '%.200s'", o->svg_path);
         }
     }
     r.lcm = lcm_create("memq://");
     if (r.lcm == NULL) {
         sim_run_free(&r, n);
-        return cli_fail(CLI_EXIT_INTERNAL, "internal error: LCM's memq provider is unavailable");
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: LCM's memq provider is unavailable");
     }
 
     /* A track message numbers tracks 1..2^31-1, once each; the scenario may use any
@@ -559,7 +559,7 @@ static int sim(void *options, scenario_t *s)
         r.tracks = calloc(s->track_count, sizeof *r.tracks);
         if (r.tracks == NULL) {
             sim_run_free(&r, n);
-            return cli_fail(CLI_EXIT_INVALID, "%s: cannot allocate the tracks", file);
+            return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: cannot allocate the tracks", file);
         }
         for (size_t i = 0; i < s->track_count; i++) {
             r.tracks[i] = s->tracks[i];
@@ -569,26 +569,26 @@ static int sim(void *options, scenario_t *s)
     }
 
     int error = COA_OK;
-    coa_world_config_t world;
+    coavoid_world_config_t world;
     memset(&world, 0, sizeof world);
     world.common = common;
-    world.id = COA_NODE_WORLD_ID;
+    world.id = COAVOID_NODE_WORLD_ID;
     world.obstacles = s->obstacles;
     world.obstacle_count = s->obstacle_count;
     world.tracks = world_tracks;
     world.track_count = s->track_count;
-    r.world = coa_world_create(&world, r.lcm, &error);
+    r.world = coavoid_world_create(&world, r.lcm, &error);
     if (r.world == NULL) {
         sim_run_free(&r, n);
         if (error == COA_ERR_ARGUMENT) {
-            return cli_fail(CLI_EXIT_INVALID,
+            return coavoid_cli_fail(CLI_EXIT_INVALID,
                             "%s: obstacles: more than an obstacle map message holds (%d boxes, "
                             "%d polytopes of at most %d vertices)",
                             file, COAVOID_OBSTACLE_MAP_T_MAX_BOXES,
                             COAVOID_OBSTACLE_MAP_T_MAX_POLYTOPES,
                             COAVOID_OBSTACLE_MAP_T_MAX_VERTICES);
         }
-        return cli_fail(CLI_EXIT_INTERNAL, "internal error: out of memory for the world node");
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: out of memory for the world node");
     }
 
     /* UAVs run in priority order (ascending priority, ties by ascending id), whatever
@@ -597,51 +597,51 @@ static int sim(void *options, scenario_t *s)
      * published), so a lower priority stepped first would decide around nothing there. */
     if (coa_priority_order(s->vehicles, n, r.index) != COA_OK) {
         sim_run_free(&r, n);
-        return cli_fail(CLI_EXIT_INTERNAL, "internal error: no priority order of %zu UAVs", n);
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: no priority order of %zu UAVs", n);
     }
     for (size_t j = 0; j < n; j++) {
         size_t i = r.index[j];
-        coa_vehicle_node_config_t config;
+        coavoid_vehicle_node_config_t config;
         memset(&config, 0, sizeof config);
         config.common = common;
         config.common.beta = vehicle_beta;
         config.vehicle = s->vehicles[i];
-        config.mode = o->decoupled ? COA_NODE_DECOUPLED : COA_NODE_CENTRALISED;
-        r.vehicles[j] = coa_vehicle_node_create(&config, r.lcm, &error);
+        config.mode = o->decoupled ? COAVOID_NODE_DECOUPLED : COAVOID_NODE_CENTRALISED;
+        r.vehicles[j] = coavoid_vehicle_node_create(&config, r.lcm, &error);
         if (r.vehicles[j] == NULL) {
             sim_run_free(&r, n);
             if (error == COA_ERR_ARGUMENT) {
-                return cli_fail(CLI_EXIT_INVALID, "%s: vehicles[%zu]: cannot run as a node (%s)",
-                                file, i, coa_lcm_error_name(error));
+                return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: vehicles[%zu]: cannot run as a node (%s)",
+                                file, i, coavoid_lcm_error_name(error));
             }
-            return cli_fail(CLI_EXIT_INVALID,
+            return coavoid_cli_fail(CLI_EXIT_INVALID,
                             "%s: vehicles[%zu]: cannot allocate its node (beta %lu)", file, i,
                             (unsigned long)vehicle_beta);
         }
     }
     if (!o->decoupled) {
-        coa_coordinator_config_t config;
+        coavoid_coordinator_config_t config;
         memset(&config, 0, sizeof config);
         config.common = common;
         config.common.beta = coordinator_beta;
-        config.id = COA_NODE_COORDINATOR_ID;
+        config.id = COAVOID_NODE_COORDINATOR_ID;
         config.max_centralised = max_centralised;
         config.collect_us = common.dt_us / 4 > 0 ? common.dt_us / 4 : 1;
         if (config.collect_us >= common.dt_us) {
             sim_run_free(&r, n);
-            return cli_fail(CLI_EXIT_INVALID,
+            return coavoid_cli_fail(CLI_EXIT_INVALID,
                             "%s: dt: %g s leaves the coordinator no time within a cycle", file,
                             (double)s->dt);
         }
-        r.coordinator = coa_coordinator_create(&config, r.lcm, &error);
+        r.coordinator = coavoid_coordinator_create(&config, r.lcm, &error);
         if (r.coordinator == NULL) {
             sim_run_free(&r, n);
             if (error == COA_ERR_ARGUMENT) {
-                return cli_fail(CLI_EXIT_INVALID,
+                return coavoid_cli_fail(CLI_EXIT_INVALID,
                                 "%s: beta: %lu cannot size the coordinator's planner", file,
                                 (unsigned long)coordinator_beta);
             }
-            return cli_fail(CLI_EXIT_INVALID,
+            return coavoid_cli_fail(CLI_EXIT_INVALID,
                             "%s: cannot allocate the coordinator's planner (beta %lu, %zu UAVs "
                             "together)",
                             file, (unsigned long)coordinator_beta, max_centralised);
@@ -657,17 +657,17 @@ static int sim(void *options, scenario_t *s)
     bool lcm_ok = true;
     for (uint32_t k = 0; k <= steps && lcm_ok; k++) {
         if (r.coordinator != NULL && o->stop_text != NULL && k == o->stop_step) {
-            coordinator_plans = coa_coordinator_state(r.coordinator)->plans_run;
-            coa_coordinator_destroy(r.coordinator);
+            coordinator_plans = coavoid_coordinator_state(r.coordinator)->plans_run;
+            coavoid_coordinator_destroy(r.coordinator);
             r.coordinator = NULL;
         }
-        const int64_t cycle_start = coa_node_cycle_utime(&common, (int64_t)k);
+        const int64_t cycle_start = coavoid_node_cycle_utime(&common, (int64_t)k);
         now = cycle_start;
-        rc = coa_world_cycle(r.world, now);
+        rc = coavoid_world_cycle(r.world, now);
         node_error = node_error != COA_OK ? node_error : rc;
         lcm_ok = drain(r.lcm);
         for (size_t j = 0; j < n && lcm_ok; j++) {
-            rc = coa_vehicle_node_cycle(r.vehicles[j], now);
+            rc = coavoid_vehicle_node_cycle(r.vehicles[j], now);
             node_error = node_error != COA_OK ? node_error : rc;
             lcm_ok = drain(r.lcm);
         }
@@ -677,7 +677,7 @@ static int sim(void *options, scenario_t *s)
             while (changed && lcm_ok) {
                 changed = false;
                 for (size_t j = 0; j < n && lcm_ok; j++) {
-                    rc = coa_vehicle_node_poll(r.vehicles[j], now);
+                    rc = coavoid_vehicle_node_poll(r.vehicles[j], now);
                     if (rc < 0) {
                         node_error = node_error != COA_OK ? node_error : rc;
                     } else if (rc > 0) {
@@ -688,7 +688,7 @@ static int sim(void *options, scenario_t *s)
             }
             int64_t deadline = INT64_MAX;
             for (size_t j = 0; j < n; j++) {
-                int64_t d = coa_vehicle_node_deadline(r.vehicles[j]);
+                int64_t d = coavoid_vehicle_node_deadline(r.vehicles[j]);
                 deadline = d < deadline ? d : deadline;
             }
             if (deadline == INT64_MAX || !lcm_ok) {
@@ -699,52 +699,52 @@ static int sim(void *options, scenario_t *s)
         /* The coordinator plans cycles 0..K-1: cycle K only flies the last sample. */
         if (r.coordinator != NULL && k < steps && lcm_ok) {
             now = cycle_start + collect_us > now ? cycle_start + collect_us : now;
-            rc = coa_coordinator_cycle(r.coordinator, now);
+            rc = coavoid_coordinator_cycle(r.coordinator, now);
             node_error = node_error != COA_OK ? node_error : rc;
             lcm_ok = drain(r.lcm);
         }
         for (size_t j = 0; j < n; j++) {
-            const coa_vehicle_node_state_t *st = coa_vehicle_node_state(r.vehicles[j]);
+            const coavoid_vehicle_node_state_t *st = coavoid_vehicle_node_state(r.vehicles[j]);
             size_t i = r.index[j];
             r.references[i * samples + k] = st->reference;
             r.offsets[i * samples + k] = st->offset;
         }
     }
     if (r.coordinator != NULL) {
-        coordinator_plans = coa_coordinator_state(r.coordinator)->plans_run;
+        coordinator_plans = coavoid_coordinator_state(r.coordinator)->plans_run;
     }
     if (!lcm_ok) {
         sim_run_free(&r, n);
-        return cli_fail(CLI_EXIT_INTERNAL, "internal error: LCM failed while handling messages");
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: LCM failed while handling messages");
     }
     if (node_error != COA_OK) {
         sim_run_free(&r, n);
-        return cli_fail(CLI_EXIT_INTERNAL, "internal error: a node failed (%s)",
-                        coa_lcm_error_name(node_error));
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: a node failed (%s)",
+                        coavoid_lcm_error_name(node_error));
     }
 
     uint32_t replans = coordinator_plans;
     uint32_t fallbacks = 0;
     for (size_t j = 0; j < n; j++) {
-        const coa_vehicle_node_state_t *st = coa_vehicle_node_state(r.vehicles[j]);
+        const coavoid_vehicle_node_state_t *st = coavoid_vehicle_node_state(r.vehicles[j]);
         replans += st->plans_run;
         fallbacks += st->fallbacks;
     }
-    rc = judge_run(&r.judged, s, o->mode, steps, replans, r.references, r.offsets, NULL);
-    const coa_flight_t *flight = &r.judged.flight;
-    const coa_flight_eval_t *eval = &r.judged.eval;
+    rc = coavoid_judge_run(&r.judged, s, o->mode, steps, replans, r.references, r.offsets, NULL);
+    const coavoid_flight_t *flight = &r.judged.flight;
+    const coavoid_flight_eval_t *eval = &r.judged.eval;
     if (rc != COA_OK) {
         sim_run_free(&r, n);
-        return cli_fail(CLI_EXIT_INTERNAL, "internal error: the flight cannot be judged (%s)",
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: the flight cannot be judged (%s)",
                         coa_status_name(rc));
     }
     if (r.svg != NULL) {
-        rc = coa_flight_svg(flight, eval, r.svg);
+        rc = coavoid_flight_svg(flight, eval, r.svg);
         int closed = fclose(r.svg);
         r.svg = NULL;
         if (rc != COA_OK || closed != 0) {
             sim_run_free(&r, n);
-            return cli_fail(CLI_EXIT_INTERNAL, "--svg: writing '%.200s' failed", o->svg_path);
+            return coavoid_cli_fail(CLI_EXIT_INTERNAL, "--svg: writing '%.200s' failed", o->svg_path);
         }
     }
     if (o->json) {
@@ -752,11 +752,11 @@ static int sim(void *options, scenario_t *s)
         char stopped_text[16];
         snprintf(fallbacks_text, sizeof fallbacks_text, "%lu", (unsigned long)fallbacks);
         snprintf(stopped_text, sizeof stopped_text, "%lu", (unsigned long)o->stop_step);
-        const coa_flight_extra_t extra[2] = {{"fallbacks", fallbacks_text},
+        const coavoid_flight_extra_t extra[2] = {{"fallbacks", fallbacks_text},
                                              {"coordinator_stopped_at", stopped_text}};
-        rc = coa_flight_json_extra(flight, eval, extra, o->stop_text != NULL ? 2u : 1u, stdout);
+        rc = coavoid_flight_json_extra(flight, eval, extra, o->stop_text != NULL ? 2u : 1u, stdout);
     } else {
-        rc = coa_flight_text(flight, eval, stdout);
+        rc = coavoid_flight_text(flight, eval, stdout);
         if (rc == COA_OK &&
             (printf("fallbacks: %lu\n", (unsigned long)fallbacks) < 0 || fflush(stdout) != 0)) {
             rc = COA_ERR_WORKSPACE;
@@ -764,17 +764,17 @@ static int sim(void *options, scenario_t *s)
     }
     sim_run_free(&r, n);
     if (rc != COA_OK) {
-        return cli_fail(CLI_EXIT_INTERNAL, "internal error: the result could not be written");
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: the result could not be written");
     }
     return eval->loss_of_separation ? CLI_EXIT_NOT_SOLVED : CLI_EXIT_OK;
 }
 
-int command_sim(int argc, char **argv)
+int coavoid_command_sim(int argc, char **argv)
 {
     sim_options_t options;
     int status = parse_sim_options(argc, argv, &options);
     if (status != CLI_CONTINUE) {
         return status;
     }
-    return cli_run_scenario(options.scenario_path, sim, &options);
+    return coavoid_cli_run_scenario(options.scenario_path, sim, &options);
 }

@@ -60,9 +60,9 @@
     "                       [--json] [--svg FILE] [--epoch UTIME]\n"                          \
     "\n"                                                                                      \
     "Rebuilds what each UAV of the scenario flew from an lcm-logger log of a real-time\n"     \
-    "run (the intents on " COA_CHANNEL_INTENT "), judges it as 'coavoid sim' does (loss of\n" \
-    "separation, deviation, effort), and counts the planning calls (" COA_CHANNEL_STATUS     \
-    ",\n" COA_CHANNEL_PLAN ").\n"                                                             \
+    "run (the intents on " COAVOID_CHANNEL_INTENT "), judges it as 'coavoid sim' does (loss of\n" \
+    "separation, deviation, effort), and counts the planning calls (" COAVOID_CHANNEL_STATUS     \
+    ",\n" COAVOID_CHANNEL_PLAN ").\n"                                                             \
     "\n"                                                                                      \
     "options:\n"                                                                              \
     "  --mode MODE     centralised or decoupled: the mode the run was started in\n"           \
@@ -113,19 +113,19 @@ static int summary_option(int argc, char **argv, int *i, void *options)
     summary_options_t *o = options;
     const char *arg = argv[*i];
     int status = CLI_UNKNOWN_OPTION;
-    if (cli_option_is(arg, "--mode")) {
-        status = cli_mode_option(argc, argv, i, &o->mode, NULL);
-    } else if (cli_option_is(arg, "--json")) {
-        status = cli_flag_option(arg, "--json", &o->json);
-    } else if (cli_option_is(arg, "--svg")) {
-        status = cli_text_option(argc, argv, i, "--svg", "a file to write", false, &o->svg_path);
-    } else if (cli_option_is(arg, "--epoch")) {
+    if (coavoid_cli_option_is(arg, "--mode")) {
+        status = coavoid_cli_mode_option(argc, argv, i, &o->mode, NULL);
+    } else if (coavoid_cli_option_is(arg, "--json")) {
+        status = coavoid_cli_flag_option(arg, "--json", &o->json);
+    } else if (coavoid_cli_option_is(arg, "--svg")) {
+        status = coavoid_cli_text_option(argc, argv, i, "--svg", "a file to write", false, &o->svg_path);
+    } else if (coavoid_cli_option_is(arg, "--epoch")) {
         uint64_t epoch = 0;
-        status = cli_text_option(argc, argv, i, "--epoch", "microseconds, an integer >= 1", true,
+        status = coavoid_cli_text_option(argc, argv, i, "--epoch", "microseconds, an integer >= 1", true,
                                  &o->epoch_text);
-        if (status == CLI_CONTINUE && !cli_parse_count(o->epoch_text, strlen(o->epoch_text),
+        if (status == CLI_CONTINUE && !coavoid_cli_parse_count(o->epoch_text, strlen(o->epoch_text),
                                                        (uint64_t)INT64_MAX / 2u, &epoch)) {
-            return cli_fail(CLI_EXIT_INVALID,
+            return coavoid_cli_fail(CLI_EXIT_INVALID,
                             "--epoch: must be an integer from 1 to %" PRIu64
                             " (microseconds), got '%.40s'",
                             (uint64_t)INT64_MAX / 2u, o->epoch_text);
@@ -135,7 +135,7 @@ static int summary_option(int argc, char **argv, int *i, void *options)
     return status;
 }
 
-static const cli_command_t summary_command = {
+static const coavoid_cli_command_t summary_command = {
     "summary", "coavoid summary", 2, {"LOGFILE", "SCENARIO.json"}, "one log and one scenario",
     summary_help, summary_option};
 
@@ -143,14 +143,14 @@ static int parse_summary_options(int argc, char **argv, summary_options_t *o)
 {
     const char *args[2] = {NULL, NULL};
     memset(o, 0, sizeof *o);
-    int status = cli_parse_args(&summary_command, argc, argv, o, args);
+    int status = coavoid_cli_parse_args(&summary_command, argc, argv, o, args);
     if (status != CLI_CONTINUE) {
         return status;
     }
     o->log_path = args[0];
     o->scenario_path = args[1];
     if (o->mode == NULL) {
-        return cli_fail(CLI_EXIT_INVALID, "--mode: required (centralised or decoupled)");
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "--mode: required (centralised or decoupled)");
     }
     return CLI_CONTINUE;
 }
@@ -171,28 +171,28 @@ static int log_open(log_reader_t *r, const char *path, int64_t limit)
     memset(r, 0, sizeof *r);
     r->path = path;
     if (stat(path, &st) != 0) {
-        return cli_fail(CLI_EXIT_INVALID, "%s: cannot open: %s", path, strerror(errno));
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: cannot open: %s", path, strerror(errno));
     }
     if (!S_ISREG(st.st_mode)) {
-        return cli_fail(CLI_EXIT_INVALID, "%s: not a regular file (an lcm-logger log is one)",
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: not a regular file (an lcm-logger log is one)",
                         path);
     }
     errno = 0;
     r->log = lcm_eventlog_create(path, "r");
     if (r->log == NULL) {
-        return cli_fail(CLI_EXIT_INVALID, "%s: cannot open: %s", path,
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: cannot open: %s", path,
                         errno != 0 ? strerror(errno) : "lcm_eventlog_create failed");
     }
     /* The size of what was opened (the path may have been replaced since stat). */
     if (fstat(fileno(r->log->f), &st) != 0) {
-        return cli_fail(CLI_EXIT_INVALID, "%s: cannot read: %s", path, strerror(errno));
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: cannot read: %s", path, strerror(errno));
     }
     r->size = (int64_t)st.st_size;
     if (limit >= 0 && limit < r->size) {
         r->size = limit;
     }
     if (r->size == 0) {
-        return cli_fail(CLI_EXIT_INVALID, "%s: empty file, not an LCM log", path);
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: empty file, not an LCM log", path);
     }
     return CLI_CONTINUE;
 }
@@ -221,13 +221,13 @@ static int log_next(log_reader_t *r, lcm_eventlog_event_t **event)
         return 0;
     }
     if (fseeko(r->log->f, (off_t)r->offset, SEEK_SET) != 0) {
-        return cli_fail(CLI_EXIT_INVALID, "%s: cannot seek to byte %" PRId64 ": %s", r->path,
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: cannot seek to byte %" PRId64 ": %s", r->path,
                         r->offset, strerror(errno));
     }
     size_t want = left < LOG_HEADER_BYTES ? (size_t)left : (size_t)LOG_HEADER_BYTES;
     size_t got = fread(header, 1, want, r->log->f);
     if (got != want) {
-        return cli_fail(CLI_EXIT_INVALID, "%s: read error at byte %" PRId64, r->path, r->offset);
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: read error at byte %" PRId64, r->path, r->offset);
     }
     /* Whether the bytes there are (the start of) an event header. */
     bool magic = true;
@@ -236,16 +236,16 @@ static int log_next(log_reader_t *r, lcm_eventlog_event_t **event)
     }
     if (!magic) {
         if (r->offset == 0) {
-            return cli_fail(CLI_EXIT_INVALID,
+            return coavoid_cli_fail(CLI_EXIT_INVALID,
                             "%s: not an LCM log (it does not start with an event header)", r->path);
         }
-        return cli_fail(CLI_EXIT_INVALID,
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
                         "%s: corrupt: no event header at byte %" PRId64 " (after %" PRId64
                         " events)",
                         r->path, r->offset, r->events);
     }
     if (got < (size_t)LOG_HEADER_BYTES) {
-        return cli_fail(CLI_EXIT_INVALID,
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
                         "%s: truncated: event %" PRId64 " at byte %" PRId64
                         " is cut off in its header (was the logger stopped mid-write?)",
                         r->path, r->events, r->offset);
@@ -254,14 +254,14 @@ static int log_next(log_reader_t *r, lcm_eventlog_event_t **event)
     int32_t data_length = (int32_t)be32(header + 24);
     if (channel_length < 1 || channel_length > LOG_MAX_CHANNEL || data_length < 0 ||
         data_length > LOG_MAX_DATA) {
-        return cli_fail(CLI_EXIT_INVALID,
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
                         "%s: corrupt: event %" PRId64 " at byte %" PRId64
                         " claims a %ld-byte channel name and %ld bytes of data",
                         r->path, r->events, r->offset, (long)channel_length, (long)data_length);
     }
     int64_t length = LOG_HEADER_BYTES + (int64_t)channel_length + (int64_t)data_length;
     if (length > left) {
-        return cli_fail(CLI_EXIT_INVALID,
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
                         "%s: truncated: event %" PRId64 " at byte %" PRId64 " needs %" PRId64
                         " bytes, the file has %" PRId64 " left (was the logger stopped "
                         "mid-write?)",
@@ -274,18 +274,18 @@ static int log_next(log_reader_t *r, lcm_eventlog_event_t **event)
         unsigned char next[4];
         if (fseeko(r->log->f, (off_t)(r->offset + length), SEEK_SET) != 0 ||
             fread(next, 1, 4u, r->log->f) != 4u) {
-            return cli_fail(CLI_EXIT_INVALID, "%s: read error at byte %" PRId64, r->path,
+            return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: read error at byte %" PRId64, r->path,
                             r->offset + length);
         }
         if (be32(next) != LOG_MAGIC) {
-            return cli_fail(CLI_EXIT_INVALID,
+            return coavoid_cli_fail(CLI_EXIT_INVALID,
                             "%s: corrupt: no event header at byte %" PRId64 " (after %" PRId64
                             " events)",
                             r->path, r->offset + length, r->events + 1);
         }
     }
     if (fseeko(r->log->f, (off_t)r->offset, SEEK_SET) != 0) {
-        return cli_fail(CLI_EXIT_INVALID, "%s: cannot seek to byte %" PRId64 ": %s", r->path,
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: cannot seek to byte %" PRId64 ": %s", r->path,
                         r->offset, strerror(errno));
     }
     lcm_eventlog_event_t *e = lcm_eventlog_read_next_event(r->log);
@@ -293,7 +293,7 @@ static int log_next(log_reader_t *r, lcm_eventlog_event_t **event)
         if (e != NULL) {
             lcm_eventlog_free_event(e);
         }
-        return cli_fail(CLI_EXIT_INVALID, "%s: cannot read event %" PRId64 " at byte %" PRId64,
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: cannot read event %" PRId64 " at byte %" PRId64,
                         r->path, r->events, r->offset);
     }
     r->offset += length;
@@ -371,7 +371,7 @@ static bool intent_add(intent_list_t *list, intent_seen_t item)
 
 typedef struct {
     const summary_options_t *o;
-    const scenario_t *s;
+    const coavoid_scenario_t *s;
     int64_t dt_us;
 
     /* Decoding space (the plan type is 16.6 kB). */
@@ -399,7 +399,7 @@ typedef struct {
     int64_t intents_of[COA_MAX_VEHICLES];
 } log_summary_t;
 
-static const coa_lcm_context_t no_clock = {0, 0, 0, 0};
+static const coavoid_lcm_context_t no_clock = {0, 0, 0, 0};
 
 /* Decodes and validates an intent. Returns the scenario's index of its UAV (>= 0), -1
  * refused (counted), -2 a valid intent of another UAV (counted), or -3 after an error
@@ -409,8 +409,8 @@ static long accept_intent(log_summary_t *ls, const lcm_eventlog_event_t *e, bool
     const char *reason = "intent: does not decode (wrong type or truncated)";
     coavoid_intent_t *m = &ls->intent;
     int used = coavoid_intent_t_decode(e->data, 0, e->datalen, m);
-    int rc = used == e->datalen ? coa_lcm_intent_check(m, &no_clock, &reason)
-                                : COA_LCM_ERR_DECODE;
+    int rc = used == e->datalen ? coavoid_lcm_intent_check(m, &no_clock, &reason)
+                                : COAVOID_LCM_ERR_DECODE;
     if (used >= 0) {
         coavoid_intent_t_decode_cleanup(m);
     }
@@ -426,7 +426,7 @@ static long accept_intent(log_summary_t *ls, const lcm_eventlog_event_t *e, bool
         }
         return -1;
     }
-    long index = scenario_vehicle_index(ls->s, (long)m->uav_id);
+    long index = coavoid_scenario_vehicle_index(ls->s, (long)m->uav_id);
     if (index < 0) {
         if (count) {
             ls->intents_foreign++;
@@ -464,7 +464,7 @@ static long accept_intent(log_summary_t *ls, const lcm_eventlog_event_t *e, bool
         ours = v->steep_factor;
     }
     if (field != NULL) {
-        cli_fail(CLI_EXIT_INVALID,
+        coavoid_cli_fail(CLI_EXIT_INVALID,
                  "%s: UAV %ld's intents have %s %.17g, %s says %.17g: not a run of this "
                  "scenario",
                  ls->o->log_path, (long)m->uav_id, field, theirs, ls->o->scenario_path, ours);
@@ -497,7 +497,7 @@ static int read_log(log_summary_t *ls, log_reader_t *r)
         }
         ls->events++;
         bool ok = true;
-        if (strcmp(e->channel, COA_CHANNEL_INTENT) == 0) {
+        if (strcmp(e->channel, COAVOID_CHANNEL_INTENT) == 0) {
             long index = accept_intent(ls, e, true);
             if (index == -3) {
                 lcm_eventlog_free_event(e);
@@ -513,11 +513,11 @@ static int read_log(log_summary_t *ls, log_reader_t *r)
                 intent_seen_t seen = {i, p};
                 ok = intent_add(&ls->seen, seen);
             }
-        } else if (strcmp(e->channel, COA_CHANNEL_STATUS) == 0) {
+        } else if (strcmp(e->channel, COAVOID_CHANNEL_STATUS) == 0) {
             const char *reason = "status: does not decode (wrong type or truncated)";
             int used = coavoid_status_t_decode(e->data, 0, e->datalen, &ls->status);
-            int vrc = used == e->datalen ? coa_lcm_status_check(&ls->status, &no_clock, &reason)
-                                         : COA_LCM_ERR_DECODE;
+            int vrc = used == e->datalen ? coavoid_lcm_status_check(&ls->status, &no_clock, &reason)
+                                         : COAVOID_LCM_ERR_DECODE;
             if (used >= 0) {
                 coavoid_status_t_decode_cleanup(&ls->status);
             }
@@ -530,11 +530,11 @@ static int read_log(log_summary_t *ls, log_reader_t *r)
                                    ls->status.utime, ls->status.plans_run};
                 ok = planning_add(&ls->heartbeats, item);
             }
-        } else if (strcmp(e->channel, COA_CHANNEL_PLAN) == 0) {
+        } else if (strcmp(e->channel, COAVOID_CHANNEL_PLAN) == 0) {
             const char *reason = "plan: does not decode (wrong type or truncated)";
             int used = coavoid_plan_t_decode(e->data, 0, e->datalen, &ls->plan);
-            int vrc = used == e->datalen ? coa_lcm_plan_check(&ls->plan, &no_clock, &reason)
-                                         : COA_LCM_ERR_DECODE;
+            int vrc = used == e->datalen ? coavoid_lcm_plan_check(&ls->plan, &no_clock, &reason)
+                                         : COAVOID_LCM_ERR_DECODE;
             if (used >= 0) {
                 coavoid_plan_t_decode_cleanup(&ls->plan);
             }
@@ -553,7 +553,7 @@ static int read_log(log_summary_t *ls, log_reader_t *r)
         }
         lcm_eventlog_free_event(e);
         if (!ok) {
-            return cli_fail(CLI_EXIT_INTERNAL, "out of memory reading %s", r->path);
+            return coavoid_cli_fail(CLI_EXIT_INTERNAL, "out of memory reading %s", r->path);
         }
     }
     return CLI_CONTINUE;
@@ -685,7 +685,7 @@ static int fill_samples(log_summary_t *ls, log_reader_t *r, rebuilt_t *b, int64_
         if (rc != 1) {
             return rc;
         }
-        if (strcmp(e->channel, COA_CHANNEL_INTENT) == 0) {
+        if (strcmp(e->channel, COAVOID_CHANNEL_INTENT) == 0) {
             long index = accept_intent(ls, e, false);
             if (index == -3) {
                 lcm_eventlog_free_event(e);
@@ -718,7 +718,7 @@ static int fill_samples(log_summary_t *ls, log_reader_t *r, rebuilt_t *b, int64_
 }
 
 /* Samples no intent covered: the scenario's reference, the offset held. */
-static int fill_gaps(const scenario_t *s, rebuilt_t *b)
+static int fill_gaps(const coavoid_scenario_t *s, rebuilt_t *b)
 {
     const size_t row = (size_t)b->steps + 1u;
     coa_vec3_t *scenario_reference = malloc(row * sizeof *scenario_reference);
@@ -789,7 +789,7 @@ static bool add_count(cJSON *obj, const char *key, int64_t value)
 /* The flight's JSON with a "log" object added. The log object holds only integers and
  * strings, which cJSON prints exactly. */
 static int print_json(const log_summary_t *ls, const rebuilt_t *b, int64_t epoch,
-                      const coa_flight_t *flight, const coa_flight_eval_t *eval)
+                      const coavoid_flight_t *flight, const coavoid_flight_eval_t *eval)
 {
     cJSON *log = cJSON_CreateObject();
     bool ok = log != NULL && cJSON_AddStringToObject(log, "file", ls->o->log_path) != NULL &&
@@ -810,42 +810,42 @@ static int print_json(const log_summary_t *ls, const rebuilt_t *b, int64_t epoch
     char *log_text = ok ? cJSON_PrintUnformatted(log) : NULL;
     cJSON_Delete(log);
     if (log_text == NULL) {
-        return cli_fail(CLI_EXIT_INTERNAL, "out of memory printing the result");
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "out of memory printing the result");
     }
-    const coa_flight_extra_t extra = {"log", log_text};
+    const coavoid_flight_extra_t extra = {"log", log_text};
     errno = 0;
-    int rc = coa_flight_json_extra(flight, eval, &extra, 1u, stdout);
+    int rc = coavoid_flight_json_extra(flight, eval, &extra, 1u, stdout);
     free(log_text);
     if (rc == COA_ERR_ARGUMENT) {
-        return cli_fail(CLI_EXIT_INTERNAL, "internal error: cannot print the result (%s)",
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: cannot print the result (%s)",
                         coa_status_name(rc));
     }
     if (rc != COA_OK) {
-        return cli_fail(CLI_EXIT_INTERNAL, "cannot write the result: %s",
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "cannot write the result: %s",
                         errno != 0 ? strerror(errno) : "write error");
     }
     return CLI_CONTINUE;
 }
 
-static int write_svg(const char *path, const coa_flight_t *flight, const coa_flight_eval_t *eval)
+static int write_svg(const char *path, const coavoid_flight_t *flight, const coavoid_flight_eval_t *eval)
 {
     FILE *out = fopen(path, "w");
     if (out == NULL) {
-        return cli_fail(CLI_EXIT_INVALID, "--svg %s: cannot write: %s", path, strerror(errno));
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "--svg %s: cannot write: %s", path, strerror(errno));
     }
-    int rc = coa_flight_svg(flight, eval, out);
+    int rc = coavoid_flight_svg(flight, eval, out);
     if (fclose(out) != 0 && rc == COA_OK) {
         rc = COA_ERR_WORKSPACE;
     }
     if (rc != COA_OK) {
-        return cli_fail(CLI_EXIT_INTERNAL, "--svg %s: cannot write the figure (%s)", path,
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "--svg %s: cannot write the figure (%s)", path,
                         coa_status_name(rc));
     }
     return CLI_CONTINUE;
 }
 
 /* The evaluation refused the record: name the step no action makes, if that is why. */
-static int refused_record(const summary_options_t *o, const coa_flight_t *f, const rebuilt_t *b)
+static int refused_record(const summary_options_t *o, const coavoid_flight_t *f, const rebuilt_t *b)
 {
     const size_t row = (size_t)f->steps + 1u;
     for (size_t i = 0; i < f->vehicle_count; i++) {
@@ -854,7 +854,7 @@ static int refused_record(const summary_options_t *o, const coa_flight_t *f, con
             if (coa_action_between(offsets[k], offsets[k + 1u],
                                    f->vehicles[i].vehicle.steep_factor) < 0) {
                 bool gap = !b->own[i * row + k] || !b->own[i * row + k + 1u];
-                return cli_fail(CLI_EXIT_INVALID,
+                return coavoid_cli_fail(CLI_EXIT_INVALID,
                                 "%s: UAV %u's offset goes from %ld at cycle %lu to %ld at cycle "
                                 "%lu, which no action does%s",
                                 o->log_path, (unsigned)f->vehicles[i].vehicle.id,
@@ -865,11 +865,11 @@ static int refused_record(const summary_options_t *o, const coa_flight_t *f, con
             }
         }
     }
-    return cli_fail(CLI_EXIT_INTERNAL, "internal error: the flight record was refused");
+    return coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: the flight record was refused");
 }
 
 /* Everything after the options and the scenario. Returns the exit status. */
-static int summarise(void *options, scenario_t *s)
+static int summarise(void *options, coavoid_scenario_t *s)
 {
     const summary_options_t *o = options;
     log_summary_t *ls = calloc(1, sizeof *ls);
@@ -879,21 +879,21 @@ static int summarise(void *options, scenario_t *s)
     memset(&b, 0, sizeof b);
     memset(&r, 0, sizeof r);
     if (ls == NULL) {
-        return cli_fail(CLI_EXIT_INTERNAL, "out of memory");
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "out of memory");
     }
     ls->o = o;
     ls->s = s;
     double dt_us = (double)s->dt * 1e6;
     if (!(dt_us >= 1.0) || dt_us > 3.6e9) {
         free(ls);
-        return cli_fail(CLI_EXIT_INVALID, "%s: dt: %g s cannot be a cycle of whole microseconds "
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: dt: %g s cannot be a cycle of whole microseconds "
                                           "(1 us to 1 h)",
                         o->scenario_path, (double)s->dt);
     }
     ls->dt_us = llround(dt_us);
     if (s->vehicle_count > COA_MAX_VEHICLES) {
         free(ls);
-        return cli_fail(CLI_EXIT_INVALID, "%s: %zu vehicles, at most %u", o->scenario_path,
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: %zu vehicles, at most %u", o->scenario_path,
                         s->vehicle_count, COA_MAX_VEHICLES);
     }
 
@@ -910,7 +910,7 @@ static int summarise(void *options, scenario_t *s)
         int64_t earliest = INT64_MAX;
         for (size_t i = 0; i < s->vehicle_count && status == CLI_CONTINUE; i++) {
             if (ls->intents_of[i] == 0) {
-                status = cli_fail(CLI_EXIT_INVALID,
+                status = coavoid_cli_fail(CLI_EXIT_INVALID,
                                   "%s: UAV %u of %s never published an accepted intent "
                                   "(%" PRId64 " intents in the log, %" PRId64 " refused)",
                                   o->log_path, (unsigned)s->vehicles[i].id, o->scenario_path,
@@ -926,9 +926,9 @@ static int summarise(void *options, scenario_t *s)
     if (status == CLI_CONTINUE) {
         k = last_complete_cycle(ls, epoch, cap, &b.off_grid);
         if (k < 0) {
-            status = cli_fail(CLI_EXIT_INTERNAL, "out of memory");
+            status = coavoid_cli_fail(CLI_EXIT_INTERNAL, "out of memory");
         } else if (k == 0) {
-            status = cli_fail(CLI_EXIT_INVALID,
+            status = coavoid_cli_fail(CLI_EXIT_INVALID,
                               "%s: no cycle after cycle 0 (epoch %" PRId64
                               " us, dt %g s) has every UAV's own intent: nothing to judge",
                               o->log_path, epoch, (double)s->dt);
@@ -945,7 +945,7 @@ static int summarise(void *options, scenario_t *s)
         b.offsets = calloc(cells, sizeof *b.offsets);
         if (b.best == NULL || b.own == NULL || b.known == NULL || b.reference == NULL ||
             b.offsets == NULL) {
-            status = cli_fail(CLI_EXIT_INTERNAL, "out of memory");
+            status = coavoid_cli_fail(CLI_EXIT_INTERNAL, "out of memory");
         }
     }
     /* Pass 2: the samples, from the same bytes pass 1 checked. */
@@ -957,21 +957,21 @@ static int summarise(void *options, scenario_t *s)
         log_close(&r);
     }
     if (status == CLI_CONTINUE && fill_gaps(s, &b) != COA_OK) {
-        status = cli_fail(CLI_EXIT_INVALID, "%s: a route cannot be sampled over %lu steps",
+        status = coavoid_cli_fail(CLI_EXIT_INVALID, "%s: a route cannot be sampled over %lu steps",
                           o->scenario_path, (unsigned long)b.steps);
     }
 
-    judged_t judged;
-    const coa_flight_t *flight = &judged.flight;
-    const coa_flight_eval_t *eval = &judged.eval;
+    coavoid_judged_t judged;
+    const coavoid_flight_t *flight = &judged.flight;
+    const coavoid_flight_eval_t *eval = &judged.eval;
     if (status == CLI_CONTINUE) {
         uint32_t replans = count_replans(ls, epoch + ((int64_t)b.steps + 1) * ls->dt_us);
-        int rc = judge_run(&judged, s, o->mode, b.steps, replans, b.reference, b.offsets,
+        int rc = coavoid_judge_run(&judged, s, o->mode, b.steps, replans, b.reference, b.offsets,
                            b.known);
         if (rc == COA_ERR_ARGUMENT) {
             status = refused_record(o, flight, &b);
         } else if (rc != COA_OK) {
-            status = cli_fail(CLI_EXIT_INTERNAL, "cannot judge the flight (%s)",
+            status = coavoid_cli_fail(CLI_EXIT_INTERNAL, "cannot judge the flight (%s)",
                               coa_status_name(rc));
         }
         /* The figure first: a file that cannot be written is a usage error, reported
@@ -984,8 +984,8 @@ static int summarise(void *options, scenario_t *s)
                 status = print_json(ls, &b, epoch, flight, eval);
             } else {
                 print_log_text(ls, &b, epoch);
-                if (coa_flight_text(flight, eval, stdout) != COA_OK) {
-                    status = cli_fail(CLI_EXIT_INTERNAL, "cannot write the result");
+                if (coavoid_flight_text(flight, eval, stdout) != COA_OK) {
+                    status = coavoid_cli_fail(CLI_EXIT_INTERNAL, "cannot write the result");
                 }
             }
         }
@@ -1001,12 +1001,12 @@ static int summarise(void *options, scenario_t *s)
     return status;
 }
 
-int command_summary(int argc, char **argv)
+int coavoid_command_summary(int argc, char **argv)
 {
     summary_options_t options;
     int status = parse_summary_options(argc, argv, &options);
     if (status != CLI_CONTINUE) {
         return status;
     }
-    return cli_run_scenario(options.scenario_path, summarise, &options);
+    return coavoid_cli_run_scenario(options.scenario_path, summarise, &options);
 }

@@ -26,7 +26,7 @@
     "of a real-time run, for the coordinator and the vehicles (coavoid-coordinator,\n"       \
     "coavoid-vehicle).\n"                                                                     \
     "\n"                                                                                      \
-    "options:\n" COA_RT_OPTIONS_USAGE                                                         \
+    "options:\n" COAVOID_RT_OPTIONS_USAGE                                                         \
     "  -h, --help          show this help\n"                                                  \
     "\n"                                                                                      \
     "exit status: 0 done, 2 invalid input or usage (one line on stderr), 3 internal error\n"
@@ -38,73 +38,73 @@ static void world_help(void)
 
 static int world_option(int argc, char **argv, int *i, void *options)
 {
-    return coa_rt_parse_option(argc, argv, i, options);
+    return coavoid_rt_parse_option(argc, argv, i, options);
 }
 
-static const cli_command_t world_command = {
+static const coavoid_cli_command_t world_command = {
     "world", "coavoid world", 2, {"SCENARIO.json", NULL}, "one scenario only", world_help,
     world_option};
 
 typedef struct {
     const char *path;
-    coa_rt_options_t rt;
+    coavoid_rt_options_t rt;
 } world_options_t;
 
-static void world_report(void *user, const char *name, const coa_rt_result_t *result,
+static void world_report(void *user, const char *name, const coavoid_rt_result_t *result,
                          const char *tail)
 {
-    const scenario_t *s = user;
+    const coavoid_scenario_t *s = user;
     fprintf(stderr, "%s: %lld cycles, %zu obstacles and %zu tracks published each%s\n", name,
             (long long)result->cycles, s->obstacle_count, s->track_count, tail);
 }
 
 /* Everything after the scenario is loaded. Returns the exit status. */
-static int world(void *options, scenario_t *s)
+static int world(void *options, coavoid_scenario_t *s)
 {
     world_options_t *o = options;
     int64_t now = 0; /* the node's clock (common.clock), written by the loop */
-    coa_world_config_t config;
+    coavoid_world_config_t config;
     memset(&config, 0, sizeof config);
-    int status = coa_rt_setup(o->path, s, &o->rt, &now, &config.common);
+    int status = coavoid_rt_setup(o->path, s, &o->rt, &now, &config.common);
     if (status != CLI_CONTINUE) {
         return status;
     }
-    config.id = COA_NODE_WORLD_ID;
+    config.id = COAVOID_NODE_WORLD_ID;
     config.obstacles = s->obstacles;
     config.obstacle_count = s->obstacle_count;
     config.tracks = s->tracks;
     config.track_count = s->track_count;
 
     char err[512];
-    lcm_t *lcm = coa_rt_lcm_create(o->rt.lcm_url, err, sizeof err);
+    lcm_t *lcm = coavoid_rt_lcm_create(o->rt.lcm_url, err, sizeof err);
     if (lcm == NULL) {
-        return cli_fail(CLI_EXIT_INVALID, "%s", err);
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s", err);
     }
     int error = COA_OK;
-    coa_world_t *node = coa_world_create(&config, lcm, &error);
+    coavoid_world_t *node = coavoid_world_create(&config, lcm, &error);
     if (node == NULL) {
         lcm_destroy(lcm);
-        return cli_fail(error == COA_ERR_ARGUMENT ? CLI_EXIT_INVALID : CLI_EXIT_INTERNAL,
-                        "world: %s: cannot publish it (%s)", o->path, coa_lcm_error_name(error));
+        return coavoid_cli_fail(error == COA_ERR_ARGUMENT ? CLI_EXIT_INVALID : CLI_EXIT_INTERNAL,
+                        "world: %s: cannot publish it (%s)", o->path, coavoid_lcm_error_name(error));
     }
-    coa_rt_loop_t loop;
-    coa_rt_loop_init(&loop, &o->rt, lcm, &now, &config.common, "world");
+    coavoid_rt_loop_t loop;
+    coavoid_rt_loop_init(&loop, &o->rt, lcm, &now, &config.common, "world");
     loop.world = node;
     loop.world_lead_us = config.common.dt_us / 4;
-    status = coa_rt_drive(&loop, o->rt.lcm_url, world_report, s);
-    coa_world_destroy(node);
+    status = coavoid_rt_drive(&loop, o->rt.lcm_url, world_report, s);
+    coavoid_world_destroy(node);
     lcm_destroy(lcm);
     return status;
 }
 
-int command_world(int argc, char **argv)
+int coavoid_command_world(int argc, char **argv)
 {
     world_options_t options;
     options.path = NULL;
-    coa_rt_options_init(&options.rt);
-    int status = cli_parse_args(&world_command, argc, argv, &options.rt, &options.path);
+    coavoid_rt_options_init(&options.rt);
+    int status = coavoid_cli_parse_args(&world_command, argc, argv, &options.rt, &options.path);
     if (status != CLI_CONTINUE) {
         return status;
     }
-    return cli_run_scenario(options.path, world, &options);
+    return coavoid_cli_run_scenario(options.path, world, &options);
 }

@@ -32,7 +32,7 @@
     "\n"                                                                                       \
     "options:\n"                                                                               \
     "  --scenario FILE     the scenario (docs/scenario-format.md)\n"                          \
-    COA_RT_OPTIONS_USAGE                                                                       \
+    COAVOID_RT_OPTIONS_USAGE                                                                       \
     "  --beta B            nodes a joint search of its planner stores, B >= 1; default the\n" \
     "                      scenario's \"beta\", else %u lowered so the workspace fits 1 GiB\n" \
     "  --max-centralised N largest cluster planned centrally, 1..%u (default %u); the\n"     \
@@ -57,7 +57,7 @@ typedef struct {
     size_t max_centralised;
     const char *collect_text;
     double collect;
-    coa_rt_options_t rt;
+    coavoid_rt_options_t rt;
 } coordinator_options_t;
 
 static void coordinator_help(void)
@@ -71,27 +71,27 @@ static int coordinator_option(int argc, char **argv, int *i, void *options)
     coordinator_options_t *o = options;
     const char *arg = argv[*i];
     uint64_t value = 0;
-    int status = coa_rt_parse_option(argc, argv, i, &o->rt);
+    int status = coavoid_rt_parse_option(argc, argv, i, &o->rt);
     if (status != CLI_UNKNOWN_OPTION) {
         return status;
     }
-    if (cli_option_is(arg, "--scenario")) {
-        status = cli_text_option(argc, argv, i, "--scenario", "a scenario file", false,
+    if (coavoid_cli_option_is(arg, "--scenario")) {
+        status = coavoid_cli_text_option(argc, argv, i, "--scenario", "a scenario file", false,
                                  &o->scenario_path);
-    } else if (cli_option_is(arg, "--beta")) {
-        status = cli_count_option(argc, argv, i, "--beta", "an integer >= 1", false, UINT32_MAX,
+    } else if (coavoid_cli_option_is(arg, "--beta")) {
+        status = coavoid_cli_count_option(argc, argv, i, "--beta", "an integer >= 1", false, UINT32_MAX,
                                   &o->beta_text, &value);
         o->beta = (uint32_t)value;
-    } else if (cli_option_is(arg, "--max-centralised")) {
-        status = cli_count_option(argc, argv, i, "--max-centralised", NULL, false,
+    } else if (coavoid_cli_option_is(arg, "--max-centralised")) {
+        status = coavoid_cli_count_option(argc, argv, i, "--max-centralised", NULL, false,
                                   COA_MAX_CENTRALISED, &o->max_text, &value);
         o->max_centralised = (size_t)value;
-    } else if (cli_option_is(arg, "--collect")) {
-        status = cli_text_option(argc, argv, i, "--collect", "scenario seconds", true,
+    } else if (coavoid_cli_option_is(arg, "--collect")) {
+        status = coavoid_cli_text_option(argc, argv, i, "--collect", "scenario seconds", true,
                                  &o->collect_text);
-        if (status == CLI_CONTINUE && (!cli_parse_real(o->collect_text, &o->collect) ||
+        if (status == CLI_CONTINUE && (!coavoid_cli_parse_real(o->collect_text, &o->collect) ||
                                        !(o->collect > 0))) {
-            status = cli_fail(CLI_EXIT_INVALID,
+            status = coavoid_cli_fail(CLI_EXIT_INVALID,
                               "--collect: must be a number of seconds > 0, got '%.40s'",
                               o->collect_text);
         }
@@ -99,29 +99,29 @@ static int coordinator_option(int argc, char **argv, int *i, void *options)
     return status;
 }
 
-static const cli_command_t coordinator_command = {
+static const coavoid_cli_command_t coordinator_command = {
     "coordinator", "coavoid-coordinator", 1, {NULL, NULL}, "the scenario is --scenario FILE",
     coordinator_help, coordinator_option};
 
 static int parse_options(int argc, char **argv, coordinator_options_t *o)
 {
     memset(o, 0, sizeof *o);
-    coa_rt_options_init(&o->rt);
+    coavoid_rt_options_init(&o->rt);
     o->max_centralised = COORDINATOR_DEFAULT_MAX_CENTRALISED;
-    int status = cli_parse_args(&coordinator_command, argc, argv, o, NULL);
+    int status = coavoid_cli_parse_args(&coordinator_command, argc, argv, o, NULL);
     if (status != CLI_CONTINUE) {
         return status;
     }
     if (o->scenario_path == NULL) {
-        return cli_fail(CLI_EXIT_INVALID, "--scenario: required (a scenario file)");
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "--scenario: required (a scenario file)");
     }
     return CLI_CONTINUE;
 }
 
-static void coordinator_report(void *user, const char *name, const coa_rt_result_t *result,
+static void coordinator_report(void *user, const char *name, const coavoid_rt_result_t *result,
                                const char *tail)
 {
-    const coa_coordinator_state_t *st = coa_coordinator_state(user);
+    const coavoid_coordinator_state_t *st = coavoid_coordinator_state(user);
     fprintf(stderr,
             "%s: %lld cycles, plans run %u, plans published %u, last plan %.1f ms "
             "(%llu nodes expanded), messages received %lld, rejected %lld (last: %s)%s\n",
@@ -133,22 +133,22 @@ static void coordinator_report(void *user, const char *name, const coa_rt_result
 }
 
 /* Everything after the options. Returns the exit status. */
-static int run(void *options, scenario_t *s)
+static int run(void *options, coavoid_scenario_t *s)
 {
     coordinator_options_t *o = options;
     int64_t now = 0; /* the node's clock (common.clock), written by the loop */
-    coa_coordinator_config_t config;
+    coavoid_coordinator_config_t config;
     memset(&config, 0, sizeof config);
-    int status = coa_rt_setup(o->scenario_path, s, &o->rt, &now, &config.common);
+    int status = coavoid_rt_setup(o->scenario_path, s, &o->rt, &now, &config.common);
     if (status != CLI_CONTINUE) {
         return status;
     }
     const int64_t dt_us = config.common.dt_us;
-    config.id = COA_NODE_COORDINATOR_ID;
+    config.id = COAVOID_NODE_COORDINATOR_ID;
     config.max_centralised = o->max_centralised;
     config.collect_us = o->collect_text != NULL ? llround(o->collect * 1e6) : dt_us / 4;
     if (config.collect_us < 1 || config.collect_us >= dt_us) {
-        return cli_fail(CLI_EXIT_INVALID,
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
                         "--collect: must be above 0 and below the scenario's dt (%g s), got %g",
                         (double)s->dt, o->collect);
     }
@@ -159,46 +159,46 @@ static int run(void *options, scenario_t *s)
     } else if (s->has_beta) {
         beta_source = "the scenario's beta";
     } else {
-        coa_planner_config_t shape = coa_node_planner_config(config.common.horizon,
+        coa_planner_config_t shape = coavoid_node_planner_config(config.common.horizon,
                                                              o->max_centralised, CLI_DEFAULT_BETA);
-        config.common.beta = cli_default_beta(&shape);
+        config.common.beta = coavoid_cli_default_beta(&shape);
         beta_source = "the default beta";
     }
     coa_planner_config_t planner_config =
-        coa_node_planner_config(config.common.horizon, o->max_centralised, config.common.beta);
+        coavoid_node_planner_config(config.common.horizon, o->max_centralised, config.common.beta);
     size_t size = coa_planner_workspace_size(&planner_config);
     if (size == 0) {
-        return cli_fail(CLI_EXIT_INVALID,
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
                         "%s %lu: the workspace for %zu vehicles would not fit in memory (lower "
                         "--beta or --max-centralised)",
                         beta_source, (unsigned long)config.common.beta, o->max_centralised);
     }
 
     char err[512];
-    lcm_t *lcm = coa_rt_lcm_create(o->rt.lcm_url, err, sizeof err);
+    lcm_t *lcm = coavoid_rt_lcm_create(o->rt.lcm_url, err, sizeof err);
     if (lcm == NULL) {
-        return cli_fail(CLI_EXIT_INVALID, "%s", err);
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s", err);
     }
     int error = COA_OK;
-    coa_coordinator_t *node = coa_coordinator_create(&config, lcm, &error);
+    coavoid_coordinator_t *node = coavoid_coordinator_create(&config, lcm, &error);
     if (node == NULL) {
         lcm_destroy(lcm);
         if (error == COA_ERR_WORKSPACE) {
-            return cli_fail(CLI_EXIT_INVALID,
+            return coavoid_cli_fail(CLI_EXIT_INVALID,
                             "%s %lu: cannot allocate the planner's %zu bytes for %zu vehicles "
                             "(lower --beta or --max-centralised)",
                             beta_source, (unsigned long)config.common.beta, size,
                             o->max_centralised);
         }
-        return cli_fail(error == COA_ERR_ARGUMENT ? CLI_EXIT_INVALID : CLI_EXIT_INTERNAL,
-                        "coordinator: cannot start (%s)", coa_lcm_error_name(error));
+        return coavoid_cli_fail(error == COA_ERR_ARGUMENT ? CLI_EXIT_INVALID : CLI_EXIT_INTERNAL,
+                        "coordinator: cannot start (%s)", coavoid_lcm_error_name(error));
     }
-    coa_rt_loop_t loop;
-    coa_rt_loop_init(&loop, &o->rt, lcm, &now, &config.common, "coordinator");
+    coavoid_rt_loop_t loop;
+    coavoid_rt_loop_init(&loop, &o->rt, lcm, &now, &config.common, "coordinator");
     loop.collect_us = config.collect_us;
     loop.coordinator = node;
-    status = coa_rt_drive(&loop, o->rt.lcm_url, coordinator_report, node);
-    coa_coordinator_destroy(node);
+    status = coavoid_rt_drive(&loop, o->rt.lcm_url, coordinator_report, node);
+    coavoid_coordinator_destroy(node);
     lcm_destroy(lcm);
     return status;
 }
@@ -210,5 +210,5 @@ int main(int argc, char **argv)
     if (status != CLI_CONTINUE) {
         return status;
     }
-    return cli_run_scenario(options.scenario_path, run, &options);
+    return coavoid_cli_run_scenario(options.scenario_path, run, &options);
 }

@@ -36,7 +36,7 @@ static void rt_on_signal(int sig)
     rt_stop_signal = sig;
 }
 
-int coa_rt_install_signal_handlers(void)
+int coavoid_rt_install_signal_handlers(void)
 {
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
@@ -49,14 +49,14 @@ int coa_rt_install_signal_handlers(void)
     return 0;
 }
 
-int64_t coa_rt_wall_utime(void)
+int64_t coavoid_rt_wall_utime(void)
 {
     struct timespec ts;
     clock_gettime(CLOCK_REALTIME, &ts);
     return (int64_t)ts.tv_sec * 1000000 + (int64_t)ts.tv_nsec / 1000;
 }
 
-int64_t coa_rt_stopwatch_us(void *user)
+int64_t coavoid_rt_stopwatch_us(void *user)
 {
     (void)user;
     struct timespec ts;
@@ -64,7 +64,7 @@ int64_t coa_rt_stopwatch_us(void *user)
     return (int64_t)ts.tv_sec * 1000000 + (int64_t)ts.tv_nsec / 1000;
 }
 
-int64_t coa_rt_scenario_utime(const coa_rt_clock_t *clock, int64_t wall_utime)
+int64_t coavoid_rt_scenario_utime(const coavoid_rt_clock_t *clock, int64_t wall_utime)
 {
     if (wall_utime < clock->epoch_utime) {
         return wall_utime;
@@ -76,7 +76,7 @@ int64_t coa_rt_scenario_utime(const coa_rt_clock_t *clock, int64_t wall_utime)
     return clock->epoch_utime + (int64_t)elapsed;
 }
 
-int64_t coa_rt_wall_at(const coa_rt_clock_t *clock, int64_t scenario_utime)
+int64_t coavoid_rt_wall_at(const coavoid_rt_clock_t *clock, int64_t scenario_utime)
 {
     if (scenario_utime <= clock->epoch_utime) {
         return scenario_utime;
@@ -88,7 +88,7 @@ int64_t coa_rt_wall_at(const coa_rt_clock_t *clock, int64_t scenario_utime)
     }
     int64_t wall = clock->epoch_utime + (int64_t)elapsed;
     /* Rounding in the division can leave it a microsecond short of the inverse. */
-    while (coa_rt_scenario_utime(clock, wall) < scenario_utime) {
+    while (coavoid_rt_scenario_utime(clock, wall) < scenario_utime) {
         wall++;
     }
     return wall;
@@ -96,63 +96,63 @@ int64_t coa_rt_wall_at(const coa_rt_clock_t *clock, int64_t scenario_utime)
 
 /* ---- options ---- */
 
-void coa_rt_options_init(coa_rt_options_t *o)
+void coavoid_rt_options_init(coavoid_rt_options_t *o)
 {
     memset(o, 0, sizeof *o);
     o->speed = 1.0;
 }
 
-int coa_rt_parse_option(int argc, char **argv, int *i, coa_rt_options_t *o)
+int coavoid_rt_parse_option(int argc, char **argv, int *i, coavoid_rt_options_t *o)
 {
     const char *arg = argv[*i];
     uint64_t value = 0;
     int status = CLI_UNKNOWN_OPTION;
-    if (cli_option_is(arg, "--lcm-url")) {
-        status = cli_text_option(argc, argv, i, "--lcm-url",
-                                 "an LCM URL, e.g. " COA_RT_DEFAULT_LCM_URL, false, &o->lcm_url);
-    } else if (cli_option_is(arg, "--epoch")) {
-        status = cli_text_option(argc, argv, i, "--epoch", "wall-clock microseconds since 1970",
+    if (coavoid_cli_option_is(arg, "--lcm-url")) {
+        status = coavoid_cli_text_option(argc, argv, i, "--lcm-url",
+                                 "an LCM URL, e.g. " COAVOID_RT_DEFAULT_LCM_URL, false, &o->lcm_url);
+    } else if (coavoid_cli_option_is(arg, "--epoch")) {
+        status = coavoid_cli_text_option(argc, argv, i, "--epoch", "wall-clock microseconds since 1970",
                                  true, &o->epoch_text);
         if (status == CLI_CONTINUE &&
-            !cli_parse_count(o->epoch_text, strlen(o->epoch_text), (uint64_t)INT64_MAX, &value)) {
-            status = cli_fail(CLI_EXIT_INVALID,
+            !coavoid_cli_parse_count(o->epoch_text, strlen(o->epoch_text), (uint64_t)INT64_MAX, &value)) {
+            status = coavoid_cli_fail(CLI_EXIT_INVALID,
                               "--epoch: must be a positive integer (wall-clock microseconds "
                               "since 1970), got '%.40s'",
                               o->epoch_text);
         }
         o->epoch_utime = (int64_t)value;
-    } else if (cli_option_is(arg, "--speed")) {
-        status = cli_text_option(argc, argv, i, "--speed", "scenario seconds per wall second",
+    } else if (coavoid_cli_option_is(arg, "--speed")) {
+        status = coavoid_cli_text_option(argc, argv, i, "--speed", "scenario seconds per wall second",
                                  true, &o->speed_text);
-        if (status == CLI_CONTINUE && (!cli_parse_real(o->speed_text, &o->speed) ||
-                                       !(o->speed > 0) || o->speed > COA_RT_MAX_SPEED)) {
-            status = cli_fail(CLI_EXIT_INVALID,
+        if (status == CLI_CONTINUE && (!coavoid_cli_parse_real(o->speed_text, &o->speed) ||
+                                       !(o->speed > 0) || o->speed > COAVOID_RT_MAX_SPEED)) {
+            status = coavoid_cli_fail(CLI_EXIT_INVALID,
                               "--speed: must be a number with 0 < S <= %g, got '%.40s'",
-                              COA_RT_MAX_SPEED, o->speed_text);
+                              COAVOID_RT_MAX_SPEED, o->speed_text);
         }
-    } else if (cli_option_is(arg, "--steps")) {
-        status = cli_count_option(argc, argv, i, "--steps", "an integer >= 1", false, RT_MAX_STEPS,
+    } else if (coavoid_cli_option_is(arg, "--steps")) {
+        status = coavoid_cli_count_option(argc, argv, i, "--steps", "an integer >= 1", false, RT_MAX_STEPS,
                                   &o->steps_text, &value);
         o->steps = (int64_t)value;
     }
     return status;
 }
 
-int coa_rt_options_finish(coa_rt_options_t *o, int64_t dt_us, uint32_t horizon)
+int coavoid_rt_options_finish(coavoid_rt_options_t *o, int64_t dt_us, uint32_t horizon)
 {
     if (o->lcm_url == NULL) {
-        o->lcm_url = COA_RT_DEFAULT_LCM_URL;
+        o->lcm_url = COAVOID_RT_DEFAULT_LCM_URL;
     }
     if (o->steps_text == NULL) {
         o->steps = 2 * (int64_t)horizon;
     }
-    int64_t now = coa_rt_wall_utime();
+    int64_t now = coavoid_rt_wall_utime();
     if (o->epoch_text == NULL) {
         o->epoch_utime = now;
         return CLI_CONTINUE;
     }
-    if (o->epoch_utime > now && o->epoch_utime - now > COA_RT_MAX_EPOCH_AHEAD_US) {
-        return cli_fail(CLI_EXIT_INVALID,
+    if (o->epoch_utime > now && o->epoch_utime - now > COAVOID_RT_MAX_EPOCH_AHEAD_US) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
                         "--epoch: %lld is more than a day ahead of this clock (%lld): it is "
                         "microseconds since 1970, e.g. $(( $(date +%%s) + 2 ))000000",
                         (long long)o->epoch_utime, (long long)now);
@@ -161,7 +161,7 @@ int coa_rt_options_finish(coa_rt_options_t *o, int64_t dt_us, uint32_t horizon)
     double run_us = (double)o->steps * (double)dt_us / o->speed;
     double end = (double)o->epoch_utime + run_us;
     if (end < (double)now) {
-        return cli_fail(CLI_EXIT_INVALID,
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
                         "--epoch: the run of %lld cycles from %lld ended %.1f s ago (this "
                         "clock: %lld)",
                         (long long)o->steps, (long long)o->epoch_utime,
@@ -170,30 +170,30 @@ int coa_rt_options_finish(coa_rt_options_t *o, int64_t dt_us, uint32_t horizon)
     return CLI_CONTINUE;
 }
 
-int coa_rt_setup(const char *path, scenario_t *s, coa_rt_options_t *o, const int64_t *now,
-                 coa_node_common_t *common)
+int coavoid_rt_setup(const char *path, coavoid_scenario_t *s, coavoid_rt_options_t *o, const int64_t *now,
+                 coavoid_node_common_t *common)
 {
-    int status = cli_sample_scenario(path, s);
+    int status = coavoid_cli_sample_scenario(path, s);
     if (status != CLI_CONTINUE) {
         return status;
     }
-    if (s->horizon > COA_NODE_MAX_HORIZON) {
-        return cli_fail(CLI_EXIT_INVALID,
+    if (s->horizon > COAVOID_NODE_MAX_HORIZON) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
                         "%s: horizon: %lu steps, the nodes' messages carry at most %u",
-                        path, (unsigned long)s->horizon, COA_NODE_MAX_HORIZON);
+                        path, (unsigned long)s->horizon, COAVOID_NODE_MAX_HORIZON);
     }
     int64_t dt_us = llround((double)s->dt * 1e6);
     if (dt_us < 1) {
-        return cli_fail(CLI_EXIT_INVALID, "%s: dt: below a microsecond", path);
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: dt: below a microsecond", path);
     }
-    status = coa_rt_options_finish(o, dt_us, s->horizon);
+    status = coavoid_rt_options_finish(o, dt_us, s->horizon);
     if (status != CLI_CONTINUE) {
         return status;
     }
-    if (coa_node_common_defaults(common, o->epoch_utime, s->dt, s->horizon, now) != COA_OK) {
-        return cli_fail(CLI_EXIT_INVALID, "%s: dt or horizon refused by the nodes", path);
+    if (coavoid_node_common_defaults(common, o->epoch_utime, s->dt, s->horizon, now) != COA_OK) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: dt or horizon refused by the nodes", path);
     }
-    common->stopwatch_us = coa_rt_stopwatch_us;
+    common->stopwatch_us = coavoid_rt_stopwatch_us;
     common->stopwatch_user = NULL;
     if (s->has_beta) {
         common->beta = s->beta;
@@ -218,7 +218,7 @@ static void first_line(const char *text, char *out, size_t size)
     out[n] = '\0';
 }
 
-lcm_t *coa_rt_lcm_create(const char *url, char *err, size_t err_size)
+lcm_t *coavoid_rt_lcm_create(const char *url, char *err, size_t err_size)
 {
     char said[4096];
     size_t said_length = 0;
@@ -270,8 +270,8 @@ lcm_t *coa_rt_lcm_create(const char *url, char *err, size_t err_size)
 
 /* ---- the loop ---- */
 
-void coa_rt_loop_init(coa_rt_loop_t *loop, const coa_rt_options_t *o, lcm_t *lcm, int64_t *now,
-                      const coa_node_common_t *common, const char *name)
+void coavoid_rt_loop_init(coavoid_rt_loop_t *loop, const coavoid_rt_options_t *o, lcm_t *lcm, int64_t *now,
+                      const coavoid_node_common_t *common, const char *name)
 {
     memset(loop, 0, sizeof *loop);
     loop->clock.epoch_utime = o->epoch_utime;
@@ -284,33 +284,33 @@ void coa_rt_loop_init(coa_rt_loop_t *loop, const coa_rt_options_t *o, lcm_t *lcm
     loop->warnings = stderr;
 }
 
-int coa_rt_drive(const coa_rt_loop_t *loop, const char *lcm_url, coa_rt_report_t report,
+int coavoid_rt_drive(const coavoid_rt_loop_t *loop, const char *lcm_url, coavoid_rt_report_t report,
                  void *user)
 {
-    if (coa_rt_install_signal_handlers() != 0) {
-        return cli_fail(CLI_EXIT_INTERNAL, "%s: cannot handle SIGINT/SIGTERM", loop->name);
+    if (coavoid_rt_install_signal_handlers() != 0) {
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "%s: cannot handle SIGINT/SIGTERM", loop->name);
     }
-    coa_rt_result_t result;
-    int rc = coa_rt_run(loop, &result);
+    coavoid_rt_result_t result;
+    int rc = coavoid_rt_run(loop, &result);
     char tail[256];
-    coa_rt_result_text(&result, tail, sizeof tail);
+    coavoid_rt_result_text(&result, tail, sizeof tail);
     report(user, loop->name, &result, tail);
     if (rc != COA_OK) {
-        return cli_fail(CLI_EXIT_INTERNAL, "%s: LCM failed while running (%s)", loop->name,
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "%s: LCM failed while running (%s)", loop->name,
                         lcm_url);
     }
     return result.errors > 0 ? CLI_EXIT_INTERNAL : CLI_EXIT_OK;
 }
 
 typedef struct {
-    const coa_rt_loop_t *loop;
-    coa_rt_result_t *result;
-    const coa_node_common_t *common;
+    const coavoid_rt_loop_t *loop;
+    coavoid_rt_result_t *result;
+    const coavoid_node_common_t *common;
 } rt_run_t;
 
 static int64_t rt_now(const rt_run_t *r)
 {
-    return coa_rt_scenario_utime(&r->loop->clock, coa_rt_wall_utime());
+    return coavoid_rt_scenario_utime(&r->loop->clock, coavoid_rt_wall_utime());
 }
 
 static void rt_warn(const rt_run_t *r, const char *fmt, ...) CLI_PRINTF_LIKE(2, 3);
@@ -335,7 +335,7 @@ static void rt_error(const rt_run_t *r, const char *what, int64_t cycle, int rc)
     if (r->result->first_error == 0) {
         r->result->first_error = rc;
     }
-    rt_warn(r, "cycle %lld: %s failed (%s)", (long long)cycle, what, coa_lcm_error_name(rc));
+    rt_warn(r, "cycle %lld: %s failed (%s)", (long long)cycle, what, coavoid_lcm_error_name(rc));
 }
 
 /* Work that ended at `end` (scenario time) for an event whose successor is due at `next`;
@@ -347,7 +347,7 @@ static void rt_check_overrun(const rt_run_t *r, const char *what, int64_t cycle,
         return;
     }
     r->result->overruns++;
-    int64_t took = coa_rt_stopwatch_us(NULL) - started;
+    int64_t took = coavoid_rt_stopwatch_us(NULL) - started;
     rt_warn(r,
             "cycle %lld: %s overran: it ended %.0f ms (scenario time) after cycle %lld began, "
             "having taken %.0f ms of wall time at speed %g; lower --speed",
@@ -358,24 +358,24 @@ static void rt_check_overrun(const rt_run_t *r, const char *what, int64_t cycle,
 /* Cycle k's start for the world and the vehicles. */
 static void rt_cycle_start(const rt_run_t *r, int64_t k)
 {
-    const coa_rt_loop_t *loop = r->loop;
-    int64_t next = coa_node_cycle_utime(r->common, k + 1);
+    const coavoid_rt_loop_t *loop = r->loop;
+    int64_t next = coavoid_node_cycle_utime(r->common, k + 1);
     if (loop->world != NULL) {
-        int64_t started = coa_rt_stopwatch_us(NULL);
+        int64_t started = coavoid_rt_stopwatch_us(NULL);
         *loop->now = rt_now(r);
         /* Ahead of the cycle (world_lead_us), its messages still speak of the cycle. */
-        int64_t at = *loop->now > coa_node_cycle_utime(r->common, k) ? *loop->now
-                                                                      : coa_node_cycle_utime(r->common, k);
-        int rc = coa_world_cycle(loop->world, at);
+        int64_t at = *loop->now > coavoid_node_cycle_utime(r->common, k) ? *loop->now
+                                                                      : coavoid_node_cycle_utime(r->common, k);
+        int rc = coavoid_world_cycle(loop->world, at);
         if (rc < 0) {
             rt_error(r, "the world's cycle", k, rc);
         }
         rt_check_overrun(r, "publishing the world", k, rt_now(r), next, started);
     }
     for (size_t i = 0; i < loop->vehicle_count; i++) {
-        int64_t started = coa_rt_stopwatch_us(NULL);
+        int64_t started = coavoid_rt_stopwatch_us(NULL);
         *loop->now = rt_now(r);
-        int rc = coa_vehicle_node_cycle(loop->vehicles[i], *loop->now);
+        int rc = coavoid_vehicle_node_cycle(loop->vehicles[i], *loop->now);
         if (rc < 0) {
             rt_error(r, "the vehicle's cycle", k, rc);
         }
@@ -388,12 +388,12 @@ static void rt_cycle_start(const rt_run_t *r, int64_t k)
  * that a deadline the node does not move cannot make the loop spin. */
 static void rt_poll(const rt_run_t *r, size_t i, int64_t *deadline_polled)
 {
-    const coa_rt_loop_t *loop = r->loop;
-    int64_t started = coa_rt_stopwatch_us(NULL);
-    int64_t deadline = coa_vehicle_node_deadline(loop->vehicles[i]);
+    const coavoid_rt_loop_t *loop = r->loop;
+    int64_t started = coavoid_rt_stopwatch_us(NULL);
+    int64_t deadline = coavoid_vehicle_node_deadline(loop->vehicles[i]);
     *loop->now = rt_now(r);
-    int64_t k = coa_node_cycle_of(r->common, *loop->now);
-    int rc = coa_vehicle_node_poll(loop->vehicles[i], *loop->now);
+    int64_t k = coavoid_node_cycle_of(r->common, *loop->now);
+    int rc = coavoid_vehicle_node_poll(loop->vehicles[i], *loop->now);
     if (deadline <= *loop->now) {
         *deadline_polled = deadline;
     }
@@ -401,20 +401,20 @@ static void rt_poll(const rt_run_t *r, size_t i, int64_t *deadline_polled)
         rt_error(r, "the vehicle's poll", k, rc);
     } else if (rc > 0) {
         rt_check_overrun(r, "the vehicle's planning", k, rt_now(r),
-                         coa_node_cycle_utime(r->common, k + 1), started);
+                         coavoid_node_cycle_utime(r->common, k + 1), started);
     }
 }
 
 /* The vehicle's deadline unless it was already polled for. */
 static int64_t rt_pending_deadline(const rt_run_t *r, size_t i, int64_t deadline_polled)
 {
-    int64_t deadline = coa_vehicle_node_deadline(r->loop->vehicles[i]);
+    int64_t deadline = coavoid_vehicle_node_deadline(r->loop->vehicles[i]);
     return deadline == deadline_polled ? INT64_MAX : deadline;
 }
 
 /* Dispatches the messages waiting, each with the clock set just before, at most
  * RT_MAX_DRAIN at a time so that a flood cannot starve the nodes' own events. Returns
- * how many, or COA_RT_ERR_LCM. */
+ * how many, or COAVOID_RT_ERR_LCM. */
 static int rt_drain(const rt_run_t *r)
 {
     int handled = 0;
@@ -424,7 +424,7 @@ static int rt_drain(const rt_run_t *r)
         int rc = lcm_handle_timeout(r->loop->lcm, 0);
         if (rc < 0) {
             /* A signal during LCM's own select: the loop looks at the stop flag next. */
-            return errno == EINTR ? handled : COA_RT_ERR_LCM;
+            return errno == EINTR ? handled : COAVOID_RT_ERR_LCM;
         }
         if (rc == 0) {
             break;
@@ -435,10 +435,10 @@ static int rt_drain(const rt_run_t *r)
 }
 
 /* Waits until wall time `wake` or a message, whichever is first. Returns 1 when LCM has a
- * message, 0 on time-out or a signal, COA_RT_ERR_LCM on failure. */
+ * message, 0 on time-out or a signal, COAVOID_RT_ERR_LCM on failure. */
 static int rt_wait(int fd, int64_t wake_wall)
 {
-    int64_t wait_us = wake_wall - coa_rt_wall_utime();
+    int64_t wait_us = wake_wall - coavoid_rt_wall_utime();
     if (wait_us < 0) {
         wait_us = 0;
     }
@@ -453,32 +453,32 @@ static int rt_wait(int fd, int64_t wake_wall)
     tv.tv_usec = (suseconds_t)(wait_us % 1000000);
     int rc = select(fd + 1, &fds, NULL, NULL, &tv);
     if (rc < 0) {
-        return errno == EINTR ? 0 : COA_RT_ERR_LCM;
+        return errno == EINTR ? 0 : COAVOID_RT_ERR_LCM;
     }
     return rc > 0 ? 1 : 0;
 }
 
-int coa_rt_run(const coa_rt_loop_t *loop, coa_rt_result_t *result)
+int coavoid_rt_run(const coavoid_rt_loop_t *loop, coavoid_rt_result_t *result)
 {
     if (result != NULL) {
         memset(result, 0, sizeof *result);
     }
     if (loop == NULL || result == NULL || loop->lcm == NULL || loop->now == NULL ||
         loop->common == NULL || loop->steps < 1 || !(loop->clock.speed > 0) ||
-        loop->vehicle_count > COA_NODE_MAX_PEERS ||
+        loop->vehicle_count > COAVOID_NODE_MAX_PEERS ||
         (loop->vehicle_count > 0 && loop->vehicles == NULL) ||
         (loop->world == NULL && loop->coordinator == NULL && loop->vehicle_count == 0)) {
         return COA_ERR_ARGUMENT;
     }
     int fd = lcm_get_fileno(loop->lcm);
     if (fd < 0 || fd >= FD_SETSIZE) {
-        return COA_RT_ERR_LCM;
+        return COAVOID_RT_ERR_LCM;
     }
     rt_run_t run = {loop, result, loop->common};
     const rt_run_t *r = &run;
-    const coa_node_common_t *c = loop->common;
+    const coavoid_node_common_t *c = loop->common;
     const int64_t K = loop->steps;
-    int64_t polled[COA_NODE_MAX_PEERS];
+    int64_t polled[COAVOID_NODE_MAX_PEERS];
     for (size_t i = 0; i < loop->vehicle_count; i++) {
         polled[i] = INT64_MIN;
     }
@@ -486,7 +486,7 @@ int coa_rt_run(const coa_rt_loop_t *loop, coa_rt_result_t *result)
     /* A process started late joins at the current cycle; the coordinator, if its collect
      * time for that cycle has passed, at the next one. */
     int64_t now = rt_now(r);
-    int64_t first = now < c->epoch_utime ? 0 : coa_node_cycle_of(c, now);
+    int64_t first = now < c->epoch_utime ? 0 : coavoid_node_cycle_of(c, now);
     if (first < 0) {
         first = 0;
     }
@@ -499,7 +499,7 @@ int coa_rt_run(const coa_rt_loop_t *loop, coa_rt_result_t *result)
     int64_t next_collect = K;
     if (loop->coordinator != NULL) {
         next_collect = first;
-        if (now > coa_node_cycle_utime(c, first) + loop->collect_us) {
+        if (now > coavoid_node_cycle_utime(c, first) + loop->collect_us) {
             next_collect++;
         }
     }
@@ -511,8 +511,8 @@ int coa_rt_run(const coa_rt_loop_t *loop, coa_rt_result_t *result)
         }
         now = rt_now(r);
 
-        if (next_start <= K && now >= coa_node_cycle_utime(c, next_start) - lead) {
-            int64_t k = coa_node_cycle_of(c, now + lead);
+        if (next_start <= K && now >= coavoid_node_cycle_utime(c, next_start) - lead) {
+            int64_t k = coavoid_node_cycle_of(c, now + lead);
             if (k > K) {
                 k = K;
             }
@@ -520,15 +520,15 @@ int coa_rt_run(const coa_rt_loop_t *loop, coa_rt_result_t *result)
                 result->skipped += (uint32_t)(k - next_start);
                 rt_warn(r, "cycles %lld..%lld skipped: the loop was %.0f ms (scenario time) late",
                         (long long)next_start, (long long)(k - 1),
-                        (double)(now - coa_node_cycle_utime(c, next_start)) * 1e-3);
+                        (double)(now - coavoid_node_cycle_utime(c, next_start)) * 1e-3);
             }
             rt_cycle_start(r, k);
             next_start = k + 1;
             continue;
         }
 
-        if (next_collect < K && now >= coa_node_cycle_utime(c, next_collect) + loop->collect_us) {
-            int64_t k = coa_node_cycle_of(c, now);
+        if (next_collect < K && now >= coavoid_node_cycle_utime(c, next_collect) + loop->collect_us) {
+            int64_t k = coavoid_node_cycle_of(c, now);
             if (k > next_collect) {
                 /* Its plans would be valid until a cycle start already past: nobody could
                  * adopt them. */
@@ -536,19 +536,19 @@ int coa_rt_run(const coa_rt_loop_t *loop, coa_rt_result_t *result)
                 result->skipped += (uint32_t)missed;
                 rt_warn(r, "cycles %lld..%lld: no plans: the loop was %.0f ms (scenario time) late",
                         (long long)next_collect, (long long)(next_collect + missed - 1),
-                        (double)(now - coa_node_cycle_utime(c, next_collect) - loop->collect_us) *
+                        (double)(now - coavoid_node_cycle_utime(c, next_collect) - loop->collect_us) *
                             1e-3);
                 next_collect += missed;
                 continue;
             }
-            int64_t started = coa_rt_stopwatch_us(NULL);
+            int64_t started = coavoid_rt_stopwatch_us(NULL);
             *loop->now = now;
-            int rc = coa_coordinator_cycle(loop->coordinator, now);
+            int rc = coavoid_coordinator_cycle(loop->coordinator, now);
             if (rc < 0) {
                 rt_error(r, "the coordinator's cycle", k, rc);
             }
             rt_check_overrun(r, "the coordinator's planning", k, rt_now(r),
-                             coa_node_cycle_utime(c, k + 1), started);
+                             coavoid_node_cycle_utime(c, k + 1), started);
             if (!has_starts) {
                 result->cycles++;
             }
@@ -571,15 +571,15 @@ int coa_rt_run(const coa_rt_loop_t *loop, coa_rt_result_t *result)
             break;
         }
         if (next_start <= K) {
-            int64_t t = coa_node_cycle_utime(c, next_start) - lead;
+            int64_t t = coavoid_node_cycle_utime(c, next_start) - lead;
             wake = t < wake ? t : wake;
         }
         if (next_collect < K) {
-            int64_t t = coa_node_cycle_utime(c, next_collect) + loop->collect_us;
+            int64_t t = coavoid_node_cycle_utime(c, next_collect) + loop->collect_us;
             wake = t < wake ? t : wake;
         }
 
-        int rc = rt_wait(fd, coa_rt_wall_at(&loop->clock, wake));
+        int rc = rt_wait(fd, coavoid_rt_wall_at(&loop->clock, wake));
         if (rc < 0) {
             return rc;
         }
@@ -590,7 +590,7 @@ int coa_rt_run(const coa_rt_loop_t *loop, coa_rt_result_t *result)
             }
             /* A message may be the intent a waiting vehicle needed. */
             for (size_t i = 0; i < loop->vehicle_count; i++) {
-                const coa_vehicle_node_state_t *s = coa_vehicle_node_state(loop->vehicles[i]);
+                const coavoid_vehicle_node_state_t *s = coavoid_vehicle_node_state(loop->vehicles[i]);
                 if (s != NULL && s->waiting) {
                     rt_poll(r, i, &polled[i]);
                 }
@@ -601,7 +601,7 @@ int coa_rt_run(const coa_rt_loop_t *loop, coa_rt_result_t *result)
     return COA_OK;
 }
 
-void coa_rt_result_text(const coa_rt_result_t *result, char *out, size_t size)
+void coavoid_rt_result_text(const coavoid_rt_result_t *result, char *out, size_t size)
 {
     const char *signal_name = result->signal == SIGINT    ? "SIGINT"
                               : result->signal == SIGTERM ? "SIGTERM"
@@ -610,7 +610,7 @@ void coa_rt_result_text(const coa_rt_result_t *result, char *out, size_t size)
                      (unsigned)result->skipped);
     if (n >= 0 && (size_t)n < size && result->errors > 0) {
         n += snprintf(out + n, size - (size_t)n, ", errors %u (first: %s)",
-                      (unsigned)result->errors, coa_lcm_error_name(result->first_error));
+                      (unsigned)result->errors, coavoid_lcm_error_name(result->first_error));
     }
     if (n >= 0 && (size_t)n < size && result->signal != 0) {
         snprintf(out + n, size - (size_t)n, ", stopped by %s", signal_name);

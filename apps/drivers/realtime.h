@@ -14,7 +14,7 @@
  * (dt - collect) / S wall seconds of its collect time. Processes on one host share one
  * wall clock; on several hosts they need synchronised clocks (NTP) to well under a cycle.
  *
- * The loop (coa_rt_run). Between events it waits on LCM's file descriptor and, for every
+ * The loop (coavoid_rt_run). Between events it waits on LCM's file descriptor and, for every
  * message, sets the clock variable the nodes read (common.clock) and lets LCM dispatch it
  * (lcm_handle_timeout). At its times it calls:
  *   - at cycle_utime(k), k = first..K: the world's cycle, then each vehicle's cycle (a
@@ -33,7 +33,7 @@
  * loop resumes at the current cycle. A node's error return is reported once per
  * occurrence and the loop goes on: one failed publish must not ground a UAV.
  *
- * Stopping: SIGINT or SIGTERM (coa_rt_install_signal_handlers) ends the loop at its next
+ * Stopping: SIGINT or SIGTERM (coavoid_rt_install_signal_handlers) ends the loop at its next
  * wake-up, within a few milliseconds; the caller then destroys its nodes and LCM.
  *
  * Memory: nothing is allocated by the loop. Not thread-safe: one loop per process (the
@@ -54,75 +54,75 @@
 
 /* The LCM URL of every driver unless --lcm-url says otherwise: LCM's default group and
  * port, with ttl=0 so that the traffic never leaves the host. */
-#define COA_RT_DEFAULT_LCM_URL "udpm://239.255.76.67:7667?ttl=0"
+#define COAVOID_RT_DEFAULT_LCM_URL "udpm://239.255.76.67:7667?ttl=0"
 
 /* Largest --speed: beyond it even a 1 s cycle is shorter than the loop's own jitter. */
-#define COA_RT_MAX_SPEED 1000.0
+#define COAVOID_RT_MAX_SPEED 1000.0
 
 /* How far ahead an --epoch may be: a value further out is more likely seconds or
  * nanoseconds than the microseconds meant. */
-#define COA_RT_MAX_EPOCH_AHEAD_US (24LL * 3600LL * 1000000LL)
+#define COAVOID_RT_MAX_EPOCH_AHEAD_US (24LL * 3600LL * 1000000LL)
 
 typedef struct {
     int64_t epoch_utime; /* wall-clock utime of cycle 0's start, > 0 */
-    double speed;        /* scenario seconds per wall second, 0 < speed <= COA_RT_MAX_SPEED */
-} coa_rt_clock_t;
+    double speed;        /* scenario seconds per wall second, 0 < speed <= COAVOID_RT_MAX_SPEED */
+} coavoid_rt_clock_t;
 
 /* The wall clock (CLOCK_REALTIME) in microseconds. Cannot fail. */
-int64_t coa_rt_wall_utime(void);
+int64_t coavoid_rt_wall_utime(void);
 
 /* A monotonic microsecond count (CLOCK_MONOTONIC), with the signature of
- * coa_node_common_t.stopwatch_us; user is unused. Cannot fail. */
-int64_t coa_rt_stopwatch_us(void *user);
+ * coavoid_node_common_t.stopwatch_us; user is unused. Cannot fail. */
+int64_t coavoid_rt_stopwatch_us(void *user);
 
 /* Scenario utime at a wall utime, by the formula above (rounded down). O(1). */
-int64_t coa_rt_scenario_utime(const coa_rt_clock_t *clock, int64_t wall_utime);
+int64_t coavoid_rt_scenario_utime(const coavoid_rt_clock_t *clock, int64_t wall_utime);
 
 /* The earliest wall utime at which the scenario clock reaches `scenario_utime` (for
  * times before epoch, the time itself). O(1). */
-int64_t coa_rt_wall_at(const coa_rt_clock_t *clock, int64_t scenario_utime);
+int64_t coavoid_rt_wall_at(const coavoid_rt_clock_t *clock, int64_t scenario_utime);
 
 /* ---- options every driver shares ---- */
 
 typedef struct {
-    const char *lcm_url;      /* NULL until given; then COA_RT_DEFAULT_LCM_URL */
+    const char *lcm_url;      /* NULL until given; then COAVOID_RT_DEFAULT_LCM_URL */
     const char *epoch_text;   /* NULL until given */
-    int64_t epoch_utime;      /* --epoch; when not given, coa_rt_options_finish sets now */
+    int64_t epoch_utime;      /* --epoch; when not given, coavoid_rt_options_finish sets now */
     const char *speed_text;   /* NULL: 1 */
     double speed;
     const char *steps_text;   /* NULL: 2N */
     int64_t steps;            /* K >= 1 */
-} coa_rt_options_t;
+} coavoid_rt_options_t;
 
 /* Sets the defaults (no epoch yet, speed 1, steps unset, the default URL). */
-void coa_rt_options_init(coa_rt_options_t *o);
+void coavoid_rt_options_init(coavoid_rt_options_t *o);
 
 /* Whether argv[*i] is one of --lcm-url, --epoch, --speed, --steps; if so consumes it
  * (and its value) and returns CLI_CONTINUE, or returns CLI_EXIT_INVALID after the one-line
  * error (missing or bad value, given twice). Returns CLI_UNKNOWN_OPTION for any other
  * argument (cli.h's option parser contract). */
-int coa_rt_parse_option(int argc, char **argv, int *i, coa_rt_options_t *o);
+int coavoid_rt_parse_option(int argc, char **argv, int *i, coavoid_rt_options_t *o);
 
 /* After the scenario is loaded: steps defaults to 2 * horizon; the epoch defaults to now
  * (a process run alone starts at once; processes that run together must all be given
- * one --epoch); an epoch more than COA_RT_MAX_EPOCH_AHEAD_US ahead, or one whose run of
+ * one --epoch); an epoch more than COAVOID_RT_MAX_EPOCH_AHEAD_US ahead, or one whose run of
  * `steps` cycles of dt_us has already ended, is refused. Returns CLI_CONTINUE or
  * CLI_EXIT_INVALID after the one-line error. */
-int coa_rt_options_finish(coa_rt_options_t *o, int64_t dt_us, uint32_t horizon);
+int coavoid_rt_options_finish(coavoid_rt_options_t *o, int64_t dt_us, uint32_t horizon);
 
 /* What every driver does once its options are parsed and the scenario at `path` is loaded
- * into *s (cli_run_scenario): samples it, refuses a horizon beyond COA_NODE_MAX_HORIZON,
- * finishes the options (coa_rt_options_finish), and fills *common with the node defaults
+ * into *s (coavoid_cli_run_scenario): samples it, refuses a horizon beyond COAVOID_NODE_MAX_HORIZON,
+ * finishes the options (coavoid_rt_options_finish), and fills *common with the node defaults
  * on the scenario's dt and horizon, the epoch, `now` as the clock, the monotonic
  * stopwatch, and the scenario's beta when it gives one. Returns CLI_CONTINUE, or
  * CLI_EXIT_INVALID after the one-line error. Cost: sampling the scenario; no memory
  * beyond the scenario's samples. */
-int coa_rt_setup(const char *path, scenario_t *s, coa_rt_options_t *o, const int64_t *now,
-                 coa_node_common_t *common);
+int coavoid_rt_setup(const char *path, coavoid_scenario_t *s, coavoid_rt_options_t *o, const int64_t *now,
+                 coavoid_node_common_t *common);
 
 /* The usage lines of the shared options (for each driver's --help). */
-#define COA_RT_OPTIONS_USAGE                                                                   \
-    "  --lcm-url URL       LCM provider; default " COA_RT_DEFAULT_LCM_URL "\n"                  \
+#define COAVOID_RT_OPTIONS_USAGE                                                                   \
+    "  --lcm-url URL       LCM provider; default " COAVOID_RT_DEFAULT_LCM_URL "\n"                  \
     "                      (ttl=0: the traffic stays on this host)\n"                           \
     "  --epoch UTIME       wall-clock microseconds since 1970 at which cycle 0 starts;\n"      \
     "                      every process of a run must be given the same value;\n"             \
@@ -133,15 +133,15 @@ int coa_rt_setup(const char *path, scenario_t *s, coa_rt_options_t *o, const int
 /* lcm_create(url) with LCM's own multi-line messages on stderr held back: on failure
  * returns NULL with one line in err naming the URL and, for udpm, the multicast route
  * that is missing and how to add it. On success, anything LCM printed is passed on. */
-lcm_t *coa_rt_lcm_create(const char *url, char *err, size_t err_size);
+lcm_t *coavoid_rt_lcm_create(const char *url, char *err, size_t err_size);
 
 /* ---- the loop ---- */
 
 typedef struct {
-    coa_rt_clock_t clock;
+    coavoid_rt_clock_t clock;
     lcm_t *lcm;
     int64_t *now;                    /* the variable every node's common.clock points to */
-    const coa_node_common_t *common; /* any node's: epoch (as scenario time), dt_us */
+    const coavoid_node_common_t *common; /* any node's: epoch (as scenario time), dt_us */
     int64_t steps;                   /* K */
     int64_t collect_us;              /* the coordinator's, when there is one */
     /* The world alone (no vehicle in the loop): how long before cycle k's start it
@@ -149,13 +149,13 @@ typedef struct {
      * one cycle ahead), so that they are in every vehicle's view when the cycle begins, as
      * in `coavoid sim`, where the world's cycle runs first. 0: at the cycle's start. */
     int64_t world_lead_us;
-    coa_world_t *world;              /* each optional */
-    coa_coordinator_t *coordinator;
-    coa_vehicle_node_t *const *vehicles;
+    coavoid_world_t *world;              /* each optional */
+    coavoid_coordinator_t *coordinator;
+    coavoid_vehicle_node_t *const *vehicles;
     size_t vehicle_count;
     const char *name;                /* prefix of warning lines, e.g. "vehicle 3" */
     FILE *warnings;                  /* stderr, usually */
-} coa_rt_loop_t;
+} coavoid_rt_loop_t;
 
 typedef struct {
     int64_t cycles;       /* cycle starts (or coordinator cycles) run */
@@ -164,42 +164,42 @@ typedef struct {
     uint32_t errors;      /* node calls that returned an error */
     int first_error;      /* the first such code, 0 none */
     int signal;           /* the signal that stopped the loop, 0 when it ran to the end */
-} coa_rt_result_t;
+} coavoid_rt_result_t;
 
 /* Sets SIGINT and SIGTERM to ask the loop to stop (no SA_RESTART, so a wait is cut
  * short). Returns 0, or -1 when sigaction failed. */
-int coa_rt_install_signal_handlers(void);
+int coavoid_rt_install_signal_handlers(void);
 
 /* LCM itself failed: waiting on its descriptor or lcm_handle returned an error, so the
  * provider is unusable. */
-#define COA_RT_ERR_LCM (-200)
+#define COAVOID_RT_ERR_LCM (-200)
 
 /* Sets the loop's fields every driver sets alike: the clock (epoch, speed) and steps from
  * the finished options, lcm, now, common, name, and warnings on stderr; the rest (the
  * nodes, collect_us, world_lead_us) is zero for the caller to set. O(1). */
-void coa_rt_loop_init(coa_rt_loop_t *loop, const coa_rt_options_t *o, lcm_t *lcm, int64_t *now,
-                      const coa_node_common_t *common, const char *name);
+void coavoid_rt_loop_init(coavoid_rt_loop_t *loop, const coavoid_rt_options_t *o, lcm_t *lcm, int64_t *now,
+                      const coavoid_node_common_t *common, const char *name);
 
 /* Prints a driver's summary line on stderr from its node's state, starting with the
- * loop's name and ending with `tail` (coa_rt_result_text). */
-typedef void (*coa_rt_report_t)(void *user, const char *name, const coa_rt_result_t *result,
+ * loop's name and ending with `tail` (coavoid_rt_result_text). */
+typedef void (*coavoid_rt_report_t)(void *user, const char *name, const coavoid_rt_result_t *result,
                                 const char *tail);
 
 /* What every driver does once its node is in the loop: installs the signal handlers, runs
  * the loop and calls report. Returns CLI_EXIT_OK, or CLI_EXIT_INTERNAL when a node call
  * failed, or after the line "NAME: cannot handle SIGINT/SIGTERM" (nothing ran) or "NAME:
  * LCM failed while running (URL)". The caller destroys its node and the LCM afterwards.
- * Cost and memory: coa_rt_run's. */
-int coa_rt_drive(const coa_rt_loop_t *loop, const char *lcm_url, coa_rt_report_t report,
+ * Cost and memory: coavoid_rt_run's. */
+int coavoid_rt_drive(const coavoid_rt_loop_t *loop, const char *lcm_url, coavoid_rt_report_t report,
                  void *user);
 
 /* Runs the loop until cycle K is done or a signal asks it to stop. Returns COA_OK,
- * COA_ERR_ARGUMENT (no node, NULL lcm/now/common, steps < 1) or COA_RT_ERR_LCM. Node
+ * COA_ERR_ARGUMENT (no node, NULL lcm/now/common, steps < 1) or COAVOID_RT_ERR_LCM. Node
  * errors are counted in result, not returned. */
-int coa_rt_run(const coa_rt_loop_t *loop, coa_rt_result_t *result);
+int coavoid_rt_run(const coavoid_rt_loop_t *loop, coavoid_rt_result_t *result);
 
 /* The end of a driver's summary line: ", overruns N, skipped N" and, when a signal
  * stopped it, ", stopped by SIGTERM". Cannot fail (truncates to size). */
-void coa_rt_result_text(const coa_rt_result_t *result, char *out, size_t size);
+void coavoid_rt_result_text(const coavoid_rt_result_t *result, char *out, size_t size);
 
 #endif /* COAVOID_APP_REALTIME_H */

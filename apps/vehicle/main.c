@@ -35,7 +35,7 @@
     "  --mode centralised  follow the coordinator; plan for itself while the coordinator\n"    \
     "                      is silent (default)\n"                                              \
     "  --mode decoupled    always plan for itself, in priority order\n"                        \
-    COA_RT_OPTIONS_USAGE                                                                       \
+    COAVOID_RT_OPTIONS_USAGE                                                                       \
     "  --coordinator-timeout S  scenario seconds of coordinator silence after which it\n"     \
     "                      plans for itself; default 2.5 * dt\n"                               \
     "  --coordinator-id ID the node id of the coordinator it follows (1 to 65535, not its\n" \
@@ -66,18 +66,18 @@ typedef struct {
     uint16_t coordinator_id;
     const char *wait_text;
     double wait;
-    coa_rt_options_t rt;
+    coavoid_rt_options_t rt;
 } vehicle_options_t;
 
 /* A duration option in scenario seconds: finite, >= 0 (> 0 unless zero_ok). */
 static int parse_seconds(int argc, char **argv, int *i, const char *name, bool zero_ok,
                          const char **text, double *out)
 {
-    int status = cli_text_option(argc, argv, i, name, "scenario seconds", true, text);
-    if (status == CLI_CONTINUE && (!cli_parse_real(*text, out) || *out < 0 ||
-                                   (*out == 0 && !zero_ok) || *out > COA_LCM_MAX_STEP)) {
-        status = cli_fail(CLI_EXIT_INVALID, "%s: must be a number of seconds, %s %g, got '%.40s'",
-                          name, zero_ok ? "0 <= S <=" : "0 < S <=", COA_LCM_MAX_STEP, *text);
+    int status = coavoid_cli_text_option(argc, argv, i, name, "scenario seconds", true, text);
+    if (status == CLI_CONTINUE && (!coavoid_cli_parse_real(*text, out) || *out < 0 ||
+                                   (*out == 0 && !zero_ok) || *out > COAVOID_LCM_MAX_STEP)) {
+        status = coavoid_cli_fail(CLI_EXIT_INVALID, "%s: must be a number of seconds, %s %g, got '%.40s'",
+                          name, zero_ok ? "0 <= S <=" : "0 < S <=", COAVOID_LCM_MAX_STEP, *text);
     }
     return status;
 }
@@ -92,99 +92,99 @@ static int vehicle_option(int argc, char **argv, int *i, void *options)
     vehicle_options_t *o = options;
     const char *arg = argv[*i];
     uint64_t value = 0;
-    int status = coa_rt_parse_option(argc, argv, i, &o->rt);
+    int status = coavoid_rt_parse_option(argc, argv, i, &o->rt);
     if (status != CLI_UNKNOWN_OPTION) {
         return status;
     }
-    if (cli_option_is(arg, "--scenario")) {
-        status = cli_text_option(argc, argv, i, "--scenario", "a scenario file", false,
+    if (coavoid_cli_option_is(arg, "--scenario")) {
+        status = coavoid_cli_text_option(argc, argv, i, "--scenario", "a scenario file", false,
                                  &o->scenario_path);
-    } else if (cli_option_is(arg, "--id")) {
-        status = cli_text_option(argc, argv, i, "--id", "a vehicle id", true, &o->id_text);
+    } else if (coavoid_cli_option_is(arg, "--id")) {
+        status = coavoid_cli_text_option(argc, argv, i, "--id", "a vehicle id", true, &o->id_text);
         if (status == CLI_CONTINUE &&
-            !cli_parse_count(o->id_text, strlen(o->id_text), 65535u, &value)) {
-            status = cli_fail(CLI_EXIT_INVALID,
+            !coavoid_cli_parse_count(o->id_text, strlen(o->id_text), 65535u, &value)) {
+            status = coavoid_cli_fail(CLI_EXIT_INVALID,
                               "--id: must be a vehicle id from 1 to 65535, got '%.40s'",
                               o->id_text);
         }
         o->id = (uint16_t)value;
-    } else if (cli_option_is(arg, "--list-ids")) {
-        status = cli_flag_option(arg, "--list-ids", &o->list_ids);
-    } else if (cli_option_is(arg, "--mode")) {
-        status = cli_mode_option(argc, argv, i, &o->mode, &o->decoupled);
-    } else if (cli_option_is(arg, "--coordinator-timeout")) {
+    } else if (coavoid_cli_option_is(arg, "--list-ids")) {
+        status = coavoid_cli_flag_option(arg, "--list-ids", &o->list_ids);
+    } else if (coavoid_cli_option_is(arg, "--mode")) {
+        status = coavoid_cli_mode_option(argc, argv, i, &o->mode, &o->decoupled);
+    } else if (coavoid_cli_option_is(arg, "--coordinator-timeout")) {
         status = parse_seconds(argc, argv, i, "--coordinator-timeout", false, &o->timeout_text,
                                &o->timeout);
-    } else if (cli_option_is(arg, "--coordinator-id")) {
-        status = cli_text_option(argc, argv, i, "--coordinator-id", "a node id", true,
+    } else if (coavoid_cli_option_is(arg, "--coordinator-id")) {
+        status = coavoid_cli_text_option(argc, argv, i, "--coordinator-id", "a node id", true,
                                  &o->coordinator_text);
         if (status == CLI_CONTINUE &&
-            !cli_parse_count(o->coordinator_text, strlen(o->coordinator_text), 65535u, &value)) {
-            status = cli_fail(CLI_EXIT_INVALID,
+            !coavoid_cli_parse_count(o->coordinator_text, strlen(o->coordinator_text), 65535u, &value)) {
+            status = coavoid_cli_fail(CLI_EXIT_INVALID,
                               "--coordinator-id: must be a node id from 1 to 65535, got '%.40s'",
                               o->coordinator_text);
         }
         o->coordinator_id = (uint16_t)value;
-    } else if (cli_option_is(arg, "--priority-wait")) {
+    } else if (coavoid_cli_option_is(arg, "--priority-wait")) {
         status = parse_seconds(argc, argv, i, "--priority-wait", true, &o->wait_text, &o->wait);
     }
     return status;
 }
 
-static const cli_command_t vehicle_command = {
+static const coavoid_cli_command_t vehicle_command = {
     "vehicle", "coavoid-vehicle", 1, {NULL, NULL}, "the scenario is --scenario FILE",
     vehicle_help, vehicle_option};
 
 static int parse_options(int argc, char **argv, vehicle_options_t *o)
 {
     memset(o, 0, sizeof *o);
-    coa_rt_options_init(&o->rt);
-    int status = cli_parse_args(&vehicle_command, argc, argv, o, NULL);
+    coavoid_rt_options_init(&o->rt);
+    int status = coavoid_cli_parse_args(&vehicle_command, argc, argv, o, NULL);
     if (status != CLI_CONTINUE) {
         return status;
     }
     if (o->scenario_path == NULL) {
-        return cli_fail(CLI_EXIT_INVALID, "--scenario: required (a scenario file)");
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "--scenario: required (a scenario file)");
     }
     if (o->list_ids) {
         if (o->id_text != NULL || o->mode != NULL || o->timeout_text != NULL ||
             o->coordinator_text != NULL || o->wait_text != NULL || o->rt.lcm_url != NULL ||
             o->rt.epoch_text != NULL || o->rt.speed_text != NULL || o->rt.steps_text != NULL) {
-            return cli_fail(CLI_EXIT_INVALID, "--list-ids: takes only --scenario FILE");
+            return coavoid_cli_fail(CLI_EXIT_INVALID, "--list-ids: takes only --scenario FILE");
         }
         return CLI_CONTINUE;
     }
     if (o->id_text == NULL) {
-        return cli_fail(CLI_EXIT_INVALID, "--id: required (which vehicle of the scenario)");
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "--id: required (which vehicle of the scenario)");
     }
     /* The coordinator timeout only decides when a centralised vehicle plans for itself. */
     if (o->decoupled && o->timeout_text != NULL) {
-        return cli_fail(CLI_EXIT_INVALID, "--coordinator-timeout: only valid with --mode centralised");
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "--coordinator-timeout: only valid with --mode centralised");
     }
     if (o->decoupled && o->coordinator_text != NULL) {
-        return cli_fail(CLI_EXIT_INVALID, "--coordinator-id: only valid with --mode centralised");
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "--coordinator-id: only valid with --mode centralised");
     }
     if (o->coordinator_text != NULL && o->coordinator_id == o->id) {
-        return cli_fail(CLI_EXIT_INVALID, "--coordinator-id: %u is this vehicle's own id",
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "--coordinator-id: %u is this vehicle's own id",
                         (unsigned)o->id);
     }
     return CLI_CONTINUE;
 }
 
 /* The scenario's vehicle ids, one a line (--list-ids). */
-static int list_ids(const scenario_t *s)
+static int list_ids(const coavoid_scenario_t *s)
 {
     for (size_t i = 0; i < s->vehicle_count; i++) {
         printf("%u\n", (unsigned)s->vehicles[i].id);
     }
     return fflush(stdout) == 0 ? CLI_EXIT_OK
-                               : cli_fail(CLI_EXIT_INTERNAL, "--list-ids: cannot write");
+                               : coavoid_cli_fail(CLI_EXIT_INTERNAL, "--list-ids: cannot write");
 }
 
-static void vehicle_report(void *user, const char *name, const coa_rt_result_t *result,
+static void vehicle_report(void *user, const char *name, const coavoid_rt_result_t *result,
                            const char *tail)
 {
-    const coa_vehicle_node_state_t *st = coa_vehicle_node_state(user);
+    const coavoid_vehicle_node_state_t *st = coavoid_vehicle_node_state(user);
     fprintf(stderr,
             "%s: %lld cycles, plans run %u, plans adopted %u, fallbacks %u, messages received "
             "%lld, rejected %lld (last: %s)%s\n",
@@ -195,63 +195,63 @@ static void vehicle_report(void *user, const char *name, const coa_rt_result_t *
 }
 
 /* Everything after the options and the scenario. Returns the exit status. */
-static int run(void *options, scenario_t *s)
+static int run(void *options, coavoid_scenario_t *s)
 {
     vehicle_options_t *o = options;
     if (o->list_ids) {
         return list_ids(s);
     }
     int64_t now = 0; /* the nodes' clock (common.clock), written by the loop */
-    coa_vehicle_node_config_t config;
+    coavoid_vehicle_node_config_t config;
     memset(&config, 0, sizeof config);
-    int status = coa_rt_setup(o->scenario_path, s, &o->rt, &now, &config.common);
+    int status = coavoid_rt_setup(o->scenario_path, s, &o->rt, &now, &config.common);
     if (status != CLI_CONTINUE) {
         return status;
     }
-    long index = scenario_vehicle_index(s, (long)o->id);
+    long index = coavoid_scenario_vehicle_index(s, (long)o->id);
     if (index < 0) {
-        return cli_fail(CLI_EXIT_INVALID, "--id: %s has no vehicle %u", o->scenario_path,
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "--id: %s has no vehicle %u", o->scenario_path,
                         (unsigned)o->id);
     }
     const int64_t dt_us = config.common.dt_us;
     config.vehicle = s->vehicles[index];
-    config.mode = o->decoupled ? COA_NODE_DECOUPLED : COA_NODE_CENTRALISED;
+    config.mode = o->decoupled ? COAVOID_NODE_DECOUPLED : COAVOID_NODE_CENTRALISED;
     config.coordinator_id = o->coordinator_id; /* 0: the default */
     config.coordinator_timeout_us =
         o->timeout_text != NULL ? llround(o->timeout * 1e6) : llround(2.5 * (double)dt_us);
     config.priority_wait_us = o->wait_text != NULL ? llround(o->wait * 1e6) : dt_us / 2;
     if (config.coordinator_timeout_us < 1) {
-        return cli_fail(CLI_EXIT_INVALID, "--coordinator-timeout: below a microsecond");
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "--coordinator-timeout: below a microsecond");
     }
     /* A wait into the next cycle would publish this cycle's intent after the next one's. */
     if (config.priority_wait_us >= dt_us) {
-        return cli_fail(CLI_EXIT_INVALID,
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
                         "--priority-wait: %g s is not less than the scenario's dt (%g s)", o->wait,
                         (double)s->dt);
     }
 
     char err[512];
-    lcm_t *lcm = coa_rt_lcm_create(o->rt.lcm_url, err, sizeof err);
+    lcm_t *lcm = coavoid_rt_lcm_create(o->rt.lcm_url, err, sizeof err);
     if (lcm == NULL) {
-        return cli_fail(CLI_EXIT_INVALID, "%s", err);
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s", err);
     }
     int error = COA_OK;
-    coa_vehicle_node_t *node = coa_vehicle_node_create(&config, lcm, &error);
+    coavoid_vehicle_node_t *node = coavoid_vehicle_node_create(&config, lcm, &error);
     if (node == NULL) {
         lcm_destroy(lcm);
-        return cli_fail(error == COA_ERR_ARGUMENT ? CLI_EXIT_INVALID : CLI_EXIT_INTERNAL,
+        return coavoid_cli_fail(error == COA_ERR_ARGUMENT ? CLI_EXIT_INVALID : CLI_EXIT_INTERNAL,
                         "vehicle %u: cannot start (%s)", (unsigned)o->id,
-                        coa_lcm_error_name(error));
+                        coavoid_lcm_error_name(error));
     }
     char name[32];
     snprintf(name, sizeof name, "vehicle %u", (unsigned)o->id);
-    coa_vehicle_node_t *const vehicles[1] = {node};
-    coa_rt_loop_t loop;
-    coa_rt_loop_init(&loop, &o->rt, lcm, &now, &config.common, name);
+    coavoid_vehicle_node_t *const vehicles[1] = {node};
+    coavoid_rt_loop_t loop;
+    coavoid_rt_loop_init(&loop, &o->rt, lcm, &now, &config.common, name);
     loop.vehicles = vehicles;
     loop.vehicle_count = 1;
-    status = coa_rt_drive(&loop, o->rt.lcm_url, vehicle_report, node);
-    coa_vehicle_node_destroy(node);
+    status = coavoid_rt_drive(&loop, o->rt.lcm_url, vehicle_report, node);
+    coavoid_vehicle_node_destroy(node);
     lcm_destroy(lcm);
     return status;
 }
@@ -263,5 +263,5 @@ int main(int argc, char **argv)
     if (status != CLI_CONTINUE) {
         return status;
     }
-    return cli_run_scenario(options.scenario_path, run, &options);
+    return coavoid_cli_run_scenario(options.scenario_path, run, &options);
 }

@@ -105,8 +105,8 @@ static bool layout_compute(const coa_planner_config_t *c, plan_layout_t *lo)
         return false;
     }
     *lo = (plan_layout_t){0};
-    cells = plan_table_cells(c->horizon, c->steep_factor, bound_of(c->max_offset));
-    width = plan_table_row_width(c->horizon, c->steep_factor, bound_of(c->max_offset));
+    cells = coa_plan_table_cells(c->horizon, c->steep_factor, bound_of(c->max_offset));
+    width = coa_plan_table_row_width(c->horizon, c->steep_factor, bound_of(c->max_offset));
     if (cells == 0u || cells > SIZE_MAX || width > SIZE_MAX) {
         return false;
     }
@@ -435,7 +435,7 @@ int coa_plan_vehicle_cost(const coa_vehicle_t *vehicle, coa_real_t dt, uint32_t 
 /* ------------------------------------------------------------------------------------ */
 /* Geometry and costs of rows                                                            */
 
-coa_sweep_t plan_vehicle_sweep(const coa_problem_t *pr, const coa_real_t *dh, size_t v,
+coa_sweep_t coa_plan_vehicle_sweep(const coa_problem_t *pr, const coa_real_t *dh, size_t v,
                                uint32_t k0, int32_t a, uint32_t k1, int32_t b)
 {
     coa_sweep_t s;
@@ -447,7 +447,7 @@ coa_sweep_t plan_vehicle_sweep(const coa_problem_t *pr, const coa_real_t *dh, si
     return s;
 }
 
-bool plan_static_clear(const coa_problem_t *pr, const coa_sweep_t *s, uint32_t k0, uint32_t k1)
+bool coa_plan_static_clear(const coa_problem_t *pr, const coa_sweep_t *s, uint32_t k0, uint32_t k1)
 {
     size_t j;
     for (j = 0; j < pr->obstacle_count; ++j) {
@@ -469,7 +469,7 @@ bool plan_static_clear(const coa_problem_t *pr, const coa_sweep_t *s, uint32_t k
     return true;
 }
 
-coa_cost_t plan_row_units(const coa_planner_t *pl, size_t v, const int32_t *row,
+coa_cost_t coa_plan_row_units(const coa_planner_t *pl, size_t v, const int32_t *row,
                           uint64_t *effort)
 {
     const uint32_t steep = pl->problem->vehicles[v].steep_factor;
@@ -538,14 +538,14 @@ static int load(coa_planner_t *pl, const coa_problem_t *problem, const int32_t *
     }
     for (i = 0; i < problem->vehicle_count; ++i) {
         const coa_vehicle_t *v = &problem->vehicles[i];
-        if (plan_table_cells(problem->horizon, v->steep_factor, offset_limit(v)) >
+        if (coa_plan_table_cells(problem->horizon, v->steep_factor, offset_limit(v)) >
                 pl->table_cells ||
-            plan_table_row_width(problem->horizon, v->steep_factor, offset_limit(v)) >
+            coa_plan_table_row_width(problem->horizon, v->steep_factor, offset_limit(v)) >
                 pl->row_width) {
             return COA_ERR_WORKSPACE;
         }
     }
-    plan_search_release(pl);
+    coa_plan_search_release(pl);
     pl->problem = problem;
     pl->rows = (int32_t *)(uintptr_t)offsets;
     for (i = 0; i < problem->vehicle_count; ++i) {
@@ -556,7 +556,7 @@ static int load(coa_planner_t *pl, const coa_problem_t *problem, const int32_t *
     return COA_OK;
 }
 
-void plan_fill_costs(const coa_planner_t *pl, const size_t *which, size_t count,
+void coa_plan_fill_costs(const coa_planner_t *pl, const size_t *which, size_t count,
                      coa_plan_result_t *r)
 {
     const coa_problem_t *pr = pl->problem;
@@ -574,11 +574,11 @@ void plan_fill_costs(const coa_planner_t *pl, const size_t *which, size_t count,
         r->deviation += dev;
         r->effort += eff;
         r->deviation_units =
-            coa_cost_add(r->deviation_units, plan_row_units(pl, which[i], row, NULL));
+            coa_cost_add(r->deviation_units, coa_plan_row_units(pl, which[i], row, NULL));
     }
 }
 
-bool plan_any_initial_conflict(const coa_planner_t *pl)
+bool coa_plan_any_initial_conflict(const coa_planner_t *pl)
 {
     const coa_problem_t *pr = pl->problem;
     coa_sweep_t at0[COA_MAX_VEHICLES];
@@ -587,8 +587,8 @@ bool plan_any_initial_conflict(const coa_planner_t *pl)
 
     for (i = 0; i < pr->vehicle_count; ++i) {
         int32_t o = pr->vehicles[i].initial_offset;
-        at0[i] = plan_vehicle_sweep(pr, pl->dh, i, 0u, o, 0u, o);
-        if (!plan_static_clear(pr, &at0[i], 0u, 0u)) {
+        at0[i] = coa_plan_vehicle_sweep(pr, pl->dh, i, 0u, o, 0u, o);
+        if (!coa_plan_static_clear(pr, &at0[i], 0u, 0u)) {
             return true;
         }
         for (j = 0; j < i; ++j) {
@@ -631,16 +631,16 @@ int coa_plan_centralised(coa_planner_t *planner, const coa_problem_t *problem,
     }
     result->workspace_bytes = planner->bytes;
     result->orders_tried = 1u;
-    if (plan_any_initial_conflict(planner)) {
+    if (coa_plan_any_initial_conflict(planner)) {
         return COA_OK; /* infeasible, nothing expanded */
     }
-    result->status = plan_independence(planner, result);
+    result->status = coa_plan_independence(planner, result);
     if (result->status == COA_PLAN_SOLVED) {
         for (i = 0; i < problem->vehicle_count; ++i) {
             result->order[i] = i;
         }
         result->planned_count = problem->vehicle_count;
-        plan_fill_costs(planner, result->order, problem->vehicle_count, result);
+        coa_plan_fill_costs(planner, result->order, problem->vehicle_count, result);
     }
     return COA_OK;
 }
@@ -652,12 +652,12 @@ static coa_plan_status_t plan_one(coa_planner_t *pl, const size_t *order, size_t
 {
     const size_t v = order[level];
     const int32_t start = pl->problem->vehicles[v].initial_offset;
-    plan_table_build(pl, &pl->scratch, v, order, level);
+    coa_plan_table_build(pl, &pl->scratch, v, order, level);
     ++r->searches;
     if (cell_dead(plan_table_at(&pl->scratch, 0u, start))) {
         return COA_PLAN_INFEASIBLE;
     }
-    plan_table_walk(pl, &pl->scratch, 0u, start);
+    coa_plan_table_walk(pl, &pl->scratch, 0u, start);
     r->nodes_expanded += pl->problem->horizon;
     return COA_PLAN_SOLVED;
 }
@@ -747,7 +747,7 @@ int coa_plan_decoupled(coa_planner_t *planner, const coa_problem_t *problem,
                 result->order[i] = cur[i];
             }
             result->planned_count = n;
-            plan_fill_costs(planner, cur, n, result);
+            coa_plan_fill_costs(planner, cur, n, result);
             return COA_OK;
         }
         if (st == COA_PLAN_BUDGET_EXHAUSTED) {
@@ -762,7 +762,7 @@ int coa_plan_decoupled(coa_planner_t *planner, const coa_problem_t *problem,
             /* Checked only once an order has failed, so a solved call never pays for it;
              * without it, two vehicles in conflict at t = 0 among n would cost up to n!
              * attempts before the order space ran out. */
-            if (!proven && plan_any_initial_conflict(planner)) {
+            if (!proven && coa_plan_any_initial_conflict(planner)) {
                 proven = true;
             }
         }
@@ -816,7 +816,7 @@ int coa_plan_decoupled(coa_planner_t *planner, const coa_problem_t *problem,
         }
     }
     result->failed_vehicle = first[result->planned_count];
-    plan_fill_costs(planner, first, result->planned_count, result);
+    coa_plan_fill_costs(planner, first, result->planned_count, result);
     return COA_OK;
 }
 
@@ -857,12 +857,12 @@ int coa_plan_find_conflict(const coa_problem_t *problem, const int32_t *offsets,
         for (i = 0; i < count; ++i) {
             size_t v = which[i];
             const int32_t *ov = &offsets[v * row];
-            coa_sweep_t s = plan_vehicle_sweep(problem, dh, v, k, ov[k], k + 1u, ov[k + 1u]);
-            bool hit = !plan_static_clear(problem, &s, k, k + 1u);
+            coa_sweep_t s = coa_plan_vehicle_sweep(problem, dh, v, k, ov[k], k + 1u, ov[k + 1u]);
+            bool hit = !coa_plan_static_clear(problem, &s, k, k + 1u);
             for (j = 0; !hit && j < count; ++j) {
                 if (j != i) {
                     const int32_t *ou = &offsets[which[j] * row];
-                    coa_sweep_t t = plan_vehicle_sweep(problem, dh, which[j], k, ou[k], k + 1u,
+                    coa_sweep_t t = coa_plan_vehicle_sweep(problem, dh, which[j], k, ou[k], k + 1u,
                                                   ou[k + 1u]);
                     hit = coa_conflict_volumes(&s, &t);
                 }

@@ -31,7 +31,7 @@ static coa_cost_t row_cost(const coa_planner_t *pl, size_t v)
 {
     uint64_t eff;
     coa_cost_t dev =
-        plan_row_units(pl, v, &pl->rows[v * ((size_t)pl->problem->horizon + 1u)], &eff);
+        coa_plan_row_units(pl, v, &pl->rows[v * ((size_t)pl->problem->horizon + 1u)], &eff);
     return plan_pack(dev, eff);
 }
 
@@ -59,8 +59,8 @@ static void near_steps(coa_planner_t *pl, size_t u, size_t v, uint32_t *first, u
     *first = UINT32_MAX;
     *last = 0u;
     for (k = 0; k < pr->horizon; ++k) {
-        coa_sweep_t a = plan_vehicle_sweep(pr, pl->dh, u, k, 0, k + 1u, 0);
-        coa_sweep_t b = plan_vehicle_sweep(pr, pl->dh, v, k, 0, k + 1u, 0);
+        coa_sweep_t a = coa_plan_vehicle_sweep(pr, pl->dh, u, k, 0, k + 1u, 0);
+        coa_sweep_t b = coa_plan_vehicle_sweep(pr, pl->dh, v, k, 0, k + 1u, 0);
         if (coa_conflict_horizontal(&a, &b)) {
             *first = k < *first ? k : *first;
             *last = k;
@@ -223,13 +223,13 @@ static bool members_in_turn(coa_planner_t *pl, coa_cost_t *cost, coa_plan_result
         const size_t v = g->vehicle[i];
         const int32_t start = pl->problem->vehicles[v].initial_offset;
         uint64_t root;
-        plan_table_build(pl, &pl->scratch, v, against, n);
+        coa_plan_table_build(pl, &pl->scratch, v, against, n);
         ++r->searches;
         root = plan_table_at(&pl->scratch, 0u, start);
         if (cell_dead(root)) {
             return false;
         }
-        plan_table_walk(pl, &pl->scratch, 0u, start);
+        coa_plan_table_walk(pl, &pl->scratch, 0u, start);
         r->nodes_expanded += pl->problem->horizon;
         *cost = plan_cost_add(*cost, plan_cell_cost(pl, v, root));
         against[n++] = v;
@@ -274,7 +274,7 @@ static void group_collect(coa_planner_t *pl, uint32_t members, uint32_t fixed)
     plan_group_t *g = &pl->group;
     size_t v;
 
-    plan_search_release(pl);
+    coa_plan_search_release(pl);
     g->count = 0u;
     g->fixed_count = 0u;
     for (v = 0; v < pl->problem->vehicle_count; ++v) {
@@ -321,7 +321,7 @@ static bool group_setup(coa_planner_t *pl, uint32_t members, uint32_t fixed,
     for (i = 0; i < g->count; ++i) {
         group_entries(pl, i, g->capped ? &slack : NULL);
     }
-    plan_pairs_build(pl);
+    coa_plan_pairs_build(pl);
     return false;
 }
 
@@ -333,7 +333,7 @@ static coa_plan_status_t search_group(coa_planner_t *pl, uint32_t members, uint3
     if (group_setup(pl, members, fixed, bound, r)) {
         return COA_PLAN_SOLVED;
     }
-    plan_search(pl, &out);
+    coa_plan_search(pl, &out);
     r->nodes_expanded += out.expanded;
     r->nodes_generated += out.stored;
     ++r->searches;
@@ -378,7 +378,7 @@ static bool groups_conflict(const coa_planner_t *pl, const groups_t *g, size_t *
     for (k = 0; k < pr->horizon; ++k) {
         for (i = 0; i < n; ++i) {
             const int32_t *r = &pl->rows[i * row];
-            s[i] = plan_vehicle_sweep(pr, pl->dh, i, k, r[k], k + 1u, r[k + 1u]);
+            s[i] = coa_plan_vehicle_sweep(pr, pl->dh, i, k, r[k], k + 1u, r[k + 1u]);
             for (j = 0; j < i; ++j) {
                 if (gi[i] != gi[j] && k >= pl->near_first[i][j] && k <= pl->near_last[i][j] &&
                     coa_conflict_volumes(&s[j], &s[i])) {
@@ -446,13 +446,13 @@ static bool replan_around(coa_planner_t *pl, const groups_t *g, size_t x, size_t
     for (v = 0; (g->members[x] & (UINT32_C(1) << v)) == 0u; ++v) {
     }
     start = pl->problem->vehicles[v].initial_offset;
-    plan_table_build(pl, &pl->scratch, v, against, n);
+    coa_plan_table_build(pl, &pl->scratch, v, against, n);
     ++r->searches;
     root = plan_table_at(&pl->scratch, 0u, start);
     if (cell_dead(root) || plan_cost_compare(plan_cell_cost(pl, v, root), g->cost[x]) != 0) {
         return false;
     }
-    plan_table_walk(pl, &pl->scratch, 0u, start);
+    coa_plan_table_walk(pl, &pl->scratch, 0u, start);
     r->nodes_expanded += pl->problem->horizon;
     return true;
 }
@@ -488,16 +488,16 @@ static coa_plan_status_t alone(coa_planner_t *pl, groups_t *g, coa_plan_result_t
     for (v = 0; v < pr->vehicle_count; ++v) {
         const int32_t start = pr->vehicles[v].initial_offset;
         uint64_t root;
-        plan_table_build(pl, &pl->to_go[v], v, NULL, 0u);
+        coa_plan_table_build(pl, &pl->to_go[v], v, NULL, 0u);
         ++r->searches;
         root = plan_table_at(&pl->to_go[v], 0u, start);
         if (cell_dead(root)) {
             return COA_PLAN_INFEASIBLE;
         }
         if (pr->vehicle_count > 1u) {
-            plan_table_build_from_start(&pl->from_start[v], &pl->to_go[v]);
+            coa_plan_table_build_from_start(&pl->from_start[v], &pl->to_go[v]);
         }
-        plan_table_walk(pl, &pl->to_go[v], 0u, start);
+        coa_plan_table_walk(pl, &pl->to_go[v], 0u, start);
         r->nodes_expanded += pr->horizon;
         g->members[v] = UINT32_C(1) << v;
         g->cost[v] = plan_cell_cost(pl, v, root);
@@ -506,7 +506,7 @@ static coa_plan_status_t alone(coa_planner_t *pl, groups_t *g, coa_plan_result_t
     return COA_PLAN_SOLVED;
 }
 
-coa_plan_status_t plan_independence(coa_planner_t *pl, coa_plan_result_t *r)
+coa_plan_status_t coa_plan_independence(coa_planner_t *pl, coa_plan_result_t *r)
 {
     coa_plan_status_t st;
     groups_t g;
@@ -537,15 +537,15 @@ coa_plan_status_t plan_independence(coa_planner_t *pl, coa_plan_result_t *r)
 /* ------------------------------------------------------------------------------------ */
 /* Test hooks (plan_internal.h)                                                          */
 
-void plan_test_group_setup(coa_planner_t *pl, uint32_t members)
+void coa_plan_test_group_setup(coa_planner_t *pl, uint32_t members)
 {
     plan_group_t *g = &pl->group;
     size_t v;
     size_t i;
 
     for (v = 0; v < pl->problem->vehicle_count; ++v) {
-        plan_table_build(pl, &pl->to_go[v], v, NULL, 0u);
-        plan_table_build_from_start(&pl->from_start[v], &pl->to_go[v]);
+        coa_plan_table_build(pl, &pl->to_go[v], v, NULL, 0u);
+        coa_plan_table_build_from_start(&pl->from_start[v], &pl->to_go[v]);
     }
     near_all(pl);
     group_collect(pl, members, 0u);
@@ -555,5 +555,5 @@ void plan_test_group_setup(coa_planner_t *pl, uint32_t members)
     for (i = 0; i < g->count; ++i) {
         group_entries(pl, i, NULL);
     }
-    plan_pairs_build(pl);
+    coa_plan_pairs_build(pl);
 }

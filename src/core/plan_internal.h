@@ -319,12 +319,12 @@ static inline const plan_table_t *plan_from_start(const coa_planner_t *pl, size_
 /* Shared functions                                                                      */
 
 /* The swept volume of vehicle v from offset a at sample k0 to offset b at k1. */
-coa_sweep_t plan_vehicle_sweep(const coa_problem_t *pr, const coa_real_t *dh, size_t v,
+coa_sweep_t coa_plan_vehicle_sweep(const coa_problem_t *pr, const coa_real_t *dh, size_t v,
                                uint32_t k0, int32_t a, uint32_t k1, int32_t b);
 
 /* Whether a sweep over samples k0 -> k1 is clear of every obstacle and track (k0 == k1:
  * the instant t_k0). */
-bool plan_static_clear(const coa_problem_t *pr, const coa_sweep_t *s, uint32_t k0, uint32_t k1);
+bool coa_plan_static_clear(const coa_problem_t *pr, const coa_sweep_t *s, uint32_t k0, uint32_t k1);
 
 /* A step's area in the planner's own units, coa_area_scaled(a, b, 2s) exactly, whose
  * divisions were a tenth of a plan's time: a step that does not cross the reference is
@@ -340,10 +340,10 @@ static inline uint64_t plan_area(int32_t a, int32_t b, uint32_t steep)
 
 /* Cells of a table for horizon N, steep factor s and offset bound L (0 when it would not
  * fit 64 bits, which the limits of common.h rule out). */
-uint64_t plan_table_cells(uint32_t horizon, uint32_t steep, int32_t limit);
+uint64_t coa_plan_table_cells(uint32_t horizon, uint32_t steep, int32_t limit);
 
 /* Widest row of such a table: min(2Ns + 1, 2L + 1). */
-uint64_t plan_table_row_width(uint32_t horizon, uint32_t steep, int32_t limit);
+uint64_t coa_plan_table_row_width(uint32_t horizon, uint32_t steep, int32_t limit);
 
 /* Where row k starts in a table of steep factor s, offset bound L and q = L / s. Inline,
  * with q kept in the table, because every search step and pair cell reads table cells
@@ -380,34 +380,34 @@ static inline uint64_t plan_table_at(const plan_table_t *t, uint32_t k, int32_t 
 
 /* Builds cost-to-go table t for vehicle v against the obstacles, the tracks and the
  * vehicles fixed[0..nfixed-1] flying their rows of pl->rows. */
-void plan_table_build(coa_planner_t *pl, plan_table_t *t, size_t v, const size_t *fixed,
+void coa_plan_table_build(coa_planner_t *pl, plan_table_t *t, size_t v, const size_t *fixed,
                       size_t nfixed);
 
 /* Builds cost-from-start table f of the vehicle of cost-to-go table t, over t's moves. */
-void plan_table_build_from_start(plan_table_t *f, const plan_table_t *t);
+void coa_plan_table_build_from_start(plan_table_t *f, const plan_table_t *t);
 
 /* The moves out of offset `from` at sample k of cost-to-go table t, sorted (see
  * plan_moves_t). */
-void plan_table_moves(const plan_table_t *t, uint32_t k, int32_t from, plan_moves_t *mv);
+void coa_plan_table_moves(const plan_table_t *t, uint32_t k, int32_t from, plan_moves_t *mv);
 
 /* Writes t's vehicle's row of pl->rows from sample k on, from `offset`, along its
- * cheapest plan (each step the first of plan_table_moves). Precondition: live. */
-void plan_table_walk(coa_planner_t *pl, const plan_table_t *t, uint32_t k, int32_t offset);
+ * cheapest plan (each step the first of coa_plan_table_moves). Precondition: live. */
+void coa_plan_table_walk(coa_planner_t *pl, const plan_table_t *t, uint32_t k, int32_t offset);
 
 /* Writes t's vehicle's row of pl->rows up to sample k, ending at `offset`, along a
  * cheapest plan from its initial offset (cost-from-start table f). Precondition: f's
  * cell there is reachable. */
-void plan_table_walk_back(coa_planner_t *pl, const plan_table_t *t, const plan_table_t *f,
+void coa_plan_table_walk_back(coa_planner_t *pl, const plan_table_t *t, const plan_table_t *f,
                           uint32_t k, int32_t offset);
 
 /* Builds the pair tables of the current group within the arena (pairs that do not fit
  * are left out). */
-void plan_pairs_build(coa_planner_t *pl);
+void coa_plan_pairs_build(coa_planner_t *pl);
 
 /* The surcharge of members a < b at sample k (packed: their joint cost-to-go less the sum
  * of their own), 0 where the pair has no table or the sample is outside it, or
  * PLAN_COST_DEAD. */
-coa_cost_t plan_pair_surcharge(const coa_planner_t *pl, size_t a, size_t b, uint32_t k,
+coa_cost_t coa_plan_pair_surcharge(const coa_planner_t *pl, size_t a, size_t b, uint32_t k,
                                int32_t oa, int32_t ob, coa_cost_t to_go_a, coa_cost_t to_go_b);
 
 /* Index of pair (a, b), a < b < m. */
@@ -418,29 +418,29 @@ static inline size_t plan_pair_index(size_t a, size_t b, size_t m)
 
 /* The exact deviation of vehicle v's row (N + 1 offsets) in the problem's units, as the
  * search counts it, and its effort in *effort when not NULL. */
-coa_cost_t plan_row_units(const coa_planner_t *pl, size_t v, const int32_t *row,
+coa_cost_t coa_plan_row_units(const coa_planner_t *pl, size_t v, const int32_t *row,
                           uint64_t *effort);
 
 /* Totals of the rows of vehicles which[0..count-1] into r's costs. */
-void plan_fill_costs(const coa_planner_t *pl, const size_t *which, size_t count,
+void coa_plan_fill_costs(const coa_planner_t *pl, const size_t *which, size_t count,
                      coa_plan_result_t *r);
 
 /* Whether some vehicle meets an obstacle, a track or another vehicle at t = 0 (positions
  * at k = 0 with the initial offsets): then no plan and no order avoids it. */
-bool plan_any_initial_conflict(const coa_planner_t *pl);
+bool coa_plan_any_initial_conflict(const coa_planner_t *pl);
 
 /* Independence detection over the loaded problem (plan_group.c): the centralised plan's
  * status; the rows of every vehicle when solved. */
-coa_plan_status_t plan_independence(coa_planner_t *pl, coa_plan_result_t *r);
+coa_plan_status_t coa_plan_independence(coa_planner_t *pl, coa_plan_result_t *r);
 
 /* One joint search over pl->group. When solved, writes the members' rows of pl->rows.
- * Precondition: plan_search_release since the last search. */
-void plan_search(coa_planner_t *pl, plan_search_out_t *out);
+ * Precondition: coa_plan_search_release since the last search. */
+void coa_plan_search(coa_planner_t *pl, plan_search_out_t *out);
 
 /* Empties the hash table of the last search's nodes (wholesale when they filled a good
  * part of it, else one by one so that a small search does not pay for a large table).
  * Call it before pl->group changes: the states' hashes depend on the group. */
-void plan_search_release(coa_planner_t *pl);
+void coa_plan_search_release(coa_planner_t *pl);
 
 /* ------------------------------------------------------------------------------------ */
 /* Test hooks (tests/test_heuristic.c): not used by the planner itself.                  */
@@ -451,15 +451,15 @@ void plan_search_release(coa_planner_t *pl);
  * vehicles can meet, the spans, the entry lists and the pair tables. Precondition: the
  * problem is loaded (a coa_plan_* call on it returned COA_OK) and the planner has room
  * for a joint search of all its vehicles. */
-void plan_test_group_setup(coa_planner_t *pl, uint32_t members);
+void coa_plan_test_group_setup(coa_planner_t *pl, uint32_t members);
 
 /* The joint search's doubled heuristic (plan_search.c) of the state at sample k with
  * member offsets off[0..count-1] (read only for the members in the search at k): false
  * when a pair is dead there. */
-bool plan_test_heuristic(const coa_planner_t *pl, uint32_t k, const int16_t *off, coa_cost_t *h2);
+bool coa_plan_test_heuristic(const coa_planner_t *pl, uint32_t k, const int16_t *off, coa_cost_t *h2);
 
 /* The doubled matching the heuristic adds (plan_search.c) of surcharges s[] (pairs of m
  * members in plan_pair_index order) among the members of mask. */
-coa_cost_t plan_test_matching(const coa_cost_t *s, size_t m, uint32_t mask);
+coa_cost_t coa_plan_test_matching(const coa_cost_t *s, size_t m, uint32_t mask);
 
 #endif /* COAVOID_CORE_PLAN_INTERNAL_H */

@@ -186,7 +186,7 @@ static void pair_moves(const coa_planner_t *pl, size_t i, uint32_t k, int32_t o,
         mv->alone[n] = plan_cost_add(mv->step[n],
                                      plan_cell_cost(pl, v, plan_table_at(t, k + 1u, to)));
         if (sweeps) {
-            mv->sweep[n] = plan_vehicle_sweep(pl->problem, pl->dh, v, k, o, k + 1u, to);
+            mv->sweep[n] = coa_plan_vehicle_sweep(pl->problem, pl->dh, v, k, o, k + 1u, to);
         }
         pair_moves_sort(mv, n);
         ++mv->count;
@@ -309,8 +309,8 @@ static bool pair_near(const coa_planner_t *pl, size_t a, size_t b, uint32_t k,
     if (k < pl->group.near_first[pi] || k > pl->group.near_last[pi]) {
         return false;
     }
-    sa = plan_vehicle_sweep(pl->problem, pl->dh, pl->group.vehicle[a], k, 0, k + 1u, 0);
-    sb = plan_vehicle_sweep(pl->problem, pl->dh, pl->group.vehicle[b], k, 0, k + 1u, 0);
+    sa = coa_plan_vehicle_sweep(pl->problem, pl->dh, pl->group.vehicle[a], k, 0, k + 1u, 0);
+    sb = coa_plan_vehicle_sweep(pl->problem, pl->dh, pl->group.vehicle[b], k, 0, k + 1u, 0);
     *horizontal = coa_conflict_horizontal_span(&sa, &sb);
     return coa_conflict_span_in_step(*horizontal);
 }
@@ -371,7 +371,7 @@ static void pair_build(coa_planner_t *pl, size_t a, size_t b, const coa_cost_t *
     p->present = true;
 }
 
-void plan_pairs_build(coa_planner_t *pl)
+void coa_plan_pairs_build(coa_planner_t *pl)
 {
     const plan_group_t *g = &pl->group;
     coa_cost_t slack;
@@ -389,7 +389,7 @@ void plan_pairs_build(coa_planner_t *pl)
     }
 }
 
-coa_cost_t plan_pair_surcharge(const coa_planner_t *pl, size_t a, size_t b, uint32_t k,
+coa_cost_t coa_plan_pair_surcharge(const coa_planner_t *pl, size_t a, size_t b, uint32_t k,
                                int32_t oa, int32_t ob, coa_cost_t to_go_a, coa_cost_t to_go_b)
 {
     const plan_pair_t *p = &pl->pair[plan_pair_index(a, b, pl->group.count)];

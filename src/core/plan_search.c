@@ -118,7 +118,7 @@ static uint32_t state_find(const coa_planner_t *pl, uint32_t k, const int16_t *o
     return PLAN_NONE;
 }
 
-void plan_search_release(coa_planner_t *pl)
+void coa_plan_search_release(coa_planner_t *pl)
 {
     uint32_t n;
     if ((uint64_t)pl->used * 4u >= (uint64_t)pl->slot_count) {
@@ -356,7 +356,7 @@ static bool heuristic(const coa_planner_t *pl, uint32_t k, const int16_t *off, h
         for (j = i + 1u; j < m; ++j) {
             coa_cost_t c = {0u, 0u};
             if ((mask & (1u << i)) != 0u && (mask & (1u << j)) != 0u) {
-                c = plan_pair_surcharge(pl, i, j, k, off[i], off[j], own[i], own[j]);
+                c = coa_plan_pair_surcharge(pl, i, j, k, off[i], off[j], own[i], own[j]);
                 if (plan_cost_dead(c)) {
                     return false;
                 }
@@ -494,7 +494,7 @@ static void choosers_make(const coa_planner_t *pl, uint32_t n, choosers_t *ch)
             ch->member[c] = i;
             ch->enters[c] = false;
             uint32_t t;
-            plan_table_moves(plan_to_go(pl, i), k, off[i], &ch->moves[c]);
+            coa_plan_table_moves(plan_to_go(pl, i), k, off[i], &ch->moves[c]);
             ch->options[c] = ch->moves[c].count;
             for (t = 0; t < ch->options[c]; ++t) {
                 ch->move_inc[c][t] = increase_of(pl, ch, c, k, t);
@@ -535,7 +535,7 @@ static bool fixed_clear(const coa_planner_t *pl, const coa_sweep_t *s, uint32_t 
     for (j = 0; j < g->fixed_count; ++j) {
         size_t u = g->fixed[j];
         const int32_t *r = &pl->rows[u * row];
-        coa_sweep_t f = plan_vehicle_sweep(pl->problem, pl->dh, u, k, r[k], k + 1u, r[k + 1u]);
+        coa_sweep_t f = coa_plan_vehicle_sweep(pl->problem, pl->dh, u, k, r[k], k + 1u, r[k + 1u]);
         if (coa_conflict_volumes(s, &f)) {
             return false;
         }
@@ -555,7 +555,7 @@ static bool mover_clear(const coa_planner_t *pl, choosers_t *ch, uint32_t k, siz
     if (ch->pair_ok[c][c][a][a] == 0u) {
         /* pair_ok[c][c][a][a]: option a's sweep is built and was checked against the
          * fixed vehicles (a mover is never paired with itself) */
-        ch->sweep[c][a] = plan_vehicle_sweep(pl->problem, pl->dh, g->vehicle[i], k, off[i],
+        ch->sweep[c][a] = coa_plan_vehicle_sweep(pl->problem, pl->dh, g->vehicle[i], k, off[i],
                                              k + 1u, ch->moves[c].to[a]);
         ch->pair_ok[c][c][a][a] = fixed_clear(pl, &ch->sweep[c][a], k) ? 1u : 2u;
     }
@@ -646,7 +646,7 @@ static bool choose(const coa_planner_t *pl, expansion_t *e, size_t c)
             if (!in_search(g, j, k1)) {
                 continue;
             }
-            e->s[pi] = plan_pair_surcharge(pl, j, i, k1, e->off[j], e->off[i], e->own[j],
+            e->s[pi] = coa_plan_pair_surcharge(pl, j, i, k1, e->off[j], e->off[i], e->own[j],
                                            e->own[i]);
             if (plan_cost_dead(e->s[pi])) {
                 return false;
@@ -843,7 +843,7 @@ static bool root_clear(const coa_planner_t *pl)
         if (g->first[i] != 0u) {
             continue;
         }
-        at0[i] = plan_vehicle_sweep(pr, pl->dh, g->vehicle[i], 0u, o, 0u, o);
+        at0[i] = coa_plan_vehicle_sweep(pr, pl->dh, g->vehicle[i], 0u, o, 0u, o);
         for (j = 0; j < i; ++j) {
             if (g->first[j] == 0u && coa_conflict_volumes(&at0[i], &at0[j])) {
                 return false;
@@ -852,7 +852,7 @@ static bool root_clear(const coa_planner_t *pl)
         for (j = 0; j < g->fixed_count; ++j) {
             size_t u = g->fixed[j];
             int32_t ou = pl->rows[u * ((size_t)pr->horizon + 1u)];
-            coa_sweep_t f = plan_vehicle_sweep(pr, pl->dh, u, 0u, ou, 0u, ou);
+            coa_sweep_t f = coa_plan_vehicle_sweep(pr, pl->dh, u, 0u, ou, 0u, ou);
             if (coa_conflict_volumes(&at0[i], &f)) {
                 return false;
             }
@@ -915,12 +915,12 @@ static void write_rows(coa_planner_t *pl, uint32_t goal)
     }
     for (i = 0; i < g->count; ++i) {
         int32_t entry = pl->rows[g->vehicle[i] * row + g->first[i]];
-        plan_table_walk_back(pl, plan_to_go(pl, i), plan_from_start(pl, i), g->first[i], entry);
-        plan_table_walk(pl, plan_to_go(pl, i), g->last[i] + 1u, node_off(pl, goal)[i]);
+        coa_plan_table_walk_back(pl, plan_to_go(pl, i), plan_from_start(pl, i), g->first[i], entry);
+        coa_plan_table_walk(pl, plan_to_go(pl, i), g->last[i] + 1u, node_off(pl, goal)[i]);
     }
 }
 
-void plan_search(coa_planner_t *pl, plan_search_out_t *out)
+void coa_plan_search(coa_planner_t *pl, plan_search_out_t *out)
 {
     out->status = COA_PLAN_INFEASIBLE;
     out->expanded = 0u;
@@ -954,7 +954,7 @@ void plan_search(coa_planner_t *pl, plan_search_out_t *out)
 /* ------------------------------------------------------------------------------------ */
 /* Test hooks (plan_internal.h)                                                          */
 
-bool plan_test_heuristic(const coa_planner_t *pl, uint32_t k, const int16_t *off, coa_cost_t *h2)
+bool coa_plan_test_heuristic(const coa_planner_t *pl, uint32_t k, const int16_t *off, coa_cost_t *h2)
 {
     heur_t h;
     if (!heuristic(pl, k, off, &h)) {
@@ -964,7 +964,7 @@ bool plan_test_heuristic(const coa_planner_t *pl, uint32_t k, const int16_t *off
     return true;
 }
 
-coa_cost_t plan_test_matching(const coa_cost_t *s, size_t m, uint32_t mask)
+coa_cost_t coa_plan_test_matching(const coa_cost_t *s, size_t m, uint32_t mask)
 {
     return matching(s, m, mask);
 }

@@ -20,12 +20,12 @@
  */
 #include "plan_internal.h"
 
-uint64_t plan_table_cells(uint32_t horizon, uint32_t steep, int32_t limit)
+uint64_t coa_plan_table_cells(uint32_t horizon, uint32_t steep, int32_t limit)
 {
     return plan_row_base(horizon + 1u, steep, (uint32_t)limit / steep, limit);
 }
 
-uint64_t plan_table_row_width(uint32_t horizon, uint32_t steep, int32_t limit)
+uint64_t coa_plan_table_row_width(uint32_t horizon, uint32_t steep, int32_t limit)
 {
     uint64_t reach = 2u * (uint64_t)horizon * steep + 1u;
     uint64_t bound = 2u * (uint64_t)limit + 1u;
@@ -148,7 +148,7 @@ static void row_clear_item(const row_ctx_t *r, const row_item_t *it)
             if ((*c & (UINT64_C(1) << a)) == 0u) {
                 continue;
             }
-            s = plan_vehicle_sweep(pl->problem, pl->dh, t->vehicle, r->k, o, r->k + 1u,
+            s = coa_plan_vehicle_sweep(pl->problem, pl->dh, t->vehicle, r->k, o, r->k + 1u,
                                    o + coa_action_delta((coa_action_t)a, t->steep));
             sb = coa_sweep_bounds(&s);
             if (coa_boxes_touch(&sb, &item) && item_conflict(it, &s)) {
@@ -181,7 +181,7 @@ static void row_clear_conflicts(const row_ctx_t *r, const size_t *fixed, size_t 
     }
     for (j = 0; j < nfixed; ++j) {
         const int32_t *row = &r->pl->rows[fixed[j] * ((size_t)pr->horizon + 1u)];
-        it.moving = plan_vehicle_sweep(pr, r->pl->dh, fixed[j], r->k, row[r->k], r->k + 1u,
+        it.moving = coa_plan_vehicle_sweep(pr, r->pl->dh, fixed[j], r->k, row[r->k], r->k + 1u,
                                        row[r->k + 1u]);
         it.bounds = coa_sweep_bounds(&it.moving);
         row_clear_item(r, &it);
@@ -241,16 +241,16 @@ static void row_costs(const plan_table_t *t, uint32_t k, int32_t lo, int32_t hi,
 /* The box that holds every step of row k: its lowest and highest steps span it. */
 static coa_box_t row_bounds(const coa_planner_t *pl, const plan_table_t *t, uint32_t k)
 {
-    coa_sweep_t low = plan_vehicle_sweep(pl->problem, pl->dh, t->vehicle, k, plan_row_lo(t, k),
+    coa_sweep_t low = coa_plan_vehicle_sweep(pl->problem, pl->dh, t->vehicle, k, plan_row_lo(t, k),
                                          k + 1u, plan_row_lo(t, k + 1u));
-    coa_sweep_t high = plan_vehicle_sweep(pl->problem, pl->dh, t->vehicle, k, plan_row_hi(t, k),
+    coa_sweep_t high = coa_plan_vehicle_sweep(pl->problem, pl->dh, t->vehicle, k, plan_row_hi(t, k),
                                           k + 1u, plan_row_hi(t, k + 1u));
     coa_box_t b = coa_sweep_bounds(&low);
     coa_box_t h = coa_sweep_bounds(&high);
     return box_union(b, &h);
 }
 
-void plan_table_build(coa_planner_t *pl, plan_table_t *tb, size_t v, const size_t *fixed,
+void coa_plan_table_build(coa_planner_t *pl, plan_table_t *tb, size_t v, const size_t *fixed,
                       size_t nfixed)
 {
     const coa_vehicle_t *veh = &pl->problem->vehicles[v];
@@ -285,7 +285,7 @@ void plan_table_build(coa_planner_t *pl, plan_table_t *tb, size_t v, const size_
 /* ------------------------------------------------------------------------------------ */
 /* Moves in search order                                                                 */
 
-void plan_table_moves(const plan_table_t *t, uint32_t k, int32_t from, plan_moves_t *mv)
+void coa_plan_table_moves(const plan_table_t *t, uint32_t k, int32_t from, plan_moves_t *mv)
 {
     const uint64_t here = *cell_of(t, k, from);
     const uint32_t mask = cell_mask(here);
@@ -327,7 +327,7 @@ void plan_table_moves(const plan_table_t *t, uint32_t k, int32_t from, plan_move
 /* ------------------------------------------------------------------------------------ */
 /* Cost from the start, and plans                                                        */
 
-void plan_table_build_from_start(plan_table_t *f, const plan_table_t *t)
+void coa_plan_table_build_from_start(plan_table_t *f, const plan_table_t *t)
 {
     uint32_t k;
     int32_t o;
@@ -371,19 +371,19 @@ void plan_table_build_from_start(plan_table_t *f, const plan_table_t *t)
     }
 }
 
-void plan_table_walk(coa_planner_t *pl, const plan_table_t *t, uint32_t k, int32_t offset)
+void coa_plan_table_walk(coa_planner_t *pl, const plan_table_t *t, uint32_t k, int32_t offset)
 {
     int32_t *row = &pl->rows[t->vehicle * ((size_t)t->horizon + 1u)];
     row[k] = offset;
     for (; k < t->horizon; ++k) {
         plan_moves_t mv;
-        plan_table_moves(t, k, offset, &mv);
+        coa_plan_table_moves(t, k, offset, &mv);
         offset = mv.to[0];
         row[k + 1u] = offset;
     }
 }
 
-void plan_table_walk_back(coa_planner_t *pl, const plan_table_t *t, const plan_table_t *f,
+void coa_plan_table_walk_back(coa_planner_t *pl, const plan_table_t *t, const plan_table_t *f,
                           uint32_t k, int32_t offset)
 {
     int32_t *row = &pl->rows[t->vehicle * ((size_t)t->horizon + 1u)];

@@ -24,7 +24,7 @@
 
 /* The checks every entry point shares before it reads the arrays. The core's own checks
  * (vehicles, obstacles, tracks, finite samples) come later through the problem. */
-static int check_record(const coa_flight_t *f)
+static int check_record(const coavoid_flight_t *f)
 {
     if (f == NULL || f->vehicles == NULL || f->vehicle_count == 0u ||
         f->vehicle_count > COA_MAX_VEHICLES || f->steps == 0u || f->steps > COA_MAX_HORIZON ||
@@ -41,9 +41,9 @@ static int check_record(const coa_flight_t *f)
     return COA_OK;
 }
 
-coa_vec3_t coa_flight_position(const coa_flight_t *flight, size_t i, uint32_t k, int32_t offset)
+coa_vec3_t coavoid_flight_position(const coavoid_flight_t *flight, size_t i, uint32_t k, int32_t offset)
 {
-    const coa_flight_vehicle_t *v = &flight->vehicles[i];
+    const coavoid_flight_vehicle_t *v = &flight->vehicles[i];
     coa_vec3_t p = v->reference[k];
     p.z += (coa_real_t)offset * coa_climb_step(&v->vehicle, flight->dt);
     return p;
@@ -73,7 +73,7 @@ static void view_free(problem_view_t *pv)
 
 /* Builds the view; with `which` REFERENCE every row holds offsets[0]. Returns COA_OK,
  * COA_ERR_ARGUMENT (a track the core refuses to sample) or COA_ERR_WORKSPACE. */
-static int view_build(const coa_flight_t *f, coa_flight_trajectory_t which, problem_view_t *pv)
+static int view_build(const coavoid_flight_t *f, coavoid_flight_trajectory_t which, problem_view_t *pv)
 {
     const size_t n = f->vehicle_count;
     const size_t row = (size_t)f->steps + 1u;
@@ -90,7 +90,7 @@ static int view_build(const coa_flight_t *f, coa_flight_trajectory_t which, prob
     for (size_t i = 0; i < n; i++) {
         const int32_t *src = f->vehicles[i].offsets;
         for (size_t k = 0; k < row; k++) {
-            pv->offsets[i * row + k] = which == COA_FLIGHT_REFERENCE ? src[0] : src[k];
+            pv->offsets[i * row + k] = which == COAVOID_FLIGHT_REFERENCE ? src[0] : src[k];
         }
     }
     if (f->track_count > 0u) {
@@ -126,7 +126,7 @@ static int view_build(const coa_flight_t *f, coa_flight_trajectory_t which, prob
     return COA_OK;
 }
 
-int coa_flight_evaluate(const coa_flight_t *flight, coa_flight_eval_t *eval)
+int coavoid_flight_evaluate(const coavoid_flight_t *flight, coavoid_flight_eval_t *eval)
 {
     if (eval == NULL || check_record(flight) != COA_OK) {
         return COA_ERR_ARGUMENT;
@@ -148,7 +148,7 @@ int coa_flight_evaluate(const coa_flight_t *flight, coa_flight_eval_t *eval)
     }
 
     problem_view_t pv;
-    int rc = view_build(flight, COA_FLIGHT_FLOWN, &pv);
+    int rc = view_build(flight, COAVOID_FLIGHT_FLOWN, &pv);
     if (rc != COA_OK) {
         return rc;
     }
@@ -188,7 +188,7 @@ static coa_sweep_t sweep_of(const problem_view_t *pv, size_t i, uint32_t k)
     return s;
 }
 
-static void note(coa_flight_conflict_t *out, size_t capacity, size_t *found,
+static void note(coavoid_flight_conflict_t *out, size_t capacity, size_t *found,
                  coa_conflict_kind_t kind, size_t vehicle, size_t other, uint32_t step)
 {
     if (*found < capacity) {
@@ -200,11 +200,11 @@ static void note(coa_flight_conflict_t *out, size_t capacity, size_t *found,
     (*found)++;
 }
 
-int coa_flight_conflicts(const coa_flight_t *flight, coa_flight_trajectory_t which,
-                         coa_flight_conflict_t *out, size_t capacity, size_t *found)
+int coavoid_flight_conflicts(const coavoid_flight_t *flight, coavoid_flight_trajectory_t which,
+                         coavoid_flight_conflict_t *out, size_t capacity, size_t *found)
 {
     if (found == NULL || (capacity > 0u && out == NULL) ||
-        (which != COA_FLIGHT_FLOWN && which != COA_FLIGHT_REFERENCE) ||
+        (which != COAVOID_FLIGHT_FLOWN && which != COAVOID_FLIGHT_REFERENCE) ||
         check_record(flight) != COA_OK) {
         return COA_ERR_ARGUMENT;
     }
@@ -282,17 +282,17 @@ static bool add_number(cJSON *obj, const char *key, double value)
     return true;
 }
 
-static double sample_time(const coa_flight_t *f, uint32_t k)
+static double sample_time(const coavoid_flight_t *f, uint32_t k)
 {
     return (double)k * (double)f->dt;
 }
 
-static bool add_vehicle(cJSON *vehicles, const coa_flight_t *f, const coa_flight_eval_t *eval,
+static bool add_vehicle(cJSON *vehicles, const coavoid_flight_t *f, const coavoid_flight_eval_t *eval,
                         size_t i)
 {
-    const coa_flight_vehicle_t *v = &f->vehicles[i];
+    const coavoid_flight_vehicle_t *v = &f->vehicles[i];
     cJSON *entry = cJSON_CreateObject();
-    if (!output_append(vehicles, entry) || !add_number(entry, "id", v->vehicle.id)) {
+    if (!coavoid_output_append(vehicles, entry) || !add_number(entry, "id", v->vehicle.id)) {
         return false;
     }
     cJSON *flown = cJSON_AddArrayToObject(entry, "flown");
@@ -300,14 +300,14 @@ static bool add_vehicle(cJSON *vehicles, const coa_flight_t *f, const coa_flight
         return false;
     }
     for (uint32_t k = 0; k <= f->steps; k++) {
-        coa_vec3_t p = coa_flight_position(f, i, k, v->offsets[k]);
+        coa_vec3_t p = coavoid_flight_position(f, i, k, v->offsets[k]);
         double sample[4] = {sample_time(f, k), (double)p.x, (double)p.y, (double)p.z};
         cJSON *point = cJSON_CreateArray();
-        if (!output_append(flown, point)) {
+        if (!coavoid_output_append(flown, point)) {
             return false;
         }
         for (int q = 0; q < 4; q++) {
-            if (!output_append(point, exact_number(sample[q]))) {
+            if (!coavoid_output_append(point, exact_number(sample[q]))) {
                 return false;
             }
         }
@@ -331,7 +331,7 @@ static bool add_vehicle(cJSON *vehicles, const coa_flight_t *f, const coa_flight
     return true;
 }
 
-static cJSON *build_json(const coa_flight_t *f, const coa_flight_eval_t *eval)
+static cJSON *build_json(const coavoid_flight_t *f, const coavoid_flight_eval_t *eval)
 {
     cJSON *root = cJSON_CreateObject();
     if (root == NULL ||
@@ -368,13 +368,13 @@ fail:
     return NULL;
 }
 
-int coa_flight_json(const coa_flight_t *flight, const coa_flight_eval_t *eval, FILE *out)
+int coavoid_flight_json(const coavoid_flight_t *flight, const coavoid_flight_eval_t *eval, FILE *out)
 {
-    return coa_flight_json_extra(flight, eval, NULL, 0u, out);
+    return coavoid_flight_json_extra(flight, eval, NULL, 0u, out);
 }
 
-int coa_flight_json_extra(const coa_flight_t *flight, const coa_flight_eval_t *eval,
-                          const coa_flight_extra_t *extra, size_t extra_count, FILE *out)
+int coavoid_flight_json_extra(const coavoid_flight_t *flight, const coavoid_flight_eval_t *eval,
+                          const coavoid_flight_extra_t *extra, size_t extra_count, FILE *out)
 {
     if (eval == NULL || out == NULL || check_record(flight) != COA_OK ||
         (eval->loss_of_separation && eval->first_vehicle >= flight->vehicle_count) ||
@@ -396,30 +396,30 @@ int coa_flight_json_extra(const coa_flight_t *flight, const coa_flight_eval_t *e
             return COA_ERR_WORKSPACE;
         }
     }
-    return output_json(out, root, NULL, 0) == 0 ? COA_OK : COA_ERR_WORKSPACE;
+    return coavoid_output_json(out, root, NULL, 0) == 0 ? COA_OK : COA_ERR_WORKSPACE;
 }
 
 /* ---- text ---- */
 
 /* "UAV 3 and track 7": who UAV first_vehicle lost separation with at first_step, from the
  * pairwise list (the core names only one side). Empty when the list cannot be made. */
-static void describe_first_loss(const coa_flight_t *f, const coa_flight_eval_t *eval, char *buf,
+static void describe_first_loss(const coavoid_flight_t *f, const coavoid_flight_eval_t *eval, char *buf,
                                 size_t size)
 {
     size_t found = 0;
     buf[0] = '\0';
-    if (coa_flight_conflicts(f, COA_FLIGHT_FLOWN, NULL, 0u, &found) != COA_OK || found == 0u) {
+    if (coavoid_flight_conflicts(f, COAVOID_FLIGHT_FLOWN, NULL, 0u, &found) != COA_OK || found == 0u) {
         return;
     }
-    coa_flight_conflict_t *list = malloc(found * sizeof *list);
+    coavoid_flight_conflict_t *list = malloc(found * sizeof *list);
     if (list == NULL) {
         return;
     }
     size_t again = 0;
-    if (coa_flight_conflicts(f, COA_FLIGHT_FLOWN, list, found, &again) == COA_OK) {
+    if (coavoid_flight_conflicts(f, COAVOID_FLIGHT_FLOWN, list, found, &again) == COA_OK) {
         const size_t me = eval->first_vehicle;
         for (size_t c = 0; c < found && c < again; c++) {
-            const coa_flight_conflict_t *x = &list[c];
+            const coavoid_flight_conflict_t *x = &list[c];
             bool mine = x->vehicle == me || (x->kind == COA_CONFLICT_VEHICLE && x->other == me);
             if (x->step != eval->first_step || !mine) {
                 continue;
@@ -441,12 +441,12 @@ static void describe_first_loss(const coa_flight_t *f, const coa_flight_eval_t *
     free(list);
 }
 
-int coa_flight_text(const coa_flight_t *flight, const coa_flight_eval_t *eval, FILE *out)
+int coavoid_flight_text(const coavoid_flight_t *flight, const coavoid_flight_eval_t *eval, FILE *out)
 {
     if (eval == NULL || out == NULL || check_record(flight) != COA_OK) {
         return COA_ERR_ARGUMENT;
     }
-    const coa_flight_t *f = flight;
+    const coavoid_flight_t *f = flight;
     fprintf(out, "scenario: %s\n", f->scenario != NULL ? f->scenario : "");
     fprintf(out, "mode: %s\n", f->mode != NULL ? f->mode : "");
     fprintf(out, "steps: %lu (dt %.9g s, %.9g s flown)\n", (unsigned long)f->steps,
@@ -466,7 +466,7 @@ int coa_flight_text(const coa_flight_t *flight, const coa_flight_eval_t *eval, F
     fprintf(out, "deviation: %.10g m^2\n", eval->deviation);
     fprintf(out, "effort: %lu\n", (unsigned long)eval->effort);
     for (size_t i = 0; i < f->vehicle_count; i++) {
-        const coa_flight_vehicle_t *v = &f->vehicles[i];
+        const coavoid_flight_vehicle_t *v = &f->vehicles[i];
         fprintf(out, "UAV %u:", (unsigned)v->vehicle.id);
         if (eval->vehicle_deviation != NULL) {
             fprintf(out, " deviation %.10g m^2", eval->vehicle_deviation[i]);

@@ -4,12 +4,12 @@
  * nodes, and by `coavoid summary` from an lcm-logger log of a real-time run (the intents
  * each UAV published: its reference and offset at each cycle's start).
  *
- *   - coa_flight_evaluate: loss of separation by the contract's semantics (the flown
+ *   - coavoid_flight_evaluate: loss of separation by the contract's semantics (the flown
  *     samples, straight between consecutive samples, against each other, the tracks and
  *     the obstacles: the same tests the planner uses, via coa_plan_find_conflict over a
  *     problem whose references are the flown references), and the deviation and effort
  *     of what was flown (coa_plan_vehicle_cost over the flown offsets).
- *   - coa_flight_svg: the figure: a top view (routes, terrain footprints, tracks, where
+ *   - coavoid_flight_svg: the figure: a top view (routes, terrain footprints, tracks, where
  *     the references would have conflicted, where separation was lost) and, per UAV, its
  *     altitude against time: reference dashed, flown solid, the terrain under its path
  *     and the tracks near it drawn, conflicts marked, as in the paper's figures.
@@ -35,21 +35,21 @@ typedef struct {
                                    in a log covered that sample (neither the cycle's own
                                    nor an earlier plan reaching it): reference and offset
                                    there are stand-ins, not what was flown */
-} coa_flight_vehicle_t;
+} coavoid_flight_vehicle_t;
 
 typedef struct {
     const char *scenario;       /* name */
     const char *mode;           /* "centralised" or "decoupled" */
     coa_real_t dt;
     uint32_t steps;             /* K: samples 0..K */
-    coa_flight_vehicle_t *vehicles;
+    coavoid_flight_vehicle_t *vehicles;
     size_t vehicle_count;
     const coa_obstacle_t *obstacles;
     size_t obstacle_count;
     const coa_track_t *tracks;  /* positions at t = 0, as the scenario gives them */
     size_t track_count;
     uint32_t replans;           /* planning calls during the run */
-} coa_flight_t;
+} coavoid_flight_t;
 
 typedef struct {
     bool loss_of_separation;
@@ -59,7 +59,7 @@ typedef struct {
     uint32_t effort;
     double *vehicle_deviation;  /* caller's array of vehicle_count, or NULL */
     uint32_t *vehicle_effort;   /* caller's array of vehicle_count, or NULL */
-} coa_flight_eval_t;
+} coavoid_flight_eval_t;
 
 /* Returns COA_OK, COA_ERR_ARGUMENT (a flown step is not an action, more than
  * COA_MAX_VEHICLES UAVs, steps out of range, NULL, or what coa_plan_find_conflict refuses:
@@ -68,19 +68,19 @@ typedef struct {
  * coa_plan_find_conflict's (the earliest step, the first UAV in conflict there); else
  * first_vehicle is COA_NO_VEHICLE and first_step 0. Cost O(K n (n + obstacles + tracks))
  * plus sampling the tracks; allocates O(K (n + tracks)) scratch. */
-int coa_flight_evaluate(const coa_flight_t *flight, coa_flight_eval_t *eval);
+int coavoid_flight_evaluate(const coavoid_flight_t *flight, coavoid_flight_eval_t *eval);
 
 /* Where UAV i is at sample k when it flies `offset` there: reference[k] +
  * (coa_real_t)offset * coa_climb_step(vehicle, dt) * z_hat, the planner's formula, so
  * that every consumer of a record computes the same positions bit for bit.
  * Preconditions: i < vehicle_count, k <= steps. Cost O(1). */
-coa_vec3_t coa_flight_position(const coa_flight_t *flight, size_t i, uint32_t k, int32_t offset);
+coa_vec3_t coavoid_flight_position(const coavoid_flight_t *flight, size_t i, uint32_t k, int32_t offset);
 
-/* Which trajectories coa_flight_conflicts judges. */
+/* Which trajectories coavoid_flight_conflicts judges. */
 typedef enum {
-    COA_FLIGHT_FLOWN = 0,      /* offsets[k] at every sample: what was flown */
-    COA_FLIGHT_REFERENCE = 1   /* offsets[0] at every sample: the run without manoeuvres */
-} coa_flight_trajectory_t;
+    COAVOID_FLIGHT_FLOWN = 0,      /* offsets[k] at every sample: what was flown */
+    COAVOID_FLIGHT_REFERENCE = 1   /* offsets[0] at every sample: the run without manoeuvres */
+} coavoid_flight_trajectory_t;
 
 /* One conflicting pair over one step. */
 typedef struct {
@@ -88,23 +88,23 @@ typedef struct {
     size_t vehicle;            /* UAV index */
     size_t other;              /* a UAV index (> vehicle), a track or an obstacle index */
     uint32_t step;             /* the interval [t_k, t_k+1] */
-} coa_flight_conflict_t;
+} coavoid_flight_conflict_t;
 
-/* Every (pair, step) in conflict by the same geometry tests as coa_flight_evaluate (so
- * with COA_FLIGHT_FLOWN the list is empty exactly when no separation was lost), ordered by
+/* Every (pair, step) in conflict by the same geometry tests as coavoid_flight_evaluate (so
+ * with COAVOID_FLIGHT_FLOWN the list is empty exactly when no separation was lost), ordered by
  * step, then UAV, then UAV-UAV, track, obstacle pairs. Writes the first `capacity` to out
  * (out may be NULL when capacity is 0) and the total to *found. Returns COA_OK,
- * COA_ERR_ARGUMENT (as coa_flight_evaluate, except that steps need not be actions) or
+ * COA_ERR_ARGUMENT (as coavoid_flight_evaluate, except that steps need not be actions) or
  * COA_ERR_WORKSPACE (out of memory). Cost O(K n (n + obstacles + tracks)); allocates the
  * tracks' samples. */
-int coa_flight_conflicts(const coa_flight_t *flight, coa_flight_trajectory_t which,
-                         coa_flight_conflict_t *out, size_t capacity, size_t *found);
+int coavoid_flight_conflicts(const coavoid_flight_t *flight, coavoid_flight_trajectory_t which,
+                         coavoid_flight_conflict_t *out, size_t capacity, size_t *found);
 
 /* Writes the SVG document to out: self-contained (no scripts, no external references).
  * eval may be NULL (no result line). Returns COA_OK, COA_ERR_ARGUMENT (as
- * coa_flight_conflicts, or a NULL flight or out), or COA_ERR_WORKSPACE (out of memory or
+ * coavoid_flight_conflicts, or a NULL flight or out), or COA_ERR_WORKSPACE (out of memory or
  * a write failed). Cost O(K n (n + obstacles + tracks)); allocates O(K (n + tracks)). */
-int coa_flight_svg(const coa_flight_t *flight, const coa_flight_eval_t *eval, FILE *out);
+int coavoid_flight_svg(const coavoid_flight_t *flight, const coavoid_flight_eval_t *eval, FILE *out);
 
 /* Writes the simulation result of docs/scenario-format.md ("Simulation result") as JSON:
  * scenario, mode, steps, replans, loss_of_separation, deviation, effort, and per UAV id and
@@ -117,29 +117,29 @@ int coa_flight_svg(const coa_flight_t *flight, const coa_flight_eval_t *eval, FI
  * Returns COA_OK, COA_ERR_ARGUMENT (NULL; counts, steps or dt out of range; NULL arrays;
  * a loss without a valid first_vehicle) or COA_ERR_WORKSPACE (out of memory, write
  * failed). Cost O(K n); allocates the document, O(K n), while printing. */
-int coa_flight_json(const coa_flight_t *flight, const coa_flight_eval_t *eval, FILE *out);
+int coavoid_flight_json(const coavoid_flight_t *flight, const coavoid_flight_eval_t *eval, FILE *out);
 
 /* A member a command adds to the result beyond the record's: its key and its value as
  * JSON text, written as given (e.g. "3", or an object printed by cJSON). */
 typedef struct {
     const char *key;
     const char *json;
-} coa_flight_extra_t;
+} coavoid_flight_extra_t;
 
-/* coa_flight_json with extra[0..extra_count) appended to the object, in order, the way
+/* coavoid_flight_json with extra[0..extra_count) appended to the object, in order, the way
  * `coavoid sim` adds "fallbacks" and `coavoid summary` its "log": so no command has to
  * parse the document and print it again. The json texts are not checked. Returns, costs
- * and allocates as coa_flight_json; COA_ERR_ARGUMENT also for an extra without a key or
+ * and allocates as coavoid_flight_json; COA_ERR_ARGUMENT also for an extra without a key or
  * text. */
-int coa_flight_json_extra(const coa_flight_t *flight, const coa_flight_eval_t *eval,
-                          const coa_flight_extra_t *extra, size_t extra_count, FILE *out);
+int coavoid_flight_json_extra(const coavoid_flight_t *flight, const coavoid_flight_eval_t *eval,
+                          const coavoid_flight_extra_t *extra, size_t extra_count, FILE *out);
 
 /* Writes the result for a reader, one fact a line ("loss of separation: no", "deviation:
  * ... m^2", per UAV its costs), as `coavoid sim` and `coavoid summary` print it without
- * --json; a loss names both sides ("UAV 1 and obstacle 0") from coa_flight_conflicts.
- * Returns COA_OK, COA_ERR_ARGUMENT (NULL, or counts out of range as coa_flight_json) or
+ * --json; a loss names both sides ("UAV 1 and obstacle 0") from coavoid_flight_conflicts.
+ * Returns COA_OK, COA_ERR_ARGUMENT (NULL, or counts out of range as coavoid_flight_json) or
  * COA_ERR_WORKSPACE (write failed). Cost O(K n), plus the pairwise listing when lost,
  * which it allocates and frees. */
-int coa_flight_text(const coa_flight_t *flight, const coa_flight_eval_t *eval, FILE *out);
+int coavoid_flight_text(const coavoid_flight_t *flight, const coavoid_flight_eval_t *eval, FILE *out);
 
 #endif /* COAVOID_APP_FLIGHT_H */

@@ -6,7 +6,7 @@
 
 #include <string.h>
 
-int judge_run(judged_t *j, const scenario_t *s, const char *mode, uint32_t steps,
+int coavoid_judge_run(coavoid_judged_t *j, const coavoid_scenario_t *s, const char *mode, uint32_t steps,
               uint32_t replans, coa_vec3_t *reference, int32_t *offsets, bool *known)
 {
     const size_t n = s->vehicle_count;
@@ -34,5 +34,5 @@ int judge_run(judged_t *j, const scenario_t *s, const char *mode, uint32_t steps
     j->flight.replans = replans;
     j->eval.vehicle_deviation = j->vehicle_deviation;
     j->eval.vehicle_effort = j->vehicle_effort;
-    return coa_flight_evaluate(&j->flight, &j->eval);
+    return coavoid_flight_evaluate(&j->flight, &j->eval);
 }

@@ -14,20 +14,20 @@
 #include "scenario.h"
 
 typedef struct {
-    coa_flight_t flight;
-    coa_flight_eval_t eval;
-    coa_flight_vehicle_t vehicles[COA_MAX_VEHICLES];
+    coavoid_flight_t flight;
+    coavoid_flight_eval_t eval;
+    coavoid_flight_vehicle_t vehicles[COA_MAX_VEHICLES];
     double vehicle_deviation[COA_MAX_VEHICLES];
     uint32_t vehicle_effort[COA_MAX_VEHICLES];
-} judged_t;
+} coavoid_judged_t;
 
 /* Records scenario s flown in `mode` over samples 0..steps, with `replans` planning calls,
  * in j->flight: UAV i (the scenario's order) flew row i of reference and offsets (n rows
  * of steps + 1), known as row i of `known` (NULL: every sample known); then evaluates it
- * into j->eval. Returns coa_flight_evaluate's status (COA_ERR_ARGUMENT also for more than
+ * into j->eval. Returns coavoid_flight_evaluate's status (COA_ERR_ARGUMENT also for more than
  * COA_MAX_VEHICLES UAVs). The record points into j, s and the arrays, which must outlive
- * it and not move. Cost: coa_flight_evaluate's; no memory beyond its scratch. */
-int judge_run(judged_t *j, const scenario_t *s, const char *mode, uint32_t steps,
+ * it and not move. Cost: coavoid_flight_evaluate's; no memory beyond its scratch. */
+int coavoid_judge_run(coavoid_judged_t *j, const coavoid_scenario_t *s, const char *mode, uint32_t steps,
               uint32_t replans, coa_vec3_t *reference, int32_t *offsets, bool *known);
 
 #endif /* COAVOID_APP_JUDGE_H */

@@ -8,7 +8,7 @@
  * references are to its own clip paths. Text that came from input (the scenario's name)
  * is escaped and invalid UTF-8 is replaced, so the file is always well-formed XML.
  *
- * Conflict markers come from coa_flight_conflicts, the same geometry tests as the
+ * Conflict markers come from coavoid_flight_conflicts, the same geometry tests as the
  * evaluation: hollow red circles where the references (offsets held at their initial
  * value) would have conflicted, filled red crosses where the flown paths lost separation.
  */
@@ -62,15 +62,15 @@ static double py(const frame_t *fr, double y)
 }
 
 typedef struct {
-    const coa_flight_t *f;
+    const coavoid_flight_t *f;
     FILE *out;
     size_t row;             /* steps + 1 */
     coa_vec3_t *flown;      /* n rows: flown positions */
     coa_vec3_t *refpos;     /* n rows: positions at the initial offset (no manoeuvre) */
     coa_vec3_t *tracks;     /* track_count rows */
-    coa_flight_conflict_t *ref_conflicts;
+    coavoid_flight_conflict_t *ref_conflicts;
     size_t ref_count;
-    coa_flight_conflict_t *losses;
+    coavoid_flight_conflict_t *losses;
     size_t loss_count;
     bool *ref_mark;         /* n * steps: UAV i's step k conflicts (references) */
     bool *loss_mark;        /* n * steps: UAV i's step k conflicts (flown) */
@@ -252,7 +252,7 @@ static void ring(FILE *out, double x, double y)
 }
 
 /* Marks which (UAV, step) pairs are in a conflict of the list. */
-static void mark_steps(const svg_t *s, const coa_flight_conflict_t *list, size_t count,
+static void mark_steps(const svg_t *s, const coavoid_flight_conflict_t *list, size_t count,
                        bool *mark)
 {
     const size_t steps = s->f->steps;
@@ -460,10 +460,10 @@ static double legend(const svg_t *s, double y)
     return y + 16.0;
 }
 
-static void header(const svg_t *s, const coa_flight_eval_t *eval, double *y)
+static void header(const svg_t *s, const coavoid_flight_eval_t *eval, double *y)
 {
     FILE *out = s->out;
-    const coa_flight_t *f = s->f;
+    const coavoid_flight_t *f = s->f;
     char line[512];
     fprintf(out, "<text x=\"%.1f\" y=\"%.1f\" class=\"title\">", SVG_LEFT, *y);
     put_text(out, f->scenario);
@@ -475,7 +475,7 @@ static void header(const svg_t *s, const coa_flight_eval_t *eval, double *y)
         if (eval->loss_of_separation && s->loss_count > 0u) {
             /* The list's first entry is the core's first: the earliest step, and there the
              * lowest-indexed UAV in conflict, which is the one the evaluation names. */
-            const coa_flight_conflict_t *c = &s->losses[0];
+            const coavoid_flight_conflict_t *c = &s->losses[0];
             char other[64];
             if (c->kind == COA_CONFLICT_VEHICLE) {
                 snprintf(other, sizeof other, "UAV %u", (unsigned)f->vehicles[c->other].vehicle.id);
@@ -509,7 +509,7 @@ static void header(const svg_t *s, const coa_flight_eval_t *eval, double *y)
 static void top_view(const svg_t *s, double *y)
 {
     FILE *out = s->out;
-    const coa_flight_t *f = s->f;
+    const coavoid_flight_t *f = s->f;
     const size_t n = f->vehicle_count;
     double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY, reach = 0.0;
     for (size_t i = 0; i < n; i++) {
@@ -720,7 +720,7 @@ typedef struct {
 
 static svg_other_t other_traffic(const svg_t *s, size_t i, size_t q)
 {
-    const coa_flight_t *f = s->f;
+    const coavoid_flight_t *f = s->f;
     svg_other_t o;
     o.is_track = q >= f->vehicle_count;
     o.j = o.is_track ? q - f->vehicle_count : q;
@@ -736,7 +736,7 @@ static svg_other_t other_traffic(const svg_t *s, size_t i, size_t q)
 static void near_traffic(const svg_t *s, size_t i, const frame_t *fr, bool draw_labels)
 {
     FILE *out = s->out;
-    const coa_flight_t *f = s->f;
+    const coavoid_flight_t *f = s->f;
     const coa_vec3_t *me = &s->flown[i * s->row];
     const size_t others = f->vehicle_count + f->track_count;
     for (size_t q = 0; q < others; q++) {
@@ -801,7 +801,7 @@ static void near_traffic(const svg_t *s, size_t i, const frame_t *fr, bool draw_
 static void near_extent(const svg_t *s, size_t i, double lo_own, double hi_own, double *lo,
                         double *hi)
 {
-    const coa_flight_t *f = s->f;
+    const coavoid_flight_t *f = s->f;
     const coa_vec3_t *me = &s->flown[i * s->row];
     const double hi_vol = (double)f->vehicles[i].vehicle.volume.half_height;
     for (size_t q = 0; q < f->vehicle_count + f->track_count; q++) {
@@ -822,11 +822,11 @@ static void near_extent(const svg_t *s, size_t i, double lo_own, double hi_own, 
     }
 }
 
-static void altitude_panel(const svg_t *s, const coa_flight_eval_t *eval, size_t i, double *y)
+static void altitude_panel(const svg_t *s, const coavoid_flight_eval_t *eval, size_t i, double *y)
 {
     FILE *out = s->out;
-    const coa_flight_t *f = s->f;
-    const coa_flight_vehicle_t *v = &f->vehicles[i];
+    const coavoid_flight_t *f = s->f;
+    const coavoid_flight_vehicle_t *v = &f->vehicles[i];
     const coa_vec3_t *flown = &s->flown[i * s->row];
     const coa_vec3_t *ref = &s->refpos[i * s->row];
     const double dt = (double)f->dt;
@@ -973,11 +973,11 @@ static void svg_free(svg_t *s)
 }
 
 /* The list of conflicts of one kind of trajectory, allocated. */
-static int list_conflicts(const coa_flight_t *f, coa_flight_trajectory_t which,
-                          coa_flight_conflict_t **list, size_t *count)
+static int list_conflicts(const coavoid_flight_t *f, coavoid_flight_trajectory_t which,
+                          coavoid_flight_conflict_t **list, size_t *count)
 {
     size_t found = 0;
-    int rc = coa_flight_conflicts(f, which, NULL, 0u, &found);
+    int rc = coavoid_flight_conflicts(f, which, NULL, 0u, &found);
     if (rc != COA_OK) {
         return rc;
     }
@@ -985,14 +985,14 @@ static int list_conflicts(const coa_flight_t *f, coa_flight_trajectory_t which,
     if (*list == NULL) {
         return COA_ERR_WORKSPACE;
     }
-    rc = coa_flight_conflicts(f, which, *list, found, count);
+    rc = coavoid_flight_conflicts(f, which, *list, found, count);
     if (rc == COA_OK && *count != found) {
         rc = COA_ERR_WORKSPACE; /* cannot happen: the same record twice */
     }
     return rc;
 }
 
-static int prepare(svg_t *s, const coa_flight_t *f, FILE *out)
+static int prepare(svg_t *s, const coavoid_flight_t *f, FILE *out)
 {
     const size_t n = f->vehicle_count;
     memset(s, 0, sizeof *s);
@@ -1000,9 +1000,9 @@ static int prepare(svg_t *s, const coa_flight_t *f, FILE *out)
     s->out = out;
     s->row = (size_t)f->steps + 1u;
     /* The lists first: they run the core's checks on the whole record. */
-    int rc = list_conflicts(f, COA_FLIGHT_REFERENCE, &s->ref_conflicts, &s->ref_count);
+    int rc = list_conflicts(f, COAVOID_FLIGHT_REFERENCE, &s->ref_conflicts, &s->ref_count);
     if (rc == COA_OK) {
-        rc = list_conflicts(f, COA_FLIGHT_FLOWN, &s->losses, &s->loss_count);
+        rc = list_conflicts(f, COAVOID_FLIGHT_FLOWN, &s->losses, &s->loss_count);
     }
     if (rc != COA_OK) {
         return rc;
@@ -1017,10 +1017,10 @@ static int prepare(svg_t *s, const coa_flight_t *f, FILE *out)
         return COA_ERR_WORKSPACE;
     }
     for (size_t i = 0; i < n; i++) {
-        const coa_flight_vehicle_t *v = &f->vehicles[i];
+        const coavoid_flight_vehicle_t *v = &f->vehicles[i];
         for (uint32_t k = 0; k <= f->steps; k++) {
-            s->flown[i * s->row + k] = coa_flight_position(f, i, k, v->offsets[k]);
-            s->refpos[i * s->row + k] = coa_flight_position(f, i, k, v->offsets[0]);
+            s->flown[i * s->row + k] = coavoid_flight_position(f, i, k, v->offsets[k]);
+            s->refpos[i * s->row + k] = coavoid_flight_position(f, i, k, v->offsets[0]);
             s->any_unknown = s->any_unknown || (v->known != NULL && !v->known[k]);
         }
     }
@@ -1035,7 +1035,7 @@ static int prepare(svg_t *s, const coa_flight_t *f, FILE *out)
     return COA_OK;
 }
 
-int coa_flight_svg(const coa_flight_t *flight, const coa_flight_eval_t *eval, FILE *out)
+int coavoid_flight_svg(const coavoid_flight_t *flight, const coavoid_flight_eval_t *eval, FILE *out)
 {
     if (flight == NULL || out == NULL) {
         return COA_ERR_ARGUMENT;
@@ -1046,7 +1046,7 @@ int coa_flight_svg(const coa_flight_t *flight, const coa_flight_eval_t *eval, FI
         svg_free(&s);
         return rc;
     }
-    const coa_flight_t *f = flight;
+    const coavoid_flight_t *f = flight;
 
     /* Write the body to a memory stream first: the document's height is only known once
      * the panels are laid out. */

@@ -7,7 +7,7 @@
  * message's capacity, known enum values, valid ids, sane times); each *_to_core function
  * runs the check, then the sender's sequence rule, and only then converts, so the core
  * never sees a number that was not validated. A refusal returns a named negative
- * COA_LCM_ERR_* code and sets *reason to a static string naming the message and the
+ * COAVOID_LCM_ERR_* code and sets *reason to a static string naming the message and the
  * field; the caller counts it and reports it in its status message: it is never fatal.
  *
  * *_from_core functions build a message from core types and run the same check on the
@@ -41,24 +41,24 @@ extern "C" {
 
 /* Refusals. Distinct from the core's -1..-3 so that a status message's last_reject_code
  * says which rule refused. COA_ERR_ARGUMENT is still returned for NULL arguments. */
-#define COA_LCM_ERR_DECODE (-100)    /* bytes do not decode: wrong type (fingerprint) or truncated */
-#define COA_LCM_ERR_NONFINITE (-101) /* NaN or infinity */
-#define COA_LCM_ERR_VALUE (-102)     /* a finite number outside its range (negative size, 1e300 m, ...) */
-#define COA_LCM_ERR_COUNT (-103)     /* a count beyond the message's capacity or inconsistent */
-#define COA_LCM_ERR_ENUM (-104)      /* an unknown mode, status, kind, ... */
-#define COA_LCM_ERR_ID (-105)        /* an id out of range or repeated */
-#define COA_LCM_ERR_TIME (-106)      /* a time stamp in the future, stale, or out of order */
-#define COA_LCM_ERR_SEQUENCE (-107)  /* a sequence number (or version) that went backwards */
-#define COA_LCM_ERR_SENDERS (-108)   /* the caller's sequence table is full */
-#define COA_LCM_ERR_CAPACITY (-109)  /* the caller's output array is too small */
+#define COAVOID_LCM_ERR_DECODE (-100)    /* bytes do not decode: wrong type (fingerprint) or truncated */
+#define COAVOID_LCM_ERR_NONFINITE (-101) /* NaN or infinity */
+#define COAVOID_LCM_ERR_VALUE (-102)     /* a finite number outside its range (negative size, 1e300 m, ...) */
+#define COAVOID_LCM_ERR_COUNT (-103)     /* a count beyond the message's capacity or inconsistent */
+#define COAVOID_LCM_ERR_ENUM (-104)      /* an unknown mode, status, kind, ... */
+#define COAVOID_LCM_ERR_ID (-105)        /* an id out of range or repeated */
+#define COAVOID_LCM_ERR_TIME (-106)      /* a time stamp in the future, stale, or out of order */
+#define COAVOID_LCM_ERR_SEQUENCE (-107)  /* a sequence number (or version) that went backwards */
+#define COAVOID_LCM_ERR_SENDERS (-108)   /* the caller's sequence table is full */
+#define COAVOID_LCM_ERR_CAPACITY (-109)  /* the caller's output array is too small */
 
 /* Bounds on numbers, beyond finiteness. They keep every converted value finite in float
  * too (COA_SINGLE_PRECISION) and refuse values no aircraft has. */
-#define COA_LCM_MAX_COORDINATE 1.0e7 /* m, |x|, |y|, |z| of any position */
-#define COA_LCM_MAX_SPEED 1.0e4      /* m/s, each velocity component */
-#define COA_LCM_MAX_SIZE 1.0e5       /* m: radius, half-height, sigma */
-#define COA_LCM_MAX_STEP 3600.0      /* s: plan step or dt */
-#define COA_LCM_MAX_ID 65535         /* UAV and node ids are 1..65535 (coa_vehicle_t.id) */
+#define COAVOID_LCM_MAX_COORDINATE 1.0e7 /* m, |x|, |y|, |z| of any position */
+#define COAVOID_LCM_MAX_SPEED 1.0e4      /* m/s, each velocity component */
+#define COAVOID_LCM_MAX_SIZE 1.0e5       /* m: radius, half-height, sigma */
+#define COAVOID_LCM_MAX_STEP 3600.0      /* s: plan step or dt */
+#define COAVOID_LCM_MAX_ID 65535         /* UAV and node ids are 1..65535 (coa_vehicle_t.id) */
 
 /* How the receiver judges times. All microseconds. */
 typedef struct {
@@ -67,37 +67,37 @@ typedef struct {
                              times around utime) */
     int64_t max_future_us; /* utime > now + max_future: a clock ahead or a bad stamp */
     int64_t epoch_utime;  /* origin of the core's clock */
-} coa_lcm_context_t;
+} coavoid_lcm_context_t;
 
 /* Per-sender last sequence numbers, in the caller's array (one table per message type). */
 typedef struct {
     uint32_t sender;
     int64_t last;
-} coa_lcm_sender_t;
+} coavoid_lcm_sender_t;
 
 typedef struct {
-    coa_lcm_sender_t *entries;
+    coavoid_lcm_sender_t *entries;
     size_t capacity;
     size_t count;
-} coa_lcm_sequence_table_t;
+} coavoid_lcm_sequence_table_t;
 
 /* Empties the table over entries[0..capacity-1]. Cannot fail on non-NULL table. */
-void coa_lcm_sequence_init(coa_lcm_sequence_table_t *table, coa_lcm_sender_t *entries,
+void coavoid_lcm_sequence_init(coavoid_lcm_sequence_table_t *table, coavoid_lcm_sender_t *entries,
                            size_t capacity);
 
 /* Accepts `sequence` from `sender` when it is greater than the last one accepted (or
  * equal, with allow_equal: a republished version), recording it. Returns COA_OK,
- * COA_LCM_ERR_SEQUENCE (backwards: nothing recorded), COA_LCM_ERR_SENDERS (new sender,
+ * COAVOID_LCM_ERR_SEQUENCE (backwards: nothing recorded), COAVOID_LCM_ERR_SENDERS (new sender,
  * table full) or COA_ERR_ARGUMENT. A sender that restarts its numbering is refused until
- * coa_lcm_sequence_forget (e.g. after its heartbeat went silent). Cost O(count). */
-int coa_lcm_sequence_accept(coa_lcm_sequence_table_t *table, uint32_t sender, int64_t sequence,
+ * coavoid_lcm_sequence_forget (e.g. after its heartbeat went silent). Cost O(count). */
+int coavoid_lcm_sequence_accept(coavoid_lcm_sequence_table_t *table, uint32_t sender, int64_t sequence,
                             bool allow_equal);
 
 /* Forgets a sender. Cost O(count). */
-void coa_lcm_sequence_forget(coa_lcm_sequence_table_t *table, uint32_t sender);
+void coavoid_lcm_sequence_forget(coavoid_lcm_sequence_table_t *table, uint32_t sender);
 
-/* A short English name of any COA_LCM_ERR_* or core status. Never NULL. */
-const char *coa_lcm_error_name(int status);
+/* A short English name of any COAVOID_LCM_ERR_* or core status. Never NULL. */
+const char *coavoid_lcm_error_name(int status);
 
 /* ---- intent ---- */
 
@@ -112,7 +112,7 @@ typedef struct {
     coa_real_t step;    /* s */
     coa_real_t sigma_horizontal;
     coa_real_t sigma_vertical;
-} coa_lcm_intent_info_t;
+} coavoid_lcm_intent_info_t;
 
 /* The arrays an intent's core view points into (9.7 kB in double): the caller's, so that
  * nothing is allocated. */
@@ -120,7 +120,7 @@ typedef struct {
     coa_vec3_t reference[COAVOID_INTENT_T_MAX_SAMPLES];
     coa_vec3_t samples[COAVOID_INTENT_T_MAX_SAMPLES]; /* reference + offset * dh */
     int32_t offsets[COAVOID_INTENT_T_MAX_SAMPLES];
-} coa_lcm_intent_arrays_t;
+} coavoid_lcm_intent_arrays_t;
 
 /* Every rule of intent_t (its .lcm file): times, id, priority, mode, finite and bounded
  * state, volume and performance, sample count 2..MAX_SAMPLES, reference points that differ
@@ -129,8 +129,8 @@ typedef struct {
  * Speeds, step, volume and route legs are also judged as the core sees them, in its
  * precision (coa_vehicle_check, a positive deviation weight and climb step), so every
  * accepted intent gives a vehicle the planner accepts.
- * Returns COA_OK or a COA_LCM_ERR_* with *reason naming the field. Cost O(sample_count). */
-int coa_lcm_intent_check(const coavoid_intent_t *msg, const coa_lcm_context_t *ctx,
+ * Returns COA_OK or a COAVOID_LCM_ERR_* with *reason naming the field. Cost O(sample_count). */
+int coavoid_lcm_intent_check(const coavoid_intent_t *msg, const coavoid_lcm_context_t *ctx,
                          const char **reason);
 
 /* The core's views of an intent, after the check and the sequence rule (seq may be NULL:
@@ -142,22 +142,22 @@ int coa_lcm_intent_check(const coavoid_intent_t *msg, const coa_lcm_context_t *c
  *   - *plan: the positions as the predictor takes them, t0 on ctx's clock, samples =
  *     arrays->samples computed as the planner computes positions (reference z +
  *     (coa_real_t)offset * coa_climb_step(vehicle, step)).
- * arrays must outlive both views. Errors as the check, plus COA_LCM_ERR_SEQUENCE /
- * COA_LCM_ERR_SENDERS, COA_ERR_ARGUMENT for NULL outputs; outputs are unspecified on an
+ * arrays must outlive both views. Errors as the check, plus COAVOID_LCM_ERR_SEQUENCE /
+ * COAVOID_LCM_ERR_SENDERS, COA_ERR_ARGUMENT for NULL outputs; outputs are unspecified on an
  * error. Cost O(sample_count), no memory. */
-int coa_lcm_intent_to_core(const coavoid_intent_t *msg, const coa_lcm_context_t *ctx,
-                           coa_lcm_sequence_table_t *seq, coa_lcm_intent_info_t *info,
+int coavoid_lcm_intent_to_core(const coavoid_intent_t *msg, const coavoid_lcm_context_t *ctx,
+                           coavoid_lcm_sequence_table_t *seq, coavoid_lcm_intent_info_t *info,
                            coa_vehicle_t *vehicle, coa_intent_plan_t *plan,
-                           coa_lcm_intent_arrays_t *arrays, const char **reason);
+                           coavoid_lcm_intent_arrays_t *arrays, const char **reason);
 
 /* An intent from a vehicle (its id, priority, volume, speeds, steep factor, max_offset;
  * its route is not read), info, and `count` reference points with their offsets. The
  * result is checked as a receiver would check it, so a node cannot publish what its
- * peers refuse. Returns COA_OK, COA_ERR_ARGUMENT (NULL), COA_LCM_ERR_COUNT (count not in
+ * peers refuse. Returns COA_OK, COA_ERR_ARGUMENT (NULL), COAVOID_LCM_ERR_COUNT (count not in
  * 2..MAX_SAMPLES) or the check's refusal. Cost O(count). */
-int coa_lcm_intent_from_core(const coa_vehicle_t *vehicle, const coa_lcm_intent_info_t *info,
+int coavoid_lcm_intent_from_core(const coa_vehicle_t *vehicle, const coavoid_lcm_intent_info_t *info,
                              const coa_vec3_t *reference, const int32_t *offsets, size_t count,
-                             const coa_lcm_context_t *ctx, coavoid_intent_t *msg,
+                             const coavoid_lcm_context_t *ctx, coavoid_intent_t *msg,
                              const char **reason);
 
 /* ---- plan ---- */
@@ -173,21 +173,21 @@ typedef struct {
     int8_t mode;            /* COAVOID_PLAN_T_MODE_* */
     size_t vehicle_count;
     uint16_t uav_ids[COAVOID_PLAN_T_MAX_VEHICLES];
-} coa_lcm_plan_info_t;
+} coavoid_lcm_plan_info_t;
 
-int coa_lcm_plan_check(const coavoid_plan_t *msg, const coa_lcm_context_t *ctx,
+int coavoid_lcm_plan_check(const coavoid_plan_t *msg, const coavoid_lcm_context_t *ctx,
                        const char **reason);
 /* offsets: capacity >= vehicle_count * (horizon + 1) int32, row i = uav_ids[i] (the
  * layout the planner writes); result's status, costs, nodes_expanded and planned_count
  * are set, order is 0..n-1. */
-int coa_lcm_plan_to_core(const coavoid_plan_t *msg, const coa_lcm_context_t *ctx,
-                         coa_lcm_sequence_table_t *seq, coa_lcm_plan_info_t *info,
+int coavoid_lcm_plan_to_core(const coavoid_plan_t *msg, const coavoid_lcm_context_t *ctx,
+                         coavoid_lcm_sequence_table_t *seq, coavoid_lcm_plan_info_t *info,
                          coa_plan_result_t *result, int32_t *offsets, size_t capacity,
                          const char **reason);
 /* offsets as the planner wrote them for info->vehicle_count vehicles (rows in vehicle
  * index order; the message lists them in result->order). */
-int coa_lcm_plan_from_core(const coa_lcm_plan_info_t *info, const coa_plan_result_t *result,
-                           const int32_t *offsets, const coa_lcm_context_t *ctx,
+int coavoid_lcm_plan_from_core(const coavoid_lcm_plan_info_t *info, const coa_plan_result_t *result,
+                           const int32_t *offsets, const coavoid_lcm_context_t *ctx,
                            coavoid_plan_t *msg, const char **reason);
 
 /* ---- track ---- */
@@ -196,62 +196,62 @@ typedef struct {
     int64_t utime;
     uint32_t source_id;
     int64_t sequence;
-} coa_lcm_track_info_t;
+} coavoid_lcm_track_info_t;
 
-int coa_lcm_track_check(const coavoid_track_t *msg, const coa_lcm_context_t *ctx,
+int coavoid_lcm_track_check(const coavoid_track_t *msg, const coavoid_lcm_context_t *ctx,
                         const char **reason);
 /* track->position is extrapolated to the core clock's t = 0 (the core's convention);
  * path: capacity >= msg->path_count. */
-int coa_lcm_track_to_core(const coavoid_track_t *msg, const coa_lcm_context_t *ctx,
-                          coa_lcm_sequence_table_t *seq, coa_lcm_track_info_t *info,
+int coavoid_lcm_track_to_core(const coavoid_track_t *msg, const coavoid_lcm_context_t *ctx,
+                          coavoid_lcm_sequence_table_t *seq, coavoid_lcm_track_info_t *info,
                           coa_track_t *track, coa_track_point_t *path, size_t capacity,
                           const char **reason);
-int coa_lcm_track_from_core(const coa_track_t *track, const coa_lcm_track_info_t *info,
-                            const coa_lcm_context_t *ctx, coavoid_track_t *msg,
+int coavoid_lcm_track_from_core(const coa_track_t *track, const coavoid_lcm_track_info_t *info,
+                            const coavoid_lcm_context_t *ctx, coavoid_track_t *msg,
                             const char **reason);
 
 /* ---- obstacle map ---- */
 
-int coa_lcm_obstacle_map_check(const coavoid_obstacle_map_t *msg, const coa_lcm_context_t *ctx,
+int coavoid_lcm_obstacle_map_check(const coavoid_obstacle_map_t *msg, const coavoid_lcm_context_t *ctx,
                                const char **reason);
 /* Boxes first, then polytopes. obstacles: capacity >= box_count + polytope_count;
  * vertices: vertex_capacity >= the sum of vertex_count. Equal versions are accepted
  * (a republished map). */
-int coa_lcm_obstacle_map_to_core(const coavoid_obstacle_map_t *msg, const coa_lcm_context_t *ctx,
-                                 coa_lcm_sequence_table_t *seq, coa_obstacle_t *obstacles,
+int coavoid_lcm_obstacle_map_to_core(const coavoid_obstacle_map_t *msg, const coavoid_lcm_context_t *ctx,
+                                 coavoid_lcm_sequence_table_t *seq, coa_obstacle_t *obstacles,
                                  size_t capacity, size_t *count, coa_vec3_t *vertices,
                                  size_t vertex_capacity, const char **reason);
-int coa_lcm_obstacle_map_from_core(const coa_obstacle_t *obstacles, size_t count, int64_t utime,
-                                   uint32_t map_id, int64_t version, const coa_lcm_context_t *ctx,
+int coavoid_lcm_obstacle_map_from_core(const coa_obstacle_t *obstacles, size_t count, int64_t utime,
+                                   uint32_t map_id, int64_t version, const coavoid_lcm_context_t *ctx,
                                    coavoid_obstacle_map_t *msg, const char **reason);
 
 /* ---- conflict report (monitoring) ---- */
 
-int coa_lcm_conflict_report_check(const coavoid_conflict_report_t *msg,
-                                  const coa_lcm_context_t *ctx, const char **reason);
+int coavoid_lcm_conflict_report_check(const coavoid_conflict_report_t *msg,
+                                  const coavoid_lcm_context_t *ctx, const char **reason);
 /* From a prediction: a and b indices are mapped to ids through plan_ids (and track_ids
  * for track conflicts); obstacles keep their index. cluster may be NULL. Conflicts past
  * the message's capacity are counted in conflicts_found only. */
-int coa_lcm_conflict_report_from_core(const coa_conflict_t *conflicts, size_t count,
+int coavoid_lcm_conflict_report_from_core(const coa_conflict_t *conflicts, size_t count,
                                       size_t conflicts_found, const uint16_t *plan_ids,
                                       size_t plan_count, const uint32_t *track_ids,
                                       size_t track_count, const uint32_t *cluster,
                                       int64_t utime, uint32_t reporter_id, int64_t sequence,
                                       int64_t prediction_utime, coa_real_t dt, uint32_t horizon,
-                                      const coa_lcm_context_t *ctx,
+                                      const coavoid_lcm_context_t *ctx,
                                       coavoid_conflict_report_t *msg, const char **reason);
 
 /* ---- status ---- */
 
-int coa_lcm_status_check(const coavoid_status_t *msg, const coa_lcm_context_t *ctx,
+int coavoid_lcm_status_check(const coavoid_status_t *msg, const coavoid_lcm_context_t *ctx,
                          const char **reason);
 
 /* Check + sequence rule for the two types that have no core counterpart to convert to. */
-int coa_lcm_conflict_report_accept(const coavoid_conflict_report_t *msg,
-                                   const coa_lcm_context_t *ctx, coa_lcm_sequence_table_t *seq,
+int coavoid_lcm_conflict_report_accept(const coavoid_conflict_report_t *msg,
+                                   const coavoid_lcm_context_t *ctx, coavoid_lcm_sequence_table_t *seq,
                                    const char **reason);
-int coa_lcm_status_accept(const coavoid_status_t *msg, const coa_lcm_context_t *ctx,
-                          coa_lcm_sequence_table_t *seq, const char **reason);
+int coavoid_lcm_status_accept(const coavoid_status_t *msg, const coavoid_lcm_context_t *ctx,
+                          coavoid_lcm_sequence_table_t *seq, const char **reason);
 
 /* ---- counting what arrives ---- */
 
@@ -261,16 +261,16 @@ typedef struct {
     int64_t rejected;          /* refused by decoding or validation; <= received */
     int32_t last_reject_code;  /* the last refusal's code (<= 0; 0: none yet) */
     const char *last_reason;   /* its reason (static string), or "none" */
-} coa_lcm_rx_stats_t;
+} coavoid_lcm_rx_stats_t;
 
 /* Zeroes the counters. Cannot fail on non-NULL stats. */
-void coa_lcm_rx_init(coa_lcm_rx_stats_t *stats);
+void coavoid_lcm_rx_init(coavoid_lcm_rx_stats_t *stats);
 
 /* Counts one received message whose decode-and-validate step returned rc: a negative rc
- * (COA_LCM_ERR_*, COA_ERR_*) is a refusal, recorded with its reason (NULL: the code's
+ * (COAVOID_LCM_ERR_*, COA_ERR_*) is a refusal, recorded with its reason (NULL: the code's
  * name); COA_OK or any rc >= 0 (a decoder's byte count) is an acceptance. Saturates rather
  * than wrapping. Cannot fail on non-NULL stats. Cost O(1). */
-void coa_lcm_rx_count(coa_lcm_rx_stats_t *stats, int rc, const char *reason);
+void coavoid_lcm_rx_count(coavoid_lcm_rx_stats_t *stats, int rc, const char *reason);
 
 #ifdef __cplusplus
 }

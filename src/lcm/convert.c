@@ -24,23 +24,23 @@
         }                     \
     } while (0)
 
-/* 0 ok, COA_LCM_ERR_NONFINITE, or COA_LCM_ERR_VALUE when |x| > bound. */
+/* 0 ok, COAVOID_LCM_ERR_NONFINITE, or COAVOID_LCM_ERR_VALUE when |x| > bound. */
 static int number_rule(double x, double bound)
 {
     if (!isfinite(x)) {
-        return COA_LCM_ERR_NONFINITE;
+        return COAVOID_LCM_ERR_NONFINITE;
     }
-    return (fabs(x) <= bound) ? COA_OK : COA_LCM_ERR_VALUE;
+    return (fabs(x) <= bound) ? COA_OK : COAVOID_LCM_ERR_VALUE;
 }
 
-/* Sizes and sigmas: finite, in (0, COA_LCM_MAX_SIZE] when positive, else [0, COA_LCM_MAX_SIZE]. */
+/* Sizes and sigmas: finite, in (0, COAVOID_LCM_MAX_SIZE] when positive, else [0, COAVOID_LCM_MAX_SIZE]. */
 static int size_rule(double x, bool positive)
 {
-    int rc = number_rule(x, COA_LCM_MAX_SIZE);
+    int rc = number_rule(x, COAVOID_LCM_MAX_SIZE);
     if (rc != COA_OK) {
         return rc;
     }
-    return (positive ? x > 0.0 : x >= 0.0) ? COA_OK : COA_LCM_ERR_VALUE;
+    return (positive ? x > 0.0 : x >= 0.0) ? COA_OK : COAVOID_LCM_ERR_VALUE;
 }
 
 static int vec_rule(const double v[3], double bound)
@@ -57,23 +57,23 @@ static int vec_rule(const double v[3], double bound)
 
 static bool id_ok(int32_t id)
 {
-    return id >= 1 && id <= COA_LCM_MAX_ID;
+    return id >= 1 && id <= COAVOID_LCM_MAX_ID;
 }
 
 /* utime > 0 and, with a clock, neither stale nor in the future. */
-static int utime_rule(int64_t utime, const coa_lcm_context_t *ctx)
+static int utime_rule(int64_t utime, const coavoid_lcm_context_t *ctx)
 {
     if (utime <= 0) {
-        return COA_LCM_ERR_TIME;
+        return COAVOID_LCM_ERR_TIME;
     }
     if (ctx != NULL && ctx->now_utime > 0) {
         if (ctx->max_future_us >= 0 && utime > ctx->now_utime &&
             utime - ctx->now_utime > ctx->max_future_us) {
-            return COA_LCM_ERR_TIME;
+            return COAVOID_LCM_ERR_TIME;
         }
         if (ctx->max_age_us >= 0 && utime < ctx->now_utime &&
             ctx->now_utime - utime > ctx->max_age_us) {
-            return COA_LCM_ERR_TIME;
+            return COAVOID_LCM_ERR_TIME;
         }
     }
     return COA_OK;
@@ -81,26 +81,26 @@ static int utime_rule(int64_t utime, const coa_lcm_context_t *ctx)
 
 /* A time stamp that belongs to the message (plan start, estimate): > 0 and within the
  * age window of its utime in either direction, so a converted time stays small. */
-static int related_time_rule(int64_t t, int64_t utime, const coa_lcm_context_t *ctx)
+static int related_time_rule(int64_t t, int64_t utime, const coavoid_lcm_context_t *ctx)
 {
     int64_t window = (ctx != NULL && ctx->max_age_us > 0) ? ctx->max_age_us : INT64_C(3600000000);
     if (t <= 0) {
-        return COA_LCM_ERR_TIME;
+        return COAVOID_LCM_ERR_TIME;
     }
     if ((t > utime && t - utime > window) || (t < utime && utime - t > window)) {
-        return COA_LCM_ERR_TIME;
+        return COAVOID_LCM_ERR_TIME;
     }
     return COA_OK;
 }
 
-static coa_real_t core_time(int64_t utime, const coa_lcm_context_t *ctx)
+static coa_real_t core_time(int64_t utime, const coavoid_lcm_context_t *ctx)
 {
     int64_t epoch = (ctx != NULL) ? ctx->epoch_utime : 0;
     /* Difference first, in integers, so that double keeps microseconds. */
     return (coa_real_t)((double)(utime - epoch) * 1e-6);
 }
 
-static int64_t utime_of(coa_real_t t, const coa_lcm_context_t *ctx)
+static int64_t utime_of(coa_real_t t, const coavoid_lcm_context_t *ctx)
 {
     int64_t epoch = (ctx != NULL) ? ctx->epoch_utime : 0;
     double us = (double)t * 1e6;
@@ -128,7 +128,7 @@ static void vec_to(coa_vec3_t v, double out[3])
 
 /* ---- sequence table ---- */
 
-void coa_lcm_sequence_init(coa_lcm_sequence_table_t *table, coa_lcm_sender_t *entries,
+void coavoid_lcm_sequence_init(coavoid_lcm_sequence_table_t *table, coavoid_lcm_sender_t *entries,
                            size_t capacity)
 {
     if (table == NULL) {
@@ -139,7 +139,7 @@ void coa_lcm_sequence_init(coa_lcm_sequence_table_t *table, coa_lcm_sender_t *en
     table->count = 0u;
 }
 
-int coa_lcm_sequence_accept(coa_lcm_sequence_table_t *table, uint32_t sender, int64_t sequence,
+int coavoid_lcm_sequence_accept(coavoid_lcm_sequence_table_t *table, uint32_t sender, int64_t sequence,
                             bool allow_equal)
 {
     size_t i;
@@ -150,14 +150,14 @@ int coa_lcm_sequence_accept(coa_lcm_sequence_table_t *table, uint32_t sender, in
         if (table->entries[i].sender == sender) {
             int64_t last = table->entries[i].last;
             if (sequence < last || (sequence == last && !allow_equal)) {
-                return COA_LCM_ERR_SEQUENCE;
+                return COAVOID_LCM_ERR_SEQUENCE;
             }
             table->entries[i].last = sequence;
             return COA_OK;
         }
     }
     if (table->count == table->capacity) {
-        return COA_LCM_ERR_SENDERS;
+        return COAVOID_LCM_ERR_SENDERS;
     }
     table->entries[table->count].sender = sender;
     table->entries[table->count].last = sequence;
@@ -165,7 +165,7 @@ int coa_lcm_sequence_accept(coa_lcm_sequence_table_t *table, uint32_t sender, in
     return COA_OK;
 }
 
-void coa_lcm_sequence_forget(coa_lcm_sequence_table_t *table, uint32_t sender)
+void coavoid_lcm_sequence_forget(coavoid_lcm_sequence_table_t *table, uint32_t sender)
 {
     size_t i;
     if (table == NULL || table->count > table->capacity) {
@@ -180,25 +180,25 @@ void coa_lcm_sequence_forget(coa_lcm_sequence_table_t *table, uint32_t sender)
     }
 }
 
-const char *coa_lcm_error_name(int status)
+const char *coavoid_lcm_error_name(int status)
 {
     switch (status) {
-    case COA_LCM_ERR_DECODE: return "message does not decode";
-    case COA_LCM_ERR_NONFINITE: return "non-finite number";
-    case COA_LCM_ERR_VALUE: return "number out of range";
-    case COA_LCM_ERR_COUNT: return "count out of range";
-    case COA_LCM_ERR_ENUM: return "unknown enum value";
-    case COA_LCM_ERR_ID: return "invalid id";
-    case COA_LCM_ERR_TIME: return "bad time stamp";
-    case COA_LCM_ERR_SEQUENCE: return "sequence went backwards";
-    case COA_LCM_ERR_SENDERS: return "too many senders";
-    case COA_LCM_ERR_CAPACITY: return "output too small";
+    case COAVOID_LCM_ERR_DECODE: return "message does not decode";
+    case COAVOID_LCM_ERR_NONFINITE: return "non-finite number";
+    case COAVOID_LCM_ERR_VALUE: return "number out of range";
+    case COAVOID_LCM_ERR_COUNT: return "count out of range";
+    case COAVOID_LCM_ERR_ENUM: return "unknown enum value";
+    case COAVOID_LCM_ERR_ID: return "invalid id";
+    case COAVOID_LCM_ERR_TIME: return "bad time stamp";
+    case COAVOID_LCM_ERR_SEQUENCE: return "sequence went backwards";
+    case COAVOID_LCM_ERR_SENDERS: return "too many senders";
+    case COAVOID_LCM_ERR_CAPACITY: return "output too small";
     default: return coa_status_name(status);
     }
 }
 
 /* The sequence rule after a message passed its check. */
-static int sequence_rule(coa_lcm_sequence_table_t *seq, int32_t sender, int64_t sequence,
+static int sequence_rule(coavoid_lcm_sequence_table_t *seq, int32_t sender, int64_t sequence,
                          bool allow_equal, const char **reason, const char *backwards,
                          const char *full)
 {
@@ -206,11 +206,11 @@ static int sequence_rule(coa_lcm_sequence_table_t *seq, int32_t sender, int64_t 
     if (seq == NULL) {
         return COA_OK;
     }
-    rc = coa_lcm_sequence_accept(seq, (uint32_t)sender, sequence, allow_equal);
-    if (rc == COA_LCM_ERR_SEQUENCE) {
+    rc = coavoid_lcm_sequence_accept(seq, (uint32_t)sender, sequence, allow_equal);
+    if (rc == COAVOID_LCM_ERR_SEQUENCE) {
         REJECT(rc, backwards);
     }
-    if (rc == COA_LCM_ERR_SENDERS) {
+    if (rc == COAVOID_LCM_ERR_SENDERS) {
         REJECT(rc, full);
     }
     if (rc != COA_OK) {
@@ -281,7 +281,7 @@ static bool intent_leg_ok(const coavoid_intent_t *msg, coa_vec3_t a, coa_vec3_t 
     return coa_vehicle_check(&v) == COA_OK;
 }
 
-int coa_lcm_intent_check(const coavoid_intent_t *msg, const coa_lcm_context_t *ctx,
+int coavoid_lcm_intent_check(const coavoid_intent_t *msg, const coavoid_lcm_context_t *ctx,
                          const char **reason)
 {
     int rc;
@@ -293,22 +293,22 @@ int coa_lcm_intent_check(const coavoid_intent_t *msg, const coa_lcm_context_t *c
         REJECT(rc, "intent: utime stale, in the future or not positive");
     }
     if (!id_ok(msg->uav_id)) {
-        REJECT(COA_LCM_ERR_ID, "intent: uav_id not in 1..65535");
+        REJECT(COAVOID_LCM_ERR_ID, "intent: uav_id not in 1..65535");
     }
     if (msg->sequence < 0) {
-        REJECT(COA_LCM_ERR_VALUE, "intent: sequence negative");
+        REJECT(COAVOID_LCM_ERR_VALUE, "intent: sequence negative");
     }
     if (msg->priority < 1) {
-        REJECT(COA_LCM_ERR_VALUE, "intent: priority < 1");
+        REJECT(COAVOID_LCM_ERR_VALUE, "intent: priority < 1");
     }
     if (msg->mode != COAVOID_INTENT_T_MODE_CENTRALISED &&
         msg->mode != COAVOID_INTENT_T_MODE_DECOUPLED && msg->mode != COAVOID_INTENT_T_MODE_REFERENCE) {
-        REJECT(COA_LCM_ERR_ENUM, "intent: unknown mode");
+        REJECT(COAVOID_LCM_ERR_ENUM, "intent: unknown mode");
     }
-    if ((rc = vec_rule(msg->position, COA_LCM_MAX_COORDINATE)) != COA_OK) {
+    if ((rc = vec_rule(msg->position, COAVOID_LCM_MAX_COORDINATE)) != COA_OK) {
         REJECT(rc, "intent: position non-finite or out of range");
     }
-    if ((rc = vec_rule(msg->velocity, COA_LCM_MAX_SPEED)) != COA_OK) {
+    if ((rc = vec_rule(msg->velocity, COAVOID_LCM_MAX_SPEED)) != COA_OK) {
         REJECT(rc, "intent: velocity non-finite or out of range");
     }
     if ((rc = size_rule(msg->radius, true)) != COA_OK) {
@@ -317,30 +317,30 @@ int coa_lcm_intent_check(const coavoid_intent_t *msg, const coa_lcm_context_t *c
     if ((rc = size_rule(msg->half_height, true)) != COA_OK) {
         REJECT(rc, "intent: half_height not in (0, 1e5] m");
     }
-    if ((rc = number_rule(msg->cruise_speed, COA_LCM_MAX_SPEED)) != COA_OK || !(msg->cruise_speed > 0.0)) {
-        REJECT(rc != COA_OK ? rc : COA_LCM_ERR_VALUE, "intent: cruise_speed not in (0, 1e4] m/s");
+    if ((rc = number_rule(msg->cruise_speed, COAVOID_LCM_MAX_SPEED)) != COA_OK || !(msg->cruise_speed > 0.0)) {
+        REJECT(rc != COA_OK ? rc : COAVOID_LCM_ERR_VALUE, "intent: cruise_speed not in (0, 1e4] m/s");
     }
-    if ((rc = number_rule(msg->climb_rate, COA_LCM_MAX_SPEED)) != COA_OK || !(msg->climb_rate > 0.0)) {
-        REJECT(rc != COA_OK ? rc : COA_LCM_ERR_VALUE, "intent: climb_rate not in (0, 1e4] m/s");
+    if ((rc = number_rule(msg->climb_rate, COAVOID_LCM_MAX_SPEED)) != COA_OK || !(msg->climb_rate > 0.0)) {
+        REJECT(rc != COA_OK ? rc : COAVOID_LCM_ERR_VALUE, "intent: climb_rate not in (0, 1e4] m/s");
     }
     if (msg->steep_factor < 2 || msg->steep_factor > (int32_t)COA_MAX_STEEP_FACTOR) {
-        REJECT(COA_LCM_ERR_VALUE, "intent: steep_factor not in 2..10");
+        REJECT(COAVOID_LCM_ERR_VALUE, "intent: steep_factor not in 2..10");
     }
     if (msg->max_offset < -1 || msg->max_offset > COA_MAX_OFFSET) {
-        REJECT(COA_LCM_ERR_VALUE, "intent: max_offset not in -1..32767");
+        REJECT(COAVOID_LCM_ERR_VALUE, "intent: max_offset not in -1..32767");
     }
     if ((rc = related_time_rule(msg->plan_utime, msg->utime, ctx)) != COA_OK) {
         REJECT(rc, "intent: plan_utime not positive or too far from utime");
     }
-    if ((rc = number_rule(msg->step, COA_LCM_MAX_STEP)) != COA_OK || !(msg->step > 0.0)) {
-        REJECT(rc != COA_OK ? rc : COA_LCM_ERR_VALUE, "intent: step not in (0, 3600] s");
+    if ((rc = number_rule(msg->step, COAVOID_LCM_MAX_STEP)) != COA_OK || !(msg->step > 0.0)) {
+        REJECT(rc != COA_OK ? rc : COAVOID_LCM_ERR_VALUE, "intent: step not in (0, 3600] s");
     }
     if (!intent_core_numbers_ok(msg)) {
-        REJECT(COA_LCM_ERR_VALUE, "intent: cruise_speed, climb_rate, step, radius or half_height "
+        REJECT(COAVOID_LCM_ERR_VALUE, "intent: cruise_speed, climb_rate, step, radius or half_height "
                                   "vanishes in the core's precision");
     }
     if (msg->sample_count < 2 || msg->sample_count > COAVOID_INTENT_T_MAX_SAMPLES) {
-        REJECT(COA_LCM_ERR_COUNT, "intent: sample_count not in 2..MAX_SAMPLES");
+        REJECT(COAVOID_LCM_ERR_COUNT, "intent: sample_count not in 2..MAX_SAMPLES");
     }
     {
         /* Positions and the route rule are judged in the core's precision, as the
@@ -353,25 +353,25 @@ int coa_lcm_intent_check(const coavoid_intent_t *msg, const coa_lcm_context_t *c
             coa_vec3_t r;
             coa_vec3_t p;
             int32_t o = msg->offsets[j];
-            if ((rc = vec_rule(msg->reference[j], COA_LCM_MAX_COORDINATE)) != COA_OK) {
+            if ((rc = vec_rule(msg->reference[j], COAVOID_LCM_MAX_COORDINATE)) != COA_OK) {
                 REJECT(rc, "intent: a reference point non-finite or out of range");
             }
             r = vec_of(msg->reference[j]);
             if (j > 0 && !intent_leg_ok(msg, previous, r)) {
-                REJECT(COA_LCM_ERR_VALUE, "intent: consecutive reference points without horizontal separation");
+                REJECT(COAVOID_LCM_ERR_VALUE, "intent: consecutive reference points without horizontal separation");
             }
             if (o < -bound || o > bound) {
-                REJECT(COA_LCM_ERR_VALUE, "intent: an offset beyond max_offset or 32767");
+                REJECT(COAVOID_LCM_ERR_VALUE, "intent: an offset beyond max_offset or 32767");
             }
             if (j > 0) {
                 int32_t d = o - msg->offsets[j - 1];
                 if (d != 0 && d != 1 && d != -1 && d != msg->steep_factor && d != -msg->steep_factor) {
-                    REJECT(COA_LCM_ERR_VALUE, "intent: consecutive offsets differ by no action");
+                    REJECT(COAVOID_LCM_ERR_VALUE, "intent: consecutive offsets differ by no action");
                 }
             }
             p = intent_position(&r, o, dh);
-            if (!isfinite((double)p.z) || fabs((double)p.z) > COA_LCM_MAX_COORDINATE) {
-                REJECT(COA_LCM_ERR_VALUE, "intent: a planned position out of range");
+            if (!isfinite((double)p.z) || fabs((double)p.z) > COAVOID_LCM_MAX_COORDINATE) {
+                REJECT(COAVOID_LCM_ERR_VALUE, "intent: a planned position out of range");
             }
             previous = r;
         }
@@ -386,10 +386,10 @@ int coa_lcm_intent_check(const coavoid_intent_t *msg, const coa_lcm_context_t *c
     return COA_OK;
 }
 
-int coa_lcm_intent_to_core(const coavoid_intent_t *msg, const coa_lcm_context_t *ctx,
-                           coa_lcm_sequence_table_t *seq, coa_lcm_intent_info_t *info,
+int coavoid_lcm_intent_to_core(const coavoid_intent_t *msg, const coavoid_lcm_context_t *ctx,
+                           coavoid_lcm_sequence_table_t *seq, coavoid_lcm_intent_info_t *info,
                            coa_vehicle_t *vehicle, coa_intent_plan_t *plan,
-                           coa_lcm_intent_arrays_t *arrays, const char **reason)
+                           coavoid_lcm_intent_arrays_t *arrays, const char **reason)
 {
     int rc;
     int32_t j;
@@ -397,7 +397,7 @@ int coa_lcm_intent_to_core(const coavoid_intent_t *msg, const coa_lcm_context_t 
     if (info == NULL || vehicle == NULL || plan == NULL || arrays == NULL) {
         REJECT(COA_ERR_ARGUMENT, "intent: NULL output");
     }
-    if ((rc = coa_lcm_intent_check(msg, ctx, reason)) != COA_OK) {
+    if ((rc = coavoid_lcm_intent_check(msg, ctx, reason)) != COA_OK) {
         return rc;
     }
     if ((rc = sequence_rule(seq, msg->uav_id, msg->sequence, false, reason,
@@ -434,9 +434,9 @@ int coa_lcm_intent_to_core(const coavoid_intent_t *msg, const coa_lcm_context_t 
     return COA_OK;
 }
 
-int coa_lcm_intent_from_core(const coa_vehicle_t *vehicle, const coa_lcm_intent_info_t *info,
+int coavoid_lcm_intent_from_core(const coa_vehicle_t *vehicle, const coavoid_lcm_intent_info_t *info,
                              const coa_vec3_t *reference, const int32_t *offsets, size_t count,
-                             const coa_lcm_context_t *ctx, coavoid_intent_t *msg,
+                             const coavoid_lcm_context_t *ctx, coavoid_intent_t *msg,
                              const char **reason)
 {
     size_t j;
@@ -444,10 +444,10 @@ int coa_lcm_intent_from_core(const coa_vehicle_t *vehicle, const coa_lcm_intent_
         REJECT(COA_ERR_ARGUMENT, "intent: NULL argument");
     }
     if (count < 2u || count > (size_t)COAVOID_INTENT_T_MAX_SAMPLES) {
-        REJECT(COA_LCM_ERR_COUNT, "intent: sample count not in 2..MAX_SAMPLES");
+        REJECT(COAVOID_LCM_ERR_COUNT, "intent: sample count not in 2..MAX_SAMPLES");
     }
     if (vehicle->priority > (uint32_t)INT32_MAX || vehicle->steep_factor > (uint32_t)INT32_MAX) {
-        REJECT(COA_LCM_ERR_VALUE, "intent: priority or steep factor too large");
+        REJECT(COAVOID_LCM_ERR_VALUE, "intent: priority or steep factor too large");
     }
     memset(msg, 0, sizeof *msg);
     msg->utime = info->utime;
@@ -472,12 +472,12 @@ int coa_lcm_intent_from_core(const coa_vehicle_t *vehicle, const coa_lcm_intent_
     }
     msg->sigma_horizontal = (double)info->sigma_horizontal;
     msg->sigma_vertical = (double)info->sigma_vertical;
-    return coa_lcm_intent_check(msg, ctx, reason);
+    return coavoid_lcm_intent_check(msg, ctx, reason);
 }
 
 /* ---- plan ---- */
 
-int coa_lcm_plan_check(const coavoid_plan_t *msg, const coa_lcm_context_t *ctx,
+int coavoid_lcm_plan_check(const coavoid_plan_t *msg, const coavoid_lcm_context_t *ctx,
                        const char **reason)
 {
     int rc;
@@ -491,54 +491,54 @@ int coa_lcm_plan_check(const coavoid_plan_t *msg, const coa_lcm_context_t *ctx,
         REJECT(rc, "plan: utime stale, in the future or not positive");
     }
     if (!id_ok(msg->coordinator_id)) {
-        REJECT(COA_LCM_ERR_ID, "plan: coordinator_id not in 1..65535");
+        REJECT(COAVOID_LCM_ERR_ID, "plan: coordinator_id not in 1..65535");
     }
     if (msg->plan_id < 0) {
-        REJECT(COA_LCM_ERR_VALUE, "plan: plan_id negative");
+        REJECT(COAVOID_LCM_ERR_VALUE, "plan: plan_id negative");
     }
     if ((rc = related_time_rule(msg->valid_from_utime, msg->utime, ctx)) != COA_OK) {
         REJECT(rc, "plan: valid_from_utime not positive or too far from utime");
     }
     if (msg->valid_until_utime <= msg->valid_from_utime ||
         related_time_rule(msg->valid_until_utime, msg->utime, ctx) != COA_OK) {
-        REJECT(COA_LCM_ERR_TIME, "plan: valid_until_utime not after valid_from_utime or too far");
+        REJECT(COAVOID_LCM_ERR_TIME, "plan: valid_until_utime not after valid_from_utime or too far");
     }
-    if ((rc = number_rule(msg->dt, COA_LCM_MAX_STEP)) != COA_OK || !(msg->dt > 0.0)) {
-        REJECT(rc != COA_OK ? rc : COA_LCM_ERR_VALUE, "plan: dt not in (0, 3600] s");
+    if ((rc = number_rule(msg->dt, COAVOID_LCM_MAX_STEP)) != COA_OK || !(msg->dt > 0.0)) {
+        REJECT(rc != COA_OK ? rc : COAVOID_LCM_ERR_VALUE, "plan: dt not in (0, 3600] s");
     }
     if (msg->horizon < 1 || msg->horizon > COAVOID_PLAN_T_MAX_SAMPLES - 1) {
-        REJECT(COA_LCM_ERR_COUNT, "plan: horizon not in 1..MAX_SAMPLES-1");
+        REJECT(COAVOID_LCM_ERR_COUNT, "plan: horizon not in 1..MAX_SAMPLES-1");
     }
     if (msg->mode != COAVOID_PLAN_T_MODE_CENTRALISED && msg->mode != COAVOID_PLAN_T_MODE_DECOUPLED) {
-        REJECT(COA_LCM_ERR_ENUM, "plan: unknown mode");
+        REJECT(COAVOID_LCM_ERR_ENUM, "plan: unknown mode");
     }
     if (msg->status != COAVOID_PLAN_T_STATUS_SOLVED && msg->status != COAVOID_PLAN_T_STATUS_INFEASIBLE &&
         msg->status != COAVOID_PLAN_T_STATUS_BUDGET_EXHAUSTED) {
-        REJECT(COA_LCM_ERR_ENUM, "plan: unknown status");
+        REJECT(COAVOID_LCM_ERR_ENUM, "plan: unknown status");
     }
     if ((rc = number_rule(msg->deviation, 1.0e300)) != COA_OK || msg->deviation < 0.0) {
-        REJECT(rc != COA_OK ? rc : COA_LCM_ERR_VALUE, "plan: deviation negative or non-finite");
+        REJECT(rc != COA_OK ? rc : COAVOID_LCM_ERR_VALUE, "plan: deviation negative or non-finite");
     }
     if (msg->effort < 0) {
-        REJECT(COA_LCM_ERR_VALUE, "plan: effort negative");
+        REJECT(COAVOID_LCM_ERR_VALUE, "plan: effort negative");
     }
     if (msg->nodes_expanded < 0) {
-        REJECT(COA_LCM_ERR_VALUE, "plan: nodes_expanded negative");
+        REJECT(COAVOID_LCM_ERR_VALUE, "plan: nodes_expanded negative");
     }
     if (msg->vehicle_count < 1 || msg->vehicle_count > COAVOID_PLAN_T_MAX_VEHICLES) {
-        REJECT(COA_LCM_ERR_COUNT, "plan: vehicle_count not in 1..MAX_VEHICLES");
+        REJECT(COAVOID_LCM_ERR_COUNT, "plan: vehicle_count not in 1..MAX_VEHICLES");
     }
     if (msg->planned_count < 0 || msg->planned_count > msg->vehicle_count ||
         (msg->status == COAVOID_PLAN_T_STATUS_SOLVED && msg->planned_count != msg->vehicle_count)) {
-        REJECT(COA_LCM_ERR_COUNT, "plan: planned_count not in 0..vehicle_count (all when solved)");
+        REJECT(COAVOID_LCM_ERR_COUNT, "plan: planned_count not in 0..vehicle_count (all when solved)");
     }
     for (i = 0; i < msg->vehicle_count; ++i) {
         if (!id_ok(msg->uav_ids[i])) {
-            REJECT(COA_LCM_ERR_ID, "plan: a uav_id not in 1..65535");
+            REJECT(COAVOID_LCM_ERR_ID, "plan: a uav_id not in 1..65535");
         }
         for (j = 0; j < i; ++j) {
             if (msg->uav_ids[j] == msg->uav_ids[i]) {
-                REJECT(COA_LCM_ERR_ID, "plan: a uav_id repeated");
+                REJECT(COAVOID_LCM_ERR_ID, "plan: a uav_id repeated");
             }
         }
     }
@@ -546,13 +546,13 @@ int coa_lcm_plan_check(const coavoid_plan_t *msg, const coa_lcm_context_t *ctx,
         for (k = 0; k <= msg->horizon; ++k) {
             int32_t o = msg->offsets[i][k];
             if (o > COA_MAX_OFFSET || o < -COA_MAX_OFFSET) {
-                REJECT(COA_LCM_ERR_VALUE, "plan: an offset beyond COA_MAX_OFFSET");
+                REJECT(COAVOID_LCM_ERR_VALUE, "plan: an offset beyond COA_MAX_OFFSET");
             }
             /* No action moves more than the largest steep factor in one step. */
             if (k > 0) {
                 int32_t d = o - msg->offsets[i][k - 1];
                 if (d > (int32_t)COA_MAX_STEEP_FACTOR || d < -(int32_t)COA_MAX_STEEP_FACTOR) {
-                    REJECT(COA_LCM_ERR_VALUE, "plan: an offset step no action makes");
+                    REJECT(COAVOID_LCM_ERR_VALUE, "plan: an offset step no action makes");
                 }
             }
         }
@@ -561,8 +561,8 @@ int coa_lcm_plan_check(const coavoid_plan_t *msg, const coa_lcm_context_t *ctx,
     return COA_OK;
 }
 
-int coa_lcm_plan_to_core(const coavoid_plan_t *msg, const coa_lcm_context_t *ctx,
-                         coa_lcm_sequence_table_t *seq, coa_lcm_plan_info_t *info,
+int coavoid_lcm_plan_to_core(const coavoid_plan_t *msg, const coavoid_lcm_context_t *ctx,
+                         coavoid_lcm_sequence_table_t *seq, coavoid_lcm_plan_info_t *info,
                          coa_plan_result_t *result, int32_t *offsets, size_t capacity,
                          const char **reason)
 {
@@ -574,13 +574,13 @@ int coa_lcm_plan_to_core(const coavoid_plan_t *msg, const coa_lcm_context_t *ctx
     if (info == NULL || result == NULL || offsets == NULL) {
         REJECT(COA_ERR_ARGUMENT, "plan: NULL output");
     }
-    if ((rc = coa_lcm_plan_check(msg, ctx, reason)) != COA_OK) {
+    if ((rc = coavoid_lcm_plan_check(msg, ctx, reason)) != COA_OK) {
         return rc;
     }
     n = (size_t)msg->vehicle_count;
     samples = (size_t)msg->horizon + 1u;
     if (n * samples > capacity) {
-        REJECT(COA_LCM_ERR_CAPACITY, "plan: more offsets than the caller's array holds");
+        REJECT(COAVOID_LCM_ERR_CAPACITY, "plan: more offsets than the caller's array holds");
     }
     if ((rc = sequence_rule(seq, msg->coordinator_id, msg->plan_id, false, reason,
                             "plan: plan_id not after the last one from this coordinator",
@@ -615,8 +615,8 @@ int coa_lcm_plan_to_core(const coavoid_plan_t *msg, const coa_lcm_context_t *ctx
     return COA_OK;
 }
 
-int coa_lcm_plan_from_core(const coa_lcm_plan_info_t *info, const coa_plan_result_t *result,
-                           const int32_t *offsets, const coa_lcm_context_t *ctx,
+int coavoid_lcm_plan_from_core(const coavoid_lcm_plan_info_t *info, const coa_plan_result_t *result,
+                           const int32_t *offsets, const coavoid_lcm_context_t *ctx,
                            coavoid_plan_t *msg, const char **reason)
 {
     size_t i;
@@ -628,14 +628,14 @@ int coa_lcm_plan_from_core(const coa_lcm_plan_info_t *info, const coa_plan_resul
     }
     n = info->vehicle_count;
     if (n < 1u || n > (size_t)COAVOID_PLAN_T_MAX_VEHICLES || result->planned_count > n) {
-        REJECT(COA_LCM_ERR_COUNT, "plan: vehicle_count not in 1..MAX_VEHICLES");
+        REJECT(COAVOID_LCM_ERR_COUNT, "plan: vehicle_count not in 1..MAX_VEHICLES");
     }
     if (info->horizon < 1u || info->horizon > (uint32_t)COAVOID_PLAN_T_MAX_SAMPLES - 1u) {
-        REJECT(COA_LCM_ERR_COUNT, "plan: horizon not in 1..MAX_SAMPLES-1");
+        REJECT(COAVOID_LCM_ERR_COUNT, "plan: horizon not in 1..MAX_SAMPLES-1");
     }
     if (result->effort > (uint32_t)INT32_MAX || result->nodes_expanded > (uint64_t)INT64_MAX ||
-        info->coordinator_id > (uint32_t)COA_LCM_MAX_ID) {
-        REJECT(COA_LCM_ERR_VALUE, "plan: a number too large for the message");
+        info->coordinator_id > (uint32_t)COAVOID_LCM_MAX_ID) {
+        REJECT(COAVOID_LCM_ERR_VALUE, "plan: a number too large for the message");
     }
     samples = (size_t)info->horizon + 1u;
     memset(msg, 0, sizeof *msg);
@@ -665,12 +665,12 @@ int coa_lcm_plan_from_core(const coa_lcm_plan_info_t *info, const coa_plan_resul
             }
         }
     }
-    return coa_lcm_plan_check(msg, ctx, reason);
+    return coavoid_lcm_plan_check(msg, ctx, reason);
 }
 
 /* ---- track ---- */
 
-int coa_lcm_track_check(const coavoid_track_t *msg, const coa_lcm_context_t *ctx,
+int coavoid_lcm_track_check(const coavoid_track_t *msg, const coavoid_lcm_context_t *ctx,
                         const char **reason)
 {
     int rc;
@@ -682,21 +682,21 @@ int coa_lcm_track_check(const coavoid_track_t *msg, const coa_lcm_context_t *ctx
         REJECT(rc, "track: utime stale, in the future or not positive");
     }
     if (!id_ok(msg->source_id)) {
-        REJECT(COA_LCM_ERR_ID, "track: source_id not in 1..65535");
+        REJECT(COAVOID_LCM_ERR_ID, "track: source_id not in 1..65535");
     }
     if (msg->sequence < 0) {
-        REJECT(COA_LCM_ERR_VALUE, "track: sequence negative");
+        REJECT(COAVOID_LCM_ERR_VALUE, "track: sequence negative");
     }
     if (msg->track_id < 1) {
-        REJECT(COA_LCM_ERR_ID, "track: track_id < 1");
+        REJECT(COAVOID_LCM_ERR_ID, "track: track_id < 1");
     }
     if ((rc = related_time_rule(msg->estimate_utime, msg->utime, ctx)) != COA_OK) {
         REJECT(rc, "track: estimate_utime not positive or too far from utime");
     }
-    if ((rc = vec_rule(msg->position, COA_LCM_MAX_COORDINATE)) != COA_OK) {
+    if ((rc = vec_rule(msg->position, COAVOID_LCM_MAX_COORDINATE)) != COA_OK) {
         REJECT(rc, "track: position non-finite or out of range");
     }
-    if ((rc = vec_rule(msg->velocity, COA_LCM_MAX_SPEED)) != COA_OK) {
+    if ((rc = vec_rule(msg->velocity, COAVOID_LCM_MAX_SPEED)) != COA_OK) {
         REJECT(rc, "track: velocity non-finite or out of range");
     }
     if ((rc = size_rule(msg->radius, true)) != COA_OK) {
@@ -706,16 +706,16 @@ int coa_lcm_track_check(const coavoid_track_t *msg, const coa_lcm_context_t *ctx
         REJECT(rc, "track: half_height not in (0, 1e5] m");
     }
     if (msg->path_count < 0 || msg->path_count > COAVOID_TRACK_T_MAX_PATH) {
-        REJECT(COA_LCM_ERR_COUNT, "track: path_count not in 0..MAX_PATH");
+        REJECT(COAVOID_LCM_ERR_COUNT, "track: path_count not in 0..MAX_PATH");
     }
     for (j = 0; j < msg->path_count; ++j) {
         if (related_time_rule(msg->path_utime[j], msg->utime, ctx) != COA_OK) {
-            REJECT(COA_LCM_ERR_TIME, "track: a path time not positive or too far from utime");
+            REJECT(COAVOID_LCM_ERR_TIME, "track: a path time not positive or too far from utime");
         }
         if (j > 0 && msg->path_utime[j] <= msg->path_utime[j - 1]) {
-            REJECT(COA_LCM_ERR_TIME, "track: path times not strictly ascending");
+            REJECT(COAVOID_LCM_ERR_TIME, "track: path times not strictly ascending");
         }
-        if ((rc = vec_rule(msg->path[j], COA_LCM_MAX_COORDINATE)) != COA_OK) {
+        if ((rc = vec_rule(msg->path[j], COAVOID_LCM_MAX_COORDINATE)) != COA_OK) {
             REJECT(rc, "track: a path point non-finite or out of range");
         }
     }
@@ -729,8 +729,8 @@ int coa_lcm_track_check(const coavoid_track_t *msg, const coa_lcm_context_t *ctx
     return COA_OK;
 }
 
-int coa_lcm_track_to_core(const coavoid_track_t *msg, const coa_lcm_context_t *ctx,
-                          coa_lcm_sequence_table_t *seq, coa_lcm_track_info_t *info,
+int coavoid_lcm_track_to_core(const coavoid_track_t *msg, const coavoid_lcm_context_t *ctx,
+                          coavoid_lcm_sequence_table_t *seq, coavoid_lcm_track_info_t *info,
                           coa_track_t *track, coa_track_point_t *path, size_t capacity,
                           const char **reason)
 {
@@ -740,11 +740,11 @@ int coa_lcm_track_to_core(const coavoid_track_t *msg, const coa_lcm_context_t *c
     if (info == NULL || track == NULL || (path == NULL && capacity > 0u)) {
         REJECT(COA_ERR_ARGUMENT, "track: NULL output");
     }
-    if ((rc = coa_lcm_track_check(msg, ctx, reason)) != COA_OK) {
+    if ((rc = coavoid_lcm_track_check(msg, ctx, reason)) != COA_OK) {
         return rc;
     }
     if ((size_t)msg->path_count > capacity) {
-        REJECT(COA_LCM_ERR_CAPACITY, "track: more path points than the caller's array holds");
+        REJECT(COAVOID_LCM_ERR_CAPACITY, "track: more path points than the caller's array holds");
     }
     /* The core predicts from position at t = 0 of its clock: move the estimate there.
      * Both the epoch and the estimate are caller-bounded, so this stays finite. */
@@ -755,7 +755,7 @@ int coa_lcm_track_to_core(const coavoid_track_t *msg, const coa_lcm_context_t *c
         for (a = 0; a < 3; ++a) {
             p[a] = msg->position[a] - msg->velocity[a] * tau;
             if (!isfinite(p[a])) {
-                REJECT(COA_LCM_ERR_VALUE, "track: position at the core epoch overflows");
+                REJECT(COAVOID_LCM_ERR_VALUE, "track: position at the core epoch overflows");
             }
         }
         track->position = vec_of(p);
@@ -784,8 +784,8 @@ int coa_lcm_track_to_core(const coavoid_track_t *msg, const coa_lcm_context_t *c
     return COA_OK;
 }
 
-int coa_lcm_track_from_core(const coa_track_t *track, const coa_lcm_track_info_t *info,
-                            const coa_lcm_context_t *ctx, coavoid_track_t *msg,
+int coavoid_lcm_track_from_core(const coa_track_t *track, const coavoid_lcm_track_info_t *info,
+                            const coavoid_lcm_context_t *ctx, coavoid_track_t *msg,
                             const char **reason)
 {
     size_t j;
@@ -794,10 +794,10 @@ int coa_lcm_track_from_core(const coa_track_t *track, const coa_lcm_track_info_t
         REJECT(COA_ERR_ARGUMENT, "track: NULL argument");
     }
     if (track->path_count > (size_t)COAVOID_TRACK_T_MAX_PATH) {
-        REJECT(COA_LCM_ERR_COUNT, "track: path_count not in 0..MAX_PATH");
+        REJECT(COAVOID_LCM_ERR_COUNT, "track: path_count not in 0..MAX_PATH");
     }
-    if (track->id > (uint32_t)INT32_MAX || info->source_id > (uint32_t)COA_LCM_MAX_ID) {
-        REJECT(COA_LCM_ERR_ID, "track: id too large for the message");
+    if (track->id > (uint32_t)INT32_MAX || info->source_id > (uint32_t)COAVOID_LCM_MAX_ID) {
+        REJECT(COAVOID_LCM_ERR_ID, "track: id too large for the message");
     }
     memset(msg, 0, sizeof *msg);
     msg->utime = info->utime;
@@ -817,12 +817,12 @@ int coa_lcm_track_from_core(const coa_track_t *track, const coa_lcm_track_info_t
     }
     msg->sigma_horizontal = (double)track->sigma_horizontal;
     msg->sigma_vertical = (double)track->sigma_vertical;
-    return coa_lcm_track_check(msg, ctx, reason);
+    return coavoid_lcm_track_check(msg, ctx, reason);
 }
 
 /* ---- obstacle map ---- */
 
-int coa_lcm_obstacle_map_check(const coavoid_obstacle_map_t *msg, const coa_lcm_context_t *ctx,
+int coavoid_lcm_obstacle_map_check(const coavoid_obstacle_map_t *msg, const coavoid_lcm_context_t *ctx,
                                const char **reason)
 {
     int rc;
@@ -834,41 +834,41 @@ int coa_lcm_obstacle_map_check(const coavoid_obstacle_map_t *msg, const coa_lcm_
     }
     /* A map is latched and long-lived: only positivity, not age, applies to utime. */
     if (msg->utime <= 0) {
-        REJECT(COA_LCM_ERR_TIME, "obstacle_map: utime not positive");
+        REJECT(COAVOID_LCM_ERR_TIME, "obstacle_map: utime not positive");
     }
     if (ctx != NULL && ctx->now_utime > 0 && ctx->max_future_us >= 0 && msg->utime > ctx->now_utime &&
         msg->utime - ctx->now_utime > ctx->max_future_us) {
-        REJECT(COA_LCM_ERR_TIME, "obstacle_map: utime in the future");
+        REJECT(COAVOID_LCM_ERR_TIME, "obstacle_map: utime in the future");
     }
     if (!id_ok(msg->map_id)) {
-        REJECT(COA_LCM_ERR_ID, "obstacle_map: map_id not in 1..65535");
+        REJECT(COAVOID_LCM_ERR_ID, "obstacle_map: map_id not in 1..65535");
     }
     if (msg->version < 0) {
-        REJECT(COA_LCM_ERR_VALUE, "obstacle_map: version negative");
+        REJECT(COAVOID_LCM_ERR_VALUE, "obstacle_map: version negative");
     }
     if (msg->box_count < 0 || msg->box_count > COAVOID_OBSTACLE_MAP_T_MAX_BOXES) {
-        REJECT(COA_LCM_ERR_COUNT, "obstacle_map: box_count not in 0..MAX_BOXES");
+        REJECT(COAVOID_LCM_ERR_COUNT, "obstacle_map: box_count not in 0..MAX_BOXES");
     }
     for (i = 0; i < msg->box_count; ++i) {
-        if ((rc = vec_rule(msg->box_min[i], COA_LCM_MAX_COORDINATE)) != COA_OK ||
-            (rc = vec_rule(msg->box_max[i], COA_LCM_MAX_COORDINATE)) != COA_OK) {
+        if ((rc = vec_rule(msg->box_min[i], COAVOID_LCM_MAX_COORDINATE)) != COA_OK ||
+            (rc = vec_rule(msg->box_max[i], COAVOID_LCM_MAX_COORDINATE)) != COA_OK) {
             REJECT(rc, "obstacle_map: a box corner non-finite or out of range");
         }
         for (a = 0; a < 3; ++a) {
             if (msg->box_min[i][a] > msg->box_max[i][a]) {
-                REJECT(COA_LCM_ERR_VALUE, "obstacle_map: a box with min > max");
+                REJECT(COAVOID_LCM_ERR_VALUE, "obstacle_map: a box with min > max");
             }
         }
     }
     if (msg->polytope_count < 0 || msg->polytope_count > COAVOID_OBSTACLE_MAP_T_MAX_POLYTOPES) {
-        REJECT(COA_LCM_ERR_COUNT, "obstacle_map: polytope_count not in 0..MAX_POLYTOPES");
+        REJECT(COAVOID_LCM_ERR_COUNT, "obstacle_map: polytope_count not in 0..MAX_POLYTOPES");
     }
     for (i = 0; i < msg->polytope_count; ++i) {
         if (msg->vertex_count[i] < 4 || msg->vertex_count[i] > COAVOID_OBSTACLE_MAP_T_MAX_VERTICES) {
-            REJECT(COA_LCM_ERR_COUNT, "obstacle_map: a vertex_count not in 4..MAX_VERTICES");
+            REJECT(COAVOID_LCM_ERR_COUNT, "obstacle_map: a vertex_count not in 4..MAX_VERTICES");
         }
         for (j = 0; j < msg->vertex_count[i]; ++j) {
-            if ((rc = vec_rule(msg->vertices[i][j], COA_LCM_MAX_COORDINATE)) != COA_OK) {
+            if ((rc = vec_rule(msg->vertices[i][j], COAVOID_LCM_MAX_COORDINATE)) != COA_OK) {
                 REJECT(rc, "obstacle_map: a vertex non-finite or out of range");
             }
         }
@@ -877,8 +877,8 @@ int coa_lcm_obstacle_map_check(const coavoid_obstacle_map_t *msg, const coa_lcm_
     return COA_OK;
 }
 
-int coa_lcm_obstacle_map_to_core(const coavoid_obstacle_map_t *msg, const coa_lcm_context_t *ctx,
-                                 coa_lcm_sequence_table_t *seq, coa_obstacle_t *obstacles,
+int coavoid_lcm_obstacle_map_to_core(const coavoid_obstacle_map_t *msg, const coavoid_lcm_context_t *ctx,
+                                 coavoid_lcm_sequence_table_t *seq, coa_obstacle_t *obstacles,
                                  size_t capacity, size_t *count, coa_vec3_t *vertices,
                                  size_t vertex_capacity, const char **reason)
 {
@@ -891,14 +891,14 @@ int coa_lcm_obstacle_map_to_core(const coavoid_obstacle_map_t *msg, const coa_lc
     if (obstacles == NULL || count == NULL || (vertices == NULL && vertex_capacity > 0u)) {
         REJECT(COA_ERR_ARGUMENT, "obstacle_map: NULL output");
     }
-    if ((rc = coa_lcm_obstacle_map_check(msg, ctx, reason)) != COA_OK) {
+    if ((rc = coavoid_lcm_obstacle_map_check(msg, ctx, reason)) != COA_OK) {
         return rc;
     }
     for (i = 0; i < msg->polytope_count; ++i) {
         need += (size_t)msg->vertex_count[i];
     }
     if ((size_t)msg->box_count + (size_t)msg->polytope_count > capacity || need > vertex_capacity) {
-        REJECT(COA_LCM_ERR_CAPACITY, "obstacle_map: more obstacles than the caller's arrays hold");
+        REJECT(COAVOID_LCM_ERR_CAPACITY, "obstacle_map: more obstacles than the caller's arrays hold");
     }
     if ((rc = sequence_rule(seq, msg->map_id, msg->version, true, reason,
                             "obstacle_map: version lower than one already seen",
@@ -925,8 +925,8 @@ int coa_lcm_obstacle_map_to_core(const coavoid_obstacle_map_t *msg, const coa_lc
     return COA_OK;
 }
 
-int coa_lcm_obstacle_map_from_core(const coa_obstacle_t *obstacles, size_t count, int64_t utime,
-                                   uint32_t map_id, int64_t version, const coa_lcm_context_t *ctx,
+int coavoid_lcm_obstacle_map_from_core(const coa_obstacle_t *obstacles, size_t count, int64_t utime,
+                                   uint32_t map_id, int64_t version, const coavoid_lcm_context_t *ctx,
                                    coavoid_obstacle_map_t *msg, const char **reason)
 {
     size_t i;
@@ -936,8 +936,8 @@ int coa_lcm_obstacle_map_from_core(const coa_obstacle_t *obstacles, size_t count
     if ((obstacles == NULL && count > 0u) || msg == NULL) {
         REJECT(COA_ERR_ARGUMENT, "obstacle_map: NULL argument");
     }
-    if (map_id > (uint32_t)COA_LCM_MAX_ID) {
-        REJECT(COA_LCM_ERR_ID, "obstacle_map: map_id not in 1..65535");
+    if (map_id > (uint32_t)COAVOID_LCM_MAX_ID) {
+        REJECT(COAVOID_LCM_ERR_ID, "obstacle_map: map_id not in 1..65535");
     }
     memset(msg, 0, sizeof *msg);
     msg->utime = utime;
@@ -947,7 +947,7 @@ int coa_lcm_obstacle_map_from_core(const coa_obstacle_t *obstacles, size_t count
         const coa_obstacle_t *o = &obstacles[i];
         if (o->kind == COA_OBSTACLE_BOX) {
             if (boxes >= COAVOID_OBSTACLE_MAP_T_MAX_BOXES) {
-                REJECT(COA_LCM_ERR_COUNT, "obstacle_map: more than MAX_BOXES boxes");
+                REJECT(COAVOID_LCM_ERR_COUNT, "obstacle_map: more than MAX_BOXES boxes");
             }
             vec_to(o->box.min, msg->box_min[boxes]);
             vec_to(o->box.max, msg->box_max[boxes]);
@@ -956,7 +956,7 @@ int coa_lcm_obstacle_map_from_core(const coa_obstacle_t *obstacles, size_t count
             if (polys >= COAVOID_OBSTACLE_MAP_T_MAX_POLYTOPES ||
                 o->polytope.count > (size_t)COAVOID_OBSTACLE_MAP_T_MAX_VERTICES ||
                 o->polytope.vertices == NULL) {
-                REJECT(COA_LCM_ERR_COUNT, "obstacle_map: too many polytopes or vertices");
+                REJECT(COAVOID_LCM_ERR_COUNT, "obstacle_map: too many polytopes or vertices");
             }
             msg->vertex_count[polys] = (int32_t)o->polytope.count;
             for (j = 0; j < o->polytope.count; ++j) {
@@ -964,18 +964,18 @@ int coa_lcm_obstacle_map_from_core(const coa_obstacle_t *obstacles, size_t count
             }
             polys++;
         } else {
-            REJECT(COA_LCM_ERR_ENUM, "obstacle_map: unknown obstacle kind");
+            REJECT(COAVOID_LCM_ERR_ENUM, "obstacle_map: unknown obstacle kind");
         }
     }
     msg->box_count = boxes;
     msg->polytope_count = polys;
-    return coa_lcm_obstacle_map_check(msg, ctx, reason);
+    return coavoid_lcm_obstacle_map_check(msg, ctx, reason);
 }
 
 /* ---- conflict report ---- */
 
-int coa_lcm_conflict_report_check(const coavoid_conflict_report_t *msg,
-                                  const coa_lcm_context_t *ctx, const char **reason)
+int coavoid_lcm_conflict_report_check(const coavoid_conflict_report_t *msg,
+                                  const coavoid_lcm_context_t *ctx, const char **reason)
 {
     int rc;
     int32_t i;
@@ -986,66 +986,66 @@ int coa_lcm_conflict_report_check(const coavoid_conflict_report_t *msg,
         REJECT(rc, "conflict_report: utime stale, in the future or not positive");
     }
     if (!id_ok(msg->reporter_id)) {
-        REJECT(COA_LCM_ERR_ID, "conflict_report: reporter_id not in 1..65535");
+        REJECT(COAVOID_LCM_ERR_ID, "conflict_report: reporter_id not in 1..65535");
     }
     if (msg->sequence < 0) {
-        REJECT(COA_LCM_ERR_VALUE, "conflict_report: sequence negative");
+        REJECT(COAVOID_LCM_ERR_VALUE, "conflict_report: sequence negative");
     }
     if ((rc = related_time_rule(msg->prediction_utime, msg->utime, ctx)) != COA_OK) {
         REJECT(rc, "conflict_report: prediction_utime not positive or too far from utime");
     }
-    if ((rc = number_rule(msg->dt, COA_LCM_MAX_STEP)) != COA_OK || !(msg->dt > 0.0)) {
-        REJECT(rc != COA_OK ? rc : COA_LCM_ERR_VALUE, "conflict_report: dt not in (0, 3600] s");
+    if ((rc = number_rule(msg->dt, COAVOID_LCM_MAX_STEP)) != COA_OK || !(msg->dt > 0.0)) {
+        REJECT(rc != COA_OK ? rc : COAVOID_LCM_ERR_VALUE, "conflict_report: dt not in (0, 3600] s");
     }
     if (msg->horizon < 1 || msg->horizon > (int32_t)COA_MAX_HORIZON) {
-        REJECT(COA_LCM_ERR_COUNT, "conflict_report: horizon not in 1..COA_MAX_HORIZON");
+        REJECT(COAVOID_LCM_ERR_COUNT, "conflict_report: horizon not in 1..COA_MAX_HORIZON");
     }
     if (msg->conflict_count < 0 || msg->conflict_count > COAVOID_CONFLICT_REPORT_T_MAX_CONFLICTS ||
         msg->conflicts_found < msg->conflict_count) {
-        REJECT(COA_LCM_ERR_COUNT, "conflict_report: conflict_count not in 0..MAX_CONFLICTS or > conflicts_found");
+        REJECT(COAVOID_LCM_ERR_COUNT, "conflict_report: conflict_count not in 0..MAX_CONFLICTS or > conflicts_found");
     }
     for (i = 0; i < msg->conflict_count; ++i) {
         int8_t kind = msg->kind[i];
         if (kind != COAVOID_CONFLICT_REPORT_T_KIND_VEHICLE && kind != COAVOID_CONFLICT_REPORT_T_KIND_TRACK &&
             kind != COAVOID_CONFLICT_REPORT_T_KIND_OBSTACLE) {
-            REJECT(COA_LCM_ERR_ENUM, "conflict_report: unknown kind");
+            REJECT(COAVOID_LCM_ERR_ENUM, "conflict_report: unknown kind");
         }
         if (!id_ok(msg->a_id[i])) {
-            REJECT(COA_LCM_ERR_ID, "conflict_report: an a_id not in 1..65535");
+            REJECT(COAVOID_LCM_ERR_ID, "conflict_report: an a_id not in 1..65535");
         }
         if (msg->b_id[i] < 0 || (kind == COAVOID_CONFLICT_REPORT_T_KIND_VEHICLE &&
                                  (!id_ok(msg->b_id[i]) || msg->b_id[i] == msg->a_id[i]))) {
-            REJECT(COA_LCM_ERR_ID, "conflict_report: a b_id invalid for its kind");
+            REJECT(COAVOID_LCM_ERR_ID, "conflict_report: a b_id invalid for its kind");
         }
         if (msg->first_step[i] < 0 || msg->first_step[i] >= msg->horizon) {
-            REJECT(COA_LCM_ERR_VALUE, "conflict_report: a first_step not in 0..horizon-1");
+            REJECT(COAVOID_LCM_ERR_VALUE, "conflict_report: a first_step not in 0..horizon-1");
         }
-        if ((rc = number_rule(msg->min_horizontal[i], COA_LCM_MAX_COORDINATE * 4.0)) != COA_OK ||
-            (rc = number_rule(msg->min_vertical[i], COA_LCM_MAX_COORDINATE * 4.0)) != COA_OK ||
+        if ((rc = number_rule(msg->min_horizontal[i], COAVOID_LCM_MAX_COORDINATE * 4.0)) != COA_OK ||
+            (rc = number_rule(msg->min_vertical[i], COAVOID_LCM_MAX_COORDINATE * 4.0)) != COA_OK ||
             msg->min_horizontal[i] < 0.0 || msg->min_vertical[i] < 0.0) {
-            REJECT(rc != COA_OK ? rc : COA_LCM_ERR_VALUE, "conflict_report: a distance negative or non-finite");
+            REJECT(rc != COA_OK ? rc : COAVOID_LCM_ERR_VALUE, "conflict_report: a distance negative or non-finite");
         }
         if (!isfinite(msg->probability[i])) {
-            REJECT(COA_LCM_ERR_NONFINITE, "conflict_report: a probability non-finite");
+            REJECT(COAVOID_LCM_ERR_NONFINITE, "conflict_report: a probability non-finite");
         }
         if (msg->probability[i] < 0.0 || msg->probability[i] > 1.0) {
-            REJECT(COA_LCM_ERR_VALUE, "conflict_report: a probability outside [0, 1]");
+            REJECT(COAVOID_LCM_ERR_VALUE, "conflict_report: a probability outside [0, 1]");
         }
         if (msg->cluster[i] < -1 || msg->cluster[i] >= COAVOID_CONFLICT_REPORT_T_MAX_CONFLICTS * 2) {
-            REJECT(COA_LCM_ERR_VALUE, "conflict_report: a cluster label out of range");
+            REJECT(COAVOID_LCM_ERR_VALUE, "conflict_report: a cluster label out of range");
         }
     }
     OK_REASON();
     return COA_OK;
 }
 
-int coa_lcm_conflict_report_from_core(const coa_conflict_t *conflicts, size_t count,
+int coavoid_lcm_conflict_report_from_core(const coa_conflict_t *conflicts, size_t count,
                                       size_t conflicts_found, const uint16_t *plan_ids,
                                       size_t plan_count, const uint32_t *track_ids,
                                       size_t track_count, const uint32_t *cluster,
                                       int64_t utime, uint32_t reporter_id, int64_t sequence,
                                       int64_t prediction_utime, coa_real_t dt, uint32_t horizon,
-                                      const coa_lcm_context_t *ctx,
+                                      const coavoid_lcm_context_t *ctx,
                                       coavoid_conflict_report_t *msg, const char **reason)
 {
     size_t i;
@@ -1054,8 +1054,8 @@ int coa_lcm_conflict_report_from_core(const coa_conflict_t *conflicts, size_t co
         (track_ids == NULL && track_count > 0u)) {
         REJECT(COA_ERR_ARGUMENT, "conflict_report: NULL argument");
     }
-    if (reporter_id > (uint32_t)COA_LCM_MAX_ID || horizon > (uint32_t)INT32_MAX) {
-        REJECT(COA_LCM_ERR_VALUE, "conflict_report: reporter_id or horizon too large");
+    if (reporter_id > (uint32_t)COAVOID_LCM_MAX_ID || horizon > (uint32_t)INT32_MAX) {
+        REJECT(COAVOID_LCM_ERR_VALUE, "conflict_report: reporter_id or horizon too large");
     }
     if (conflicts_found < count) {
         conflicts_found = count;
@@ -1100,14 +1100,14 @@ int coa_lcm_conflict_report_from_core(const coa_conflict_t *conflicts, size_t co
                               ? -1
                               : (int32_t)cluster[c->a];
     }
-    return coa_lcm_conflict_report_check(msg, ctx, reason);
+    return coavoid_lcm_conflict_report_check(msg, ctx, reason);
 }
 
-int coa_lcm_conflict_report_accept(const coavoid_conflict_report_t *msg,
-                                   const coa_lcm_context_t *ctx, coa_lcm_sequence_table_t *seq,
+int coavoid_lcm_conflict_report_accept(const coavoid_conflict_report_t *msg,
+                                   const coavoid_lcm_context_t *ctx, coavoid_lcm_sequence_table_t *seq,
                                    const char **reason)
 {
-    int rc = coa_lcm_conflict_report_check(msg, ctx, reason);
+    int rc = coavoid_lcm_conflict_report_check(msg, ctx, reason);
     if (rc != COA_OK) {
         return rc;
     }
@@ -1118,7 +1118,7 @@ int coa_lcm_conflict_report_accept(const coavoid_conflict_report_t *msg,
 
 /* ---- status ---- */
 
-int coa_lcm_status_check(const coavoid_status_t *msg, const coa_lcm_context_t *ctx,
+int coavoid_lcm_status_check(const coavoid_status_t *msg, const coavoid_lcm_context_t *ctx,
                          const char **reason)
 {
     int rc;
@@ -1129,48 +1129,48 @@ int coa_lcm_status_check(const coavoid_status_t *msg, const coa_lcm_context_t *c
         REJECT(rc, "status: utime stale, in the future or not positive");
     }
     if (!id_ok(msg->node_id)) {
-        REJECT(COA_LCM_ERR_ID, "status: node_id not in 1..65535");
+        REJECT(COAVOID_LCM_ERR_ID, "status: node_id not in 1..65535");
     }
     if (msg->node_kind != COAVOID_STATUS_T_NODE_COORDINATOR && msg->node_kind != COAVOID_STATUS_T_NODE_VEHICLE) {
-        REJECT(COA_LCM_ERR_ENUM, "status: unknown node_kind");
+        REJECT(COAVOID_LCM_ERR_ENUM, "status: unknown node_kind");
     }
     if (msg->sequence < 0) {
-        REJECT(COA_LCM_ERR_VALUE, "status: sequence negative");
+        REJECT(COAVOID_LCM_ERR_VALUE, "status: sequence negative");
     }
     if (msg->health != COAVOID_STATUS_T_HEALTH_OK && msg->health != COAVOID_STATUS_T_HEALTH_DEGRADED &&
         msg->health != COAVOID_STATUS_T_HEALTH_FAULT) {
-        REJECT(COA_LCM_ERR_ENUM, "status: unknown health");
+        REJECT(COAVOID_LCM_ERR_ENUM, "status: unknown health");
     }
     if (msg->mode != COAVOID_STATUS_T_MODE_CENTRALISED && msg->mode != COAVOID_STATUS_T_MODE_DECOUPLED &&
         msg->mode != COAVOID_STATUS_T_MODE_REFERENCE) {
-        REJECT(COA_LCM_ERR_ENUM, "status: unknown mode");
+        REJECT(COAVOID_LCM_ERR_ENUM, "status: unknown mode");
     }
     if (msg->outcome != COAVOID_STATUS_T_OUTCOME_SOLVED && msg->outcome != COAVOID_STATUS_T_OUTCOME_INFEASIBLE &&
         msg->outcome != COAVOID_STATUS_T_OUTCOME_BUDGET_EXHAUSTED && msg->outcome != COAVOID_STATUS_T_OUTCOME_NONE) {
-        REJECT(COA_LCM_ERR_ENUM, "status: unknown outcome");
+        REJECT(COAVOID_LCM_ERR_ENUM, "status: unknown outcome");
     }
     if (msg->last_plan_utime < 0 || msg->last_plan_utime > msg->utime) {
-        REJECT(COA_LCM_ERR_TIME, "status: last_plan_utime negative or after utime");
+        REJECT(COAVOID_LCM_ERR_TIME, "status: last_plan_utime negative or after utime");
     }
     if (msg->last_plan_duration_us < 0 || msg->nodes_expanded < 0 || msg->conflicts < 0 ||
         msg->plans_run < 0) {
-        REJECT(COA_LCM_ERR_VALUE, "status: a negative duration, node count, conflict count or plans_run");
+        REJECT(COAVOID_LCM_ERR_VALUE, "status: a negative duration, node count, conflict count or plans_run");
     }
     if (msg->messages_received < 0 || msg->messages_rejected < 0 ||
         msg->messages_rejected > msg->messages_received) {
-        REJECT(COA_LCM_ERR_COUNT, "status: messages_rejected not in 0..messages_received");
+        REJECT(COAVOID_LCM_ERR_COUNT, "status: messages_rejected not in 0..messages_received");
     }
     if (msg->last_reject_code > 0) {
-        REJECT(COA_LCM_ERR_VALUE, "status: last_reject_code positive");
+        REJECT(COAVOID_LCM_ERR_VALUE, "status: last_reject_code positive");
     }
     OK_REASON();
     return COA_OK;
 }
 
-int coa_lcm_status_accept(const coavoid_status_t *msg, const coa_lcm_context_t *ctx,
-                          coa_lcm_sequence_table_t *seq, const char **reason)
+int coavoid_lcm_status_accept(const coavoid_status_t *msg, const coavoid_lcm_context_t *ctx,
+                          coavoid_lcm_sequence_table_t *seq, const char **reason)
 {
-    int rc = coa_lcm_status_check(msg, ctx, reason);
+    int rc = coavoid_lcm_status_check(msg, ctx, reason);
     if (rc != COA_OK) {
         return rc;
     }
@@ -1181,7 +1181,7 @@ int coa_lcm_status_accept(const coavoid_status_t *msg, const coa_lcm_context_t *
 
 /* ---- counting what arrives ---- */
 
-void coa_lcm_rx_init(coa_lcm_rx_stats_t *stats)
+void coavoid_lcm_rx_init(coavoid_lcm_rx_stats_t *stats)
 {
     if (stats == NULL) {
         return;
@@ -1192,7 +1192,7 @@ void coa_lcm_rx_init(coa_lcm_rx_stats_t *stats)
     stats->last_reason = "none";
 }
 
-void coa_lcm_rx_count(coa_lcm_rx_stats_t *stats, int rc, const char *reason)
+void coavoid_lcm_rx_count(coavoid_lcm_rx_stats_t *stats, int rc, const char *reason)
 {
     if (stats == NULL) {
         return;
@@ -1207,6 +1207,6 @@ void coa_lcm_rx_count(coa_lcm_rx_stats_t *stats, int rc, const char *reason)
             stats->rejected++;
         }
         stats->last_reject_code = rc;
-        stats->last_reason = (reason != NULL) ? reason : coa_lcm_error_name(rc);
+        stats->last_reason = (reason != NULL) ? reason : coavoid_lcm_error_name(rc);
     }
 }

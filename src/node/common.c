@@ -14,14 +14,14 @@
 /* A generous queue per subscription: a cycle publishes one intent and one heartbeat per
  * UAV and one estimate per track, all handled before the next cycle. LCM's default (30)
  * would drop messages of a large fleet without a word. */
-#define COA_NODE_QUEUE_CAPACITY ((int)(4u * COA_NODE_MAX_PEERS + 2u * COA_NODE_MAX_TRACKS + 16u))
+#define COAVOID_NODE_QUEUE_CAPACITY ((int)(4u * COAVOID_NODE_MAX_PEERS + 2u * COAVOID_NODE_MAX_TRACKS + 16u))
 
-int coa_node_common_defaults(coa_node_common_t *c, int64_t epoch_utime, coa_real_t dt,
+int coavoid_node_common_defaults(coavoid_node_common_t *c, int64_t epoch_utime, coa_real_t dt,
                              uint32_t horizon, const int64_t *clock)
 {
     if (c == NULL || clock == NULL || epoch_utime <= 0 || !isfinite((double)dt) ||
-        !(dt > (coa_real_t)0) || (double)dt > COA_LCM_MAX_STEP || horizon < 1u ||
-        horizon > COA_NODE_MAX_HORIZON) {
+        !(dt > (coa_real_t)0) || (double)dt > COAVOID_LCM_MAX_STEP || horizon < 1u ||
+        horizon > COAVOID_NODE_MAX_HORIZON) {
         return COA_ERR_ARGUMENT;
     }
     int64_t dt_us = (int64_t)llround((double)dt * 1e6);
@@ -48,11 +48,11 @@ static bool rate_ok(coa_real_t r)
     return isfinite((double)r) && r >= (coa_real_t)0;
 }
 
-int coa_node_common_check(const coa_node_common_t *c)
+int coavoid_node_common_check(const coavoid_node_common_t *c)
 {
     if (c == NULL || c->clock == NULL || c->epoch_utime <= 0 || !isfinite((double)c->dt) ||
-        !(c->dt > (coa_real_t)0) || (double)c->dt > COA_LCM_MAX_STEP || c->horizon < 1u ||
-        c->horizon > COA_NODE_MAX_HORIZON || c->dt_us < 1 ||
+        !(c->dt > (coa_real_t)0) || (double)c->dt > COAVOID_LCM_MAX_STEP || c->horizon < 1u ||
+        c->horizon > COAVOID_NODE_MAX_HORIZON || c->dt_us < 1 ||
         c->dt_us != (int64_t)llround((double)c->dt * 1e6)) {
         return COA_ERR_ARGUMENT;
     }
@@ -69,12 +69,12 @@ int coa_node_common_check(const coa_node_common_t *c)
     return COA_OK;
 }
 
-int64_t coa_node_cycle_utime(const coa_node_common_t *c, int64_t k)
+int64_t coavoid_node_cycle_utime(const coavoid_node_common_t *c, int64_t k)
 {
     return c->epoch_utime + k * c->dt_us;
 }
 
-int64_t coa_node_cycle_of(const coa_node_common_t *c, int64_t utime)
+int64_t coavoid_node_cycle_of(const coavoid_node_common_t *c, int64_t utime)
 {
     int64_t d = utime - c->epoch_utime;
     int64_t k = d / c->dt_us;
@@ -84,25 +84,25 @@ int64_t coa_node_cycle_of(const coa_node_common_t *c, int64_t utime)
     return k;
 }
 
-int64_t coa_node_stopwatch(const coa_node_common_t *c)
+int64_t coavoid_node_stopwatch(const coavoid_node_common_t *c)
 {
     return (c->stopwatch_us != NULL) ? c->stopwatch_us(c->stopwatch_user) : 0;
 }
 
-bool coa_node_outranks(uint32_t priority_a, uint16_t id_a, uint32_t priority_b, uint16_t id_b)
+bool coavoid_node_outranks(uint32_t priority_a, uint16_t id_a, uint32_t priority_b, uint16_t id_b)
 {
     return priority_a < priority_b || (priority_a == priority_b && id_a < id_b);
 }
 
 /* ---- senders ---- */
 
-static void senders_init(coa_node_senders_t *s)
+static void senders_init(coavoid_node_senders_t *s)
 {
-    coa_lcm_sequence_init(&s->table, s->entries, COA_NODE_MAX_SENDERS);
+    coavoid_lcm_sequence_init(&s->table, s->entries, COAVOID_NODE_MAX_SENDERS);
     s->heard_count = 0;
 }
 
-static void senders_heard(coa_node_senders_t *s, uint32_t sender, int64_t now)
+static void senders_heard(coavoid_node_senders_t *s, uint32_t sender, int64_t now)
 {
     for (size_t i = 0; i < s->heard_count; i++) {
         if (s->heard_sender[i] == sender) {
@@ -110,7 +110,7 @@ static void senders_heard(coa_node_senders_t *s, uint32_t sender, int64_t now)
             return;
         }
     }
-    if (s->heard_count < COA_NODE_MAX_SENDERS) {
+    if (s->heard_count < COAVOID_NODE_MAX_SENDERS) {
         s->heard_sender[s->heard_count] = sender;
         s->heard_utime[s->heard_count] = now;
         s->heard_count++;
@@ -118,12 +118,12 @@ static void senders_heard(coa_node_senders_t *s, uint32_t sender, int64_t now)
 }
 
 /* Forgets every sender not heard for longer than limit, so its numbering may restart. */
-static void senders_expire(coa_node_senders_t *s, int64_t now, int64_t limit)
+static void senders_expire(coavoid_node_senders_t *s, int64_t now, int64_t limit)
 {
     size_t i = 0;
     while (i < s->heard_count) {
         if (now - s->heard_utime[i] > limit) {
-            coa_lcm_sequence_forget(&s->table, s->heard_sender[i]);
+            coavoid_lcm_sequence_forget(&s->table, s->heard_sender[i]);
             s->heard_count--;
             s->heard_sender[i] = s->heard_sender[s->heard_count];
             s->heard_utime[i] = s->heard_utime[s->heard_count];
@@ -135,9 +135,9 @@ static void senders_expire(coa_node_senders_t *s, int64_t now, int64_t limit)
 
 /* ---- the inbox ---- */
 
-coa_lcm_context_t coa_node_context(const coa_node_inbox_t *in, int64_t now, int64_t epoch)
+coavoid_lcm_context_t coavoid_node_context(const coavoid_node_inbox_t *in, int64_t now, int64_t epoch)
 {
-    coa_lcm_context_t ctx;
+    coavoid_lcm_context_t ctx;
     ctx.now_utime = now;
     ctx.max_age_us = in->max_age_us;
     ctx.max_future_us = in->common.dt_us;
@@ -155,9 +155,9 @@ static bool received_size(const lcm_recv_buf_t *rbuf, int *size)
     return true;
 }
 
-static void count_undecodable(coa_node_inbox_t *in, const char *reason)
+static void count_undecodable(coavoid_node_inbox_t *in, const char *reason)
 {
-    coa_lcm_rx_count(in->rx, COA_LCM_ERR_DECODE, reason);
+    coavoid_lcm_rx_count(in->rx, COAVOID_LCM_ERR_DECODE, reason);
 }
 
 /* FNV-1a (64 bits) of a message's bytes. */
@@ -171,10 +171,10 @@ static uint64_t fingerprint(const void *data, size_t size)
     return h;
 }
 
-static bool sent_by_self(const coa_node_inbox_t *in, const void *data, size_t size)
+static bool sent_by_self(const coavoid_node_inbox_t *in, const void *data, size_t size)
 {
     const uint64_t h = fingerprint(data, size);
-    for (size_t i = 0; i < COA_NODE_OWN_INTENTS; i++) {
+    for (size_t i = 0; i < COAVOID_NODE_OWN_INTENTS; i++) {
         if (in->own_size[i] > 0 && (size_t)in->own_size[i] == size && in->own_hash[i] == h) {
             return true;
         }
@@ -184,7 +184,7 @@ static bool sent_by_self(const coa_node_inbox_t *in, const void *data, size_t si
 
 static void on_intent(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
 {
-    coa_node_inbox_t *in = user;
+    coavoid_node_inbox_t *in = user;
     coavoid_intent_t *msg = &in->rx_msg.intent;
     int size = 0;
     (void)channel;
@@ -200,15 +200,15 @@ static void on_intent(const lcm_recv_buf_t *rbuf, const char *channel, void *use
         if (in->foreign_intents < UINT32_MAX) {
             in->foreign_intents++;
         }
-        coa_lcm_rx_count(in->rx, COA_LCM_ERR_ID, "intent: another UAV uses this node's id");
+        coavoid_lcm_rx_count(in->rx, COAVOID_LCM_ERR_ID, "intent: another UAV uses this node's id");
         return;
     }
     const int64_t now = *in->common.clock;
     /* A place to keep it before the sequence rule, so that a full table does not
      * swallow a sequence number it then drops. */
-    size_t slot = COA_NODE_MAX_PEERS;
+    size_t slot = COAVOID_NODE_MAX_PEERS;
     size_t used = 0;
-    for (size_t i = 0; i < COA_NODE_MAX_PEERS; i++) {
+    for (size_t i = 0; i < COAVOID_NODE_MAX_PEERS; i++) {
         if (in->peers[i].used) {
             used++;
             if (in->peers[i].msg.uav_id == msg->uav_id) {
@@ -216,26 +216,26 @@ static void on_intent(const lcm_recv_buf_t *rbuf, const char *channel, void *use
             }
         }
     }
-    if (slot == COA_NODE_MAX_PEERS && used < in->peer_capacity) {
-        for (size_t i = 0; i < COA_NODE_MAX_PEERS; i++) {
+    if (slot == COAVOID_NODE_MAX_PEERS && used < in->peer_capacity) {
+        for (size_t i = 0; i < COAVOID_NODE_MAX_PEERS; i++) {
             if (!in->peers[i].used) {
                 slot = i;
                 break;
             }
         }
     }
-    if (slot == COA_NODE_MAX_PEERS) {
-        coa_lcm_rx_count(in->rx, COA_LCM_ERR_SENDERS, "intent: more UAVs than the node holds");
+    if (slot == COAVOID_NODE_MAX_PEERS) {
+        coavoid_lcm_rx_count(in->rx, COAVOID_LCM_ERR_SENDERS, "intent: more UAVs than the node holds");
         return;
     }
-    coa_lcm_context_t ctx = coa_node_context(in, now, now);
-    coa_lcm_intent_info_t info;
+    coavoid_lcm_context_t ctx = coavoid_node_context(in, now, now);
+    coavoid_lcm_intent_info_t info;
     coa_vehicle_t vehicle;
     coa_intent_plan_t plan;
     const char *reason = NULL;
-    int rc = coa_lcm_intent_to_core(msg, &ctx, &in->intent_seq.table, &info, &vehicle, &plan,
+    int rc = coavoid_lcm_intent_to_core(msg, &ctx, &in->intent_seq.table, &info, &vehicle, &plan,
                                     &in->rx_arrays, &reason);
-    coa_lcm_rx_count(in->rx, rc, reason);
+    coavoid_lcm_rx_count(in->rx, rc, reason);
     if (rc != COA_OK) {
         return;
     }
@@ -247,7 +247,7 @@ static void on_intent(const lcm_recv_buf_t *rbuf, const char *channel, void *use
 
 static void on_track(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
 {
-    coa_node_inbox_t *in = user;
+    coavoid_node_inbox_t *in = user;
     coavoid_track_t *msg = &in->rx_msg.track;
     int size = 0;
     (void)channel;
@@ -256,34 +256,34 @@ static void on_track(const lcm_recv_buf_t *rbuf, const char *channel, void *user
         return;
     }
     const int64_t now = *in->common.clock;
-    size_t slot = COA_NODE_MAX_TRACKS;
-    for (size_t i = 0; i < COA_NODE_MAX_TRACKS; i++) {
+    size_t slot = COAVOID_NODE_MAX_TRACKS;
+    for (size_t i = 0; i < COAVOID_NODE_MAX_TRACKS; i++) {
         if (in->tracks[i].used && in->tracks[i].msg.source_id == msg->source_id &&
             in->tracks[i].msg.track_id == msg->track_id) {
             slot = i;
             break;
         }
     }
-    if (slot == COA_NODE_MAX_TRACKS) {
-        for (size_t i = 0; i < COA_NODE_MAX_TRACKS; i++) {
+    if (slot == COAVOID_NODE_MAX_TRACKS) {
+        for (size_t i = 0; i < COAVOID_NODE_MAX_TRACKS; i++) {
             if (!in->tracks[i].used) {
                 slot = i;
                 break;
             }
         }
     }
-    if (slot == COA_NODE_MAX_TRACKS) {
-        coa_lcm_rx_count(in->rx, COA_LCM_ERR_CAPACITY, "track: more tracks than the node holds");
+    if (slot == COAVOID_NODE_MAX_TRACKS) {
+        coavoid_lcm_rx_count(in->rx, COAVOID_LCM_ERR_CAPACITY, "track: more tracks than the node holds");
         return;
     }
-    coa_lcm_context_t ctx = coa_node_context(in, now, now);
-    coa_lcm_track_info_t info;
+    coavoid_lcm_context_t ctx = coavoid_node_context(in, now, now);
+    coavoid_lcm_track_info_t info;
     coa_track_t track;
     coa_track_point_t path[COAVOID_TRACK_T_MAX_PATH];
     const char *reason = NULL;
-    int rc = coa_lcm_track_to_core(msg, &ctx, &in->track_seq.table, &info, &track, path,
+    int rc = coavoid_lcm_track_to_core(msg, &ctx, &in->track_seq.table, &info, &track, path,
                                    COAVOID_TRACK_T_MAX_PATH, &reason);
-    coa_lcm_rx_count(in->rx, rc, reason);
+    coavoid_lcm_rx_count(in->rx, rc, reason);
     if (rc != COA_OK) {
         return;
     }
@@ -294,7 +294,7 @@ static void on_track(const lcm_recv_buf_t *rbuf, const char *channel, void *user
 
 static void on_map(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
 {
-    coa_node_inbox_t *in = user;
+    coavoid_node_inbox_t *in = user;
     coavoid_obstacle_map_t *msg = &in->rx_msg.map;
     int size = 0;
     (void)channel;
@@ -304,15 +304,15 @@ static void on_map(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
         return;
     }
     const int64_t now = *in->common.clock;
-    coa_lcm_context_t ctx = coa_node_context(in, now, now);
+    coavoid_lcm_context_t ctx = coavoid_node_context(in, now, now);
     size_t count = 0;
     const char *reason = NULL;
     /* The conversion checks everything before it writes, so a refused map leaves the
      * one in use untouched. */
-    int rc = coa_lcm_obstacle_map_to_core(msg, &ctx, &in->map_seq.table, in->obstacles,
-                                          COA_NODE_MAX_OBSTACLES, &count, in->vertices,
-                                          COA_NODE_MAX_VERTICES, &reason);
-    coa_lcm_rx_count(in->rx, rc, reason);
+    int rc = coavoid_lcm_obstacle_map_to_core(msg, &ctx, &in->map_seq.table, in->obstacles,
+                                          COAVOID_NODE_MAX_OBSTACLES, &count, in->vertices,
+                                          COAVOID_NODE_MAX_VERTICES, &reason);
+    coavoid_lcm_rx_count(in->rx, rc, reason);
     if (rc != COA_OK) {
         return;
     }
@@ -323,7 +323,7 @@ static void on_map(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
 
 static void on_status(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
 {
-    coa_node_inbox_t *in = user;
+    coavoid_node_inbox_t *in = user;
     coavoid_status_t *msg = &in->rx_msg.status;
     int size = 0;
     (void)channel;
@@ -337,14 +337,14 @@ static void on_status(const lcm_recv_buf_t *rbuf, const char *channel, void *use
     /* Before the sequence rule, so that impostors take no room in its table. */
     if (msg->node_kind == COAVOID_STATUS_T_NODE_COORDINATOR &&
         msg->node_id != (int32_t)in->coordinator_id) {
-        coa_lcm_rx_count(in->rx, COA_LCM_ERR_ID, "status: a coordinator that is not this UAV's");
+        coavoid_lcm_rx_count(in->rx, COAVOID_LCM_ERR_ID, "status: a coordinator that is not this UAV's");
         return;
     }
     const int64_t now = *in->common.clock;
-    coa_lcm_context_t ctx = coa_node_context(in, now, now);
+    coavoid_lcm_context_t ctx = coavoid_node_context(in, now, now);
     const char *reason = NULL;
-    int rc = coa_lcm_status_accept(msg, &ctx, &in->status_seq.table, &reason);
-    coa_lcm_rx_count(in->rx, rc, reason);
+    int rc = coavoid_lcm_status_accept(msg, &ctx, &in->status_seq.table, &reason);
+    coavoid_lcm_rx_count(in->rx, rc, reason);
     if (rc != COA_OK) {
         return;
     }
@@ -359,7 +359,7 @@ static void on_status(const lcm_recv_buf_t *rbuf, const char *channel, void *use
 
 static void on_plan(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
 {
-    coa_node_inbox_t *in = user;
+    coavoid_node_inbox_t *in = user;
     coavoid_plan_t *msg = &in->rx_msg.plan;
     int size = 0;
     (void)channel;
@@ -368,56 +368,56 @@ static void on_plan(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
         return;
     }
     if (msg->coordinator_id != (int32_t)in->coordinator_id) {
-        coa_lcm_rx_count(in->rx, COA_LCM_ERR_ID, "plan: from a coordinator that is not this UAV's");
+        coavoid_lcm_rx_count(in->rx, COAVOID_LCM_ERR_ID, "plan: from a coordinator that is not this UAV's");
         return;
     }
     const int64_t now = *in->common.clock;
-    coa_lcm_context_t ctx = coa_node_context(in, now, now);
-    coa_lcm_plan_info_t info;
+    coavoid_lcm_context_t ctx = coavoid_node_context(in, now, now);
+    coavoid_lcm_plan_info_t info;
     coa_plan_result_t result;
     const char *reason = NULL;
     /* No sequence rule across cycles: a plan is only ever adopted in the cycle its
      * valid_from names, and the vehicle orders the plans of one cycle itself. A table
      * remembering plan_ids would let one forged INT64_MAX, or a coordinator restarted
      * while its heartbeat kept the entry alive, lock every later plan out. */
-    int rc = coa_lcm_plan_to_core(msg, &ctx, NULL, &info, &result, in->rx_offsets,
+    int rc = coavoid_lcm_plan_to_core(msg, &ctx, NULL, &info, &result, in->rx_offsets,
                                   sizeof in->rx_offsets / sizeof in->rx_offsets[0], &reason);
     if (rc != COA_OK) {
-        coa_lcm_rx_count(in->rx, rc, reason);
+        coavoid_lcm_rx_count(in->rx, rc, reason);
         return;
     }
     in->on_plan(in->owner, msg, &info, &result, in->rx_offsets);
 }
 
-static int subscribe(coa_node_inbox_t *in, const char *channel, lcm_msg_handler_t handler)
+static int subscribe(coavoid_node_inbox_t *in, const char *channel, lcm_msg_handler_t handler)
 {
     lcm_subscription_t *sub = lcm_subscribe(in->tx.lcm, channel, handler, in);
     if (sub == NULL) {
         return COA_ERR_ARGUMENT;
     }
-    lcm_subscription_set_queue_capacity(sub, COA_NODE_QUEUE_CAPACITY);
+    lcm_subscription_set_queue_capacity(sub, COAVOID_NODE_QUEUE_CAPACITY);
     in->subs[in->sub_count++] = sub;
     return COA_OK;
 }
 
-int coa_node_inbox_init(coa_node_inbox_t *in, const coa_node_common_t *common, uint16_t self_uav,
+int coavoid_node_inbox_init(coavoid_node_inbox_t *in, const coavoid_node_common_t *common, uint16_t self_uav,
                         uint16_t self_node, uint16_t coordinator_id, size_t peer_capacity,
-                        lcm_t *lcm, coa_lcm_rx_stats_t *rx, bool want_status,
-                        coa_node_plan_handler_t plan_handler, void *owner)
+                        lcm_t *lcm, coavoid_lcm_rx_stats_t *rx, bool want_status,
+                        coavoid_node_plan_handler_t plan_handler, void *owner)
 {
     in->common = *common;
     in->self_uav = self_uav;
     in->self_node = self_node;
     in->coordinator_id = coordinator_id;
     in->rx = rx;
-    in->peer_capacity = peer_capacity > COA_NODE_MAX_PEERS ? COA_NODE_MAX_PEERS : peer_capacity;
+    in->peer_capacity = peer_capacity > COAVOID_NODE_MAX_PEERS ? COAVOID_NODE_MAX_PEERS : peer_capacity;
     /* Old enough to still extrapolate a silent UAV for a horizon, and wide enough for a
      * track's path and a plan's samples around their stamps. */
     int64_t horizon_us = ((int64_t)common->horizon + 2) * common->dt_us;
     in->max_age_us = common->stale_after_us + horizon_us;
     in->tx.lcm = lcm;
     in->sub_count = 0;
-    coa_lcm_rx_init(in->rx);
+    coavoid_lcm_rx_init(in->rx);
     senders_init(&in->intent_seq);
     senders_init(&in->track_seq);
     senders_init(&in->map_seq);
@@ -435,26 +435,26 @@ int coa_node_inbox_init(coa_node_inbox_t *in, const coa_node_common_t *common, u
     in->coordinator_utime = 0;
     in->on_plan = plan_handler;
     in->owner = owner;
-    int rc = subscribe(in, COA_CHANNEL_INTENT, on_intent);
+    int rc = subscribe(in, COAVOID_CHANNEL_INTENT, on_intent);
     if (rc == COA_OK) {
-        rc = subscribe(in, COA_CHANNEL_TRACK, on_track);
+        rc = subscribe(in, COAVOID_CHANNEL_TRACK, on_track);
     }
     if (rc == COA_OK) {
-        rc = subscribe(in, COA_CHANNEL_OBSTACLES, on_map);
+        rc = subscribe(in, COAVOID_CHANNEL_OBSTACLES, on_map);
     }
     if (rc == COA_OK && want_status) {
-        rc = subscribe(in, COA_CHANNEL_STATUS, on_status);
+        rc = subscribe(in, COAVOID_CHANNEL_STATUS, on_status);
     }
     if (rc == COA_OK && plan_handler != NULL) {
-        rc = subscribe(in, COA_CHANNEL_PLAN, on_plan);
+        rc = subscribe(in, COAVOID_CHANNEL_PLAN, on_plan);
     }
     if (rc != COA_OK) {
-        coa_node_inbox_fini(in);
+        coavoid_node_inbox_fini(in);
     }
     return rc;
 }
 
-void coa_node_inbox_fini(coa_node_inbox_t *in)
+void coavoid_node_inbox_fini(coavoid_node_inbox_t *in)
 {
     for (size_t i = 0; i < in->sub_count; i++) {
         lcm_unsubscribe(in->tx.lcm, in->subs[i]);
@@ -462,32 +462,32 @@ void coa_node_inbox_fini(coa_node_inbox_t *in)
     in->sub_count = 0;
 }
 
-static int64_t drop_after(const coa_node_inbox_t *in)
+static int64_t drop_after(const coavoid_node_inbox_t *in)
 {
     return in->common.stale_after_us +
-           (int64_t)COA_NODE_DROP_HORIZONS * (int64_t)in->common.horizon * in->common.dt_us;
+           (int64_t)COAVOID_NODE_DROP_HORIZONS * (int64_t)in->common.horizon * in->common.dt_us;
 }
 
-void coa_node_inbox_expire(coa_node_inbox_t *in, int64_t now)
+void coavoid_node_inbox_expire(coavoid_node_inbox_t *in, int64_t now)
 {
     const int64_t stale = in->common.stale_after_us;
     const int64_t drop = drop_after(in);
-    for (size_t i = 0; i < COA_NODE_MAX_PEERS; i++) {
-        coa_node_peer_t *p = &in->peers[i];
+    for (size_t i = 0; i < COAVOID_NODE_MAX_PEERS; i++) {
+        coavoid_node_peer_t *p = &in->peers[i];
         if (!p->used) {
             continue;
         }
         int64_t age = now - p->msg.utime;
         if (age > stale && !p->forgotten) {
             /* A UAV that comes back after a restart numbers from 0 again. */
-            coa_lcm_sequence_forget(&in->intent_seq.table, (uint32_t)p->msg.uav_id);
+            coavoid_lcm_sequence_forget(&in->intent_seq.table, (uint32_t)p->msg.uav_id);
             p->forgotten = true;
         }
         if (age > drop) {
             p->used = false;
         }
     }
-    for (size_t i = 0; i < COA_NODE_MAX_TRACKS; i++) {
+    for (size_t i = 0; i < COAVOID_NODE_MAX_TRACKS; i++) {
         if (in->tracks[i].used && now - in->tracks[i].msg.utime > stale) {
             in->tracks[i].used = false;
         }
@@ -507,7 +507,7 @@ static bool vec_finite(coa_vec3_t v)
 
 /* A stale UAV as a track: constant velocity from the state of its last intent, moved to
  * t = 0 at cycle_start, its sigma grown with the silence. */
-static bool stale_track(const coavoid_intent_t *msg, const coa_node_common_t *c,
+static bool stale_track(const coavoid_intent_t *msg, const coavoid_node_common_t *c,
                         int64_t cycle_start, int64_t now, coa_track_t *tr)
 {
     double lead = (double)(cycle_start - msg->utime) * 1e-6;
@@ -535,13 +535,13 @@ static bool stale_track(const coavoid_intent_t *msg, const coa_node_common_t *c,
            isfinite((double)tr->sigma_vertical) && coa_track_check(tr) == COA_OK;
 }
 
-void coa_node_view_build(coa_node_view_t *view, const coa_node_inbox_t *in,
+void coavoid_node_view_build(coavoid_node_view_t *view, const coavoid_node_inbox_t *in,
                          int64_t cycle_start, int64_t now)
 {
-    const coa_node_common_t *c = &in->common;
-    const coa_lcm_context_t ctx = coa_node_context(in, now, cycle_start);
+    const coavoid_node_common_t *c = &in->common;
+    const coavoid_lcm_context_t ctx = coavoid_node_context(in, now, cycle_start);
     const int64_t drop = drop_after(in);
-    size_t order[COA_NODE_MAX_PEERS];
+    size_t order[COAVOID_NODE_MAX_PEERS];
     size_t n = 0;
 
     view->cycle_start = cycle_start;
@@ -552,7 +552,7 @@ void coa_node_view_build(coa_node_view_t *view, const coa_node_inbox_t *in,
 
     /* UAVs by ascending id, so that plan indices (and the clusters' order) do not depend
      * on the order intents arrived in. */
-    for (size_t i = 0; i < COA_NODE_MAX_PEERS; i++) {
+    for (size_t i = 0; i < COAVOID_NODE_MAX_PEERS; i++) {
         if (!in->peers[i].used) {
             continue;
         }
@@ -563,7 +563,7 @@ void coa_node_view_build(coa_node_view_t *view, const coa_node_inbox_t *in,
         }
         order[j] = i;
     }
-    bool stale[COA_NODE_MAX_PEERS];
+    bool stale[COAVOID_NODE_MAX_PEERS];
     for (size_t s = 0; s < n; s++) {
         const coavoid_intent_t *msg = &in->peers[order[s]].msg;
         int64_t age = now - msg->utime;
@@ -572,7 +572,7 @@ void coa_node_view_build(coa_node_view_t *view, const coa_node_inbox_t *in,
             continue;
         }
         size_t i = view->live_count;
-        if (coa_lcm_intent_to_core(msg, &ctx, NULL, &view->live_info[i], &view->live_vehicle[i],
+        if (coavoid_lcm_intent_to_core(msg, &ctx, NULL, &view->live_info[i], &view->live_vehicle[i],
                                    &view->live_plan[i], &view->live_arrays[i], NULL) != COA_OK) {
             continue; /* e.g. stamped further ahead of this clock than allowed */
         }
@@ -583,10 +583,10 @@ void coa_node_view_build(coa_node_view_t *view, const coa_node_inbox_t *in,
     }
 
     /* Real tracks by (source, id). */
-    size_t torder[COA_NODE_MAX_TRACKS];
+    size_t torder[COAVOID_NODE_MAX_TRACKS];
     size_t m = 0;
-    for (size_t i = 0; i < COA_NODE_MAX_TRACKS; i++) {
-        const coa_node_track_slot_t *t = &in->tracks[i];
+    for (size_t i = 0; i < COAVOID_NODE_MAX_TRACKS; i++) {
+        const coavoid_node_track_slot_t *t = &in->tracks[i];
         if (!t->used || now - t->msg.utime > c->stale_after_us) {
             continue;
         }
@@ -605,8 +605,8 @@ void coa_node_view_build(coa_node_view_t *view, const coa_node_inbox_t *in,
     for (size_t s = 0; s < m; s++) {
         const coavoid_track_t *msg = &in->tracks[torder[s]].msg;
         size_t i = view->track_count;
-        coa_lcm_track_info_t info;
-        if (coa_lcm_track_to_core(msg, &ctx, NULL, &info, &view->tracks[i], view->real_paths[s],
+        coavoid_lcm_track_info_t info;
+        if (coavoid_lcm_track_to_core(msg, &ctx, NULL, &info, &view->tracks[i], view->real_paths[s],
                                   COAVOID_TRACK_T_MAX_PATH, NULL) != COA_OK) {
             continue;
         }
@@ -630,8 +630,8 @@ void coa_node_view_build(coa_node_view_t *view, const coa_node_inbox_t *in,
     }
 }
 
-int coa_node_problem_tracks(coa_node_problem_tracks_t *out, const coa_node_view_t *view,
-                            const bool *include, const coa_node_common_t *c)
+int coavoid_node_problem_tracks(coavoid_node_problem_tracks_t *out, const coavoid_node_view_t *view,
+                            const bool *include, const coavoid_node_common_t *c)
 {
     size_t n = 0;
     size_t paths = 0;
@@ -681,13 +681,13 @@ int coa_node_problem_tracks(coa_node_problem_tracks_t *out, const coa_node_view_
     return COA_OK;
 }
 
-size_t coa_node_max_pairs(void)
+size_t coavoid_node_max_pairs(void)
 {
-    const size_t n = COA_NODE_MAX_PEERS;
-    return n * (n - 1u) / 2u + n * COA_NODE_TRACK_CAPACITY + n * COA_NODE_MAX_OBSTACLES;
+    const size_t n = COAVOID_NODE_MAX_PEERS;
+    return n * (n - 1u) / 2u + n * COAVOID_NODE_TRACK_CAPACITY + n * COAVOID_NODE_MAX_OBSTACLES;
 }
 
-coa_predict_config_t coa_node_predict_config(const coa_node_common_t *c)
+coa_predict_config_t coavoid_node_predict_config(const coavoid_node_common_t *c)
 {
     coa_predict_config_t config;
     memset(&config, 0, sizeof config);
@@ -703,9 +703,9 @@ coa_predict_config_t coa_node_predict_config(const coa_node_common_t *c)
     return config;
 }
 
-int coa_node_predict(coa_predictor_t *predictor, const coa_node_common_t *c,
-                     const coa_intent_plan_t *plans, size_t n, const coa_node_view_t *view,
-                     const coa_node_inbox_t *in, coa_conflict_t *conflicts, size_t capacity,
+int coavoid_node_predict(coa_predictor_t *predictor, const coavoid_node_common_t *c,
+                     const coa_intent_plan_t *plans, size_t n, const coavoid_node_view_t *view,
+                     const coavoid_node_inbox_t *in, coa_conflict_t *conflicts, size_t capacity,
                      coa_predict_result_t *result, uint32_t *labels, size_t *cluster_count)
 {
     memset(result, 0, sizeof *result);
@@ -713,7 +713,7 @@ int coa_node_predict(coa_predictor_t *predictor, const coa_node_common_t *c,
     if (n == 0) {
         return COA_OK;
     }
-    coa_predict_config_t config = coa_node_predict_config(c);
+    coa_predict_config_t config = coavoid_node_predict_config(c);
     int rc = coa_predict(predictor, &config, plans, n, in->obstacles, in->obstacle_count,
                          view->tracks, view->track_count, conflicts, capacity, result);
     if (rc != COA_OK) {
@@ -725,7 +725,7 @@ int coa_node_predict(coa_predictor_t *predictor, const coa_node_common_t *c,
     return coa_predict_clusters(conflicts, result->conflict_count, n, labels, cluster_count);
 }
 
-coa_planner_config_t coa_node_planner_config(uint32_t horizon, size_t searched, uint32_t beta)
+coa_planner_config_t coavoid_node_planner_config(uint32_t horizon, size_t searched, uint32_t beta)
 {
     coa_planner_config_t c;
     c.vehicles = searched;
@@ -736,13 +736,13 @@ coa_planner_config_t coa_node_planner_config(uint32_t horizon, size_t searched, 
     return c;
 }
 
-int coa_node_solver_init(coa_node_solver_t *s, uint32_t horizon, size_t searched, uint32_t beta)
+int coavoid_node_solver_init(coavoid_node_solver_t *s, uint32_t horizon, size_t searched, uint32_t beta)
 {
     memset(s, 0, sizeof *s);
-    const size_t pairs = coa_node_max_pairs();
+    const size_t pairs = coavoid_node_max_pairs();
     const size_t predictor_size = coa_predictor_workspace_size(
-        COA_NODE_MAX_PEERS, COA_NODE_TRACK_CAPACITY, horizon, pairs);
-    const coa_planner_config_t config = coa_node_planner_config(horizon, searched, beta);
+        COAVOID_NODE_MAX_PEERS, COAVOID_NODE_TRACK_CAPACITY, horizon, pairs);
+    const coa_planner_config_t config = coavoid_node_planner_config(horizon, searched, beta);
     const size_t planner_size = coa_planner_workspace_size(&config);
     if (predictor_size == 0u || planner_size == 0u) {
         return COA_ERR_ARGUMENT;
@@ -752,20 +752,20 @@ int coa_node_solver_init(coa_node_solver_t *s, uint32_t horizon, size_t searched
     s->conflict_capacity = pairs;
     s->conflicts = calloc(pairs, sizeof *s->conflicts);
     if (s->predictor_memory != NULL) {
-        s->predictor = coa_predictor_init(s->predictor_memory, predictor_size, COA_NODE_MAX_PEERS,
-                                          COA_NODE_TRACK_CAPACITY, horizon, pairs);
+        s->predictor = coa_predictor_init(s->predictor_memory, predictor_size, COAVOID_NODE_MAX_PEERS,
+                                          COAVOID_NODE_TRACK_CAPACITY, horizon, pairs);
     }
     if (s->planner_memory != NULL) {
         s->planner = coa_planner_init(s->planner_memory, planner_size, &config);
     }
     if (s->predictor == NULL || s->planner == NULL || s->conflicts == NULL) {
-        coa_node_solver_fini(s);
+        coavoid_node_solver_fini(s);
         return COA_ERR_WORKSPACE;
     }
     return COA_OK;
 }
 
-void coa_node_solver_fini(coa_node_solver_t *s)
+void coavoid_node_solver_fini(coavoid_node_solver_t *s)
 {
     free(s->predictor_memory);
     free(s->planner_memory);
@@ -773,8 +773,8 @@ void coa_node_solver_fini(coa_node_solver_t *s)
     memset(s, 0, sizeof *s);
 }
 
-int coa_node_publish_heartbeat(coa_node_inbox_t *in, coavoid_status_t *m, int64_t now,
-                               int64_t cycle_start, const coa_node_heartbeat_t *h)
+int coavoid_node_publish_heartbeat(coavoid_node_inbox_t *in, coavoid_status_t *m, int64_t now,
+                               int64_t cycle_start, const coavoid_node_heartbeat_t *h)
 {
     memset(m, 0, sizeof *m);
     m->utime = now;
@@ -798,17 +798,17 @@ int coa_node_publish_heartbeat(coa_node_inbox_t *in, coavoid_status_t *m, int64_
     m->messages_received = h->rx->received;
     m->messages_rejected = h->rx->rejected;
     m->last_reject_code = h->rx->last_reject_code;
-    coa_lcm_context_t ctx = coa_node_context(in, now, cycle_start);
-    if (coa_lcm_status_check(m, &ctx, NULL) != COA_OK) {
+    coavoid_lcm_context_t ctx = coavoid_node_context(in, now, cycle_start);
+    if (coavoid_lcm_status_check(m, &ctx, NULL) != COA_OK) {
         return COA_ERR_ARGUMENT;
     }
-    return coa_node_publish_status(&in->tx, m);
+    return coavoid_node_publish_status(&in->tx, m);
 }
 
 /* ---- publishing ---- */
 
-#define COA_NODE_DEFINE_PUBLISH(function, type, channel)                                   \
-    int function(coa_node_tx_t *tx, const type *msg)                                       \
+#define COAVOID_NODE_DEFINE_PUBLISH(function, type, channel)                                   \
+    int function(coavoid_node_tx_t *tx, const type *msg)                                       \
     {                                                                                       \
         int size = type##_encoded_size(msg);                                                \
         if (size <= 0 || (size_t)size > sizeof tx->buf ||                                   \
@@ -820,16 +820,16 @@ int coa_node_publish_heartbeat(coa_node_inbox_t *in, coavoid_status_t *m, int64_
                    : COA_ERR_ARGUMENT;                                                      \
     }
 
-COA_NODE_DEFINE_PUBLISH(coa_node_publish_plan, coavoid_plan_t, COA_CHANNEL_PLAN)
-COA_NODE_DEFINE_PUBLISH(coa_node_publish_track, coavoid_track_t, COA_CHANNEL_TRACK)
-COA_NODE_DEFINE_PUBLISH(coa_node_publish_map, coavoid_obstacle_map_t, COA_CHANNEL_OBSTACLES)
-COA_NODE_DEFINE_PUBLISH(coa_node_publish_conflicts, coavoid_conflict_report_t,
-                        COA_CHANNEL_CONFLICTS)
-COA_NODE_DEFINE_PUBLISH(coa_node_publish_status, coavoid_status_t, COA_CHANNEL_STATUS)
+COAVOID_NODE_DEFINE_PUBLISH(coavoid_node_publish_plan, coavoid_plan_t, COAVOID_CHANNEL_PLAN)
+COAVOID_NODE_DEFINE_PUBLISH(coavoid_node_publish_track, coavoid_track_t, COAVOID_CHANNEL_TRACK)
+COAVOID_NODE_DEFINE_PUBLISH(coavoid_node_publish_map, coavoid_obstacle_map_t, COAVOID_CHANNEL_OBSTACLES)
+COAVOID_NODE_DEFINE_PUBLISH(coavoid_node_publish_conflicts, coavoid_conflict_report_t,
+                        COAVOID_CHANNEL_CONFLICTS)
+COAVOID_NODE_DEFINE_PUBLISH(coavoid_node_publish_status, coavoid_status_t, COAVOID_CHANNEL_STATUS)
 
-int coa_node_publish_intent(coa_node_inbox_t *in, const coavoid_intent_t *msg)
+int coavoid_node_publish_intent(coavoid_node_inbox_t *in, const coavoid_intent_t *msg)
 {
-    coa_node_tx_t *tx = &in->tx;
+    coavoid_node_tx_t *tx = &in->tx;
     int size = coavoid_intent_t_encoded_size(msg);
     if (size <= 0 || (size_t)size > sizeof tx->buf ||
         coavoid_intent_t_encode(tx->buf, 0, size, msg) != size) {
@@ -838,8 +838,8 @@ int coa_node_publish_intent(coa_node_inbox_t *in, const coavoid_intent_t *msg)
     /* Remembered before it is sent: a provider may hand it back within lcm_publish. */
     in->own_hash[in->own_next] = fingerprint(tx->buf, (size_t)size);
     in->own_size[in->own_next] = size;
-    in->own_next = (in->own_next + 1u) % COA_NODE_OWN_INTENTS;
-    return lcm_publish(tx->lcm, COA_CHANNEL_INTENT, tx->buf, (unsigned int)size) == 0
+    in->own_next = (in->own_next + 1u) % COAVOID_NODE_OWN_INTENTS;
+    return lcm_publish(tx->lcm, COAVOID_CHANNEL_INTENT, tx->buf, (unsigned int)size) == 0
                ? COA_OK
                : COA_ERR_ARGUMENT;
 }

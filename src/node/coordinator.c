@@ -12,9 +12,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-struct coa_coordinator {
-    coa_coordinator_config_t config;
-    coa_coordinator_state_t state;
+struct coavoid_coordinator {
+    coavoid_coordinator_config_t config;
+    coavoid_coordinator_state_t state;
     bool started;
     bool degraded;                 /* a cluster's plan failed in this cycle */
     bool fault;                    /* an internal error in this cycle */
@@ -23,23 +23,23 @@ struct coa_coordinator {
     int64_t status_sequence;
     int64_t last_plan_utime;
 
-    uint32_t labels[COA_NODE_MAX_PEERS];
-    bool include[COA_NODE_MAX_PEERS];
+    uint32_t labels[COAVOID_NODE_MAX_PEERS];
+    bool include[COAVOID_NODE_MAX_PEERS];
     size_t member[COA_MAX_VEHICLES];            /* live indices of the cluster planned */
     coa_vehicle_t vehicles[COA_MAX_VEHICLES];
     const coa_vec3_t *references[COA_MAX_VEHICLES];
-    int32_t offsets[(size_t)COA_MAX_VEHICLES * COA_NODE_MAX_SAMPLES];
+    int32_t offsets[(size_t)COA_MAX_VEHICLES * COAVOID_NODE_MAX_SAMPLES];
     coavoid_plan_t tx_plan;
     coavoid_conflict_report_t tx_report;
     coavoid_status_t tx_status;
 
-    coa_node_solver_t solver;
-    coa_node_inbox_t inbox;
-    coa_node_view_t view;
-    coa_node_problem_tracks_t problem_tracks;
+    coavoid_node_solver_t solver;
+    coavoid_node_inbox_t inbox;
+    coavoid_node_view_t view;
+    coavoid_node_problem_tracks_t problem_tracks;
 };
 
-coa_coordinator_t *coa_coordinator_create(const coa_coordinator_config_t *config, lcm_t *lcm,
+coavoid_coordinator_t *coavoid_coordinator_create(const coavoid_coordinator_config_t *config, lcm_t *lcm,
                                           int *error)
 {
     int dummy;
@@ -47,22 +47,22 @@ coa_coordinator_t *coa_coordinator_create(const coa_coordinator_config_t *config
         error = &dummy;
     }
     *error = COA_ERR_ARGUMENT;
-    if (config == NULL || lcm == NULL || coa_node_common_check(&config->common) != COA_OK ||
+    if (config == NULL || lcm == NULL || coavoid_node_common_check(&config->common) != COA_OK ||
         config->max_centralised > COA_MAX_CENTRALISED || config->collect_us < 0 ||
         config->collect_us >= config->common.dt_us) {
         return NULL;
     }
-    const coa_node_common_t *c = &config->common;
+    const coavoid_node_common_t *c = &config->common;
     const size_t max_centralised = config->max_centralised == 0u ? 3u : config->max_centralised;
-    coa_node_solver_t solver;
-    int rc = coa_node_solver_init(&solver, c->horizon, max_centralised, c->beta);
+    coavoid_node_solver_t solver;
+    int rc = coavoid_node_solver_init(&solver, c->horizon, max_centralised, c->beta);
     if (rc != COA_OK) {
         *error = rc;
         return NULL;
     }
-    coa_coordinator_t *node = calloc(1, sizeof *node);
+    coavoid_coordinator_t *node = calloc(1, sizeof *node);
     if (node == NULL) {
-        coa_node_solver_fini(&solver);
+        coavoid_node_solver_fini(&solver);
         *error = COA_ERR_WORKSPACE;
         return NULL;
     }
@@ -70,7 +70,7 @@ coa_coordinator_t *coa_coordinator_create(const coa_coordinator_config_t *config
     node->config = *config;
     node->config.max_centralised = max_centralised;
     if (node->config.id == 0u) {
-        node->config.id = (uint16_t)COA_NODE_COORDINATOR_ID;
+        node->config.id = (uint16_t)COAVOID_NODE_COORDINATOR_ID;
     }
     if (node->config.collect_us == 0) {
         node->config.collect_us = c->dt_us / 4;
@@ -78,10 +78,10 @@ coa_coordinator_t *coa_coordinator_create(const coa_coordinator_config_t *config
     node->state.cycle = -1;
     node->state.last_outcome = -1;
     /* No UAV is its own: intents are all others'. */
-    rc = coa_node_inbox_init(&node->inbox, c, 0u, node->config.id, 0u, COA_NODE_MAX_PEERS, lcm,
+    rc = coavoid_node_inbox_init(&node->inbox, c, 0u, node->config.id, 0u, COAVOID_NODE_MAX_PEERS, lcm,
                              &node->state.rx, false, NULL, node);
     if (rc != COA_OK) {
-        coa_node_solver_fini(&node->solver);
+        coavoid_node_solver_fini(&node->solver);
         free(node);
         *error = rc;
         return NULL;
@@ -90,28 +90,28 @@ coa_coordinator_t *coa_coordinator_create(const coa_coordinator_config_t *config
     return node;
 }
 
-void coa_coordinator_destroy(coa_coordinator_t *node)
+void coavoid_coordinator_destroy(coavoid_coordinator_t *node)
 {
     if (node == NULL) {
         return;
     }
-    coa_node_inbox_fini(&node->inbox);
-    coa_node_solver_fini(&node->solver);
+    coavoid_node_inbox_fini(&node->inbox);
+    coavoid_node_solver_fini(&node->solver);
     free(node);
 }
 
-const coa_coordinator_state_t *coa_coordinator_state(const coa_coordinator_t *node)
+const coavoid_coordinator_state_t *coavoid_coordinator_state(const coavoid_coordinator_t *node)
 {
     return node != NULL ? &node->state : NULL;
 }
 
-static int publish_report(coa_coordinator_t *node, int64_t now, int64_t cycle_start,
+static int publish_report(coavoid_coordinator_t *node, int64_t now, int64_t cycle_start,
                           const coa_predict_result_t *result)
 {
-    const coa_node_common_t *c = &node->config.common;
-    const coa_node_view_t *view = &node->view;
-    coa_lcm_context_t ctx = coa_node_context(&node->inbox, now, cycle_start);
-    int rc = coa_lcm_conflict_report_from_core(
+    const coavoid_node_common_t *c = &node->config.common;
+    const coavoid_node_view_t *view = &node->view;
+    coavoid_lcm_context_t ctx = coavoid_node_context(&node->inbox, now, cycle_start);
+    int rc = coavoid_lcm_conflict_report_from_core(
         node->solver.conflicts, result->conflict_count, result->conflicts_found, view->live_id,
         view->live_count, view->track_ids, view->track_count,
         view->live_count > 0u ? node->labels : NULL, now, node->config.id,
@@ -119,13 +119,13 @@ static int publish_report(coa_coordinator_t *node, int64_t now, int64_t cycle_st
     if (rc != COA_OK) {
         return COA_ERR_ARGUMENT;
     }
-    return coa_node_publish_conflicts(&node->inbox.tx, &node->tx_report);
+    return coavoid_node_publish_conflicts(&node->inbox.tx, &node->tx_report);
 }
 
-static int publish_status(coa_coordinator_t *node, int64_t now, int64_t cycle_start)
+static int publish_status(coavoid_coordinator_t *node, int64_t now, int64_t cycle_start)
 {
-    const coa_coordinator_state_t *s = &node->state;
-    const coa_node_heartbeat_t h = {node->config.id,
+    const coavoid_coordinator_state_t *s = &node->state;
+    const coavoid_node_heartbeat_t h = {node->config.id,
                                     COAVOID_STATUS_T_NODE_COORDINATOR,
                                     node->status_sequence++,
                                     node->fault,
@@ -138,7 +138,7 @@ static int publish_status(coa_coordinator_t *node, int64_t now, int64_t cycle_st
                                     s->conflicts,
                                     s->plans_run,
                                     &s->rx};
-    return coa_node_publish_heartbeat(&node->inbox, &node->tx_status, now, cycle_start, &h);
+    return coavoid_node_publish_heartbeat(&node->inbox, &node->tx_status, now, cycle_start, &h);
 }
 
 /* Which UAVs a planning call takes: one cluster, every clustered UAV, or every UAV. */
@@ -149,9 +149,9 @@ static int publish_status(coa_coordinator_t *node, int64_t now, int64_t cycle_st
  * this cycle that follow the coordinator, ascending id; past COA_MAX_VEHICLES (a plan_t's
  * rows) only the highest priorities are planned and the rest stay moving obstacles.
  * Returns the count. */
-static size_t cluster_members(coa_coordinator_t *node, uint32_t group)
+static size_t cluster_members(coavoid_coordinator_t *node, uint32_t group)
 {
-    const coa_node_view_t *view = &node->view;
+    const coavoid_node_view_t *view = &node->view;
     size_t count = 0;
     for (size_t i = 0; i < view->live_count; i++) {
         bool in = group == GROUP_ALL ||
@@ -173,13 +173,13 @@ static size_t cluster_members(coa_coordinator_t *node, uint32_t group)
         for (size_t m = 1; m < count; m++) {
             const coa_vehicle_t *a = &view->live_vehicle[node->member[m]];
             const coa_vehicle_t *b = &view->live_vehicle[node->member[worst]];
-            if (coa_node_outranks(b->priority, b->id, a->priority, a->id)) {
+            if (coavoid_node_outranks(b->priority, b->id, a->priority, a->id)) {
                 worst = m;
             }
         }
         const coa_vehicle_t *w = &view->live_vehicle[node->member[worst]];
         const coa_vehicle_t *v = &view->live_vehicle[i];
-        if (coa_node_outranks(v->priority, v->id, w->priority, w->id)) {
+        if (coavoid_node_outranks(v->priority, v->id, w->priority, w->id)) {
             node->member[worst] = i;
         }
     }
@@ -198,11 +198,11 @@ static size_t cluster_members(coa_coordinator_t *node, uint32_t group)
 
 /* Plans one cluster and publishes its plan; a solved plan replaces the members' positions
  * in the view, so that later clusters plan around it. *solved says how it went. */
-static int plan_cluster(coa_coordinator_t *node, int64_t now, int64_t cycle_start, size_t count,
+static int plan_cluster(coavoid_coordinator_t *node, int64_t now, int64_t cycle_start, size_t count,
                         bool *solved)
 {
-    const coa_node_common_t *c = &node->config.common;
-    coa_node_view_t *view = &node->view;
+    const coavoid_node_common_t *c = &node->config.common;
+    coavoid_node_view_t *view = &node->view;
     for (size_t i = 0; i < view->live_count; i++) {
         node->include[i] = true;
     }
@@ -212,7 +212,7 @@ static int plan_cluster(coa_coordinator_t *node, int64_t now, int64_t cycle_star
         node->vehicles[m] = view->live_vehicle[i];
         node->references[m] = view->live_arrays[i].reference;
     }
-    int rc = coa_node_problem_tracks(&node->problem_tracks, view, node->include, c);
+    int rc = coavoid_node_problem_tracks(&node->problem_tracks, view, node->include, c);
     if (rc != COA_OK) {
         return rc;
     }
@@ -233,7 +233,7 @@ static int plan_cluster(coa_coordinator_t *node, int64_t now, int64_t cycle_star
     coa_planner_t *planner = node->solver.planner;
     coa_plan_result_t result;
     *solved = false;
-    int64_t start = coa_node_stopwatch(c);
+    int64_t start = coavoid_node_stopwatch(c);
     if (centralised) {
         rc = coa_plan_centralised(planner, &problem, node->offsets, &result);
         /* A joint search can fill its beta nodes: when beta runs out before it proves
@@ -248,7 +248,7 @@ static int plan_cluster(coa_coordinator_t *node, int64_t now, int64_t cycle_star
     } else {
         rc = coa_plan_decoupled(planner, &problem, NULL, 1u, node->offsets, &result);
     }
-    int64_t duration = coa_node_stopwatch(c) - start;
+    int64_t duration = coavoid_node_stopwatch(c) - start;
     node->state.plans_run++;
     node->state.clusters_planned++;
     node->last_plan_utime = now;
@@ -259,7 +259,7 @@ static int plan_cluster(coa_coordinator_t *node, int64_t now, int64_t cycle_star
     node->state.last_outcome = (int)result.status;
     node->state.last_nodes_expanded = result.nodes_expanded;
 
-    coa_lcm_plan_info_t info;
+    coavoid_lcm_plan_info_t info;
     memset(&info, 0, sizeof info);
     info.utime = now;
     info.coordinator_id = node->config.id;
@@ -273,18 +273,18 @@ static int plan_cluster(coa_coordinator_t *node, int64_t now, int64_t cycle_star
     for (size_t m = 0; m < count; m++) {
         info.uav_ids[m] = node->vehicles[m].id;
     }
-    coa_lcm_context_t ctx = coa_node_context(&node->inbox, now, cycle_start);
-    rc = coa_lcm_plan_from_core(&info, &result, node->offsets, &ctx, &node->tx_plan, NULL);
+    coavoid_lcm_context_t ctx = coavoid_node_context(&node->inbox, now, cycle_start);
+    rc = coavoid_lcm_plan_from_core(&info, &result, node->offsets, &ctx, &node->tx_plan, NULL);
     if (rc == COA_OK) {
         /* The validity window in exact microseconds, whatever the core's precision. */
         node->tx_plan.valid_from_utime = cycle_start;
         node->tx_plan.valid_until_utime = cycle_start + c->dt_us;
-        rc = coa_lcm_plan_check(&node->tx_plan, &ctx, NULL);
+        rc = coavoid_lcm_plan_check(&node->tx_plan, &ctx, NULL);
     }
     if (rc != COA_OK) {
         return COA_ERR_ARGUMENT;
     }
-    rc = coa_node_publish_plan(&node->inbox.tx, &node->tx_plan);
+    rc = coavoid_node_publish_plan(&node->inbox.tx, &node->tx_plan);
     if (result.status != COA_PLAN_SOLVED) {
         return rc;
     }
@@ -293,7 +293,7 @@ static int plan_cluster(coa_coordinator_t *node, int64_t now, int64_t cycle_star
     const size_t samples = (size_t)c->horizon + 1u;
     for (size_t m = 0; m < count; m++) {
         size_t i = node->member[m];
-        coa_lcm_intent_arrays_t *a = &view->live_arrays[i];
+        coavoid_lcm_intent_arrays_t *a = &view->live_arrays[i];
         coa_real_t dh = coa_climb_step(&view->live_vehicle[i], c->dt);
         for (size_t j = 0; j < samples; j++) {
             a->offsets[j] = node->offsets[m * samples + j];
@@ -304,13 +304,13 @@ static int plan_cluster(coa_coordinator_t *node, int64_t now, int64_t cycle_star
     return rc;
 }
 
-int coa_coordinator_cycle(coa_coordinator_t *node, int64_t now)
+int coavoid_coordinator_cycle(coavoid_coordinator_t *node, int64_t now)
 {
     if (node == NULL) {
         return COA_ERR_ARGUMENT;
     }
-    const coa_node_common_t *c = &node->config.common;
-    const int64_t k = coa_node_cycle_of(c, now);
+    const coavoid_node_common_t *c = &node->config.common;
+    const int64_t k = coavoid_node_cycle_of(c, now);
     if (k < 0) {
         return COA_ERR_ARGUMENT;
     }
@@ -322,15 +322,15 @@ int coa_coordinator_cycle(coa_coordinator_t *node, int64_t now)
     node->state.clusters_planned = 0;
     node->degraded = false;
     node->fault = false;
-    const int64_t cycle_start = coa_node_cycle_utime(c, k);
-    coa_node_inbox_expire(&node->inbox, now);
-    coa_node_view_t *view = &node->view;
-    coa_node_view_build(view, &node->inbox, cycle_start, now);
+    const int64_t cycle_start = coavoid_node_cycle_utime(c, k);
+    coavoid_node_inbox_expire(&node->inbox, now);
+    coavoid_node_view_t *view = &node->view;
+    coavoid_node_view_build(view, &node->inbox, cycle_start, now);
 
     coa_predict_result_t result;
     size_t clusters = 0;
-    coa_node_solver_t *sv = &node->solver;
-    int first_error = coa_node_predict(sv->predictor, c, view->live_plan, view->live_count, view,
+    coavoid_node_solver_t *sv = &node->solver;
+    int first_error = coavoid_node_predict(sv->predictor, c, view->live_plan, view->live_count, view,
                                        &node->inbox, sv->conflicts, sv->conflict_capacity, &result,
                                        node->labels, &clusters);
     if (first_error != COA_OK) {
@@ -372,7 +372,7 @@ int coa_coordinator_cycle(coa_coordinator_t *node, int64_t now)
         if (count <= failed_size) {
             continue;
         }
-        coa_node_view_build(view, &node->inbox, cycle_start, now);
+        coavoid_node_view_build(view, &node->inbox, cycle_start, now);
         bool solved = false;
         rc = plan_cluster(node, now, cycle_start, count, &solved);
         if (rc != COA_OK) {

@@ -24,7 +24,7 @@
  *        coordinator not found wanting, below): it publishes its intent at once
  *        (reference and offsets for samples k..k+N) and follows the coordinator. Its
  *        coordinator is the node id it is configured with: heartbeats of a coordinator
- *        and plans from any other id are refused (COA_LCM_ERR_ID), and a heartbeat with
+ *        and plans from any other id are refused (COAVOID_LCM_ERR_ID), and a heartbeat with
  *        HEALTH_FAULT does not count. A heartbeat alone does not keep a UAV safe (plans
  *        that come late, an impostor): so at the start of cycle k + 1, a UAV that
  *        followed the coordinator in cycle k and got no answer from it there (it adopted
@@ -100,11 +100,11 @@
  * the node's status and otherwise ignored, never fatal. A node's own messages come back
  * to it and are not counted; but an intent with a UAV's own id that it did not publish
  * (not byte for byte one of its latest) is another UAV using the same id: refused
- * (COA_LCM_ERR_ID), and the UAV's next heartbeat says HEALTH_FAULT.
+ * (COAVOID_LCM_ERR_ID), and the UAV's next heartbeat says HEALTH_FAULT.
  *
  * Memory: a node is one struct of fixed size plus the planner and predictor workspaces,
  * allocated once by init and released by fini: nothing is allocated per cycle.
- * Errors: negative codes (COA_ERR_*, COA_LCM_ERR_*); a failed planning call is not an
+ * Errors: negative codes (COA_ERR_*, COAVOID_LCM_ERR_*); a failed planning call is not an
  * error of the node (it keeps its plan, reports HEALTH_DEGRADED and the outcome).
  */
 #ifndef COAVOID_APP_NODE_H
@@ -119,33 +119,33 @@
 #include "coavoid/coavoid.h"
 #include "coavoid_lcm.h"
 
-#define COA_CHANNEL_INTENT "COAVOID_INTENT"
-#define COA_CHANNEL_PLAN "COAVOID_PLAN"
-#define COA_CHANNEL_TRACK "COAVOID_TRACK"
-#define COA_CHANNEL_OBSTACLES "COAVOID_OBSTACLES"
-#define COA_CHANNEL_CONFLICTS "COAVOID_CONFLICTS"
-#define COA_CHANNEL_STATUS "COAVOID_STATUS"
+#define COAVOID_CHANNEL_INTENT "COAVOID_INTENT"
+#define COAVOID_CHANNEL_PLAN "COAVOID_PLAN"
+#define COAVOID_CHANNEL_TRACK "COAVOID_TRACK"
+#define COAVOID_CHANNEL_OBSTACLES "COAVOID_OBSTACLES"
+#define COAVOID_CHANNEL_CONFLICTS "COAVOID_CONFLICTS"
+#define COAVOID_CHANNEL_STATUS "COAVOID_STATUS"
 
 /* Capacities of one node's view of the airspace. */
-#define COA_NODE_MAX_PEERS 64u      /* co-operative UAVs a node tracks, itself included */
-#define COA_NODE_MAX_TRACKS 32u     /* non-cooperative tracks */
-#define COA_NODE_MAX_HORIZON 127u   /* N: intent_t carries N + 1 samples */
+#define COAVOID_NODE_MAX_PEERS 64u      /* co-operative UAVs a node tracks, itself included */
+#define COAVOID_NODE_MAX_TRACKS 32u     /* non-cooperative tracks */
+#define COAVOID_NODE_MAX_HORIZON 127u   /* N: intent_t carries N + 1 samples */
 
 /* The world's id (map_id of the obstacle map, source_id of tracks) by default. */
-#define COA_NODE_WORLD_ID 65000u
-#define COA_NODE_COORDINATOR_ID 65001u
+#define COAVOID_NODE_WORLD_ID 65000u
+#define COAVOID_NODE_COORDINATOR_ID 65001u
 
 typedef enum {
-    COA_NODE_CENTRALISED = 0, /* follow the coordinator; plan for itself when it is silent */
-    COA_NODE_DECOUPLED = 1    /* always plan for itself in priority order */
-} coa_node_mode_t;
+    COAVOID_NODE_CENTRALISED = 0, /* follow the coordinator; plan for itself when it is silent */
+    COAVOID_NODE_DECOUPLED = 1    /* always plan for itself in priority order */
+} coavoid_node_mode_t;
 
 /* What every node shares. */
 typedef struct {
     int64_t epoch_utime;    /* cycle 0 starts here; > 0 */
     coa_real_t dt;          /* s, > 0: the scenario's dt */
     int64_t dt_us;          /* llround(dt * 1e6), >= 1 */
-    uint32_t horizon;       /* N, 1..COA_NODE_MAX_HORIZON */
+    uint32_t horizon;       /* N, 1..COAVOID_NODE_MAX_HORIZON */
     const int64_t *clock;   /* the driver's current utime, read by the message handlers */
     /* Optional: a monotonic microsecond reader used only to measure how long planning
      * took (status_t.last_plan_duration_us). NULL in simulation, where durations are 0 so
@@ -163,24 +163,24 @@ typedef struct {
     coa_real_t stale_sigma_rate;
     int64_t stale_after_us;     /* peer intent older than this: a track (default 2.5 dt) */
     uint32_t beta;              /* closed-set bound of the node's planner */
-} coa_node_common_t;
+} coavoid_node_common_t;
 
 /* Fills c with the defaults for (epoch, dt, horizon, clock): threshold 0.01, no sigma
  * growth, stale_after 2.5 cycles, stale_sigma_rate 1 m/s, beta 20000. Returns COA_OK or
  * COA_ERR_ARGUMENT (dt, horizon, epoch or clock invalid). */
-int coa_node_common_defaults(coa_node_common_t *c, int64_t epoch_utime, coa_real_t dt,
+int coavoid_node_common_defaults(coavoid_node_common_t *c, int64_t epoch_utime, coa_real_t dt,
                              uint32_t horizon, const int64_t *clock);
 
 /* utime of cycle k's start, and the cycle a time falls in (floor; negative before epoch). */
-int64_t coa_node_cycle_utime(const coa_node_common_t *c, int64_t k);
-int64_t coa_node_cycle_of(const coa_node_common_t *c, int64_t utime);
+int64_t coavoid_node_cycle_utime(const coavoid_node_common_t *c, int64_t k);
+int64_t coavoid_node_cycle_of(const coavoid_node_common_t *c, int64_t utime);
 
 /* ---- vehicle ---- */
 
 typedef struct {
-    coa_node_common_t common;
+    coavoid_node_common_t common;
     coa_vehicle_t vehicle;          /* its route is the caller's and must outlive the node */
-    coa_node_mode_t mode;
+    coavoid_node_mode_t mode;
     int64_t coordinator_timeout_us; /* heartbeat silence before it plans for itself (0: the
                                        default, 2.5 dt) */
     int64_t priority_wait_us;       /* bounded wait for higher-priority intents (0: the
@@ -188,9 +188,9 @@ typedef struct {
     coa_real_t sigma_horizontal;    /* its own position uncertainty, published (default 0) */
     coa_real_t sigma_vertical;
     uint16_t coordinator_id;        /* the only node whose heartbeats and plans it follows
-                                       (0: the default, COA_NODE_COORDINATOR_ID); not its
+                                       (0: the default, COAVOID_NODE_COORDINATOR_ID); not its
                                        own id */
-} coa_vehicle_node_config_t;
+} coavoid_vehicle_node_config_t;
 
 /* What a vehicle did; read by drivers, the simulation and tests. */
 typedef struct {
@@ -208,28 +208,28 @@ typedef struct {
     int64_t last_plan_duration_us;  /* measured by the driver's clock: 0 in simulation */
     uint32_t conflicts;             /* conflicts in its last prediction */
     uint32_t fallbacks;             /* switches from coordinated to own planning */
-    coa_lcm_rx_stats_t rx;
-} coa_vehicle_node_state_t;
+    coavoid_lcm_rx_stats_t rx;
+} coavoid_vehicle_node_state_t;
 
-typedef struct coa_vehicle_node coa_vehicle_node_t;
+typedef struct coavoid_vehicle_node coavoid_vehicle_node_t;
 
 /* The planner config of a node planning `searched` UAVs at once over a horizon of N
  * steps: any UAV an intent may describe (steep factor up to COA_MAX_STEEP_FACTOR, offsets
  * unbounded), so that no valid intent meets a planner too small for it. */
-coa_planner_config_t coa_node_planner_config(uint32_t horizon, size_t searched, uint32_t beta);
+coa_planner_config_t coavoid_node_planner_config(uint32_t horizon, size_t searched, uint32_t beta);
 
 /* Creates a vehicle node publishing and subscribing on lcm (not owned). Allocates the node,
  * its one-UAV planner (beta) and its predictor once: about 1.4 MB of node, 1.2 MB of
- * predictor and conflicts at N = 24, and the workspace of coa_node_planner_config(N, 1,
+ * predictor and conflicts at N = 24, and the workspace of coavoid_node_planner_config(N, 1,
  * beta) (1.1 MB at N = 24 and beta 20000). Returns NULL on bad config (invalid vehicle, horizon >
- * COA_NODE_MAX_HORIZON, ...: COA_ERR_ARGUMENT, also when LCM refuses a subscription) or
+ * COAVOID_NODE_MAX_HORIZON, ...: COA_ERR_ARGUMENT, also when LCM refuses a subscription) or
  * out of memory (COA_ERR_WORKSPACE), with *error set (error may be NULL). */
-coa_vehicle_node_t *coa_vehicle_node_create(const coa_vehicle_node_config_t *config, lcm_t *lcm,
+coavoid_vehicle_node_t *coavoid_vehicle_node_create(const coavoid_vehicle_node_config_t *config, lcm_t *lcm,
                                             int *error);
 /* Unsubscribes and frees. NULL is fine. */
-void coa_vehicle_node_destroy(coa_vehicle_node_t *node);
+void coavoid_vehicle_node_destroy(coavoid_vehicle_node_t *node);
 
-/* Starts cycle k = coa_node_cycle_of(now): flies to sample k, then step 2 of the file
+/* Starts cycle k = coavoid_node_cycle_of(now): flies to sample k, then step 2 of the file
  * comment. Calling it again within the same cycle (or an earlier one) does nothing.
  * Returns COA_OK or a negative error (COA_ERR_ARGUMENT: NULL, now before the epoch, or an
  * intent it cannot publish; a publishing or internal error); it publishes its intent and
@@ -237,31 +237,31 @@ void coa_vehicle_node_destroy(coa_vehicle_node_t *node);
  * without an adopted plan, one prediction over its peers, tracks and obstacles
  * (coa_predict); decoupled, one more and at most two one-UAV searches of beta
  * expansions. No memory is allocated. */
-int coa_vehicle_node_cycle(coa_vehicle_node_t *node, int64_t now);
+int coavoid_vehicle_node_cycle(coavoid_vehicle_node_t *node, int64_t now);
 
 /* Completes a decoupled wait once its condition holds at `now` (the intents arrived, or
  * priority_wait_us has passed since the cycle began). Returns 1 when it planned and
  * published, 0 when there was nothing to do or it still waits, negative on error. Cost
  * while waiting: one prediction (it looks again with the intents that came); then as
- * coa_vehicle_node_cycle. No memory. */
-int coa_vehicle_node_poll(coa_vehicle_node_t *node, int64_t now);
+ * coavoid_vehicle_node_cycle. No memory. */
+int coavoid_vehicle_node_poll(coavoid_vehicle_node_t *node, int64_t now);
 
 /* The utime by which poll must be called again (the end of a wait), or INT64_MAX. O(1). */
-int64_t coa_vehicle_node_deadline(const coa_vehicle_node_t *node);
+int64_t coavoid_vehicle_node_deadline(const coavoid_vehicle_node_t *node);
 
-const coa_vehicle_node_state_t *coa_vehicle_node_state(const coa_vehicle_node_t *node);
+const coavoid_vehicle_node_state_t *coavoid_vehicle_node_state(const coavoid_vehicle_node_t *node);
 
 /* ---- coordinator ---- */
 
 typedef struct {
-    coa_node_common_t common;
-    uint16_t id;                     /* 0: the default, COA_NODE_COORDINATOR_ID */
+    coavoid_node_common_t common;
+    uint16_t id;                     /* 0: the default, COAVOID_NODE_COORDINATOR_ID */
     size_t max_centralised;          /* largest cluster planned in one composite search
                                         (1..COA_MAX_CENTRALISED; 0: the default, 3); larger clusters
                                         are planned decoupled by the coordinator */
     int64_t collect_us;              /* after the cycle start, when it plans, < dt (0: the
                                         default, dt / 4) */
-} coa_coordinator_config_t;
+} coavoid_coordinator_config_t;
 
 typedef struct {
     int64_t cycle;
@@ -272,48 +272,48 @@ typedef struct {
     int last_outcome;
     uint64_t last_nodes_expanded;
     int64_t last_plan_duration_us;
-    coa_lcm_rx_stats_t rx;
-} coa_coordinator_state_t;
+    coavoid_lcm_rx_stats_t rx;
+} coavoid_coordinator_state_t;
 
-typedef struct coa_coordinator coa_coordinator_t;
+typedef struct coavoid_coordinator coavoid_coordinator_t;
 
-/* As coa_vehicle_node_create, with a planner for max_centralised UAVs at once
- * (the workspace of coa_node_planner_config(N, max_centralised, beta): 1.3 MB for 3 UAVs
+/* As coavoid_vehicle_node_create, with a planner for max_centralised UAVs at once
+ * (the workspace of coavoid_node_planner_config(N, max_centralised, beta): 1.3 MB for 3 UAVs
  * at N = 24 and beta 20,000). Errors as there (collect_us >= dt, max_centralised >
  * COA_MAX_CENTRALISED: COA_ERR_ARGUMENT). */
-coa_coordinator_t *coa_coordinator_create(const coa_coordinator_config_t *config, lcm_t *lcm,
+coavoid_coordinator_t *coavoid_coordinator_create(const coavoid_coordinator_config_t *config, lcm_t *lcm,
                                           int *error);
 /* Unsubscribes and frees. NULL is fine. */
-void coa_coordinator_destroy(coa_coordinator_t *node);
+void coavoid_coordinator_destroy(coavoid_coordinator_t *node);
 /* Step 3 of the file comment for the cycle `now` falls in (call it at cycle start +
  * collect_us). Once per cycle; again within one cycle does nothing. Returns COA_OK or the
  * first negative error (NULL, before the epoch, a publishing or internal error); a plan
  * that fails is not an error. Cost: one prediction, then per cluster one search of at
  * most beta expansions each (centralised: independence detection's searches), and when one fails at most two
  * more over larger groups. No memory is allocated. */
-int coa_coordinator_cycle(coa_coordinator_t *node, int64_t now);
-const coa_coordinator_state_t *coa_coordinator_state(const coa_coordinator_t *node);
+int coavoid_coordinator_cycle(coavoid_coordinator_t *node, int64_t now);
+const coavoid_coordinator_state_t *coavoid_coordinator_state(const coavoid_coordinator_t *node);
 
 /* ---- world: the terrain database and the tracker of a scenario ---- */
 
 typedef struct {
-    coa_node_common_t common;
-    uint16_t id;                      /* map_id and track source_id; 0: COA_NODE_WORLD_ID */
+    coavoid_node_common_t common;
+    uint16_t id;                      /* map_id and track source_id; 0: COAVOID_NODE_WORLD_ID */
     const coa_obstacle_t *obstacles;  /* the caller's, outliving the node */
     size_t obstacle_count;
     const coa_track_t *tracks;        /* positions at scenario t = 0 (epoch) */
     size_t track_count;
-} coa_world_config_t;
+} coavoid_world_config_t;
 
-typedef struct coa_world coa_world_t;
+typedef struct coavoid_world coavoid_world_t;
 
 /* Creates the world node (about 40 kB; it subscribes to nothing). NULL with
  * COA_ERR_ARGUMENT when the obstacles do not fit one obstacle_map_t, there are more than
- * COA_NODE_MAX_TRACKS tracks, or a track is invalid or its id not unique in
+ * COAVOID_NODE_MAX_TRACKS tracks, or a track is invalid or its id not unique in
  * 1..2^31-1; COA_ERR_WORKSPACE when out of memory. */
-coa_world_t *coa_world_create(const coa_world_config_t *config, lcm_t *lcm, int *error);
+coavoid_world_t *coavoid_world_create(const coavoid_world_config_t *config, lcm_t *lcm, int *error);
 /* Frees. NULL is fine. */
-void coa_world_destroy(coa_world_t *node);
+void coavoid_world_destroy(coavoid_world_t *node);
 /* Step 1 of the file comment: the obstacle map (version 1, republished every cycle so that
  * late joiners get it) and every track's estimate at the cycle's start (its position and
  * velocity there; a path track also with its path over the next horizon: its position
@@ -321,6 +321,6 @@ void coa_world_destroy(coa_world_t *node);
  * end or the horizon does). Once per cycle. Returns COA_OK or the first error (a message
  * refused by its own check, or publishing failed). Cost O(obstacle vertices + tracks *
  * path). No memory. */
-int coa_world_cycle(coa_world_t *node, int64_t now);
+int coavoid_world_cycle(coavoid_world_t *node, int64_t now);
 
 #endif /* COAVOID_APP_NODE_H */

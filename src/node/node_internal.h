@@ -22,73 +22,73 @@
 
 #include "node.h"
 
-#define COA_NODE_MAX_SAMPLES (COA_NODE_MAX_HORIZON + 1u)
-_Static_assert(COA_NODE_MAX_SAMPLES == (unsigned)COAVOID_INTENT_T_MAX_SAMPLES &&
-                   COA_NODE_MAX_SAMPLES == (unsigned)COAVOID_PLAN_T_MAX_SAMPLES,
+#define COAVOID_NODE_MAX_SAMPLES (COAVOID_NODE_MAX_HORIZON + 1u)
+_Static_assert(COAVOID_NODE_MAX_SAMPLES == (unsigned)COAVOID_INTENT_T_MAX_SAMPLES &&
+                   COAVOID_NODE_MAX_SAMPLES == (unsigned)COAVOID_PLAN_T_MAX_SAMPLES,
                "an intent and a plan carry N + 1 samples of the node's largest horizon");
 
 /* Room for one obstacle map (boxes, then polytopes) and its vertices. */
-#define COA_NODE_MAX_OBSTACLES \
+#define COAVOID_NODE_MAX_OBSTACLES \
     ((size_t)COAVOID_OBSTACLE_MAP_T_MAX_BOXES + (size_t)COAVOID_OBSTACLE_MAP_T_MAX_POLYTOPES)
-#define COA_NODE_MAX_VERTICES \
+#define COAVOID_NODE_MAX_VERTICES \
     ((size_t)COAVOID_OBSTACLE_MAP_T_MAX_POLYTOPES * (size_t)COAVOID_OBSTACLE_MAP_T_MAX_VERTICES)
 
 /* Tracks one cycle can hold: the real ones plus every UAV as a moving obstacle (live or
  * stale: together at most MAX_PEERS). */
-#define COA_NODE_TRACK_CAPACITY (COA_NODE_MAX_TRACKS + COA_NODE_MAX_PEERS)
+#define COAVOID_NODE_TRACK_CAPACITY (COAVOID_NODE_MAX_TRACKS + COAVOID_NODE_MAX_PEERS)
 
 /* Senders per sequence table: every UAV, plus a few coordinators and trackers. */
-#define COA_NODE_MAX_SENDERS (COA_NODE_MAX_PEERS + 8u)
+#define COAVOID_NODE_MAX_SENDERS (COAVOID_NODE_MAX_PEERS + 8u)
 
 /* An intent older than this many horizons is dropped, not extrapolated: its constant-
  * velocity guess is meaningless by then. */
-#define COA_NODE_DROP_HORIZONS 1
+#define COAVOID_NODE_DROP_HORIZONS 1
 
 /* Encoded messages are written here before lcm_publish: the largest type (plan_t) is
  * about 16.6 kB. */
-#define COA_NODE_TX_BYTES 20000u
+#define COAVOID_NODE_TX_BYTES 20000u
 
 /* How many of its latest intents a node remembers, to tell them when they come back. */
-#define COA_NODE_OWN_INTENTS 4u
+#define COAVOID_NODE_OWN_INTENTS 4u
 
 /* Where a node encodes what it publishes. */
 typedef struct {
     lcm_t *lcm;
-    uint8_t buf[COA_NODE_TX_BYTES];
-} coa_node_tx_t;
+    uint8_t buf[COAVOID_NODE_TX_BYTES];
+} coavoid_node_tx_t;
 
 /* A sequence table with the time each sender was last heard, so that a sender silent
  * past a limit is forgotten (a restarted node numbers from 0 again). */
 typedef struct {
-    coa_lcm_sequence_table_t table;
-    coa_lcm_sender_t entries[COA_NODE_MAX_SENDERS];
-    uint32_t heard_sender[COA_NODE_MAX_SENDERS];
-    int64_t heard_utime[COA_NODE_MAX_SENDERS];
+    coavoid_lcm_sequence_table_t table;
+    coavoid_lcm_sender_t entries[COAVOID_NODE_MAX_SENDERS];
+    uint32_t heard_sender[COAVOID_NODE_MAX_SENDERS];
+    int64_t heard_utime[COAVOID_NODE_MAX_SENDERS];
     size_t heard_count;
-} coa_node_senders_t;
+} coavoid_node_senders_t;
 
 typedef struct {
     bool used;
     bool forgotten;           /* its sequence was forgotten when it went stale */
     coavoid_intent_t msg;     /* validated on arrival */
-} coa_node_peer_t;
+} coavoid_node_peer_t;
 
 typedef struct {
     bool used;
     coavoid_track_t msg;      /* validated on arrival */
-} coa_node_track_slot_t;
+} coavoid_node_track_slot_t;
 
-typedef struct coa_node_inbox coa_node_inbox_t;
+typedef struct coavoid_node_inbox coavoid_node_inbox_t;
 
 /* Called for a plan_t that decoded, is not the node's own and passed validation; no
  * sequence rule is applied to plans (vehicle.c orders those of one cycle, decides on
  * adoption and counts the outcome itself). */
-typedef void (*coa_node_plan_handler_t)(void *owner, const coavoid_plan_t *msg,
-                                        const coa_lcm_plan_info_t *info,
+typedef void (*coavoid_node_plan_handler_t)(void *owner, const coavoid_plan_t *msg,
+                                        const coavoid_lcm_plan_info_t *info,
                                         const coa_plan_result_t *result, const int32_t *offsets);
 
-struct coa_node_inbox {
-    coa_node_common_t common;
+struct coavoid_node_inbox {
+    coavoid_node_common_t common;
     uint16_t self_uav;              /* intents from this UAV are the node's own (0: none) */
     uint16_t self_node;             /* status and plans from this node id are its own */
     uint16_t coordinator_id;        /* the only coordinator it hears (0: none) */
@@ -96,26 +96,26 @@ struct coa_node_inbox {
     int64_t max_age_us;             /* validation window (context max_age) */
     lcm_subscription_t *subs[6];
     size_t sub_count;
-    coa_lcm_rx_stats_t *rx;         /* the owner's counters (its state's rx) */
+    coavoid_lcm_rx_stats_t *rx;         /* the owner's counters (its state's rx) */
 
-    coa_node_senders_t intent_seq;
-    coa_node_senders_t track_seq;
-    coa_node_senders_t map_seq;
-    coa_node_senders_t status_seq;
+    coavoid_node_senders_t intent_seq;
+    coavoid_node_senders_t track_seq;
+    coavoid_node_senders_t map_seq;
+    coavoid_node_senders_t status_seq;
 
-    coa_node_peer_t peers[COA_NODE_MAX_PEERS];
-    coa_node_track_slot_t tracks[COA_NODE_MAX_TRACKS];
+    coavoid_node_peer_t peers[COAVOID_NODE_MAX_PEERS];
+    coavoid_node_track_slot_t tracks[COAVOID_NODE_MAX_TRACKS];
 
     bool have_map;
-    coa_obstacle_t obstacles[COA_NODE_MAX_OBSTACLES];
+    coa_obstacle_t obstacles[COAVOID_NODE_MAX_OBSTACLES];
     size_t obstacle_count;
-    coa_vec3_t vertices[COA_NODE_MAX_VERTICES];
+    coa_vec3_t vertices[COAVOID_NODE_MAX_VERTICES];
 
     /* Its latest published intents (FNV-1a of the encoded bytes, and their size): an
      * intent with its own UAV id that is none of these was sent by another UAV using the
      * same id, even when the times and sequence numbers happen to agree. */
-    uint64_t own_hash[COA_NODE_OWN_INTENTS];
-    int own_size[COA_NODE_OWN_INTENTS];
+    uint64_t own_hash[COAVOID_NODE_OWN_INTENTS];
+    int own_size[COAVOID_NODE_OWN_INTENTS];
     size_t own_next;
     uint32_t foreign_intents;       /* such intents since the owner last cleared it */
 
@@ -124,7 +124,7 @@ struct coa_node_inbox {
     bool heard_coordinator;         /* a coordinator's status_t was received */
     int64_t coordinator_utime;      /* when (driver clock) */
 
-    coa_node_plan_handler_t on_plan;
+    coavoid_node_plan_handler_t on_plan;
     void *owner;
 
     /* Decoding buffers (LCM dispatches one message at a time) and the transmit buffer. */
@@ -135,9 +135,9 @@ struct coa_node_inbox {
         coavoid_obstacle_map_t map;
         coavoid_status_t status;
     } rx_msg;
-    coa_lcm_intent_arrays_t rx_arrays;
-    int32_t rx_offsets[(size_t)COAVOID_PLAN_T_MAX_VEHICLES * COA_NODE_MAX_SAMPLES];
-    coa_node_tx_t tx;
+    coavoid_lcm_intent_arrays_t rx_arrays;
+    int32_t rx_offsets[(size_t)COAVOID_PLAN_T_MAX_VEHICLES * COAVOID_NODE_MAX_SAMPLES];
+    coavoid_node_tx_t tx;
 };
 
 /* The cycle's view: live UAVs (ascending id) and tracks (real ones first, by source and
@@ -145,33 +145,33 @@ struct coa_node_inbox {
 typedef struct {
     int64_t cycle_start;
     size_t live_count;
-    uint16_t live_id[COA_NODE_MAX_PEERS];
-    bool live_current[COA_NODE_MAX_PEERS]; /* an intent for this cycle: plan_utime ==
+    uint16_t live_id[COAVOID_NODE_MAX_PEERS];
+    bool live_current[COAVOID_NODE_MAX_PEERS]; /* an intent for this cycle: plan_utime ==
                                               cycle_start, step dt, N + 1 samples */
-    coa_vehicle_t live_vehicle[COA_NODE_MAX_PEERS];
-    coa_intent_plan_t live_plan[COA_NODE_MAX_PEERS];
-    coa_lcm_intent_info_t live_info[COA_NODE_MAX_PEERS];
-    coa_lcm_intent_arrays_t live_arrays[COA_NODE_MAX_PEERS];
+    coa_vehicle_t live_vehicle[COAVOID_NODE_MAX_PEERS];
+    coa_intent_plan_t live_plan[COAVOID_NODE_MAX_PEERS];
+    coavoid_lcm_intent_info_t live_info[COAVOID_NODE_MAX_PEERS];
+    coavoid_lcm_intent_arrays_t live_arrays[COAVOID_NODE_MAX_PEERS];
 
     size_t real_track_count;
     size_t track_count;             /* real + stale UAVs */
-    coa_track_t tracks[COA_NODE_TRACK_CAPACITY];
-    uint32_t track_ids[COA_NODE_TRACK_CAPACITY];
-    coa_track_point_t real_paths[COA_NODE_MAX_TRACKS][COAVOID_TRACK_T_MAX_PATH];
+    coa_track_t tracks[COAVOID_NODE_TRACK_CAPACITY];
+    uint32_t track_ids[COAVOID_NODE_TRACK_CAPACITY];
+    coa_track_point_t real_paths[COAVOID_NODE_MAX_TRACKS][COAVOID_TRACK_T_MAX_PATH];
     size_t stale_count;             /* tracks[real_track_count ..] are stale UAVs */
-} coa_node_view_t;
+} coavoid_node_view_t;
 
 /* The tracks of one planning problem, sampled over the horizon. */
 typedef struct {
     size_t count;
-    coa_track_t tracks[COA_NODE_TRACK_CAPACITY];
-    const coa_vec3_t *samples[COA_NODE_TRACK_CAPACITY];
-    coa_vec3_t storage[COA_NODE_TRACK_CAPACITY][COA_NODE_MAX_SAMPLES];
-    coa_track_point_t paths[COA_NODE_MAX_PEERS][COA_NODE_MAX_SAMPLES];
-} coa_node_problem_tracks_t;
+    coa_track_t tracks[COAVOID_NODE_TRACK_CAPACITY];
+    const coa_vec3_t *samples[COAVOID_NODE_TRACK_CAPACITY];
+    coa_vec3_t storage[COAVOID_NODE_TRACK_CAPACITY][COAVOID_NODE_MAX_SAMPLES];
+    coa_track_point_t paths[COAVOID_NODE_MAX_PEERS][COAVOID_NODE_MAX_SAMPLES];
+} coavoid_node_problem_tracks_t;
 
 /* A node's prediction and planning memory, allocated once when it is created: room for
- * every pair coa_node_max_pairs allows, a predictor over MAX_PEERS plans and
+ * every pair coavoid_node_max_pairs allows, a predictor over MAX_PEERS plans and
  * TRACK_CAPACITY tracks, and a planner of `searched` UAVs a search. */
 typedef struct {
     coa_conflict_t *conflicts;
@@ -180,7 +180,7 @@ typedef struct {
     coa_predictor_t *predictor;
     void *planner_memory;
     coa_planner_t *planner;
-} coa_node_solver_t;
+} coavoid_node_solver_t;
 
 /* What a node's heartbeat (status_t) says: who it is and how it is, as the node judges,
  * and the counters its state keeps (saturated to the message's types when sent). */
@@ -197,102 +197,102 @@ typedef struct {
     int last_outcome;               /* coa_plan_status_t, -1 none */
     uint32_t conflicts;
     uint32_t plans_run;
-    const coa_lcm_rx_stats_t *rx;
-} coa_node_heartbeat_t;
+    const coavoid_lcm_rx_stats_t *rx;
+} coavoid_node_heartbeat_t;
 
 /* Checks a common configuration (node.h's ranges). COA_OK or COA_ERR_ARGUMENT. O(1). */
-int coa_node_common_check(const coa_node_common_t *c);
+int coavoid_node_common_check(const coavoid_node_common_t *c);
 
 /* The validation context at `now` with t = 0 at `epoch`: messages up to a horizon and
  * stale_after old, at most one cycle ahead. Cannot fail; O(1). */
-coa_lcm_context_t coa_node_context(const coa_node_inbox_t *in, int64_t now, int64_t epoch);
+coavoid_lcm_context_t coavoid_node_context(const coavoid_node_inbox_t *in, int64_t now, int64_t epoch);
 
 /* Initialises the inbox and subscribes to intents, tracks and the obstacle map, and to
  * heartbeats (want_status) and plans (plan_handler non-NULL) when asked; counts into rx.
  * A coordinator's heartbeat or a plan from another node than coordinator_id is refused
- * (COA_LCM_ERR_ID).
+ * (COAVOID_LCM_ERR_ID).
  * Returns COA_OK, or COA_ERR_ARGUMENT when LCM refused a subscription (everything
  * subscribed so far is unsubscribed). The handlers cost O(message) each (decoding and
  * validation, O(senders) for the sequence rule) and allocate nothing. */
-int coa_node_inbox_init(coa_node_inbox_t *in, const coa_node_common_t *common, uint16_t self_uav,
+int coavoid_node_inbox_init(coavoid_node_inbox_t *in, const coavoid_node_common_t *common, uint16_t self_uav,
                         uint16_t self_node, uint16_t coordinator_id, size_t peer_capacity,
-                        lcm_t *lcm, coa_lcm_rx_stats_t *rx, bool want_status,
-                        coa_node_plan_handler_t plan_handler, void *owner);
+                        lcm_t *lcm, coavoid_lcm_rx_stats_t *rx, bool want_status,
+                        coavoid_node_plan_handler_t plan_handler, void *owner);
 
 /* Unsubscribes everything. O(subscriptions). */
-void coa_node_inbox_fini(coa_node_inbox_t *in);
+void coavoid_node_inbox_fini(coavoid_node_inbox_t *in);
 
 /* Forgets senders silent past stale_after (a restarted one numbers from 0 again) and
  * drops intents and tracks too old to be of use. Cost O(senders). */
-void coa_node_inbox_expire(coa_node_inbox_t *in, int64_t now);
+void coavoid_node_inbox_expire(coavoid_node_inbox_t *in, int64_t now);
 
 /* Builds the view of the cycle starting at cycle_start, at `now`. Cost O(peers * samples +
  * tracks). Cannot fail: a stored message that no longer converts is left out. */
-void coa_node_view_build(coa_node_view_t *view, const coa_node_inbox_t *in,
+void coavoid_node_view_build(coavoid_node_view_t *view, const coavoid_node_inbox_t *in,
                          int64_t cycle_start, int64_t now);
 
 /* Whether a outranks b in the decoupled order (ascending priority, ties by ascending id).
  * O(1). */
-bool coa_node_outranks(uint32_t priority_a, uint16_t id_a, uint32_t priority_b, uint16_t id_b);
+bool coavoid_node_outranks(uint32_t priority_a, uint16_t id_a, uint32_t priority_b, uint16_t id_b);
 
 /* Fills out with the planner's tracks: every real and stale track of the view and each
  * live UAV i with include[i] (its positions as a path; exactly its samples when the intent
  * is for this cycle), each sampled over samples 0..N. Returns COA_OK or COA_ERR_ARGUMENT
  * (a track that does not sample). Cost O(tracks * (N + path)). No memory. */
-int coa_node_problem_tracks(coa_node_problem_tracks_t *out, const coa_node_view_t *view,
-                            const bool *include, const coa_node_common_t *c);
+int coavoid_node_problem_tracks(coavoid_node_problem_tracks_t *out, const coavoid_node_view_t *view,
+                            const bool *include, const coavoid_node_common_t *c);
 
 /* The predictor's configuration for one cycle of a node: t = 0 at the cycle's start,
  * the common dt, horizon, sigma rates and threshold. Cannot fail; O(1). */
-coa_predict_config_t coa_node_predict_config(const coa_node_common_t *c);
+coa_predict_config_t coavoid_node_predict_config(const coavoid_node_common_t *c);
 
 /* Predicts over samples 0..N of the view's clock for plans[0..n) against the view's
  * tracks and the inbox's obstacles, then clusters (labels[0..n)). n == 0 gives no
  * conflict. Returns COA_OK, the predictor's or the clustering's error, or
  * COA_ERR_WORKSPACE when the conflicts overflow `capacity`. Cost: coa_predict's. No
  * memory beyond the predictor's workspace. */
-int coa_node_predict(coa_predictor_t *predictor, const coa_node_common_t *c,
-                     const coa_intent_plan_t *plans, size_t n, const coa_node_view_t *view,
-                     const coa_node_inbox_t *in, coa_conflict_t *conflicts, size_t capacity,
+int coavoid_node_predict(coa_predictor_t *predictor, const coavoid_node_common_t *c,
+                     const coa_intent_plan_t *plans, size_t n, const coavoid_node_view_t *view,
+                     const coavoid_node_inbox_t *in, coa_conflict_t *conflicts, size_t capacity,
                      coa_predict_result_t *result, uint32_t *labels, size_t *cluster_count);
 
 /* The predictor's pair bound for a node: every pair that can exist among MAX_PEERS
  * plans, TRACK_CAPACITY tracks and MAX_OBSTACLES obstacles, so that the broad phase
  * cannot run out (13,280). O(1). */
-size_t coa_node_max_pairs(void);
+size_t coavoid_node_max_pairs(void);
 
 /* Allocates *s for a horizon of N steps and a planner of `searched` UAVs at beta. Returns
  * COA_OK, COA_ERR_ARGUMENT (sizes the core refuses; nothing allocated) or COA_ERR_WORKSPACE
  * (out of memory; nothing kept). Memory: the predictor's and planner's workspaces
  * (coa_predictor_workspace_size, coa_planner_workspace_size) and the conflict array. */
-int coa_node_solver_init(coa_node_solver_t *s, uint32_t horizon, size_t searched, uint32_t beta);
+int coavoid_node_solver_init(coavoid_node_solver_t *s, uint32_t horizon, size_t searched, uint32_t beta);
 
-/* Frees what coa_node_solver_init allocated; a zeroed *s is fine. */
-void coa_node_solver_fini(coa_node_solver_t *s);
+/* Frees what coavoid_node_solver_init allocated; a zeroed *s is fine. */
+void coavoid_node_solver_fini(coavoid_node_solver_t *s);
 
 /* Fills *m from h at `now`, validates it on the clock whose t = 0 is cycle_start
- * (coa_node_context) and publishes it. Its health is HEALTH_DEGRADED (unless a fault)
+ * (coavoid_node_context) and publishes it. Its health is HEALTH_DEGRADED (unless a fault)
  * also when messages were refused since the previous heartbeat: a clock that disagrees,
  * more peers than the node holds or a bad sender show in the heartbeat as they happen.
- * Returns COA_OK, COA_ERR_ARGUMENT (it does not validate) or coa_node_publish_status's
+ * Returns COA_OK, COA_ERR_ARGUMENT (it does not validate) or coavoid_node_publish_status's
  * error. O(1); no memory. */
-int coa_node_publish_heartbeat(coa_node_inbox_t *in, coavoid_status_t *m, int64_t now,
-                               int64_t cycle_start, const coa_node_heartbeat_t *h);
+int coavoid_node_publish_heartbeat(coavoid_node_inbox_t *in, coavoid_status_t *m, int64_t now,
+                               int64_t cycle_start, const coavoid_node_heartbeat_t *h);
 
 /* Publishing: encodes into tx->buf and publishes on the type's channel. COA_OK, or
  * COA_ERR_WORKSPACE (does not encode into the buffer) or COA_ERR_ARGUMENT (LCM refused
  * it). O(message); our code allocates nothing (the provider may, inside lcm_publish). */
-int coa_node_publish_plan(coa_node_tx_t *tx, const coavoid_plan_t *msg);
-int coa_node_publish_track(coa_node_tx_t *tx, const coavoid_track_t *msg);
-int coa_node_publish_map(coa_node_tx_t *tx, const coavoid_obstacle_map_t *msg);
-int coa_node_publish_conflicts(coa_node_tx_t *tx, const coavoid_conflict_report_t *msg);
-int coa_node_publish_status(coa_node_tx_t *tx, const coavoid_status_t *msg);
+int coavoid_node_publish_plan(coavoid_node_tx_t *tx, const coavoid_plan_t *msg);
+int coavoid_node_publish_track(coavoid_node_tx_t *tx, const coavoid_track_t *msg);
+int coavoid_node_publish_map(coavoid_node_tx_t *tx, const coavoid_obstacle_map_t *msg);
+int coavoid_node_publish_conflicts(coavoid_node_tx_t *tx, const coavoid_conflict_report_t *msg);
+int coavoid_node_publish_status(coavoid_node_tx_t *tx, const coavoid_status_t *msg);
 
 /* Publishes the node's own intent as the functions above do, and remembers it so that the
  * inbox knows it when it comes back (node_internal.h, own_hash). Same returns and cost. */
-int coa_node_publish_intent(coa_node_inbox_t *in, const coavoid_intent_t *msg);
+int coavoid_node_publish_intent(coavoid_node_inbox_t *in, const coavoid_intent_t *msg);
 
 /* The common stopwatch's reading (us), 0 without one: durations are differences. O(1). */
-int64_t coa_node_stopwatch(const coa_node_common_t *c);
+int64_t coavoid_node_stopwatch(const coavoid_node_common_t *c);
 
 #endif /* COAVOID_APP_NODE_INTERNAL_H */

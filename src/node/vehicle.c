@@ -12,9 +12,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-struct coa_vehicle_node {
-    coa_vehicle_node_config_t config;
-    coa_vehicle_node_state_t state;
+struct coavoid_vehicle_node {
+    coavoid_vehicle_node_config_t config;
+    coavoid_vehicle_node_state_t state;
     coa_real_t dh;
     bool started;
     int64_t first_cycle_start;
@@ -37,29 +37,29 @@ struct coa_vehicle_node {
      * its end the last offset holds. */
     int64_t plan_start;
     uint32_t plan_count;
-    int32_t plan_offsets[COA_NODE_MAX_SAMPLES];
+    int32_t plan_offsets[COAVOID_NODE_MAX_SAMPLES];
 
     /* This cycle's intent: samples k .. k + N. */
-    coa_vec3_t own_reference[COA_NODE_MAX_SAMPLES];
-    int32_t own_offsets[COA_NODE_MAX_SAMPLES];
-    coa_vec3_t own_samples[COA_NODE_MAX_SAMPLES];
+    coa_vec3_t own_reference[COAVOID_NODE_MAX_SAMPLES];
+    int32_t own_offsets[COAVOID_NODE_MAX_SAMPLES];
+    coa_vec3_t own_samples[COAVOID_NODE_MAX_SAMPLES];
 
-    int32_t plan_out[COA_NODE_MAX_SAMPLES];
-    int32_t checked[COA_NODE_MAX_SAMPLES];      /* a coordinator's plan over this window */
-    coa_intent_plan_t plans[COA_NODE_MAX_PEERS]; /* itself first, then the live peers */
-    coa_intent_plan_t tall[COA_NODE_MAX_PEERS];  /* the same, with unbounded height */
-    uint32_t labels[COA_NODE_MAX_PEERS];
-    bool include[COA_NODE_MAX_PEERS];
+    int32_t plan_out[COAVOID_NODE_MAX_SAMPLES];
+    int32_t checked[COAVOID_NODE_MAX_SAMPLES];      /* a coordinator's plan over this window */
+    coa_intent_plan_t plans[COAVOID_NODE_MAX_PEERS]; /* itself first, then the live peers */
+    coa_intent_plan_t tall[COAVOID_NODE_MAX_PEERS];  /* the same, with unbounded height */
+    uint32_t labels[COAVOID_NODE_MAX_PEERS];
+    bool include[COAVOID_NODE_MAX_PEERS];
     coavoid_intent_t tx_intent;
     coavoid_status_t tx_status;
 
-    coa_node_solver_t solver;
-    coa_node_inbox_t inbox;
-    coa_node_view_t view;
-    coa_node_problem_tracks_t problem_tracks;
+    coavoid_node_solver_t solver;
+    coavoid_node_inbox_t inbox;
+    coavoid_node_view_t view;
+    coavoid_node_problem_tracks_t problem_tracks;
 };
 
-static int32_t offset_at(const coa_vehicle_node_t *node, int64_t k)
+static int32_t offset_at(const coavoid_vehicle_node_t *node, int64_t k)
 {
     int64_t i = k - node->plan_start;
     if (i < 0) {
@@ -73,16 +73,16 @@ static int32_t offset_at(const coa_vehicle_node_t *node, int64_t k)
 
 static coa_vec3_t lifted(coa_vec3_t reference, int32_t offset, coa_real_t dh)
 {
-    /* As the planner and every receiver compute it (coa_lcm_intent_to_core). */
+    /* As the planner and every receiver compute it (coavoid_lcm_intent_to_core). */
     reference.z += (coa_real_t)offset * dh;
     return reference;
 }
 
 /* The intent of cycle k from the adopted plan, which is then re-based at k so that its
  * storage never needs more than N + 1 samples. */
-static void build_own(coa_vehicle_node_t *node, int64_t k)
+static void build_own(coavoid_vehicle_node_t *node, int64_t k)
 {
-    const coa_node_common_t *c = &node->config.common;
+    const coavoid_node_common_t *c = &node->config.common;
     const uint32_t n = c->horizon + 1u;
     for (uint32_t j = 0; j < n; j++) {
         node->own_reference[j] =
@@ -97,11 +97,11 @@ static void build_own(coa_vehicle_node_t *node, int64_t k)
     node->plan_count = n;
 }
 
-static void adopt(coa_vehicle_node_t *node, const int32_t *offsets, uint32_t count)
+static void adopt(coavoid_vehicle_node_t *node, const int32_t *offsets, uint32_t count)
 {
     const uint32_t n = node->config.common.horizon + 1u;
     node->plan_start = node->state.cycle;
-    node->plan_count = count < COA_NODE_MAX_SAMPLES ? count : COA_NODE_MAX_SAMPLES;
+    node->plan_count = count < COAVOID_NODE_MAX_SAMPLES ? count : COAVOID_NODE_MAX_SAMPLES;
     memcpy(node->plan_offsets, offsets, node->plan_count * sizeof offsets[0]);
     for (uint32_t j = 0; j < n; j++) {
         node->own_offsets[j] = offset_at(node, node->state.cycle + (int64_t)j);
@@ -110,10 +110,10 @@ static void adopt(coa_vehicle_node_t *node, const int32_t *offsets, uint32_t cou
     node->state.plans_adopted++;
 }
 
-static bool stale_inputs(const coa_vehicle_node_t *node, int64_t now)
+static bool stale_inputs(const coavoid_vehicle_node_t *node, int64_t now)
 {
-    for (size_t i = 0; i < COA_NODE_MAX_PEERS; i++) {
-        const coa_node_peer_t *p = &node->inbox.peers[i];
+    for (size_t i = 0; i < COAVOID_NODE_MAX_PEERS; i++) {
+        const coavoid_node_peer_t *p = &node->inbox.peers[i];
         if (p->used && now - p->msg.utime > node->config.common.stale_after_us) {
             return true;
         }
@@ -121,20 +121,20 @@ static bool stale_inputs(const coa_vehicle_node_t *node, int64_t now)
     return false;
 }
 
-static int publish_status(coa_vehicle_node_t *node, int64_t now)
+static int publish_status(coavoid_vehicle_node_t *node, int64_t now)
 {
-    const coa_vehicle_node_state_t *s = &node->state;
+    const coavoid_vehicle_node_state_t *s = &node->state;
     /* Another UAV using its id makes every peer's view of it wrong: a fault for as long
      * as that UAV's intents keep coming. */
     const bool twin = node->inbox.foreign_intents > 0u;
     node->inbox.foreign_intents = 0;
-    const coa_node_heartbeat_t h = {
+    const coavoid_node_heartbeat_t h = {
         node->config.vehicle.id,
         COAVOID_STATUS_T_NODE_VEHICLE,
         node->status_sequence++,
         node->fault || twin,
         s->last_outcome > 0 || stale_inputs(node, now) ||
-            (node->config.mode == COA_NODE_CENTRALISED && !s->coordinated),
+            (node->config.mode == COAVOID_NODE_CENTRALISED && !s->coordinated),
         s->coordinated ? COAVOID_STATUS_T_MODE_CENTRALISED : COAVOID_STATUS_T_MODE_DECOUPLED,
         node->last_plan_utime,
         s->last_plan_duration_us,
@@ -143,15 +143,15 @@ static int publish_status(coa_vehicle_node_t *node, int64_t now)
         s->conflicts,
         s->plans_run,
         &s->rx};
-    return coa_node_publish_heartbeat(&node->inbox, &node->tx_status, now, node->cycle_start, &h);
+    return coavoid_node_publish_heartbeat(&node->inbox, &node->tx_status, now, node->cycle_start, &h);
 }
 
 /* Publishes this cycle's intent and heartbeat; the wait, if any, is over. Returns 1 or a
  * negative error. */
-static int finish(coa_vehicle_node_t *node, int64_t now)
+static int finish(coavoid_vehicle_node_t *node, int64_t now)
 {
-    const coa_node_common_t *c = &node->config.common;
-    coa_lcm_intent_info_t info;
+    const coavoid_node_common_t *c = &node->config.common;
+    coavoid_lcm_intent_info_t info;
     memset(&info, 0, sizeof info);
     info.utime = now;
     info.sequence = node->intent_sequence++;
@@ -172,12 +172,12 @@ static int finish(coa_vehicle_node_t *node, int64_t now)
     info.step = c->dt;
     info.sigma_horizontal = node->config.sigma_horizontal;
     info.sigma_vertical = node->config.sigma_vertical;
-    coa_lcm_context_t ctx = coa_node_context(&node->inbox, now, node->cycle_start);
-    int rc = coa_lcm_intent_from_core(&node->config.vehicle, &info, node->own_reference,
+    coavoid_lcm_context_t ctx = coavoid_node_context(&node->inbox, now, node->cycle_start);
+    int rc = coavoid_lcm_intent_from_core(&node->config.vehicle, &info, node->own_reference,
                                       node->own_offsets, (size_t)c->horizon + 1u, &ctx,
                                       &node->tx_intent, NULL);
     if (rc == COA_OK) {
-        rc = coa_node_publish_intent(&node->inbox, &node->tx_intent);
+        rc = coavoid_node_publish_intent(&node->inbox, &node->tx_intent);
     } else {
         rc = COA_ERR_ARGUMENT; /* its own reference left the range a message can carry */
     }
@@ -197,10 +197,10 @@ static int finish(coa_vehicle_node_t *node, int64_t now)
 /* The one-UAV problem of this cycle: itself from the offset it flies now along its
  * reference window, the known obstacles and node->problem_tracks (filled by the caller).
  * vehicle and references are the caller's storage the problem points to. */
-static coa_problem_t own_problem(const coa_vehicle_node_t *node, coa_vehicle_t *vehicle,
+static coa_problem_t own_problem(const coavoid_vehicle_node_t *node, coa_vehicle_t *vehicle,
                                  const coa_vec3_t **references)
 {
-    const coa_node_common_t *c = &node->config.common;
+    const coavoid_node_common_t *c = &node->config.common;
     *vehicle = node->config.vehicle;
     vehicle->initial_offset = node->state.offset;
     references[0] = node->own_reference;
@@ -221,10 +221,10 @@ static coa_problem_t own_problem(const coa_vehicle_node_t *node, coa_vehicle_t *
 
 /* One one-UAV A* search for itself around the view's tracks and the live UAVs marked in
  * node->include. Returns COA_OK with *result, or a negative error. */
-static int search_self(coa_vehicle_node_t *node, int64_t now, coa_plan_result_t *result)
+static int search_self(coavoid_vehicle_node_t *node, int64_t now, coa_plan_result_t *result)
 {
-    const coa_node_common_t *c = &node->config.common;
-    int rc = coa_node_problem_tracks(&node->problem_tracks, &node->view, node->include, c);
+    const coavoid_node_common_t *c = &node->config.common;
+    int rc = coavoid_node_problem_tracks(&node->problem_tracks, &node->view, node->include, c);
     if (rc != COA_OK) {
         return rc;
     }
@@ -232,9 +232,9 @@ static int search_self(coa_vehicle_node_t *node, int64_t now, coa_plan_result_t 
     const coa_vec3_t *references[1];
     coa_problem_t problem = own_problem(node, &vehicle, references);
 
-    int64_t start = coa_node_stopwatch(c);
+    int64_t start = coavoid_node_stopwatch(c);
     rc = coa_plan_centralised(node->solver.planner, &problem, node->plan_out, result);
-    int64_t duration = coa_node_stopwatch(c) - start;
+    int64_t duration = coavoid_node_stopwatch(c) - start;
     node->state.plans_run++;
     node->last_plan_utime = now;
     node->state.last_plan_duration_us = duration > 0 ? duration : 0;
@@ -249,14 +249,14 @@ static int search_self(coa_vehicle_node_t *node, int64_t now, coa_plan_result_t 
 /* Plans for itself against obstacles, tracks, stale UAVs and every live UAV that is not a
  * lower-priority member of its cluster (my = its cluster label), and adopts a solved
  * plan. Returns COA_OK (whatever the outcome) or a negative error. */
-static int plan_self(coa_vehicle_node_t *node, int64_t now, uint32_t my)
+static int plan_self(coavoid_vehicle_node_t *node, int64_t now, uint32_t my)
 {
     const coa_vehicle_t *self = &node->config.vehicle;
-    const coa_node_view_t *view = &node->view;
+    const coavoid_node_view_t *view = &node->view;
     bool lower_outside = false;
     for (size_t i = 0; i < view->live_count; i++) {
         const coa_vehicle_t *peer = &view->live_vehicle[i];
-        bool lower = coa_node_outranks(self->priority, self->id, peer->priority, peer->id);
+        bool lower = coavoid_node_outranks(self->priority, self->id, peer->priority, peer->id);
         node->include[i] = !(lower && node->labels[i + 1u] == my);
         lower_outside = lower_outside || (lower && node->include[i]);
     }
@@ -269,7 +269,7 @@ static int plan_self(coa_vehicle_node_t *node, int64_t now, uint32_t my)
     if (rc == COA_OK && result.status != COA_PLAN_SOLVED && lower_outside) {
         for (size_t i = 0; i < view->live_count; i++) {
             const coa_vehicle_t *peer = &view->live_vehicle[i];
-            node->include[i] = !coa_node_outranks(self->priority, self->id, peer->priority, peer->id);
+            node->include[i] = !coavoid_node_outranks(self->priority, self->id, peer->priority, peer->id);
         }
         rc = search_self(node, now, &result);
     }
@@ -281,12 +281,12 @@ static int plan_self(coa_vehicle_node_t *node, int64_t now, uint32_t my)
 
 /* Builds the cycle's view at `now` and the plans to predict: its own intent first, then
  * the live UAVs' (view order). Returns their count. */
-static size_t gather(coa_vehicle_node_t *node, int64_t now)
+static size_t gather(coavoid_vehicle_node_t *node, int64_t now)
 {
-    const coa_node_common_t *c = &node->config.common;
+    const coavoid_node_common_t *c = &node->config.common;
     const coa_vehicle_t *self = &node->config.vehicle;
-    coa_node_view_t *view = &node->view;
-    coa_node_view_build(view, &node->inbox, node->cycle_start, now);
+    coavoid_node_view_t *view = &node->view;
+    coavoid_node_view_build(view, &node->inbox, node->cycle_start, now);
     coa_intent_plan_t *own = &node->plans[0];
     memset(own, 0, sizeof *own);
     own->id = self->id;
@@ -306,11 +306,11 @@ static size_t gather(coa_vehicle_node_t *node, int64_t now)
 /* Predicts over the n gathered plans with the view's tracks and the known obstacles:
  * node->labels, the solver's conflicts and state.conflicts. Returns COA_OK or the
  * prediction's error. */
-static int predict(coa_vehicle_node_t *node, size_t n, coa_predict_result_t *result)
+static int predict(coavoid_vehicle_node_t *node, size_t n, coa_predict_result_t *result)
 {
     size_t clusters = 0;
-    coa_node_solver_t *sv = &node->solver;
-    int rc = coa_node_predict(sv->predictor, &node->config.common, node->plans, n, &node->view,
+    coavoid_node_solver_t *sv = &node->solver;
+    int rc = coavoid_node_predict(sv->predictor, &node->config.common, node->plans, n, &node->view,
                               &node->inbox, sv->conflicts, sv->conflict_capacity, result,
                               node->labels, &clusters);
     if (rc != COA_OK) {
@@ -330,7 +330,7 @@ static int predict(coa_vehicle_node_t *node, size_t n, coa_predict_result_t *res
  * the previous cycle's start instead would have seen some peers' intents of the cycle
  * before it, without the plans they adopted since, and taken a solved conflict for an
  * open one. Returns COA_OK or the prediction's error. */
-static int missed_conflict(coa_vehicle_node_t *node, int64_t now, bool *conflict)
+static int missed_conflict(coavoid_vehicle_node_t *node, int64_t now, bool *conflict)
 {
     coa_predict_result_t result;
     *conflict = false;
@@ -357,16 +357,16 @@ static int missed_conflict(coa_vehicle_node_t *node, int64_t now, bool *conflict
  * predictor's own, with every volume made as tall as a message allows, so that only the
  * horizontal distance (and its uncertainty) decides. Cost: one coa_predict over the live
  * UAVs, no obstacles or tracks. */
-static bool near_pending(coa_vehicle_node_t *node, size_t n)
+static bool near_pending(coavoid_vehicle_node_t *node, size_t n)
 {
-    const coa_node_common_t *c = &node->config.common;
+    const coavoid_node_common_t *c = &node->config.common;
     const coa_vehicle_t *self = &node->config.vehicle;
-    const coa_node_view_t *view = &node->view;
+    const coavoid_node_view_t *view = &node->view;
     bool any = false;
     for (size_t i = 0; i < view->live_count; i++) {
         const coa_vehicle_t *peer = &view->live_vehicle[i];
         if (!view->live_current[i] &&
-            coa_node_outranks(peer->priority, peer->id, self->priority, self->id)) {
+            coavoid_node_outranks(peer->priority, peer->id, self->priority, self->id)) {
             any = true;
         }
     }
@@ -375,11 +375,11 @@ static bool near_pending(coa_vehicle_node_t *node, size_t n)
     }
     for (size_t i = 0; i < n; i++) {
         node->tall[i] = node->plans[i];
-        node->tall[i].volume.half_height = (coa_real_t)COA_LCM_MAX_SIZE;
+        node->tall[i].volume.half_height = (coa_real_t)COAVOID_LCM_MAX_SIZE;
     }
-    coa_predict_config_t config = coa_node_predict_config(c);
+    coa_predict_config_t config = coavoid_node_predict_config(c);
     coa_predict_result_t result;
-    coa_node_solver_t *sv = &node->solver;
+    coavoid_node_solver_t *sv = &node->solver;
     if (coa_predict(sv->predictor, &config, node->tall, n, NULL, 0, NULL, 0, sv->conflicts,
                     sv->conflict_capacity, &result) != COA_OK) {
         return true; /* cannot tell: wait, bounded by the deadline */
@@ -394,7 +394,7 @@ static bool near_pending(coa_vehicle_node_t *node, size_t n)
         size_t i = cf->b - 1u;
         const coa_vehicle_t *peer = &view->live_vehicle[i];
         if (!view->live_current[i] &&
-            coa_node_outranks(peer->priority, peer->id, self->priority, self->id)) {
+            coavoid_node_outranks(peer->priority, peer->id, self->priority, self->id)) {
             return true;
         }
     }
@@ -404,10 +404,10 @@ static bool near_pending(coa_vehicle_node_t *node, size_t n)
 /* The decoupled step: predict with what it has; publish at once without a conflict;
  * otherwise wait for the higher-priority members of its cluster (until the deadline),
  * then plan and publish. Returns 1 when it published, 0 while it waits, or an error. */
-static int decide(coa_vehicle_node_t *node, int64_t now)
+static int decide(coavoid_vehicle_node_t *node, int64_t now)
 {
     const coa_vehicle_t *self = &node->config.vehicle;
-    const coa_node_view_t *view = &node->view;
+    const coavoid_node_view_t *view = &node->view;
     const size_t n = gather(node, now);
     if (now < node->wait_deadline && near_pending(node, n)) {
         node->state.waiting = true;
@@ -429,7 +429,7 @@ static int decide(coa_vehicle_node_t *node, int64_t now)
     for (size_t i = 0; i < view->live_count; i++) {
         const coa_vehicle_t *peer = &view->live_vehicle[i];
         if (node->labels[i + 1u] == my && !view->live_current[i] &&
-            coa_node_outranks(peer->priority, peer->id, self->priority, self->id)) {
+            coavoid_node_outranks(peer->priority, peer->id, self->priority, self->id)) {
             pending = true;
         }
     }
@@ -451,9 +451,9 @@ static int decide(coa_vehicle_node_t *node, int64_t now)
     return finish(node, now);
 }
 
-static void reject(coa_vehicle_node_t *node, int code, const char *reason)
+static void reject(coavoid_vehicle_node_t *node, int code, const char *reason)
 {
-    coa_lcm_rx_count(&node->state.rx, code, reason);
+    coavoid_lcm_rx_count(&node->state.rx, code, reason);
 }
 
 /* Whether flying `offsets` (a plan's row from this cycle's start, `count` samples; past its
@@ -462,16 +462,16 @@ static void reject(coa_vehicle_node_t *node, int code, const char *reason)
  * with plans this UAV has not seen). A coordinator may know less terrain than the UAV, or
  * be an impostor: what the UAV knows it can check before it flies. Returns 0 (clear), 1
  * (a conflict) or a negative error (it cannot tell). */
-static int plan_hits_known(coa_vehicle_node_t *node, const int32_t *offsets, size_t count,
+static int plan_hits_known(coavoid_vehicle_node_t *node, const int32_t *offsets, size_t count,
                            int64_t now)
 {
-    const coa_node_common_t *c = &node->config.common;
+    const coavoid_node_common_t *c = &node->config.common;
     const size_t n = (size_t)c->horizon + 1u;
     for (size_t j = 0; j < n; j++) {
         node->checked[j] = offsets[j < count ? j : count - 1u];
     }
-    coa_node_view_build(&node->view, &node->inbox, node->cycle_start, now);
-    int rc = coa_node_problem_tracks(&node->problem_tracks, &node->view, NULL, c);
+    coavoid_node_view_build(&node->view, &node->inbox, node->cycle_start, now);
+    int rc = coavoid_node_problem_tracks(&node->problem_tracks, &node->view, NULL, c);
     if (rc != COA_OK) {
         return rc;
     }
@@ -483,10 +483,10 @@ static int plan_hits_known(coa_vehicle_node_t *node, const int32_t *offsets, siz
 }
 
 /* Step 4 of node.h: a coordinator's plan that lists it. */
-static void on_plan(void *owner, const coavoid_plan_t *msg, const coa_lcm_plan_info_t *info,
+static void on_plan(void *owner, const coavoid_plan_t *msg, const coavoid_lcm_plan_info_t *info,
                     const coa_plan_result_t *result, const int32_t *offsets)
 {
-    coa_vehicle_node_t *node = owner;
+    coavoid_vehicle_node_t *node = owner;
     const coa_vehicle_t *self = &node->config.vehicle;
     const int64_t now = *node->config.common.clock;
     size_t row = SIZE_MAX;
@@ -503,44 +503,44 @@ static void on_plan(void *owner, const coavoid_plan_t *msg, const coa_lcm_plan_i
         node->cycle_plan_failed = true;
     }
     if (row == SIZE_MAX || result->status != COA_PLAN_SOLVED || row >= result->planned_count) {
-        coa_lcm_rx_count(&node->state.rx, COA_OK, NULL); /* not a plan for it */
+        coavoid_lcm_rx_count(&node->state.rx, COA_OK, NULL); /* not a plan for it */
         return;
     }
     if (!node->started || msg->valid_from_utime != node->cycle_start) {
-        reject(node, COA_LCM_ERR_TIME, "plan: valid_from is not this cycle's start");
+        reject(node, COAVOID_LCM_ERR_TIME, "plan: valid_from is not this cycle's start");
         return;
     }
     if (now >= msg->valid_until_utime) {
-        reject(node, COA_LCM_ERR_TIME, "plan: arrived after valid_until");
+        reject(node, COAVOID_LCM_ERR_TIME, "plan: arrived after valid_until");
         return;
     }
     if (node->cycle_plan_adopted && msg->plan_id <= node->cycle_plan_id) {
-        reject(node, COA_LCM_ERR_SEQUENCE, "plan: plan_id not after the one adopted this cycle");
+        reject(node, COAVOID_LCM_ERR_SEQUENCE, "plan: plan_id not after the one adopted this cycle");
         return;
     }
     if (msg->dt != (double)node->config.common.dt) {
-        reject(node, COA_LCM_ERR_VALUE, "plan: dt is not this UAV's");
+        reject(node, COAVOID_LCM_ERR_VALUE, "plan: dt is not this UAV's");
         return;
     }
     const size_t samples = (size_t)info->horizon + 1u;
     const int32_t *mine = offsets + row * samples;
     if (mine[0] != node->state.offset) {
-        reject(node, COA_LCM_ERR_VALUE, "plan: does not start at the offset flown now");
+        reject(node, COAVOID_LCM_ERR_VALUE, "plan: does not start at the offset flown now");
         return;
     }
     for (size_t j = 0; j < samples; j++) {
         if (self->max_offset >= 0 && (mine[j] > self->max_offset || mine[j] < -self->max_offset)) {
-            reject(node, COA_LCM_ERR_VALUE, "plan: an offset beyond this UAV's max_offset");
+            reject(node, COAVOID_LCM_ERR_VALUE, "plan: an offset beyond this UAV's max_offset");
             return;
         }
         if (j > 0 && coa_action_between(mine[j - 1], mine[j], self->steep_factor) < 0) {
-            reject(node, COA_LCM_ERR_VALUE, "plan: a step this UAV cannot fly");
+            reject(node, COAVOID_LCM_ERR_VALUE, "plan: a step this UAV cannot fly");
             return;
         }
     }
     int hit = plan_hits_known(node, mine, samples, now);
     if (hit != 0) {
-        reject(node, hit > 0 ? COA_LCM_ERR_VALUE : hit,
+        reject(node, hit > 0 ? COAVOID_LCM_ERR_VALUE : hit,
                hit > 0 ? "plan: flies this UAV into an obstacle or track it knows"
                        : "plan: cannot be checked against the obstacles and tracks it knows");
         return;
@@ -548,10 +548,10 @@ static void on_plan(void *owner, const coavoid_plan_t *msg, const coa_lcm_plan_i
     adopt(node, mine, (uint32_t)samples);
     node->cycle_plan_adopted = true;
     node->cycle_plan_id = msg->plan_id;
-    coa_lcm_rx_count(&node->state.rx, COA_OK, NULL);
+    coavoid_lcm_rx_count(&node->state.rx, COA_OK, NULL);
 }
 
-coa_vehicle_node_t *coa_vehicle_node_create(const coa_vehicle_node_config_t *config, lcm_t *lcm,
+coavoid_vehicle_node_t *coavoid_vehicle_node_create(const coavoid_vehicle_node_config_t *config, lcm_t *lcm,
                                             int *error)
 {
     int dummy;
@@ -559,9 +559,9 @@ coa_vehicle_node_t *coa_vehicle_node_create(const coa_vehicle_node_config_t *con
         error = &dummy;
     }
     *error = COA_ERR_ARGUMENT;
-    if (config == NULL || lcm == NULL || coa_node_common_check(&config->common) != COA_OK ||
+    if (config == NULL || lcm == NULL || coavoid_node_common_check(&config->common) != COA_OK ||
         coa_vehicle_check(&config->vehicle) != COA_OK ||
-        (config->mode != COA_NODE_CENTRALISED && config->mode != COA_NODE_DECOUPLED) ||
+        (config->mode != COAVOID_NODE_CENTRALISED && config->mode != COAVOID_NODE_DECOUPLED) ||
         config->coordinator_timeout_us < 0 || config->priority_wait_us < 0 ||
         !isfinite((double)config->sigma_horizontal) || !isfinite((double)config->sigma_vertical) ||
         config->sigma_horizontal < (coa_real_t)0 || config->sigma_vertical < (coa_real_t)0 ||
@@ -570,20 +570,20 @@ coa_vehicle_node_t *coa_vehicle_node_create(const coa_vehicle_node_config_t *con
     }
     const uint16_t coordinator_id = config->coordinator_id != 0u
                                         ? config->coordinator_id
-                                        : (uint16_t)COA_NODE_COORDINATOR_ID;
+                                        : (uint16_t)COAVOID_NODE_COORDINATOR_ID;
     if (coordinator_id == config->vehicle.id) {
         return NULL; /* its own heartbeats and plans would be taken for its coordinator's */
     }
-    const coa_node_common_t *c = &config->common;
-    coa_node_solver_t solver;
-    int rc = coa_node_solver_init(&solver, c->horizon, 1u, c->beta);
+    const coavoid_node_common_t *c = &config->common;
+    coavoid_node_solver_t solver;
+    int rc = coavoid_node_solver_init(&solver, c->horizon, 1u, c->beta);
     if (rc != COA_OK) {
         *error = rc;
         return NULL;
     }
-    coa_vehicle_node_t *node = calloc(1, sizeof *node);
+    coavoid_vehicle_node_t *node = calloc(1, sizeof *node);
     if (node == NULL) {
-        coa_node_solver_fini(&solver);
+        coavoid_node_solver_fini(&solver);
         *error = COA_ERR_WORKSPACE;
         return NULL;
     }
@@ -604,12 +604,12 @@ coa_vehicle_node_t *coa_vehicle_node_create(const coa_vehicle_node_config_t *con
     node->state.offset = node->config.vehicle.initial_offset;
     node->state.last_outcome = -1;
     node->wait_deadline = INT64_MAX;
-    const bool centralised = node->config.mode == COA_NODE_CENTRALISED;
-    rc = coa_node_inbox_init(&node->inbox, c, node->config.vehicle.id, node->config.vehicle.id,
-                             coordinator_id, COA_NODE_MAX_PEERS - 1u, lcm, &node->state.rx,
+    const bool centralised = node->config.mode == COAVOID_NODE_CENTRALISED;
+    rc = coavoid_node_inbox_init(&node->inbox, c, node->config.vehicle.id, node->config.vehicle.id,
+                             coordinator_id, COAVOID_NODE_MAX_PEERS - 1u, lcm, &node->state.rx,
                              centralised, centralised ? on_plan : NULL, node);
     if (rc != COA_OK) {
-        coa_node_solver_fini(&node->solver);
+        coavoid_node_solver_fini(&node->solver);
         free(node);
         *error = rc;
         return NULL;
@@ -618,23 +618,23 @@ coa_vehicle_node_t *coa_vehicle_node_create(const coa_vehicle_node_config_t *con
     return node;
 }
 
-void coa_vehicle_node_destroy(coa_vehicle_node_t *node)
+void coavoid_vehicle_node_destroy(coavoid_vehicle_node_t *node)
 {
     if (node == NULL) {
         return;
     }
-    coa_node_inbox_fini(&node->inbox);
-    coa_node_solver_fini(&node->solver);
+    coavoid_node_inbox_fini(&node->inbox);
+    coavoid_node_solver_fini(&node->solver);
     free(node);
 }
 
-int coa_vehicle_node_cycle(coa_vehicle_node_t *node, int64_t now)
+int coavoid_vehicle_node_cycle(coavoid_vehicle_node_t *node, int64_t now)
 {
     if (node == NULL) {
         return COA_ERR_ARGUMENT;
     }
-    const coa_node_common_t *c = &node->config.common;
-    const int64_t k = coa_node_cycle_of(c, now);
+    const coavoid_node_common_t *c = &node->config.common;
+    const int64_t k = coavoid_node_cycle_of(c, now);
     if (k < 0) {
         return COA_ERR_ARGUMENT;
     }
@@ -643,7 +643,7 @@ int coa_vehicle_node_cycle(coa_vehicle_node_t *node, int64_t now)
     }
     if (!node->started) {
         node->started = true;
-        node->first_cycle_start = coa_node_cycle_utime(c, k);
+        node->first_cycle_start = coavoid_node_cycle_utime(c, k);
     }
     node->fault = false;
     const bool previous_adopted = node->cycle_plan_adopted;
@@ -651,8 +651,8 @@ int coa_vehicle_node_cycle(coa_vehicle_node_t *node, int64_t now)
     node->cycle_plan_adopted = false;
     node->cycle_plan_failed = false;
     node->state.cycle = k;
-    node->cycle_start = coa_node_cycle_utime(c, k);
-    coa_node_inbox_expire(&node->inbox, now);
+    node->cycle_start = coavoid_node_cycle_utime(c, k);
+    coavoid_node_inbox_expire(&node->inbox, now);
 
     build_own(node, k);
     node->state.offset = node->own_offsets[0];
@@ -684,7 +684,7 @@ int coa_vehicle_node_cycle(coa_vehicle_node_t *node, int64_t now)
 
     const int64_t timeout = node->config.coordinator_timeout_us;
     const bool coordinated =
-        node->config.mode == COA_NODE_CENTRALISED && !node->distrust &&
+        node->config.mode == COAVOID_NODE_CENTRALISED && !node->distrust &&
         ((node->inbox.heard_coordinator && now - node->inbox.coordinator_utime <= timeout) ||
          now - node->first_cycle_start < timeout);
     if (node->was_coordinated && !coordinated) {
@@ -709,7 +709,7 @@ int coa_vehicle_node_cycle(coa_vehicle_node_t *node, int64_t now)
     return rc < 0 ? rc : COA_OK;
 }
 
-int coa_vehicle_node_poll(coa_vehicle_node_t *node, int64_t now)
+int coavoid_vehicle_node_poll(coavoid_vehicle_node_t *node, int64_t now)
 {
     if (node == NULL) {
         return COA_ERR_ARGUMENT;
@@ -721,12 +721,12 @@ int coa_vehicle_node_poll(coa_vehicle_node_t *node, int64_t now)
     return rc;
 }
 
-int64_t coa_vehicle_node_deadline(const coa_vehicle_node_t *node)
+int64_t coavoid_vehicle_node_deadline(const coavoid_vehicle_node_t *node)
 {
     return (node != NULL && node->state.waiting) ? node->wait_deadline : INT64_MAX;
 }
 
-const coa_vehicle_node_state_t *coa_vehicle_node_state(const coa_vehicle_node_t *node)
+const coavoid_vehicle_node_state_t *coavoid_vehicle_node_state(const coavoid_vehicle_node_t *node)
 {
     return node != NULL ? &node->state : NULL;
 }

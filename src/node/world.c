@@ -10,9 +10,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-struct coa_world {
-    coa_world_config_t config;
-    coa_node_tx_t tx;
+struct coavoid_world {
+    coavoid_world_config_t config;
+    coavoid_node_tx_t tx;
     bool started;
     int64_t cycle;
     int64_t track_sequence;
@@ -85,9 +85,9 @@ static size_t estimate_path(const coa_track_t *tr, coa_real_t t, coa_real_t wind
     return n;
 }
 
-static coa_lcm_context_t world_context(const coa_world_t *w, int64_t now, int64_t epoch)
+static coavoid_lcm_context_t world_context(const coavoid_world_t *w, int64_t now, int64_t epoch)
 {
-    coa_lcm_context_t ctx;
+    coavoid_lcm_context_t ctx;
     ctx.now_utime = now;
     ctx.max_age_us = w->max_age_us;
     ctx.max_future_us = w->config.common.dt_us;
@@ -95,17 +95,17 @@ static coa_lcm_context_t world_context(const coa_world_t *w, int64_t now, int64_
     return ctx;
 }
 
-coa_world_t *coa_world_create(const coa_world_config_t *config, lcm_t *lcm, int *error)
+coavoid_world_t *coavoid_world_create(const coavoid_world_config_t *config, lcm_t *lcm, int *error)
 {
     int dummy;
     if (error == NULL) {
         error = &dummy;
     }
     *error = COA_ERR_ARGUMENT;
-    if (config == NULL || lcm == NULL || coa_node_common_check(&config->common) != COA_OK ||
+    if (config == NULL || lcm == NULL || coavoid_node_common_check(&config->common) != COA_OK ||
         (config->obstacles == NULL && config->obstacle_count > 0u) ||
         (config->tracks == NULL && config->track_count > 0u) ||
-        config->track_count > COA_NODE_MAX_TRACKS) {
+        config->track_count > COAVOID_NODE_MAX_TRACKS) {
         return NULL;
     }
     for (size_t i = 0; i < config->track_count; i++) {
@@ -119,22 +119,22 @@ coa_world_t *coa_world_create(const coa_world_config_t *config, lcm_t *lcm, int 
             }
         }
     }
-    coa_world_t *w = calloc(1, sizeof *w);
+    coavoid_world_t *w = calloc(1, sizeof *w);
     if (w == NULL) {
         *error = COA_ERR_WORKSPACE;
         return NULL;
     }
     w->config = *config;
     if (w->config.id == 0u) {
-        w->config.id = (uint16_t)COA_NODE_WORLD_ID;
+        w->config.id = (uint16_t)COAVOID_NODE_WORLD_ID;
     }
     w->tx.lcm = lcm;
     w->cycle = -1;
     w->max_age_us = config->common.stale_after_us +
                     ((int64_t)config->common.horizon + 2) * config->common.dt_us;
     /* The map must fit the message and pass its check: find out now, not every cycle. */
-    coa_lcm_context_t ctx = world_context(w, 0, config->common.epoch_utime);
-    if (coa_lcm_obstacle_map_from_core(config->obstacles, config->obstacle_count,
+    coavoid_lcm_context_t ctx = world_context(w, 0, config->common.epoch_utime);
+    if (coavoid_lcm_obstacle_map_from_core(config->obstacles, config->obstacle_count,
                                        config->common.epoch_utime, w->config.id, 1, &ctx,
                                        &w->map_msg, NULL) != COA_OK) {
         free(w);
@@ -144,18 +144,18 @@ coa_world_t *coa_world_create(const coa_world_config_t *config, lcm_t *lcm, int 
     return w;
 }
 
-void coa_world_destroy(coa_world_t *node)
+void coavoid_world_destroy(coavoid_world_t *node)
 {
     free(node);
 }
 
-int coa_world_cycle(coa_world_t *node, int64_t now)
+int coavoid_world_cycle(coavoid_world_t *node, int64_t now)
 {
     if (node == NULL) {
         return COA_ERR_ARGUMENT;
     }
-    const coa_node_common_t *c = &node->config.common;
-    int64_t k = coa_node_cycle_of(c, now);
+    const coavoid_node_common_t *c = &node->config.common;
+    int64_t k = coavoid_node_cycle_of(c, now);
     if (k < 0) {
         return COA_ERR_ARGUMENT;
     }
@@ -164,12 +164,12 @@ int coa_world_cycle(coa_world_t *node, int64_t now)
     }
     node->started = true;
     node->cycle = k;
-    const int64_t cycle_start = coa_node_cycle_utime(c, k);
-    coa_lcm_context_t ctx = world_context(node, now, cycle_start);
-    int rc = coa_lcm_obstacle_map_from_core(node->config.obstacles, node->config.obstacle_count,
+    const int64_t cycle_start = coavoid_node_cycle_utime(c, k);
+    coavoid_lcm_context_t ctx = world_context(node, now, cycle_start);
+    int rc = coavoid_lcm_obstacle_map_from_core(node->config.obstacles, node->config.obstacle_count,
                                             now, node->config.id, 1, &ctx, &node->map_msg, NULL);
     if (rc == COA_OK) {
-        rc = coa_node_publish_map(&node->tx, &node->map_msg);
+        rc = coavoid_node_publish_map(&node->tx, &node->map_msg);
     }
     int first_error = rc;
 
@@ -187,13 +187,13 @@ int coa_world_cycle(coa_world_t *node, int64_t now)
             estimate.path_count = estimate_path(tr, t, window, path);
             estimate.path = path;
         }
-        coa_lcm_track_info_t info;
+        coavoid_lcm_track_info_t info;
         info.utime = now;
         info.source_id = node->config.id;
         info.sequence = node->track_sequence++;
-        rc = coa_lcm_track_from_core(&estimate, &info, &ctx, &node->track_msg, NULL);
+        rc = coavoid_lcm_track_from_core(&estimate, &info, &ctx, &node->track_msg, NULL);
         if (rc == COA_OK) {
-            rc = coa_node_publish_track(&node->tx, &node->track_msg);
+            rc = coavoid_node_publish_track(&node->tx, &node->track_msg);
         }
         if (first_error == COA_OK) {
             first_error = rc;

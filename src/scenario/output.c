@@ -8,7 +8,7 @@
 
 #include <cjson/cJSON.h>
 
-const char *output_status_name(coa_plan_status_t status)
+const char *coavoid_output_status_name(coa_plan_status_t status)
 {
     switch (status) {
     case COA_PLAN_SOLVED:
@@ -44,7 +44,7 @@ static bool add_number(cJSON *obj, const char *key, double value)
     return cJSON_AddNumberToObject(obj, key, value) != NULL;
 }
 
-bool output_append(cJSON *array, cJSON *item)
+bool coavoid_output_append(cJSON *array, cJSON *item)
 {
     if (item == NULL) {
         return false;
@@ -58,7 +58,7 @@ bool output_append(cJSON *array, cJSON *item)
 
 /* One entry of "vehicles". Returns 0, -1 out of memory, -2 a row the core should never
  * have produced (err set). */
-static int add_vehicle(cJSON *array, const scenario_t *s, size_t index, const int32_t *row,
+static int add_vehicle(cJSON *array, const coavoid_scenario_t *s, size_t index, const int32_t *row,
                        char *err, size_t err_size)
 {
     const coa_vehicle_t *v = &s->vehicles[index];
@@ -70,7 +70,7 @@ static int add_vehicle(cJSON *array, const scenario_t *s, size_t index, const in
         return -2;
     }
     cJSON *entry = cJSON_CreateObject();
-    if (!output_append(array, entry) || !add_number(entry, "id", v->id)) {
+    if (!coavoid_output_append(array, entry) || !add_number(entry, "id", v->id)) {
         return -1;
     }
     cJSON *offsets = cJSON_AddArrayToObject(entry, "offsets");
@@ -79,7 +79,7 @@ static int add_vehicle(cJSON *array, const scenario_t *s, size_t index, const in
         return -1;
     }
     for (uint32_t k = 0; k <= s->horizon; k++) {
-        if (!output_append(offsets, cJSON_CreateNumber(row[k]))) {
+        if (!coavoid_output_append(offsets, cJSON_CreateNumber(row[k]))) {
             return -1;
         }
     }
@@ -91,7 +91,7 @@ static int add_vehicle(cJSON *array, const scenario_t *s, size_t index, const in
                       (unsigned)v->id, (long)row[k], (long)row[k + 1], (unsigned long)k);
             return -2;
         }
-        if (!output_append(actions, cJSON_CreateString(coa_action_name((coa_action_t)action)))) {
+        if (!coavoid_output_append(actions, cJSON_CreateString(coa_action_name((coa_action_t)action)))) {
             return -1;
         }
     }
@@ -102,9 +102,9 @@ static int add_vehicle(cJSON *array, const scenario_t *s, size_t index, const in
 }
 
 /* Builds the result object; NULL with err set on failure. */
-static cJSON *build(const output_plan_t *plan, char *err, size_t err_size)
+static cJSON *build(const coavoid_output_plan_t *plan, char *err, size_t err_size)
 {
-    const scenario_t *s = plan->scenario;
+    const coavoid_scenario_t *s = plan->scenario;
     const coa_plan_result_t *r = plan->result;
     const size_t n = s->vehicle_count;
     const size_t per_row = (size_t)s->horizon + 1u;
@@ -117,7 +117,7 @@ static cJSON *build(const output_plan_t *plan, char *err, size_t err_size)
     if (cJSON_AddStringToObject(root, "scenario", s->name) == NULL ||
         cJSON_AddStringToObject(root, "mode", plan->decoupled ? "decoupled" : "centralised") ==
             NULL ||
-        cJSON_AddStringToObject(root, "status", output_status_name(r->status)) == NULL) {
+        cJSON_AddStringToObject(root, "status", coavoid_output_status_name(r->status)) == NULL) {
         goto out_of_memory;
     }
 
@@ -132,7 +132,7 @@ static cJSON *build(const output_plan_t *plan, char *err, size_t err_size)
             set_error(err, err_size, "internal error: planning order names vehicle index %zu", i);
             goto fail;
         }
-        if (!output_append(order, cJSON_CreateNumber(s->vehicles[i].id))) {
+        if (!coavoid_output_append(order, cJSON_CreateNumber(s->vehicles[i].id))) {
             goto out_of_memory;
         }
     }
@@ -201,7 +201,7 @@ fail:
     return NULL;
 }
 
-int output_json(FILE *out, cJSON *root, char *err, size_t err_size)
+int coavoid_output_json(FILE *out, cJSON *root, char *err, size_t err_size)
 {
     char *text = cJSON_Print(root);
     cJSON_Delete(root);
@@ -218,16 +218,16 @@ int output_json(FILE *out, cJSON *root, char *err, size_t err_size)
     return 0;
 }
 
-int output_plan(FILE *out, const output_plan_t *plan, char *err, size_t err_size)
+int coavoid_output_plan(FILE *out, const coavoid_output_plan_t *plan, char *err, size_t err_size)
 {
     cJSON *root = build(plan, err, err_size);
     if (root == NULL) {
         return -1;
     }
-    return output_json(out, root, err, err_size);
+    return coavoid_output_json(out, root, err, err_size);
 }
 
-const char *output_conflict_kind_name(coa_conflict_kind_t kind)
+const char *coavoid_output_conflict_kind_name(coa_conflict_kind_t kind)
 {
     switch (kind) {
     case COA_CONFLICT_VEHICLE:
@@ -240,11 +240,11 @@ const char *output_conflict_kind_name(coa_conflict_kind_t kind)
     return "unknown";
 }
 
-static bool add_conflict(cJSON *array, const output_conflict_t *c)
+static bool add_conflict(cJSON *array, const coavoid_output_conflict_t *c)
 {
     cJSON *entry = cJSON_CreateObject();
-    return output_append(array, entry) &&
-           cJSON_AddStringToObject(entry, "kind", output_conflict_kind_name(c->kind)) != NULL &&
+    return coavoid_output_append(array, entry) &&
+           cJSON_AddStringToObject(entry, "kind", coavoid_output_conflict_kind_name(c->kind)) != NULL &&
            add_number(entry, "a", c->a) && add_number(entry, "b", c->b) &&
            add_number(entry, "first_step", c->first_step) &&
            add_number(entry, "probability", c->probability) &&
@@ -253,7 +253,7 @@ static bool add_conflict(cJSON *array, const output_conflict_t *c)
            add_number(entry, "min_vertical", c->min_vertical);
 }
 
-static cJSON *build_prediction(const output_predict_t *p)
+static cJSON *build_prediction(const coavoid_output_predict_t *p)
 {
     cJSON *root = cJSON_CreateObject();
     if (root == NULL || cJSON_AddStringToObject(root, "scenario", p->scenario) == NULL) {
@@ -274,11 +274,11 @@ static cJSON *build_prediction(const output_predict_t *p)
     }
     for (size_t c = 0; c < p->cluster_count; c++) {
         cJSON *cluster = cJSON_CreateArray();
-        if (!output_append(clusters, cluster)) {
+        if (!coavoid_output_append(clusters, cluster)) {
             goto fail;
         }
         for (size_t j = p->cluster_start[c]; j < p->cluster_start[c + 1]; j++) {
-            if (!output_append(cluster, cJSON_CreateNumber(p->cluster_ids[j]))) {
+            if (!coavoid_output_append(cluster, cJSON_CreateNumber(p->cluster_ids[j]))) {
                 goto fail;
             }
         }
@@ -290,11 +290,11 @@ fail:
     return NULL;
 }
 
-int output_predict(FILE *out, const output_predict_t *prediction, char *err, size_t err_size)
+int coavoid_output_predict(FILE *out, const coavoid_output_predict_t *prediction, char *err, size_t err_size)
 {
     cJSON *root = build_prediction(prediction);
     if (root == NULL) {
         return set_error(err, err_size, "out of memory printing the result");
     }
-    return output_json(out, root, err, err_size);
+    return coavoid_output_json(out, root, err, err_size);
 }

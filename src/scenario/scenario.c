@@ -23,7 +23,7 @@
 #define PATH_SIZE 128u
 
 typedef struct {
-    scenario_t *s;
+    coavoid_scenario_t *s;
     char *err;
     size_t err_size;
 } parser_t;
@@ -62,7 +62,7 @@ static void set_error(char *err, size_t err_size, const char *fmt, ...)
 
 /* ---- memory: every block is recorded so that one call frees them all ---- */
 
-static void *scenario_alloc(scenario_t *s, size_t count, size_t size)
+static void *scenario_alloc(coavoid_scenario_t *s, size_t count, size_t size)
 {
     if (count == 0) {
         count = 1;
@@ -86,7 +86,7 @@ static void *scenario_alloc(scenario_t *s, size_t count, size_t size)
     return block;
 }
 
-void scenario_free(scenario_t *s)
+void coavoid_scenario_free(coavoid_scenario_t *s)
 {
     if (s == NULL) {
         return;
@@ -580,7 +580,7 @@ static bool check_step_sizes(parser_t *p, const coa_vehicle_t *v, coa_real_t dt,
  * problem check would report it as a range error of the whole problem; here the first
  * pair of vehicles that cannot be weighed together is named. The test is the core's own,
  * on two vehicles at a time: the set fails exactly when the pair of its extremes does. */
-static bool check_weights(parser_t *p, const scenario_t *s, const char *path)
+static bool check_weights(parser_t *p, const coavoid_scenario_t *s, const char *path)
 {
     uint64_t weights[COA_MAX_VEHICLES];
     int exponent;
@@ -619,7 +619,7 @@ static bool parse_vehicles(parser_t *p, const cJSON *root)
         !read_array(p, array, path, 1, COA_MAX_VEHICLES, "vehicle", "COA_MAX_VEHICLES", &n)) {
         return false;
     }
-    scenario_t *s = p->s;
+    coavoid_scenario_t *s = p->s;
     s->vehicles = scenario_alloc(s, n, sizeof *s->vehicles);
     if (s->vehicles == NULL) {
         return out_of_memory(p, path);
@@ -734,7 +734,7 @@ static bool parse_obstacles(parser_t *p, const cJSON *root)
     if (!read_array(p, array, path, 0, SIZE_MAX, "obstacle", NULL, &n)) {
         return false;
     }
-    scenario_t *s = p->s;
+    coavoid_scenario_t *s = p->s;
     s->obstacles = scenario_alloc(s, n, sizeof *s->obstacles);
     if (s->obstacles == NULL) {
         return out_of_memory(p, path);
@@ -884,7 +884,7 @@ static bool parse_tracks(parser_t *p, const cJSON *root)
     if (!read_array(p, array, path, 0, SIZE_MAX, "track", NULL, &n)) {
         return false;
     }
-    scenario_t *s = p->s;
+    coavoid_scenario_t *s = p->s;
     s->tracks = scenario_alloc(s, n, sizeof *s->tracks);
     if (s->tracks == NULL) {
         return out_of_memory(p, path);
@@ -906,7 +906,7 @@ static bool parse_tracks(parser_t *p, const cJSON *root)
 
 static bool parse_root(parser_t *p, const cJSON *root)
 {
-    scenario_t *s = p->s;
+    coavoid_scenario_t *s = p->s;
     char path[PATH_SIZE];
     const cJSON *item;
     const char *name;
@@ -949,7 +949,7 @@ static void locate(const char *text, size_t at, size_t *line, size_t *column)
     }
 }
 
-int scenario_parse(const char *text, size_t length, scenario_t *s, char *err, size_t err_size)
+int coavoid_scenario_parse(const char *text, size_t length, coavoid_scenario_t *s, char *err, size_t err_size)
 {
     memset(s, 0, sizeof *s);
     const char *nul = memchr(text, '\0', length);
@@ -989,13 +989,13 @@ int scenario_parse(const char *text, size_t length, scenario_t *s, char *err, si
     cJSON_Delete(root);
     free(copy);
     if (!ok) {
-        scenario_free(s);
+        coavoid_scenario_free(s);
         return -1;
     }
     return 0;
 }
 
-int scenario_load(const char *path, scenario_t *s, char *err, size_t err_size)
+int coavoid_scenario_load(const char *path, coavoid_scenario_t *s, char *err, size_t err_size)
 {
     memset(s, 0, sizeof *s);
     FILE *f = fopen(path, "rb");
@@ -1028,13 +1028,13 @@ int scenario_load(const char *path, scenario_t *s, char *err, size_t err_size)
                   SCENARIO_MAX_BYTES / (1024u * 1024u));
         return -1;
     }
-    int rc = scenario_parse(text, length, s, err, err_size);
+    int rc = coavoid_scenario_parse(text, length, s, err, err_size);
     free(text);
     return rc;
 }
 
 /* Samples into a fresh block of count rows of horizon+1 points. */
-static const coa_vec3_t **alloc_rows(scenario_t *s, size_t count, coa_vec3_t **block)
+static const coa_vec3_t **alloc_rows(coavoid_scenario_t *s, size_t count, coa_vec3_t **block)
 {
     size_t per_row = (size_t)s->horizon + 1u;
     if (count != 0 && per_row > SIZE_MAX / count) {
@@ -1061,7 +1061,7 @@ static bool samples_finite(const coa_vec3_t *samples, uint32_t horizon)
     return true;
 }
 
-int scenario_sample(scenario_t *s, char *err, size_t err_size)
+int coavoid_scenario_sample(coavoid_scenario_t *s, char *err, size_t err_size)
 {
     size_t per_row = (size_t)s->horizon + 1u;
     coa_vec3_t *block;
@@ -1104,7 +1104,7 @@ int scenario_sample(scenario_t *s, char *err, size_t err_size)
     return 0;
 }
 
-coa_problem_t scenario_problem(const scenario_t *s)
+coa_problem_t coavoid_scenario_problem(const coavoid_scenario_t *s)
 {
     coa_problem_t problem;
     memset(&problem, 0, sizeof problem);
@@ -1121,7 +1121,7 @@ coa_problem_t scenario_problem(const scenario_t *s)
     return problem;
 }
 
-long scenario_vehicle_index(const scenario_t *s, long id)
+long coavoid_scenario_vehicle_index(const coavoid_scenario_t *s, long id)
 {
     for (size_t i = 0; i < s->vehicle_count; i++) {
         if ((long)s->vehicles[i].id == id) {

@@ -10,7 +10,7 @@
  * Fields the contract does not define are ignored, so that a newer scenario still loads;
  * a field the contract does define may appear only once in its object.
  *
- * Everything a scenario_t points to is owned by it and released by scenario_free.
+ * Everything a coavoid_scenario_t points to is owned by it and released by coavoid_scenario_free.
  */
 #ifndef COAVOID_APP_SCENARIO_H
 #define COAVOID_APP_SCENARIO_H
@@ -42,35 +42,35 @@ typedef struct {
     coa_track_t *tracks;
     size_t track_count;
 
-    /* Filled by scenario_sample: horizon+1 samples per vehicle reference and per track. */
+    /* Filled by coavoid_scenario_sample: horizon+1 samples per vehicle reference and per track. */
     const coa_vec3_t **references;
     const coa_vec3_t **track_samples;
 
-    /* Every block the fields above point into, freed together by scenario_free. */
+    /* Every block the fields above point into, freed together by coavoid_scenario_free. */
     void **owned;
     size_t owned_count;
     size_t owned_capacity;
-} scenario_t;
+} coavoid_scenario_t;
 
 /* Reads and validates the file at `path`. Returns 0 with *s filled, or -1 with the reason
- * in err (the file name is not part of it) and *s empty. Either way scenario_free(s) is
+ * in err (the file name is not part of it) and *s empty. Either way coavoid_scenario_free(s) is
  * safe afterwards. */
-int scenario_load(const char *path, scenario_t *s, char *err, size_t err_size);
+int coavoid_scenario_load(const char *path, coavoid_scenario_t *s, char *err, size_t err_size);
 
-/* As scenario_load, from `length` bytes of JSON text in memory. */
-int scenario_parse(const char *text, size_t length, scenario_t *s, char *err, size_t err_size);
+/* As coavoid_scenario_load, from `length` bytes of JSON text in memory. */
+int coavoid_scenario_parse(const char *text, size_t length, coavoid_scenario_t *s, char *err, size_t err_size);
 
 /* Samples every vehicle's reference and every track at t_k = k*dt, k = 0..horizon, into
  * s->references and s->track_samples, refusing samples that are not finite (a route or a
  * track that runs off to infinity within the horizon). Returns 0 or -1 with err set. */
-int scenario_sample(scenario_t *s, char *err, size_t err_size);
+int coavoid_scenario_sample(coavoid_scenario_t *s, char *err, size_t err_size);
 
 /* The core's view of a sampled scenario; it points into *s. */
-coa_problem_t scenario_problem(const scenario_t *s);
+coa_problem_t coavoid_scenario_problem(const coavoid_scenario_t *s);
 
 /* Index of the vehicle with this id, or -1. */
-long scenario_vehicle_index(const scenario_t *s, long id);
+long coavoid_scenario_vehicle_index(const coavoid_scenario_t *s, long id);
 
-void scenario_free(scenario_t *s);
+void coavoid_scenario_free(coavoid_scenario_t *s);
 
 #endif /* COAVOID_APP_SCENARIO_H */

@@ -106,16 +106,16 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    scenario_t s;
+    coavoid_scenario_t s;
     char err[SCENARIO_ERROR_MAX];
-    if (scenario_parse((const char *)data, size, &s, err, sizeof err) == 0 &&
-        s.horizon <= 64u && scenario_sample(&s, err, sizeof err) == 0) {
-        const coa_problem_t problem = scenario_problem(&s);
+    if (coavoid_scenario_parse((const char *)data, size, &s, err, sizeof err) == 0 &&
+        s.horizon <= 64u && coavoid_scenario_sample(&s, err, sizeof err) == 0) {
+        const coa_problem_t problem = coavoid_scenario_problem(&s);
         if (coa_problem_check(&problem) == COA_OK) {
             plan_both(&problem);
             predict_all(&problem);
         }
     }
-    scenario_free(&s);
+    coavoid_scenario_free(&s);
     return 0;
 }

@@ -1,0 +1,45 @@
+# SPDX-License-Identifier: MIT
+# Every non-static symbol carries the project's prefix: coa_ in the core (its namespace
+# holds only the core's), coavoid_ in every other library (docs/library.md, "Names").
+# Usage: cmake -DNM=<nm> -DCORE=<core archive> -DLIBS=<archive;...> -P check_prefixes.cmake
+cmake_minimum_required(VERSION 3.16)
+if(NOT NM OR NOT CORE)
+  message(FATAL_ERROR "usage: cmake -DNM=<nm> -DCORE=<archive> -DLIBS=<archives> -P check_prefixes.cmake")
+endif()
+set(failures 0)
+function(check_archive archive prefix)
+  execute_process(COMMAND ${NM} -g --defined-only ${archive}
+    OUTPUT_VARIABLE out RESULT_VARIABLE rc ERROR_QUIET)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "${NM} failed on ${archive}")
+  endif()
+  string(REPLACE "\n" ";" lines "${out}")
+  set(bad "")
+  set(count 0)
+  foreach(line ${lines})
+    # "address type name": defined code and data symbols (T, D, B, R and lowercase
+    # are local; C common).
+    if(line MATCHES "^[0-9a-fA-F]+ [TDBRC] ([A-Za-z_][A-Za-z0-9_]*)$")
+      set(symbol ${CMAKE_MATCH_1}) # the next MATCHES resets CMAKE_MATCH_1
+      math(EXPR count "${count} + 1")
+      if(NOT symbol MATCHES "^${prefix}")
+        list(APPEND bad ${symbol})
+      endif()
+    endif()
+  endforeach()
+  get_filename_component(name ${archive} NAME)
+  if(bad)
+    list(LENGTH bad n)
+    message(SEND_ERROR "${name}: ${n} symbol(s) without the prefix ${prefix}: ${bad}")
+    set(failures 1 PARENT_SCOPE)
+  else()
+    message(STATUS "${name}: ${count} symbols, all ${prefix}*")
+  endif()
+endfunction()
+check_archive(${CORE} coa_)
+foreach(lib ${LIBS})
+  check_archive(${lib} coavoid_)
+endforeach()
+if(failures)
+  message(FATAL_ERROR "symbol prefixes: see above")
+endif()
