@@ -295,8 +295,8 @@ int coa_plan_centralised(coa_planner_t *planner, const coa_problem_t *problem,
  * n (obstacles + tracks) + n(n-1)/2 volume checks at t = 0. The rules above only cut
  * this short in the cases they name: two UAVs that can never pass each other (but are
  * clear at t = 0) among n-2 that never interact still take about half of the n! orders
- * (measured: 3262 attempts for n = 7, 191802 for n = 9), so bound max_orders when n is
- * more than a few. No memory beyond the workspace, O(n) stack. */
+ * (docs/benchmarks.md has counts), so bound max_orders when n is more than a few. No
+ * memory beyond the workspace, O(n) stack. */
 int coa_plan_decoupled(coa_planner_t *planner, const coa_problem_t *problem,
                        const size_t *order, uint32_t max_orders, int32_t *offsets,
                        coa_plan_result_t *result);

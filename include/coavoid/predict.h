@@ -154,9 +154,8 @@ typedef struct coa_predictor coa_predictor_t;
  * Per mover (plan or track), 24 (N + 1) + 124 bytes in double (12 (N + 1) + 72 in
  * float; of these, 16 are the broad phase's grid of at most 4 cells per mover), plus 48
  * (24) per plan; per pair 12 bytes plus 16 to 32 bytes of hash table (a power of two of
- * at least 2 max_pairs slots of 8 bytes); a header of about 180 bytes. For example,
- * N = 60 and max_pairs = 4 max_vehicles, no tracks: 1,000 plans 1.75 MB, 10,000 plans
- * 17.9 MB. */
+ * at least 2 max_pairs slots of 8 bytes); a header of about 180 bytes (docs/benchmarks.md
+ * gives sizes for 100 to 10,000 UAVs). */
 size_t coa_predictor_workspace_size(size_t max_vehicles, size_t max_tracks, uint32_t max_horizon,
                                     size_t max_pairs);
 
@@ -184,11 +183,9 @@ coa_predictor_t *coa_predictor_init(void *buffer, size_t size, size_t max_vehicl
  * pairs the broad phase produced (0 with all_pairs).
  * Cost: alignment O((n + m) N + plan samples + track paths * N); broad phase
  * O(N (n + m + pairs of boxes in neighbouring grid cells + wide boxes x (the cells they
- * reach + log wide boxes) + wide pairs overlapping in x)): near-linear for sparse traffic (measured, -O3,
- * one core, 10 UAVs per km^2 and N = 60: 1,000 UAVs 3.3 ms a cycle, 10,000 UAVs 44 ms,
- * the rest of the growth being cache misses on the samples; the pair tests grow
- * linearly, 394 and 4,922); quadratic only when every box is in a few cells (a crowd)
- * or wide. Plus
+ * reach + log wide boxes) + wide pairs overlapping in x)): near-linear for sparse traffic
+ * (docs/benchmarks.md, "Collision prediction"); quadratic only when every box is in a few
+ * cells (a crowd) or wide. Plus
  * O(n * obstacles + obstacle vertices); sorting the candidates O(P log P); narrow phase
  * O(candidates * N), a polytope step costing what coa_conflict_polytope does, an
  * uncertain step at most 7 coa_conflict_probability calls. No heap, O(1) stack. */

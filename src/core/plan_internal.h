@@ -225,8 +225,8 @@ struct coa_planner {
 
 /* plan_cost_add and plan_cost_compare are coa_cost_add and coa_cost_compare (trajectory.h)
  * inlined: the joint search forms and compares costs for every combination it tries, and
- * calling the library's out of line costs 19 % more instructions on a 4-UAV search
- * (callgrind, bench encounter 4-4). */
+ * calling the library's out of line costs a fifth more instructions in a joint search
+ * (docs/benchmarks.md). */
 
 static inline coa_cost_t plan_cost_add(coa_cost_t a, coa_cost_t b)
 {
