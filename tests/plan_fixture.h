@@ -91,8 +91,8 @@ static inline void fx_init(fx_t *f, double dt, uint32_t horizon)
 /* A vehicle on the straight route start -> end, level at offset 0 and unbounded; the
  * caller may lengthen the route (route[i], route_count) or set the offsets after. */
 static inline coa_vehicle_t *fx_vehicle(fx_t *f, uint16_t id, uint32_t priority, double speed,
-                                        double climb, uint32_t steep, double radius,
-                                        double half, coa_vec3_t start, coa_vec3_t end)
+                                        double climb, uint32_t steep, double radius, double half,
+                                        coa_vec3_t start, coa_vec3_t end)
 {
     size_t i = f->p.vehicle_count++;
     coa_vehicle_t *v = &f->veh[i];

@@ -16,7 +16,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-
 #include <math.h>
 
 #include <time.h>
@@ -125,7 +124,8 @@ START_TEST(test_exact_touch_is_not_a_loss)
     ck_assert(f.eval.deviation == 0.0);
     ck_assert_uint_eq(f.eval.effort, 0u);
     size_t found = 99;
-    ck_assert_int_eq(coavoid_flight_conflicts(&f.flight, COAVOID_FLIGHT_FLOWN, NULL, 0u, &found), COA_OK);
+    ck_assert_int_eq(coavoid_flight_conflicts(&f.flight, COAVOID_FLIGHT_FLOWN, NULL, 0u, &found),
+                     COA_OK);
     ck_assert_uint_eq(found, 0u);
 
     /* Vertically as well: one above the other by exactly h_a + h_b = 10 m, on one line. */
@@ -151,7 +151,8 @@ START_TEST(test_a_centimetre_closer_is_a_loss)
     ck_assert(f.eval.loss_of_separation);
     ck_assert_uint_eq(f.eval.first_vehicle, 0u);
     ck_assert_uint_eq(f.eval.first_step, 15u);
-    ck_assert_int_eq(coavoid_flight_conflicts(&f.flight, COAVOID_FLIGHT_FLOWN, list, 8u, &found), COA_OK);
+    ck_assert_int_eq(coavoid_flight_conflicts(&f.flight, COAVOID_FLIGHT_FLOWN, list, 8u, &found),
+                     COA_OK);
     /* Within 0.77 m of the meeting point only: one step. */
     ck_assert_uint_eq(found, 1u);
     ck_assert_int_eq(list[0].kind, COA_CONFLICT_VEHICLE);
@@ -173,8 +174,8 @@ START_TEST(test_a_centimetre_closer_is_a_loss)
     set_offsets(&f, 1, climb, sizeof climb / sizeof climb[0]);
     ck_assert_int_eq(coavoid_flight_evaluate(&f.flight, &f.eval), COA_OK);
     ck_assert(!f.eval.loss_of_separation);
-    ck_assert_int_eq(coavoid_flight_conflicts(&f.flight, COAVOID_FLIGHT_REFERENCE, list, 8u, &found),
-                     COA_OK);
+    ck_assert_int_eq(
+        coavoid_flight_conflicts(&f.flight, COAVOID_FLIGHT_REFERENCE, list, 8u, &found), COA_OK);
     ck_assert_uint_ge(found, 1u); /* the references still would have */
 }
 END_TEST
@@ -194,7 +195,8 @@ START_TEST(test_through_a_box)
     ck_assert(f.eval.loss_of_separation);
     ck_assert_uint_eq(f.eval.first_vehicle, 0u);
     ck_assert_uint_eq(f.eval.first_step, 8u);
-    ck_assert_int_eq(coavoid_flight_conflicts(&f.flight, COAVOID_FLIGHT_FLOWN, list, 64u, &found), COA_OK);
+    ck_assert_int_eq(coavoid_flight_conflicts(&f.flight, COAVOID_FLIGHT_FLOWN, list, 64u, &found),
+                     COA_OK);
     /* Steps 8..21: x from 80 to 220 overlaps 85..215 in each. */
     ck_assert_uint_eq(found, 14u);
     for (size_t c = 0; c < found; c++) {
@@ -204,8 +206,8 @@ START_TEST(test_through_a_box)
     }
 
     /* Up by 5 climb steps (10 m) by t = 5, held over the box, back down after it. */
-    int32_t over[] = {0, 1, 2, 3, 4, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5,
-                      5, 5, 5, 5, 5, 5, 4, 3, 2, 1, 0};
+    int32_t over[] = {0, 1, 2, 3, 4, 5, 5, 5, 5, 5, 5, 5, 5, 5,
+                      5, 5, 5, 5, 5, 5, 5, 5, 5, 4, 3, 2, 1, 0};
     set_offsets(&f, 0, over, sizeof over / sizeof over[0]);
     ck_assert_int_eq(coavoid_flight_evaluate(&f.flight, &f.eval), COA_OK);
     ck_assert(!f.eval.loss_of_separation);
@@ -240,7 +242,8 @@ START_TEST(test_track_crossing)
     ck_assert_int_eq(coavoid_flight_evaluate(&f.flight, &f.eval), COA_OK);
     ck_assert(f.eval.loss_of_separation);
     ck_assert_uint_eq(f.eval.first_step, 12u);
-    ck_assert_int_eq(coavoid_flight_conflicts(&f.flight, COAVOID_FLIGHT_FLOWN, list, 32u, &found), COA_OK);
+    ck_assert_int_eq(coavoid_flight_conflicts(&f.flight, COAVOID_FLIGHT_FLOWN, list, 32u, &found),
+                     COA_OK);
     ck_assert_uint_ge(found, 1u);
     ck_assert_int_eq(list[0].kind, COA_CONFLICT_TRACK);
     ck_assert_uint_eq(list[0].other, 0u);
@@ -311,7 +314,8 @@ START_TEST(test_refusals)
     ck_assert_int_eq(coavoid_flight_evaluate(&f.flight, &f.eval), COA_ERR_ARGUMENT);
     /* The figure and the listing judge geometry only: they still work. */
     size_t found = 0;
-    ck_assert_int_eq(coavoid_flight_conflicts(&f.flight, COAVOID_FLIGHT_FLOWN, NULL, 0u, &found), COA_OK);
+    ck_assert_int_eq(coavoid_flight_conflicts(&f.flight, COAVOID_FLIGHT_FLOWN, NULL, 0u, &found),
+                     COA_OK);
     int32_t ok[] = {0, 1, 3};
     set_offsets(&f, 0, ok, 3u);
     ck_assert_int_eq(coavoid_flight_evaluate(&f.flight, &f.eval), COA_OK);
@@ -359,8 +363,8 @@ START_TEST(test_listing_agrees_with_the_core)
             double x = unif(&seed, -100, 100), y = unif(&seed, -100, 100);
             double heading = unif(&seed, 0, 6.283185307179586);
             double z = unif(&seed, 90, 110);
-            size_t v = add_uav(&f, vec(x, y, z),
-                               vec(x + 1000 * cos(heading), y + 1000 * sin(heading), z));
+            size_t v =
+                add_uav(&f, vec(x, y, z), vec(x + 1000 * cos(heading), y + 1000 * sin(heading), z));
             int32_t o = (int32_t)pick(&seed, 5u) - 2;
             for (uint32_t k = 0; k <= steps; k++) {
                 f.offsets[v][k] = o;
@@ -370,8 +374,8 @@ START_TEST(test_listing_agrees_with_the_core)
         }
         if (pick(&seed, 2u) == 0u) {
             double x = unif(&seed, -150, 150), y = unif(&seed, -150, 150);
-            add_box(&f, vec(x, y, 0), vec(x + unif(&seed, 5, 60), y + unif(&seed, 5, 60),
-                                          unif(&seed, 80, 105)));
+            add_box(&f, vec(x, y, 0),
+                    vec(x + unif(&seed, 5, 60), y + unif(&seed, 5, 60), unif(&seed, 80, 105)));
         }
         if (pick(&seed, 2u) == 0u) {
             coa_track_t *t = &f.tracks[f.flight.track_count++];
@@ -384,7 +388,8 @@ START_TEST(test_listing_agrees_with_the_core)
         REQUIRE(coavoid_flight_evaluate(&f.flight, &f.eval) == COA_OK);
         coavoid_flight_conflict_t list[512];
         size_t found = 0;
-        REQUIRE(coavoid_flight_conflicts(&f.flight, COAVOID_FLIGHT_FLOWN, list, 512u, &found) == COA_OK);
+        REQUIRE(coavoid_flight_conflicts(&f.flight, COAVOID_FLIGHT_FLOWN, list, 512u, &found) ==
+                COA_OK);
         REQUIRE((found > 0u) == f.eval.loss_of_separation);
         if (found > 0u) {
             lost++;
@@ -467,7 +472,8 @@ START_TEST(test_json_fields)
         for (int k = 0; k <= 12; k++) {
             const cJSON *s = cJSON_GetArrayItem(flown, k);
             ck_assert_int_eq(cJSON_GetArraySize(s), 4);
-            coa_vec3_t p = coavoid_flight_position(&f.flight, (size_t)i, (uint32_t)k, f.offsets[i][k]);
+            coa_vec3_t p =
+                coavoid_flight_position(&f.flight, (size_t)i, (uint32_t)k, f.offsets[i][k]);
             /* Round trip: exactly the planner's positions. */
             ck_assert(cJSON_GetArrayItem(s, 0)->valuedouble == (double)k * 0.5);
             ck_assert(cJSON_GetArrayItem(s, 1)->valuedouble == (double)p.x);
@@ -559,8 +565,8 @@ START_TEST(test_svg_shape)
     add_uav(&f, vec(0, 0, 100), vec(600, 0, 100));
     add_uav(&f, vec(305, 29.99, 100), vec(-295, 29.99, 100));
     add_box(&f, vec(100, -60, 0), vec(200, 60, 104));
-    static const coa_vec3_t hill[5] = {{300, -50, 0}, {400, -50, 0}, {400, 50, 0},
-                                       {300, 50, 0}, {350, 0, 60}};
+    static const coa_vec3_t hill[5] = {
+        {300, -50, 0}, {400, -50, 0}, {400, 50, 0}, {300, 50, 0}, {350, 0, 60}};
     coa_obstacle_t *o = &f.obstacles[f.flight.obstacle_count++];
     o->kind = COA_OBSTACLE_POLYTOPE;
     o->polytope.vertices = hill;
@@ -717,11 +723,13 @@ static int write_log(int argc, char **argv)
     long stale_id = -1, stale_cycle = -1;
     bool junk = false;
     for (int a = 5; a < argc; a++) {
-        if (drops < 8u && sscanf(argv[a], "drop=%ld:%ld", &drop_id[drops], &drop_cycle[drops]) == 2) {
+        if (drops < 8u &&
+            sscanf(argv[a], "drop=%ld:%ld", &drop_id[drops], &drop_cycle[drops]) == 2) {
             drops++;
             continue;
         }
-        if (sscanf(argv[a], "skip=%ld", &skip_id) == 1 || sscanf(argv[a], "cycles=%ld", &cycles) == 1 ||
+        if (sscanf(argv[a], "skip=%ld", &skip_id) == 1 ||
+            sscanf(argv[a], "cycles=%ld", &cycles) == 1 ||
             sscanf(argv[a], "step=%lf", &step_claim) == 1 ||
             sscanf(argv[a], "stale=%ld:%ld", &stale_id, &stale_cycle) == 2) {
             continue;
@@ -735,7 +743,8 @@ static int write_log(int argc, char **argv)
 
     coavoid_scenario_t s;
     char err[SCENARIO_ERROR_MAX];
-    if (coavoid_scenario_load(argv[3], &s, err, sizeof err) != 0 || coavoid_scenario_sample(&s, err, sizeof err) != 0) {
+    if (coavoid_scenario_load(argv[3], &s, err, sizeof err) != 0 ||
+        coavoid_scenario_sample(&s, err, sizeof err) != 0) {
         coavoid_scenario_free(&s);
         return fail_writer(err);
     }
@@ -764,7 +773,8 @@ static int write_log(int argc, char **argv)
         for (size_t k = 0; k < row; k++) {
             plan[i * row + k] = s.vehicles[i].initial_offset;
         }
-        if (coa_reference_sample(&s.vehicles[i], s.dt, 3u * N, &reference[i * 3u * row]) != COA_OK) {
+        if (coa_reference_sample(&s.vehicles[i], s.dt, 3u * N, &reference[i * 3u * row]) !=
+            COA_OK) {
             status = fail_writer("cannot sample a reference");
             goto done;
         }
@@ -829,7 +839,8 @@ static int write_log(int argc, char **argv)
             info.position.z += (coa_real_t)offsets[0] * coa_climb_step(v, s.dt);
             info.plan_utime = start;
             info.step = s.dt;
-            if (coavoid_lcm_intent_from_core(v, &info, ref, offsets, row, &ctx, msg, &reason) != COA_OK) {
+            if (coavoid_lcm_intent_from_core(v, &info, ref, offsets, row, &ctx, msg, &reason) !=
+                COA_OK) {
                 status = fail_writer(reason);
                 break;
             }
@@ -855,7 +866,8 @@ static int write_log(int argc, char **argv)
             memset(&hb, 0, sizeof hb);
             hb.utime = start + 5000;
             hb.node_id = i < n ? s.vehicles[i].id : (int32_t)COAVOID_NODE_COORDINATOR_ID;
-            hb.node_kind = i < n ? COAVOID_STATUS_T_NODE_VEHICLE : COAVOID_STATUS_T_NODE_COORDINATOR;
+            hb.node_kind =
+                i < n ? COAVOID_STATUS_T_NODE_VEHICLE : COAVOID_STATUS_T_NODE_COORDINATOR;
             hb.sequence = c;
             hb.outcome = COAVOID_STATUS_T_OUTCOME_NONE;
             if (i == n && planned) {
@@ -893,7 +905,8 @@ static int write_log(int argc, char **argv)
             }
             if (coavoid_lcm_plan_check(plan_msg, &ctx, &reason) != COA_OK ||
                 put_event(w, plan_msg->utime, COAVOID_CHANNEL_PLAN,
-                          coavoid_plan_t_encode(w->buffer, 0, (int)sizeof w->buffer, plan_msg)) != 0) {
+                          coavoid_plan_t_encode(w->buffer, 0, (int)sizeof w->buffer, plan_msg)) !=
+                    0) {
                 status = fail_writer(reason);
             }
         }

@@ -206,8 +206,8 @@ static void gjk_poly_support(const void *obj, const ccd_vec3_t *d, ccd_vec3_t *o
     size_t i, best = 0;
     double bd = -INFINITY;
     for (i = 0; i < p->n; ++i) {
-        double dot = (double)p->v[i].x * d->v[0] + (double)p->v[i].y * d->v[1] +
-                     (double)p->v[i].z * d->v[2];
+        double dot =
+            (double)p->v[i].x * d->v[0] + (double)p->v[i].y * d->v[1] + (double)p->v[i].z * d->v[2];
         if (dot > bd) {
             bd = dot;
             best = i;
@@ -315,8 +315,7 @@ static void print_sweep(const char *what, const coa_sweep_t *s)
 {
     fprintf(stderr, "%s: r %.17g h %.17g p0 (%.17g %.17g %.17g) p1 (%.17g %.17g %.17g)\n", what,
             (double)s->volume.radius, (double)s->volume.half_height, (double)s->p0.x,
-            (double)s->p0.y, (double)s->p0.z, (double)s->p1.x, (double)s->p1.y,
-            (double)s->p1.z);
+            (double)s->p0.y, (double)s->p0.z, (double)s->p1.x, (double)s->p1.y, (double)s->p1.z);
 }
 
 static void print_box(const coa_box_t *b)
@@ -345,8 +344,9 @@ static coa_sweep_t rng_sweep(rng_t *r, double spread, double motion)
     } else if (kind == 2u) { /* hover */
         d = vec(0, 0, 0);
     }
-    return sweep(rad, hh, p0, vec((double)p0.x + (double)d.x, (double)p0.y + (double)d.y,
-                                  (double)p0.z + (double)d.z));
+    return sweep(
+        rad, hh, p0,
+        vec((double)p0.x + (double)d.x, (double)p0.y + (double)d.y, (double)p0.z + (double)d.z));
 }
 
 static coa_box_t rng_box(rng_t *r)
@@ -593,8 +593,8 @@ START_TEST(test_volumes_touching)
     /* Side by side at exactly r_a + r_b, at rest and moving together. */
     ck_assert(!vols(a, still(2, 1, 3, 0, 0)));
     ck_assert(vols(a, still(2, 1, 2.999, 0, 0)));
-    ck_assert(!vols(sweep(1, 1, vec(0, 0, 0), vec(10, 5, 0)),
-                    sweep(2, 1, vec(3, 0, 0), vec(13, 5, 0))));
+    ck_assert(
+        !vols(sweep(1, 1, vec(0, 0, 0), vec(10, 5, 0)), sweep(2, 1, vec(3, 0, 0), vec(13, 5, 0))));
     /* Passing by at a closest approach of exactly r_a + r_b. */
     ck_assert(!vols(a, sweep(1, 1, vec(-5, 2, 0), vec(5, 2, 0))));
     ck_assert(vols(a, sweep(1, 1, vec(-5, 1.999, 0), vec(5, 1.999, 0))));
@@ -747,16 +747,16 @@ START_TEST(test_volumes_touching_off_axis)
         /* ... and on from there, inside for u in (0, 0.2). */
         ck_assert(vols(a, sweep(5 * k, 2 * k, vec(-8 * k, 6 * k, 0), vec(-16 * k, -10 * k, 0))));
         /* The same closing speed along y, 9 apart in x: contact (9, 12, 15) at u = 1. */
-        ck_assert(!vols(still(5 * k, 2.5 * k, 0, 0, 0),
-                        sweep(10 * k, 2 * k, vec(9 * k, 21 * k, 4.375 * k),
-                              vec(9 * k, 12 * k, 4.375 * k))));
-        ck_assert(vols(still(5 * k, 2.5 * k, 0, 0, 0),
-                       sweep(10 * k, 2 * k, vec(9 * k, 12 * k, 4.375 * k),
-                             vec(9 * k, 3 * k, 4.375 * k))));
+        ck_assert(!vols(
+            still(5 * k, 2.5 * k, 0, 0, 0),
+            sweep(10 * k, 2 * k, vec(9 * k, 21 * k, 4.375 * k), vec(9 * k, 12 * k, 4.375 * k))));
+        ck_assert(
+            vols(still(5 * k, 2.5 * k, 0, 0, 0), sweep(10 * k, 2 * k, vec(9 * k, 12 * k, 4.375 * k),
+                                                       vec(9 * k, 3 * k, 4.375 * k))));
         /* A box's rounded corner (its max x, max y edge), reached at u = 1. */
         ck_assert(!boxc(sweep(10 * k, 1 * k, vec(22 * k, 0, 0), vec(6 * k, 8 * k, 0)), corner));
-        ck_assert(boxc(sweep(10 * k, 1 * k, vec(6 * k, 8 * k, 0), vec(-10 * k, 16 * k, 0)),
-                       corner));
+        ck_assert(
+            boxc(sweep(10 * k, 1 * k, vec(6 * k, 8 * k, 0), vec(-10 * k, 16 * k, 0)), corner));
     }
 }
 END_TEST
@@ -1042,10 +1042,10 @@ START_TEST(test_polytope_far_away)
         cube_points(cube, 0, 10, s);
         ck_assert_int_eq(polyc(still(1, 1, s + 11.01, s + 5, s + 5), cube, 8), 0);
         ck_assert_int_eq(polyc(still(1, 1, s + 10.99, s + 5, s + 5), cube, 8), 1);
-        ck_assert_int_eq(polyc(sweep(1, 1, vec(s - 5, s + 5, s + 5), vec(s + 15, s + 5, s + 5)),
-                               cube, 8), 1);
-        ck_assert_int_eq(polyc(sweep(1, 1, vec(s + 25, s + 5, s + 5), vec(s + 5, s + 5, s + 25)),
-                               cube, 8), 0);
+        ck_assert_int_eq(
+            polyc(sweep(1, 1, vec(s - 5, s + 5, s + 5), vec(s + 15, s + 5, s + 5)), cube, 8), 1);
+        ck_assert_int_eq(
+            polyc(sweep(1, 1, vec(s + 25, s + 5, s + 5), vec(s + 5, s + 5, s + 25)), cube, 8), 0);
     }
 }
 END_TEST
@@ -1068,10 +1068,10 @@ START_TEST(test_polytope_extreme_scales)
         cube_points(cube, 0, 10 * s, 0);
         ck_assert_int_eq(polyc(still(s, s, 11.01 * s, 5 * s, 5 * s), cube, 8), 0);
         ck_assert_int_eq(polyc(still(s, s, 10.99 * s, 5 * s, 5 * s), cube, 8), 1);
-        ck_assert_int_eq(polyc(sweep(s, s, vec(-5 * s, 5 * s, 5 * s), vec(15 * s, 5 * s, 5 * s)),
-                               cube, 8), 1);
-        ck_assert_int_eq(polyc(sweep(s, s, vec(25 * s, 5 * s, 5 * s), vec(5 * s, 5 * s, 25 * s)),
-                               cube, 8), 0);
+        ck_assert_int_eq(
+            polyc(sweep(s, s, vec(-5 * s, 5 * s, 5 * s), vec(15 * s, 5 * s, 5 * s)), cube, 8), 1);
+        ck_assert_int_eq(
+            polyc(sweep(s, s, vec(25 * s, 5 * s, 5 * s), vec(5 * s, 5 * s, 25 * s)), cube, 8), 0);
         cube_points(cube, -s, s, 0);
         ck_assert_int_eq(polyc(still(1, 1, 0.99 * s, 0, 0), cube, 8), 1);
         ck_assert_int_eq(polyc(still(1, 1, 1.01 * s, 0.3 * s, 0), cube, 8), s > 100 ? 0 : 1);
@@ -1087,8 +1087,8 @@ START_TEST(test_polytope_scale_contrast)
     cube_points(big, -1e5, 1e5, 0);
     ck_assert_int_eq(polyc(still(0.5, 0.5, 1e5 + 0.6, 3, -7), big, 8), 0);
     ck_assert_int_eq(polyc(still(0.5, 0.5, 1e5 + 0.4, 3, -7), big, 8), 1);
-    ck_assert_int_eq(polyc(sweep(0.5, 0.5, vec(1e5 + 0.6, -3, 7), vec(1e5 + 0.6, 4, -7)),
-                           big, 8), 0);
+    ck_assert_int_eq(polyc(sweep(0.5, 0.5, vec(1e5 + 0.6, -3, 7), vec(1e5 + 0.6, 4, -7)), big, 8),
+                     0);
 }
 END_TEST
 
@@ -1136,8 +1136,8 @@ START_TEST(test_polytope_near_contact)
         for (b = 0; b < 60; ++b) {
             double t = 0.5 * (lo + hi);
             int got;
-            probe = still(rad, hh, c[0] + t * e[0] / len, c[1] + t * e[1] / len,
-                          c[2] + t * e[2] / len);
+            probe =
+                still(rad, hh, c[0] + t * e[0] / len, c[1] + t * e[1] / len, c[2] + t * e[2] / len);
             got = coa_conflict_polytope(&probe, &poly);
             ck_assert(got == 0 || got == 1);
             if (got) {
@@ -1150,13 +1150,13 @@ START_TEST(test_polytope_near_contact)
         ctx.p = &poly;
         ctx.bounds = bb;
         ctx.a = &probe;
-        probe = still(rad, hh, c[0] + (lo - 1e-3 * size) * e[0] / len,
-                      c[1] + (lo - 1e-3 * size) * e[1] / len,
-                      c[2] + (lo - 1e-3 * size) * e[2] / len);
+        probe =
+            still(rad, hh, c[0] + (lo - 1e-3 * size) * e[0] / len,
+                  c[1] + (lo - 1e-3 * size) * e[1] / len, c[2] + (lo - 1e-3 * size) * e[2] / len);
         ck_assert_msg(poly_inst(&ctx, 0, 1.0), "case %u: GJK finds no contact inside", k);
-        probe = still(rad, hh, c[0] + (lo + 1e-3 * size) * e[0] / len,
-                      c[1] + (lo + 1e-3 * size) * e[1] / len,
-                      c[2] + (lo + 1e-3 * size) * e[2] / len);
+        probe =
+            still(rad, hh, c[0] + (lo + 1e-3 * size) * e[0] / len,
+                  c[1] + (lo + 1e-3 * size) * e[1] / len, c[2] + (lo + 1e-3 * size) * e[2] / len);
         ck_assert_msg(!poly_inst(&ctx, 0, 1.0), "case %u: GJK finds contact outside", k);
     }
 }

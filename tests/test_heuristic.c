@@ -46,13 +46,13 @@
 #endif
 __extension__ typedef unsigned __int128 u128_t;
 
-#define MAXM 3u                            /* UAVs */
-#define MAXN 8u                            /* horizon */
-#define MAXS 3u                            /* steep factor */
-#define ROWW (2u * MAXN * MAXS + 1u)       /* widest row */
+#define MAXM 3u                      /* UAVs */
+#define MAXN 8u                      /* horizon */
+#define MAXS 3u                      /* steep factor */
+#define ROWW (2u * MAXN * MAXS + 1u) /* widest row */
 #define ACTS 5u
 #define INF (~(u128_t)0)
-#define EFF_BITS 18u                       /* the planner's packing (plan_internal.h) */
+#define EFF_BITS 18u /* the planner's packing (plan_internal.h) */
 
 /* The problem holder, sized to these problems. */
 #define FX_MAXV MAXM
@@ -101,9 +101,9 @@ static const char *pk(u128_t x)
 /* Problems                                                                              */
 
 /* A UAV flying straight at `speed` along heading th, over (cx, cy, cz) at time tm. */
-static coa_vehicle_t *fx_flyby(fx_t *f, double speed, double climb, uint32_t steep,
-                               double radius, double half, double th, double tm, double cx,
-                               double cy, double cz, double slope)
+static coa_vehicle_t *fx_flyby(fx_t *f, double speed, double climb, uint32_t steep, double radius,
+                               double half, double th, double tm, double cx, double cy, double cz,
+                               double slope)
 {
     size_t i = f->p.vehicle_count;
     double span = (double)f->p.dt * (double)f->p.horizon;
@@ -120,8 +120,8 @@ static void fx_crossing(fx_t *f, double speed, double th, double tm, double cx, 
                         double cz, double radius, double half)
 {
     coa_vec3_t vel = V(speed * cos(th), speed * sin(th), 0.0);
-    coa_track_t *t = fx_track(f, V(cx - (double)vel.x * tm, cy - (double)vel.y * tm, cz), vel,
-                              radius, half);
+    coa_track_t *t =
+        fx_track(f, V(cx - (double)vel.x * tm, cy - (double)vel.y * tm, cz), vel, radius, half);
     t->id = 100u;
 }
 
@@ -164,8 +164,8 @@ static void fx_single(fx_t *f, uint64_t *rng, uint32_t horizon, uint32_t steep)
     coa_vehicle_t *v;
 
     fx_init(f, dt, horizon);
-    v = fx_flyby(f, speed, climb, steep, speed * dt * unif(rng, 0.2, 0.5),
-                 dh * unif(rng, 0.6, 1.6), 0.0, 0.0, 0.0, 0.0, cz, 0.0);
+    v = fx_flyby(f, speed, climb, steep, speed * dt * unif(rng, 0.2, 0.5), dh * unif(rng, 0.6, 1.6),
+                 0.0, 0.0, 0.0, 0.0, cz, 0.0);
     random_offsets(rng, v);
     if (pick(rng, 6u) != 0u) {
         double t0 = unif(rng, -0.2, 0.8) * span;
@@ -186,7 +186,8 @@ static void fx_single(fx_t *f, uint64_t *rng, uint32_t horizon, uint32_t steep)
             hi = lo + unif(rng, 0.5, 5.0) * dh;
             break;
         }
-        fx_box(f, V(speed * t0, -unif(rng, 1, 20), cz + lo), V(speed * t1, unif(rng, 1, 20), cz + hi));
+        fx_box(f, V(speed * t0, -unif(rng, 1, 20), cz + lo),
+               V(speed * t1, unif(rng, 1, 20), cz + hi));
     }
     if (pick(rng, 3u) == 0u) {
         fx_crossing(f, unif(rng, 5, 20), unif(rng, 0.5, 2.6), unif(rng, 0.1, 1.0) * span,
@@ -217,13 +218,12 @@ static void fx_group(fx_t *f, uint64_t *rng, size_t m, uint32_t horizon, uint32_
         double climb = (double)(1u + pick(rng, 3u));
         double dh = climb * dt;
         double th = base + 6.283185307179586 * (double)i / (double)m + unif(rng, -0.5, 0.5);
-        coa_vehicle_t *v = fx_flyby(
-            f, speed, climb, 2u + pick(rng, max_steep - 1u), speed * dt * unif(rng, 0.25, 0.6),
-            dh * unif(rng, 0.6, 1.6), th,
-            (together ? common + unif(rng, -0.1, 0.1) : unif(rng, 0.15, 0.95)) * span,
-            unif(rng, -3, 3),
-            unif(rng, -3, 3), cz + unif(rng, -1.5, 1.5) * dh,
-            pick(rng, 3u) == 0u ? unif(rng, -0.1, 0.1) : 0.0);
+        coa_vehicle_t *v =
+            fx_flyby(f, speed, climb, 2u + pick(rng, max_steep - 1u),
+                     speed * dt * unif(rng, 0.25, 0.6), dh * unif(rng, 0.6, 1.6), th,
+                     (together ? common + unif(rng, -0.1, 0.1) : unif(rng, 0.15, 0.95)) * span,
+                     unif(rng, -3, 3), unif(rng, -3, 3), cz + unif(rng, -1.5, 1.5) * dh,
+                     pick(rng, 3u) == 0u ? unif(rng, -0.1, 0.1) : 0.0);
         random_offsets(rng, v);
         dhmin = dh < dhmin ? dh : dhmin;
     }
@@ -257,10 +257,10 @@ typedef struct {
     int32_t lim[MAXM];
     uint32_t steep[MAXM];
     coa_real_t dh[MAXM];
-    u128_t wunit[MAXM];                           /* W_i * S / (2 s_i) */
-    uint8_t ok[MAXM][MAXN][ROWW][ACTS];           /* in the bound, clear of obstacles and tracks */
-    u128_t tg[MAXM][MAXN + 1u][ROWW];             /* cost to go alone, packed; INF: dead */
-    u128_t fs[MAXM][MAXN + 1u][ROWW];             /* cost from the start alone; INF: none */
+    u128_t wunit[MAXM];                 /* W_i * S / (2 s_i) */
+    uint8_t ok[MAXM][MAXN][ROWW][ACTS]; /* in the bound, clear of obstacles and tracks */
+    u128_t tg[MAXM][MAXN + 1u][ROWW];   /* cost to go alone, packed; INF: dead */
+    u128_t fs[MAXM][MAXN + 1u][ROWW];   /* cost from the start alone; INF: none */
 } oracle_t;
 
 static int32_t delta(const oracle_t *o, size_t i, uint32_t a)
@@ -359,8 +359,7 @@ static void oracle_init(oracle_t *o, const fx_t *f)
                         continue;
                     }
                     s = sweep_of(o, i, k, x, b);
-                    o->ok[i][k][x - lo_of(o, i, k)][a] =
-                        fx_static_clear(o->f, &s, k) ? 1u : 0u;
+                    o->ok[i][k][x - lo_of(o, i, k)][a] = fx_static_clear(o->f, &s, k) ? 1u : 0u;
                 }
             }
         }
@@ -449,8 +448,8 @@ typedef struct {
 } best_t;
 
 /* Every action sequence from (k, x) to the horizon, by brute force. */
-static void dfs(const oracle_t *o, uint32_t k, int32_t x, uint64_t dev, uint32_t eff,
-                int32_t *path, best_t *b, uint64_t *visits)
+static void dfs(const oracle_t *o, uint32_t k, int32_t x, uint64_t dev, uint32_t eff, int32_t *path,
+                best_t *b, uint64_t *visits)
 {
     uint32_t a;
     ++*visits;
@@ -550,8 +549,7 @@ static void check_table(uint64_t seed, table_stats_t *st)
                 if (!cell_dead(cell) || cell_mask(cell) != 0u) {
                     ck_abort_msg("seed %llu: k=%u offset %d: brute force dead, table %s "
                                  "(dev %llu eff %u mask %#x)",
-                                 (unsigned long long)seed, k, x,
-                                 cell_dead(cell) ? "dead" : "live",
+                                 (unsigned long long)seed, k, x, cell_dead(cell) ? "dead" : "live",
                                  (unsigned long long)cell_dev(cell), cell_eff(cell),
                                  cell_mask(cell));
                 }
@@ -574,9 +572,9 @@ static void check_table(uint64_t seed, table_stats_t *st)
                 double want = (double)f.veh[0].cruise_speed * (double)f.p.dt *
                               ((double)f.veh[0].climb_rate * (double)f.p.dt) * (double)b->dev /
                               (2.0 * (double)steep);
-                ck_assert_int_eq(coa_plan_vehicle_cost(&f.veh[0], f.p.dt, horizon - k,
-                                                       &b->path[k], &dev, &eff),
-                                 COA_OK);
+                ck_assert_int_eq(
+                    coa_plan_vehicle_cost(&f.veh[0], f.p.dt, horizon - k, &b->path[k], &dev, &eff),
+                    COA_OK);
                 REQUIRE(eff == b->eff);
                 REQUIRE(fabs(dev - want) <= 1e-9 * (1.0 + want));
             }
@@ -610,8 +608,8 @@ START_TEST(table_exact)
     fprintf(stderr,
             "table_exact: %u problems, %u cells (%u live, %u dead), %u dead roots, %u initial "
             "conflicts, %u solved, %u actions masked out of live cells, %llu DFS visits\n",
-            st.problems, st.cells, st.live, st.dead, st.dead_roots, st.initial_conflicts,
-            st.solved, st.masked_out, (unsigned long long)st.visits);
+            st.problems, st.cells, st.live, st.dead, st.dead_roots, st.initial_conflicts, st.solved,
+            st.masked_out, (unsigned long long)st.visits);
     /* the generator must exercise dead states and masks */
     ck_assert_uint_gt(st.dead, 200u);
     ck_assert_uint_gt(st.masked_out, 200u);
@@ -779,9 +777,9 @@ typedef struct {
     const plan_group_t *g;
     uint32_t k0;
     uint32_t end;
-    layer_t layer[MAXN + 2u];  /* over the members in the search at k */
-    u128_t *ha[MAXN + 2u];     /* (A) exact cost to go over the search's graph */
-    u128_t *hb[MAXN + 2u];     /* (B) the same from the full programme */
+    layer_t layer[MAXN + 2u]; /* over the members in the search at k */
+    u128_t *ha[MAXN + 2u];    /* (A) exact cost to go over the search's graph */
+    u128_t *hb[MAXN + 2u];    /* (B) the same from the full programme */
     uint8_t *reach[MAXN + 2u];
     uint8_t *hlive[MAXN + 2u]; /* the heuristic says live */
     u128_t *h2[MAXN + 2u];     /* the doubled heuristic */
@@ -919,8 +917,8 @@ typedef struct {
     unsigned states;
     unsigned live_states;
     unsigned dead_by_h;
-    unsigned dead_by_own;  /* truly dead states the heuristic prices finite */
-    unsigned tight;        /* h == exact */
+    unsigned dead_by_own; /* truly dead states the heuristic prices finite */
+    unsigned tight;       /* h == exact */
     unsigned positive_matching;
     unsigned waiting_states; /* reachable states with a member waiting */
     unsigned left_states;    /* ... with a member that has left */
@@ -1015,8 +1013,8 @@ static unsigned check_pair_table(const oracle_t *o, const coa_planner_t *pl, siz
                 u128_t best = INF;
                 u128_t ti = tg_at(o, i, k, x);
                 u128_t tj = tg_at(o, j, k, y);
-                bool live = ti != INF && tj != INF && fs_at(o, i, k, x) != INF &&
-                            fs_at(o, j, k, y) != INF;
+                bool live =
+                    ti != INF && tj != INF && fs_at(o, i, k, x) != INF && fs_at(o, j, k, y) != INF;
                 coa_cost_t sur;
                 uint32_t a;
                 uint32_t b;
@@ -1042,13 +1040,13 @@ static unsigned check_pair_table(const oracle_t *o, const coa_planner_t *pl, siz
                 }
                 exact[k & 1u][x - lo_of(o, i, k)][y - lo_of(o, j, k)] = best;
                 sur = coa_plan_pair_surcharge(pl, i, j, k, x, y, to_cost(live ? ti : 0u),
-                                          to_cost(live ? tj : 0u));
+                                              to_cost(live ? tj : 0u));
                 if (!live || best == INF) {
                     if (!plan_cost_dead(sur)) {
                         ck_abort_msg("seed %llu: pair (%zu,%zu) k=%u (%d,%d): table live "
                                      "(surcharge %s), exact %s, offsets live both ways: %d",
-                                     (unsigned long long)seed, i, j, k, x, y,
-                                     pk(from_cost(sur)), pk(best), (int)live);
+                                     (unsigned long long)seed, i, j, k, x, y, pk(from_cost(sur)),
+                                     pk(best), (int)live);
                     }
                     continue;
                 }
@@ -1140,8 +1138,8 @@ static void check_joint(uint64_t seed, size_t m, joint_stats_t *st, coa_planner_
                 if (tv != tg || fv != fw) {
                     ck_abort_msg("%s seed %llu: UAV %zu k=%u offset %d: cost to go %s (exact "
                                  "%s), from the start %s (exact %s)",
-                                 fail_seed_msg, (unsigned long long)seed, i, k, x, pk(tv),
-                                 pk(tg), pk(fv), pk(fw));
+                                 fail_seed_msg, (unsigned long long)seed, i, k, x, pk(tv), pk(tg),
+                                 pk(fv), pk(fw));
                 }
             }
         }
@@ -1358,8 +1356,8 @@ static void check_joint(uint64_t seed, size_t m, joint_stats_t *st, coa_planner_
                             continue;
                         }
                         c = coa_plan_pair_surcharge(pl, pa[j], pb[j], k, at[pa[j]], at[pb[j]],
-                                                to_cost(tg_at(&o, pa[j], k, at[pa[j]])),
-                                                to_cost(tg_at(&o, pb[j], k, at[pb[j]])));
+                                                    to_cost(tg_at(&o, pa[j], k, at[pa[j]])),
+                                                    to_cost(tg_at(&o, pb[j], k, at[pb[j]])));
                         REQUIRE(!plan_cost_dead(c)); /* the heuristic said live */
                         sur[j] = from_cost(c);
                         pos += sur[j] > 0u ? 1u : 0u;
@@ -1412,8 +1410,7 @@ static void check_joint(uint64_t seed, size_t m, joint_stats_t *st, coa_planner_
                 size_t which[MAXM] = {0u, 1u, 2u};
                 if (out.status != COA_PLAN_SOLVED) {
                     ck_abort_msg("%s seed %llu: uncapped search status %d, optimum %s",
-                                 fail_seed_msg, (unsigned long long)seed, (int)out.status,
-                                 pk(opt));
+                                 fail_seed_msg, (unsigned long long)seed, (int)out.status, pk(opt));
                 }
                 ck_assert_int_eq(coa_plan_find_conflict(&f.p, rows, which, m, NULL, NULL), 0);
                 if (rows_cost(&o, rows) != opt) {
@@ -1571,7 +1568,8 @@ START_TEST(area_exact)
             int32_t d;
             for (d = -(int32_t)s; d <= (int32_t)s; ++d) {
                 int32_t far = a < 0 ? -COA_MAX_OFFSET - a : COA_MAX_OFFSET - a;
-                ck_assert_uint_eq(plan_area(a, a + d, s), (uint64_t)coa_area_scaled(a, a + d, 2u * s));
+                ck_assert_uint_eq(plan_area(a, a + d, s),
+                                  (uint64_t)coa_area_scaled(a, a + d, 2u * s));
                 if (far + d >= -COA_MAX_OFFSET && far + d <= COA_MAX_OFFSET) {
                     ck_assert_uint_eq(plan_area(far, far + d, s),
                                       (uint64_t)coa_area_scaled(far, far + d, 2u * s));

@@ -11,7 +11,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-
 #include "coavoid_lcm.h"
 #include "test_support.h"
 
@@ -216,18 +215,18 @@ static coavoid_status_t good_status(void)
 
 /* Encodes `m` of a generated type, decodes it into a zeroed struct and compares bytes
  * (fixed-size arrays only, so the structs hold no pointers). */
-#define ROUND_TRIP(type, m)                                                        \
-    do {                                                                           \
-        type back_;                                                                \
-        int size_ = type##_encoded_size(&(m));                                     \
-        unsigned char *buf_ = malloc((size_t)size_);                               \
-        ck_assert_ptr_nonnull(buf_);                                               \
-        ck_assert_int_eq(type##_encode(buf_, 0, size_, &(m)), size_);              \
-        memset(&back_, 0, sizeof back_);                                           \
-        ck_assert_int_eq(type##_decode(buf_, 0, size_, &back_), size_);            \
-        ck_assert_int_eq(memcmp(&back_, &(m), sizeof back_), 0);                   \
-        type##_decode_cleanup(&back_);                                             \
-        free(buf_);                                                                \
+#define ROUND_TRIP(type, m)                                             \
+    do {                                                                \
+        type back_;                                                     \
+        int size_ = type##_encoded_size(&(m));                          \
+        unsigned char *buf_ = malloc((size_t)size_);                    \
+        ck_assert_ptr_nonnull(buf_);                                    \
+        ck_assert_int_eq(type##_encode(buf_, 0, size_, &(m)), size_);   \
+        memset(&back_, 0, sizeof back_);                                \
+        ck_assert_int_eq(type##_decode(buf_, 0, size_, &back_), size_); \
+        ck_assert_int_eq(memcmp(&back_, &(m), sizeof back_), 0);        \
+        type##_decode_cleanup(&back_);                                  \
+        free(buf_);                                                     \
     } while (0)
 
 START_TEST(test_round_trip_wire)
@@ -268,7 +267,8 @@ static int intent_view(const coavoid_intent_t *m, intent_view_t *v, const char *
 {
     coavoid_lcm_context_t ctx = ctx_now();
     memset(v, 0, sizeof *v);
-    return coavoid_lcm_intent_to_core(m, &ctx, NULL, &v->info, &v->vehicle, &v->plan, &v->arrays, why);
+    return coavoid_lcm_intent_to_core(m, &ctx, NULL, &v->info, &v->vehicle, &v->plan, &v->arrays,
+                                      why);
 }
 
 /* Bits, not values: -0.0 == 0.0 and the test is about the last bit. */
@@ -364,7 +364,8 @@ START_TEST(test_round_trip_intent_core)
     /* And back: the sender's message, bit for bit in double; in float, a message that
      * gives the same core views again. */
     ck_assert_int_eq(coavoid_lcm_intent_from_core(&v->vehicle, &v->info, v->arrays.reference,
-                                              v->arrays.offsets, v->plan.count, &ctx, &back, &why),
+                                                  v->arrays.offsets, v->plan.count, &ctx, &back,
+                                                  &why),
                      COA_OK);
 #ifndef COA_SINGLE_PRECISION
     ck_assert_int_eq(memcmp(&back, &m, sizeof m), 0);
@@ -393,27 +394,29 @@ START_TEST(test_round_trip_intent_core)
     unbounded = v->vehicle;
     unbounded.max_offset = -5;
     ck_assert_int_eq(coavoid_lcm_intent_from_core(&unbounded, &v->info, v->arrays.reference,
-                                              v->arrays.offsets, v->plan.count, &ctx, &back, &why),
+                                                  v->arrays.offsets, v->plan.count, &ctx, &back,
+                                                  &why),
                      COA_OK);
     ck_assert_int_eq(back.max_offset, -1);
 
     /* What from_core and to_core refuse themselves. */
     ck_assert_int_eq(coavoid_lcm_intent_from_core(&v->vehicle, &v->info, v->arrays.reference,
-                                              v->arrays.offsets, 1, &ctx, &back, &why),
+                                                  v->arrays.offsets, 1, &ctx, &back, &why),
                      COAVOID_LCM_ERR_COUNT);
     ck_assert_int_eq(coavoid_lcm_intent_from_core(&v->vehicle, &v->info, v->arrays.reference,
-                                              v->arrays.offsets, 129, &ctx, &back, &why),
+                                                  v->arrays.offsets, 129, &ctx, &back, &why),
                      COAVOID_LCM_ERR_COUNT);
-    ck_assert_int_eq(coavoid_lcm_intent_from_core(&v->vehicle, &v->info, NULL, v->arrays.offsets, 61,
-                                              &ctx, &back, &why),
+    ck_assert_int_eq(coavoid_lcm_intent_from_core(&v->vehicle, &v->info, NULL, v->arrays.offsets,
+                                                  61, &ctx, &back, &why),
                      COA_ERR_ARGUMENT);
     unbounded.id = 0;
     ck_assert_int_eq(coavoid_lcm_intent_from_core(&unbounded, &v->info, v->arrays.reference,
-                                              v->arrays.offsets, v->plan.count, &ctx, &back, &why),
+                                                  v->arrays.offsets, v->plan.count, &ctx, &back,
+                                                  &why),
                      COAVOID_LCM_ERR_ID);
-    ck_assert_int_eq(coavoid_lcm_intent_to_core(&m, &ctx, NULL, &v->info, &v->vehicle, &v->plan, NULL,
-                                            &why),
-                     COA_ERR_ARGUMENT);
+    ck_assert_int_eq(
+        coavoid_lcm_intent_to_core(&m, &ctx, NULL, &v->info, &v->vehicle, &v->plan, NULL, &why),
+        COA_ERR_ARGUMENT);
     free(v);
     free(w);
 }
@@ -480,8 +483,8 @@ START_TEST(test_plan_from_intent)
     ck_assert_int_eq(offsets[0], -2);
     ck_assert_int_eq(offsets[60], 0);
     ck_assert(result.deviation > 0.0);
-    ck_assert_int_eq(coavoid_lcm_intent_from_core(&v->vehicle, &v->info, v->arrays.reference, offsets,
-                                              v->plan.count, &ctx, &replanned, &why),
+    ck_assert_int_eq(coavoid_lcm_intent_from_core(&v->vehicle, &v->info, v->arrays.reference,
+                                                  offsets, v->plan.count, &ctx, &replanned, &why),
                      COA_OK);
 
     /* The positions the receiver computed are the planner's to the last bit. The UAV flies
@@ -520,9 +523,9 @@ START_TEST(test_plan_from_intent)
     problem = intent_problem(v, references);
     problem.obstacles = slabs;
     problem.obstacle_count = 2u;
-    ck_assert_int_eq(coa_plan_find_conflict(&problem, v->arrays.offsets, (const size_t[]){0u}, 1u,
-                                             NULL, NULL),
-                      0);
+    ck_assert_int_eq(
+        coa_plan_find_conflict(&problem, v->arrays.offsets, (const size_t[]){0u}, 1u, NULL, NULL),
+        0);
     ck_assert_int_eq(coa_plan_centralised(ws.planner, &problem, offsets, &result), COA_OK);
     ck_assert_int_eq(result.status, COA_PLAN_SOLVED);
     ck_assert_uint_eq(result.nodes_expanded, 20u);
@@ -531,17 +534,17 @@ START_TEST(test_plan_from_intent)
     }
     /* Each slab one ulp closer: now it is a conflict from t = 0. */
     slabs[0].box.max.z = real_next(z - h, 1);
-    ck_assert_int_eq(coa_plan_find_conflict(&problem, v->arrays.offsets, (const size_t[]){0u}, 1u,
-                                            NULL, NULL),
-                     1);
+    ck_assert_int_eq(
+        coa_plan_find_conflict(&problem, v->arrays.offsets, (const size_t[]){0u}, 1u, NULL, NULL),
+        1);
     ck_assert_int_eq(coa_plan_centralised(ws.planner, &problem, offsets, &result), COA_OK);
     ck_assert_int_eq(result.status, COA_PLAN_INFEASIBLE);
     ck_assert_uint_eq(result.nodes_expanded, 0u);
     slabs[0].box.max.z = z - h;
     slabs[1].box.min.z = real_next(z + h, 0);
-    ck_assert_int_eq(coa_plan_find_conflict(&problem, v->arrays.offsets, (const size_t[]){0u}, 1u,
-                                            NULL, NULL),
-                     1);
+    ck_assert_int_eq(
+        coa_plan_find_conflict(&problem, v->arrays.offsets, (const size_t[]){0u}, 1u, NULL, NULL),
+        1);
     free(ws.mem);
     free(v);
 }
@@ -592,11 +595,21 @@ START_TEST(test_accepted_intent_is_plannable)
         for (c = 0; c < changes; ++c) {
             int32_t j = 1 + (int32_t)pick(&rng_state, 60u);
             switch (pick(&rng_state, 6u)) {
-            case 0: m.cruise_speed = wild(); break;
-            case 1: m.climb_rate = wild(); break;
-            case 2: m.step = wild(); break;
-            case 3: m.radius = wild(); break;
-            case 4: m.half_height = wild(); break;
+            case 0:
+                m.cruise_speed = wild();
+                break;
+            case 1:
+                m.climb_rate = wild();
+                break;
+            case 2:
+                m.step = wild();
+                break;
+            case 3:
+                m.radius = wild();
+                break;
+            case 4:
+                m.half_height = wild();
+                break;
             default:
                 m.reference[j][0] = m.reference[j - 1][0] + wild();
                 m.reference[j][1] = m.reference[j - 1][1] + (pick(&rng_state, 2u) ? wild() : 0.0);
@@ -625,14 +638,17 @@ START_TEST(test_round_trip_plan_core)
     int32_t offsets[COAVOID_PLAN_T_MAX_VEHICLES * COAVOID_PLAN_T_MAX_SAMPLES];
     const char *why = NULL;
     ck_assert_int_eq(coavoid_lcm_plan_to_core(&m, &ctx, NULL, &info, &result, offsets,
-                                          sizeof offsets / sizeof offsets[0], &why), COA_OK);
+                                              sizeof offsets / sizeof offsets[0], &why),
+                     COA_OK);
     ck_assert_int_eq(result.status, COA_PLAN_SOLVED);
     ck_assert_uint_eq(result.planned_count, 3u);
     ck_assert_int_eq(offsets[2 * 61 + 60], 9);
-    ck_assert_int_eq(coavoid_lcm_plan_from_core(&info, &result, offsets, &ctx, &back, &why), COA_OK);
+    ck_assert_int_eq(coavoid_lcm_plan_from_core(&info, &result, offsets, &ctx, &back, &why),
+                     COA_OK);
     ck_assert_int_eq(memcmp(&back, &m, sizeof m), 0);
-    ck_assert_int_eq(coavoid_lcm_plan_to_core(&m, &ctx, NULL, &info, &result, offsets, 3 * 61 - 1, &why),
-                     COAVOID_LCM_ERR_CAPACITY);
+    ck_assert_int_eq(
+        coavoid_lcm_plan_to_core(&m, &ctx, NULL, &info, &result, offsets, 3 * 61 - 1, &why),
+        COAVOID_LCM_ERR_CAPACITY);
 }
 END_TEST
 
@@ -646,7 +662,8 @@ START_TEST(test_round_trip_track_core)
     coa_track_point_t path[COAVOID_TRACK_T_MAX_PATH];
     const char *why = NULL;
     ck_assert_int_eq(coavoid_lcm_track_to_core(&m, &ctx, NULL, &info, &track, path,
-                                           COAVOID_TRACK_T_MAX_PATH, &why), COA_OK);
+                                               COAVOID_TRACK_T_MAX_PATH, &why),
+                     COA_OK);
     ck_assert_int_eq(coa_track_check(&track), COA_OK);
     /* Estimated at t = 4.8 s of the core clock: at t = 0 it was 4.8 s * 30 m/s east. */
     ck_assert(fabs((double)track.position.x - (500.0 + 30.0 * 4.8)) < 1e-3);
@@ -665,24 +682,28 @@ START_TEST(test_round_trip_map_core)
     coavoid_obstacle_map_t m = good_map();
     coavoid_obstacle_map_t back;
     coavoid_lcm_context_t ctx = ctx_now();
-    coa_obstacle_t obstacles[COAVOID_OBSTACLE_MAP_T_MAX_BOXES + COAVOID_OBSTACLE_MAP_T_MAX_POLYTOPES];
+    coa_obstacle_t
+        obstacles[COAVOID_OBSTACLE_MAP_T_MAX_BOXES + COAVOID_OBSTACLE_MAP_T_MAX_POLYTOPES];
     coa_vec3_t vertices[COAVOID_OBSTACLE_MAP_T_MAX_POLYTOPES * COAVOID_OBSTACLE_MAP_T_MAX_VERTICES];
     size_t n = 0;
     size_t i;
     const char *why = NULL;
-    ck_assert_int_eq(coavoid_lcm_obstacle_map_to_core(&m, &ctx, NULL, obstacles, 80, &n, vertices, 512,
-                                                  &why), COA_OK);
+    ck_assert_int_eq(
+        coavoid_lcm_obstacle_map_to_core(&m, &ctx, NULL, obstacles, 80, &n, vertices, 512, &why),
+        COA_OK);
     ck_assert_uint_eq(n, 3u);
     for (i = 0; i < n; ++i) {
         ck_assert_int_eq(coa_obstacle_check(&obstacles[i]), COA_OK);
     }
-    ck_assert_int_eq(coavoid_lcm_obstacle_map_from_core(obstacles, n, m.utime, 2, 4, &ctx, &back, &why),
-                     COA_OK);
+    ck_assert_int_eq(
+        coavoid_lcm_obstacle_map_from_core(obstacles, n, m.utime, 2, 4, &ctx, &back, &why), COA_OK);
     ck_assert_int_eq(memcmp(&back, &m, sizeof m), 0);
-    ck_assert_int_eq(coavoid_lcm_obstacle_map_to_core(&m, &ctx, NULL, obstacles, 2, &n, vertices, 512,
-                                                  &why), COAVOID_LCM_ERR_CAPACITY);
-    ck_assert_int_eq(coavoid_lcm_obstacle_map_to_core(&m, &ctx, NULL, obstacles, 80, &n, vertices, 4,
-                                                  &why), COAVOID_LCM_ERR_CAPACITY);
+    ck_assert_int_eq(
+        coavoid_lcm_obstacle_map_to_core(&m, &ctx, NULL, obstacles, 2, &n, vertices, 512, &why),
+        COAVOID_LCM_ERR_CAPACITY);
+    ck_assert_int_eq(
+        coavoid_lcm_obstacle_map_to_core(&m, &ctx, NULL, obstacles, 80, &n, vertices, 4, &why),
+        COAVOID_LCM_ERR_CAPACITY);
 }
 END_TEST
 
@@ -711,8 +732,9 @@ START_TEST(test_round_trip_report_core)
     c[1].min_horizontal = 40.0;
     c[1].min_vertical = 5.0;
     c[1].probability = 0.25;
-    ck_assert_int_eq(coavoid_lcm_conflict_report_from_core(c, 2, 2, plan_ids, 3, track_ids, 1, cluster,
-                                                       T0, 1, 100, T0, 1.0, 60, &ctx, &back, &why),
+    ck_assert_int_eq(coavoid_lcm_conflict_report_from_core(c, 2, 2, plan_ids, 3, track_ids, 1,
+                                                           cluster, T0, 1, 100, T0, 1.0, 60, &ctx,
+                                                           &back, &why),
                      COA_OK);
     ck_assert_int_eq(memcmp(&back, &m, sizeof m), 0);
 }
@@ -720,14 +742,14 @@ END_TEST
 
 /* ---- each rule refuses its bad message ---- */
 
-#define EXPECT(type, checker, mutate, code)                           \
-    do {                                                              \
-        type m_ = good_##checker##_msg();                             \
-        const char *why_ = NULL;                                      \
-        coavoid_lcm_context_t ctx_ = ctx_now();                           \
-        mutate;                                                       \
+#define EXPECT(type, checker, mutate, code)                                         \
+    do {                                                                            \
+        type m_ = good_##checker##_msg();                                           \
+        const char *why_ = NULL;                                                    \
+        coavoid_lcm_context_t ctx_ = ctx_now();                                     \
+        mutate;                                                                     \
         ck_assert_int_eq(coavoid_lcm_##checker##_check(&m_, &ctx_, &why_), (code)); \
-        ck_assert_ptr_nonnull(why_);                                  \
+        ck_assert_ptr_nonnull(why_);                                                \
     } while (0)
 
 #define good_intent_msg good_intent
@@ -739,16 +761,16 @@ END_TEST
 
 /* An intent mutation refused with `code`, by the rule whose reason contains `field`: many
  * rules share COAVOID_LCM_ERR_VALUE, and the reason shows which one fired. */
-#define EXPECT_INTENT(mutate, code, field)                                                 \
-    do {                                                                                   \
-        coavoid_intent_t m_ = good_intent();                                               \
-        const char *why_ = NULL;                                                           \
-        coavoid_lcm_context_t ctx_ = ctx_now();                                                \
-        mutate;                                                                            \
-        ck_assert_int_eq(coavoid_lcm_intent_check(&m_, &ctx_, &why_), (code));                 \
-        ck_assert_ptr_nonnull(why_);                                                       \
+#define EXPECT_INTENT(mutate, code, field)                                                   \
+    do {                                                                                     \
+        coavoid_intent_t m_ = good_intent();                                                 \
+        const char *why_ = NULL;                                                             \
+        coavoid_lcm_context_t ctx_ = ctx_now();                                              \
+        mutate;                                                                              \
+        ck_assert_int_eq(coavoid_lcm_intent_check(&m_, &ctx_, &why_), (code));               \
+        ck_assert_ptr_nonnull(why_);                                                         \
         ck_assert_msg(strstr(why_, (field)) != NULL, "reason \"%s\" does not name %s", why_, \
-                      (field));                                                            \
+                      (field));                                                              \
     } while (0)
 
 START_TEST(test_reject_intent)
@@ -792,7 +814,8 @@ START_TEST(test_reject_intent)
     /* Positive in double but nothing in the core: two tiny factors whose product (the
      * climb step, the planner's deviation weight) is 0 in either precision; and a volume
      * that is 0 once in float. */
-    EXPECT_INTENT((m_.climb_rate = 1e-200, m_.step = 1e-200), COAVOID_LCM_ERR_VALUE, "core's precision");
+    EXPECT_INTENT((m_.climb_rate = 1e-200, m_.step = 1e-200), COAVOID_LCM_ERR_VALUE,
+                  "core's precision");
     EXPECT_INTENT((m_.cruise_speed = 1e-200, m_.climb_rate = 1e-200), COAVOID_LCM_ERR_VALUE,
                   "core's precision");
 #ifdef COA_SINGLE_PRECISION
@@ -821,8 +844,9 @@ START_TEST(test_reject_intent)
     EXPECT_INTENT(m_.reference[60][0] = NAN, COAVOID_LCM_ERR_NONFINITE, "reference point");
     EXPECT_INTENT(m_.reference[0][2] = INFINITY, COAVOID_LCM_ERR_NONFINITE, "reference point");
     EXPECT_INTENT(m_.reference[10][1] = -2e7, COAVOID_LCM_ERR_VALUE, "reference point");
-    EXPECT_INTENT((m_.reference[5][0] = m_.reference[4][0], m_.reference[5][1] = m_.reference[4][1]),
-                  COAVOID_LCM_ERR_VALUE, "horizontal separation");
+    EXPECT_INTENT(
+        (m_.reference[5][0] = m_.reference[4][0], m_.reference[5][1] = m_.reference[4][1]),
+        COAVOID_LCM_ERR_VALUE, "horizontal separation");
     /* Only z differs: a vertical leg, which no cruise speed flies. */
     EXPECT_INTENT((m_.reference[5][0] = m_.reference[4][0], m_.reference[5][1] = m_.reference[4][1],
                    m_.reference[5][2] += 50.0),
@@ -931,7 +955,8 @@ START_TEST(test_reject_obstacle_map)
     EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.polytope_count = 17, COAVOID_LCM_ERR_COUNT);
     EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.vertex_count[0] = 3, COAVOID_LCM_ERR_COUNT);
     EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.vertex_count[0] = 33, COAVOID_LCM_ERR_COUNT);
-    EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.vertices[0][4][1] = -INFINITY, COAVOID_LCM_ERR_NONFINITE);
+    EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.vertices[0][4][1] = -INFINITY,
+           COAVOID_LCM_ERR_NONFINITE);
 }
 END_TEST
 
@@ -940,20 +965,28 @@ START_TEST(test_reject_conflict_report)
     EXPECT(coavoid_conflict_report_t, conflict_report, m_.utime = 0, COAVOID_LCM_ERR_TIME);
     EXPECT(coavoid_conflict_report_t, conflict_report, m_.reporter_id = 0, COAVOID_LCM_ERR_ID);
     EXPECT(coavoid_conflict_report_t, conflict_report, m_.sequence = -1, COAVOID_LCM_ERR_VALUE);
-    EXPECT(coavoid_conflict_report_t, conflict_report, m_.prediction_utime = 0, COAVOID_LCM_ERR_TIME);
+    EXPECT(coavoid_conflict_report_t, conflict_report, m_.prediction_utime = 0,
+           COAVOID_LCM_ERR_TIME);
     EXPECT(coavoid_conflict_report_t, conflict_report, m_.dt = 0.0, COAVOID_LCM_ERR_VALUE);
     EXPECT(coavoid_conflict_report_t, conflict_report, m_.horizon = 0, COAVOID_LCM_ERR_COUNT);
-    EXPECT(coavoid_conflict_report_t, conflict_report, m_.conflict_count = 65, COAVOID_LCM_ERR_COUNT);
-    EXPECT(coavoid_conflict_report_t, conflict_report, m_.conflicts_found = 1, COAVOID_LCM_ERR_COUNT);
+    EXPECT(coavoid_conflict_report_t, conflict_report, m_.conflict_count = 65,
+           COAVOID_LCM_ERR_COUNT);
+    EXPECT(coavoid_conflict_report_t, conflict_report, m_.conflicts_found = 1,
+           COAVOID_LCM_ERR_COUNT);
     EXPECT(coavoid_conflict_report_t, conflict_report, m_.kind[1] = 3, COAVOID_LCM_ERR_ENUM);
     EXPECT(coavoid_conflict_report_t, conflict_report, m_.a_id[0] = 0, COAVOID_LCM_ERR_ID);
     EXPECT(coavoid_conflict_report_t, conflict_report, m_.b_id[0] = m_.a_id[0], COAVOID_LCM_ERR_ID);
     EXPECT(coavoid_conflict_report_t, conflict_report, m_.b_id[1] = -1, COAVOID_LCM_ERR_ID);
-    EXPECT(coavoid_conflict_report_t, conflict_report, m_.first_step[0] = 60, COAVOID_LCM_ERR_VALUE);
-    EXPECT(coavoid_conflict_report_t, conflict_report, m_.min_horizontal[0] = NAN, COAVOID_LCM_ERR_NONFINITE);
-    EXPECT(coavoid_conflict_report_t, conflict_report, m_.min_vertical[1] = -1.0, COAVOID_LCM_ERR_VALUE);
-    EXPECT(coavoid_conflict_report_t, conflict_report, m_.probability[1] = 1.5, COAVOID_LCM_ERR_VALUE);
-    EXPECT(coavoid_conflict_report_t, conflict_report, m_.probability[1] = NAN, COAVOID_LCM_ERR_NONFINITE);
+    EXPECT(coavoid_conflict_report_t, conflict_report, m_.first_step[0] = 60,
+           COAVOID_LCM_ERR_VALUE);
+    EXPECT(coavoid_conflict_report_t, conflict_report, m_.min_horizontal[0] = NAN,
+           COAVOID_LCM_ERR_NONFINITE);
+    EXPECT(coavoid_conflict_report_t, conflict_report, m_.min_vertical[1] = -1.0,
+           COAVOID_LCM_ERR_VALUE);
+    EXPECT(coavoid_conflict_report_t, conflict_report, m_.probability[1] = 1.5,
+           COAVOID_LCM_ERR_VALUE);
+    EXPECT(coavoid_conflict_report_t, conflict_report, m_.probability[1] = NAN,
+           COAVOID_LCM_ERR_NONFINITE);
     EXPECT(coavoid_conflict_report_t, conflict_report, m_.cluster[0] = -2, COAVOID_LCM_ERR_VALUE);
 }
 END_TEST
@@ -1019,10 +1052,15 @@ START_TEST(test_sequence_rules)
     free(v);
     /* A map may be republished with the same version, never an older one. */
     coavoid_lcm_sequence_init(&table, entries, 2);
-    ck_assert_int_eq(coavoid_lcm_obstacle_map_to_core(&map, &ctx, &table, obstacles, 80, &n, vertices, 512, &why), COA_OK);
-    ck_assert_int_eq(coavoid_lcm_obstacle_map_to_core(&map, &ctx, &table, obstacles, 80, &n, vertices, 512, &why), COA_OK);
+    ck_assert_int_eq(coavoid_lcm_obstacle_map_to_core(&map, &ctx, &table, obstacles, 80, &n,
+                                                      vertices, 512, &why),
+                     COA_OK);
+    ck_assert_int_eq(coavoid_lcm_obstacle_map_to_core(&map, &ctx, &table, obstacles, 80, &n,
+                                                      vertices, 512, &why),
+                     COA_OK);
     map.version = 3;
-    ck_assert_int_eq(coavoid_lcm_obstacle_map_to_core(&map, &ctx, &table, obstacles, 80, &n, vertices, 512, &why),
+    ck_assert_int_eq(coavoid_lcm_obstacle_map_to_core(&map, &ctx, &table, obstacles, 80, &n,
+                                                      vertices, 512, &why),
                      COAVOID_LCM_ERR_SEQUENCE);
     ck_assert_str_eq(coavoid_lcm_error_name(COAVOID_LCM_ERR_SEQUENCE), "sequence went backwards");
 }
@@ -1103,21 +1141,21 @@ END_TEST
 
 /* Decodes buf[0..len) as `type` and, when it decodes, validates it and runs `usable` on
  * what the check accepted. Either way nothing may crash, leak or read out of bounds. */
-#define HOSTILE(type, checker, buf, len, usable)                                            \
-    do {                                                                                    \
-        type m_;                                                                            \
-        const char *why_ = NULL;                                                            \
-        coavoid_lcm_context_t ctx_ = ctx_now();                                                 \
-        memset(&m_, 0, sizeof m_);                                                          \
-        if (type##_decode((buf), 0, (int)(len), &m_) >= 0) {                                \
-            decoded++;                                                                      \
-            if (coavoid_lcm_##checker##_check(&m_, &ctx_, &why_) == COA_OK) {                    \
-                accepted++;                                                                 \
-                usable;                                                                     \
-            }                                                                               \
-            REQUIRE(why_ != NULL);                                                          \
-            type##_decode_cleanup(&m_);                                                     \
-        }                                                                                   \
+#define HOSTILE(type, checker, buf, len, usable)                              \
+    do {                                                                      \
+        type m_;                                                              \
+        const char *why_ = NULL;                                              \
+        coavoid_lcm_context_t ctx_ = ctx_now();                               \
+        memset(&m_, 0, sizeof m_);                                            \
+        if (type##_decode((buf), 0, (int)(len), &m_) >= 0) {                  \
+            decoded++;                                                        \
+            if (coavoid_lcm_##checker##_check(&m_, &ctx_, &why_) == COA_OK) { \
+                accepted++;                                                   \
+                usable;                                                       \
+            }                                                                 \
+            REQUIRE(why_ != NULL);                                            \
+            type##_decode_cleanup(&m_);                                       \
+        }                                                                     \
     } while (0)
 
 static void hostile_all(const unsigned char *buf, size_t len, int which, int *decoded_out,
@@ -1127,12 +1165,24 @@ static void hostile_all(const unsigned char *buf, size_t len, int which, int *de
     int accepted = 0;
     switch (which) {
     /* An intent a receiver accepts is one its planner can take. */
-    case 0: HOSTILE(coavoid_intent_t, intent, buf, len, require_usable_intent(&m_)); break;
-    case 1: HOSTILE(coavoid_plan_t, plan, buf, len, (void)0); break;
-    case 2: HOSTILE(coavoid_track_t, track, buf, len, (void)0); break;
-    case 3: HOSTILE(coavoid_obstacle_map_t, obstacle_map, buf, len, (void)0); break;
-    case 4: HOSTILE(coavoid_conflict_report_t, conflict_report, buf, len, (void)0); break;
-    default: HOSTILE(coavoid_status_t, status, buf, len, (void)0); break;
+    case 0:
+        HOSTILE(coavoid_intent_t, intent, buf, len, require_usable_intent(&m_));
+        break;
+    case 1:
+        HOSTILE(coavoid_plan_t, plan, buf, len, (void)0);
+        break;
+    case 2:
+        HOSTILE(coavoid_track_t, track, buf, len, (void)0);
+        break;
+    case 3:
+        HOSTILE(coavoid_obstacle_map_t, obstacle_map, buf, len, (void)0);
+        break;
+    case 4:
+        HOSTILE(coavoid_conflict_report_t, conflict_report, buf, len, (void)0);
+        break;
+    default:
+        HOSTILE(coavoid_status_t, status, buf, len, (void)0);
+        break;
     }
     *decoded_out += decoded;
     *accepted_out += accepted;
@@ -1144,21 +1194,33 @@ static unsigned char *encode_good(int which, size_t *len)
 {
     unsigned char *buf = NULL;
     int size = 0;
-#define ENC(type, fn)                                     \
-    do {                                                  \
-        type m_ = fn();                                   \
-        size = type##_encoded_size(&m_);                  \
-        buf = malloc((size_t)size);                       \
-        ck_assert_ptr_nonnull(buf);                       \
+#define ENC(type, fn)                                             \
+    do {                                                          \
+        type m_ = fn();                                           \
+        size = type##_encoded_size(&m_);                          \
+        buf = malloc((size_t)size);                               \
+        ck_assert_ptr_nonnull(buf);                               \
         ck_assert_int_eq(type##_encode(buf, 0, size, &m_), size); \
     } while (0)
     switch (which) {
-    case 0: ENC(coavoid_intent_t, good_intent); break;
-    case 1: ENC(coavoid_plan_t, good_plan); break;
-    case 2: ENC(coavoid_track_t, good_track); break;
-    case 3: ENC(coavoid_obstacle_map_t, good_map); break;
-    case 4: ENC(coavoid_conflict_report_t, good_report); break;
-    default: ENC(coavoid_status_t, good_status); break;
+    case 0:
+        ENC(coavoid_intent_t, good_intent);
+        break;
+    case 1:
+        ENC(coavoid_plan_t, good_plan);
+        break;
+    case 2:
+        ENC(coavoid_track_t, good_track);
+        break;
+    case 3:
+        ENC(coavoid_obstacle_map_t, good_map);
+        break;
+    case 4:
+        ENC(coavoid_conflict_report_t, good_report);
+        break;
+    default:
+        ENC(coavoid_status_t, good_status);
+        break;
     }
 #undef ENC
     *len = (size_t)size;

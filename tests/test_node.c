@@ -25,7 +25,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-
 #include <math.h>
 #include <string.h>
 
@@ -48,8 +47,8 @@ static void rig_init(rig_t *r, uint32_t horizon)
     r->lcm = lcm_create("memq://");
     ck_assert_ptr_nonnull(r->lcm);
     r->now = EPOCH;
-    ck_assert_int_eq(coavoid_node_common_defaults(&r->common, EPOCH, (coa_real_t)1, horizon, &r->now),
-                     COA_OK);
+    ck_assert_int_eq(
+        coavoid_node_common_defaults(&r->common, EPOCH, (coa_real_t)1, horizon, &r->now), COA_OK);
 }
 
 static void drain(lcm_t *lcm)
@@ -89,7 +88,8 @@ static coa_vehicle_t uav(uint16_t id, uint32_t priority, coa_vec3_t *route, coa_
     return v;
 }
 
-static coavoid_vehicle_node_t *vehicle_node(const rig_t *r, coa_vehicle_t v, coavoid_node_mode_t mode)
+static coavoid_vehicle_node_t *vehicle_node(const rig_t *r, coa_vehicle_t v,
+                                            coavoid_node_mode_t mode)
 {
     coavoid_vehicle_node_config_t config;
     memset(&config, 0, sizeof config);
@@ -172,7 +172,8 @@ START_TEST(test_undecodable_counted_own_ignored)
     rig_t r;
     rig_init(&r, 10);
     coa_vec3_t route[2];
-    coavoid_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, route, 0, 500, 0, 100), COAVOID_NODE_CENTRALISED);
+    coavoid_vehicle_node_t *a =
+        vehicle_node(&r, uav(1, 1, route, 0, 500, 0, 100), COAVOID_NODE_CENTRALISED);
     const coavoid_vehicle_node_state_t *s = coavoid_vehicle_node_state(a);
     ck_assert_int_eq(s->cycle, -1);
 
@@ -183,8 +184,9 @@ START_TEST(test_undecodable_counted_own_ignored)
     ck_assert_int_eq(s->rx.received, 0);
 
     const uint8_t junk[7] = {1, 2, 3, 4, 5, 6, 7};
-    const char *channels[] = {COAVOID_CHANNEL_INTENT, COAVOID_CHANNEL_TRACK, COAVOID_CHANNEL_OBSTACLES,
-                              COAVOID_CHANNEL_STATUS, COAVOID_CHANNEL_PLAN};
+    const char *channels[] = {COAVOID_CHANNEL_INTENT, COAVOID_CHANNEL_TRACK,
+                              COAVOID_CHANNEL_OBSTACLES, COAVOID_CHANNEL_STATUS,
+                              COAVOID_CHANNEL_PLAN};
     for (size_t i = 0; i < 5; i++) {
         ck_assert_int_eq(lcm_publish(r.lcm, channels[i], junk, sizeof junk), 0);
     }
@@ -195,7 +197,8 @@ START_TEST(test_undecodable_counted_own_ignored)
 
     /* Another UAV's intent is counted and accepted. */
     coa_vec3_t route2[2];
-    coavoid_vehicle_node_t *b = vehicle_node(&r, uav(2, 2, route2, 0, 500, 500, 100), COAVOID_NODE_DECOUPLED);
+    coavoid_vehicle_node_t *b =
+        vehicle_node(&r, uav(2, 2, route2, 0, 500, 500, 100), COAVOID_NODE_DECOUPLED);
     ck_assert_int_eq(coavoid_vehicle_node_cycle(b, r.now), COA_OK);
     drain(r.lcm);
     ck_assert_int_eq(s->rx.received, 7); /* its intent and its heartbeat */
@@ -214,7 +217,8 @@ START_TEST(test_restarted_peer_accepted_after_silence)
     rig_init(&r, 10);
     coa_vec3_t r1[2], r2[2];
     coa_vehicle_t v2 = uav(2, 2, r2, 0, 500, 800, 100);
-    coavoid_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, r1, 0, 500, 0, 100), COAVOID_NODE_DECOUPLED);
+    coavoid_vehicle_node_t *a =
+        vehicle_node(&r, uav(1, 1, r1, 0, 500, 0, 100), COAVOID_NODE_DECOUPLED);
     coavoid_vehicle_node_t *b = vehicle_node(&r, v2, COAVOID_NODE_DECOUPLED);
     const coavoid_vehicle_node_state_t *s = coavoid_vehicle_node_state(a);
     for (int64_t k = 0; k <= 3; k++) {
@@ -256,7 +260,8 @@ START_TEST(test_plan_adoption_rules)
     rig_t r;
     rig_init(&r, 10);
     coa_vec3_t route[2];
-    coavoid_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, route, 0, 500, 0, 100), COAVOID_NODE_CENTRALISED);
+    coavoid_vehicle_node_t *a =
+        vehicle_node(&r, uav(1, 1, route, 0, 500, 0, 100), COAVOID_NODE_CENTRALISED);
     const coavoid_vehicle_node_state_t *s = coavoid_vehicle_node_state(a);
     ck_assert_int_eq(coavoid_vehicle_node_cycle(a, cycle(0)), COA_OK);
     drain(r.lcm);
@@ -318,7 +323,8 @@ START_TEST(test_plan_ids_do_not_lock_out)
     rig_t r;
     rig_init(&r, 10);
     coa_vec3_t route[2];
-    coavoid_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, route, 0, 500, 0, 100), COAVOID_NODE_CENTRALISED);
+    coavoid_vehicle_node_t *a =
+        vehicle_node(&r, uav(1, 1, route, 0, 500, 0, 100), COAVOID_NODE_CENTRALISED);
     const coavoid_vehicle_node_state_t *s = coavoid_vehicle_node_state(a);
     int64_t sequence = 0;
     ck_assert_int_eq(coavoid_vehicle_node_cycle(a, cycle(0)), COA_OK);
@@ -384,7 +390,8 @@ START_TEST(test_plan_into_terrain_refused)
     coavoid_world_t *w = coavoid_world_create(&wc, r.lcm, &error);
     ck_assert_ptr_nonnull(w);
     coa_vec3_t route[2];
-    coavoid_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, route, 0, 500, 0, 100), COAVOID_NODE_CENTRALISED);
+    coavoid_vehicle_node_t *a =
+        vehicle_node(&r, uav(1, 1, route, 0, 500, 0, 100), COAVOID_NODE_CENTRALISED);
     const coavoid_vehicle_node_state_t *s = coavoid_vehicle_node_state(a);
     ck_assert_int_eq(coavoid_world_cycle(w, r.now), COA_OK);
     drain(r.lcm);
@@ -466,14 +473,16 @@ START_TEST(test_duplicate_id_reported)
     health_probe_t probe = {1, 0, -1};
     lcm_subscription_t *sub = lcm_subscribe(r.lcm, COAVOID_CHANNEL_STATUS, on_status_probe, &probe);
     coa_vec3_t r1[2], r2[2];
-    coavoid_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, r1, 0, 500, 0, 100), COAVOID_NODE_DECOUPLED);
+    coavoid_vehicle_node_t *a =
+        vehicle_node(&r, uav(1, 1, r1, 0, 500, 0, 100), COAVOID_NODE_DECOUPLED);
     const coavoid_vehicle_node_state_t *s = coavoid_vehicle_node_state(a);
     ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
     drain(r.lcm);
     ck_assert_int_eq(probe.health, COAVOID_STATUS_T_HEALTH_OK);
     ck_assert_int_eq(s->rx.received, 0); /* its own intent came back: not counted */
     /* Its twin starts in the same cycle, on the same clock: the same utime and sequence. */
-    coavoid_vehicle_node_t *b = vehicle_node(&r, uav(1, 1, r2, 0, 500, 800, 100), COAVOID_NODE_DECOUPLED);
+    coavoid_vehicle_node_t *b =
+        vehicle_node(&r, uav(1, 1, r2, 0, 500, 800, 100), COAVOID_NODE_DECOUPLED);
     ck_assert_int_eq(coavoid_vehicle_node_cycle(b, r.now), COA_OK);
     drain(r.lcm);
     coavoid_vehicle_node_destroy(b);
@@ -509,7 +518,8 @@ START_TEST(test_refusals_degrade_health)
     lcm_subscription_t *sa = lcm_subscribe(r.lcm, COAVOID_CHANNEL_STATUS, on_status_probe, &pa);
     lcm_subscription_t *sc = lcm_subscribe(r.lcm, COAVOID_CHANNEL_STATUS, on_status_probe, &pc);
     coa_vec3_t r1[2], r2[2];
-    coavoid_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, r1, 0, 500, 0, 100), COAVOID_NODE_DECOUPLED);
+    coavoid_vehicle_node_t *a =
+        vehicle_node(&r, uav(1, 1, r1, 0, 500, 0, 100), COAVOID_NODE_DECOUPLED);
     const coavoid_vehicle_node_state_t *s = coavoid_vehicle_node_state(a);
     coavoid_coordinator_config_t cc;
     memset(&cc, 0, sizeof cc);
@@ -535,8 +545,8 @@ START_TEST(test_refusals_degrade_health)
         drain(r.lcm);
         ck_assert_int_eq(coavoid_coordinator_cycle(co, r.now + DT_US / 4), COA_OK);
         drain(r.lcm);
-        const int8_t want = k == 0 || k == 3 ? COAVOID_STATUS_T_HEALTH_OK
-                                             : COAVOID_STATUS_T_HEALTH_DEGRADED;
+        const int8_t want =
+            k == 0 || k == 3 ? COAVOID_STATUS_T_HEALTH_OK : COAVOID_STATUS_T_HEALTH_DEGRADED;
         ck_assert_msg(pa.health == want, "cycle %d: vehicle health %d", (int)k, pa.health);
         ck_assert_msg(pc.health == want, "cycle %d: coordinator health %d", (int)k, pc.health);
         if (k == 0) {
@@ -567,7 +577,8 @@ START_TEST(test_fallback_and_return)
     rig_t r;
     rig_init(&r, 10);
     coa_vec3_t route[2];
-    coavoid_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, route, 0, 500, 0, 100), COAVOID_NODE_CENTRALISED);
+    coavoid_vehicle_node_t *a =
+        vehicle_node(&r, uav(1, 1, route, 0, 500, 0, 100), COAVOID_NODE_CENTRALISED);
     const coavoid_vehicle_node_state_t *s = coavoid_vehicle_node_state(a);
     int64_t sequence = 0;
     /* Heartbeats at k + 1/4 for k in 0..4 and 10..14; timeout 2.5 cycles. */
@@ -653,7 +664,8 @@ START_TEST(test_faulty_coordinator_not_followed)
     rig_t r;
     rig_init(&r, 10);
     coa_vec3_t route[2];
-    coavoid_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, route, 0, 500, 0, 100), COAVOID_NODE_CENTRALISED);
+    coavoid_vehicle_node_t *a =
+        vehicle_node(&r, uav(1, 1, route, 0, 500, 0, 100), COAVOID_NODE_CENTRALISED);
     const coavoid_vehicle_node_state_t *s = coavoid_vehicle_node_state(a);
     /* Heartbeats every cycle, HEALTH_FAULT from cycle 2 on: the last one that counts is
      * at 1.25, so from cycle 4 (2.75 s later) the UAV plans for itself. */
@@ -701,7 +713,7 @@ START_TEST(test_late_plans_fall_back)
     v[0] = vehicle_node(&r, uav(1, 1, r1, 0, 600, 0, 100), COAVOID_NODE_CENTRALISED);
     v[1] = vehicle_node(&r, uav(2, 2, r2, 300, -300, 0, 100), COAVOID_NODE_CENTRALISED);
     const coavoid_vehicle_node_state_t *s[2] = {coavoid_vehicle_node_state(v[0]),
-                                            coavoid_vehicle_node_state(v[1])};
+                                                coavoid_vehicle_node_state(v[1])};
     coavoid_coordinator_config_t cc;
     memset(&cc, 0, sizeof cc);
     cc.common = r.common;
@@ -824,8 +836,10 @@ START_TEST(test_coordinator_skips_decoupled_uav)
     memset(&probe, 0, sizeof probe);
     lcm_subscription_t *sub = lcm_subscribe(r.lcm, COAVOID_CHANNEL_PLAN, on_plan_probe, &probe);
     coa_vec3_t r1[2], r2[2];
-    coavoid_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, r1, 0, 600, 0, 100), COAVOID_NODE_DECOUPLED);
-    coavoid_vehicle_node_t *b = vehicle_node(&r, uav(2, 2, r2, 300, -300, 0, 100), COAVOID_NODE_CENTRALISED);
+    coavoid_vehicle_node_t *a =
+        vehicle_node(&r, uav(1, 1, r1, 0, 600, 0, 100), COAVOID_NODE_DECOUPLED);
+    coavoid_vehicle_node_t *b =
+        vehicle_node(&r, uav(2, 2, r2, 300, -300, 0, 100), COAVOID_NODE_CENTRALISED);
     coavoid_coordinator_config_t cc;
     memset(&cc, 0, sizeof cc);
     cc.common = r.common;
@@ -860,8 +874,10 @@ START_TEST(test_lower_priority_waits)
     rig_init(&r, 24);
     coa_vec3_t r1[2], r2[2];
     /* Head-on, conflict around t = 13.5 s. 1 has priority. */
-    coavoid_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, r1, 0, 600, 0, 100), COAVOID_NODE_DECOUPLED);
-    coavoid_vehicle_node_t *b = vehicle_node(&r, uav(2, 2, r2, 300, -300, 0, 100), COAVOID_NODE_DECOUPLED);
+    coavoid_vehicle_node_t *a =
+        vehicle_node(&r, uav(1, 1, r1, 0, 600, 0, 100), COAVOID_NODE_DECOUPLED);
+    coavoid_vehicle_node_t *b =
+        vehicle_node(&r, uav(2, 2, r2, 300, -300, 0, 100), COAVOID_NODE_DECOUPLED);
     const coavoid_vehicle_node_state_t *sa = coavoid_vehicle_node_state(a);
     const coavoid_vehicle_node_state_t *sb = coavoid_vehicle_node_state(b);
     /* Cycle 0: only 1 runs, so 2 knows 1's intent of cycle 0 and nothing newer. */
@@ -904,9 +920,12 @@ START_TEST(test_waits_for_near_higher_priority)
     rig_init(&r, 24);
     coa_vec3_t r1[2], r2[2], r3[2];
     /* 1 and 2 meet head-on 30 m apart vertically (clear); 3 is 5 km away. */
-    coavoid_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, r1, 0, 600, 0, 100), COAVOID_NODE_DECOUPLED);
-    coavoid_vehicle_node_t *b = vehicle_node(&r, uav(2, 2, r2, 300, -300, 0, 130), COAVOID_NODE_DECOUPLED);
-    coavoid_vehicle_node_t *c = vehicle_node(&r, uav(3, 1, r3, 0, 600, 5000, 100), COAVOID_NODE_DECOUPLED);
+    coavoid_vehicle_node_t *a =
+        vehicle_node(&r, uav(1, 1, r1, 0, 600, 0, 100), COAVOID_NODE_DECOUPLED);
+    coavoid_vehicle_node_t *b =
+        vehicle_node(&r, uav(2, 2, r2, 300, -300, 0, 130), COAVOID_NODE_DECOUPLED);
+    coavoid_vehicle_node_t *c =
+        vehicle_node(&r, uav(3, 1, r3, 0, 600, 5000, 100), COAVOID_NODE_DECOUPLED);
     const coavoid_vehicle_node_state_t *sb = coavoid_vehicle_node_state(b);
     ck_assert_int_eq(coavoid_vehicle_node_cycle(a, cycle(0)), COA_OK);
     ck_assert_int_eq(coavoid_vehicle_node_cycle(c, cycle(0)), COA_OK);
@@ -935,8 +954,10 @@ START_TEST(test_wait_ends_at_deadline)
     rig_t r;
     rig_init(&r, 24);
     coa_vec3_t r1[2], r2[2];
-    coavoid_vehicle_node_t *a = vehicle_node(&r, uav(1, 1, r1, 0, 600, 0, 100), COAVOID_NODE_DECOUPLED);
-    coavoid_vehicle_node_t *b = vehicle_node(&r, uav(2, 2, r2, 300, -300, 0, 100), COAVOID_NODE_DECOUPLED);
+    coavoid_vehicle_node_t *a =
+        vehicle_node(&r, uav(1, 1, r1, 0, 600, 0, 100), COAVOID_NODE_DECOUPLED);
+    coavoid_vehicle_node_t *b =
+        vehicle_node(&r, uav(2, 2, r2, 300, -300, 0, 100), COAVOID_NODE_DECOUPLED);
     const coavoid_vehicle_node_state_t *sb = coavoid_vehicle_node_state(b);
     ck_assert_int_eq(coavoid_vehicle_node_cycle(a, cycle(0)), COA_OK);
     drain(r.lcm);
@@ -994,7 +1015,7 @@ START_TEST(test_higher_priority_replans_in_cluster)
     coa_vehicle_t v2 = uav(2, 2, r2, 600, -200, 0, 112);
     v2.max_offset = 1;
     coavoid_vehicle_node_t *v[2] = {vehicle_node(&r, v1, COAVOID_NODE_DECOUPLED),
-                                vehicle_node(&r, v2, COAVOID_NODE_DECOUPLED)};
+                                    vehicle_node(&r, v2, COAVOID_NODE_DECOUPLED)};
     const coavoid_vehicle_node_state_t *sa = coavoid_vehicle_node_state(v[0]);
     const coavoid_vehicle_node_state_t *sb = coavoid_vehicle_node_state(v[1]);
     coa_vec3_t p[2][41];
@@ -1034,7 +1055,8 @@ START_TEST(test_silent_uav_avoided_as_track)
     /* 2 has priority and is 620 m away head-on: they would meet around t = 30 s, beyond
      * the first horizon. 2 publishes once and falls silent. */
     coa_vehicle_t v2 = uav(2, 1, r2, 620, -1380, 0, 100);
-    coavoid_vehicle_node_t *a = vehicle_node(&r, uav(1, 2, r1, 0, 2000, 0, 100), COAVOID_NODE_DECOUPLED);
+    coavoid_vehicle_node_t *a =
+        vehicle_node(&r, uav(1, 2, r1, 0, 2000, 0, 100), COAVOID_NODE_DECOUPLED);
     coavoid_vehicle_node_t *b = vehicle_node(&r, v2, COAVOID_NODE_DECOUPLED);
     const coavoid_vehicle_node_state_t *sa = coavoid_vehicle_node_state(a);
     ck_assert_int_eq(coavoid_vehicle_node_cycle(a, cycle(0)), COA_OK);
@@ -1096,14 +1118,15 @@ static void on_track(const lcm_recv_buf_t *rbuf, const char *channel, void *user
     coa_track_t got;
     coa_track_point_t path[COAVOID_TRACK_T_MAX_PATH];
     REQUIRE(coavoid_lcm_track_to_core(&msg, &ctx, NULL, &info, &got, path, COAVOID_TRACK_T_MAX_PATH,
-                                  NULL) == COA_OK);
+                                      NULL) == COA_OK);
     REQUIRE(got.path_count >= 2);
     p->truncated += got.path_count == COAVOID_TRACK_T_MAX_PATH;
     const coa_real_t covered = got.path[got.path_count - 1u].t;
     for (int j = 0; j <= 20 && (coa_real_t)j <= covered; j++) {
         coa_vec3_t a = coa_track_at(&got, (coa_real_t)j);
         coa_vec3_t b = coa_track_at(&p->original, (coa_real_t)(k + j));
-        double e = fmax(fabs((double)(a.x - b.x)), fmax(fabs((double)(a.y - b.y)), fabs((double)(a.z - b.z))));
+        double e = fmax(fabs((double)(a.x - b.x)),
+                        fmax(fabs((double)(a.y - b.y)), fabs((double)(a.z - b.z))));
         p->worst = fmax(p->worst, e);
     }
     /* The path reaches the horizon's end unless the message ran out of points. */
@@ -1166,10 +1189,14 @@ START_TEST(test_bad_configs_refused)
     rig_t r;
     rig_init(&r, 10);
     coavoid_node_common_t c;
-    ck_assert_int_eq(coavoid_node_common_defaults(&c, EPOCH, (coa_real_t)1, 128, &r.now), COA_ERR_ARGUMENT);
-    ck_assert_int_eq(coavoid_node_common_defaults(&c, EPOCH, (coa_real_t)0, 10, &r.now), COA_ERR_ARGUMENT);
-    ck_assert_int_eq(coavoid_node_common_defaults(&c, 0, (coa_real_t)1, 10, &r.now), COA_ERR_ARGUMENT);
-    ck_assert_int_eq(coavoid_node_common_defaults(&c, EPOCH, (coa_real_t)1, 10, NULL), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coavoid_node_common_defaults(&c, EPOCH, (coa_real_t)1, 128, &r.now),
+                     COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coavoid_node_common_defaults(&c, EPOCH, (coa_real_t)0, 10, &r.now),
+                     COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coavoid_node_common_defaults(&c, 0, (coa_real_t)1, 10, &r.now),
+                     COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coavoid_node_common_defaults(&c, EPOCH, (coa_real_t)1, 10, NULL),
+                     COA_ERR_ARGUMENT);
     ck_assert_int_eq(coavoid_node_cycle_of(&r.common, EPOCH - 1), -1);
     ck_assert_int_eq(coavoid_node_cycle_of(&r.common, EPOCH + 2 * DT_US), 2);
     ck_assert_int_eq(coavoid_node_cycle_utime(&r.common, 3), EPOCH + 3 * DT_US);

@@ -252,10 +252,10 @@ START_TEST(predictor_makes_no_heap_call)
         for (j = 0; j < 12u; ++j) {
             double t = (double)plans[i].t0 + (double)j * (double)plans[i].step;
             /* 0 and 1 meet head-on; 2 crosses them; 3 hovers where 0 passes. */
-            samples[i][j] = i == 0u ? V(-60.0 + 10.0 * t, 0, 100)
-                          : i == 1u ? V(60.0 - 10.0 * t, 5, 100)
-                          : i == 2u ? V(0, -40.0 + 8.0 * t, 102)
-                                    : V(30, 3, 98);
+            samples[i][j] = i == 0u   ? V(-60.0 + 10.0 * t, 0, 100)
+                            : i == 1u ? V(60.0 - 10.0 * t, 5, 100)
+                            : i == 2u ? V(0, -40.0 + 8.0 * t, 102)
+                                      : V(30, 3, 98);
         }
     }
     obs[0].kind = COA_OBSTACLE_BOX;
@@ -295,8 +295,8 @@ START_TEST(predictor_makes_no_heap_call)
         cfg.all_pairs = i == 1u;
         rc[i] = coa_predict(pr, &cfg, plans, 4u, obs, 2u, &track, 1u, conflicts[i], 3u, &res[i]);
     }
-    rc_clusters = coa_predict_clusters(conflicts[0], res[0].conflict_count, 4u, cluster,
-                                       &cluster_count);
+    rc_clusters =
+        coa_predict_clusters(conflicts[0], res[0].conflict_count, 4u, cluster, &cluster_count);
     p = coa_conflict_probability((coa_real_t)25.0, (coa_real_t)2.0, (coa_real_t)20.0,
                                  (coa_real_t)10.0, (coa_real_t)5.0, (coa_real_t)1.0);
     armed = false;

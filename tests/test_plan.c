@@ -50,11 +50,11 @@ __extension__ typedef unsigned __int128 u128_t;
 static struct {
     unsigned dt_half;
     unsigned dt_two;
-    unsigned extrapolated;     /* a route that ends inside the window */
-    unsigned multi_leg_climb;  /* a route of 2 or more legs with a climbing or descending leg */
-    unsigned path_late_start;  /* a track path whose first point comes after t = 0 */
-    unsigned far_offset;       /* |initial_offset| >= 2 */
-    unsigned pinned;           /* max_offset == |initial_offset| */
+    unsigned extrapolated;    /* a route that ends inside the window */
+    unsigned multi_leg_climb; /* a route of 2 or more legs with a climbing or descending leg */
+    unsigned path_late_start; /* a track path whose first point comes after t = 0 */
+    unsigned far_offset;      /* |initial_offset| >= 2 */
+    unsigned pinned;          /* max_offset == |initial_offset| */
 } gen;
 
 static void fx_random(fx_t *f, uint64_t *rng, size_t n, uint32_t horizon, uint32_t max_steep)
@@ -93,11 +93,10 @@ static void fx_random(fx_t *f, uint64_t *rng, size_t n, uint32_t horizon, uint32
         bool climbs = false;
         coa_vec3_t at;
         coa_vec3_t shift;
-        coa_vehicle_t *v = fx_vehicle(f, (uint16_t)(10u + pick(rng, 5u) * 10u + i),
-                                      1u + pick(rng, 3u), speed, climb,
-                                      2u + pick(rng, max_steep - 1u),
-                                      speed * dt * unif(rng, 0.3, 0.6), dh * unif(rng, 0.6, 1.6),
-                                      V(0, 0, 0), V(1, 0, 0));
+        coa_vehicle_t *v =
+            fx_vehicle(f, (uint16_t)(10u + pick(rng, 5u) * 10u + i), 1u + pick(rng, 3u), speed,
+                       climb, 2u + pick(rng, max_steep - 1u), speed * dt * unif(rng, 0.3, 0.6),
+                       dh * unif(rng, 0.6, 1.6), V(0, 0, 0), V(1, 0, 0));
         f->route[i][0] = V(0, 0, 0);
         for (j = 1; j < npts; ++j) {
             double len = total / (double)(npts - 1u) * unif(rng, 0.6, 1.4);
@@ -364,8 +363,8 @@ static uint32_t effort_of_delta(int32_t d)
     return d == 0 ? 0u : (d == 1 || d == -1) ? 1u : 3u;
 }
 
-static void row_cost(const fx_t *f, size_t v, const int32_t *rows, u128_t *units,
-                     uint32_t *effort, double *dev)
+static void row_cost(const fx_t *f, size_t v, const int32_t *rows, u128_t *units, uint32_t *effort,
+                     double *dev)
 {
     const int32_t *r = &rows[v * ROW(f)];
     oracle_t o;
@@ -389,7 +388,7 @@ static void row_cost(const fx_t *f, size_t v, const int32_t *rows, u128_t *units
 /* Exhaustive search: layered dynamic programming over offset vectors                    */
 
 #define DP_MAXM 3u
-#define DP_MAXR 41u    /* offsets a vehicle can reach, when several move together */
+#define DP_MAXR 41u     /* offsets a vehicle can reach, when several move together */
 #define DP_MAXSPAN 129u /* the same for one vehicle alone */
 #define DP_MAXSTATES (DP_MAXR * DP_MAXR * DP_MAXR)
 #define DP_CELLS (DP_MAXR * 5u)
@@ -853,16 +852,14 @@ START_TEST(decoupled_each_vehicle_optimal_given_earlier)
         ck_assert(r.status != COA_PLAN_BUDGET_EXHAUSTED);
         ck_assert_uint_eq(r.nodes_generated, 0u);
         /* One search per UAV planned, the one that failed included. */
-        ck_assert_uint_eq(r.searches,
-                          r.planned_count + (r.status == COA_PLAN_SOLVED ? 0u : 1u));
+        ck_assert_uint_eq(r.searches, r.planned_count + (r.status == COA_PLAN_SOLVED ? 0u : 1u));
         for (i = 0; i < n; ++i) {
             ck_assert_uint_eq(r.order[i], prio[i]);
         }
         check_decoupled_attempt(&f, rows, &r);
         /* One order only: every order is covered just when a proof covers them all. */
-        ck_assert(r.all_orders_covered ==
-                  (r.status == COA_PLAN_INFEASIBLE &&
-                   (r.planned_count == 0u || conflict_at_start(&f))));
+        ck_assert(r.all_orders_covered == (r.status == COA_PLAN_INFEASIBLE &&
+                                           (r.planned_count == 0u || conflict_at_start(&f))));
         if (r.status == COA_PLAN_SOLVED) {
             ++solved;
         } else {
@@ -954,7 +951,8 @@ START_TEST(reordering_finds_an_order_iff_one_exists)
                       "trial %u: status %d after %u orders; orders that work alone: %d%d%d%d%d%d "
                       "prio %zu%zu%zu failed %zu at %zu",
                       trial, (int)r.status, r.orders_tried, works[0], works[1], works[2], works[3],
-                      works[4], works[5], prio[0], prio[1], prio[2], r.failed_vehicle, r.planned_count);
+                      works[4], works[5], prio[0], prio[1], prio[2], r.failed_vehicle,
+                      r.planned_count);
         /* Six orders are all there are: a failure covers every one of them, and a
          * conflict at t = 0 is found without trying a second order. */
         ck_assert(r.all_orders_covered == !any);
@@ -1669,8 +1667,7 @@ START_TEST(problem_check_and_helpers)
     offs[1] = -1; /* 0 -> -1 -> 3 is not an action either */
     ck_assert_int_eq(coa_plan_vehicle_cost(&f.veh[0], R(1.0), 4u, offs, &dev, &eff),
                      COA_ERR_ARGUMENT);
-    ck_assert_int_eq(coa_plan_vehicle_cost(NULL, R(1.0), 4u, offs, &dev, &eff),
-                     COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coa_plan_vehicle_cost(NULL, R(1.0), 4u, offs, &dev, &eff), COA_ERR_ARGUMENT);
 }
 END_TEST
 
@@ -1848,8 +1845,7 @@ START_TEST(conflict_at_start_rules_out_every_order)
         ck_assert(conflict_at_start(&f));
         for (m = 0; m < 3u; ++m) {
             memset(rows, 0x55, sizeof rows);
-            ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, NULL, max_orders[m], rows, &r),
-                             COA_OK);
+            ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, NULL, max_orders[m], rows, &r), COA_OK);
             ck_assert_int_eq(r.status, COA_PLAN_INFEASIBLE);
             ck_assert(r.all_orders_covered);
             ck_assert_uint_eq(r.orders_tried, 1u);
@@ -1903,8 +1899,7 @@ START_TEST(proof_for_every_order_outranks_budget)
         ck_assert_uint_eq(r.failed_vehicle, variant == 0 ? 1u : 2u);
         check_decoupled_attempt(&f, rows, &r);
         /* One order: the same failure, covering every order only through the t = 0 proof. */
-        ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, (const size_t[]){0u, 1u, 2u}, 1u, rows,
-                                            &r),
+        ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, (const size_t[]){0u, 1u, 2u}, 1u, rows, &r),
                          COA_OK);
         ck_assert_int_eq(r.status, COA_PLAN_INFEASIBLE);
         ck_assert(r.all_orders_covered == (variant == 1));

@@ -28,18 +28,18 @@
 #include "reference/plan_v1.h"
 #include "test_support.h"
 
-#define MAXV 4u      /* UAVs of an encounter */
-#define MINN 8u      /* horizon range */
+#define MAXV 4u /* UAVs of an encounter */
+#define MINN 8u /* horizon range */
 #define MAXN 14u
 #define MAXSTEEP 4u  /* steep factors 2..MAXSTEEP */
 #define TRIALS 2500u /* encounters; at least 2000 must be compared */
 
 /* REQUIRE (test_support.h) with a message. */
-#define REQUIRE_MSG(cond, ...)                                                              \
-    do {                                                                                    \
-        if (!(cond)) {                                                                      \
-            ck_abort_msg(__VA_ARGS__);                                                      \
-        }                                                                                   \
+#define REQUIRE_MSG(cond, ...)         \
+    do {                               \
+        if (!(cond)) {                 \
+            ck_abort_msg(__VA_ARGS__); \
+        }                              \
     } while (0)
 
 /* Expansions per search of each planner. The old one closes at most beta states and
@@ -61,8 +61,8 @@ static struct {
     unsigned conflicting; /* the level plan (every UAV at its initial offset) conflicts */
     unsigned with_box;
     unsigned with_track;
-    unsigned bounded;     /* some UAV has a max_offset */
-    unsigned offset;      /* some UAV starts off its reference */
+    unsigned bounded; /* some UAV has a max_offset */
+    unsigned offset;  /* some UAV starts off its reference */
 } gen;
 
 /* n UAVs converging on one point in a loose vertical stack: each flies straight through
@@ -83,7 +83,7 @@ static const struct {
     double overlap_lo;
     double overlap_hi;
     uint32_t max_horizon[MAXV + 1u]; /* per UAV count; MINN is the least */
-    uint32_t scenery[MAXV + 1u]; /* per UAV count: 1 in `scenery` has a box, 1 a track */
+    uint32_t scenery[MAXV + 1u];     /* per UAV count: 1 in `scenery` has a box, 1 a track */
 } shape = {3.0, 0.8, 1.2, {0u, 0u, MAXN, 12u, 10u}, {0u, 0u, 4u, 5u, 12u}};
 
 static void enc_random(fx_t *e, uint64_t *rng, size_t n)
@@ -274,8 +274,7 @@ static const char *status_name(coa_plan_status_t s)
 
 /* Rows start at the initial offset, move by actions (coa_plan_vehicle_cost checks that)
  * and respect max_offset. */
-static bool rows_well_formed(const fx_t *e, const int32_t *rows, const size_t *which,
-                             size_t count)
+static bool rows_well_formed(const fx_t *e, const int32_t *rows, const size_t *which, size_t count)
 {
     size_t i;
     uint32_t k;
@@ -300,8 +299,7 @@ static bool rows_well_formed(const fx_t *e, const int32_t *rows, const size_t *w
 
 /* Vehicle v's own exact cost: its deviation in units of L*dh / (2s) (every step's area is
  * an integer there) and its effort. */
-static void own_cost(const fx_t *e, size_t v, const int32_t *rows, int64_t *units,
-                     uint32_t *effort)
+static void own_cost(const fx_t *e, size_t v, const int32_t *rows, int64_t *units, uint32_t *effort)
 {
     const int32_t *r = &rows[v * ROW(e)];
     uint32_t s = e->veh[v].steep_factor;
@@ -399,12 +397,12 @@ START_TEST(new_planner_matches_old_on_random_encounters)
     unsigned skipped[MAXV + 1u] = {0u};
     unsigned solved[MAXV + 1u] = {0u};
     unsigned infeasible[MAXV + 1u] = {0u};
-    unsigned merged = 0u;        /* new centralised searched two or more UAVs jointly */
-    unsigned dec_compared = 0u;  /* decoupled calls compared */
+    unsigned merged = 0u;       /* new centralised searched two or more UAVs jointly */
+    unsigned dec_compared = 0u; /* decoupled calls compared */
     unsigned dec_solved = 0u;
-    unsigned dec_reordered = 0u; /* solved by an order other than the first */
-    unsigned dec_skipped = 0u;   /* the old planner ran out of beta */
-    unsigned dec_tie = 0u;       /* diverged after a tie (decoupled_compare) */
+    unsigned dec_reordered = 0u;  /* solved by an order other than the first */
+    unsigned dec_skipped = 0u;    /* the old planner ran out of beta */
+    unsigned dec_tie = 0u;        /* diverged after a tie (decoupled_compare) */
     unsigned dec_tie_status = 0u; /* ... and ended with another status */
     unsigned dec_tie_cost = 0u;   /* ... or, both solved, with another total cost */
     unsigned total_compared = 0u;
@@ -509,11 +507,11 @@ START_TEST(new_planner_matches_old_on_random_encounters)
                 tie = true;
                 ++dec_tie;
                 dec_tie_status += ro.status != rn.status ? 1u : 0u;
-                dec_tie_cost += (ro.status == COA_PLAN_SOLVED && rn.status == COA_PLAN_SOLVED &&
-                                 (!cost_eq(ro.deviation_units, rn.deviation_units) ||
-                                  ro.effort != rn.effort))
-                                    ? 1u
-                                    : 0u;
+                dec_tie_cost +=
+                    (ro.status == COA_PLAN_SOLVED && rn.status == COA_PLAN_SOLVED &&
+                     (!cost_eq(ro.deviation_units, rn.deviation_units) || ro.effort != rn.effort))
+                        ? 1u
+                        : 0u;
             }
             if (rn.status == COA_PLAN_SOLVED) {
                 ++dec_solved;
@@ -528,11 +526,10 @@ START_TEST(new_planner_matches_old_on_random_encounters)
            "skipped), %u of them diverged after a tie (%u with another status, %u with another "
            "cost); encounters: %u conflicting, %u with a box, %u with a track, %u bounded, %u "
            "off-reference\n",
-           compared[2], solved[2], infeasible[2], skipped[2], compared[3], solved[3],
-           infeasible[3], skipped[3], compared[4], solved[4], infeasible[4], skipped[4],
-           total_compared, TRIALS, merged, dec_compared, dec_solved, dec_reordered, dec_skipped,
-           dec_tie, dec_tie_status, dec_tie_cost, gen.conflicting, gen.with_box, gen.with_track,
-           gen.bounded, gen.offset);
+           compared[2], solved[2], infeasible[2], skipped[2], compared[3], solved[3], infeasible[3],
+           skipped[3], compared[4], solved[4], infeasible[4], skipped[4], total_compared, TRIALS,
+           merged, dec_compared, dec_solved, dec_reordered, dec_skipped, dec_tie, dec_tie_status,
+           dec_tie_cost, gen.conflicting, gen.with_box, gen.with_track, gen.bounded, gen.offset);
     fflush(stdout);
 
     ck_assert_uint_ge(total_compared, 2000u);

@@ -44,7 +44,6 @@
 #define PROB_REL 1e-9
 #endif
 
-
 /* Two independent standard normals (Box-Muller; u1 in (0, 1] so the log is finite). */
 static void normal_pair(uint64_t *s, double *z1, double *z2)
 {
@@ -154,8 +153,8 @@ static void add_obstacles(fleet_t *f, uint64_t *s, size_t boxes, size_t hulls, d
 }
 
 /* A track: constant velocity, or a three-point path over the horizon. */
-static void add_track(fleet_t *f, uint64_t *s, double side, double zlo, double zhi,
-                      double speed_lo, double speed_hi, bool with_sigma)
+static void add_track(fleet_t *f, uint64_t *s, double side, double zlo, double zhi, double speed_lo,
+                      double speed_hi, bool with_sigma)
 {
     coa_track_t *t = &f->tracks[f->m];
     double heading = unif(s, 0.0, 2.0 * PI);
@@ -259,7 +258,9 @@ static void city_fleet(fleet_t *f, uint64_t seed, size_t n, double side, bool ua
         uint32_t shape = pick(&s, 20u);
 
         if (pick(&s, 5u) == 0u) {
-            z1 = layer == 0u ? layers[1] : (layer == 3u ? layers[2] : layers[layer + (pick(&s, 2u) ? 1u : -1u)]);
+            z1 = layer == 0u
+                     ? layers[1]
+                     : (layer == 3u ? layers[2] : layers[layer + (pick(&s, 2u) ? 1u : -1u)]);
         }
         if (shape == 0u) {
             count = 1u; /* hovering */
@@ -523,7 +524,8 @@ START_TEST(separations_are_the_exact_minima)
                     if (box == NULL) {
                         dx = x - ((double)pb[k].x + u * ((double)pb[k + 1u].x - (double)pb[k].x));
                         dy = y - ((double)pb[k].y + u * ((double)pb[k + 1u].y - (double)pb[k].y));
-                        dz = fabs(z - ((double)pb[k].z + u * ((double)pb[k + 1u].z - (double)pb[k].z)));
+                        dz = fabs(z -
+                                  ((double)pb[k].z + u * ((double)pb[k + 1u].z - (double)pb[k].z)));
                     } else {
                         dx = fmax(0.0, fmax((double)box->min.x - x, x - (double)box->max.x));
                         dy = fmax(0.0, fmax((double)box->min.y - y, y - (double)box->max.y));
@@ -719,33 +721,33 @@ END_TEST
 
 /* P_h = P(|d + e| < R), e ~ N(0, sigma^2 I_2), from mpmath: d, R, sigma, P_h. */
 static const double mpmath_ph[][4] = {
-        {0.5, 1, 1, 0.35728576972745623084},
-        {3, 2, 1, 0.11327924559760774296},
-        {1, 3, 1, 0.956284028421364313},
-        {20, 20, 4, 0.45990161322628164579},
-        {35, 20, 5, 0.00098782376443072170745},
-        {12, 20, 5, 0.92473142139048613419},
-        {60, 20, 10, 0.000017402248322776218949},
-        {80, 20, 10, 4.7708162170470193081e-10},
-        {100, 30, 40, 0.015977437969185396958},
-        {0.01, 10, 50, 0.019801326301165232338},
-        {45, 20, 5, 1.8722942801872037718e-7},
-        {5.5, 5, 0.5, 0.14738185775961113937},
-        {9.5, 10, 0.5, 0.83505666144705509966},
-        {19, 20, 1.05, 0.82263120400118708082},
-        {21.5, 20, 1.0, 0.063739827591868474629},
-        {40, 50, 1, 1.0 - 7.6e-24},
-        {50, 50, 1, 0.49601037767994575408},
-        {52.5, 50, 1, 0.006040685022141321731},
-        {48, 50, 2, 0.83635408828425743799},
-        {103, 100, 1, 0.0013282249644854483998},
-        {100.3, 100, 0.1, 0.0013476870805463340812},
-        {99.2, 100, 0.2, 0.99996819411950087503},
-        {1000.5, 1000, 0.5, 0.15859478392374621566},
-        {998, 1000, 1, 0.97722283200434516055},
-        {30, 20, 2.2, 2.2149707383238507744e-6},
-        {70, 25, 5, 6.6828800545218856684e-20},
-        {26, 25, 0.7, 0.074608822017087222259},
+    {0.5, 1, 1, 0.35728576972745623084},
+    {3, 2, 1, 0.11327924559760774296},
+    {1, 3, 1, 0.956284028421364313},
+    {20, 20, 4, 0.45990161322628164579},
+    {35, 20, 5, 0.00098782376443072170745},
+    {12, 20, 5, 0.92473142139048613419},
+    {60, 20, 10, 0.000017402248322776218949},
+    {80, 20, 10, 4.7708162170470193081e-10},
+    {100, 30, 40, 0.015977437969185396958},
+    {0.01, 10, 50, 0.019801326301165232338},
+    {45, 20, 5, 1.8722942801872037718e-7},
+    {5.5, 5, 0.5, 0.14738185775961113937},
+    {9.5, 10, 0.5, 0.83505666144705509966},
+    {19, 20, 1.05, 0.82263120400118708082},
+    {21.5, 20, 1.0, 0.063739827591868474629},
+    {40, 50, 1, 1.0 - 7.6e-24},
+    {50, 50, 1, 0.49601037767994575408},
+    {52.5, 50, 1, 0.006040685022141321731},
+    {48, 50, 2, 0.83635408828425743799},
+    {103, 100, 1, 0.0013282249644854483998},
+    {100.3, 100, 0.1, 0.0013476870805463340812},
+    {99.2, 100, 0.2, 0.99996819411950087503},
+    {1000.5, 1000, 0.5, 0.15859478392374621566},
+    {998, 1000, 1, 0.97722283200434516055},
+    {30, 20, 2.2, 2.2149707383238507744e-6},
+    {70, 25, 5, 6.6828800545218856684e-20},
+    {26, 25, 0.7, 0.074608822017087222259},
 };
 
 START_TEST(probability_closed_forms_and_edges)
@@ -822,11 +824,13 @@ START_TEST(probability_closed_forms_and_edges)
     /* Out of range: 1, the safe side. */
     ck_assert(coa_conflict_probability(R(-1.0), R(0.0), R(20.0), R(10.0), R(1.0), R(1.0)) == 1.0);
     ck_assert(coa_conflict_probability(R(NAN), R(0.0), R(20.0), R(10.0), R(1.0), R(1.0)) == 1.0);
-    ck_assert(coa_conflict_probability(R(100.0), R(INFINITY), R(20.0), R(10.0), R(1.0), R(1.0)) == 1.0);
+    ck_assert(coa_conflict_probability(R(100.0), R(INFINITY), R(20.0), R(10.0), R(1.0), R(1.0)) ==
+              1.0);
     ck_assert(coa_conflict_probability(R(100.0), R(0.0), R(0.0), R(10.0), R(1.0), R(1.0)) == 1.0);
     ck_assert(coa_conflict_probability(R(100.0), R(0.0), R(20.0), R(-1.0), R(1.0), R(1.0)) == 1.0);
     ck_assert(coa_conflict_probability(R(100.0), R(0.0), R(20.0), R(10.0), R(-1.0), R(1.0)) == 1.0);
-    ck_assert(coa_conflict_probability(R(100.0), R(0.0), R(20.0), R(10.0), R(1.0), R(INFINITY)) == 1.0);
+    ck_assert(coa_conflict_probability(R(100.0), R(0.0), R(20.0), R(10.0), R(1.0), R(INFINITY)) ==
+              1.0);
 }
 END_TEST
 
@@ -1184,9 +1188,9 @@ START_TEST(probability_is_the_combined_sigma_maximum)
         f->cfg.vehicle_sigma_rate_horizontal = R(0.5);
         want = 0.0;
         for (j = 0; j <= 40; ++j) {
-            double p = coa_conflict_probability(
-                R(30.0), R(4.0), R(20.0), R(9.0), R(hover_sigma(6.0, 8.0, 0.5, 0.5 * (double)j)),
-                R(3.0));
+            double p =
+                coa_conflict_probability(R(30.0), R(4.0), R(20.0), R(9.0),
+                                         R(hover_sigma(6.0, 8.0, 0.5, 0.5 * (double)j)), R(3.0));
             want = p > want ? p : want;
         }
     }
@@ -1321,7 +1325,8 @@ START_TEST(capacity_overflow_is_reported)
     for (i = 1; i < res.conflict_count; ++i) {
         const coa_conflict_t *p = &all[i - 1u];
         const coa_conflict_t *c = &all[i];
-        ck_assert(p->kind < c->kind || (p->kind == c->kind && (p->a < c->a || (p->a == c->a && p->b < c->b))));
+        ck_assert(p->kind < c->kind ||
+                  (p->kind == c->kind && (p->a < c->a || (p->a == c->a && p->b < c->b))));
     }
     for (cap = 0; cap < res.conflicts_found; ++cap) {
         memset(some, 0xA5, sizeof some);
@@ -1419,7 +1424,8 @@ START_TEST(workspace_size_is_exact)
     ck_assert_uint_eq(coa_predictor_workspace_size(10u, 4u, 60u, 100u) - bytes,
                       2u * (24u * 61u + 124u));
     ck_assert_uint_eq(coa_predictor_workspace_size(10u, 2u, 60u, 110u) - bytes, 10u * 12u);
-    ck_assert_uint_eq(coa_predictor_workspace_size(10u, 2u, 60u, 130u) - bytes, 30u * 12u + 256u * 8u);
+    ck_assert_uint_eq(coa_predictor_workspace_size(10u, 2u, 60u, 130u) - bytes,
+                      30u * 12u + 256u * 8u);
 #endif
 
     mem = malloc(bytes + 16u);
@@ -1457,9 +1463,9 @@ START_TEST(workspace_size_is_exact)
     ck_assert_int_eq(coa_predict(pr, &f->cfg, f->plans, 11u, f->obstacles, f->o, f->tracks, f->m,
                                  got, 64u, &res),
                      COA_ERR_ARGUMENT);
-    ck_assert_int_eq(coa_predict(pr, &f->cfg, f->plans, f->n, f->obstacles, f->o, f->tracks, 3u,
-                                 got, 64u, &res),
-                     COA_ERR_ARGUMENT);
+    ck_assert_int_eq(
+        coa_predict(pr, &f->cfg, f->plans, f->n, f->obstacles, f->o, f->tracks, 3u, got, 64u, &res),
+        COA_ERR_ARGUMENT);
     f->cfg.horizon = 61u;
     ck_assert_int_eq(coa_predict(pr, &f->cfg, f->plans, f->n, f->obstacles, f->o, f->tracks, f->m,
                                  got, 64u, &res),
@@ -1491,11 +1497,11 @@ START_TEST(bad_config_and_plans_are_refused)
     coa_real_t nan = R(NAN);
     coa_real_t inf = R(INFINITY);
 
-#define EXPECT_ARG()                                                                        \
-    do {                                                                                    \
-        res.conflicts_found = 7u;                                                           \
-        ck_assert_int_eq(run(&w, f, false, got, 64u, &res), COA_ERR_ARGUMENT);              \
-        ck_assert_uint_eq(res.conflicts_found, 0u);                                         \
+#define EXPECT_ARG()                                                           \
+    do {                                                                       \
+        res.conflicts_found = 7u;                                              \
+        ck_assert_int_eq(run(&w, f, false, got, 64u, &res), COA_ERR_ARGUMENT); \
+        ck_assert_uint_eq(res.conflicts_found, 0u);                            \
     } while (0)
 
     ws_make(&w, 8u, 2u, 16u, 256u);
@@ -1606,26 +1612,26 @@ START_TEST(bad_config_and_plans_are_refused)
     EXPECT_ARG();
     f->obstacles[0] = obs0;
     /* Pointers. */
-    ck_assert_int_eq(coa_predict(NULL, &f->cfg, f->plans, f->n, f->obstacles, f->o, f->tracks,
-                                 f->m, got, 64u, &res),
+    ck_assert_int_eq(coa_predict(NULL, &f->cfg, f->plans, f->n, f->obstacles, f->o, f->tracks, f->m,
+                                 got, 64u, &res),
                      COA_ERR_ARGUMENT);
     ck_assert_int_eq(coa_predict(w.pr, NULL, f->plans, f->n, f->obstacles, f->o, f->tracks, f->m,
                                  got, 64u, &res),
                      COA_ERR_ARGUMENT);
-    ck_assert_int_eq(coa_predict(w.pr, &f->cfg, NULL, f->n, f->obstacles, f->o, f->tracks, f->m,
-                                 got, 64u, &res),
+    ck_assert_int_eq(
+        coa_predict(w.pr, &f->cfg, NULL, f->n, f->obstacles, f->o, f->tracks, f->m, got, 64u, &res),
+        COA_ERR_ARGUMENT);
+    ck_assert_int_eq(
+        coa_predict(w.pr, &f->cfg, f->plans, f->n, NULL, f->o, f->tracks, f->m, got, 64u, &res),
+        COA_ERR_ARGUMENT);
+    ck_assert_int_eq(
+        coa_predict(w.pr, &f->cfg, f->plans, f->n, f->obstacles, f->o, NULL, f->m, got, 64u, &res),
+        COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coa_predict(w.pr, &f->cfg, f->plans, f->n, f->obstacles, f->o, f->tracks, f->m,
+                                 NULL, 64u, &res),
                      COA_ERR_ARGUMENT);
-    ck_assert_int_eq(coa_predict(w.pr, &f->cfg, f->plans, f->n, NULL, f->o, f->tracks, f->m, got,
-                                 64u, &res),
-                     COA_ERR_ARGUMENT);
-    ck_assert_int_eq(coa_predict(w.pr, &f->cfg, f->plans, f->n, f->obstacles, f->o, NULL, f->m,
-                                 got, 64u, &res),
-                     COA_ERR_ARGUMENT);
-    ck_assert_int_eq(coa_predict(w.pr, &f->cfg, f->plans, f->n, f->obstacles, f->o, f->tracks,
-                                 f->m, NULL, 64u, &res),
-                     COA_ERR_ARGUMENT);
-    ck_assert_int_eq(coa_predict(w.pr, &f->cfg, f->plans, f->n, f->obstacles, f->o, f->tracks,
-                                 f->m, got, 64u, NULL),
+    ck_assert_int_eq(coa_predict(w.pr, &f->cfg, f->plans, f->n, f->obstacles, f->o, f->tracks, f->m,
+                                 got, 64u, NULL),
                      COA_ERR_ARGUMENT);
     /* Nothing at all is fine. */
     ck_assert_int_eq(coa_predict(w.pr, &f->cfg, NULL, 0u, NULL, 0u, NULL, 0u, NULL, 0u, &res),

@@ -11,11 +11,11 @@
 
 /* An assertion for inner loops: Check logs the place of every ck_assert it passes, which
  * in a loop run millions of times costs more than the code under test. */
-#define REQUIRE(cond)                                                                       \
-    do {                                                                                    \
-        if (!(cond)) {                                                                      \
-            ck_abort_msg("%s:%d: %s", __FILE__, __LINE__, #cond);                          \
-        }                                                                                   \
+#define REQUIRE(cond)                                             \
+    do {                                                          \
+        if (!(cond)) {                                            \
+            ck_abort_msg("%s:%d: %s", __FILE__, __LINE__, #cond); \
+        }                                                         \
     } while (0)
 
 /* Deterministic random numbers (splitmix64): fixed seeds, the same on every machine. */

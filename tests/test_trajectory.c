@@ -51,10 +51,10 @@ static int near(double got, double want)
     return fabs(got - want) <= REL_TOL * (1.0 + fabs(want));
 }
 
-#define ck_assert_vec_near(p, ex, ey, ez)                                                   \
-    ck_assert_msg(near((double)(p).x, (ex)) && near((double)(p).y, (ey)) &&                 \
-                      near((double)(p).z, (ez)),                                            \
-                  "got (%.12g, %.12g, %.12g), want (%.12g, %.12g, %.12g)", (double)(p).x,  \
+#define ck_assert_vec_near(p, ex, ey, ez)                                                 \
+    ck_assert_msg(near((double)(p).x, (ex)) && near((double)(p).y, (ey)) &&               \
+                      near((double)(p).z, (ez)),                                          \
+                  "got (%.12g, %.12g, %.12g), want (%.12g, %.12g, %.12g)", (double)(p).x, \
                   (double)(p).y, (double)(p).z, (double)(ex), (double)(ey), (double)(ez))
 
 static int vec_same(coa_vec3_t a, coa_vec3_t b)
@@ -276,8 +276,8 @@ START_TEST(test_reference_random_routes)
 
         for (i = 0; i < n; ++i) {
             do {
-                route[i] = v3(rng_uniform(-1000, 1000), rng_uniform(-1000, 1000),
-                              rng_uniform(0, 300));
+                route[i] =
+                    v3(rng_uniform(-1000, 1000), rng_uniform(-1000, 1000), rng_uniform(0, 300));
             } while (i > 0 && hypot((double)(route[i].x - route[i - 1].x),
                                     (double)(route[i].y - route[i - 1].y)) < 1.0);
         }
@@ -321,8 +321,8 @@ START_TEST(test_reference_random_routes)
                 long double d_prev =
                     (long double)v.cruise_speed * (long double)((coa_real_t)(k - 1) * dt);
                 if (oracle_leg(route, n, d_prev, &cum_prev) == leg) {
-                    double h = hypot((double)(out[k].x - out[k - 1].x),
-                                     (double)(out[k].y - out[k - 1].y));
+                    double h =
+                        hypot((double)(out[k].x - out[k - 1].x), (double)(out[k].y - out[k - 1].y));
                     ck_assert(fabs(h - (double)(d - d_prev)) <= REL_TOL * scale * 10);
                 }
             }
@@ -350,8 +350,7 @@ START_TEST(test_reference_sample_errors)
     ck_assert_int_eq(coa_reference_sample(&v, R(NAN), 10, out), COA_ERR_ARGUMENT);
     ck_assert_int_eq(coa_reference_sample(&v, R(INFINITY), 10, out), COA_ERR_ARGUMENT);
     ck_assert_int_eq(coa_reference_sample(&v, R(1), 0, out), COA_ERR_ARGUMENT);
-    ck_assert_int_eq(coa_reference_sample(&v, R(1), COA_MAX_HORIZON + 1u, out),
-                     COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coa_reference_sample(&v, R(1), COA_MAX_HORIZON + 1u, out), COA_ERR_ARGUMENT);
     bad = v;
     bad.route_count = 1;
     ck_assert_int_eq(coa_reference_sample(&bad, R(1), 10, out), COA_ERR_ARGUMENT);
@@ -468,8 +467,7 @@ START_TEST(test_track_random_paths_agree)
 
         for (i = 0; i < n; ++i) {
             path[i].t = R(t);
-            path[i].p = v3(rng_uniform(-500, 500), rng_uniform(-500, 500),
-                           rng_uniform(0, 300));
+            path[i].p = v3(rng_uniform(-500, 500), rng_uniform(-500, 500), rng_uniform(0, 300));
             t += rng_uniform(0.5, 20);
         }
         tr.path = path;
@@ -483,13 +481,13 @@ START_TEST(test_track_random_paths_agree)
         for (i = 0; i + 1 < n; ++i) {
             coa_real_t tm = R(0.5) * (path[i].t + path[i + 1].t);
             coa_vec3_t p = coa_track_at(&tr, tm);
-            double u = ((double)tm - (double)path[i].t) /
-                       ((double)path[i + 1].t - (double)path[i].t);
-            ck_assert(fabs((double)p.x - ((double)path[i].p.x +
-                                          u * ((double)path[i + 1].p.x - path[i].p.x))) <
+            double u =
+                ((double)tm - (double)path[i].t) / ((double)path[i + 1].t - (double)path[i].t);
+            ck_assert(fabs((double)p.x -
+                           ((double)path[i].p.x + u * ((double)path[i + 1].p.x - path[i].p.x))) <
                       REL_TOL * 1e3);
-            ck_assert(fabs((double)p.z - ((double)path[i].p.z +
-                                          u * ((double)path[i + 1].p.z - path[i].p.z))) <
+            ck_assert(fabs((double)p.z -
+                           ((double)path[i].p.z + u * ((double)path[i + 1].p.z - path[i].p.z))) <
                       REL_TOL * 1e3);
         }
     }
@@ -507,8 +505,7 @@ START_TEST(test_track_sample_errors)
     ck_assert_int_eq(coa_track_sample(&tr, R(0), 10, out), COA_ERR_ARGUMENT);
     ck_assert_int_eq(coa_track_sample(&tr, R(NAN), 10, out), COA_ERR_ARGUMENT);
     ck_assert_int_eq(coa_track_sample(&tr, R(1), 0, out), COA_ERR_ARGUMENT);
-    ck_assert_int_eq(coa_track_sample(&tr, R(1), COA_MAX_HORIZON + 1u, out),
-                     COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coa_track_sample(&tr, R(1), COA_MAX_HORIZON + 1u, out), COA_ERR_ARGUMENT);
     bad.volume.radius = R(0);
     ck_assert_int_eq(coa_track_sample(&bad, R(1), 10, out), COA_ERR_ARGUMENT);
     ck_assert_int_eq(coa_track_sample(&tr, R(REAL_MAX / 2), 3, out), COA_ERR_ARGUMENT);
@@ -534,17 +531,17 @@ START_TEST(test_vehicle_check)
     ck_assert_int_eq(coa_vehicle_check(&good), COA_OK);
     ck_assert_int_eq(coa_vehicle_check(NULL), COA_ERR_ARGUMENT);
 
-#define EXPECT_BAD(stmt)                                                                    \
-    do {                                                                                    \
-        v = good;                                                                           \
-        stmt;                                                                               \
-        ck_assert_msg(coa_vehicle_check(&v) == COA_ERR_ARGUMENT, "accepted: %s", #stmt);    \
+#define EXPECT_BAD(stmt)                                                                 \
+    do {                                                                                 \
+        v = good;                                                                        \
+        stmt;                                                                            \
+        ck_assert_msg(coa_vehicle_check(&v) == COA_ERR_ARGUMENT, "accepted: %s", #stmt); \
     } while (0)
-#define EXPECT_OK(stmt)                                                                     \
-    do {                                                                                    \
-        v = good;                                                                           \
-        stmt;                                                                               \
-        ck_assert_msg(coa_vehicle_check(&v) == COA_OK, "rejected: %s", #stmt);             \
+#define EXPECT_OK(stmt)                                                        \
+    do {                                                                       \
+        v = good;                                                              \
+        stmt;                                                                  \
+        ck_assert_msg(coa_vehicle_check(&v) == COA_OK, "rejected: %s", #stmt); \
     } while (0)
 
     EXPECT_BAD(v.id = 0);
@@ -625,17 +622,17 @@ START_TEST(test_track_check)
     ck_assert_int_eq(coa_track_check(&good), COA_OK);
     ck_assert_int_eq(coa_track_check(NULL), COA_ERR_ARGUMENT);
 
-#define EXPECT_BAD(stmt)                                                                    \
-    do {                                                                                    \
-        tr = good;                                                                          \
-        stmt;                                                                               \
-        ck_assert_msg(coa_track_check(&tr) == COA_ERR_ARGUMENT, "accepted: %s", #stmt);     \
+#define EXPECT_BAD(stmt)                                                                \
+    do {                                                                                \
+        tr = good;                                                                      \
+        stmt;                                                                           \
+        ck_assert_msg(coa_track_check(&tr) == COA_ERR_ARGUMENT, "accepted: %s", #stmt); \
     } while (0)
-#define EXPECT_OK(stmt)                                                                     \
-    do {                                                                                    \
-        tr = good;                                                                          \
-        stmt;                                                                               \
-        ck_assert_msg(coa_track_check(&tr) == COA_OK, "rejected: %s", #stmt);              \
+#define EXPECT_OK(stmt)                                                       \
+    do {                                                                      \
+        tr = good;                                                            \
+        stmt;                                                                 \
+        ck_assert_msg(coa_track_check(&tr) == COA_OK, "rejected: %s", #stmt); \
     } while (0)
 
     EXPECT_BAD(tr.volume.radius = R(0));
@@ -685,8 +682,7 @@ END_TEST
 
 START_TEST(test_actions)
 {
-    static const char *const names[5] = {"level", "climb", "dive", "steep_climb",
-                                         "steep_dive"};
+    static const char *const names[5] = {"level", "climb", "dive", "steep_climb", "steep_dive"};
     static const int32_t delta3[5] = {0, 1, -1, 3, -3};
     static const uint32_t effort[5] = {0, 1, 1, 3, 3};
     coa_vehicle_t v;
@@ -752,8 +748,7 @@ START_TEST(test_area_hand_values)
     ck_assert_int_eq(coa_area_scaled(32767, 32757, 5040), (int64_t)65524 * 2520);
     ck_assert_int_eq(coa_area_scaled(-32767, -32767, 5040), (int64_t)65534 * 2520);
     ck_assert_int_eq(coa_area_scaled(32767, -32767, 131068), (int64_t)2 * 32767 * 32767);
-    ck_assert_int_eq(coa_area_scaled(32767, -32767, 131068u * 30u),
-                     (int64_t)60 * 32767 * 32767);
+    ck_assert_int_eq(coa_area_scaled(32767, -32767, 131068u * 30u), (int64_t)60 * 32767 * 32767);
     ck_assert_int_eq(coa_area_scaled(INT32_MIN, INT32_MIN, 2), (int64_t)1 << 32);
 }
 END_TEST
@@ -794,8 +789,8 @@ START_TEST(test_area_is_geometric_area)
                 sum += fabs(a + (b - a) * x);
             }
             sum /= n;
-            ck_assert_msg(fabs(sum - coa_area(a, b)) < 1e-6, "A(%d,%d)=%g, integral %g", a,
-                          b, coa_area(a, b), sum);
+            ck_assert_msg(fabs(sum - coa_area(a, b)) < 1e-6, "A(%d,%d)=%g, integral %g", a, b,
+                          coa_area(a, b), sum);
         }
     }
     {
@@ -837,16 +832,15 @@ START_TEST(test_heuristic_hand_values)
     ck_assert_int_eq(coa_heuristic_scaled(0, 0, 3, 6), 0);
     ck_assert_int_eq(coa_heuristic_scaled(1000, 0, 3, 6), 0);
     /* Large values stay exact: a^2/(2s) with a = 32767, s = 10, R = 10000. */
-    ck_assert_int_eq(coa_heuristic_scaled(32767, 10000, 10, 5040),
-                     (int64_t)32767 * 32767 * 252);
+    ck_assert_int_eq(coa_heuristic_scaled(32767, 10000, 10, 5040), (int64_t)32767 * 32767 * 252);
     /* R = 100, s = 10, a = 32767: 100*32767 - 10*100^2/2 = 3226700. */
     ck_assert_int_eq(coa_heuristic_scaled(-32767, 100, 10, 5040), (int64_t)3226700 * 5040);
 }
 END_TEST
 
-#define DP_A 60  /* offsets -DP_A..DP_A */
-#define DP_R 6   /* steps left 0..DP_R */
-#define DP_Q 15  /* offsets checked: -DP_Q..DP_Q */
+#define DP_A 60 /* offsets -DP_A..DP_A */
+#define DP_R 6  /* steps left 0..DP_R */
+#define DP_Q 15 /* offsets checked: -DP_Q..DP_Q */
 
 START_TEST(test_heuristic_admissible_consistent)
 {
@@ -906,9 +900,8 @@ START_TEST(test_heuristic_admissible_consistent)
                         int64_t step = coa_area_scaled(a, b, scale);
                         int64_t hb = coa_heuristic_scaled(b, (uint32_t)(r - 1), s, scale);
                         ck_assert_msg(h <= step + hb,
-                                      "not consistent: s %u R %d a %d b %d: %lld > %lld + %lld",
-                                      s, r, a, b, (long long)h, (long long)step,
-                                      (long long)hb);
+                                      "not consistent: s %u R %d a %d b %d: %lld > %lld + %lld", s,
+                                      r, a, b, (long long)h, (long long)step, (long long)hb);
                     }
                     /* Exactly the truncated triangle. */
                     {
@@ -940,18 +933,18 @@ START_TEST(test_area_scale)
         vs[i] = make_vehicle(route, 2, 10.0);
         vs[i].steep_factor = (uint32_t)(i + 2);
     }
-    ck_assert_uint_eq(coa_area_scale(vs, 1), 4);            /* s = 2 */
-    ck_assert_uint_eq(coa_area_scale(vs, 2), 12);           /* lcm(4, 6) */
-    ck_assert_uint_eq(coa_area_scale(vs + 2, 1), 8);        /* s = 4 */
-    ck_assert_uint_eq(coa_area_scale(vs, 9), 5040);         /* every s: 2 * lcm(2..10) */
-    ck_assert_uint_eq(coa_area_scale(vs + 8, 1), 20);       /* s = 10 */
+    ck_assert_uint_eq(coa_area_scale(vs, 1), 4);      /* s = 2 */
+    ck_assert_uint_eq(coa_area_scale(vs, 2), 12);     /* lcm(4, 6) */
+    ck_assert_uint_eq(coa_area_scale(vs + 2, 1), 8);  /* s = 4 */
+    ck_assert_uint_eq(coa_area_scale(vs, 9), 5040);   /* every s: 2 * lcm(2..10) */
+    ck_assert_uint_eq(coa_area_scale(vs + 8, 1), 20); /* s = 10 */
     vs[3].steep_factor = 4;
     vs[4].steep_factor = 6;
     vs[5].steep_factor = 10;
-    ck_assert_uint_eq(coa_area_scale(vs + 3, 3), 120);      /* lcm(8, 12, 20) */
+    ck_assert_uint_eq(coa_area_scale(vs + 3, 3), 120); /* lcm(8, 12, 20) */
     vs[4].steep_factor = 4;
     vs[5].steep_factor = 4;
-    ck_assert_uint_eq(coa_area_scale(vs + 3, 3), 8);        /* repeated factors */
+    ck_assert_uint_eq(coa_area_scale(vs + 3, 3), 8); /* repeated factors */
     ck_assert_uint_eq(coa_area_scale(vs, 0), 0);
     ck_assert_uint_eq(coa_area_scale(NULL, 3), 0);
     vs[1].steep_factor = 1;
@@ -1046,10 +1039,10 @@ START_TEST(test_deviation_weights)
         bool odd = false;
         int rc;
         for (i = 0; i < 4; ++i) {
-            vs[i].cruise_speed = R(trial % 2 == 0 ? (double)(5u + rng_below(20u))
-                                                  : rng_uniform(5.0, 30.0));
-            vs[i].climb_rate = R(trial % 2 == 0 ? (double)(1u + rng_below(4u))
-                                                : rng_uniform(1.0, 6.0));
+            vs[i].cruise_speed =
+                R(trial % 2 == 0 ? (double)(5u + rng_below(20u)) : rng_uniform(5.0, 30.0));
+            vs[i].climb_rate =
+                R(trial % 2 == 0 ? (double)(1u + rng_below(4u)) : rng_uniform(1.0, 6.0));
         }
         rc = coa_deviation_weights(vs, 4, dt, w, &e);
         ck_assert_int_eq(rc, COA_OK); /* ratios below 2^6: W_i fit in 54 + 6 bits */
@@ -1141,9 +1134,15 @@ static coa_cost_t from_u128(u128_t x)
 
 START_TEST(test_cost_arithmetic)
 {
-    static const uint64_t edge[] = {0u, 1u, 2u, 0xffffffffu, UINT64_C(0x100000000),
-                                    UINT64_C(0x1ffffffff), UINT64_C(0x8000000000000000),
-                                    UINT64_MAX - 1u, UINT64_MAX};
+    static const uint64_t edge[] = {0u,
+                                    1u,
+                                    2u,
+                                    0xffffffffu,
+                                    UINT64_C(0x100000000),
+                                    UINT64_C(0x1ffffffff),
+                                    UINT64_C(0x8000000000000000),
+                                    UINT64_MAX - 1u,
+                                    UINT64_MAX};
     const size_t ne = sizeof edge / sizeof edge[0];
     size_t i;
     size_t j;

@@ -51,13 +51,14 @@ bool coavoid_cli_option_value(int argc, char **argv, int *i, const char *name, c
 }
 
 int coavoid_cli_text_option(int argc, char **argv, int *i, const char *name, const char *hint,
-                    bool allow_empty, const char **text)
+                            bool allow_empty, const char **text)
 {
     const char *value = NULL;
     if (*text != NULL) {
         return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: given more than once", name);
     }
-    if (!coavoid_cli_option_value(argc, argv, i, name, &value) || (value[0] == '\0' && !allow_empty)) {
+    if (!coavoid_cli_option_value(argc, argv, i, name, &value) ||
+        (value[0] == '\0' && !allow_empty)) {
         return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: missing value (%s)", name, hint);
     }
     *text = value;
@@ -65,19 +66,21 @@ int coavoid_cli_text_option(int argc, char **argv, int *i, const char *name, con
 }
 
 int coavoid_cli_count_option(int argc, char **argv, int *i, const char *name, const char *hint,
-                     bool zero_ok, uint64_t max, const char **text, uint64_t *out)
+                             bool zero_ok, uint64_t max, const char **text, uint64_t *out)
 {
     char range[64];
     const char *value = *text;
     snprintf(range, sizeof range, "an integer from %d to %llu", zero_ok ? 0 : 1,
              (unsigned long long)max);
-    int status = coavoid_cli_text_option(argc, argv, i, name, hint != NULL ? hint : range, true, &value);
+    int status =
+        coavoid_cli_text_option(argc, argv, i, name, hint != NULL ? hint : range, true, &value);
     if (status != CLI_CONTINUE) {
         return status;
     }
     if (!(zero_ok ? coavoid_cli_parse_index(value, max, out)
                   : coavoid_cli_parse_count(value, strlen(value), max, out))) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: must be %s, got '%.40s'", name, range, value);
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: must be %s, got '%.40s'", name, range,
+                                value);
     }
     *text = value;
     return CLI_CONTINUE;
@@ -98,13 +101,15 @@ int coavoid_cli_flag_option(const char *arg, const char *name, bool *flag)
 int coavoid_cli_mode_option(int argc, char **argv, int *i, const char **mode, bool *decoupled)
 {
     const char *value = *mode;
-    int status = coavoid_cli_text_option(argc, argv, i, "--mode", "centralised or decoupled", true, &value);
+    int status =
+        coavoid_cli_text_option(argc, argv, i, "--mode", "centralised or decoupled", true, &value);
     if (status != CLI_CONTINUE) {
         return status;
     }
     if (strcmp(value, "centralised") != 0 && strcmp(value, "decoupled") != 0) {
         return coavoid_cli_fail(CLI_EXIT_INVALID,
-                        "--mode: unknown mode '%.40s' (expected centralised or decoupled)", value);
+                                "--mode: unknown mode '%.40s' (expected centralised or decoupled)",
+                                value);
     }
     *mode = value;
     if (decoupled != NULL) {
@@ -176,7 +181,8 @@ bool coavoid_cli_parse_real(const char *text, double *out)
     return true;
 }
 
-coa_planner_config_t coavoid_cli_planner_config(const coavoid_scenario_t *s, size_t searched, uint32_t beta)
+coa_planner_config_t coavoid_cli_planner_config(const coavoid_scenario_t *s, size_t searched,
+                                                uint32_t beta)
 {
     coa_planner_config_t config;
     coa_problem_t problem = coavoid_scenario_problem(s);
@@ -236,7 +242,7 @@ int coavoid_cli_sample_scenario(const char *path, coavoid_scenario_t *s)
 }
 
 int coavoid_cli_parse_args(const coavoid_cli_command_t *c, int argc, char **argv, void *options,
-                   const char **args)
+                           const char **args)
 {
     size_t wanted = 0;
     size_t given = 0;
@@ -248,8 +254,8 @@ int coavoid_cli_parse_args(const coavoid_cli_command_t *c, int argc, char **argv
         const char *arg = argv[i];
         if (options_done || arg[0] != '-' || (wanted > 0u && strcmp(arg, "-") == 0)) {
             if (given == wanted) {
-                return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: unexpected argument '%.80s' (%s)", c->name,
-                                arg, c->too_many);
+                return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: unexpected argument '%.80s' (%s)",
+                                        c->name, arg, c->too_many);
             }
             args[given++] = arg;
             continue;
@@ -264,8 +270,9 @@ int coavoid_cli_parse_args(const coavoid_cli_command_t *c, int argc, char **argv
         }
         int status = c->option(argc, argv, &i, options);
         if (status == CLI_UNKNOWN_OPTION) {
-            return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: unknown option '%.40s' (see '%s --help')",
-                            c->name, arg, c->see);
+            return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                    "%s: unknown option '%.40s' (see '%s --help')", c->name, arg,
+                                    c->see);
         }
         if (status != CLI_CONTINUE) {
             return status;
@@ -273,12 +280,13 @@ int coavoid_cli_parse_args(const coavoid_cli_command_t *c, int argc, char **argv
     }
     if (given < wanted) {
         return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: missing %s (see '%s --help')", c->name,
-                        c->arguments[given], c->see);
+                                c->arguments[given], c->see);
     }
     return CLI_CONTINUE;
 }
 
-int coavoid_cli_run_scenario(const char *path, int (*run)(void *options, coavoid_scenario_t *s), void *options)
+int coavoid_cli_run_scenario(const char *path, int (*run)(void *options, coavoid_scenario_t *s),
+                             void *options)
 {
     coavoid_scenario_t scenario;
     int status = coavoid_cli_load_scenario(path, &scenario);

@@ -62,13 +62,13 @@ bool coavoid_cli_option_value(int argc, char **argv, int *i, const char *name, c
 typedef int (*cli_option_parser_t)(int argc, char **argv, int *i, void *options);
 
 typedef struct {
-    const char *name;          /* its messages' prefix: "plan", "coordinator" */
-    const char *see;           /* how its help is asked for: "coavoid plan" */
-    int first;                 /* argv index of its first argument: 2 for coavoid's commands */
-    const char *arguments[2];  /* its arguments in order ("LOGFILE", "SCENARIO.json"), NULL
+    const char *name;         /* its messages' prefix: "plan", "coordinator" */
+    const char *see;          /* how its help is asked for: "coavoid plan" */
+    int first;                /* argv index of its first argument: 2 for coavoid's commands */
+    const char *arguments[2]; /* its arguments in order ("LOGFILE", "SCENARIO.json"), NULL
                                   after the last; none for the drivers, which take options */
-    const char *too_many;      /* why one more argument is refused: "one scenario only" */
-    void (*help)(void);        /* prints the usage on stdout */
+    const char *too_many;     /* why one more argument is refused: "one scenario only" */
+    void (*help)(void);       /* prints the usage on stdout */
     cli_option_parser_t option;
 } coavoid_cli_command_t;
 
@@ -80,12 +80,13 @@ typedef struct {
  * unknown option 'ARG' (see 'SEE --help')", "NAME: missing ARGUMENT (see 'SEE --help')",
  * or c->option's status. O(argc) plus the parser's, no memory. */
 int coavoid_cli_parse_args(const coavoid_cli_command_t *c, int argc, char **argv, void *options,
-                   const char **args);
+                           const char **args);
 
 /* A command's step after its options: runs run(options, s) on the scenario at path, loaded
  * (coavoid_cli_load_scenario) and freed afterwards. Returns run's status, or CLI_EXIT_INVALID after
  * the loader's message. Memory: the scenario's, until run returns. */
-int coavoid_cli_run_scenario(const char *path, int (*run)(void *options, coavoid_scenario_t *s), void *options);
+int coavoid_cli_run_scenario(const char *path, int (*run)(void *options, coavoid_scenario_t *s),
+                             void *options);
 
 /* ---- one option's value ----
  * Each takes the option `name` at argv[*i] (already matched by coavoid_cli_option_is), consumes its
@@ -96,12 +97,12 @@ int coavoid_cli_run_scenario(const char *path, int (*run)(void *options, coavoid
 /* Any text, which *text (NULL until given) is set to. An empty value is missing unless
  * allow_empty (then the caller judges it). */
 int coavoid_cli_text_option(int argc, char **argv, int *i, const char *name, const char *hint,
-                    bool allow_empty, const char **text);
+                            bool allow_empty, const char **text);
 
 /* An integer from 1 (0 with zero_ok) to max: "NAME: must be an integer from 1 to MAX, got
  * 'VALUE'". hint NULL: "an integer from 1 to MAX". Sets *text (NULL until given) and *out. */
 int coavoid_cli_count_option(int argc, char **argv, int *i, const char *name, const char *hint,
-                     bool zero_ok, uint64_t max, const char **text, uint64_t *out);
+                             bool zero_ok, uint64_t max, const char **text, uint64_t *out);
 
 /* A flag, `arg` matched by coavoid_cli_option_is(arg, name): "NAME: takes no value" for
  * "NAME=...". Sets *flag. */
@@ -137,7 +138,8 @@ bool coavoid_cli_parse_real(const char *text, double *out);
  * factor and offset bound) for `searched` UAVs a search and `beta`. The scenario need not
  * be sampled. Cannot fail for a scenario that coavoid_scenario_load accepted and searched in
  * 1..COA_MAX_CENTRALISED, beta >= 1 (asserted). */
-coa_planner_config_t coavoid_cli_planner_config(const coavoid_scenario_t *s, size_t searched, uint32_t beta);
+coa_planner_config_t coavoid_cli_planner_config(const coavoid_scenario_t *s, size_t searched,
+                                                uint32_t beta);
 
 /* Widens *into so that it also takes every problem `with` takes: the longer horizon, the
  * larger steep factor and offset bound (unbounded when either is). */

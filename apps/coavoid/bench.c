@@ -125,51 +125,53 @@ static int parse_bench_options(int argc, char **argv, bench_options_t *o)
             print_usage();
             return CLI_EXIT_OK;
         } else if (coavoid_cli_option_is(arg, "--vehicles")) {
-            status = coavoid_cli_count_option(argc, argv, &i, "--vehicles", NULL, false, BENCH_MAX_VEHICLES,
-                                      &o->vehicles_text, &value);
+            status = coavoid_cli_count_option(argc, argv, &i, "--vehicles", NULL, false,
+                                              BENCH_MAX_VEHICLES, &o->vehicles_text, &value);
             o->vehicles = (uint32_t)value;
         } else if (coavoid_cli_option_is(arg, "--horizon")) {
-            status = coavoid_cli_count_option(argc, argv, &i, "--horizon", NULL, false, COA_MAX_HORIZON,
-                                      &o->horizon_text, &value);
+            status = coavoid_cli_count_option(argc, argv, &i, "--horizon", NULL, false,
+                                              COA_MAX_HORIZON, &o->horizon_text, &value);
             o->horizon = (uint32_t)value;
         } else if (coavoid_cli_option_is(arg, "--seed")) {
             status = coavoid_cli_count_option(argc, argv, &i, "--seed", NULL, true, UINT64_MAX,
-                                      &o->seed_text, &value);
+                                              &o->seed_text, &value);
             o->seed = value;
         } else if (coavoid_cli_option_is(arg, "--repeat")) {
-            status = coavoid_cli_count_option(argc, argv, &i, "--repeat", NULL, false, BENCH_MAX_REPEAT,
-                                      &o->repeat_text, &value);
+            status = coavoid_cli_count_option(argc, argv, &i, "--repeat", NULL, false,
+                                              BENCH_MAX_REPEAT, &o->repeat_text, &value);
             o->repeat = (uint32_t)value;
         } else if (coavoid_cli_option_is(arg, "--side-km")) {
-            status = coavoid_cli_text_option(argc, argv, &i, "--side-km", "km, > 0", true, &o->side_text);
-            if (status == CLI_CONTINUE &&
-                (!coavoid_cli_parse_real(o->side_text, &o->side_km) || !(o->side_km > 0) ||
-                 o->side_km > BENCH_MAX_SIDE_KM)) {
+            status = coavoid_cli_text_option(argc, argv, &i, "--side-km", "km, > 0", true,
+                                             &o->side_text);
+            if (status == CLI_CONTINUE && (!coavoid_cli_parse_real(o->side_text, &o->side_km) ||
+                                           !(o->side_km > 0) || o->side_km > BENCH_MAX_SIDE_KM)) {
                 return coavoid_cli_fail(CLI_EXIT_INVALID,
-                                "--side-km: must be a number with 0 < L <= %g, got '%.40s'",
-                                BENCH_MAX_SIDE_KM, o->side_text);
+                                        "--side-km: must be a number with 0 < L <= %g, got '%.40s'",
+                                        BENCH_MAX_SIDE_KM, o->side_text);
             }
         } else if (coavoid_cli_option_is(arg, "--all-pairs")) {
             status = coavoid_cli_flag_option(arg, "--all-pairs", &o->all_pairs);
         } else if (coavoid_cli_option_is(arg, "--json")) {
             status = coavoid_cli_flag_option(arg, "--json", &o->json);
         } else {
-            return coavoid_cli_fail(CLI_EXIT_INVALID,
-                            "bench predict: unexpected argument '%.40s' (see 'coavoid bench "
-                            "predict --help')",
-                            arg);
+            return coavoid_cli_fail(
+                CLI_EXIT_INVALID,
+                "bench predict: unexpected argument '%.40s' (see 'coavoid bench "
+                "predict --help')",
+                arg);
         }
         if (status != CLI_CONTINUE) {
             return status;
         }
     }
     if (o->vehicles_text == NULL) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "--vehicles: required (the number of UAVs, 1..%u)",
-                        BENCH_MAX_VEHICLES);
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                "--vehicles: required (the number of UAVs, 1..%u)",
+                                BENCH_MAX_VEHICLES);
     }
     if (o->horizon_text == NULL) {
         return coavoid_cli_fail(CLI_EXIT_INVALID, "--horizon: required (steps to predict, 1..%u)",
-                        COA_MAX_HORIZON);
+                                COA_MAX_HORIZON);
     }
     if (o->seed_text == NULL) {
         o->seed = BENCH_DEFAULT_SEED;
@@ -273,18 +275,20 @@ static int build_airspace(const bench_options_t *o, airspace_t *a)
     size_t per_plan = plan_samples(o->horizon, BENCH_STEPS[0]);
     size_t bytes_per_plan = per_plan * sizeof(coa_vec3_t);
     if (bytes_per_plan > BENCH_MAX_SAMPLE_BYTES / o->vehicles) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID,
-                        "--vehicles, --horizon: %lu UAVs over %lu steps need up to %zu MiB of "
-                        "plans, more than the benchmark's %zu MiB",
-                        (unsigned long)o->vehicles, (unsigned long)o->horizon,
-                        bytes_per_plan / 1024u * o->vehicles / 1024u, BENCH_MAX_SAMPLE_BYTES >> 20);
+        return coavoid_cli_fail(
+            CLI_EXIT_INVALID,
+            "--vehicles, --horizon: %lu UAVs over %lu steps need up to %zu MiB of "
+            "plans, more than the benchmark's %zu MiB",
+            (unsigned long)o->vehicles, (unsigned long)o->horizon,
+            bytes_per_plan / 1024u * o->vehicles / 1024u, BENCH_MAX_SAMPLE_BYTES >> 20);
     }
     a->plans = calloc(o->vehicles, sizeof *a->plans);
     a->samples = calloc((size_t)o->vehicles * per_plan, sizeof *a->samples);
     a->tracks = calloc(a->track_count + 1u, sizeof *a->tracks);
     if (a->plans == NULL || a->samples == NULL || a->tracks == NULL) {
         airspace_free(a);
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "--vehicles, --horizon: out of memory for the plans");
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                "--vehicles, --horizon: out of memory for the plans");
     }
 
     prng_t r = {o->seed};
@@ -354,20 +358,23 @@ static int size_predictor(const airspace_t *a, uint32_t horizon, bench_memory_t 
     m->workspace = NULL;
     m->size = coa_predictor_workspace_size(a->vehicles, a->track_count, horizon, m->max_pairs);
     if (m->size == 0 || m->size > BENCH_MAX_WORKSPACE_BYTES) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID,
-                        "--vehicles, --horizon: the predictor's workspace for %zu candidate "
-                        "pairs would exceed the benchmark's %zu MiB",
-                        m->max_pairs, BENCH_MAX_WORKSPACE_BYTES >> 20);
+        return coavoid_cli_fail(
+            CLI_EXIT_INVALID,
+            "--vehicles, --horizon: the predictor's workspace for %zu candidate "
+            "pairs would exceed the benchmark's %zu MiB",
+            m->max_pairs, BENCH_MAX_WORKSPACE_BYTES >> 20);
     }
     m->workspace = malloc(m->size);
     if (m->workspace == NULL) {
         return coavoid_cli_fail(CLI_EXIT_INVALID,
-                        "--vehicles, --horizon: out of memory for %zu bytes of workspace", m->size);
+                                "--vehicles, --horizon: out of memory for %zu bytes of workspace",
+                                m->size);
     }
     m->predictor = coa_predictor_init(m->workspace, m->size, a->vehicles, a->track_count, horizon,
                                       m->max_pairs);
     if (m->predictor == NULL) {
-        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: the predictor refused its workspace");
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL,
+                                "internal error: the predictor refused its workspace");
     }
     return CLI_CONTINUE;
 }
@@ -397,7 +404,7 @@ static int first_cycle(const airspace_t *a, const coa_predict_config_t *config, 
         }
         if (rc != COA_OK) {
             return coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: the predictor failed (%s)",
-                            coa_status_name(rc));
+                                    coa_status_name(rc));
         }
         if (!result->overflow) {
             return CLI_CONTINUE;
@@ -407,7 +414,7 @@ static int first_cycle(const airspace_t *a, const coa_predict_config_t *config, 
         m->conflicts = calloc(m->capacity, sizeof *m->conflicts);
         if (m->conflicts == NULL) {
             return coavoid_cli_fail(CLI_EXIT_INVALID, "--vehicles: out of memory for %zu conflicts",
-                            m->capacity);
+                                    m->capacity);
         }
     }
 }
@@ -453,9 +460,9 @@ static int run(const bench_options_t *o, const airspace_t *a, bench_result_t *ou
         if (rc != COA_OK || result.overflow || result.pair_tests != first.pair_tests ||
             result.candidate_pairs != first.candidate_pairs ||
             result.conflicts_found != first.conflicts_found) {
-            status =
-                coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: cycle %lu differs from the first (%s)",
-                         (unsigned long)k + 1u, coa_status_name(rc));
+            status = coavoid_cli_fail(CLI_EXIT_INTERNAL,
+                                      "internal error: cycle %lu differs from the first (%s)",
+                                      (unsigned long)k + 1u, coa_status_name(rc));
         }
     }
     if (status == CLI_CONTINUE) {
@@ -560,8 +567,9 @@ static int bench_predict(int argc, char **argv)
 int coavoid_command_bench(int argc, char **argv)
 {
     if (argc < 3) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID,
-                        "bench: missing benchmark (predict or plan; see 'coavoid bench --help')");
+        return coavoid_cli_fail(
+            CLI_EXIT_INVALID,
+            "bench: missing benchmark (predict or plan; see 'coavoid bench --help')");
     }
     const char *name = argv[2];
     if (strcmp(name, "-h") == 0 || strcmp(name, "--help") == 0) {
@@ -583,8 +591,9 @@ int coavoid_command_bench(int argc, char **argv)
     if (strcmp(name, "plan") == 0) {
         return coavoid_bench_plan(argc, argv);
     }
-    return coavoid_cli_fail(CLI_EXIT_INVALID,
-                    "bench: unknown benchmark '%.40s' (expected predict or plan; see 'coavoid bench "
-                    "--help')",
-                    name);
+    return coavoid_cli_fail(
+        CLI_EXIT_INVALID,
+        "bench: unknown benchmark '%.40s' (expected predict or plan; see 'coavoid bench "
+        "--help')",
+        name);
 }

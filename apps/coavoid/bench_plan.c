@@ -67,8 +67,8 @@ _Static_assert(BP_MIN_VEHICLES == 2u && BP_MAX_VEHICLES == 6u, "--vehicles' hint
     "\n"                                                                                    \
     "Times the planner, centralised and decoupled, on the paper scenario and on C random\n" \
     "encounters each of 2, 3, 4 and 5 UAVs (6 with --vehicles 6) converging on one point\n" \
-    "(staggered altitudes, half with a terrain box; %u steps of %g s), or on the N-UAV\n"  \
-    "encounters only with --vehicles. One run plans every problem of a set once; prints\n" \
+    "(staggered altitudes, half with a terrain box; %u steps of %g s), or on the N-UAV\n"   \
+    "encounters only with --vehicles. One run plans every problem of a set once; prints\n"  \
     "per set and mode the median, min and max run time over R runs, the nodes expanded,\n"  \
     "nodes per second, the workspace and the outcomes (a table, or a JSON object with\n"    \
     "--json).\n"                                                                            \
@@ -121,35 +121,37 @@ static int bp_option(int argc, char **argv, int *i, void *options)
     int status = CLI_UNKNOWN_OPTION;
     if (coavoid_cli_option_is(arg, "--vehicles")) {
         /* 2..6, which coavoid_cli_count_option (1..max) cannot say. */
-        status = coavoid_cli_text_option(argc, argv, i, "--vehicles", "an integer from 2 to 6", true,
-                                 &o->vehicles_text);
+        status = coavoid_cli_text_option(argc, argv, i, "--vehicles", "an integer from 2 to 6",
+                                         true, &o->vehicles_text);
         if (status == CLI_CONTINUE &&
             (!coavoid_cli_parse_count(o->vehicles_text, strlen(o->vehicles_text), BP_MAX_VEHICLES,
-                              &value) ||
+                                      &value) ||
              value < BP_MIN_VEHICLES)) {
-            status = coavoid_cli_fail(CLI_EXIT_INVALID, "--vehicles: must be an integer from %u to %u, "
-                              "got '%.40s'", BP_MIN_VEHICLES, BP_MAX_VEHICLES, o->vehicles_text);
+            status = coavoid_cli_fail(CLI_EXIT_INVALID,
+                                      "--vehicles: must be an integer from %u to %u, "
+                                      "got '%.40s'",
+                                      BP_MIN_VEHICLES, BP_MAX_VEHICLES, o->vehicles_text);
         }
         o->vehicles = (uint32_t)value;
     } else if (coavoid_cli_option_is(arg, "--count")) {
         status = coavoid_cli_count_option(argc, argv, i, "--count", NULL, false, BP_MAX_COUNT,
-                                  &o->count_text, &value);
+                                          &o->count_text, &value);
         o->count = (uint32_t)value;
     } else if (coavoid_cli_option_is(arg, "--seed")) {
-        status = coavoid_cli_count_option(argc, argv, i, "--seed", NULL, true, UINT64_MAX, &o->seed_text,
-                                  &value);
+        status = coavoid_cli_count_option(argc, argv, i, "--seed", NULL, true, UINT64_MAX,
+                                          &o->seed_text, &value);
         o->seed = value;
     } else if (coavoid_cli_option_is(arg, "--repeat")) {
         status = coavoid_cli_count_option(argc, argv, i, "--repeat", NULL, false, BP_MAX_REPEAT,
-                                  &o->repeat_text, &value);
+                                          &o->repeat_text, &value);
         o->repeat = (uint32_t)value;
     } else if (coavoid_cli_option_is(arg, "--beta")) {
-        status = coavoid_cli_count_option(argc, argv, i, "--beta", "an integer >= 1", false, UINT32_MAX,
-                                  &o->beta_text, &value);
+        status = coavoid_cli_count_option(argc, argv, i, "--beta", "an integer >= 1", false,
+                                          UINT32_MAX, &o->beta_text, &value);
         o->beta = (uint32_t)value;
     } else if (coavoid_cli_option_is(arg, "--scenario")) {
         status = coavoid_cli_text_option(argc, argv, i, "--scenario", "a scenario file", false,
-                                 &o->scenario);
+                                         &o->scenario);
     } else if (coavoid_cli_option_is(arg, "--json")) {
         status = coavoid_cli_flag_option(arg, "--json", &o->json);
     }
@@ -158,8 +160,8 @@ static int bp_option(int argc, char **argv, int *i, void *options)
 
 /* bench's argv[2] is the benchmark's name, so options start at argv[3]. */
 static const coavoid_cli_command_t bench_plan_command = {
-    "bench plan", "coavoid bench plan", 3, {NULL, NULL}, "it takes options only",
-    bench_plan_help, bp_option};
+    "bench plan", "coavoid bench plan", 3, {NULL, NULL}, "it takes options only", bench_plan_help,
+    bp_option};
 
 static int parse_bp_options(int argc, char **argv, bp_options_t *o)
 {
@@ -169,9 +171,9 @@ static int parse_bp_options(int argc, char **argv, bp_options_t *o)
         return status;
     }
     if (o->scenario != NULL && o->vehicles_text != NULL) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID,
-                        "--scenario: only without --vehicles (which times random encounters "
-                        "only)");
+        return coavoid_cli_fail(
+            CLI_EXIT_INVALID, "--scenario: only without --vehicles (which times random encounters "
+                              "only)");
     }
     if (o->seed_text == NULL) {
         o->seed = BP_DEFAULT_SEED;
@@ -193,8 +195,8 @@ static int parse_bp_options(int argc, char **argv, bp_options_t *o)
 /* ---- the sets ---- */
 
 typedef struct {
-    char label[16];       /* "paper", "2 UAVs" */
-    uint32_t vehicles;    /* per problem (the paper: its own) */
+    char label[16];               /* "paper", "2 UAVs" */
+    uint32_t vehicles;            /* per problem (the paper: its own) */
     coavoid_scenario_t *problems; /* sampled */
     uint32_t count;
 } bp_set_t;
@@ -215,20 +217,23 @@ static int build_random_set(const bp_options_t *o, uint32_t n, bp_set_t *set)
     set->problems = calloc(o->count, sizeof *set->problems);
     if (set->problems == NULL) {
         return coavoid_cli_fail(CLI_EXIT_INVALID, "--count: out of memory for %lu problems",
-                        (unsigned long)o->count);
+                                (unsigned long)o->count);
     }
     for (uint32_t j = 0; j < o->count; j++) {
         char json[ENCOUNTER_JSON_MAX];
         char err[SCENARIO_ERROR_MAX];
         set->count = j + 1u; /* so set_free frees this one too */
-        if (!coavoid_encounter_json(&coavoid_encounter_bench, o->seed, n, j, 0u, json, sizeof json, NULL)) {
-            return coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: encounter %u of %u UAVs does "
-                            "not fit %u bytes", j, n, ENCOUNTER_JSON_MAX);
+        if (!coavoid_encounter_json(&coavoid_encounter_bench, o->seed, n, j, 0u, json, sizeof json,
+                                    NULL)) {
+            return coavoid_cli_fail(CLI_EXIT_INTERNAL,
+                                    "internal error: encounter %u of %u UAVs does "
+                                    "not fit %u bytes",
+                                    j, n, ENCOUNTER_JSON_MAX);
         }
         if (coavoid_scenario_parse(json, strlen(json), &set->problems[j], err, sizeof err) != 0 ||
             coavoid_scenario_sample(&set->problems[j], err, sizeof err) != 0) {
-            return coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: encounter %u of %u UAVs: %s", j,
-                            n, err);
+            return coavoid_cli_fail(CLI_EXIT_INTERNAL,
+                                    "internal error: encounter %u of %u UAVs: %s", j, n, err);
         }
     }
     return CLI_CONTINUE;
@@ -247,9 +252,10 @@ static int build_paper_set(const bp_options_t *o, bp_set_t *set)
         status = coavoid_cli_sample_scenario(o->scenario, &set->problems[0]);
     }
     if (status == CLI_CONTINUE && set->problems[0].vehicle_count > COA_MAX_CENTRALISED) {
-        status = coavoid_cli_fail(CLI_EXIT_INVALID, "%s: %zu vehicles, at most %u can be planned "
-                          "centrally", o->scenario, set->problems[0].vehicle_count,
-                          COA_MAX_CENTRALISED);
+        status = coavoid_cli_fail(CLI_EXIT_INVALID,
+                                  "%s: %zu vehicles, at most %u can be planned "
+                                  "centrally",
+                                  o->scenario, set->problems[0].vehicle_count, COA_MAX_CENTRALISED);
     }
     set->vehicles = (uint32_t)set->problems[0].vehicle_count;
     return status;
@@ -286,8 +292,8 @@ static int run_once(coa_planner_t *planner, const bp_set_t *set, bool decoupled,
         clock_gettime(CLOCK_MONOTONIC, &end);
         if (rc != COA_OK) {
             return coavoid_cli_fail(rc == COA_ERR_RANGE ? CLI_EXIT_INVALID : CLI_EXIT_INTERNAL,
-                            "%s, problem %u: the planner failed (%s)", set->label, j,
-                            coa_status_name(rc));
+                                    "%s, problem %u: the planner failed (%s)", set->label, j,
+                                    coa_status_name(rc));
         }
         *ms += bench_elapsed_ms(&start, &end);
         row->nodes_expanded += result.nodes_expanded;
@@ -307,12 +313,13 @@ static int run_set(const bp_options_t *o, const bp_set_t *set, bool decoupled, b
     row->vehicles = set->vehicles;
     row->problems = set->count;
     size_t searched = decoupled ? 1u : set->vehicles;
-    uint32_t wanted = o->beta_text != NULL                          ? o->beta
+    uint32_t wanted = o->beta_text != NULL                            ? o->beta
                       : set->count == 1u && set->problems[0].has_beta ? set->problems[0].beta
                                                                       : CLI_DEFAULT_BETA;
     coa_planner_config_t config = coavoid_cli_planner_config(&set->problems[0], searched, wanted);
     for (uint32_t j = 1; j < set->count; j++) {
-        coa_planner_config_t other = coavoid_cli_planner_config(&set->problems[j], searched, wanted);
+        coa_planner_config_t other =
+            coavoid_cli_planner_config(&set->problems[j], searched, wanted);
         coavoid_cli_planner_config_widen(&config, &other);
     }
     if (!coavoid_cli_workspace_fits(&config)) {
@@ -328,9 +335,10 @@ static int run_set(const bp_options_t *o, const bp_set_t *set, bool decoupled, b
     coa_planner_t *planner = NULL;
     if (workspace == NULL || offsets == NULL || times == NULL) {
         status = coavoid_cli_fail(CLI_EXIT_INVALID, "%s: out of memory for %zu bytes of workspace",
-                          set->label, size);
+                                  set->label, size);
     } else if ((planner = coa_planner_init(workspace, size, &config)) == NULL) {
-        status = coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: the planner refused its workspace");
+        status = coavoid_cli_fail(CLI_EXIT_INTERNAL,
+                                  "internal error: the planner refused its workspace");
     }
     row->workspace_bytes = size;
     bp_row_t first;
@@ -346,8 +354,10 @@ static int run_set(const bp_options_t *o, const bp_set_t *set, bool decoupled, b
             (row->nodes_expanded != first.nodes_expanded ||
              row->nodes_generated != first.nodes_generated || row->solved != first.solved ||
              row->budget_exhausted != first.budget_exhausted)) {
-            status = coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: %s, run %lu differs from the "
-                              "first", set->label, (unsigned long)k + 1u);
+            status = coavoid_cli_fail(CLI_EXIT_INTERNAL,
+                                      "internal error: %s, run %lu differs from the "
+                                      "first",
+                                      set->label, (unsigned long)k + 1u);
         }
     }
     if (status == CLI_CONTINUE) {
@@ -370,13 +380,14 @@ static int report_text(FILE *f, const bp_options_t *o, const bp_row_t *rows, siz
 {
     fprintf(f, "benchmark: plan\nseed: %llu\nrepeat: %lu\ncount: %lu\n",
             (unsigned long long)o->seed, (unsigned long)o->repeat, (unsigned long)o->count);
-    fprintf(f, "%-7s %-11s %8s %6s %10s %6s %5s %6s %10s %10s %10s %14s %12s %15s\n", "set",
-            "mode", "problems", "solved", "infeasible", "budget", "uavs", "beta", "median_ms",
-            "min_ms", "max_ms", "nodes_expanded", "nodes_per_s", "workspace_bytes");
+    fprintf(f, "%-7s %-11s %8s %6s %10s %6s %5s %6s %10s %10s %10s %14s %12s %15s\n", "set", "mode",
+            "problems", "solved", "infeasible", "budget", "uavs", "beta", "median_ms", "min_ms",
+            "max_ms", "nodes_expanded", "nodes_per_s", "workspace_bytes");
     for (size_t i = 0; i < count; i++) {
         const bp_row_t *r = &rows[i];
-        fprintf(f, "%-7s %-11s %8lu %6lu %10lu %6lu %5lu %5lu%s %10.3f %10.3f %10.3f %14llu %12.0f "
-                   "%15zu\n",
+        fprintf(f,
+                "%-7s %-11s %8lu %6lu %10lu %6lu %5lu %5lu%s %10.3f %10.3f %10.3f %14llu %12.0f "
+                "%15zu\n",
                 r->set, r->decoupled ? "decoupled" : "centralised", (unsigned long)r->problems,
                 (unsigned long)r->solved, (unsigned long)r->infeasible,
                 (unsigned long)r->budget_exhausted, (unsigned long)r->vehicles,
@@ -416,11 +427,9 @@ static int report_json(FILE *f, const bp_options_t *o, const bp_row_t *rows, siz
              cJSON_AddNumberToObject(row, "min_ms", r->min_ms) != NULL &&
              cJSON_AddNumberToObject(row, "max_ms", r->max_ms) != NULL &&
              cJSON_AddNumberToObject(row, "nodes_expanded", (double)r->nodes_expanded) != NULL &&
-             cJSON_AddNumberToObject(row, "nodes_generated", (double)r->nodes_generated) !=
-                 NULL &&
+             cJSON_AddNumberToObject(row, "nodes_generated", (double)r->nodes_generated) != NULL &&
              cJSON_AddNumberToObject(row, "nodes_per_s", nodes_per_s(r)) != NULL &&
-             cJSON_AddNumberToObject(row, "workspace_bytes", (double)r->workspace_bytes) !=
-                 NULL &&
+             cJSON_AddNumberToObject(row, "workspace_bytes", (double)r->workspace_bytes) != NULL &&
              cJSON_AddNumberToObject(row, "solved", r->solved) != NULL &&
              cJSON_AddNumberToObject(row, "infeasible", r->infeasible) != NULL &&
              cJSON_AddNumberToObject(row, "budget_exhausted", r->budget_exhausted) != NULL;
@@ -444,7 +453,8 @@ int coavoid_bench_plan(int argc, char **argv)
     size_t set_count = 0;
     if (o.vehicles_text == NULL) {
         status = build_paper_set(&o, &sets[set_count++]);
-        for (uint32_t n = BP_MIN_VEHICLES; status == CLI_CONTINUE && n <= BP_DEFAULT_MAX_VEHICLES; n++) {
+        for (uint32_t n = BP_MIN_VEHICLES; status == CLI_CONTINUE && n <= BP_DEFAULT_MAX_VEHICLES;
+             n++) {
             status = build_random_set(&o, n, &sets[set_count++]);
         }
     } else {
@@ -460,7 +470,8 @@ int coavoid_bench_plan(int argc, char **argv)
     if (status == CLI_CONTINUE) {
         int rc = o.json ? report_json(stdout, &o, rows, row_count)
                         : report_text(stdout, &o, rows, row_count);
-        status = rc == 0 ? CLI_EXIT_OK : coavoid_cli_fail(CLI_EXIT_INTERNAL, "cannot write the result");
+        status =
+            rc == 0 ? CLI_EXIT_OK : coavoid_cli_fail(CLI_EXIT_INTERNAL, "cannot write the result");
     }
     for (size_t i = 0; i < set_count; i++) {
         set_free(&sets[i]);

@@ -114,8 +114,8 @@ static bool hill_json(const coavoid_encounter_design_t *d, prng_t *r, double top
         ok = append(buf, size, used, "[%.3f, %.3f, 0], ", quantise(d, cx + w * cos(a)),
                     quantise(d, cy + w * sin(a)));
     }
-    return ok && append(buf, size, used, "[%.3f, %.3f, %.3f]]}", quantise(d, ax),
-                        quantise(d, ay), top);
+    return ok &&
+           append(buf, size, used, "[%.3f, %.3f, %.3f]]}", quantise(d, ax), quantise(d, ay), top);
 }
 
 /* A non-cooperative aircraft flying level and straight through a point near the origin
@@ -142,8 +142,9 @@ static bool track_json(const coavoid_encounter_design_t *d, prng_t *r, uint32_t 
                   quantise(d, py - vy * when), quantise(d, z), vx, vy);
 }
 
-bool coavoid_encounter_json(const coavoid_encounter_design_t *d, uint64_t seed, uint32_t n, uint32_t index,
-                    uint32_t attempt, char *buf, size_t size, coavoid_encounter_info_t *info)
+bool coavoid_encounter_json(const coavoid_encounter_design_t *d, uint64_t seed, uint32_t n,
+                            uint32_t index, uint32_t attempt, char *buf, size_t size,
+                            coavoid_encounter_info_t *info)
 {
     /* Attempt 0 is bench plan's original stream; a redraw moves to another. */
     prng_t r = {seed ^ ((uint64_t)n << 56) ^ ((uint64_t)index * 0x9e3779b97f4a7c15u) ^
@@ -163,10 +164,10 @@ bool coavoid_encounter_json(const coavoid_encounter_design_t *d, uint64_t seed, 
         double speed = quantise(d, prng_uniform(&r, d->speed_min, d->speed_max));
         double climb = quantise(d, prng_uniform(&r, d->climb_min, d->climb_max));
         double arrive = prng_uniform(&r, d->arrive_min, d->arrive_max);
-        double z = quantise(d, d->base_altitude +
-                                   d->altitude_grid *
-                                       ((double)prng_below(&r, 2u * d->max_stagger + 1u) -
-                                        (double)d->max_stagger));
+        double z =
+            quantise(d, d->base_altitude +
+                            d->altitude_grid * ((double)prng_below(&r, 2u * d->max_stagger + 1u) -
+                                                (double)d->max_stagger));
         lowest = z < lowest ? z : lowest;
         double ux = cos(heading), uy = sin(heading);
         /* Flying along (ux, uy) through the origin at t = arrive, and on past the horizon. */
@@ -180,8 +181,8 @@ bool coavoid_encounter_json(const coavoid_encounter_design_t *d, uint64_t seed, 
                     quantise(d, -before * ux), quantise(d, -before * uy), z,
                     quantise(d, after * ux), quantise(d, after * uy), z);
         if (ok && d->max_offset_max > 0) {
-            uint32_t bound = d->max_offset_min +
-                             prng_below(&r, d->max_offset_max - d->max_offset_min + 1u);
+            uint32_t bound =
+                d->max_offset_min + prng_below(&r, d->max_offset_max - d->max_offset_min + 1u);
             ok = append(buf, size, &used, ", \"max_offset\": %u", bound);
         }
         ok = ok && append(buf, size, &used, "}");

@@ -32,24 +32,24 @@
 #define ENCOUNTER_MAX_VEHICLES 6u
 
 typedef struct {
-    const char *name;        /* "bench encounter", in each problem's name */
-    uint32_t horizon;        /* steps */
-    double dt;               /* s */
+    const char *name;              /* "bench encounter", in each problem's name */
+    uint32_t horizon;              /* steps */
+    double dt;                     /* s */
     double speed_min, speed_max;   /* cruise speed, m/s */
     double climb_min, climb_max;   /* climb rate, m/s */
     double arrive_min, arrive_max; /* when each reaches the origin, s */
-    double jitter;           /* heading jitter, rad either side */
-    double base_altitude;    /* m */
-    double altitude_grid;    /* m per stagger step */
-    uint32_t max_stagger;    /* stagger steps either side of the base */
-    double radius, half_height; /* every UAV's protected volume, m */
+    double jitter;                 /* heading jitter, rad either side */
+    double base_altitude;          /* m */
+    double altitude_grid;          /* m per stagger step */
+    uint32_t max_stagger;          /* stagger steps either side of the base */
+    double radius, half_height;    /* every UAV's protected volume, m */
     /* 0: numbers as drawn (printed to 3 decimals); otherwise every coordinate, speed and
      * rate is rounded to a multiple of it. A power of two such as 1/8 makes each one a
      * float exactly, so single- and double-precision builds read the same problem. */
     double quantum;
-    bool box_half;           /* bench: half the encounters get a box under the origin */
-    bool terrain_hills;      /* montecarlo: 1-3 hills (boxes or pyramids) near the origin */
-    uint32_t max_tracks;     /* 0..max_tracks non-cooperative tracks crossing near the origin */
+    bool box_half;       /* bench: half the encounters get a box under the origin */
+    bool terrain_hills;  /* montecarlo: 1-3 hills (boxes or pyramids) near the origin */
+    uint32_t max_tracks; /* 0..max_tracks non-cooperative tracks crossing near the origin */
     double track_radius, track_half_height; /* their protected volumes, m */
     /* 0: unbounded; otherwise each UAV's max_offset is drawn from min..max. */
     uint32_t max_offset_min, max_offset_max;
@@ -70,7 +70,8 @@ typedef struct {
  * design d, draw `attempt` (0 first; a caller that rejects a draw asks for the next), as
  * scenario JSON into buf[size]. info may be NULL. Returns false when it does not fit (a
  * bug: ENCOUNTER_JSON_MAX bounds a problem). O(n + hills + tracks), no memory. */
-bool coavoid_encounter_json(const coavoid_encounter_design_t *d, uint64_t seed, uint32_t n, uint32_t index,
-                    uint32_t attempt, char *buf, size_t size, coavoid_encounter_info_t *info);
+bool coavoid_encounter_json(const coavoid_encounter_design_t *d, uint64_t seed, uint32_t n,
+                            uint32_t index, uint32_t attempt, char *buf, size_t size,
+                            coavoid_encounter_info_t *info);
 
 #endif /* COAVOID_APP_ENCOUNTER_H */

@@ -27,7 +27,7 @@
  * the one place where that option reaches the code: their sources are left out of the
  * build otherwise, not replaced by stubs. */
 #ifdef COAVOID_HAVE_NODE
-#define USAGE_NODES                                                                  \
+#define USAGE_NODES                                                                 \
     "  sim         fly a scenario in closed loop over the nodes (deterministic)\n"  \
     "  summary     judge a real-time run from its lcm-logger log (costs, figure)\n" \
     "  world       publish a scenario's terrain and tracks to a real-time run\n"
@@ -35,16 +35,15 @@
 #define USAGE_NODES ""
 #endif
 
-#define USAGE                                                                         \
-    "usage: coavoid <command> [options]\n"                                            \
-    "\n"                                                                              \
-    "commands:\n"                                                                     \
-    "  plan        plan collision-free altitude manoeuvres for a scenario\n"          \
-    "  predict     predict the conflicts of a scenario's reference trajectories\n"    \
-    "  bench       time the core: bench predict, bench plan\n"                        \
-    "  montecarlo  compare centralised and decoupled planning over random encounters\n" \
-    USAGE_NODES                                                                       \
-    "\n"                                                                              \
+#define USAGE                                                                      \
+    "usage: coavoid <command> [options]\n"                                         \
+    "\n"                                                                           \
+    "commands:\n"                                                                  \
+    "  plan        plan collision-free altitude manoeuvres for a scenario\n"       \
+    "  predict     predict the conflicts of a scenario's reference trajectories\n" \
+    "  bench       time the core: bench predict, bench plan\n"                     \
+    "  montecarlo  compare centralised and decoupled planning over random "        \
+    "encounters\n" USAGE_NODES "\n"                                                \
     "Run 'coavoid <command> --help' for the options of a command.\n"
 
 int main(int argc, char **argv)
@@ -81,7 +80,9 @@ int main(int argc, char **argv)
     }
 #endif
     if (command[0] == '-') {
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "unknown option '%.40s' (see 'coavoid --help')", command);
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "unknown option '%.40s' (see 'coavoid --help')",
+                                command);
     }
-    return coavoid_cli_fail(CLI_EXIT_INVALID, "unknown command '%.40s' (see 'coavoid --help')", command);
+    return coavoid_cli_fail(CLI_EXIT_INVALID, "unknown command '%.40s' (see 'coavoid --help')",
+                            command);
 }

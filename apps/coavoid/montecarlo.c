@@ -61,43 +61,43 @@ enum { MC_CENTRALISED, MC_FIXED, MC_REORDERED, MC_METHODS };
 static const char *const method_names[MC_METHODS] = {"centralised", "decoupled_fixed",
                                                      "decoupled_reordered"};
 
-#define MONTECARLO_USAGE                                                                     \
+#define MONTECARLO_USAGE                                                                    \
     "usage: coavoid montecarlo --vehicles N[,N...] [--count C] [--seed S] [--beta B]\n"     \
-    "                          [--max-orders M] [--csv FILE] [--svg FILE] [--json]\n"      \
-    "                          [--save DIR] [--jobs J] [--quiet]\n"                        \
-    "\n"                                                                                   \
-    "Draws C random encounters of N UAVs (for each N listed) converging on a point over\n" \
-    "hills, with 0 to 2 non-cooperative tracks crossing (%u steps of %g s), and solves\n"  \
-    "each one centralised, decoupled in the fixed priority order and decoupled with\n"     \
+    "                          [--max-orders M] [--csv FILE] [--svg FILE] [--json]\n"       \
+    "                          [--save DIR] [--jobs J] [--quiet]\n"                         \
+    "\n"                                                                                    \
+    "Draws C random encounters of N UAVs (for each N listed) converging on a point over\n"  \
+    "hills, with 0 to 2 non-cooperative tracks crossing (%u steps of %g s), and solves\n"   \
+    "each one centralised, decoupled in the fixed priority order and decoupled with\n"      \
     "reordering. Prints per N and method the outcomes, the success rate with its 95%%\n"    \
     "Wilson interval, the distribution of the decoupled/centralised deviation ratio\n"      \
-    "over the encounters both solve, and the planning times (a text summary, or a JSON\n"  \
-    "object with --json). See docs/evaluation.md.\n"                                       \
-    "\n"                                                                                   \
-    "options:\n"                                                                           \
-    "  --vehicles N,...  UAVs per encounter, each %u..%u, e.g. 2,3,4 (required)\n"         \
-    "  --count C         encounters per N, 1..%u; default %u\n"                            \
+    "over the encounters both solve, and the planning times (a text summary, or a JSON\n"   \
+    "object with --json). See docs/evaluation.md.\n"                                        \
+    "\n"                                                                                    \
+    "options:\n"                                                                            \
+    "  --vehicles N,...  UAVs per encounter, each %u..%u, e.g. 2,3,4 (required)\n"          \
+    "  --count C         encounters per N, 1..%u; default %u\n"                             \
     "  --seed S          the encounters' random seed, an integer >= 0; default %u\n"        \
     "  --beta B          closed-set bound, B >= 1, for every search; default %u, lowered\n" \
     "                    per N where the centralised workspace would pass 1 GiB\n"          \
-    "  --max-orders M    reordering: at most M priority orders, M >= 1; default N!\n"      \
-    "                    (every order)\n"                                                  \
-    "  --csv FILE        one row per encounter and method (times in time_us)\n"           \
-    "  --svg FILE        success rates and the ratio's cumulative distribution\n"          \
-    "  --save DIR        write each encounter as DIR/montecarlo-SEED-N-INDEX.json (an\n"   \
-    "                    existing directory), for `coavoid plan` to replay\n"              \
-    "  --json            print the summary as a JSON object\n"                             \
-    "  --jobs J          worker threads, 1..%u; default 1; results do not depend on it\n"  \
-    "  --quiet           no progress on stderr (otherwise: a line updated every second\n"  \
-    "                    on a terminal, a line every 10%% when stderr is not one)\n"       \
-    "  -h, --help        show this help\n"                                                 \
-    "\n"                                                                                   \
-    "A seed gives the same encounters and results on every machine with the same C\n"     \
-    "maths library (headings use cos and sin), except the times.\n"                      \
-    "\n"                                                                                   \
-    "exit status: 0 done (whatever the plans' outcomes), 2 invalid usage (one line on\n"  \
-    "stderr naming the option and why), 3 internal error or a defect of the planner (a\n" \
-    "decoupled plan cheaper than the optimal centralised one or where it proved none, a\n" \
+    "  --max-orders M    reordering: at most M priority orders, M >= 1; default N!\n"       \
+    "                    (every order)\n"                                                   \
+    "  --csv FILE        one row per encounter and method (times in time_us)\n"             \
+    "  --svg FILE        success rates and the ratio's cumulative distribution\n"           \
+    "  --save DIR        write each encounter as DIR/montecarlo-SEED-N-INDEX.json (an\n"    \
+    "                    existing directory), for `coavoid plan` to replay\n"               \
+    "  --json            print the summary as a JSON object\n"                              \
+    "  --jobs J          worker threads, 1..%u; default 1; results do not depend on it\n"   \
+    "  --quiet           no progress on stderr (otherwise: a line updated every second\n"   \
+    "                    on a terminal, a line every 10%% when stderr is not one)\n"        \
+    "  -h, --help        show this help\n"                                                  \
+    "\n"                                                                                    \
+    "A seed gives the same encounters and results on every machine with the same C\n"       \
+    "maths library (headings use cos and sin), except the times.\n"                         \
+    "\n"                                                                                    \
+    "exit status: 0 done (whatever the plans' outcomes), 2 invalid usage (one line on\n"    \
+    "stderr naming the option and why), 3 internal error or a defect of the planner (a\n"   \
+    "decoupled plan cheaper than the optimal centralised one or where it proved none, a\n"  \
     "solved plan in conflict or with no deviation: one line each on stderr)\n"
 
 static void montecarlo_help(void)
@@ -141,15 +141,15 @@ static int parse_sizes(mc_options_t *o)
         if (!coavoid_cli_parse_count(token, length, ENCOUNTER_MAX_VEHICLES, &n) ||
             n < ENCOUNTER_MIN_VEHICLES) {
             return coavoid_cli_fail(CLI_EXIT_INVALID,
-                            "--vehicles: each entry must be an integer from %u to %u, got "
-                            "'%.*s'",
-                            ENCOUNTER_MIN_VEHICLES, ENCOUNTER_MAX_VEHICLES,
-                            (int)(length > 40 ? 40 : length), token);
+                                    "--vehicles: each entry must be an integer from %u to %u, got "
+                                    "'%.*s'",
+                                    ENCOUNTER_MIN_VEHICLES, ENCOUNTER_MAX_VEHICLES,
+                                    (int)(length > 40 ? 40 : length), token);
         }
         for (uint32_t k = 0; k < o->size_count; k++) {
             if (o->sizes[k] == n) {
                 return coavoid_cli_fail(CLI_EXIT_INVALID, "--vehicles: %lu is listed twice",
-                                (unsigned long)n);
+                                        (unsigned long)n);
             }
         }
         o->sizes[o->size_count++] = (uint32_t)n; /* at most MC_SIZES distinct values */
@@ -167,26 +167,27 @@ static int mc_option(int argc, char **argv, int *i, void *options)
     uint64_t value = 0;
     int status = CLI_UNKNOWN_OPTION;
     if (coavoid_cli_option_is(arg, "--vehicles")) {
-        status = coavoid_cli_text_option(argc, argv, i, "--vehicles", "UAV counts from 2 to 6, e.g. 2,3,4",
-                                 false, &o->vehicles_text);
+        status =
+            coavoid_cli_text_option(argc, argv, i, "--vehicles",
+                                    "UAV counts from 2 to 6, e.g. 2,3,4", false, &o->vehicles_text);
         if (status == CLI_CONTINUE) {
             status = parse_sizes(o);
         }
     } else if (coavoid_cli_option_is(arg, "--count")) {
         status = coavoid_cli_count_option(argc, argv, i, "--count", NULL, false, MC_MAX_COUNT,
-                                  &o->count_text, &value);
+                                          &o->count_text, &value);
         o->count = (uint32_t)value;
     } else if (coavoid_cli_option_is(arg, "--seed")) {
-        status = coavoid_cli_count_option(argc, argv, i, "--seed", NULL, true, UINT64_MAX, &o->seed_text,
-                                  &value);
+        status = coavoid_cli_count_option(argc, argv, i, "--seed", NULL, true, UINT64_MAX,
+                                          &o->seed_text, &value);
         o->seed = value;
     } else if (coavoid_cli_option_is(arg, "--beta")) {
-        status = coavoid_cli_count_option(argc, argv, i, "--beta", "an integer >= 1", false, UINT32_MAX,
-                                  &o->beta_text, &value);
+        status = coavoid_cli_count_option(argc, argv, i, "--beta", "an integer >= 1", false,
+                                          UINT32_MAX, &o->beta_text, &value);
         o->beta = (uint32_t)value;
     } else if (coavoid_cli_option_is(arg, "--max-orders")) {
         status = coavoid_cli_count_option(argc, argv, i, "--max-orders", "an integer >= 1", false,
-                                  UINT32_MAX, &o->max_orders_text, &value);
+                                          UINT32_MAX, &o->max_orders_text, &value);
         o->max_orders = (uint32_t)value;
     } else if (coavoid_cli_option_is(arg, "--csv")) {
         status = coavoid_cli_text_option(argc, argv, i, "--csv", "a file to write", false, &o->csv);
@@ -198,7 +199,7 @@ static int mc_option(int argc, char **argv, int *i, void *options)
         status = coavoid_cli_flag_option(arg, "--json", &o->json);
     } else if (coavoid_cli_option_is(arg, "--jobs")) {
         status = coavoid_cli_count_option(argc, argv, i, "--jobs", NULL, false, MC_MAX_JOBS,
-                                  &o->jobs_text, &value);
+                                          &o->jobs_text, &value);
         o->jobs = (uint32_t)value;
     } else if (coavoid_cli_option_is(arg, "--quiet")) {
         status = coavoid_cli_flag_option(arg, "--quiet", &o->quiet);
@@ -207,8 +208,8 @@ static int mc_option(int argc, char **argv, int *i, void *options)
 }
 
 static const coavoid_cli_command_t montecarlo_command = {
-    "montecarlo", "coavoid montecarlo", 2, {NULL, NULL}, "it takes options only",
-    montecarlo_help, mc_option};
+    "montecarlo", "coavoid montecarlo", 2, {NULL, NULL}, "it takes options only", montecarlo_help,
+    mc_option};
 
 static int parse_mc_options(int argc, char **argv, mc_options_t *o)
 {
@@ -218,11 +219,14 @@ static int parse_mc_options(int argc, char **argv, mc_options_t *o)
         return status;
     }
     if (o->vehicles_text == NULL) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "--vehicles: required (UAV counts from %u to %u, "
-                        "e.g. 2,3,4)", ENCOUNTER_MIN_VEHICLES, ENCOUNTER_MAX_VEHICLES);
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                "--vehicles: required (UAV counts from %u to %u, "
+                                "e.g. 2,3,4)",
+                                ENCOUNTER_MIN_VEHICLES, ENCOUNTER_MAX_VEHICLES);
     }
     if (o->csv != NULL && o->svg != NULL && strcmp(o->csv, o->svg) == 0) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "--svg: the same file as --csv ('%.200s')", o->csv);
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "--svg: the same file as --csv ('%.200s')",
+                                o->csv);
     }
     if (o->count_text == NULL) {
         o->count = MC_DEFAULT_COUNT;
@@ -326,17 +330,20 @@ static int planners_ready(mc_planners_t *p, const mc_size_t *size, char *err, si
     size_t central = coa_planner_workspace_size(&central_config);
     size_t decoupled = coa_planner_workspace_size(&decoupled_config);
     if (central == 0 || decoupled == 0) {
-        snprintf(err, err_size, "--beta: %lu is too large for %lu UAVs centralised (the node "
-                 "pool would pass 2^30)", (unsigned long)size->beta, (unsigned long)size->n);
+        snprintf(err, err_size,
+                 "--beta: %lu is too large for %lu UAVs centralised (the node "
+                 "pool would pass 2^30)",
+                 (unsigned long)size->beta, (unsigned long)size->n);
         return -1;
     }
     p->central_buffer = malloc(central);
     p->decoupled_buffer = malloc(decoupled);
     if (p->central_buffer == NULL || p->decoupled_buffer == NULL || p->offsets == NULL ||
         p->zeros == NULL) {
-        snprintf(err, err_size, "out of memory for %zu bytes of workspace (%lu UAVs at beta "
-                 "%lu; lower --beta or --jobs)", central, (unsigned long)size->n,
-                 (unsigned long)size->beta);
+        snprintf(err, err_size,
+                 "out of memory for %zu bytes of workspace (%lu UAVs at beta "
+                 "%lu; lower --beta or --jobs)",
+                 central, (unsigned long)size->n, (unsigned long)size->beta);
         return -1;
     }
     p->central = coa_planner_init(p->central_buffer, central, &central_config);
@@ -380,10 +387,12 @@ static int draw_encounter(uint64_t seed, const mc_size_t *size, uint32_t index,
     for (uint32_t attempt = 0; attempt < MC_MAX_ATTEMPTS; attempt++) {
         char json[ENCOUNTER_JSON_MAX];
         char why[SCENARIO_ERROR_MAX];
-        if (!coavoid_encounter_json(&coavoid_encounter_montecarlo, seed, n, index, attempt, json, sizeof json,
-                            &r->info)) {
-            snprintf(err, err_size, "internal error: encounter %lu of %lu UAVs does not fit %u "
-                     "bytes", (unsigned long)index, (unsigned long)n, ENCOUNTER_JSON_MAX);
+        if (!coavoid_encounter_json(&coavoid_encounter_montecarlo, seed, n, index, attempt, json,
+                                    sizeof json, &r->info)) {
+            snprintf(err, err_size,
+                     "internal error: encounter %lu of %lu UAVs does not fit %u "
+                     "bytes",
+                     (unsigned long)index, (unsigned long)n, ENCOUNTER_JSON_MAX);
             return -1;
         }
         memset(s, 0, sizeof *s);
@@ -400,16 +409,19 @@ static int draw_encounter(uint64_t seed, const mc_size_t *size, uint32_t index,
         int rc = coa_plan_find_conflict(&problem, p->zeros, which, n, &vehicle, &step);
         if (rc < 0) {
             coavoid_scenario_free(s);
-            snprintf(err, err_size, "internal error: encounter %lu of %lu UAVs: the conflict "
-                     "check failed (%s)", (unsigned long)index, (unsigned long)n,
-                     coa_status_name(rc));
+            snprintf(err, err_size,
+                     "internal error: encounter %lu of %lu UAVs: the conflict "
+                     "check failed (%s)",
+                     (unsigned long)index, (unsigned long)n, coa_status_name(rc));
             return -1;
         }
         if (rc == 1 && step > 0) {
             if (save_dir != NULL && save_encounter(save_dir, seed, n, index, json) != 0) {
                 coavoid_scenario_free(s);
-                snprintf(err, err_size, "--save: cannot write encounter %lu of %lu UAVs in "
-                         "'%.200s'", (unsigned long)index, (unsigned long)n, save_dir);
+                snprintf(err, err_size,
+                         "--save: cannot write encounter %lu of %lu UAVs in "
+                         "'%.200s'",
+                         (unsigned long)index, (unsigned long)n, save_dir);
                 return -1;
             }
             r->redraws = attempt;
@@ -418,9 +430,10 @@ static int draw_encounter(uint64_t seed, const mc_size_t *size, uint32_t index,
         }
         coavoid_scenario_free(s);
     }
-    snprintf(err, err_size, "internal error: encounter %lu of %lu UAVs: no draw in %u has a "
-             "conflict after its first step", (unsigned long)index, (unsigned long)n,
-             MC_MAX_ATTEMPTS);
+    snprintf(err, err_size,
+             "internal error: encounter %lu of %lu UAVs: no draw in %u has a "
+             "conflict after its first step",
+             (unsigned long)index, (unsigned long)n, MC_MAX_ATTEMPTS);
     return -1;
 }
 
@@ -456,16 +469,18 @@ static int solve_encounter(uint64_t seed, const mc_size_t *size, uint32_t index,
         memset(&result, 0, sizeof result);
         struct timespec start, end;
         clock_gettime(CLOCK_MONOTONIC, &start);
-        int rc = m == MC_CENTRALISED
-                     ? coa_plan_centralised(p->central, &problem, p->offsets, &result)
-                     : coa_plan_decoupled(p->decoupled, &problem, NULL,
-                                          m == MC_FIXED ? 1u : size->max_orders, p->offsets,
-                                          &result);
+        int rc =
+            m == MC_CENTRALISED
+                ? coa_plan_centralised(p->central, &problem, p->offsets, &result)
+                : coa_plan_decoupled(p->decoupled, &problem, NULL,
+                                     m == MC_FIXED ? 1u : size->max_orders, p->offsets, &result);
         clock_gettime(CLOCK_MONOTONIC, &end);
         if (rc != COA_OK) {
-            snprintf(err, err_size, "internal error: encounter %lu of %lu UAVs, %s: the "
-                     "planner failed (%s)", (unsigned long)index, (unsigned long)size->n,
-                     method_names[m], coa_status_name(rc));
+            snprintf(err, err_size,
+                     "internal error: encounter %lu of %lu UAVs, %s: the "
+                     "planner failed (%s)",
+                     (unsigned long)index, (unsigned long)size->n, method_names[m],
+                     coa_status_name(rc));
             status = -1;
             break;
         }
@@ -483,8 +498,10 @@ static int solve_encounter(uint64_t seed, const mc_size_t *size, uint32_t index,
             uint32_t step = 0;
             rc = coa_plan_find_conflict(&problem, p->offsets, which, size->n, &vehicle, &step);
             if (rc != 0) {
-                snprintf(r->defect, sizeof r->defect, "the %s plan has a conflict (check %d) "
-                         "at step %lu", method_names[m], rc, (unsigned long)step);
+                snprintf(r->defect, sizeof r->defect,
+                         "the %s plan has a conflict (check %d) "
+                         "at step %lu",
+                         method_names[m], rc, (unsigned long)step);
             }
         }
     }
@@ -492,9 +509,10 @@ static int solve_encounter(uint64_t seed, const mc_size_t *size, uint32_t index,
     const mc_outcome_t *c = &r->m[MC_CENTRALISED];
     /* The reference plan conflicts, so every plan moves someone: a deviation of 0 would
      * be wrong (and the ratios divide by it). */
-    if (status == 0 && r->defect[0] == '\0' && c->status == COA_PLAN_SOLVED &&
-        c->units.hi == 0 && c->units.lo == 0) {
-        snprintf(r->defect, sizeof r->defect, "the centralised plan has no deviation although "
+    if (status == 0 && r->defect[0] == '\0' && c->status == COA_PLAN_SOLVED && c->units.hi == 0 &&
+        c->units.lo == 0) {
+        snprintf(r->defect, sizeof r->defect,
+                 "the centralised plan has no deviation although "
                  "the reference plan conflicts at step %lu",
                  (unsigned long)r->first_conflict_step);
     }
@@ -503,8 +521,10 @@ static int solve_encounter(uint64_t seed, const mc_size_t *size, uint32_t index,
         /* A decoupled plan is a plan for the whole group, which the centralised search
          * cannot have proven absent. */
         if (c->status == COA_PLAN_INFEASIBLE && d->status == COA_PLAN_SOLVED) {
-            snprintf(r->defect, sizeof r->defect, "%s solved an encounter the centralised "
-                     "search proved infeasible", method_names[m]);
+            snprintf(r->defect, sizeof r->defect,
+                     "%s solved an encounter the centralised "
+                     "search proved infeasible",
+                     method_names[m]);
             continue;
         }
         if (c->status != COA_PLAN_SOLVED || d->status != COA_PLAN_SOLVED) {
@@ -512,7 +532,8 @@ static int solve_encounter(uint64_t seed, const mc_size_t *size, uint32_t index,
         }
         int cmp = coa_cost_compare(d->units, c->units);
         if (cmp < 0 || (cmp == 0 && d->effort < c->effort)) {
-            snprintf(r->defect, sizeof r->defect, "%s plan (deviation %.17g units, effort %lu) "
+            snprintf(r->defect, sizeof r->defect,
+                     "%s plan (deviation %.17g units, effort %lu) "
                      "is cheaper than the optimal centralised one (%.17g units, effort %lu)",
                      method_names[m], cost_to_double(d->units), (unsigned long)d->effort,
                      cost_to_double(c->units), (unsigned long)c->effort);
@@ -530,8 +551,8 @@ typedef struct {
     mc_result_t *results;
     bool *done;
     pthread_mutex_t lock;
-    uint32_t next;      /* the next item a worker takes */
-    bool stop;          /* an error: workers take nothing more */
+    uint32_t next; /* the next item a worker takes */
+    bool stop;     /* an error: workers take nothing more */
     char error[SCENARIO_ERROR_MAX + 128];
 } mc_run_t;
 
@@ -604,8 +625,8 @@ static void cost_text(coa_cost_t c, char *buf, size_t size)
     buf[j] = '\0';
 }
 
-#define MC_CSV_HEADER                                                                    \
-    "seed,vehicles,index,redraws,hills,tracks,first_conflict_step,method,status,"         \
+#define MC_CSV_HEADER                                                             \
+    "seed,vehicles,index,redraws,hills,tracks,first_conflict_step,method,status," \
     "deviation,deviation_units,effort,expanded,generated,orders_tried,time_us\n"
 
 static void csv_rows(FILE *f, uint64_t seed, const mc_result_t *r)
@@ -656,8 +677,8 @@ static void progress(mc_progress_t *p, uint32_t done, uint32_t total, double ela
     }
     double eta = done > 0 ? elapsed * (double)(total - done) / (double)done : 0.0;
     fprintf(stderr, "%smontecarlo: %lu/%lu encounters (%.0f%%), %.0f s elapsed, ETA %.0f s%s",
-            p->tty ? "\r" : "", (unsigned long)done, (unsigned long)total,
-            100.0 * done / total, elapsed, eta, p->tty && !last ? "   " : "\n");
+            p->tty ? "\r" : "", (unsigned long)done, (unsigned long)total, 100.0 * done / total,
+            elapsed, eta, p->tty && !last ? "   " : "\n");
     fflush(stderr);
     p->reported_tenth = tenth;
     p->reported_at = elapsed;
@@ -704,11 +725,12 @@ static int run_all(mc_run_t *run, FILE *csv)
                     fputc('\n', stderr);
                     prog.line_open = false;
                 }
-                coavoid_cli_fail(CLI_EXIT_INTERNAL, "montecarlo: defect: seed %llu, %lu UAVs, "
-                         "encounter %lu: %s", (unsigned long long)o->seed,
-                         (unsigned long)run->results[written].vehicles,
-                         (unsigned long)run->results[written].index,
-                         run->results[written].defect);
+                coavoid_cli_fail(
+                    CLI_EXIT_INTERNAL,
+                    "montecarlo: defect: seed %llu, %lu UAVs, "
+                    "encounter %lu: %s",
+                    (unsigned long long)o->seed, (unsigned long)run->results[written].vehicles,
+                    (unsigned long)run->results[written].index, run->results[written].defect);
             }
         }
         if (csv != NULL) {
@@ -729,8 +751,8 @@ static int run_all(mc_run_t *run, FILE *csv)
     pthread_mutex_destroy(&run->lock);
     if (run->stop) {
         return coavoid_cli_fail(strncmp(run->error, "internal error", 14) == 0 ? CLI_EXIT_INTERNAL
-                                                                        : CLI_EXIT_INVALID,
-                        "montecarlo: %s", run->error);
+                                                                               : CLI_EXIT_INVALID,
+                                "montecarlo: %s", run->error);
     }
     return CLI_CONTINUE;
 }
@@ -783,7 +805,7 @@ typedef struct {
     double rate, low, high; /* success rate and its 95 % Wilson interval */
     mc_dist_t time_ms;      /* of every encounter */
     mc_dist_t expanded;
-    mc_dist_t ratio;        /* decoupled methods: deviation / centralised's, both solved */
+    mc_dist_t ratio; /* decoupled methods: deviation / centralised's, both solved */
     uint32_t fails_where_central_solves, solves_where_central_fails;
     double mean_deviation_both; /* mean deviation (m^2) over the encounters both solve */
     double central_mean_deviation_both;
@@ -807,8 +829,8 @@ static void wilson(uint32_t k, uint32_t n, double *rate, double *low, double *hi
 }
 
 /* Summarises the count results of one size; x: room for count doubles. */
-static void summarise(const mc_result_t *results, uint32_t count, const mc_size_t *size,
-                      double *x, mc_summary_t *s)
+static void summarise(const mc_result_t *results, uint32_t count, const mc_size_t *size, double *x,
+                      mc_summary_t *s)
 {
     memset(s, 0, sizeof *s);
     s->size = *size;
@@ -862,22 +884,22 @@ static void text_summary(FILE *f, const mc_options_t *o, const mc_summary_t *s, 
     for (uint32_t k = 0; k < sizes; k++) {
         const mc_summary_t *z = &s[k];
         fprintf(f, "\n%lu UAVs: %lu encounters (%lu redraws), beta %lu, max orders %lu\n",
-                (unsigned long)z->size.n, (unsigned long)z->encounters,
-                (unsigned long)z->redraws, (unsigned long)z->size.beta,
-                (unsigned long)z->size.max_orders);
+                (unsigned long)z->size.n, (unsigned long)z->encounters, (unsigned long)z->redraws,
+                (unsigned long)z->size.beta, (unsigned long)z->size.max_orders);
         fprintf(f, "  %-20s %7s %10s %7s %8s %16s %10s %10s %10s %12s\n", "method", "solved",
-                "infeasible", "budget", "success", "95% Wilson", "median_ms", "p90_ms",
-                "max_ms", "median_nodes");
+                "infeasible", "budget", "success", "95% Wilson", "median_ms", "p90_ms", "max_ms",
+                "median_nodes");
         for (int m = 0; m < MC_METHODS; m++) {
             const mc_method_summary_t *ms = &z->m[m];
-            fprintf(f, "  %-20s %7lu %10lu %7lu %7.1f%% %7.1f-%5.1f%% %10.3f %10.3f %10.3f %12.0f\n",
+            fprintf(f,
+                    "  %-20s %7lu %10lu %7lu %7.1f%% %7.1f-%5.1f%% %10.3f %10.3f %10.3f %12.0f\n",
                     method_names[m], (unsigned long)ms->solved, (unsigned long)ms->infeasible,
                     (unsigned long)ms->budget, 100 * ms->rate, 100 * ms->low, 100 * ms->high,
                     ms->time_ms.median, ms->time_ms.p90, ms->time_ms.max, ms->expanded.median);
         }
         fprintf(f, "  deviation ratio to centralised, over the encounters both solve:\n");
-        fprintf(f, "  %-20s %6s %7s %7s %7s %7s %7s %7s %7s %7s %9s %9s\n", "method", "both",
-                "min", "p25", "median", "p75", "p90", "max", "mean", "=1", "fails*", "solves*");
+        fprintf(f, "  %-20s %6s %7s %7s %7s %7s %7s %7s %7s %7s %9s %9s\n", "method", "both", "min",
+                "p25", "median", "p75", "p90", "max", "mean", "=1", "fails*", "solves*");
         for (int m = MC_FIXED; m < MC_METHODS; m++) {
             const mc_method_summary_t *ms = &z->m[m];
             const mc_dist_t *r = &ms->ratio;
@@ -890,8 +912,9 @@ static void text_summary(FILE *f, const mc_options_t *o, const mc_summary_t *s, 
                         solves);
                 continue;
             }
-            fprintf(f, "  %-20s %6lu %7.3f %7.3f %7.3f %7.3f %7.3f %7.3f %7.3f %6.1f%% %8.1f%% "
-                       "%8.1f%%\n",
+            fprintf(f,
+                    "  %-20s %6lu %7.3f %7.3f %7.3f %7.3f %7.3f %7.3f %7.3f %6.1f%% %8.1f%% "
+                    "%8.1f%%\n",
                     method_names[m], (unsigned long)r->count, r->min, r->p25, r->median, r->p75,
                     r->p90, r->max, r->mean, 100 * r->equal_share, fails, solves);
         }
@@ -926,12 +949,13 @@ static int json_summary(FILE *f, const mc_options_t *o, const mc_summary_t *s, u
     snprintf(seed, sizeof seed, "%llu", (unsigned long long)o->seed);
     cJSON *root = cJSON_CreateObject();
     cJSON *list = NULL;
-    bool ok = root != NULL && cJSON_AddStringToObject(root, "command", "montecarlo") != NULL &&
-              cJSON_AddRawToObject(root, "seed", seed) != NULL &&
-              cJSON_AddNumberToObject(root, "count", o->count) != NULL &&
-              cJSON_AddNumberToObject(root, "horizon", coavoid_encounter_montecarlo.horizon) != NULL &&
-              cJSON_AddNumberToObject(root, "dt", coavoid_encounter_montecarlo.dt) != NULL &&
-              (list = cJSON_AddArrayToObject(root, "sizes")) != NULL;
+    bool ok =
+        root != NULL && cJSON_AddStringToObject(root, "command", "montecarlo") != NULL &&
+        cJSON_AddRawToObject(root, "seed", seed) != NULL &&
+        cJSON_AddNumberToObject(root, "count", o->count) != NULL &&
+        cJSON_AddNumberToObject(root, "horizon", coavoid_encounter_montecarlo.horizon) != NULL &&
+        cJSON_AddNumberToObject(root, "dt", coavoid_encounter_montecarlo.dt) != NULL &&
+        (list = cJSON_AddArrayToObject(root, "sizes")) != NULL;
     for (uint32_t k = 0; ok && k < sizes; k++) {
         const mc_summary_t *z = &s[k];
         cJSON *item = cJSON_CreateObject();
@@ -1058,10 +1082,11 @@ static int write_svg(const char *path, const mc_options_t *o, const mc_run_t *ru
         return -1;
     }
     const double y0 = SVG_PANEL_TOP + SVG_PANEL_H;
-    fprintf(f, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
-               "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" "
-               "viewBox=\"0 0 %.0f %.0f\" font-family=\"sans-serif\" font-size=\"13\">\n"
-               "<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n",
+    fprintf(f,
+            "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+            "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" "
+            "viewBox=\"0 0 %.0f %.0f\" font-family=\"sans-serif\" font-size=\"13\">\n"
+            "<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n",
             SVG_W, SVG_H, SVG_W, SVG_H);
     char betas[64] = "";
     for (uint32_t k = 0, used = 0; k < sizes && used < sizeof betas; k++) {
@@ -1071,17 +1096,21 @@ static int write_svg(const char *path, const mc_options_t *o, const mc_run_t *ru
             used += w > 0 ? (uint32_t)w : 0u;
         }
     }
-    fprintf(f, "<text x=\"%.0f\" y=\"24\" font-size=\"15\" font-weight=\"bold\">coavoid "
-               "montecarlo: seed %llu, %lu encounters per UAV count, beta %s</text>\n",
+    fprintf(f,
+            "<text x=\"%.0f\" y=\"24\" font-size=\"15\" font-weight=\"bold\">coavoid "
+            "montecarlo: seed %llu, %lu encounters per UAV count, beta %s</text>\n",
             SVG_BAR_LEFT, (unsigned long long)o->seed, (unsigned long)o->count, betas);
 
     /* Left: success rates, a group of three bars per UAV count, with Wilson intervals. */
-    fprintf(f, "<text x=\"%.0f\" y=\"%.0f\" font-weight=\"bold\">success rate (95%% Wilson "
-               "interval)</text>\n", SVG_BAR_LEFT, SVG_PANEL_TOP - 10);
+    fprintf(f,
+            "<text x=\"%.0f\" y=\"%.0f\" font-weight=\"bold\">success rate (95%% Wilson "
+            "interval)</text>\n",
+            SVG_BAR_LEFT, SVG_PANEL_TOP - 10);
     for (int t = 0; t <= 10; t += 2) {
         double py = y0 - t / 10.0 * SVG_PANEL_H;
-        fprintf(f, "<line x1=\"%.0f\" y1=\"%.1f\" x2=\"%.0f\" y2=\"%.1f\" stroke=\"#ddd\"/>\n"
-                   "<text x=\"%.0f\" y=\"%.1f\" text-anchor=\"end\">%d%%</text>\n",
+        fprintf(f,
+                "<line x1=\"%.0f\" y1=\"%.1f\" x2=\"%.0f\" y2=\"%.1f\" stroke=\"#ddd\"/>\n"
+                "<text x=\"%.0f\" y=\"%.1f\" text-anchor=\"end\">%d%%</text>\n",
                 SVG_BAR_LEFT, py, SVG_BAR_LEFT + SVG_BAR_W, py, SVG_BAR_LEFT - 6, py + 4, t * 10);
     }
     double group = SVG_BAR_W / sizes, bar = group / (MC_METHODS + 1.5);
@@ -1093,15 +1122,17 @@ static int write_svg(const char *path, const mc_options_t *o, const mc_run_t *ru
             double cx = bx + 0.45 * bar;
             if (ms->budget > 0) { /* above the bar, pale: unknown, not failed */
                 double h = (double)ms->budget / s[k].encounters * SVG_PANEL_H;
-                fprintf(f, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" "
-                           "fill=\"%s\" fill-opacity=\"0.3\"/>\n",
+                fprintf(f,
+                        "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" "
+                        "fill=\"%s\" fill-opacity=\"0.3\"/>\n",
                         bx, top - h, 0.9 * bar, h, method_colours[m]);
             }
-            fprintf(f, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" "
-                       "fill=\"%s\"/>\n"
-                       "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"black\"/>\n",
-                    bx, top, 0.9 * bar, y0 - top, method_colours[m], cx,
-                    y0 - ms->low * SVG_PANEL_H, cx, y0 - ms->high * SVG_PANEL_H);
+            fprintf(f,
+                    "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" "
+                    "fill=\"%s\"/>\n"
+                    "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"black\"/>\n",
+                    bx, top, 0.9 * bar, y0 - top, method_colours[m], cx, y0 - ms->low * SVG_PANEL_H,
+                    cx, y0 - ms->high * SVG_PANEL_H);
         }
         fprintf(f, "<text x=\"%.1f\" y=\"%.0f\" text-anchor=\"middle\">%lu UAVs</text>\n",
                 gx + 1.5 * bar, y0 + 18, (unsigned long)s[k].size.n);
@@ -1110,51 +1141,62 @@ static int write_svg(const char *path, const mc_options_t *o, const mc_run_t *ru
             SVG_BAR_LEFT, y0, SVG_BAR_LEFT + SVG_BAR_W, y0);
     for (int m = 0; m < MC_METHODS; m++) {
         double ly = y0 + 44 + 16 * m;
-        fprintf(f, "<rect x=\"%.0f\" y=\"%.0f\" width=\"12\" height=\"12\" fill=\"%s\"/>"
-                   "<text x=\"%.0f\" y=\"%.0f\">%s</text>\n",
-                SVG_BAR_LEFT, ly - 10, method_colours[m], SVG_BAR_LEFT + 18, ly,
-                method_names[m]);
+        fprintf(f,
+                "<rect x=\"%.0f\" y=\"%.0f\" width=\"12\" height=\"12\" fill=\"%s\"/>"
+                "<text x=\"%.0f\" y=\"%.0f\">%s</text>\n",
+                SVG_BAR_LEFT, ly - 10, method_colours[m], SVG_BAR_LEFT + 18, ly, method_names[m]);
     }
     fprintf(f, "<text x=\"%.0f\" y=\"%.0f\">pale above a bar: budget exhausted</text>\n",
             SVG_BAR_LEFT + 170, y0 + 44);
 
     /* Right: the CDF of the deviation ratio per UAV count, fixed solid, reordered dashed. */
     double right = cdf_right(s, sizes);
-    fprintf(f, "<text x=\"%.0f\" y=\"%.0f\" font-weight=\"bold\">decoupled / centralised "
-               "deviation, both solved (CDF)</text>\n", SVG_CDF_LEFT, SVG_PANEL_TOP - 10);
+    fprintf(f,
+            "<text x=\"%.0f\" y=\"%.0f\" font-weight=\"bold\">decoupled / centralised "
+            "deviation, both solved (CDF)</text>\n",
+            SVG_CDF_LEFT, SVG_PANEL_TOP - 10);
     for (int t = 0; t <= 4; t++) {
         double py = y0 - t / 4.0 * SVG_PANEL_H;
-        fprintf(f, "<line x1=\"%.0f\" y1=\"%.1f\" x2=\"%.0f\" y2=\"%.1f\" stroke=\"#ddd\"/>\n"
-                   "<text x=\"%.0f\" y=\"%.1f\" text-anchor=\"end\">%.2f</text>\n",
-                SVG_CDF_LEFT, py, SVG_CDF_LEFT + SVG_CDF_W, py, SVG_CDF_LEFT - 6, py + 4,
-                t / 4.0);
+        fprintf(f,
+                "<line x1=\"%.0f\" y1=\"%.1f\" x2=\"%.0f\" y2=\"%.1f\" stroke=\"#ddd\"/>\n"
+                "<text x=\"%.0f\" y=\"%.1f\" text-anchor=\"end\">%.2f</text>\n",
+                SVG_CDF_LEFT, py, SVG_CDF_LEFT + SVG_CDF_W, py, SVG_CDF_LEFT - 6, py + 4, t / 4.0);
     }
     static const double ticks[] = {1.0, 1.25, 1.5, 2.0, 3.0, 5.0, 10.0};
     for (size_t t = 0; t < sizeof ticks / sizeof ticks[0] && ticks[t] <= right * 1.0001; t++) {
         double px = cdf_x(ticks[t], right);
-        fprintf(f, "<line x1=\"%.1f\" y1=\"%.0f\" x2=\"%.1f\" y2=\"%.0f\" stroke=\"#ddd\"/>\n"
-                   "<text x=\"%.1f\" y=\"%.0f\" text-anchor=\"middle\">%g</text>\n",
+        fprintf(f,
+                "<line x1=\"%.1f\" y1=\"%.0f\" x2=\"%.1f\" y2=\"%.0f\" stroke=\"#ddd\"/>\n"
+                "<text x=\"%.1f\" y=\"%.0f\" text-anchor=\"middle\">%g</text>\n",
                 px, SVG_PANEL_TOP, px, y0, px, y0 + 18, ticks[t]);
     }
-    fprintf(f, "<text x=\"%.0f\" y=\"%.0f\" text-anchor=\"middle\">deviation ratio "
-               "(log scale)</text>\n", SVG_CDF_LEFT + SVG_CDF_W / 2, y0 + 34);
-    fprintf(f, "<text transform=\"translate(%.0f %.0f) rotate(-90)\" text-anchor=\"middle\">"
-               "share of encounters</text>\n", SVG_CDF_LEFT - 44, SVG_PANEL_TOP + SVG_PANEL_H / 2);
-    fprintf(f, "<rect x=\"%.0f\" y=\"%.0f\" width=\"%.0f\" height=\"%.0f\" fill=\"none\" "
-               "stroke=\"black\"/>\n", SVG_CDF_LEFT, SVG_PANEL_TOP, SVG_CDF_W, SVG_PANEL_H);
+    fprintf(f,
+            "<text x=\"%.0f\" y=\"%.0f\" text-anchor=\"middle\">deviation ratio "
+            "(log scale)</text>\n",
+            SVG_CDF_LEFT + SVG_CDF_W / 2, y0 + 34);
+    fprintf(f,
+            "<text transform=\"translate(%.0f %.0f) rotate(-90)\" text-anchor=\"middle\">"
+            "share of encounters</text>\n",
+            SVG_CDF_LEFT - 44, SVG_PANEL_TOP + SVG_PANEL_H / 2);
+    fprintf(f,
+            "<rect x=\"%.0f\" y=\"%.0f\" width=\"%.0f\" height=\"%.0f\" fill=\"none\" "
+            "stroke=\"black\"/>\n",
+            SVG_CDF_LEFT, SVG_PANEL_TOP, SVG_CDF_W, SVG_PANEL_H);
     for (uint32_t k = 0; k < sizes; k++) {
         const mc_result_t *first = &run->results[k * o->count];
         const char *colour = size_colours[(s[k].size.n - ENCOUNTER_MIN_VEHICLES) % MC_SIZES];
         svg_cdf(f, first, o->count, MC_FIXED, right, x, colour, false);
         svg_cdf(f, first, o->count, MC_REORDERED, right, x, colour, true);
         double ly = y0 + 56 + 16 * k;
-        fprintf(f, "<line x1=\"%.0f\" y1=\"%.0f\" x2=\"%.0f\" y2=\"%.0f\" stroke=\"%s\" "
-                   "stroke-width=\"2\"/><text x=\"%.0f\" y=\"%.0f\">%lu UAVs</text>\n",
+        fprintf(f,
+                "<line x1=\"%.0f\" y1=\"%.0f\" x2=\"%.0f\" y2=\"%.0f\" stroke=\"%s\" "
+                "stroke-width=\"2\"/><text x=\"%.0f\" y=\"%.0f\">%lu UAVs</text>\n",
                 SVG_CDF_LEFT, ly - 4, SVG_CDF_LEFT + 24, ly - 4, colour, SVG_CDF_LEFT + 30, ly,
                 (unsigned long)s[k].size.n);
     }
-    fprintf(f, "<text x=\"%.0f\" y=\"%.0f\">solid: decoupled_fixed</text>\n"
-               "<text x=\"%.0f\" y=\"%.0f\">dashed: decoupled_reordered</text>\n",
+    fprintf(f,
+            "<text x=\"%.0f\" y=\"%.0f\">solid: decoupled_fixed</text>\n"
+            "<text x=\"%.0f\" y=\"%.0f\">dashed: decoupled_reordered</text>\n",
             SVG_CDF_LEFT + 110, y0 + 56, SVG_CDF_LEFT + 110, y0 + 72);
     if (right >= 10.0) {
         fprintf(f, "<text x=\"%.0f\" y=\"%.0f\">ratios above 10 at the right edge</text>\n",
@@ -1183,16 +1225,17 @@ int coavoid_command_montecarlo(int argc, char **argv)
         sizes[k].max_orders = o.max_orders_text != NULL ? o.max_orders : factorial(n);
         shape.beta = sizes[k].beta;
         if (coa_planner_workspace_size(&shape) == 0) {
-            return coavoid_cli_fail(CLI_EXIT_INVALID, "--beta: %lu is too large for %lu UAVs "
-                            "centralised (the node pool would pass 2^30)",
-                            (unsigned long)sizes[k].beta, (unsigned long)n);
+            return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                    "--beta: %lu is too large for %lu UAVs "
+                                    "centralised (the node pool would pass 2^30)",
+                                    (unsigned long)sizes[k].beta, (unsigned long)n);
         }
     }
     struct stat info;
-    if (o.save != NULL && (stat(o.save, &info) != 0 || !S_ISDIR(info.st_mode) ||
-                           access(o.save, W_OK | X_OK) != 0)) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "--save: '%.200s' is not a directory we can write in",
-                        o.save);
+    if (o.save != NULL &&
+        (stat(o.save, &info) != 0 || !S_ISDIR(info.st_mode) || access(o.save, W_OK | X_OK) != 0)) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                "--save: '%.200s' is not a directory we can write in", o.save);
     }
     FILE *csv = NULL;
     if (o.csv != NULL && (csv = fopen(o.csv, "w")) == NULL) {
@@ -1218,7 +1261,7 @@ int coavoid_command_montecarlo(int argc, char **argv)
     double *x = calloc(o.count, sizeof *x);
     if (run.results == NULL || run.done == NULL || x == NULL) {
         status = coavoid_cli_fail(CLI_EXIT_INVALID, "--count: out of memory for %lu encounters",
-                          (unsigned long)run.total);
+                                  (unsigned long)run.total);
     }
     if (status == CLI_CONTINUE && csv != NULL && fputs(MC_CSV_HEADER, csv) < 0) {
         status = coavoid_cli_fail(CLI_EXIT_INTERNAL, "--csv: cannot write '%.200s'", o.csv);
@@ -1229,9 +1272,10 @@ int coavoid_command_montecarlo(int argc, char **argv)
     if (csv != NULL) {
         bool ok = !ferror(csv);
         if (fclose(csv) != 0 || !ok) {
-            status = status == CLI_CONTINUE
-                         ? coavoid_cli_fail(CLI_EXIT_INTERNAL, "--csv: cannot write '%.200s'", o.csv)
-                         : status;
+            status =
+                status == CLI_CONTINUE
+                    ? coavoid_cli_fail(CLI_EXIT_INTERNAL, "--csv: cannot write '%.200s'", o.csv)
+                    : status;
         }
     }
     bool defects = false;
@@ -1255,8 +1299,9 @@ int coavoid_command_montecarlo(int argc, char **argv)
         }
         rc = rc == 0 && fflush(stdout) == 0 && !ferror(stdout) ? 0 : -1;
         status = rc != 0 ? coavoid_cli_fail(CLI_EXIT_INTERNAL, "cannot write the summary")
-                 : defects ? coavoid_cli_fail(CLI_EXIT_INTERNAL, "montecarlo: defects found (above)")
-                           : CLI_EXIT_OK;
+                 : defects
+                     ? coavoid_cli_fail(CLI_EXIT_INTERNAL, "montecarlo: defects found (above)")
+                     : CLI_EXIT_OK;
     }
     free(x);
     free(run.done);

@@ -29,28 +29,28 @@ _Static_assert(COAVOID_DEFAULT_MAX_ORDERS == 7u * 6u * 5u * 4u * 3u * 2u * 1u &&
                "the default max orders is COAVOID_DEFAULT_MAX_ORDERS_COVER factorial");
 
 /* A printf format so that the limits it quotes come from one place. */
-#define PLAN_USAGE                                                                          \
-    "usage: coavoid plan SCENARIO.json --mode centralised|decoupled\n"                      \
-    "                    [--priority ID,ID,...] [--beta N] [--reorder [--max-orders N]]\n"  \
-    "\n"                                                                                    \
-    "Reads a scenario (JSON, at most %u MiB) and prints the plan result as JSON.\n"         \
-    "\n"                                                                                    \
-    "options:\n"                                                                            \
-    "  --mode centralised  optimal for all UAVs together (at most %u UAVs)\n"               \
-    "  --mode decoupled    each UAV in turn, in priority order\n"                           \
-    "  --priority ID,...   decoupled: plan in this order (every vehicle id exactly once)\n" \
-    "  --beta N            nodes a joint search may store, N >= 1; overrides the\n"        \
+#define PLAN_USAGE                                                                            \
+    "usage: coavoid plan SCENARIO.json --mode centralised|decoupled\n"                        \
+    "                    [--priority ID,ID,...] [--beta N] [--reorder [--max-orders N]]\n"    \
+    "\n"                                                                                      \
+    "Reads a scenario (JSON, at most %u MiB) and prints the plan result as JSON.\n"           \
+    "\n"                                                                                      \
+    "options:\n"                                                                              \
+    "  --mode centralised  optimal for all UAVs together (at most %u UAVs)\n"                 \
+    "  --mode decoupled    each UAV in turn, in priority order\n"                             \
+    "  --priority ID,...   decoupled: plan in this order (every vehicle id exactly once)\n"   \
+    "  --beta N            nodes a joint search may store, N >= 1; overrides the\n"           \
     "                      scenario's \"beta\"; default %u, lowered so the workspace stays\n" \
-    "                      within 1 GiB (a node is 70 + 2 bytes per UAV)\n"                \
-    "  --reorder           decoupled: when a UAV fails, try other priority orders\n"        \
-    "  --max-orders N      with --reorder: try at most N orders, N >= 1; default %u\n"      \
-    "                      (every order of up to %u UAVs); stats.all_orders_covered\n"      \
-    "                      says whether a failure is proven for every order\n"              \
-    "  -h, --help          show this help\n"                                                \
-    "\n"                                                                                    \
-    "Fields of the scenario that the format does not define are ignored.\n"                 \
-    "\n"                                                                                    \
-    "exit status: 0 solved, 1 infeasible or budget exhausted, 2 invalid input or usage\n"   \
+    "                      within 1 GiB (a node is 70 + 2 bytes per UAV)\n"                   \
+    "  --reorder           decoupled: when a UAV fails, try other priority orders\n"          \
+    "  --max-orders N      with --reorder: try at most N orders, N >= 1; default %u\n"        \
+    "                      (every order of up to %u UAVs); stats.all_orders_covered\n"        \
+    "                      says whether a failure is proven for every order\n"                \
+    "  -h, --help          show this help\n"                                                  \
+    "\n"                                                                                      \
+    "Fields of the scenario that the format does not define are ignored.\n"                   \
+    "\n"                                                                                      \
+    "exit status: 0 solved, 1 infeasible or budget exhausted, 2 invalid input or usage\n"     \
     "(one line on stderr naming the input and why), 3 internal error\n"
 
 /* ---- options ---- */
@@ -69,8 +69,8 @@ typedef struct {
 
 static void plan_help(void)
 {
-    printf(PLAN_USAGE, SCENARIO_MAX_BYTES / (1024u * 1024u), COA_MAX_CENTRALISED,
-           CLI_DEFAULT_BETA, COAVOID_DEFAULT_MAX_ORDERS, COAVOID_DEFAULT_MAX_ORDERS_COVER);
+    printf(PLAN_USAGE, SCENARIO_MAX_BYTES / (1024u * 1024u), COA_MAX_CENTRALISED, CLI_DEFAULT_BETA,
+           COAVOID_DEFAULT_MAX_ORDERS, COAVOID_DEFAULT_MAX_ORDERS_COVER);
 }
 
 static int plan_option(int argc, char **argv, int *i, void *options)
@@ -82,25 +82,25 @@ static int plan_option(int argc, char **argv, int *i, void *options)
     if (coavoid_cli_option_is(arg, "--mode")) {
         status = coavoid_cli_mode_option(argc, argv, i, &o->mode, &o->decoupled);
     } else if (coavoid_cli_option_is(arg, "--priority")) {
-        status = coavoid_cli_text_option(argc, argv, i, "--priority", "vehicle ids, e.g. 3,1,2", true,
-                                 &o->priority);
+        status = coavoid_cli_text_option(argc, argv, i, "--priority", "vehicle ids, e.g. 3,1,2",
+                                         true, &o->priority);
     } else if (coavoid_cli_option_is(arg, "--beta")) {
-        status = coavoid_cli_count_option(argc, argv, i, "--beta", "an integer >= 1", false, UINT32_MAX,
-                                  &o->beta_text, &value);
+        status = coavoid_cli_count_option(argc, argv, i, "--beta", "an integer >= 1", false,
+                                          UINT32_MAX, &o->beta_text, &value);
         o->beta = (uint32_t)value;
     } else if (coavoid_cli_option_is(arg, "--reorder")) {
         status = coavoid_cli_flag_option(arg, "--reorder", &o->reorder);
     } else if (coavoid_cli_option_is(arg, "--max-orders")) {
         status = coavoid_cli_count_option(argc, argv, i, "--max-orders", "an integer >= 1", false,
-                                  UINT32_MAX, &o->max_orders_text, &value);
+                                          UINT32_MAX, &o->max_orders_text, &value);
         o->max_orders = (uint32_t)value;
     }
     return status;
 }
 
 static const coavoid_cli_command_t plan_command = {
-    "plan", "coavoid plan", 2, {"SCENARIO.json", NULL}, "one scenario only", plan_help,
-    plan_option};
+    "plan",    "coavoid plan", 2, {"SCENARIO.json", NULL}, "one scenario only",
+    plan_help, plan_option};
 
 /* Returns CLI_CONTINUE, or the exit status (help printed: 0; a usage error: 2). */
 static int parse_plan_options(int argc, char **argv, plan_options_t *o)
@@ -124,7 +124,7 @@ static int parse_plan_options(int argc, char **argv, plan_options_t *o)
     /* Without --reorder exactly one order is planned: a bound on orders would do nothing. */
     if (o->max_orders_text != NULL && !o->reorder) {
         return coavoid_cli_fail(CLI_EXIT_INVALID,
-                        "--max-orders: only valid with --reorder (and --mode decoupled)");
+                                "--max-orders: only valid with --reorder (and --mode decoupled)");
     }
     if (o->max_orders_text == NULL) {
         o->max_orders = COAVOID_DEFAULT_MAX_ORDERS;
@@ -146,25 +146,26 @@ static int parse_priority(const char *text, const coavoid_scenario_t *s, size_t 
         if (!coavoid_cli_parse_count(token, length, 65535u, &id)) {
             if (text[0] == '\0') {
                 return coavoid_cli_fail(CLI_EXIT_INVALID,
-                                "--priority: empty (expected vehicle ids separated "
-                                "by commas)");
+                                        "--priority: empty (expected vehicle ids separated "
+                                        "by commas)");
             }
             if (length == 0) {
                 return coavoid_cli_fail(CLI_EXIT_INVALID,
-                                "--priority: empty entry in '%.80s' "
-                                "(expected vehicle ids separated by commas)",
-                                text);
+                                        "--priority: empty entry in '%.80s' "
+                                        "(expected vehicle ids separated by commas)",
+                                        text);
             }
             return coavoid_cli_fail(CLI_EXIT_INVALID, "--priority: '%.*s' is not a vehicle id",
-                            (int)(length > 40 ? 40 : length), token);
+                                    (int)(length > 40 ? 40 : length), token);
         }
         long index = coavoid_scenario_vehicle_index(s, (long)id);
         if (index < 0) {
             return coavoid_cli_fail(CLI_EXIT_INVALID, "--priority: %lu is not a vehicle id",
-                            (unsigned long)id);
+                                    (unsigned long)id);
         }
         if (listed[index]) {
-            return coavoid_cli_fail(CLI_EXIT_INVALID, "--priority: %lu is listed twice", (unsigned long)id);
+            return coavoid_cli_fail(CLI_EXIT_INVALID, "--priority: %lu is listed twice",
+                                    (unsigned long)id);
         }
         listed[index] = true;
         order[count++] = (size_t)index;
@@ -176,8 +177,8 @@ static int parse_priority(const char *text, const coavoid_scenario_t *s, size_t 
     for (size_t i = 0; i < s->vehicle_count; i++) {
         if (!listed[i]) {
             return coavoid_cli_fail(CLI_EXIT_INVALID,
-                            "--priority: vehicle %u is missing (list every id once)",
-                            (unsigned)s->vehicles[i].id);
+                                    "--priority: vehicle %u is missing (list every id once)",
+                                    (unsigned)s->vehicles[i].id);
         }
     }
     return CLI_CONTINUE;
@@ -189,10 +190,11 @@ static int parse_priority(const char *text, const coavoid_scenario_t *s, size_t 
  * horizon is what the user is most likely to change. A backstop. */
 static int range_error(const char *file, const coavoid_scenario_t *s)
 {
-    return coavoid_cli_fail(CLI_EXIT_INVALID,
-                    "%s: horizon: %lu steps is too long for these vehicles' offsets and costs "
-                    "(beyond the core's integer range; shorten it or bound max_offset)",
-                    file, (unsigned long)s->horizon);
+    return coavoid_cli_fail(
+        CLI_EXIT_INVALID,
+        "%s: horizon: %lu steps is too long for these vehicles' offsets and costs "
+        "(beyond the core's integer range; shorten it or bound max_offset)",
+        file, (unsigned long)s->horizon);
 }
 
 /* beta from --beta, else the scenario, else the default; *source names it for messages. */
@@ -232,10 +234,11 @@ static int plan(void *options, coavoid_scenario_t *s)
     }
 
     if (!o->decoupled && n > COA_MAX_CENTRALISED) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID,
-                        "--mode centralised: %zu vehicles, at most %u (COA_MAX_CENTRALISED) can be "
-                        "planned together",
-                        n, COA_MAX_CENTRALISED);
+        return coavoid_cli_fail(
+            CLI_EXIT_INVALID,
+            "--mode centralised: %zu vehicles, at most %u (COA_MAX_CENTRALISED) can be "
+            "planned together",
+            n, COA_MAX_CENTRALISED);
     }
     const size_t searched = o->decoupled ? 1u : n;
     char beta_source[SCENARIO_ERROR_MAX];
@@ -251,32 +254,34 @@ static int plan(void *options, coavoid_scenario_t *s)
         return range_error(file, s);
     }
     if (rc != COA_OK) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: rejected by the core's problem check (%s)", file,
-                        coa_status_name(rc));
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: rejected by the core's problem check (%s)",
+                                file, coa_status_name(rc));
     }
 
     coa_planner_config_t config = coavoid_cli_planner_config(s, searched, beta);
     /* The tables alone (every reachable step and offset) do not depend on beta: when they
      * pass the limit no beta helps, whatever --beta or the scenario say. */
     if (beta == 0 || coa_planner_max_beta(&config, CLI_DEFAULT_WORKSPACE_MAX) == 0) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID,
-                        "%s: too large: the cost-to-go tables of a %lu-step horizon would not "
-                        "fit in %zu MiB of workspace (shorten the horizon or bound max_offset)",
-                        file, (unsigned long)s->horizon, CLI_DEFAULT_WORKSPACE_MAX >> 20);
+        return coavoid_cli_fail(
+            CLI_EXIT_INVALID,
+            "%s: too large: the cost-to-go tables of a %lu-step horizon would not "
+            "fit in %zu MiB of workspace (shorten the horizon or bound max_offset)",
+            file, (unsigned long)s->horizon, CLI_DEFAULT_WORKSPACE_MAX >> 20);
     }
     size_t size = coa_planner_workspace_size(&config);
     if (size == 0) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID,
-                        "%s: too large: the workspace for %zu vehicle(s) over %lu steps would "
-                        "not fit in memory (lower it with --beta)",
-                        beta_source, searched, (unsigned long)s->horizon);
+        return coavoid_cli_fail(
+            CLI_EXIT_INVALID,
+            "%s: too large: the workspace for %zu vehicle(s) over %lu steps would "
+            "not fit in memory (lower it with --beta)",
+            beta_source, searched, (unsigned long)s->horizon);
     }
     void *workspace = malloc(size);
     if (workspace == NULL) {
         return coavoid_cli_fail(CLI_EXIT_INVALID,
-                        "%s: cannot allocate %zu bytes of workspace for %zu vehicle(s) "
-                        "(lower it with --beta)",
-                        beta_source, size, searched);
+                                "%s: cannot allocate %zu bytes of workspace for %zu vehicle(s) "
+                                "(lower it with --beta)",
+                                beta_source, size, searched);
     }
     coa_planner_t *planner = coa_planner_init(workspace, size, &config);
     int32_t *offsets = calloc(n * ((size_t)s->horizon + 1u), sizeof *offsets);
@@ -284,8 +289,9 @@ static int plan(void *options, coavoid_scenario_t *s)
         free(workspace);
         free(offsets);
         return coavoid_cli_fail(CLI_EXIT_INTERNAL, "%s",
-                        planner == NULL ? "internal error: the planner refused its workspace"
-                                        : "out of memory for the plan");
+                                planner == NULL
+                                    ? "internal error: the planner refused its workspace"
+                                    : "out of memory for the plan");
     }
 
     coa_plan_result_t result;
@@ -306,10 +312,10 @@ static int plan(void *options, coavoid_scenario_t *s)
         status = range_error(file, s);
     } else if (rc != COA_OK) {
         status = coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: the planner failed (%s)",
-                          coa_status_name(rc));
+                                  coa_status_name(rc));
     } else {
-        coavoid_output_plan_t view = {s,   o->decoupled, &result, offsets, coavoid_cli_elapsed_us(&start, &end),
-                              beta};
+        coavoid_output_plan_t view = {
+            s, o->decoupled, &result, offsets, coavoid_cli_elapsed_us(&start, &end), beta};
         if (coavoid_output_plan(stdout, &view, err, sizeof err) != 0) {
             status = coavoid_cli_fail(CLI_EXIT_INTERNAL, "%s", err);
         } else {

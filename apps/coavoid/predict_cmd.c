@@ -72,8 +72,8 @@ static bool parse_growth(const char *text, double *horizontal, double *vertical)
     }
     memcpy(first, text, length);
     first[length] = '\0';
-    return coavoid_cli_parse_real(first, horizontal) && coavoid_cli_parse_real(comma + 1, vertical) &&
-           *horizontal >= 0 && *vertical >= 0;
+    return coavoid_cli_parse_real(first, horizontal) &&
+           coavoid_cli_parse_real(comma + 1, vertical) && *horizontal >= 0 && *vertical >= 0;
 }
 
 static void predict_help(void)
@@ -86,26 +86,25 @@ static int predict_option(int argc, char **argv, int *i, void *options)
     predict_options_t *o = options;
     const char *arg = argv[*i];
     if (coavoid_cli_option_is(arg, "--threshold")) {
-        int status = coavoid_cli_text_option(argc, argv, i, "--threshold", "a probability, 0 < P <= 1",
-                                     true, &o->threshold_text);
-        if (status == CLI_CONTINUE &&
-            (!coavoid_cli_parse_real(o->threshold_text, &o->threshold) || !(o->threshold > 0) ||
-             o->threshold > 1)) {
+        int status = coavoid_cli_text_option(argc, argv, i, "--threshold",
+                                             "a probability, 0 < P <= 1", true, &o->threshold_text);
+        if (status == CLI_CONTINUE && (!coavoid_cli_parse_real(o->threshold_text, &o->threshold) ||
+                                       !(o->threshold > 0) || o->threshold > 1)) {
             status = coavoid_cli_fail(CLI_EXIT_INVALID,
-                              "--threshold: must be a number with 0 < P <= 1, got '%.40s'",
-                              o->threshold_text);
+                                      "--threshold: must be a number with 0 < P <= 1, got '%.40s'",
+                                      o->threshold_text);
         }
         return status;
     }
     if (coavoid_cli_option_is(arg, "--sigma-growth")) {
         int status = coavoid_cli_text_option(argc, argv, i, "--sigma-growth",
-                                     "H,V in m/s, e.g. 0.5,0.1", true, &o->growth_text);
+                                             "H,V in m/s, e.g. 0.5,0.1", true, &o->growth_text);
         if (status == CLI_CONTINUE &&
             !parse_growth(o->growth_text, &o->growth_horizontal, &o->growth_vertical)) {
             status = coavoid_cli_fail(CLI_EXIT_INVALID,
-                              "--sigma-growth: must be two numbers >= 0 as H,V (m/s), "
-                              "got '%.40s'",
-                              o->growth_text);
+                                      "--sigma-growth: must be two numbers >= 0 as H,V (m/s), "
+                                      "got '%.40s'",
+                                      o->growth_text);
         }
         return status;
     }
@@ -113,8 +112,8 @@ static int predict_option(int argc, char **argv, int *i, void *options)
 }
 
 static const coavoid_cli_command_t predict_command = {
-    "predict", "coavoid predict", 2, {"SCENARIO.json", NULL}, "one scenario only", predict_help,
-    predict_option};
+    "predict",    "coavoid predict", 2, {"SCENARIO.json", NULL}, "one scenario only",
+    predict_help, predict_option};
 
 /* Returns CLI_CONTINUE, or the exit status (help printed: 0; a usage error: 2). */
 static int parse_predict_options(int argc, char **argv, predict_options_t *o)
@@ -314,10 +313,11 @@ static int build_plans(const char *file, const coavoid_scenario_t *s, predict_me
             row[k] = s->references[i][k];
             row[k].z += lift;
             if (!isfinite(row[k].z)) {
-                return coavoid_cli_fail(CLI_EXIT_INVALID,
-                                "%s: vehicles[%zu]: initial_offset: the altitude it gives is "
-                                "not finite",
-                                file, i);
+                return coavoid_cli_fail(
+                    CLI_EXIT_INVALID,
+                    "%s: vehicles[%zu]: initial_offset: the altitude it gives is "
+                    "not finite",
+                    file, i);
             }
         }
         coa_intent_plan_t *p = &m->plans[i];
@@ -352,7 +352,8 @@ static int predict(void *options, coavoid_scenario_t *s)
     size_t with_tracks, max_pairs;
     if (!size_mul_add(n, tracks, vehicle_pairs, &with_tracks) ||
         !size_mul_add(n, s->obstacle_count, with_tracks, &max_pairs)) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: too many tracks and obstacles to size for", file);
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: too many tracks and obstacles to size for",
+                                file);
     }
     if (max_pairs == 0) {
         max_pairs = 1; /* one UAV alone: the size function refuses a limit of 0 */
@@ -360,10 +361,11 @@ static int predict(void *options, coavoid_scenario_t *s)
     const size_t capacity = max_pairs;
     size_t size = coa_predictor_workspace_size(n, tracks, s->horizon, max_pairs);
     if (size == 0) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID,
-                        "%s: too large: the predictor's workspace for %zu vehicles, %zu tracks, "
-                        "%zu obstacles and %lu steps is beyond its limits",
-                        file, n, tracks, s->obstacle_count, (unsigned long)s->horizon);
+        return coavoid_cli_fail(
+            CLI_EXIT_INVALID,
+            "%s: too large: the predictor's workspace for %zu vehicles, %zu tracks, "
+            "%zu obstacles and %lu steps is beyond its limits",
+            file, n, tracks, s->obstacle_count, (unsigned long)s->horizon);
     }
 
     predict_memory_t m;
@@ -382,9 +384,9 @@ static int predict(void *options, coavoid_scenario_t *s)
         m.cluster_start == NULL) {
         predict_memory_free(&m);
         return coavoid_cli_fail(CLI_EXIT_INVALID,
-                        "%s: cannot allocate %zu bytes of predictor workspace and %zu "
-                        "conflicts",
-                        file, size, capacity);
+                                "%s: cannot allocate %zu bytes of predictor workspace and %zu "
+                                "conflicts",
+                                file, size, capacity);
     }
     status = build_plans(file, s, &m);
     if (status != CLI_CONTINUE) {
@@ -396,7 +398,8 @@ static int predict(void *options, coavoid_scenario_t *s)
         coa_predictor_init(m.workspace, size, n, tracks, s->horizon, max_pairs);
     if (predictor == NULL) {
         predict_memory_free(&m);
-        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: the predictor refused its workspace");
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL,
+                                "internal error: the predictor refused its workspace");
     }
 
     coa_predict_config_t config;
@@ -418,24 +421,25 @@ static int predict(void *options, coavoid_scenario_t *s)
     if (rc == COA_ERR_ARGUMENT) {
         /* The loader checked every field the contract defines; what is left is a
          * combination the core refuses (like plan's problem check). */
-        status = coavoid_cli_fail(CLI_EXIT_INVALID, "%s: rejected by the core's predictor (%s)", file,
-                          coa_status_name(rc));
+        status = coavoid_cli_fail(CLI_EXIT_INVALID, "%s: rejected by the core's predictor (%s)",
+                                  file, coa_status_name(rc));
     } else if (rc != COA_OK) {
         status = coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: the predictor failed (%s)",
-                          coa_status_name(rc));
+                                  coa_status_name(rc));
     } else if (result.overflow || result.conflict_count > capacity ||
                result.conflicts_found != result.conflict_count) {
         status = coavoid_cli_fail(CLI_EXIT_INTERNAL,
-                          "internal error: the predictor found %zu conflicts, room for %zu",
-                          result.conflicts_found, capacity);
+                                  "internal error: the predictor found %zu conflicts, room for %zu",
+                                  result.conflicts_found, capacity);
     } else if (coa_predict_clusters(m.conflicts, result.conflict_count, n, m.label,
                                     &cluster_labels) != COA_OK ||
                cluster_labels > n) {
-        status = coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: the conflicts do not cluster");
+        status =
+            coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: the conflicts do not cluster");
     } else if (!map_conflicts(s, m.conflicts, result.conflict_count, m.listed)) {
-        status = coavoid_cli_fail(CLI_EXIT_INTERNAL,
-                          "internal error: the predictor named a vehicle, track or obstacle "
-                          "out of range");
+        status = coavoid_cli_fail(
+            CLI_EXIT_INTERNAL, "internal error: the predictor named a vehicle, track or obstacle "
+                               "out of range");
     } else {
         coavoid_output_predict_t view;
         memset(&view, 0, sizeof view);

@@ -17,7 +17,6 @@
 #include "cli.h"
 #include "commands.h"
 
-
 #include <lcm/lcm.h>
 
 #include "flight.h"
@@ -45,20 +44,20 @@
     "                       it, and plan for themselves when its heartbeat stops\n"            \
     "  --mode decoupled     no coordinator: each UAV plans for itself in priority order\n"     \
     "  --steps K            fly K steps (samples 0..K), K >= 1; default 2 * horizon\n"         \
-    "  --json               print the simulation result as JSON (default: text)\n"            \
+    "  --json               print the simulation result as JSON (default: text)\n"             \
     "  --svg FILE           write the figure (top view, altitude profiles) to FILE\n"          \
     "  --coordinator-stops STEP\n"                                                             \
-    "                       centralised: stop the coordinator before step STEP (0..K)\n"      \
+    "                       centralised: stop the coordinator before step STEP (0..K)\n"       \
     "  -h, --help           show this help\n"                                                  \
     "\n"                                                                                       \
-    "Beyond the contract's fields the result has \"fallbacks\" (times a UAV went from\n"      \
-    "following the coordinator to planning for itself) and, with --coordinator-stops,\n"      \
+    "Beyond the contract's fields the result has \"fallbacks\" (times a UAV went from\n"       \
+    "following the coordinator to planning for itself) and, with --coordinator-stops,\n"       \
     "\"coordinator_stopped_at\".\n"                                                            \
     "\n"                                                                                       \
-    "The scenario's horizon may be at most %u steps (an intent carries N + 1 samples) and\n"  \
-    "it may have at most %u UAVs. What its messages carry over the run (references and\n"     \
-    "tracks up to t = (K + N) dt, with the climbs a UAV can make) must stay within their\n"   \
-    "bounds: positions %g m, speeds %g m/s, sizes and sigmas %g m.\n"                         \
+    "The scenario's horizon may be at most %u steps (an intent carries N + 1 samples) and\n"   \
+    "it may have at most %u UAVs. What its messages carry over the run (references and\n"      \
+    "tracks up to t = (K + N) dt, with the climbs a UAV can make) must stay within their\n"    \
+    "bounds: positions %g m, speeds %g m/s, sizes and sigmas %g m.\n"                          \
     "\n"                                                                                       \
     "exit status: 0 no loss of separation, 1 a loss of separation, 2 invalid input or\n"       \
     "usage (one line on stderr naming the input and why), 3 internal error\n"
@@ -91,19 +90,21 @@ static int sim_option(int argc, char **argv, int *i, void *options)
         status = coavoid_cli_mode_option(argc, argv, i, &o->mode, &o->decoupled);
     } else if (coavoid_cli_option_is(arg, "--steps")) {
         status = coavoid_cli_count_option(argc, argv, i, "--steps", "an integer >= 1", false,
-                                  SIM_MAX_STEPS, &o->steps_text, &value);
+                                          SIM_MAX_STEPS, &o->steps_text, &value);
         o->steps = (uint32_t)value;
     } else if (coavoid_cli_option_is(arg, "--json")) {
         status = coavoid_cli_flag_option(arg, "--json", &o->json);
     } else if (coavoid_cli_option_is(arg, "--svg")) {
-        status = coavoid_cli_text_option(argc, argv, i, "--svg", "a file to write", false, &o->svg_path);
+        status =
+            coavoid_cli_text_option(argc, argv, i, "--svg", "a file to write", false, &o->svg_path);
     } else if (coavoid_cli_option_is(arg, "--coordinator-stops")) {
-        status = coavoid_cli_text_option(argc, argv, i, "--coordinator-stops", "a step, 0 or more", true,
-                                 &o->stop_text);
-        if (status == CLI_CONTINUE && !coavoid_cli_parse_index(o->stop_text, SIM_MAX_STEPS, &value)) {
-            status = coavoid_cli_fail(CLI_EXIT_INVALID,
-                              "--coordinator-stops: must be a step from 0 to %u, got '%.40s'",
-                              SIM_MAX_STEPS, o->stop_text);
+        status = coavoid_cli_text_option(argc, argv, i, "--coordinator-stops", "a step, 0 or more",
+                                         true, &o->stop_text);
+        if (status == CLI_CONTINUE &&
+            !coavoid_cli_parse_index(o->stop_text, SIM_MAX_STEPS, &value)) {
+            status = coavoid_cli_fail(
+                CLI_EXIT_INVALID, "--coordinator-stops: must be a step from 0 to %u, got '%.40s'",
+                SIM_MAX_STEPS, o->stop_text);
         }
         o->stop_step = (uint32_t)value;
     }
@@ -124,9 +125,9 @@ static int parse_sim_options(int argc, char **argv, sim_options_t *o)
         return coavoid_cli_fail(CLI_EXIT_INVALID, "--mode: required (centralised or decoupled)");
     }
     if (o->decoupled && o->stop_text != NULL) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID,
-                        "--coordinator-stops: only valid with --mode centralised (decoupled "
-                        "runs without a coordinator)");
+        return coavoid_cli_fail(
+            CLI_EXIT_INVALID, "--coordinator-stops: only valid with --mode centralised (decoupled "
+                              "runs without a coordinator)");
     }
     return CLI_CONTINUE;
 }
@@ -136,10 +137,10 @@ typedef struct {
     coavoid_world_t *world;
     coavoid_coordinator_t *coordinator;
     coavoid_vehicle_node_t **vehicles; /* in priority order: the order they run in */
-    size_t *index;                 /* index[j]: scenario index of vehicles[j] */
-    coa_vec3_t *references;        /* by scenario index, rows of K + 1 */
+    size_t *index;                     /* index[j]: scenario index of vehicles[j] */
+    coa_vec3_t *references;            /* by scenario index, rows of K + 1 */
     int32_t *offsets;
-    coa_track_t *tracks;           /* the world's copy when the scenario's ids do not fit */
+    coa_track_t *tracks; /* the world's copy when the scenario's ids do not fit */
     coavoid_judged_t judged;
     FILE *svg;
 } sim_run_t;
@@ -202,26 +203,26 @@ static char far_axis(coa_vec3_t p, double *value)
  * reference point and the positions and velocities its offsets can give there. An offset
  * at sample j is at most initial_offset + steep_factor * j climb steps from the reference
  * (and within max_offset), whatever is planned. */
-static int check_vehicle_limits(const char *file, size_t i, const coa_vehicle_t *v,
-                                coa_real_t dt, uint64_t last)
+static int check_vehicle_limits(const char *file, size_t i, const coa_vehicle_t *v, coa_real_t dt,
+                                uint64_t last)
 {
     if (beyond((double)v->volume.radius, COAVOID_LCM_MAX_SIZE)) {
         return coavoid_cli_fail(CLI_EXIT_INVALID,
-                        "%s: vehicles[%zu].radius: %g m is beyond what " SIM_INTENT
-                        " carries (%g m)",
-                        file, i, (double)v->volume.radius, COAVOID_LCM_MAX_SIZE);
+                                "%s: vehicles[%zu].radius: %g m is beyond what " SIM_INTENT
+                                " carries (%g m)",
+                                file, i, (double)v->volume.radius, COAVOID_LCM_MAX_SIZE);
     }
     if (beyond((double)v->volume.half_height, COAVOID_LCM_MAX_SIZE)) {
         return coavoid_cli_fail(CLI_EXIT_INVALID,
-                        "%s: vehicles[%zu].half_height: %g m is beyond what " SIM_INTENT
-                        " carries (%g m)",
-                        file, i, (double)v->volume.half_height, COAVOID_LCM_MAX_SIZE);
+                                "%s: vehicles[%zu].half_height: %g m is beyond what " SIM_INTENT
+                                " carries (%g m)",
+                                file, i, (double)v->volume.half_height, COAVOID_LCM_MAX_SIZE);
     }
     if (beyond((double)v->cruise_speed, COAVOID_LCM_MAX_SPEED)) {
         return coavoid_cli_fail(CLI_EXIT_INVALID,
-                        "%s: vehicles[%zu].cruise_speed: %g m/s is beyond what " SIM_INTENT
-                        " carries (%g m/s)",
-                        file, i, (double)v->cruise_speed, COAVOID_LCM_MAX_SPEED);
+                                "%s: vehicles[%zu].cruise_speed: %g m/s is beyond what " SIM_INTENT
+                                " carries (%g m/s)",
+                                file, i, (double)v->cruise_speed, COAVOID_LCM_MAX_SPEED);
     }
     /* The largest change of offset in one step, and the vertical speed it adds. */
     uint32_t max_change = v->steep_factor;
@@ -231,20 +232,20 @@ static int check_vehicle_limits(const char *file, size_t i, const coa_vehicle_t 
     const double climb = (double)max_change * (double)v->climb_rate;
     if (beyond(climb, COAVOID_LCM_MAX_SPEED)) {
         return coavoid_cli_fail(CLI_EXIT_INVALID,
-                        "%s: vehicles[%zu].climb_rate: %g m/s, %g m/s in a steep climb, is "
-                        "beyond what " SIM_INTENT " carries (%g m/s)",
-                        file, i, (double)v->climb_rate, climb, COAVOID_LCM_MAX_SPEED);
+                                "%s: vehicles[%zu].climb_rate: %g m/s, %g m/s in a steep climb, is "
+                                "beyond what " SIM_INTENT " carries (%g m/s)",
+                                file, i, (double)v->climb_rate, climb, COAVOID_LCM_MAX_SPEED);
     }
     if (v->priority > (uint32_t)INT32_MAX) {
         return coavoid_cli_fail(CLI_EXIT_INVALID,
-                        "%s: vehicles[%zu].priority: %lu is beyond what " SIM_INTENT
-                        " carries (%ld)",
-                        file, i, (unsigned long)v->priority, (long)INT32_MAX);
+                                "%s: vehicles[%zu].priority: %lu is beyond what " SIM_INTENT
+                                " carries (%ld)",
+                                file, i, (unsigned long)v->priority, (long)INT32_MAX);
     }
     const double dh = (double)coa_climb_step(v, dt);
     const int64_t bound = v->max_offset >= 0 ? v->max_offset : COA_MAX_OFFSET;
-    const int64_t initial = v->initial_offset < 0 ? -(int64_t)v->initial_offset
-                                                  : (int64_t)v->initial_offset;
+    const int64_t initial =
+        v->initial_offset < 0 ? -(int64_t)v->initial_offset : (int64_t)v->initial_offset;
     coa_vec3_t previous = coa_reference_at(v, (coa_real_t)0);
     for (uint64_t j = 0; j <= last; j++) {
         const coa_real_t t = (coa_real_t)j * dt;
@@ -252,23 +253,25 @@ static int check_vehicle_limits(const char *file, size_t i, const coa_vehicle_t 
         double value = 0.0;
         char axis = far_axis(r, &value);
         if (axis != 0) {
-            return coavoid_cli_fail(CLI_EXIT_INVALID,
-                            "%s: vehicles[%zu].route: its reference reaches %c = %.10g m at t "
-                            "= %g s, beyond what " SIM_INTENT " carries (%g m; this run's "
-                            "intents reach t = %g s)",
-                            file, i, axis, value, (double)t, COAVOID_LCM_MAX_COORDINATE,
-                            (double)last * (double)dt);
+            return coavoid_cli_fail(
+                CLI_EXIT_INVALID,
+                "%s: vehicles[%zu].route: its reference reaches %c = %.10g m at t "
+                "= %g s, beyond what " SIM_INTENT " carries (%g m; this run's "
+                "intents reach t = %g s)",
+                file, i, axis, value, (double)t, COAVOID_LCM_MAX_COORDINATE,
+                (double)last * (double)dt);
         }
         const int64_t reach_steps = initial + (int64_t)v->steep_factor * (int64_t)j;
         const int64_t reach = reach_steps < bound ? reach_steps : bound;
         const double top = fabs((double)r.z) + (double)reach * dh;
         if (beyond(top, COAVOID_LCM_MAX_COORDINATE)) {
-            return coavoid_cli_fail(CLI_EXIT_INVALID,
-                            "%s: vehicles[%zu]: at t = %g s its reference is at z = %.10g m, "
-                            "and the %lld climb steps of %g m it may have taken by then take "
-                            "|z| to %.10g m: beyond what " SIM_INTENT " carries (%g m)",
-                            file, i, (double)t, (double)r.z, (long long)reach, dh, top,
-                            COAVOID_LCM_MAX_COORDINATE);
+            return coavoid_cli_fail(
+                CLI_EXIT_INVALID,
+                "%s: vehicles[%zu]: at t = %g s its reference is at z = %.10g m, "
+                "and the %lld climb steps of %g m it may have taken by then take "
+                "|z| to %.10g m: beyond what " SIM_INTENT " carries (%g m)",
+                file, i, (double)t, (double)r.z, (long long)reach, dh, top,
+                COAVOID_LCM_MAX_COORDINATE);
         }
         if (j == 0u) {
             continue;
@@ -279,11 +282,12 @@ static int check_vehicle_limits(const char *file, size_t i, const coa_vehicle_t 
         const double vz = fabs((double)((r.z - previous.z) / dt)) + climb;
         if (beyond(vx, COAVOID_LCM_MAX_SPEED) || beyond(vy, COAVOID_LCM_MAX_SPEED) ||
             beyond(vz, COAVOID_LCM_MAX_SPEED)) {
-            return coavoid_cli_fail(CLI_EXIT_INVALID,
-                            "%s: vehicles[%zu].route: its reference moves at (%g, %g) m/s "
-                            "horizontally and %g m/s vertically with its steepest climb at t = "
-                            "%g s, beyond what " SIM_INTENT " carries (%g m/s each)",
-                            file, i, vx, vy, vz, (double)t, COAVOID_LCM_MAX_SPEED);
+            return coavoid_cli_fail(
+                CLI_EXIT_INVALID,
+                "%s: vehicles[%zu].route: its reference moves at (%g, %g) m/s "
+                "horizontally and %g m/s vertically with its steepest climb at t = "
+                "%g s, beyond what " SIM_INTENT " carries (%g m/s each)",
+                file, i, vx, vy, vz, (double)t, COAVOID_LCM_MAX_SPEED);
         }
         /* Consecutive reference points must differ horizontally in the core's precision,
          * as the intent's check judges them (a route far out flown very slowly does not). */
@@ -293,12 +297,12 @@ static int check_vehicle_limits(const char *file, size_t i, const coa_vehicle_t 
         probe.route_count = 2u;
         probe.initial_offset = 0;
         if (coa_vehicle_check(&probe) != COA_OK) {
-            return coavoid_cli_fail(CLI_EXIT_INVALID,
-                            "%s: vehicles[%zu].cruise_speed: %g m/s moves it too little in a "
-                            "step to tell its position at t = %g s from the one before "
-                            "(%.10g, %.10g m), as " SIM_INTENT " must",
-                            file, i, (double)v->cruise_speed, (double)t, (double)r.x,
-                            (double)r.y);
+            return coavoid_cli_fail(
+                CLI_EXIT_INVALID,
+                "%s: vehicles[%zu].cruise_speed: %g m/s moves it too little in a "
+                "step to tell its position at t = %g s from the one before "
+                "(%.10g, %.10g m), as " SIM_INTENT " must",
+                file, i, (double)v->cruise_speed, (double)t, (double)r.x, (double)r.y);
         }
         previous = r;
     }
@@ -321,24 +325,25 @@ static int check_track_limits(const char *file, size_t i, const coa_track_t *tr,
                   {"sigma[1]", tr->sigma_vertical}};
     for (size_t f = 0; f < 4u; f++) {
         if (beyond((double)sizes[f].value, COAVOID_LCM_MAX_SIZE)) {
-            return coavoid_cli_fail(CLI_EXIT_INVALID,
-                            "%s: tracks[%zu].%s: %g m is beyond what " SIM_TRACK
-                            " carries (%g m)",
-                            file, i, sizes[f].name, (double)sizes[f].value, COAVOID_LCM_MAX_SIZE);
+            return coavoid_cli_fail(
+                CLI_EXIT_INVALID,
+                "%s: tracks[%zu].%s: %g m is beyond what " SIM_TRACK " carries (%g m)", file, i,
+                sizes[f].name, (double)sizes[f].value, COAVOID_LCM_MAX_SIZE);
         }
     }
     if (tr->path_count == 0u) {
         double value = 0.0;
         const coa_vec3_t v = tr->velocity;
-        if (beyond((double)v.x, COAVOID_LCM_MAX_SPEED) || beyond((double)v.y, COAVOID_LCM_MAX_SPEED) ||
+        if (beyond((double)v.x, COAVOID_LCM_MAX_SPEED) ||
+            beyond((double)v.y, COAVOID_LCM_MAX_SPEED) ||
             beyond((double)v.z, COAVOID_LCM_MAX_SPEED)) {
             value = beyond((double)v.x, COAVOID_LCM_MAX_SPEED)   ? (double)v.x
                     : beyond((double)v.y, COAVOID_LCM_MAX_SPEED) ? (double)v.y
-                                                              : (double)v.z;
+                                                                 : (double)v.z;
             return coavoid_cli_fail(CLI_EXIT_INVALID,
-                            "%s: tracks[%zu].velocity: %g m/s is beyond what " SIM_TRACK
-                            " carries (%g m/s)",
-                            file, i, value, COAVOID_LCM_MAX_SPEED);
+                                    "%s: tracks[%zu].velocity: %g m/s is beyond what " SIM_TRACK
+                                    " carries (%g m/s)",
+                                    file, i, value, COAVOID_LCM_MAX_SPEED);
         }
     } else if (tr->path_count > 1u) {
         /* The leg in use at t_k, as coa_track_at and the world choose it: the first one
@@ -358,10 +363,11 @@ static int check_track_limits(const char *file, size_t i, const coa_track_t *tr,
                                  (double)((b->p.z - a->p.z) / span)};
             for (int c = 0; c < 3; c++) {
                 if (beyond(v[c], COAVOID_LCM_MAX_SPEED)) {
-                    return coavoid_cli_fail(CLI_EXIT_INVALID,
-                                    "%s: tracks[%zu].path[%zu]: the leg to it is flown at %g m/s, "
-                                    "beyond what " SIM_TRACK " carries (%g m/s)",
-                                    file, i, leg + 1u, v[c], COAVOID_LCM_MAX_SPEED);
+                    return coavoid_cli_fail(
+                        CLI_EXIT_INVALID,
+                        "%s: tracks[%zu].path[%zu]: the leg to it is flown at %g m/s, "
+                        "beyond what " SIM_TRACK " carries (%g m/s)",
+                        file, i, leg + 1u, v[c], COAVOID_LCM_MAX_SPEED);
                 }
             }
         }
@@ -372,10 +378,11 @@ static int check_track_limits(const char *file, size_t i, const coa_track_t *tr,
         double value = 0.0;
         char axis = far_axis(tr->path[j].p, &value);
         if (axis != 0 && tr->path[j].t > (coa_real_t)0 && tr->path[j].t < end) {
-            return coavoid_cli_fail(CLI_EXIT_INVALID,
-                            "%s: tracks[%zu].path[%zu]: %c = %.10g m is beyond what " SIM_TRACK
-                            " carries (%g m)",
-                            file, i, j, axis, value, COAVOID_LCM_MAX_COORDINATE);
+            return coavoid_cli_fail(
+                CLI_EXIT_INVALID,
+                "%s: tracks[%zu].path[%zu]: %c = %.10g m is beyond what " SIM_TRACK
+                " carries (%g m)",
+                file, i, j, axis, value, COAVOID_LCM_MAX_COORDINATE);
         }
     }
     for (uint64_t j = 0; j <= sampled; j++) {
@@ -383,12 +390,12 @@ static int check_track_limits(const char *file, size_t i, const coa_track_t *tr,
         double value = 0.0;
         char axis = far_axis(coa_track_at(tr, t), &value);
         if (axis != 0) {
-            return coavoid_cli_fail(CLI_EXIT_INVALID,
-                            "%s: tracks[%zu]: at t = %g s it is at %c = %.10g m, beyond what "
-                            SIM_TRACK " carries (%g m; this run's track messages reach t = %g "
-                            "s)",
-                            file, i, (double)t, axis, value, COAVOID_LCM_MAX_COORDINATE,
-                            (double)end);
+            return coavoid_cli_fail(
+                CLI_EXIT_INVALID,
+                "%s: tracks[%zu]: at t = %g s it is at %c = %.10g m, beyond what " SIM_TRACK
+                " carries (%g m; this run's track messages reach t = %g "
+                "s)",
+                file, i, (double)t, axis, value, COAVOID_LCM_MAX_COORDINATE, (double)end);
         }
     }
     return CLI_CONTINUE;
@@ -407,20 +414,20 @@ static int check_obstacle_limits(const char *file, size_t i, const coa_obstacle_
         }
         if (axis != 0) {
             return coavoid_cli_fail(CLI_EXIT_INVALID,
-                            "%s: obstacles[%zu].%s: %c = %.10g m is beyond what " SIM_MAP
-                            " carries (%g m)",
-                            file, i, corner, axis, value, COAVOID_LCM_MAX_COORDINATE);
+                                    "%s: obstacles[%zu].%s: %c = %.10g m is beyond what " SIM_MAP
+                                    " carries (%g m)",
+                                    file, i, corner, axis, value, COAVOID_LCM_MAX_COORDINATE);
         }
         return CLI_CONTINUE;
     }
     for (size_t j = 0; j < o->polytope.count; j++) {
         axis = far_axis(o->polytope.vertices[j], &value);
         if (axis != 0) {
-            return coavoid_cli_fail(CLI_EXIT_INVALID,
-                            "%s: obstacles[%zu].vertices[%zu]: %c = %.10g m is beyond what "
-                            SIM_MAP
-                            " carries (%g m)",
-                            file, i, j, axis, value, COAVOID_LCM_MAX_COORDINATE);
+            return coavoid_cli_fail(
+                CLI_EXIT_INVALID,
+                "%s: obstacles[%zu].vertices[%zu]: %c = %.10g m is beyond what " SIM_MAP
+                " carries (%g m)",
+                file, i, j, axis, value, COAVOID_LCM_MAX_COORDINATE);
         }
     }
     return CLI_CONTINUE;
@@ -464,24 +471,27 @@ static int sim(void *options, coavoid_scenario_t *s)
     const char *file = o->scenario_path;
     const size_t n = s->vehicle_count;
     if (s->horizon > COAVOID_NODE_MAX_HORIZON) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID,
-                        "%s: horizon: %lu steps, at most %u in a simulation (an intent carries "
-                        "N + 1 samples)",
-                        file, (unsigned long)s->horizon, COAVOID_NODE_MAX_HORIZON);
+        return coavoid_cli_fail(
+            CLI_EXIT_INVALID,
+            "%s: horizon: %lu steps, at most %u in a simulation (an intent carries "
+            "N + 1 samples)",
+            file, (unsigned long)s->horizon, COAVOID_NODE_MAX_HORIZON);
     }
     if (n > COA_MAX_VEHICLES || n > COAVOID_NODE_MAX_PEERS) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: vehicles: %zu UAVs, at most %u in a simulation",
-                        file, n, COA_MAX_VEHICLES < COAVOID_NODE_MAX_PEERS ? COA_MAX_VEHICLES
-                                                                       : COAVOID_NODE_MAX_PEERS);
+        return coavoid_cli_fail(
+            CLI_EXIT_INVALID, "%s: vehicles: %zu UAVs, at most %u in a simulation", file, n,
+            COA_MAX_VEHICLES < COAVOID_NODE_MAX_PEERS ? COA_MAX_VEHICLES : COAVOID_NODE_MAX_PEERS);
     }
     if (s->track_count > COAVOID_NODE_MAX_TRACKS) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: tracks: %zu tracks, at most %u in a simulation",
-                        file, s->track_count, COAVOID_NODE_MAX_TRACKS);
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                "%s: tracks: %zu tracks, at most %u in a simulation", file,
+                                s->track_count, COAVOID_NODE_MAX_TRACKS);
     }
     const uint32_t steps = o->steps_text != NULL ? o->steps : 2u * s->horizon;
     if (o->stop_text != NULL && o->stop_step > steps) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "--coordinator-stops: step %lu is after the last, %lu",
-                        (unsigned long)o->stop_step, (unsigned long)steps);
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                "--coordinator-stops: step %lu is after the last, %lu",
+                                (unsigned long)o->stop_step, (unsigned long)steps);
     }
     int rc = coavoid_cli_sample_scenario(file, s);
     if (rc != CLI_CONTINUE) {
@@ -492,8 +502,8 @@ static int sim(void *options, coavoid_scenario_t *s)
     coavoid_node_common_t common;
     if (coavoid_node_common_defaults(&common, SIM_EPOCH_UTIME, s->dt, s->horizon, &now) != COA_OK) {
         return coavoid_cli_fail(CLI_EXIT_INVALID,
-                        "%s: dt: %g s cannot be a cycle (whole microseconds, at most %g s)", file,
-                        (double)s->dt, COAVOID_LCM_MAX_STEP);
+                                "%s: dt: %g s cannot be a cycle (whole microseconds, at most %g s)",
+                                file, (double)s->dt, COAVOID_LCM_MAX_STEP);
     }
     rc = check_message_limits(file, s, steps);
     if (rc != CLI_CONTINUE) {
@@ -502,18 +512,20 @@ static int sim(void *options, coavoid_scenario_t *s)
 
     /* Planner sizes: each UAV plans alone; the coordinator searches up to max_centralised
      * UAVs together, fewer when the scenario's beta would not fit the cap otherwise. */
-    coa_planner_config_t vehicle_shape = coavoid_node_planner_config(s->horizon, 1u, CLI_DEFAULT_BETA);
+    coa_planner_config_t vehicle_shape =
+        coavoid_node_planner_config(s->horizon, 1u, CLI_DEFAULT_BETA);
     const uint32_t vehicle_beta = s->has_beta ? s->beta : coavoid_cli_default_beta(&vehicle_shape);
     vehicle_shape.beta = vehicle_beta;
     if (vehicle_beta == 0 || !coavoid_cli_workspace_fits(&vehicle_shape)) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID,
-                        "%s: beta: %lu is too large: a UAV's planner would not fit in 1 GiB", file,
-                        (unsigned long)vehicle_beta);
+        return coavoid_cli_fail(
+            CLI_EXIT_INVALID, "%s: beta: %lu is too large: a UAV's planner would not fit in 1 GiB",
+            file, (unsigned long)vehicle_beta);
     }
     size_t max_centralised = n < COA_MAX_CENTRALISED ? n : COA_MAX_CENTRALISED;
     coa_planner_config_t coordinator_shape =
         coavoid_node_planner_config(s->horizon, max_centralised, CLI_DEFAULT_BETA);
-    uint32_t coordinator_beta = s->has_beta ? s->beta : coavoid_cli_default_beta(&coordinator_shape);
+    uint32_t coordinator_beta =
+        s->has_beta ? s->beta : coavoid_cli_default_beta(&coordinator_shape);
     coordinator_shape.beta = coordinator_beta;
     while (max_centralised > 1u && !coavoid_cli_workspace_fits(&coordinator_shape)) {
         coordinator_shape.vehicles = --max_centralised;
@@ -528,8 +540,8 @@ static int sim(void *options, coavoid_scenario_t *s)
     r.offsets = calloc(n * samples, sizeof *r.offsets);
     if (r.vehicles == NULL || r.index == NULL || r.references == NULL || r.offsets == NULL) {
         sim_run_free(&r, n);
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: cannot allocate the record of %lu steps", file,
-                        (unsigned long)steps);
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: cannot allocate the record of %lu steps",
+                                file, (unsigned long)steps);
     }
     if (o->svg_path != NULL) {
         r.svg = fopen(o->svg_path, "w");
@@ -541,7 +553,8 @@ static int sim(void *options, coavoid_scenario_t *s)
     r.lcm = lcm_create("memq://");
     if (r.lcm == NULL) {
         sim_run_free(&r, n);
-        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: LCM's memq provider is unavailable");
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL,
+                                "internal error: LCM's memq provider is unavailable");
     }
 
     /* A track message numbers tracks 1..2^31-1, once each; the scenario may use any
@@ -581,14 +594,15 @@ static int sim(void *options, coavoid_scenario_t *s)
     if (r.world == NULL) {
         sim_run_free(&r, n);
         if (error == COA_ERR_ARGUMENT) {
-            return coavoid_cli_fail(CLI_EXIT_INVALID,
-                            "%s: obstacles: more than an obstacle map message holds (%d boxes, "
-                            "%d polytopes of at most %d vertices)",
-                            file, COAVOID_OBSTACLE_MAP_T_MAX_BOXES,
-                            COAVOID_OBSTACLE_MAP_T_MAX_POLYTOPES,
-                            COAVOID_OBSTACLE_MAP_T_MAX_VERTICES);
+            return coavoid_cli_fail(
+                CLI_EXIT_INVALID,
+                "%s: obstacles: more than an obstacle map message holds (%d boxes, "
+                "%d polytopes of at most %d vertices)",
+                file, COAVOID_OBSTACLE_MAP_T_MAX_BOXES, COAVOID_OBSTACLE_MAP_T_MAX_POLYTOPES,
+                COAVOID_OBSTACLE_MAP_T_MAX_VERTICES);
         }
-        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: out of memory for the world node");
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL,
+                                "internal error: out of memory for the world node");
     }
 
     /* UAVs run in priority order (ascending priority, ties by ascending id), whatever
@@ -597,7 +611,8 @@ static int sim(void *options, coavoid_scenario_t *s)
      * published), so a lower priority stepped first would decide around nothing there. */
     if (coa_priority_order(s->vehicles, n, r.index) != COA_OK) {
         sim_run_free(&r, n);
-        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: no priority order of %zu UAVs", n);
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: no priority order of %zu UAVs",
+                                n);
     }
     for (size_t j = 0; j < n; j++) {
         size_t i = r.index[j];
@@ -611,12 +626,13 @@ static int sim(void *options, coavoid_scenario_t *s)
         if (r.vehicles[j] == NULL) {
             sim_run_free(&r, n);
             if (error == COA_ERR_ARGUMENT) {
-                return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: vehicles[%zu]: cannot run as a node (%s)",
-                                file, i, coavoid_lcm_error_name(error));
+                return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                        "%s: vehicles[%zu]: cannot run as a node (%s)", file, i,
+                                        coavoid_lcm_error_name(error));
             }
             return coavoid_cli_fail(CLI_EXIT_INVALID,
-                            "%s: vehicles[%zu]: cannot allocate its node (beta %lu)", file, i,
-                            (unsigned long)vehicle_beta);
+                                    "%s: vehicles[%zu]: cannot allocate its node (beta %lu)", file,
+                                    i, (unsigned long)vehicle_beta);
         }
     }
     if (!o->decoupled) {
@@ -630,21 +646,22 @@ static int sim(void *options, coavoid_scenario_t *s)
         if (config.collect_us >= common.dt_us) {
             sim_run_free(&r, n);
             return coavoid_cli_fail(CLI_EXIT_INVALID,
-                            "%s: dt: %g s leaves the coordinator no time within a cycle", file,
-                            (double)s->dt);
+                                    "%s: dt: %g s leaves the coordinator no time within a cycle",
+                                    file, (double)s->dt);
         }
         r.coordinator = coavoid_coordinator_create(&config, r.lcm, &error);
         if (r.coordinator == NULL) {
             sim_run_free(&r, n);
             if (error == COA_ERR_ARGUMENT) {
                 return coavoid_cli_fail(CLI_EXIT_INVALID,
-                                "%s: beta: %lu cannot size the coordinator's planner", file,
-                                (unsigned long)coordinator_beta);
+                                        "%s: beta: %lu cannot size the coordinator's planner", file,
+                                        (unsigned long)coordinator_beta);
             }
-            return coavoid_cli_fail(CLI_EXIT_INVALID,
-                            "%s: cannot allocate the coordinator's planner (beta %lu, %zu UAVs "
-                            "together)",
-                            file, (unsigned long)coordinator_beta, max_centralised);
+            return coavoid_cli_fail(
+                CLI_EXIT_INVALID,
+                "%s: cannot allocate the coordinator's planner (beta %lu, %zu UAVs "
+                "together)",
+                file, (unsigned long)coordinator_beta, max_centralised);
         }
     }
 
@@ -715,12 +732,13 @@ static int sim(void *options, coavoid_scenario_t *s)
     }
     if (!lcm_ok) {
         sim_run_free(&r, n);
-        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: LCM failed while handling messages");
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL,
+                                "internal error: LCM failed while handling messages");
     }
     if (node_error != COA_OK) {
         sim_run_free(&r, n);
         return coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: a node failed (%s)",
-                        coavoid_lcm_error_name(node_error));
+                                coavoid_lcm_error_name(node_error));
     }
 
     uint32_t replans = coordinator_plans;
@@ -735,8 +753,9 @@ static int sim(void *options, coavoid_scenario_t *s)
     const coavoid_flight_eval_t *eval = &r.judged.eval;
     if (rc != COA_OK) {
         sim_run_free(&r, n);
-        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: the flight cannot be judged (%s)",
-                        coa_status_name(rc));
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL,
+                                "internal error: the flight cannot be judged (%s)",
+                                coa_status_name(rc));
     }
     if (r.svg != NULL) {
         rc = coavoid_flight_svg(flight, eval, r.svg);
@@ -744,7 +763,8 @@ static int sim(void *options, coavoid_scenario_t *s)
         r.svg = NULL;
         if (rc != COA_OK || closed != 0) {
             sim_run_free(&r, n);
-            return coavoid_cli_fail(CLI_EXIT_INTERNAL, "--svg: writing '%.200s' failed", o->svg_path);
+            return coavoid_cli_fail(CLI_EXIT_INTERNAL, "--svg: writing '%.200s' failed",
+                                    o->svg_path);
         }
     }
     if (o->json) {
@@ -753,7 +773,7 @@ static int sim(void *options, coavoid_scenario_t *s)
         snprintf(fallbacks_text, sizeof fallbacks_text, "%lu", (unsigned long)fallbacks);
         snprintf(stopped_text, sizeof stopped_text, "%lu", (unsigned long)o->stop_step);
         const coavoid_flight_extra_t extra[2] = {{"fallbacks", fallbacks_text},
-                                             {"coordinator_stopped_at", stopped_text}};
+                                                 {"coordinator_stopped_at", stopped_text}};
         rc = coavoid_flight_json_extra(flight, eval, extra, o->stop_text != NULL ? 2u : 1u, stdout);
     } else {
         rc = coavoid_flight_text(flight, eval, stdout);
@@ -764,7 +784,8 @@ static int sim(void *options, coavoid_scenario_t *s)
     }
     sim_run_free(&r, n);
     if (rc != COA_OK) {
-        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: the result could not be written");
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL,
+                                "internal error: the result could not be written");
     }
     return eval->loss_of_separation ? CLI_EXIT_NOT_SOLVED : CLI_EXIT_OK;
 }

@@ -55,30 +55,30 @@
 #include "node.h"
 #include "scenario.h"
 
-#define SUMMARY_USAGE                                                                         \
-    "usage: coavoid summary LOGFILE SCENARIO.json --mode centralised|decoupled\n"             \
-    "                       [--json] [--svg FILE] [--epoch UTIME]\n"                          \
-    "\n"                                                                                      \
-    "Rebuilds what each UAV of the scenario flew from an lcm-logger log of a real-time\n"     \
+#define SUMMARY_USAGE                                                                             \
+    "usage: coavoid summary LOGFILE SCENARIO.json --mode centralised|decoupled\n"                 \
+    "                       [--json] [--svg FILE] [--epoch UTIME]\n"                              \
+    "\n"                                                                                          \
+    "Rebuilds what each UAV of the scenario flew from an lcm-logger log of a real-time\n"         \
     "run (the intents on " COAVOID_CHANNEL_INTENT "), judges it as 'coavoid sim' does (loss of\n" \
-    "separation, deviation, effort), and counts the planning calls (" COAVOID_CHANNEL_STATUS     \
+    "separation, deviation, effort), and counts the planning calls (" COAVOID_CHANNEL_STATUS      \
     ",\n" COAVOID_CHANNEL_PLAN ").\n"                                                             \
-    "\n"                                                                                      \
-    "options:\n"                                                                              \
-    "  --mode MODE     centralised or decoupled: the mode the run was started in\n"           \
-    "  --json          print the simulation result as JSON (with a \"log\" object)\n"         \
-    "  --svg FILE      write the figure (top view, altitude per UAV) to FILE\n"               \
-    "  --epoch UTIME   cycle 0's start, in microseconds; default: the earliest\n"             \
-    "                  plan_utime of the scenario's UAVs in the log\n"                        \
-    "  -h, --help      show this help\n"                                                      \
-    "\n"                                                                                      \
-    "Replans are the planning calls of every node up to the last sample, from the\n"       \
-    "plans_run of their heartbeats (as coavoid sim counts them).\n"                          \
-    "Samples run from cycle 0 to the last cycle in which every UAV's own intent was\n"        \
-    "logged, at most twice the scenario's horizon. A sample no intent covers is taken\n"      \
-    "from the scenario's reference with the offset held, and reported.\n"                     \
-    "\n"                                                                                      \
-    "exit status: 0 no loss of separation, 1 loss of separation, 2 invalid input or usage\n"  \
+    "\n"                                                                                          \
+    "options:\n"                                                                                  \
+    "  --mode MODE     centralised or decoupled: the mode the run was started in\n"               \
+    "  --json          print the simulation result as JSON (with a \"log\" object)\n"             \
+    "  --svg FILE      write the figure (top view, altitude per UAV) to FILE\n"                   \
+    "  --epoch UTIME   cycle 0's start, in microseconds; default: the earliest\n"                 \
+    "                  plan_utime of the scenario's UAVs in the log\n"                            \
+    "  -h, --help      show this help\n"                                                          \
+    "\n"                                                                                          \
+    "Replans are the planning calls of every node up to the last sample, from the\n"              \
+    "plans_run of their heartbeats (as coavoid sim counts them).\n"                               \
+    "Samples run from cycle 0 to the last cycle in which every UAV's own intent was\n"            \
+    "logged, at most twice the scenario's horizon. A sample no intent covers is taken\n"          \
+    "from the scenario's reference with the offset held, and reported.\n"                         \
+    "\n"                                                                                          \
+    "exit status: 0 no loss of separation, 1 loss of separation, 2 invalid input or usage\n"      \
     "(one line on stderr naming the input and why), 3 internal error\n"
 
 /* An event's header in the file: magic, event number, time stamp, channel and data
@@ -118,17 +118,18 @@ static int summary_option(int argc, char **argv, int *i, void *options)
     } else if (coavoid_cli_option_is(arg, "--json")) {
         status = coavoid_cli_flag_option(arg, "--json", &o->json);
     } else if (coavoid_cli_option_is(arg, "--svg")) {
-        status = coavoid_cli_text_option(argc, argv, i, "--svg", "a file to write", false, &o->svg_path);
+        status =
+            coavoid_cli_text_option(argc, argv, i, "--svg", "a file to write", false, &o->svg_path);
     } else if (coavoid_cli_option_is(arg, "--epoch")) {
         uint64_t epoch = 0;
-        status = coavoid_cli_text_option(argc, argv, i, "--epoch", "microseconds, an integer >= 1", true,
-                                 &o->epoch_text);
+        status = coavoid_cli_text_option(argc, argv, i, "--epoch", "microseconds, an integer >= 1",
+                                         true, &o->epoch_text);
         if (status == CLI_CONTINUE && !coavoid_cli_parse_count(o->epoch_text, strlen(o->epoch_text),
-                                                       (uint64_t)INT64_MAX / 2u, &epoch)) {
+                                                               (uint64_t)INT64_MAX / 2u, &epoch)) {
             return coavoid_cli_fail(CLI_EXIT_INVALID,
-                            "--epoch: must be an integer from 1 to %" PRIu64
-                            " (microseconds), got '%.40s'",
-                            (uint64_t)INT64_MAX / 2u, o->epoch_text);
+                                    "--epoch: must be an integer from 1 to %" PRIu64
+                                    " (microseconds), got '%.40s'",
+                                    (uint64_t)INT64_MAX / 2u, o->epoch_text);
         }
         o->epoch = (int64_t)epoch;
     }
@@ -136,7 +137,7 @@ static int summary_option(int argc, char **argv, int *i, void *options)
 }
 
 static const coavoid_cli_command_t summary_command = {
-    "summary", "coavoid summary", 2, {"LOGFILE", "SCENARIO.json"}, "one log and one scenario",
+    "summary",    "coavoid summary", 2, {"LOGFILE", "SCENARIO.json"}, "one log and one scenario",
     summary_help, summary_option};
 
 static int parse_summary_options(int argc, char **argv, summary_options_t *o)
@@ -174,14 +175,14 @@ static int log_open(log_reader_t *r, const char *path, int64_t limit)
         return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: cannot open: %s", path, strerror(errno));
     }
     if (!S_ISREG(st.st_mode)) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: not a regular file (an lcm-logger log is one)",
-                        path);
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                "%s: not a regular file (an lcm-logger log is one)", path);
     }
     errno = 0;
     r->log = lcm_eventlog_create(path, "r");
     if (r->log == NULL) {
         return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: cannot open: %s", path,
-                        errno != 0 ? strerror(errno) : "lcm_eventlog_create failed");
+                                errno != 0 ? strerror(errno) : "lcm_eventlog_create failed");
     }
     /* The size of what was opened (the path may have been replaced since stat). */
     if (fstat(fileno(r->log->f), &st) != 0) {
@@ -221,13 +222,14 @@ static int log_next(log_reader_t *r, lcm_eventlog_event_t **event)
         return 0;
     }
     if (fseeko(r->log->f, (off_t)r->offset, SEEK_SET) != 0) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: cannot seek to byte %" PRId64 ": %s", r->path,
-                        r->offset, strerror(errno));
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: cannot seek to byte %" PRId64 ": %s",
+                                r->path, r->offset, strerror(errno));
     }
     size_t want = left < LOG_HEADER_BYTES ? (size_t)left : (size_t)LOG_HEADER_BYTES;
     size_t got = fread(header, 1, want, r->log->f);
     if (got != want) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: read error at byte %" PRId64, r->path, r->offset);
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: read error at byte %" PRId64, r->path,
+                                r->offset);
     }
     /* Whether the bytes there are (the start of) an event header. */
     bool magic = true;
@@ -237,35 +239,38 @@ static int log_next(log_reader_t *r, lcm_eventlog_event_t **event)
     if (!magic) {
         if (r->offset == 0) {
             return coavoid_cli_fail(CLI_EXIT_INVALID,
-                            "%s: not an LCM log (it does not start with an event header)", r->path);
+                                    "%s: not an LCM log (it does not start with an event header)",
+                                    r->path);
         }
         return coavoid_cli_fail(CLI_EXIT_INVALID,
-                        "%s: corrupt: no event header at byte %" PRId64 " (after %" PRId64
-                        " events)",
-                        r->path, r->offset, r->events);
+                                "%s: corrupt: no event header at byte %" PRId64 " (after %" PRId64
+                                " events)",
+                                r->path, r->offset, r->events);
     }
     if (got < (size_t)LOG_HEADER_BYTES) {
         return coavoid_cli_fail(CLI_EXIT_INVALID,
-                        "%s: truncated: event %" PRId64 " at byte %" PRId64
-                        " is cut off in its header (was the logger stopped mid-write?)",
-                        r->path, r->events, r->offset);
+                                "%s: truncated: event %" PRId64 " at byte %" PRId64
+                                " is cut off in its header (was the logger stopped mid-write?)",
+                                r->path, r->events, r->offset);
     }
     int32_t channel_length = (int32_t)be32(header + 20);
     int32_t data_length = (int32_t)be32(header + 24);
     if (channel_length < 1 || channel_length > LOG_MAX_CHANNEL || data_length < 0 ||
         data_length > LOG_MAX_DATA) {
         return coavoid_cli_fail(CLI_EXIT_INVALID,
-                        "%s: corrupt: event %" PRId64 " at byte %" PRId64
-                        " claims a %ld-byte channel name and %ld bytes of data",
-                        r->path, r->events, r->offset, (long)channel_length, (long)data_length);
+                                "%s: corrupt: event %" PRId64 " at byte %" PRId64
+                                " claims a %ld-byte channel name and %ld bytes of data",
+                                r->path, r->events, r->offset, (long)channel_length,
+                                (long)data_length);
     }
     int64_t length = LOG_HEADER_BYTES + (int64_t)channel_length + (int64_t)data_length;
     if (length > left) {
         return coavoid_cli_fail(CLI_EXIT_INVALID,
-                        "%s: truncated: event %" PRId64 " at byte %" PRId64 " needs %" PRId64
-                        " bytes, the file has %" PRId64 " left (was the logger stopped "
-                        "mid-write?)",
-                        r->path, r->events, r->offset, length, left);
+                                "%s: truncated: event %" PRId64 " at byte %" PRId64
+                                " needs %" PRId64 " bytes, the file has %" PRId64
+                                " left (was the logger stopped "
+                                "mid-write?)",
+                                r->path, r->events, r->offset, length, left);
     }
     /* Debian's 1.3.1 reader also looks at the 4 bytes after the event and, when they are
      * not the next header's magic, prints a complaint and drops the event: judge them
@@ -275,26 +280,27 @@ static int log_next(log_reader_t *r, lcm_eventlog_event_t **event)
         if (fseeko(r->log->f, (off_t)(r->offset + length), SEEK_SET) != 0 ||
             fread(next, 1, 4u, r->log->f) != 4u) {
             return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: read error at byte %" PRId64, r->path,
-                            r->offset + length);
+                                    r->offset + length);
         }
         if (be32(next) != LOG_MAGIC) {
             return coavoid_cli_fail(CLI_EXIT_INVALID,
-                            "%s: corrupt: no event header at byte %" PRId64 " (after %" PRId64
-                            " events)",
-                            r->path, r->offset + length, r->events + 1);
+                                    "%s: corrupt: no event header at byte %" PRId64
+                                    " (after %" PRId64 " events)",
+                                    r->path, r->offset + length, r->events + 1);
         }
     }
     if (fseeko(r->log->f, (off_t)r->offset, SEEK_SET) != 0) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: cannot seek to byte %" PRId64 ": %s", r->path,
-                        r->offset, strerror(errno));
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: cannot seek to byte %" PRId64 ": %s",
+                                r->path, r->offset, strerror(errno));
     }
     lcm_eventlog_event_t *e = lcm_eventlog_read_next_event(r->log);
     if (e == NULL || e->channellen != channel_length || e->datalen != data_length) {
         if (e != NULL) {
             lcm_eventlog_free_event(e);
         }
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: cannot read event %" PRId64 " at byte %" PRId64,
-                        r->path, r->events, r->offset);
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                "%s: cannot read event %" PRId64 " at byte %" PRId64, r->path,
+                                r->events, r->offset);
     }
     r->offset += length;
     r->events++;
@@ -382,15 +388,15 @@ typedef struct {
     /* Counts over the whole log. */
     int64_t events;
     int64_t other_events;
-    int64_t intents;            /* on the intent channel */
-    int64_t intents_refused;    /* did not decode or failed validation */
-    const char *intent_reason;  /* the first refusal's reason */
-    int64_t intents_foreign;    /* valid, from a UAV that is not in the scenario */
+    int64_t intents;           /* on the intent channel */
+    int64_t intents_refused;   /* did not decode or failed validation */
+    const char *intent_reason; /* the first refusal's reason */
+    int64_t intents_foreign;   /* valid, from a UAV that is not in the scenario */
     int64_t statuses;
     int64_t statuses_refused;
     int64_t plans;
     int64_t plans_refused;
-    const char *other_reason;   /* the first refusal of a status or plan */
+    const char *other_reason; /* the first refusal of a status or plan */
 
     intent_list_t seen;         /* accepted intents of the scenario's UAVs */
     planning_list_t heartbeats; /* (node, utime, plans_run) of accepted heartbeats */
@@ -465,9 +471,10 @@ static long accept_intent(log_summary_t *ls, const lcm_eventlog_event_t *e, bool
     }
     if (field != NULL) {
         coavoid_cli_fail(CLI_EXIT_INVALID,
-                 "%s: UAV %ld's intents have %s %.17g, %s says %.17g: not a run of this "
-                 "scenario",
-                 ls->o->log_path, (long)m->uav_id, field, theirs, ls->o->scenario_path, ours);
+                         "%s: UAV %ld's intents have %s %.17g, %s says %.17g: not a run of this "
+                         "scenario",
+                         ls->o->log_path, (long)m->uav_id, field, theirs, ls->o->scenario_path,
+                         ours);
         return -3;
     }
     return index;
@@ -600,16 +607,16 @@ static uint32_t count_replans(log_summary_t *ls, int64_t to)
 /* ---- the flight ---- */
 
 typedef struct {
-    uint32_t steps;                 /* K */
-    int64_t *best;                  /* n rows of K + 1: plan_utime of the sample's source */
-    bool *own;                      /* n rows of K + 1: from the cycle's own intent */
-    bool *known;                    /* n rows of K + 1 */
-    coa_vec3_t *reference;          /* n rows */
-    int32_t *offsets;               /* n rows */
+    uint32_t steps;        /* K */
+    int64_t *best;         /* n rows of K + 1: plan_utime of the sample's source */
+    bool *own;             /* n rows of K + 1: from the cycle's own intent */
+    bool *known;           /* n rows of K + 1 */
+    coa_vec3_t *reference; /* n rows */
+    int32_t *offsets;      /* n rows */
     int64_t own_samples;
     int64_t earlier_samples;
     int64_t missing_samples;
-    int64_t off_grid;               /* accepted intents whose plan_utime is not a cycle start */
+    int64_t off_grid; /* accepted intents whose plan_utime is not a cycle start */
 } rebuilt_t;
 
 static void rebuilt_free(rebuilt_t *b)
@@ -770,8 +777,7 @@ static void print_log_text(const log_summary_t *ls, const rebuilt_t *b, int64_t 
         printf("first refused plan or heartbeat: %s\n", ls->other_reason);
     }
     printf("epoch: %" PRId64 " us (%s); cycles 0..%lu judged\n", epoch,
-           ls->o->epoch_text != NULL ? "--epoch" : "earliest plan_utime",
-           (unsigned long)b->steps);
+           ls->o->epoch_text != NULL ? "--epoch" : "earliest plan_utime", (unsigned long)b->steps);
     printf("samples: %" PRId64 " from their cycle's own intent, %" PRId64
            " from an earlier plan, %" PRId64 " not covered by any intent (scenario reference, "
            "offset held)\n",
@@ -818,20 +824,22 @@ static int print_json(const log_summary_t *ls, const rebuilt_t *b, int64_t epoch
     free(log_text);
     if (rc == COA_ERR_ARGUMENT) {
         return coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: cannot print the result (%s)",
-                        coa_status_name(rc));
+                                coa_status_name(rc));
     }
     if (rc != COA_OK) {
         return coavoid_cli_fail(CLI_EXIT_INTERNAL, "cannot write the result: %s",
-                        errno != 0 ? strerror(errno) : "write error");
+                                errno != 0 ? strerror(errno) : "write error");
     }
     return CLI_CONTINUE;
 }
 
-static int write_svg(const char *path, const coavoid_flight_t *flight, const coavoid_flight_eval_t *eval)
+static int write_svg(const char *path, const coavoid_flight_t *flight,
+                     const coavoid_flight_eval_t *eval)
 {
     FILE *out = fopen(path, "w");
     if (out == NULL) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "--svg %s: cannot write: %s", path, strerror(errno));
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "--svg %s: cannot write: %s", path,
+                                strerror(errno));
     }
     int rc = coavoid_flight_svg(flight, eval, out);
     if (fclose(out) != 0 && rc == COA_OK) {
@@ -839,7 +847,7 @@ static int write_svg(const char *path, const coavoid_flight_t *flight, const coa
     }
     if (rc != COA_OK) {
         return coavoid_cli_fail(CLI_EXIT_INTERNAL, "--svg %s: cannot write the figure (%s)", path,
-                        coa_status_name(rc));
+                                coa_status_name(rc));
     }
     return CLI_CONTINUE;
 }
@@ -854,14 +862,13 @@ static int refused_record(const summary_options_t *o, const coavoid_flight_t *f,
             if (coa_action_between(offsets[k], offsets[k + 1u],
                                    f->vehicles[i].vehicle.steep_factor) < 0) {
                 bool gap = !b->own[i * row + k] || !b->own[i * row + k + 1u];
-                return coavoid_cli_fail(CLI_EXIT_INVALID,
-                                "%s: UAV %u's offset goes from %ld at cycle %lu to %ld at cycle "
-                                "%lu, which no action does%s",
-                                o->log_path, (unsigned)f->vehicles[i].vehicle.id,
-                                (long)offsets[k], (unsigned long)k, (long)offsets[k + 1u],
-                                (unsigned long)k + 1ul,
-                                gap ? " (a cycle's own intent is missing from the log there)"
-                                    : "");
+                return coavoid_cli_fail(
+                    CLI_EXIT_INVALID,
+                    "%s: UAV %u's offset goes from %ld at cycle %lu to %ld at cycle "
+                    "%lu, which no action does%s",
+                    o->log_path, (unsigned)f->vehicles[i].vehicle.id, (long)offsets[k],
+                    (unsigned long)k, (long)offsets[k + 1u], (unsigned long)k + 1ul,
+                    gap ? " (a cycle's own intent is missing from the log there)" : "");
             }
         }
     }
@@ -886,15 +893,16 @@ static int summarise(void *options, coavoid_scenario_t *s)
     double dt_us = (double)s->dt * 1e6;
     if (!(dt_us >= 1.0) || dt_us > 3.6e9) {
         free(ls);
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: dt: %g s cannot be a cycle of whole microseconds "
-                                          "(1 us to 1 h)",
-                        o->scenario_path, (double)s->dt);
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                "%s: dt: %g s cannot be a cycle of whole microseconds "
+                                "(1 us to 1 h)",
+                                o->scenario_path, (double)s->dt);
     }
     ls->dt_us = llround(dt_us);
     if (s->vehicle_count > COA_MAX_VEHICLES) {
         free(ls);
         return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: %zu vehicles, at most %u", o->scenario_path,
-                        s->vehicle_count, COA_MAX_VEHICLES);
+                                s->vehicle_count, COA_MAX_VEHICLES);
     }
 
     /* Pass 1: counts, the epoch, who was seen. */
@@ -911,10 +919,10 @@ static int summarise(void *options, coavoid_scenario_t *s)
         for (size_t i = 0; i < s->vehicle_count && status == CLI_CONTINUE; i++) {
             if (ls->intents_of[i] == 0) {
                 status = coavoid_cli_fail(CLI_EXIT_INVALID,
-                                  "%s: UAV %u of %s never published an accepted intent "
-                                  "(%" PRId64 " intents in the log, %" PRId64 " refused)",
-                                  o->log_path, (unsigned)s->vehicles[i].id, o->scenario_path,
-                                  ls->intents, ls->intents_refused);
+                                          "%s: UAV %u of %s never published an accepted intent "
+                                          "(%" PRId64 " intents in the log, %" PRId64 " refused)",
+                                          o->log_path, (unsigned)s->vehicles[i].id,
+                                          o->scenario_path, ls->intents, ls->intents_refused);
             }
             earliest = ls->first_plan_utime[i] < earliest ? ls->first_plan_utime[i] : earliest;
         }
@@ -929,9 +937,9 @@ static int summarise(void *options, coavoid_scenario_t *s)
             status = coavoid_cli_fail(CLI_EXIT_INTERNAL, "out of memory");
         } else if (k == 0) {
             status = coavoid_cli_fail(CLI_EXIT_INVALID,
-                              "%s: no cycle after cycle 0 (epoch %" PRId64
-                              " us, dt %g s) has every UAV's own intent: nothing to judge",
-                              o->log_path, epoch, (double)s->dt);
+                                      "%s: no cycle after cycle 0 (epoch %" PRId64
+                                      " us, dt %g s) has every UAV's own intent: nothing to judge",
+                                      o->log_path, epoch, (double)s->dt);
         }
     }
     const size_t n = s->vehicle_count;
@@ -958,7 +966,7 @@ static int summarise(void *options, coavoid_scenario_t *s)
     }
     if (status == CLI_CONTINUE && fill_gaps(s, &b) != COA_OK) {
         status = coavoid_cli_fail(CLI_EXIT_INVALID, "%s: a route cannot be sampled over %lu steps",
-                          o->scenario_path, (unsigned long)b.steps);
+                                  o->scenario_path, (unsigned long)b.steps);
     }
 
     coavoid_judged_t judged;
@@ -967,12 +975,12 @@ static int summarise(void *options, coavoid_scenario_t *s)
     if (status == CLI_CONTINUE) {
         uint32_t replans = count_replans(ls, epoch + ((int64_t)b.steps + 1) * ls->dt_us);
         int rc = coavoid_judge_run(&judged, s, o->mode, b.steps, replans, b.reference, b.offsets,
-                           b.known);
+                                   b.known);
         if (rc == COA_ERR_ARGUMENT) {
             status = refused_record(o, flight, &b);
         } else if (rc != COA_OK) {
             status = coavoid_cli_fail(CLI_EXIT_INTERNAL, "cannot judge the flight (%s)",
-                              coa_status_name(rc));
+                                      coa_status_name(rc));
         }
         /* The figure first: a file that cannot be written is a usage error, reported
          * before anything is printed. */

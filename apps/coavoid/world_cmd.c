@@ -13,22 +13,20 @@
 #include "cli.h"
 #include "commands.h"
 
-
 #include "node.h"
 #include "realtime.h"
 #include "scenario.h"
 
-#define WORLD_USAGE                                                                           \
+#define WORLD_USAGE                                                                          \
     "usage: coavoid world SCENARIO.json [--lcm-url URL] [--epoch UTIME] [--speed S]\n"       \
-    "                     [--steps K]\n"                                                      \
-    "\n"                                                                                      \
+    "                     [--steps K]\n"                                                     \
+    "\n"                                                                                     \
     "Publishes the scenario's obstacle map and its tracks' estimates over LCM every cycle\n" \
     "of a real-time run, for the coordinator and the vehicles (coavoid-coordinator,\n"       \
-    "coavoid-vehicle).\n"                                                                     \
-    "\n"                                                                                      \
-    "options:\n" COAVOID_RT_OPTIONS_USAGE                                                         \
-    "  -h, --help          show this help\n"                                                  \
-    "\n"                                                                                      \
+    "coavoid-vehicle).\n"                                                                    \
+    "\n"                                                                                     \
+    "options:\n" COAVOID_RT_OPTIONS_USAGE "  -h, --help          show this help\n"           \
+    "\n"                                                                                     \
     "exit status: 0 done, 2 invalid input or usage (one line on stderr), 3 internal error\n"
 
 static void world_help(void)
@@ -42,8 +40,8 @@ static int world_option(int argc, char **argv, int *i, void *options)
 }
 
 static const coavoid_cli_command_t world_command = {
-    "world", "coavoid world", 2, {"SCENARIO.json", NULL}, "one scenario only", world_help,
-    world_option};
+    "world",    "coavoid world", 2, {"SCENARIO.json", NULL}, "one scenario only",
+    world_help, world_option};
 
 typedef struct {
     const char *path;
@@ -85,7 +83,8 @@ static int world(void *options, coavoid_scenario_t *s)
     if (node == NULL) {
         lcm_destroy(lcm);
         return coavoid_cli_fail(error == COA_ERR_ARGUMENT ? CLI_EXIT_INVALID : CLI_EXIT_INTERNAL,
-                        "world: %s: cannot publish it (%s)", o->path, coavoid_lcm_error_name(error));
+                                "world: %s: cannot publish it (%s)", o->path,
+                                coavoid_lcm_error_name(error));
     }
     coavoid_rt_loop_t loop;
     coavoid_rt_loop_init(&loop, &o->rt, lcm, &now, &config.common, "world");

@@ -22,31 +22,30 @@
 
 #define COORDINATOR_DEFAULT_MAX_CENTRALISED 3u
 
-#define COORDINATOR_USAGE                                                                      \
-    "usage: coavoid-coordinator --scenario FILE [--lcm-url URL] [--epoch UTIME] [--speed S]\n" \
-    "                           [--steps K] [--beta B] [--max-centralised N] [--collect S]\n"  \
-    "\n"                                                                                       \
-    "The ground coordinator of a real-time run: plans the conflicting clusters of the\n"      \
-    "vehicles it hears over LCM centrally and publishes the plans. The scenario gives dt,\n"  \
-    "the horizon and the default beta; the vehicles and obstacles come from the messages.\n" \
-    "\n"                                                                                       \
-    "options:\n"                                                                               \
-    "  --scenario FILE     the scenario (docs/scenario-format.md)\n"                          \
-    COAVOID_RT_OPTIONS_USAGE                                                                       \
-    "  --beta B            nodes a joint search of its planner stores, B >= 1; default the\n" \
-    "                      scenario's \"beta\", else %u lowered so the workspace fits 1 GiB\n" \
-    "  --max-centralised N largest cluster planned centrally, 1..%u (default %u); the\n"     \
+#define COORDINATOR_USAGE                                                                         \
+    "usage: coavoid-coordinator --scenario FILE [--lcm-url URL] [--epoch UTIME] [--speed S]\n"    \
+    "                           [--steps K] [--beta B] [--max-centralised N] [--collect S]\n"     \
+    "\n"                                                                                          \
+    "The ground coordinator of a real-time run: plans the conflicting clusters of the\n"          \
+    "vehicles it hears over LCM centrally and publishes the plans. The scenario gives dt,\n"      \
+    "the horizon and the default beta; the vehicles and obstacles come from the messages.\n"      \
+    "\n"                                                                                          \
+    "options:\n"                                                                                  \
+    "  --scenario FILE     the scenario (docs/scenario-format.md)\n" COAVOID_RT_OPTIONS_USAGE     \
+    "  --beta B            nodes a joint search of its planner stores, B >= 1; default the\n"     \
+    "                      scenario's \"beta\", else %u lowered so the workspace fits 1 GiB\n"    \
+    "  --max-centralised N largest cluster planned centrally, 1..%u (default %u); the\n"          \
     "                      workspace grows by about 20 kB per UAV; a larger cluster is planned\n" \
-    "                      decoupled by the coordinator\n"                                     \
-    "  --collect S         scenario seconds after each cycle start at which it plans,\n"       \
-    "                      0 < S < dt; default dt / 4. Its plans must reach the vehicles\n"    \
-    "                      before the next cycle starts: planning gets (dt - S) / speed\n"     \
-    "                      wall seconds\n"                                                     \
-    "  -h, --help          show this help\n"                                                   \
-    "\n"                                                                                       \
-    "At the end (after K cycles, or on SIGINT/SIGTERM) it prints one summary line on\n"       \
-    "stderr.\n"                                                                                \
-    "\n"                                                                                       \
+    "                      decoupled by the coordinator\n"                                        \
+    "  --collect S         scenario seconds after each cycle start at which it plans,\n"          \
+    "                      0 < S < dt; default dt / 4. Its plans must reach the vehicles\n"       \
+    "                      before the next cycle starts: planning gets (dt - S) / speed\n"        \
+    "                      wall seconds\n"                                                        \
+    "  -h, --help          show this help\n"                                                      \
+    "\n"                                                                                          \
+    "At the end (after K cycles, or on SIGINT/SIGTERM) it prints one summary line on\n"           \
+    "stderr.\n"                                                                                   \
+    "\n"                                                                                          \
     "exit status: 0 done, 2 invalid input or usage (one line on stderr), 3 internal error\n"
 
 typedef struct {
@@ -77,30 +76,30 @@ static int coordinator_option(int argc, char **argv, int *i, void *options)
     }
     if (coavoid_cli_option_is(arg, "--scenario")) {
         status = coavoid_cli_text_option(argc, argv, i, "--scenario", "a scenario file", false,
-                                 &o->scenario_path);
+                                         &o->scenario_path);
     } else if (coavoid_cli_option_is(arg, "--beta")) {
-        status = coavoid_cli_count_option(argc, argv, i, "--beta", "an integer >= 1", false, UINT32_MAX,
-                                  &o->beta_text, &value);
+        status = coavoid_cli_count_option(argc, argv, i, "--beta", "an integer >= 1", false,
+                                          UINT32_MAX, &o->beta_text, &value);
         o->beta = (uint32_t)value;
     } else if (coavoid_cli_option_is(arg, "--max-centralised")) {
         status = coavoid_cli_count_option(argc, argv, i, "--max-centralised", NULL, false,
-                                  COA_MAX_CENTRALISED, &o->max_text, &value);
+                                          COA_MAX_CENTRALISED, &o->max_text, &value);
         o->max_centralised = (size_t)value;
     } else if (coavoid_cli_option_is(arg, "--collect")) {
         status = coavoid_cli_text_option(argc, argv, i, "--collect", "scenario seconds", true,
-                                 &o->collect_text);
-        if (status == CLI_CONTINUE && (!coavoid_cli_parse_real(o->collect_text, &o->collect) ||
-                                       !(o->collect > 0))) {
+                                         &o->collect_text);
+        if (status == CLI_CONTINUE &&
+            (!coavoid_cli_parse_real(o->collect_text, &o->collect) || !(o->collect > 0))) {
             status = coavoid_cli_fail(CLI_EXIT_INVALID,
-                              "--collect: must be a number of seconds > 0, got '%.40s'",
-                              o->collect_text);
+                                      "--collect: must be a number of seconds > 0, got '%.40s'",
+                                      o->collect_text);
         }
     }
     return status;
 }
 
 static const coavoid_cli_command_t coordinator_command = {
-    "coordinator", "coavoid-coordinator", 1, {NULL, NULL}, "the scenario is --scenario FILE",
+    "coordinator",    "coavoid-coordinator", 1, {NULL, NULL}, "the scenario is --scenario FILE",
     coordinator_help, coordinator_option};
 
 static int parse_options(int argc, char **argv, coordinator_options_t *o)
@@ -126,10 +125,9 @@ static void coordinator_report(void *user, const char *name, const coavoid_rt_re
             "%s: %lld cycles, plans run %u, plans published %u, last plan %.1f ms "
             "(%llu nodes expanded), messages received %lld, rejected %lld (last: %s)%s\n",
             name, (long long)result->cycles, (unsigned)st->plans_run, (unsigned)st->plans_published,
-            (double)st->last_plan_duration_us * 1e-3,
-            (unsigned long long)st->last_nodes_expanded, (long long)st->rx.received,
-            (long long)st->rx.rejected, st->rx.last_reason != NULL ? st->rx.last_reason : "none",
-            tail);
+            (double)st->last_plan_duration_us * 1e-3, (unsigned long long)st->last_nodes_expanded,
+            (long long)st->rx.received, (long long)st->rx.rejected,
+            st->rx.last_reason != NULL ? st->rx.last_reason : "none", tail);
 }
 
 /* Everything after the options. Returns the exit status. */
@@ -148,9 +146,10 @@ static int run(void *options, coavoid_scenario_t *s)
     config.max_centralised = o->max_centralised;
     config.collect_us = o->collect_text != NULL ? llround(o->collect * 1e6) : dt_us / 4;
     if (config.collect_us < 1 || config.collect_us >= dt_us) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID,
-                        "--collect: must be above 0 and below the scenario's dt (%g s), got %g",
-                        (double)s->dt, o->collect);
+        return coavoid_cli_fail(
+            CLI_EXIT_INVALID,
+            "--collect: must be above 0 and below the scenario's dt (%g s), got %g", (double)s->dt,
+            o->collect);
     }
     const char *beta_source;
     if (o->beta_text != NULL) {
@@ -159,8 +158,8 @@ static int run(void *options, coavoid_scenario_t *s)
     } else if (s->has_beta) {
         beta_source = "the scenario's beta";
     } else {
-        coa_planner_config_t shape = coavoid_node_planner_config(config.common.horizon,
-                                                             o->max_centralised, CLI_DEFAULT_BETA);
+        coa_planner_config_t shape = coavoid_node_planner_config(
+            config.common.horizon, o->max_centralised, CLI_DEFAULT_BETA);
         config.common.beta = coavoid_cli_default_beta(&shape);
         beta_source = "the default beta";
     }
@@ -168,10 +167,11 @@ static int run(void *options, coavoid_scenario_t *s)
         coavoid_node_planner_config(config.common.horizon, o->max_centralised, config.common.beta);
     size_t size = coa_planner_workspace_size(&planner_config);
     if (size == 0) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID,
-                        "%s %lu: the workspace for %zu vehicles would not fit in memory (lower "
-                        "--beta or --max-centralised)",
-                        beta_source, (unsigned long)config.common.beta, o->max_centralised);
+        return coavoid_cli_fail(
+            CLI_EXIT_INVALID,
+            "%s %lu: the workspace for %zu vehicles would not fit in memory (lower "
+            "--beta or --max-centralised)",
+            beta_source, (unsigned long)config.common.beta, o->max_centralised);
     }
 
     char err[512];
@@ -184,14 +184,14 @@ static int run(void *options, coavoid_scenario_t *s)
     if (node == NULL) {
         lcm_destroy(lcm);
         if (error == COA_ERR_WORKSPACE) {
-            return coavoid_cli_fail(CLI_EXIT_INVALID,
-                            "%s %lu: cannot allocate the planner's %zu bytes for %zu vehicles "
-                            "(lower --beta or --max-centralised)",
-                            beta_source, (unsigned long)config.common.beta, size,
-                            o->max_centralised);
+            return coavoid_cli_fail(
+                CLI_EXIT_INVALID,
+                "%s %lu: cannot allocate the planner's %zu bytes for %zu vehicles "
+                "(lower --beta or --max-centralised)",
+                beta_source, (unsigned long)config.common.beta, size, o->max_centralised);
         }
         return coavoid_cli_fail(error == COA_ERR_ARGUMENT ? CLI_EXIT_INVALID : CLI_EXIT_INTERNAL,
-                        "coordinator: cannot start (%s)", coavoid_lcm_error_name(error));
+                                "coordinator: cannot start (%s)", coavoid_lcm_error_name(error));
     }
     coavoid_rt_loop_t loop;
     coavoid_rt_loop_init(&loop, &o->rt, lcm, &now, &config.common, "coordinator");

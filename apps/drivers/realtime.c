@@ -109,30 +109,32 @@ int coavoid_rt_parse_option(int argc, char **argv, int *i, coavoid_rt_options_t 
     int status = CLI_UNKNOWN_OPTION;
     if (coavoid_cli_option_is(arg, "--lcm-url")) {
         status = coavoid_cli_text_option(argc, argv, i, "--lcm-url",
-                                 "an LCM URL, e.g. " COAVOID_RT_DEFAULT_LCM_URL, false, &o->lcm_url);
+                                         "an LCM URL, e.g. " COAVOID_RT_DEFAULT_LCM_URL, false,
+                                         &o->lcm_url);
     } else if (coavoid_cli_option_is(arg, "--epoch")) {
-        status = coavoid_cli_text_option(argc, argv, i, "--epoch", "wall-clock microseconds since 1970",
-                                 true, &o->epoch_text);
-        if (status == CLI_CONTINUE &&
-            !coavoid_cli_parse_count(o->epoch_text, strlen(o->epoch_text), (uint64_t)INT64_MAX, &value)) {
-            status = coavoid_cli_fail(CLI_EXIT_INVALID,
-                              "--epoch: must be a positive integer (wall-clock microseconds "
-                              "since 1970), got '%.40s'",
-                              o->epoch_text);
+        status = coavoid_cli_text_option(
+            argc, argv, i, "--epoch", "wall-clock microseconds since 1970", true, &o->epoch_text);
+        if (status == CLI_CONTINUE && !coavoid_cli_parse_count(o->epoch_text, strlen(o->epoch_text),
+                                                               (uint64_t)INT64_MAX, &value)) {
+            status =
+                coavoid_cli_fail(CLI_EXIT_INVALID,
+                                 "--epoch: must be a positive integer (wall-clock microseconds "
+                                 "since 1970), got '%.40s'",
+                                 o->epoch_text);
         }
         o->epoch_utime = (int64_t)value;
     } else if (coavoid_cli_option_is(arg, "--speed")) {
-        status = coavoid_cli_text_option(argc, argv, i, "--speed", "scenario seconds per wall second",
-                                 true, &o->speed_text);
+        status = coavoid_cli_text_option(argc, argv, i, "--speed",
+                                         "scenario seconds per wall second", true, &o->speed_text);
         if (status == CLI_CONTINUE && (!coavoid_cli_parse_real(o->speed_text, &o->speed) ||
                                        !(o->speed > 0) || o->speed > COAVOID_RT_MAX_SPEED)) {
             status = coavoid_cli_fail(CLI_EXIT_INVALID,
-                              "--speed: must be a number with 0 < S <= %g, got '%.40s'",
-                              COAVOID_RT_MAX_SPEED, o->speed_text);
+                                      "--speed: must be a number with 0 < S <= %g, got '%.40s'",
+                                      COAVOID_RT_MAX_SPEED, o->speed_text);
         }
     } else if (coavoid_cli_option_is(arg, "--steps")) {
-        status = coavoid_cli_count_option(argc, argv, i, "--steps", "an integer >= 1", false, RT_MAX_STEPS,
-                                  &o->steps_text, &value);
+        status = coavoid_cli_count_option(argc, argv, i, "--steps", "an integer >= 1", false,
+                                          RT_MAX_STEPS, &o->steps_text, &value);
         o->steps = (int64_t)value;
     }
     return status;
@@ -152,26 +154,27 @@ int coavoid_rt_options_finish(coavoid_rt_options_t *o, int64_t dt_us, uint32_t h
         return CLI_CONTINUE;
     }
     if (o->epoch_utime > now && o->epoch_utime - now > COAVOID_RT_MAX_EPOCH_AHEAD_US) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID,
-                        "--epoch: %lld is more than a day ahead of this clock (%lld): it is "
-                        "microseconds since 1970, e.g. $(( $(date +%%s) + 2 ))000000",
-                        (long long)o->epoch_utime, (long long)now);
+        return coavoid_cli_fail(
+            CLI_EXIT_INVALID,
+            "--epoch: %lld is more than a day ahead of this clock (%lld): it is "
+            "microseconds since 1970, e.g. $(( $(date +%%s) + 2 ))000000",
+            (long long)o->epoch_utime, (long long)now);
     }
     /* The run's last event is the start of cycle K, in wall time. */
     double run_us = (double)o->steps * (double)dt_us / o->speed;
     double end = (double)o->epoch_utime + run_us;
     if (end < (double)now) {
         return coavoid_cli_fail(CLI_EXIT_INVALID,
-                        "--epoch: the run of %lld cycles from %lld ended %.1f s ago (this "
-                        "clock: %lld)",
-                        (long long)o->steps, (long long)o->epoch_utime,
-                        ((double)now - end) * 1e-6, (long long)now);
+                                "--epoch: the run of %lld cycles from %lld ended %.1f s ago (this "
+                                "clock: %lld)",
+                                (long long)o->steps, (long long)o->epoch_utime,
+                                ((double)now - end) * 1e-6, (long long)now);
     }
     return CLI_CONTINUE;
 }
 
-int coavoid_rt_setup(const char *path, coavoid_scenario_t *s, coavoid_rt_options_t *o, const int64_t *now,
-                 coavoid_node_common_t *common)
+int coavoid_rt_setup(const char *path, coavoid_scenario_t *s, coavoid_rt_options_t *o,
+                     const int64_t *now, coavoid_node_common_t *common)
 {
     int status = coavoid_cli_sample_scenario(path, s);
     if (status != CLI_CONTINUE) {
@@ -179,8 +182,8 @@ int coavoid_rt_setup(const char *path, coavoid_scenario_t *s, coavoid_rt_options
     }
     if (s->horizon > COAVOID_NODE_MAX_HORIZON) {
         return coavoid_cli_fail(CLI_EXIT_INVALID,
-                        "%s: horizon: %lu steps, the nodes' messages carry at most %u",
-                        path, (unsigned long)s->horizon, COAVOID_NODE_MAX_HORIZON);
+                                "%s: horizon: %lu steps, the nodes' messages carry at most %u",
+                                path, (unsigned long)s->horizon, COAVOID_NODE_MAX_HORIZON);
     }
     int64_t dt_us = llround((double)s->dt * 1e6);
     if (dt_us < 1) {
@@ -270,8 +273,8 @@ lcm_t *coavoid_rt_lcm_create(const char *url, char *err, size_t err_size)
 
 /* ---- the loop ---- */
 
-void coavoid_rt_loop_init(coavoid_rt_loop_t *loop, const coavoid_rt_options_t *o, lcm_t *lcm, int64_t *now,
-                      const coavoid_node_common_t *common, const char *name)
+void coavoid_rt_loop_init(coavoid_rt_loop_t *loop, const coavoid_rt_options_t *o, lcm_t *lcm,
+                          int64_t *now, const coavoid_node_common_t *common, const char *name)
 {
     memset(loop, 0, sizeof *loop);
     loop->clock.epoch_utime = o->epoch_utime;
@@ -285,7 +288,7 @@ void coavoid_rt_loop_init(coavoid_rt_loop_t *loop, const coavoid_rt_options_t *o
 }
 
 int coavoid_rt_drive(const coavoid_rt_loop_t *loop, const char *lcm_url, coavoid_rt_report_t report,
-                 void *user)
+                     void *user)
 {
     if (coavoid_rt_install_signal_handlers() != 0) {
         return coavoid_cli_fail(CLI_EXIT_INTERNAL, "%s: cannot handle SIGINT/SIGTERM", loop->name);
@@ -297,7 +300,7 @@ int coavoid_rt_drive(const coavoid_rt_loop_t *loop, const char *lcm_url, coavoid
     report(user, loop->name, &result, tail);
     if (rc != COA_OK) {
         return coavoid_cli_fail(CLI_EXIT_INTERNAL, "%s: LCM failed while running (%s)", loop->name,
-                        lcm_url);
+                                lcm_url);
     }
     return result.errors > 0 ? CLI_EXIT_INTERNAL : CLI_EXIT_OK;
 }
@@ -364,8 +367,9 @@ static void rt_cycle_start(const rt_run_t *r, int64_t k)
         int64_t started = coavoid_rt_stopwatch_us(NULL);
         *loop->now = rt_now(r);
         /* Ahead of the cycle (world_lead_us), its messages still speak of the cycle. */
-        int64_t at = *loop->now > coavoid_node_cycle_utime(r->common, k) ? *loop->now
-                                                                      : coavoid_node_cycle_utime(r->common, k);
+        int64_t at = *loop->now > coavoid_node_cycle_utime(r->common, k)
+                         ? *loop->now
+                         : coavoid_node_cycle_utime(r->common, k);
         int rc = coavoid_world_cycle(loop->world, at);
         if (rc < 0) {
             rt_error(r, "the world's cycle", k, rc);
@@ -527,17 +531,19 @@ int coavoid_rt_run(const coavoid_rt_loop_t *loop, coavoid_rt_result_t *result)
             continue;
         }
 
-        if (next_collect < K && now >= coavoid_node_cycle_utime(c, next_collect) + loop->collect_us) {
+        if (next_collect < K &&
+            now >= coavoid_node_cycle_utime(c, next_collect) + loop->collect_us) {
             int64_t k = coavoid_node_cycle_of(c, now);
             if (k > next_collect) {
                 /* Its plans would be valid until a cycle start already past: nobody could
                  * adopt them. */
                 int64_t missed = (k < K ? k : K) - next_collect;
                 result->skipped += (uint32_t)missed;
-                rt_warn(r, "cycles %lld..%lld: no plans: the loop was %.0f ms (scenario time) late",
-                        (long long)next_collect, (long long)(next_collect + missed - 1),
-                        (double)(now - coavoid_node_cycle_utime(c, next_collect) - loop->collect_us) *
-                            1e-3);
+                rt_warn(
+                    r, "cycles %lld..%lld: no plans: the loop was %.0f ms (scenario time) late",
+                    (long long)next_collect, (long long)(next_collect + missed - 1),
+                    (double)(now - coavoid_node_cycle_utime(c, next_collect) - loop->collect_us) *
+                        1e-3);
                 next_collect += missed;
                 continue;
             }
@@ -590,7 +596,8 @@ int coavoid_rt_run(const coavoid_rt_loop_t *loop, coavoid_rt_result_t *result)
             }
             /* A message may be the intent a waiting vehicle needed. */
             for (size_t i = 0; i < loop->vehicle_count; i++) {
-                const coavoid_vehicle_node_state_t *s = coavoid_vehicle_node_state(loop->vehicles[i]);
+                const coavoid_vehicle_node_state_t *s =
+                    coavoid_vehicle_node_state(loop->vehicles[i]);
                 if (s != NULL && s->waiting) {
                     rt_poll(r, i, &polled[i]);
                 }

@@ -85,13 +85,13 @@ int64_t coavoid_rt_wall_at(const coavoid_rt_clock_t *clock, int64_t scenario_uti
 /* ---- options every driver shares ---- */
 
 typedef struct {
-    const char *lcm_url;      /* NULL until given; then COAVOID_RT_DEFAULT_LCM_URL */
-    const char *epoch_text;   /* NULL until given */
-    int64_t epoch_utime;      /* --epoch; when not given, coavoid_rt_options_finish sets now */
-    const char *speed_text;   /* NULL: 1 */
+    const char *lcm_url;    /* NULL until given; then COAVOID_RT_DEFAULT_LCM_URL */
+    const char *epoch_text; /* NULL until given */
+    int64_t epoch_utime;    /* --epoch; when not given, coavoid_rt_options_finish sets now */
+    const char *speed_text; /* NULL: 1 */
     double speed;
-    const char *steps_text;   /* NULL: 2N */
-    int64_t steps;            /* K >= 1 */
+    const char *steps_text; /* NULL: 2N */
+    int64_t steps;          /* K >= 1 */
 } coavoid_rt_options_t;
 
 /* Sets the defaults (no epoch yet, speed 1, steps unset, the default URL). */
@@ -117,17 +117,17 @@ int coavoid_rt_options_finish(coavoid_rt_options_t *o, int64_t dt_us, uint32_t h
  * stopwatch, and the scenario's beta when it gives one. Returns CLI_CONTINUE, or
  * CLI_EXIT_INVALID after the one-line error. Cost: sampling the scenario; no memory
  * beyond the scenario's samples. */
-int coavoid_rt_setup(const char *path, coavoid_scenario_t *s, coavoid_rt_options_t *o, const int64_t *now,
-                 coavoid_node_common_t *common);
+int coavoid_rt_setup(const char *path, coavoid_scenario_t *s, coavoid_rt_options_t *o,
+                     const int64_t *now, coavoid_node_common_t *common);
 
 /* The usage lines of the shared options (for each driver's --help). */
-#define COAVOID_RT_OPTIONS_USAGE                                                                   \
-    "  --lcm-url URL       LCM provider; default " COAVOID_RT_DEFAULT_LCM_URL "\n"                  \
-    "                      (ttl=0: the traffic stays on this host)\n"                           \
-    "  --epoch UTIME       wall-clock microseconds since 1970 at which cycle 0 starts;\n"      \
-    "                      every process of a run must be given the same value;\n"             \
-    "                      default: now\n"                                                     \
-    "  --speed S           scenario seconds per wall second, 0 < S <= 1000; default 1\n"       \
+#define COAVOID_RT_OPTIONS_USAGE                                                          \
+    "  --lcm-url URL       LCM provider; default " COAVOID_RT_DEFAULT_LCM_URL "\n"        \
+    "                      (ttl=0: the traffic stays on this host)\n"                     \
+    "  --epoch UTIME       wall-clock microseconds since 1970 at which cycle 0 starts;\n" \
+    "                      every process of a run must be given the same value;\n"        \
+    "                      default: now\n"                                                \
+    "  --speed S           scenario seconds per wall second, 0 < S <= 1000; default 1\n"  \
     "  --steps K           run K cycles, flying samples 0..K; default 2 * horizon\n"
 
 /* lcm_create(url) with LCM's own multi-line messages on stderr held back: on failure
@@ -140,30 +140,30 @@ lcm_t *coavoid_rt_lcm_create(const char *url, char *err, size_t err_size);
 typedef struct {
     coavoid_rt_clock_t clock;
     lcm_t *lcm;
-    int64_t *now;                    /* the variable every node's common.clock points to */
+    int64_t *now;                        /* the variable every node's common.clock points to */
     const coavoid_node_common_t *common; /* any node's: epoch (as scenario time), dt_us */
-    int64_t steps;                   /* K */
-    int64_t collect_us;              /* the coordinator's, when there is one */
+    int64_t steps;                       /* K */
+    int64_t collect_us;                  /* the coordinator's, when there is one */
     /* The world alone (no vehicle in the loop): how long before cycle k's start it
      * publishes cycle k's map and track estimates (stamped with the cycle's start, at most
      * one cycle ahead), so that they are in every vehicle's view when the cycle begins, as
      * in `coavoid sim`, where the world's cycle runs first. 0: at the cycle's start. */
     int64_t world_lead_us;
-    coavoid_world_t *world;              /* each optional */
+    coavoid_world_t *world; /* each optional */
     coavoid_coordinator_t *coordinator;
     coavoid_vehicle_node_t *const *vehicles;
     size_t vehicle_count;
-    const char *name;                /* prefix of warning lines, e.g. "vehicle 3" */
-    FILE *warnings;                  /* stderr, usually */
+    const char *name; /* prefix of warning lines, e.g. "vehicle 3" */
+    FILE *warnings;   /* stderr, usually */
 } coavoid_rt_loop_t;
 
 typedef struct {
-    int64_t cycles;       /* cycle starts (or coordinator cycles) run */
-    uint32_t overruns;    /* calls that ended after the node's next event */
-    uint32_t skipped;     /* events skipped because an earlier one ran late */
-    uint32_t errors;      /* node calls that returned an error */
-    int first_error;      /* the first such code, 0 none */
-    int signal;           /* the signal that stopped the loop, 0 when it ran to the end */
+    int64_t cycles;    /* cycle starts (or coordinator cycles) run */
+    uint32_t overruns; /* calls that ended after the node's next event */
+    uint32_t skipped;  /* events skipped because an earlier one ran late */
+    uint32_t errors;   /* node calls that returned an error */
+    int first_error;   /* the first such code, 0 none */
+    int signal;        /* the signal that stopped the loop, 0 when it ran to the end */
 } coavoid_rt_result_t;
 
 /* Sets SIGINT and SIGTERM to ask the loop to stop (no SA_RESTART, so a wait is cut
@@ -177,13 +177,13 @@ int coavoid_rt_install_signal_handlers(void);
 /* Sets the loop's fields every driver sets alike: the clock (epoch, speed) and steps from
  * the finished options, lcm, now, common, name, and warnings on stderr; the rest (the
  * nodes, collect_us, world_lead_us) is zero for the caller to set. O(1). */
-void coavoid_rt_loop_init(coavoid_rt_loop_t *loop, const coavoid_rt_options_t *o, lcm_t *lcm, int64_t *now,
-                      const coavoid_node_common_t *common, const char *name);
+void coavoid_rt_loop_init(coavoid_rt_loop_t *loop, const coavoid_rt_options_t *o, lcm_t *lcm,
+                          int64_t *now, const coavoid_node_common_t *common, const char *name);
 
 /* Prints a driver's summary line on stderr from its node's state, starting with the
  * loop's name and ending with `tail` (coavoid_rt_result_text). */
 typedef void (*coavoid_rt_report_t)(void *user, const char *name, const coavoid_rt_result_t *result,
-                                const char *tail);
+                                    const char *tail);
 
 /* What every driver does once its node is in the loop: installs the signal handlers, runs
  * the loop and calls report. Returns CLI_EXIT_OK, or CLI_EXIT_INTERNAL when a node call
@@ -191,7 +191,7 @@ typedef void (*coavoid_rt_report_t)(void *user, const char *name, const coavoid_
  * LCM failed while running (URL)". The caller destroys its node and the LCM afterwards.
  * Cost and memory: coavoid_rt_run's. */
 int coavoid_rt_drive(const coavoid_rt_loop_t *loop, const char *lcm_url, coavoid_rt_report_t report,
-                 void *user);
+                     void *user);
 
 /* Runs the loop until cycle K is done or a signal asks it to stop. Returns COA_OK,
  * COA_ERR_ARGUMENT (no node, NULL lcm/now/common, steps < 1) or COAVOID_RT_ERR_LCM. Node

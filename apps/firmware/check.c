@@ -261,8 +261,8 @@ static bool run_predict(const fwc_problem_t *p)
     static const char *const kinds[] = {"vehicle", "track", "obstacle"};
     const size_t n = p->vehicle_count;
     size_t pairs = n * (n - 1u) / 2u + n * (p->track_count + p->obstacle_count);
-    coa_predict_config_t config = {.t0 = 0.0f, .dt = p->dt, .horizon = p->horizon,
-                                   .threshold = 0.01, .all_pairs = false};
+    coa_predict_config_t config = {
+        .t0 = 0.0f, .dt = p->dt, .horizon = p->horizon, .threshold = 0.01, .all_pairs = false};
     coa_predict_result_t result;
     coa_predictor_t *predictor;
     uint64_t start;
@@ -288,13 +288,16 @@ static bool run_predict(const fwc_problem_t *p)
             intent_samples[i][k] = references[i][k];
             intent_samples[i][k].z += lift;
         }
-        intents[i] = (coa_intent_plan_t){.id = v->id, .volume = v->volume, .t0 = 0.0f,
-                                         .step = p->dt, .samples = intent_samples[i],
+        intents[i] = (coa_intent_plan_t){.id = v->id,
+                                         .volume = v->volume,
+                                         .t0 = 0.0f,
+                                         .step = p->dt,
+                                         .samples = intent_samples[i],
                                          .count = p->horizon + 1u};
     }
     start = ticks_now();
-    rc = coa_predict(predictor, &config, intents, n, p->obstacles, p->obstacle_count,
-                     p->tracks, p->track_count, conflicts, pairs, &result);
+    rc = coa_predict(predictor, &config, intents, n, p->obstacles, p->obstacle_count, p->tracks,
+                     p->track_count, conflicts, pairs, &result);
     start = ticks_now() - start;
     put("predict ");
     put(p->name);
@@ -364,10 +367,15 @@ static bool run_problem(const fwc_problem_t *p)
     if (!run_predict(p)) {
         return false;
     }
-    problem = (coa_problem_t){.dt = p->dt, .horizon = p->horizon, .vehicles = p->vehicles,
-                              .vehicle_count = p->vehicle_count, .references = reference_rows,
-                              .obstacles = p->obstacles, .obstacle_count = p->obstacle_count,
-                              .tracks = p->tracks, .track_count = p->track_count,
+    problem = (coa_problem_t){.dt = p->dt,
+                              .horizon = p->horizon,
+                              .vehicles = p->vehicles,
+                              .vehicle_count = p->vehicle_count,
+                              .references = reference_rows,
+                              .obstacles = p->obstacles,
+                              .obstacle_count = p->obstacle_count,
+                              .tracks = p->tracks,
+                              .track_count = p->track_count,
                               .track_samples = track_rows};
     if (p->decoupled) {
         coa_planner_config_t config;

@@ -63,7 +63,10 @@ void reset_handler(void)
     }
 }
 
-#define FW_IRQ1 {.handler = unused_handler}
+#define FW_IRQ1                   \
+    {                             \
+        .handler = unused_handler \
+    }
 #define FW_IRQ2 FW_IRQ1, FW_IRQ1
 #define FW_IRQ8 FW_IRQ2, FW_IRQ2, FW_IRQ2, FW_IRQ2
 #define FW_IRQ16 FW_IRQ8, FW_IRQ8
@@ -86,5 +89,10 @@ __attribute__((section(".isr_vector"), used)) const fw_vector_t fw_vectors[16 + 
     {.handler = 0},
     {.handler = unused_handler}, /* PendSV */
     {.handler = fw_systick_handler},
-    FW_IRQ16, FW_IRQ16, FW_IRQ16, FW_IRQ16, FW_IRQ16, FW_IRQ2,
+    FW_IRQ16,
+    FW_IRQ16,
+    FW_IRQ16,
+    FW_IRQ16,
+    FW_IRQ16,
+    FW_IRQ2,
 };

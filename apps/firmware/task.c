@@ -64,8 +64,8 @@ int fw_task_init(void)
 
     config.beta = coa_planner_max_beta(&config, sizeof planner_buffer);
     planner = coa_planner_init(planner_buffer, sizeof planner_buffer, &config);
-    predictor = coa_predictor_init(predictor_buffer, sizeof predictor_buffer, FW_PLANS,
-                                   FW_TRACKS, FW_HORIZON, FW_MAX_PAIRS);
+    predictor = coa_predictor_init(predictor_buffer, sizeof predictor_buffer, FW_PLANS, FW_TRACKS,
+                                   FW_HORIZON, FW_MAX_PAIRS);
     if (planner == NULL || predictor == NULL) {
         return COA_ERR_WORKSPACE;
     }
@@ -116,8 +116,8 @@ static int collect_obstacles(const coa_vehicle_t *self, coa_real_t now, size_t *
             paths[m][j].t = n->t0 - now + (coa_real_t)j * n->step;
             paths[m][j].p = n->samples[j];
         }
-        obstacles[m] = (coa_track_t){.id = n->id, .volume = n->volume, .path = paths[m],
-                                     .path_count = n->count};
+        obstacles[m] = (coa_track_t){
+            .id = n->id, .volume = n->volume, .path = paths[m], .path_count = n->count};
         ++m;
     }
     for (i = 0; i < fw_inputs.track_count && i < FW_TRACKS; ++i) {
@@ -177,17 +177,25 @@ fw_status_t fw_task_cycle(coa_real_t now)
     write_intent(dh);
 
     /* 1. Prediction: our intent (plan 0) with the neighbours' and the tracks. */
-    plans[0] = (coa_intent_plan_t){.id = self.id, .volume = self.volume, .t0 = 0.0f,
-                                   .step = FW_DT, .samples = fw_outputs.intent,
-                                   .count = FW_SAMPLES, .sigma_horizontal = 5.0f,
+    plans[0] = (coa_intent_plan_t){.id = self.id,
+                                   .volume = self.volume,
+                                   .t0 = 0.0f,
+                                   .step = FW_DT,
+                                   .samples = fw_outputs.intent,
+                                   .count = FW_SAMPLES,
+                                   .sigma_horizontal = 5.0f,
                                    .sigma_vertical = 2.0f};
     for (i = 0; i < FW_NEIGHBOURS; ++i) {
         const fw_intent_t *nb = &fw_inputs.neighbours[i];
         if (nb->valid) {
-            plans[n++] = (coa_intent_plan_t){.id = nb->id, .volume = nb->volume,
-                                             .t0 = nb->t0 - now, .step = nb->step,
-                                             .samples = nb->samples, .count = nb->count,
-                                             .sigma_horizontal = 5.0f, .sigma_vertical = 2.0f};
+            plans[n++] = (coa_intent_plan_t){.id = nb->id,
+                                             .volume = nb->volume,
+                                             .t0 = nb->t0 - now,
+                                             .step = nb->step,
+                                             .samples = nb->samples,
+                                             .count = nb->count,
+                                             .sigma_horizontal = 5.0f,
+                                             .sigma_vertical = 2.0f};
         }
     }
     rc = coa_predict(predictor, &config, plans, n, NULL, 0u, fw_inputs.tracks,
@@ -225,10 +233,16 @@ fw_status_t fw_task_cycle(coa_real_t now)
     if (rc < 0) {
         return finish(FW_ERROR, rc);
     }
-    problem = (coa_problem_t){.dt = FW_DT, .horizon = FW_HORIZON, .vehicles = &self,
-                              .vehicle_count = 1u, .references = reference_rows,
-                              .obstacles = NULL, .obstacle_count = 0u, .tracks = obstacles,
-                              .track_count = m, .track_samples = obstacle_rows};
+    problem = (coa_problem_t){.dt = FW_DT,
+                              .horizon = FW_HORIZON,
+                              .vehicles = &self,
+                              .vehicle_count = 1u,
+                              .references = reference_rows,
+                              .obstacles = NULL,
+                              .obstacle_count = 0u,
+                              .tracks = obstacles,
+                              .track_count = m,
+                              .track_samples = obstacle_rows};
     rc = coa_plan_decoupled(planner, &problem, NULL, 1u, new_offsets, &fw_outputs.plan);
     if (rc < 0) {
         return finish(FW_ERROR, rc);
@@ -257,13 +271,21 @@ void fw_example_inputs(void)
     fw_inputs.route_count = 2u;
     fw_inputs.offset = 0;
     /* Head-on at our altitude, 600 m ahead, priority 1: we must give way. */
-    *ahead = (fw_intent_t){.valid = true, .id = 3u, .priority = 1u,
+    *ahead = (fw_intent_t){.valid = true,
+                           .id = 3u,
+                           .priority = 1u,
                            .volume = {.radius = 50.0f, .half_height = 15.0f},
-                           .t0 = 0.0f, .step = FW_DT, .count = FW_SAMPLES};
+                           .t0 = 0.0f,
+                           .step = FW_DT,
+                           .count = FW_SAMPLES};
     /* Crossing 1.5 km behind us, priority 5: its problem, not ours. */
-    *behind = (fw_intent_t){.valid = true, .id = 9u, .priority = 5u,
+    *behind = (fw_intent_t){.valid = true,
+                            .id = 9u,
+                            .priority = 5u,
                             .volume = {.radius = 50.0f, .half_height = 15.0f},
-                            .t0 = 0.0f, .step = FW_DT, .count = FW_SAMPLES};
+                            .t0 = 0.0f,
+                            .step = FW_DT,
+                            .count = FW_SAMPLES};
     for (k = 0; k < FW_SAMPLES; ++k) {
         ahead->samples[k] = (coa_vec3_t){600.0f - 20.0f * (coa_real_t)k, 0.0f, 100.0f};
         behind->samples[k] = (coa_vec3_t){-1500.0f, -300.0f + 20.0f * (coa_real_t)k, 100.0f};
@@ -272,6 +294,7 @@ void fw_example_inputs(void)
                                         .volume = {.radius = 150.0f, .half_height = 60.0f},
                                         .position = {3000.0f, 3000.0f, 400.0f},
                                         .velocity = {-30.0f, 0.0f, 0.0f},
-                                        .sigma_horizontal = 20.0f, .sigma_vertical = 10.0f};
+                                        .sigma_horizontal = 20.0f,
+                                        .sigma_vertical = 10.0f};
     fw_inputs.track_count = 1u;
 }

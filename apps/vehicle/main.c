@@ -19,38 +19,37 @@
 #include "realtime.h"
 #include "scenario.h"
 
-#define VEHICLE_USAGE                                                                          \
-    "usage: coavoid-vehicle --scenario FILE --id ID [--mode centralised|decoupled]\n"          \
-    "                       [--lcm-url URL] [--epoch UTIME] [--speed S] [--steps K]\n"         \
-    "                       [--coordinator-timeout S] [--coordinator-id ID]\n"                 \
-    "                       [--priority-wait S]\n"                                              \
-    "       coavoid-vehicle --scenario FILE --list-ids\n"                                      \
-    "\n"                                                                                       \
-    "Flies the UAV with this id from the scenario in real time, exchanging intents and\n"     \
-    "plans over LCM with the other vehicles, the coordinator and `coavoid world`.\n"          \
-    "\n"                                                                                       \
-    "options:\n"                                                                               \
-    "  --scenario FILE     the scenario (docs/scenario-format.md): route, dt, horizon, beta\n" \
-    "  --id ID             which of its vehicles this process flies\n"                         \
-    "  --mode centralised  follow the coordinator; plan for itself while the coordinator\n"    \
-    "                      is silent (default)\n"                                              \
-    "  --mode decoupled    always plan for itself, in priority order\n"                        \
-    COAVOID_RT_OPTIONS_USAGE                                                                       \
-    "  --coordinator-timeout S  scenario seconds of coordinator silence after which it\n"     \
-    "                      plans for itself; default 2.5 * dt\n"                               \
-    "  --coordinator-id ID the node id of the coordinator it follows (1 to 65535, not its\n" \
-    "                      own); heartbeats and plans from any other are refused; default\n"   \
-    "                      65001, coavoid-coordinator's\n"                                       \
-    "  --priority-wait S   decoupled: scenario seconds it waits for the intents of the\n"     \
+#define VEHICLE_USAGE                                                                             \
+    "usage: coavoid-vehicle --scenario FILE --id ID [--mode centralised|decoupled]\n"             \
+    "                       [--lcm-url URL] [--epoch UTIME] [--speed S] [--steps K]\n"            \
+    "                       [--coordinator-timeout S] [--coordinator-id ID]\n"                    \
+    "                       [--priority-wait S]\n"                                                \
+    "       coavoid-vehicle --scenario FILE --list-ids\n"                                         \
+    "\n"                                                                                          \
+    "Flies the UAV with this id from the scenario in real time, exchanging intents and\n"         \
+    "plans over LCM with the other vehicles, the coordinator and `coavoid world`.\n"              \
+    "\n"                                                                                          \
+    "options:\n"                                                                                  \
+    "  --scenario FILE     the scenario (docs/scenario-format.md): route, dt, horizon, beta\n"    \
+    "  --id ID             which of its vehicles this process flies\n"                            \
+    "  --mode centralised  follow the coordinator; plan for itself while the coordinator\n"       \
+    "                      is silent (default)\n"                                                 \
+    "  --mode decoupled    always plan for itself, in priority order\n" COAVOID_RT_OPTIONS_USAGE  \
+    "  --coordinator-timeout S  scenario seconds of coordinator silence after which it\n"         \
+    "                      plans for itself; default 2.5 * dt\n"                                  \
+    "  --coordinator-id ID the node id of the coordinator it follows (1 to 65535, not its\n"      \
+    "                      own); heartbeats and plans from any other are refused; default\n"      \
+    "                      65001, coavoid-coordinator's\n"                                        \
+    "  --priority-wait S   decoupled: scenario seconds it waits for the intents of the\n"         \
     "                      higher-priority UAVs that pass near it, 0 <= S < dt; default dt / 2\n" \
-    "  --list-ids          print the scenario's vehicle ids, one per line, and exit (for\n"   \
-    "                      scripts that start one process per UAV)\n"                         \
-    "  -h, --help          show this help\n"                                                   \
-    "\n"                                                                                       \
-    "At the end (after K cycles, or on SIGINT/SIGTERM) it prints one summary line on\n"       \
-    "stderr: cycles, plans run and adopted, fallbacks to its own planning, messages\n"        \
-    "received and rejected.\n"                                                                 \
-    "\n"                                                                                       \
+    "  --list-ids          print the scenario's vehicle ids, one per line, and exit (for\n"       \
+    "                      scripts that start one process per UAV)\n"                             \
+    "  -h, --help          show this help\n"                                                      \
+    "\n"                                                                                          \
+    "At the end (after K cycles, or on SIGINT/SIGTERM) it prints one summary line on\n"           \
+    "stderr: cycles, plans run and adopted, fallbacks to its own planning, messages\n"            \
+    "received and rejected.\n"                                                                    \
+    "\n"                                                                                          \
     "exit status: 0 done, 2 invalid input or usage (one line on stderr), 3 internal error\n"
 
 typedef struct {
@@ -76,8 +75,9 @@ static int parse_seconds(int argc, char **argv, int *i, const char *name, bool z
     int status = coavoid_cli_text_option(argc, argv, i, name, "scenario seconds", true, text);
     if (status == CLI_CONTINUE && (!coavoid_cli_parse_real(*text, out) || *out < 0 ||
                                    (*out == 0 && !zero_ok) || *out > COAVOID_LCM_MAX_STEP)) {
-        status = coavoid_cli_fail(CLI_EXIT_INVALID, "%s: must be a number of seconds, %s %g, got '%.40s'",
-                          name, zero_ok ? "0 <= S <=" : "0 < S <=", COAVOID_LCM_MAX_STEP, *text);
+        status = coavoid_cli_fail(CLI_EXIT_INVALID,
+                                  "%s: must be a number of seconds, %s %g, got '%.40s'", name,
+                                  zero_ok ? "0 <= S <=" : "0 < S <=", COAVOID_LCM_MAX_STEP, *text);
     }
     return status;
 }
@@ -98,14 +98,14 @@ static int vehicle_option(int argc, char **argv, int *i, void *options)
     }
     if (coavoid_cli_option_is(arg, "--scenario")) {
         status = coavoid_cli_text_option(argc, argv, i, "--scenario", "a scenario file", false,
-                                 &o->scenario_path);
+                                         &o->scenario_path);
     } else if (coavoid_cli_option_is(arg, "--id")) {
         status = coavoid_cli_text_option(argc, argv, i, "--id", "a vehicle id", true, &o->id_text);
         if (status == CLI_CONTINUE &&
             !coavoid_cli_parse_count(o->id_text, strlen(o->id_text), 65535u, &value)) {
             status = coavoid_cli_fail(CLI_EXIT_INVALID,
-                              "--id: must be a vehicle id from 1 to 65535, got '%.40s'",
-                              o->id_text);
+                                      "--id: must be a vehicle id from 1 to 65535, got '%.40s'",
+                                      o->id_text);
         }
         o->id = (uint16_t)value;
     } else if (coavoid_cli_option_is(arg, "--list-ids")) {
@@ -117,12 +117,14 @@ static int vehicle_option(int argc, char **argv, int *i, void *options)
                                &o->timeout);
     } else if (coavoid_cli_option_is(arg, "--coordinator-id")) {
         status = coavoid_cli_text_option(argc, argv, i, "--coordinator-id", "a node id", true,
-                                 &o->coordinator_text);
+                                         &o->coordinator_text);
         if (status == CLI_CONTINUE &&
-            !coavoid_cli_parse_count(o->coordinator_text, strlen(o->coordinator_text), 65535u, &value)) {
-            status = coavoid_cli_fail(CLI_EXIT_INVALID,
-                              "--coordinator-id: must be a node id from 1 to 65535, got '%.40s'",
-                              o->coordinator_text);
+            !coavoid_cli_parse_count(o->coordinator_text, strlen(o->coordinator_text), 65535u,
+                                     &value)) {
+            status =
+                coavoid_cli_fail(CLI_EXIT_INVALID,
+                                 "--coordinator-id: must be a node id from 1 to 65535, got '%.40s'",
+                                 o->coordinator_text);
         }
         o->coordinator_id = (uint16_t)value;
     } else if (coavoid_cli_option_is(arg, "--priority-wait")) {
@@ -132,7 +134,7 @@ static int vehicle_option(int argc, char **argv, int *i, void *options)
 }
 
 static const coavoid_cli_command_t vehicle_command = {
-    "vehicle", "coavoid-vehicle", 1, {NULL, NULL}, "the scenario is --scenario FILE",
+    "vehicle",    "coavoid-vehicle", 1, {NULL, NULL}, "the scenario is --scenario FILE",
     vehicle_help, vehicle_option};
 
 static int parse_options(int argc, char **argv, vehicle_options_t *o)
@@ -159,14 +161,16 @@ static int parse_options(int argc, char **argv, vehicle_options_t *o)
     }
     /* The coordinator timeout only decides when a centralised vehicle plans for itself. */
     if (o->decoupled && o->timeout_text != NULL) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "--coordinator-timeout: only valid with --mode centralised");
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                "--coordinator-timeout: only valid with --mode centralised");
     }
     if (o->decoupled && o->coordinator_text != NULL) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "--coordinator-id: only valid with --mode centralised");
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                "--coordinator-id: only valid with --mode centralised");
     }
     if (o->coordinator_text != NULL && o->coordinator_id == o->id) {
         return coavoid_cli_fail(CLI_EXIT_INVALID, "--coordinator-id: %u is this vehicle's own id",
-                        (unsigned)o->id);
+                                (unsigned)o->id);
     }
     return CLI_CONTINUE;
 }
@@ -188,10 +192,9 @@ static void vehicle_report(void *user, const char *name, const coavoid_rt_result
     fprintf(stderr,
             "%s: %lld cycles, plans run %u, plans adopted %u, fallbacks %u, messages received "
             "%lld, rejected %lld (last: %s)%s\n",
-            name, (long long)result->cycles, (unsigned)st->plans_run,
-            (unsigned)st->plans_adopted, (unsigned)st->fallbacks, (long long)st->rx.received,
-            (long long)st->rx.rejected, st->rx.last_reason != NULL ? st->rx.last_reason : "none",
-            tail);
+            name, (long long)result->cycles, (unsigned)st->plans_run, (unsigned)st->plans_adopted,
+            (unsigned)st->fallbacks, (long long)st->rx.received, (long long)st->rx.rejected,
+            st->rx.last_reason != NULL ? st->rx.last_reason : "none", tail);
 }
 
 /* Everything after the options and the scenario. Returns the exit status. */
@@ -211,7 +214,7 @@ static int run(void *options, coavoid_scenario_t *s)
     long index = coavoid_scenario_vehicle_index(s, (long)o->id);
     if (index < 0) {
         return coavoid_cli_fail(CLI_EXIT_INVALID, "--id: %s has no vehicle %u", o->scenario_path,
-                        (unsigned)o->id);
+                                (unsigned)o->id);
     }
     const int64_t dt_us = config.common.dt_us;
     config.vehicle = s->vehicles[index];
@@ -226,8 +229,8 @@ static int run(void *options, coavoid_scenario_t *s)
     /* A wait into the next cycle would publish this cycle's intent after the next one's. */
     if (config.priority_wait_us >= dt_us) {
         return coavoid_cli_fail(CLI_EXIT_INVALID,
-                        "--priority-wait: %g s is not less than the scenario's dt (%g s)", o->wait,
-                        (double)s->dt);
+                                "--priority-wait: %g s is not less than the scenario's dt (%g s)",
+                                o->wait, (double)s->dt);
     }
 
     char err[512];
@@ -240,8 +243,8 @@ static int run(void *options, coavoid_scenario_t *s)
     if (node == NULL) {
         lcm_destroy(lcm);
         return coavoid_cli_fail(error == COA_ERR_ARGUMENT ? CLI_EXIT_INVALID : CLI_EXIT_INTERNAL,
-                        "vehicle %u: cannot start (%s)", (unsigned)o->id,
-                        coavoid_lcm_error_name(error));
+                                "vehicle %u: cannot start (%s)", (unsigned)o->id,
+                                coavoid_lcm_error_name(error));
     }
     char name[32];
     snprintf(name, sizeof name, "vehicle %u", (unsigned)o->id);

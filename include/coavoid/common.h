@@ -64,16 +64,17 @@ typedef struct {
 
 /* Status codes. 0 is success; every error is negative so `if (rc < 0)` catches them all. */
 #define COA_OK 0
-#define COA_ERR_ARGUMENT (-1)  /* NULL pointer, count out of range, non-finite or out-of-range number */
+#define COA_ERR_ARGUMENT \
+    (-1) /* NULL pointer, count out of range, non-finite or out-of-range number */
 #define COA_ERR_WORKSPACE (-2) /* workspace missing, too small or built for fewer vehicles/beta */
 #define COA_ERR_RANGE (-3)     /* the problem is too large for the integer cost or offset types */
 
 /* Limits of the core. They bound every loop and every fixed array. */
-#define COA_MAX_VEHICLES 32u       /* co-operative UAVs in one problem */
-#define COA_MAX_CENTRALISED 6u     /* UAVs in one centralised problem: each has a cost-to-go table */
-#define COA_MAX_STEEP_FACTOR 10u   /* largest steep_factor; keeps the integer cost scale small */
-#define COA_MAX_HORIZON 10000u     /* N: samples k = 0..N */
-#define COA_MAX_OFFSET 32767       /* |altitude offset| in climb steps at any sample */
+#define COA_MAX_VEHICLES 32u     /* co-operative UAVs in one problem */
+#define COA_MAX_CENTRALISED 6u   /* UAVs in one centralised problem: each has a cost-to-go table */
+#define COA_MAX_STEEP_FACTOR 10u /* largest steep_factor; keeps the integer cost scale small */
+#define COA_MAX_HORIZON 10000u   /* N: samples k = 0..N */
+#define COA_MAX_OFFSET 32767     /* |altitude offset| in climb steps at any sample */
 
 /* The workspace buffer passed to coa_planner_init must be aligned to this many bytes. */
 #define COA_WORKSPACE_ALIGNMENT 8u

@@ -62,10 +62,7 @@ typedef struct {
 
 #define COA_POLYTOPE_MAX_VERTICES 256u /* bounds the cost of one support evaluation */
 
-typedef enum {
-    COA_OBSTACLE_BOX = 0,
-    COA_OBSTACLE_POLYTOPE = 1
-} coa_obstacle_kind_t;
+typedef enum { COA_OBSTACLE_BOX = 0, COA_OBSTACLE_POLYTOPE = 1 } coa_obstacle_kind_t;
 
 /* A static obstacle: `box` is used when kind is COA_OBSTACLE_BOX, `polytope` otherwise. */
 typedef struct {

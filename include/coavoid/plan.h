@@ -127,10 +127,10 @@ extern "C" {
 
 /* A planning problem. Everything is the caller's and is only read. */
 typedef struct {
-    coa_real_t dt;         /* s, > 0 */
-    uint32_t horizon;      /* N, 1..COA_MAX_HORIZON */
+    coa_real_t dt;    /* s, > 0 */
+    uint32_t horizon; /* N, 1..COA_MAX_HORIZON */
     const coa_vehicle_t *vehicles;
-    size_t vehicle_count;  /* 1..COA_MAX_VEHICLES */
+    size_t vehicle_count; /* 1..COA_MAX_VEHICLES */
     /* references[i] holds horizon+1 samples of vehicle i's reference (coa_reference_sample) */
     const coa_vec3_t *const *references;
     const coa_obstacle_t *obstacles;
@@ -142,9 +142,10 @@ typedef struct {
 } coa_problem_t;
 
 typedef enum {
-    COA_PLAN_SOLVED = 0,           /* a plan was found and it is optimal */
-    COA_PLAN_INFEASIBLE = 1,       /* the search space is exhausted: no plan exists (decoupled: for this order) */
-    COA_PLAN_BUDGET_EXHAUSTED = 2  /* a joint search filled its beta nodes: nothing proven */
+    COA_PLAN_SOLVED = 0, /* a plan was found and it is optimal */
+    COA_PLAN_INFEASIBLE =
+        1, /* the search space is exhausted: no plan exists (decoupled: for this order) */
+    COA_PLAN_BUDGET_EXHAUSTED = 2 /* a joint search filled its beta nodes: nothing proven */
 } coa_plan_status_t;
 
 #define COA_NO_VEHICLE ((size_t)-1)
@@ -153,33 +154,33 @@ typedef struct {
     coa_plan_status_t status;
     /* Costs: totals over every vehicle when solved; decoupled and not solved, over the
      * planned_count vehicles of `order`; otherwise 0. */
-    double deviation;          /* m^2, by the exact formula */
+    double deviation;           /* m^2, by the exact formula */
     coa_cost_t deviation_units; /* the exact integer the planner minimised, in units of
                                    2^E / S m^2 (file comment, "Costs") */
     uint32_t effort;
-    uint64_t nodes_expanded;   /* over every search this call ran */
-    uint64_t nodes_generated;  /* states the joint searches stored (at most beta a
+    uint64_t nodes_expanded;  /* over every search this call ran */
+    uint64_t nodes_generated; /* states the joint searches stored (at most beta a
                                   search; 0 when none ran): duplicates of stored states,
                                   dead ones and those above the cap are not stored */
-    size_t workspace_bytes;    /* size of the workspace the planner ran in */
+    size_t workspace_bytes;   /* size of the workspace the planner ran in */
     /* Planning order as vehicle indices: decoupled, the order of the reported attempt;
      * centralised, 0..n-1. */
     size_t order[COA_MAX_VEHICLES];
     /* Vehicles whose offsets rows are a valid plan: n when solved; decoupled and not
      * solved, the first planned_count vehicles of `order`. */
     size_t planned_count;
-    size_t failed_vehicle;     /* decoupled, not solved: index of the first UAV with no plan */
-    uint32_t orders_tried;     /* decoupled: priority orders attempted (1 without reordering) */
-    bool all_orders_covered;   /* decoupled, not solved: every order was tried or ruled out
+    size_t failed_vehicle;   /* decoupled, not solved: index of the first UAV with no plan */
+    uint32_t orders_tried;   /* decoupled: priority orders attempted (1 without reordering) */
+    bool all_orders_covered; /* decoupled, not solved: every order was tried or ruled out
                                   (a failing prefix; a UAV infeasible when planned first; a
                                   conflict at t = 0, which no order avoids). With status
                                   infeasible, no order has a plan; with budget exhausted,
                                   some order failed only through beta. false when solved,
                                   centralised, or when max_orders ended the search first */
-    uint32_t searches;         /* plans this call made: each table built and walked
+    uint32_t searches;       /* plans this call made: each table built and walked
                                   against fixed UAVs (decoupled: one per UAV planned)
                                   and each joint search of a group */
-    size_t largest_group;      /* centralised: the most UAVs searched together (0 when
+    size_t largest_group;    /* centralised: the most UAVs searched together (0 when
                                   nothing was searched) */
 } coa_plan_result_t;
 
@@ -259,8 +260,8 @@ int coa_problem_check(const coa_problem_t *problem);
  * solved. Cost: the problem check, 2n tables, then fewer than n^2 joint searches (each
  * with its pair tables) of at most beta stored nodes each (see the file comment); no
  * memory beyond the workspace and O(1) stack. */
-int coa_plan_centralised(coa_planner_t *planner, const coa_problem_t *problem,
-                         int32_t *offsets, coa_plan_result_t *result);
+int coa_plan_centralised(coa_planner_t *planner, const coa_problem_t *problem, int32_t *offsets,
+                         coa_plan_result_t *result);
 
 /* Decoupled plan: vehicles plan one at a time in `order` (vehicle indices, a permutation
  * of 0..n-1; NULL: ascending priority, ties by ascending id), each against obstacles,
@@ -297,9 +298,8 @@ int coa_plan_centralised(coa_planner_t *planner, const coa_problem_t *problem,
  * clear at t = 0) among n-2 that never interact still take about half of the n! orders
  * (docs/benchmarks.md has counts), so bound max_orders when n is more than a few. No
  * memory beyond the workspace, O(n) stack. */
-int coa_plan_decoupled(coa_planner_t *planner, const coa_problem_t *problem,
-                       const size_t *order, uint32_t max_orders, int32_t *offsets,
-                       coa_plan_result_t *result);
+int coa_plan_decoupled(coa_planner_t *planner, const coa_problem_t *problem, const size_t *order,
+                       uint32_t max_orders, int32_t *offsets, coa_plan_result_t *result);
 
 /* The priority order of a problem's vehicles (ascending priority, ties by ascending id)
  * as indices into order[0..n-1]. Returns COA_OK or COA_ERR_ARGUMENT (NULL, n == 0 or

@@ -99,49 +99,51 @@ typedef struct {
     uint16_t id;
     coa_volume_t volume;
     coa_real_t t0;
-    coa_real_t step;               /* s, > 0 */
+    coa_real_t step; /* s, > 0 */
     const coa_vec3_t *samples;
-    size_t count;                  /* >= 1 */
-    coa_real_t sigma_horizontal;   /* m at look-ahead 0, >= 0 */
+    size_t count;                /* >= 1 */
+    coa_real_t sigma_horizontal; /* m at look-ahead 0, >= 0 */
     coa_real_t sigma_vertical;
 } coa_intent_plan_t;
 
 typedef struct {
-    coa_real_t t0;                 /* predictor's clock at k = 0 (s) */
-    coa_real_t dt;                 /* s, > 0 */
-    uint32_t horizon;              /* N, 1..max_horizon of the workspace */
+    coa_real_t t0;                            /* predictor's clock at k = 0 (s) */
+    coa_real_t dt;                            /* s, > 0 */
+    uint32_t horizon;                         /* N, 1..max_horizon of the workspace */
     coa_real_t vehicle_sigma_rate_horizontal; /* m/s of look-ahead, >= 0 */
     coa_real_t vehicle_sigma_rate_vertical;
     coa_real_t track_sigma_rate_horizontal;
     coa_real_t track_sigma_rate_vertical;
-    double threshold;              /* a pair with uncertainty is a conflict when P >= threshold, in (0, 1] */
-    bool all_pairs;                /* skip the broad phase: every pair is a candidate (the
+    double threshold; /* a pair with uncertainty is a conflict when P >= threshold, in (0, 1] */
+    bool all_pairs;   /* skip the broad phase: every pair is a candidate (the
                                       reference the broad phase is tested against) */
 } coa_predict_config_t;
 
 typedef enum {
-    COA_CONFLICT_VEHICLE = 0,  /* b is another plan's index, a < b */
-    COA_CONFLICT_TRACK = 1,    /* b is a track's index */
-    COA_CONFLICT_OBSTACLE = 2  /* b is an obstacle's index */
+    COA_CONFLICT_VEHICLE = 0, /* b is another plan's index, a < b */
+    COA_CONFLICT_TRACK = 1,   /* b is a track's index */
+    COA_CONFLICT_OBSTACLE = 2 /* b is an obstacle's index */
 } coa_conflict_kind_t;
 
 typedef struct {
     coa_conflict_kind_t kind;
-    uint32_t a;                /* plan index */
+    uint32_t a; /* plan index */
     uint32_t b;
-    uint32_t first_step;       /* first k whose [t_k, t_k+1] holds the conflict (P >= threshold) */
-    coa_real_t first_time;     /* t_k of first_step on the predictor's clock */
-    coa_real_t min_horizontal; /* least horizontal centre distance over the horizon (m); obstacles: to a box, 0 for a polytope */
-    coa_real_t min_vertical;   /* least vertical centre distance over the horizon (m); obstacles as above */
-    double probability;        /* of conflict over the horizon, see the file comment */
+    uint32_t first_step;   /* first k whose [t_k, t_k+1] holds the conflict (P >= threshold) */
+    coa_real_t first_time; /* t_k of first_step on the predictor's clock */
+    coa_real_t
+        min_horizontal; /* least horizontal centre distance over the horizon (m); obstacles: to a box, 0 for a polytope */
+    coa_real_t
+        min_vertical; /* least vertical centre distance over the horizon (m); obstacles as above */
+    double probability; /* of conflict over the horizon, see the file comment */
 } coa_conflict_t;
 
 typedef struct {
-    size_t conflict_count;     /* entries written to the caller's array (<= capacity) */
-    size_t conflicts_found;    /* every conflict found; more than conflict_count: overflow */
-    bool overflow;             /* conflicts_found > capacity: the array holds the first ones found */
-    uint64_t pair_tests;       /* pairs evaluated in the narrow phase (vs n(n-1)/2 all-pairs) */
-    uint64_t candidate_pairs;  /* distinct pairs the broad phase produced */
+    size_t conflict_count;    /* entries written to the caller's array (<= capacity) */
+    size_t conflicts_found;   /* every conflict found; more than conflict_count: overflow */
+    bool overflow;            /* conflicts_found > capacity: the array holds the first ones found */
+    uint64_t pair_tests;      /* pairs evaluated in the narrow phase (vs n(n-1)/2 all-pairs) */
+    uint64_t candidate_pairs; /* distinct pairs the broad phase produced */
 } coa_predict_result_t;
 
 typedef struct coa_predictor coa_predictor_t;
@@ -190,9 +192,8 @@ coa_predictor_t *coa_predictor_init(void *buffer, size_t size, size_t max_vehicl
  * O(candidates * N), a polytope step costing what coa_conflict_polytope does, an
  * uncertain step at most 7 coa_conflict_probability calls. No heap, O(1) stack. */
 int coa_predict(coa_predictor_t *predictor, const coa_predict_config_t *config,
-                const coa_intent_plan_t *plans, size_t plan_count,
-                const coa_obstacle_t *obstacles, size_t obstacle_count,
-                const coa_track_t *tracks, size_t track_count,
+                const coa_intent_plan_t *plans, size_t plan_count, const coa_obstacle_t *obstacles,
+                size_t obstacle_count, const coa_track_t *tracks, size_t track_count,
                 coa_conflict_t *conflicts, size_t capacity, coa_predict_result_t *result);
 
 /* Groups to plan together: cluster[i] receives the cluster label of plan i, or

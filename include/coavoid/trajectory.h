@@ -55,16 +55,16 @@ extern "C" {
 
 /* A co-operative UAV. All numbers finite; the pointers are the caller's. */
 typedef struct {
-    uint16_t id;              /* 1..65535, unique in a problem */
-    uint32_t priority;        /* >= 1; 1 is highest; ties by ascending id */
-    coa_real_t cruise_speed;  /* m/s, > 0 */
-    coa_real_t climb_rate;    /* m/s, > 0 */
-    uint32_t steep_factor;    /* 2..COA_MAX_STEEP_FACTOR */
-    coa_volume_t volume;      /* protected volume */
-    const coa_vec3_t *route;  /* >= 2 points; consecutive points differ horizontally */
+    uint16_t id;             /* 1..65535, unique in a problem */
+    uint32_t priority;       /* >= 1; 1 is highest; ties by ascending id */
+    coa_real_t cruise_speed; /* m/s, > 0 */
+    coa_real_t climb_rate;   /* m/s, > 0 */
+    uint32_t steep_factor;   /* 2..COA_MAX_STEEP_FACTOR */
+    coa_volume_t volume;     /* protected volume */
+    const coa_vec3_t *route; /* >= 2 points; consecutive points differ horizontally */
     size_t route_count;
-    int32_t initial_offset;   /* offset at k = 0, climb steps */
-    int32_t max_offset;       /* bound on |offset| at every k; negative: unbounded */
+    int32_t initial_offset; /* offset at k = 0, climb steps */
+    int32_t max_offset;     /* bound on |offset| at every k; negative: unbounded */
 } coa_vehicle_t;
 
 /* One point of a track's predicted path. */
@@ -111,8 +111,7 @@ coa_vec3_t coa_reference_at(const coa_vehicle_t *v, coa_real_t t);
  * COA_ERR_ARGUMENT (NULL, invalid vehicle, dt not finite or <= 0, horizon == 0 or >
  * COA_MAX_HORIZON, or a sample that overflows to a non-finite position). Cost
  * O(horizon + route_count) in one walk along the route. */
-int coa_reference_sample(const coa_vehicle_t *v, coa_real_t dt, uint32_t horizon,
-                         coa_vec3_t *out);
+int coa_reference_sample(const coa_vehicle_t *v, coa_real_t dt, uint32_t horizon, coa_vec3_t *out);
 
 /* Track position at time t. Precondition: coa_track_check(tr) == COA_OK. Cost O(path). */
 coa_vec3_t coa_track_at(const coa_track_t *tr, coa_real_t t);
@@ -153,8 +152,7 @@ int64_t coa_area_scaled(int32_t a, int32_t b, uint32_t scale);
 
 /* The truncated-triangle heuristic H(a, steps_left) * scale exactly, for steep factor s.
  * Precondition: scale is a multiple of 2s. Cost O(1). */
-int64_t coa_heuristic_scaled(int32_t a, uint32_t steps_left, uint32_t steep_factor,
-                             uint32_t scale);
+int64_t coa_heuristic_scaled(int32_t a, uint32_t steps_left, uint32_t steep_factor, uint32_t scale);
 
 /* The problem's area scale S = lcm over the vehicles of 2*steep_factor. Returns 0 when n
  * is 0 or a steep factor is out of range. Cost O(n). */
@@ -167,8 +165,8 @@ uint32_t coa_area_scale(const coa_vehicle_t *vehicles, size_t n);
  * (the weights span too many binary orders of magnitude for 64-bit integers); on an
  * error the outputs are unspecified. Computed in double whatever coa_real_t is, read
  * from the IEEE 754 bits rather than through libm, so host and firmware agree. Cost O(n). */
-int coa_deviation_weights(const coa_vehicle_t *vehicles, size_t n, coa_real_t dt,
-                          uint64_t *weights, int *exponent);
+int coa_deviation_weights(const coa_vehicle_t *vehicles, size_t n, coa_real_t dt, uint64_t *weights,
+                          int *exponent);
 
 /* An exact non-negative cost in the planner's deviation unit: hi * 2^64 + lo. The
  * helpers below use only 64-bit arithmetic (no __int128), so they build for 32-bit

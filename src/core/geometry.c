@@ -33,7 +33,6 @@
 /* ---------------------------------------------------------------------------------- */
 /* Intervals of the step parameter u.                                                  */
 
-
 static coa_span_t span_all(void)
 {
     coa_span_t s = {-(coa_real_t)INFINITY, (coa_real_t)INFINITY};
@@ -62,7 +61,7 @@ static coa_span_t span_meet(coa_span_t a, coa_span_t b)
 /* The u with p + u*v in (bmin, bmax) (open) or [bmin, bmax] (closed). Only the numbers
  * differ between the two: which ends belong to the set matters only when v == 0. */
 static inline coa_span_t span_linear(coa_real_t p, coa_real_t v, coa_real_t bmin, coa_real_t bmax,
-                              bool closed)
+                                     bool closed)
 {
     coa_real_t t1;
     coa_real_t t2;
@@ -127,8 +126,7 @@ static coa_span_t span_disc(coa_real_t qx, coa_real_t qy, coa_real_t wx, coa_rea
     m = real_fabs(wx) > m ? real_fabs(wx) : m;
     m = real_fabs(wy) > m ? real_fabs(wy) : m;
     m = radius > m ? radius : m;
-    if (m > real_ldexp((coa_real_t)1, DISC_RANGE) ||
-        m < real_ldexp((coa_real_t)1, -DISC_RANGE)) {
+    if (m > real_ldexp((coa_real_t)1, DISC_RANGE) || m < real_ldexp((coa_real_t)1, -DISC_RANGE)) {
         /* Each input by ldexp rather than times 2^-e: for a subnormal m, 2^-e itself
          * overflows (float's 2^-e for m < 2^-127) and the product would be inf or NaN. */
         int e = 0;
@@ -199,9 +197,8 @@ static bool conflict_vertical(const coa_sweep_t *a, const coa_sweep_t *b,
     if (!span_meets_step(vert)) {
         return false;
     }
-    return span_meets_step(span_meet(horizontal != NULL ? *horizontal
-                                                        : coa_conflict_horizontal_span(a, b),
-                                     vert));
+    return span_meets_step(
+        span_meet(horizontal != NULL ? *horizontal : coa_conflict_horizontal_span(a, b), vert));
 }
 
 bool coa_conflict_volumes(const coa_sweep_t *a, const coa_sweep_t *b)
@@ -209,8 +206,7 @@ bool coa_conflict_volumes(const coa_sweep_t *a, const coa_sweep_t *b)
     return conflict_vertical(a, b, NULL);
 }
 
-bool coa_conflict_volumes_given(const coa_sweep_t *a, const coa_sweep_t *b,
-                                coa_span_t horizontal)
+bool coa_conflict_volumes_given(const coa_sweep_t *a, const coa_sweep_t *b, coa_span_t horizontal)
 {
     return conflict_vertical(a, b, &horizontal);
 }
@@ -514,8 +510,8 @@ int coa_conflict_polytope(const coa_sweep_t *a, const coa_polytope_t *poly)
     size_t i;
     int hit;
 
-    if (a == NULL || poly == NULL || poly->vertices == NULL ||
-        poly->count < 4u || poly->count > COA_POLYTOPE_MAX_VERTICES) {
+    if (a == NULL || poly == NULL || poly->vertices == NULL || poly->count < 4u ||
+        poly->count > COA_POLYTOPE_MAX_VERTICES) {
         return COA_ERR_ARGUMENT;
     }
     if (!vec_finite(&a->p0) || !vec_finite(&a->p1) || !isfinite(a->volume.radius) ||

@@ -326,8 +326,8 @@ static coa_cost_t worst_f(const coa_problem_t *p, const uint64_t *weights, uint3
             bound = (uint64_t)offset_limit(v);
         }
         /* S <= 5040, B <= 32767, 2N <= 20000: the factor is below 2^42. */
-        total = coa_cost_add(total,
-                             coa_cost_mul(weights[i], (uint64_t)s * bound * 2u * p->horizon));
+        total =
+            coa_cost_add(total, coa_cost_mul(weights[i], (uint64_t)s * bound * 2u * p->horizon));
     }
     return total;
 }
@@ -436,7 +436,7 @@ int coa_plan_vehicle_cost(const coa_vehicle_t *vehicle, coa_real_t dt, uint32_t 
 /* Geometry and costs of rows                                                            */
 
 coa_sweep_t coa_plan_vehicle_sweep(const coa_problem_t *pr, const coa_real_t *dh, size_t v,
-                               uint32_t k0, int32_t a, uint32_t k1, int32_t b)
+                                   uint32_t k0, int32_t a, uint32_t k1, int32_t b)
 {
     coa_sweep_t s;
     s.volume = pr->vehicles[v].volume;
@@ -470,7 +470,7 @@ bool coa_plan_static_clear(const coa_problem_t *pr, const coa_sweep_t *s, uint32
 }
 
 coa_cost_t coa_plan_row_units(const coa_planner_t *pl, size_t v, const int32_t *row,
-                          uint64_t *effort)
+                              uint64_t *effort)
 {
     const uint32_t steep = pl->problem->vehicles[v].steep_factor;
     uint64_t own = 0u;
@@ -557,7 +557,7 @@ static int load(coa_planner_t *pl, const coa_problem_t *problem, const int32_t *
 }
 
 void coa_plan_fill_costs(const coa_planner_t *pl, const size_t *which, size_t count,
-                     coa_plan_result_t *r)
+                         coa_plan_result_t *r)
 {
     const coa_problem_t *pr = pl->problem;
     size_t i;
@@ -610,8 +610,8 @@ static bool packed_range_ok(const coa_planner_t *pl)
            (UINT64_C(1) << (64u - PLAN_EFF_BITS - 2u));
 }
 
-int coa_plan_centralised(coa_planner_t *planner, const coa_problem_t *problem,
-                         int32_t *offsets, coa_plan_result_t *result)
+int coa_plan_centralised(coa_planner_t *planner, const coa_problem_t *problem, int32_t *offsets,
+                         coa_plan_result_t *result)
 {
     size_t i;
     int rc;
@@ -673,9 +673,8 @@ static void promote(size_t *order, size_t from, size_t to)
     order[to] = v;
 }
 
-int coa_plan_decoupled(coa_planner_t *planner, const coa_problem_t *problem,
-                       const size_t *order, uint32_t max_orders, int32_t *offsets,
-                       coa_plan_result_t *result)
+int coa_plan_decoupled(coa_planner_t *planner, const coa_problem_t *problem, const size_t *order,
+                       uint32_t max_orders, int32_t *offsets, coa_plan_result_t *result)
 {
     size_t first[COA_MAX_VEHICLES];
     size_t cur[COA_MAX_VEHICLES];
@@ -683,7 +682,7 @@ int coa_plan_decoupled(coa_planner_t *planner, const coa_problem_t *problem,
     uint32_t tried[COA_MAX_VEHICLES];
     size_t n;
     size_t start = 0u;
-    size_t keep;          /* levels below this still hold the first attempt's plans */
+    size_t keep; /* levels below this still hold the first attempt's plans */
     size_t first_fail = 0u;
     bool any_budget = false;
     bool proven = false;  /* infeasible in every order, whatever beta did */
@@ -862,8 +861,8 @@ int coa_plan_find_conflict(const coa_problem_t *problem, const int32_t *offsets,
             for (j = 0; !hit && j < count; ++j) {
                 if (j != i) {
                     const int32_t *ou = &offsets[which[j] * row];
-                    coa_sweep_t t = coa_plan_vehicle_sweep(problem, dh, which[j], k, ou[k], k + 1u,
-                                                  ou[k + 1u]);
+                    coa_sweep_t t =
+                        coa_plan_vehicle_sweep(problem, dh, which[j], k, ou[k], k + 1u, ou[k + 1u]);
                     hit = coa_conflict_volumes(&s, &t);
                 }
             }

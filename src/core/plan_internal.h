@@ -29,10 +29,10 @@
 
 #define PLAN_ACTIONS COA_ACTION_COUNT
 #define PLAN_MAXM COA_MAX_CENTRALISED
-#define PLAN_NONE UINT32_MAX   /* no node, an empty slot, not in the heap */
-#define PLAN_EFF_BITS 18u      /* effort bits of a packed cost */
+#define PLAN_NONE UINT32_MAX /* no node, an empty slot, not in the heap */
+#define PLAN_EFF_BITS 18u    /* effort bits of a packed cost */
 #define PLAN_PAIRS (PLAN_MAXM * (PLAN_MAXM - 1u) / 2u)
-#define PLAN_OUT INT16_MIN     /* a group member's offset while it is not in the search */
+#define PLAN_OUT INT16_MIN /* a group member's offset while it is not in the search */
 
 /* ------------------------------------------------------------------------------------ */
 /* Tables                                                                                */
@@ -76,10 +76,10 @@ static inline bool cell_dead(uint64_t c)
  * sample k, stored row after row. Rows are laid out by their widest possible width,
  * min(2ks + 1, 2L + 1), so that a row's start has a closed form. */
 typedef struct {
-    size_t vehicle;  /* index into the problem */
-    int32_t origin;  /* initial offset */
-    int32_t limit;   /* L: the largest |offset| */
-    uint32_t steep;  /* s */
+    size_t vehicle; /* index into the problem */
+    int32_t origin; /* initial offset */
+    int32_t limit;  /* L: the largest |offset| */
+    uint32_t steep; /* s */
     uint32_t horizon;
     uint32_t growing; /* q = L / s: rows 0..q are 2ks + 1 wide, the later ones 2L + 1 */
     uint64_t *cells;
@@ -108,8 +108,8 @@ typedef struct {
     size_t vehicle[PLAN_MAXM];
     uint32_t first[PLAN_MAXM];
     uint32_t last[PLAN_MAXM];
-    uint32_t end;             /* 1 + the largest `last`: the search's goal sample */
-    coa_cost_t alone[PLAN_MAXM]; /* each member's cost alone, packed */
+    uint32_t end;                    /* 1 + the largest `last`: the search's goal sample */
+    coa_cost_t alone[PLAN_MAXM];     /* each member's cost alone, packed */
     uint32_t entry_count[PLAN_MAXM]; /* offsets in its entry list (pl->entries) */
     /* Pairs (a, b) of members, a < b, in the order (0,1), (0,2), .., (1,2), ..: the steps
      * where they can meet (near_first > near_last: never). */
@@ -119,9 +119,9 @@ typedef struct {
      * each member can meet each. */
     size_t fixed[COA_MAX_VEHICLES];
     size_t fixed_count;
-    bool bounded;             /* plans that cost more than bound are not wanted */
-    coa_cost_t bound;         /* packed */
-    bool capped;              /* a plan is known that costs `cap` (packed): prune above */
+    bool bounded;     /* plans that cost more than bound are not wanted */
+    coa_cost_t bound; /* packed */
+    bool capped;      /* a plan is known that costs `cap` (packed): prune above */
     coa_cost_t cap;
 } plan_group_t;
 
@@ -160,15 +160,15 @@ struct coa_planner {
     uint32_t magic;
     coa_planner_config_t config;
     size_t bytes;
-    size_t table_cells;   /* cells one table holds */
-    size_t table_count;   /* tables in the workspace */
-    size_t row_width;     /* the widest row a table can have */
-    uint32_t capacity;    /* nodes: beta (0: no joint search, vehicles == 1) */
-    uint32_t slot_count;  /* hash slots: 2 * capacity */
-    size_t pair_cells;    /* cells of the pair arena */
+    size_t table_cells;  /* cells one table holds */
+    size_t table_count;  /* tables in the workspace */
+    size_t row_width;    /* the widest row a table can have */
+    uint32_t capacity;   /* nodes: beta (0: no joint search, vehicles == 1) */
+    uint32_t slot_count; /* hash slots: 2 * capacity */
+    size_t pair_cells;   /* cells of the pair arena */
 
-    uint64_t *cells;      /* table_count tables of table_cells */
-    int16_t *entries;     /* per member: its entry offsets, cheapest first (row_width) */
+    uint64_t *cells;  /* table_count tables of table_cells */
+    int16_t *entries; /* per member: its entry offsets, cheapest first (row_width) */
     coa_cost_t *pair_arena;
 
     /* Node pool (one array per field). key: the packed, doubled f of the node's next
@@ -187,7 +187,7 @@ struct coa_planner {
     uint32_t used;
     uint32_t heap_count;
     size_t m;
-    coa_cost_t batch;     /* doubled f beyond its key an expansion also generates */
+    coa_cost_t batch; /* doubled f beyond its key an expansion also generates */
 
     /* Per call: the problem and its exact cost parameters. */
     const coa_problem_t *problem;
@@ -213,7 +213,7 @@ struct coa_planner {
     plan_group_t group;
     int32_t *saved_rows;
     plan_pair_t pair[PLAN_PAIRS];
-    size_t pair_used;     /* arena cells taken */
+    size_t pair_used; /* arena cells taken */
 
     /* Independence detection: pairs of groups (member bit masks) it tried to re-plan. */
     uint32_t tried[PLAN_MAX_TRIED][2];
@@ -320,7 +320,7 @@ static inline const plan_table_t *plan_from_start(const coa_planner_t *pl, size_
 
 /* The swept volume of vehicle v from offset a at sample k0 to offset b at k1. */
 coa_sweep_t coa_plan_vehicle_sweep(const coa_problem_t *pr, const coa_real_t *dh, size_t v,
-                               uint32_t k0, int32_t a, uint32_t k1, int32_t b);
+                                   uint32_t k0, int32_t a, uint32_t k1, int32_t b);
 
 /* Whether a sweep over samples k0 -> k1 is clear of every obstacle and track (k0 == k1:
  * the instant t_k0). */
@@ -381,7 +381,7 @@ static inline uint64_t plan_table_at(const plan_table_t *t, uint32_t k, int32_t 
 /* Builds cost-to-go table t for vehicle v against the obstacles, the tracks and the
  * vehicles fixed[0..nfixed-1] flying their rows of pl->rows. */
 void coa_plan_table_build(coa_planner_t *pl, plan_table_t *t, size_t v, const size_t *fixed,
-                      size_t nfixed);
+                          size_t nfixed);
 
 /* Builds cost-from-start table f of the vehicle of cost-to-go table t, over t's moves. */
 void coa_plan_table_build_from_start(plan_table_t *f, const plan_table_t *t);
@@ -398,7 +398,7 @@ void coa_plan_table_walk(coa_planner_t *pl, const plan_table_t *t, uint32_t k, i
  * cheapest plan from its initial offset (cost-from-start table f). Precondition: f's
  * cell there is reachable. */
 void coa_plan_table_walk_back(coa_planner_t *pl, const plan_table_t *t, const plan_table_t *f,
-                          uint32_t k, int32_t offset);
+                              uint32_t k, int32_t offset);
 
 /* Builds the pair tables of the current group within the arena (pairs that do not fit
  * are left out). */
@@ -408,7 +408,7 @@ void coa_plan_pairs_build(coa_planner_t *pl);
  * of their own), 0 where the pair has no table or the sample is outside it, or
  * PLAN_COST_DEAD. */
 coa_cost_t coa_plan_pair_surcharge(const coa_planner_t *pl, size_t a, size_t b, uint32_t k,
-                               int32_t oa, int32_t ob, coa_cost_t to_go_a, coa_cost_t to_go_b);
+                                   int32_t oa, int32_t ob, coa_cost_t to_go_a, coa_cost_t to_go_b);
 
 /* Index of pair (a, b), a < b < m. */
 static inline size_t plan_pair_index(size_t a, size_t b, size_t m)
@@ -419,11 +419,11 @@ static inline size_t plan_pair_index(size_t a, size_t b, size_t m)
 /* The exact deviation of vehicle v's row (N + 1 offsets) in the problem's units, as the
  * search counts it, and its effort in *effort when not NULL. */
 coa_cost_t coa_plan_row_units(const coa_planner_t *pl, size_t v, const int32_t *row,
-                          uint64_t *effort);
+                              uint64_t *effort);
 
 /* Totals of the rows of vehicles which[0..count-1] into r's costs. */
 void coa_plan_fill_costs(const coa_planner_t *pl, const size_t *which, size_t count,
-                     coa_plan_result_t *r);
+                         coa_plan_result_t *r);
 
 /* Whether some vehicle meets an obstacle, a track or another vehicle at t = 0 (positions
  * at k = 0 with the initial offsets): then no plan and no order avoids it. */
@@ -456,7 +456,8 @@ void coa_plan_test_group_setup(coa_planner_t *pl, uint32_t members);
 /* The joint search's doubled heuristic (plan_search.c) of the state at sample k with
  * member offsets off[0..count-1] (read only for the members in the search at k): false
  * when a pair is dead there. */
-bool coa_plan_test_heuristic(const coa_planner_t *pl, uint32_t k, const int16_t *off, coa_cost_t *h2);
+bool coa_plan_test_heuristic(const coa_planner_t *pl, uint32_t k, const int16_t *off,
+                             coa_cost_t *h2);
 
 /* The doubled matching the heuristic adds (plan_search.c) of surcharges s[] (pairs of m
  * members in plan_pair_index order) among the members of mask. */

@@ -180,11 +180,10 @@ static void pair_moves(const coa_planner_t *pl, size_t i, uint32_t k, int32_t o,
         }
         to = o + coa_action_delta((coa_action_t)a, t->steep);
         mv->to[n] = to;
-        mv->step[n] =
-            plan_pack(plan_units(pl, v, plan_area(o, to, t->steep)),
-                      coa_action_effort((coa_action_t)a));
-        mv->alone[n] = plan_cost_add(mv->step[n],
-                                     plan_cell_cost(pl, v, plan_table_at(t, k + 1u, to)));
+        mv->step[n] = plan_pack(plan_units(pl, v, plan_area(o, to, t->steep)),
+                                coa_action_effort((coa_action_t)a));
+        mv->alone[n] =
+            plan_cost_add(mv->step[n], plan_cell_cost(pl, v, plan_table_at(t, k + 1u, to)));
         if (sweeps) {
             mv->sweep[n] = coa_plan_vehicle_sweep(pl->problem, pl->dh, v, k, o, k + 1u, to);
         }
@@ -390,7 +389,7 @@ void coa_plan_pairs_build(coa_planner_t *pl)
 }
 
 coa_cost_t coa_plan_pair_surcharge(const coa_planner_t *pl, size_t a, size_t b, uint32_t k,
-                               int32_t oa, int32_t ob, coa_cost_t to_go_a, coa_cost_t to_go_b)
+                                   int32_t oa, int32_t ob, coa_cost_t to_go_a, coa_cost_t to_go_b)
 {
     const plan_pair_t *p = &pl->pair[plan_pair_index(a, b, pl->group.count)];
     const coa_cost_t *c;

@@ -263,15 +263,16 @@ static bool matching_direct(const coa_cost_t *s, size_t m, uint32_t mask, coa_co
     } else if (count == 4u) {
         for (i = 0; i < 3u; ++i) {
             const uint8_t *p = perfect[i];
-            best = cost_larger(best, plan_cost_twice(plan_cost_add(
-                                         s[plan_pair_index(at[p[0]], at[p[1]], m)],
-                                         s[plan_pair_index(at[p[2]], at[p[3]], m)])));
+            best = cost_larger(
+                best, plan_cost_twice(plan_cost_add(s[plan_pair_index(at[p[0]], at[p[1]], m)],
+                                                    s[plan_pair_index(at[p[2]], at[p[3]], m)])));
         }
         for (i = 0; i < 4u; ++i) {
             const uint8_t *t = triangles[i];
-            best = cost_larger(best, plan_cost_add(s[plan_pair_index(at[t[0]], at[t[1]], m)],
-                                                   plan_cost_add(s[plan_pair_index(at[t[0]], at[t[2]], m)],
-                                                                 s[plan_pair_index(at[t[1]], at[t[2]], m)])));
+            best = cost_larger(
+                best, plan_cost_add(s[plan_pair_index(at[t[0]], at[t[1]], m)],
+                                    plan_cost_add(s[plan_pair_index(at[t[0]], at[t[2]], m)],
+                                                  s[plan_pair_index(at[t[1]], at[t[2]], m)])));
         }
     }
     *out = best;
@@ -315,10 +316,10 @@ static coa_cost_t matching(const coa_cost_t *s, size_t m, uint32_t mask)
                 if ((rest & (1u << l)) == 0u) {
                     continue;
                 }
-                v = plan_cost_add(plan_cost_add(s[plan_pair_index(i, j, m)],
-                                                s[plan_pair_index(i, l, m)]),
-                                  plan_cost_add(s[plan_pair_index(j, l, m)],
-                                                best[rest & ~(1u << j) & ~(1u << l)]));
+                v = plan_cost_add(
+                    plan_cost_add(s[plan_pair_index(i, j, m)], s[plan_pair_index(i, l, m)]),
+                    plan_cost_add(s[plan_pair_index(j, l, m)],
+                                  best[rest & ~(1u << j) & ~(1u << l)]));
                 best[sub] = cost_larger(v, best[sub]);
             }
         }
@@ -327,8 +328,8 @@ static coa_cost_t matching(const coa_cost_t *s, size_t m, uint32_t mask)
 }
 
 typedef struct {
-    coa_cost_t h2;      /* the doubled heuristic */
-    coa_cost_t m2;      /* its matching part */
+    coa_cost_t h2; /* the doubled heuristic */
+    coa_cost_t m2; /* its matching part */
 } heur_t;
 
 /* The doubled heuristic of a state at sample k; false when a pair is dead there. */
@@ -396,8 +397,7 @@ static bool node_put(coa_planner_t *pl, const node_init_t *in, uint32_t n, uint3
     size_t i;
 
     if (n != PLAN_NONE) {
-        if ((pl->node_k[n] & K_EXPANDED) != 0u ||
-            plan_cost_compare(in->f2, pl->key[n]) >= 0) {
+        if ((pl->node_k[n] & K_EXPANDED) != 0u || plan_cost_compare(in->f2, pl->key[n]) >= 0) {
             return true; /* closed (final, the heuristic is consistent) or no better */
         }
     } else {
@@ -438,9 +438,9 @@ typedef struct {
     size_t member[PLAN_MAXM];
     bool enters[PLAN_MAXM];
     uint32_t options[PLAN_MAXM];
-    plan_moves_t moves[PLAN_MAXM];         /* movers */
+    plan_moves_t moves[PLAN_MAXM];                /* movers */
     coa_cost_t move_inc[PLAN_MAXM][PLAN_ACTIONS]; /* movers: increase() of each move */
-    coa_cost_t rest_min[PLAN_MAXM + 1u];   /* least increase of choosers c.. */
+    coa_cost_t rest_min[PLAN_MAXM + 1u];          /* least increase of choosers c.. */
     coa_sweep_t sweep[PLAN_MAXM][PLAN_ACTIONS];
     uint8_t pair_ok[PLAN_MAXM][PLAN_MAXM][PLAN_ACTIONS][PLAN_ACTIONS]; /* 0 ?, 1 ok, 2 no */
 } choosers_t;
@@ -449,8 +449,8 @@ typedef struct {
  * a mover, its move's increase (W * unit * dev, and the effort's, which may be negative
  * when the deviation's is positive); for a member entering at k + 1, the slack of its
  * entry offset (its cheapest cost through it less its cost alone). */
-static coa_cost_t increase_of(const coa_planner_t *pl, const choosers_t *ch, size_t c,
-                              uint32_t k, uint32_t t)
+static coa_cost_t increase_of(const coa_planner_t *pl, const choosers_t *ch, size_t c, uint32_t k,
+                              uint32_t t)
 {
     const size_t i = ch->member[c];
     const size_t v = pl->group.vehicle[i];
@@ -556,7 +556,7 @@ static bool mover_clear(const coa_planner_t *pl, choosers_t *ch, uint32_t k, siz
         /* pair_ok[c][c][a][a]: option a's sweep is built and was checked against the
          * fixed vehicles (a mover is never paired with itself) */
         ch->sweep[c][a] = coa_plan_vehicle_sweep(pl->problem, pl->dh, g->vehicle[i], k, off[i],
-                                             k + 1u, ch->moves[c].to[a]);
+                                                 k + 1u, ch->moves[c].to[a]);
         ch->pair_ok[c][c][a][a] = fixed_clear(pl, &ch->sweep[c][a], k) ? 1u : 2u;
     }
     if (ch->pair_ok[c][c][a][a] != 1u) {
@@ -591,9 +591,9 @@ static bool mover_clear(const coa_planner_t *pl, choosers_t *ch, uint32_t k, siz
 typedef struct {
     uint32_t n;
     uint32_t k;
-    coa_cost_t key;   /* children of doubled f up to this are generated */
+    coa_cost_t key; /* children of doubled f up to this are generated */
     bool have_next;
-    coa_cost_t next;  /* the least doubled f, or bound, left above the key */
+    coa_cost_t next; /* the least doubled f, or bound, left above the key */
     choosers_t ch;
     uint32_t choice[PLAN_MAXM];
     coa_cost_t partial[PLAN_MAXM + 1u]; /* additive doubled f after choosers 0..c-1 */
@@ -635,8 +635,8 @@ static bool choose(const coa_planner_t *pl, expansion_t *e, size_t c)
     coa_cost_t best = e->pairmax[c];
     size_t d;
 
-    e->off[i] = e->ch.enters[c] ? pl->entries[i * pl->row_width + t]
-                                : (int16_t)e->ch.moves[c].to[t];
+    e->off[i] =
+        e->ch.enters[c] ? pl->entries[i * pl->row_width + t] : (int16_t)e->ch.moves[c].to[t];
     if (in_search(g, i, k1)) {
         e->own[i] = own_to_go(pl, i, k1, e->off[i]);
         for (d = 0; d < c; ++d) {
@@ -646,8 +646,8 @@ static bool choose(const coa_planner_t *pl, expansion_t *e, size_t c)
             if (!in_search(g, j, k1)) {
                 continue;
             }
-            e->s[pi] = coa_plan_pair_surcharge(pl, j, i, k1, e->off[j], e->off[i], e->own[j],
-                                           e->own[i]);
+            e->s[pi] =
+                coa_plan_pair_surcharge(pl, j, i, k1, e->off[j], e->off[i], e->own[j], e->own[i]);
             if (plan_cost_dead(e->s[pi])) {
                 return false;
             }
@@ -684,9 +684,9 @@ static bool child_add(coa_planner_t *pl, const expansion_t *e, coa_cost_t f2, ui
             continue;
         }
         in.g = plan_cost_add(
-            in.g, plan_pack(plan_units(pl, v, plan_area(
-                                                  from[i], e->off[i], plan_to_go(pl, i)->steep)),
-                            coa_action_effort((coa_action_t)e->ch.moves[c].action[t])));
+            in.g,
+            plan_pack(plan_units(pl, v, plan_area(from[i], e->off[i], plan_to_go(pl, i)->steep)),
+                      coa_action_effort((coa_action_t)e->ch.moves[c].action[t])));
         if (g->last[i] == e->k) { /* leaves the search: its cost to go is exact */
             in.g = plan_cost_add(in.g, own_to_go(pl, i, k1, e->off[i]));
         }
@@ -887,7 +887,8 @@ static bool root_add(coa_planner_t *pl, plan_search_out_t *out)
     in.f2 = h.h2;
     pl->batch = (coa_cost_t){0u, 0u};
     if (!over(pl, in.f2)) {
-        coa_cost_t span = pl->group.capped ? plan_cost_sub(plan_cost_twice(pl->group.cap), in.f2) : in.f2;
+        coa_cost_t span =
+            pl->group.capped ? plan_cost_sub(plan_cost_twice(pl->group.cap), in.f2) : in.f2;
         unsigned sh = BATCH_SHIFT;
         pl->batch.lo = (span.lo >> sh) | (span.hi << (64u - sh));
         pl->batch.hi = span.hi >> sh;
@@ -954,7 +955,8 @@ void coa_plan_search(coa_planner_t *pl, plan_search_out_t *out)
 /* ------------------------------------------------------------------------------------ */
 /* Test hooks (plan_internal.h)                                                          */
 
-bool coa_plan_test_heuristic(const coa_planner_t *pl, uint32_t k, const int16_t *off, coa_cost_t *h2)
+bool coa_plan_test_heuristic(const coa_planner_t *pl, uint32_t k, const int16_t *off,
+                             coa_cost_t *h2)
 {
     heur_t h;
     if (!heuristic(pl, k, off, &h)) {

@@ -74,8 +74,8 @@ typedef struct {
     uint32_t k;
     int32_t lo;
     int32_t hi;
-    uint64_t *row;      /* row k: only the action bits are set while conflicts are cleared */
-    coa_box_t bounds;   /* every step of the row lies in it */
+    uint64_t *row;    /* row k: only the action bits are set while conflicts are cleared */
+    coa_box_t bounds; /* every step of the row lies in it */
 } row_ctx_t;
 
 static bool item_conflict(const row_item_t *it, const coa_sweep_t *s)
@@ -149,7 +149,7 @@ static void row_clear_item(const row_ctx_t *r, const row_item_t *it)
                 continue;
             }
             s = coa_plan_vehicle_sweep(pl->problem, pl->dh, t->vehicle, r->k, o, r->k + 1u,
-                                   o + coa_action_delta((coa_action_t)a, t->steep));
+                                       o + coa_action_delta((coa_action_t)a, t->steep));
             sb = coa_sweep_bounds(&s);
             if (coa_boxes_touch(&sb, &item) && item_conflict(it, &s)) {
                 *c &= ~(UINT64_C(1) << a);
@@ -182,7 +182,7 @@ static void row_clear_conflicts(const row_ctx_t *r, const size_t *fixed, size_t 
     for (j = 0; j < nfixed; ++j) {
         const int32_t *row = &r->pl->rows[fixed[j] * ((size_t)pr->horizon + 1u)];
         it.moving = coa_plan_vehicle_sweep(pr, r->pl->dh, fixed[j], r->k, row[r->k], r->k + 1u,
-                                       row[r->k + 1u]);
+                                           row[r->k + 1u]);
         it.bounds = coa_sweep_bounds(&it.moving);
         row_clear_item(r, &it);
     }
@@ -233,8 +233,8 @@ static void row_costs(const plan_table_t *t, uint32_t k, int32_t lo, int32_t hi,
                 best = cost < best ? cost : best;
             }
         }
-        row[o - lo] = mask == 0u ? cell_pack(CELL_DEV_DEAD, 0u, 0u)
-                                 : (best << CELL_EFF_SHIFT) | mask;
+        row[o - lo] =
+            mask == 0u ? cell_pack(CELL_DEV_DEAD, 0u, 0u) : (best << CELL_EFF_SHIFT) | mask;
     }
 }
 
@@ -242,16 +242,16 @@ static void row_costs(const plan_table_t *t, uint32_t k, int32_t lo, int32_t hi,
 static coa_box_t row_bounds(const coa_planner_t *pl, const plan_table_t *t, uint32_t k)
 {
     coa_sweep_t low = coa_plan_vehicle_sweep(pl->problem, pl->dh, t->vehicle, k, plan_row_lo(t, k),
-                                         k + 1u, plan_row_lo(t, k + 1u));
+                                             k + 1u, plan_row_lo(t, k + 1u));
     coa_sweep_t high = coa_plan_vehicle_sweep(pl->problem, pl->dh, t->vehicle, k, plan_row_hi(t, k),
-                                          k + 1u, plan_row_hi(t, k + 1u));
+                                              k + 1u, plan_row_hi(t, k + 1u));
     coa_box_t b = coa_sweep_bounds(&low);
     coa_box_t h = coa_sweep_bounds(&high);
     return box_union(b, &h);
 }
 
 void coa_plan_table_build(coa_planner_t *pl, plan_table_t *tb, size_t v, const size_t *fixed,
-                      size_t nfixed)
+                          size_t nfixed)
 {
     const coa_vehicle_t *veh = &pl->problem->vehicles[v];
     const uint32_t horizon = pl->problem->horizon;
@@ -308,8 +308,8 @@ void coa_plan_table_moves(const plan_table_t *t, uint32_t k, int32_t from, plan_
         eff = (int32_t)(cell_eff(next) + coa_action_effort((coa_action_t)a)) -
               (int32_t)cell_eff(here);
         /* Insertion: stable for equal increases, so ties keep coa_action_t order. */
-        for (i = mv->count; i > 0u && (mv->dev[i - 1u] > dev ||
-                                       (mv->dev[i - 1u] == dev && mv->eff[i - 1u] > eff));
+        for (i = mv->count;
+             i > 0u && (mv->dev[i - 1u] > dev || (mv->dev[i - 1u] == dev && mv->eff[i - 1u] > eff));
              --i) {
             mv->action[i] = mv->action[i - 1u];
             mv->to[i] = mv->to[i - 1u];
@@ -384,7 +384,7 @@ void coa_plan_table_walk(coa_planner_t *pl, const plan_table_t *t, uint32_t k, i
 }
 
 void coa_plan_table_walk_back(coa_planner_t *pl, const plan_table_t *t, const plan_table_t *f,
-                          uint32_t k, int32_t offset)
+                              uint32_t k, int32_t offset)
 {
     int32_t *row = &pl->rows[t->vehicle * ((size_t)t->horizon + 1u)];
 

@@ -106,7 +106,6 @@ typedef struct {
 /* ------------------------------------------------------------------------------------ */
 /* Sizes                                                                                 */
 
-
 static bool layout_compute(size_t max_vehicles, size_t max_tracks, uint32_t max_horizon,
                            size_t max_pairs, predict_layout_t *lo)
 {
@@ -162,8 +161,7 @@ coa_predictor_t *coa_predictor_init(void *buffer, size_t size, size_t max_vehicl
     if (buffer == NULL || (uintptr_t)buffer % WS_ALIGN != 0u) {
         return NULL;
     }
-    if (!layout_compute(max_vehicles, max_tracks, max_horizon, max_pairs, &lo) ||
-        size < lo.total) {
+    if (!layout_compute(max_vehicles, max_tracks, max_horizon, max_pairs, &lo) || size < lo.total) {
         return NULL;
     }
     pr = (coa_predictor_t *)buffer;
@@ -211,13 +209,22 @@ coa_predictor_t *coa_predictor_init(void *buffer, size_t size, size_t max_vehicl
 
 /* ln(n!) - (n + 1/2) ln n + n - ln sqrt(2 pi), the error of Stirling's formula, for
  * n = 1..15 (mpmath, 50 digits); the asymptotic series beyond. */
-static const double stirling_error[16] = {
-    0.0, /* n = 0 is never asked for */
-    0.0810614667953272582197, 0.0413406959554092940938, 0.0276779256849983391488,
-    0.0207906721037650931115, 0.0166446911898211921632, 0.0138761288230707479987,
-    0.0118967099458917700951, 0.0104112652619720964975, 0.00925546218271273291773,
-    0.00833056343336287125647, 0.00757367548795184079497, 0.00694284010720952986566,
-    0.00640899418800420706844, 0.00595137011275884773562, 0.00555473355196280137104};
+static const double stirling_error[16] = {0.0, /* n = 0 is never asked for */
+                                          0.0810614667953272582197,
+                                          0.0413406959554092940938,
+                                          0.0276779256849983391488,
+                                          0.0207906721037650931115,
+                                          0.0166446911898211921632,
+                                          0.0138761288230707479987,
+                                          0.0118967099458917700951,
+                                          0.0104112652619720964975,
+                                          0.00925546218271273291773,
+                                          0.00833056343336287125647,
+                                          0.00757367548795184079497,
+                                          0.00694284010720952986566,
+                                          0.00640899418800420706844,
+                                          0.00595137011275884773562,
+                                          0.00555473355196280137104};
 
 static double stirlerr(double n)
 {
@@ -227,8 +234,7 @@ static double stirlerr(double n)
     }
     nn = n * n;
     return (1.0 / 12.0 -
-            (1.0 / 360.0 - (1.0 / 1260.0 - (1.0 / 1680.0 - (1.0 / 1188.0) / nn) / nn) / nn) /
-                nn) /
+            (1.0 / 360.0 - (1.0 / 1260.0 - (1.0 / 1680.0 - (1.0 / 1188.0) / nn) / nn) / nn) / nn) /
            n;
 }
 
@@ -365,11 +371,11 @@ static const double gh_node[16] = {
     7.4607557541215187579,  8.2197287653822454014,   9.06439921070240617483,
     10.0774226742294659462};
 static const double gh_weight[16] = {
-    0.21170556988047931757,     0.156538993757598444886,    0.0853448082720807601496,
-    0.0341098477260920505106,   0.00990346170232059187677,  0.0020620510513078847176,
+    0.21170556988047931757,     0.156538993757598444886,     0.0853448082720807601496,
+    0.0341098477260920505106,   0.00990346170232059187677,   0.0020620510513078847176,
     0.000302557025817062492161, 0.0000305598030608963015411, 2.05962210395342887605e-6,
-    8.88129071310589508938e-8,  2.31251841207424054098e-9,  3.34750123980120700489e-11,
-    2.37806485577780867587e-13, 6.75529022367011874058e-16, 5.20844959196086129441e-19,
+    8.88129071310589508938e-8,  2.31251841207424054098e-9,   3.34750123980120700489e-11,
+    2.37806485577780867587e-13, 6.75529022367011874058e-16,  5.20844959196086129441e-19,
     4.12460748901826933641e-23};
 
 /* P_h for a wide disc (b = R/sigma >= GH_MIN_RATIO). Conditioned on the error across the
@@ -514,7 +520,6 @@ static double log_probability_bound(double gap_h, double sigma_h, double gap_v, 
 /* ------------------------------------------------------------------------------------ */
 /* Input checks                                                                          */
 
-
 static bool positive(coa_real_t x)
 {
     return real_ok(x) && x > (coa_real_t)0;
@@ -529,11 +534,10 @@ static bool config_ok(const coa_predictor_t *pr, const coa_predict_config_t *c)
 {
     coa_real_t end;
 
-    if (!real_ok(c->t0) || !positive(c->dt) || c->horizon == 0u ||
-        c->horizon > pr->max_horizon || !nonneg(c->vehicle_sigma_rate_horizontal) ||
-        !nonneg(c->vehicle_sigma_rate_vertical) || !nonneg(c->track_sigma_rate_horizontal) ||
-        !nonneg(c->track_sigma_rate_vertical) || isfinite(c->threshold) == 0 ||
-        !(c->threshold > 0.0) || !(c->threshold <= 1.0)) {
+    if (!real_ok(c->t0) || !positive(c->dt) || c->horizon == 0u || c->horizon > pr->max_horizon ||
+        !nonneg(c->vehicle_sigma_rate_horizontal) || !nonneg(c->vehicle_sigma_rate_vertical) ||
+        !nonneg(c->track_sigma_rate_horizontal) || !nonneg(c->track_sigma_rate_vertical) ||
+        isfinite(c->threshold) == 0 || !(c->threshold > 0.0) || !(c->threshold <= 1.0)) {
         return false;
     }
     /* The grid's last instant and look-ahead must exist. */
@@ -557,7 +561,6 @@ static bool plan_ok(const coa_intent_plan_t *p)
     }
     return true;
 }
-
 
 /* ------------------------------------------------------------------------------------ */
 /* Alignment                                                                             */
@@ -746,16 +749,14 @@ static void set_clear(coa_predictor_t *pr, size_t count)
 
 /* A pair of this step's boxes: a candidate when they overlap in x, y and z and are not
  * both tracks. */
-static int sap_pair(coa_predictor_t *pr, const sap_entry_t *e, const sap_entry_t *f,
-                    size_t *count)
+static int sap_pair(coa_predictor_t *pr, const sap_entry_t *e, const sap_entry_t *f, size_t *count)
 {
     size_t n = pr->n;
     uint32_t lo;
     uint32_t hi;
 
-    if (f->min_x > e->max_x || e->min_x > f->max_x || f->min_y > e->max_y ||
-        e->min_y > f->max_y || (e->id >= n && f->id >= n) || f->min_z > e->max_z ||
-        e->min_z > f->max_z) {
+    if (f->min_x > e->max_x || e->min_x > f->max_x || f->min_y > e->max_y || e->min_y > f->max_y ||
+        (e->id >= n && f->id >= n) || f->min_z > e->max_z || e->min_z > f->max_z) {
         return COA_OK;
     }
     lo = e->id < f->id ? e->id : f->id;
@@ -1136,8 +1137,7 @@ typedef struct {
 } relative_t;
 
 /* Combined one-sigma of a pair at look-ahead tau, in double. */
-static double pair_sigma(coa_real_t s0a, coa_real_t ra, coa_real_t s0b, coa_real_t rb,
-                         double tau)
+static double pair_sigma(coa_real_t s0a, coa_real_t ra, coa_real_t s0b, coa_real_t rb, double tau)
 {
     double x = (double)s0a + (double)ra * tau;
     double y = (double)s0b + (double)rb * tau;
@@ -1146,8 +1146,7 @@ static double pair_sigma(coa_real_t s0a, coa_real_t ra, coa_real_t s0b, coa_real
 
 /* Evaluates a UAV against another moving thing over the whole horizon. Returns whether
  * the pair is a conflict (file comment of predict.h) and fills *out when it is. */
-static bool evaluate_movers(const coa_predictor_t *pr, uint32_t a, uint32_t b,
-                            coa_conflict_t *out)
+static bool evaluate_movers(const coa_predictor_t *pr, uint32_t a, uint32_t b, coa_conflict_t *out)
 {
     const coa_predict_config_t *c = pr->config;
     const mover_t *ma = &pr->mover[a];
@@ -1304,8 +1303,8 @@ static bool evaluate_movers(const coa_predictor_t *pr, uint32_t a, uint32_t b,
 
 /* The part of a coordinate beyond [lo, hi] as alpha + beta u on the piece of the step
  * around u = mid (zero inside). */
-static void outside_linear(coa_real_t p, coa_real_t v, coa_real_t lo, coa_real_t hi,
-                           coa_real_t mid, coa_real_t *alpha, coa_real_t *beta)
+static void outside_linear(coa_real_t p, coa_real_t v, coa_real_t lo, coa_real_t hi, coa_real_t mid,
+                           coa_real_t *alpha, coa_real_t *beta)
 {
     coa_real_t x = p + mid * v;
     if (x < lo) {
@@ -1523,9 +1522,8 @@ static int check_inputs(const coa_predictor_t *pr, const coa_predict_config_t *c
 }
 
 int coa_predict(coa_predictor_t *predictor, const coa_predict_config_t *config,
-                const coa_intent_plan_t *plans, size_t plan_count,
-                const coa_obstacle_t *obstacles, size_t obstacle_count,
-                const coa_track_t *tracks, size_t track_count,
+                const coa_intent_plan_t *plans, size_t plan_count, const coa_obstacle_t *obstacles,
+                size_t obstacle_count, const coa_track_t *tracks, size_t track_count,
                 coa_conflict_t *conflicts, size_t capacity, coa_predict_result_t *result)
 {
     coa_predictor_t *pr = predictor;
@@ -1540,8 +1538,8 @@ int coa_predict(coa_predictor_t *predictor, const coa_predict_config_t *config,
     if (pr->magic != PREDICT_MAGIC) {
         return COA_ERR_WORKSPACE;
     }
-    rc = check_inputs(pr, config, plans, plan_count, obstacles, obstacle_count, tracks,
-                      track_count, conflicts, capacity);
+    rc = check_inputs(pr, config, plans, plan_count, obstacles, obstacle_count, tracks, track_count,
+                      conflicts, capacity);
     if (rc != COA_OK) {
         return rc;
     }
@@ -1619,8 +1617,7 @@ int coa_predict_clusters(const coa_conflict_t *conflicts, size_t count, size_t p
     }
     for (i = 0; i < count; ++i) {
         const coa_conflict_t *c = &conflicts[i];
-        if (c->a >= plan_count ||
-            (c->kind == COA_CONFLICT_VEHICLE && c->b >= plan_count) ||
+        if (c->a >= plan_count || (c->kind == COA_CONFLICT_VEHICLE && c->b >= plan_count) ||
             (c->kind != COA_CONFLICT_VEHICLE && c->kind != COA_CONFLICT_TRACK &&
              c->kind != COA_CONFLICT_OBSTACLE)) {
             return COA_ERR_ARGUMENT;

@@ -178,8 +178,7 @@ static bool sampling_ok(coa_real_t dt, uint32_t horizon)
     return real_positive(dt) && horizon >= 1u && horizon <= COA_MAX_HORIZON;
 }
 
-int coa_reference_sample(const coa_vehicle_t *v, coa_real_t dt, uint32_t horizon,
-                         coa_vec3_t *out)
+int coa_reference_sample(const coa_vehicle_t *v, coa_real_t dt, uint32_t horizon, coa_vec3_t *out)
 {
     ref_walk_t w;
     uint32_t k;
@@ -433,8 +432,7 @@ int64_t coa_area_scaled(int32_t a, int32_t b, uint32_t scale)
     return mul_div_floor(ma + mb, scale, 2u);
 }
 
-int64_t coa_heuristic_scaled(int32_t a, uint32_t steps_left, uint32_t steep_factor,
-                             uint32_t scale)
+int64_t coa_heuristic_scaled(int32_t a, uint32_t steps_left, uint32_t steep_factor, uint32_t scale)
 {
     uint64_t m = magnitude(a);
     uint64_t r = steps_left;
@@ -489,8 +487,8 @@ uint32_t coa_area_scale(const coa_vehicle_t *vehicles, size_t n)
 
 /* The bit reading below is only right for IEEE 754 binary64 stored in the byte order of
  * uint64_t, as on x86, ARM EABI and every target the core is built for. */
-_Static_assert(sizeof(double) == sizeof(uint64_t) && DBL_MANT_DIG == 53 &&
-                   DBL_MAX_EXP == 1024 && DBL_MIN_EXP == -1021,
+_Static_assert(sizeof(double) == sizeof(uint64_t) && DBL_MANT_DIG == 53 && DBL_MAX_EXP == 1024 &&
+                   DBL_MIN_EXP == -1021,
                "coa_deviation_weights needs IEEE 754 binary64 doubles");
 
 /* A positive finite double as mant * 2^e exactly, mant odd. Read from the bits rather
@@ -540,8 +538,8 @@ static bool vehicle_weight(const coa_vehicle_t *v, double step, double *w)
     return true;
 }
 
-int coa_deviation_weights(const coa_vehicle_t *vehicles, size_t n, coa_real_t dt,
-                          uint64_t *weights, int *exponent)
+int coa_deviation_weights(const coa_vehicle_t *vehicles, size_t n, coa_real_t dt, uint64_t *weights,
+                          int *exponent)
 {
     double step = (double)dt;
     int low = 0;

@@ -41,7 +41,8 @@ static int check_record(const coavoid_flight_t *f)
     return COA_OK;
 }
 
-coa_vec3_t coavoid_flight_position(const coavoid_flight_t *flight, size_t i, uint32_t k, int32_t offset)
+coa_vec3_t coavoid_flight_position(const coavoid_flight_t *flight, size_t i, uint32_t k,
+                                   int32_t offset)
 {
     const coavoid_flight_vehicle_t *v = &flight->vehicles[i];
     coa_vec3_t p = v->reference[k];
@@ -73,7 +74,8 @@ static void view_free(problem_view_t *pv)
 
 /* Builds the view; with `which` REFERENCE every row holds offsets[0]. Returns COA_OK,
  * COA_ERR_ARGUMENT (a track the core refuses to sample) or COA_ERR_WORKSPACE. */
-static int view_build(const coavoid_flight_t *f, coavoid_flight_trajectory_t which, problem_view_t *pv)
+static int view_build(const coavoid_flight_t *f, coavoid_flight_trajectory_t which,
+                      problem_view_t *pv)
 {
     const size_t n = f->vehicle_count;
     const size_t row = (size_t)f->steps + 1u;
@@ -201,7 +203,7 @@ static void note(coavoid_flight_conflict_t *out, size_t capacity, size_t *found,
 }
 
 int coavoid_flight_conflicts(const coavoid_flight_t *flight, coavoid_flight_trajectory_t which,
-                         coavoid_flight_conflict_t *out, size_t capacity, size_t *found)
+                             coavoid_flight_conflict_t *out, size_t capacity, size_t *found)
 {
     if (found == NULL || (capacity > 0u && out == NULL) ||
         (which != COAVOID_FLIGHT_FLOWN && which != COAVOID_FLIGHT_REFERENCE) ||
@@ -287,8 +289,8 @@ static double sample_time(const coavoid_flight_t *f, uint32_t k)
     return (double)k * (double)f->dt;
 }
 
-static bool add_vehicle(cJSON *vehicles, const coavoid_flight_t *f, const coavoid_flight_eval_t *eval,
-                        size_t i)
+static bool add_vehicle(cJSON *vehicles, const coavoid_flight_t *f,
+                        const coavoid_flight_eval_t *eval, size_t i)
 {
     const coavoid_flight_vehicle_t *v = &f->vehicles[i];
     cJSON *entry = cJSON_CreateObject();
@@ -335,8 +337,7 @@ static cJSON *build_json(const coavoid_flight_t *f, const coavoid_flight_eval_t 
 {
     cJSON *root = cJSON_CreateObject();
     if (root == NULL ||
-        cJSON_AddStringToObject(root, "scenario", f->scenario != NULL ? f->scenario : "") ==
-            NULL ||
+        cJSON_AddStringToObject(root, "scenario", f->scenario != NULL ? f->scenario : "") == NULL ||
         cJSON_AddStringToObject(root, "mode", f->mode != NULL ? f->mode : "") == NULL ||
         !add_number(root, "steps", f->steps) || !add_number(root, "replans", f->replans) ||
         cJSON_AddBoolToObject(root, "loss_of_separation", eval->loss_of_separation) == NULL ||
@@ -368,13 +369,14 @@ fail:
     return NULL;
 }
 
-int coavoid_flight_json(const coavoid_flight_t *flight, const coavoid_flight_eval_t *eval, FILE *out)
+int coavoid_flight_json(const coavoid_flight_t *flight, const coavoid_flight_eval_t *eval,
+                        FILE *out)
 {
     return coavoid_flight_json_extra(flight, eval, NULL, 0u, out);
 }
 
 int coavoid_flight_json_extra(const coavoid_flight_t *flight, const coavoid_flight_eval_t *eval,
-                          const coavoid_flight_extra_t *extra, size_t extra_count, FILE *out)
+                              const coavoid_flight_extra_t *extra, size_t extra_count, FILE *out)
 {
     if (eval == NULL || out == NULL || check_record(flight) != COA_OK ||
         (eval->loss_of_separation && eval->first_vehicle >= flight->vehicle_count) ||
@@ -403,12 +405,13 @@ int coavoid_flight_json_extra(const coavoid_flight_t *flight, const coavoid_flig
 
 /* "UAV 3 and track 7": who UAV first_vehicle lost separation with at first_step, from the
  * pairwise list (the core names only one side). Empty when the list cannot be made. */
-static void describe_first_loss(const coavoid_flight_t *f, const coavoid_flight_eval_t *eval, char *buf,
-                                size_t size)
+static void describe_first_loss(const coavoid_flight_t *f, const coavoid_flight_eval_t *eval,
+                                char *buf, size_t size)
 {
     size_t found = 0;
     buf[0] = '\0';
-    if (coavoid_flight_conflicts(f, COAVOID_FLIGHT_FLOWN, NULL, 0u, &found) != COA_OK || found == 0u) {
+    if (coavoid_flight_conflicts(f, COAVOID_FLIGHT_FLOWN, NULL, 0u, &found) != COA_OK ||
+        found == 0u) {
         return;
     }
     coavoid_flight_conflict_t *list = malloc(found * sizeof *list);
@@ -441,7 +444,8 @@ static void describe_first_loss(const coavoid_flight_t *f, const coavoid_flight_
     free(list);
 }
 
-int coavoid_flight_text(const coavoid_flight_t *flight, const coavoid_flight_eval_t *eval, FILE *out)
+int coavoid_flight_text(const coavoid_flight_t *flight, const coavoid_flight_eval_t *eval,
+                        FILE *out)
 {
     if (eval == NULL || out == NULL || check_record(flight) != COA_OK) {
         return COA_ERR_ARGUMENT;
@@ -449,14 +453,15 @@ int coavoid_flight_text(const coavoid_flight_t *flight, const coavoid_flight_eva
     const coavoid_flight_t *f = flight;
     fprintf(out, "scenario: %s\n", f->scenario != NULL ? f->scenario : "");
     fprintf(out, "mode: %s\n", f->mode != NULL ? f->mode : "");
-    fprintf(out, "steps: %lu (dt %.9g s, %.9g s flown)\n", (unsigned long)f->steps,
-            (double)f->dt, sample_time(f, f->steps));
+    fprintf(out, "steps: %lu (dt %.9g s, %.9g s flown)\n", (unsigned long)f->steps, (double)f->dt,
+            sample_time(f, f->steps));
     fprintf(out, "replans: %lu\n", (unsigned long)f->replans);
     if (eval->loss_of_separation && eval->first_vehicle < f->vehicle_count) {
         char who[160];
         describe_first_loss(f, eval, who, sizeof who);
         if (who[0] == '\0') {
-            snprintf(who, sizeof who, "UAV %u", (unsigned)f->vehicles[eval->first_vehicle].vehicle.id);
+            snprintf(who, sizeof who, "UAV %u",
+                     (unsigned)f->vehicles[eval->first_vehicle].vehicle.id);
         }
         fprintf(out, "loss of separation: yes, first over step %lu (t = %.9g s): %s\n",
                 (unsigned long)eval->first_step, sample_time(f, eval->first_step), who);
@@ -481,8 +486,7 @@ int coavoid_flight_text(const coavoid_flight_t *flight, const coavoid_flight_eva
                 unknown += v->known[k] ? 0u : 1u;
             }
             fprintf(out, "%s %lu of %lu samples not covered by any intent",
-                    (eval->vehicle_deviation != NULL || eval->vehicle_effort != NULL) ? ","
-                                                                                      : "",
+                    (eval->vehicle_deviation != NULL || eval->vehicle_effort != NULL) ? "," : "",
                     unknown, (unsigned long)f->steps + 1ul);
         }
         fputc('\n', out);

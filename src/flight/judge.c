@@ -6,8 +6,9 @@
 
 #include <string.h>
 
-int coavoid_judge_run(coavoid_judged_t *j, const coavoid_scenario_t *s, const char *mode, uint32_t steps,
-              uint32_t replans, coa_vec3_t *reference, int32_t *offsets, bool *known)
+int coavoid_judge_run(coavoid_judged_t *j, const coavoid_scenario_t *s, const char *mode,
+                      uint32_t steps, uint32_t replans, coa_vec3_t *reference, int32_t *offsets,
+                      bool *known)
 {
     const size_t n = s->vehicle_count;
     const size_t row = (size_t)steps + 1u;

@@ -27,7 +27,8 @@ typedef struct {
  * into j->eval. Returns coavoid_flight_evaluate's status (COA_ERR_ARGUMENT also for more than
  * COA_MAX_VEHICLES UAVs). The record points into j, s and the arrays, which must outlive
  * it and not move. Cost: coavoid_flight_evaluate's; no memory beyond its scratch. */
-int coavoid_judge_run(coavoid_judged_t *j, const coavoid_scenario_t *s, const char *mode, uint32_t steps,
-              uint32_t replans, coa_vec3_t *reference, int32_t *offsets, bool *known);
+int coavoid_judge_run(coavoid_judged_t *j, const coavoid_scenario_t *s, const char *mode,
+                      uint32_t steps, uint32_t replans, coa_vec3_t *reference, int32_t *offsets,
+                      bool *known);
 
 #endif /* COAVOID_APP_JUDGE_H */

@@ -21,16 +21,16 @@
 #include <string.h>
 
 #define SVG_WIDTH 960.0
-#define SVG_LEFT 76.0   /* room for the z and y tick labels */
+#define SVG_LEFT 76.0 /* room for the z and y tick labels */
 #define SVG_RIGHT 24.0
 #define SVG_PLOT_WIDTH (SVG_WIDTH - SVG_LEFT - SVG_RIGHT)
 #define SVG_TOP_MIN_HEIGHT 220.0
 #define SVG_TOP_MAX_HEIGHT 560.0
 #define SVG_PANEL_HEIGHT 210.0
-#define SVG_PANEL_GAP 74.0     /* between panels: the t axis labels and the next title */
-#define SVG_SUBSTEPS 8u        /* samples per step when finding the terrain under a path */
-#define SVG_NEAR_RADII 3.0     /* traffic within this many summed radii is drawn in a panel */
-#define SVG_MAX_MARKERS 4000u  /* markers of one kind beyond this are counted, not drawn */
+#define SVG_PANEL_GAP 74.0    /* between panels: the t axis labels and the next title */
+#define SVG_SUBSTEPS 8u       /* samples per step when finding the terrain under a path */
+#define SVG_NEAR_RADII 3.0    /* traffic within this many summed radii is drawn in a panel */
+#define SVG_MAX_MARKERS 4000u /* markers of one kind beyond this are counted, not drawn */
 
 static const char *const palette[] = {"#d62728", "#1f77b4", "#2ca02c", "#ff7f0e", "#9467bd",
                                       "#8c564b", "#e377c2", "#17becf", "#bcbd22"};
@@ -64,16 +64,16 @@ static double py(const frame_t *fr, double y)
 typedef struct {
     const coavoid_flight_t *f;
     FILE *out;
-    size_t row;             /* steps + 1 */
-    coa_vec3_t *flown;      /* n rows: flown positions */
-    coa_vec3_t *refpos;     /* n rows: positions at the initial offset (no manoeuvre) */
-    coa_vec3_t *tracks;     /* track_count rows */
+    size_t row;         /* steps + 1 */
+    coa_vec3_t *flown;  /* n rows: flown positions */
+    coa_vec3_t *refpos; /* n rows: positions at the initial offset (no manoeuvre) */
+    coa_vec3_t *tracks; /* track_count rows */
     coavoid_flight_conflict_t *ref_conflicts;
     size_t ref_count;
     coavoid_flight_conflict_t *losses;
     size_t loss_count;
-    bool *ref_mark;         /* n * steps: UAV i's step k conflicts (references) */
-    bool *loss_mark;        /* n * steps: UAV i's step k conflicts (flown) */
+    bool *ref_mark;  /* n * steps: UAV i's step k conflicts (references) */
+    bool *loss_mark; /* n * steps: UAV i's step k conflicts (flown) */
     bool any_unknown;
 } svg_t;
 
@@ -199,8 +199,9 @@ static void axes(FILE *out, const frame_t *fr, const char *xtitle, const char *y
     fputs("</g>\n", out);
     text_at(out, fr->left + fr->width / 2.0, fr->top + fr->height + 34.0,
             "text-anchor=\"middle\" class=\"axis\"", xtitle);
-    fprintf(out, "<text transform=\"translate(%.1f %.1f) rotate(-90)\" "
-                 "text-anchor=\"middle\" class=\"axis\">",
+    fprintf(out,
+            "<text transform=\"translate(%.1f %.1f) rotate(-90)\" "
+            "text-anchor=\"middle\" class=\"axis\">",
             fr->left - 56.0, fr->top + fr->height / 2.0);
     put_text(out, ytitle);
     fputs("</text>\n", out);
@@ -288,8 +289,8 @@ static void polyline_xy(FILE *out, const frame_t *fr, const coa_vec3_t *row, siz
     fprintf(out, "\" %s/>\n", attrs);
 }
 
-static void polyline_tz(FILE *out, const frame_t *fr, const coa_vec3_t *row, double dt,
-                        size_t from, size_t to, double dz, const char *attrs)
+static void polyline_tz(FILE *out, const frame_t *fr, const coa_vec3_t *row, double dt, size_t from,
+                        size_t to, double dz, const char *attrs)
 {
     fputs("<polyline fill=\"none\" points=\"", out);
     for (size_t k = from; k <= to; k++) {
@@ -317,8 +318,8 @@ static void band_tz(FILE *out, const frame_t *fr, const coa_vec3_t *row, double 
 /* ---- obstacles ---- */
 
 /* Horizontal bounding rectangle of an obstacle (a polytope's vertices' extent). */
-static void obstacle_bounds(const coa_obstacle_t *o, double *x0, double *y0, double *z0,
-                            double *x1, double *y1, double *z1)
+static void obstacle_bounds(const coa_obstacle_t *o, double *x0, double *y0, double *z0, double *x1,
+                            double *y1, double *z1)
 {
     if (o->kind == COA_OBSTACLE_BOX) {
         *x0 = (double)o->box.min.x;
@@ -454,7 +455,8 @@ static double legend(const svg_t *s, double y)
                 "loss of separation (flown)");
     if (s->any_unknown) {
         legend_item(out, &x, &y,
-                    "<rect x=\"0\" y=\"-3\" width=\"28\" height=\"6\" fill=\"" UNKNOWN_COLOUR "\"/>",
+                    "<rect x=\"0\" y=\"-3\" width=\"28\" height=\"6\" fill=\"" UNKNOWN_COLOUR
+                    "\"/>",
                     "no intent in the log");
     }
     return y + 16.0;
@@ -588,10 +590,11 @@ static void top_view(const svg_t *s, double *y)
         char label[96];
         obstacle_bounds(o, &ox0, &oy0, &oz0, &ox1, &oy1, &oz1);
         if (o->kind == COA_OBSTACLE_BOX) {
-            fprintf(out,
-                    "<rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" height=\"%.2f\" fill=\"" TERRAIN_FILL
-                    "\" fill-opacity=\"0.75\" stroke=\"#777\"/>\n",
-                    px(&fr, ox0), py(&fr, oy1), (ox1 - ox0) * scale, (oy1 - oy0) * scale);
+            fprintf(
+                out,
+                "<rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" height=\"%.2f\" fill=\"" TERRAIN_FILL
+                "\" fill-opacity=\"0.75\" stroke=\"#777\"/>\n",
+                px(&fr, ox0), py(&fr, oy1), (ox1 - ox0) * scale, (oy1 - oy0) * scale);
         } else {
             size_t h = footprint_hull(&o->polytope, pts, hull);
             fputs("<polygon points=\"", out);
@@ -602,8 +605,8 @@ static void top_view(const svg_t *s, double *y)
             fputs("\" fill=\"" TERRAIN_FILL "\" fill-opacity=\"0.75\" stroke=\"#777\"/>\n", out);
         }
         snprintf(label, sizeof label, "obstacle %zu, z %g to %g m", j, oz0, oz1);
-        text_at(out, px(&fr, fmax(ox0, x0)) + 3.0, py(&fr, fmin(oy1, y1)) + 12.0,
-                "class=\"small\"", label);
+        text_at(out, px(&fr, fmax(ox0, x0)) + 3.0, py(&fr, fmin(oy1, y1)) + 12.0, "class=\"small\"",
+                label);
     }
 
     /* Tracks over the run, with their ids at the start. */
@@ -612,8 +615,9 @@ static void top_view(const svg_t *s, double *y)
         char label[48];
         polyline_xy(out, &fr, row, 0, s->row - 1u,
                     "stroke=\"" TRACK_COLOUR "\" stroke-width=\"1.6\" stroke-dasharray=\"2 3\"");
-        fprintf(out, "<rect x=\"%.2f\" y=\"%.2f\" width=\"7\" height=\"7\" fill=\"" TRACK_COLOUR
-                     "\"/>\n",
+        fprintf(out,
+                "<rect x=\"%.2f\" y=\"%.2f\" width=\"7\" height=\"7\" fill=\"" TRACK_COLOUR
+                "\"/>\n",
                 px(&fr, (double)row[0].x) - 3.5, py(&fr, (double)row[0].y) - 3.5);
         snprintf(label, sizeof label, "track %lu", (unsigned long)f->tracks[j].id);
         text_at(out, px(&fr, (double)row[0].x) + 7.0, py(&fr, (double)row[0].y) + 14.0,
@@ -712,10 +716,10 @@ static double horizontal_distance(coa_vec3_t a, coa_vec3_t b)
  * q - vehicle_count. */
 typedef struct {
     bool is_track;
-    size_t j;                  /* its index among the UAVs or among the tracks */
-    const coa_vec3_t *row;     /* its samples 0..K */
+    size_t j;              /* its index among the UAVs or among the tracks */
+    const coa_vec3_t *row; /* its samples 0..K */
     const coa_volume_t *vol;
-    double near;               /* horizontal distance to UAV i within which it is drawn */
+    double near; /* horizontal distance to UAV i within which it is drawn */
 } svg_other_t;
 
 static svg_other_t other_traffic(const svg_t *s, size_t i, size_t q)
@@ -726,8 +730,8 @@ static svg_other_t other_traffic(const svg_t *s, size_t i, size_t q)
     o.j = o.is_track ? q - f->vehicle_count : q;
     o.row = o.is_track ? &s->tracks[o.j * s->row] : &s->flown[o.j * s->row];
     o.vol = o.is_track ? &f->tracks[o.j].volume : &f->vehicles[o.j].vehicle.volume;
-    o.near = SVG_NEAR_RADII *
-             ((double)f->vehicles[i].vehicle.volume.radius + (double)o.vol->radius);
+    o.near =
+        SVG_NEAR_RADII * ((double)f->vehicles[i].vehicle.volume.radius + (double)o.vol->radius);
     return o;
 }
 
@@ -762,8 +766,7 @@ static void near_traffic(const svg_t *s, size_t i, const frame_t *fr, bool draw_
                      colour);
             band_tz(out, fr, o.row, (double)f->dt, from, to, (double)o.vol->half_height, attrs);
             if (to > from) {
-                snprintf(attrs, sizeof attrs,
-                         "stroke=\"%s\" stroke-width=\"1.4\"%s", colour,
+                snprintf(attrs, sizeof attrs, "stroke=\"%s\" stroke-width=\"1.4\"%s", colour,
                          o.is_track ? " stroke-dasharray=\"2 3\"" : "");
                 polyline_tz(out, fr, o.row, (double)f->dt, from, to, 0.0, attrs);
             } else {
@@ -783,8 +786,7 @@ static void near_traffic(const svg_t *s, size_t i, const frame_t *fr, bool draw_
                 /* Beside the run's start, outside it: conflict markers sit inside runs. */
                 double x = px(fr, (double)from * (double)f->dt);
                 bool left = x - fr->left > 90.0;
-                fprintf(out,
-                        "<text x=\"%.1f\" y=\"%.1f\" class=\"near\" fill=\"%s\"%s>",
+                fprintf(out, "<text x=\"%.1f\" y=\"%.1f\" class=\"near\" fill=\"%s\"%s>",
                         left ? x - 5.0 : x + 5.0, py(fr, (double)o.row[from].z) + 4.0, colour,
                         left ? " text-anchor=\"end\"" : "");
                 put_text(out, label);
@@ -853,16 +855,17 @@ static void altitude_panel(const svg_t *s, const coavoid_flight_eval_t *eval, si
         hi += pad;
     }
 
-    snprintf(text, sizeof text, "UAV %u: altitude along its path (radius %g m, half-height %g m, "
-                                "priority %lu)",
+    snprintf(text, sizeof text,
+             "UAV %u: altitude along its path (radius %g m, half-height %g m, "
+             "priority %lu)",
              (unsigned)v->vehicle.id, r, h, (unsigned long)v->vehicle.priority);
     fprintf(out, "<text x=\"%.1f\" y=\"%.1f\" class=\"panel\" fill=\"%s\">", SVG_LEFT, *y + 14.0,
             colour_of(i));
     put_text(out, text);
     fputs("</text>\n", out);
     if (eval != NULL && eval->vehicle_deviation != NULL && eval->vehicle_effort != NULL) {
-        snprintf(text, sizeof text, "deviation %.6g m\xc2\xb2, effort %lu", eval->vehicle_deviation[i],
-                 (unsigned long)eval->vehicle_effort[i]);
+        snprintf(text, sizeof text, "deviation %.6g m\xc2\xb2, effort %lu",
+                 eval->vehicle_deviation[i], (unsigned long)eval->vehicle_effort[i]);
         text_at(out, SVG_LEFT + SVG_PLOT_WIDTH, *y + 14.0, "text-anchor=\"end\" class=\"info\"",
                 text);
     }
@@ -898,8 +901,8 @@ static void altitude_panel(const svg_t *s, const coavoid_flight_eval_t *eval, si
             if (in_run && (!over || q == total)) {
                 double run_end = over ? t_end : fmin(t_end, t - sub / 2.0);
                 fprintf(out,
-                        "<rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" height=\"%.2f\" fill=\"" TERRAIN_FILL
-                        "\" fill-opacity=\"0.8\" stroke=\"#777\"/>\n",
+                        "<rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" height=\"%.2f\" "
+                        "fill=\"" TERRAIN_FILL "\" fill-opacity=\"0.8\" stroke=\"#777\"/>\n",
                         px(&fr, run_start), py(&fr, oz1), px(&fr, run_end) - px(&fr, run_start),
                         py(&fr, oz0) - py(&fr, oz1));
                 snprintf(text, sizeof text, "obstacle %zu%s", j,
@@ -932,10 +935,11 @@ static void altitude_panel(const svg_t *s, const coavoid_flight_eval_t *eval, si
             if (!v->known[k]) {
                 double t0 = fmax(0.0, ((double)k - 0.5) * dt);
                 double t1 = fmin(t_end, ((double)k + 0.5) * dt);
-                fprintf(out,
-                        "<rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" height=\"6\" fill=\"" UNKNOWN_COLOUR
-                        "\"/>\n",
-                        px(&fr, t0), fr.top + fr.height - 6.0, px(&fr, t1) - px(&fr, t0));
+                fprintf(
+                    out,
+                    "<rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" height=\"6\" fill=\"" UNKNOWN_COLOUR
+                    "\"/>\n",
+                    px(&fr, t0), fr.top + fr.height - 6.0, px(&fr, t1) - px(&fr, t0));
             }
         }
     }

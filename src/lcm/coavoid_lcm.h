@@ -41,16 +41,18 @@ extern "C" {
 
 /* Refusals. Distinct from the core's -1..-3 so that a status message's last_reject_code
  * says which rule refused. COA_ERR_ARGUMENT is still returned for NULL arguments. */
-#define COAVOID_LCM_ERR_DECODE (-100)    /* bytes do not decode: wrong type (fingerprint) or truncated */
+#define COAVOID_LCM_ERR_DECODE \
+    (-100) /* bytes do not decode: wrong type (fingerprint) or truncated */
 #define COAVOID_LCM_ERR_NONFINITE (-101) /* NaN or infinity */
-#define COAVOID_LCM_ERR_VALUE (-102)     /* a finite number outside its range (negative size, 1e300 m, ...) */
-#define COAVOID_LCM_ERR_COUNT (-103)     /* a count beyond the message's capacity or inconsistent */
-#define COAVOID_LCM_ERR_ENUM (-104)      /* an unknown mode, status, kind, ... */
-#define COAVOID_LCM_ERR_ID (-105)        /* an id out of range or repeated */
-#define COAVOID_LCM_ERR_TIME (-106)      /* a time stamp in the future, stale, or out of order */
-#define COAVOID_LCM_ERR_SEQUENCE (-107)  /* a sequence number (or version) that went backwards */
-#define COAVOID_LCM_ERR_SENDERS (-108)   /* the caller's sequence table is full */
-#define COAVOID_LCM_ERR_CAPACITY (-109)  /* the caller's output array is too small */
+#define COAVOID_LCM_ERR_VALUE \
+    (-102) /* a finite number outside its range (negative size, 1e300 m, ...) */
+#define COAVOID_LCM_ERR_COUNT (-103)    /* a count beyond the message's capacity or inconsistent */
+#define COAVOID_LCM_ERR_ENUM (-104)     /* an unknown mode, status, kind, ... */
+#define COAVOID_LCM_ERR_ID (-105)       /* an id out of range or repeated */
+#define COAVOID_LCM_ERR_TIME (-106)     /* a time stamp in the future, stale, or out of order */
+#define COAVOID_LCM_ERR_SEQUENCE (-107) /* a sequence number (or version) that went backwards */
+#define COAVOID_LCM_ERR_SENDERS (-108)  /* the caller's sequence table is full */
+#define COAVOID_LCM_ERR_CAPACITY (-109) /* the caller's output array is too small */
 
 /* Bounds on numbers, beyond finiteness. They keep every converted value finite in float
  * too (COA_SINGLE_PRECISION) and refuse values no aircraft has. */
@@ -62,11 +64,11 @@ extern "C" {
 
 /* How the receiver judges times. All microseconds. */
 typedef struct {
-    int64_t now_utime;    /* receiver's clock; 0 disables the age and future checks */
-    int64_t max_age_us;   /* utime < now - max_age: stale (also bounds plan/estimate
+    int64_t now_utime;     /* receiver's clock; 0 disables the age and future checks */
+    int64_t max_age_us;    /* utime < now - max_age: stale (also bounds plan/estimate
                              times around utime) */
     int64_t max_future_us; /* utime > now + max_future: a clock ahead or a bad stamp */
-    int64_t epoch_utime;  /* origin of the core's clock */
+    int64_t epoch_utime;   /* origin of the core's clock */
 } coavoid_lcm_context_t;
 
 /* Per-sender last sequence numbers, in the caller's array (one table per message type). */
@@ -83,15 +85,15 @@ typedef struct {
 
 /* Empties the table over entries[0..capacity-1]. Cannot fail on non-NULL table. */
 void coavoid_lcm_sequence_init(coavoid_lcm_sequence_table_t *table, coavoid_lcm_sender_t *entries,
-                           size_t capacity);
+                               size_t capacity);
 
 /* Accepts `sequence` from `sender` when it is greater than the last one accepted (or
  * equal, with allow_equal: a republished version), recording it. Returns COA_OK,
  * COAVOID_LCM_ERR_SEQUENCE (backwards: nothing recorded), COAVOID_LCM_ERR_SENDERS (new sender,
  * table full) or COA_ERR_ARGUMENT. A sender that restarts its numbering is refused until
  * coavoid_lcm_sequence_forget (e.g. after its heartbeat went silent). Cost O(count). */
-int coavoid_lcm_sequence_accept(coavoid_lcm_sequence_table_t *table, uint32_t sender, int64_t sequence,
-                            bool allow_equal);
+int coavoid_lcm_sequence_accept(coavoid_lcm_sequence_table_t *table, uint32_t sender,
+                                int64_t sequence, bool allow_equal);
 
 /* Forgets a sender. Cost O(count). */
 void coavoid_lcm_sequence_forget(coavoid_lcm_sequence_table_t *table, uint32_t sender);
@@ -105,7 +107,7 @@ const char *coavoid_lcm_error_name(int status);
 typedef struct {
     int64_t utime;
     int64_t sequence;
-    int8_t mode;        /* COAVOID_INTENT_T_MODE_* */
+    int8_t mode; /* COAVOID_INTENT_T_MODE_* */
     coa_vec3_t position;
     coa_vec3_t velocity;
     int64_t plan_utime; /* time of sample 0 (us) */
@@ -131,7 +133,7 @@ typedef struct {
  * accepted intent gives a vehicle the planner accepts.
  * Returns COA_OK or a COAVOID_LCM_ERR_* with *reason naming the field. Cost O(sample_count). */
 int coavoid_lcm_intent_check(const coavoid_intent_t *msg, const coavoid_lcm_context_t *ctx,
-                         const char **reason);
+                             const char **reason);
 
 /* The core's views of an intent, after the check and the sequence rule (seq may be NULL:
  * no sequence rule):
@@ -146,19 +148,20 @@ int coavoid_lcm_intent_check(const coavoid_intent_t *msg, const coavoid_lcm_cont
  * COAVOID_LCM_ERR_SENDERS, COA_ERR_ARGUMENT for NULL outputs; outputs are unspecified on an
  * error. Cost O(sample_count), no memory. */
 int coavoid_lcm_intent_to_core(const coavoid_intent_t *msg, const coavoid_lcm_context_t *ctx,
-                           coavoid_lcm_sequence_table_t *seq, coavoid_lcm_intent_info_t *info,
-                           coa_vehicle_t *vehicle, coa_intent_plan_t *plan,
-                           coavoid_lcm_intent_arrays_t *arrays, const char **reason);
+                               coavoid_lcm_sequence_table_t *seq, coavoid_lcm_intent_info_t *info,
+                               coa_vehicle_t *vehicle, coa_intent_plan_t *plan,
+                               coavoid_lcm_intent_arrays_t *arrays, const char **reason);
 
 /* An intent from a vehicle (its id, priority, volume, speeds, steep factor, max_offset;
  * its route is not read), info, and `count` reference points with their offsets. The
  * result is checked as a receiver would check it, so a node cannot publish what its
  * peers refuse. Returns COA_OK, COA_ERR_ARGUMENT (NULL), COAVOID_LCM_ERR_COUNT (count not in
  * 2..MAX_SAMPLES) or the check's refusal. Cost O(count). */
-int coavoid_lcm_intent_from_core(const coa_vehicle_t *vehicle, const coavoid_lcm_intent_info_t *info,
-                             const coa_vec3_t *reference, const int32_t *offsets, size_t count,
-                             const coavoid_lcm_context_t *ctx, coavoid_intent_t *msg,
-                             const char **reason);
+int coavoid_lcm_intent_from_core(const coa_vehicle_t *vehicle,
+                                 const coavoid_lcm_intent_info_t *info, const coa_vec3_t *reference,
+                                 const int32_t *offsets, size_t count,
+                                 const coavoid_lcm_context_t *ctx, coavoid_intent_t *msg,
+                                 const char **reason);
 
 /* ---- plan ---- */
 
@@ -166,29 +169,29 @@ typedef struct {
     int64_t utime;
     uint32_t coordinator_id;
     int64_t plan_id;
-    coa_real_t valid_from;  /* core clock (s) of sample 0 */
+    coa_real_t valid_from; /* core clock (s) of sample 0 */
     coa_real_t valid_until;
     coa_real_t dt;
     uint32_t horizon;
-    int8_t mode;            /* COAVOID_PLAN_T_MODE_* */
+    int8_t mode; /* COAVOID_PLAN_T_MODE_* */
     size_t vehicle_count;
     uint16_t uav_ids[COAVOID_PLAN_T_MAX_VEHICLES];
 } coavoid_lcm_plan_info_t;
 
 int coavoid_lcm_plan_check(const coavoid_plan_t *msg, const coavoid_lcm_context_t *ctx,
-                       const char **reason);
+                           const char **reason);
 /* offsets: capacity >= vehicle_count * (horizon + 1) int32, row i = uav_ids[i] (the
  * layout the planner writes); result's status, costs, nodes_expanded and planned_count
  * are set, order is 0..n-1. */
 int coavoid_lcm_plan_to_core(const coavoid_plan_t *msg, const coavoid_lcm_context_t *ctx,
-                         coavoid_lcm_sequence_table_t *seq, coavoid_lcm_plan_info_t *info,
-                         coa_plan_result_t *result, int32_t *offsets, size_t capacity,
-                         const char **reason);
+                             coavoid_lcm_sequence_table_t *seq, coavoid_lcm_plan_info_t *info,
+                             coa_plan_result_t *result, int32_t *offsets, size_t capacity,
+                             const char **reason);
 /* offsets as the planner wrote them for info->vehicle_count vehicles (rows in vehicle
  * index order; the message lists them in result->order). */
 int coavoid_lcm_plan_from_core(const coavoid_lcm_plan_info_t *info, const coa_plan_result_t *result,
-                           const int32_t *offsets, const coavoid_lcm_context_t *ctx,
-                           coavoid_plan_t *msg, const char **reason);
+                               const int32_t *offsets, const coavoid_lcm_context_t *ctx,
+                               coavoid_plan_t *msg, const char **reason);
 
 /* ---- track ---- */
 
@@ -199,68 +202,70 @@ typedef struct {
 } coavoid_lcm_track_info_t;
 
 int coavoid_lcm_track_check(const coavoid_track_t *msg, const coavoid_lcm_context_t *ctx,
-                        const char **reason);
+                            const char **reason);
 /* track->position is extrapolated to the core clock's t = 0 (the core's convention);
  * path: capacity >= msg->path_count. */
 int coavoid_lcm_track_to_core(const coavoid_track_t *msg, const coavoid_lcm_context_t *ctx,
-                          coavoid_lcm_sequence_table_t *seq, coavoid_lcm_track_info_t *info,
-                          coa_track_t *track, coa_track_point_t *path, size_t capacity,
-                          const char **reason);
+                              coavoid_lcm_sequence_table_t *seq, coavoid_lcm_track_info_t *info,
+                              coa_track_t *track, coa_track_point_t *path, size_t capacity,
+                              const char **reason);
 int coavoid_lcm_track_from_core(const coa_track_t *track, const coavoid_lcm_track_info_t *info,
-                            const coavoid_lcm_context_t *ctx, coavoid_track_t *msg,
-                            const char **reason);
+                                const coavoid_lcm_context_t *ctx, coavoid_track_t *msg,
+                                const char **reason);
 
 /* ---- obstacle map ---- */
 
-int coavoid_lcm_obstacle_map_check(const coavoid_obstacle_map_t *msg, const coavoid_lcm_context_t *ctx,
-                               const char **reason);
+int coavoid_lcm_obstacle_map_check(const coavoid_obstacle_map_t *msg,
+                                   const coavoid_lcm_context_t *ctx, const char **reason);
 /* Boxes first, then polytopes. obstacles: capacity >= box_count + polytope_count;
  * vertices: vertex_capacity >= the sum of vertex_count. Equal versions are accepted
  * (a republished map). */
-int coavoid_lcm_obstacle_map_to_core(const coavoid_obstacle_map_t *msg, const coavoid_lcm_context_t *ctx,
-                                 coavoid_lcm_sequence_table_t *seq, coa_obstacle_t *obstacles,
-                                 size_t capacity, size_t *count, coa_vec3_t *vertices,
-                                 size_t vertex_capacity, const char **reason);
+int coavoid_lcm_obstacle_map_to_core(const coavoid_obstacle_map_t *msg,
+                                     const coavoid_lcm_context_t *ctx,
+                                     coavoid_lcm_sequence_table_t *seq, coa_obstacle_t *obstacles,
+                                     size_t capacity, size_t *count, coa_vec3_t *vertices,
+                                     size_t vertex_capacity, const char **reason);
 int coavoid_lcm_obstacle_map_from_core(const coa_obstacle_t *obstacles, size_t count, int64_t utime,
-                                   uint32_t map_id, int64_t version, const coavoid_lcm_context_t *ctx,
-                                   coavoid_obstacle_map_t *msg, const char **reason);
+                                       uint32_t map_id, int64_t version,
+                                       const coavoid_lcm_context_t *ctx,
+                                       coavoid_obstacle_map_t *msg, const char **reason);
 
 /* ---- conflict report (monitoring) ---- */
 
 int coavoid_lcm_conflict_report_check(const coavoid_conflict_report_t *msg,
-                                  const coavoid_lcm_context_t *ctx, const char **reason);
+                                      const coavoid_lcm_context_t *ctx, const char **reason);
 /* From a prediction: a and b indices are mapped to ids through plan_ids (and track_ids
  * for track conflicts); obstacles keep their index. cluster may be NULL. Conflicts past
  * the message's capacity are counted in conflicts_found only. */
 int coavoid_lcm_conflict_report_from_core(const coa_conflict_t *conflicts, size_t count,
-                                      size_t conflicts_found, const uint16_t *plan_ids,
-                                      size_t plan_count, const uint32_t *track_ids,
-                                      size_t track_count, const uint32_t *cluster,
-                                      int64_t utime, uint32_t reporter_id, int64_t sequence,
-                                      int64_t prediction_utime, coa_real_t dt, uint32_t horizon,
-                                      const coavoid_lcm_context_t *ctx,
-                                      coavoid_conflict_report_t *msg, const char **reason);
+                                          size_t conflicts_found, const uint16_t *plan_ids,
+                                          size_t plan_count, const uint32_t *track_ids,
+                                          size_t track_count, const uint32_t *cluster,
+                                          int64_t utime, uint32_t reporter_id, int64_t sequence,
+                                          int64_t prediction_utime, coa_real_t dt, uint32_t horizon,
+                                          const coavoid_lcm_context_t *ctx,
+                                          coavoid_conflict_report_t *msg, const char **reason);
 
 /* ---- status ---- */
 
 int coavoid_lcm_status_check(const coavoid_status_t *msg, const coavoid_lcm_context_t *ctx,
-                         const char **reason);
+                             const char **reason);
 
 /* Check + sequence rule for the two types that have no core counterpart to convert to. */
 int coavoid_lcm_conflict_report_accept(const coavoid_conflict_report_t *msg,
-                                   const coavoid_lcm_context_t *ctx, coavoid_lcm_sequence_table_t *seq,
-                                   const char **reason);
+                                       const coavoid_lcm_context_t *ctx,
+                                       coavoid_lcm_sequence_table_t *seq, const char **reason);
 int coavoid_lcm_status_accept(const coavoid_status_t *msg, const coavoid_lcm_context_t *ctx,
-                          coavoid_lcm_sequence_table_t *seq, const char **reason);
+                              coavoid_lcm_sequence_table_t *seq, const char **reason);
 
 /* ---- counting what arrives ---- */
 
 /* What a node received and refused since it started, for its status message. */
 typedef struct {
-    int64_t received;          /* messages handed to the node, decoded or not */
-    int64_t rejected;          /* refused by decoding or validation; <= received */
-    int32_t last_reject_code;  /* the last refusal's code (<= 0; 0: none yet) */
-    const char *last_reason;   /* its reason (static string), or "none" */
+    int64_t received;         /* messages handed to the node, decoded or not */
+    int64_t rejected;         /* refused by decoding or validation; <= received */
+    int32_t last_reject_code; /* the last refusal's code (<= 0; 0: none yet) */
+    const char *last_reason;  /* its reason (static string), or "none" */
 } coavoid_lcm_rx_stats_t;
 
 /* Zeroes the counters. Cannot fail on non-NULL stats. */

@@ -9,12 +9,12 @@
 #include <math.h>
 #include <string.h>
 
-#define REJECT(code, text)       \
-    do {                         \
-        if (reason != NULL) {    \
-            *reason = (text);    \
-        }                        \
-        return (code);           \
+#define REJECT(code, text)    \
+    do {                      \
+        if (reason != NULL) { \
+            *reason = (text); \
+        }                     \
+        return (code);        \
     } while (0)
 
 #define OK_REASON()           \
@@ -129,7 +129,7 @@ static void vec_to(coa_vec3_t v, double out[3])
 /* ---- sequence table ---- */
 
 void coavoid_lcm_sequence_init(coavoid_lcm_sequence_table_t *table, coavoid_lcm_sender_t *entries,
-                           size_t capacity)
+                               size_t capacity)
 {
     if (table == NULL) {
         return;
@@ -139,8 +139,8 @@ void coavoid_lcm_sequence_init(coavoid_lcm_sequence_table_t *table, coavoid_lcm_
     table->count = 0u;
 }
 
-int coavoid_lcm_sequence_accept(coavoid_lcm_sequence_table_t *table, uint32_t sender, int64_t sequence,
-                            bool allow_equal)
+int coavoid_lcm_sequence_accept(coavoid_lcm_sequence_table_t *table, uint32_t sender,
+                                int64_t sequence, bool allow_equal)
 {
     size_t i;
     if (table == NULL || table->count > table->capacity) {
@@ -183,17 +183,28 @@ void coavoid_lcm_sequence_forget(coavoid_lcm_sequence_table_t *table, uint32_t s
 const char *coavoid_lcm_error_name(int status)
 {
     switch (status) {
-    case COAVOID_LCM_ERR_DECODE: return "message does not decode";
-    case COAVOID_LCM_ERR_NONFINITE: return "non-finite number";
-    case COAVOID_LCM_ERR_VALUE: return "number out of range";
-    case COAVOID_LCM_ERR_COUNT: return "count out of range";
-    case COAVOID_LCM_ERR_ENUM: return "unknown enum value";
-    case COAVOID_LCM_ERR_ID: return "invalid id";
-    case COAVOID_LCM_ERR_TIME: return "bad time stamp";
-    case COAVOID_LCM_ERR_SEQUENCE: return "sequence went backwards";
-    case COAVOID_LCM_ERR_SENDERS: return "too many senders";
-    case COAVOID_LCM_ERR_CAPACITY: return "output too small";
-    default: return coa_status_name(status);
+    case COAVOID_LCM_ERR_DECODE:
+        return "message does not decode";
+    case COAVOID_LCM_ERR_NONFINITE:
+        return "non-finite number";
+    case COAVOID_LCM_ERR_VALUE:
+        return "number out of range";
+    case COAVOID_LCM_ERR_COUNT:
+        return "count out of range";
+    case COAVOID_LCM_ERR_ENUM:
+        return "unknown enum value";
+    case COAVOID_LCM_ERR_ID:
+        return "invalid id";
+    case COAVOID_LCM_ERR_TIME:
+        return "bad time stamp";
+    case COAVOID_LCM_ERR_SEQUENCE:
+        return "sequence went backwards";
+    case COAVOID_LCM_ERR_SENDERS:
+        return "too many senders";
+    case COAVOID_LCM_ERR_CAPACITY:
+        return "output too small";
+    default:
+        return coa_status_name(status);
     }
 }
 
@@ -282,7 +293,7 @@ static bool intent_leg_ok(const coavoid_intent_t *msg, coa_vec3_t a, coa_vec3_t 
 }
 
 int coavoid_lcm_intent_check(const coavoid_intent_t *msg, const coavoid_lcm_context_t *ctx,
-                         const char **reason)
+                             const char **reason)
 {
     int rc;
     int32_t j;
@@ -302,7 +313,8 @@ int coavoid_lcm_intent_check(const coavoid_intent_t *msg, const coavoid_lcm_cont
         REJECT(COAVOID_LCM_ERR_VALUE, "intent: priority < 1");
     }
     if (msg->mode != COAVOID_INTENT_T_MODE_CENTRALISED &&
-        msg->mode != COAVOID_INTENT_T_MODE_DECOUPLED && msg->mode != COAVOID_INTENT_T_MODE_REFERENCE) {
+        msg->mode != COAVOID_INTENT_T_MODE_DECOUPLED &&
+        msg->mode != COAVOID_INTENT_T_MODE_REFERENCE) {
         REJECT(COAVOID_LCM_ERR_ENUM, "intent: unknown mode");
     }
     if ((rc = vec_rule(msg->position, COAVOID_LCM_MAX_COORDINATE)) != COA_OK) {
@@ -317,10 +329,13 @@ int coavoid_lcm_intent_check(const coavoid_intent_t *msg, const coavoid_lcm_cont
     if ((rc = size_rule(msg->half_height, true)) != COA_OK) {
         REJECT(rc, "intent: half_height not in (0, 1e5] m");
     }
-    if ((rc = number_rule(msg->cruise_speed, COAVOID_LCM_MAX_SPEED)) != COA_OK || !(msg->cruise_speed > 0.0)) {
-        REJECT(rc != COA_OK ? rc : COAVOID_LCM_ERR_VALUE, "intent: cruise_speed not in (0, 1e4] m/s");
+    if ((rc = number_rule(msg->cruise_speed, COAVOID_LCM_MAX_SPEED)) != COA_OK ||
+        !(msg->cruise_speed > 0.0)) {
+        REJECT(rc != COA_OK ? rc : COAVOID_LCM_ERR_VALUE,
+               "intent: cruise_speed not in (0, 1e4] m/s");
     }
-    if ((rc = number_rule(msg->climb_rate, COAVOID_LCM_MAX_SPEED)) != COA_OK || !(msg->climb_rate > 0.0)) {
+    if ((rc = number_rule(msg->climb_rate, COAVOID_LCM_MAX_SPEED)) != COA_OK ||
+        !(msg->climb_rate > 0.0)) {
         REJECT(rc != COA_OK ? rc : COAVOID_LCM_ERR_VALUE, "intent: climb_rate not in (0, 1e4] m/s");
     }
     if (msg->steep_factor < 2 || msg->steep_factor > (int32_t)COA_MAX_STEEP_FACTOR) {
@@ -336,8 +351,9 @@ int coavoid_lcm_intent_check(const coavoid_intent_t *msg, const coavoid_lcm_cont
         REJECT(rc != COA_OK ? rc : COAVOID_LCM_ERR_VALUE, "intent: step not in (0, 3600] s");
     }
     if (!intent_core_numbers_ok(msg)) {
-        REJECT(COAVOID_LCM_ERR_VALUE, "intent: cruise_speed, climb_rate, step, radius or half_height "
-                                  "vanishes in the core's precision");
+        REJECT(COAVOID_LCM_ERR_VALUE,
+               "intent: cruise_speed, climb_rate, step, radius or half_height "
+               "vanishes in the core's precision");
     }
     if (msg->sample_count < 2 || msg->sample_count > COAVOID_INTENT_T_MAX_SAMPLES) {
         REJECT(COAVOID_LCM_ERR_COUNT, "intent: sample_count not in 2..MAX_SAMPLES");
@@ -358,15 +374,18 @@ int coavoid_lcm_intent_check(const coavoid_intent_t *msg, const coavoid_lcm_cont
             }
             r = vec_of(msg->reference[j]);
             if (j > 0 && !intent_leg_ok(msg, previous, r)) {
-                REJECT(COAVOID_LCM_ERR_VALUE, "intent: consecutive reference points without horizontal separation");
+                REJECT(COAVOID_LCM_ERR_VALUE,
+                       "intent: consecutive reference points without horizontal separation");
             }
             if (o < -bound || o > bound) {
                 REJECT(COAVOID_LCM_ERR_VALUE, "intent: an offset beyond max_offset or 32767");
             }
             if (j > 0) {
                 int32_t d = o - msg->offsets[j - 1];
-                if (d != 0 && d != 1 && d != -1 && d != msg->steep_factor && d != -msg->steep_factor) {
-                    REJECT(COAVOID_LCM_ERR_VALUE, "intent: consecutive offsets differ by no action");
+                if (d != 0 && d != 1 && d != -1 && d != msg->steep_factor &&
+                    d != -msg->steep_factor) {
+                    REJECT(COAVOID_LCM_ERR_VALUE,
+                           "intent: consecutive offsets differ by no action");
                 }
             }
             p = intent_position(&r, o, dh);
@@ -387,9 +406,9 @@ int coavoid_lcm_intent_check(const coavoid_intent_t *msg, const coavoid_lcm_cont
 }
 
 int coavoid_lcm_intent_to_core(const coavoid_intent_t *msg, const coavoid_lcm_context_t *ctx,
-                           coavoid_lcm_sequence_table_t *seq, coavoid_lcm_intent_info_t *info,
-                           coa_vehicle_t *vehicle, coa_intent_plan_t *plan,
-                           coavoid_lcm_intent_arrays_t *arrays, const char **reason)
+                               coavoid_lcm_sequence_table_t *seq, coavoid_lcm_intent_info_t *info,
+                               coa_vehicle_t *vehicle, coa_intent_plan_t *plan,
+                               coavoid_lcm_intent_arrays_t *arrays, const char **reason)
 {
     int rc;
     int32_t j;
@@ -434,10 +453,11 @@ int coavoid_lcm_intent_to_core(const coavoid_intent_t *msg, const coavoid_lcm_co
     return COA_OK;
 }
 
-int coavoid_lcm_intent_from_core(const coa_vehicle_t *vehicle, const coavoid_lcm_intent_info_t *info,
-                             const coa_vec3_t *reference, const int32_t *offsets, size_t count,
-                             const coavoid_lcm_context_t *ctx, coavoid_intent_t *msg,
-                             const char **reason)
+int coavoid_lcm_intent_from_core(const coa_vehicle_t *vehicle,
+                                 const coavoid_lcm_intent_info_t *info, const coa_vec3_t *reference,
+                                 const int32_t *offsets, size_t count,
+                                 const coavoid_lcm_context_t *ctx, coavoid_intent_t *msg,
+                                 const char **reason)
 {
     size_t j;
     if (vehicle == NULL || info == NULL || msg == NULL || reference == NULL || offsets == NULL) {
@@ -478,7 +498,7 @@ int coavoid_lcm_intent_from_core(const coa_vehicle_t *vehicle, const coavoid_lcm
 /* ---- plan ---- */
 
 int coavoid_lcm_plan_check(const coavoid_plan_t *msg, const coavoid_lcm_context_t *ctx,
-                       const char **reason)
+                           const char **reason)
 {
     int rc;
     int32_t i;
@@ -501,7 +521,8 @@ int coavoid_lcm_plan_check(const coavoid_plan_t *msg, const coavoid_lcm_context_
     }
     if (msg->valid_until_utime <= msg->valid_from_utime ||
         related_time_rule(msg->valid_until_utime, msg->utime, ctx) != COA_OK) {
-        REJECT(COAVOID_LCM_ERR_TIME, "plan: valid_until_utime not after valid_from_utime or too far");
+        REJECT(COAVOID_LCM_ERR_TIME,
+               "plan: valid_until_utime not after valid_from_utime or too far");
     }
     if ((rc = number_rule(msg->dt, COAVOID_LCM_MAX_STEP)) != COA_OK || !(msg->dt > 0.0)) {
         REJECT(rc != COA_OK ? rc : COAVOID_LCM_ERR_VALUE, "plan: dt not in (0, 3600] s");
@@ -509,10 +530,12 @@ int coavoid_lcm_plan_check(const coavoid_plan_t *msg, const coavoid_lcm_context_
     if (msg->horizon < 1 || msg->horizon > COAVOID_PLAN_T_MAX_SAMPLES - 1) {
         REJECT(COAVOID_LCM_ERR_COUNT, "plan: horizon not in 1..MAX_SAMPLES-1");
     }
-    if (msg->mode != COAVOID_PLAN_T_MODE_CENTRALISED && msg->mode != COAVOID_PLAN_T_MODE_DECOUPLED) {
+    if (msg->mode != COAVOID_PLAN_T_MODE_CENTRALISED &&
+        msg->mode != COAVOID_PLAN_T_MODE_DECOUPLED) {
         REJECT(COAVOID_LCM_ERR_ENUM, "plan: unknown mode");
     }
-    if (msg->status != COAVOID_PLAN_T_STATUS_SOLVED && msg->status != COAVOID_PLAN_T_STATUS_INFEASIBLE &&
+    if (msg->status != COAVOID_PLAN_T_STATUS_SOLVED &&
+        msg->status != COAVOID_PLAN_T_STATUS_INFEASIBLE &&
         msg->status != COAVOID_PLAN_T_STATUS_BUDGET_EXHAUSTED) {
         REJECT(COAVOID_LCM_ERR_ENUM, "plan: unknown status");
     }
@@ -530,7 +553,8 @@ int coavoid_lcm_plan_check(const coavoid_plan_t *msg, const coavoid_lcm_context_
     }
     if (msg->planned_count < 0 || msg->planned_count > msg->vehicle_count ||
         (msg->status == COAVOID_PLAN_T_STATUS_SOLVED && msg->planned_count != msg->vehicle_count)) {
-        REJECT(COAVOID_LCM_ERR_COUNT, "plan: planned_count not in 0..vehicle_count (all when solved)");
+        REJECT(COAVOID_LCM_ERR_COUNT,
+               "plan: planned_count not in 0..vehicle_count (all when solved)");
     }
     for (i = 0; i < msg->vehicle_count; ++i) {
         if (!id_ok(msg->uav_ids[i])) {
@@ -562,9 +586,9 @@ int coavoid_lcm_plan_check(const coavoid_plan_t *msg, const coavoid_lcm_context_
 }
 
 int coavoid_lcm_plan_to_core(const coavoid_plan_t *msg, const coavoid_lcm_context_t *ctx,
-                         coavoid_lcm_sequence_table_t *seq, coavoid_lcm_plan_info_t *info,
-                         coa_plan_result_t *result, int32_t *offsets, size_t capacity,
-                         const char **reason)
+                             coavoid_lcm_sequence_table_t *seq, coavoid_lcm_plan_info_t *info,
+                             coa_plan_result_t *result, int32_t *offsets, size_t capacity,
+                             const char **reason)
 {
     int rc;
     size_t i;
@@ -616,8 +640,8 @@ int coavoid_lcm_plan_to_core(const coavoid_plan_t *msg, const coavoid_lcm_contex
 }
 
 int coavoid_lcm_plan_from_core(const coavoid_lcm_plan_info_t *info, const coa_plan_result_t *result,
-                           const int32_t *offsets, const coavoid_lcm_context_t *ctx,
-                           coavoid_plan_t *msg, const char **reason)
+                               const int32_t *offsets, const coavoid_lcm_context_t *ctx,
+                               coavoid_plan_t *msg, const char **reason)
 {
     size_t i;
     size_t k;
@@ -671,7 +695,7 @@ int coavoid_lcm_plan_from_core(const coavoid_lcm_plan_info_t *info, const coa_pl
 /* ---- track ---- */
 
 int coavoid_lcm_track_check(const coavoid_track_t *msg, const coavoid_lcm_context_t *ctx,
-                        const char **reason)
+                            const char **reason)
 {
     int rc;
     int32_t j;
@@ -730,9 +754,9 @@ int coavoid_lcm_track_check(const coavoid_track_t *msg, const coavoid_lcm_contex
 }
 
 int coavoid_lcm_track_to_core(const coavoid_track_t *msg, const coavoid_lcm_context_t *ctx,
-                          coavoid_lcm_sequence_table_t *seq, coavoid_lcm_track_info_t *info,
-                          coa_track_t *track, coa_track_point_t *path, size_t capacity,
-                          const char **reason)
+                              coavoid_lcm_sequence_table_t *seq, coavoid_lcm_track_info_t *info,
+                              coa_track_t *track, coa_track_point_t *path, size_t capacity,
+                              const char **reason)
 {
     int rc;
     int32_t j;
@@ -785,8 +809,8 @@ int coavoid_lcm_track_to_core(const coavoid_track_t *msg, const coavoid_lcm_cont
 }
 
 int coavoid_lcm_track_from_core(const coa_track_t *track, const coavoid_lcm_track_info_t *info,
-                            const coavoid_lcm_context_t *ctx, coavoid_track_t *msg,
-                            const char **reason)
+                                const coavoid_lcm_context_t *ctx, coavoid_track_t *msg,
+                                const char **reason)
 {
     size_t j;
     if (track == NULL || info == NULL || msg == NULL ||
@@ -822,8 +846,8 @@ int coavoid_lcm_track_from_core(const coa_track_t *track, const coavoid_lcm_trac
 
 /* ---- obstacle map ---- */
 
-int coavoid_lcm_obstacle_map_check(const coavoid_obstacle_map_t *msg, const coavoid_lcm_context_t *ctx,
-                               const char **reason)
+int coavoid_lcm_obstacle_map_check(const coavoid_obstacle_map_t *msg,
+                                   const coavoid_lcm_context_t *ctx, const char **reason)
 {
     int rc;
     int32_t i;
@@ -836,8 +860,8 @@ int coavoid_lcm_obstacle_map_check(const coavoid_obstacle_map_t *msg, const coav
     if (msg->utime <= 0) {
         REJECT(COAVOID_LCM_ERR_TIME, "obstacle_map: utime not positive");
     }
-    if (ctx != NULL && ctx->now_utime > 0 && ctx->max_future_us >= 0 && msg->utime > ctx->now_utime &&
-        msg->utime - ctx->now_utime > ctx->max_future_us) {
+    if (ctx != NULL && ctx->now_utime > 0 && ctx->max_future_us >= 0 &&
+        msg->utime > ctx->now_utime && msg->utime - ctx->now_utime > ctx->max_future_us) {
         REJECT(COAVOID_LCM_ERR_TIME, "obstacle_map: utime in the future");
     }
     if (!id_ok(msg->map_id)) {
@@ -864,7 +888,8 @@ int coavoid_lcm_obstacle_map_check(const coavoid_obstacle_map_t *msg, const coav
         REJECT(COAVOID_LCM_ERR_COUNT, "obstacle_map: polytope_count not in 0..MAX_POLYTOPES");
     }
     for (i = 0; i < msg->polytope_count; ++i) {
-        if (msg->vertex_count[i] < 4 || msg->vertex_count[i] > COAVOID_OBSTACLE_MAP_T_MAX_VERTICES) {
+        if (msg->vertex_count[i] < 4 ||
+            msg->vertex_count[i] > COAVOID_OBSTACLE_MAP_T_MAX_VERTICES) {
             REJECT(COAVOID_LCM_ERR_COUNT, "obstacle_map: a vertex_count not in 4..MAX_VERTICES");
         }
         for (j = 0; j < msg->vertex_count[i]; ++j) {
@@ -877,10 +902,11 @@ int coavoid_lcm_obstacle_map_check(const coavoid_obstacle_map_t *msg, const coav
     return COA_OK;
 }
 
-int coavoid_lcm_obstacle_map_to_core(const coavoid_obstacle_map_t *msg, const coavoid_lcm_context_t *ctx,
-                                 coavoid_lcm_sequence_table_t *seq, coa_obstacle_t *obstacles,
-                                 size_t capacity, size_t *count, coa_vec3_t *vertices,
-                                 size_t vertex_capacity, const char **reason)
+int coavoid_lcm_obstacle_map_to_core(const coavoid_obstacle_map_t *msg,
+                                     const coavoid_lcm_context_t *ctx,
+                                     coavoid_lcm_sequence_table_t *seq, coa_obstacle_t *obstacles,
+                                     size_t capacity, size_t *count, coa_vec3_t *vertices,
+                                     size_t vertex_capacity, const char **reason)
 {
     int rc;
     int32_t i;
@@ -898,7 +924,8 @@ int coavoid_lcm_obstacle_map_to_core(const coavoid_obstacle_map_t *msg, const co
         need += (size_t)msg->vertex_count[i];
     }
     if ((size_t)msg->box_count + (size_t)msg->polytope_count > capacity || need > vertex_capacity) {
-        REJECT(COAVOID_LCM_ERR_CAPACITY, "obstacle_map: more obstacles than the caller's arrays hold");
+        REJECT(COAVOID_LCM_ERR_CAPACITY,
+               "obstacle_map: more obstacles than the caller's arrays hold");
     }
     if ((rc = sequence_rule(seq, msg->map_id, msg->version, true, reason,
                             "obstacle_map: version lower than one already seen",
@@ -926,8 +953,9 @@ int coavoid_lcm_obstacle_map_to_core(const coavoid_obstacle_map_t *msg, const co
 }
 
 int coavoid_lcm_obstacle_map_from_core(const coa_obstacle_t *obstacles, size_t count, int64_t utime,
-                                   uint32_t map_id, int64_t version, const coavoid_lcm_context_t *ctx,
-                                   coavoid_obstacle_map_t *msg, const char **reason)
+                                       uint32_t map_id, int64_t version,
+                                       const coavoid_lcm_context_t *ctx,
+                                       coavoid_obstacle_map_t *msg, const char **reason)
 {
     size_t i;
     size_t j;
@@ -975,7 +1003,7 @@ int coavoid_lcm_obstacle_map_from_core(const coa_obstacle_t *obstacles, size_t c
 /* ---- conflict report ---- */
 
 int coavoid_lcm_conflict_report_check(const coavoid_conflict_report_t *msg,
-                                  const coavoid_lcm_context_t *ctx, const char **reason)
+                                      const coavoid_lcm_context_t *ctx, const char **reason)
 {
     int rc;
     int32_t i;
@@ -1002,11 +1030,13 @@ int coavoid_lcm_conflict_report_check(const coavoid_conflict_report_t *msg,
     }
     if (msg->conflict_count < 0 || msg->conflict_count > COAVOID_CONFLICT_REPORT_T_MAX_CONFLICTS ||
         msg->conflicts_found < msg->conflict_count) {
-        REJECT(COAVOID_LCM_ERR_COUNT, "conflict_report: conflict_count not in 0..MAX_CONFLICTS or > conflicts_found");
+        REJECT(COAVOID_LCM_ERR_COUNT,
+               "conflict_report: conflict_count not in 0..MAX_CONFLICTS or > conflicts_found");
     }
     for (i = 0; i < msg->conflict_count; ++i) {
         int8_t kind = msg->kind[i];
-        if (kind != COAVOID_CONFLICT_REPORT_T_KIND_VEHICLE && kind != COAVOID_CONFLICT_REPORT_T_KIND_TRACK &&
+        if (kind != COAVOID_CONFLICT_REPORT_T_KIND_VEHICLE &&
+            kind != COAVOID_CONFLICT_REPORT_T_KIND_TRACK &&
             kind != COAVOID_CONFLICT_REPORT_T_KIND_OBSTACLE) {
             REJECT(COAVOID_LCM_ERR_ENUM, "conflict_report: unknown kind");
         }
@@ -1020,10 +1050,12 @@ int coavoid_lcm_conflict_report_check(const coavoid_conflict_report_t *msg,
         if (msg->first_step[i] < 0 || msg->first_step[i] >= msg->horizon) {
             REJECT(COAVOID_LCM_ERR_VALUE, "conflict_report: a first_step not in 0..horizon-1");
         }
-        if ((rc = number_rule(msg->min_horizontal[i], COAVOID_LCM_MAX_COORDINATE * 4.0)) != COA_OK ||
+        if ((rc = number_rule(msg->min_horizontal[i], COAVOID_LCM_MAX_COORDINATE * 4.0)) !=
+                COA_OK ||
             (rc = number_rule(msg->min_vertical[i], COAVOID_LCM_MAX_COORDINATE * 4.0)) != COA_OK ||
             msg->min_horizontal[i] < 0.0 || msg->min_vertical[i] < 0.0) {
-            REJECT(rc != COA_OK ? rc : COAVOID_LCM_ERR_VALUE, "conflict_report: a distance negative or non-finite");
+            REJECT(rc != COA_OK ? rc : COAVOID_LCM_ERR_VALUE,
+                   "conflict_report: a distance negative or non-finite");
         }
         if (!isfinite(msg->probability[i])) {
             REJECT(COAVOID_LCM_ERR_NONFINITE, "conflict_report: a probability non-finite");
@@ -1031,7 +1063,8 @@ int coavoid_lcm_conflict_report_check(const coavoid_conflict_report_t *msg,
         if (msg->probability[i] < 0.0 || msg->probability[i] > 1.0) {
             REJECT(COAVOID_LCM_ERR_VALUE, "conflict_report: a probability outside [0, 1]");
         }
-        if (msg->cluster[i] < -1 || msg->cluster[i] >= COAVOID_CONFLICT_REPORT_T_MAX_CONFLICTS * 2) {
+        if (msg->cluster[i] < -1 ||
+            msg->cluster[i] >= COAVOID_CONFLICT_REPORT_T_MAX_CONFLICTS * 2) {
             REJECT(COAVOID_LCM_ERR_VALUE, "conflict_report: a cluster label out of range");
         }
     }
@@ -1040,13 +1073,13 @@ int coavoid_lcm_conflict_report_check(const coavoid_conflict_report_t *msg,
 }
 
 int coavoid_lcm_conflict_report_from_core(const coa_conflict_t *conflicts, size_t count,
-                                      size_t conflicts_found, const uint16_t *plan_ids,
-                                      size_t plan_count, const uint32_t *track_ids,
-                                      size_t track_count, const uint32_t *cluster,
-                                      int64_t utime, uint32_t reporter_id, int64_t sequence,
-                                      int64_t prediction_utime, coa_real_t dt, uint32_t horizon,
-                                      const coavoid_lcm_context_t *ctx,
-                                      coavoid_conflict_report_t *msg, const char **reason)
+                                          size_t conflicts_found, const uint16_t *plan_ids,
+                                          size_t plan_count, const uint32_t *track_ids,
+                                          size_t track_count, const uint32_t *cluster,
+                                          int64_t utime, uint32_t reporter_id, int64_t sequence,
+                                          int64_t prediction_utime, coa_real_t dt, uint32_t horizon,
+                                          const coavoid_lcm_context_t *ctx,
+                                          coavoid_conflict_report_t *msg, const char **reason)
 {
     size_t i;
     size_t n;
@@ -1060,8 +1093,9 @@ int coavoid_lcm_conflict_report_from_core(const coa_conflict_t *conflicts, size_
     if (conflicts_found < count) {
         conflicts_found = count;
     }
-    n = count < (size_t)COAVOID_CONFLICT_REPORT_T_MAX_CONFLICTS ? count
-                                                                  : (size_t)COAVOID_CONFLICT_REPORT_T_MAX_CONFLICTS;
+    n = count < (size_t)COAVOID_CONFLICT_REPORT_T_MAX_CONFLICTS
+            ? count
+            : (size_t)COAVOID_CONFLICT_REPORT_T_MAX_CONFLICTS;
     memset(msg, 0, sizeof *msg);
     msg->utime = utime;
     msg->reporter_id = (int32_t)reporter_id;
@@ -1069,7 +1103,8 @@ int coavoid_lcm_conflict_report_from_core(const coa_conflict_t *conflicts, size_
     msg->prediction_utime = prediction_utime;
     msg->dt = (double)dt;
     msg->horizon = (int32_t)horizon;
-    msg->conflicts_found = conflicts_found > (size_t)INT32_MAX ? INT32_MAX : (int32_t)conflicts_found;
+    msg->conflicts_found =
+        conflicts_found > (size_t)INT32_MAX ? INT32_MAX : (int32_t)conflicts_found;
     msg->conflict_count = (int32_t)n;
     for (i = 0; i < n; ++i) {
         const coa_conflict_t *c = &conflicts[i];
@@ -1104,8 +1139,8 @@ int coavoid_lcm_conflict_report_from_core(const coa_conflict_t *conflicts, size_
 }
 
 int coavoid_lcm_conflict_report_accept(const coavoid_conflict_report_t *msg,
-                                   const coavoid_lcm_context_t *ctx, coavoid_lcm_sequence_table_t *seq,
-                                   const char **reason)
+                                       const coavoid_lcm_context_t *ctx,
+                                       coavoid_lcm_sequence_table_t *seq, const char **reason)
 {
     int rc = coavoid_lcm_conflict_report_check(msg, ctx, reason);
     if (rc != COA_OK) {
@@ -1119,7 +1154,7 @@ int coavoid_lcm_conflict_report_accept(const coavoid_conflict_report_t *msg,
 /* ---- status ---- */
 
 int coavoid_lcm_status_check(const coavoid_status_t *msg, const coavoid_lcm_context_t *ctx,
-                         const char **reason)
+                             const char **reason)
 {
     int rc;
     if (msg == NULL) {
@@ -1131,22 +1166,27 @@ int coavoid_lcm_status_check(const coavoid_status_t *msg, const coavoid_lcm_cont
     if (!id_ok(msg->node_id)) {
         REJECT(COAVOID_LCM_ERR_ID, "status: node_id not in 1..65535");
     }
-    if (msg->node_kind != COAVOID_STATUS_T_NODE_COORDINATOR && msg->node_kind != COAVOID_STATUS_T_NODE_VEHICLE) {
+    if (msg->node_kind != COAVOID_STATUS_T_NODE_COORDINATOR &&
+        msg->node_kind != COAVOID_STATUS_T_NODE_VEHICLE) {
         REJECT(COAVOID_LCM_ERR_ENUM, "status: unknown node_kind");
     }
     if (msg->sequence < 0) {
         REJECT(COAVOID_LCM_ERR_VALUE, "status: sequence negative");
     }
-    if (msg->health != COAVOID_STATUS_T_HEALTH_OK && msg->health != COAVOID_STATUS_T_HEALTH_DEGRADED &&
+    if (msg->health != COAVOID_STATUS_T_HEALTH_OK &&
+        msg->health != COAVOID_STATUS_T_HEALTH_DEGRADED &&
         msg->health != COAVOID_STATUS_T_HEALTH_FAULT) {
         REJECT(COAVOID_LCM_ERR_ENUM, "status: unknown health");
     }
-    if (msg->mode != COAVOID_STATUS_T_MODE_CENTRALISED && msg->mode != COAVOID_STATUS_T_MODE_DECOUPLED &&
+    if (msg->mode != COAVOID_STATUS_T_MODE_CENTRALISED &&
+        msg->mode != COAVOID_STATUS_T_MODE_DECOUPLED &&
         msg->mode != COAVOID_STATUS_T_MODE_REFERENCE) {
         REJECT(COAVOID_LCM_ERR_ENUM, "status: unknown mode");
     }
-    if (msg->outcome != COAVOID_STATUS_T_OUTCOME_SOLVED && msg->outcome != COAVOID_STATUS_T_OUTCOME_INFEASIBLE &&
-        msg->outcome != COAVOID_STATUS_T_OUTCOME_BUDGET_EXHAUSTED && msg->outcome != COAVOID_STATUS_T_OUTCOME_NONE) {
+    if (msg->outcome != COAVOID_STATUS_T_OUTCOME_SOLVED &&
+        msg->outcome != COAVOID_STATUS_T_OUTCOME_INFEASIBLE &&
+        msg->outcome != COAVOID_STATUS_T_OUTCOME_BUDGET_EXHAUSTED &&
+        msg->outcome != COAVOID_STATUS_T_OUTCOME_NONE) {
         REJECT(COAVOID_LCM_ERR_ENUM, "status: unknown outcome");
     }
     if (msg->last_plan_utime < 0 || msg->last_plan_utime > msg->utime) {
@@ -1154,7 +1194,8 @@ int coavoid_lcm_status_check(const coavoid_status_t *msg, const coavoid_lcm_cont
     }
     if (msg->last_plan_duration_us < 0 || msg->nodes_expanded < 0 || msg->conflicts < 0 ||
         msg->plans_run < 0) {
-        REJECT(COAVOID_LCM_ERR_VALUE, "status: a negative duration, node count, conflict count or plans_run");
+        REJECT(COAVOID_LCM_ERR_VALUE,
+               "status: a negative duration, node count, conflict count or plans_run");
     }
     if (msg->messages_received < 0 || msg->messages_rejected < 0 ||
         msg->messages_rejected > msg->messages_received) {
@@ -1168,7 +1209,7 @@ int coavoid_lcm_status_check(const coavoid_status_t *msg, const coavoid_lcm_cont
 }
 
 int coavoid_lcm_status_accept(const coavoid_status_t *msg, const coavoid_lcm_context_t *ctx,
-                          coavoid_lcm_sequence_table_t *seq, const char **reason)
+                              coavoid_lcm_sequence_table_t *seq, const char **reason)
 {
     int rc = coavoid_lcm_status_check(msg, ctx, reason);
     if (rc != COA_OK) {

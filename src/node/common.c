@@ -14,10 +14,11 @@
 /* A generous queue per subscription: a cycle publishes one intent and one heartbeat per
  * UAV and one estimate per track, all handled before the next cycle. LCM's default (30)
  * would drop messages of a large fleet without a word. */
-#define COAVOID_NODE_QUEUE_CAPACITY ((int)(4u * COAVOID_NODE_MAX_PEERS + 2u * COAVOID_NODE_MAX_TRACKS + 16u))
+#define COAVOID_NODE_QUEUE_CAPACITY \
+    ((int)(4u * COAVOID_NODE_MAX_PEERS + 2u * COAVOID_NODE_MAX_TRACKS + 16u))
 
 int coavoid_node_common_defaults(coavoid_node_common_t *c, int64_t epoch_utime, coa_real_t dt,
-                             uint32_t horizon, const int64_t *clock)
+                                 uint32_t horizon, const int64_t *clock)
 {
     if (c == NULL || clock == NULL || epoch_utime <= 0 || !isfinite((double)dt) ||
         !(dt > (coa_real_t)0) || (double)dt > COAVOID_LCM_MAX_STEP || horizon < 1u ||
@@ -135,7 +136,8 @@ static void senders_expire(coavoid_node_senders_t *s, int64_t now, int64_t limit
 
 /* ---- the inbox ---- */
 
-coavoid_lcm_context_t coavoid_node_context(const coavoid_node_inbox_t *in, int64_t now, int64_t epoch)
+coavoid_lcm_context_t coavoid_node_context(const coavoid_node_inbox_t *in, int64_t now,
+                                           int64_t epoch)
 {
     coavoid_lcm_context_t ctx;
     ctx.now_utime = now;
@@ -225,7 +227,8 @@ static void on_intent(const lcm_recv_buf_t *rbuf, const char *channel, void *use
         }
     }
     if (slot == COAVOID_NODE_MAX_PEERS) {
-        coavoid_lcm_rx_count(in->rx, COAVOID_LCM_ERR_SENDERS, "intent: more UAVs than the node holds");
+        coavoid_lcm_rx_count(in->rx, COAVOID_LCM_ERR_SENDERS,
+                             "intent: more UAVs than the node holds");
         return;
     }
     coavoid_lcm_context_t ctx = coavoid_node_context(in, now, now);
@@ -234,7 +237,7 @@ static void on_intent(const lcm_recv_buf_t *rbuf, const char *channel, void *use
     coa_intent_plan_t plan;
     const char *reason = NULL;
     int rc = coavoid_lcm_intent_to_core(msg, &ctx, &in->intent_seq.table, &info, &vehicle, &plan,
-                                    &in->rx_arrays, &reason);
+                                        &in->rx_arrays, &reason);
     coavoid_lcm_rx_count(in->rx, rc, reason);
     if (rc != COA_OK) {
         return;
@@ -273,7 +276,8 @@ static void on_track(const lcm_recv_buf_t *rbuf, const char *channel, void *user
         }
     }
     if (slot == COAVOID_NODE_MAX_TRACKS) {
-        coavoid_lcm_rx_count(in->rx, COAVOID_LCM_ERR_CAPACITY, "track: more tracks than the node holds");
+        coavoid_lcm_rx_count(in->rx, COAVOID_LCM_ERR_CAPACITY,
+                             "track: more tracks than the node holds");
         return;
     }
     coavoid_lcm_context_t ctx = coavoid_node_context(in, now, now);
@@ -282,7 +286,7 @@ static void on_track(const lcm_recv_buf_t *rbuf, const char *channel, void *user
     coa_track_point_t path[COAVOID_TRACK_T_MAX_PATH];
     const char *reason = NULL;
     int rc = coavoid_lcm_track_to_core(msg, &ctx, &in->track_seq.table, &info, &track, path,
-                                   COAVOID_TRACK_T_MAX_PATH, &reason);
+                                       COAVOID_TRACK_T_MAX_PATH, &reason);
     coavoid_lcm_rx_count(in->rx, rc, reason);
     if (rc != COA_OK) {
         return;
@@ -310,8 +314,8 @@ static void on_map(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
     /* The conversion checks everything before it writes, so a refused map leaves the
      * one in use untouched. */
     int rc = coavoid_lcm_obstacle_map_to_core(msg, &ctx, &in->map_seq.table, in->obstacles,
-                                          COAVOID_NODE_MAX_OBSTACLES, &count, in->vertices,
-                                          COAVOID_NODE_MAX_VERTICES, &reason);
+                                              COAVOID_NODE_MAX_OBSTACLES, &count, in->vertices,
+                                              COAVOID_NODE_MAX_VERTICES, &reason);
     coavoid_lcm_rx_count(in->rx, rc, reason);
     if (rc != COA_OK) {
         return;
@@ -337,7 +341,8 @@ static void on_status(const lcm_recv_buf_t *rbuf, const char *channel, void *use
     /* Before the sequence rule, so that impostors take no room in its table. */
     if (msg->node_kind == COAVOID_STATUS_T_NODE_COORDINATOR &&
         msg->node_id != (int32_t)in->coordinator_id) {
-        coavoid_lcm_rx_count(in->rx, COAVOID_LCM_ERR_ID, "status: a coordinator that is not this UAV's");
+        coavoid_lcm_rx_count(in->rx, COAVOID_LCM_ERR_ID,
+                             "status: a coordinator that is not this UAV's");
         return;
     }
     const int64_t now = *in->common.clock;
@@ -368,7 +373,8 @@ static void on_plan(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
         return;
     }
     if (msg->coordinator_id != (int32_t)in->coordinator_id) {
-        coavoid_lcm_rx_count(in->rx, COAVOID_LCM_ERR_ID, "plan: from a coordinator that is not this UAV's");
+        coavoid_lcm_rx_count(in->rx, COAVOID_LCM_ERR_ID,
+                             "plan: from a coordinator that is not this UAV's");
         return;
     }
     const int64_t now = *in->common.clock;
@@ -381,7 +387,7 @@ static void on_plan(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
      * remembering plan_ids would let one forged INT64_MAX, or a coordinator restarted
      * while its heartbeat kept the entry alive, lock every later plan out. */
     int rc = coavoid_lcm_plan_to_core(msg, &ctx, NULL, &info, &result, in->rx_offsets,
-                                  sizeof in->rx_offsets / sizeof in->rx_offsets[0], &reason);
+                                      sizeof in->rx_offsets / sizeof in->rx_offsets[0], &reason);
     if (rc != COA_OK) {
         coavoid_lcm_rx_count(in->rx, rc, reason);
         return;
@@ -400,17 +406,18 @@ static int subscribe(coavoid_node_inbox_t *in, const char *channel, lcm_msg_hand
     return COA_OK;
 }
 
-int coavoid_node_inbox_init(coavoid_node_inbox_t *in, const coavoid_node_common_t *common, uint16_t self_uav,
-                        uint16_t self_node, uint16_t coordinator_id, size_t peer_capacity,
-                        lcm_t *lcm, coavoid_lcm_rx_stats_t *rx, bool want_status,
-                        coavoid_node_plan_handler_t plan_handler, void *owner)
+int coavoid_node_inbox_init(coavoid_node_inbox_t *in, const coavoid_node_common_t *common,
+                            uint16_t self_uav, uint16_t self_node, uint16_t coordinator_id,
+                            size_t peer_capacity, lcm_t *lcm, coavoid_lcm_rx_stats_t *rx,
+                            bool want_status, coavoid_node_plan_handler_t plan_handler, void *owner)
 {
     in->common = *common;
     in->self_uav = self_uav;
     in->self_node = self_node;
     in->coordinator_id = coordinator_id;
     in->rx = rx;
-    in->peer_capacity = peer_capacity > COAVOID_NODE_MAX_PEERS ? COAVOID_NODE_MAX_PEERS : peer_capacity;
+    in->peer_capacity =
+        peer_capacity > COAVOID_NODE_MAX_PEERS ? COAVOID_NODE_MAX_PEERS : peer_capacity;
     /* Old enough to still extrapolate a silent UAV for a horizon, and wide enough for a
      * track's path and a plan's samples around their stamps. */
     int64_t horizon_us = ((int64_t)common->horizon + 2) * common->dt_us;
@@ -536,7 +543,7 @@ static bool stale_track(const coavoid_intent_t *msg, const coavoid_node_common_t
 }
 
 void coavoid_node_view_build(coavoid_node_view_t *view, const coavoid_node_inbox_t *in,
-                         int64_t cycle_start, int64_t now)
+                             int64_t cycle_start, int64_t now)
 {
     const coavoid_node_common_t *c = &in->common;
     const coavoid_lcm_context_t ctx = coavoid_node_context(in, now, cycle_start);
@@ -573,7 +580,8 @@ void coavoid_node_view_build(coavoid_node_view_t *view, const coavoid_node_inbox
         }
         size_t i = view->live_count;
         if (coavoid_lcm_intent_to_core(msg, &ctx, NULL, &view->live_info[i], &view->live_vehicle[i],
-                                   &view->live_plan[i], &view->live_arrays[i], NULL) != COA_OK) {
+                                       &view->live_plan[i], &view->live_arrays[i],
+                                       NULL) != COA_OK) {
             continue; /* e.g. stamped further ahead of this clock than allowed */
         }
         view->live_id[i] = (uint16_t)msg->uav_id;
@@ -607,7 +615,7 @@ void coavoid_node_view_build(coavoid_node_view_t *view, const coavoid_node_inbox
         size_t i = view->track_count;
         coavoid_lcm_track_info_t info;
         if (coavoid_lcm_track_to_core(msg, &ctx, NULL, &info, &view->tracks[i], view->real_paths[s],
-                                  COAVOID_TRACK_T_MAX_PATH, NULL) != COA_OK) {
+                                      COAVOID_TRACK_T_MAX_PATH, NULL) != COA_OK) {
             continue;
         }
         view->track_ids[i] = (uint32_t)msg->track_id;
@@ -631,7 +639,7 @@ void coavoid_node_view_build(coavoid_node_view_t *view, const coavoid_node_inbox
 }
 
 int coavoid_node_problem_tracks(coavoid_node_problem_tracks_t *out, const coavoid_node_view_t *view,
-                            const bool *include, const coavoid_node_common_t *c)
+                                const bool *include, const coavoid_node_common_t *c)
 {
     size_t n = 0;
     size_t paths = 0;
@@ -704,9 +712,9 @@ coa_predict_config_t coavoid_node_predict_config(const coavoid_node_common_t *c)
 }
 
 int coavoid_node_predict(coa_predictor_t *predictor, const coavoid_node_common_t *c,
-                     const coa_intent_plan_t *plans, size_t n, const coavoid_node_view_t *view,
-                     const coavoid_node_inbox_t *in, coa_conflict_t *conflicts, size_t capacity,
-                     coa_predict_result_t *result, uint32_t *labels, size_t *cluster_count)
+                         const coa_intent_plan_t *plans, size_t n, const coavoid_node_view_t *view,
+                         const coavoid_node_inbox_t *in, coa_conflict_t *conflicts, size_t capacity,
+                         coa_predict_result_t *result, uint32_t *labels, size_t *cluster_count)
 {
     memset(result, 0, sizeof *result);
     *cluster_count = 0;
@@ -736,7 +744,8 @@ coa_planner_config_t coavoid_node_planner_config(uint32_t horizon, size_t search
     return c;
 }
 
-int coavoid_node_solver_init(coavoid_node_solver_t *s, uint32_t horizon, size_t searched, uint32_t beta)
+int coavoid_node_solver_init(coavoid_node_solver_t *s, uint32_t horizon, size_t searched,
+                             uint32_t beta)
 {
     memset(s, 0, sizeof *s);
     const size_t pairs = coavoid_node_max_pairs();
@@ -752,8 +761,9 @@ int coavoid_node_solver_init(coavoid_node_solver_t *s, uint32_t horizon, size_t 
     s->conflict_capacity = pairs;
     s->conflicts = calloc(pairs, sizeof *s->conflicts);
     if (s->predictor_memory != NULL) {
-        s->predictor = coa_predictor_init(s->predictor_memory, predictor_size, COAVOID_NODE_MAX_PEERS,
-                                          COAVOID_NODE_TRACK_CAPACITY, horizon, pairs);
+        s->predictor =
+            coa_predictor_init(s->predictor_memory, predictor_size, COAVOID_NODE_MAX_PEERS,
+                               COAVOID_NODE_TRACK_CAPACITY, horizon, pairs);
     }
     if (s->planner_memory != NULL) {
         s->planner = coa_planner_init(s->planner_memory, planner_size, &config);
@@ -774,7 +784,7 @@ void coavoid_node_solver_fini(coavoid_node_solver_t *s)
 }
 
 int coavoid_node_publish_heartbeat(coavoid_node_inbox_t *in, coavoid_status_t *m, int64_t now,
-                               int64_t cycle_start, const coavoid_node_heartbeat_t *h)
+                                   int64_t cycle_start, const coavoid_node_heartbeat_t *h)
 {
     memset(m, 0, sizeof *m);
     m->utime = now;
@@ -789,9 +799,8 @@ int coavoid_node_publish_heartbeat(coavoid_node_inbox_t *in, coavoid_status_t *m
     m->mode = h->mode;
     m->last_plan_utime = h->last_plan_utime;
     m->last_plan_duration_us = h->last_plan_duration_us;
-    m->nodes_expanded = h->last_nodes_expanded > (uint64_t)INT64_MAX
-                            ? INT64_MAX
-                            : (int64_t)h->last_nodes_expanded;
+    m->nodes_expanded =
+        h->last_nodes_expanded > (uint64_t)INT64_MAX ? INT64_MAX : (int64_t)h->last_nodes_expanded;
     m->outcome = h->last_outcome < 0 ? COAVOID_STATUS_T_OUTCOME_NONE : (int8_t)h->last_outcome;
     m->conflicts = h->conflicts > (uint32_t)INT32_MAX ? INT32_MAX : (int32_t)h->conflicts;
     m->plans_run = h->plans_run > (uint32_t)INT32_MAX ? INT32_MAX : (int32_t)h->plans_run;
@@ -807,24 +816,24 @@ int coavoid_node_publish_heartbeat(coavoid_node_inbox_t *in, coavoid_status_t *m
 
 /* ---- publishing ---- */
 
-#define COAVOID_NODE_DEFINE_PUBLISH(function, type, channel)                                   \
-    int function(coavoid_node_tx_t *tx, const type *msg)                                       \
-    {                                                                                       \
-        int size = type##_encoded_size(msg);                                                \
-        if (size <= 0 || (size_t)size > sizeof tx->buf ||                                   \
-            type##_encode(tx->buf, 0, size, msg) != size) {                                 \
-            return COA_ERR_WORKSPACE;                                                       \
-        }                                                                                   \
-        return lcm_publish(tx->lcm, channel, tx->buf, (unsigned int)size) == 0             \
-                   ? COA_OK                                                                 \
-                   : COA_ERR_ARGUMENT;                                                      \
+#define COAVOID_NODE_DEFINE_PUBLISH(function, type, channel)                                       \
+    int function(coavoid_node_tx_t *tx, const type *msg)                                           \
+    {                                                                                              \
+        int size = type##_encoded_size(msg);                                                       \
+        if (size <= 0 || (size_t)size > sizeof tx->buf ||                                          \
+            type##_encode(tx->buf, 0, size, msg) != size) {                                        \
+            return COA_ERR_WORKSPACE;                                                              \
+        }                                                                                          \
+        return lcm_publish(tx->lcm, channel, tx->buf, (unsigned int)size) == 0 ? COA_OK            \
+                                                                               : COA_ERR_ARGUMENT; \
     }
 
 COAVOID_NODE_DEFINE_PUBLISH(coavoid_node_publish_plan, coavoid_plan_t, COAVOID_CHANNEL_PLAN)
 COAVOID_NODE_DEFINE_PUBLISH(coavoid_node_publish_track, coavoid_track_t, COAVOID_CHANNEL_TRACK)
-COAVOID_NODE_DEFINE_PUBLISH(coavoid_node_publish_map, coavoid_obstacle_map_t, COAVOID_CHANNEL_OBSTACLES)
+COAVOID_NODE_DEFINE_PUBLISH(coavoid_node_publish_map, coavoid_obstacle_map_t,
+                            COAVOID_CHANNEL_OBSTACLES)
 COAVOID_NODE_DEFINE_PUBLISH(coavoid_node_publish_conflicts, coavoid_conflict_report_t,
-                        COAVOID_CHANNEL_CONFLICTS)
+                            COAVOID_CHANNEL_CONFLICTS)
 COAVOID_NODE_DEFINE_PUBLISH(coavoid_node_publish_status, coavoid_status_t, COAVOID_CHANNEL_STATUS)
 
 int coavoid_node_publish_intent(coavoid_node_inbox_t *in, const coavoid_intent_t *msg)

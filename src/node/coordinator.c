@@ -16,8 +16,8 @@ struct coavoid_coordinator {
     coavoid_coordinator_config_t config;
     coavoid_coordinator_state_t state;
     bool started;
-    bool degraded;                 /* a cluster's plan failed in this cycle */
-    bool fault;                    /* an internal error in this cycle */
+    bool degraded; /* a cluster's plan failed in this cycle */
+    bool fault;    /* an internal error in this cycle */
     int64_t plan_id;
     int64_t report_sequence;
     int64_t status_sequence;
@@ -25,7 +25,7 @@ struct coavoid_coordinator {
 
     uint32_t labels[COAVOID_NODE_MAX_PEERS];
     bool include[COAVOID_NODE_MAX_PEERS];
-    size_t member[COA_MAX_VEHICLES];            /* live indices of the cluster planned */
+    size_t member[COA_MAX_VEHICLES]; /* live indices of the cluster planned */
     coa_vehicle_t vehicles[COA_MAX_VEHICLES];
     const coa_vec3_t *references[COA_MAX_VEHICLES];
     int32_t offsets[(size_t)COA_MAX_VEHICLES * COAVOID_NODE_MAX_SAMPLES];
@@ -39,8 +39,8 @@ struct coavoid_coordinator {
     coavoid_node_problem_tracks_t problem_tracks;
 };
 
-coavoid_coordinator_t *coavoid_coordinator_create(const coavoid_coordinator_config_t *config, lcm_t *lcm,
-                                          int *error)
+coavoid_coordinator_t *coavoid_coordinator_create(const coavoid_coordinator_config_t *config,
+                                                  lcm_t *lcm, int *error)
 {
     int dummy;
     if (error == NULL) {
@@ -78,8 +78,8 @@ coavoid_coordinator_t *coavoid_coordinator_create(const coavoid_coordinator_conf
     node->state.cycle = -1;
     node->state.last_outcome = -1;
     /* No UAV is its own: intents are all others'. */
-    rc = coavoid_node_inbox_init(&node->inbox, c, 0u, node->config.id, 0u, COAVOID_NODE_MAX_PEERS, lcm,
-                             &node->state.rx, false, NULL, node);
+    rc = coavoid_node_inbox_init(&node->inbox, c, 0u, node->config.id, 0u, COAVOID_NODE_MAX_PEERS,
+                                 lcm, &node->state.rx, false, NULL, node);
     if (rc != COA_OK) {
         coavoid_node_solver_fini(&node->solver);
         free(node);
@@ -114,8 +114,8 @@ static int publish_report(coavoid_coordinator_t *node, int64_t now, int64_t cycl
     int rc = coavoid_lcm_conflict_report_from_core(
         node->solver.conflicts, result->conflict_count, result->conflicts_found, view->live_id,
         view->live_count, view->track_ids, view->track_count,
-        view->live_count > 0u ? node->labels : NULL, now, node->config.id,
-        node->report_sequence++, cycle_start, c->dt, c->horizon, &ctx, &node->tx_report, NULL);
+        view->live_count > 0u ? node->labels : NULL, now, node->config.id, node->report_sequence++,
+        cycle_start, c->dt, c->horizon, &ctx, &node->tx_report, NULL);
     if (rc != COA_OK) {
         return COA_ERR_ARGUMENT;
     }
@@ -126,18 +126,18 @@ static int publish_status(coavoid_coordinator_t *node, int64_t now, int64_t cycl
 {
     const coavoid_coordinator_state_t *s = &node->state;
     const coavoid_node_heartbeat_t h = {node->config.id,
-                                    COAVOID_STATUS_T_NODE_COORDINATOR,
-                                    node->status_sequence++,
-                                    node->fault,
-                                    node->degraded || node->view.stale_count > 0u,
-                                    COAVOID_STATUS_T_MODE_CENTRALISED,
-                                    node->last_plan_utime,
-                                    s->last_plan_duration_us,
-                                    s->last_nodes_expanded,
-                                    s->last_outcome,
-                                    s->conflicts,
-                                    s->plans_run,
-                                    &s->rx};
+                                        COAVOID_STATUS_T_NODE_COORDINATOR,
+                                        node->status_sequence++,
+                                        node->fault,
+                                        node->degraded || node->view.stale_count > 0u,
+                                        COAVOID_STATUS_T_MODE_CENTRALISED,
+                                        node->last_plan_utime,
+                                        s->last_plan_duration_us,
+                                        s->last_nodes_expanded,
+                                        s->last_outcome,
+                                        s->conflicts,
+                                        s->plans_run,
+                                        &s->rx};
     return coavoid_node_publish_heartbeat(&node->inbox, &node->tx_status, now, cycle_start, &h);
 }
 
@@ -154,9 +154,9 @@ static size_t cluster_members(coavoid_coordinator_t *node, uint32_t group)
     const coavoid_node_view_t *view = &node->view;
     size_t count = 0;
     for (size_t i = 0; i < view->live_count; i++) {
-        bool in = group == GROUP_ALL ||
-                  (group == GROUP_CLUSTERED ? node->labels[i] != COA_NO_CLUSTER
-                                            : node->labels[i] == group);
+        bool in =
+            group == GROUP_ALL || (group == GROUP_CLUSTERED ? node->labels[i] != COA_NO_CLUSTER
+                                                            : node->labels[i] == group);
         /* A UAV that says it plans for itself (decoupled intent) will not fly a plan of
          * the coordinator's: planning it jointly would leave the others' plans relying on
          * a move it does not make. It stays a moving obstacle. */
@@ -330,9 +330,9 @@ int coavoid_coordinator_cycle(coavoid_coordinator_t *node, int64_t now)
     coa_predict_result_t result;
     size_t clusters = 0;
     coavoid_node_solver_t *sv = &node->solver;
-    int first_error = coavoid_node_predict(sv->predictor, c, view->live_plan, view->live_count, view,
-                                       &node->inbox, sv->conflicts, sv->conflict_capacity, &result,
-                                       node->labels, &clusters);
+    int first_error = coavoid_node_predict(sv->predictor, c, view->live_plan, view->live_count,
+                                           view, &node->inbox, sv->conflicts, sv->conflict_capacity,
+                                           &result, node->labels, &clusters);
     if (first_error != COA_OK) {
         memset(&result, 0, sizeof result);
         clusters = 0;

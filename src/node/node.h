@@ -127,9 +127,9 @@
 #define COAVOID_CHANNEL_STATUS "COAVOID_STATUS"
 
 /* Capacities of one node's view of the airspace. */
-#define COAVOID_NODE_MAX_PEERS 64u      /* co-operative UAVs a node tracks, itself included */
-#define COAVOID_NODE_MAX_TRACKS 32u     /* non-cooperative tracks */
-#define COAVOID_NODE_MAX_HORIZON 127u   /* N: intent_t carries N + 1 samples */
+#define COAVOID_NODE_MAX_PEERS 64u    /* co-operative UAVs a node tracks, itself included */
+#define COAVOID_NODE_MAX_TRACKS 32u   /* non-cooperative tracks */
+#define COAVOID_NODE_MAX_HORIZON 127u /* N: intent_t carries N + 1 samples */
 
 /* The world's id (map_id of the obstacle map, source_id of tracks) by default. */
 #define COAVOID_NODE_WORLD_ID 65000u
@@ -142,11 +142,11 @@ typedef enum {
 
 /* What every node shares. */
 typedef struct {
-    int64_t epoch_utime;    /* cycle 0 starts here; > 0 */
-    coa_real_t dt;          /* s, > 0: the scenario's dt */
-    int64_t dt_us;          /* llround(dt * 1e6), >= 1 */
-    uint32_t horizon;       /* N, 1..COAVOID_NODE_MAX_HORIZON */
-    const int64_t *clock;   /* the driver's current utime, read by the message handlers */
+    int64_t epoch_utime;  /* cycle 0 starts here; > 0 */
+    coa_real_t dt;        /* s, > 0: the scenario's dt */
+    int64_t dt_us;        /* llround(dt * 1e6), >= 1 */
+    uint32_t horizon;     /* N, 1..COAVOID_NODE_MAX_HORIZON */
+    const int64_t *clock; /* the driver's current utime, read by the message handlers */
     /* Optional: a monotonic microsecond reader used only to measure how long planning
      * took (status_t.last_plan_duration_us). NULL in simulation, where durations are 0 so
      * that a run's output is repeatable. */
@@ -161,15 +161,15 @@ typedef struct {
     coa_real_t track_sigma_rate_horizontal;
     coa_real_t track_sigma_rate_vertical;
     coa_real_t stale_sigma_rate;
-    int64_t stale_after_us;     /* peer intent older than this: a track (default 2.5 dt) */
-    uint32_t beta;              /* closed-set bound of the node's planner */
+    int64_t stale_after_us; /* peer intent older than this: a track (default 2.5 dt) */
+    uint32_t beta;          /* closed-set bound of the node's planner */
 } coavoid_node_common_t;
 
 /* Fills c with the defaults for (epoch, dt, horizon, clock): threshold 0.01, no sigma
  * growth, stale_after 2.5 cycles, stale_sigma_rate 1 m/s, beta 20000. Returns COA_OK or
  * COA_ERR_ARGUMENT (dt, horizon, epoch or clock invalid). */
 int coavoid_node_common_defaults(coavoid_node_common_t *c, int64_t epoch_utime, coa_real_t dt,
-                             uint32_t horizon, const int64_t *clock);
+                                 uint32_t horizon, const int64_t *clock);
 
 /* utime of cycle k's start, and the cycle a time falls in (floor; negative before epoch). */
 int64_t coavoid_node_cycle_utime(const coavoid_node_common_t *c, int64_t k);
@@ -179,7 +179,7 @@ int64_t coavoid_node_cycle_of(const coavoid_node_common_t *c, int64_t utime);
 
 typedef struct {
     coavoid_node_common_t common;
-    coa_vehicle_t vehicle;          /* its route is the caller's and must outlive the node */
+    coa_vehicle_t vehicle; /* its route is the caller's and must outlive the node */
     coavoid_node_mode_t mode;
     int64_t coordinator_timeout_us; /* heartbeat silence before it plans for itself (0: the
                                        default, 2.5 dt) */
@@ -187,27 +187,27 @@ typedef struct {
                                        default, dt / 2) */
     coa_real_t sigma_horizontal;    /* its own position uncertainty, published (default 0) */
     coa_real_t sigma_vertical;
-    uint16_t coordinator_id;        /* the only node whose heartbeats and plans it follows
+    uint16_t coordinator_id; /* the only node whose heartbeats and plans it follows
                                        (0: the default, COAVOID_NODE_COORDINATOR_ID); not its
                                        own id */
 } coavoid_vehicle_node_config_t;
 
 /* What a vehicle did; read by drivers, the simulation and tests. */
 typedef struct {
-    int64_t cycle;                  /* the current cycle k (-1 before the first) */
-    int32_t offset;                 /* offset flown at sample k */
-    coa_vec3_t reference;           /* reference at t_k */
-    coa_vec3_t position;            /* reference + offset * dh: where it is */
-    bool coordinated;               /* following the coordinator this cycle */
-    bool waiting;                   /* decoupled: still waiting for higher priorities */
-    bool published;                 /* published its intent for this cycle */
-    uint32_t plans_run;             /* its own planning calls since start */
-    uint32_t plans_adopted;         /* plans adopted (own and coordinator's) */
-    int last_outcome;               /* coa_plan_status_t of its last call, -1 none */
+    int64_t cycle;          /* the current cycle k (-1 before the first) */
+    int32_t offset;         /* offset flown at sample k */
+    coa_vec3_t reference;   /* reference at t_k */
+    coa_vec3_t position;    /* reference + offset * dh: where it is */
+    bool coordinated;       /* following the coordinator this cycle */
+    bool waiting;           /* decoupled: still waiting for higher priorities */
+    bool published;         /* published its intent for this cycle */
+    uint32_t plans_run;     /* its own planning calls since start */
+    uint32_t plans_adopted; /* plans adopted (own and coordinator's) */
+    int last_outcome;       /* coa_plan_status_t of its last call, -1 none */
     uint64_t last_nodes_expanded;
-    int64_t last_plan_duration_us;  /* measured by the driver's clock: 0 in simulation */
-    uint32_t conflicts;             /* conflicts in its last prediction */
-    uint32_t fallbacks;             /* switches from coordinated to own planning */
+    int64_t last_plan_duration_us; /* measured by the driver's clock: 0 in simulation */
+    uint32_t conflicts;            /* conflicts in its last prediction */
+    uint32_t fallbacks;            /* switches from coordinated to own planning */
     coavoid_lcm_rx_stats_t rx;
 } coavoid_vehicle_node_state_t;
 
@@ -224,8 +224,8 @@ coa_planner_config_t coavoid_node_planner_config(uint32_t horizon, size_t search
  * beta) (1.1 MB at N = 24 and beta 20000). Returns NULL on bad config (invalid vehicle, horizon >
  * COAVOID_NODE_MAX_HORIZON, ...: COA_ERR_ARGUMENT, also when LCM refuses a subscription) or
  * out of memory (COA_ERR_WORKSPACE), with *error set (error may be NULL). */
-coavoid_vehicle_node_t *coavoid_vehicle_node_create(const coavoid_vehicle_node_config_t *config, lcm_t *lcm,
-                                            int *error);
+coavoid_vehicle_node_t *coavoid_vehicle_node_create(const coavoid_vehicle_node_config_t *config,
+                                                    lcm_t *lcm, int *error);
 /* Unsubscribes and frees. NULL is fine. */
 void coavoid_vehicle_node_destroy(coavoid_vehicle_node_t *node);
 
@@ -255,20 +255,20 @@ const coavoid_vehicle_node_state_t *coavoid_vehicle_node_state(const coavoid_veh
 
 typedef struct {
     coavoid_node_common_t common;
-    uint16_t id;                     /* 0: the default, COAVOID_NODE_COORDINATOR_ID */
-    size_t max_centralised;          /* largest cluster planned in one composite search
+    uint16_t id;            /* 0: the default, COAVOID_NODE_COORDINATOR_ID */
+    size_t max_centralised; /* largest cluster planned in one composite search
                                         (1..COA_MAX_CENTRALISED; 0: the default, 3); larger clusters
                                         are planned decoupled by the coordinator */
-    int64_t collect_us;              /* after the cycle start, when it plans, < dt (0: the
+    int64_t collect_us;     /* after the cycle start, when it plans, < dt (0: the
                                         default, dt / 4) */
 } coavoid_coordinator_config_t;
 
 typedef struct {
     int64_t cycle;
-    uint32_t conflicts;              /* in its last prediction */
-    uint32_t clusters_planned;       /* planning calls in the last cycle */
-    uint32_t plans_run;              /* planning calls since start */
-    uint32_t plans_published;        /* solved plans published since start */
+    uint32_t conflicts;        /* in its last prediction */
+    uint32_t clusters_planned; /* planning calls in the last cycle */
+    uint32_t plans_run;        /* planning calls since start */
+    uint32_t plans_published;  /* solved plans published since start */
     int last_outcome;
     uint64_t last_nodes_expanded;
     int64_t last_plan_duration_us;
@@ -281,8 +281,8 @@ typedef struct coavoid_coordinator coavoid_coordinator_t;
  * (the workspace of coavoid_node_planner_config(N, max_centralised, beta): 1.3 MB for 3 UAVs
  * at N = 24 and beta 20,000). Errors as there (collect_us >= dt, max_centralised >
  * COA_MAX_CENTRALISED: COA_ERR_ARGUMENT). */
-coavoid_coordinator_t *coavoid_coordinator_create(const coavoid_coordinator_config_t *config, lcm_t *lcm,
-                                          int *error);
+coavoid_coordinator_t *coavoid_coordinator_create(const coavoid_coordinator_config_t *config,
+                                                  lcm_t *lcm, int *error);
 /* Unsubscribes and frees. NULL is fine. */
 void coavoid_coordinator_destroy(coavoid_coordinator_t *node);
 /* Step 3 of the file comment for the cycle `now` falls in (call it at cycle start +
@@ -298,10 +298,10 @@ const coavoid_coordinator_state_t *coavoid_coordinator_state(const coavoid_coord
 
 typedef struct {
     coavoid_node_common_t common;
-    uint16_t id;                      /* map_id and track source_id; 0: COAVOID_NODE_WORLD_ID */
-    const coa_obstacle_t *obstacles;  /* the caller's, outliving the node */
+    uint16_t id;                     /* map_id and track source_id; 0: COAVOID_NODE_WORLD_ID */
+    const coa_obstacle_t *obstacles; /* the caller's, outliving the node */
     size_t obstacle_count;
-    const coa_track_t *tracks;        /* positions at scenario t = 0 (epoch) */
+    const coa_track_t *tracks; /* positions at scenario t = 0 (epoch) */
     size_t track_count;
 } coavoid_world_config_t;
 

@@ -69,13 +69,13 @@ typedef struct {
 
 typedef struct {
     bool used;
-    bool forgotten;           /* its sequence was forgotten when it went stale */
-    coavoid_intent_t msg;     /* validated on arrival */
+    bool forgotten;       /* its sequence was forgotten when it went stale */
+    coavoid_intent_t msg; /* validated on arrival */
 } coavoid_node_peer_t;
 
 typedef struct {
     bool used;
-    coavoid_track_t msg;      /* validated on arrival */
+    coavoid_track_t msg; /* validated on arrival */
 } coavoid_node_track_slot_t;
 
 typedef struct coavoid_node_inbox coavoid_node_inbox_t;
@@ -84,19 +84,20 @@ typedef struct coavoid_node_inbox coavoid_node_inbox_t;
  * sequence rule is applied to plans (vehicle.c orders those of one cycle, decides on
  * adoption and counts the outcome itself). */
 typedef void (*coavoid_node_plan_handler_t)(void *owner, const coavoid_plan_t *msg,
-                                        const coavoid_lcm_plan_info_t *info,
-                                        const coa_plan_result_t *result, const int32_t *offsets);
+                                            const coavoid_lcm_plan_info_t *info,
+                                            const coa_plan_result_t *result,
+                                            const int32_t *offsets);
 
 struct coavoid_node_inbox {
     coavoid_node_common_t common;
-    uint16_t self_uav;              /* intents from this UAV are the node's own (0: none) */
-    uint16_t self_node;             /* status and plans from this node id are its own */
-    uint16_t coordinator_id;        /* the only coordinator it hears (0: none) */
-    size_t peer_capacity;           /* other UAVs it keeps (vehicle: MAX_PEERS - 1) */
-    int64_t max_age_us;             /* validation window (context max_age) */
+    uint16_t self_uav;       /* intents from this UAV are the node's own (0: none) */
+    uint16_t self_node;      /* status and plans from this node id are its own */
+    uint16_t coordinator_id; /* the only coordinator it hears (0: none) */
+    size_t peer_capacity;    /* other UAVs it keeps (vehicle: MAX_PEERS - 1) */
+    int64_t max_age_us;      /* validation window (context max_age) */
     lcm_subscription_t *subs[6];
     size_t sub_count;
-    coavoid_lcm_rx_stats_t *rx;         /* the owner's counters (its state's rx) */
+    coavoid_lcm_rx_stats_t *rx; /* the owner's counters (its state's rx) */
 
     coavoid_node_senders_t intent_seq;
     coavoid_node_senders_t track_seq;
@@ -117,12 +118,12 @@ struct coavoid_node_inbox {
     uint64_t own_hash[COAVOID_NODE_OWN_INTENTS];
     int own_size[COAVOID_NODE_OWN_INTENTS];
     size_t own_next;
-    uint32_t foreign_intents;       /* such intents since the owner last cleared it */
+    uint32_t foreign_intents; /* such intents since the owner last cleared it */
 
-    int64_t rejected_at_heartbeat;  /* rx->rejected when the last heartbeat was sent */
+    int64_t rejected_at_heartbeat; /* rx->rejected when the last heartbeat was sent */
 
-    bool heard_coordinator;         /* a coordinator's status_t was received */
-    int64_t coordinator_utime;      /* when (driver clock) */
+    bool heard_coordinator;    /* a coordinator's status_t was received */
+    int64_t coordinator_utime; /* when (driver clock) */
 
     coavoid_node_plan_handler_t on_plan;
     void *owner;
@@ -154,11 +155,11 @@ typedef struct {
     coavoid_lcm_intent_arrays_t live_arrays[COAVOID_NODE_MAX_PEERS];
 
     size_t real_track_count;
-    size_t track_count;             /* real + stale UAVs */
+    size_t track_count; /* real + stale UAVs */
     coa_track_t tracks[COAVOID_NODE_TRACK_CAPACITY];
     uint32_t track_ids[COAVOID_NODE_TRACK_CAPACITY];
     coa_track_point_t real_paths[COAVOID_NODE_MAX_TRACKS][COAVOID_TRACK_T_MAX_PATH];
-    size_t stale_count;             /* tracks[real_track_count ..] are stale UAVs */
+    size_t stale_count; /* tracks[real_track_count ..] are stale UAVs */
 } coavoid_node_view_t;
 
 /* The tracks of one planning problem, sampled over the horizon. */
@@ -186,15 +187,15 @@ typedef struct {
  * and the counters its state keeps (saturated to the message's types when sent). */
 typedef struct {
     uint16_t node_id;
-    int8_t node_kind;               /* COAVOID_STATUS_T_NODE_* */
+    int8_t node_kind; /* COAVOID_STATUS_T_NODE_* */
     int64_t sequence;
-    bool fault;                     /* an internal error: HEALTH_FAULT */
-    bool degraded;                  /* otherwise HEALTH_DEGRADED, else HEALTH_OK */
-    int8_t mode;                    /* COAVOID_STATUS_T_MODE_* */
+    bool fault;    /* an internal error: HEALTH_FAULT */
+    bool degraded; /* otherwise HEALTH_DEGRADED, else HEALTH_OK */
+    int8_t mode;   /* COAVOID_STATUS_T_MODE_* */
     int64_t last_plan_utime;
     int64_t last_plan_duration_us;
     uint64_t last_nodes_expanded;
-    int last_outcome;               /* coa_plan_status_t, -1 none */
+    int last_outcome; /* coa_plan_status_t, -1 none */
     uint32_t conflicts;
     uint32_t plans_run;
     const coavoid_lcm_rx_stats_t *rx;
@@ -205,7 +206,8 @@ int coavoid_node_common_check(const coavoid_node_common_t *c);
 
 /* The validation context at `now` with t = 0 at `epoch`: messages up to a horizon and
  * stale_after old, at most one cycle ahead. Cannot fail; O(1). */
-coavoid_lcm_context_t coavoid_node_context(const coavoid_node_inbox_t *in, int64_t now, int64_t epoch);
+coavoid_lcm_context_t coavoid_node_context(const coavoid_node_inbox_t *in, int64_t now,
+                                           int64_t epoch);
 
 /* Initialises the inbox and subscribes to intents, tracks and the obstacle map, and to
  * heartbeats (want_status) and plans (plan_handler non-NULL) when asked; counts into rx.
@@ -214,10 +216,11 @@ coavoid_lcm_context_t coavoid_node_context(const coavoid_node_inbox_t *in, int64
  * Returns COA_OK, or COA_ERR_ARGUMENT when LCM refused a subscription (everything
  * subscribed so far is unsubscribed). The handlers cost O(message) each (decoding and
  * validation, O(senders) for the sequence rule) and allocate nothing. */
-int coavoid_node_inbox_init(coavoid_node_inbox_t *in, const coavoid_node_common_t *common, uint16_t self_uav,
-                        uint16_t self_node, uint16_t coordinator_id, size_t peer_capacity,
-                        lcm_t *lcm, coavoid_lcm_rx_stats_t *rx, bool want_status,
-                        coavoid_node_plan_handler_t plan_handler, void *owner);
+int coavoid_node_inbox_init(coavoid_node_inbox_t *in, const coavoid_node_common_t *common,
+                            uint16_t self_uav, uint16_t self_node, uint16_t coordinator_id,
+                            size_t peer_capacity, lcm_t *lcm, coavoid_lcm_rx_stats_t *rx,
+                            bool want_status, coavoid_node_plan_handler_t plan_handler,
+                            void *owner);
 
 /* Unsubscribes everything. O(subscriptions). */
 void coavoid_node_inbox_fini(coavoid_node_inbox_t *in);
@@ -229,7 +232,7 @@ void coavoid_node_inbox_expire(coavoid_node_inbox_t *in, int64_t now);
 /* Builds the view of the cycle starting at cycle_start, at `now`. Cost O(peers * samples +
  * tracks). Cannot fail: a stored message that no longer converts is left out. */
 void coavoid_node_view_build(coavoid_node_view_t *view, const coavoid_node_inbox_t *in,
-                         int64_t cycle_start, int64_t now);
+                             int64_t cycle_start, int64_t now);
 
 /* Whether a outranks b in the decoupled order (ascending priority, ties by ascending id).
  * O(1). */
@@ -240,7 +243,7 @@ bool coavoid_node_outranks(uint32_t priority_a, uint16_t id_a, uint32_t priority
  * is for this cycle), each sampled over samples 0..N. Returns COA_OK or COA_ERR_ARGUMENT
  * (a track that does not sample). Cost O(tracks * (N + path)). No memory. */
 int coavoid_node_problem_tracks(coavoid_node_problem_tracks_t *out, const coavoid_node_view_t *view,
-                            const bool *include, const coavoid_node_common_t *c);
+                                const bool *include, const coavoid_node_common_t *c);
 
 /* The predictor's configuration for one cycle of a node: t = 0 at the cycle's start,
  * the common dt, horizon, sigma rates and threshold. Cannot fail; O(1). */
@@ -252,9 +255,9 @@ coa_predict_config_t coavoid_node_predict_config(const coavoid_node_common_t *c)
  * COA_ERR_WORKSPACE when the conflicts overflow `capacity`. Cost: coa_predict's. No
  * memory beyond the predictor's workspace. */
 int coavoid_node_predict(coa_predictor_t *predictor, const coavoid_node_common_t *c,
-                     const coa_intent_plan_t *plans, size_t n, const coavoid_node_view_t *view,
-                     const coavoid_node_inbox_t *in, coa_conflict_t *conflicts, size_t capacity,
-                     coa_predict_result_t *result, uint32_t *labels, size_t *cluster_count);
+                         const coa_intent_plan_t *plans, size_t n, const coavoid_node_view_t *view,
+                         const coavoid_node_inbox_t *in, coa_conflict_t *conflicts, size_t capacity,
+                         coa_predict_result_t *result, uint32_t *labels, size_t *cluster_count);
 
 /* The predictor's pair bound for a node: every pair that can exist among MAX_PEERS
  * plans, TRACK_CAPACITY tracks and MAX_OBSTACLES obstacles, so that the broad phase
@@ -265,7 +268,8 @@ size_t coavoid_node_max_pairs(void);
  * COA_OK, COA_ERR_ARGUMENT (sizes the core refuses; nothing allocated) or COA_ERR_WORKSPACE
  * (out of memory; nothing kept). Memory: the predictor's and planner's workspaces
  * (coa_predictor_workspace_size, coa_planner_workspace_size) and the conflict array. */
-int coavoid_node_solver_init(coavoid_node_solver_t *s, uint32_t horizon, size_t searched, uint32_t beta);
+int coavoid_node_solver_init(coavoid_node_solver_t *s, uint32_t horizon, size_t searched,
+                             uint32_t beta);
 
 /* Frees what coavoid_node_solver_init allocated; a zeroed *s is fine. */
 void coavoid_node_solver_fini(coavoid_node_solver_t *s);
@@ -277,7 +281,7 @@ void coavoid_node_solver_fini(coavoid_node_solver_t *s);
  * Returns COA_OK, COA_ERR_ARGUMENT (it does not validate) or coavoid_node_publish_status's
  * error. O(1); no memory. */
 int coavoid_node_publish_heartbeat(coavoid_node_inbox_t *in, coavoid_status_t *m, int64_t now,
-                               int64_t cycle_start, const coavoid_node_heartbeat_t *h);
+                                   int64_t cycle_start, const coavoid_node_heartbeat_t *h);
 
 /* Publishing: encodes into tx->buf and publishes on the type's channel. COA_OK, or
  * COA_ERR_WORKSPACE (does not encode into the buffer) or COA_ERR_ARGUMENT (LCM refused

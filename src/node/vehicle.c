@@ -21,9 +21,9 @@ struct coavoid_vehicle_node {
     int64_t cycle_start;
     int64_t wait_deadline;
     bool was_coordinated;
-    bool cycle_conflict;             /* a conflict of its own in this cycle's prediction */
-    bool distrust;                   /* not following a coordinator it hears (cycle()) */
-    bool fault;                      /* an internal error in this cycle */
+    bool cycle_conflict; /* a conflict of its own in this cycle's prediction */
+    bool distrust;       /* not following a coordinator it hears (cycle()) */
+    bool fault;          /* an internal error in this cycle */
     int64_t intent_sequence;
     int64_t status_sequence;
     int64_t last_plan_utime;
@@ -31,7 +31,7 @@ struct coavoid_vehicle_node {
      * the last one. Plans are ordered within a cycle only (node.h, step 4). */
     bool cycle_plan_adopted;
     int64_t cycle_plan_id;
-    bool cycle_plan_failed;          /* one listed it, in time, but was not solved */
+    bool cycle_plan_failed; /* one listed it, in time, but was not solved */
 
     /* The adopted plan: offsets of samples plan_start .. plan_start + plan_count - 1; past
      * its end the last offset holds. */
@@ -45,7 +45,7 @@ struct coavoid_vehicle_node {
     coa_vec3_t own_samples[COAVOID_NODE_MAX_SAMPLES];
 
     int32_t plan_out[COAVOID_NODE_MAX_SAMPLES];
-    int32_t checked[COAVOID_NODE_MAX_SAMPLES];      /* a coordinator's plan over this window */
+    int32_t checked[COAVOID_NODE_MAX_SAMPLES];       /* a coordinator's plan over this window */
     coa_intent_plan_t plans[COAVOID_NODE_MAX_PEERS]; /* itself first, then the live peers */
     coa_intent_plan_t tall[COAVOID_NODE_MAX_PEERS];  /* the same, with unbounded height */
     uint32_t labels[COAVOID_NODE_MAX_PEERS];
@@ -143,7 +143,8 @@ static int publish_status(coavoid_vehicle_node_t *node, int64_t now)
         s->conflicts,
         s->plans_run,
         &s->rx};
-    return coavoid_node_publish_heartbeat(&node->inbox, &node->tx_status, now, node->cycle_start, &h);
+    return coavoid_node_publish_heartbeat(&node->inbox, &node->tx_status, now, node->cycle_start,
+                                          &h);
 }
 
 /* Publishes this cycle's intent and heartbeat; the wait, if any, is over. Returns 1 or a
@@ -174,8 +175,8 @@ static int finish(coavoid_vehicle_node_t *node, int64_t now)
     info.sigma_vertical = node->config.sigma_vertical;
     coavoid_lcm_context_t ctx = coavoid_node_context(&node->inbox, now, node->cycle_start);
     int rc = coavoid_lcm_intent_from_core(&node->config.vehicle, &info, node->own_reference,
-                                      node->own_offsets, (size_t)c->horizon + 1u, &ctx,
-                                      &node->tx_intent, NULL);
+                                          node->own_offsets, (size_t)c->horizon + 1u, &ctx,
+                                          &node->tx_intent, NULL);
     if (rc == COA_OK) {
         rc = coavoid_node_publish_intent(&node->inbox, &node->tx_intent);
     } else {
@@ -269,7 +270,8 @@ static int plan_self(coavoid_vehicle_node_t *node, int64_t now, uint32_t my)
     if (rc == COA_OK && result.status != COA_PLAN_SOLVED && lower_outside) {
         for (size_t i = 0; i < view->live_count; i++) {
             const coa_vehicle_t *peer = &view->live_vehicle[i];
-            node->include[i] = !coavoid_node_outranks(self->priority, self->id, peer->priority, peer->id);
+            node->include[i] =
+                !coavoid_node_outranks(self->priority, self->id, peer->priority, peer->id);
         }
         rc = search_self(node, now, &result);
     }
@@ -311,8 +313,8 @@ static int predict(coavoid_vehicle_node_t *node, size_t n, coa_predict_result_t 
     size_t clusters = 0;
     coavoid_node_solver_t *sv = &node->solver;
     int rc = coavoid_node_predict(sv->predictor, &node->config.common, node->plans, n, &node->view,
-                              &node->inbox, sv->conflicts, sv->conflict_capacity, result,
-                              node->labels, &clusters);
+                                  &node->inbox, sv->conflicts, sv->conflict_capacity, result,
+                                  node->labels, &clusters);
     if (rc != COA_OK) {
         return rc;
     }
@@ -515,7 +517,8 @@ static void on_plan(void *owner, const coavoid_plan_t *msg, const coavoid_lcm_pl
         return;
     }
     if (node->cycle_plan_adopted && msg->plan_id <= node->cycle_plan_id) {
-        reject(node, COAVOID_LCM_ERR_SEQUENCE, "plan: plan_id not after the one adopted this cycle");
+        reject(node, COAVOID_LCM_ERR_SEQUENCE,
+               "plan: plan_id not after the one adopted this cycle");
         return;
     }
     if (msg->dt != (double)node->config.common.dt) {
@@ -551,8 +554,8 @@ static void on_plan(void *owner, const coavoid_plan_t *msg, const coavoid_lcm_pl
     coavoid_lcm_rx_count(&node->state.rx, COA_OK, NULL);
 }
 
-coavoid_vehicle_node_t *coavoid_vehicle_node_create(const coavoid_vehicle_node_config_t *config, lcm_t *lcm,
-                                            int *error)
+coavoid_vehicle_node_t *coavoid_vehicle_node_create(const coavoid_vehicle_node_config_t *config,
+                                                    lcm_t *lcm, int *error)
 {
     int dummy;
     if (error == NULL) {
@@ -606,8 +609,8 @@ coavoid_vehicle_node_t *coavoid_vehicle_node_create(const coavoid_vehicle_node_c
     node->wait_deadline = INT64_MAX;
     const bool centralised = node->config.mode == COAVOID_NODE_CENTRALISED;
     rc = coavoid_node_inbox_init(&node->inbox, c, node->config.vehicle.id, node->config.vehicle.id,
-                             coordinator_id, COAVOID_NODE_MAX_PEERS - 1u, lcm, &node->state.rx,
-                             centralised, centralised ? on_plan : NULL, node);
+                                 coordinator_id, COAVOID_NODE_MAX_PEERS - 1u, lcm, &node->state.rx,
+                                 centralised, centralised ? on_plan : NULL, node);
     if (rc != COA_OK) {
         coavoid_node_solver_fini(&node->solver);
         free(node);

@@ -135,8 +135,8 @@ coavoid_world_t *coavoid_world_create(const coavoid_world_config_t *config, lcm_
     /* The map must fit the message and pass its check: find out now, not every cycle. */
     coavoid_lcm_context_t ctx = world_context(w, 0, config->common.epoch_utime);
     if (coavoid_lcm_obstacle_map_from_core(config->obstacles, config->obstacle_count,
-                                       config->common.epoch_utime, w->config.id, 1, &ctx,
-                                       &w->map_msg, NULL) != COA_OK) {
+                                           config->common.epoch_utime, w->config.id, 1, &ctx,
+                                           &w->map_msg, NULL) != COA_OK) {
         free(w);
         return NULL;
     }
@@ -166,8 +166,9 @@ int coavoid_world_cycle(coavoid_world_t *node, int64_t now)
     node->cycle = k;
     const int64_t cycle_start = coavoid_node_cycle_utime(c, k);
     coavoid_lcm_context_t ctx = world_context(node, now, cycle_start);
-    int rc = coavoid_lcm_obstacle_map_from_core(node->config.obstacles, node->config.obstacle_count,
-                                            now, node->config.id, 1, &ctx, &node->map_msg, NULL);
+    int rc =
+        coavoid_lcm_obstacle_map_from_core(node->config.obstacles, node->config.obstacle_count, now,
+                                           node->config.id, 1, &ctx, &node->map_msg, NULL);
     if (rc == COA_OK) {
         rc = coavoid_node_publish_map(&node->tx, &node->map_msg);
     }

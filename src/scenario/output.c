@@ -91,7 +91,8 @@ static int add_vehicle(cJSON *array, const coavoid_scenario_t *s, size_t index, 
                       (unsigned)v->id, (long)row[k], (long)row[k + 1], (unsigned long)k);
             return -2;
         }
-        if (!coavoid_output_append(actions, cJSON_CreateString(coa_action_name((coa_action_t)action)))) {
+        if (!coavoid_output_append(actions,
+                                   cJSON_CreateString(coa_action_name((coa_action_t)action)))) {
             return -1;
         }
     }
@@ -244,7 +245,8 @@ static bool add_conflict(cJSON *array, const coavoid_output_conflict_t *c)
 {
     cJSON *entry = cJSON_CreateObject();
     return coavoid_output_append(array, entry) &&
-           cJSON_AddStringToObject(entry, "kind", coavoid_output_conflict_kind_name(c->kind)) != NULL &&
+           cJSON_AddStringToObject(entry, "kind", coavoid_output_conflict_kind_name(c->kind)) !=
+               NULL &&
            add_number(entry, "a", c->a) && add_number(entry, "b", c->b) &&
            add_number(entry, "first_step", c->first_step) &&
            add_number(entry, "probability", c->probability) &&
@@ -290,7 +292,8 @@ fail:
     return NULL;
 }
 
-int coavoid_output_predict(FILE *out, const coavoid_output_predict_t *prediction, char *err, size_t err_size)
+int coavoid_output_predict(FILE *out, const coavoid_output_predict_t *prediction, char *err,
+                           size_t err_size)
 {
     cJSON *root = build_prediction(prediction);
     if (root == NULL) {

@@ -19,11 +19,11 @@
 
 typedef struct {
     const coavoid_scenario_t *scenario;
-    bool decoupled;                  /* mode: decoupled, else centralised */
+    bool decoupled; /* mode: decoupled, else centralised */
     const coa_plan_result_t *result;
-    const int32_t *offsets;          /* vehicle_count rows of horizon+1, row i is vehicle i */
-    int64_t time_us;                 /* wall time of the planning call */
-    uint32_t beta;                   /* the closed-set bound the planner ran with */
+    const int32_t *offsets; /* vehicle_count rows of horizon+1, row i is vehicle i */
+    int64_t time_us;        /* wall time of the planning call */
+    uint32_t beta;          /* the closed-set bound the planner ran with */
 } coavoid_output_plan_t;
 
 /* Writes the result object (and a newline) to `out`. Returns 0, or -1 with the reason in
@@ -37,28 +37,29 @@ const char *coavoid_output_status_name(coa_plan_status_t status);
 /* One entry of the prediction result's "conflicts", already in the contract's terms. */
 typedef struct {
     coa_conflict_kind_t kind;
-    uint32_t a;             /* UAV id */
-    uint32_t b;             /* the other UAV's id (a < b), the track's id or the obstacle's index */
+    uint32_t a; /* UAV id */
+    uint32_t b; /* the other UAV's id (a < b), the track's id or the obstacle's index */
     uint32_t first_step;
-    double first_time;      /* s, t of first_step */
-    double min_horizontal;  /* m, as coa_conflict_t */
-    double min_vertical;    /* m */
+    double first_time;     /* s, t of first_step */
+    double min_horizontal; /* m, as coa_conflict_t */
+    double min_vertical;   /* m */
     double probability;
 } coavoid_output_conflict_t;
 
 typedef struct {
-    const char *scenario;                /* the scenario's name */
-    const coavoid_output_conflict_t *conflicts;  /* in the order to print */
+    const char *scenario;                       /* the scenario's name */
+    const coavoid_output_conflict_t *conflicts; /* in the order to print */
     size_t conflict_count;
-    const uint32_t *cluster_ids;         /* the clusters' UAV ids, one cluster after another */
-    const size_t *cluster_start;         /* cluster c is cluster_ids[cluster_start[c] ..
+    const uint32_t *cluster_ids; /* the clusters' UAV ids, one cluster after another */
+    const size_t *cluster_start; /* cluster c is cluster_ids[cluster_start[c] ..
                                             cluster_start[c + 1] - 1]: cluster_count + 1 entries */
     size_t cluster_count;
 } coavoid_output_predict_t;
 
 /* Writes the prediction result object (and a newline) to `out`. Returns 0, or -1 with the
  * reason in err (out of memory, a write error). */
-int coavoid_output_predict(FILE *out, const coavoid_output_predict_t *prediction, char *err, size_t err_size);
+int coavoid_output_predict(FILE *out, const coavoid_output_predict_t *prediction, char *err,
+                           size_t err_size);
 
 /* The contract's name of a conflict kind ("vehicle", "track", "obstacle"). */
 const char *coavoid_output_conflict_kind_name(coa_conflict_kind_t kind);

@@ -206,16 +206,15 @@ static const char *plural(const char *noun_singular, const char *noun_plural, si
 }
 
 /* An array of min..max elements; `what` names one element in messages ("point"). */
-static bool read_array(parser_t *p, const cJSON *item, const char *path, size_t min,
-                       size_t max, const char *what, const char *max_name, size_t *count)
+static bool read_array(parser_t *p, const cJSON *item, const char *path, size_t min, size_t max,
+                       const char *what, const char *max_name, size_t *count)
 {
     if (!cJSON_IsArray(item)) {
         return fail(p, path, "must be an array, got %s", json_type_name(item));
     }
     size_t n = array_length(item);
     if (n < min) {
-        return fail(p, path, "needs at least %zu %s%s, got %zu", min, what, min == 1 ? "" : "s",
-                    n);
+        return fail(p, path, "needs at least %zu %s%s, got %zu", min, what, min == 1 ? "" : "s", n);
     }
     if (n > max) {
         return fail(p, path, "at most %zu %ss%s%s%s are supported, got %zu", max, what,
@@ -227,9 +226,9 @@ static bool read_array(parser_t *p, const cJSON *item, const char *path, size_t 
 }
 
 typedef enum {
-    ANY_REAL,     /* every finite number */
-    POSITIVE,     /* > 0 */
-    NON_NEGATIVE  /* >= 0 */
+    ANY_REAL,    /* every finite number */
+    POSITIVE,    /* > 0 */
+    NON_NEGATIVE /* >= 0 */
 } real_bound_t;
 
 /* A finite JSON number that is also finite (and within the bound) as a coa_real_t, which
@@ -303,8 +302,8 @@ static bool read_point(parser_t *p, const cJSON *item, const char *path, size_t 
     if (!cJSON_IsArray(item) || array_length(item) != dim) {
         if (cJSON_IsArray(item)) {
             size_t n = array_length(item);
-            return fail(p, path, "must be an array of %zu numbers %s, got %zu %s", dim, shape,
-                        n, plural("element", "elements", n));
+            return fail(p, path, "must be an array of %zu numbers %s, got %zu %s", dim, shape, n,
+                        plural("element", "elements", n));
         }
         return fail(p, path, "must be an array of %zu numbers %s, got %s", dim, shape,
                     json_type_name(item));
@@ -419,8 +418,7 @@ static bool vec3_field(parser_t *p, const cJSON *obj, const char *obj_path, cons
 {
     char path[PATH_SIZE];
     const cJSON *item;
-    return get_field(p, obj, obj_path, key, REQUIRED, &item, path) &&
-           read_vec3(p, item, path, out);
+    return get_field(p, obj, obj_path, key, REQUIRED, &item, path) && read_vec3(p, item, path, out);
 }
 
 static bool out_of_memory(parser_t *p, const char *path)
@@ -433,8 +431,7 @@ static bool out_of_memory(parser_t *p, const char *path)
 static const int_range_t RANGE_VEHICLE_ID = {1, 65535, NULL};
 static const int_range_t RANGE_PRIORITY = {1, UINT32_MAX, NULL};
 static const int_range_t RANGE_STEEP = {2, COA_MAX_STEEP_FACTOR, "COA_MAX_STEEP_FACTOR"};
-static const int_range_t RANGE_INITIAL_OFFSET = {-COA_MAX_OFFSET, COA_MAX_OFFSET,
-                                                 "COA_MAX_OFFSET"};
+static const int_range_t RANGE_INITIAL_OFFSET = {-COA_MAX_OFFSET, COA_MAX_OFFSET, "COA_MAX_OFFSET"};
 static const int_range_t RANGE_MAX_OFFSET = {0, COA_MAX_OFFSET, "COA_MAX_OFFSET"};
 static const int_range_t RANGE_HORIZON = {1, COA_MAX_HORIZON, "COA_MAX_HORIZON"};
 static const int_range_t RANGE_BETA = {1, UINT32_MAX, NULL};
@@ -556,8 +553,7 @@ static double step_area(const coa_vehicle_t *v, coa_real_t dt)
  * product (the deviation scale) must be finite and positive, in double as the core's
  * weights are computed and as coa_real_t: each number can be fine while a product
  * overflows or underflows. */
-static bool check_step_sizes(parser_t *p, const coa_vehicle_t *v, coa_real_t dt,
-                             const char *path)
+static bool check_step_sizes(parser_t *p, const coa_vehicle_t *v, coa_real_t dt, const char *path)
 {
     double l = (double)v->cruise_speed * (double)dt;
     double dh = (double)v->climb_rate * (double)dt;
@@ -668,8 +664,7 @@ static bool parse_box(parser_t *p, const cJSON *obj, const char *path, coa_obsta
     return true;
 }
 
-static bool parse_polytope(parser_t *p, const cJSON *obj, const char *obj_path,
-                           coa_obstacle_t *o)
+static bool parse_polytope(parser_t *p, const cJSON *obj, const char *obj_path, coa_obstacle_t *o)
 {
     char path[PATH_SIZE];
     const cJSON *array;
@@ -949,15 +944,15 @@ static void locate(const char *text, size_t at, size_t *line, size_t *column)
     }
 }
 
-int coavoid_scenario_parse(const char *text, size_t length, coavoid_scenario_t *s, char *err, size_t err_size)
+int coavoid_scenario_parse(const char *text, size_t length, coavoid_scenario_t *s, char *err,
+                           size_t err_size)
 {
     memset(s, 0, sizeof *s);
     const char *nul = memchr(text, '\0', length);
     if (nul != NULL) {
         size_t line, column;
         locate(text, (size_t)(nul - text), &line, &column);
-        set_error(err, err_size, "invalid JSON: NUL byte at line %zu, column %zu", line,
-                  column);
+        set_error(err, err_size, "invalid JSON: NUL byte at line %zu, column %zu", line, column);
         return -1;
     }
     /* cJSON wants the terminating NUL inside the length it is given to accept the end. */
@@ -971,8 +966,8 @@ int coavoid_scenario_parse(const char *text, size_t length, coavoid_scenario_t *
     const char *end = NULL;
     cJSON *root = cJSON_ParseWithLengthOpts(copy, length + 1, &end, 1);
     if (root == NULL) {
-        size_t at = end != NULL && end >= copy && end <= copy + length ? (size_t)(end - copy)
-                                                                       : length;
+        size_t at =
+            end != NULL && end >= copy && end <= copy + length ? (size_t)(end - copy) : length;
         size_t line, column;
         locate(copy, at, &line, &column);
         if (at >= length) {

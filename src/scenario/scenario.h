@@ -58,7 +58,8 @@ typedef struct {
 int coavoid_scenario_load(const char *path, coavoid_scenario_t *s, char *err, size_t err_size);
 
 /* As coavoid_scenario_load, from `length` bytes of JSON text in memory. */
-int coavoid_scenario_parse(const char *text, size_t length, coavoid_scenario_t *s, char *err, size_t err_size);
+int coavoid_scenario_parse(const char *text, size_t length, coavoid_scenario_t *s, char *err,
+                           size_t err_size);
 
 /* Samples every vehicle's reference and every track at t_k = k*dt, k = 0..horizon, into
  * s->references and s->track_samples, refusing samples that are not finite (a route or a

@@ -42,7 +42,8 @@ int main(void)
     }
     const int rc = coa_plan_centralised(planner, &problem, offsets, &result);
     if (rc != COA_OK || result.status != COA_PLAN_SOLVED) {
-        fprintf(stderr, "plan: rc %d (%s) status %d\n", rc, coa_status_name(rc), (int)result.status);
+        fprintf(stderr, "plan: rc %d (%s) status %d\n", rc, coa_status_name(rc),
+                (int)result.status);
         return 1;
     }
     const size_t all[2] = {0, 1};

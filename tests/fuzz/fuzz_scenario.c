@@ -37,11 +37,13 @@ static void plan_both(const coa_problem_t *problem)
         if (size > FUZZ_MAX_WORKSPACE) {
             continue; /* tables of a long unbounded horizon: gigabytes, not a bug */
         }
-        void *buffer = size ? aligned_alloc(COA_WORKSPACE_ALIGNMENT, (size + 7u) & ~(size_t)7u) : NULL;
+        void *buffer =
+            size ? aligned_alloc(COA_WORKSPACE_ALIGNMENT, (size + 7u) & ~(size_t)7u) : NULL;
         coa_planner_t *planner = buffer ? coa_planner_init(buffer, size, &config) : NULL;
         if (planner != NULL) {
-            const int rc = (m == 1) ? coa_plan_decoupled(planner, problem, NULL, 4u, offsets, &result)
-                                    : coa_plan_centralised(planner, problem, offsets, &result);
+            const int rc = (m == 1)
+                               ? coa_plan_decoupled(planner, problem, NULL, 4u, offsets, &result)
+                               : coa_plan_centralised(planner, problem, offsets, &result);
             if (rc == COA_ERR_ARGUMENT) {
                 abort(); /* the app validated it: the core must accept it */
             }
@@ -57,16 +59,20 @@ static void plan_both(const coa_problem_t *problem)
 static void predict_all(const coa_problem_t *problem)
 {
     const size_t n = problem->vehicle_count;
-    const size_t pairs = n * (n - 1u) / 2u + n * (problem->track_count + problem->obstacle_count) + 1u;
-    const size_t size = coa_predictor_workspace_size(n, problem->track_count, problem->horizon, pairs);
+    const size_t pairs =
+        n * (n - 1u) / 2u + n * (problem->track_count + problem->obstacle_count) + 1u;
+    const size_t size =
+        coa_predictor_workspace_size(n, problem->track_count, problem->horizon, pairs);
     coa_intent_plan_t *plans = calloc(n, sizeof *plans);
     coa_vec3_t *samples = calloc(n * (problem->horizon + 1u), sizeof *samples);
     coa_conflict_t *conflicts = calloc(pairs, sizeof *conflicts);
     uint32_t *cluster = calloc(n, sizeof *cluster);
     void *buffer = size ? aligned_alloc(COA_WORKSPACE_ALIGNMENT, (size + 7u) & ~(size_t)7u) : NULL;
     coa_predictor_t *predictor =
-        buffer ? coa_predictor_init(buffer, size, n, problem->track_count, problem->horizon, pairs) : NULL;
-    if (plans != NULL && samples != NULL && conflicts != NULL && cluster != NULL && predictor != NULL) {
+        buffer ? coa_predictor_init(buffer, size, n, problem->track_count, problem->horizon, pairs)
+               : NULL;
+    if (plans != NULL && samples != NULL && conflicts != NULL && cluster != NULL &&
+        predictor != NULL) {
         for (size_t i = 0; i < n; ++i) {
             const coa_vehicle_t *v = &problem->vehicles[i];
             const coa_real_t lift = (coa_real_t)v->initial_offset * coa_climb_step(v, problem->dt);
@@ -87,11 +93,12 @@ static void predict_all(const coa_problem_t *problem)
                                              .threshold = 0.01};
         coa_predict_result_t result;
         size_t clusters = 0;
-        const int rc = coa_predict(predictor, &config, plans, n, problem->obstacles,
-                                   problem->obstacle_count, problem->tracks, problem->track_count,
-                                   conflicts, pairs, &result);
+        const int rc =
+            coa_predict(predictor, &config, plans, n, problem->obstacles, problem->obstacle_count,
+                        problem->tracks, problem->track_count, conflicts, pairs, &result);
         if (rc != COA_OK || result.overflow ||
-            coa_predict_clusters(conflicts, result.conflict_count, n, cluster, &clusters) != COA_OK) {
+            coa_predict_clusters(conflicts, result.conflict_count, n, cluster, &clusters) !=
+                COA_OK) {
             abort(); /* sized for every pair and validated: the predictor must succeed */
         }
     }

@@ -14,8 +14,8 @@
 
 #include "internal.h"
 
-#define PLAN_MAGIC 0x434f4150u      /* marks a buffer built by ref_planner_init */
-#define NONE UINT32_MAX             /* no node, empty table slot, not in the heap */
+#define PLAN_MAGIC 0x434f4150u /* marks a buffer built by ref_planner_init */
+#define NONE UINT32_MAX        /* no node, empty table slot, not in the heap */
 #define ACTIONS COA_ACTION_COUNT
 #define MAXM COA_MAX_CENTRALISED
 /* Node indices, heap positions and table slots are uint32 with NONE reserved; a pool of
@@ -124,7 +124,6 @@ static inline int cost_compare(coa_cost_t a, coa_cost_t b)
 /* ------------------------------------------------------------------------------------ */
 /* Sizes                                                                                 */
 
-
 /* Children of one expansion of n searched UAVs at most: 5^n (n <= MAXM, so below 2^14). */
 static uint32_t children_per_node(size_t n)
 {
@@ -180,7 +179,6 @@ size_t ref_planner_workspace_size(size_t max_vehicles, uint32_t beta)
     return layout_compute(max_vehicles, beta, &lo) ? lo.total : 0u;
 }
 
-
 ref_planner_t *ref_planner_init(void *buffer, size_t size, size_t max_vehicles, uint32_t beta)
 {
     plan_layout_t lo;
@@ -221,7 +219,6 @@ ref_planner_t *ref_planner_init(void *buffer, size_t size, size_t max_vehicles, 
 /* ------------------------------------------------------------------------------------ */
 /* Problem validation                                                                    */
 
-
 static bool samples_ok(const coa_vec3_t *s, uint32_t horizon)
 {
     uint32_t k;
@@ -235,7 +232,6 @@ static bool samples_ok(const coa_vec3_t *s, uint32_t horizon)
     }
     return true;
 }
-
 
 /* Everything but the integer range: what a conflict check needs to be safe to run. */
 static int check_arguments(const coa_problem_t *p)
@@ -282,8 +278,7 @@ static int check_arguments(const coa_problem_t *p)
 /* The largest |offset| a vehicle may take: its own bound, and the int16 node storage. */
 static int32_t offset_limit(const coa_vehicle_t *v)
 {
-    return (v->max_offset >= 0 && v->max_offset < COA_MAX_OFFSET) ? v->max_offset
-                                                                   : COA_MAX_OFFSET;
+    return (v->max_offset >= 0 && v->max_offset < COA_MAX_OFFSET) ? v->max_offset : COA_MAX_OFFSET;
 }
 
 /* Whether the worst case f = g + h of any node stays below 2^127, which leaves every sum
@@ -331,8 +326,6 @@ static int check_range(const coa_problem_t *p, uint64_t *weights, uint32_t *scal
     return COA_OK;
 }
 
-
-
 /* ------------------------------------------------------------------------------------ */
 /* Costs of a finished row                                                               */
 
@@ -340,7 +333,6 @@ static int32_t abs_i32(int32_t a)
 {
     return a < 0 ? -a : a;
 }
-
 
 /* The exact deviation of one step in the search's units. Areas and heuristics are never
  * negative, so the casts below are exact. */
@@ -678,9 +670,9 @@ static bool expand(ref_planner_t *pl, uint32_t n, search_out_t *out)
         for (j = i + 1u; j < m; ++j) {
             for (a = 0; a < (int)ACTIONS; ++a) {
                 for (b = 0; b < (int)ACTIONS; ++b) {
-                    pl->pair_ok[i][j][a][b] = pl->env_ok[i][a] && pl->env_ok[j][b] &&
-                                              !coa_conflict_volumes(&pl->sweep[i][a],
-                                                                    &pl->sweep[j][b]);
+                    pl->pair_ok[i][j][a][b] =
+                        pl->env_ok[i][a] && pl->env_ok[j][b] &&
+                        !coa_conflict_volumes(&pl->sweep[i][a], &pl->sweep[j][b]);
                 }
             }
         }
@@ -892,8 +884,8 @@ static void fill_costs(const ref_planner_t *pl, const size_t *which, size_t coun
     }
 }
 
-int ref_plan_centralised(ref_planner_t *planner, const coa_problem_t *problem,
-                         int32_t *offsets, coa_plan_result_t *result)
+int ref_plan_centralised(ref_planner_t *planner, const coa_problem_t *problem, int32_t *offsets,
+                         coa_plan_result_t *result)
 {
     search_out_t out;
     size_t i;
@@ -981,9 +973,8 @@ static void promote(size_t *order, size_t from, size_t to)
     order[to] = v;
 }
 
-int ref_plan_decoupled(ref_planner_t *planner, const coa_problem_t *problem,
-                       const size_t *order, uint32_t max_orders, int32_t *offsets,
-                       coa_plan_result_t *result)
+int ref_plan_decoupled(ref_planner_t *planner, const coa_problem_t *problem, const size_t *order,
+                       uint32_t max_orders, int32_t *offsets, coa_plan_result_t *result)
 {
     size_t first[COA_MAX_VEHICLES];
     size_t cur[COA_MAX_VEHICLES];
@@ -991,7 +982,7 @@ int ref_plan_decoupled(ref_planner_t *planner, const coa_problem_t *problem,
     uint32_t tried[COA_MAX_VEHICLES];
     size_t n;
     size_t start = 0u;
-    size_t keep;          /* levels below this still hold the first attempt's plans */
+    size_t keep; /* levels below this still hold the first attempt's plans */
     size_t first_fail = 0u;
     bool any_budget = false;
     bool proven = false;  /* infeasible in every order, whatever beta did */
@@ -1131,4 +1122,3 @@ int ref_plan_decoupled(ref_planner_t *planner, const coa_problem_t *problem,
 
 /* ------------------------------------------------------------------------------------ */
 /* Checking a finished plan                                                              */
-
