@@ -133,6 +133,20 @@ static int parse_sim_options(int argc, char **argv, sim_options_t *o)
 }
 
 typedef struct {
+    /* The run's parameters (sim_check, sim_planner_sizes). */
+    const sim_options_t *o;
+    const coavoid_scenario_t *s;
+    const char *file;
+    size_t n;       /* UAVs */
+    uint32_t steps; /* samples 0..steps are flown */
+    size_t samples; /* steps + 1 */
+    int64_t now;    /* the nodes' clock (common.clock points here) */
+    coavoid_node_common_t common;
+    uint32_t vehicle_beta;
+    uint32_t coordinator_beta;
+    size_t max_centralised;
+    uint32_t coordinator_plans; /* plans the coordinator ran, when it stopped or at the end */
+    /* What the run holds (sim_run_free releases it). */
     lcm_t *lcm;
     coavoid_world_t *world;
     coavoid_coordinator_t *coordinator;
@@ -465,11 +479,11 @@ static bool drain(lcm_t *lcm)
     }
 }
 
-static int sim(void *options, coavoid_scenario_t *s)
+/* The scenario's limits for a simulation, then its samples and the nodes' common config. */
+static int sim_check(sim_run_t *r, coavoid_scenario_t *s)
 {
-    const sim_options_t *o = options;
-    const char *file = o->scenario_path;
-    const size_t n = s->vehicle_count;
+    const char *file = r->file;
+    const size_t n = r->n;
     if (s->horizon > COAVOID_NODE_MAX_HORIZON) {
         return coavoid_cli_fail(
             CLI_EXIT_INVALID,
@@ -487,79 +501,85 @@ static int sim(void *options, coavoid_scenario_t *s)
                                 "%s: tracks: %zu tracks, at most %u in a simulation", file,
                                 s->track_count, COAVOID_NODE_MAX_TRACKS);
     }
-    const uint32_t steps = o->steps_text != NULL ? o->steps : 2u * s->horizon;
-    if (o->stop_text != NULL && o->stop_step > steps) {
+    r->steps = r->o->steps_text != NULL ? r->o->steps : 2u * s->horizon;
+    r->samples = (size_t)r->steps + 1u;
+    if (r->o->stop_text != NULL && r->o->stop_step > r->steps) {
         return coavoid_cli_fail(CLI_EXIT_INVALID,
                                 "--coordinator-stops: step %lu is after the last, %lu",
-                                (unsigned long)o->stop_step, (unsigned long)steps);
+                                (unsigned long)r->o->stop_step, (unsigned long)r->steps);
     }
     int rc = coavoid_cli_sample_scenario(file, s);
     if (rc != CLI_CONTINUE) {
         return rc;
     }
-
-    int64_t now = SIM_EPOCH_UTIME;
-    coavoid_node_common_t common;
-    if (coavoid_node_common_defaults(&common, SIM_EPOCH_UTIME, s->dt, s->horizon, &now) != COA_OK) {
+    r->now = SIM_EPOCH_UTIME;
+    if (coavoid_node_common_defaults(&r->common, SIM_EPOCH_UTIME, s->dt, s->horizon, &r->now) !=
+        COA_OK) {
         return coavoid_cli_fail(CLI_EXIT_INVALID,
                                 "%s: dt: %g s cannot be a cycle (whole microseconds, at most %g s)",
                                 file, (double)s->dt, COAVOID_LCM_MAX_STEP);
     }
-    rc = check_message_limits(file, s, steps);
-    if (rc != CLI_CONTINUE) {
-        return rc;
-    }
+    return check_message_limits(file, s, r->steps);
+}
 
-    /* Planner sizes: each UAV plans alone; the coordinator searches up to max_centralised
-     * UAVs together, fewer when the scenario's beta would not fit the cap otherwise. */
+/* Planner sizes: each UAV plans alone; the coordinator searches up to max_centralised UAVs
+ * together, fewer when the scenario's beta would not fit the cap otherwise. */
+static int sim_planner_sizes(sim_run_t *r)
+{
+    const coavoid_scenario_t *s = r->s;
     coa_planner_config_t vehicle_shape =
         coavoid_node_planner_config(s->horizon, 1u, CLI_DEFAULT_BETA);
-    const uint32_t vehicle_beta = s->has_beta ? s->beta : coavoid_cli_default_beta(&vehicle_shape);
-    vehicle_shape.beta = vehicle_beta;
-    if (vehicle_beta == 0 || !coavoid_cli_workspace_fits(&vehicle_shape)) {
+    r->vehicle_beta = s->has_beta ? s->beta : coavoid_cli_default_beta(&vehicle_shape);
+    vehicle_shape.beta = r->vehicle_beta;
+    if (r->vehicle_beta == 0 || !coavoid_cli_workspace_fits(&vehicle_shape)) {
         return coavoid_cli_fail(
             CLI_EXIT_INVALID, "%s: beta: %lu is too large: a UAV's planner would not fit in 1 GiB",
-            file, (unsigned long)vehicle_beta);
+            r->file, (unsigned long)r->vehicle_beta);
     }
-    size_t max_centralised = n < COA_MAX_CENTRALISED ? n : COA_MAX_CENTRALISED;
+    r->max_centralised = r->n < COA_MAX_CENTRALISED ? r->n : COA_MAX_CENTRALISED;
     coa_planner_config_t coordinator_shape =
-        coavoid_node_planner_config(s->horizon, max_centralised, CLI_DEFAULT_BETA);
-    uint32_t coordinator_beta =
-        s->has_beta ? s->beta : coavoid_cli_default_beta(&coordinator_shape);
-    coordinator_shape.beta = coordinator_beta;
-    while (max_centralised > 1u && !coavoid_cli_workspace_fits(&coordinator_shape)) {
-        coordinator_shape.vehicles = --max_centralised;
+        coavoid_node_planner_config(s->horizon, r->max_centralised, CLI_DEFAULT_BETA);
+    r->coordinator_beta = s->has_beta ? s->beta : coavoid_cli_default_beta(&coordinator_shape);
+    coordinator_shape.beta = r->coordinator_beta;
+    while (r->max_centralised > 1u && !coavoid_cli_workspace_fits(&coordinator_shape)) {
+        coordinator_shape.vehicles = --r->max_centralised;
     }
+    return CLI_CONTINUE;
+}
 
-    sim_run_t r;
-    memset(&r, 0, sizeof r);
-    const size_t samples = (size_t)steps + 1u;
-    r.vehicles = calloc(n, sizeof *r.vehicles);
-    r.index = calloc(n, sizeof *r.index);
-    r.references = calloc(n * samples, sizeof *r.references);
-    r.offsets = calloc(n * samples, sizeof *r.offsets);
-    if (r.vehicles == NULL || r.index == NULL || r.references == NULL || r.offsets == NULL) {
-        sim_run_free(&r, n);
+/* The flight record, the figure's file and LCM's in-process provider. */
+static int sim_open(sim_run_t *r)
+{
+    const size_t n = r->n;
+    r->vehicles = calloc(n, sizeof *r->vehicles);
+    r->index = calloc(n, sizeof *r->index);
+    r->references = calloc(n * r->samples, sizeof *r->references);
+    r->offsets = calloc(n * r->samples, sizeof *r->offsets);
+    if (r->vehicles == NULL || r->index == NULL || r->references == NULL || r->offsets == NULL) {
         return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: cannot allocate the record of %lu steps",
-                                file, (unsigned long)steps);
+                                r->file, (unsigned long)r->steps);
     }
-    if (o->svg_path != NULL) {
-        r.svg = fopen(o->svg_path, "w");
-        if (r.svg == NULL) {
-            sim_run_free(&r, n);
-            return coavoid_cli_fail(CLI_EXIT_INVALID, "--svg: cannot write '%.200s'", o->svg_path);
+    if (r->o->svg_path != NULL) {
+        r->svg = fopen(r->o->svg_path, "w");
+        if (r->svg == NULL) {
+            return coavoid_cli_fail(CLI_EXIT_INVALID, "--svg: cannot write '%.200s'",
+                                    r->o->svg_path);
         }
     }
-    r.lcm = lcm_create("memq://");
-    if (r.lcm == NULL) {
-        sim_run_free(&r, n);
+    r->lcm = lcm_create("memq://");
+    if (r->lcm == NULL) {
         return coavoid_cli_fail(CLI_EXIT_INTERNAL,
                                 "internal error: LCM's memq provider is unavailable");
     }
+    return CLI_CONTINUE;
+}
 
-    /* A track message numbers tracks 1..2^31-1, once each; the scenario may use any
-     * integer, so then the world's tracks are numbered by position instead (the ids only
-     * name tracks in the messages: the flight is judged on the scenario's own tracks). */
+/* The world node. A track message numbers tracks 1..2^31-1, once each; the scenario may
+ * use any integer, so then the world's tracks are numbered by position instead (the ids
+ * only name tracks in the messages: the flight is judged on the scenario's own tracks). */
+static int sim_world(sim_run_t *r)
+{
+    const coavoid_scenario_t *s = r->s;
     const coa_track_t *world_tracks = s->tracks;
     bool ids_fit = true;
     for (size_t i = 0; i < s->track_count; i++) {
@@ -569,200 +589,226 @@ static int sim(void *options, coavoid_scenario_t *s)
         }
     }
     if (!ids_fit) {
-        r.tracks = calloc(s->track_count, sizeof *r.tracks);
-        if (r.tracks == NULL) {
-            sim_run_free(&r, n);
-            return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: cannot allocate the tracks", file);
+        r->tracks = calloc(s->track_count, sizeof *r->tracks);
+        if (r->tracks == NULL) {
+            return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: cannot allocate the tracks", r->file);
         }
         for (size_t i = 0; i < s->track_count; i++) {
-            r.tracks[i] = s->tracks[i];
-            r.tracks[i].id = (uint32_t)i + 1u;
+            r->tracks[i] = s->tracks[i];
+            r->tracks[i].id = (uint32_t)i + 1u;
         }
-        world_tracks = r.tracks;
+        world_tracks = r->tracks;
     }
-
     int error = COA_OK;
     coavoid_world_config_t world;
     memset(&world, 0, sizeof world);
-    world.common = common;
+    world.common = r->common;
     world.id = COAVOID_NODE_WORLD_ID;
     world.obstacles = s->obstacles;
     world.obstacle_count = s->obstacle_count;
     world.tracks = world_tracks;
     world.track_count = s->track_count;
-    r.world = coavoid_world_create(&world, r.lcm, &error);
-    if (r.world == NULL) {
-        sim_run_free(&r, n);
-        if (error == COA_ERR_ARGUMENT) {
-            return coavoid_cli_fail(
-                CLI_EXIT_INVALID,
-                "%s: obstacles: more than an obstacle map message holds (%d boxes, "
-                "%d polytopes of at most %d vertices)",
-                file, COAVOID_OBSTACLE_MAP_T_MAX_BOXES, COAVOID_OBSTACLE_MAP_T_MAX_POLYTOPES,
-                COAVOID_OBSTACLE_MAP_T_MAX_VERTICES);
-        }
+    r->world = coavoid_world_create(&world, r->lcm, &error);
+    if (r->world == NULL && error == COA_ERR_ARGUMENT) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                "%s: obstacles: more than an obstacle map message holds (%d boxes, "
+                                "%d polytopes of at most %d vertices)",
+                                r->file, COAVOID_OBSTACLE_MAP_T_MAX_BOXES,
+                                COAVOID_OBSTACLE_MAP_T_MAX_POLYTOPES,
+                                COAVOID_OBSTACLE_MAP_T_MAX_VERTICES);
+    }
+    if (r->world == NULL) {
         return coavoid_cli_fail(CLI_EXIT_INTERNAL,
                                 "internal error: out of memory for the world node");
     }
+    return CLI_CONTINUE;
+}
 
-    /* UAVs run in priority order (ascending priority, ties by ascending id), whatever
-     * the file's order or their ids: the order in which a real fleet's decisions settle.
-     * A UAV that has not yet heard a peer cannot wait for it (cycle 0, before anyone has
-     * published), so a lower priority stepped first would decide around nothing there. */
-    if (coa_priority_order(s->vehicles, n, r.index) != COA_OK) {
-        sim_run_free(&r, n);
+/* The UAVs' nodes, in priority order (ascending priority, ties by ascending id), whatever
+ * the file's order or their ids: the order in which a real fleet's decisions settle. A UAV
+ * that has not yet heard a peer cannot wait for it (cycle 0, before anyone has published),
+ * so a lower priority stepped first would decide around nothing there. */
+static int sim_vehicles(sim_run_t *r)
+{
+    const coavoid_scenario_t *s = r->s;
+    if (coa_priority_order(s->vehicles, r->n, r->index) != COA_OK) {
         return coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: no priority order of %zu UAVs",
-                                n);
+                                r->n);
     }
-    for (size_t j = 0; j < n; j++) {
-        size_t i = r.index[j];
+    for (size_t j = 0; j < r->n; j++) {
+        size_t i = r->index[j];
+        int error = COA_OK;
         coavoid_vehicle_node_config_t config;
         memset(&config, 0, sizeof config);
-        config.common = common;
-        config.common.beta = vehicle_beta;
+        config.common = r->common;
+        config.common.beta = r->vehicle_beta;
         config.vehicle = s->vehicles[i];
-        config.mode = o->decoupled ? COAVOID_NODE_DECOUPLED : COAVOID_NODE_CENTRALISED;
-        r.vehicles[j] = coavoid_vehicle_node_create(&config, r.lcm, &error);
-        if (r.vehicles[j] == NULL) {
-            sim_run_free(&r, n);
-            if (error == COA_ERR_ARGUMENT) {
-                return coavoid_cli_fail(CLI_EXIT_INVALID,
-                                        "%s: vehicles[%zu]: cannot run as a node (%s)", file, i,
-                                        coavoid_lcm_error_name(error));
-            }
+        config.mode = r->o->decoupled ? COAVOID_NODE_DECOUPLED : COAVOID_NODE_CENTRALISED;
+        r->vehicles[j] = coavoid_vehicle_node_create(&config, r->lcm, &error);
+        if (r->vehicles[j] == NULL && error == COA_ERR_ARGUMENT) {
             return coavoid_cli_fail(CLI_EXIT_INVALID,
-                                    "%s: vehicles[%zu]: cannot allocate its node (beta %lu)", file,
-                                    i, (unsigned long)vehicle_beta);
+                                    "%s: vehicles[%zu]: cannot run as a node (%s)", r->file, i,
+                                    coavoid_lcm_error_name(error));
+        }
+        if (r->vehicles[j] == NULL) {
+            return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                    "%s: vehicles[%zu]: cannot allocate its node (beta %lu)",
+                                    r->file, i, (unsigned long)r->vehicle_beta);
         }
     }
-    if (!o->decoupled) {
-        coavoid_coordinator_config_t config;
-        memset(&config, 0, sizeof config);
-        config.common = common;
-        config.common.beta = coordinator_beta;
-        config.id = COAVOID_NODE_COORDINATOR_ID;
-        config.max_centralised = max_centralised;
-        config.collect_us = common.dt_us / 4 > 0 ? common.dt_us / 4 : 1;
-        if (config.collect_us >= common.dt_us) {
-            sim_run_free(&r, n);
-            return coavoid_cli_fail(CLI_EXIT_INVALID,
-                                    "%s: dt: %g s leaves the coordinator no time within a cycle",
-                                    file, (double)s->dt);
-        }
-        r.coordinator = coavoid_coordinator_create(&config, r.lcm, &error);
-        if (r.coordinator == NULL) {
-            sim_run_free(&r, n);
-            if (error == COA_ERR_ARGUMENT) {
-                return coavoid_cli_fail(CLI_EXIT_INVALID,
-                                        "%s: beta: %lu cannot size the coordinator's planner", file,
-                                        (unsigned long)coordinator_beta);
-            }
-            return coavoid_cli_fail(
-                CLI_EXIT_INVALID,
-                "%s: cannot allocate the coordinator's planner (beta %lu, %zu UAVs "
-                "together)",
-                file, (unsigned long)coordinator_beta, max_centralised);
-        }
-    }
+    return CLI_CONTINUE;
+}
 
-    /* The loop of node.h: world, then the UAVs in priority order, their waits, then the
-     * coordinator at cycle start + collect; each message is handled as soon as it is
-     * published, as on a quiet network. */
-    const int64_t collect_us = common.dt_us / 4 > 0 ? common.dt_us / 4 : 1;
-    uint32_t coordinator_plans = 0;
-    int node_error = COA_OK;
+/* The coordinator's node (centralised runs). */
+static int sim_coordinator(sim_run_t *r)
+{
+    if (r->o->decoupled) {
+        return CLI_CONTINUE;
+    }
+    int error = COA_OK;
+    coavoid_coordinator_config_t config;
+    memset(&config, 0, sizeof config);
+    config.common = r->common;
+    config.common.beta = r->coordinator_beta;
+    config.id = COAVOID_NODE_COORDINATOR_ID;
+    config.max_centralised = r->max_centralised;
+    config.collect_us = r->common.dt_us / 4 > 0 ? r->common.dt_us / 4 : 1;
+    if (config.collect_us >= r->common.dt_us) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                "%s: dt: %g s leaves the coordinator no time within a cycle",
+                                r->file, (double)r->s->dt);
+    }
+    r->coordinator = coavoid_coordinator_create(&config, r->lcm, &error);
+    if (r->coordinator == NULL && error == COA_ERR_ARGUMENT) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                "%s: beta: %lu cannot size the coordinator's planner", r->file,
+                                (unsigned long)r->coordinator_beta);
+    }
+    if (r->coordinator == NULL) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                "%s: cannot allocate the coordinator's planner (beta %lu, %zu UAVs "
+                                "together)",
+                                r->file, (unsigned long)r->coordinator_beta, r->max_centralised);
+    }
+    return CLI_CONTINUE;
+}
+
+/* The UAVs' waits of one cycle: poll until nobody moves on, then the clock jumps to the
+ * first deadline, until none is left. Keeps the first node error in *node_error. */
+static bool sim_waits(sim_run_t *r, int *node_error)
+{
     bool lcm_ok = true;
-    for (uint32_t k = 0; k <= steps && lcm_ok; k++) {
-        if (r.coordinator != NULL && o->stop_text != NULL && k == o->stop_step) {
-            coordinator_plans = coavoid_coordinator_state(r.coordinator)->plans_run;
-            coavoid_coordinator_destroy(r.coordinator);
-            r.coordinator = NULL;
-        }
-        const int64_t cycle_start = coavoid_node_cycle_utime(&common, (int64_t)k);
-        now = cycle_start;
-        rc = coavoid_world_cycle(r.world, now);
-        node_error = node_error != COA_OK ? node_error : rc;
-        lcm_ok = drain(r.lcm);
-        for (size_t j = 0; j < n && lcm_ok; j++) {
-            rc = coavoid_vehicle_node_cycle(r.vehicles[j], now);
-            node_error = node_error != COA_OK ? node_error : rc;
-            lcm_ok = drain(r.lcm);
-        }
-        /* Waits: poll until nobody moves on; then the clock jumps to the first deadline. */
-        for (;;) {
-            bool changed = true;
-            while (changed && lcm_ok) {
-                changed = false;
-                for (size_t j = 0; j < n && lcm_ok; j++) {
-                    rc = coavoid_vehicle_node_poll(r.vehicles[j], now);
-                    if (rc < 0) {
-                        node_error = node_error != COA_OK ? node_error : rc;
-                    } else if (rc > 0) {
-                        changed = true;
-                        lcm_ok = drain(r.lcm);
-                    }
+    for (;;) {
+        bool changed = true;
+        while (changed && lcm_ok) {
+            changed = false;
+            for (size_t j = 0; j < r->n && lcm_ok; j++) {
+                int rc = coavoid_vehicle_node_poll(r->vehicles[j], r->now);
+                if (rc < 0) {
+                    *node_error = *node_error != COA_OK ? *node_error : rc;
+                } else if (rc > 0) {
+                    changed = true;
+                    lcm_ok = drain(r->lcm);
                 }
             }
-            int64_t deadline = INT64_MAX;
-            for (size_t j = 0; j < n; j++) {
-                int64_t d = coavoid_vehicle_node_deadline(r.vehicles[j]);
-                deadline = d < deadline ? d : deadline;
-            }
-            if (deadline == INT64_MAX || !lcm_ok) {
-                break;
-            }
-            now = deadline > now ? deadline : now;
         }
-        /* The coordinator plans cycles 0..K-1: cycle K only flies the last sample. */
-        if (r.coordinator != NULL && k < steps && lcm_ok) {
-            now = cycle_start + collect_us > now ? cycle_start + collect_us : now;
-            rc = coavoid_coordinator_cycle(r.coordinator, now);
-            node_error = node_error != COA_OK ? node_error : rc;
-            lcm_ok = drain(r.lcm);
+        int64_t deadline = INT64_MAX;
+        for (size_t j = 0; j < r->n; j++) {
+            int64_t d = coavoid_vehicle_node_deadline(r->vehicles[j]);
+            deadline = d < deadline ? d : deadline;
         }
-        for (size_t j = 0; j < n; j++) {
-            const coavoid_vehicle_node_state_t *st = coavoid_vehicle_node_state(r.vehicles[j]);
-            size_t i = r.index[j];
-            r.references[i * samples + k] = st->reference;
-            r.offsets[i * samples + k] = st->offset;
+        if (deadline == INT64_MAX || !lcm_ok) {
+            return lcm_ok;
         }
+        r->now = deadline > r->now ? deadline : r->now;
     }
-    if (r.coordinator != NULL) {
-        coordinator_plans = coavoid_coordinator_state(r.coordinator)->plans_run;
+}
+
+/* Cycle k of the loop of node.h: world, then the UAVs in priority order, their waits, then
+ * the coordinator at cycle start + collect; each message is handled as soon as it is
+ * published, as on a quiet network. False when LCM failed. */
+static bool sim_cycle(sim_run_t *r, uint32_t k, int *node_error)
+{
+    const int64_t collect_us = r->common.dt_us / 4 > 0 ? r->common.dt_us / 4 : 1;
+    if (r->coordinator != NULL && r->o->stop_text != NULL && k == r->o->stop_step) {
+        r->coordinator_plans = coavoid_coordinator_state(r->coordinator)->plans_run;
+        coavoid_coordinator_destroy(r->coordinator);
+        r->coordinator = NULL;
+    }
+    const int64_t cycle_start = coavoid_node_cycle_utime(&r->common, (int64_t)k);
+    r->now = cycle_start;
+    int rc = coavoid_world_cycle(r->world, r->now);
+    *node_error = *node_error != COA_OK ? *node_error : rc;
+    bool lcm_ok = drain(r->lcm);
+    for (size_t j = 0; j < r->n && lcm_ok; j++) {
+        rc = coavoid_vehicle_node_cycle(r->vehicles[j], r->now);
+        *node_error = *node_error != COA_OK ? *node_error : rc;
+        lcm_ok = drain(r->lcm);
+    }
+    lcm_ok = lcm_ok && sim_waits(r, node_error);
+    /* The coordinator plans cycles 0..K-1: cycle K only flies the last sample. */
+    if (r->coordinator != NULL && k < r->steps && lcm_ok) {
+        r->now = cycle_start + collect_us > r->now ? cycle_start + collect_us : r->now;
+        rc = coavoid_coordinator_cycle(r->coordinator, r->now);
+        *node_error = *node_error != COA_OK ? *node_error : rc;
+        lcm_ok = drain(r->lcm);
+    }
+    for (size_t j = 0; j < r->n; j++) {
+        const coavoid_vehicle_node_state_t *st = coavoid_vehicle_node_state(r->vehicles[j]);
+        size_t i = r->index[j];
+        r->references[i * r->samples + k] = st->reference;
+        r->offsets[i * r->samples + k] = st->offset;
+    }
+    return lcm_ok;
+}
+
+/* Flies samples 0..steps. */
+static int sim_fly(sim_run_t *r)
+{
+    int node_error = COA_OK;
+    bool lcm_ok = true;
+    for (uint32_t k = 0; k <= r->steps && lcm_ok; k++) {
+        lcm_ok = sim_cycle(r, k, &node_error);
+    }
+    if (r->coordinator != NULL) {
+        r->coordinator_plans = coavoid_coordinator_state(r->coordinator)->plans_run;
     }
     if (!lcm_ok) {
-        sim_run_free(&r, n);
         return coavoid_cli_fail(CLI_EXIT_INTERNAL,
                                 "internal error: LCM failed while handling messages");
     }
     if (node_error != COA_OK) {
-        sim_run_free(&r, n);
         return coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: a node failed (%s)",
                                 coavoid_lcm_error_name(node_error));
     }
+    return CLI_CONTINUE;
+}
 
-    uint32_t replans = coordinator_plans;
+/* Judges the flight and writes the figure and the result; the exit status. */
+static int sim_report(sim_run_t *r)
+{
+    const sim_options_t *o = r->o;
+    uint32_t replans = r->coordinator_plans;
     uint32_t fallbacks = 0;
-    for (size_t j = 0; j < n; j++) {
-        const coavoid_vehicle_node_state_t *st = coavoid_vehicle_node_state(r.vehicles[j]);
+    for (size_t j = 0; j < r->n; j++) {
+        const coavoid_vehicle_node_state_t *st = coavoid_vehicle_node_state(r->vehicles[j]);
         replans += st->plans_run;
         fallbacks += st->fallbacks;
     }
-    rc = coavoid_judge_run(&r.judged, s, o->mode, steps, replans, r.references, r.offsets, NULL);
-    const coavoid_flight_t *flight = &r.judged.flight;
-    const coavoid_flight_eval_t *eval = &r.judged.eval;
+    int rc = coavoid_judge_run(&r->judged, r->s, o->mode, r->steps, replans, r->references,
+                               r->offsets, NULL);
+    const coavoid_flight_t *flight = &r->judged.flight;
+    const coavoid_flight_eval_t *eval = &r->judged.eval;
     if (rc != COA_OK) {
-        sim_run_free(&r, n);
         return coavoid_cli_fail(CLI_EXIT_INTERNAL,
                                 "internal error: the flight cannot be judged (%s)",
                                 coa_status_name(rc));
     }
-    if (r.svg != NULL) {
-        rc = coavoid_flight_svg(flight, eval, r.svg);
-        int closed = fclose(r.svg);
-        r.svg = NULL;
+    if (r->svg != NULL) {
+        rc = coavoid_flight_svg(flight, eval, r->svg);
+        int closed = fclose(r->svg);
+        r->svg = NULL;
         if (rc != COA_OK || closed != 0) {
-            sim_run_free(&r, n);
             return coavoid_cli_fail(CLI_EXIT_INTERNAL, "--svg: writing '%.200s' failed",
                                     o->svg_path);
         }
@@ -782,12 +828,45 @@ static int sim(void *options, coavoid_scenario_t *s)
             rc = COA_ERR_WORKSPACE;
         }
     }
-    sim_run_free(&r, n);
     if (rc != COA_OK) {
         return coavoid_cli_fail(CLI_EXIT_INTERNAL,
                                 "internal error: the result could not be written");
     }
     return eval->loss_of_separation ? CLI_EXIT_NOT_SOLVED : CLI_EXIT_OK;
+}
+
+static int sim(void *options, coavoid_scenario_t *s)
+{
+    sim_run_t r;
+    memset(&r, 0, sizeof r);
+    r.o = options;
+    r.s = s;
+    r.file = r.o->scenario_path;
+    r.n = s->vehicle_count;
+    int rc = sim_check(&r, s);
+    if (rc == CLI_CONTINUE) {
+        rc = sim_planner_sizes(&r);
+    }
+    if (rc == CLI_CONTINUE) {
+        rc = sim_open(&r);
+    }
+    if (rc == CLI_CONTINUE) {
+        rc = sim_world(&r);
+    }
+    if (rc == CLI_CONTINUE) {
+        rc = sim_vehicles(&r);
+    }
+    if (rc == CLI_CONTINUE) {
+        rc = sim_coordinator(&r);
+    }
+    if (rc == CLI_CONTINUE) {
+        rc = sim_fly(&r);
+    }
+    if (rc == CLI_CONTINUE) {
+        rc = sim_report(&r);
+    }
+    sim_run_free(&r, r.n);
+    return rc;
 }
 
 int coavoid_command_sim(int argc, char **argv)
