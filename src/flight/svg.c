@@ -508,80 +508,71 @@ static void header(const svg_t *s, const coavoid_flight_eval_t *eval, double *y)
 }
 
 /* The top view: x east to the right, y north up, one metre the same on both axes. */
-static void top_view(const svg_t *s, double *y)
+/* The top view's world box: every sample flown and every track's, grown by the largest
+ * protected radius, with the terrain near the traffic (a box the size of a continent would
+ * otherwise shrink the run to a dot; anything beyond is clipped), then padded. */
+static void top_extent(const svg_t *s, double *x0, double *x1, double *y0, double *y1)
+{
+    const coavoid_flight_t *f = s->f;
+    double reach = 0.0;
+    *x0 = INFINITY, *x1 = -INFINITY, *y0 = INFINITY, *y1 = -INFINITY;
+    for (size_t m = 0; m < f->vehicle_count + f->track_count; m++) {
+        const bool uav = m < f->vehicle_count;
+        const size_t j = uav ? m : m - f->vehicle_count;
+        const coa_vec3_t *row = uav ? &s->flown[j * s->row] : &s->tracks[j * s->row];
+        reach = fmax(reach, (double)(uav ? f->vehicles[j].vehicle.volume.radius
+                                         : f->tracks[j].volume.radius));
+        for (size_t k = 0; k < s->row; k++) {
+            *x0 = fmin(*x0, (double)row[k].x);
+            *x1 = fmax(*x1, (double)row[k].x);
+            *y0 = fmin(*y0, (double)row[k].y);
+            *y1 = fmax(*y1, (double)row[k].y);
+        }
+    }
+    *x0 -= reach;
+    *x1 += reach;
+    *y0 -= reach;
+    *y1 += reach;
+    double grow = 0.5 * fmax(*x1 - *x0, *y1 - *y0);
+    double lx0 = *x0 - grow, lx1 = *x1 + grow, ly0 = *y0 - grow, ly1 = *y1 + grow;
+    for (size_t j = 0; j < f->obstacle_count; j++) {
+        double ox0, oy0, oz0, ox1, oy1, oz1;
+        obstacle_bounds(&f->obstacles[j], &ox0, &oy0, &oz0, &ox1, &oy1, &oz1);
+        *x0 = fmin(*x0, fmax(ox0, lx0));
+        *x1 = fmax(*x1, fmin(ox1, lx1));
+        *y0 = fmin(*y0, fmax(oy0, ly0));
+        *y1 = fmax(*y1, fmin(oy1, ly1));
+    }
+    ensure_span(x0, x1, 10.0);
+    ensure_span(y0, y1, 10.0);
+    double pad = 0.05 * fmax(*x1 - *x0, *y1 - *y0);
+    *x0 -= pad;
+    *x1 += pad;
+    *y0 -= pad;
+    *y1 += pad;
+}
+
+/* The top view's frame at `top`: equal scale, the panel's height following the run's shape
+ * within limits, and the shorter side of the world box grown to fill the panel. */
+static frame_t top_frame(const svg_t *s, double top, double *scale)
+{
+    double x0, x1, y0, y1;
+    top_extent(s, &x0, &x1, &y0, &y1);
+    double height = SVG_PLOT_WIDTH * (y1 - y0) / (x1 - x0);
+    height = fmin(fmax(height, SVG_TOP_MIN_HEIGHT), SVG_TOP_MAX_HEIGHT);
+    *scale = fmin(SVG_PLOT_WIDTH / (x1 - x0), height / (y1 - y0));
+    double wx = SVG_PLOT_WIDTH / *scale, wy = height / *scale;
+    double cx = (x0 + x1) / 2.0, cy = (y0 + y1) / 2.0;
+    frame_t fr = {SVG_LEFT,      top,           SVG_PLOT_WIDTH, height,
+                  cx - wx / 2.0, cx + wx / 2.0, cy - wy / 2.0,  cy + wy / 2.0};
+    return fr;
+}
+
+/* Terrain footprints, each labelled with its altitudes. */
+static void top_terrain(const svg_t *s, const frame_t *fr, double scale)
 {
     FILE *out = s->out;
     const coavoid_flight_t *f = s->f;
-    const size_t n = f->vehicle_count;
-    double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY, reach = 0.0;
-    for (size_t i = 0; i < n; i++) {
-        reach = fmax(reach, (double)f->vehicles[i].vehicle.volume.radius);
-        for (size_t k = 0; k < s->row; k++) {
-            const coa_vec3_t *p = &s->flown[i * s->row + k];
-            x0 = fmin(x0, (double)p->x);
-            x1 = fmax(x1, (double)p->x);
-            y0 = fmin(y0, (double)p->y);
-            y1 = fmax(y1, (double)p->y);
-        }
-    }
-    for (size_t j = 0; j < f->track_count; j++) {
-        reach = fmax(reach, (double)f->tracks[j].volume.radius);
-        for (size_t k = 0; k < s->row; k++) {
-            const coa_vec3_t *p = &s->tracks[j * s->row + k];
-            x0 = fmin(x0, (double)p->x);
-            x1 = fmax(x1, (double)p->x);
-            y0 = fmin(y0, (double)p->y);
-            y1 = fmax(y1, (double)p->y);
-        }
-    }
-    x0 -= reach;
-    x1 += reach;
-    y0 -= reach;
-    y1 += reach;
-    /* Terrain is shown where it is near the traffic: a box the size of a continent would
-     * otherwise shrink the run to a dot. Anything beyond is clipped. */
-    {
-        double grow = 0.5 * fmax(x1 - x0, y1 - y0);
-        double lx0 = x0 - grow, lx1 = x1 + grow, ly0 = y0 - grow, ly1 = y1 + grow;
-        for (size_t j = 0; j < f->obstacle_count; j++) {
-            double ox0, oy0, oz0, ox1, oy1, oz1;
-            obstacle_bounds(&f->obstacles[j], &ox0, &oy0, &oz0, &ox1, &oy1, &oz1);
-            x0 = fmin(x0, fmax(ox0, lx0));
-            x1 = fmax(x1, fmin(ox1, lx1));
-            y0 = fmin(y0, fmax(oy0, ly0));
-            y1 = fmax(y1, fmin(oy1, ly1));
-        }
-    }
-    ensure_span(&x0, &x1, 10.0);
-    ensure_span(&y0, &y1, 10.0);
-    {
-        double pad = 0.05 * fmax(x1 - x0, y1 - y0);
-        x0 -= pad;
-        x1 += pad;
-        y0 -= pad;
-        y1 += pad;
-    }
-    /* Equal scale: the panel's height follows the run's shape within limits, and the
-     * shorter side of the world box grows to fill the panel. */
-    double height = SVG_PLOT_WIDTH * (y1 - y0) / (x1 - x0);
-    height = fmin(fmax(height, SVG_TOP_MIN_HEIGHT), SVG_TOP_MAX_HEIGHT);
-    double scale = fmin(SVG_PLOT_WIDTH / (x1 - x0), height / (y1 - y0));
-    {
-        double wx = SVG_PLOT_WIDTH / scale, wy = height / scale;
-        double cx = (x0 + x1) / 2.0, cy = (y0 + y1) / 2.0;
-        x0 = cx - wx / 2.0;
-        x1 = cx + wx / 2.0;
-        y0 = cy - wy / 2.0;
-        y1 = cy + wy / 2.0;
-    }
-    text_at(out, SVG_LEFT, *y + 14.0, "class=\"panel\"",
-            "Top view (x east, y north, equal scale): routes over the run, traffic, terrain");
-    frame_t fr = {SVG_LEFT, *y + 24.0, SVG_PLOT_WIDTH, height, x0, x1, y0, y1};
-    clip_path(out, "clip-top", &fr);
-    axes(out, &fr, "x (m, east)", "y (m, north)");
-    fputs("<g clip-path=\"url(#clip-top)\">\n", out);
-
-    /* Terrain footprints. */
     pt_t pts[COA_POLYTOPE_MAX_VERTICES];
     pt_t hull[2u * COA_POLYTOPE_MAX_VERTICES + 1u];
     for (size_t j = 0; j < f->obstacle_count; j++) {
@@ -594,62 +585,77 @@ static void top_view(const svg_t *s, double *y)
                 out,
                 "<rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" height=\"%.2f\" fill=\"" TERRAIN_FILL
                 "\" fill-opacity=\"0.75\" stroke=\"#777\"/>\n",
-                px(&fr, ox0), py(&fr, oy1), (ox1 - ox0) * scale, (oy1 - oy0) * scale);
+                px(fr, ox0), py(fr, oy1), (ox1 - ox0) * scale, (oy1 - oy0) * scale);
         } else {
             size_t h = footprint_hull(&o->polytope, pts, hull);
             fputs("<polygon points=\"", out);
             for (size_t q = 0; q < h; q++) {
-                fprintf(out, "%s%.2f,%.2f", q == 0 ? "" : " ", px(&fr, hull[q].x),
-                        py(&fr, hull[q].y));
+                fprintf(out, "%s%.2f,%.2f", q == 0 ? "" : " ", px(fr, hull[q].x),
+                        py(fr, hull[q].y));
             }
             fputs("\" fill=\"" TERRAIN_FILL "\" fill-opacity=\"0.75\" stroke=\"#777\"/>\n", out);
         }
         snprintf(label, sizeof label, "obstacle %zu, z %g to %g m", j, oz0, oz1);
-        text_at(out, px(&fr, fmax(ox0, x0)) + 3.0, py(&fr, fmin(oy1, y1)) + 12.0, "class=\"small\"",
-                label);
+        text_at(out, px(fr, fmax(ox0, fr->x0)) + 3.0, py(fr, fmin(oy1, fr->y1)) + 12.0,
+                "class=\"small\"", label);
     }
+}
 
-    /* Tracks over the run, with their ids at the start. */
+/* Tracks over the run, with their ids at the start. */
+static void top_tracks(const svg_t *s, const frame_t *fr)
+{
+    FILE *out = s->out;
+    const coavoid_flight_t *f = s->f;
     for (size_t j = 0; j < f->track_count; j++) {
         const coa_vec3_t *row = &s->tracks[j * s->row];
         char label[48];
-        polyline_xy(out, &fr, row, 0, s->row - 1u,
+        polyline_xy(out, fr, row, 0, s->row - 1u,
                     "stroke=\"" TRACK_COLOUR "\" stroke-width=\"1.6\" stroke-dasharray=\"2 3\"");
         fprintf(out,
                 "<rect x=\"%.2f\" y=\"%.2f\" width=\"7\" height=\"7\" fill=\"" TRACK_COLOUR
                 "\"/>\n",
-                px(&fr, (double)row[0].x) - 3.5, py(&fr, (double)row[0].y) - 3.5);
+                px(fr, (double)row[0].x) - 3.5, py(fr, (double)row[0].y) - 3.5);
         snprintf(label, sizeof label, "track %lu", (unsigned long)f->tracks[j].id);
-        text_at(out, px(&fr, (double)row[0].x) + 7.0, py(&fr, (double)row[0].y) + 14.0,
+        text_at(out, px(fr, (double)row[0].x) + 7.0, py(fr, (double)row[0].y) + 14.0,
                 "class=\"label\"", label);
     }
+}
 
-    /* Routes: the reference dashed and wide beneath, the flown solid on top (the same
-     * horizontally: only altitude changes). */
+/* Routes: the reference dashed and wide beneath, the flown solid on top (the same
+ * horizontally: only altitude changes). */
+static void top_routes(const svg_t *s, const frame_t *fr)
+{
+    const size_t n = s->f->vehicle_count;
     for (size_t i = 0; i < n; i++) {
         char attrs[160];
         snprintf(attrs, sizeof attrs,
                  "stroke=\"%s\" stroke-width=\"5\" stroke-opacity=\"0.35\" "
                  "stroke-dasharray=\"10 6\"",
                  colour_of(i));
-        polyline_xy(out, &fr, &s->refpos[i * s->row], 0, s->row - 1u, attrs);
+        polyline_xy(s->out, fr, &s->refpos[i * s->row], 0, s->row - 1u, attrs);
     }
     for (size_t i = 0; i < n; i++) {
         char attrs[96];
         snprintf(attrs, sizeof attrs, "stroke=\"%s\" stroke-width=\"2.2\"", colour_of(i));
-        polyline_xy(out, &fr, &s->flown[i * s->row], 0, s->row - 1u, attrs);
+        polyline_xy(s->out, fr, &s->flown[i * s->row], 0, s->row - 1u, attrs);
     }
-    /* Start markers: the protected radius to scale, a dot, and the id; labels of UAVs that
-     * start at the same place are stacked. */
-    for (size_t i = 0; i < n; i++) {
+}
+
+/* Start markers: the protected radius to scale, a dot, and the id; labels of UAVs that
+ * start at the same place are stacked. */
+static void top_starts(const svg_t *s, const frame_t *fr, double scale)
+{
+    FILE *out = s->out;
+    const coavoid_flight_t *f = s->f;
+    for (size_t i = 0; i < f->vehicle_count; i++) {
         const coa_vec3_t *p = &s->flown[i * s->row];
         const coa_vec3_t *e = &s->flown[i * s->row + s->row - 1u];
         size_t same = 0;
         char label[32];
         for (size_t q = 0; q < i; q++) {
             const coa_vec3_t *o = &s->flown[q * s->row];
-            if (fabs(px(&fr, (double)o->x) - px(&fr, (double)p->x)) < 40.0 &&
-                fabs(py(&fr, (double)o->y) - py(&fr, (double)p->y)) < 14.0) {
+            if (fabs(px(fr, (double)o->x) - px(fr, (double)p->x)) < 40.0 &&
+                fabs(py(fr, (double)o->y) - py(fr, (double)p->y)) < 14.0) {
                 same++;
             }
         }
@@ -659,39 +665,55 @@ static void top_view(const svg_t *s, double *y)
                 "<circle cx=\"%.2f\" cy=\"%.2f\" r=\"3.5\" fill=\"%s\"/>\n"
                 "<path d=\"M%.2f %.2fl-4 -4m4 4l-4 4\" stroke=\"%s\" stroke-width=\"2\" "
                 "fill=\"none\"/>\n",
-                px(&fr, (double)p->x), py(&fr, (double)p->y),
+                px(fr, (double)p->x), py(fr, (double)p->y),
                 (double)f->vehicles[i].vehicle.volume.radius * scale, colour_of(i), colour_of(i),
-                px(&fr, (double)p->x), py(&fr, (double)p->y), colour_of(i), px(&fr, (double)e->x),
-                py(&fr, (double)e->y), colour_of(i));
+                px(fr, (double)p->x), py(fr, (double)p->y), colour_of(i), px(fr, (double)e->x),
+                py(fr, (double)e->y), colour_of(i));
         snprintf(label, sizeof label, "UAV %u", (unsigned)f->vehicles[i].vehicle.id);
         fprintf(out, "<text x=\"%.1f\" y=\"%.1f\" class=\"label\" fill=\"%s\">",
-                px(&fr, (double)p->x) + 6.0, py(&fr, (double)p->y) - 7.0 - 14.0 * (double)same,
+                px(fr, (double)p->x) + 6.0, py(fr, (double)p->y) - 7.0 - 14.0 * (double)same,
                 colour_of(i));
         put_text(out, label);
         fputs("</text>\n", out);
     }
+}
 
-    /* Conflict markers at the middle of each conflicting step. */
-    size_t drawn = 0;
-    for (size_t i = 0; i < n; i++) {
-        for (uint32_t k = 0; k < f->steps && drawn < SVG_MAX_MARKERS; k++) {
-            if (s->ref_mark[i * f->steps + k]) {
-                coa_vec3_t m = mid(s->refpos[i * s->row + k], s->refpos[i * s->row + k + 1u]);
-                ring(out, px(&fr, (double)m.x), py(&fr, (double)m.y));
-                drawn++;
+/* Conflict markers at the middle of each conflicting step: rings on the references' predicted
+ * conflicts, crosses where the flight lost separation (at most SVG_MAX_MARKERS each). */
+static void top_markers(const svg_t *s, const frame_t *fr)
+{
+    const coavoid_flight_t *f = s->f;
+    for (int kind = 0; kind < 2; kind++) {
+        const bool *marks = kind == 0 ? s->ref_mark : s->loss_mark;
+        const coa_vec3_t *rows = kind == 0 ? s->refpos : s->flown;
+        size_t drawn = 0;
+        for (size_t i = 0; i < f->vehicle_count; i++) {
+            for (uint32_t k = 0; k < f->steps && drawn < SVG_MAX_MARKERS; k++) {
+                if (marks[i * f->steps + k]) {
+                    coa_vec3_t m = mid(rows[i * s->row + k], rows[i * s->row + k + 1u]);
+                    (kind == 0 ? ring : cross)(s->out, px(fr, (double)m.x), py(fr, (double)m.y));
+                    drawn++;
+                }
             }
         }
     }
-    drawn = 0;
-    for (size_t i = 0; i < n; i++) {
-        for (uint32_t k = 0; k < f->steps && drawn < SVG_MAX_MARKERS; k++) {
-            if (s->loss_mark[i * f->steps + k]) {
-                coa_vec3_t m = mid(s->flown[i * s->row + k], s->flown[i * s->row + k + 1u]);
-                cross(out, px(&fr, (double)m.x), py(&fr, (double)m.y));
-                drawn++;
-            }
-        }
-    }
+}
+
+static void top_view(const svg_t *s, double *y)
+{
+    FILE *out = s->out;
+    double scale;
+    text_at(out, SVG_LEFT, *y + 14.0, "class=\"panel\"",
+            "Top view (x east, y north, equal scale): routes over the run, traffic, terrain");
+    frame_t fr = top_frame(s, *y + 24.0, &scale);
+    clip_path(out, "clip-top", &fr);
+    axes(out, &fr, "x (m, east)", "y (m, north)");
+    fputs("<g clip-path=\"url(#clip-top)\">\n", out);
+    top_terrain(s, &fr, scale);
+    top_tracks(s, &fr);
+    top_routes(s, &fr);
+    top_starts(s, &fr, scale);
+    top_markers(s, &fr);
     fputs("</g>\n", out);
     frame_border(out, &fr);
     *y = fr.top + fr.height + SVG_PANEL_GAP;
