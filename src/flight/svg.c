@@ -846,142 +846,177 @@ static void near_extent(const svg_t *s, size_t i, double lo_own, double hi_own, 
     }
 }
 
-static void altitude_panel(const svg_t *s, const coavoid_flight_eval_t *eval, size_t i, double *y)
+/* UAV i's altitude range for its panel: flown and reference, its half-height, the traffic
+ * near it, padded. */
+static void altitude_range(const svg_t *s, size_t i, double *lo, double *hi)
 {
-    FILE *out = s->out;
-    const coavoid_flight_t *f = s->f;
-    const coavoid_flight_vehicle_t *v = &f->vehicles[i];
     const coa_vec3_t *flown = &s->flown[i * s->row];
     const coa_vec3_t *ref = &s->refpos[i * s->row];
-    const double dt = (double)f->dt;
-    const double h = (double)v->vehicle.volume.half_height;
-    const double r = (double)v->vehicle.volume.radius;
-    const double t_end = (double)f->steps * dt;
-    double lo = INFINITY, hi = -INFINITY;
-    char text[256];
-
+    const double h = (double)s->f->vehicles[i].vehicle.volume.half_height;
+    *lo = INFINITY, *hi = -INFINITY;
     for (size_t k = 0; k < s->row; k++) {
-        lo = fmin(lo, fmin((double)flown[k].z, (double)ref[k].z));
-        hi = fmax(hi, fmax((double)flown[k].z, (double)ref[k].z));
+        *lo = fmin(*lo, fmin((double)flown[k].z, (double)ref[k].z));
+        *hi = fmax(*hi, fmax((double)flown[k].z, (double)ref[k].z));
     }
-    {
-        double own_lo = lo, own_hi = hi;
-        lo -= h;
-        hi += h;
-        near_extent(s, i, own_lo, own_hi, &lo, &hi);
-    }
-    ensure_span(&lo, &hi, 4.0 * h);
-    {
-        double pad = 0.15 * (hi - lo);
-        lo -= pad;
-        hi += pad;
-    }
+    double own_lo = *lo, own_hi = *hi;
+    *lo -= h;
+    *hi += h;
+    near_extent(s, i, own_lo, own_hi, lo, hi);
+    ensure_span(lo, hi, 4.0 * h);
+    double pad = 0.15 * (*hi - *lo);
+    *lo -= pad;
+    *hi += pad;
+}
 
+/* The panel's title (the UAV, its volume and priority) and its costs when judged. */
+static void altitude_title(const svg_t *s, const coavoid_flight_eval_t *eval, size_t i, double y)
+{
+    FILE *out = s->out;
+    const coavoid_flight_vehicle_t *v = &s->f->vehicles[i];
+    char text[256];
     snprintf(text, sizeof text,
              "UAV %u: altitude along its path (radius %g m, half-height %g m, "
              "priority %lu)",
-             (unsigned)v->vehicle.id, r, h, (unsigned long)v->vehicle.priority);
-    fprintf(out, "<text x=\"%.1f\" y=\"%.1f\" class=\"panel\" fill=\"%s\">", SVG_LEFT, *y + 14.0,
+             (unsigned)v->vehicle.id, (double)v->vehicle.volume.radius,
+             (double)v->vehicle.volume.half_height, (unsigned long)v->vehicle.priority);
+    fprintf(out, "<text x=\"%.1f\" y=\"%.1f\" class=\"panel\" fill=\"%s\">", SVG_LEFT, y + 14.0,
             colour_of(i));
     put_text(out, text);
     fputs("</text>\n", out);
     if (eval != NULL && eval->vehicle_deviation != NULL && eval->vehicle_effort != NULL) {
         snprintf(text, sizeof text, "deviation %.6g m\xc2\xb2, effort %lu",
                  eval->vehicle_deviation[i], (unsigned long)eval->vehicle_effort[i]);
-        text_at(out, SVG_LEFT + SVG_PLOT_WIDTH, *y + 14.0, "text-anchor=\"end\" class=\"info\"",
+        text_at(out, SVG_LEFT + SVG_PLOT_WIDTH, y + 14.0, "text-anchor=\"end\" class=\"info\"",
                 text);
     }
-    frame_t fr = {SVG_LEFT, *y + 24.0, SVG_PLOT_WIDTH, SVG_PANEL_HEIGHT, 0.0, t_end, lo, hi};
+}
+
+/* Obstacle o under UAV i's flown path, found on sub-samples of each step and merged into
+ * runs, each drawn as its altitude band and labelled. */
+static void altitude_terrain(const svg_t *s, size_t i, size_t j, const frame_t *fr)
+{
+    const coavoid_flight_t *f = s->f;
+    const coa_obstacle_t *o = &f->obstacles[j];
+    const coa_vec3_t *flown = &s->flown[i * s->row];
+    const double dt = (double)f->dt;
+    const double t_end = (double)f->steps * dt;
+    const double r = (double)f->vehicles[i].vehicle.volume.radius;
+    double ox0, oy0, oz0, ox1, oy1, oz1;
+    obstacle_bounds(o, &ox0, &oy0, &oz0, &ox1, &oy1, &oz1);
+    const size_t total = (size_t)f->steps * SVG_SUBSTEPS;
+    const double sub = dt / (double)SVG_SUBSTEPS;
+    bool in_run = false;
+    double run_start = 0.0;
+    for (size_t q = 0; q <= total; q++) {
+        size_t k = q / SVG_SUBSTEPS;
+        double u = (double)(q % SVG_SUBSTEPS) / (double)SVG_SUBSTEPS;
+        coa_vec3_t a = flown[k];
+        coa_vec3_t b = flown[k < f->steps ? k + 1u : k];
+        double x = (double)a.x + u * ((double)b.x - (double)a.x);
+        double yy = (double)a.y + u * ((double)b.y - (double)a.y);
+        bool over = over_footprint(o, x, yy, r);
+        double t = (double)q * sub;
+        if (over && !in_run) {
+            in_run = true;
+            run_start = fmax(0.0, t - sub / 2.0);
+        }
+        if (in_run && (!over || q == total)) {
+            char text[256];
+            double run_end = over ? t_end : fmin(t_end, t - sub / 2.0);
+            fprintf(s->out,
+                    "<rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" height=\"%.2f\" "
+                    "fill=\"" TERRAIN_FILL "\" fill-opacity=\"0.8\" stroke=\"#777\"/>\n",
+                    px(fr, run_start), py(fr, oz1), px(fr, run_end) - px(fr, run_start),
+                    py(fr, oz0) - py(fr, oz1));
+            snprintf(text, sizeof text, "obstacle %zu%s", j,
+                     o->kind == COA_OBSTACLE_BOX ? "" : " (bounding box)");
+            text_at(s->out, px(fr, run_start) + 3.0, fmax(py(fr, oz1), fr->top) + 12.0,
+                    "class=\"small\"", text);
+            in_run = false;
+        }
+    }
+}
+
+/* Its own protected half-height around the flown path, the reference, the flown; then the
+ * samples no intent covered (a log that missed them). */
+static void altitude_paths(const svg_t *s, size_t i, const frame_t *fr)
+{
+    FILE *out = s->out;
+    const coavoid_flight_vehicle_t *v = &s->f->vehicles[i];
+    const coa_vec3_t *flown = &s->flown[i * s->row];
+    const double dt = (double)s->f->dt;
+    const double t_end = (double)s->f->steps * dt;
+    char attrs[128];
+    snprintf(attrs, sizeof attrs, "fill=\"%s\" fill-opacity=\"0.15\" stroke=\"none\"",
+             colour_of(i));
+    band_tz(out, fr, flown, dt, 0, s->row - 1u, (double)v->vehicle.volume.half_height, attrs);
+    snprintf(attrs, sizeof attrs, "stroke=\"%s\" stroke-width=\"2\" stroke-dasharray=\"7 4\"",
+             colour_of(i));
+    polyline_tz(out, fr, &s->refpos[i * s->row], dt, 0, s->row - 1u, 0.0, attrs);
+    snprintf(attrs, sizeof attrs, "stroke=\"%s\" stroke-width=\"2.2\"", colour_of(i));
+    polyline_tz(out, fr, flown, dt, 0, s->row - 1u, 0.0, attrs);
+    if (v->known == NULL) {
+        return;
+    }
+    for (size_t k = 0; k < s->row; k++) {
+        if (!v->known[k]) {
+            double t0 = fmax(0.0, ((double)k - 0.5) * dt);
+            double t1 = fmin(t_end, ((double)k + 0.5) * dt);
+            fprintf(out,
+                    "<rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" height=\"6\" fill=\"" UNKNOWN_COLOUR
+                    "\"/>\n",
+                    px(fr, t0), fr->top + fr->height - 6.0, px(fr, t1) - px(fr, t0));
+        }
+    }
+}
+
+/* Conflict markers mid-step: rings on the reference's predicted conflicts, crosses where the
+ * flight lost separation (at most SVG_MAX_MARKERS each). */
+static void altitude_markers(const svg_t *s, size_t i, const frame_t *fr)
+{
+    const coavoid_flight_t *f = s->f;
+    const double dt = (double)f->dt;
+    for (int kind = 0; kind < 2; kind++) {
+        const bool *marks = kind == 0 ? s->ref_mark : s->loss_mark;
+        const coa_vec3_t *row = kind == 0 ? &s->refpos[i * s->row] : &s->flown[i * s->row];
+        size_t drawn = 0;
+        for (uint32_t k = 0; k < f->steps && drawn < SVG_MAX_MARKERS; k++) {
+            if (marks[i * f->steps + k]) {
+                (kind == 0 ? ring
+                           : cross)(s->out, px(fr, ((double)k + 0.5) * dt),
+                                    py(fr, ((double)row[k].z + (double)row[k + 1u].z) / 2.0));
+                drawn++;
+            }
+        }
+    }
+}
+
+static void altitude_panel(const svg_t *s, const coavoid_flight_eval_t *eval, size_t i, double *y)
+{
+    FILE *out = s->out;
+    const coavoid_flight_t *f = s->f;
+    double lo, hi;
+    altitude_range(s, i, &lo, &hi);
+    altitude_title(s, eval, i, *y);
+    frame_t fr = {SVG_LEFT,
+                  *y + 24.0,
+                  SVG_PLOT_WIDTH,
+                  SVG_PANEL_HEIGHT,
+                  0.0,
+                  (double)f->steps * (double)f->dt,
+                  lo,
+                  hi};
     char clip[32];
     snprintf(clip, sizeof clip, "clip-alt-%zu", i);
     clip_path(out, clip, &fr);
     axes(out, &fr, "t (s)", "z (m, up)");
     fprintf(out, "<g clip-path=\"url(#%s)\">\n", clip);
-
-    /* Terrain under the path, found on sub-samples of each step and merged into runs. */
     for (size_t j = 0; j < f->obstacle_count; j++) {
-        const coa_obstacle_t *o = &f->obstacles[j];
-        double ox0, oy0, oz0, ox1, oy1, oz1;
-        obstacle_bounds(o, &ox0, &oy0, &oz0, &ox1, &oy1, &oz1);
-        const size_t total = (size_t)f->steps * SVG_SUBSTEPS;
-        const double sub = dt / (double)SVG_SUBSTEPS;
-        bool in_run = false;
-        double run_start = 0.0;
-        for (size_t q = 0; q <= total; q++) {
-            size_t k = q / SVG_SUBSTEPS;
-            double u = (double)(q % SVG_SUBSTEPS) / (double)SVG_SUBSTEPS;
-            coa_vec3_t a = flown[k];
-            coa_vec3_t b = flown[k < f->steps ? k + 1u : k];
-            double x = (double)a.x + u * ((double)b.x - (double)a.x);
-            double yy = (double)a.y + u * ((double)b.y - (double)a.y);
-            bool over = over_footprint(o, x, yy, r);
-            double t = (double)q * sub;
-            if (over && !in_run) {
-                in_run = true;
-                run_start = fmax(0.0, t - sub / 2.0);
-            }
-            if (in_run && (!over || q == total)) {
-                double run_end = over ? t_end : fmin(t_end, t - sub / 2.0);
-                fprintf(out,
-                        "<rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" height=\"%.2f\" "
-                        "fill=\"" TERRAIN_FILL "\" fill-opacity=\"0.8\" stroke=\"#777\"/>\n",
-                        px(&fr, run_start), py(&fr, oz1), px(&fr, run_end) - px(&fr, run_start),
-                        py(&fr, oz0) - py(&fr, oz1));
-                snprintf(text, sizeof text, "obstacle %zu%s", j,
-                         o->kind == COA_OBSTACLE_BOX ? "" : " (bounding box)");
-                text_at(out, px(&fr, run_start) + 3.0, fmax(py(&fr, oz1), fr.top) + 12.0,
-                        "class=\"small\"", text);
-                in_run = false;
-            }
-        }
+        altitude_terrain(s, i, j, &fr);
     }
-
     near_traffic(s, i, &fr, true);
-
-    /* Its own protected half-height around the flown path, the reference, the flown. */
-    {
-        char attrs[128];
-        snprintf(attrs, sizeof attrs, "fill=\"%s\" fill-opacity=\"0.15\" stroke=\"none\"",
-                 colour_of(i));
-        band_tz(out, &fr, flown, dt, 0, s->row - 1u, h, attrs);
-        snprintf(attrs, sizeof attrs, "stroke=\"%s\" stroke-width=\"2\" stroke-dasharray=\"7 4\"",
-                 colour_of(i));
-        polyline_tz(out, &fr, ref, dt, 0, s->row - 1u, 0.0, attrs);
-        snprintf(attrs, sizeof attrs, "stroke=\"%s\" stroke-width=\"2.2\"", colour_of(i));
-        polyline_tz(out, &fr, flown, dt, 0, s->row - 1u, 0.0, attrs);
-    }
-
-    /* Samples no intent covered (a log that missed them). */
-    if (v->known != NULL) {
-        for (size_t k = 0; k < s->row; k++) {
-            if (!v->known[k]) {
-                double t0 = fmax(0.0, ((double)k - 0.5) * dt);
-                double t1 = fmin(t_end, ((double)k + 0.5) * dt);
-                fprintf(
-                    out,
-                    "<rect x=\"%.2f\" y=\"%.2f\" width=\"%.2f\" height=\"6\" fill=\"" UNKNOWN_COLOUR
-                    "\"/>\n",
-                    px(&fr, t0), fr.top + fr.height - 6.0, px(&fr, t1) - px(&fr, t0));
-            }
-        }
-    }
-
-    size_t drawn = 0;
-    for (uint32_t k = 0; k < f->steps && drawn < SVG_MAX_MARKERS; k++) {
-        if (s->ref_mark[i * f->steps + k]) {
-            ring(out, px(&fr, ((double)k + 0.5) * dt),
-                 py(&fr, ((double)ref[k].z + (double)ref[k + 1u].z) / 2.0));
-            drawn++;
-        }
-    }
-    drawn = 0;
-    for (uint32_t k = 0; k < f->steps && drawn < SVG_MAX_MARKERS; k++) {
-        if (s->loss_mark[i * f->steps + k]) {
-            cross(out, px(&fr, ((double)k + 0.5) * dt),
-                  py(&fr, ((double)flown[k].z + (double)flown[k + 1u].z) / 2.0));
-            drawn++;
-        }
-    }
+    altitude_paths(s, i, &fr);
+    altitude_markers(s, i, &fr);
     fputs("</g>\n", out);
     frame_border(out, &fr);
     *y = fr.top + fr.height + SVG_PANEL_GAP;
