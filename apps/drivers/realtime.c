@@ -462,16 +462,164 @@ static int rt_wait(int fd, int64_t wake_wall)
     return rc > 0 ? 1 : 0;
 }
 
+/* Where a run's schedule stands: the next cycle to start and the next to collect. */
+typedef struct {
+    int64_t K;            /* the last cycle */
+    int64_t next_start;   /* K + 1: none left */
+    int64_t next_collect; /* K: none left */
+    int64_t lead;         /* a world alone starts its cycles this early */
+    bool has_starts;      /* a world or vehicles: cycles start */
+    int64_t polled[COAVOID_NODE_MAX_PEERS];
+} rt_sched_t;
+
+static bool rt_loop_ok(const coavoid_rt_loop_t *loop, const coavoid_rt_result_t *result)
+{
+    return loop != NULL && result != NULL && loop->lcm != NULL && loop->now != NULL &&
+           loop->common != NULL && loop->steps >= 1 && loop->clock.speed > 0 &&
+           loop->vehicle_count <= COAVOID_NODE_MAX_PEERS &&
+           (loop->vehicle_count == 0 || loop->vehicles != NULL) &&
+           (loop->world != NULL || loop->coordinator != NULL || loop->vehicle_count > 0);
+}
+
+/* A process started late joins at the current cycle; the coordinator, if its collect time
+ * for that cycle has passed, at the next one. */
+static void rt_sched_init(const rt_run_t *r, rt_sched_t *sc)
+{
+    const coavoid_rt_loop_t *loop = r->loop;
+    const coavoid_node_common_t *c = loop->common;
+    int64_t now = rt_now(r);
+    int64_t first = now < c->epoch_utime ? 0 : coavoid_node_cycle_of(c, now);
+    first = first < 0 ? 0 : first;
+    sc->K = loop->steps;
+    sc->has_starts = loop->world != NULL || loop->vehicle_count > 0;
+    sc->lead = (loop->world != NULL && loop->vehicle_count == 0 && loop->world_lead_us > 0 &&
+                loop->world_lead_us < c->dt_us)
+                   ? loop->world_lead_us
+                   : 0;
+    sc->next_start = sc->has_starts ? first : sc->K + 1;
+    sc->next_collect = sc->K;
+    if (loop->coordinator != NULL) {
+        sc->next_collect = first;
+        if (now > coavoid_node_cycle_utime(c, first) + loop->collect_us) {
+            sc->next_collect++;
+        }
+    }
+    for (size_t i = 0; i < loop->vehicle_count; i++) {
+        sc->polled[i] = INT64_MIN;
+    }
+}
+
+/* Starts the cycle that is due, if one is (skipping those the loop was too late for). */
+static bool rt_due_start(const rt_run_t *r, rt_sched_t *sc, int64_t now)
+{
+    const coavoid_node_common_t *c = r->loop->common;
+    if (sc->next_start > sc->K || now < coavoid_node_cycle_utime(c, sc->next_start) - sc->lead) {
+        return false;
+    }
+    int64_t k = coavoid_node_cycle_of(c, now + sc->lead);
+    k = k > sc->K ? sc->K : k;
+    if (k > sc->next_start) {
+        r->result->skipped += (uint32_t)(k - sc->next_start);
+        rt_warn(r, "cycles %lld..%lld skipped: the loop was %.0f ms (scenario time) late",
+                (long long)sc->next_start, (long long)(k - 1),
+                (double)(now - coavoid_node_cycle_utime(c, sc->next_start)) * 1e-3);
+    }
+    rt_cycle_start(r, k);
+    sc->next_start = k + 1;
+    return true;
+}
+
+/* Runs the coordinator's collect that is due, if one is. */
+static bool rt_due_collect(const rt_run_t *r, rt_sched_t *sc, int64_t now)
+{
+    const coavoid_rt_loop_t *loop = r->loop;
+    const coavoid_node_common_t *c = loop->common;
+    if (sc->next_collect >= sc->K ||
+        now < coavoid_node_cycle_utime(c, sc->next_collect) + loop->collect_us) {
+        return false;
+    }
+    int64_t k = coavoid_node_cycle_of(c, now);
+    if (k > sc->next_collect) {
+        /* Its plans would be valid until a cycle start already past: nobody could adopt
+         * them. */
+        int64_t missed = (k < sc->K ? k : sc->K) - sc->next_collect;
+        r->result->skipped += (uint32_t)missed;
+        rt_warn(r, "cycles %lld..%lld: no plans: the loop was %.0f ms (scenario time) late",
+                (long long)sc->next_collect, (long long)(sc->next_collect + missed - 1),
+                (double)(now - coavoid_node_cycle_utime(c, sc->next_collect) - loop->collect_us) *
+                    1e-3);
+        sc->next_collect += missed;
+        return true;
+    }
+    int64_t started = coavoid_rt_stopwatch_us(NULL);
+    *loop->now = now;
+    int rc = coavoid_coordinator_cycle(loop->coordinator, now);
+    if (rc < 0) {
+        rt_error(r, "the coordinator's cycle", k, rc);
+    }
+    rt_check_overrun(r, "the coordinator's planning", k, rt_now(r),
+                     coavoid_node_cycle_utime(c, k + 1), started);
+    if (!sc->has_starts) {
+        r->result->cycles++;
+    }
+    sc->next_collect = k + 1;
+    return true;
+}
+
+/* Polls the vehicles whose deadline has come; the next time anything is due (INT64_MAX:
+ * nothing is left to do). */
+static int64_t rt_next_wake(const rt_run_t *r, rt_sched_t *sc, int64_t now)
+{
+    const coavoid_rt_loop_t *loop = r->loop;
+    const coavoid_node_common_t *c = loop->common;
+    int64_t wake = INT64_MAX;
+    for (size_t i = 0; i < loop->vehicle_count; i++) {
+        int64_t deadline = rt_pending_deadline(r, i, sc->polled[i]);
+        if (deadline <= now) {
+            rt_poll(r, i, &sc->polled[i]);
+            deadline = rt_pending_deadline(r, i, sc->polled[i]);
+        }
+        wake = deadline < wake ? deadline : wake;
+    }
+    if (sc->next_start <= sc->K) {
+        int64_t t = coavoid_node_cycle_utime(c, sc->next_start) - sc->lead;
+        wake = t < wake ? t : wake;
+    }
+    if (sc->next_collect < sc->K) {
+        int64_t t = coavoid_node_cycle_utime(c, sc->next_collect) + loop->collect_us;
+        wake = t < wake ? t : wake;
+    }
+    return wake;
+}
+
+/* Waits until `wake` or a message; handles what arrived. Negative: an LCM failure. */
+static int rt_wait_messages(const rt_run_t *r, rt_sched_t *sc, int fd, int64_t wake)
+{
+    const coavoid_rt_loop_t *loop = r->loop;
+    int rc = rt_wait(fd, coavoid_rt_wall_at(&loop->clock, wake));
+    if (rc <= 0) {
+        return rc;
+    }
+    rc = rt_drain(r);
+    if (rc < 0) {
+        return rc;
+    }
+    /* A message may be the intent a waiting vehicle needed. */
+    for (size_t i = 0; i < loop->vehicle_count; i++) {
+        const coavoid_vehicle_node_state_t *s = coavoid_vehicle_node_state(loop->vehicles[i]);
+        if (s != NULL && s->waiting) {
+            rt_poll(r, i, &sc->polled[i]);
+        }
+    }
+    return COA_OK;
+}
+
 int coavoid_rt_run(const coavoid_rt_loop_t *loop, coavoid_rt_result_t *result)
 {
     if (result != NULL) {
         memset(result, 0, sizeof *result);
     }
-    if (loop == NULL || result == NULL || loop->lcm == NULL || loop->now == NULL ||
-        loop->common == NULL || loop->steps < 1 || !(loop->clock.speed > 0) ||
-        loop->vehicle_count > COAVOID_NODE_MAX_PEERS ||
-        (loop->vehicle_count > 0 && loop->vehicles == NULL) ||
-        (loop->world == NULL && loop->coordinator == NULL && loop->vehicle_count == 0)) {
+    if (!rt_loop_ok(loop, result)) {
         return COA_ERR_ARGUMENT;
     }
     int fd = lcm_get_fileno(loop->lcm);
@@ -480,128 +628,24 @@ int coavoid_rt_run(const coavoid_rt_loop_t *loop, coavoid_rt_result_t *result)
     }
     rt_run_t run = {loop, result, loop->common};
     const rt_run_t *r = &run;
-    const coavoid_node_common_t *c = loop->common;
-    const int64_t K = loop->steps;
-    int64_t polled[COAVOID_NODE_MAX_PEERS];
-    for (size_t i = 0; i < loop->vehicle_count; i++) {
-        polled[i] = INT64_MIN;
-    }
-
-    /* A process started late joins at the current cycle; the coordinator, if its collect
-     * time for that cycle has passed, at the next one. */
-    int64_t now = rt_now(r);
-    int64_t first = now < c->epoch_utime ? 0 : coavoid_node_cycle_of(c, now);
-    if (first < 0) {
-        first = 0;
-    }
-    bool has_starts = loop->world != NULL || loop->vehicle_count > 0;
-    const int64_t lead = (loop->world != NULL && loop->vehicle_count == 0 &&
-                          loop->world_lead_us > 0 && loop->world_lead_us < c->dt_us)
-                             ? loop->world_lead_us
-                             : 0;
-    int64_t next_start = has_starts ? first : K + 1;
-    int64_t next_collect = K;
-    if (loop->coordinator != NULL) {
-        next_collect = first;
-        if (now > coavoid_node_cycle_utime(c, first) + loop->collect_us) {
-            next_collect++;
-        }
-    }
-
+    rt_sched_t sc;
+    rt_sched_init(r, &sc);
     for (;;) {
         if (rt_stop_signal != 0) {
             result->signal = (int)rt_stop_signal;
             break;
         }
-        now = rt_now(r);
-
-        if (next_start <= K && now >= coavoid_node_cycle_utime(c, next_start) - lead) {
-            int64_t k = coavoid_node_cycle_of(c, now + lead);
-            if (k > K) {
-                k = K;
-            }
-            if (k > next_start) {
-                result->skipped += (uint32_t)(k - next_start);
-                rt_warn(r, "cycles %lld..%lld skipped: the loop was %.0f ms (scenario time) late",
-                        (long long)next_start, (long long)(k - 1),
-                        (double)(now - coavoid_node_cycle_utime(c, next_start)) * 1e-3);
-            }
-            rt_cycle_start(r, k);
-            next_start = k + 1;
+        int64_t now = rt_now(r);
+        if (rt_due_start(r, &sc, now) || rt_due_collect(r, &sc, now)) {
             continue;
         }
-
-        if (next_collect < K &&
-            now >= coavoid_node_cycle_utime(c, next_collect) + loop->collect_us) {
-            int64_t k = coavoid_node_cycle_of(c, now);
-            if (k > next_collect) {
-                /* Its plans would be valid until a cycle start already past: nobody could
-                 * adopt them. */
-                int64_t missed = (k < K ? k : K) - next_collect;
-                result->skipped += (uint32_t)missed;
-                rt_warn(
-                    r, "cycles %lld..%lld: no plans: the loop was %.0f ms (scenario time) late",
-                    (long long)next_collect, (long long)(next_collect + missed - 1),
-                    (double)(now - coavoid_node_cycle_utime(c, next_collect) - loop->collect_us) *
-                        1e-3);
-                next_collect += missed;
-                continue;
-            }
-            int64_t started = coavoid_rt_stopwatch_us(NULL);
-            *loop->now = now;
-            int rc = coavoid_coordinator_cycle(loop->coordinator, now);
-            if (rc < 0) {
-                rt_error(r, "the coordinator's cycle", k, rc);
-            }
-            rt_check_overrun(r, "the coordinator's planning", k, rt_now(r),
-                             coavoid_node_cycle_utime(c, k + 1), started);
-            if (!has_starts) {
-                result->cycles++;
-            }
-            next_collect = k + 1;
-            continue;
-        }
-
-        int64_t wake = INT64_MAX;
-        for (size_t i = 0; i < loop->vehicle_count; i++) {
-            int64_t deadline = rt_pending_deadline(r, i, polled[i]);
-            if (deadline <= now) {
-                rt_poll(r, i, &polled[i]);
-                deadline = rt_pending_deadline(r, i, polled[i]);
-            }
-            if (deadline < wake) {
-                wake = deadline;
-            }
-        }
-        if (next_start > K && next_collect >= K && wake == INT64_MAX) {
+        int64_t wake = rt_next_wake(r, &sc, now);
+        if (sc.next_start > sc.K && sc.next_collect >= sc.K && wake == INT64_MAX) {
             break;
         }
-        if (next_start <= K) {
-            int64_t t = coavoid_node_cycle_utime(c, next_start) - lead;
-            wake = t < wake ? t : wake;
-        }
-        if (next_collect < K) {
-            int64_t t = coavoid_node_cycle_utime(c, next_collect) + loop->collect_us;
-            wake = t < wake ? t : wake;
-        }
-
-        int rc = rt_wait(fd, coavoid_rt_wall_at(&loop->clock, wake));
+        int rc = rt_wait_messages(r, &sc, fd, wake);
         if (rc < 0) {
             return rc;
-        }
-        if (rc > 0) {
-            rc = rt_drain(r);
-            if (rc < 0) {
-                return rc;
-            }
-            /* A message may be the intent a waiting vehicle needed. */
-            for (size_t i = 0; i < loop->vehicle_count; i++) {
-                const coavoid_vehicle_node_state_t *s =
-                    coavoid_vehicle_node_state(loop->vehicles[i]);
-                if (s != NULL && s->waiting) {
-                    rt_poll(r, i, &polled[i]);
-                }
-            }
         }
     }
     *loop->now = rt_now(r);
