@@ -876,23 +876,13 @@ static int refused_record(const summary_options_t *o, const coavoid_flight_t *f,
 }
 
 /* Everything after the options and the scenario. Returns the exit status. */
-static int summarise(void *options, coavoid_scenario_t *s)
+/* The scenario's dt as whole microseconds, and its UAV count, as a log can carry them. */
+static int summary_check(log_summary_t *ls)
 {
-    const summary_options_t *o = options;
-    log_summary_t *ls = calloc(1, sizeof *ls);
-    rebuilt_t b;
-    log_reader_t r;
-    int status = CLI_CONTINUE;
-    memset(&b, 0, sizeof b);
-    memset(&r, 0, sizeof r);
-    if (ls == NULL) {
-        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "out of memory");
-    }
-    ls->o = o;
-    ls->s = s;
+    const summary_options_t *o = ls->o;
+    const coavoid_scenario_t *s = ls->s;
     double dt_us = (double)s->dt * 1e6;
     if (!(dt_us >= 1.0) || dt_us > 3.6e9) {
-        free(ls);
         return coavoid_cli_fail(CLI_EXIT_INVALID,
                                 "%s: dt: %g s cannot be a cycle of whole microseconds "
                                 "(1 us to 1 h)",
@@ -900,106 +890,141 @@ static int summarise(void *options, coavoid_scenario_t *s)
     }
     ls->dt_us = llround(dt_us);
     if (s->vehicle_count > COA_MAX_VEHICLES) {
-        free(ls);
         return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: %zu vehicles, at most %u", o->scenario_path,
                                 s->vehicle_count, COA_MAX_VEHICLES);
     }
+    return CLI_CONTINUE;
+}
 
-    /* Pass 1: counts, the epoch, who was seen. */
-    status = log_open(&r, o->log_path, -1);
+/* Pass 1: counts, who was seen, the epoch (the earliest plan time unless --epoch), the
+ * log's size (pass 2 reads the same bytes) and the last cycle every UAV's intent covers. */
+static int summary_pass1(log_summary_t *ls, rebuilt_t *b, int64_t *epoch, int64_t *size)
+{
+    const summary_options_t *o = ls->o;
+    const coavoid_scenario_t *s = ls->s;
+    log_reader_t r;
+    memset(&r, 0, sizeof r);
+    int status = log_open(&r, o->log_path, -1);
     if (status == CLI_CONTINUE) {
         status = read_log(ls, &r);
     }
-    const int64_t size = r.size;
+    *size = r.size;
     log_close(&r);
-    int64_t epoch = o->epoch;
-    uint32_t cap = s->horizon > COA_MAX_HORIZON / 2u ? COA_MAX_HORIZON : 2u * s->horizon;
-    if (status == CLI_CONTINUE) {
-        int64_t earliest = INT64_MAX;
-        for (size_t i = 0; i < s->vehicle_count && status == CLI_CONTINUE; i++) {
-            if (ls->intents_of[i] == 0) {
-                status = coavoid_cli_fail(CLI_EXIT_INVALID,
-                                          "%s: UAV %u of %s never published an accepted intent "
-                                          "(%" PRId64 " intents in the log, %" PRId64 " refused)",
-                                          o->log_path, (unsigned)s->vehicles[i].id,
-                                          o->scenario_path, ls->intents, ls->intents_refused);
-            }
-            earliest = ls->first_plan_utime[i] < earliest ? ls->first_plan_utime[i] : earliest;
-        }
-        if (o->epoch_text == NULL) {
-            epoch = earliest;
-        }
-    }
-    int64_t k = 0;
-    if (status == CLI_CONTINUE) {
-        k = last_complete_cycle(ls, epoch, cap, &b.off_grid);
-        if (k < 0) {
-            status = coavoid_cli_fail(CLI_EXIT_INTERNAL, "out of memory");
-        } else if (k == 0) {
+    int64_t earliest = INT64_MAX;
+    for (size_t i = 0; i < s->vehicle_count && status == CLI_CONTINUE; i++) {
+        if (ls->intents_of[i] == 0) {
             status = coavoid_cli_fail(CLI_EXIT_INVALID,
-                                      "%s: no cycle after cycle 0 (epoch %" PRId64
-                                      " us, dt %g s) has every UAV's own intent: nothing to judge",
-                                      o->log_path, epoch, (double)s->dt);
+                                      "%s: UAV %u of %s never published an accepted intent "
+                                      "(%" PRId64 " intents in the log, %" PRId64 " refused)",
+                                      o->log_path, (unsigned)s->vehicles[i].id, o->scenario_path,
+                                      ls->intents, ls->intents_refused);
         }
+        earliest = ls->first_plan_utime[i] < earliest ? ls->first_plan_utime[i] : earliest;
     }
-    const size_t n = s->vehicle_count;
-    if (status == CLI_CONTINUE) {
-        b.steps = (uint32_t)k;
-        size_t cells = n * ((size_t)k + 1u);
-        b.best = calloc(cells, sizeof *b.best);
-        b.own = calloc(cells, sizeof *b.own);
-        b.known = calloc(cells, sizeof *b.known);
-        b.reference = calloc(cells, sizeof *b.reference);
-        b.offsets = calloc(cells, sizeof *b.offsets);
-        if (b.best == NULL || b.own == NULL || b.known == NULL || b.reference == NULL ||
-            b.offsets == NULL) {
-            status = coavoid_cli_fail(CLI_EXIT_INTERNAL, "out of memory");
-        }
+    if (status != CLI_CONTINUE) {
+        return status;
     }
-    /* Pass 2: the samples, from the same bytes pass 1 checked. */
-    if (status == CLI_CONTINUE) {
-        status = log_open(&r, o->log_path, size);
-        if (status == CLI_CONTINUE) {
-            status = fill_samples(ls, &r, &b, epoch);
-        }
-        log_close(&r);
+    *epoch = o->epoch_text == NULL ? earliest : o->epoch;
+    uint32_t cap = s->horizon > COA_MAX_HORIZON / 2u ? COA_MAX_HORIZON : 2u * s->horizon;
+    int64_t k = last_complete_cycle(ls, *epoch, cap, &b->off_grid);
+    if (k < 0) {
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "out of memory");
     }
-    if (status == CLI_CONTINUE && fill_gaps(s, &b) != COA_OK) {
-        status = coavoid_cli_fail(CLI_EXIT_INVALID, "%s: a route cannot be sampled over %lu steps",
-                                  o->scenario_path, (unsigned long)b.steps);
+    if (k == 0) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                "%s: no cycle after cycle 0 (epoch %" PRId64
+                                " us, dt %g s) has every UAV's own intent: nothing to judge",
+                                o->log_path, *epoch, (double)s->dt);
     }
+    b->steps = (uint32_t)k;
+    return CLI_CONTINUE;
+}
 
+/* Pass 2: the samples of cycles 0..steps, from the same bytes pass 1 checked, and the gaps
+ * no intent covered from the scenario's reference. */
+static int summary_pass2(log_summary_t *ls, rebuilt_t *b, int64_t epoch, int64_t size)
+{
+    const summary_options_t *o = ls->o;
+    size_t cells = ls->s->vehicle_count * ((size_t)b->steps + 1u);
+    b->best = calloc(cells, sizeof *b->best);
+    b->own = calloc(cells, sizeof *b->own);
+    b->known = calloc(cells, sizeof *b->known);
+    b->reference = calloc(cells, sizeof *b->reference);
+    b->offsets = calloc(cells, sizeof *b->offsets);
+    if (b->best == NULL || b->own == NULL || b->known == NULL || b->reference == NULL ||
+        b->offsets == NULL) {
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "out of memory");
+    }
+    log_reader_t r;
+    memset(&r, 0, sizeof r);
+    int status = log_open(&r, o->log_path, size);
+    if (status == CLI_CONTINUE) {
+        status = fill_samples(ls, &r, b, epoch);
+    }
+    log_close(&r);
+    if (status == CLI_CONTINUE && fill_gaps(ls->s, b) != COA_OK) {
+        status = coavoid_cli_fail(CLI_EXIT_INVALID, "%s: a route cannot be sampled over %lu steps",
+                                  o->scenario_path, (unsigned long)b->steps);
+    }
+    return status;
+}
+
+/* Judges the rebuilt flight, writes the figure (first: a file that cannot be written is a
+ * usage error, reported before anything is printed) and the result; the exit status. */
+static int summary_report(log_summary_t *ls, rebuilt_t *b, int64_t epoch)
+{
+    const summary_options_t *o = ls->o;
     coavoid_judged_t judged;
     const coavoid_flight_t *flight = &judged.flight;
     const coavoid_flight_eval_t *eval = &judged.eval;
+    int status = CLI_CONTINUE;
+    uint32_t replans = count_replans(ls, epoch + ((int64_t)b->steps + 1) * ls->dt_us);
+    int rc = coavoid_judge_run(&judged, ls->s, o->mode, b->steps, replans, b->reference, b->offsets,
+                               b->known);
+    if (rc == COA_ERR_ARGUMENT) {
+        status = refused_record(o, flight, b);
+    } else if (rc != COA_OK) {
+        status = coavoid_cli_fail(CLI_EXIT_INTERNAL, "cannot judge the flight (%s)",
+                                  coa_status_name(rc));
+    }
+    if (status == CLI_CONTINUE && o->svg_path != NULL) {
+        status = write_svg(o->svg_path, flight, eval);
+    }
+    if (status == CLI_CONTINUE && o->json) {
+        status = print_json(ls, b, epoch, flight, eval);
+    } else if (status == CLI_CONTINUE) {
+        print_log_text(ls, b, epoch);
+        if (coavoid_flight_text(flight, eval, stdout) != COA_OK) {
+            status = coavoid_cli_fail(CLI_EXIT_INTERNAL, "cannot write the result");
+        }
+    }
     if (status == CLI_CONTINUE) {
-        uint32_t replans = count_replans(ls, epoch + ((int64_t)b.steps + 1) * ls->dt_us);
-        int rc = coavoid_judge_run(&judged, s, o->mode, b.steps, replans, b.reference, b.offsets,
-                                   b.known);
-        if (rc == COA_ERR_ARGUMENT) {
-            status = refused_record(o, flight, &b);
-        } else if (rc != COA_OK) {
-            status = coavoid_cli_fail(CLI_EXIT_INTERNAL, "cannot judge the flight (%s)",
-                                      coa_status_name(rc));
-        }
-        /* The figure first: a file that cannot be written is a usage error, reported
-         * before anything is printed. */
-        if (status == CLI_CONTINUE && o->svg_path != NULL) {
-            status = write_svg(o->svg_path, flight, eval);
-        }
-        if (status == CLI_CONTINUE) {
-            if (o->json) {
-                status = print_json(ls, &b, epoch, flight, eval);
-            } else {
-                print_log_text(ls, &b, epoch);
-                if (coavoid_flight_text(flight, eval, stdout) != COA_OK) {
-                    status = coavoid_cli_fail(CLI_EXIT_INTERNAL, "cannot write the result");
-                }
-            }
-        }
-        if (status == CLI_CONTINUE) {
-            status = eval->loss_of_separation ? CLI_EXIT_NOT_SOLVED : CLI_EXIT_OK;
-        }
+        status = eval->loss_of_separation ? CLI_EXIT_NOT_SOLVED : CLI_EXIT_OK;
+    }
+    return status;
+}
+
+static int summarise(void *options, coavoid_scenario_t *s)
+{
+    log_summary_t *ls = calloc(1, sizeof *ls);
+    rebuilt_t b;
+    memset(&b, 0, sizeof b);
+    if (ls == NULL) {
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "out of memory");
+    }
+    ls->o = options;
+    ls->s = s;
+    int64_t epoch = 0;
+    int64_t size = 0;
+    int status = summary_check(ls);
+    if (status == CLI_CONTINUE) {
+        status = summary_pass1(ls, &b, &epoch, &size);
+    }
+    if (status == CLI_CONTINUE) {
+        status = summary_pass2(ls, &b, epoch, size);
+    }
+    if (status == CLI_CONTINUE) {
+        status = summary_report(ls, &b, epoch);
     }
     rebuilt_free(&b);
     free(ls->seen.items);
