@@ -286,6 +286,8 @@ typedef struct {
     labelled_t *scratch;
     uint32_t *cluster_ids;
     size_t *cluster_start;
+    size_t size;      /* workspace bytes */
+    size_t max_pairs; /* candidate pairs the predictor is sized for; the conflicts' room */
 } predict_memory_t;
 
 static void predict_memory_free(predict_memory_t *m)
@@ -334,74 +336,95 @@ static int build_plans(const char *file, const coavoid_scenario_t *s, predict_me
 }
 
 /* Everything after the scenario is loaded. Returns the exit status. */
-static int predict(void *options, coavoid_scenario_t *s)
+/* Sizes and allocates everything a prediction of the scenario needs. Every pair (UAV-UAV,
+ * UAV-track and UAV-obstacle) may be a candidate and may conflict: a scenario is small
+ * enough to size for that, so neither the pair set nor the conflict array can run out. */
+static int predict_allocate(const char *file, const coavoid_scenario_t *s, predict_memory_t *m)
 {
-    const predict_options_t *o = options;
-    const char *file = o->scenario_path;
     const size_t n = s->vehicle_count;
-    const size_t tracks = s->track_count;
-    int status = coavoid_cli_sample_scenario(file, s);
-    if (status != CLI_CONTINUE) {
-        return status;
-    }
-
-    /* Every pair (UAV-UAV, UAV-track and UAV-obstacle) may be a candidate and may
-     * conflict: a scenario is small enough to size for that, so neither the pair set nor
-     * the conflict array can run out here. */
     size_t vehicle_pairs = n * (n - 1u) / 2u; /* n <= COA_MAX_VEHICLES */
-    size_t with_tracks, max_pairs;
-    if (!size_mul_add(n, tracks, vehicle_pairs, &with_tracks) ||
-        !size_mul_add(n, s->obstacle_count, with_tracks, &max_pairs)) {
+    size_t with_tracks;
+    if (!size_mul_add(n, s->track_count, vehicle_pairs, &with_tracks) ||
+        !size_mul_add(n, s->obstacle_count, with_tracks, &m->max_pairs)) {
         return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: too many tracks and obstacles to size for",
                                 file);
     }
-    if (max_pairs == 0) {
-        max_pairs = 1; /* one UAV alone: the size function refuses a limit of 0 */
+    if (m->max_pairs == 0) {
+        m->max_pairs = 1; /* one UAV alone: the size function refuses a limit of 0 */
     }
-    const size_t capacity = max_pairs;
-    size_t size = coa_predictor_workspace_size(n, tracks, s->horizon, max_pairs);
-    if (size == 0) {
+    m->size = coa_predictor_workspace_size(n, s->track_count, s->horizon, m->max_pairs);
+    if (m->size == 0) {
         return coavoid_cli_fail(
             CLI_EXIT_INVALID,
             "%s: too large: the predictor's workspace for %zu vehicles, %zu tracks, "
             "%zu obstacles and %lu steps is beyond its limits",
-            file, n, tracks, s->obstacle_count, (unsigned long)s->horizon);
+            file, n, s->track_count, s->obstacle_count, (unsigned long)s->horizon);
     }
-
-    predict_memory_t m;
-    memset(&m, 0, sizeof m);
-    m.samples = calloc(n * ((size_t)s->horizon + 1u), sizeof *m.samples);
-    m.plans = calloc(n, sizeof *m.plans);
-    m.workspace = malloc(size);
-    m.conflicts = calloc(capacity, sizeof *m.conflicts);
-    m.listed = calloc(capacity, sizeof *m.listed);
-    m.label = calloc(n, sizeof *m.label);
-    m.scratch = calloc(n, sizeof *m.scratch);
-    m.cluster_ids = calloc(n, sizeof *m.cluster_ids);
-    m.cluster_start = calloc(n + 1u, sizeof *m.cluster_start);
-    if (m.samples == NULL || m.plans == NULL || m.workspace == NULL || m.conflicts == NULL ||
-        m.listed == NULL || m.label == NULL || m.scratch == NULL || m.cluster_ids == NULL ||
-        m.cluster_start == NULL) {
-        predict_memory_free(&m);
+    m->samples = calloc(n * ((size_t)s->horizon + 1u), sizeof *m->samples);
+    m->plans = calloc(n, sizeof *m->plans);
+    m->workspace = malloc(m->size);
+    m->conflicts = calloc(m->max_pairs, sizeof *m->conflicts);
+    m->listed = calloc(m->max_pairs, sizeof *m->listed);
+    m->label = calloc(n, sizeof *m->label);
+    m->scratch = calloc(n, sizeof *m->scratch);
+    m->cluster_ids = calloc(n, sizeof *m->cluster_ids);
+    m->cluster_start = calloc(n + 1u, sizeof *m->cluster_start);
+    if (m->samples == NULL || m->plans == NULL || m->workspace == NULL || m->conflicts == NULL ||
+        m->listed == NULL || m->label == NULL || m->scratch == NULL || m->cluster_ids == NULL ||
+        m->cluster_start == NULL) {
         return coavoid_cli_fail(CLI_EXIT_INVALID,
                                 "%s: cannot allocate %zu bytes of predictor workspace and %zu "
                                 "conflicts",
-                                file, size, capacity);
+                                file, m->size, m->max_pairs);
     }
-    status = build_plans(file, s, &m);
-    if (status != CLI_CONTINUE) {
-        predict_memory_free(&m);
-        return status;
-    }
+    return build_plans(file, s, m);
+}
 
-    coa_predictor_t *predictor =
-        coa_predictor_init(m.workspace, size, n, tracks, s->horizon, max_pairs);
+/* Clusters the conflicts found and prints the prediction result; the exit status. */
+static int predict_report(const coavoid_scenario_t *s, predict_memory_t *m,
+                          const coa_predict_result_t *result)
+{
+    const size_t n = s->vehicle_count;
+    size_t cluster_labels = 0;
+    char err[SCENARIO_ERROR_MAX];
+    if (coa_predict_clusters(m->conflicts, result->conflict_count, n, m->label, &cluster_labels) !=
+            COA_OK ||
+        cluster_labels > n) {
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: the conflicts do not cluster");
+    }
+    if (!map_conflicts(s, m->conflicts, result->conflict_count, m->listed)) {
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL,
+                                "internal error: the predictor named a vehicle, track or obstacle "
+                                "out of range");
+    }
+    coavoid_output_predict_t view;
+    memset(&view, 0, sizeof view);
+    view.scenario = s->name;
+    view.conflicts = m->listed;
+    view.conflict_count = result->conflict_count;
+    view.cluster_ids = m->cluster_ids;
+    view.cluster_start = m->cluster_start;
+    if (!build_clusters(s, m->label, cluster_labels, m->scratch, m->cluster_ids, m->cluster_start,
+                        &view.cluster_count)) {
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: bad cluster labels");
+    }
+    if (coavoid_output_predict(stdout, &view, err, sizeof err) != 0) {
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "%s", err);
+    }
+    return CLI_EXIT_OK;
+}
+
+/* One coa_predict over the scenario's reference plans; its result checked. */
+static int predict_run(const predict_options_t *o, const coavoid_scenario_t *s, predict_memory_t *m,
+                       coa_predict_result_t *result)
+{
+    const char *file = o->scenario_path;
+    coa_predictor_t *predictor = coa_predictor_init(m->workspace, m->size, s->vehicle_count,
+                                                    s->track_count, s->horizon, m->max_pairs);
     if (predictor == NULL) {
-        predict_memory_free(&m);
         return coavoid_cli_fail(CLI_EXIT_INTERNAL,
                                 "internal error: the predictor refused its workspace");
     }
-
     coa_predict_config_t config;
     memset(&config, 0, sizeof config);
     config.t0 = 0;
@@ -411,51 +434,46 @@ static int predict(void *options, coavoid_scenario_t *s)
     config.track_sigma_rate_vertical = (coa_real_t)o->growth_vertical;
     config.threshold = o->threshold;
     config.all_pairs = false;
-
-    coa_predict_result_t result;
-    memset(&result, 0, sizeof result);
-    int rc = coa_predict(predictor, &config, m.plans, n, s->obstacles, s->obstacle_count, s->tracks,
-                         tracks, m.conflicts, capacity, &result);
-    size_t cluster_labels = 0;
-    char err[SCENARIO_ERROR_MAX];
+    memset(result, 0, sizeof *result);
+    int rc =
+        coa_predict(predictor, &config, m->plans, s->vehicle_count, s->obstacles, s->obstacle_count,
+                    s->tracks, s->track_count, m->conflicts, m->max_pairs, result);
     if (rc == COA_ERR_ARGUMENT) {
         /* The loader checked every field the contract defines; what is left is a
          * combination the core refuses (like plan's problem check). */
-        status = coavoid_cli_fail(CLI_EXIT_INVALID, "%s: rejected by the core's predictor (%s)",
-                                  file, coa_status_name(rc));
-    } else if (rc != COA_OK) {
-        status = coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: the predictor failed (%s)",
-                                  coa_status_name(rc));
-    } else if (result.overflow || result.conflict_count > capacity ||
-               result.conflicts_found != result.conflict_count) {
-        status = coavoid_cli_fail(CLI_EXIT_INTERNAL,
-                                  "internal error: the predictor found %zu conflicts, room for %zu",
-                                  result.conflicts_found, capacity);
-    } else if (coa_predict_clusters(m.conflicts, result.conflict_count, n, m.label,
-                                    &cluster_labels) != COA_OK ||
-               cluster_labels > n) {
-        status =
-            coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: the conflicts do not cluster");
-    } else if (!map_conflicts(s, m.conflicts, result.conflict_count, m.listed)) {
-        status = coavoid_cli_fail(
-            CLI_EXIT_INTERNAL, "internal error: the predictor named a vehicle, track or obstacle "
-                               "out of range");
-    } else {
-        coavoid_output_predict_t view;
-        memset(&view, 0, sizeof view);
-        view.scenario = s->name;
-        view.conflicts = m.listed;
-        view.conflict_count = result.conflict_count;
-        view.cluster_ids = m.cluster_ids;
-        view.cluster_start = m.cluster_start;
-        if (!build_clusters(s, m.label, cluster_labels, m.scratch, m.cluster_ids, m.cluster_start,
-                            &view.cluster_count)) {
-            status = coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: bad cluster labels");
-        } else if (coavoid_output_predict(stdout, &view, err, sizeof err) != 0) {
-            status = coavoid_cli_fail(CLI_EXIT_INTERNAL, "%s", err);
-        } else {
-            status = CLI_EXIT_OK;
-        }
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: rejected by the core's predictor (%s)", file,
+                                coa_status_name(rc));
+    }
+    if (rc != COA_OK) {
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: the predictor failed (%s)",
+                                coa_status_name(rc));
+    }
+    if (result->overflow || result->conflict_count > m->max_pairs ||
+        result->conflicts_found != result->conflict_count) {
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL,
+                                "internal error: the predictor found %zu conflicts, room for %zu",
+                                result->conflicts_found, m->max_pairs);
+    }
+    return CLI_CONTINUE;
+}
+
+static int predict(void *options, coavoid_scenario_t *s)
+{
+    const predict_options_t *o = options;
+    const char *file = o->scenario_path;
+    int status = coavoid_cli_sample_scenario(file, s);
+    if (status != CLI_CONTINUE) {
+        return status;
+    }
+    predict_memory_t m;
+    memset(&m, 0, sizeof m);
+    coa_predict_result_t result;
+    status = predict_allocate(file, s, &m);
+    if (status == CLI_CONTINUE) {
+        status = predict_run(o, s, &m, &result);
+    }
+    if (status == CLI_CONTINUE) {
+        status = predict_report(s, &m, &result);
     }
     predict_memory_free(&m);
     return status;
