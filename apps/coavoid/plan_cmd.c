@@ -216,48 +216,12 @@ static uint32_t choose_beta(const plan_options_t *o, const coavoid_scenario_t *s
 }
 
 /* Everything after the scenario is loaded. Returns the exit status. */
-static int plan(void *options, coavoid_scenario_t *s)
+/* The planner for `searched` UAVs at `beta`, in a workspace of its exact size, and the
+ * offsets' rows; *workspace and *offsets are the caller's to free, also on failure. */
+static int plan_allocate(const char *file, const char *beta_source, const coavoid_scenario_t *s,
+                         size_t searched, uint32_t beta, void **workspace, int32_t **offsets,
+                         coa_planner_t **planner)
 {
-    const plan_options_t *o = options;
-    const char *file = o->scenario_path;
-    char err[SCENARIO_ERROR_MAX];
-    size_t order_storage[COA_MAX_VEHICLES];
-    const size_t *order = NULL;
-    const size_t n = s->vehicle_count;
-
-    if (o->priority != NULL) {
-        int status = parse_priority(o->priority, s, order_storage);
-        if (status != CLI_CONTINUE) {
-            return status;
-        }
-        order = order_storage;
-    }
-
-    if (!o->decoupled && n > COA_MAX_CENTRALISED) {
-        return coavoid_cli_fail(
-            CLI_EXIT_INVALID,
-            "--mode centralised: %zu vehicles, at most %u (COA_MAX_CENTRALISED) can be "
-            "planned together",
-            n, COA_MAX_CENTRALISED);
-    }
-    const size_t searched = o->decoupled ? 1u : n;
-    char beta_source[SCENARIO_ERROR_MAX];
-    uint32_t beta = choose_beta(o, s, searched, beta_source, sizeof beta_source);
-
-    int rc = coavoid_cli_sample_scenario(file, s);
-    if (rc != CLI_CONTINUE) {
-        return rc;
-    }
-    coa_problem_t problem = coavoid_scenario_problem(s);
-    rc = coa_problem_check(&problem);
-    if (rc == COA_ERR_RANGE) {
-        return range_error(file, s);
-    }
-    if (rc != COA_OK) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: rejected by the core's problem check (%s)",
-                                file, coa_status_name(rc));
-    }
-
     coa_planner_config_t config = coavoid_cli_planner_config(s, searched, beta);
     /* The tables alone (every reachable step and offset) do not depend on beta: when they
      * pass the limit no beta helps, whatever --beta or the scenario say. */
@@ -276,52 +240,113 @@ static int plan(void *options, coavoid_scenario_t *s)
             "not fit in memory (lower it with --beta)",
             beta_source, searched, (unsigned long)s->horizon);
     }
-    void *workspace = malloc(size);
-    if (workspace == NULL) {
+    *workspace = malloc(size);
+    if (*workspace == NULL) {
         return coavoid_cli_fail(CLI_EXIT_INVALID,
                                 "%s: cannot allocate %zu bytes of workspace for %zu vehicle(s) "
                                 "(lower it with --beta)",
                                 beta_source, size, searched);
     }
-    coa_planner_t *planner = coa_planner_init(workspace, size, &config);
-    int32_t *offsets = calloc(n * ((size_t)s->horizon + 1u), sizeof *offsets);
-    if (planner == NULL || offsets == NULL) {
-        free(workspace);
-        free(offsets);
+    *planner = coa_planner_init(*workspace, size, &config);
+    *offsets = calloc(s->vehicle_count * ((size_t)s->horizon + 1u), sizeof **offsets);
+    if (*planner == NULL || *offsets == NULL) {
         return coavoid_cli_fail(CLI_EXIT_INTERNAL, "%s",
-                                planner == NULL
+                                *planner == NULL
                                     ? "internal error: the planner refused its workspace"
                                     : "out of memory for the plan");
     }
+    return CLI_CONTINUE;
+}
 
+/* The scenario sampled and accepted by the core's problem check. */
+static int plan_problem(const char *file, coavoid_scenario_t *s, coa_problem_t *problem)
+{
+    int rc = coavoid_cli_sample_scenario(file, s);
+    if (rc != CLI_CONTINUE) {
+        return rc;
+    }
+    *problem = coavoid_scenario_problem(s);
+    rc = coa_problem_check(problem);
+    if (rc == COA_ERR_RANGE) {
+        return range_error(file, s);
+    }
+    if (rc != COA_OK) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: rejected by the core's problem check (%s)",
+                                file, coa_status_name(rc));
+    }
+    return CLI_CONTINUE;
+}
+
+/* Plans in the mode asked for and prints the result; the exit status. */
+static int plan_run(const plan_options_t *o, const coavoid_scenario_t *s,
+                    const coa_problem_t *problem, const size_t *order, coa_planner_t *planner,
+                    int32_t *offsets, uint32_t beta)
+{
+    char err[SCENARIO_ERROR_MAX];
     coa_plan_result_t result;
     memset(&result, 0, sizeof result);
     struct timespec start, end;
+    int rc;
     clock_gettime(CLOCK_MONOTONIC, &start);
     if (o->decoupled) {
-        rc = coa_plan_decoupled(planner, &problem, order, o->reorder ? o->max_orders : 1u, offsets,
+        rc = coa_plan_decoupled(planner, problem, order, o->reorder ? o->max_orders : 1u, offsets,
                                 &result);
     } else {
-        rc = coa_plan_centralised(planner, &problem, offsets, &result);
+        rc = coa_plan_centralised(planner, problem, offsets, &result);
     }
     clock_gettime(CLOCK_MONOTONIC, &end);
-    free(workspace);
-
-    int status;
     if (rc == COA_ERR_RANGE) {
-        status = range_error(file, s);
-    } else if (rc != COA_OK) {
-        status = coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: the planner failed (%s)",
-                                  coa_status_name(rc));
-    } else {
-        coavoid_output_plan_t view = {
-            s, o->decoupled, &result, offsets, coavoid_cli_elapsed_us(&start, &end), beta};
-        if (coavoid_output_plan(stdout, &view, err, sizeof err) != 0) {
-            status = coavoid_cli_fail(CLI_EXIT_INTERNAL, "%s", err);
-        } else {
-            status = result.status == COA_PLAN_SOLVED ? CLI_EXIT_OK : CLI_EXIT_NOT_SOLVED;
-        }
+        return range_error(o->scenario_path, s);
     }
+    if (rc != COA_OK) {
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: the planner failed (%s)",
+                                coa_status_name(rc));
+    }
+    coavoid_output_plan_t view = {
+        s, o->decoupled, &result, offsets, coavoid_cli_elapsed_us(&start, &end), beta};
+    if (coavoid_output_plan(stdout, &view, err, sizeof err) != 0) {
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "%s", err);
+    }
+    return result.status == COA_PLAN_SOLVED ? CLI_EXIT_OK : CLI_EXIT_NOT_SOLVED;
+}
+
+static int plan(void *options, coavoid_scenario_t *s)
+{
+    const plan_options_t *o = options;
+    const char *file = o->scenario_path;
+    size_t order_storage[COA_MAX_VEHICLES];
+    const size_t *order = NULL;
+    const size_t n = s->vehicle_count;
+    if (o->priority != NULL) {
+        int status = parse_priority(o->priority, s, order_storage);
+        if (status != CLI_CONTINUE) {
+            return status;
+        }
+        order = order_storage;
+    }
+    if (!o->decoupled && n > COA_MAX_CENTRALISED) {
+        return coavoid_cli_fail(
+            CLI_EXIT_INVALID,
+            "--mode centralised: %zu vehicles, at most %u (COA_MAX_CENTRALISED) can be "
+            "planned together",
+            n, COA_MAX_CENTRALISED);
+    }
+    const size_t searched = o->decoupled ? 1u : n;
+    char beta_source[SCENARIO_ERROR_MAX];
+    uint32_t beta = choose_beta(o, s, searched, beta_source, sizeof beta_source);
+    coa_problem_t problem;
+    int status = plan_problem(file, s, &problem);
+    if (status != CLI_CONTINUE) {
+        return status;
+    }
+    void *workspace = NULL;
+    int32_t *offsets = NULL;
+    coa_planner_t *planner = NULL;
+    status = plan_allocate(file, beta_source, s, searched, beta, &workspace, &offsets, &planner);
+    if (status == CLI_CONTINUE) {
+        status = plan_run(o, s, &problem, order, planner, offsets, beta);
+    }
+    free(workspace);
     free(offsets);
     return status;
 }
