@@ -1209,20 +1209,16 @@ static int write_svg(const char *path, const mc_options_t *o, const mc_run_t *ru
 
 /* ---- the command ---- */
 
-int coavoid_command_montecarlo(int argc, char **argv)
+/* Each UAV count's beta and order limit; refused when its centralised planner cannot be
+ * sized. */
+static int mc_sizes(const mc_options_t *o, mc_size_t *sizes)
 {
-    mc_options_t o;
-    int status = parse_mc_options(argc, argv, &o);
-    if (status != CLI_CONTINUE) {
-        return status;
-    }
-    mc_size_t sizes[MC_SIZES];
-    for (uint32_t k = 0; k < o.size_count; k++) {
-        uint32_t n = o.sizes[k];
+    for (uint32_t k = 0; k < o->size_count; k++) {
+        uint32_t n = o->sizes[k];
         sizes[k].n = n;
         coa_planner_config_t shape = mc_config(n, CLI_DEFAULT_BETA);
-        sizes[k].beta = o.beta_text != NULL ? o.beta : coavoid_cli_default_beta(&shape);
-        sizes[k].max_orders = o.max_orders_text != NULL ? o.max_orders : factorial(n);
+        sizes[k].beta = o->beta_text != NULL ? o->beta : coavoid_cli_default_beta(&shape);
+        sizes[k].max_orders = o->max_orders_text != NULL ? o->max_orders : factorial(n);
         shape.beta = sizes[k].beta;
         if (coa_planner_workspace_size(&shape) == 0) {
             return coavoid_cli_fail(CLI_EXIT_INVALID,
@@ -1231,25 +1227,90 @@ int coavoid_command_montecarlo(int argc, char **argv)
                                     (unsigned long)sizes[k].beta, (unsigned long)n);
         }
     }
+    return CLI_CONTINUE;
+}
+
+/* The output files, checked before an hour's run rather than after: --save's directory,
+ * --csv opened (in *csv) and --svg writable. */
+static int mc_outputs(const mc_options_t *o, FILE **csv)
+{
     struct stat info;
-    if (o.save != NULL &&
-        (stat(o.save, &info) != 0 || !S_ISDIR(info.st_mode) || access(o.save, W_OK | X_OK) != 0)) {
+    if (o->save != NULL && (stat(o->save, &info) != 0 || !S_ISDIR(info.st_mode) ||
+                            access(o->save, W_OK | X_OK) != 0)) {
         return coavoid_cli_fail(CLI_EXIT_INVALID,
-                                "--save: '%.200s' is not a directory we can write in", o.save);
+                                "--save: '%.200s' is not a directory we can write in", o->save);
     }
-    FILE *csv = NULL;
-    if (o.csv != NULL && (csv = fopen(o.csv, "w")) == NULL) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "--csv: cannot write '%.200s'", o.csv);
+    if (o->csv != NULL && (*csv = fopen(o->csv, "w")) == NULL) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "--csv: cannot write '%.200s'", o->csv);
     }
-    if (o.svg != NULL) { /* refused now rather than after an hour's run */
-        FILE *probe = fopen(o.svg, "w");
+    if (o->svg != NULL) {
+        FILE *probe = fopen(o->svg, "w");
         if (probe == NULL) {
-            if (csv != NULL) {
-                fclose(csv);
-            }
-            return coavoid_cli_fail(CLI_EXIT_INVALID, "--svg: cannot write '%.200s'", o.svg);
+            return coavoid_cli_fail(CLI_EXIT_INVALID, "--svg: cannot write '%.200s'", o->svg);
         }
         fclose(probe);
+    }
+    return CLI_CONTINUE;
+}
+
+/* Closes --csv's file; a write that failed is an error unless one came first. */
+static int mc_close_csv(const mc_options_t *o, FILE *csv, int status)
+{
+    if (csv == NULL) {
+        return status;
+    }
+    bool ok = !ferror(csv);
+    if ((fclose(csv) != 0 || !ok) && status == CLI_CONTINUE) {
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "--csv: cannot write '%.200s'", o->csv);
+    }
+    return status;
+}
+
+/* The summaries of every UAV count, the figure and the table; the exit status. */
+static int mc_report(const mc_options_t *o, mc_run_t *run, double *x)
+{
+    bool defects = false;
+    for (uint32_t j = 0; j < run->total; j++) {
+        defects = defects || run->results[j].defect[0] != '\0';
+    }
+    mc_summary_t summary[MC_SIZES];
+    for (uint32_t k = 0; k < o->size_count; k++) {
+        summarise(&run->results[k * o->count], o->count, &run->sizes[k], x, &summary[k]);
+    }
+    if (o->svg != NULL && write_svg(o->svg, o, run, summary, o->size_count, x) != 0) {
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "--svg: cannot write '%.200s'", o->svg);
+    }
+    int rc = 0;
+    if (o->json) {
+        rc = json_summary(stdout, o, summary, o->size_count);
+    } else {
+        text_summary(stdout, o, summary, o->size_count);
+    }
+    if (rc != 0 || fflush(stdout) != 0 || ferror(stdout)) {
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "cannot write the summary");
+    }
+    return defects ? coavoid_cli_fail(CLI_EXIT_INTERNAL, "montecarlo: defects found (above)")
+                   : CLI_EXIT_OK;
+}
+
+int coavoid_command_montecarlo(int argc, char **argv)
+{
+    mc_options_t o;
+    int status = parse_mc_options(argc, argv, &o);
+    if (status != CLI_CONTINUE) {
+        return status;
+    }
+    mc_size_t sizes[MC_SIZES];
+    FILE *csv = NULL;
+    status = mc_sizes(&o, sizes);
+    if (status == CLI_CONTINUE) {
+        status = mc_outputs(&o, &csv);
+    }
+    if (status != CLI_CONTINUE) {
+        if (csv != NULL) {
+            fclose(csv);
+        }
+        return status;
     }
     mc_run_t run;
     memset(&run, 0, sizeof run);
@@ -1269,39 +1330,9 @@ int coavoid_command_montecarlo(int argc, char **argv)
     if (status == CLI_CONTINUE) {
         status = run_all(&run, csv);
     }
-    if (csv != NULL) {
-        bool ok = !ferror(csv);
-        if (fclose(csv) != 0 || !ok) {
-            status =
-                status == CLI_CONTINUE
-                    ? coavoid_cli_fail(CLI_EXIT_INTERNAL, "--csv: cannot write '%.200s'", o.csv)
-                    : status;
-        }
-    }
-    bool defects = false;
-    for (uint32_t j = 0; status == CLI_CONTINUE && j < run.total; j++) {
-        defects = defects || run.results[j].defect[0] != '\0';
-    }
-    mc_summary_t summary[MC_SIZES];
-    for (uint32_t k = 0; status == CLI_CONTINUE && k < o.size_count; k++) {
-        summarise(&run.results[k * o.count], o.count, &sizes[k], x, &summary[k]);
-    }
-    if (status == CLI_CONTINUE && o.svg != NULL &&
-        write_svg(o.svg, &o, &run, summary, o.size_count, x) != 0) {
-        status = coavoid_cli_fail(CLI_EXIT_INTERNAL, "--svg: cannot write '%.200s'", o.svg);
-    }
+    status = mc_close_csv(&o, csv, status);
     if (status == CLI_CONTINUE) {
-        int rc = 0;
-        if (o.json) {
-            rc = json_summary(stdout, &o, summary, o.size_count);
-        } else {
-            text_summary(stdout, &o, summary, o.size_count);
-        }
-        rc = rc == 0 && fflush(stdout) == 0 && !ferror(stdout) ? 0 : -1;
-        status = rc != 0 ? coavoid_cli_fail(CLI_EXIT_INTERNAL, "cannot write the summary")
-                 : defects
-                     ? coavoid_cli_fail(CLI_EXIT_INTERNAL, "montecarlo: defects found (above)")
-                     : CLI_EXIT_OK;
+        status = mc_report(&o, &run, x);
     }
     free(x);
     free(run.done);
