@@ -102,60 +102,57 @@ static int add_vehicle(cJSON *array, const coavoid_scenario_t *s, size_t index, 
     return 0;
 }
 
-/* Builds the result object; NULL with err set on failure. */
-static cJSON *build(const coavoid_output_plan_t *plan, char *err, size_t err_size)
+/* The result's scenario, mode, status, planning order and, when there is one, the failed
+ * vehicle and the cost. 0, or -1 out of memory, -2 an inconsistent result (err set). */
+static int build_head(cJSON *root, const coavoid_output_plan_t *plan, char *err, size_t err_size)
 {
     const coavoid_scenario_t *s = plan->scenario;
     const coa_plan_result_t *r = plan->result;
     const size_t n = s->vehicle_count;
-    const size_t per_row = (size_t)s->horizon + 1u;
-    const bool solved = r->status == COA_PLAN_SOLVED;
-
-    cJSON *root = cJSON_CreateObject();
-    if (root == NULL) {
-        goto out_of_memory;
-    }
     if (cJSON_AddStringToObject(root, "scenario", s->name) == NULL ||
         cJSON_AddStringToObject(root, "mode", plan->decoupled ? "decoupled" : "centralised") ==
             NULL ||
         cJSON_AddStringToObject(root, "status", coavoid_output_status_name(r->status)) == NULL) {
-        goto out_of_memory;
+        return -1;
     }
-
     cJSON *order = cJSON_AddArrayToObject(root, "priority_order");
     if (order == NULL) {
-        goto out_of_memory;
+        return -1;
     }
     for (size_t j = 0; j < n; j++) {
         /* Centralised plans everyone at once: its "order" is the input order. */
         size_t i = plan->decoupled ? r->order[j] : j;
         if (i >= n) {
             set_error(err, err_size, "internal error: planning order names vehicle index %zu", i);
-            goto fail;
+            return -2;
         }
         if (!coavoid_output_append(order, cJSON_CreateNumber(s->vehicles[i].id))) {
-            goto out_of_memory;
+            return -1;
         }
     }
-
-    if (plan->decoupled && !solved) {
+    if (plan->decoupled && r->status != COA_PLAN_SOLVED) {
         if (r->failed_vehicle >= n) {
             set_error(err, err_size, "internal error: no failed vehicle reported");
-            goto fail;
+            return -2;
         }
         if (!add_number(root, "failed_vehicle", s->vehicles[r->failed_vehicle].id)) {
-            goto out_of_memory;
+            return -1;
         }
     }
-
-    if (solved) {
+    if (r->status == COA_PLAN_SOLVED) {
         cJSON *cost = cJSON_AddObjectToObject(root, "cost");
         if (cost == NULL || !add_number(cost, "deviation", r->deviation) ||
             !add_number(cost, "effort", r->effort)) {
-            goto out_of_memory;
+            return -1;
         }
     }
+    return 0;
+}
 
+/* The search statistics. 0, or -1 out of memory. */
+static int build_stats(cJSON *root, const coavoid_output_plan_t *plan)
+{
+    const coa_plan_result_t *r = plan->result;
     cJSON *stats = cJSON_AddObjectToObject(root, "stats");
     if (stats == NULL || !add_number(stats, "nodes_expanded", (double)r->nodes_expanded) ||
         !add_number(stats, "nodes_generated", (double)r->nodes_generated) ||
@@ -163,41 +160,64 @@ static cJSON *build(const coavoid_output_plan_t *plan, char *err, size_t err_siz
         !add_number(stats, "workspace_bytes", (double)r->workspace_bytes) ||
         !add_number(stats, "beta", plan->beta) ||
         (plan->decoupled && !add_number(stats, "orders_tried", r->orders_tried))) {
-        goto out_of_memory;
+        return -1;
     }
     /* Whether the failure, if any, holds for every order: with --max-orders an unsolved
      * result may only say that the orders tried failed. */
     if (plan->decoupled &&
         cJSON_AddBoolToObject(stats, "all_orders_covered", r->all_orders_covered) == NULL) {
-        goto out_of_memory;
+        return -1;
     }
+    return 0;
+}
 
+/* The vehicles with a plan: solved, everyone in input order; decoupled and not solved, those
+ * planned before the failure, in planning order; centralised and not solved, nobody. 0, -1
+ * out of memory, -2 an inconsistent result (err set). */
+static int build_vehicles(cJSON *root, const coavoid_output_plan_t *plan, char *err,
+                          size_t err_size)
+{
+    const coavoid_scenario_t *s = plan->scenario;
+    const coa_plan_result_t *r = plan->result;
+    const size_t n = s->vehicle_count;
+    const bool solved = r->status == COA_PLAN_SOLVED;
     cJSON *vehicles = cJSON_AddArrayToObject(root, "vehicles");
     if (vehicles == NULL) {
-        goto out_of_memory;
+        return -1;
     }
-    /* Solved: everyone in input order. Decoupled and not solved: those planned before the
-     * failure, in planning order. Centralised and not solved: nobody has a plan. */
     size_t listed = solved ? n : (plan->decoupled ? r->planned_count : 0);
     if (listed > n) {
         set_error(err, err_size, "internal error: %zu planned vehicles of %zu", listed, n);
-        goto fail;
+        return -2;
     }
     for (size_t j = 0; j < listed; j++) {
         size_t i = solved ? j : r->order[j];
-        int rc = add_vehicle(vehicles, s, i, plan->offsets + i * per_row, err, err_size);
-        if (rc == -1) {
-            goto out_of_memory;
-        }
+        int rc = add_vehicle(vehicles, s, i, plan->offsets + i * ((size_t)s->horizon + 1u), err,
+                             err_size);
         if (rc < 0) {
-            goto fail;
+            return rc;
         }
     }
-    return root;
+    return 0;
+}
 
-out_of_memory:
-    set_error(err, err_size, "out of memory printing the result");
-fail:
+/* Builds the result object; NULL with err set on failure. */
+static cJSON *build(const coavoid_output_plan_t *plan, char *err, size_t err_size)
+{
+    cJSON *root = cJSON_CreateObject();
+    int rc = root == NULL ? -1 : build_head(root, plan, err, err_size);
+    if (rc == 0) {
+        rc = build_stats(root, plan);
+    }
+    if (rc == 0) {
+        rc = build_vehicles(root, plan, err, err_size);
+    }
+    if (rc == 0) {
+        return root;
+    }
+    if (rc == -1) {
+        set_error(err, err_size, "out of memory printing the result");
+    }
     cJSON_Delete(root);
     return NULL;
 }
