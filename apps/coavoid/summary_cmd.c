@@ -213,14 +213,12 @@ static uint32_t be32(const unsigned char *b)
 
 /* The next event: 1 with *event (free it with lcm_eventlog_free_event), 0 at the end of
  * the log, or the exit status after the message. */
-static int log_next(log_reader_t *r, lcm_eventlog_event_t **event)
+/* The event header at the reader's offset (`left` bytes remain): its length in *length, or
+ * an error naming what is wrong there. */
+static int log_header(log_reader_t *r, int64_t left, int32_t *channel_length, int32_t *data_length,
+                      int64_t *length)
 {
     unsigned char header[LOG_HEADER_BYTES];
-    int64_t left = r->size - r->offset;
-    *event = NULL;
-    if (left <= 0) {
-        return 0;
-    }
     if (fseeko(r->log->f, (off_t)r->offset, SEEK_SET) != 0) {
         return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: cannot seek to byte %" PRId64 ": %s",
                                 r->path, r->offset, strerror(errno));
@@ -236,12 +234,12 @@ static int log_next(log_reader_t *r, lcm_eventlog_event_t **event)
     for (size_t j = 0; j < 4u && j < got; j++) {
         magic = magic && header[j] == (unsigned char)(LOG_MAGIC >> (24u - 8u * j));
     }
+    if (!magic && r->offset == 0) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                "%s: not an LCM log (it does not start with an event header)",
+                                r->path);
+    }
     if (!magic) {
-        if (r->offset == 0) {
-            return coavoid_cli_fail(CLI_EXIT_INVALID,
-                                    "%s: not an LCM log (it does not start with an event header)",
-                                    r->path);
-        }
         return coavoid_cli_fail(CLI_EXIT_INVALID,
                                 "%s: corrupt: no event header at byte %" PRId64 " (after %" PRId64
                                 " events)",
@@ -253,41 +251,67 @@ static int log_next(log_reader_t *r, lcm_eventlog_event_t **event)
                                 " is cut off in its header (was the logger stopped mid-write?)",
                                 r->path, r->events, r->offset);
     }
-    int32_t channel_length = (int32_t)be32(header + 20);
-    int32_t data_length = (int32_t)be32(header + 24);
-    if (channel_length < 1 || channel_length > LOG_MAX_CHANNEL || data_length < 0 ||
-        data_length > LOG_MAX_DATA) {
+    *channel_length = (int32_t)be32(header + 20);
+    *data_length = (int32_t)be32(header + 24);
+    if (*channel_length < 1 || *channel_length > LOG_MAX_CHANNEL || *data_length < 0 ||
+        *data_length > LOG_MAX_DATA) {
         return coavoid_cli_fail(CLI_EXIT_INVALID,
                                 "%s: corrupt: event %" PRId64 " at byte %" PRId64
                                 " claims a %ld-byte channel name and %ld bytes of data",
-                                r->path, r->events, r->offset, (long)channel_length,
-                                (long)data_length);
+                                r->path, r->events, r->offset, (long)*channel_length,
+                                (long)*data_length);
     }
-    int64_t length = LOG_HEADER_BYTES + (int64_t)channel_length + (int64_t)data_length;
-    if (length > left) {
+    *length = LOG_HEADER_BYTES + (int64_t)*channel_length + (int64_t)*data_length;
+    if (*length > left) {
         return coavoid_cli_fail(CLI_EXIT_INVALID,
                                 "%s: truncated: event %" PRId64 " at byte %" PRId64
                                 " needs %" PRId64 " bytes, the file has %" PRId64
                                 " left (was the logger stopped "
                                 "mid-write?)",
-                                r->path, r->events, r->offset, length, left);
+                                r->path, r->events, r->offset, *length, left);
     }
-    /* Debian's 1.3.1 reader also looks at the 4 bytes after the event and, when they are
-     * not the next header's magic, prints a complaint and drops the event: judge them
-     * here first, so the message is ours and names the place. */
-    if (length + 4 <= left) {
-        unsigned char next[4];
-        if (fseeko(r->log->f, (off_t)(r->offset + length), SEEK_SET) != 0 ||
-            fread(next, 1, 4u, r->log->f) != 4u) {
-            return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: read error at byte %" PRId64, r->path,
-                                    r->offset + length);
-        }
-        if (be32(next) != LOG_MAGIC) {
-            return coavoid_cli_fail(CLI_EXIT_INVALID,
-                                    "%s: corrupt: no event header at byte %" PRId64
-                                    " (after %" PRId64 " events)",
-                                    r->path, r->offset + length, r->events + 1);
-        }
+    return CLI_CONTINUE;
+}
+
+/* Debian's 1.3.1 reader also looks at the 4 bytes after the event and, when they are not the
+ * next header's magic, prints a complaint and drops the event: judge them here first, so
+ * the message is ours and names the place. */
+static int log_check_next(log_reader_t *r, int64_t left, int64_t length)
+{
+    if (length + 4 > left) {
+        return CLI_CONTINUE;
+    }
+    unsigned char next[4];
+    if (fseeko(r->log->f, (off_t)(r->offset + length), SEEK_SET) != 0 ||
+        fread(next, 1, 4u, r->log->f) != 4u) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: read error at byte %" PRId64, r->path,
+                                r->offset + length);
+    }
+    if (be32(next) != LOG_MAGIC) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                "%s: corrupt: no event header at byte %" PRId64 " (after %" PRId64
+                                " events)",
+                                r->path, r->offset + length, r->events + 1);
+    }
+    return CLI_CONTINUE;
+}
+
+static int log_next(log_reader_t *r, lcm_eventlog_event_t **event)
+{
+    int64_t left = r->size - r->offset;
+    int32_t channel_length = 0;
+    int32_t data_length = 0;
+    int64_t length = 0;
+    *event = NULL;
+    if (left <= 0) {
+        return 0;
+    }
+    int status = log_header(r, left, &channel_length, &data_length, &length);
+    if (status == CLI_CONTINUE) {
+        status = log_check_next(r, left, length);
+    }
+    if (status != CLI_CONTINUE) {
+        return status;
     }
     if (fseeko(r->log->f, (off_t)r->offset, SEEK_SET) != 0) {
         return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: cannot seek to byte %" PRId64 ": %s",
