@@ -304,6 +304,56 @@ static int plan_cluster(coavoid_coordinator_t *node, int64_t now, int64_t cycle_
     return rc;
 }
 
+/* The clusters in label order (by smallest id), each around the plans before it; the
+ * size of the largest that found no plan (0: none). Keeps the first error in *first_error. */
+static size_t plan_clusters(coavoid_coordinator_t *node, int64_t now, int64_t cycle_start,
+                            size_t clusters, int *first_error)
+{
+    size_t failed_size = 0;
+    for (uint32_t label = 0; label < clusters; label++) {
+        size_t count = cluster_members(node, label);
+        if (count == 0u) {
+            continue;
+        }
+        bool solved = false;
+        int rc = plan_cluster(node, now, cycle_start, count, &solved);
+        if (rc != COA_OK) {
+            node->fault = true;
+            *first_error = *first_error != COA_OK ? *first_error : rc;
+        }
+        if (!solved && count > failed_size) {
+            failed_size = count;
+        }
+    }
+    return failed_size;
+}
+
+/* A cluster is only the UAVs that conflict now; its way out may be blocked by UAVs that do
+ * not (a UAV that must climb over terrain into traffic at the altitude it needs). Then the
+ * clusters are planned as one group, and failing that every UAV, each from the intents as
+ * they came (the plans just published are superseded by the newer plan_id, which every UAV
+ * of the group adopts). Returns the size of the group left without a plan (0: none). */
+static size_t escalate(coavoid_coordinator_t *node, int64_t now, int64_t cycle_start,
+                       size_t failed_size, int *first_error)
+{
+    const uint32_t escalation[2] = {GROUP_CLUSTERED, GROUP_ALL};
+    for (size_t e = 0; e < 2u && failed_size > 0u && *first_error == COA_OK; e++) {
+        size_t count = cluster_members(node, escalation[e]);
+        if (count <= failed_size) {
+            continue;
+        }
+        coavoid_node_view_build(&node->view, &node->inbox, cycle_start, now);
+        bool solved = false;
+        int rc = plan_cluster(node, now, cycle_start, count, &solved);
+        if (rc != COA_OK) {
+            node->fault = true;
+            *first_error = rc;
+        }
+        failed_size = solved ? 0u : count;
+    }
+    return failed_size;
+}
+
 int coavoid_coordinator_cycle(coavoid_coordinator_t *node, int64_t now)
 {
     if (node == NULL) {
@@ -344,43 +394,8 @@ int coavoid_coordinator_cycle(coavoid_coordinator_t *node, int64_t now)
     if (first_error == COA_OK) {
         first_error = rc;
     }
-    /* Clusters in label order (by smallest id), each around the plans before it. */
-    size_t failed_size = 0;
-    for (uint32_t label = 0; label < clusters; label++) {
-        size_t count = cluster_members(node, label);
-        if (count == 0u) {
-            continue;
-        }
-        bool solved = false;
-        rc = plan_cluster(node, now, cycle_start, count, &solved);
-        if (rc != COA_OK) {
-            node->fault = true;
-            first_error = first_error != COA_OK ? first_error : rc;
-        }
-        if (!solved && count > failed_size) {
-            failed_size = count;
-        }
-    }
-    /* A cluster is only the UAVs that conflict now; its way out may be blocked by UAVs
-     * that do not (a UAV that must climb over terrain into traffic at the altitude it
-     * needs). Then the clusters are planned as one group, and failing that every UAV,
-     * each from the intents as they came (the plans just published are superseded by the
-     * newer plan_id, which every UAV of the group adopts). */
-    const uint32_t escalation[2] = {GROUP_CLUSTERED, GROUP_ALL};
-    for (size_t e = 0; e < 2u && failed_size > 0u && first_error == COA_OK; e++) {
-        size_t count = cluster_members(node, escalation[e]);
-        if (count <= failed_size) {
-            continue;
-        }
-        coavoid_node_view_build(view, &node->inbox, cycle_start, now);
-        bool solved = false;
-        rc = plan_cluster(node, now, cycle_start, count, &solved);
-        if (rc != COA_OK) {
-            node->fault = true;
-            first_error = rc;
-        }
-        failed_size = solved ? 0u : count;
-    }
+    size_t failed_size = plan_clusters(node, now, cycle_start, clusters, &first_error);
+    failed_size = escalate(node, now, cycle_start, failed_size, &first_error);
     node->degraded = failed_size > 0u;
     rc = publish_status(node, now, cycle_start);
     if (first_error == COA_OK) {
