@@ -1146,158 +1146,209 @@ static double pair_sigma(coa_real_t s0a, coa_real_t ra, coa_real_t s0b, coa_real
 
 /* Evaluates a UAV against another moving thing over the whole horizon. Returns whether
  * the pair is a conflict (file comment of predict.h) and fills *out when it is. */
+/* Where the evaluation of one pair of movers stands, step by step. */
+typedef struct {
+    const coa_predictor_t *pr;
+    const mover_t *ma;
+    const mover_t *mb;
+    const coa_vec3_t *pa; /* their positions, rows of N + 1 */
+    const coa_vec3_t *pb;
+    coa_real_t rsum;
+    coa_real_t hsum;
+    coa_real_t near_h; /* rsum and hsum widened by the slack */
+    coa_real_t near_v;
+    uint32_t first; /* the first conflicting step, NONE so far */
+    double pmax;    /* the largest probability seen (uncertain pairs) */
+    double log_cut; /* log of what an instant must reach to matter */
+} pair_eval_t;
+
+/* One step's relative motion and its least separations, exactly: the closest point of a
+ * segment (at uh) and a sign change of a linear function (at uv). */
+typedef struct {
+    relative_t r;
+    coa_real_t d1z;
+    coa_real_t uh;
+    coa_real_t uv;
+    coa_real_t h2;   /* least horizontal separation, squared */
+    coa_real_t vmin; /* least vertical separation */
+} step_sep_t;
+
+static void step_separations(const pair_eval_t *e, uint32_t k, step_sep_t *st)
+{
+    const coa_vec3_t *pa = e->pa;
+    const coa_vec3_t *pb = e->pb;
+    relative_t *r = &st->r;
+    coa_real_t len2;
+    coa_real_t hx;
+    coa_real_t hy;
+    r->d0x = pa[k].x - pb[k].x;
+    r->d0y = pa[k].y - pb[k].y;
+    r->d0z = pa[k].z - pb[k].z;
+    r->wx = (pa[k + 1u].x - pb[k + 1u].x) - r->d0x;
+    r->wy = (pa[k + 1u].y - pb[k + 1u].y) - r->d0y;
+    st->d1z = pa[k + 1u].z - pb[k + 1u].z;
+    r->wz = st->d1z - r->d0z;
+    st->uh = (coa_real_t)0;
+    len2 = r->wx * r->wx + r->wy * r->wy;
+    if (len2 > (coa_real_t)0) {
+        st->uh = -(r->d0x * r->wx + r->d0y * r->wy) / len2;
+        st->uh = st->uh < (coa_real_t)0 ? (coa_real_t)0
+                                        : (st->uh > (coa_real_t)1 ? (coa_real_t)1 : st->uh);
+    }
+    hx = r->d0x + st->uh * r->wx;
+    hy = r->d0y + st->uh * r->wy;
+    st->h2 = hx * hx + hy * hy;
+    if ((r->d0z <= (coa_real_t)0 && st->d1z >= (coa_real_t)0) ||
+        (r->d0z >= (coa_real_t)0 && st->d1z <= (coa_real_t)0)) {
+        st->vmin = (coa_real_t)0;
+        st->uv = r->d0z == st->d1z ? (coa_real_t)0 : r->d0z / (r->d0z - st->d1z);
+    } else if (real_fabs(r->d0z) <= real_fabs(st->d1z)) {
+        st->vmin = real_fabs(r->d0z);
+        st->uv = (coa_real_t)0;
+    } else {
+        st->vmin = real_fabs(st->d1z);
+        st->uv = (coa_real_t)1;
+    }
+}
+
+/* A certain pair: the exact test only where the separations (widened by the slack) allow
+ * a conflict: both are necessary conditions of it. */
+static void step_certain(pair_eval_t *e, uint32_t k, const step_sep_t *st)
+{
+    coa_sweep_t sa;
+    coa_sweep_t sb;
+    if (e->first != NONE || !(st->h2 < e->near_h * e->near_h && st->vmin < e->near_v)) {
+        return;
+    }
+    sa.volume = e->ma->volume;
+    sa.p0 = e->pa[k];
+    sa.p1 = e->pa[k + 1u];
+    sb.volume = e->mb->volume;
+    sb.p0 = e->pb[k];
+    sb.p1 = e->pb[k + 1u];
+    if (coa_conflict_volumes(&sa, &sb)) {
+        e->first = k;
+    }
+}
+
+/* The instants of the file comment: the endpoints (the start only at k = 0: later it is
+ * the previous step's end), the least separations, quarters. Returns how many. */
+static size_t step_instants(uint32_t k, const step_sep_t *st, coa_real_t *instants)
+{
+    size_t count = 0u;
+    if (k == 0u) {
+        instants[count++] = (coa_real_t)0;
+    }
+    instants[count++] = (coa_real_t)1;
+    if (st->uh > (coa_real_t)0 && st->uh < (coa_real_t)1) {
+        instants[count++] = st->uh;
+    }
+    if (st->uv > (coa_real_t)0 && st->uv < (coa_real_t)1 && st->uv != st->uh) {
+        instants[count++] = st->uv;
+    }
+    instants[count++] = (coa_real_t)0.25;
+    instants[count++] = (coa_real_t)0.5;
+    instants[count++] = (coa_real_t)0.75;
+    return count;
+}
+
+/* An uncertain pair. Sigmas only grow with look-ahead, so the step's end bounds them.
+ * Below the cut (the threshold, or the maximum once it is above) an instant cannot change
+ * the answer: before the threshold is met it cannot meet it, after, it cannot raise the
+ * maximum. */
+static void step_uncertain(pair_eval_t *e, uint32_t k, const step_sep_t *st)
+{
+    const coa_predict_config_t *c = e->pr->config;
+    const mover_t *ma = e->ma;
+    const mover_t *mb = e->mb;
+    const relative_t *r = &st->r;
+    double tau1 = (double)((coa_real_t)(k + 1u) * c->dt);
+    double sh1 = pair_sigma(ma->sigma_h, ma->rate_h, mb->sigma_h, mb->rate_h, tau1);
+    double sv1 = pair_sigma(ma->sigma_v, ma->rate_v, mb->sigma_v, mb->rate_v, tau1);
+    double gap_h = (double)real_sqrt(st->h2) - (double)e->near_h;
+    double gap_v = (double)st->vmin - (double)e->near_v;
+    coa_real_t instants[7];
+    size_t count;
+    size_t i;
+    if (log_probability_bound(gap_h, sh1, gap_v, sv1) + PRUNE_MARGIN < e->log_cut) {
+        return;
+    }
+    count = step_instants(k, st, instants);
+    for (i = 0; i < count; ++i) {
+        coa_real_t u = instants[i];
+        coa_real_t x = r->d0x + u * r->wx;
+        coa_real_t y = r->d0y + u * r->wy;
+        coa_real_t d = real_norm2(x, y);
+        coa_real_t dz = r->d0z + u * r->wz;
+        double tau = (double)(((coa_real_t)k + u) * c->dt);
+        double sh = pair_sigma(ma->sigma_h, ma->rate_h, mb->sigma_h, mb->rate_h, tau);
+        double sv = pair_sigma(ma->sigma_v, ma->rate_v, mb->sigma_v, mb->rate_v, tau);
+        double p;
+        if (!real_ok(d) || !real_ok(dz) ||
+            log_probability_bound((double)d - (double)e->rsum, sh,
+                                  (double)real_fabs(dz) - (double)e->hsum, sv) +
+                    PRUNE_MARGIN <
+                e->log_cut) {
+            continue;
+        }
+        p = coa_conflict_probability(d, dz, e->rsum, e->hsum, (coa_real_t)sh, (coa_real_t)sv);
+        if (p > e->pmax) {
+            e->pmax = p;
+        }
+        if (e->first == NONE && p >= c->threshold) {
+            e->first = k;
+        }
+        if (p > c->threshold && p == e->pmax) {
+            e->log_cut = log(e->pmax);
+        }
+    }
+}
+
 static bool evaluate_movers(const coa_predictor_t *pr, uint32_t a, uint32_t b, coa_conflict_t *out)
 {
     const coa_predict_config_t *c = pr->config;
     const mover_t *ma = &pr->mover[a];
     const mover_t *mb = &pr->mover[b];
-    const coa_vec3_t *pa = &pr->pos[(size_t)a * pr->stride];
-    const coa_vec3_t *pb = &pr->pos[(size_t)b * pr->stride];
-    coa_real_t rsum = ma->volume.radius + mb->volume.radius;
-    coa_real_t hsum = ma->volume.half_height + mb->volume.half_height;
-    coa_real_t near_h = rsum + pr->slack;
-    coa_real_t near_v = hsum + pr->slack;
+    pair_eval_t e;
     coa_real_t best_h2 = (coa_real_t)INFINITY;
     coa_real_t best_v = (coa_real_t)INFINITY;
     bool uncertain = ma->sigma_h != (coa_real_t)0 || ma->rate_h != (coa_real_t)0 ||
                      ma->sigma_v != (coa_real_t)0 || ma->rate_v != (coa_real_t)0 ||
                      mb->sigma_h != (coa_real_t)0 || mb->rate_h != (coa_real_t)0 ||
                      mb->sigma_v != (coa_real_t)0 || mb->rate_v != (coa_real_t)0;
-    uint32_t first = NONE;
-    double pmax = 0.0;
-    double log_cut = pr->log_threshold;
     uint32_t k;
 
+    e.pr = pr;
+    e.ma = ma;
+    e.mb = mb;
+    e.pa = &pr->pos[(size_t)a * pr->stride];
+    e.pb = &pr->pos[(size_t)b * pr->stride];
+    e.rsum = ma->volume.radius + mb->volume.radius;
+    e.hsum = ma->volume.half_height + mb->volume.half_height;
+    e.near_h = e.rsum + pr->slack;
+    e.near_v = e.hsum + pr->slack;
+    e.first = NONE;
+    e.pmax = 0.0;
+    e.log_cut = pr->log_threshold;
     for (k = 0; k < c->horizon; ++k) {
-        relative_t r;
-        coa_real_t len2;
-        coa_real_t uh = (coa_real_t)0;
-        coa_real_t uv;
-        coa_real_t hx;
-        coa_real_t hy;
-        coa_real_t h2;
-        coa_real_t vmin;
-        coa_real_t d1z;
-
-        r.d0x = pa[k].x - pb[k].x;
-        r.d0y = pa[k].y - pb[k].y;
-        r.d0z = pa[k].z - pb[k].z;
-        r.wx = (pa[k + 1u].x - pb[k + 1u].x) - r.d0x;
-        r.wy = (pa[k + 1u].y - pb[k + 1u].y) - r.d0y;
-        d1z = pa[k + 1u].z - pb[k + 1u].z;
-        r.wz = d1z - r.d0z;
-
-        /* The least horizontal and vertical separation over the step, exactly: the
-         * closest point of a segment, and a sign change of a linear function. */
-        len2 = r.wx * r.wx + r.wy * r.wy;
-        if (len2 > (coa_real_t)0) {
-            uh = -(r.d0x * r.wx + r.d0y * r.wy) / len2;
-            uh = uh < (coa_real_t)0 ? (coa_real_t)0 : (uh > (coa_real_t)1 ? (coa_real_t)1 : uh);
-        }
-        hx = r.d0x + uh * r.wx;
-        hy = r.d0y + uh * r.wy;
-        h2 = hx * hx + hy * hy;
-        if ((r.d0z <= (coa_real_t)0 && d1z >= (coa_real_t)0) ||
-            (r.d0z >= (coa_real_t)0 && d1z <= (coa_real_t)0)) {
-            vmin = (coa_real_t)0;
-            uv = r.d0z == d1z ? (coa_real_t)0 : r.d0z / (r.d0z - d1z);
-        } else if (real_fabs(r.d0z) <= real_fabs(d1z)) {
-            vmin = real_fabs(r.d0z);
-            uv = (coa_real_t)0;
-        } else {
-            vmin = real_fabs(d1z);
-            uv = (coa_real_t)1;
-        }
-        best_h2 = h2 < best_h2 ? h2 : best_h2;
-        best_v = vmin < best_v ? vmin : best_v;
-
+        step_sep_t st;
+        step_separations(&e, k, &st);
+        best_h2 = st.h2 < best_h2 ? st.h2 : best_h2;
+        best_v = st.vmin < best_v ? st.vmin : best_v;
         if (!uncertain) {
-            /* The exact test only where the separations (widened by the slack) allow a
-             * conflict: both are necessary conditions of it. */
-            if (first == NONE && h2 < near_h * near_h && vmin < near_v) {
-                coa_sweep_t sa;
-                coa_sweep_t sb;
-                sa.volume = ma->volume;
-                sa.p0 = pa[k];
-                sa.p1 = pa[k + 1u];
-                sb.volume = mb->volume;
-                sb.p0 = pb[k];
-                sb.p1 = pb[k + 1u];
-                if (coa_conflict_volumes(&sa, &sb)) {
-                    first = k;
-                }
-            }
+            step_certain(&e, k, &st);
         } else {
-            /* Sigmas only grow with look-ahead, so the step's end bounds them. Below
-             * the cut (the threshold, or the maximum once it is above) an instant cannot
-             * change the answer: before the threshold is met it cannot meet it, after,
-             * it cannot raise the maximum. */
-            double tau1 = (double)((coa_real_t)(k + 1u) * c->dt);
-            double sh1 = pair_sigma(ma->sigma_h, ma->rate_h, mb->sigma_h, mb->rate_h, tau1);
-            double sv1 = pair_sigma(ma->sigma_v, ma->rate_v, mb->sigma_v, mb->rate_v, tau1);
-
-            double gap_h = (double)real_sqrt(h2) - (double)near_h;
-            double gap_v = (double)vmin - (double)near_v;
-            coa_real_t instants[7];
-            size_t count = 0u;
-            size_t i;
-
-            if (log_probability_bound(gap_h, sh1, gap_v, sv1) + PRUNE_MARGIN < log_cut) {
-                continue;
-            }
-            /* The instants of the file comment: the endpoints (the start only at k = 0:
-             * later it is the previous step's end), the least separations, quarters. */
-            if (k == 0u) {
-                instants[count++] = (coa_real_t)0;
-            }
-            instants[count++] = (coa_real_t)1;
-            if (uh > (coa_real_t)0 && uh < (coa_real_t)1) {
-                instants[count++] = uh;
-            }
-            if (uv > (coa_real_t)0 && uv < (coa_real_t)1 && uv != uh) {
-                instants[count++] = uv;
-            }
-            instants[count++] = (coa_real_t)0.25;
-            instants[count++] = (coa_real_t)0.5;
-            instants[count++] = (coa_real_t)0.75;
-            for (i = 0; i < count; ++i) {
-                coa_real_t u = instants[i];
-                coa_real_t x = r.d0x + u * r.wx;
-                coa_real_t y = r.d0y + u * r.wy;
-                coa_real_t d = real_norm2(x, y);
-                coa_real_t dz = r.d0z + u * r.wz;
-                double tau = (double)(((coa_real_t)k + u) * c->dt);
-                double sh = pair_sigma(ma->sigma_h, ma->rate_h, mb->sigma_h, mb->rate_h, tau);
-                double sv = pair_sigma(ma->sigma_v, ma->rate_v, mb->sigma_v, mb->rate_v, tau);
-                double p;
-                if (!real_ok(d) || !real_ok(dz) ||
-                    log_probability_bound((double)d - (double)rsum, sh,
-                                          (double)real_fabs(dz) - (double)hsum, sv) +
-                            PRUNE_MARGIN <
-                        log_cut) {
-                    continue;
-                }
-                p = coa_conflict_probability(d, dz, rsum, hsum, (coa_real_t)sh, (coa_real_t)sv);
-                if (p > pmax) {
-                    pmax = p;
-                }
-                if (first == NONE && p >= c->threshold) {
-                    first = k;
-                }
-                if (p > c->threshold && p == pmax) {
-                    log_cut = log(pmax);
-                }
-            }
+            step_uncertain(&e, k, &st);
         }
     }
-    if (first == NONE) {
+    if (e.first == NONE) {
         return false;
     }
-    out->first_step = first;
-    out->first_time = c->t0 + (coa_real_t)first * c->dt;
+    out->first_step = e.first;
+    out->first_time = c->t0 + (coa_real_t)e.first * c->dt;
     out->min_horizontal = real_sqrt(best_h2);
     out->min_vertical = best_v;
-    out->probability = uncertain ? pmax : 1.0;
+    out->probability = uncertain ? e.pmax : 1.0;
     return true;
 }
 
