@@ -495,21 +495,12 @@ static ccd_real_t inverse_power_of_two(ccd_real_t m)
     return mpr_ldexp((ccd_real_t)1, -e);
 }
 
-int coa_conflict_polytope(const coa_sweep_t *a, const coa_polytope_t *poly)
+/* The inputs checked, the polytope's bounding box, and the largest coordinate magnitude of
+ * the scene (sweep and vertices). COA_OK or COA_ERR_ARGUMENT. */
+static int polytope_scene(const coa_sweep_t *a, const coa_polytope_t *poly, coa_box_t *poly_box,
+                          ccd_real_t *m)
 {
-    coa_box_t sweep_box;
-    coa_box_t poly_box;
-    coa_mpr_budget_t budget;
-    coa_mpr_sweep_t sweep;
-    coa_mpr_poly_t hull;
-    ccd_t ccd;
-    ccd_vec3_t v;
-    ccd_real_t m;
-    ccd_real_t pre;
-    ccd_real_t n;
     size_t i;
-    int hit;
-
     if (a == NULL || poly == NULL || poly->vertices == NULL || poly->count < 4u ||
         poly->count > COA_POLYTOPE_MAX_VERTICES) {
         return COA_ERR_ARGUMENT;
@@ -519,81 +510,104 @@ int coa_conflict_polytope(const coa_sweep_t *a, const coa_polytope_t *poly)
         !(a->volume.half_height > (coa_real_t)0)) {
         return COA_ERR_ARGUMENT;
     }
-    poly_box.min = poly->vertices[0];
-    poly_box.max = poly->vertices[0];
-    m = mpr_max(vec_max_abs(&a->p0), vec_max_abs(&a->p1));
-    m = mpr_max(m, mpr_max((ccd_real_t)a->volume.radius, (ccd_real_t)a->volume.half_height));
+    poly_box->min = poly->vertices[0];
+    poly_box->max = poly->vertices[0];
+    *m = mpr_max(vec_max_abs(&a->p0), vec_max_abs(&a->p1));
+    *m = mpr_max(*m, mpr_max((ccd_real_t)a->volume.radius, (ccd_real_t)a->volume.half_height));
     for (i = 0; i < poly->count; ++i) {
         const coa_vec3_t *p = &poly->vertices[i];
         if (!vec_finite(p)) {
             return COA_ERR_ARGUMENT;
         }
-        poly_box.min.x = p->x < poly_box.min.x ? p->x : poly_box.min.x;
-        poly_box.min.y = p->y < poly_box.min.y ? p->y : poly_box.min.y;
-        poly_box.min.z = p->z < poly_box.min.z ? p->z : poly_box.min.z;
-        poly_box.max.x = p->x > poly_box.max.x ? p->x : poly_box.max.x;
-        poly_box.max.y = p->y > poly_box.max.y ? p->y : poly_box.max.y;
-        poly_box.max.z = p->z > poly_box.max.z ? p->z : poly_box.max.z;
-        m = mpr_max(m, vec_max_abs(p));
+        poly_box->min.x = p->x < poly_box->min.x ? p->x : poly_box->min.x;
+        poly_box->min.y = p->y < poly_box->min.y ? p->y : poly_box->min.y;
+        poly_box->min.z = p->z < poly_box->min.z ? p->z : poly_box->min.z;
+        poly_box->max.x = p->x > poly_box->max.x ? p->x : poly_box->max.x;
+        poly_box->max.y = p->y > poly_box->max.y ? p->y : poly_box->max.y;
+        poly_box->max.z = p->z > poly_box->max.z ? p->z : poly_box->max.z;
+        *m = mpr_max(*m, vec_max_abs(p));
+    }
+    return COA_OK;
+}
+
+/* The MPR frame: the sweep about its midpoint, pre-scaled when raw coordinates pass 1 in
+ * magnitude, then post-scaled to unit size; the hull's centre in it. COA_OK, or
+ * COA_ERR_ARGUMENT when the sizes are too far apart for one floating-point frame (below
+ * 2^-1000 of the coordinates): no answer would mean anything. */
+static int polytope_frame(const coa_sweep_t *a, const coa_polytope_t *poly, ccd_real_t m,
+                          coa_mpr_sweep_t *sweep, coa_mpr_poly_t *hull)
+{
+    ccd_real_t pre = m > (ccd_real_t)1 ? inverse_power_of_two(m) : (ccd_real_t)1;
+    ccd_vec3_t v;
+    size_t i;
+    sweep->half.v[0] = ((ccd_real_t)a->p1.x * pre - (ccd_real_t)a->p0.x * pre) / 2;
+    sweep->half.v[1] = ((ccd_real_t)a->p1.y * pre - (ccd_real_t)a->p0.y * pre) / 2;
+    sweep->half.v[2] = ((ccd_real_t)a->p1.z * pre - (ccd_real_t)a->p0.z * pre) / 2;
+    hull->frame.pre = pre;
+    hull->frame.mid.v[0] = (ccd_real_t)a->p0.x * pre + sweep->half.v[0];
+    hull->frame.mid.v[1] = (ccd_real_t)a->p0.y * pre + sweep->half.v[1];
+    hull->frame.mid.v[2] = (ccd_real_t)a->p0.z * pre + sweep->half.v[2];
+    sweep->radius = (ccd_real_t)a->volume.radius * pre;
+    sweep->half_height = (ccd_real_t)a->volume.half_height * pre;
+    /* The scene's size about the midpoint, before post-scaling. */
+    hull->frame.post = 1;
+    m = mpr_max(mpr_fabs(sweep->half.v[0]), mpr_fabs(sweep->half.v[1])) + sweep->radius;
+    m = mpr_max(m, mpr_fabs(sweep->half.v[2]) + sweep->half_height);
+    for (i = 0; i < poly->count; ++i) {
+        frame_point(&hull->frame, &poly->vertices[i], &v);
+        m = mpr_max(m, mpr_vec_max_abs(&v));
+    }
+    hull->frame.post = inverse_power_of_two(m);
+    if (!(m > 0) || !isfinite(m) || !(hull->frame.post > 0) || !isfinite(hull->frame.post)) {
+        return COA_ERR_ARGUMENT;
+    }
+    sweep->half.v[0] *= hull->frame.post;
+    sweep->half.v[1] *= hull->frame.post;
+    sweep->half.v[2] *= hull->frame.post;
+    sweep->radius *= hull->frame.post;
+    sweep->half_height *= hull->frame.post;
+    hull->vertices = poly->vertices;
+    hull->count = poly->count;
+    hull->centre.v[0] = 0;
+    hull->centre.v[1] = 0;
+    hull->centre.v[2] = 0;
+    for (i = 0; i < poly->count; ++i) {
+        frame_point(&hull->frame, &poly->vertices[i], &v);
+        hull->centre.v[0] += v.v[0];
+        hull->centre.v[1] += v.v[1];
+        hull->centre.v[2] += v.v[2];
+    }
+    hull->centre.v[0] /= (ccd_real_t)poly->count;
+    hull->centre.v[1] /= (ccd_real_t)poly->count;
+    hull->centre.v[2] /= (ccd_real_t)poly->count;
+    return COA_OK;
+}
+
+int coa_conflict_polytope(const coa_sweep_t *a, const coa_polytope_t *poly)
+{
+    coa_box_t sweep_box;
+    coa_box_t poly_box;
+    coa_mpr_budget_t budget;
+    coa_mpr_sweep_t sweep;
+    coa_mpr_poly_t hull;
+    ccd_t ccd;
+    ccd_real_t m;
+    int hit;
+
+    if (polytope_scene(a, poly, &poly_box, &m) != COA_OK) {
+        return COA_ERR_ARGUMENT;
     }
     sweep_box = coa_sweep_bounds(a);
     if (!coa_boxes_touch(&sweep_box, &poly_box)) {
         return 0;
     }
-
-    budget.calls = 0;
-    budget.exhausted = false;
-
-    /* Raw coordinates up to 1 in magnitude need no pre-scaling; larger ones get it. */
-    pre = m > (ccd_real_t)1 ? inverse_power_of_two(m) : (ccd_real_t)1;
-    sweep.half.v[0] = ((ccd_real_t)a->p1.x * pre - (ccd_real_t)a->p0.x * pre) / 2;
-    sweep.half.v[1] = ((ccd_real_t)a->p1.y * pre - (ccd_real_t)a->p0.y * pre) / 2;
-    sweep.half.v[2] = ((ccd_real_t)a->p1.z * pre - (ccd_real_t)a->p0.z * pre) / 2;
-    hull.frame.pre = pre;
-    hull.frame.mid.v[0] = (ccd_real_t)a->p0.x * pre + sweep.half.v[0];
-    hull.frame.mid.v[1] = (ccd_real_t)a->p0.y * pre + sweep.half.v[1];
-    hull.frame.mid.v[2] = (ccd_real_t)a->p0.z * pre + sweep.half.v[2];
-    sweep.radius = (ccd_real_t)a->volume.radius * pre;
-    sweep.half_height = (ccd_real_t)a->volume.half_height * pre;
-
-    /* The scene's size about the midpoint, before post-scaling. */
-    hull.frame.post = 1;
-    m = mpr_max(mpr_fabs(sweep.half.v[0]), mpr_fabs(sweep.half.v[1])) + sweep.radius;
-    m = mpr_max(m, mpr_fabs(sweep.half.v[2]) + sweep.half_height);
-    for (i = 0; i < poly->count; ++i) {
-        frame_point(&hull.frame, &poly->vertices[i], &v);
-        m = mpr_max(m, mpr_vec_max_abs(&v));
-    }
-    hull.frame.post = inverse_power_of_two(m);
-    if (!(m > 0) || !isfinite(m) || !(hull.frame.post > 0) || !isfinite(hull.frame.post)) {
-        /* The sizes are too far apart for one floating-point frame (below 2^-1000 of the
-         * coordinates): no answer would mean anything. */
+    if (polytope_frame(a, poly, m, &sweep, &hull) != COA_OK) {
         return COA_ERR_ARGUMENT;
     }
-
-    sweep.half.v[0] *= hull.frame.post;
-    sweep.half.v[1] *= hull.frame.post;
-    sweep.half.v[2] *= hull.frame.post;
-    sweep.radius *= hull.frame.post;
-    sweep.half_height *= hull.frame.post;
+    budget.calls = 0;
+    budget.exhausted = false;
     sweep.budget = &budget;
-
-    hull.vertices = poly->vertices;
-    hull.count = poly->count;
     hull.budget = &budget;
-    hull.centre.v[0] = 0;
-    hull.centre.v[1] = 0;
-    hull.centre.v[2] = 0;
-    for (i = 0; i < poly->count; ++i) {
-        frame_point(&hull.frame, &poly->vertices[i], &v);
-        hull.centre.v[0] += v.v[0];
-        hull.centre.v[1] += v.v[1];
-        hull.centre.v[2] += v.v[2];
-    }
-    n = (ccd_real_t)poly->count;
-    hull.centre.v[0] /= n;
-    hull.centre.v[1] /= n;
-    hull.centre.v[2] /= n;
 
     CCD_INIT(&ccd);
     ccd.support1 = sweep_support;
