@@ -880,23 +880,21 @@ static uint32_t box_slot(const grid_t *g, const sap_entry_t *e)
  * per mover, cells GRID_EXTENTS median box extents wide where that fits (a robust width:
  * a few large boxes, such as tracks with a large sigma, do not coarsen every cell), and
  * counting-sorts the boxes into it (one cell when the scene is degenerate). */
-static void grid_fill(coa_predictor_t *pr, grid_t *g)
+/* The grid's shape over the movers' boxes: origin at their least corner; square cells a few
+ * times the median box's extent (GRID_EXTENTS, from up to GRID_SAMPLES boxes), at least
+ * wide enough that rx ry / w^2 and (rx + ry) / w are within the room, so that
+ * (rx / w + 1) (ry / w + 1) is within about twice it; then grown in steps of 1/8 until it
+ * fits (a few steps). Fewer than 4 movers, or a degenerate scene: one cell. */
+static void grid_shape(const coa_predictor_t *pr, grid_t *g)
 {
-    sap_entry_t *sap = pr->sap;
-    size_t m = pr->movers;
-    uint32_t *start = pr->cell_start;
+    const sap_entry_t *sap = pr->sap;
+    const size_t m = pr->movers;
+    const size_t s = m < GRID_SAMPLES ? m : GRID_SAMPLES;
     coa_real_t sample[GRID_SAMPLES];
     coa_real_t x1 = sap[0].max_x;
     coa_real_t y1 = sap[0].max_y;
-    coa_real_t rx;
-    coa_real_t ry;
-    coa_real_t w;
-    size_t s = m < GRID_SAMPLES ? m : GRID_SAMPLES;
-    size_t cells;
     size_t p;
     size_t i;
-    int grow;
-
     g->x0 = sap[0].min_x;
     g->y0 = sap[0].min_y;
     for (p = 1; p < m; ++p) {
@@ -917,59 +915,65 @@ static void grid_fill(coa_predictor_t *pr, grid_t *g)
         }
         sample[j] = h;
     }
-    w = sample[s / 2u] * (coa_real_t)GRID_EXTENTS;
-    rx = x1 - g->x0;
-    ry = y1 - g->y0;
+    const coa_real_t w = sample[s / 2u] * (coa_real_t)GRID_EXTENTS;
+    const coa_real_t rx = x1 - g->x0;
+    const coa_real_t ry = y1 - g->y0;
     g->nx = 1u;
     g->ny = 1u;
     g->inv_w = (coa_real_t)0;
     g->inv_h = (coa_real_t)0;
-    if (m >= 4u && w > (coa_real_t)0 && real_ok(w) && real_ok(rx) && real_ok(ry)) {
-        /* At least wide enough that rx ry / w^2 and (rx + ry) / w are within the room,
-         * so that (rx / w + 1) (ry / w + 1) is within about twice it; then grown in
-         * steps of 1/8 until it fits (a few steps). */
-        double room = (double)m * (double)GRID_CELLS_PER_MOVER;
-        double fit = sqrt((double)rx * (double)ry / room);
-        double line = ((double)rx + (double)ry) / room; /* a long thin scene */
-        double wd = (double)w > fit ? (double)w : fit;
-        wd = wd > line ? wd : line;
-        for (grow = 0; grow < GRID_GROWTH; ++grow) {
-            double cx = (double)rx > wd ? (double)rx / wd : 0.0;
-            double cy = (double)ry > wd ? (double)ry / wd : 0.0;
-            if ((cx + 1.0) * (cy + 1.0) <= room) {
-                /* floor(c) + 1 <= c + 1, so nx ny <= the cells' room. */
-                g->nx = (uint32_t)cx + 1u;
-                g->ny = (uint32_t)cy + 1u;
-                g->inv_w = g->nx > 1u ? (coa_real_t)(1.0 / wd) : (coa_real_t)0;
-                g->inv_h = g->ny > 1u ? (coa_real_t)(1.0 / wd) : (coa_real_t)0;
-                break;
-            }
-            wd *= 1.125;
-        }
+    if (!(m >= 4u && w > (coa_real_t)0 && real_ok(w) && real_ok(rx) && real_ok(ry))) {
+        return;
     }
+    double room = (double)m * (double)GRID_CELLS_PER_MOVER;
+    double fit = sqrt((double)rx * (double)ry / room);
+    double line = ((double)rx + (double)ry) / room; /* a long thin scene */
+    double wd = (double)w > fit ? (double)w : fit;
+    wd = wd > line ? wd : line;
+    for (int grow = 0; grow < GRID_GROWTH; ++grow) {
+        double cx = (double)rx > wd ? (double)rx / wd : 0.0;
+        double cy = (double)ry > wd ? (double)ry / wd : 0.0;
+        if ((cx + 1.0) * (cy + 1.0) <= room) {
+            /* floor(c) + 1 <= c + 1, so nx ny <= the cells' room. */
+            g->nx = (uint32_t)cx + 1u;
+            g->ny = (uint32_t)cy + 1u;
+            g->inv_w = g->nx > 1u ? (coa_real_t)(1.0 / wd) : (coa_real_t)0;
+            g->inv_h = g->ny > 1u ? (coa_real_t)(1.0 / wd) : (coa_real_t)0;
+            return;
+        }
+        wd *= 1.125;
+    }
+}
+
+static void grid_fill(coa_predictor_t *pr, grid_t *g)
+{
+    const size_t m = pr->movers;
+    uint32_t *start = pr->cell_start;
+    size_t cells;
+    size_t p;
+    size_t i;
+    grid_shape(pr, g);
     cells = (size_t)g->nx * g->ny;
     for (i = 0; i <= cells + 1u; ++i) {
         start[i] = 0u;
     }
     for (p = 0; p < m; ++p) {
-        uint32_t slot = box_slot(g, &sap[p]);
+        uint32_t slot = box_slot(g, &pr->sap[p]);
         pr->place[p] = slot;
         start[slot] += 1u;
     }
-    {
-        uint32_t sum = 0u;
-        for (i = 0; i <= cells; ++i) {
-            uint32_t c = start[i];
-            start[i] = sum;
-            sum += c;
-        }
-        start[cells + 1u] = sum;
+    uint32_t sum = 0u;
+    for (i = 0; i <= cells; ++i) {
+        uint32_t c = start[i];
+        start[i] = sum;
+        sum += c;
     }
+    start[cells + 1u] = sum;
     for (p = 0; p < m; ++p) {
         pr->place[p] = start[pr->place[p]]++;
     }
-    /* Moves each box to its place in cell order, in place: every swap puts one box
-     * where it belongs, so at most m swaps. */
+    /* Moves each box to its place in cell order, in place: every swap puts one box where it
+     * belongs, so at most m swaps. */
     for (p = 0; p < m; ++p) {
         while (pr->place[p] != (uint32_t)p) {
             uint32_t d = pr->place[p];
