@@ -600,72 +600,96 @@ static coa_vec3_t plan_at(const coa_intent_plan_t *p, coa_real_t u)
 
 /* Fills the samples, the movers and the UAVs' reach. Returns COA_ERR_ARGUMENT when a
  * position or a sigma over the horizon is not finite. */
-static int align(coa_predictor_t *pr, const coa_intent_plan_t *plans, const coa_track_t *tracks)
+/* Plan i resampled on the predictor's grid, its volume and sigmas, and the box its samples
+ * reach (widened by the volume later, once the slack is known). */
+static void align_plan(coa_predictor_t *pr, size_t i, const coa_intent_plan_t *p)
 {
     const coa_predict_config_t *c = pr->config;
-    coa_real_t horizon_tau = (coa_real_t)c->horizon * c->dt;
+    mover_t *mv = &pr->mover[i];
+    coa_vec3_t *row = &pr->pos[i * pr->stride];
+    /* u_k = off + k * ratio rather than (t_k - t0') / step: a plan on the predictor's own
+     * grid then lands on its samples exactly. */
+    coa_real_t off = (c->t0 - p->t0) / p->step;
+    coa_real_t ratio = c->dt / p->step;
+    coa_box_t *rb = &pr->reach[i];
+    uint32_t k;
+    mv->volume = p->volume;
+    mv->sigma_h = p->sigma_horizontal;
+    mv->sigma_v = p->sigma_vertical;
+    mv->rate_h = c->vehicle_sigma_rate_horizontal;
+    mv->rate_v = c->vehicle_sigma_rate_vertical;
+    for (k = 0; k <= c->horizon; ++k) {
+        row[k] = plan_at(p, off + (coa_real_t)k * ratio);
+    }
+    rb->min = row[0];
+    rb->max = row[0];
+    for (k = 1; k <= c->horizon; ++k) {
+        rb->min.x = row[k].x < rb->min.x ? row[k].x : rb->min.x;
+        rb->min.y = row[k].y < rb->min.y ? row[k].y : rb->min.y;
+        rb->min.z = row[k].z < rb->min.z ? row[k].z : rb->min.z;
+        rb->max.x = row[k].x > rb->max.x ? row[k].x : rb->max.x;
+        rb->max.y = row[k].y > rb->max.y ? row[k].y : rb->max.y;
+        rb->max.z = row[k].z > rb->max.z ? row[k].z : rb->max.z;
+    }
+}
+
+/* Track t (mover i) extrapolated on the predictor's grid, with its volume and sigmas. */
+static void align_track(coa_predictor_t *pr, size_t i, const coa_track_t *t)
+{
+    const coa_predict_config_t *c = pr->config;
+    mover_t *mv = &pr->mover[i];
+    coa_vec3_t *row = &pr->pos[i * pr->stride];
+    uint32_t k;
+    mv->volume = t->volume;
+    mv->sigma_h = t->sigma_horizontal;
+    mv->sigma_v = t->sigma_vertical;
+    mv->rate_h = c->track_sigma_rate_horizontal;
+    mv->rate_v = c->track_sigma_rate_vertical;
+    for (k = 0; k <= c->horizon; ++k) {
+        row[k] = coa_track_at(t, c->t0 + (coa_real_t)k * c->dt);
+    }
+}
+
+/* Mover i's samples checked finite, and the scene's scale raised to them and to the widest
+ * its box gets (the volume plus the margin at the horizon's end). False: not finite. */
+static bool align_scale(const coa_predictor_t *pr, size_t i, coa_real_t *scale)
+{
+    const coa_predict_config_t *c = pr->config;
+    const mover_t *mv = &pr->mover[i];
+    const coa_vec3_t *row = &pr->pos[i * pr->stride];
+    const coa_real_t horizon_tau = (coa_real_t)c->horizon * c->dt;
+    uint32_t k;
+    for (k = 0; k <= c->horizon; ++k) {
+        if (!vec_ok(&row[k])) {
+            return false;
+        }
+        *scale = real_max_abs3(&row[k], *scale);
+    }
+    coa_real_t worst_h = mv->volume.radius + (coa_real_t)COA_PREDICT_SIGMA_MARGIN *
+                                                 (mv->sigma_h + mv->rate_h * horizon_tau);
+    coa_real_t worst_v = mv->volume.half_height + (coa_real_t)COA_PREDICT_SIGMA_MARGIN *
+                                                      (mv->sigma_v + mv->rate_v * horizon_tau);
+    if (!real_ok(worst_h) || !real_ok(worst_v)) {
+        return false;
+    }
+    *scale = worst_h > *scale ? worst_h : *scale;
+    *scale = worst_v > *scale ? worst_v : *scale;
+    return true;
+}
+
+static int align(coa_predictor_t *pr, const coa_intent_plan_t *plans, const coa_track_t *tracks)
+{
     coa_real_t scale = (coa_real_t)0;
     size_t i;
-    uint32_t k;
-
     for (i = 0; i < pr->movers; ++i) {
-        mover_t *mv = &pr->mover[i];
-        coa_vec3_t *row = &pr->pos[i * pr->stride];
-        coa_real_t worst_h;
-        coa_real_t worst_v;
-
         if (i < pr->n) {
-            const coa_intent_plan_t *p = &plans[i];
-            /* u_k = off + k * ratio rather than (t_k - t0') / step: a plan on the
-             * predictor's own grid then lands on its samples exactly. */
-            coa_real_t off = (c->t0 - p->t0) / p->step;
-            coa_real_t ratio = c->dt / p->step;
-            coa_box_t *rb = &pr->reach[i];
-            mv->volume = p->volume;
-            mv->sigma_h = p->sigma_horizontal;
-            mv->sigma_v = p->sigma_vertical;
-            mv->rate_h = c->vehicle_sigma_rate_horizontal;
-            mv->rate_v = c->vehicle_sigma_rate_vertical;
-            for (k = 0; k <= c->horizon; ++k) {
-                row[k] = plan_at(p, off + (coa_real_t)k * ratio);
-            }
-            rb->min = row[0];
-            rb->max = row[0];
-            for (k = 1; k <= c->horizon; ++k) {
-                rb->min.x = row[k].x < rb->min.x ? row[k].x : rb->min.x;
-                rb->min.y = row[k].y < rb->min.y ? row[k].y : rb->min.y;
-                rb->min.z = row[k].z < rb->min.z ? row[k].z : rb->min.z;
-                rb->max.x = row[k].x > rb->max.x ? row[k].x : rb->max.x;
-                rb->max.y = row[k].y > rb->max.y ? row[k].y : rb->max.y;
-                rb->max.z = row[k].z > rb->max.z ? row[k].z : rb->max.z;
-            }
+            align_plan(pr, i, &plans[i]);
         } else {
-            const coa_track_t *t = &tracks[i - pr->n];
-            mv->volume = t->volume;
-            mv->sigma_h = t->sigma_horizontal;
-            mv->sigma_v = t->sigma_vertical;
-            mv->rate_h = c->track_sigma_rate_horizontal;
-            mv->rate_v = c->track_sigma_rate_vertical;
-            for (k = 0; k <= c->horizon; ++k) {
-                row[k] = coa_track_at(t, c->t0 + (coa_real_t)k * c->dt);
-            }
+            align_track(pr, i, &tracks[i - pr->n]);
         }
-        for (k = 0; k <= c->horizon; ++k) {
-            if (!vec_ok(&row[k])) {
-                return COA_ERR_ARGUMENT;
-            }
-            scale = real_max_abs3(&row[k], scale);
-        }
-        /* The widest a box gets: the volume plus the margin at the horizon's end. */
-        worst_h = mv->volume.radius +
-                  (coa_real_t)COA_PREDICT_SIGMA_MARGIN * (mv->sigma_h + mv->rate_h * horizon_tau);
-        worst_v = mv->volume.half_height +
-                  (coa_real_t)COA_PREDICT_SIGMA_MARGIN * (mv->sigma_v + mv->rate_v * horizon_tau);
-        if (!real_ok(worst_h) || !real_ok(worst_v)) {
+        if (!align_scale(pr, i, &scale)) {
             return COA_ERR_ARGUMENT;
         }
-        scale = worst_h > scale ? worst_h : scale;
-        scale = worst_v > scale ? worst_v : scale;
     }
     pr->slack = scale * (coa_real_t)(SLACK_ULPS * REAL_EPSILON);
     for (i = 0; i < pr->n; ++i) {
