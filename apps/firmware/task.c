@@ -134,10 +134,9 @@ static int collect_obstacles(const coa_vehicle_t *self, coa_real_t now, size_t *
     return COA_OK;
 }
 
-fw_status_t fw_task_cycle(coa_real_t now)
+/* 1. Prediction: our intent (plan 0) with the neighbours' and the tracks. */
+static int predict_own(const coa_vehicle_t *self, coa_real_t now, coa_predict_result_t *predicted)
 {
-    coa_vehicle_t self = self_template;
-    const coa_vec3_t *reference_rows[1] = {reference};
     coa_predict_config_t config = {
         .t0 = 0.0f, /* the predictor's clock is relative to now: floats stay small */
         .dt = FW_DT,
@@ -149,43 +148,16 @@ fw_status_t fw_task_cycle(coa_real_t now)
         .threshold = 1e-3,
         .all_pairs = false,
     };
-    coa_predict_result_t predicted;
-    coa_problem_t problem;
     size_t n = 1;
-    size_t m = 0;
-    size_t c;
-    uint32_t i;
-    uint32_t k;
-    bool replan = false;
-    coa_real_t dh;
-    int rc;
-
-    self.route = fw_inputs.route;
-    self.route_count = fw_inputs.route_count;
-    self.initial_offset = fw_inputs.offset;
-    rc = coa_reference_sample(&self, FW_DT, FW_HORIZON, reference);
-    if (rc < 0) {
-        return finish(FW_ERROR, rc);
-    }
-    dh = coa_climb_step(&self, FW_DT);
-    /* The plan in force, moved on by the step flown since the last cycle, from the offset
-     * we are actually at. */
-    for (k = 0; k + 1u < FW_SAMPLES; ++k) {
-        fw_outputs.offsets[k] = fw_outputs.offsets[k + 1u];
-    }
-    fw_outputs.offsets[0] = fw_inputs.offset;
-    write_intent(dh);
-
-    /* 1. Prediction: our intent (plan 0) with the neighbours' and the tracks. */
-    plans[0] = (coa_intent_plan_t){.id = self.id,
-                                   .volume = self.volume,
+    plans[0] = (coa_intent_plan_t){.id = self->id,
+                                   .volume = self->volume,
                                    .t0 = 0.0f,
                                    .step = FW_DT,
                                    .samples = fw_outputs.intent,
                                    .count = FW_SAMPLES,
                                    .sigma_horizontal = 5.0f,
                                    .sigma_vertical = 2.0f};
-    for (i = 0; i < FW_NEIGHBOURS; ++i) {
+    for (uint32_t i = 0; i < FW_NEIGHBOURS; ++i) {
         const fw_intent_t *nb = &fw_inputs.neighbours[i];
         if (nb->valid) {
             plans[n++] = (coa_intent_plan_t){.id = nb->id,
@@ -198,16 +170,18 @@ fw_status_t fw_task_cycle(coa_real_t now)
                                              .sigma_vertical = 2.0f};
         }
     }
-    rc = coa_predict(predictor, &config, plans, n, NULL, 0u, fw_inputs.tracks,
-                     fw_inputs.track_count, conflicts, FW_MAX_CONFLICTS, &predicted);
-    if (rc < 0) {
-        return finish(FW_ERROR, rc);
-    }
-    /* Ours: plan 0 is always `a`. A conflict with a lower-priority neighbour is its to
-     * solve; with a higher-priority one or a track, ours. An overflowing list may hide
-     * one of ours: replan to be safe. */
+    return coa_predict(predictor, &config, plans, n, NULL, 0u, fw_inputs.tracks,
+                       fw_inputs.track_count, conflicts, FW_MAX_CONFLICTS, predicted);
+}
+
+/* Whether a predicted conflict is ours to solve (and counts ours). Plan 0 is always `a`. A
+ * conflict with a lower-priority neighbour is its to solve; with a higher-priority one or
+ * a track, ours. */
+static bool ours_to_solve(const coa_vehicle_t *self, const coa_predict_result_t *predicted)
+{
+    bool replan = false;
     fw_outputs.conflicts = 0u;
-    for (c = 0; c < predicted.conflict_count; ++c) {
+    for (size_t c = 0; c < predicted->conflict_count; ++c) {
         const coa_conflict_t *cf = &conflicts[c];
         if (cf->a != 0u) {
             continue;
@@ -215,27 +189,31 @@ fw_status_t fw_task_cycle(coa_real_t now)
         ++fw_outputs.conflicts;
         if (cf->kind != COA_CONFLICT_VEHICLE) {
             replan = true;
-        } else {
-            for (i = 0; i < FW_NEIGHBOURS; ++i) {
-                const fw_intent_t *nb = &fw_inputs.neighbours[i];
-                if (nb->valid && nb->id == plans[cf->b].id && outranks(nb, &self)) {
-                    replan = true;
-                }
+            continue;
+        }
+        for (uint32_t i = 0; i < FW_NEIGHBOURS; ++i) {
+            const fw_intent_t *nb = &fw_inputs.neighbours[i];
+            if (nb->valid && nb->id == plans[cf->b].id && outranks(nb, self)) {
+                replan = true;
             }
         }
     }
-    if (!replan && !predicted.overflow) {
-        return finish(FW_CLEAR, COA_OK);
-    }
+    return replan;
+}
 
-    /* 2. Planning: our offsets around what outranks us, at most beta expansions. */
-    rc = collect_obstacles(&self, now, &m);
+/* 2. Planning: our offsets around what outranks us, at most beta expansions. */
+static fw_status_t plan_own(coa_vehicle_t *self, coa_real_t now, coa_real_t dh)
+{
+    const coa_vec3_t *reference_rows[1] = {reference};
+    coa_problem_t problem;
+    size_t m = 0;
+    int rc = collect_obstacles(self, now, &m);
     if (rc < 0) {
         return finish(FW_ERROR, rc);
     }
     problem = (coa_problem_t){.dt = FW_DT,
                               .horizon = FW_HORIZON,
-                              .vehicles = &self,
+                              .vehicles = self,
                               .vehicle_count = 1u,
                               .references = reference_rows,
                               .obstacles = NULL,
@@ -252,11 +230,44 @@ fw_status_t fw_task_cycle(coa_real_t now)
          * neighbours were told) and the autopilot's failsafe decides. */
         return finish(FW_NO_PLAN, COA_OK);
     }
-    for (k = 0; k < FW_SAMPLES; ++k) {
+    for (uint32_t k = 0; k < FW_SAMPLES; ++k) {
         fw_outputs.offsets[k] = new_offsets[k];
     }
     write_intent(dh);
     return finish(FW_REPLANNED, COA_OK);
+}
+
+fw_status_t fw_task_cycle(coa_real_t now)
+{
+    coa_vehicle_t self = self_template;
+    coa_predict_result_t predicted;
+    coa_real_t dh;
+    int rc;
+
+    self.route = fw_inputs.route;
+    self.route_count = fw_inputs.route_count;
+    self.initial_offset = fw_inputs.offset;
+    rc = coa_reference_sample(&self, FW_DT, FW_HORIZON, reference);
+    if (rc < 0) {
+        return finish(FW_ERROR, rc);
+    }
+    dh = coa_climb_step(&self, FW_DT);
+    /* The plan in force, moved on by the step flown since the last cycle, from the offset
+     * we are actually at. */
+    for (uint32_t k = 0; k + 1u < FW_SAMPLES; ++k) {
+        fw_outputs.offsets[k] = fw_outputs.offsets[k + 1u];
+    }
+    fw_outputs.offsets[0] = fw_inputs.offset;
+    write_intent(dh);
+    rc = predict_own(&self, now, &predicted);
+    if (rc < 0) {
+        return finish(FW_ERROR, rc);
+    }
+    /* An overflowing list may hide one of ours: replan to be safe. */
+    if (!ours_to_solve(&self, &predicted) && !predicted.overflow) {
+        return finish(FW_CLEAR, COA_OK);
+    }
+    return plan_own(&self, now, dh);
 }
 
 void fw_example_inputs(void)
