@@ -673,20 +673,130 @@ static void promote(size_t *order, size_t from, size_t to)
     order[to] = v;
 }
 
+/* The search over priority orders of coa_plan_decoupled (plan.h). */
+typedef struct {
+    size_t n;
+    size_t first[COA_MAX_VEHICLES]; /* the order asked for */
+    size_t cur[COA_MAX_VEHICLES];   /* the order being tried */
+    /* tried[L]: vehicles already tried at position L under the current cur[0..L-1]. */
+    uint32_t tried[COA_MAX_VEHICLES];
+    size_t start;      /* the first position the next attempt plans */
+    size_t keep;       /* levels below this still hold the first attempt's plans */
+    size_t first_fail; /* where the first attempt failed */
+    bool any_budget;   /* an attempt ran out of beta */
+    bool proven;       /* infeasible in every order, whatever beta did */
+    bool covered;      /* every order tried or ruled out */
+} orders_t;
+
+/* The first order (the one given, checked to be a permutation, or priority order). */
+static int orders_init(const coa_problem_t *problem, const size_t *order, orders_t *o)
+{
+    size_t i;
+    *o = (orders_t){0};
+    o->n = problem->vehicle_count;
+    if (order != NULL) {
+        uint32_t seen = 0u;
+        for (i = 0; i < o->n; ++i) {
+            if (order[i] >= o->n || (seen & (UINT32_C(1) << order[i])) != 0u) {
+                return COA_ERR_ARGUMENT;
+            }
+            seen |= UINT32_C(1) << order[i];
+            o->first[i] = order[i];
+        }
+    } else {
+        (void)coa_priority_order(problem->vehicles, o->n, o->first);
+    }
+    for (i = 0; i < o->n; ++i) {
+        o->cur[i] = o->first[i];
+    }
+    o->keep = o->n;
+    return COA_OK;
+}
+
+/* One attempt: the vehicles of cur from `start` on, each against those before it. Returns
+ * the position that failed (n: solved), its status in *st. */
+static size_t orders_attempt(coa_planner_t *planner, orders_t *o, coa_plan_result_t *result,
+                             coa_plan_status_t *st)
+{
+    size_t level;
+    if (result->orders_tried > 0u && o->start < o->keep) {
+        o->keep = o->start;
+    }
+    ++result->orders_tried;
+    *st = COA_PLAN_SOLVED;
+    for (level = o->start; level < o->n; ++level) {
+        o->tried[level] |= UINT32_C(1) << o->cur[level];
+        *st = plan_one(planner, o->cur, level, result);
+        if (*st != COA_PLAN_SOLVED) {
+            return level;
+        }
+    }
+    return o->n;
+}
+
+/* The next order after a failure at `fail`, depth first: every order below cur[0..fail] is
+ * ruled out, so go back to the deepest position that still has an untried candidate under
+ * its prefix (deeper positions have been exhausted). There the failing vehicle goes first
+ * if it has not been tried there, else the first untried one in the current order. Jumping
+ * higher would abandon part of a subtree that the per-position bitmasks could never
+ * return to, and the search would no longer be exhaustive. False: every order is tried or
+ * ruled out. */
+static bool orders_next(orders_t *o, size_t fail)
+{
+    const size_t v = o->cur[fail];
+    bool found = false;
+    size_t to;
+    size_t i;
+    for (to = fail + 1u; !found && to-- > 0u;) {
+        if ((o->tried[to] & (UINT32_C(1) << v)) == 0u) {
+            promote(o->cur, fail, to);
+            found = true;
+        }
+        for (i = to; i < o->n && !found; ++i) {
+            if ((o->tried[to] & (UINT32_C(1) << o->cur[i])) == 0u) {
+                promote(o->cur, i, to);
+                found = true;
+            }
+        }
+    }
+    if (!found) {
+        return false;
+    }
+    for (i = to + 1u; i < o->n; ++i) {
+        o->tried[i] = 0u;
+    }
+    o->start = to;
+    return true;
+}
+
+/* No order worked: report the first attempt, re-planning the part of its prefix that later
+ * attempts overwrote (the searches are deterministic, so they succeed again). A proof for
+ * every order outranks an attempt that ran out of beta: more beta could not have helped
+ * it. */
+static void orders_report(coa_planner_t *planner, const orders_t *o, coa_plan_result_t *result)
+{
+    size_t i;
+    result->all_orders_covered = o->proven || o->covered;
+    result->status =
+        (o->any_budget && !o->proven) ? COA_PLAN_BUDGET_EXHAUSTED : COA_PLAN_INFEASIBLE;
+    result->planned_count = o->first_fail;
+    for (i = 0; i < o->n; ++i) {
+        result->order[i] = o->first[i];
+    }
+    for (i = o->keep; i < o->first_fail; ++i) {
+        if (plan_one(planner, o->first, i, result) != COA_PLAN_SOLVED) {
+            result->planned_count = i; /* unreachable; keeps the report truthful anyway */
+            break;
+        }
+    }
+    result->failed_vehicle = o->first[result->planned_count];
+    coa_plan_fill_costs(planner, o->first, result->planned_count, result);
+}
+
 int coa_plan_decoupled(coa_planner_t *planner, const coa_problem_t *problem, const size_t *order,
                        uint32_t max_orders, int32_t *offsets, coa_plan_result_t *result)
 {
-    size_t first[COA_MAX_VEHICLES];
-    size_t cur[COA_MAX_VEHICLES];
-    /* tried[L]: vehicles already tried at position L under the current cur[0..L-1]. */
-    uint32_t tried[COA_MAX_VEHICLES];
-    size_t n;
-    size_t start = 0u;
-    size_t keep; /* levels below this still hold the first attempt's plans */
-    size_t first_fail = 0u;
-    bool any_budget = false;
-    bool proven = false;  /* infeasible in every order, whatever beta did */
-    bool covered = false; /* every order tried or ruled out */
+    orders_t o;
     size_t i;
     int rc;
 
@@ -697,125 +807,44 @@ int coa_plan_decoupled(coa_planner_t *planner, const coa_problem_t *problem, con
         return COA_ERR_ARGUMENT;
     }
     rc = load(planner, problem, offsets, result);
+    if (rc == COA_OK) {
+        rc = orders_init(problem, order, &o);
+    }
     if (rc != COA_OK) {
         return rc;
     }
-    n = problem->vehicle_count;
-    if (order != NULL) {
-        uint32_t seen = 0u;
-        for (i = 0; i < n; ++i) {
-            if (order[i] >= n || (seen & (UINT32_C(1) << order[i])) != 0u) {
-                return COA_ERR_ARGUMENT;
-            }
-            seen |= UINT32_C(1) << order[i];
-            first[i] = order[i];
-        }
-    } else {
-        (void)coa_priority_order(problem->vehicles, n, first);
-    }
-    for (i = 0; i < n; ++i) {
-        cur[i] = first[i];
-        tried[i] = 0u;
-    }
-    keep = n;
     result->workspace_bytes = planner->bytes;
-
     while (result->orders_tried < max_orders) {
-        size_t level;
-        size_t fail = n;
-        coa_plan_status_t st = COA_PLAN_SOLVED;
-        size_t v;
-        size_t to;
-        bool found;
-
-        if (result->orders_tried > 0u && start < keep) {
-            keep = start;
-        }
-        ++result->orders_tried;
-        for (level = start; level < n; ++level) {
-            tried[level] |= UINT32_C(1) << cur[level];
-            st = plan_one(planner, cur, level, result);
-            if (st != COA_PLAN_SOLVED) {
-                fail = level;
-                break;
-            }
-        }
-        if (fail == n) {
+        coa_plan_status_t st;
+        size_t fail = orders_attempt(planner, &o, result, &st);
+        if (fail == o.n) {
             result->status = COA_PLAN_SOLVED;
-            for (i = 0; i < n; ++i) {
-                result->order[i] = cur[i];
+            for (i = 0; i < o.n; ++i) {
+                result->order[i] = o.cur[i];
             }
-            result->planned_count = n;
-            coa_plan_fill_costs(planner, cur, n, result);
+            result->planned_count = o.n;
+            coa_plan_fill_costs(planner, o.cur, o.n, result);
             return COA_OK;
         }
-        if (st == COA_PLAN_BUDGET_EXHAUSTED) {
-            any_budget = true;
-        }
+        o.any_budget = o.any_budget || st == COA_PLAN_BUDGET_EXHAUSTED;
         /* Alone against obstacles and tracks, nothing it could meet later is easier. */
-        if (fail == 0u && st == COA_PLAN_INFEASIBLE) {
-            proven = true;
-        }
+        o.proven = o.proven || (fail == 0u && st == COA_PLAN_INFEASIBLE);
         if (result->orders_tried == 1u) {
-            first_fail = fail;
+            o.first_fail = fail;
             /* Checked only once an order has failed, so a solved call never pays for it;
              * without it, two vehicles in conflict at t = 0 among n would cost up to n!
              * attempts before the order space ran out. */
-            if (!proven && coa_plan_any_initial_conflict(planner)) {
-                proven = true;
-            }
+            o.proven = o.proven || coa_plan_any_initial_conflict(planner);
         }
-        if (proven) {
+        if (o.proven) {
             break;
         }
-        v = cur[fail];
-        /* Depth-first: every order below cur[0..fail] is ruled out, so go back to the
-         * deepest position that still has an untried candidate under its prefix (deeper
-         * positions have been exhausted). There the failing vehicle goes first if it has
-         * not been tried there, else the first untried one in the current order. Jumping
-         * higher would abandon part of a subtree that the per-position bitmasks could never
-         * return to, and the search would no longer be exhaustive. */
-        found = false;
-        for (to = fail + 1u; !found && to-- > 0u;) {
-            if ((tried[to] & (UINT32_C(1) << v)) == 0u) {
-                promote(cur, fail, to);
-                found = true;
-            }
-            for (i = to; i < n && !found; ++i) {
-                if ((tried[to] & (UINT32_C(1) << cur[i])) == 0u) {
-                    promote(cur, i, to);
-                    found = true;
-                }
-            }
-        }
-        if (!found) {
-            covered = true; /* every order tried or ruled out */
-            break;
-        }
-        for (i = to + 1u; i < n; ++i) {
-            tried[i] = 0u;
-        }
-        start = to;
-    }
-
-    /* No order worked: report the first attempt, re-planning the part of its prefix that
-     * later attempts overwrote (the searches are deterministic, so they succeed again).
-     * A proof for every order outranks an attempt that ran out of beta: more beta could
-     * not have helped it. */
-    result->all_orders_covered = proven || covered;
-    result->status = (any_budget && !proven) ? COA_PLAN_BUDGET_EXHAUSTED : COA_PLAN_INFEASIBLE;
-    result->planned_count = first_fail;
-    for (i = 0; i < n; ++i) {
-        result->order[i] = first[i];
-    }
-    for (i = keep; i < first_fail; ++i) {
-        if (plan_one(planner, first, i, result) != COA_PLAN_SOLVED) {
-            result->planned_count = i; /* unreachable; keeps the report truthful anyway */
+        if (!orders_next(&o, fail)) {
+            o.covered = true;
             break;
         }
     }
-    result->failed_vehicle = first[result->planned_count];
-    coa_plan_fill_costs(planner, first, result->planned_count, result);
+    orders_report(planner, &o, result);
     return COA_OK;
 }
 
