@@ -217,8 +217,9 @@ static char far_axis(coa_vec3_t p, double *value)
  * reference point and the positions and velocities its offsets can give there. An offset
  * at sample j is at most initial_offset + steep_factor * j climb steps from the reference
  * (and within max_offset), whatever is planned. */
-static int check_vehicle_limits(const char *file, size_t i, const coa_vehicle_t *v, coa_real_t dt,
-                                uint64_t last)
+/* Vehicle i's volume, speeds and priority within what an intent carries; *climb is the
+ * vertical speed its largest change of offset in one step adds. */
+static int check_vehicle_sizes(const char *file, size_t i, const coa_vehicle_t *v, double *climb)
 {
     if (beyond((double)v->volume.radius, COAVOID_LCM_MAX_SIZE)) {
         return coavoid_cli_fail(CLI_EXIT_INVALID,
@@ -238,23 +239,66 @@ static int check_vehicle_limits(const char *file, size_t i, const coa_vehicle_t 
                                 " carries (%g m/s)",
                                 file, i, (double)v->cruise_speed, COAVOID_LCM_MAX_SPEED);
     }
-    /* The largest change of offset in one step, and the vertical speed it adds. */
     uint32_t max_change = v->steep_factor;
     if (v->max_offset >= 0 && (uint64_t)2u * (uint32_t)v->max_offset < max_change) {
         max_change = 2u * (uint32_t)v->max_offset;
     }
-    const double climb = (double)max_change * (double)v->climb_rate;
-    if (beyond(climb, COAVOID_LCM_MAX_SPEED)) {
+    *climb = (double)max_change * (double)v->climb_rate;
+    if (beyond(*climb, COAVOID_LCM_MAX_SPEED)) {
         return coavoid_cli_fail(CLI_EXIT_INVALID,
                                 "%s: vehicles[%zu].climb_rate: %g m/s, %g m/s in a steep climb, is "
                                 "beyond what " SIM_INTENT " carries (%g m/s)",
-                                file, i, (double)v->climb_rate, climb, COAVOID_LCM_MAX_SPEED);
+                                file, i, (double)v->climb_rate, *climb, COAVOID_LCM_MAX_SPEED);
     }
     if (v->priority > (uint32_t)INT32_MAX) {
         return coavoid_cli_fail(CLI_EXIT_INVALID,
                                 "%s: vehicles[%zu].priority: %lu is beyond what " SIM_INTENT
                                 " carries (%ld)",
                                 file, i, (unsigned long)v->priority, (long)INT32_MAX);
+    }
+    return CLI_CONTINUE;
+}
+
+/* The step from sample `previous` to r (at t): the intent's velocity is that step, and
+ * consecutive reference points must differ horizontally in the core's precision, as the
+ * intent's check judges them (a route far out flown very slowly does not). */
+static int check_vehicle_step(const char *file, size_t i, const coa_vehicle_t *v, coa_real_t dt,
+                              coa_real_t t, coa_vec3_t previous, coa_vec3_t r, double climb)
+{
+    const double vx = (double)((r.x - previous.x) / dt);
+    const double vy = (double)((r.y - previous.y) / dt);
+    const double vz = fabs((double)((r.z - previous.z) / dt)) + climb;
+    if (beyond(vx, COAVOID_LCM_MAX_SPEED) || beyond(vy, COAVOID_LCM_MAX_SPEED) ||
+        beyond(vz, COAVOID_LCM_MAX_SPEED)) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                "%s: vehicles[%zu].route: its reference moves at (%g, %g) m/s "
+                                "horizontally and %g m/s vertically with its steepest climb at t = "
+                                "%g s, beyond what " SIM_INTENT " carries (%g m/s each)",
+                                file, i, vx, vy, vz, (double)t, COAVOID_LCM_MAX_SPEED);
+    }
+    const coa_vec3_t leg[2] = {previous, r};
+    coa_vehicle_t probe = *v;
+    probe.route = leg;
+    probe.route_count = 2u;
+    probe.initial_offset = 0;
+    if (coa_vehicle_check(&probe) != COA_OK) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                "%s: vehicles[%zu].cruise_speed: %g m/s moves it too little in a "
+                                "step to tell its position at t = %g s from the one before "
+                                "(%.10g, %.10g m), as " SIM_INTENT " must",
+                                file, i, (double)v->cruise_speed, (double)t, (double)r.x,
+                                (double)r.y);
+    }
+    return CLI_CONTINUE;
+}
+
+static int check_vehicle_limits(const char *file, size_t i, const coa_vehicle_t *v, coa_real_t dt,
+                                uint64_t last)
+{
+    double climb = 0.0;
+    int status = check_vehicle_sizes(file, i, v, &climb);
+    if (status != CLI_CONTINUE) {
+        return status;
     }
     const double dh = (double)coa_climb_step(v, dt);
     const int64_t bound = v->max_offset >= 0 ? v->max_offset : COA_MAX_OFFSET;
@@ -287,36 +331,11 @@ static int check_vehicle_limits(const char *file, size_t i, const coa_vehicle_t 
                 file, i, (double)t, (double)r.z, (long long)reach, dh, top,
                 COAVOID_LCM_MAX_COORDINATE);
         }
-        if (j == 0u) {
-            continue;
-        }
-        /* The intent's velocity is the step from one sample to the next. */
-        const double vx = (double)((r.x - previous.x) / dt);
-        const double vy = (double)((r.y - previous.y) / dt);
-        const double vz = fabs((double)((r.z - previous.z) / dt)) + climb;
-        if (beyond(vx, COAVOID_LCM_MAX_SPEED) || beyond(vy, COAVOID_LCM_MAX_SPEED) ||
-            beyond(vz, COAVOID_LCM_MAX_SPEED)) {
-            return coavoid_cli_fail(
-                CLI_EXIT_INVALID,
-                "%s: vehicles[%zu].route: its reference moves at (%g, %g) m/s "
-                "horizontally and %g m/s vertically with its steepest climb at t = "
-                "%g s, beyond what " SIM_INTENT " carries (%g m/s each)",
-                file, i, vx, vy, vz, (double)t, COAVOID_LCM_MAX_SPEED);
-        }
-        /* Consecutive reference points must differ horizontally in the core's precision,
-         * as the intent's check judges them (a route far out flown very slowly does not). */
-        const coa_vec3_t leg[2] = {previous, r};
-        coa_vehicle_t probe = *v;
-        probe.route = leg;
-        probe.route_count = 2u;
-        probe.initial_offset = 0;
-        if (coa_vehicle_check(&probe) != COA_OK) {
-            return coavoid_cli_fail(
-                CLI_EXIT_INVALID,
-                "%s: vehicles[%zu].cruise_speed: %g m/s moves it too little in a "
-                "step to tell its position at t = %g s from the one before "
-                "(%.10g, %.10g m), as " SIM_INTENT " must",
-                file, i, (double)v->cruise_speed, (double)t, (double)r.x, (double)r.y);
+        if (j > 0u) {
+            status = check_vehicle_step(file, i, v, dt, t, previous, r, climb);
+            if (status != CLI_CONTINUE) {
+                return status;
+            }
         }
         previous = r;
     }
@@ -327,24 +346,12 @@ static int check_vehicle_limits(const char *file, size_t i, const coa_vehicle_t 
  * cycle its velocity (a path track's: that of the leg in use) and position; a path track's
  * message also carries its path over the next horizon, so its points and positions up to
  * sample `last` too. */
-static int check_track_limits(const char *file, size_t i, const coa_track_t *tr, coa_real_t dt,
-                              uint64_t steps, uint64_t last)
+/* Track i's speeds within what a track message carries: its velocity, or the speed of the
+ * leg in use at each step t_k, as coa_track_at and the world choose it (the first one
+ * before path[1], the last one from path[last - 1] on). */
+static int check_track_speeds(const char *file, size_t i, const coa_track_t *tr, coa_real_t dt,
+                              uint64_t steps)
 {
-    const struct {
-        const char *name;
-        coa_real_t value;
-    } sizes[4] = {{"radius", tr->volume.radius},
-                  {"half_height", tr->volume.half_height},
-                  {"sigma[0]", tr->sigma_horizontal},
-                  {"sigma[1]", tr->sigma_vertical}};
-    for (size_t f = 0; f < 4u; f++) {
-        if (beyond((double)sizes[f].value, COAVOID_LCM_MAX_SIZE)) {
-            return coavoid_cli_fail(
-                CLI_EXIT_INVALID,
-                "%s: tracks[%zu].%s: %g m is beyond what " SIM_TRACK " carries (%g m)", file, i,
-                sizes[f].name, (double)sizes[f].value, COAVOID_LCM_MAX_SIZE);
-        }
-    }
     if (tr->path_count == 0u) {
         double value = 0.0;
         const coa_vec3_t v = tr->velocity;
@@ -360,8 +367,6 @@ static int check_track_limits(const char *file, size_t i, const coa_track_t *tr,
                                     file, i, value, COAVOID_LCM_MAX_SPEED);
         }
     } else if (tr->path_count > 1u) {
-        /* The leg in use at t_k, as coa_track_at and the world choose it: the first one
-         * before path[1], the last one from path[last - 1] on. */
         const size_t final = tr->path_count - 1u;
         size_t leg = 0;
         for (uint64_t k = 0; k <= steps; k++) {
@@ -385,6 +390,31 @@ static int check_track_limits(const char *file, size_t i, const coa_track_t *tr,
                 }
             }
         }
+    }
+    return CLI_CONTINUE;
+}
+
+static int check_track_limits(const char *file, size_t i, const coa_track_t *tr, coa_real_t dt,
+                              uint64_t steps, uint64_t last)
+{
+    const struct {
+        const char *name;
+        coa_real_t value;
+    } sizes[4] = {{"radius", tr->volume.radius},
+                  {"half_height", tr->volume.half_height},
+                  {"sigma[0]", tr->sigma_horizontal},
+                  {"sigma[1]", tr->sigma_vertical}};
+    for (size_t f = 0; f < 4u; f++) {
+        if (beyond((double)sizes[f].value, COAVOID_LCM_MAX_SIZE)) {
+            return coavoid_cli_fail(
+                CLI_EXIT_INVALID,
+                "%s: tracks[%zu].%s: %g m is beyond what " SIM_TRACK " carries (%g m)", file, i,
+                sizes[f].name, (double)sizes[f].value, COAVOID_LCM_MAX_SIZE);
+        }
+    }
+    int status = check_track_speeds(file, i, tr, dt, steps);
+    if (status != CLI_CONTINUE) {
+        return status;
     }
     const uint64_t sampled = tr->path_count > 0u ? last : steps;
     const coa_real_t end = (coa_real_t)sampled * dt;
