@@ -292,14 +292,11 @@ static bool intent_leg_ok(const coavoid_intent_t *msg, coa_vec3_t a, coa_vec3_t 
     return coa_vehicle_check(&v) == COA_OK;
 }
 
-int coavoid_lcm_intent_check(const coavoid_intent_t *msg, const coavoid_lcm_context_t *ctx,
-                             const char **reason)
+/* The intent's header: times, ids, mode, position and velocity. */
+static int intent_header_check(const coavoid_intent_t *msg, const coavoid_lcm_context_t *ctx,
+                               const char **reason)
 {
     int rc;
-    int32_t j;
-    if (msg == NULL) {
-        REJECT(COA_ERR_ARGUMENT, "intent: NULL");
-    }
     if ((rc = utime_rule(msg->utime, ctx)) != COA_OK) {
         REJECT(rc, "intent: utime stale, in the future or not positive");
     }
@@ -323,6 +320,15 @@ int coavoid_lcm_intent_check(const coavoid_intent_t *msg, const coavoid_lcm_cont
     if ((rc = vec_rule(msg->velocity, COAVOID_LCM_MAX_SPEED)) != COA_OK) {
         REJECT(rc, "intent: velocity non-finite or out of range");
     }
+    return COA_OK;
+}
+
+/* The vehicle the intent describes: volume, speeds, manoeuvre limits, the plan's time and
+ * step, and the sample count. */
+static int intent_vehicle_check(const coavoid_intent_t *msg, const coavoid_lcm_context_t *ctx,
+                                const char **reason)
+{
+    int rc;
     if ((rc = size_rule(msg->radius, true)) != COA_OK) {
         REJECT(rc, "intent: radius not in (0, 1e5] m");
     }
@@ -358,42 +364,60 @@ int coavoid_lcm_intent_check(const coavoid_intent_t *msg, const coavoid_lcm_cont
     if (msg->sample_count < 2 || msg->sample_count > COAVOID_INTENT_T_MAX_SAMPLES) {
         REJECT(COAVOID_LCM_ERR_COUNT, "intent: sample_count not in 2..MAX_SAMPLES");
     }
-    {
-        /* Positions and the route rule are judged in the core's precision, as the
-         * planner and coa_vehicle_check will see them. */
-        coa_vehicle_t v = intent_vehicle(msg, NULL, 0u, 0);
-        coa_real_t dh = coa_climb_step(&v, (coa_real_t)msg->step);
-        int32_t bound = (msg->max_offset >= 0) ? msg->max_offset : COA_MAX_OFFSET;
-        coa_vec3_t previous = {0, 0, 0};
-        for (j = 0; j < msg->sample_count; ++j) {
-            coa_vec3_t r;
-            coa_vec3_t p;
-            int32_t o = msg->offsets[j];
-            if ((rc = vec_rule(msg->reference[j], COAVOID_LCM_MAX_COORDINATE)) != COA_OK) {
-                REJECT(rc, "intent: a reference point non-finite or out of range");
-            }
-            r = vec_of(msg->reference[j]);
-            if (j > 0 && !intent_leg_ok(msg, previous, r)) {
-                REJECT(COAVOID_LCM_ERR_VALUE,
-                       "intent: consecutive reference points without horizontal separation");
-            }
-            if (o < -bound || o > bound) {
-                REJECT(COAVOID_LCM_ERR_VALUE, "intent: an offset beyond max_offset or 32767");
-            }
-            if (j > 0) {
-                int32_t d = o - msg->offsets[j - 1];
-                if (d != 0 && d != 1 && d != -1 && d != msg->steep_factor &&
-                    d != -msg->steep_factor) {
-                    REJECT(COAVOID_LCM_ERR_VALUE,
-                           "intent: consecutive offsets differ by no action");
-                }
-            }
-            p = intent_position(&r, o, dh);
-            if (!isfinite((double)p.z) || fabs((double)p.z) > COAVOID_LCM_MAX_COORDINATE) {
-                REJECT(COAVOID_LCM_ERR_VALUE, "intent: a planned position out of range");
-            }
-            previous = r;
+    return COA_OK;
+}
+
+/* The samples: reference points, offsets and the positions they plan. Positions and the
+ * route rule are judged in the core's precision, as the planner and coa_vehicle_check
+ * will see them. */
+static int intent_samples_check(const coavoid_intent_t *msg, const char **reason)
+{
+    coa_vehicle_t v = intent_vehicle(msg, NULL, 0u, 0);
+    coa_real_t dh = coa_climb_step(&v, (coa_real_t)msg->step);
+    int32_t bound = (msg->max_offset >= 0) ? msg->max_offset : COA_MAX_OFFSET;
+    coa_vec3_t previous = {0, 0, 0};
+    int rc;
+    for (int32_t j = 0; j < msg->sample_count; ++j) {
+        coa_vec3_t r;
+        coa_vec3_t p;
+        int32_t o = msg->offsets[j];
+        if ((rc = vec_rule(msg->reference[j], COAVOID_LCM_MAX_COORDINATE)) != COA_OK) {
+            REJECT(rc, "intent: a reference point non-finite or out of range");
         }
+        r = vec_of(msg->reference[j]);
+        if (j > 0 && !intent_leg_ok(msg, previous, r)) {
+            REJECT(COAVOID_LCM_ERR_VALUE,
+                   "intent: consecutive reference points without horizontal separation");
+        }
+        if (o < -bound || o > bound) {
+            REJECT(COAVOID_LCM_ERR_VALUE, "intent: an offset beyond max_offset or 32767");
+        }
+        if (j > 0) {
+            int32_t d = o - msg->offsets[j - 1];
+            if (d != 0 && d != 1 && d != -1 && d != msg->steep_factor && d != -msg->steep_factor) {
+                REJECT(COAVOID_LCM_ERR_VALUE, "intent: consecutive offsets differ by no action");
+            }
+        }
+        p = intent_position(&r, o, dh);
+        if (!isfinite((double)p.z) || fabs((double)p.z) > COAVOID_LCM_MAX_COORDINATE) {
+            REJECT(COAVOID_LCM_ERR_VALUE, "intent: a planned position out of range");
+        }
+        previous = r;
+    }
+    return COA_OK;
+}
+
+int coavoid_lcm_intent_check(const coavoid_intent_t *msg, const coavoid_lcm_context_t *ctx,
+                             const char **reason)
+{
+    int rc;
+    if (msg == NULL) {
+        REJECT(COA_ERR_ARGUMENT, "intent: NULL");
+    }
+    if ((rc = intent_header_check(msg, ctx, reason)) != COA_OK ||
+        (rc = intent_vehicle_check(msg, ctx, reason)) != COA_OK ||
+        (rc = intent_samples_check(msg, reason)) != COA_OK) {
+        return rc;
     }
     if ((rc = size_rule(msg->sigma_horizontal, false)) != COA_OK) {
         REJECT(rc, "intent: sigma_horizontal not in [0, 1e5] m");
@@ -497,16 +521,11 @@ int coavoid_lcm_intent_from_core(const coa_vehicle_t *vehicle,
 
 /* ---- plan ---- */
 
-int coavoid_lcm_plan_check(const coavoid_plan_t *msg, const coavoid_lcm_context_t *ctx,
-                           const char **reason)
+/* The plan's header: times, ids, horizon, mode, status and its costs. */
+static int plan_header_check(const coavoid_plan_t *msg, const coavoid_lcm_context_t *ctx,
+                             const char **reason)
 {
     int rc;
-    int32_t i;
-    int32_t j;
-    int32_t k;
-    if (msg == NULL) {
-        REJECT(COA_ERR_ARGUMENT, "plan: NULL");
-    }
     if ((rc = utime_rule(msg->utime, ctx)) != COA_OK) {
         REJECT(rc, "plan: utime stale, in the future or not positive");
     }
@@ -548,6 +567,16 @@ int coavoid_lcm_plan_check(const coavoid_plan_t *msg, const coavoid_lcm_context_
     if (msg->nodes_expanded < 0) {
         REJECT(COAVOID_LCM_ERR_VALUE, "plan: nodes_expanded negative");
     }
+    return COA_OK;
+}
+
+/* The plan's vehicles: counts, ids (each once) and the planned offsets, each within the
+ * bound and each step one that some action makes. */
+static int plan_vehicles_check(const coavoid_plan_t *msg, const char **reason)
+{
+    int32_t i;
+    int32_t j;
+    int32_t k;
     if (msg->vehicle_count < 1 || msg->vehicle_count > COAVOID_PLAN_T_MAX_VEHICLES) {
         REJECT(COAVOID_LCM_ERR_COUNT, "plan: vehicle_count not in 1..MAX_VEHICLES");
     }
@@ -580,6 +609,20 @@ int coavoid_lcm_plan_check(const coavoid_plan_t *msg, const coavoid_lcm_context_
                 }
             }
         }
+    }
+    return COA_OK;
+}
+
+int coavoid_lcm_plan_check(const coavoid_plan_t *msg, const coavoid_lcm_context_t *ctx,
+                           const char **reason)
+{
+    int rc;
+    if (msg == NULL) {
+        REJECT(COA_ERR_ARGUMENT, "plan: NULL");
+    }
+    if ((rc = plan_header_check(msg, ctx, reason)) != COA_OK ||
+        (rc = plan_vehicles_check(msg, reason)) != COA_OK) {
+        return rc;
     }
     OK_REASON();
     return COA_OK;
