@@ -198,8 +198,9 @@ static size_t cluster_members(coavoid_coordinator_t *node, uint32_t group)
 
 /* Plans one cluster and publishes its plan; a solved plan replaces the members' positions
  * in the view, so that later clusters plan around it. *solved says how it went. */
-static int plan_cluster(coavoid_coordinator_t *node, int64_t now, int64_t cycle_start, size_t count,
-                        bool *solved)
+/* The problem of the cluster's `count` members (node->member), around everything else the
+ * view has as tracks. */
+static int cluster_problem(coavoid_coordinator_t *node, size_t count, coa_problem_t *problem)
 {
     const coavoid_node_common_t *c = &node->config.common;
     coavoid_node_view_t *view = &node->view;
@@ -216,49 +217,63 @@ static int plan_cluster(coavoid_coordinator_t *node, int64_t now, int64_t cycle_
     if (rc != COA_OK) {
         return rc;
     }
-    coa_problem_t problem;
-    memset(&problem, 0, sizeof problem);
-    problem.dt = c->dt;
-    problem.horizon = c->horizon;
-    problem.vehicles = node->vehicles;
-    problem.vehicle_count = count;
-    problem.references = node->references;
-    problem.obstacles = node->inbox.obstacles;
-    problem.obstacle_count = node->inbox.obstacle_count;
-    problem.tracks = node->problem_tracks.tracks;
-    problem.track_count = node->problem_tracks.count;
-    problem.track_samples = node->problem_tracks.samples;
+    memset(problem, 0, sizeof *problem);
+    problem->dt = c->dt;
+    problem->horizon = c->horizon;
+    problem->vehicles = node->vehicles;
+    problem->vehicle_count = count;
+    problem->references = node->references;
+    problem->obstacles = node->inbox.obstacles;
+    problem->obstacle_count = node->inbox.obstacle_count;
+    problem->tracks = node->problem_tracks.tracks;
+    problem->track_count = node->problem_tracks.count;
+    problem->track_samples = node->problem_tracks.samples;
+    return COA_OK;
+}
 
-    bool centralised = count <= node->config.max_centralised;
+/* Plans the cluster, centralised when it is small enough. A joint search can fill its beta
+ * nodes: when beta runs out before it proves anything, the cluster is planned decoupled
+ * (in priority order) rather than left to fly into its conflict. A proof of infeasibility
+ * stands: no order beats it. *centralised says which plan it is. */
+static int cluster_plan(coavoid_coordinator_t *node, int64_t now, const coa_problem_t *problem,
+                        bool *centralised, coa_plan_result_t *result)
+{
+    const coavoid_node_common_t *c = &node->config.common;
     coa_planner_t *planner = node->solver.planner;
-    coa_plan_result_t result;
-    *solved = false;
+    const size_t count = problem->vehicle_count;
+    int rc;
+    *centralised = count <= node->config.max_centralised;
     int64_t start = coavoid_node_stopwatch(c);
-    if (centralised) {
-        rc = coa_plan_centralised(planner, &problem, node->offsets, &result);
-        /* A joint search can fill its beta nodes: when beta runs out before it proves
-         * anything, the cluster is planned decoupled (in priority order) rather than left
-         * to fly into its conflict. A proof of infeasibility stands: no order beats it. */
-        if (rc == COA_OK && result.status == COA_PLAN_BUDGET_EXHAUSTED && count > 1u) {
+    if (*centralised) {
+        rc = coa_plan_centralised(planner, problem, node->offsets, result);
+        if (rc == COA_OK && result->status == COA_PLAN_BUDGET_EXHAUSTED && count > 1u) {
             node->state.plans_run++;
             node->state.clusters_planned++;
-            centralised = false;
-            rc = coa_plan_decoupled(planner, &problem, NULL, 1u, node->offsets, &result);
+            *centralised = false;
+            rc = coa_plan_decoupled(planner, problem, NULL, 1u, node->offsets, result);
         }
     } else {
-        rc = coa_plan_decoupled(planner, &problem, NULL, 1u, node->offsets, &result);
+        rc = coa_plan_decoupled(planner, problem, NULL, 1u, node->offsets, result);
     }
     int64_t duration = coavoid_node_stopwatch(c) - start;
     node->state.plans_run++;
     node->state.clusters_planned++;
     node->last_plan_utime = now;
     node->state.last_plan_duration_us = duration > 0 ? duration : 0;
-    if (rc != COA_OK) {
-        return rc;
+    if (rc == COA_OK) {
+        node->state.last_outcome = (int)result->status;
+        node->state.last_nodes_expanded = result->nodes_expanded;
     }
-    node->state.last_outcome = (int)result.status;
-    node->state.last_nodes_expanded = result.nodes_expanded;
+    return rc;
+}
 
+/* The plan message of the cluster's result, checked as a receiver would (COA_ERR_ARGUMENT
+ * when it fails), then published (what publishing returned in *published). */
+static int cluster_publish(coavoid_coordinator_t *node, int64_t now, int64_t cycle_start,
+                           size_t count, bool centralised, const coa_plan_result_t *result,
+                           int *published)
+{
+    const coavoid_node_common_t *c = &node->config.common;
     coavoid_lcm_plan_info_t info;
     memset(&info, 0, sizeof info);
     info.utime = now;
@@ -274,7 +289,7 @@ static int plan_cluster(coavoid_coordinator_t *node, int64_t now, int64_t cycle_
         info.uav_ids[m] = node->vehicles[m].id;
     }
     coavoid_lcm_context_t ctx = coavoid_node_context(&node->inbox, now, cycle_start);
-    rc = coavoid_lcm_plan_from_core(&info, &result, node->offsets, &ctx, &node->tx_plan, NULL);
+    int rc = coavoid_lcm_plan_from_core(&info, result, node->offsets, &ctx, &node->tx_plan, NULL);
     if (rc == COA_OK) {
         /* The validity window in exact microseconds, whatever the core's precision. */
         node->tx_plan.valid_from_utime = cycle_start;
@@ -284,7 +299,33 @@ static int plan_cluster(coavoid_coordinator_t *node, int64_t now, int64_t cycle_
     if (rc != COA_OK) {
         return COA_ERR_ARGUMENT;
     }
-    rc = coavoid_node_publish_plan(&node->inbox.tx, &node->tx_plan);
+    *published = coavoid_node_publish_plan(&node->inbox.tx, &node->tx_plan);
+    return COA_OK;
+}
+
+static int plan_cluster(coavoid_coordinator_t *node, int64_t now, int64_t cycle_start, size_t count,
+                        bool *solved)
+{
+    const coavoid_node_common_t *c = &node->config.common;
+    coavoid_node_view_t *view = &node->view;
+    coa_problem_t problem;
+    coa_plan_result_t result;
+    bool centralised = false;
+    *solved = false;
+    int rc = cluster_problem(node, count, &problem);
+    if (rc != COA_OK) {
+        return rc;
+    }
+    rc = cluster_plan(node, now, &problem, &centralised, &result);
+    if (rc != COA_OK) {
+        return rc;
+    }
+    int published = COA_OK;
+    if (cluster_publish(node, now, cycle_start, count, centralised, &result, &published) !=
+        COA_OK) {
+        return COA_ERR_ARGUMENT;
+    }
+    rc = published;
     if (result.status != COA_PLAN_SOLVED) {
         return rc;
     }
