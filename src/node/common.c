@@ -542,23 +542,11 @@ static bool stale_track(const coavoid_intent_t *msg, const coavoid_node_common_t
            isfinite((double)tr->sigma_vertical) && coa_track_check(tr) == COA_OK;
 }
 
-void coavoid_node_view_build(coavoid_node_view_t *view, const coavoid_node_inbox_t *in,
-                             int64_t cycle_start, int64_t now)
+/* The UAVs heard, by ascending id, so that plan indices (and the clusters' order) do not
+ * depend on the order intents arrived in. Returns how many. */
+static size_t peers_by_id(const coavoid_node_inbox_t *in, size_t *order)
 {
-    const coavoid_node_common_t *c = &in->common;
-    const coavoid_lcm_context_t ctx = coavoid_node_context(in, now, cycle_start);
-    const int64_t drop = drop_after(in);
-    size_t order[COAVOID_NODE_MAX_PEERS];
     size_t n = 0;
-
-    view->cycle_start = cycle_start;
-    view->live_count = 0;
-    view->track_count = 0;
-    view->real_track_count = 0;
-    view->stale_count = 0;
-
-    /* UAVs by ascending id, so that plan indices (and the clusters' order) do not depend
-     * on the order intents arrived in. */
     for (size_t i = 0; i < COAVOID_NODE_MAX_PEERS; i++) {
         if (!in->peers[i].used) {
             continue;
@@ -570,32 +558,16 @@ void coavoid_node_view_build(coavoid_node_view_t *view, const coavoid_node_inbox
         }
         order[j] = i;
     }
-    bool stale[COAVOID_NODE_MAX_PEERS];
-    for (size_t s = 0; s < n; s++) {
-        const coavoid_intent_t *msg = &in->peers[order[s]].msg;
-        int64_t age = now - msg->utime;
-        stale[s] = age > c->stale_after_us;
-        if (stale[s]) {
-            continue;
-        }
-        size_t i = view->live_count;
-        if (coavoid_lcm_intent_to_core(msg, &ctx, NULL, &view->live_info[i], &view->live_vehicle[i],
-                                       &view->live_plan[i], &view->live_arrays[i],
-                                       NULL) != COA_OK) {
-            continue; /* e.g. stamped further ahead of this clock than allowed */
-        }
-        view->live_id[i] = (uint16_t)msg->uav_id;
-        view->live_current[i] = msg->plan_utime == cycle_start && msg->step == (double)c->dt &&
-                                msg->sample_count == (int32_t)c->horizon + 1;
-        view->live_count++;
-    }
+    return n;
+}
 
-    /* Real tracks by (source, id). */
-    size_t torder[COAVOID_NODE_MAX_TRACKS];
+/* The live tracks heard, by (source, id). Returns how many. */
+static size_t tracks_by_id(const coavoid_node_inbox_t *in, int64_t now, size_t *torder)
+{
     size_t m = 0;
     for (size_t i = 0; i < COAVOID_NODE_MAX_TRACKS; i++) {
         const coavoid_node_track_slot_t *t = &in->tracks[i];
-        if (!t->used || now - t->msg.utime > c->stale_after_us) {
+        if (!t->used || now - t->msg.utime > in->common.stale_after_us) {
             continue;
         }
         size_t j = m++;
@@ -610,6 +582,53 @@ void coavoid_node_view_build(coavoid_node_view_t *view, const coavoid_node_inbox
         }
         torder[j] = i;
     }
+    return m;
+}
+
+/* The live UAVs' plans (those whose intent is fresh and converts), marking the stale ones. */
+static void view_live(coavoid_node_view_t *view, const coavoid_node_inbox_t *in,
+                      const coavoid_lcm_context_t *ctx, const size_t *order, size_t n, bool *stale,
+                      int64_t cycle_start, int64_t now)
+{
+    const coavoid_node_common_t *c = &in->common;
+    for (size_t s = 0; s < n; s++) {
+        const coavoid_intent_t *msg = &in->peers[order[s]].msg;
+        int64_t age = now - msg->utime;
+        stale[s] = age > c->stale_after_us;
+        if (stale[s]) {
+            continue;
+        }
+        size_t i = view->live_count;
+        if (coavoid_lcm_intent_to_core(msg, ctx, NULL, &view->live_info[i], &view->live_vehicle[i],
+                                       &view->live_plan[i], &view->live_arrays[i],
+                                       NULL) != COA_OK) {
+            continue; /* e.g. stamped further ahead of this clock than allowed */
+        }
+        view->live_id[i] = (uint16_t)msg->uav_id;
+        view->live_current[i] = msg->plan_utime == cycle_start && msg->step == (double)c->dt &&
+                                msg->sample_count == (int32_t)c->horizon + 1;
+        view->live_count++;
+    }
+}
+
+void coavoid_node_view_build(coavoid_node_view_t *view, const coavoid_node_inbox_t *in,
+                             int64_t cycle_start, int64_t now)
+{
+    const coavoid_node_common_t *c = &in->common;
+    const coavoid_lcm_context_t ctx = coavoid_node_context(in, now, cycle_start);
+    const int64_t drop = drop_after(in);
+    size_t order[COAVOID_NODE_MAX_PEERS];
+    size_t torder[COAVOID_NODE_MAX_TRACKS];
+    bool stale[COAVOID_NODE_MAX_PEERS];
+
+    view->cycle_start = cycle_start;
+    view->live_count = 0;
+    view->track_count = 0;
+    view->real_track_count = 0;
+    view->stale_count = 0;
+    const size_t n = peers_by_id(in, order);
+    view_live(view, in, &ctx, order, n, stale, cycle_start, now);
+    const size_t m = tracks_by_id(in, now, torder);
     for (size_t s = 0; s < m; s++) {
         const coavoid_track_t *msg = &in->tracks[torder[s]].msg;
         size_t i = view->track_count;
@@ -622,7 +641,7 @@ void coavoid_node_view_build(coavoid_node_view_t *view, const coavoid_node_inbox
         view->track_count++;
     }
     view->real_track_count = view->track_count;
-
+    /* The silent UAVs, until they are dropped: tracks extrapolated from their last intent. */
     for (size_t s = 0; s < n; s++) {
         const coavoid_intent_t *msg = &in->peers[order[s]].msg;
         if (!stale[s] || now - msg->utime > drop) {
