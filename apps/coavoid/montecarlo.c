@@ -444,82 +444,71 @@ static double cost_to_double(coa_cost_t c)
 
 /* Solves encounter (size, index) three ways into *r. Returns 0 or -1 with err (an error
  * of the tool, not of a plan: plans' defects go to r->defect). */
-static int solve_encounter(uint64_t seed, const mc_size_t *size, uint32_t index,
-                           const char *save_dir, mc_planners_t *p, mc_result_t *r, char *err,
-                           size_t err_size)
+/* Plans the encounter with method m into r->m[m], and records a defect when a solved plan
+ * has a conflict. -1 with err set when the planner failed. */
+static int solve_method(int m, const coa_problem_t *problem, const mc_size_t *size, uint32_t index,
+                        mc_planners_t *p, mc_result_t *r, char *err, size_t err_size)
 {
-    memset(r, 0, sizeof *r);
-    r->vehicles = size->n;
-    r->index = index;
-    if (planners_ready(p, size, err, err_size) != 0) {
-        return -1;
-    }
-    coavoid_scenario_t s;
-    if (draw_encounter(seed, size, index, save_dir, p, &s, r, err, err_size) != 0) {
-        return -1;
-    }
-    coa_problem_t problem = coavoid_scenario_problem(&s);
     size_t which[ENCOUNTER_MAX_VEHICLES];
-    for (size_t i = 0; i < size->n; i++) {
-        which[i] = i;
+    coa_plan_result_t result;
+    struct timespec start, end;
+    memset(&result, 0, sizeof result);
+    clock_gettime(CLOCK_MONOTONIC, &start);
+    int rc = m == MC_CENTRALISED
+                 ? coa_plan_centralised(p->central, problem, p->offsets, &result)
+                 : coa_plan_decoupled(p->decoupled, problem, NULL,
+                                      m == MC_FIXED ? 1u : size->max_orders, p->offsets, &result);
+    clock_gettime(CLOCK_MONOTONIC, &end);
+    if (rc != COA_OK) {
+        snprintf(err, err_size,
+                 "internal error: encounter %lu of %lu UAVs, %s: the "
+                 "planner failed (%s)",
+                 (unsigned long)index, (unsigned long)size->n, method_names[m],
+                 coa_status_name(rc));
+        return -1;
     }
-    int status = 0;
-    for (int m = 0; m < MC_METHODS && status == 0; m++) {
-        coa_plan_result_t result;
-        memset(&result, 0, sizeof result);
-        struct timespec start, end;
-        clock_gettime(CLOCK_MONOTONIC, &start);
-        int rc =
-            m == MC_CENTRALISED
-                ? coa_plan_centralised(p->central, &problem, p->offsets, &result)
-                : coa_plan_decoupled(p->decoupled, &problem, NULL,
-                                     m == MC_FIXED ? 1u : size->max_orders, p->offsets, &result);
-        clock_gettime(CLOCK_MONOTONIC, &end);
-        if (rc != COA_OK) {
-            snprintf(err, err_size,
-                     "internal error: encounter %lu of %lu UAVs, %s: the "
-                     "planner failed (%s)",
-                     (unsigned long)index, (unsigned long)size->n, method_names[m],
-                     coa_status_name(rc));
-            status = -1;
-            break;
+    mc_outcome_t *o = &r->m[m];
+    o->status = result.status;
+    o->deviation = result.deviation;
+    o->units = result.deviation_units;
+    o->effort = result.effort;
+    o->expanded = result.nodes_expanded;
+    o->generated = result.nodes_generated;
+    o->orders_tried = result.orders_tried;
+    o->time_us = bench_elapsed_ms(&start, &end) * 1e3;
+    if (result.status == COA_PLAN_SOLVED && r->defect[0] == '\0') {
+        size_t vehicle = 0;
+        uint32_t step = 0;
+        for (size_t i = 0; i < size->n; i++) {
+            which[i] = i;
         }
-        mc_outcome_t *o = &r->m[m];
-        o->status = result.status;
-        o->deviation = result.deviation;
-        o->units = result.deviation_units;
-        o->effort = result.effort;
-        o->expanded = result.nodes_expanded;
-        o->generated = result.nodes_generated;
-        o->orders_tried = result.orders_tried;
-        o->time_us = bench_elapsed_ms(&start, &end) * 1e3;
-        if (result.status == COA_PLAN_SOLVED && r->defect[0] == '\0') {
-            size_t vehicle = 0;
-            uint32_t step = 0;
-            rc = coa_plan_find_conflict(&problem, p->offsets, which, size->n, &vehicle, &step);
-            if (rc != 0) {
-                snprintf(r->defect, sizeof r->defect,
-                         "the %s plan has a conflict (check %d) "
-                         "at step %lu",
-                         method_names[m], rc, (unsigned long)step);
-            }
+        rc = coa_plan_find_conflict(problem, p->offsets, which, size->n, &vehicle, &step);
+        if (rc != 0) {
+            snprintf(r->defect, sizeof r->defect,
+                     "the %s plan has a conflict (check %d) "
+                     "at step %lu",
+                     method_names[m], rc, (unsigned long)step);
         }
     }
-    coavoid_scenario_free(&s);
+    return 0;
+}
+
+/* The defects the methods' outcomes can show against each other: the reference plan
+ * conflicts, so every plan moves someone (a deviation of 0 would be wrong, and the ratios
+ * divide by it); a decoupled plan is a plan for the whole group, which the centralised
+ * search cannot have proven absent, nor beaten. */
+static void cross_check(mc_result_t *r)
+{
     const mc_outcome_t *c = &r->m[MC_CENTRALISED];
-    /* The reference plan conflicts, so every plan moves someone: a deviation of 0 would
-     * be wrong (and the ratios divide by it). */
-    if (status == 0 && r->defect[0] == '\0' && c->status == COA_PLAN_SOLVED && c->units.hi == 0 &&
+    if (r->defect[0] == '\0' && c->status == COA_PLAN_SOLVED && c->units.hi == 0 &&
         c->units.lo == 0) {
         snprintf(r->defect, sizeof r->defect,
                  "the centralised plan has no deviation although "
                  "the reference plan conflicts at step %lu",
                  (unsigned long)r->first_conflict_step);
     }
-    for (int m = MC_FIXED; status == 0 && m < MC_METHODS && r->defect[0] == '\0'; m++) {
+    for (int m = MC_FIXED; m < MC_METHODS && r->defect[0] == '\0'; m++) {
         const mc_outcome_t *d = &r->m[m];
-        /* A decoupled plan is a plan for the whole group, which the centralised search
-         * cannot have proven absent. */
         if (c->status == COA_PLAN_INFEASIBLE && d->status == COA_PLAN_SOLVED) {
             snprintf(r->defect, sizeof r->defect,
                      "%s solved an encounter the centralised "
@@ -538,6 +527,31 @@ static int solve_encounter(uint64_t seed, const mc_size_t *size, uint32_t index,
                      method_names[m], cost_to_double(d->units), (unsigned long)d->effort,
                      cost_to_double(c->units), (unsigned long)c->effort);
         }
+    }
+}
+
+static int solve_encounter(uint64_t seed, const mc_size_t *size, uint32_t index,
+                           const char *save_dir, mc_planners_t *p, mc_result_t *r, char *err,
+                           size_t err_size)
+{
+    memset(r, 0, sizeof *r);
+    r->vehicles = size->n;
+    r->index = index;
+    if (planners_ready(p, size, err, err_size) != 0) {
+        return -1;
+    }
+    coavoid_scenario_t s;
+    if (draw_encounter(seed, size, index, save_dir, p, &s, r, err, err_size) != 0) {
+        return -1;
+    }
+    coa_problem_t problem = coavoid_scenario_problem(&s);
+    int status = 0;
+    for (int m = 0; m < MC_METHODS && status == 0; m++) {
+        status = solve_method(m, &problem, size, index, p, r, err, err_size);
+    }
+    coavoid_scenario_free(&s);
+    if (status == 0) {
+        cross_check(r);
     }
     return status;
 }
@@ -1074,14 +1088,9 @@ static void svg_cdf(FILE *f, const mc_result_t *results, uint32_t count, int m, 
     fprintf(f, " %.1f,%.1f\"/>\n", SVG_CDF_LEFT + SVG_CDF_W, last_py);
 }
 
-static int write_svg(const char *path, const mc_options_t *o, const mc_run_t *run,
-                     const mc_summary_t *s, uint32_t sizes, double *x)
+/* The figure's header and title (seed, count, the betas used). */
+static void svg_head(FILE *f, const mc_options_t *o, const mc_summary_t *s, uint32_t sizes)
 {
-    FILE *f = fopen(path, "w");
-    if (f == NULL) {
-        return -1;
-    }
-    const double y0 = SVG_PANEL_TOP + SVG_PANEL_H;
     fprintf(f,
             "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
             "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" "
@@ -1100,8 +1109,13 @@ static int write_svg(const char *path, const mc_options_t *o, const mc_run_t *ru
             "<text x=\"%.0f\" y=\"24\" font-size=\"15\" font-weight=\"bold\">coavoid "
             "montecarlo: seed %llu, %lu encounters per UAV count, beta %s</text>\n",
             SVG_BAR_LEFT, (unsigned long long)o->seed, (unsigned long)o->count, betas);
+}
 
-    /* Left: success rates, a group of three bars per UAV count, with Wilson intervals. */
+/* Left: success rates, a group of three bars per UAV count, with Wilson intervals; budget
+ * exhausted shown pale above a bar (unknown, not failed). */
+static void svg_rates(FILE *f, const mc_summary_t *s, uint32_t sizes)
+{
+    const double y0 = SVG_PANEL_TOP + SVG_PANEL_H;
     fprintf(f,
             "<text x=\"%.0f\" y=\"%.0f\" font-weight=\"bold\">success rate (95%% Wilson "
             "interval)</text>\n",
@@ -1148,8 +1162,13 @@ static int write_svg(const char *path, const mc_options_t *o, const mc_run_t *ru
     }
     fprintf(f, "<text x=\"%.0f\" y=\"%.0f\">pale above a bar: budget exhausted</text>\n",
             SVG_BAR_LEFT + 170, y0 + 44);
+}
 
-    /* Right: the CDF of the deviation ratio per UAV count, fixed solid, reordered dashed. */
+/* Right: the CDF of the deviation ratio per UAV count, fixed solid, reordered dashed. */
+static void svg_ratios(FILE *f, const mc_options_t *o, const mc_run_t *run, const mc_summary_t *s,
+                       uint32_t sizes, double *x)
+{
+    const double y0 = SVG_PANEL_TOP + SVG_PANEL_H;
     double right = cdf_right(s, sizes);
     fprintf(f,
             "<text x=\"%.0f\" y=\"%.0f\" font-weight=\"bold\">decoupled / centralised "
@@ -1202,6 +1221,18 @@ static int write_svg(const char *path, const mc_options_t *o, const mc_run_t *ru
         fprintf(f, "<text x=\"%.0f\" y=\"%.0f\">ratios above 10 at the right edge</text>\n",
                 SVG_CDF_LEFT + 110, y0 + 88);
     }
+}
+
+static int write_svg(const char *path, const mc_options_t *o, const mc_run_t *run,
+                     const mc_summary_t *s, uint32_t sizes, double *x)
+{
+    FILE *f = fopen(path, "w");
+    if (f == NULL) {
+        return -1;
+    }
+    svg_head(f, o, s, sizes);
+    svg_rates(f, s, sizes);
+    svg_ratios(f, o, run, s, sizes, x);
     fprintf(f, "</svg>\n");
     bool ok = !ferror(f);
     return fclose(f) == 0 && ok ? 0 : -1;
