@@ -3,7 +3,7 @@
  * coavoid world: the terrain database and the tracker of a real-time run, standing in for
  * the ground station's sources: every cycle it publishes the scenario's obstacle map and
  * the estimate of every non-cooperative track at that cycle's start. The node is
- * src/node/world.c, run in real time by apps/drivers/realtime.c. See WORLD_USAGE below.
+ * src/node/world.c, run in real time by src/realtime/realtime.c. See WORLD_USAGE below.
  */
 #define _POSIX_C_SOURCE 200809L
 
@@ -14,7 +14,7 @@
 #include "commands.h"
 
 #include "node.h"
-#include "realtime.h"
+#include "drivers.h"
 #include "scenario.h"
 
 #define WORLD_USAGE                                                                          \

@@ -17,7 +17,7 @@
 
 #include "cli.h"
 #include "node.h"
-#include "realtime.h"
+#include "drivers.h"
 #include "scenario.h"
 
 #define COORDINATOR_DEFAULT_MAX_CENTRALISED 3u

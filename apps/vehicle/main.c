@@ -16,7 +16,7 @@
 
 #include "cli.h"
 #include "node.h"
-#include "realtime.h"
+#include "drivers.h"
 #include "scenario.h"
 
 #define VEHICLE_USAGE                                                                             \

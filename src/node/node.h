@@ -3,7 +3,7 @@
  * node.h: the coavoid nodes (a UAV, the ground coordinator, and the "world" that stands
  * in for the terrain database and the tracker), written once and driven two ways:
  *   - in real time over UDP multicast by apps/vehicle, apps/coordinator and
- *     `coavoid world` (apps/drivers/realtime.h), one process each;
+ *     `coavoid world` (src/realtime/realtime.h), one process each;
  *   - deterministically in one process over LCM's memq provider by `coavoid sim`, which
  *     calls the same functions at simulated times.
  * A node never reads a clock: every call takes the time (utime, microseconds), and the

@@ -1,0 +1,162 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * drivers.c: the options every real-time driver shares, the set-up from a scenario and
+ * the run of one node with its summary line (drivers.h).
+ */
+#define _POSIX_C_SOURCE 200809L
+
+#include "drivers.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "cli.h"
+
+/* Largest --steps: a day of 0.1 s cycles; more is a typo, not a run. */
+#define RT_MAX_STEPS 1000000u
+
+/* ---- options ---- */
+
+void coavoid_rt_options_init(coavoid_rt_options_t *o)
+{
+    memset(o, 0, sizeof *o);
+    o->speed = 1.0;
+}
+
+int coavoid_rt_parse_option(int argc, char **argv, int *i, coavoid_rt_options_t *o)
+{
+    const char *arg = argv[*i];
+    uint64_t value = 0;
+    int status = CLI_UNKNOWN_OPTION;
+    if (coavoid_cli_option_is(arg, "--lcm-url")) {
+        status = coavoid_cli_text_option(argc, argv, i, "--lcm-url",
+                                         "an LCM URL, e.g. " COAVOID_RT_DEFAULT_LCM_URL, false,
+                                         &o->lcm_url);
+    } else if (coavoid_cli_option_is(arg, "--epoch")) {
+        status = coavoid_cli_text_option(
+            argc, argv, i, "--epoch", "wall-clock microseconds since 1970", true, &o->epoch_text);
+        if (status == CLI_CONTINUE && !coavoid_cli_parse_count(o->epoch_text, strlen(o->epoch_text),
+                                                               (uint64_t)INT64_MAX, &value)) {
+            status =
+                coavoid_cli_fail(CLI_EXIT_INVALID,
+                                 "--epoch: must be a positive integer (wall-clock microseconds "
+                                 "since 1970), got '%.40s'",
+                                 o->epoch_text);
+        }
+        o->epoch_utime = (int64_t)value;
+    } else if (coavoid_cli_option_is(arg, "--speed")) {
+        status = coavoid_cli_text_option(argc, argv, i, "--speed",
+                                         "scenario seconds per wall second", true, &o->speed_text);
+        if (status == CLI_CONTINUE && (!coavoid_cli_parse_real(o->speed_text, &o->speed) ||
+                                       !(o->speed > 0) || o->speed > COAVOID_RT_MAX_SPEED)) {
+            status = coavoid_cli_fail(CLI_EXIT_INVALID,
+                                      "--speed: must be a number with 0 < S <= %g, got '%.40s'",
+                                      COAVOID_RT_MAX_SPEED, o->speed_text);
+        }
+    } else if (coavoid_cli_option_is(arg, "--steps")) {
+        status = coavoid_cli_count_option(argc, argv, i, "--steps", "an integer >= 1", false,
+                                          RT_MAX_STEPS, &o->steps_text, &value);
+        o->steps = (int64_t)value;
+    }
+    return status;
+}
+
+int coavoid_rt_options_finish(coavoid_rt_options_t *o, int64_t dt_us, uint32_t horizon)
+{
+    if (o->lcm_url == NULL) {
+        o->lcm_url = COAVOID_RT_DEFAULT_LCM_URL;
+    }
+    if (o->steps_text == NULL) {
+        o->steps = 2 * (int64_t)horizon;
+    }
+    int64_t now = coavoid_rt_wall_utime();
+    if (o->epoch_text == NULL) {
+        o->epoch_utime = now;
+        return CLI_CONTINUE;
+    }
+    if (o->epoch_utime > now && o->epoch_utime - now > COAVOID_RT_MAX_EPOCH_AHEAD_US) {
+        return coavoid_cli_fail(
+            CLI_EXIT_INVALID,
+            "--epoch: %lld is more than a day ahead of this clock (%lld): it is "
+            "microseconds since 1970, e.g. $(( $(date +%%s) + 2 ))000000",
+            (long long)o->epoch_utime, (long long)now);
+    }
+    /* The run's last event is the start of cycle K, in wall time. */
+    double run_us = (double)o->steps * (double)dt_us / o->speed;
+    double end = (double)o->epoch_utime + run_us;
+    if (end < (double)now) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                "--epoch: the run of %lld cycles from %lld ended %.1f s ago (this "
+                                "clock: %lld)",
+                                (long long)o->steps, (long long)o->epoch_utime,
+                                ((double)now - end) * 1e-6, (long long)now);
+    }
+    return CLI_CONTINUE;
+}
+
+int coavoid_rt_setup(const char *path, coavoid_scenario_t *s, coavoid_rt_options_t *o,
+                     const int64_t *now, coavoid_node_common_t *common)
+{
+    int status = coavoid_cli_sample_scenario(path, s);
+    if (status != CLI_CONTINUE) {
+        return status;
+    }
+    if (s->horizon > COAVOID_NODE_MAX_HORIZON) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                "%s: horizon: %lu steps, the nodes' messages carry at most %u",
+                                path, (unsigned long)s->horizon, COAVOID_NODE_MAX_HORIZON);
+    }
+    int64_t dt_us = llround((double)s->dt * 1e6);
+    if (dt_us < 1) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: dt: below a microsecond", path);
+    }
+    status = coavoid_rt_options_finish(o, dt_us, s->horizon);
+    if (status != CLI_CONTINUE) {
+        return status;
+    }
+    if (coavoid_node_common_defaults(common, o->epoch_utime, s->dt, s->horizon, now) != COA_OK) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: dt or horizon refused by the nodes", path);
+    }
+    common->stopwatch_us = coavoid_rt_stopwatch_us;
+    common->stopwatch_user = NULL;
+    if (s->has_beta) {
+        common->beta = s->beta;
+    }
+    return CLI_CONTINUE;
+}
+
+/* ---- the loop ---- */
+
+void coavoid_rt_loop_init(coavoid_rt_loop_t *loop, const coavoid_rt_options_t *o, lcm_t *lcm,
+                          int64_t *now, const coavoid_node_common_t *common, const char *name)
+{
+    memset(loop, 0, sizeof *loop);
+    loop->clock.epoch_utime = o->epoch_utime;
+    loop->clock.speed = o->speed;
+    loop->lcm = lcm;
+    loop->now = now;
+    loop->common = common;
+    loop->steps = o->steps;
+    loop->name = name;
+    loop->warnings = stderr;
+}
+
+int coavoid_rt_drive(const coavoid_rt_loop_t *loop, const char *lcm_url, coavoid_rt_report_t report,
+                     void *user)
+{
+    if (coavoid_rt_install_signal_handlers() != 0) {
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "%s: cannot handle SIGINT/SIGTERM", loop->name);
+    }
+    coavoid_rt_result_t result;
+    int rc = coavoid_rt_run(loop, &result);
+    char tail[256];
+    coavoid_rt_result_text(&result, tail, sizeof tail);
+    report(user, loop->name, &result, tail);
+    if (rc != COA_OK) {
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "%s: LCM failed while running (%s)", loop->name,
+                                lcm_url);
+    }
+    return result.errors > 0 ? CLI_EXIT_INTERNAL : CLI_EXIT_OK;
+}

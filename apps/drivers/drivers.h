@@ -1,0 +1,81 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * drivers.h: what the real-time drivers (apps/coordinator, apps/vehicle, `coavoid world`)
+ * share on top of the loop of realtime.h: their common options (--lcm-url, --epoch,
+ * --speed, --steps), the set-up from a scenario, and running one node to the end with its
+ * summary line.
+ */
+#ifndef COAVOID_DRIVERS_H
+#define COAVOID_DRIVERS_H
+
+#include "realtime.h"
+#include "scenario.h"
+
+/* ---- options every driver shares ---- */
+
+typedef struct {
+    const char *lcm_url;    /* NULL until given; then COAVOID_RT_DEFAULT_LCM_URL */
+    const char *epoch_text; /* NULL until given */
+    int64_t epoch_utime;    /* --epoch; when not given, coavoid_rt_options_finish sets now */
+    const char *speed_text; /* NULL: 1 */
+    double speed;
+    const char *steps_text; /* NULL: 2N */
+    int64_t steps;          /* K >= 1 */
+} coavoid_rt_options_t;
+
+/* Sets the defaults (no epoch yet, speed 1, steps unset, the default URL). */
+void coavoid_rt_options_init(coavoid_rt_options_t *o);
+
+/* Whether argv[*i] is one of --lcm-url, --epoch, --speed, --steps; if so consumes it
+ * (and its value) and returns CLI_CONTINUE, or returns CLI_EXIT_INVALID after the one-line
+ * error (missing or bad value, given twice). Returns CLI_UNKNOWN_OPTION for any other
+ * argument (cli.h's option parser contract). */
+int coavoid_rt_parse_option(int argc, char **argv, int *i, coavoid_rt_options_t *o);
+
+/* After the scenario is loaded: steps defaults to 2 * horizon; the epoch defaults to now
+ * (a process run alone starts at once; processes that run together must all be given
+ * one --epoch); an epoch more than COAVOID_RT_MAX_EPOCH_AHEAD_US ahead, or one whose run of
+ * `steps` cycles of dt_us has already ended, is refused. Returns CLI_CONTINUE or
+ * CLI_EXIT_INVALID after the one-line error. */
+int coavoid_rt_options_finish(coavoid_rt_options_t *o, int64_t dt_us, uint32_t horizon);
+
+/* What every driver does once its options are parsed and the scenario at `path` is loaded
+ * into *s (coavoid_cli_run_scenario): samples it, refuses a horizon beyond COAVOID_NODE_MAX_HORIZON,
+ * finishes the options (coavoid_rt_options_finish), and fills *common with the node defaults
+ * on the scenario's dt and horizon, the epoch, `now` as the clock, the monotonic
+ * stopwatch, and the scenario's beta when it gives one. Returns CLI_CONTINUE, or
+ * CLI_EXIT_INVALID after the one-line error. Cost: sampling the scenario; no memory
+ * beyond the scenario's samples. */
+int coavoid_rt_setup(const char *path, coavoid_scenario_t *s, coavoid_rt_options_t *o,
+                     const int64_t *now, coavoid_node_common_t *common);
+
+/* The usage lines of the shared options (for each driver's --help). */
+#define COAVOID_RT_OPTIONS_USAGE                                                          \
+    "  --lcm-url URL       LCM provider; default " COAVOID_RT_DEFAULT_LCM_URL "\n"        \
+    "                      (ttl=0: the traffic stays on this host)\n"                     \
+    "  --epoch UTIME       wall-clock microseconds since 1970 at which cycle 0 starts;\n" \
+    "                      every process of a run must be given the same value;\n"        \
+    "                      default: now\n"                                                \
+    "  --speed S           scenario seconds per wall second, 0 < S <= 1000; default 1\n"  \
+    "  --steps K           run K cycles, flying samples 0..K; default 2 * horizon\n"
+
+/* Sets the loop's fields every driver sets alike: the clock (epoch, speed) and steps from
+ * the finished options, lcm, now, common, name, and warnings on stderr; the rest (the
+ * nodes, collect_us, world_lead_us) is zero for the caller to set. O(1). */
+void coavoid_rt_loop_init(coavoid_rt_loop_t *loop, const coavoid_rt_options_t *o, lcm_t *lcm,
+                          int64_t *now, const coavoid_node_common_t *common, const char *name);
+
+/* Prints a driver's summary line on stderr from its node's state, starting with the
+ * loop's name and ending with `tail` (coavoid_rt_result_text). */
+typedef void (*coavoid_rt_report_t)(void *user, const char *name, const coavoid_rt_result_t *result,
+                                    const char *tail);
+
+/* What every driver does once its node is in the loop: installs the signal handlers, runs
+ * the loop and calls report. Returns CLI_EXIT_OK, or CLI_EXIT_INTERNAL when a node call
+ * failed, or after the line "NAME: cannot handle SIGINT/SIGTERM" (nothing ran) or "NAME:
+ * LCM failed while running (URL)". The caller destroys its node and the LCM afterwards.
+ * Cost and memory: coavoid_rt_run's. */
+int coavoid_rt_drive(const coavoid_rt_loop_t *loop, const char *lcm_url, coavoid_rt_report_t report,
+                     void *user);
+
+#endif /* COAVOID_DRIVERS_H */
