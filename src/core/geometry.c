@@ -300,13 +300,7 @@ coa_box_t coa_obstacle_bounds(const coa_obstacle_t *o)
     b.min = o->polytope.vertices[0];
     b.max = o->polytope.vertices[0];
     for (v = 1; v < o->polytope.count; ++v) {
-        const coa_vec3_t *q = &o->polytope.vertices[v];
-        b.min.x = q->x < b.min.x ? q->x : b.min.x;
-        b.min.y = q->y < b.min.y ? q->y : b.min.y;
-        b.min.z = q->z < b.min.z ? q->z : b.min.z;
-        b.max.x = q->x > b.max.x ? q->x : b.max.x;
-        b.max.y = q->y > b.max.y ? q->y : b.max.y;
-        b.max.z = q->z > b.max.z ? q->z : b.max.z;
+        box_include(&b, &o->polytope.vertices[v]);
     }
     return b;
 }
@@ -519,12 +513,7 @@ static int polytope_scene(const coa_sweep_t *a, const coa_polytope_t *poly, coa_
         if (!vec_finite(p)) {
             return COA_ERR_ARGUMENT;
         }
-        poly_box->min.x = p->x < poly_box->min.x ? p->x : poly_box->min.x;
-        poly_box->min.y = p->y < poly_box->min.y ? p->y : poly_box->min.y;
-        poly_box->min.z = p->z < poly_box->min.z ? p->z : poly_box->min.z;
-        poly_box->max.x = p->x > poly_box->max.x ? p->x : poly_box->max.x;
-        poly_box->max.y = p->y > poly_box->max.y ? p->y : poly_box->max.y;
-        poly_box->max.z = p->z > poly_box->max.z ? p->z : poly_box->max.z;
+        box_include(poly_box, p);
         *m = mpr_max(*m, vec_max_abs(p));
     }
     return COA_OK;

@@ -121,6 +121,17 @@ static inline coa_box_t box_widened(coa_box_t b, coa_real_t slack)
     return b;
 }
 
+/* b grown to hold point p (the bounding box of a set of points, one point at a time). */
+static inline void box_include(coa_box_t *b, const coa_vec3_t *p)
+{
+    b->min.x = p->x < b->min.x ? p->x : b->min.x;
+    b->min.y = p->y < b->min.y ? p->y : b->min.y;
+    b->min.z = p->z < b->min.z ? p->z : b->min.z;
+    b->max.x = p->x > b->max.x ? p->x : b->max.x;
+    b->max.y = p->y > b->max.y ? p->y : b->max.y;
+    b->max.z = p->z > b->max.z ? p->z : b->max.z;
+}
+
 /* The largest of m and |p|'s coordinates. */
 static inline coa_real_t real_max_abs3(const coa_vec3_t *p, coa_real_t m)
 {

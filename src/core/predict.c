@@ -624,12 +624,7 @@ static void align_plan(coa_predictor_t *pr, size_t i, const coa_intent_plan_t *p
     rb->min = row[0];
     rb->max = row[0];
     for (k = 1; k <= c->horizon; ++k) {
-        rb->min.x = row[k].x < rb->min.x ? row[k].x : rb->min.x;
-        rb->min.y = row[k].y < rb->min.y ? row[k].y : rb->min.y;
-        rb->min.z = row[k].z < rb->min.z ? row[k].z : rb->min.z;
-        rb->max.x = row[k].x > rb->max.x ? row[k].x : rb->max.x;
-        rb->max.y = row[k].y > rb->max.y ? row[k].y : rb->max.y;
-        rb->max.z = row[k].z > rb->max.z ? row[k].z : rb->max.z;
+        box_include(rb, &row[k]);
     }
 }
 
