@@ -116,21 +116,43 @@ static bool pair_layout(coa_planner_t *pl, plan_pair_t *p, size_t a, size_t b,
     return true;
 }
 
+/* One row of a pair as its cells are read: NULL cells when the row is not the pair's. */
+typedef struct {
+    coa_cost_t *cells;
+    int16_t a_lo, a_hi, b_lo, b_hi; /* the row's corridor */
+    size_t b_width;
+} pair_view_t;
+
+static pair_view_t pair_view(const plan_pair_t *p, uint32_t k)
+{
+    pair_view_t v = {NULL, 0, -1, 0, -1, 0u};
+    if (k >= p->first && k <= p->last) {
+        const size_t r = (size_t)(k - p->first);
+        const int16_t *c = &p->row_lo[4u * r];
+        v.cells = &p->cells[p->row_base[r]];
+        v.a_lo = c[0];
+        v.a_hi = c[1];
+        v.b_lo = c[2];
+        v.b_hi = c[3];
+        v.b_width = width(c[2], c[3]);
+    }
+    return v;
+}
+
+/* The view's cell of (oa, ob): NULL outside the row or its corridor. */
+static coa_cost_t *pair_view_cell(const pair_view_t *v, int32_t oa, int32_t ob)
+{
+    if (v->cells == NULL || oa < v->a_lo || oa > v->a_hi || ob < v->b_lo || ob > v->b_hi) {
+        return NULL;
+    }
+    return &v->cells[(size_t)(oa - v->a_lo) * v->b_width + (size_t)(ob - v->b_lo)];
+}
+
 /* The pair's cell at (k, oa, ob): NULL outside its rows or corridor. */
 static coa_cost_t *pair_cell(const plan_pair_t *p, uint32_t k, int32_t oa, int32_t ob)
 {
-    const int16_t *c;
-    size_t r;
-    if (k < p->first || k > p->last) {
-        return NULL;
-    }
-    r = (size_t)(k - p->first);
-    c = &p->row_lo[4u * r];
-    if (oa < c[0] || oa > c[1] || ob < c[2] || ob > c[3]) {
-        return NULL;
-    }
-    return &p->cells[p->row_base[r] + (size_t)(oa - c[0]) * width(c[2], c[3]) +
-                     (size_t)(ob - c[2])];
+    const pair_view_t v = pair_view(p, k);
+    return pair_view_cell(&v, oa, ob);
 }
 
 /* One member's moves out of (k, o) as packed step costs and targets, cheapest first by
@@ -192,52 +214,33 @@ static void pair_moves(const coa_planner_t *pl, size_t i, uint32_t k, int32_t o,
     }
 }
 
-/* Row k + 1 of a pair, as pair_value reads it for every combination of moves: NULL
- * cells past the pair's last row, where the pair's cost to go is the sum of its members'
- * own (so a combination costs exactly its two moves' `alone`). */
-typedef struct {
-    const coa_cost_t *cells;
-    int16_t a_lo, a_hi, b_lo, b_hi;
-    size_t b_width;
-} pair_next_t;
-
-static pair_next_t pair_next_row(const plan_pair_t *p, uint32_t k)
+/* Row k + 1 of a pair, as pair_value reads it for every combination of moves: no cells
+ * past the pair's last row, where the pair's cost to go is the sum of its members' own (so
+ * a combination costs exactly its two moves' `alone`). */
+static pair_view_t pair_next_row(const plan_pair_t *p, uint32_t k)
 {
-    pair_next_t n = {NULL, 0, -1, 0, -1, 0u};
-    if (k < p->last) {
-        const size_t r = (size_t)(k + 1u - p->first);
-        const int16_t *c = &p->row_lo[4u * r];
-        n.cells = &p->cells[p->row_base[r]];
-        n.a_lo = c[0];
-        n.a_hi = c[1];
-        n.b_lo = c[2];
-        n.b_hi = c[3];
-        n.b_width = width(c[2], c[3]);
-    }
-    return n;
+    pair_view_t none = {NULL, 0, -1, 0, -1, 0u};
+    return k < p->last ? pair_view(p, k + 1u) : none;
 }
 
 /* What moves x of a and y of b cost the pair from (k, ., .) on, conflicts aside. */
-static coa_cost_t pair_next(const pair_next_t *n, const pair_moves_t *ma, uint32_t x,
+static coa_cost_t pair_next(const pair_view_t *n, const pair_moves_t *ma, uint32_t x,
                             const pair_moves_t *mb, uint32_t y)
 {
-    const int32_t a2 = ma->to[x];
-    const int32_t b2 = mb->to[y];
+    const coa_cost_t *c;
     if (n->cells == NULL) {
         return plan_cost_add(ma->alone[x], mb->alone[y]);
     }
-    if (a2 < n->a_lo || a2 > n->a_hi || b2 < n->b_lo || b2 > n->b_hi) {
+    c = pair_view_cell(n, ma->to[x], mb->to[y]);
+    if (c == NULL || plan_cost_dead(*c)) {
         return PLAN_COST_DEAD;
     }
-    {
-        coa_cost_t c = n->cells[(size_t)(a2 - n->a_lo) * n->b_width + (size_t)(b2 - n->b_lo)];
-        return plan_cost_dead(c) ? c : plan_cost_add(c, plan_cost_add(ma->step[x], mb->step[y]));
-    }
+    return plan_cost_add(*c, plan_cost_add(ma->step[x], mb->step[y]));
 }
 
 /* The pair's cell at (k, oa, ob) from the cells of row k + 1, given both members' moves
  * out of it. */
-static coa_cost_t pair_value(const pair_next_t *next, const pair_moves_t *ma,
+static coa_cost_t pair_value(const pair_view_t *next, const pair_moves_t *ma,
                              const pair_moves_t *mb, const coa_span_t *near)
 {
     coa_cost_t best = PLAN_COST_DEAD;
@@ -319,7 +322,7 @@ static void pair_row(coa_planner_t *pl, plan_pair_t *p, size_t a, size_t b, uint
                      const coa_cost_t *slack)
 {
     const int16_t *c = &p->row_lo[4u * (size_t)(k - p->first)];
-    const pair_next_t next = pair_next_row(p, k);
+    const pair_view_t next = pair_next_row(p, k);
     coa_span_t horizontal;
     const bool near = pair_near(pl, a, b, k, &horizontal);
     pair_moves_t mb[PAIR_BLOCK];
