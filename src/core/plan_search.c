@@ -612,15 +612,17 @@ static void cut(expansion_t *e, coa_cost_t bound)
     }
 }
 
-/* Whether a branch whose children's f is at least `bound` can be left: it generates none
- * (bound above the key) and cannot lower the next key (which an exact f found so far
- * already beats). Branches above the key are still searched while they might hold the
- * least f above it, so that the node goes back under its exact next key, never under a
- * bound that would make it come back with nothing to generate. */
-static bool beyond(const expansion_t *e, coa_cost_t bound)
+/* Whether a branch whose children's f is at least `bound` can be left: all of them cost
+ * more than the cap or the bound (none would be stored, and a next key above it retires
+ * the node), or it generates none (bound above the key) and cannot lower the next key
+ * (which an exact f found so far already beats). Branches above the key are still
+ * searched while they might hold the least f above it, so that the node goes back under
+ * its exact next key, never under a bound that would make it come back with nothing to
+ * generate. */
+static bool beyond(const coa_planner_t *pl, const expansion_t *e, coa_cost_t bound)
 {
-    return plan_cost_compare(bound, e->key) > 0 && e->have_next &&
-           plan_cost_compare(bound, e->next) >= 0;
+    return over(pl, bound) || (plan_cost_compare(bound, e->key) > 0 && e->have_next &&
+                               plan_cost_compare(bound, e->next) >= 0);
 }
 
 /* Chooser c takes option choice[c]: its offset at k + 1, and, if it is in the search
@@ -752,8 +754,7 @@ static bool enumerate(coa_planner_t *pl, expansion_t *e, plan_search_out_t *out)
         }
         inc = increase(pl, &e->ch, c, e->k, e->choice[c]);
         bound = plan_cost_add(plan_cost_add(e->partial[c], inc), e->ch.rest_min[c + 1u]);
-        if (beyond(e, plan_cost_add(bound, e->pairmax[c])) ||
-            over(pl, plan_cost_add(bound, e->pairmax[c]))) {
+        if (beyond(pl, e, plan_cost_add(bound, e->pairmax[c]))) {
             e->choice[c] = e->ch.options[c]; /* cheapest first: the rest go past it too */
             continue;
         }
@@ -763,7 +764,7 @@ static bool enumerate(coa_planner_t *pl, expansion_t *e, plan_search_out_t *out)
             continue;
         }
         bound = plan_cost_add(bound, e->pairmax[c + 1u]);
-        if (beyond(e, bound) || over(pl, bound)) {
+        if (beyond(pl, e, bound)) {
             ++e->choice[c];
             continue;
         }
