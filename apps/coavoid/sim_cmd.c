@@ -142,6 +142,7 @@ typedef struct {
     size_t samples; /* steps + 1 */
     int64_t now;    /* the nodes' clock (common.clock points here) */
     coavoid_node_common_t common;
+    int64_t collect_us; /* the coordinator plans this long after each cycle start */
     uint32_t vehicle_beta;
     uint32_t coordinator_beta;
     size_t max_centralised;
@@ -549,6 +550,7 @@ static int sim_check(sim_run_t *r, coavoid_scenario_t *s)
                                 "%s: dt: %g s cannot be a cycle (whole microseconds, at most %g s)",
                                 file, (double)s->dt, COAVOID_LCM_MAX_STEP);
     }
+    r->collect_us = r->common.dt_us / 4 > 0 ? r->common.dt_us / 4 : 1;
     return check_message_limits(file, s, r->steps);
 }
 
@@ -702,7 +704,7 @@ static int sim_coordinator(sim_run_t *r)
     config.common.beta = r->coordinator_beta;
     config.id = COAVOID_NODE_COORDINATOR_ID;
     config.max_centralised = r->max_centralised;
-    config.collect_us = r->common.dt_us / 4 > 0 ? r->common.dt_us / 4 : 1;
+    config.collect_us = r->collect_us;
     if (config.collect_us >= r->common.dt_us) {
         return coavoid_cli_fail(CLI_EXIT_INVALID,
                                 "%s: dt: %g s leaves the coordinator no time within a cycle",
@@ -759,7 +761,6 @@ static bool sim_waits(sim_run_t *r, int *node_error)
  * published, as on a quiet network. False when LCM failed. */
 static bool sim_cycle(sim_run_t *r, uint32_t k, int *node_error)
 {
-    const int64_t collect_us = r->common.dt_us / 4 > 0 ? r->common.dt_us / 4 : 1;
     if (r->coordinator != NULL && r->o->stop_text != NULL && k == r->o->stop_step) {
         r->coordinator_plans = coavoid_coordinator_state(r->coordinator)->plans_run;
         coavoid_coordinator_destroy(r->coordinator);
@@ -778,7 +779,7 @@ static bool sim_cycle(sim_run_t *r, uint32_t k, int *node_error)
     lcm_ok = lcm_ok && sim_waits(r, node_error);
     /* The coordinator plans cycles 0..K-1: cycle K only flies the last sample. */
     if (r->coordinator != NULL && k < r->steps && lcm_ok) {
-        r->now = cycle_start + collect_us > r->now ? cycle_start + collect_us : r->now;
+        r->now = cycle_start + r->collect_us > r->now ? cycle_start + r->collect_us : r->now;
         rc = coavoid_coordinator_cycle(r->coordinator, r->now);
         *node_error = *node_error != COA_OK ? *node_error : rc;
         lcm_ok = drain(r->lcm);
