@@ -124,35 +124,14 @@ bool coavoid_cli_parse_index(const char *text, uint64_t max, uint64_t *out);
  * "inf" and hexadecimal, which in an option are more likely a mistake than meant. */
 bool coavoid_cli_parse_real(const char *text, double *out);
 
-/* The bound beta on the nodes each joint search stores when neither an option nor the
- * scenario's "beta" gives one (`coavoid plan`, `coavoid sim`, coavoid-coordinator,
- * bench plan, montecarlo). 200,000 nodes are 15-17 MB for 2-6 UAVs; at 20,000 a quarter
- * of bench plan's 4-UAV encounters and 14 % of montecarlo's 5-UAV ones ran out of beta,
- * at 200,000 none of either (docs/benchmarks.md, docs/evaluation.md). */
-#define CLI_DEFAULT_BETA 200000u
-/* The default beta is lowered until the workspace fits this many bytes (a default that
- * asks a laptop for gigabytes is a trap). A beta that is given is taken as given. */
-#define CLI_DEFAULT_WORKSPACE_MAX ((size_t)1u << 30)
-
-/* The planner config of a scenario (coa_planner_config_of: its horizon, largest steep
- * factor and offset bound) for `searched` UAVs a search and `beta`. The scenario need not
- * be sampled. Cannot fail for a scenario that coavoid_scenario_load accepted and searched in
- * 1..COA_MAX_CENTRALISED, beta >= 1 (asserted). */
-coa_planner_config_t coavoid_cli_planner_config(const coavoid_scenario_t *s, size_t searched,
-                                                uint32_t beta);
-
-/* Widens *into so that it also takes every problem `with` takes: the longer horizon, the
- * larger steep factor and offset bound (unbounded when either is). */
-void coavoid_cli_planner_config_widen(coa_planner_config_t *into, const coa_planner_config_t *with);
-
-/* Whether a planner of this config has a size and fits CLI_DEFAULT_WORKSPACE_MAX.
- * O(1), no memory, cannot fail. */
-bool coavoid_cli_workspace_fits(const coa_planner_config_t *config);
-
-/* The default beta for planners of this config (its beta ignored): CLI_DEFAULT_BETA, or
- * the largest beta whose workspace fits CLI_DEFAULT_WORKSPACE_MAX when that is smaller;
- * 0 when none does (the cost-to-go tables alone are too large: a very long horizon). */
-uint32_t coavoid_cli_default_beta(const coa_planner_config_t *config);
+/* The sizing policy moved to coavoid::scenario (scenario.h); these names stay until the
+ * last callers under apps/ use the library's. */
+#define CLI_DEFAULT_BETA COAVOID_DEFAULT_BETA
+#define CLI_DEFAULT_WORKSPACE_MAX COAVOID_DEFAULT_WORKSPACE_MAX
+#define coavoid_cli_planner_config coavoid_scenario_planner_config
+#define coavoid_cli_planner_config_widen coavoid_planner_config_widen
+#define coavoid_cli_workspace_fits coavoid_workspace_fits
+#define coavoid_cli_default_beta coavoid_default_beta
 
 /* Microseconds from start to end. */
 int64_t coavoid_cli_elapsed_us(const struct timespec *start, const struct timespec *end);

@@ -69,8 +69,8 @@ typedef struct {
 
 static void plan_help(void)
 {
-    printf(PLAN_USAGE, SCENARIO_MAX_BYTES / (1024u * 1024u), COA_MAX_CENTRALISED, CLI_DEFAULT_BETA,
-           COAVOID_DEFAULT_MAX_ORDERS, COAVOID_DEFAULT_MAX_ORDERS_COVER);
+    printf(PLAN_USAGE, SCENARIO_MAX_BYTES / (1024u * 1024u), COA_MAX_CENTRALISED,
+           COAVOID_DEFAULT_BETA, COAVOID_DEFAULT_MAX_ORDERS, COAVOID_DEFAULT_MAX_ORDERS_COVER);
 }
 
 static int plan_option(int argc, char **argv, int *i, void *options)
@@ -209,8 +209,8 @@ static uint32_t choose_beta(const plan_options_t *o, const coavoid_scenario_t *s
         snprintf(source, source_size, "%.400s: beta %lu", o->scenario_path, (unsigned long)s->beta);
         return s->beta;
     }
-    coa_planner_config_t shape = coavoid_cli_planner_config(s, searched, CLI_DEFAULT_BETA);
-    uint32_t beta = coavoid_cli_default_beta(&shape);
+    coa_planner_config_t shape = coavoid_scenario_planner_config(s, searched, COAVOID_DEFAULT_BETA);
+    uint32_t beta = coavoid_default_beta(&shape);
     snprintf(source, source_size, "default beta %lu", (unsigned long)beta);
     return beta;
 }
@@ -222,15 +222,15 @@ static int plan_allocate(const char *file, const char *beta_source, const coavoi
                          size_t searched, uint32_t beta, void **workspace, int32_t **offsets,
                          coa_planner_t **planner)
 {
-    coa_planner_config_t config = coavoid_cli_planner_config(s, searched, beta);
+    coa_planner_config_t config = coavoid_scenario_planner_config(s, searched, beta);
     /* The tables alone (every reachable step and offset) do not depend on beta: when they
      * pass the limit no beta helps, whatever --beta or the scenario say. */
-    if (beta == 0 || coa_planner_max_beta(&config, CLI_DEFAULT_WORKSPACE_MAX) == 0) {
+    if (beta == 0 || coa_planner_max_beta(&config, COAVOID_DEFAULT_WORKSPACE_MAX) == 0) {
         return coavoid_cli_fail(
             CLI_EXIT_INVALID,
             "%s: too large: the cost-to-go tables of a %lu-step horizon would not "
             "fit in %zu MiB of workspace (shorten the horizon or bound max_offset)",
-            file, (unsigned long)s->horizon, CLI_DEFAULT_WORKSPACE_MAX >> 20);
+            file, (unsigned long)s->horizon, COAVOID_DEFAULT_WORKSPACE_MAX >> 20);
     }
     size_t size = coa_planner_workspace_size(&config);
     if (size == 0) {

@@ -61,7 +61,7 @@ typedef struct {
 
 static void coordinator_help(void)
 {
-    printf(COORDINATOR_USAGE, CLI_DEFAULT_BETA, COA_MAX_CENTRALISED,
+    printf(COORDINATOR_USAGE, COAVOID_DEFAULT_BETA, COA_MAX_CENTRALISED,
            COORDINATOR_DEFAULT_MAX_CENTRALISED);
 }
 
@@ -159,8 +159,8 @@ static int run(void *options, coavoid_scenario_t *s)
         beta_source = "the scenario's beta";
     } else {
         coa_planner_config_t shape = coavoid_node_planner_config(
-            config.common.horizon, o->max_centralised, CLI_DEFAULT_BETA);
-        config.common.beta = coavoid_cli_default_beta(&shape);
+            config.common.horizon, o->max_centralised, COAVOID_DEFAULT_BETA);
+        config.common.beta = coavoid_default_beta(&shape);
         beta_source = "the default beta";
     }
     coa_planner_config_t planner_config =

@@ -72,6 +72,35 @@ coa_problem_t coavoid_scenario_problem(const coavoid_scenario_t *s);
 /* Index of the vehicle with this id, or -1. */
 long coavoid_scenario_vehicle_index(const coavoid_scenario_t *s, long id);
 
+/* ---- sizing a scenario's planners ----
+ * The policy every program shares for a planner's beta (`coavoid plan`, `coavoid sim`,
+ * coavoid-coordinator, bench plan, montecarlo): the scenario's "beta" or an option when one
+ * is given, taken as given; otherwise COAVOID_DEFAULT_BETA, lowered until the workspace fits
+ * COAVOID_DEFAULT_WORKSPACE_MAX (a default that asks a laptop for gigabytes is a trap).
+ * Why 200,000: docs/benchmarks.md and docs/evaluation.md ("beta"). */
+#define COAVOID_DEFAULT_BETA 200000u
+#define COAVOID_DEFAULT_WORKSPACE_MAX ((size_t)1u << 30)
+
+/* The planner config of a scenario (coa_planner_config_of: its horizon, largest steep
+ * factor and offset bound) for `searched` UAVs a search and `beta`. The scenario need not
+ * be sampled. Cannot fail for a scenario that coavoid_scenario_load accepted and searched in
+ * 1..COA_MAX_CENTRALISED, beta >= 1 (asserted). */
+coa_planner_config_t coavoid_scenario_planner_config(const coavoid_scenario_t *s, size_t searched,
+                                                     uint32_t beta);
+
+/* Widens *into so that it also takes every problem `with` takes: the longer horizon, the
+ * larger steep factor and offset bound (unbounded when either is). */
+void coavoid_planner_config_widen(coa_planner_config_t *into, const coa_planner_config_t *with);
+
+/* Whether a planner of this config has a size and fits COAVOID_DEFAULT_WORKSPACE_MAX.
+ * O(1), no memory, cannot fail. */
+bool coavoid_workspace_fits(const coa_planner_config_t *config);
+
+/* The default beta for planners of this config (its beta ignored): COAVOID_DEFAULT_BETA, or
+ * the largest beta whose workspace fits COAVOID_DEFAULT_WORKSPACE_MAX when that is smaller;
+ * 0 when none does (the cost-to-go tables alone are too large: a very long horizon). */
+uint32_t coavoid_default_beta(const coa_planner_config_t *config);
+
 void coavoid_scenario_free(coavoid_scenario_t *s);
 
 #endif /* COAVOID_APP_SCENARIO_H */
