@@ -1,0 +1,808 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * sim.c: the one-process closed loop of sim.h. The nodes handle each message as soon as
+ * it is published (LCM's memq provider, drained after every step of a node), as on a
+ * quiet network, and the clock jumps from deadline to deadline.
+ */
+#define _POSIX_C_SOURCE 200809L
+
+#include <math.h>
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <lcm/lcm.h>
+
+#include "flight.h"
+#include "judge.h"
+#include "node.h"
+#include "sim.h"
+#include "sim_internal.h"
+
+/* Cycle 0's utime: a fixed constant (2001-09-09), never the wall clock, so that every
+ * run stamps its messages alike and prints the same result. */
+#define SIM_EPOCH_UTIME INT64_C(1000000000000000)
+typedef struct {
+    /* The run's parameters (sim_check, sim_planner_sizes). */
+    const coavoid_sim_config_t *o;
+    coavoid_sim_error_t *err;
+    FILE *out;
+    const coavoid_scenario_t *s;
+    const char *file;
+    size_t n;       /* UAVs */
+    uint32_t steps; /* samples 0..steps are flown */
+    size_t samples; /* steps + 1 */
+    int64_t now;    /* the nodes' clock (common.clock points here) */
+    coavoid_node_common_t common;
+    int64_t collect_us; /* the coordinator plans this long after each cycle start */
+    uint32_t vehicle_beta;
+    uint32_t coordinator_beta;
+    size_t max_centralised;
+    uint32_t coordinator_plans; /* plans the coordinator ran, when it stopped or at the end */
+    /* What the run holds (sim_run_free releases it). */
+    lcm_t *lcm;
+    coavoid_world_t *world;
+    coavoid_coordinator_t *coordinator;
+    coavoid_vehicle_node_t **vehicles; /* in priority order: the order they run in */
+    size_t *index;                     /* index[j]: scenario index of vehicles[j] */
+    coa_vec3_t *references;            /* by scenario index, rows of K + 1 */
+    int32_t *offsets;
+    coa_track_t *tracks; /* the world's copy when the scenario's ids do not fit */
+    coavoid_judged_t judged;
+    FILE *svg;
+} sim_run_t;
+
+static void sim_run_free(sim_run_t *r, size_t n)
+{
+    coavoid_coordinator_destroy(r->coordinator);
+    if (r->vehicles != NULL) {
+        for (size_t j = 0; j < n; j++) {
+            coavoid_vehicle_node_destroy(r->vehicles[j]);
+        }
+    }
+    coavoid_world_destroy(r->world);
+    if (r->lcm != NULL) {
+        lcm_destroy(r->lcm);
+    }
+    free(r->vehicles);
+    free(r->index);
+    free(r->references);
+    free(r->offsets);
+    free(r->tracks);
+    if (r->svg != NULL) {
+        fclose(r->svg);
+    }
+}
+
+/* ---- what the messages can carry ----
+ *
+ * The nodes talk in messages whose numbers have bounds (coavoid_lcm.h, COAVOID_LCM_MAX_*) that
+ * a scenario's do not: coavoid plan takes a radius of 1e300 m. A node that cannot publish
+ * its intent, or a world that cannot publish a track, would stop the run as a failed node,
+ * so the whole run is checked before it starts, and the field is named. "The whole run":
+ * every sample a message of it carries, t_0 .. t_{K+N} (the intent of cycle K reaches N
+ * samples beyond the last flown one), as the nodes compute them. */
+
+#define SIM_INTENT "an intent"
+#define SIM_TRACK "a track message"
+#define SIM_MAP "an obstacle map"
+
+static bool beyond(double x, double limit)
+{
+    return !isfinite(x) || fabs(x) > limit;
+}
+
+/* The first coordinate of p that is beyond COAVOID_LCM_MAX_COORDINATE, as 'x', 'y' or 'z'
+ * with *value set; or 0. */
+static char far_axis(coa_vec3_t p, double *value)
+{
+    const double c[3] = {(double)p.x, (double)p.y, (double)p.z};
+    for (int a = 0; a < 3; a++) {
+        if (beyond(c[a], COAVOID_LCM_MAX_COORDINATE)) {
+            *value = c[a];
+            return (char)('x' + a);
+        }
+    }
+    return 0;
+}
+
+/* A vehicle's intents over samples 0..last: its volume, speeds and priority, and every
+ * reference point and the positions and velocities its offsets can give there. An offset
+ * at sample j is at most initial_offset + steep_factor * j climb steps from the reference
+ * (and within max_offset), whatever is planned. */
+/* Vehicle i's volume, speeds and priority within what an intent carries; *climb is the
+ * vertical speed its largest change of offset in one step adds. */
+static int check_vehicle_sizes(coavoid_sim_error_t *err, const char *file, size_t i,
+                               const coa_vehicle_t *v, double *climb)
+{
+    if (beyond((double)v->volume.radius, COAVOID_LCM_MAX_SIZE)) {
+        return coavoid_sim_fail(err, COAVOID_SIM_ERR_INPUT,
+                                "%s: vehicles[%zu].radius: %g m is beyond what " SIM_INTENT
+                                " carries (%g m)",
+                                file, i, (double)v->volume.radius, COAVOID_LCM_MAX_SIZE);
+    }
+    if (beyond((double)v->volume.half_height, COAVOID_LCM_MAX_SIZE)) {
+        return coavoid_sim_fail(err, COAVOID_SIM_ERR_INPUT,
+                                "%s: vehicles[%zu].half_height: %g m is beyond what " SIM_INTENT
+                                " carries (%g m)",
+                                file, i, (double)v->volume.half_height, COAVOID_LCM_MAX_SIZE);
+    }
+    if (beyond((double)v->cruise_speed, COAVOID_LCM_MAX_SPEED)) {
+        return coavoid_sim_fail(err, COAVOID_SIM_ERR_INPUT,
+                                "%s: vehicles[%zu].cruise_speed: %g m/s is beyond what " SIM_INTENT
+                                " carries (%g m/s)",
+                                file, i, (double)v->cruise_speed, COAVOID_LCM_MAX_SPEED);
+    }
+    uint32_t max_change = v->steep_factor;
+    if (v->max_offset >= 0 && (uint64_t)2u * (uint32_t)v->max_offset < max_change) {
+        max_change = 2u * (uint32_t)v->max_offset;
+    }
+    *climb = (double)max_change * (double)v->climb_rate;
+    if (beyond(*climb, COAVOID_LCM_MAX_SPEED)) {
+        return coavoid_sim_fail(err, COAVOID_SIM_ERR_INPUT,
+                                "%s: vehicles[%zu].climb_rate: %g m/s, %g m/s in a steep climb, is "
+                                "beyond what " SIM_INTENT " carries (%g m/s)",
+                                file, i, (double)v->climb_rate, *climb, COAVOID_LCM_MAX_SPEED);
+    }
+    if (v->priority > (uint32_t)INT32_MAX) {
+        return coavoid_sim_fail(err, COAVOID_SIM_ERR_INPUT,
+                                "%s: vehicles[%zu].priority: %lu is beyond what " SIM_INTENT
+                                " carries (%ld)",
+                                file, i, (unsigned long)v->priority, (long)INT32_MAX);
+    }
+    return SIM_GO_ON;
+}
+
+/* The step from sample `previous` to r (at t): the intent's velocity is that step, and
+ * consecutive reference points must differ horizontally in the core's precision, as the
+ * intent's check judges them (a route far out flown very slowly does not). */
+static int check_vehicle_step(coavoid_sim_error_t *err, const char *file, size_t i,
+                              const coa_vehicle_t *v, coa_real_t dt, coa_real_t t,
+                              coa_vec3_t previous, coa_vec3_t r, double climb)
+{
+    const double vx = (double)((r.x - previous.x) / dt);
+    const double vy = (double)((r.y - previous.y) / dt);
+    const double vz = fabs((double)((r.z - previous.z) / dt)) + climb;
+    if (beyond(vx, COAVOID_LCM_MAX_SPEED) || beyond(vy, COAVOID_LCM_MAX_SPEED) ||
+        beyond(vz, COAVOID_LCM_MAX_SPEED)) {
+        return coavoid_sim_fail(err, COAVOID_SIM_ERR_INPUT,
+                                "%s: vehicles[%zu].route: its reference moves at (%g, %g) m/s "
+                                "horizontally and %g m/s vertically with its steepest climb at t = "
+                                "%g s, beyond what " SIM_INTENT " carries (%g m/s each)",
+                                file, i, vx, vy, vz, (double)t, COAVOID_LCM_MAX_SPEED);
+    }
+    const coa_vec3_t leg[2] = {previous, r};
+    coa_vehicle_t probe = *v;
+    probe.route = leg;
+    probe.route_count = 2u;
+    probe.initial_offset = 0;
+    if (coa_vehicle_check(&probe) != COA_OK) {
+        return coavoid_sim_fail(err, COAVOID_SIM_ERR_INPUT,
+                                "%s: vehicles[%zu].cruise_speed: %g m/s moves it too little in a "
+                                "step to tell its position at t = %g s from the one before "
+                                "(%.10g, %.10g m), as " SIM_INTENT " must",
+                                file, i, (double)v->cruise_speed, (double)t, (double)r.x,
+                                (double)r.y);
+    }
+    return SIM_GO_ON;
+}
+
+static int check_vehicle_limits(coavoid_sim_error_t *err, const char *file, size_t i,
+                                const coa_vehicle_t *v, coa_real_t dt, uint64_t last)
+{
+    double climb = 0.0;
+    int status = check_vehicle_sizes(err, file, i, v, &climb);
+    if (status != SIM_GO_ON) {
+        return status;
+    }
+    const double dh = (double)coa_climb_step(v, dt);
+    const int64_t bound = v->max_offset >= 0 ? v->max_offset : COA_MAX_OFFSET;
+    const int64_t initial =
+        v->initial_offset < 0 ? -(int64_t)v->initial_offset : (int64_t)v->initial_offset;
+    coa_vec3_t previous = coa_reference_at(v, (coa_real_t)0);
+    for (uint64_t j = 0; j <= last; j++) {
+        const coa_real_t t = (coa_real_t)j * dt;
+        const coa_vec3_t r = j == 0u ? previous : coa_reference_at(v, t);
+        double value = 0.0;
+        char axis = far_axis(r, &value);
+        if (axis != 0) {
+            return coavoid_sim_fail(
+                err, COAVOID_SIM_ERR_INPUT,
+                "%s: vehicles[%zu].route: its reference reaches %c = %.10g m at t "
+                "= %g s, beyond what " SIM_INTENT " carries (%g m; this run's "
+                "intents reach t = %g s)",
+                file, i, axis, value, (double)t, COAVOID_LCM_MAX_COORDINATE,
+                (double)last * (double)dt);
+        }
+        const int64_t reach_steps = initial + (int64_t)v->steep_factor * (int64_t)j;
+        const int64_t reach = reach_steps < bound ? reach_steps : bound;
+        const double top = fabs((double)r.z) + (double)reach * dh;
+        if (beyond(top, COAVOID_LCM_MAX_COORDINATE)) {
+            return coavoid_sim_fail(
+                err, COAVOID_SIM_ERR_INPUT,
+                "%s: vehicles[%zu]: at t = %g s its reference is at z = %.10g m, "
+                "and the %lld climb steps of %g m it may have taken by then take "
+                "|z| to %.10g m: beyond what " SIM_INTENT " carries (%g m)",
+                file, i, (double)t, (double)r.z, (long long)reach, dh, top,
+                COAVOID_LCM_MAX_COORDINATE);
+        }
+        if (j > 0u) {
+            status = check_vehicle_step(err, file, i, v, dt, t, previous, r, climb);
+            if (status != SIM_GO_ON) {
+                return status;
+            }
+        }
+        previous = r;
+    }
+    return SIM_GO_ON;
+}
+
+/* A track's messages over cycles 0..steps (world.c): its volume and sigmas, and at each
+ * cycle its velocity (a path track's: that of the leg in use) and position; a path track's
+ * message also carries its path over the next horizon, so its points and positions up to
+ * sample `last` too. */
+/* Track i's speeds within what a track message carries: its velocity, or the speed of the
+ * leg in use at each step t_k, as coa_track_at and the world choose it (the first one
+ * before path[1], the last one from path[last - 1] on). */
+static int check_track_speeds(coavoid_sim_error_t *err, const char *file, size_t i,
+                              const coa_track_t *tr, coa_real_t dt, uint64_t steps)
+{
+    if (tr->path_count == 0u) {
+        double value = 0.0;
+        const coa_vec3_t v = tr->velocity;
+        if (beyond((double)v.x, COAVOID_LCM_MAX_SPEED) ||
+            beyond((double)v.y, COAVOID_LCM_MAX_SPEED) ||
+            beyond((double)v.z, COAVOID_LCM_MAX_SPEED)) {
+            value = beyond((double)v.x, COAVOID_LCM_MAX_SPEED)   ? (double)v.x
+                    : beyond((double)v.y, COAVOID_LCM_MAX_SPEED) ? (double)v.y
+                                                                 : (double)v.z;
+            return coavoid_sim_fail(err, COAVOID_SIM_ERR_INPUT,
+                                    "%s: tracks[%zu].velocity: %g m/s is beyond what " SIM_TRACK
+                                    " carries (%g m/s)",
+                                    file, i, value, COAVOID_LCM_MAX_SPEED);
+        }
+    } else if (tr->path_count > 1u) {
+        const size_t final = tr->path_count - 1u;
+        size_t leg = 0;
+        for (uint64_t k = 0; k <= steps; k++) {
+            const coa_real_t t = (coa_real_t)k * dt;
+            while (leg + 1u < final && !(t < tr->path[leg + 1u].t)) {
+                leg++;
+            }
+            const coa_track_point_t *a = &tr->path[leg];
+            const coa_track_point_t *b = &tr->path[leg + 1u];
+            const coa_real_t span = b->t - a->t;
+            const double v[3] = {(double)((b->p.x - a->p.x) / span),
+                                 (double)((b->p.y - a->p.y) / span),
+                                 (double)((b->p.z - a->p.z) / span)};
+            for (int c = 0; c < 3; c++) {
+                if (beyond(v[c], COAVOID_LCM_MAX_SPEED)) {
+                    return coavoid_sim_fail(
+                        err, COAVOID_SIM_ERR_INPUT,
+                        "%s: tracks[%zu].path[%zu]: the leg to it is flown at %g m/s, "
+                        "beyond what " SIM_TRACK " carries (%g m/s)",
+                        file, i, leg + 1u, v[c], COAVOID_LCM_MAX_SPEED);
+                }
+            }
+        }
+    }
+    return SIM_GO_ON;
+}
+
+static int check_track_limits(coavoid_sim_error_t *err, const char *file, size_t i,
+                              const coa_track_t *tr, coa_real_t dt, uint64_t steps, uint64_t last)
+{
+    const struct {
+        const char *name;
+        coa_real_t value;
+    } sizes[4] = {{"radius", tr->volume.radius},
+                  {"half_height", tr->volume.half_height},
+                  {"sigma[0]", tr->sigma_horizontal},
+                  {"sigma[1]", tr->sigma_vertical}};
+    for (size_t f = 0; f < 4u; f++) {
+        if (beyond((double)sizes[f].value, COAVOID_LCM_MAX_SIZE)) {
+            return coavoid_sim_fail(
+                err, COAVOID_SIM_ERR_INPUT,
+                "%s: tracks[%zu].%s: %g m is beyond what " SIM_TRACK " carries (%g m)", file, i,
+                sizes[f].name, (double)sizes[f].value, COAVOID_LCM_MAX_SIZE);
+        }
+    }
+    int status = check_track_speeds(err, file, i, tr, dt, steps);
+    if (status != SIM_GO_ON) {
+        return status;
+    }
+    const uint64_t sampled = tr->path_count > 0u ? last : steps;
+    const coa_real_t end = (coa_real_t)sampled * dt;
+    for (size_t j = 0; j < tr->path_count; j++) {
+        double value = 0.0;
+        char axis = far_axis(tr->path[j].p, &value);
+        if (axis != 0 && tr->path[j].t > (coa_real_t)0 && tr->path[j].t < end) {
+            return coavoid_sim_fail(
+                err, COAVOID_SIM_ERR_INPUT,
+                "%s: tracks[%zu].path[%zu]: %c = %.10g m is beyond what " SIM_TRACK
+                " carries (%g m)",
+                file, i, j, axis, value, COAVOID_LCM_MAX_COORDINATE);
+        }
+    }
+    for (uint64_t j = 0; j <= sampled; j++) {
+        const coa_real_t t = (coa_real_t)j * dt;
+        double value = 0.0;
+        char axis = far_axis(coa_track_at(tr, t), &value);
+        if (axis != 0) {
+            return coavoid_sim_fail(
+                err, COAVOID_SIM_ERR_INPUT,
+                "%s: tracks[%zu]: at t = %g s it is at %c = %.10g m, beyond what " SIM_TRACK
+                " carries (%g m; this run's track messages reach t = %g "
+                "s)",
+                file, i, (double)t, axis, value, COAVOID_LCM_MAX_COORDINATE, (double)end);
+        }
+    }
+    return SIM_GO_ON;
+}
+
+static int check_obstacle_limits(coavoid_sim_error_t *err, const char *file, size_t i,
+                                 const coa_obstacle_t *o)
+{
+    double value = 0.0;
+    char axis = 0;
+    if (o->kind == COA_OBSTACLE_BOX) {
+        const char *corner = "min";
+        axis = far_axis(o->box.min, &value);
+        if (axis == 0) {
+            corner = "max";
+            axis = far_axis(o->box.max, &value);
+        }
+        if (axis != 0) {
+            return coavoid_sim_fail(err, COAVOID_SIM_ERR_INPUT,
+                                    "%s: obstacles[%zu].%s: %c = %.10g m is beyond what " SIM_MAP
+                                    " carries (%g m)",
+                                    file, i, corner, axis, value, COAVOID_LCM_MAX_COORDINATE);
+        }
+        return SIM_GO_ON;
+    }
+    for (size_t j = 0; j < o->polytope.count; j++) {
+        axis = far_axis(o->polytope.vertices[j], &value);
+        if (axis != 0) {
+            return coavoid_sim_fail(
+                err, COAVOID_SIM_ERR_INPUT,
+                "%s: obstacles[%zu].vertices[%zu]: %c = %.10g m is beyond what " SIM_MAP
+                " carries (%g m)",
+                file, i, j, axis, value, COAVOID_LCM_MAX_COORDINATE);
+        }
+    }
+    return SIM_GO_ON;
+}
+
+/* Every check above, over a run of `steps` cycles. Cost O((steps + N) * (vehicles * route +
+ * tracks * path) + obstacle vertices), no memory. */
+static int check_message_limits(coavoid_sim_error_t *err, const char *file,
+                                const coavoid_scenario_t *s, uint32_t steps)
+{
+    const uint64_t last = (uint64_t)steps + s->horizon;
+    int rc = SIM_GO_ON;
+    for (size_t i = 0; i < s->vehicle_count && rc == SIM_GO_ON; i++) {
+        rc = check_vehicle_limits(err, file, i, &s->vehicles[i], s->dt, last);
+    }
+    for (size_t i = 0; i < s->track_count && rc == SIM_GO_ON; i++) {
+        rc = check_track_limits(err, file, i, &s->tracks[i], s->dt, steps, last);
+    }
+    for (size_t i = 0; i < s->obstacle_count && rc == SIM_GO_ON; i++) {
+        rc = check_obstacle_limits(err, file, i, &s->obstacles[i]);
+    }
+    return rc;
+}
+
+/* Handles every queued message. false when LCM failed. */
+static bool drain(lcm_t *lcm)
+{
+    for (;;) {
+        int rc = lcm_handle_timeout(lcm, 0);
+        if (rc == 0) {
+            return true;
+        }
+        if (rc < 0) {
+            return false;
+        }
+    }
+}
+
+/* The scenario's limits for a simulation, then its samples and the nodes' common config. */
+static int sim_check(sim_run_t *r, coavoid_scenario_t *s)
+{
+    const char *file = r->file;
+    const size_t n = r->n;
+    if (s->horizon > COAVOID_NODE_MAX_HORIZON) {
+        return coavoid_sim_fail(
+            r->err, COAVOID_SIM_ERR_INPUT,
+            "%s: horizon: %lu steps, at most %u in a simulation (an intent carries "
+            "N + 1 samples)",
+            file, (unsigned long)s->horizon, COAVOID_NODE_MAX_HORIZON);
+    }
+    if (n > COA_MAX_VEHICLES || n > COAVOID_NODE_MAX_PEERS) {
+        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+                                "%s: vehicles: %zu UAVs, at most %u in a simulation", file, n,
+                                COA_MAX_VEHICLES < COAVOID_NODE_MAX_PEERS ? COA_MAX_VEHICLES
+                                                                          : COAVOID_NODE_MAX_PEERS);
+    }
+    if (s->track_count > COAVOID_NODE_MAX_TRACKS) {
+        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+                                "%s: tracks: %zu tracks, at most %u in a simulation", file,
+                                s->track_count, COAVOID_NODE_MAX_TRACKS);
+    }
+    r->steps = r->o->has_steps ? r->o->steps : 2u * s->horizon;
+    r->samples = (size_t)r->steps + 1u;
+    if (r->o->has_stop && r->o->stop_step > r->steps) {
+        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+                                "--coordinator-stops: step %lu is after the last, %lu",
+                                (unsigned long)r->o->stop_step, (unsigned long)r->steps);
+    }
+    char sample_err[SCENARIO_ERROR_MAX];
+    if (coavoid_scenario_sample(s, sample_err, sizeof sample_err) != 0) {
+        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT, "%s: %s", file, sample_err);
+    }
+    r->now = SIM_EPOCH_UTIME;
+    if (coavoid_node_common_defaults(&r->common, SIM_EPOCH_UTIME, s->dt, s->horizon, &r->now) !=
+        COA_OK) {
+        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+                                "%s: dt: %g s cannot be a cycle (whole microseconds, at most %g s)",
+                                file, (double)s->dt, COAVOID_LCM_MAX_STEP);
+    }
+    r->collect_us = r->common.dt_us / 4 > 0 ? r->common.dt_us / 4 : 1;
+    return check_message_limits(r->err, file, s, r->steps);
+}
+
+/* Planner sizes: each UAV plans alone; the coordinator searches up to max_centralised UAVs
+ * together, fewer when the scenario's beta would not fit the cap otherwise. */
+static int sim_planner_sizes(sim_run_t *r)
+{
+    const coavoid_scenario_t *s = r->s;
+    coa_planner_config_t vehicle_shape =
+        coavoid_node_planner_config(s->horizon, 1u, COAVOID_DEFAULT_BETA);
+    r->vehicle_beta = s->has_beta ? s->beta : coavoid_default_beta(&vehicle_shape);
+    vehicle_shape.beta = r->vehicle_beta;
+    if (r->vehicle_beta == 0 || !coavoid_workspace_fits(&vehicle_shape)) {
+        return coavoid_sim_fail(
+            r->err, COAVOID_SIM_ERR_INPUT,
+            "%s: beta: %lu is too large: a UAV's planner would not fit in 1 GiB", r->file,
+            (unsigned long)r->vehicle_beta);
+    }
+    r->max_centralised = r->n < COA_MAX_CENTRALISED ? r->n : COA_MAX_CENTRALISED;
+    coa_planner_config_t coordinator_shape =
+        coavoid_node_planner_config(s->horizon, r->max_centralised, COAVOID_DEFAULT_BETA);
+    r->coordinator_beta = s->has_beta ? s->beta : coavoid_default_beta(&coordinator_shape);
+    coordinator_shape.beta = r->coordinator_beta;
+    while (r->max_centralised > 1u && !coavoid_workspace_fits(&coordinator_shape)) {
+        coordinator_shape.vehicles = --r->max_centralised;
+    }
+    return SIM_GO_ON;
+}
+
+/* The flight record, the figure's file and LCM's in-process provider. */
+static int sim_open(sim_run_t *r)
+{
+    const size_t n = r->n;
+    r->vehicles = calloc(n, sizeof *r->vehicles);
+    r->index = calloc(n, sizeof *r->index);
+    r->references = calloc(n * r->samples, sizeof *r->references);
+    r->offsets = calloc(n * r->samples, sizeof *r->offsets);
+    if (r->vehicles == NULL || r->index == NULL || r->references == NULL || r->offsets == NULL) {
+        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+                                "%s: cannot allocate the record of %lu steps", r->file,
+                                (unsigned long)r->steps);
+    }
+    if (r->o->svg_path != NULL) {
+        r->svg = fopen(r->o->svg_path, "w");
+        if (r->svg == NULL) {
+            return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT, "--svg: cannot write '%.200s'",
+                                    r->o->svg_path);
+        }
+    }
+    r->lcm = lcm_create("memq://");
+    if (r->lcm == NULL) {
+        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INTERNAL,
+                                "internal error: LCM's memq provider is unavailable");
+    }
+    return SIM_GO_ON;
+}
+
+/* The world node. A track message numbers tracks 1..2^31-1, once each; the scenario may
+ * use any integer, so then the world's tracks are numbered by position instead (the ids
+ * only name tracks in the messages: the flight is judged on the scenario's own tracks). */
+static int sim_world(sim_run_t *r)
+{
+    const coavoid_scenario_t *s = r->s;
+    const coa_track_t *world_tracks = s->tracks;
+    bool ids_fit = true;
+    for (size_t i = 0; i < s->track_count; i++) {
+        ids_fit = ids_fit && s->tracks[i].id >= 1u && s->tracks[i].id <= (uint32_t)INT32_MAX;
+        for (size_t j = 0; j < i; j++) {
+            ids_fit = ids_fit && s->tracks[j].id != s->tracks[i].id;
+        }
+    }
+    if (!ids_fit) {
+        r->tracks = calloc(s->track_count, sizeof *r->tracks);
+        if (r->tracks == NULL) {
+            return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT, "%s: cannot allocate the tracks",
+                                    r->file);
+        }
+        for (size_t i = 0; i < s->track_count; i++) {
+            r->tracks[i] = s->tracks[i];
+            r->tracks[i].id = (uint32_t)i + 1u;
+        }
+        world_tracks = r->tracks;
+    }
+    int error = COA_OK;
+    coavoid_world_config_t world;
+    memset(&world, 0, sizeof world);
+    world.common = r->common;
+    world.id = COAVOID_NODE_WORLD_ID;
+    world.obstacles = s->obstacles;
+    world.obstacle_count = s->obstacle_count;
+    world.tracks = world_tracks;
+    world.track_count = s->track_count;
+    r->world = coavoid_world_create(&world, r->lcm, &error);
+    if (r->world == NULL && error == COA_ERR_ARGUMENT) {
+        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+                                "%s: obstacles: more than an obstacle map message holds (%d boxes, "
+                                "%d polytopes of at most %d vertices)",
+                                r->file, COAVOID_OBSTACLE_MAP_T_MAX_BOXES,
+                                COAVOID_OBSTACLE_MAP_T_MAX_POLYTOPES,
+                                COAVOID_OBSTACLE_MAP_T_MAX_VERTICES);
+    }
+    if (r->world == NULL) {
+        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INTERNAL,
+                                "internal error: out of memory for the world node");
+    }
+    return SIM_GO_ON;
+}
+
+/* The UAVs' nodes, in priority order (ascending priority, ties by ascending id), whatever
+ * the file's order or their ids: the order in which a real fleet's decisions settle. A UAV
+ * that has not yet heard a peer cannot wait for it (cycle 0, before anyone has published),
+ * so a lower priority stepped first would decide around nothing there. */
+static int sim_vehicles(sim_run_t *r)
+{
+    const coavoid_scenario_t *s = r->s;
+    if (coa_priority_order(s->vehicles, r->n, r->index) != COA_OK) {
+        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INTERNAL,
+                                "internal error: no priority order of %zu UAVs", r->n);
+    }
+    for (size_t j = 0; j < r->n; j++) {
+        size_t i = r->index[j];
+        int error = COA_OK;
+        coavoid_vehicle_node_config_t config;
+        memset(&config, 0, sizeof config);
+        config.common = r->common;
+        config.common.beta = r->vehicle_beta;
+        config.vehicle = s->vehicles[i];
+        config.mode = r->o->decoupled ? COAVOID_NODE_DECOUPLED : COAVOID_NODE_CENTRALISED;
+        r->vehicles[j] = coavoid_vehicle_node_create(&config, r->lcm, &error);
+        if (r->vehicles[j] == NULL && error == COA_ERR_ARGUMENT) {
+            return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+                                    "%s: vehicles[%zu]: cannot run as a node (%s)", r->file, i,
+                                    coavoid_lcm_error_name(error));
+        }
+        if (r->vehicles[j] == NULL) {
+            return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+                                    "%s: vehicles[%zu]: cannot allocate its node (beta %lu)",
+                                    r->file, i, (unsigned long)r->vehicle_beta);
+        }
+    }
+    return SIM_GO_ON;
+}
+
+/* The coordinator's node (centralised runs). */
+static int sim_coordinator(sim_run_t *r)
+{
+    if (r->o->decoupled) {
+        return SIM_GO_ON;
+    }
+    int error = COA_OK;
+    coavoid_coordinator_config_t config;
+    memset(&config, 0, sizeof config);
+    config.common = r->common;
+    config.common.beta = r->coordinator_beta;
+    config.id = COAVOID_NODE_COORDINATOR_ID;
+    config.max_centralised = r->max_centralised;
+    config.collect_us = r->collect_us;
+    if (config.collect_us >= r->common.dt_us) {
+        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+                                "%s: dt: %g s leaves the coordinator no time within a cycle",
+                                r->file, (double)r->s->dt);
+    }
+    r->coordinator = coavoid_coordinator_create(&config, r->lcm, &error);
+    if (r->coordinator == NULL && error == COA_ERR_ARGUMENT) {
+        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+                                "%s: beta: %lu cannot size the coordinator's planner", r->file,
+                                (unsigned long)r->coordinator_beta);
+    }
+    if (r->coordinator == NULL) {
+        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+                                "%s: cannot allocate the coordinator's planner (beta %lu, %zu UAVs "
+                                "together)",
+                                r->file, (unsigned long)r->coordinator_beta, r->max_centralised);
+    }
+    return SIM_GO_ON;
+}
+
+/* The UAVs' waits of one cycle: poll until nobody moves on, then the clock jumps to the
+ * first deadline, until none is left. Keeps the first node error in *node_error. */
+static bool sim_waits(sim_run_t *r, int *node_error)
+{
+    bool lcm_ok = true;
+    for (;;) {
+        bool changed = true;
+        while (changed && lcm_ok) {
+            changed = false;
+            for (size_t j = 0; j < r->n && lcm_ok; j++) {
+                int rc = coavoid_vehicle_node_poll(r->vehicles[j], r->now);
+                if (rc < 0) {
+                    *node_error = *node_error != COA_OK ? *node_error : rc;
+                } else if (rc > 0) {
+                    changed = true;
+                    lcm_ok = drain(r->lcm);
+                }
+            }
+        }
+        int64_t deadline = INT64_MAX;
+        for (size_t j = 0; j < r->n; j++) {
+            int64_t d = coavoid_vehicle_node_deadline(r->vehicles[j]);
+            deadline = d < deadline ? d : deadline;
+        }
+        if (deadline == INT64_MAX || !lcm_ok) {
+            return lcm_ok;
+        }
+        r->now = deadline > r->now ? deadline : r->now;
+    }
+}
+
+/* Cycle k of the loop of node.h: world, then the UAVs in priority order, their waits, then
+ * the coordinator at cycle start + collect; each message is handled as soon as it is
+ * published, as on a quiet network. False when LCM failed. */
+static bool sim_cycle(sim_run_t *r, uint32_t k, int *node_error)
+{
+    if (r->coordinator != NULL && r->o->has_stop && k == r->o->stop_step) {
+        r->coordinator_plans = coavoid_coordinator_state(r->coordinator)->plans_run;
+        coavoid_coordinator_destroy(r->coordinator);
+        r->coordinator = NULL;
+    }
+    const int64_t cycle_start = coavoid_node_cycle_utime(&r->common, (int64_t)k);
+    r->now = cycle_start;
+    int rc = coavoid_world_cycle(r->world, r->now);
+    *node_error = *node_error != COA_OK ? *node_error : rc;
+    bool lcm_ok = drain(r->lcm);
+    for (size_t j = 0; j < r->n && lcm_ok; j++) {
+        rc = coavoid_vehicle_node_cycle(r->vehicles[j], r->now);
+        *node_error = *node_error != COA_OK ? *node_error : rc;
+        lcm_ok = drain(r->lcm);
+    }
+    lcm_ok = lcm_ok && sim_waits(r, node_error);
+    /* The coordinator plans cycles 0..K-1: cycle K only flies the last sample. */
+    if (r->coordinator != NULL && k < r->steps && lcm_ok) {
+        r->now = cycle_start + r->collect_us > r->now ? cycle_start + r->collect_us : r->now;
+        rc = coavoid_coordinator_cycle(r->coordinator, r->now);
+        *node_error = *node_error != COA_OK ? *node_error : rc;
+        lcm_ok = drain(r->lcm);
+    }
+    for (size_t j = 0; j < r->n; j++) {
+        const coavoid_vehicle_node_state_t *st = coavoid_vehicle_node_state(r->vehicles[j]);
+        size_t i = r->index[j];
+        r->references[i * r->samples + k] = st->reference;
+        r->offsets[i * r->samples + k] = st->offset;
+    }
+    return lcm_ok;
+}
+
+/* Flies samples 0..steps. */
+static int sim_fly(sim_run_t *r)
+{
+    int node_error = COA_OK;
+    bool lcm_ok = true;
+    for (uint32_t k = 0; k <= r->steps && lcm_ok; k++) {
+        lcm_ok = sim_cycle(r, k, &node_error);
+    }
+    if (r->coordinator != NULL) {
+        r->coordinator_plans = coavoid_coordinator_state(r->coordinator)->plans_run;
+    }
+    if (!lcm_ok) {
+        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INTERNAL,
+                                "internal error: LCM failed while handling messages");
+    }
+    if (node_error != COA_OK) {
+        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INTERNAL,
+                                "internal error: a node failed (%s)",
+                                coavoid_lcm_error_name(node_error));
+    }
+    return SIM_GO_ON;
+}
+
+/* Judges the flight and writes the figure and the result; the exit status. */
+static int sim_report(sim_run_t *r)
+{
+    const coavoid_sim_config_t *o = r->o;
+    uint32_t replans = r->coordinator_plans;
+    uint32_t fallbacks = 0;
+    for (size_t j = 0; j < r->n; j++) {
+        const coavoid_vehicle_node_state_t *st = coavoid_vehicle_node_state(r->vehicles[j]);
+        replans += st->plans_run;
+        fallbacks += st->fallbacks;
+    }
+    int rc = coavoid_judge_run(&r->judged, r->s, o->mode, r->steps, replans, r->references,
+                               r->offsets, NULL);
+    const coavoid_flight_t *flight = &r->judged.flight;
+    const coavoid_flight_eval_t *eval = &r->judged.eval;
+    if (rc != COA_OK) {
+        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INTERNAL,
+                                "internal error: the flight cannot be judged (%s)",
+                                coa_status_name(rc));
+    }
+    if (r->svg != NULL) {
+        rc = coavoid_flight_svg(flight, eval, r->svg);
+        int closed = fclose(r->svg);
+        r->svg = NULL;
+        if (rc != COA_OK || closed != 0) {
+            return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INTERNAL,
+                                    "--svg: writing '%.200s' failed", o->svg_path);
+        }
+    }
+    if (o->json) {
+        char fallbacks_text[16];
+        char stopped_text[16];
+        snprintf(fallbacks_text, sizeof fallbacks_text, "%lu", (unsigned long)fallbacks);
+        snprintf(stopped_text, sizeof stopped_text, "%lu", (unsigned long)o->stop_step);
+        const coavoid_flight_extra_t extra[2] = {{"fallbacks", fallbacks_text},
+                                                 {"coordinator_stopped_at", stopped_text}};
+        rc = coavoid_flight_json_extra(flight, eval, extra, o->has_stop ? 2u : 1u, r->out);
+    } else {
+        rc = coavoid_flight_text(flight, eval, r->out);
+        if (rc == COA_OK && (fprintf(r->out, "fallbacks: %lu\n", (unsigned long)fallbacks) < 0 ||
+                             fflush(r->out) != 0)) {
+            rc = COA_ERR_WORKSPACE;
+        }
+    }
+    if (rc != COA_OK) {
+        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INTERNAL,
+                                "internal error: the result could not be written");
+    }
+    return eval->loss_of_separation ? COAVOID_SIM_LOSS : COAVOID_SIM_SEPARATED;
+}
+
+int coavoid_sim_run(const coavoid_sim_config_t *c, coavoid_scenario_t *s, FILE *out,
+                    coavoid_sim_error_t *e)
+{
+    sim_run_t r;
+    memset(&r, 0, sizeof r);
+    e->text[0] = '\0';
+    r.o = c;
+    r.err = e;
+    r.out = out;
+    r.s = s;
+    r.file = c->scenario_path;
+    r.n = s->vehicle_count;
+    int rc = sim_check(&r, s);
+    if (rc == SIM_GO_ON) {
+        rc = sim_planner_sizes(&r);
+    }
+    if (rc == SIM_GO_ON) {
+        rc = sim_open(&r);
+    }
+    if (rc == SIM_GO_ON) {
+        rc = sim_world(&r);
+    }
+    if (rc == SIM_GO_ON) {
+        rc = sim_vehicles(&r);
+    }
+    if (rc == SIM_GO_ON) {
+        rc = sim_coordinator(&r);
+    }
+    if (rc == SIM_GO_ON) {
+        rc = sim_fly(&r);
+    }
+    if (rc == SIM_GO_ON) {
+        rc = sim_report(&r);
+    }
+    sim_run_free(&r, r.n);
+    return rc;
+}

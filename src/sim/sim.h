@@ -1,0 +1,93 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * sim.h: closed-loop runs of a scenario, judged (docs/scenario-format.md, "Simulation
+ * result"), from two sources:
+ *
+ *   - coavoid_sim_run flies the scenario in one process: the world, one vehicle node per
+ *     UAV and (centralised) the coordinator are the nodes the real-time programs run
+ *     (coavoid::node), here over LCM's in-process provider (memq) on a simulated clock, so
+ *     that a run is repeatable bit for bit (`coavoid sim`);
+ *   - coavoid_sim_summarise rebuilds what each UAV flew from an lcm-logger log of a
+ *     real-time run and judges it the same way (`coavoid summary`).
+ *
+ * Both write the result (text or JSON) to a stream and the figure to a file, and report
+ * the first problem with their input as one line in a coavoid_sim_error_t, naming the
+ * file and field (or the option, by its command-line name) and why; the program prefixes
+ * it with its own name. The scenario and the log are untrusted (docs/security.md): every
+ * bound a message or the run has is checked before the run starts, and a log's events are
+ * checked before LCM's reader sees them.
+ *
+ * Memory: heap, for the run's record (UAVs x steps) and the nodes' planners (their betas),
+ * released before return. Time: the run's, dominated by the planners.
+ */
+#ifndef COAVOID_SIM_SIM_H
+#define COAVOID_SIM_SIM_H
+
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include "scenario.h"
+
+/* What both return: the run's verdict, or why there is none. */
+enum {
+    COAVOID_SIM_SEPARATED = 0,     /* judged: no loss of separation */
+    COAVOID_SIM_LOSS = 1,          /* judged: a loss of separation */
+    COAVOID_SIM_ERR_INPUT = -2,    /* the scenario, the log or a setting is refused */
+    COAVOID_SIM_ERR_INTERNAL = -3, /* a bug, out of memory, or the output was not written */
+};
+
+/* Room for one report line. */
+#define COAVOID_SIM_ERROR_MAX 1024u
+
+typedef struct {
+    char text[COAVOID_SIM_ERROR_MAX]; /* "" until a problem is reported */
+} coavoid_sim_error_t;
+
+/* Formats the report line into e and returns status, so that a check reads
+ * `return coavoid_sim_fail(e, COAVOID_SIM_ERR_INPUT, ...)`. */
+int coavoid_sim_fail(coavoid_sim_error_t *e, int status, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+/* A one-process run. */
+typedef struct {
+    const char *scenario_path; /* names the scenario in reports */
+    const char *mode;          /* "centralised" or "decoupled", as the result names it */
+    bool decoupled;
+    bool has_steps;       /* steps given; otherwise 2 * horizon */
+    uint32_t steps;       /* samples 0..steps are flown, >= 1 */
+    bool has_stop;        /* centralised: the coordinator stops before step stop_step */
+    uint32_t stop_step;   /* 0..steps */
+    bool json;            /* the result as JSON (default: text) */
+    const char *svg_path; /* NULL, or where the figure goes */
+} coavoid_sim_config_t;
+
+/* The largest --steps, and with it --coordinator-stops: more is more likely a typo than a
+ * simulation anyone waits for. */
+#define COAVOID_SIM_MAX_STEPS 1000000u
+
+/* Flies scenario s (loaded, not yet sampled: sampled here) as c says and writes the
+ * result to out. Returns a verdict, or an error with e set. */
+int coavoid_sim_run(const coavoid_sim_config_t *c, coavoid_scenario_t *s, FILE *out,
+                    coavoid_sim_error_t *e);
+
+/* A log's run. */
+typedef struct {
+    const char *scenario_path; /* names the scenario in reports */
+    const char *log_path;
+    const char *mode;     /* the mode the run was started in, as the result names it */
+    bool json;            /* the result as JSON, with a "log" object */
+    const char *svg_path; /* NULL, or where the figure goes */
+    bool has_epoch;       /* cycle 0's start given; otherwise the earliest plan_utime */
+    int64_t epoch;        /* microseconds, >= 1 */
+} coavoid_sim_log_config_t;
+
+/* Judges the run of scenario s (loaded) that the lcm-logger log c->log_path recorded, and
+ * writes the result to out. Returns a verdict, or an error with e set. */
+int coavoid_sim_summarise(const coavoid_sim_log_config_t *c, coavoid_scenario_t *s, FILE *out,
+                          coavoid_sim_error_t *e);
+
+#endif /* COAVOID_SIM_SIM_H */

@@ -1,0 +1,990 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * summary.c: what a real-time run flew, rebuilt from an lcm-logger log and judged exactly
+ * as coavoid_sim_run judges its own runs (sim.h, coavoid_sim_summarise).
+ *
+ * What the log says, and how it becomes a flight record:
+ *   - Every UAV publishes an intent at each cycle's start: its reference and offsets for
+ *     samples from plan_utime on, sample 0 being where it is. The flown sample k of a UAV
+ *     is taken from the latest intent (largest plan_utime, later in the log on a tie) with
+ *     plan_utime <= cycle k's start that has a sample at exactly that time. Usually that
+ *     is the cycle's own intent; when it is missing (a dropped datagram, a late process)
+ *     an earlier plan that reaches k stands in for it. Where no intent covers k, the
+ *     scenario's reference is used with the offset held (the initial offset before the
+ *     first intent, the last covered one after): that sample is marked not known, counted,
+ *     and drawn as such.
+ *   - The epoch (cycle 0's start) is the earliest plan_utime of the scenario's UAVs unless
+ *     --epoch gives it; the step is the scenario's dt, which every intent must agree with.
+ *   - K, the last sample judged, is the last cycle for which the log holds every UAV's own
+ *     intent ("complete"), and at most the scenario's 2N (the default length of a sim).
+ *   - Replans: every node's heartbeat (status_t) carries plans_run, its planning calls
+ *     since it started; the replans of a run are the sum over nodes of the largest
+ *     plans_run among their heartbeats up to cycle K, which is what `coavoid sim` counts.
+ *
+ * The log is untrusted. LCM 1.3.1's reader skips anything until it finds an event's
+ * magic number, reports truncation as a normal end, prints its own complaints on stderr
+ * (bad lengths; no magic right after an event) and, for a data length near 2^31, hands a
+ * failed allocation to fread. So each event's header is read and checked here first
+ * (magic exactly where the previous event ended and right after this one, lengths within
+ * bounds and within the file) and only then is the event read with
+ * lcm_eventlog_read_next_event. Messages are decoded with the generated decoders and
+ * validated by src/lcm before anything is used; refused ones are counted and reported.
+ */
+#define _POSIX_C_SOURCE 200809L
+
+#include <errno.h>
+#include <inttypes.h>
+#include <math.h>
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/types.h>
+
+#include <cjson/cJSON.h>
+#include <lcm/eventlog.h>
+
+#include "coavoid/coavoid.h"
+#include "coavoid_lcm.h"
+#include "flight.h"
+#include "judge.h"
+#include "node.h"
+#include "scenario.h"
+#include "sim.h"
+#include "sim_internal.h"
+
+/* An event's header in the file: magic, event number, time stamp, channel and data
+ * lengths, all big-endian. */
+#define LOG_MAGIC 0xEDA1DA01u
+#define LOG_HEADER_BYTES 28
+/* The reader's own bound on a channel name (1.3.1 refuses >= 1000). */
+#define LOG_MAX_CHANNEL 999
+/* Larger events are taken as corruption: the biggest message of ours is about 17 kB, and
+ * the reader allocates what the header claims before it reads. */
+#define LOG_MAX_DATA (64 * 1024 * 1024)
+
+/* ---- reading the log ---- */
+
+typedef struct {
+    const char *path;
+    coavoid_sim_error_t *err;
+    lcm_eventlog_t *log;
+    int64_t size;   /* bytes to read: the file's size when opened */
+    int64_t offset; /* where the next event starts */
+    int64_t events; /* events read so far */
+} log_reader_t;
+
+static int log_open(log_reader_t *r, coavoid_sim_error_t *err, const char *path, int64_t limit)
+{
+    struct stat st;
+    memset(r, 0, sizeof *r);
+    r->err = err;
+    r->path = path;
+    if (stat(path, &st) != 0) {
+        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT, "%s: cannot open: %s", path,
+                                strerror(errno));
+    }
+    if (!S_ISREG(st.st_mode)) {
+        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+                                "%s: not a regular file (an lcm-logger log is one)", path);
+    }
+    errno = 0;
+    r->log = lcm_eventlog_create(path, "r");
+    if (r->log == NULL) {
+        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT, "%s: cannot open: %s", path,
+                                errno != 0 ? strerror(errno) : "lcm_eventlog_create failed");
+    }
+    /* The size of what was opened (the path may have been replaced since stat). */
+    if (fstat(fileno(r->log->f), &st) != 0) {
+        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT, "%s: cannot read: %s", path,
+                                strerror(errno));
+    }
+    r->size = (int64_t)st.st_size;
+    if (limit >= 0 && limit < r->size) {
+        r->size = limit;
+    }
+    if (r->size == 0) {
+        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT, "%s: empty file, not an LCM log",
+                                path);
+    }
+    return SIM_GO_ON;
+}
+
+static void log_close(log_reader_t *r)
+{
+    if (r->log != NULL) {
+        lcm_eventlog_destroy(r->log);
+        r->log = NULL;
+    }
+}
+
+static uint32_t be32(const unsigned char *b)
+{
+    return (uint32_t)b[0] << 24 | (uint32_t)b[1] << 16 | (uint32_t)b[2] << 8 | (uint32_t)b[3];
+}
+
+/* The next event: 1 with *event (free it with lcm_eventlog_free_event), 0 at the end of
+ * the log, or the exit status after the message. */
+/* The event header at the reader's offset (`left` bytes remain): its length in *length, or
+ * an error naming what is wrong there. */
+static int log_header(log_reader_t *r, int64_t left, int32_t *channel_length, int32_t *data_length,
+                      int64_t *length)
+{
+    unsigned char header[LOG_HEADER_BYTES];
+    if (fseeko(r->log->f, (off_t)r->offset, SEEK_SET) != 0) {
+        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+                                "%s: cannot seek to byte %" PRId64 ": %s", r->path, r->offset,
+                                strerror(errno));
+    }
+    size_t want = left < LOG_HEADER_BYTES ? (size_t)left : (size_t)LOG_HEADER_BYTES;
+    size_t got = fread(header, 1, want, r->log->f);
+    if (got != want) {
+        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT, "%s: read error at byte %" PRId64,
+                                r->path, r->offset);
+    }
+    /* Whether the bytes there are (the start of) an event header. */
+    bool magic = true;
+    for (size_t j = 0; j < 4u && j < got; j++) {
+        magic = magic && header[j] == (unsigned char)(LOG_MAGIC >> (24u - 8u * j));
+    }
+    if (!magic && r->offset == 0) {
+        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+                                "%s: not an LCM log (it does not start with an event header)",
+                                r->path);
+    }
+    if (!magic) {
+        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+                                "%s: corrupt: no event header at byte %" PRId64 " (after %" PRId64
+                                " events)",
+                                r->path, r->offset, r->events);
+    }
+    if (got < (size_t)LOG_HEADER_BYTES) {
+        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+                                "%s: truncated: event %" PRId64 " at byte %" PRId64
+                                " is cut off in its header (was the logger stopped mid-write?)",
+                                r->path, r->events, r->offset);
+    }
+    *channel_length = (int32_t)be32(header + 20);
+    *data_length = (int32_t)be32(header + 24);
+    if (*channel_length < 1 || *channel_length > LOG_MAX_CHANNEL || *data_length < 0 ||
+        *data_length > LOG_MAX_DATA) {
+        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+                                "%s: corrupt: event %" PRId64 " at byte %" PRId64
+                                " claims a %ld-byte channel name and %ld bytes of data",
+                                r->path, r->events, r->offset, (long)*channel_length,
+                                (long)*data_length);
+    }
+    *length = LOG_HEADER_BYTES + (int64_t)*channel_length + (int64_t)*data_length;
+    if (*length > left) {
+        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+                                "%s: truncated: event %" PRId64 " at byte %" PRId64
+                                " needs %" PRId64 " bytes, the file has %" PRId64
+                                " left (was the logger stopped "
+                                "mid-write?)",
+                                r->path, r->events, r->offset, *length, left);
+    }
+    return SIM_GO_ON;
+}
+
+/* Debian's 1.3.1 reader also looks at the 4 bytes after the event and, when they are not the
+ * next header's magic, prints a complaint and drops the event: judge them here first, so
+ * the message is ours and names the place. */
+static int log_check_next(log_reader_t *r, int64_t left, int64_t length)
+{
+    if (length + 4 > left) {
+        return SIM_GO_ON;
+    }
+    unsigned char next[4];
+    if (fseeko(r->log->f, (off_t)(r->offset + length), SEEK_SET) != 0 ||
+        fread(next, 1, 4u, r->log->f) != 4u) {
+        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT, "%s: read error at byte %" PRId64,
+                                r->path, r->offset + length);
+    }
+    if (be32(next) != LOG_MAGIC) {
+        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+                                "%s: corrupt: no event header at byte %" PRId64 " (after %" PRId64
+                                " events)",
+                                r->path, r->offset + length, r->events + 1);
+    }
+    return SIM_GO_ON;
+}
+
+static int log_next(log_reader_t *r, lcm_eventlog_event_t **event)
+{
+    int64_t left = r->size - r->offset;
+    int32_t channel_length = 0;
+    int32_t data_length = 0;
+    int64_t length = 0;
+    *event = NULL;
+    if (left <= 0) {
+        return 0;
+    }
+    int status = log_header(r, left, &channel_length, &data_length, &length);
+    if (status == SIM_GO_ON) {
+        status = log_check_next(r, left, length);
+    }
+    if (status != SIM_GO_ON) {
+        return status;
+    }
+    if (fseeko(r->log->f, (off_t)r->offset, SEEK_SET) != 0) {
+        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+                                "%s: cannot seek to byte %" PRId64 ": %s", r->path, r->offset,
+                                strerror(errno));
+    }
+    lcm_eventlog_event_t *e = lcm_eventlog_read_next_event(r->log);
+    if (e == NULL || e->channellen != channel_length || e->datalen != data_length) {
+        if (e != NULL) {
+            lcm_eventlog_free_event(e);
+        }
+        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+                                "%s: cannot read event %" PRId64 " at byte %" PRId64, r->path,
+                                r->events, r->offset);
+    }
+    r->offset += length;
+    r->events++;
+    *event = e;
+    return 1;
+}
+
+/* ---- what the log says ---- */
+
+typedef struct {
+    uint32_t node;
+    int8_t kind;
+    int64_t utime; /* the heartbeat's utime, or a plan's valid_from */
+    int64_t id;    /* plan_id for plans, plans_run for heartbeats */
+} planning_t;
+
+typedef struct {
+    planning_t *items;
+    size_t count;
+    size_t capacity;
+} planning_list_t;
+
+/* items, of *capacity items of item_size bytes, holding count, with room for one more:
+ * doubled (from 256) when full. NULL out of memory, items then unchanged. */
+static void *room_for_one(void *items, size_t count, size_t *capacity, size_t item_size)
+{
+    if (count < *capacity) {
+        return items;
+    }
+    size_t grown = *capacity > 0u ? *capacity * 2u : 256u;
+    if (grown > SIZE_MAX / item_size) {
+        return NULL;
+    }
+    void *moved = realloc(items, grown * item_size);
+    if (moved != NULL) {
+        *capacity = grown;
+    }
+    return moved;
+}
+
+static bool planning_add(planning_list_t *list, planning_t item)
+{
+    planning_t *items = room_for_one(list->items, list->count, &list->capacity, sizeof item);
+    if (items == NULL) {
+        return false;
+    }
+    list->items = items;
+    list->items[list->count++] = item;
+    return true;
+}
+
+/* One accepted intent's place on the time line. */
+typedef struct {
+    size_t vehicle;
+    int64_t plan_utime;
+} intent_seen_t;
+
+typedef struct {
+    intent_seen_t *items;
+    size_t count;
+    size_t capacity;
+} intent_list_t;
+
+static bool intent_add(intent_list_t *list, intent_seen_t item)
+{
+    intent_seen_t *items = room_for_one(list->items, list->count, &list->capacity, sizeof item);
+    if (items == NULL) {
+        return false;
+    }
+    list->items = items;
+    list->items[list->count++] = item;
+    return true;
+}
+
+typedef struct {
+    const coavoid_sim_log_config_t *o;
+    coavoid_sim_error_t *err;
+    FILE *out;
+    const coavoid_scenario_t *s;
+    int64_t dt_us;
+
+    /* Decoding space (the plan type is 16.6 kB). */
+    coavoid_intent_t intent;
+    coavoid_status_t status;
+    coavoid_plan_t plan;
+
+    /* Counts over the whole log. */
+    int64_t events;
+    int64_t other_events;
+    int64_t intents;           /* on the intent channel */
+    int64_t intents_refused;   /* did not decode or failed validation */
+    const char *intent_reason; /* the first refusal's reason */
+    int64_t intents_foreign;   /* valid, from a UAV that is not in the scenario */
+    int64_t statuses;
+    int64_t statuses_refused;
+    int64_t plans;
+    int64_t plans_refused;
+    const char *other_reason; /* the first refusal of a status or plan */
+
+    intent_list_t seen;         /* accepted intents of the scenario's UAVs */
+    planning_list_t heartbeats; /* (node, utime, plans_run) of accepted heartbeats */
+    planning_list_t plan_list;  /* (coordinator, valid_from, plan_id) of accepted plans */
+    int64_t first_plan_utime[COA_MAX_VEHICLES];
+    int64_t intents_of[COA_MAX_VEHICLES];
+} log_summary_t;
+
+static const coavoid_lcm_context_t no_clock = {0, 0, 0, 0};
+
+/* Decodes and validates an intent. Returns the scenario's index of its UAV (>= 0), -1
+ * refused (counted), -2 a valid intent of another UAV (counted), or -3 after an error
+ * message (the log is not this scenario's run). */
+static long accept_intent(log_summary_t *ls, const lcm_eventlog_event_t *e, bool count)
+{
+    const char *reason = "intent: does not decode (wrong type or truncated)";
+    coavoid_intent_t *m = &ls->intent;
+    int used = coavoid_intent_t_decode(e->data, 0, e->datalen, m);
+    int rc = used == e->datalen ? coavoid_lcm_intent_check(m, &no_clock, &reason)
+                                : COAVOID_LCM_ERR_DECODE;
+    if (used >= 0) {
+        coavoid_intent_t_decode_cleanup(m);
+    }
+    if (count) {
+        ls->intents++;
+    }
+    if (rc != COA_OK) {
+        if (count) {
+            ls->intents_refused++;
+            if (ls->intent_reason == NULL) {
+                ls->intent_reason = reason;
+            }
+        }
+        return -1;
+    }
+    long index = coavoid_scenario_vehicle_index(ls->s, (long)m->uav_id);
+    if (index < 0) {
+        if (count) {
+            ls->intents_foreign++;
+        }
+        return -2;
+    }
+    /* Intents of another scenario (or another dt) cannot be judged against this one. */
+    const coa_vehicle_t *v = &ls->s->vehicles[index];
+    const char *field = NULL;
+    double theirs = 0.0;
+    double ours = 0.0;
+    if (llround(m->step * 1e6) != ls->dt_us) {
+        field = "step (the scenario's dt)";
+        theirs = m->step;
+        ours = (double)ls->s->dt;
+    } else if ((coa_real_t)m->climb_rate != v->climb_rate) {
+        field = "climb_rate";
+        theirs = m->climb_rate;
+        ours = (double)v->climb_rate;
+    } else if ((coa_real_t)m->cruise_speed != v->cruise_speed) {
+        field = "cruise_speed";
+        theirs = m->cruise_speed;
+        ours = (double)v->cruise_speed;
+    } else if ((coa_real_t)m->radius != v->volume.radius) {
+        field = "radius";
+        theirs = m->radius;
+        ours = (double)v->volume.radius;
+    } else if ((coa_real_t)m->half_height != v->volume.half_height) {
+        field = "half_height";
+        theirs = m->half_height;
+        ours = (double)v->volume.half_height;
+    } else if ((uint32_t)m->steep_factor != v->steep_factor) {
+        field = "steep_factor";
+        theirs = m->steep_factor;
+        ours = v->steep_factor;
+    }
+    if (field != NULL) {
+        coavoid_sim_fail(ls->err, COAVOID_SIM_ERR_INPUT,
+                         "%s: UAV %ld's intents have %s %.17g, %s says %.17g: not a run of this "
+                         "scenario",
+                         ls->o->log_path, (long)m->uav_id, field, theirs, ls->o->scenario_path,
+                         ours);
+        return -3;
+    }
+    return index;
+}
+
+static void note_other(log_summary_t *ls, const char *reason)
+{
+    if (ls->other_reason == NULL) {
+        ls->other_reason = reason;
+    }
+}
+
+/* Pass 1: every event of the log. Returns SIM_GO_ON or the exit status. */
+static int read_log(log_summary_t *ls, log_reader_t *r)
+{
+    for (size_t i = 0; i < ls->s->vehicle_count; i++) {
+        ls->first_plan_utime[i] = INT64_MAX;
+    }
+    for (;;) {
+        lcm_eventlog_event_t *e = NULL;
+        int rc = log_next(r, &e);
+        if (rc == 0) {
+            break;
+        }
+        if (rc != 1) {
+            return rc;
+        }
+        ls->events++;
+        bool ok = true;
+        if (strcmp(e->channel, COAVOID_CHANNEL_INTENT) == 0) {
+            long index = accept_intent(ls, e, true);
+            if (index == -3) {
+                lcm_eventlog_free_event(e);
+                return COAVOID_SIM_ERR_INPUT;
+            }
+            if (index >= 0) {
+                size_t i = (size_t)index;
+                int64_t p = ls->intent.plan_utime;
+                ls->intents_of[i]++;
+                if (p < ls->first_plan_utime[i]) {
+                    ls->first_plan_utime[i] = p;
+                }
+                intent_seen_t seen = {i, p};
+                ok = intent_add(&ls->seen, seen);
+            }
+        } else if (strcmp(e->channel, COAVOID_CHANNEL_STATUS) == 0) {
+            const char *reason = "status: does not decode (wrong type or truncated)";
+            int used = coavoid_status_t_decode(e->data, 0, e->datalen, &ls->status);
+            int vrc = used == e->datalen ? coavoid_lcm_status_check(&ls->status, &no_clock, &reason)
+                                         : COAVOID_LCM_ERR_DECODE;
+            if (used >= 0) {
+                coavoid_status_t_decode_cleanup(&ls->status);
+            }
+            ls->statuses++;
+            if (vrc != COA_OK) {
+                ls->statuses_refused++;
+                note_other(ls, reason);
+            } else if (ls->status.plans_run > 0) {
+                planning_t item = {(uint32_t)ls->status.node_id, ls->status.node_kind,
+                                   ls->status.utime, ls->status.plans_run};
+                ok = planning_add(&ls->heartbeats, item);
+            }
+        } else if (strcmp(e->channel, COAVOID_CHANNEL_PLAN) == 0) {
+            const char *reason = "plan: does not decode (wrong type or truncated)";
+            int used = coavoid_plan_t_decode(e->data, 0, e->datalen, &ls->plan);
+            int vrc = used == e->datalen ? coavoid_lcm_plan_check(&ls->plan, &no_clock, &reason)
+                                         : COAVOID_LCM_ERR_DECODE;
+            if (used >= 0) {
+                coavoid_plan_t_decode_cleanup(&ls->plan);
+            }
+            ls->plans++;
+            if (vrc != COA_OK) {
+                ls->plans_refused++;
+                note_other(ls, reason);
+            } else {
+                planning_t item = {(uint32_t)ls->plan.coordinator_id,
+                                   COAVOID_STATUS_T_NODE_COORDINATOR, ls->plan.valid_from_utime,
+                                   ls->plan.plan_id};
+                ok = planning_add(&ls->plan_list, item);
+            }
+        } else {
+            ls->other_events++;
+        }
+        lcm_eventlog_free_event(e);
+        if (!ok) {
+            return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INTERNAL, "out of memory reading %s",
+                                    r->path);
+        }
+    }
+    return SIM_GO_ON;
+}
+
+static int planning_compare(const void *a, const void *b)
+{
+    const planning_t *p = a;
+    const planning_t *q = b;
+    if (p->node != q->node) {
+        return p->node < q->node ? -1 : 1;
+    }
+    if (p->id != q->id) {
+        return p->id < q->id ? -1 : 1;
+    }
+    if (p->utime != q->utime) {
+        return p->utime < q->utime ? -1 : 1;
+    }
+    return 0;
+}
+
+/* Planning calls up to `to`: per node, the largest plans_run of its heartbeats stamped
+ * before `to`, summed over the nodes. */
+static uint32_t count_replans(log_summary_t *ls, int64_t to)
+{
+    planning_list_t *hb = &ls->heartbeats;
+    uint64_t total = 0;
+    if (hb->count > 0u) {
+        qsort(hb->items, hb->count, sizeof *hb->items, planning_compare);
+    }
+    for (size_t h = 0; h < hb->count;) {
+        uint32_t node = hb->items[h].node;
+        int64_t most = 0;
+        for (; h < hb->count && hb->items[h].node == node; h++) {
+            if (hb->items[h].utime < to && hb->items[h].id > most) {
+                most = hb->items[h].id;
+            }
+        }
+        total += (uint64_t)most;
+    }
+    return total > UINT32_MAX ? UINT32_MAX : (uint32_t)total;
+}
+
+/* ---- the flight ---- */
+
+typedef struct {
+    uint32_t steps;        /* K */
+    int64_t *best;         /* n rows of K + 1: plan_utime of the sample's source */
+    bool *own;             /* n rows of K + 1: from the cycle's own intent */
+    bool *known;           /* n rows of K + 1 */
+    coa_vec3_t *reference; /* n rows */
+    int32_t *offsets;      /* n rows */
+    int64_t own_samples;
+    int64_t earlier_samples;
+    int64_t missing_samples;
+    int64_t off_grid; /* accepted intents whose plan_utime is not a cycle start */
+} rebuilt_t;
+
+static void rebuilt_free(rebuilt_t *b)
+{
+    free(b->best);
+    free(b->own);
+    free(b->known);
+    free(b->reference);
+    free(b->offsets);
+}
+
+/* The cycle whose start is utime, or -1 when utime is not a cycle start at or after the
+ * epoch. */
+static int64_t cycle_at(int64_t utime, int64_t epoch, int64_t dt_us)
+{
+    if (utime < epoch || (utime - epoch) % dt_us != 0) {
+        return -1;
+    }
+    return (utime - epoch) / dt_us;
+}
+
+/* K: the last cycle, at most cap, in which every UAV's own intent was logged; 0 when
+ * none after cycle 0 is. Returns -1 out of memory. */
+static int64_t last_complete_cycle(const log_summary_t *ls, int64_t epoch, uint32_t cap,
+                                   int64_t *off_grid)
+{
+    const size_t n = ls->s->vehicle_count;
+    const size_t row = (size_t)cap + 1u;
+    bool *own = calloc(n * row, sizeof *own);
+    if (own == NULL) {
+        return -1;
+    }
+    *off_grid = 0;
+    for (size_t q = 0; q < ls->seen.count; q++) {
+        int64_t c = cycle_at(ls->seen.items[q].plan_utime, epoch, ls->dt_us);
+        if (c < 0) {
+            /* Before the epoch is fine (--epoch later than the run's start); off the grid
+             * is worth reporting. */
+            if (ls->seen.items[q].plan_utime >= epoch ||
+                (epoch - ls->seen.items[q].plan_utime) % ls->dt_us != 0) {
+                (*off_grid)++;
+            }
+            continue;
+        }
+        if (c <= (int64_t)cap) {
+            own[ls->seen.items[q].vehicle * row + (size_t)c] = true;
+        }
+    }
+    int64_t k = cap;
+    for (; k > 0; k--) {
+        bool all = true;
+        for (size_t i = 0; i < n && all; i++) {
+            all = own[i * row + (size_t)k];
+        }
+        if (all) {
+            break;
+        }
+    }
+    free(own);
+    return k;
+}
+
+/* Pass 2: the samples of every accepted intent onto the cycles 0..K. */
+static int fill_samples(log_summary_t *ls, log_reader_t *r, rebuilt_t *b, int64_t epoch)
+{
+    const size_t row = (size_t)b->steps + 1u;
+    for (;;) {
+        lcm_eventlog_event_t *e = NULL;
+        int rc = log_next(r, &e);
+        if (rc == 0) {
+            break;
+        }
+        if (rc != 1) {
+            return rc;
+        }
+        if (strcmp(e->channel, COAVOID_CHANNEL_INTENT) == 0) {
+            long index = accept_intent(ls, e, false);
+            if (index == -3) {
+                lcm_eventlog_free_event(e);
+                return COAVOID_SIM_ERR_INPUT;
+            }
+            const coavoid_intent_t *m = &ls->intent;
+            for (int32_t j = 0; index >= 0 && j < m->sample_count; j++) {
+                /* The check bounds plan_utime to within an hour of a positive utime and j
+                 * below 128, so this cannot overflow. */
+                int64_t c = cycle_at(m->plan_utime + (int64_t)j * ls->dt_us, epoch, ls->dt_us);
+                if (c < 0 || c > (int64_t)b->steps) {
+                    continue;
+                }
+                size_t at = (size_t)index * row + (size_t)c;
+                if (b->known[at] && m->plan_utime < b->best[at]) {
+                    continue; /* a later plan already covers this sample */
+                }
+                b->known[at] = true;
+                b->best[at] = m->plan_utime;
+                b->own[at] = j == 0;
+                b->reference[at].x = (coa_real_t)m->reference[j][0];
+                b->reference[at].y = (coa_real_t)m->reference[j][1];
+                b->reference[at].z = (coa_real_t)m->reference[j][2];
+                b->offsets[at] = m->offsets[j];
+            }
+        }
+        lcm_eventlog_free_event(e);
+    }
+    return SIM_GO_ON;
+}
+
+/* Samples no intent covered: the scenario's reference, the offset held. */
+static int fill_gaps(const coavoid_scenario_t *s, rebuilt_t *b)
+{
+    const size_t row = (size_t)b->steps + 1u;
+    coa_vec3_t *scenario_reference = malloc(row * sizeof *scenario_reference);
+    if (scenario_reference == NULL) {
+        return COA_ERR_WORKSPACE;
+    }
+    for (size_t i = 0; i < s->vehicle_count; i++) {
+        int rc = coa_reference_sample(&s->vehicles[i], s->dt, b->steps, scenario_reference);
+        if (rc != COA_OK) {
+            free(scenario_reference);
+            return rc;
+        }
+        int32_t held = s->vehicles[i].initial_offset;
+        for (size_t k = 0; k < row; k++) {
+            size_t at = i * row + k;
+            if (b->known[at]) {
+                held = b->offsets[at];
+                if (b->own[at]) {
+                    b->own_samples++;
+                } else {
+                    b->earlier_samples++;
+                }
+                continue;
+            }
+            b->missing_samples++;
+            b->reference[at] = scenario_reference[k];
+            b->offsets[at] = held;
+        }
+    }
+    free(scenario_reference);
+    return COA_OK;
+}
+
+/* ---- output ---- */
+
+static void print_log_text(const log_summary_t *ls, const rebuilt_t *b, int64_t epoch)
+{
+    fprintf(ls->out,
+            "log: %s: %" PRId64 " events; %" PRId64 " intents (%" PRId64 " refused, %" PRId64
+            " from UAVs not in the scenario, %" PRId64 " off the cycle grid); %" PRId64
+            " plans (%" PRId64 " refused); %" PRId64 " heartbeats (%" PRId64 " refused); %" PRId64
+            " on other channels\n",
+            ls->o->log_path, ls->events, ls->intents, ls->intents_refused, ls->intents_foreign,
+            b->off_grid, ls->plans, ls->plans_refused, ls->statuses, ls->statuses_refused,
+            ls->other_events);
+    if (ls->intent_reason != NULL) {
+        fprintf(ls->out, "first refused intent: %s\n", ls->intent_reason);
+    }
+    if (ls->other_reason != NULL) {
+        fprintf(ls->out, "first refused plan or heartbeat: %s\n", ls->other_reason);
+    }
+    fprintf(ls->out, "epoch: %" PRId64 " us (%s); cycles 0..%lu judged\n", epoch,
+            ls->o->has_epoch ? "--epoch" : "earliest plan_utime", (unsigned long)b->steps);
+    fprintf(ls->out,
+            "samples: %" PRId64 " from their cycle's own intent, %" PRId64
+            " from an earlier plan, %" PRId64 " not covered by any intent (scenario reference, "
+            "offset held)\n",
+            b->own_samples, b->earlier_samples, b->missing_samples);
+}
+
+/* An integer printed as one: cJSON would print a microsecond time as 1.7e+15. */
+static bool add_count(cJSON *obj, const char *key, int64_t value)
+{
+    char text[24];
+    snprintf(text, sizeof text, "%" PRId64, value);
+    return cJSON_AddRawToObject(obj, key, text) != NULL;
+}
+
+/* The flight's JSON with a "log" object added. The log object holds only integers and
+ * strings, which cJSON prints exactly. */
+static int print_json(const log_summary_t *ls, const rebuilt_t *b, int64_t epoch,
+                      const coavoid_flight_t *flight, const coavoid_flight_eval_t *eval)
+{
+    cJSON *log = cJSON_CreateObject();
+    bool ok = log != NULL && cJSON_AddStringToObject(log, "file", ls->o->log_path) != NULL &&
+              add_count(log, "events", ls->events) && add_count(log, "intents", ls->intents) &&
+              add_count(log, "intents_refused", ls->intents_refused) &&
+              add_count(log, "intents_other_uavs", ls->intents_foreign) &&
+              add_count(log, "intents_off_grid", b->off_grid) &&
+              add_count(log, "plans", ls->plans) &&
+              add_count(log, "plans_refused", ls->plans_refused) &&
+              add_count(log, "heartbeats", ls->statuses) &&
+              add_count(log, "heartbeats_refused", ls->statuses_refused) &&
+              add_count(log, "epoch_utime", epoch) &&
+              add_count(log, "samples_own_intent", b->own_samples) &&
+              add_count(log, "samples_earlier_plan", b->earlier_samples) &&
+              add_count(log, "samples_missing", b->missing_samples) &&
+              (ls->intent_reason == NULL ||
+               cJSON_AddStringToObject(log, "first_refused_intent", ls->intent_reason) != NULL);
+    char *log_text = ok ? cJSON_PrintUnformatted(log) : NULL;
+    cJSON_Delete(log);
+    if (log_text == NULL) {
+        return coavoid_sim_fail(ls->err, COAVOID_SIM_ERR_INTERNAL,
+                                "out of memory printing the result");
+    }
+    const coavoid_flight_extra_t extra = {"log", log_text};
+    errno = 0;
+    int rc = coavoid_flight_json_extra(flight, eval, &extra, 1u, ls->out);
+    free(log_text);
+    if (rc == COA_ERR_ARGUMENT) {
+        return coavoid_sim_fail(ls->err, COAVOID_SIM_ERR_INTERNAL,
+                                "internal error: cannot print the result (%s)",
+                                coa_status_name(rc));
+    }
+    if (rc != COA_OK) {
+        return coavoid_sim_fail(ls->err, COAVOID_SIM_ERR_INTERNAL, "cannot write the result: %s",
+                                errno != 0 ? strerror(errno) : "write error");
+    }
+    return SIM_GO_ON;
+}
+
+static int write_svg(coavoid_sim_error_t *err, const char *path, const coavoid_flight_t *flight,
+                     const coavoid_flight_eval_t *eval)
+{
+    FILE *out = fopen(path, "w");
+    if (out == NULL) {
+        return coavoid_sim_fail(err, COAVOID_SIM_ERR_INPUT, "--svg %s: cannot write: %s", path,
+                                strerror(errno));
+    }
+    int rc = coavoid_flight_svg(flight, eval, out);
+    if (fclose(out) != 0 && rc == COA_OK) {
+        rc = COA_ERR_WORKSPACE;
+    }
+    if (rc != COA_OK) {
+        return coavoid_sim_fail(err, COAVOID_SIM_ERR_INTERNAL,
+                                "--svg %s: cannot write the figure (%s)", path,
+                                coa_status_name(rc));
+    }
+    return SIM_GO_ON;
+}
+
+/* The evaluation refused the record: name the step no action makes, if that is why. */
+static int refused_record(coavoid_sim_error_t *err, const coavoid_sim_log_config_t *o,
+                          const coavoid_flight_t *f, const rebuilt_t *b)
+{
+    const size_t row = (size_t)f->steps + 1u;
+    for (size_t i = 0; i < f->vehicle_count; i++) {
+        const int32_t *offsets = f->vehicles[i].offsets;
+        for (uint32_t k = 0; k < f->steps; k++) {
+            if (coa_action_between(offsets[k], offsets[k + 1u],
+                                   f->vehicles[i].vehicle.steep_factor) < 0) {
+                bool gap = !b->own[i * row + k] || !b->own[i * row + k + 1u];
+                return coavoid_sim_fail(
+                    err, COAVOID_SIM_ERR_INPUT,
+                    "%s: UAV %u's offset goes from %ld at cycle %lu to %ld at cycle "
+                    "%lu, which no action does%s",
+                    o->log_path, (unsigned)f->vehicles[i].vehicle.id, (long)offsets[k],
+                    (unsigned long)k, (long)offsets[k + 1u], (unsigned long)k + 1ul,
+                    gap ? " (a cycle's own intent is missing from the log there)" : "");
+            }
+        }
+    }
+    return coavoid_sim_fail(err, COAVOID_SIM_ERR_INTERNAL,
+                            "internal error: the flight record was refused");
+}
+
+/* Everything after the options and the scenario. Returns the exit status. */
+/* The scenario's dt as whole microseconds, and its UAV count, as a log can carry them. */
+static int summary_check(log_summary_t *ls)
+{
+    const coavoid_sim_log_config_t *o = ls->o;
+    const coavoid_scenario_t *s = ls->s;
+    double dt_us = (double)s->dt * 1e6;
+    if (!(dt_us >= 1.0) || dt_us > 3.6e9) {
+        return coavoid_sim_fail(ls->err, COAVOID_SIM_ERR_INPUT,
+                                "%s: dt: %g s cannot be a cycle of whole microseconds "
+                                "(1 us to 1 h)",
+                                o->scenario_path, (double)s->dt);
+    }
+    ls->dt_us = llround(dt_us);
+    if (s->vehicle_count > COA_MAX_VEHICLES) {
+        return coavoid_sim_fail(ls->err, COAVOID_SIM_ERR_INPUT, "%s: %zu vehicles, at most %u",
+                                o->scenario_path, s->vehicle_count, COA_MAX_VEHICLES);
+    }
+    return SIM_GO_ON;
+}
+
+/* Pass 1: counts, who was seen, the epoch (the earliest plan time unless --epoch), the
+ * log's size (pass 2 reads the same bytes) and the last cycle every UAV's intent covers. */
+static int summary_pass1(log_summary_t *ls, rebuilt_t *b, int64_t *epoch, int64_t *size)
+{
+    const coavoid_sim_log_config_t *o = ls->o;
+    const coavoid_scenario_t *s = ls->s;
+    log_reader_t r;
+    memset(&r, 0, sizeof r);
+    int status = log_open(&r, ls->err, o->log_path, -1);
+    if (status == SIM_GO_ON) {
+        status = read_log(ls, &r);
+    }
+    *size = r.size;
+    log_close(&r);
+    int64_t earliest = INT64_MAX;
+    for (size_t i = 0; i < s->vehicle_count && status == SIM_GO_ON; i++) {
+        if (ls->intents_of[i] == 0) {
+            status = coavoid_sim_fail(ls->err, COAVOID_SIM_ERR_INPUT,
+                                      "%s: UAV %u of %s never published an accepted intent "
+                                      "(%" PRId64 " intents in the log, %" PRId64 " refused)",
+                                      o->log_path, (unsigned)s->vehicles[i].id, o->scenario_path,
+                                      ls->intents, ls->intents_refused);
+        }
+        earliest = ls->first_plan_utime[i] < earliest ? ls->first_plan_utime[i] : earliest;
+    }
+    if (status != SIM_GO_ON) {
+        return status;
+    }
+    *epoch = !o->has_epoch ? earliest : o->epoch;
+    uint32_t cap = s->horizon > COA_MAX_HORIZON / 2u ? COA_MAX_HORIZON : 2u * s->horizon;
+    int64_t k = last_complete_cycle(ls, *epoch, cap, &b->off_grid);
+    if (k < 0) {
+        return coavoid_sim_fail(ls->err, COAVOID_SIM_ERR_INTERNAL, "out of memory");
+    }
+    if (k == 0) {
+        return coavoid_sim_fail(ls->err, COAVOID_SIM_ERR_INPUT,
+                                "%s: no cycle after cycle 0 (epoch %" PRId64
+                                " us, dt %g s) has every UAV's own intent: nothing to judge",
+                                o->log_path, *epoch, (double)s->dt);
+    }
+    b->steps = (uint32_t)k;
+    return SIM_GO_ON;
+}
+
+/* Pass 2: the samples of cycles 0..steps, from the same bytes pass 1 checked, and the gaps
+ * no intent covered from the scenario's reference. */
+static int summary_pass2(log_summary_t *ls, rebuilt_t *b, int64_t epoch, int64_t size)
+{
+    const coavoid_sim_log_config_t *o = ls->o;
+    size_t cells = ls->s->vehicle_count * ((size_t)b->steps + 1u);
+    b->best = calloc(cells, sizeof *b->best);
+    b->own = calloc(cells, sizeof *b->own);
+    b->known = calloc(cells, sizeof *b->known);
+    b->reference = calloc(cells, sizeof *b->reference);
+    b->offsets = calloc(cells, sizeof *b->offsets);
+    if (b->best == NULL || b->own == NULL || b->known == NULL || b->reference == NULL ||
+        b->offsets == NULL) {
+        return coavoid_sim_fail(ls->err, COAVOID_SIM_ERR_INTERNAL, "out of memory");
+    }
+    log_reader_t r;
+    memset(&r, 0, sizeof r);
+    int status = log_open(&r, ls->err, o->log_path, size);
+    if (status == SIM_GO_ON) {
+        status = fill_samples(ls, &r, b, epoch);
+    }
+    log_close(&r);
+    if (status == SIM_GO_ON && fill_gaps(ls->s, b) != COA_OK) {
+        status = coavoid_sim_fail(ls->err, COAVOID_SIM_ERR_INPUT,
+                                  "%s: a route cannot be sampled over %lu steps", o->scenario_path,
+                                  (unsigned long)b->steps);
+    }
+    return status;
+}
+
+/* Judges the rebuilt flight, writes the figure (first: a file that cannot be written is a
+ * usage error, reported before anything is printed) and the result; the exit status. */
+static int summary_report(log_summary_t *ls, rebuilt_t *b, int64_t epoch)
+{
+    const coavoid_sim_log_config_t *o = ls->o;
+    coavoid_judged_t judged;
+    const coavoid_flight_t *flight = &judged.flight;
+    const coavoid_flight_eval_t *eval = &judged.eval;
+    int status = SIM_GO_ON;
+    uint32_t replans = count_replans(ls, epoch + ((int64_t)b->steps + 1) * ls->dt_us);
+    int rc = coavoid_judge_run(&judged, ls->s, o->mode, b->steps, replans, b->reference, b->offsets,
+                               b->known);
+    if (rc == COA_ERR_ARGUMENT) {
+        status = refused_record(ls->err, o, flight, b);
+    } else if (rc != COA_OK) {
+        status = coavoid_sim_fail(ls->err, COAVOID_SIM_ERR_INTERNAL, "cannot judge the flight (%s)",
+                                  coa_status_name(rc));
+    }
+    if (status == SIM_GO_ON && o->svg_path != NULL) {
+        status = write_svg(ls->err, o->svg_path, flight, eval);
+    }
+    if (status == SIM_GO_ON && o->json) {
+        status = print_json(ls, b, epoch, flight, eval);
+    } else if (status == SIM_GO_ON) {
+        print_log_text(ls, b, epoch);
+        if (coavoid_flight_text(flight, eval, ls->out) != COA_OK) {
+            status = coavoid_sim_fail(ls->err, COAVOID_SIM_ERR_INTERNAL, "cannot write the result");
+        }
+    }
+    if (status == SIM_GO_ON) {
+        status = eval->loss_of_separation ? COAVOID_SIM_LOSS : COAVOID_SIM_SEPARATED;
+    }
+    return status;
+}
+
+int coavoid_sim_summarise(const coavoid_sim_log_config_t *c, coavoid_scenario_t *s, FILE *out,
+                          coavoid_sim_error_t *e)
+{
+    log_summary_t *ls = calloc(1, sizeof *ls);
+    rebuilt_t b;
+    memset(&b, 0, sizeof b);
+    if (ls == NULL) {
+        return coavoid_sim_fail(e, COAVOID_SIM_ERR_INTERNAL, "out of memory");
+    }
+    e->text[0] = '\0';
+    ls->o = c;
+    ls->err = e;
+    ls->out = out;
+    ls->s = s;
+    int64_t epoch = 0;
+    int64_t size = 0;
+    int status = summary_check(ls);
+    if (status == SIM_GO_ON) {
+        status = summary_pass1(ls, &b, &epoch, &size);
+    }
+    if (status == SIM_GO_ON) {
+        status = summary_pass2(ls, &b, epoch, size);
+    }
+    if (status == SIM_GO_ON) {
+        status = summary_report(ls, &b, epoch);
+    }
+    rebuilt_free(&b);
+    free(ls->seen.items);
+    free(ls->heartbeats.items);
+    free(ls->plan_list.items);
+    free(ls);
+    return status;
+}
