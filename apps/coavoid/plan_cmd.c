@@ -1,21 +1,17 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * coavoid plan: reads a scenario (docs/scenario-format.md), plans altitude manoeuvres
- * centrally or decoupled, and prints the plan result as JSON. See PLAN_USAGE below.
+ * coavoid plan: its options, and --priority's ids as an order; the plan is
+ * coavoid::scenario's (run.h, coavoid_scenario_plan). See PLAN_USAGE below.
  */
-#define _POSIX_C_SOURCE 200809L
-
 #include <stdbool.h>
 #include <stdint.h>
 #include <stdio.h>
-#include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "cli.h"
-#include "commands.h"
 #include "coavoid/coavoid.h"
-#include "output.h"
+#include "commands.h"
+#include "run.h"
 #include "scenario.h"
 
 /* How many priority orders --reorder tries unless --max-orders says otherwise. n UAVs have
@@ -184,171 +180,42 @@ static int parse_priority(const char *text, const coavoid_scenario_t *s, size_t 
     return CLI_CONTINUE;
 }
 
-/* The core's COA_ERR_RANGE from the problem check or the planner. Weights that cannot be
- * exact (the only cause the current limits allow) are named by the parser first, so what
- * is left is the worst-case cost over the horizon outgrowing the core's exact integers:
- * horizon is what the user is most likely to change. A backstop. */
-static int range_error(const char *file, const coavoid_scenario_t *s)
+/* A verdict of the library as the exit status, its report as the one-line message. */
+static int plan_status(int rc, const coavoid_run_error_t *e)
 {
-    return coavoid_cli_fail(
-        CLI_EXIT_INVALID,
-        "%s: horizon: %lu steps is too long for these vehicles' offsets and costs "
-        "(beyond the core's integer range; shorten it or bound max_offset)",
-        file, (unsigned long)s->horizon);
-}
-
-/* beta from --beta, else the scenario, else the default; *source names it for messages. */
-static uint32_t choose_beta(const plan_options_t *o, const coavoid_scenario_t *s, size_t searched,
-                            char *source, size_t source_size)
-{
-    if (o->beta_text != NULL) {
-        snprintf(source, source_size, "--beta %lu", (unsigned long)o->beta);
-        return o->beta;
+    switch (rc) {
+    case COAVOID_RUN_DONE:
+        return CLI_EXIT_OK;
+    case COAVOID_RUN_NOT_SOLVED:
+        return CLI_EXIT_NOT_SOLVED;
+    case COAVOID_RUN_ERR_INPUT:
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s", e->text);
+    default:
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "%s", e->text);
     }
-    if (s->has_beta) {
-        snprintf(source, source_size, "%.400s: beta %lu", o->scenario_path, (unsigned long)s->beta);
-        return s->beta;
-    }
-    coa_planner_config_t shape = coavoid_scenario_planner_config(s, searched, COAVOID_DEFAULT_BETA);
-    uint32_t beta = coavoid_default_beta(&shape);
-    snprintf(source, source_size, "default beta %lu", (unsigned long)beta);
-    return beta;
-}
-
-/* Everything after the scenario is loaded. Returns the exit status. */
-/* The planner for `searched` UAVs at `beta`, in a workspace of its exact size, and the
- * offsets' rows; *workspace and *offsets are the caller's to free, also on failure. */
-static int plan_allocate(const char *file, const char *beta_source, const coavoid_scenario_t *s,
-                         size_t searched, uint32_t beta, void **workspace, int32_t **offsets,
-                         coa_planner_t **planner)
-{
-    coa_planner_config_t config = coavoid_scenario_planner_config(s, searched, beta);
-    /* The tables alone (every reachable step and offset) do not depend on beta: when they
-     * pass the limit no beta helps, whatever --beta or the scenario say. */
-    if (beta == 0 || coa_planner_max_beta(&config, COAVOID_DEFAULT_WORKSPACE_MAX) == 0) {
-        return coavoid_cli_fail(
-            CLI_EXIT_INVALID,
-            "%s: too large: the cost-to-go tables of a %lu-step horizon would not "
-            "fit in %zu MiB of workspace (shorten the horizon or bound max_offset)",
-            file, (unsigned long)s->horizon, COAVOID_DEFAULT_WORKSPACE_MAX >> 20);
-    }
-    size_t size = coa_planner_workspace_size(&config);
-    if (size == 0) {
-        return coavoid_cli_fail(
-            CLI_EXIT_INVALID,
-            "%s: too large: the workspace for %zu vehicle(s) over %lu steps would "
-            "not fit in memory (lower it with --beta)",
-            beta_source, searched, (unsigned long)s->horizon);
-    }
-    *workspace = malloc(size);
-    if (*workspace == NULL) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID,
-                                "%s: cannot allocate %zu bytes of workspace for %zu vehicle(s) "
-                                "(lower it with --beta)",
-                                beta_source, size, searched);
-    }
-    *planner = coa_planner_init(*workspace, size, &config);
-    *offsets = calloc(s->vehicle_count * ((size_t)s->horizon + 1u), sizeof **offsets);
-    if (*planner == NULL || *offsets == NULL) {
-        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "%s",
-                                *planner == NULL
-                                    ? "internal error: the planner refused its workspace"
-                                    : "out of memory for the plan");
-    }
-    return CLI_CONTINUE;
-}
-
-/* The scenario sampled and accepted by the core's problem check. */
-static int plan_problem(const char *file, coavoid_scenario_t *s, coa_problem_t *problem)
-{
-    int rc = coavoid_cli_sample_scenario(file, s);
-    if (rc != CLI_CONTINUE) {
-        return rc;
-    }
-    *problem = coavoid_scenario_problem(s);
-    rc = coa_problem_check(problem);
-    if (rc == COA_ERR_RANGE) {
-        return range_error(file, s);
-    }
-    if (rc != COA_OK) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: rejected by the core's problem check (%s)",
-                                file, coa_status_name(rc));
-    }
-    return CLI_CONTINUE;
-}
-
-/* Plans in the mode asked for and prints the result; the exit status. */
-static int plan_run(const plan_options_t *o, const coavoid_scenario_t *s,
-                    const coa_problem_t *problem, const size_t *order, coa_planner_t *planner,
-                    int32_t *offsets, uint32_t beta)
-{
-    char err[SCENARIO_ERROR_MAX];
-    coa_plan_result_t result;
-    memset(&result, 0, sizeof result);
-    struct timespec start, end;
-    int rc;
-    clock_gettime(CLOCK_MONOTONIC, &start);
-    if (o->decoupled) {
-        rc = coa_plan_decoupled(planner, problem, order, o->reorder ? o->max_orders : 1u, offsets,
-                                &result);
-    } else {
-        rc = coa_plan_centralised(planner, problem, offsets, &result);
-    }
-    clock_gettime(CLOCK_MONOTONIC, &end);
-    if (rc == COA_ERR_RANGE) {
-        return range_error(o->scenario_path, s);
-    }
-    if (rc != COA_OK) {
-        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: the planner failed (%s)",
-                                coa_status_name(rc));
-    }
-    coavoid_output_plan_t view = {
-        s, o->decoupled, &result, offsets, coavoid_cli_elapsed_us(&start, &end), beta};
-    if (coavoid_output_plan(stdout, &view, err, sizeof err) != 0) {
-        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "%s", err);
-    }
-    return result.status == COA_PLAN_SOLVED ? CLI_EXIT_OK : CLI_EXIT_NOT_SOLVED;
 }
 
 static int plan(void *options, coavoid_scenario_t *s)
 {
     const plan_options_t *o = options;
-    const char *file = o->scenario_path;
-    size_t order_storage[COA_MAX_VEHICLES];
-    const size_t *order = NULL;
-    const size_t n = s->vehicle_count;
+    size_t order[COA_MAX_VEHICLES];
     if (o->priority != NULL) {
-        int status = parse_priority(o->priority, s, order_storage);
+        int status = parse_priority(o->priority, s, order);
         if (status != CLI_CONTINUE) {
             return status;
         }
-        order = order_storage;
     }
-    if (!o->decoupled && n > COA_MAX_CENTRALISED) {
-        return coavoid_cli_fail(
-            CLI_EXIT_INVALID,
-            "--mode centralised: %zu vehicles, at most %u (COA_MAX_CENTRALISED) can be "
-            "planned together",
-            n, COA_MAX_CENTRALISED);
-    }
-    const size_t searched = o->decoupled ? 1u : n;
-    char beta_source[SCENARIO_ERROR_MAX];
-    uint32_t beta = choose_beta(o, s, searched, beta_source, sizeof beta_source);
-    coa_problem_t problem;
-    int status = plan_problem(file, s, &problem);
-    if (status != CLI_CONTINUE) {
-        return status;
-    }
-    void *workspace = NULL;
-    int32_t *offsets = NULL;
-    coa_planner_t *planner = NULL;
-    status = plan_allocate(file, beta_source, s, searched, beta, &workspace, &offsets, &planner);
-    if (status == CLI_CONTINUE) {
-        status = plan_run(o, s, &problem, order, planner, offsets, beta);
-    }
-    free(workspace);
-    free(offsets);
-    return status;
+    const coavoid_plan_config_t config = {
+        .scenario_path = o->scenario_path,
+        .decoupled = o->decoupled,
+        .order = o->priority != NULL ? order : NULL,
+        .has_beta = o->beta_text != NULL,
+        .beta = o->beta,
+        .max_orders = o->reorder ? o->max_orders : 1u,
+    };
+    coavoid_run_error_t e;
+    int rc = coavoid_scenario_plan(&config, s, stdout, &e);
+    return plan_status(rc, &e);
 }
 
 int coavoid_command_plan(int argc, char **argv)
