@@ -29,6 +29,20 @@ int coavoid_cli_fail(int status, const char *fmt, ...)
     return status;
 }
 
+int coavoid_cli_run_status(int rc, const coavoid_run_error_t *e)
+{
+    switch (rc) {
+    case COAVOID_RUN_DONE:
+        return CLI_EXIT_OK;
+    case COAVOID_RUN_NOT_SOLVED:
+        return CLI_EXIT_NOT_SOLVED;
+    case COAVOID_RUN_ERR_INPUT:
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s", e->text);
+    default:
+        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "%s", e->text);
+    }
+}
+
 bool coavoid_cli_option_is(const char *arg, const char *name)
 {
     size_t length = strlen(name);

@@ -18,6 +18,7 @@
 
 #include "coavoid/common.h"
 #include "coavoid/plan.h"
+#include "run.h"
 #include "scenario.h"
 
 /* malloc's alignment is what every workspace buffer (planner, predictor) relies on. */
@@ -45,6 +46,12 @@ enum {
  * input, such as a file name or an option value, are replaced so they cannot split it) and
  * returns `status`, so that every check reads `return coavoid_cli_fail(...)`. */
 int coavoid_cli_fail(int status, const char *fmt, ...) CLI_PRINTF_LIKE(2, 3);
+
+/* A library's return (run.h: a verdict, or an error with its report in e) as the exit
+ * status: COAVOID_RUN_DONE -> CLI_EXIT_OK, COAVOID_RUN_NOT_SOLVED -> CLI_EXIT_NOT_SOLVED, an
+ * error -> its report on stderr (coavoid_cli_fail) and CLI_EXIT_INVALID or
+ * CLI_EXIT_INTERNAL. */
+int coavoid_cli_run_status(int rc, const coavoid_run_error_t *e);
 
 /* Whether `arg` is the option `name`, alone or as "name=value". */
 bool coavoid_cli_option_is(const char *arg, const char *name);

@@ -180,21 +180,6 @@ static int parse_priority(const char *text, const coavoid_scenario_t *s, size_t 
     return CLI_CONTINUE;
 }
 
-/* A verdict of the library as the exit status, its report as the one-line message. */
-static int plan_status(int rc, const coavoid_run_error_t *e)
-{
-    switch (rc) {
-    case COAVOID_RUN_DONE:
-        return CLI_EXIT_OK;
-    case COAVOID_RUN_NOT_SOLVED:
-        return CLI_EXIT_NOT_SOLVED;
-    case COAVOID_RUN_ERR_INPUT:
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s", e->text);
-    default:
-        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "%s", e->text);
-    }
-}
-
 static int plan(void *options, coavoid_scenario_t *s)
 {
     const plan_options_t *o = options;
@@ -215,7 +200,7 @@ static int plan(void *options, coavoid_scenario_t *s)
     };
     coavoid_run_error_t e;
     int rc = coavoid_scenario_plan(&config, s, stdout, &e);
-    return plan_status(rc, &e);
+    return coavoid_cli_run_status(rc, &e);
 }
 
 int coavoid_command_plan(int argc, char **argv)

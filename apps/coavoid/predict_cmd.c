@@ -118,19 +118,6 @@ static int parse_predict_options(int argc, char **argv, predict_options_t *o)
     return CLI_CONTINUE;
 }
 
-/* A verdict of the library as the exit status, its report as the one-line message. */
-static int predict_status(int rc, const coavoid_run_error_t *e)
-{
-    switch (rc) {
-    case COAVOID_RUN_DONE:
-        return CLI_EXIT_OK;
-    case COAVOID_RUN_ERR_INPUT:
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s", e->text);
-    default:
-        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "%s", e->text);
-    }
-}
-
 static int predict(void *options, coavoid_scenario_t *s)
 {
     const predict_options_t *o = options;
@@ -142,7 +129,7 @@ static int predict(void *options, coavoid_scenario_t *s)
     };
     coavoid_run_error_t e;
     int rc = coavoid_scenario_predict(&config, s, stdout, &e);
-    return predict_status(rc, &e);
+    return coavoid_cli_run_status(rc, &e);
 }
 
 int coavoid_command_predict(int argc, char **argv)

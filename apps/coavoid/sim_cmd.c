@@ -118,21 +118,6 @@ static int parse_sim_options(int argc, char **argv, sim_options_t *o)
     return CLI_CONTINUE;
 }
 
-/* A verdict of the library as the exit status, its report as the one-line message. */
-static int sim_status(int rc, const coavoid_sim_error_t *e)
-{
-    switch (rc) {
-    case COAVOID_SIM_SEPARATED:
-        return CLI_EXIT_OK;
-    case COAVOID_SIM_LOSS:
-        return CLI_EXIT_NOT_SOLVED;
-    case COAVOID_SIM_ERR_INPUT:
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s", e->text);
-    default:
-        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "%s", e->text);
-    }
-}
-
 static int sim(void *options, coavoid_scenario_t *s)
 {
     const sim_options_t *o = options;
@@ -147,9 +132,9 @@ static int sim(void *options, coavoid_scenario_t *s)
         .json = o->json,
         .svg_path = o->svg_path,
     };
-    coavoid_sim_error_t e;
+    coavoid_run_error_t e;
     int rc = coavoid_sim_run(&config, s, stdout, &e);
-    return sim_status(rc, &e);
+    return coavoid_cli_run_status(rc, &e);
 }
 
 int coavoid_command_sim(int argc, char **argv)

@@ -109,20 +109,6 @@ static int parse_summary_options(int argc, char **argv, summary_options_t *o)
     return CLI_CONTINUE;
 }
 
-static int summary_status(int rc, const coavoid_sim_error_t *e)
-{
-    switch (rc) {
-    case COAVOID_SIM_SEPARATED:
-        return CLI_EXIT_OK;
-    case COAVOID_SIM_LOSS:
-        return CLI_EXIT_NOT_SOLVED;
-    case COAVOID_SIM_ERR_INPUT:
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s", e->text);
-    default:
-        return coavoid_cli_fail(CLI_EXIT_INTERNAL, "%s", e->text);
-    }
-}
-
 static int summarise(void *options, coavoid_scenario_t *s)
 {
     const summary_options_t *o = options;
@@ -135,8 +121,8 @@ static int summarise(void *options, coavoid_scenario_t *s)
         .has_epoch = o->epoch_text != NULL,
         .epoch = o->epoch,
     };
-    coavoid_sim_error_t e;
-    return summary_status(coavoid_sim_summarise(&config, s, stdout, &e), &e);
+    coavoid_run_error_t e;
+    return coavoid_cli_run_status(coavoid_sim_summarise(&config, s, stdout, &e), &e);
 }
 
 int coavoid_command_summary(int argc, char **argv)

@@ -27,7 +27,7 @@
 typedef struct {
     /* The run's parameters (sim_check, sim_planner_sizes). */
     const coavoid_sim_config_t *o;
-    coavoid_sim_error_t *err;
+    coavoid_run_error_t *err;
     FILE *out;
     const coavoid_scenario_t *s;
     const char *file;
@@ -114,23 +114,23 @@ static char far_axis(coa_vec3_t p, double *value)
  * (and within max_offset), whatever is planned. */
 /* Vehicle i's volume, speeds and priority within what an intent carries; *climb is the
  * vertical speed its largest change of offset in one step adds. */
-static int check_vehicle_sizes(coavoid_sim_error_t *err, const char *file, size_t i,
+static int check_vehicle_sizes(coavoid_run_error_t *err, const char *file, size_t i,
                                const coa_vehicle_t *v, double *climb)
 {
     if (beyond((double)v->volume.radius, COAVOID_LCM_MAX_SIZE)) {
-        return coavoid_sim_fail(err, COAVOID_SIM_ERR_INPUT,
+        return coavoid_run_fail(err, COAVOID_RUN_ERR_INPUT,
                                 "%s: vehicles[%zu].radius: %g m is beyond what " SIM_INTENT
                                 " carries (%g m)",
                                 file, i, (double)v->volume.radius, COAVOID_LCM_MAX_SIZE);
     }
     if (beyond((double)v->volume.half_height, COAVOID_LCM_MAX_SIZE)) {
-        return coavoid_sim_fail(err, COAVOID_SIM_ERR_INPUT,
+        return coavoid_run_fail(err, COAVOID_RUN_ERR_INPUT,
                                 "%s: vehicles[%zu].half_height: %g m is beyond what " SIM_INTENT
                                 " carries (%g m)",
                                 file, i, (double)v->volume.half_height, COAVOID_LCM_MAX_SIZE);
     }
     if (beyond((double)v->cruise_speed, COAVOID_LCM_MAX_SPEED)) {
-        return coavoid_sim_fail(err, COAVOID_SIM_ERR_INPUT,
+        return coavoid_run_fail(err, COAVOID_RUN_ERR_INPUT,
                                 "%s: vehicles[%zu].cruise_speed: %g m/s is beyond what " SIM_INTENT
                                 " carries (%g m/s)",
                                 file, i, (double)v->cruise_speed, COAVOID_LCM_MAX_SPEED);
@@ -141,13 +141,13 @@ static int check_vehicle_sizes(coavoid_sim_error_t *err, const char *file, size_
     }
     *climb = (double)max_change * (double)v->climb_rate;
     if (beyond(*climb, COAVOID_LCM_MAX_SPEED)) {
-        return coavoid_sim_fail(err, COAVOID_SIM_ERR_INPUT,
+        return coavoid_run_fail(err, COAVOID_RUN_ERR_INPUT,
                                 "%s: vehicles[%zu].climb_rate: %g m/s, %g m/s in a steep climb, is "
                                 "beyond what " SIM_INTENT " carries (%g m/s)",
                                 file, i, (double)v->climb_rate, *climb, COAVOID_LCM_MAX_SPEED);
     }
     if (v->priority > (uint32_t)INT32_MAX) {
-        return coavoid_sim_fail(err, COAVOID_SIM_ERR_INPUT,
+        return coavoid_run_fail(err, COAVOID_RUN_ERR_INPUT,
                                 "%s: vehicles[%zu].priority: %lu is beyond what " SIM_INTENT
                                 " carries (%ld)",
                                 file, i, (unsigned long)v->priority, (long)INT32_MAX);
@@ -158,7 +158,7 @@ static int check_vehicle_sizes(coavoid_sim_error_t *err, const char *file, size_
 /* The step from sample `previous` to r (at t): the intent's velocity is that step, and
  * consecutive reference points must differ horizontally in the core's precision, as the
  * intent's check judges them (a route far out flown very slowly does not). */
-static int check_vehicle_step(coavoid_sim_error_t *err, const char *file, size_t i,
+static int check_vehicle_step(coavoid_run_error_t *err, const char *file, size_t i,
                               const coa_vehicle_t *v, coa_real_t dt, coa_real_t t,
                               coa_vec3_t previous, coa_vec3_t r, double climb)
 {
@@ -167,7 +167,7 @@ static int check_vehicle_step(coavoid_sim_error_t *err, const char *file, size_t
     const double vz = fabs((double)((r.z - previous.z) / dt)) + climb;
     if (beyond(vx, COAVOID_LCM_MAX_SPEED) || beyond(vy, COAVOID_LCM_MAX_SPEED) ||
         beyond(vz, COAVOID_LCM_MAX_SPEED)) {
-        return coavoid_sim_fail(err, COAVOID_SIM_ERR_INPUT,
+        return coavoid_run_fail(err, COAVOID_RUN_ERR_INPUT,
                                 "%s: vehicles[%zu].route: its reference moves at (%g, %g) m/s "
                                 "horizontally and %g m/s vertically with its steepest climb at t = "
                                 "%g s, beyond what " SIM_INTENT " carries (%g m/s each)",
@@ -179,7 +179,7 @@ static int check_vehicle_step(coavoid_sim_error_t *err, const char *file, size_t
     probe.route_count = 2u;
     probe.initial_offset = 0;
     if (coa_vehicle_check(&probe) != COA_OK) {
-        return coavoid_sim_fail(err, COAVOID_SIM_ERR_INPUT,
+        return coavoid_run_fail(err, COAVOID_RUN_ERR_INPUT,
                                 "%s: vehicles[%zu].cruise_speed: %g m/s moves it too little in a "
                                 "step to tell its position at t = %g s from the one before "
                                 "(%.10g, %.10g m), as " SIM_INTENT " must",
@@ -189,7 +189,7 @@ static int check_vehicle_step(coavoid_sim_error_t *err, const char *file, size_t
     return SIM_GO_ON;
 }
 
-static int check_vehicle_limits(coavoid_sim_error_t *err, const char *file, size_t i,
+static int check_vehicle_limits(coavoid_run_error_t *err, const char *file, size_t i,
                                 const coa_vehicle_t *v, coa_real_t dt, uint64_t last)
 {
     double climb = 0.0;
@@ -208,8 +208,8 @@ static int check_vehicle_limits(coavoid_sim_error_t *err, const char *file, size
         double value = 0.0;
         char axis = far_axis(r, &value);
         if (axis != 0) {
-            return coavoid_sim_fail(
-                err, COAVOID_SIM_ERR_INPUT,
+            return coavoid_run_fail(
+                err, COAVOID_RUN_ERR_INPUT,
                 "%s: vehicles[%zu].route: its reference reaches %c = %.10g m at t "
                 "= %g s, beyond what " SIM_INTENT " carries (%g m; this run's "
                 "intents reach t = %g s)",
@@ -220,8 +220,8 @@ static int check_vehicle_limits(coavoid_sim_error_t *err, const char *file, size
         const int64_t reach = reach_steps < bound ? reach_steps : bound;
         const double top = fabs((double)r.z) + (double)reach * dh;
         if (beyond(top, COAVOID_LCM_MAX_COORDINATE)) {
-            return coavoid_sim_fail(
-                err, COAVOID_SIM_ERR_INPUT,
+            return coavoid_run_fail(
+                err, COAVOID_RUN_ERR_INPUT,
                 "%s: vehicles[%zu]: at t = %g s its reference is at z = %.10g m, "
                 "and the %lld climb steps of %g m it may have taken by then take "
                 "|z| to %.10g m: beyond what " SIM_INTENT " carries (%g m)",
@@ -246,7 +246,7 @@ static int check_vehicle_limits(coavoid_sim_error_t *err, const char *file, size
 /* Track i's speeds within what a track message carries: its velocity, or the speed of the
  * leg in use at each step t_k, as coa_track_at and the world choose it (the first one
  * before path[1], the last one from path[last - 1] on). */
-static int check_track_speeds(coavoid_sim_error_t *err, const char *file, size_t i,
+static int check_track_speeds(coavoid_run_error_t *err, const char *file, size_t i,
                               const coa_track_t *tr, coa_real_t dt, uint64_t steps)
 {
     if (tr->path_count == 0u) {
@@ -258,7 +258,7 @@ static int check_track_speeds(coavoid_sim_error_t *err, const char *file, size_t
             value = beyond((double)v.x, COAVOID_LCM_MAX_SPEED)   ? (double)v.x
                     : beyond((double)v.y, COAVOID_LCM_MAX_SPEED) ? (double)v.y
                                                                  : (double)v.z;
-            return coavoid_sim_fail(err, COAVOID_SIM_ERR_INPUT,
+            return coavoid_run_fail(err, COAVOID_RUN_ERR_INPUT,
                                     "%s: tracks[%zu].velocity: %g m/s is beyond what " SIM_TRACK
                                     " carries (%g m/s)",
                                     file, i, value, COAVOID_LCM_MAX_SPEED);
@@ -279,8 +279,8 @@ static int check_track_speeds(coavoid_sim_error_t *err, const char *file, size_t
                                  (double)((b->p.z - a->p.z) / span)};
             for (int c = 0; c < 3; c++) {
                 if (beyond(v[c], COAVOID_LCM_MAX_SPEED)) {
-                    return coavoid_sim_fail(
-                        err, COAVOID_SIM_ERR_INPUT,
+                    return coavoid_run_fail(
+                        err, COAVOID_RUN_ERR_INPUT,
                         "%s: tracks[%zu].path[%zu]: the leg to it is flown at %g m/s, "
                         "beyond what " SIM_TRACK " carries (%g m/s)",
                         file, i, leg + 1u, v[c], COAVOID_LCM_MAX_SPEED);
@@ -291,7 +291,7 @@ static int check_track_speeds(coavoid_sim_error_t *err, const char *file, size_t
     return SIM_GO_ON;
 }
 
-static int check_track_limits(coavoid_sim_error_t *err, const char *file, size_t i,
+static int check_track_limits(coavoid_run_error_t *err, const char *file, size_t i,
                               const coa_track_t *tr, coa_real_t dt, uint64_t steps, uint64_t last)
 {
     const struct {
@@ -303,8 +303,8 @@ static int check_track_limits(coavoid_sim_error_t *err, const char *file, size_t
                   {"sigma[1]", tr->sigma_vertical}};
     for (size_t f = 0; f < 4u; f++) {
         if (beyond((double)sizes[f].value, COAVOID_LCM_MAX_SIZE)) {
-            return coavoid_sim_fail(
-                err, COAVOID_SIM_ERR_INPUT,
+            return coavoid_run_fail(
+                err, COAVOID_RUN_ERR_INPUT,
                 "%s: tracks[%zu].%s: %g m is beyond what " SIM_TRACK " carries (%g m)", file, i,
                 sizes[f].name, (double)sizes[f].value, COAVOID_LCM_MAX_SIZE);
         }
@@ -319,8 +319,8 @@ static int check_track_limits(coavoid_sim_error_t *err, const char *file, size_t
         double value = 0.0;
         char axis = far_axis(tr->path[j].p, &value);
         if (axis != 0 && tr->path[j].t > (coa_real_t)0 && tr->path[j].t < end) {
-            return coavoid_sim_fail(
-                err, COAVOID_SIM_ERR_INPUT,
+            return coavoid_run_fail(
+                err, COAVOID_RUN_ERR_INPUT,
                 "%s: tracks[%zu].path[%zu]: %c = %.10g m is beyond what " SIM_TRACK
                 " carries (%g m)",
                 file, i, j, axis, value, COAVOID_LCM_MAX_COORDINATE);
@@ -331,8 +331,8 @@ static int check_track_limits(coavoid_sim_error_t *err, const char *file, size_t
         double value = 0.0;
         char axis = far_axis(coa_track_at(tr, t), &value);
         if (axis != 0) {
-            return coavoid_sim_fail(
-                err, COAVOID_SIM_ERR_INPUT,
+            return coavoid_run_fail(
+                err, COAVOID_RUN_ERR_INPUT,
                 "%s: tracks[%zu]: at t = %g s it is at %c = %.10g m, beyond what " SIM_TRACK
                 " carries (%g m; this run's track messages reach t = %g "
                 "s)",
@@ -342,7 +342,7 @@ static int check_track_limits(coavoid_sim_error_t *err, const char *file, size_t
     return SIM_GO_ON;
 }
 
-static int check_obstacle_limits(coavoid_sim_error_t *err, const char *file, size_t i,
+static int check_obstacle_limits(coavoid_run_error_t *err, const char *file, size_t i,
                                  const coa_obstacle_t *o)
 {
     double value = 0.0;
@@ -355,7 +355,7 @@ static int check_obstacle_limits(coavoid_sim_error_t *err, const char *file, siz
             axis = far_axis(o->box.max, &value);
         }
         if (axis != 0) {
-            return coavoid_sim_fail(err, COAVOID_SIM_ERR_INPUT,
+            return coavoid_run_fail(err, COAVOID_RUN_ERR_INPUT,
                                     "%s: obstacles[%zu].%s: %c = %.10g m is beyond what " SIM_MAP
                                     " carries (%g m)",
                                     file, i, corner, axis, value, COAVOID_LCM_MAX_COORDINATE);
@@ -365,8 +365,8 @@ static int check_obstacle_limits(coavoid_sim_error_t *err, const char *file, siz
     for (size_t j = 0; j < o->polytope.count; j++) {
         axis = far_axis(o->polytope.vertices[j], &value);
         if (axis != 0) {
-            return coavoid_sim_fail(
-                err, COAVOID_SIM_ERR_INPUT,
+            return coavoid_run_fail(
+                err, COAVOID_RUN_ERR_INPUT,
                 "%s: obstacles[%zu].vertices[%zu]: %c = %.10g m is beyond what " SIM_MAP
                 " carries (%g m)",
                 file, i, j, axis, value, COAVOID_LCM_MAX_COORDINATE);
@@ -377,7 +377,7 @@ static int check_obstacle_limits(coavoid_sim_error_t *err, const char *file, siz
 
 /* Every check above, over a run of `steps` cycles. Cost O((steps + N) * (vehicles * route +
  * tracks * path) + obstacle vertices), no memory. */
-static int check_message_limits(coavoid_sim_error_t *err, const char *file,
+static int check_message_limits(coavoid_run_error_t *err, const char *file,
                                 const coavoid_scenario_t *s, uint32_t steps)
 {
     const uint64_t last = (uint64_t)steps + s->horizon;
@@ -414,38 +414,38 @@ static int sim_check(sim_run_t *r, coavoid_scenario_t *s)
     const char *file = r->file;
     const size_t n = r->n;
     if (s->horizon > COAVOID_NODE_MAX_HORIZON) {
-        return coavoid_sim_fail(
-            r->err, COAVOID_SIM_ERR_INPUT,
+        return coavoid_run_fail(
+            r->err, COAVOID_RUN_ERR_INPUT,
             "%s: horizon: %lu steps, at most %u in a simulation (an intent carries "
             "N + 1 samples)",
             file, (unsigned long)s->horizon, COAVOID_NODE_MAX_HORIZON);
     }
     if (n > COA_MAX_VEHICLES || n > COAVOID_NODE_MAX_PEERS) {
-        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT,
                                 "%s: vehicles: %zu UAVs, at most %u in a simulation", file, n,
                                 COA_MAX_VEHICLES < COAVOID_NODE_MAX_PEERS ? COA_MAX_VEHICLES
                                                                           : COAVOID_NODE_MAX_PEERS);
     }
     if (s->track_count > COAVOID_NODE_MAX_TRACKS) {
-        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT,
                                 "%s: tracks: %zu tracks, at most %u in a simulation", file,
                                 s->track_count, COAVOID_NODE_MAX_TRACKS);
     }
     r->steps = r->o->has_steps ? r->o->steps : 2u * s->horizon;
     r->samples = (size_t)r->steps + 1u;
     if (r->o->has_stop && r->o->stop_step > r->steps) {
-        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT,
                                 "--coordinator-stops: step %lu is after the last, %lu",
                                 (unsigned long)r->o->stop_step, (unsigned long)r->steps);
     }
     char sample_err[SCENARIO_ERROR_MAX];
     if (coavoid_scenario_sample(s, sample_err, sizeof sample_err) != 0) {
-        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT, "%s: %s", file, sample_err);
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT, "%s: %s", file, sample_err);
     }
     r->now = SIM_EPOCH_UTIME;
     if (coavoid_node_common_defaults(&r->common, SIM_EPOCH_UTIME, s->dt, s->horizon, &r->now) !=
         COA_OK) {
-        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT,
                                 "%s: dt: %g s cannot be a cycle (whole microseconds, at most %g s)",
                                 file, (double)s->dt, COAVOID_LCM_MAX_STEP);
     }
@@ -463,8 +463,8 @@ static int sim_planner_sizes(sim_run_t *r)
     r->vehicle_beta = s->has_beta ? s->beta : coavoid_default_beta(&vehicle_shape);
     vehicle_shape.beta = r->vehicle_beta;
     if (r->vehicle_beta == 0 || !coavoid_workspace_fits(&vehicle_shape)) {
-        return coavoid_sim_fail(
-            r->err, COAVOID_SIM_ERR_INPUT,
+        return coavoid_run_fail(
+            r->err, COAVOID_RUN_ERR_INPUT,
             "%s: beta: %lu is too large: a UAV's planner would not fit in 1 GiB", r->file,
             (unsigned long)r->vehicle_beta);
     }
@@ -488,20 +488,20 @@ static int sim_open(sim_run_t *r)
     r->references = calloc(n * r->samples, sizeof *r->references);
     r->offsets = calloc(n * r->samples, sizeof *r->offsets);
     if (r->vehicles == NULL || r->index == NULL || r->references == NULL || r->offsets == NULL) {
-        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT,
                                 "%s: cannot allocate the record of %lu steps", r->file,
                                 (unsigned long)r->steps);
     }
     if (r->o->svg_path != NULL) {
         r->svg = fopen(r->o->svg_path, "w");
         if (r->svg == NULL) {
-            return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT, "--svg: cannot write '%.200s'",
+            return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT, "--svg: cannot write '%.200s'",
                                     r->o->svg_path);
         }
     }
     r->lcm = lcm_create("memq://");
     if (r->lcm == NULL) {
-        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INTERNAL,
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INTERNAL,
                                 "internal error: LCM's memq provider is unavailable");
     }
     return SIM_GO_ON;
@@ -524,7 +524,7 @@ static int sim_world(sim_run_t *r)
     if (!ids_fit) {
         r->tracks = calloc(s->track_count, sizeof *r->tracks);
         if (r->tracks == NULL) {
-            return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT, "%s: cannot allocate the tracks",
+            return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT, "%s: cannot allocate the tracks",
                                     r->file);
         }
         for (size_t i = 0; i < s->track_count; i++) {
@@ -544,7 +544,7 @@ static int sim_world(sim_run_t *r)
     world.track_count = s->track_count;
     r->world = coavoid_world_create(&world, r->lcm, &error);
     if (r->world == NULL && error == COA_ERR_ARGUMENT) {
-        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT,
                                 "%s: obstacles: more than an obstacle map message holds (%d boxes, "
                                 "%d polytopes of at most %d vertices)",
                                 r->file, COAVOID_OBSTACLE_MAP_T_MAX_BOXES,
@@ -552,7 +552,7 @@ static int sim_world(sim_run_t *r)
                                 COAVOID_OBSTACLE_MAP_T_MAX_VERTICES);
     }
     if (r->world == NULL) {
-        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INTERNAL,
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INTERNAL,
                                 "internal error: out of memory for the world node");
     }
     return SIM_GO_ON;
@@ -566,7 +566,7 @@ static int sim_vehicles(sim_run_t *r)
 {
     const coavoid_scenario_t *s = r->s;
     if (coa_priority_order(s->vehicles, r->n, r->index) != COA_OK) {
-        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INTERNAL,
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INTERNAL,
                                 "internal error: no priority order of %zu UAVs", r->n);
     }
     for (size_t j = 0; j < r->n; j++) {
@@ -580,12 +580,12 @@ static int sim_vehicles(sim_run_t *r)
         config.mode = r->o->decoupled ? COAVOID_NODE_DECOUPLED : COAVOID_NODE_CENTRALISED;
         r->vehicles[j] = coavoid_vehicle_node_create(&config, r->lcm, &error);
         if (r->vehicles[j] == NULL && error == COA_ERR_ARGUMENT) {
-            return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+            return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT,
                                     "%s: vehicles[%zu]: cannot run as a node (%s)", r->file, i,
                                     coavoid_lcm_error_name(error));
         }
         if (r->vehicles[j] == NULL) {
-            return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+            return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT,
                                     "%s: vehicles[%zu]: cannot allocate its node (beta %lu)",
                                     r->file, i, (unsigned long)r->vehicle_beta);
         }
@@ -608,18 +608,18 @@ static int sim_coordinator(sim_run_t *r)
     config.max_centralised = r->max_centralised;
     config.collect_us = r->collect_us;
     if (config.collect_us >= r->common.dt_us) {
-        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT,
                                 "%s: dt: %g s leaves the coordinator no time within a cycle",
                                 r->file, (double)r->s->dt);
     }
     r->coordinator = coavoid_coordinator_create(&config, r->lcm, &error);
     if (r->coordinator == NULL && error == COA_ERR_ARGUMENT) {
-        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT,
                                 "%s: beta: %lu cannot size the coordinator's planner", r->file,
                                 (unsigned long)r->coordinator_beta);
     }
     if (r->coordinator == NULL) {
-        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT,
                                 "%s: cannot allocate the coordinator's planner (beta %lu, %zu UAVs "
                                 "together)",
                                 r->file, (unsigned long)r->coordinator_beta, r->max_centralised);
@@ -707,11 +707,11 @@ static int sim_fly(sim_run_t *r)
         r->coordinator_plans = coavoid_coordinator_state(r->coordinator)->plans_run;
     }
     if (!lcm_ok) {
-        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INTERNAL,
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INTERNAL,
                                 "internal error: LCM failed while handling messages");
     }
     if (node_error != COA_OK) {
-        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INTERNAL,
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INTERNAL,
                                 "internal error: a node failed (%s)",
                                 coavoid_lcm_error_name(node_error));
     }
@@ -734,7 +734,7 @@ static int sim_report(sim_run_t *r)
     const coavoid_flight_t *flight = &r->judged.flight;
     const coavoid_flight_eval_t *eval = &r->judged.eval;
     if (rc != COA_OK) {
-        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INTERNAL,
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INTERNAL,
                                 "internal error: the flight cannot be judged (%s)",
                                 coa_status_name(rc));
     }
@@ -743,7 +743,7 @@ static int sim_report(sim_run_t *r)
         int closed = fclose(r->svg);
         r->svg = NULL;
         if (rc != COA_OK || closed != 0) {
-            return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INTERNAL,
+            return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INTERNAL,
                                     "--svg: writing '%.200s' failed", o->svg_path);
         }
     }
@@ -763,14 +763,14 @@ static int sim_report(sim_run_t *r)
         }
     }
     if (rc != COA_OK) {
-        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INTERNAL,
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INTERNAL,
                                 "internal error: the result could not be written");
     }
     return eval->loss_of_separation ? COAVOID_SIM_LOSS : COAVOID_SIM_SEPARATED;
 }
 
 int coavoid_sim_run(const coavoid_sim_config_t *c, coavoid_scenario_t *s, FILE *out,
-                    coavoid_sim_error_t *e)
+                    coavoid_run_error_t *e)
 {
     sim_run_t r;
     memset(&r, 0, sizeof r);

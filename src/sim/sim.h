@@ -11,7 +11,7 @@
  *     real-time run and judges it the same way (`coavoid summary`).
  *
  * Both write the result (text or JSON) to a stream and the figure to a file, and report
- * the first problem with their input as one line in a coavoid_sim_error_t, naming the
+ * the first problem with their input as one line in a coavoid_run_error_t, naming the
  * file and field (or the option, by its command-line name) and why; the program prefixes
  * it with its own name. The scenario and the log are untrusted (docs/security.md): every
  * bound a message or the run has is checked before the run starts, and a log's events are
@@ -27,30 +27,17 @@
 #include <stdint.h>
 #include <stdio.h>
 
+#include "run.h"
 #include "scenario.h"
 
-/* What both return: the run's verdict, or why there is none. */
+/* What both return: the run's verdict (the values of run.h's verdicts, so that one mapping
+ * to exit statuses serves every program), or run.h's COAVOID_RUN_ERR_INPUT (the scenario,
+ * the log or a setting is refused) or COAVOID_RUN_ERR_INTERNAL (a bug, out of memory, or
+ * the output was not written) with the report in a coavoid_run_error_t. */
 enum {
-    COAVOID_SIM_SEPARATED = 0,     /* judged: no loss of separation */
-    COAVOID_SIM_LOSS = 1,          /* judged: a loss of separation */
-    COAVOID_SIM_ERR_INPUT = -2,    /* the scenario, the log or a setting is refused */
-    COAVOID_SIM_ERR_INTERNAL = -3, /* a bug, out of memory, or the output was not written */
+    COAVOID_SIM_SEPARATED = COAVOID_RUN_DONE,  /* judged: no loss of separation */
+    COAVOID_SIM_LOSS = COAVOID_RUN_NOT_SOLVED, /* judged: a loss of separation */
 };
-
-/* Room for one report line. */
-#define COAVOID_SIM_ERROR_MAX 1024u
-
-typedef struct {
-    char text[COAVOID_SIM_ERROR_MAX]; /* "" until a problem is reported */
-} coavoid_sim_error_t;
-
-/* Formats the report line into e and returns status, so that a check reads
- * `return coavoid_sim_fail(e, COAVOID_SIM_ERR_INPUT, ...)`. */
-int coavoid_sim_fail(coavoid_sim_error_t *e, int status, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 3, 4)))
-#endif
-    ;
 
 /* A one-process run. */
 typedef struct {
@@ -72,7 +59,7 @@ typedef struct {
 /* Flies scenario s (loaded, not yet sampled: sampled here) as c says and writes the
  * result to out. Returns a verdict, or an error with e set. */
 int coavoid_sim_run(const coavoid_sim_config_t *c, coavoid_scenario_t *s, FILE *out,
-                    coavoid_sim_error_t *e);
+                    coavoid_run_error_t *e);
 
 /* A log's run. */
 typedef struct {
@@ -88,6 +75,6 @@ typedef struct {
 /* Judges the run of scenario s (loaded) that the lcm-logger log c->log_path recorded, and
  * writes the result to out. Returns a verdict, or an error with e set. */
 int coavoid_sim_summarise(const coavoid_sim_log_config_t *c, coavoid_scenario_t *s, FILE *out,
-                          coavoid_sim_error_t *e);
+                          coavoid_run_error_t *e);
 
 #endif /* COAVOID_SIM_SIM_H */

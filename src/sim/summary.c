@@ -69,36 +69,36 @@
 
 typedef struct {
     const char *path;
-    coavoid_sim_error_t *err;
+    coavoid_run_error_t *err;
     lcm_eventlog_t *log;
     int64_t size;   /* bytes to read: the file's size when opened */
     int64_t offset; /* where the next event starts */
     int64_t events; /* events read so far */
 } log_reader_t;
 
-static int log_open(log_reader_t *r, coavoid_sim_error_t *err, const char *path, int64_t limit)
+static int log_open(log_reader_t *r, coavoid_run_error_t *err, const char *path, int64_t limit)
 {
     struct stat st;
     memset(r, 0, sizeof *r);
     r->err = err;
     r->path = path;
     if (stat(path, &st) != 0) {
-        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT, "%s: cannot open: %s", path,
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT, "%s: cannot open: %s", path,
                                 strerror(errno));
     }
     if (!S_ISREG(st.st_mode)) {
-        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT,
                                 "%s: not a regular file (an lcm-logger log is one)", path);
     }
     errno = 0;
     r->log = lcm_eventlog_create(path, "r");
     if (r->log == NULL) {
-        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT, "%s: cannot open: %s", path,
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT, "%s: cannot open: %s", path,
                                 errno != 0 ? strerror(errno) : "lcm_eventlog_create failed");
     }
     /* The size of what was opened (the path may have been replaced since stat). */
     if (fstat(fileno(r->log->f), &st) != 0) {
-        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT, "%s: cannot read: %s", path,
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT, "%s: cannot read: %s", path,
                                 strerror(errno));
     }
     r->size = (int64_t)st.st_size;
@@ -106,7 +106,7 @@ static int log_open(log_reader_t *r, coavoid_sim_error_t *err, const char *path,
         r->size = limit;
     }
     if (r->size == 0) {
-        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT, "%s: empty file, not an LCM log",
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT, "%s: empty file, not an LCM log",
                                 path);
     }
     return SIM_GO_ON;
@@ -134,14 +134,14 @@ static int log_header(log_reader_t *r, int64_t left, int32_t *channel_length, in
 {
     unsigned char header[LOG_HEADER_BYTES];
     if (fseeko(r->log->f, (off_t)r->offset, SEEK_SET) != 0) {
-        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT,
                                 "%s: cannot seek to byte %" PRId64 ": %s", r->path, r->offset,
                                 strerror(errno));
     }
     size_t want = left < LOG_HEADER_BYTES ? (size_t)left : (size_t)LOG_HEADER_BYTES;
     size_t got = fread(header, 1, want, r->log->f);
     if (got != want) {
-        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT, "%s: read error at byte %" PRId64,
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT, "%s: read error at byte %" PRId64,
                                 r->path, r->offset);
     }
     /* Whether the bytes there are (the start of) an event header. */
@@ -150,18 +150,18 @@ static int log_header(log_reader_t *r, int64_t left, int32_t *channel_length, in
         magic = magic && header[j] == (unsigned char)(LOG_MAGIC >> (24u - 8u * j));
     }
     if (!magic && r->offset == 0) {
-        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT,
                                 "%s: not an LCM log (it does not start with an event header)",
                                 r->path);
     }
     if (!magic) {
-        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT,
                                 "%s: corrupt: no event header at byte %" PRId64 " (after %" PRId64
                                 " events)",
                                 r->path, r->offset, r->events);
     }
     if (got < (size_t)LOG_HEADER_BYTES) {
-        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT,
                                 "%s: truncated: event %" PRId64 " at byte %" PRId64
                                 " is cut off in its header (was the logger stopped mid-write?)",
                                 r->path, r->events, r->offset);
@@ -170,7 +170,7 @@ static int log_header(log_reader_t *r, int64_t left, int32_t *channel_length, in
     *data_length = (int32_t)be32(header + 24);
     if (*channel_length < 1 || *channel_length > LOG_MAX_CHANNEL || *data_length < 0 ||
         *data_length > LOG_MAX_DATA) {
-        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT,
                                 "%s: corrupt: event %" PRId64 " at byte %" PRId64
                                 " claims a %ld-byte channel name and %ld bytes of data",
                                 r->path, r->events, r->offset, (long)*channel_length,
@@ -178,7 +178,7 @@ static int log_header(log_reader_t *r, int64_t left, int32_t *channel_length, in
     }
     *length = LOG_HEADER_BYTES + (int64_t)*channel_length + (int64_t)*data_length;
     if (*length > left) {
-        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT,
                                 "%s: truncated: event %" PRId64 " at byte %" PRId64
                                 " needs %" PRId64 " bytes, the file has %" PRId64
                                 " left (was the logger stopped "
@@ -199,11 +199,11 @@ static int log_check_next(log_reader_t *r, int64_t left, int64_t length)
     unsigned char next[4];
     if (fseeko(r->log->f, (off_t)(r->offset + length), SEEK_SET) != 0 ||
         fread(next, 1, 4u, r->log->f) != 4u) {
-        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT, "%s: read error at byte %" PRId64,
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT, "%s: read error at byte %" PRId64,
                                 r->path, r->offset + length);
     }
     if (be32(next) != LOG_MAGIC) {
-        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT,
                                 "%s: corrupt: no event header at byte %" PRId64 " (after %" PRId64
                                 " events)",
                                 r->path, r->offset + length, r->events + 1);
@@ -229,7 +229,7 @@ static int log_next(log_reader_t *r, lcm_eventlog_event_t **event)
         return status;
     }
     if (fseeko(r->log->f, (off_t)r->offset, SEEK_SET) != 0) {
-        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT,
                                 "%s: cannot seek to byte %" PRId64 ": %s", r->path, r->offset,
                                 strerror(errno));
     }
@@ -238,7 +238,7 @@ static int log_next(log_reader_t *r, lcm_eventlog_event_t **event)
         if (e != NULL) {
             lcm_eventlog_free_event(e);
         }
-        return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INPUT,
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT,
                                 "%s: cannot read event %" PRId64 " at byte %" PRId64, r->path,
                                 r->events, r->offset);
     }
@@ -317,7 +317,7 @@ static bool intent_add(intent_list_t *list, intent_seen_t item)
 
 typedef struct {
     const coavoid_sim_log_config_t *o;
-    coavoid_sim_error_t *err;
+    coavoid_run_error_t *err;
     FILE *out;
     const coavoid_scenario_t *s;
     int64_t dt_us;
@@ -412,7 +412,7 @@ static long accept_intent(log_summary_t *ls, const lcm_eventlog_event_t *e, bool
         ours = v->steep_factor;
     }
     if (field != NULL) {
-        coavoid_sim_fail(ls->err, COAVOID_SIM_ERR_INPUT,
+        coavoid_run_fail(ls->err, COAVOID_RUN_ERR_INPUT,
                          "%s: UAV %ld's intents have %s %.17g, %s says %.17g: not a run of this "
                          "scenario",
                          ls->o->log_path, (long)m->uav_id, field, theirs, ls->o->scenario_path,
@@ -450,7 +450,7 @@ static int read_log(log_summary_t *ls, log_reader_t *r)
             long index = accept_intent(ls, e, true);
             if (index == -3) {
                 lcm_eventlog_free_event(e);
-                return COAVOID_SIM_ERR_INPUT;
+                return COAVOID_RUN_ERR_INPUT;
             }
             if (index >= 0) {
                 size_t i = (size_t)index;
@@ -502,7 +502,7 @@ static int read_log(log_summary_t *ls, log_reader_t *r)
         }
         lcm_eventlog_free_event(e);
         if (!ok) {
-            return coavoid_sim_fail(r->err, COAVOID_SIM_ERR_INTERNAL, "out of memory reading %s",
+            return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INTERNAL, "out of memory reading %s",
                                     r->path);
         }
     }
@@ -639,7 +639,7 @@ static int fill_samples(log_summary_t *ls, log_reader_t *r, rebuilt_t *b, int64_
             long index = accept_intent(ls, e, false);
             if (index == -3) {
                 lcm_eventlog_free_event(e);
-                return COAVOID_SIM_ERR_INPUT;
+                return COAVOID_RUN_ERR_INPUT;
             }
             const coavoid_intent_t *m = &ls->intent;
             for (int32_t j = 0; index >= 0 && j < m->sample_count; j++) {
@@ -761,7 +761,7 @@ static int print_json(const log_summary_t *ls, const rebuilt_t *b, int64_t epoch
     char *log_text = ok ? cJSON_PrintUnformatted(log) : NULL;
     cJSON_Delete(log);
     if (log_text == NULL) {
-        return coavoid_sim_fail(ls->err, COAVOID_SIM_ERR_INTERNAL,
+        return coavoid_run_fail(ls->err, COAVOID_RUN_ERR_INTERNAL,
                                 "out of memory printing the result");
     }
     const coavoid_flight_extra_t extra = {"log", log_text};
@@ -769,23 +769,23 @@ static int print_json(const log_summary_t *ls, const rebuilt_t *b, int64_t epoch
     int rc = coavoid_flight_json_extra(flight, eval, &extra, 1u, ls->out);
     free(log_text);
     if (rc == COA_ERR_ARGUMENT) {
-        return coavoid_sim_fail(ls->err, COAVOID_SIM_ERR_INTERNAL,
+        return coavoid_run_fail(ls->err, COAVOID_RUN_ERR_INTERNAL,
                                 "internal error: cannot print the result (%s)",
                                 coa_status_name(rc));
     }
     if (rc != COA_OK) {
-        return coavoid_sim_fail(ls->err, COAVOID_SIM_ERR_INTERNAL, "cannot write the result: %s",
+        return coavoid_run_fail(ls->err, COAVOID_RUN_ERR_INTERNAL, "cannot write the result: %s",
                                 errno != 0 ? strerror(errno) : "write error");
     }
     return SIM_GO_ON;
 }
 
-static int write_svg(coavoid_sim_error_t *err, const char *path, const coavoid_flight_t *flight,
+static int write_svg(coavoid_run_error_t *err, const char *path, const coavoid_flight_t *flight,
                      const coavoid_flight_eval_t *eval)
 {
     FILE *out = fopen(path, "w");
     if (out == NULL) {
-        return coavoid_sim_fail(err, COAVOID_SIM_ERR_INPUT, "--svg %s: cannot write: %s", path,
+        return coavoid_run_fail(err, COAVOID_RUN_ERR_INPUT, "--svg %s: cannot write: %s", path,
                                 strerror(errno));
     }
     int rc = coavoid_flight_svg(flight, eval, out);
@@ -793,7 +793,7 @@ static int write_svg(coavoid_sim_error_t *err, const char *path, const coavoid_f
         rc = COA_ERR_WORKSPACE;
     }
     if (rc != COA_OK) {
-        return coavoid_sim_fail(err, COAVOID_SIM_ERR_INTERNAL,
+        return coavoid_run_fail(err, COAVOID_RUN_ERR_INTERNAL,
                                 "--svg %s: cannot write the figure (%s)", path,
                                 coa_status_name(rc));
     }
@@ -801,7 +801,7 @@ static int write_svg(coavoid_sim_error_t *err, const char *path, const coavoid_f
 }
 
 /* The evaluation refused the record: name the step no action makes, if that is why. */
-static int refused_record(coavoid_sim_error_t *err, const coavoid_sim_log_config_t *o,
+static int refused_record(coavoid_run_error_t *err, const coavoid_sim_log_config_t *o,
                           const coavoid_flight_t *f, const rebuilt_t *b)
 {
     const size_t row = (size_t)f->steps + 1u;
@@ -811,8 +811,8 @@ static int refused_record(coavoid_sim_error_t *err, const coavoid_sim_log_config
             if (coa_action_between(offsets[k], offsets[k + 1u],
                                    f->vehicles[i].vehicle.steep_factor) < 0) {
                 bool gap = !b->own[i * row + k] || !b->own[i * row + k + 1u];
-                return coavoid_sim_fail(
-                    err, COAVOID_SIM_ERR_INPUT,
+                return coavoid_run_fail(
+                    err, COAVOID_RUN_ERR_INPUT,
                     "%s: UAV %u's offset goes from %ld at cycle %lu to %ld at cycle "
                     "%lu, which no action does%s",
                     o->log_path, (unsigned)f->vehicles[i].vehicle.id, (long)offsets[k],
@@ -821,7 +821,7 @@ static int refused_record(coavoid_sim_error_t *err, const coavoid_sim_log_config
             }
         }
     }
-    return coavoid_sim_fail(err, COAVOID_SIM_ERR_INTERNAL,
+    return coavoid_run_fail(err, COAVOID_RUN_ERR_INTERNAL,
                             "internal error: the flight record was refused");
 }
 
@@ -833,14 +833,14 @@ static int summary_check(log_summary_t *ls)
     const coavoid_scenario_t *s = ls->s;
     double dt_us = (double)s->dt * 1e6;
     if (!(dt_us >= 1.0) || dt_us > 3.6e9) {
-        return coavoid_sim_fail(ls->err, COAVOID_SIM_ERR_INPUT,
+        return coavoid_run_fail(ls->err, COAVOID_RUN_ERR_INPUT,
                                 "%s: dt: %g s cannot be a cycle of whole microseconds "
                                 "(1 us to 1 h)",
                                 o->scenario_path, (double)s->dt);
     }
     ls->dt_us = llround(dt_us);
     if (s->vehicle_count > COA_MAX_VEHICLES) {
-        return coavoid_sim_fail(ls->err, COAVOID_SIM_ERR_INPUT, "%s: %zu vehicles, at most %u",
+        return coavoid_run_fail(ls->err, COAVOID_RUN_ERR_INPUT, "%s: %zu vehicles, at most %u",
                                 o->scenario_path, s->vehicle_count, COA_MAX_VEHICLES);
     }
     return SIM_GO_ON;
@@ -863,7 +863,7 @@ static int summary_pass1(log_summary_t *ls, rebuilt_t *b, int64_t *epoch, int64_
     int64_t earliest = INT64_MAX;
     for (size_t i = 0; i < s->vehicle_count && status == SIM_GO_ON; i++) {
         if (ls->intents_of[i] == 0) {
-            status = coavoid_sim_fail(ls->err, COAVOID_SIM_ERR_INPUT,
+            status = coavoid_run_fail(ls->err, COAVOID_RUN_ERR_INPUT,
                                       "%s: UAV %u of %s never published an accepted intent "
                                       "(%" PRId64 " intents in the log, %" PRId64 " refused)",
                                       o->log_path, (unsigned)s->vehicles[i].id, o->scenario_path,
@@ -878,10 +878,10 @@ static int summary_pass1(log_summary_t *ls, rebuilt_t *b, int64_t *epoch, int64_
     uint32_t cap = s->horizon > COA_MAX_HORIZON / 2u ? COA_MAX_HORIZON : 2u * s->horizon;
     int64_t k = last_complete_cycle(ls, *epoch, cap, &b->off_grid);
     if (k < 0) {
-        return coavoid_sim_fail(ls->err, COAVOID_SIM_ERR_INTERNAL, "out of memory");
+        return coavoid_run_fail(ls->err, COAVOID_RUN_ERR_INTERNAL, "out of memory");
     }
     if (k == 0) {
-        return coavoid_sim_fail(ls->err, COAVOID_SIM_ERR_INPUT,
+        return coavoid_run_fail(ls->err, COAVOID_RUN_ERR_INPUT,
                                 "%s: no cycle after cycle 0 (epoch %" PRId64
                                 " us, dt %g s) has every UAV's own intent: nothing to judge",
                                 o->log_path, *epoch, (double)s->dt);
@@ -903,7 +903,7 @@ static int summary_pass2(log_summary_t *ls, rebuilt_t *b, int64_t epoch, int64_t
     b->offsets = calloc(cells, sizeof *b->offsets);
     if (b->best == NULL || b->own == NULL || b->known == NULL || b->reference == NULL ||
         b->offsets == NULL) {
-        return coavoid_sim_fail(ls->err, COAVOID_SIM_ERR_INTERNAL, "out of memory");
+        return coavoid_run_fail(ls->err, COAVOID_RUN_ERR_INTERNAL, "out of memory");
     }
     log_reader_t r;
     memset(&r, 0, sizeof r);
@@ -913,7 +913,7 @@ static int summary_pass2(log_summary_t *ls, rebuilt_t *b, int64_t epoch, int64_t
     }
     log_close(&r);
     if (status == SIM_GO_ON && fill_gaps(ls->s, b) != COA_OK) {
-        status = coavoid_sim_fail(ls->err, COAVOID_SIM_ERR_INPUT,
+        status = coavoid_run_fail(ls->err, COAVOID_RUN_ERR_INPUT,
                                   "%s: a route cannot be sampled over %lu steps", o->scenario_path,
                                   (unsigned long)b->steps);
     }
@@ -935,7 +935,7 @@ static int summary_report(log_summary_t *ls, rebuilt_t *b, int64_t epoch)
     if (rc == COA_ERR_ARGUMENT) {
         status = refused_record(ls->err, o, flight, b);
     } else if (rc != COA_OK) {
-        status = coavoid_sim_fail(ls->err, COAVOID_SIM_ERR_INTERNAL, "cannot judge the flight (%s)",
+        status = coavoid_run_fail(ls->err, COAVOID_RUN_ERR_INTERNAL, "cannot judge the flight (%s)",
                                   coa_status_name(rc));
     }
     if (status == SIM_GO_ON && o->svg_path != NULL) {
@@ -946,7 +946,7 @@ static int summary_report(log_summary_t *ls, rebuilt_t *b, int64_t epoch)
     } else if (status == SIM_GO_ON) {
         print_log_text(ls, b, epoch);
         if (coavoid_flight_text(flight, eval, ls->out) != COA_OK) {
-            status = coavoid_sim_fail(ls->err, COAVOID_SIM_ERR_INTERNAL, "cannot write the result");
+            status = coavoid_run_fail(ls->err, COAVOID_RUN_ERR_INTERNAL, "cannot write the result");
         }
     }
     if (status == SIM_GO_ON) {
@@ -956,13 +956,13 @@ static int summary_report(log_summary_t *ls, rebuilt_t *b, int64_t epoch)
 }
 
 int coavoid_sim_summarise(const coavoid_sim_log_config_t *c, coavoid_scenario_t *s, FILE *out,
-                          coavoid_sim_error_t *e)
+                          coavoid_run_error_t *e)
 {
     log_summary_t *ls = calloc(1, sizeof *ls);
     rebuilt_t b;
     memset(&b, 0, sizeof b);
     if (ls == NULL) {
-        return coavoid_sim_fail(e, COAVOID_SIM_ERR_INTERNAL, "out of memory");
+        return coavoid_run_fail(e, COAVOID_RUN_ERR_INTERNAL, "out of memory");
     }
     e->text[0] = '\0';
     ls->o = c;
