@@ -8,28 +8,30 @@
  *
  * The shape. UAV i's heading is heading0 + 2 pi i / n plus jitter; it flies a straight
  * level route through the origin, reaching it `arrive` seconds into the window, at an
- * altitude staggered on a grid around a base altitude. A design (coavoid_encounter_design_t) sets
- * the ranges; with terrain_hills it adds hills under the crossing area, with max_tracks
- * non-cooperative aircraft crossing it, and with max_offset_max a vertical band per UAV.
+ * altitude staggered on a grid around a base altitude. A design
+ * (coavoid_encounter_design_t) sets the ranges; with terrain_hills it adds hills under the
+ * crossing area, with max_tracks non-cooperative aircraft crossing it, and with
+ * max_offset_max a vertical band per UAV.
  *
- * Everything comes from splitmix64 (bench_support.h), one stream per (seed, n, index,
- * attempt), so a seed gives the same problems on every machine with the same libm
- * (headings go through cos and sin, which C does not require to round correctly), and
- * adding problems or UAV counts changes none of the others. The draws are made in a fixed order and a design's
- * optional parts draw nothing when they are off, so coavoid_encounter_bench (no quantum, one box
- * half the time) gives exactly the problems bench plan gave before this file existed.
+ * Everything comes from splitmix64 (prng.h), one stream per (seed, n, index, attempt), so
+ * a seed gives the same problems on every machine with the same libm (headings go through
+ * cos and sin, which C does not require to round correctly), and adding problems or UAV
+ * counts changes none of the others. The draws are made in a fixed order and a design's
+ * optional parts draw nothing when they are off, so coavoid_encounter_bench (no quantum,
+ * one box half the time) gives exactly the problems bench plan gave before this file
+ * existed.
  */
-#ifndef COAVOID_APP_ENCOUNTER_H
-#define COAVOID_APP_ENCOUNTER_H
+#ifndef COAVOID_EVALUATION_ENCOUNTER_H
+#define COAVOID_EVALUATION_ENCOUNTER_H
 
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
 /* One problem's JSON: 6 vehicles of about 330 characters, 3 hills of about 250, 2 tracks. */
-#define ENCOUNTER_JSON_MAX 8192u
-#define ENCOUNTER_MIN_VEHICLES 2u
-#define ENCOUNTER_MAX_VEHICLES 6u
+#define COAVOID_ENCOUNTER_JSON_MAX 8192u
+#define COAVOID_ENCOUNTER_MIN_VEHICLES 2u
+#define COAVOID_ENCOUNTER_MAX_VEHICLES 6u
 
 typedef struct {
     const char *name;              /* "bench encounter", in each problem's name */
@@ -66,12 +68,13 @@ typedef struct {
     uint32_t tracks;
 } coavoid_encounter_info_t;
 
-/* Writes encounter `index` of n UAVs (ENCOUNTER_MIN_VEHICLES..ENCOUNTER_MAX_VEHICLES) of
- * design d, draw `attempt` (0 first; a caller that rejects a draw asks for the next), as
- * scenario JSON into buf[size]. info may be NULL. Returns false when it does not fit (a
- * bug: ENCOUNTER_JSON_MAX bounds a problem). O(n + hills + tracks), no memory. */
+/* Writes encounter `index` of n UAVs (COAVOID_ENCOUNTER_MIN_VEHICLES to
+ * COAVOID_ENCOUNTER_MAX_VEHICLES) of design d, draw `attempt` (0 first; a caller that
+ * rejects a draw asks for the next), as scenario JSON into buf[size]. info may be NULL.
+ * Returns false when it does not fit (a bug: COAVOID_ENCOUNTER_JSON_MAX bounds a problem).
+ * O(n + hills + tracks), no memory. */
 bool coavoid_encounter_json(const coavoid_encounter_design_t *d, uint64_t seed, uint32_t n,
                             uint32_t index, uint32_t attempt, char *buf, size_t size,
                             coavoid_encounter_info_t *info);
 
-#endif /* COAVOID_APP_ENCOUNTER_H */
+#endif /* COAVOID_EVALUATION_ENCOUNTER_H */

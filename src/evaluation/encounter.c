@@ -8,8 +8,8 @@
 #include <stdarg.h>
 #include <stdio.h>
 
-#include "bench_support.h"
-#include "cli.h"
+#include "evaluation_internal.h"
+#include "prng.h"
 
 #define ENC_PI 3.14159265358979323846
 
@@ -68,7 +68,7 @@ const coavoid_encounter_design_t coavoid_encounter_montecarlo = {
 
 /* Appends to buf; false when it would not fit. */
 static bool append(char *buf, size_t size, size_t *used, const char *fmt, ...)
-    CLI_PRINTF_LIKE(4, 5);
+    COAVOID_EVALUATION_PRINTF_LIKE(4, 5);
 
 static bool append(char *buf, size_t size, size_t *used, const char *fmt, ...)
 {
@@ -91,13 +91,13 @@ static double quantise(const coavoid_encounter_design_t *d, double x)
 
 /* A hill near the origin: a box, or a pyramid (a square base on the ground turned by a
  * random angle, its apex over a point near the centre), its top `top` m high. */
-static bool hill_json(const coavoid_encounter_design_t *d, prng_t *r, double top, char *buf,
+static bool hill_json(const coavoid_encounter_design_t *d, coavoid_prng_t *r, double top, char *buf,
                       size_t size, size_t *used)
 {
-    bool pyramid = prng_below(r, 2u) == 1u;
-    double cx = prng_uniform(r, -60.0, 60.0);
-    double cy = prng_uniform(r, -60.0, 60.0);
-    double w = prng_uniform(r, 15.0, 40.0); /* half the base's side */
+    bool pyramid = coavoid_prng_below(r, 2u) == 1u;
+    double cx = coavoid_prng_uniform(r, -60.0, 60.0);
+    double cy = coavoid_prng_uniform(r, -60.0, 60.0);
+    double w = coavoid_prng_uniform(r, 15.0, 40.0); /* half the base's side */
     top = quantise(d, top);
     if (!pyramid) {
         return append(buf, size, used,
@@ -105,9 +105,9 @@ static bool hill_json(const coavoid_encounter_design_t *d, prng_t *r, double top
                       quantise(d, cx - w), quantise(d, cy - w), quantise(d, cx + w),
                       quantise(d, cy + w), top);
     }
-    double turn = prng_uniform(r, 0.0, 0.5 * ENC_PI);
-    double ax = cx + prng_uniform(r, -0.3, 0.3) * w;
-    double ay = cy + prng_uniform(r, -0.3, 0.3) * w;
+    double turn = coavoid_prng_uniform(r, 0.0, 0.5 * ENC_PI);
+    double ax = cx + coavoid_prng_uniform(r, -0.3, 0.3) * w;
+    double ay = cy + coavoid_prng_uniform(r, -0.3, 0.3) * w;
     bool ok = append(buf, size, used, "{\"type\": \"polytope\", \"vertices\": [");
     for (uint32_t c = 0; ok && c < 4u; c++) {
         double a = turn + 0.5 * ENC_PI * c;
@@ -120,19 +120,19 @@ static bool hill_json(const coavoid_encounter_design_t *d, prng_t *r, double top
 
 /* A non-cooperative aircraft flying level and straight through a point near the origin
  * at a time when the UAVs are about there, at an altitude within or near their stagger. */
-static bool track_json(const coavoid_encounter_design_t *d, prng_t *r, uint32_t id, char *buf,
-                       size_t size, size_t *used)
+static bool track_json(const coavoid_encounter_design_t *d, coavoid_prng_t *r, uint32_t id,
+                       char *buf, size_t size, size_t *used)
 {
-    double heading = prng_uniform(r, 0.0, 2.0 * ENC_PI);
-    double speed = prng_uniform(r, 10.0, 20.0);
-    double when = prng_uniform(r, d->arrive_min, d->arrive_max);
-    double px = prng_uniform(r, -30.0, 30.0);
-    double py = prng_uniform(r, -30.0, 30.0);
+    double heading = coavoid_prng_uniform(r, 0.0, 2.0 * ENC_PI);
+    double speed = coavoid_prng_uniform(r, 10.0, 20.0);
+    double when = coavoid_prng_uniform(r, d->arrive_min, d->arrive_max);
+    double px = coavoid_prng_uniform(r, -30.0, 30.0);
+    double py = coavoid_prng_uniform(r, -30.0, 30.0);
     /* Above or below the UAVs' stagger band, overlapping its edge: in the way of a UAV
      * that climbs or dives away from the others. */
     double band = d->altitude_grid * d->max_stagger;
-    double side = prng_below(r, 2u) == 0 ? 1.0 : -1.0;
-    double z = d->base_altitude + side * (band + prng_uniform(r, 0.0, 10.0));
+    double side = coavoid_prng_below(r, 2u) == 0 ? 1.0 : -1.0;
+    double z = d->base_altitude + side * (band + coavoid_prng_uniform(r, 0.0, 10.0));
     double vx = quantise(d, speed * cos(heading));
     double vy = quantise(d, speed * sin(heading));
     return append(buf, size, used,
@@ -147,9 +147,9 @@ bool coavoid_encounter_json(const coavoid_encounter_design_t *d, uint64_t seed, 
                             coavoid_encounter_info_t *info)
 {
     /* Attempt 0 is bench plan's original stream; a redraw moves to another. */
-    prng_t r = {seed ^ ((uint64_t)n << 56) ^ ((uint64_t)index * 0x9e3779b97f4a7c15u) ^
-                ((uint64_t)attempt * 0xd1b54a32d192ed03u)};
-    prng_next(&r);
+    coavoid_prng_t r = {seed ^ ((uint64_t)n << 56) ^ ((uint64_t)index * 0x9e3779b97f4a7c15u) ^
+                        ((uint64_t)attempt * 0xd1b54a32d192ed03u)};
+    coavoid_prng_next(&r);
     coavoid_encounter_info_t drawn = {0u, 0u};
     size_t used = 0;
     const double horizon_s = d->horizon * d->dt;
@@ -157,17 +157,18 @@ bool coavoid_encounter_json(const coavoid_encounter_design_t *d, uint64_t seed, 
                      "{\"name\": \"%s %u of %u UAVs\", \"dt\": %g, \"horizon\": %u, "
                      "\"vehicles\": [",
                      d->name, index, n, d->dt, d->horizon);
-    double heading0 = prng_uniform(&r, 0.0, 2.0 * ENC_PI);
+    double heading0 = coavoid_prng_uniform(&r, 0.0, 2.0 * ENC_PI);
     double lowest = 1e300;
     for (uint32_t i = 0; ok && i < n; i++) {
-        double heading = heading0 + 2.0 * ENC_PI * i / n + prng_uniform(&r, -d->jitter, d->jitter);
-        double speed = quantise(d, prng_uniform(&r, d->speed_min, d->speed_max));
-        double climb = quantise(d, prng_uniform(&r, d->climb_min, d->climb_max));
-        double arrive = prng_uniform(&r, d->arrive_min, d->arrive_max);
-        double z =
-            quantise(d, d->base_altitude +
-                            d->altitude_grid * ((double)prng_below(&r, 2u * d->max_stagger + 1u) -
-                                                (double)d->max_stagger));
+        double heading =
+            heading0 + 2.0 * ENC_PI * i / n + coavoid_prng_uniform(&r, -d->jitter, d->jitter);
+        double speed = quantise(d, coavoid_prng_uniform(&r, d->speed_min, d->speed_max));
+        double climb = quantise(d, coavoid_prng_uniform(&r, d->climb_min, d->climb_max));
+        double arrive = coavoid_prng_uniform(&r, d->arrive_min, d->arrive_max);
+        double z = quantise(d, d->base_altitude +
+                                   d->altitude_grid *
+                                       ((double)coavoid_prng_below(&r, 2u * d->max_stagger + 1u) -
+                                        (double)d->max_stagger));
         lowest = z < lowest ? z : lowest;
         double ux = cos(heading), uy = sin(heading);
         /* Flying along (ux, uy) through the origin at t = arrive, and on past the horizon. */
@@ -181,14 +182,14 @@ bool coavoid_encounter_json(const coavoid_encounter_design_t *d, uint64_t seed, 
                     quantise(d, -before * ux), quantise(d, -before * uy), z,
                     quantise(d, after * ux), quantise(d, after * uy), z);
         if (ok && d->max_offset_max > 0) {
-            uint32_t bound =
-                d->max_offset_min + prng_below(&r, d->max_offset_max - d->max_offset_min + 1u);
+            uint32_t bound = d->max_offset_min +
+                             coavoid_prng_below(&r, d->max_offset_max - d->max_offset_min + 1u);
             ok = append(buf, size, &used, ", \"max_offset\": %u", bound);
         }
         ok = ok && append(buf, size, &used, "}");
     }
     ok = ok && append(buf, size, &used, "]");
-    if (ok && d->box_half && prng_below(&r, 2u) == 0) {
+    if (ok && d->box_half && coavoid_prng_below(&r, 2u) == 0) {
         /* Its top 4 m below the lowest UAV's volume, so diving there is limited. */
         ok = append(buf, size, &used,
                     ", \"obstacles\": [{\"type\": \"box\", \"min\": [-40, -40, 0], "
@@ -198,17 +199,17 @@ bool coavoid_encounter_json(const coavoid_encounter_design_t *d, uint64_t seed, 
     if (ok && d->terrain_hills) {
         /* Tops from 8 m below the lowest UAV's volume up to touching it: diving over a
          * hill is limited or impossible. */
-        drawn.hills = 1u + prng_below(&r, 3u);
+        drawn.hills = 1u + coavoid_prng_below(&r, 3u);
         ok = append(buf, size, &used, ", \"obstacles\": [");
         for (uint32_t h = 0; ok && h < drawn.hills; h++) {
-            double top = lowest - d->half_height - prng_uniform(&r, 0.0, 8.0);
+            double top = lowest - d->half_height - coavoid_prng_uniform(&r, 0.0, 8.0);
             ok = append(buf, size, &used, "%s", h == 0 ? "" : ", ") &&
                  hill_json(d, &r, top, buf, size, &used);
         }
         ok = ok && append(buf, size, &used, "]");
     }
     if (ok && d->max_tracks > 0) {
-        drawn.tracks = prng_below(&r, d->max_tracks + 1u);
+        drawn.tracks = coavoid_prng_below(&r, d->max_tracks + 1u);
         ok = append(buf, size, &used, ", \"tracks\": [");
         for (uint32_t t = 0; ok && t < drawn.tracks; t++) {
             ok = append(buf, size, &used, "%s", t == 0 ? "" : ", ") &&

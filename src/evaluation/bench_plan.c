@@ -1,0 +1,336 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * bench_plan.c: the harness of `coavoid bench plan` (bench_plan.h): the sets of problems
+ * (a scenario file, the random encounters), the timed runs and their report.
+ */
+#define _POSIX_C_SOURCE 200809L
+
+#include "bench_plan.h"
+
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include <cjson/cJSON.h>
+
+#include "coavoid/coavoid.h"
+#include "encounter.h"
+#include "evaluation_internal.h"
+#include "output.h"
+#include "scenario.h"
+
+/* ---- the sets ---- */
+
+typedef struct {
+    char label[COAVOID_BENCH_PLAN_LABEL_MAX]; /* "paper", "2 UAVs" */
+    uint32_t vehicles;                        /* per problem (the paper: its own) */
+    coavoid_scenario_t *problems;             /* sampled */
+    uint32_t count;
+} bp_set_t;
+
+static void set_free(bp_set_t *set)
+{
+    for (uint32_t j = 0; set->problems != NULL && j < set->count; j++) {
+        coavoid_scenario_free(&set->problems[j]);
+    }
+    free(set->problems);
+    memset(set, 0, sizeof *set);
+}
+
+static int build_random_set(const coavoid_bench_plan_config_t *o, uint32_t n, bp_set_t *set,
+                            char *err, size_t err_size)
+{
+    snprintf(set->label, sizeof set->label, "%u UAVs", n);
+    set->vehicles = n;
+    set->problems = calloc(o->count, sizeof *set->problems);
+    if (set->problems == NULL) {
+        return coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INVALID,
+                                       "--count: out of memory for %lu problems",
+                                       (unsigned long)o->count);
+    }
+    for (uint32_t j = 0; j < o->count; j++) {
+        char json[COAVOID_ENCOUNTER_JSON_MAX];
+        char why[SCENARIO_ERROR_MAX];
+        set->count = j + 1u; /* so set_free frees this one too */
+        if (!coavoid_encounter_json(&coavoid_encounter_bench, o->seed, n, j, 0u, json, sizeof json,
+                                    NULL)) {
+            return coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INTERNAL,
+                                           "internal error: encounter %u of %u UAVs does "
+                                           "not fit %u bytes",
+                                           j, n, COAVOID_ENCOUNTER_JSON_MAX);
+        }
+        if (coavoid_scenario_parse(json, strlen(json), &set->problems[j], why, sizeof why) != 0 ||
+            coavoid_scenario_sample(&set->problems[j], why, sizeof why) != 0) {
+            return coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INTERNAL,
+                                           "internal error: encounter %u of %u UAVs: %s", j, n,
+                                           why);
+        }
+    }
+    return COAVOID_EVALUATION_OK;
+}
+
+/* The scenario file as the set "paper": loaded, sampled and refused as `coavoid plan`
+ * would ("FILE: field: reason"). */
+static int build_paper_set(const coavoid_bench_plan_config_t *o, bp_set_t *set, char *err,
+                           size_t err_size)
+{
+    snprintf(set->label, sizeof set->label, "paper");
+    set->problems = calloc(1u, sizeof *set->problems);
+    if (set->problems == NULL) {
+        return coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INVALID,
+                                       "--scenario: out of memory");
+    }
+    set->count = 1u;
+    char why[SCENARIO_ERROR_MAX];
+    int status = COAVOID_EVALUATION_OK;
+    if (coavoid_scenario_load(o->scenario, &set->problems[0], why, sizeof why) != 0 ||
+        coavoid_scenario_sample(&set->problems[0], why, sizeof why) != 0) {
+        status = coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INVALID, "%s: %s",
+                                         o->scenario, why);
+    }
+    if (status == COAVOID_EVALUATION_OK && set->problems[0].vehicle_count > COA_MAX_CENTRALISED) {
+        status = coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INVALID,
+                                         "%s: %zu vehicles, at most %u can be planned "
+                                         "centrally",
+                                         o->scenario, set->problems[0].vehicle_count,
+                                         COA_MAX_CENTRALISED);
+    }
+    set->vehicles = (uint32_t)set->problems[0].vehicle_count;
+    return status;
+}
+
+/* ---- the runs ---- */
+
+/* One planner for every problem of the set at beta `wanted`, lowered to
+ * coavoid_default_beta where its workspace would pass COAVOID_DEFAULT_WORKSPACE_MAX (the
+ * programs' sizing policy, scenario.h). */
+static coa_planner_config_t set_planner(const bp_set_t *set, size_t searched, uint32_t wanted)
+{
+    coa_planner_config_t config =
+        coavoid_scenario_planner_config(&set->problems[0], searched, wanted);
+    for (uint32_t j = 1; j < set->count; j++) {
+        coa_planner_config_t other =
+            coavoid_scenario_planner_config(&set->problems[j], searched, wanted);
+        coavoid_planner_config_widen(&config, &other);
+    }
+    if (!coavoid_workspace_fits(&config)) {
+        config.beta = coavoid_default_beta(&config);
+    }
+    return config;
+}
+
+/* One run over the set: adds the time (ms) and fills the tallies of row. */
+static int run_once(coa_planner_t *planner, const bp_set_t *set, bool decoupled, int32_t *offsets,
+                    double *ms, coavoid_bench_plan_row_t *row, char *err, size_t err_size)
+{
+    *ms = 0;
+    row->nodes_expanded = row->nodes_generated = 0;
+    row->solved = row->infeasible = row->budget_exhausted = 0;
+    for (uint32_t j = 0; j < set->count; j++) {
+        coa_problem_t problem = coavoid_scenario_problem(&set->problems[j]);
+        coa_plan_result_t result;
+        memset(&result, 0, sizeof result);
+        struct timespec start, end;
+        clock_gettime(CLOCK_MONOTONIC, &start);
+        int rc = decoupled ? coa_plan_decoupled(planner, &problem, NULL, 1u, offsets, &result)
+                           : coa_plan_centralised(planner, &problem, offsets, &result);
+        clock_gettime(CLOCK_MONOTONIC, &end);
+        if (rc != COA_OK) {
+            return coavoid_evaluation_fail(
+                err, err_size,
+                rc == COA_ERR_RANGE ? COAVOID_EVALUATION_INVALID : COAVOID_EVALUATION_INTERNAL,
+                "%s, problem %u: the planner failed (%s)", set->label, j, coa_status_name(rc));
+        }
+        *ms += coavoid_timing_elapsed_ms(&start, &end);
+        row->nodes_expanded += result.nodes_expanded;
+        row->nodes_generated += result.nodes_generated;
+        row->solved += result.status == COA_PLAN_SOLVED;
+        row->infeasible += result.status == COA_PLAN_INFEASIBLE;
+        row->budget_exhausted += result.status == COA_PLAN_BUDGET_EXHAUSTED;
+    }
+    return COAVOID_EVALUATION_OK;
+}
+
+static int run_set(const coavoid_bench_plan_config_t *o, const bp_set_t *set, bool decoupled,
+                   coavoid_bench_plan_row_t *row, char *err, size_t err_size)
+{
+    memset(row, 0, sizeof *row);
+    memcpy(row->set, set->label, sizeof row->set);
+    row->decoupled = decoupled;
+    row->vehicles = set->vehicles;
+    row->problems = set->count;
+    size_t searched = decoupled ? 1u : set->vehicles;
+    uint32_t wanted = o->beta != 0                                    ? o->beta
+                      : set->count == 1u && set->problems[0].has_beta ? set->problems[0].beta
+                                                                      : COAVOID_DEFAULT_BETA;
+    coa_planner_config_t config = set_planner(set, searched, wanted);
+    row->beta_lowered = config.beta != wanted;
+    row->beta = config.beta;
+    size_t size = coa_planner_workspace_size(&config);
+    void *workspace = size != 0 ? malloc(size) : NULL;
+    int32_t *offsets = calloc((size_t)set->vehicles * (COA_MAX_HORIZON + 1u), sizeof *offsets);
+    double *times = calloc(o->repeat, sizeof *times);
+    int status = COAVOID_EVALUATION_OK;
+    coa_planner_t *planner = NULL;
+    if (workspace == NULL || offsets == NULL || times == NULL) {
+        status = coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INVALID,
+                                         "%s: out of memory for %zu bytes of workspace", set->label,
+                                         size);
+    } else if ((planner = coa_planner_init(workspace, size, &config)) == NULL) {
+        status = coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INTERNAL,
+                                         "internal error: the planner refused its workspace");
+    }
+    row->workspace_bytes = size;
+    coavoid_bench_plan_row_t first;
+    memset(&first, 0, sizeof first);
+    double ms = 0;
+    if (status == COAVOID_EVALUATION_OK) { /* untimed: warms caches and the workspace's pages */
+        first = *row;
+        status = run_once(planner, set, decoupled, offsets, &ms, &first, err, err_size);
+    }
+    for (uint32_t k = 0; status == COAVOID_EVALUATION_OK && k < o->repeat; k++) {
+        status = run_once(planner, set, decoupled, offsets, &times[k], row, err, err_size);
+        if (status == COAVOID_EVALUATION_OK &&
+            (row->nodes_expanded != first.nodes_expanded ||
+             row->nodes_generated != first.nodes_generated || row->solved != first.solved ||
+             row->budget_exhausted != first.budget_exhausted)) {
+            status = coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INTERNAL,
+                                             "internal error: %s, run %lu differs from the "
+                                             "first",
+                                             set->label, (unsigned long)k + 1u);
+        }
+    }
+    if (status == COAVOID_EVALUATION_OK) {
+        coavoid_timing_summarise(times, o->repeat, &row->median_ms, &row->min_ms, &row->max_ms);
+    }
+    free(times);
+    free(offsets);
+    free(workspace);
+    return status;
+}
+
+/* ---- the report ---- */
+
+static double nodes_per_s(const coavoid_bench_plan_row_t *row)
+{
+    return row->median_ms > 0 ? (double)row->nodes_expanded / (row->median_ms * 1e-3) : 0.0;
+}
+
+static int report_text(FILE *f, const coavoid_bench_plan_config_t *o,
+                       const coavoid_bench_plan_row_t *rows, size_t count)
+{
+    fprintf(f, "benchmark: plan\nseed: %llu\nrepeat: %lu\ncount: %lu\n",
+            (unsigned long long)o->seed, (unsigned long)o->repeat, (unsigned long)o->count);
+    fprintf(f, "%-7s %-11s %8s %6s %10s %6s %5s %6s %10s %10s %10s %14s %12s %15s\n", "set", "mode",
+            "problems", "solved", "infeasible", "budget", "uavs", "beta", "median_ms", "min_ms",
+            "max_ms", "nodes_expanded", "nodes_per_s", "workspace_bytes");
+    for (size_t i = 0; i < count; i++) {
+        const coavoid_bench_plan_row_t *r = &rows[i];
+        fprintf(f,
+                "%-7s %-11s %8lu %6lu %10lu %6lu %5lu %5lu%s %10.3f %10.3f %10.3f %14llu %12.0f "
+                "%15zu\n",
+                r->set, r->decoupled ? "decoupled" : "centralised", (unsigned long)r->problems,
+                (unsigned long)r->solved, (unsigned long)r->infeasible,
+                (unsigned long)r->budget_exhausted, (unsigned long)r->vehicles,
+                (unsigned long)r->beta, r->beta_lowered ? "*" : " ", r->median_ms, r->min_ms,
+                r->max_ms, (unsigned long long)r->nodes_expanded, nodes_per_s(r),
+                r->workspace_bytes);
+    }
+    fprintf(f, "times: per run over the set's problems; budget: budget exhausted; "
+               "beta*: lowered to keep the workspace within 1 GiB\n");
+    return fflush(f) == 0 && !ferror(f) ? 0 : -1;
+}
+
+static int report_json(FILE *f, const coavoid_bench_plan_config_t *o,
+                       const coavoid_bench_plan_row_t *rows, size_t count)
+{
+    char seed[32];
+    snprintf(seed, sizeof seed, "%llu", (unsigned long long)o->seed);
+    cJSON *root = cJSON_CreateObject();
+    cJSON *list = NULL;
+    /* A raw number keeps every digit of a 64-bit seed. */
+    bool ok = root != NULL && cJSON_AddStringToObject(root, "benchmark", "plan") != NULL &&
+              cJSON_AddRawToObject(root, "seed", seed) != NULL &&
+              cJSON_AddNumberToObject(root, "repeat", o->repeat) != NULL &&
+              cJSON_AddNumberToObject(root, "count", o->count) != NULL &&
+              (list = cJSON_AddArrayToObject(root, "results")) != NULL;
+    for (size_t i = 0; ok && i < count; i++) {
+        const coavoid_bench_plan_row_t *r = &rows[i];
+        cJSON *row = cJSON_CreateObject();
+        ok = row != NULL && cJSON_AddItemToArray(list, row);
+        ok = ok && cJSON_AddStringToObject(row, "set", r->set) != NULL &&
+             cJSON_AddStringToObject(row, "mode", r->decoupled ? "decoupled" : "centralised") !=
+                 NULL &&
+             cJSON_AddNumberToObject(row, "vehicles", r->vehicles) != NULL &&
+             cJSON_AddNumberToObject(row, "problems", r->problems) != NULL &&
+             cJSON_AddNumberToObject(row, "beta", r->beta) != NULL &&
+             cJSON_AddBoolToObject(row, "beta_lowered", r->beta_lowered) != NULL &&
+             cJSON_AddNumberToObject(row, "median_ms", r->median_ms) != NULL &&
+             cJSON_AddNumberToObject(row, "min_ms", r->min_ms) != NULL &&
+             cJSON_AddNumberToObject(row, "max_ms", r->max_ms) != NULL &&
+             cJSON_AddNumberToObject(row, "nodes_expanded", (double)r->nodes_expanded) != NULL &&
+             cJSON_AddNumberToObject(row, "nodes_generated", (double)r->nodes_generated) != NULL &&
+             cJSON_AddNumberToObject(row, "nodes_per_s", nodes_per_s(r)) != NULL &&
+             cJSON_AddNumberToObject(row, "workspace_bytes", (double)r->workspace_bytes) != NULL &&
+             cJSON_AddNumberToObject(row, "solved", r->solved) != NULL &&
+             cJSON_AddNumberToObject(row, "infeasible", r->infeasible) != NULL &&
+             cJSON_AddNumberToObject(row, "budget_exhausted", r->budget_exhausted) != NULL;
+    }
+    if (!ok) {
+        cJSON_Delete(root);
+        return -1;
+    }
+    return coavoid_output_json(f, root, NULL, 0);
+}
+
+int coavoid_bench_plan_report(FILE *f, const coavoid_bench_plan_config_t *config,
+                              const coavoid_bench_plan_result_t *result, bool json)
+{
+    return json ? report_json(f, config, result->rows, result->row_count)
+                : report_text(f, config, result->rows, result->row_count);
+}
+
+/* Every set, loaded or drawn before anything is timed: the scenario's, then one per UAV
+ * count. *set_count counts the sets begun, which set_free must free. */
+static int build_sets(const coavoid_bench_plan_config_t *o, bp_set_t *sets, size_t *set_count,
+                      char *err, size_t err_size)
+{
+    int status = COAVOID_EVALUATION_OK;
+    if (o->scenario != NULL) {
+        status = build_paper_set(o, &sets[(*set_count)++], err, err_size);
+    }
+    for (uint32_t n = o->min_vehicles; status == COAVOID_EVALUATION_OK && n <= o->max_vehicles;
+         n++) {
+        status = build_random_set(o, n, &sets[(*set_count)++], err, err_size);
+    }
+    return status;
+}
+
+int coavoid_bench_plan_run(const coavoid_bench_plan_config_t *config,
+                           coavoid_bench_plan_result_t *out, char *err, size_t err_size)
+{
+    memset(out, 0, sizeof *out);
+    if (config->count == 0 || config->repeat == 0 ||
+        config->min_vehicles < COAVOID_ENCOUNTER_MIN_VEHICLES ||
+        config->max_vehicles > COAVOID_ENCOUNTER_MAX_VEHICLES) {
+        return coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INVALID,
+                                       "bench plan: --count, --repeat or --vehicles out of range");
+    }
+    bp_set_t sets[COAVOID_BENCH_PLAN_MAX_SETS];
+    memset(sets, 0, sizeof sets);
+    size_t set_count = 0;
+    int status = build_sets(config, sets, &set_count, err, err_size);
+    for (size_t i = 0; status == COAVOID_EVALUATION_OK && i < set_count; i++) {
+        for (int mode = 0; status == COAVOID_EVALUATION_OK && mode < 2; mode++) {
+            status =
+                run_set(config, &sets[i], mode == 1, &out->rows[out->row_count++], err, err_size);
+        }
+    }
+    for (size_t i = 0; i < set_count; i++) {
+        set_free(&sets[i]);
+    }
+    return status;
+}

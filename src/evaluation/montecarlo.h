@@ -1,0 +1,107 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * montecarlo.h: the engine of `coavoid montecarlo`: the paper's question (does centralised
+ * planning succeed more often and more cheaply than decoupled planning?) asked of
+ * thousands of seeded random encounters instead of a few illustrations
+ * (docs/evaluation.md).
+ *
+ * Each encounter (encounter.h, design coavoid_encounter_montecarlo: UAVs converging on a
+ * point over hills, with non-cooperative tracks crossing) is solved three ways on the same
+ * problem: centralised (coa_plan_centralised), decoupled in the fixed priority order
+ * (coa_plan_decoupled, one order) and decoupled with reordering (up to max_orders orders).
+ * A draw whose reference plan (every offset 0) has no conflict, or has one in its first
+ * step (which includes t = 0, where nothing can be done), is replaced by the next draw of
+ * the same encounter; the redraws are counted.
+ *
+ * Every result is cross-checked. The centralised plan is optimal, so wherever both solve,
+ * a decoupled plan's exact deviation must be at least the centralised one's,
+ * lexicographically with the effort; a decoupled plan is a plan for the group, so the
+ * centralised search cannot have proven one absent (infeasible); every solved plan must be
+ * conflict-free by coa_plan_find_conflict, and must move someone (the reference
+ * conflicts). A violation is a defect of the planner: it is handed to the config's defect
+ * callback as it is found, and coavoid_montecarlo_report returns
+ * COAVOID_EVALUATION_INTERNAL after writing everything else.
+ *
+ * Jobs. Encounters are independent: `jobs` worker threads take them in order, each with
+ * its own planner workspaces, while the calling thread writes the CSV rows in encounter
+ * order as they complete and reports progress. So nothing but the times depends on jobs,
+ * and a seed gives the same encounters and results on every machine with the same C maths
+ * library.
+ *
+ * Use: fill a coavoid_montecarlo_config_t, coavoid_montecarlo_run, then
+ * coavoid_montecarlo_report (any number of times) and coavoid_montecarlo_free.
+ */
+#ifndef COAVOID_EVALUATION_MONTECARLO_H
+#define COAVOID_EVALUATION_MONTECARLO_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include "encounter.h"
+#include "evaluation.h"
+
+/* UAV counts one run compares: each of COAVOID_ENCOUNTER_MIN_VEHICLES..MAX once. */
+#define COAVOID_MONTECARLO_MAX_SIZES \
+    (COAVOID_ENCOUNTER_MAX_VEHICLES - COAVOID_ENCOUNTER_MIN_VEHICLES + 1u)
+/* Worker threads at most: beyond a machine's cores they only add workspaces. */
+#define COAVOID_MONTECARLO_MAX_JOBS 64u
+
+typedef struct {
+    /* The UAV counts, in the order of the reports, each of COAVOID_ENCOUNTER_MIN_VEHICLES to
+     * COAVOID_ENCOUNTER_MAX_VEHICLES and distinct; count encounters of each. */
+    uint32_t vehicles[COAVOID_MONTECARLO_MAX_SIZES];
+    uint32_t size_count;
+    uint32_t count;
+    uint64_t seed;
+    /* The closed-set bound of every search, >= 1; 0: per UAV count, coavoid_default_beta
+     * of its centralised planner (the programs' sizing policy, scenario.h). */
+    uint32_t beta;
+    /* Reordering's limit on priority orders, >= 1; 0: every order (N!). */
+    uint32_t max_orders;
+    uint32_t jobs;   /* worker threads, 1..COAVOID_MONTECARLO_MAX_JOBS */
+    const char *csv; /* a file for one row per encounter and method, or NULL */
+    const char *svg; /* a file for the figure, written by the report, or NULL */
+    /* An existing directory for every encounter as DIR/montecarlo-SEED-N-INDEX.json (for
+     * `coavoid plan` to replay), or NULL. */
+    const char *save;
+    /* Progress lines while it runs (updated in place every second when it is a terminal,
+     * a line every 10 % otherwise), or NULL for none. */
+    FILE *progress;
+    /* Called on the calling thread with one line per defect found, in encounter order;
+     * NULL: defects are only counted. */
+    void (*defect)(void *context, const char *line);
+    void *context;
+} coavoid_montecarlo_config_t;
+
+/* The encounters of a run and their outcomes; opaque. */
+typedef struct coavoid_montecarlo coavoid_montecarlo_t;
+
+/* Checks the config (every UAV count's centralised planner can be sized) and the outputs
+ * before the run rather than after an hour of it (save is a directory we can write in,
+ * csv is created, svg can be created), then draws, solves and cross-checks every
+ * encounter, writing csv's rows as they complete. Returns COAVOID_EVALUATION_OK with
+ * *out set, or a status of evaluation.h with one line in err[err_size] and *out NULL
+ * (csv may then be partly written). Memory: a result of about 500 bytes per encounter,
+ * kept until coavoid_montecarlo_free, and per job two planner workspaces (as beta sizes
+ * them) and two offset tables of about 240 KB, freed before it returns. Cost: count times
+ * size_count encounters, each a centralised search and up to 1 + max_orders decoupled
+ * ones, spread over the jobs. */
+int coavoid_montecarlo_run(const coavoid_montecarlo_config_t *config, coavoid_montecarlo_t **out,
+                           char *err, size_t err_size);
+
+/* Summarises the run per UAV count and method (outcomes, the success rate and its 95 %
+ * Wilson interval, the distribution of the decoupled/centralised deviation ratio over the
+ * encounters both solve, times, nodes), writes the config's svg and prints the summary on
+ * out as text or, with json, a JSON object (docs/evaluation.md). Returns
+ * COAVOID_EVALUATION_OK, or COAVOID_EVALUATION_INTERNAL with err set when a write failed
+ * or the run found defects (after writing everything). Cost O(count log count) per UAV
+ * count and method; no memory beyond cJSON's tree for json. */
+int coavoid_montecarlo_report(coavoid_montecarlo_t *mc, FILE *out, bool json, char *err,
+                              size_t err_size);
+
+/* Frees a run (NULL is fine). */
+void coavoid_montecarlo_free(coavoid_montecarlo_t *mc);
+
+#endif /* COAVOID_EVALUATION_MONTECARLO_H */

@@ -1,0 +1,62 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * montecarlo_internal.h: what the Monte Carlo engine (montecarlo.c: drawing, solving,
+ * cross-checking, the CSV) hands its reports (montecarlo_report.c: statistics, text, JSON,
+ * SVG): each encounter's outcomes. Not part of the library's interface (montecarlo.h).
+ */
+#ifndef COAVOID_EVALUATION_MONTECARLO_INTERNAL_H
+#define COAVOID_EVALUATION_MONTECARLO_INTERNAL_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "coavoid/coavoid.h"
+#include "encounter.h"
+#include "montecarlo.h"
+
+/* The three ways each encounter is solved, in the order of every report. */
+enum { COAVOID_MC_CENTRALISED, COAVOID_MC_FIXED, COAVOID_MC_REORDERED, COAVOID_MC_METHODS };
+extern const char *const coavoid_mc_method_names[COAVOID_MC_METHODS];
+
+/* One method's plan of one encounter. */
+typedef struct {
+    coa_plan_status_t status;
+    double deviation;
+    coa_cost_t units;
+    uint32_t effort;
+    uint64_t expanded, generated;
+    uint32_t orders_tried;
+    double time_us;
+} coavoid_mc_outcome_t;
+
+typedef struct {
+    uint32_t vehicles, index;
+    uint32_t redraws;
+    coavoid_encounter_info_t info;
+    uint32_t first_conflict_step;
+    coavoid_mc_outcome_t m[COAVOID_MC_METHODS];
+    char defect[256]; /* empty unless a check failed */
+} coavoid_mc_result_t;
+
+/* A UAV count and the planners' limits for it. */
+typedef struct {
+    uint32_t n;
+    uint32_t beta;
+    uint32_t max_orders;
+} coavoid_mc_size_t;
+
+struct coavoid_montecarlo {
+    coavoid_montecarlo_config_t config; /* paths and callbacks still the caller's */
+    coavoid_mc_size_t sizes[COAVOID_MONTECARLO_MAX_SIZES];
+    uint32_t total; /* count per size, sizes in the config's order */
+    coavoid_mc_result_t *results;
+    double *x; /* room for count doubles: the reports sort a size's values in it */
+};
+
+/* A 128-bit cost as a double, for ratios: exact enough for them, and it never overflows. */
+static inline double coavoid_mc_cost_real(coa_cost_t c)
+{
+    return (double)c.hi * 18446744073709551616.0 + (double)c.lo;
+}
+
+#endif /* COAVOID_EVALUATION_MONTECARLO_INTERNAL_H */

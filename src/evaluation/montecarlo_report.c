@@ -1,0 +1,534 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * montecarlo_report.c: the reports of a Monte Carlo run (montecarlo.h): per UAV count and
+ * method the outcomes, the success rate with its Wilson interval, the distributions of the
+ * times, the nodes and the decoupled/centralised deviation ratio, printed as text or JSON,
+ * and the figure (success rates beside the ratio's cumulative distribution) as SVG.
+ */
+#include "montecarlo.h"
+
+#include <math.h>
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cjson/cJSON.h>
+
+#include "coavoid/coavoid.h"
+#include "encounter.h"
+#include "evaluation_internal.h"
+#include "montecarlo_internal.h"
+#include "output.h"
+
+#define MC_Z95 1.959963984540054 /* the normal quantile of a two-sided 95 % interval */
+
+/* ---- the summary ---- */
+
+typedef struct {
+    uint32_t count;
+    double min, p25, median, p75, p90, max, mean;
+    double equal_share; /* ratio exactly 1 (the same exact deviation) */
+} mc_dist_t;
+
+/* The p-quantile of sorted x[0..m-1] (m >= 1), interpolating linearly between order
+ * statistics (numpy's default, "type 7"), so scripts can recompute it. */
+static double quantile(const double *x, uint32_t m, double p)
+{
+    double h = (double)(m - 1u) * p;
+    double lo = floor(h);
+    uint32_t k = (uint32_t)lo;
+    return k + 1u < m ? x[k] + (h - lo) * (x[k + 1u] - x[k]) : x[m - 1u];
+}
+
+/* Sorts x and summarises it; equal: how many were exactly equal. */
+static mc_dist_t distribution(double *x, uint32_t m, uint32_t equal)
+{
+    mc_dist_t d;
+    memset(&d, 0, sizeof d);
+    d.count = m;
+    if (m == 0) {
+        return d;
+    }
+    qsort(x, m, sizeof *x, coavoid_timing_compare);
+    double sum = 0;
+    for (uint32_t k = 0; k < m; k++) {
+        sum += x[k];
+    }
+    d.min = x[0];
+    d.p25 = quantile(x, m, 0.25);
+    d.median = quantile(x, m, 0.5);
+    d.p75 = quantile(x, m, 0.75);
+    d.p90 = quantile(x, m, 0.9);
+    d.max = x[m - 1u];
+    d.mean = sum / m;
+    d.equal_share = (double)equal / m;
+    return d;
+}
+
+typedef struct {
+    uint32_t solved, infeasible, budget;
+    double rate, low, high; /* success rate and its 95 % Wilson interval */
+    mc_dist_t time_ms;      /* of every encounter */
+    mc_dist_t expanded;
+    mc_dist_t ratio; /* decoupled methods: deviation / centralised's, both solved */
+    uint32_t fails_where_central_solves, solves_where_central_fails;
+    double mean_deviation_both; /* mean deviation (m^2) over the encounters both solve */
+    double central_mean_deviation_both;
+} mc_method_summary_t;
+
+typedef struct {
+    coavoid_mc_size_t size;
+    uint32_t encounters, redraws;
+    mc_method_summary_t m[COAVOID_MC_METHODS];
+} mc_summary_t;
+
+static void wilson(uint32_t k, uint32_t n, double *rate, double *low, double *high)
+{
+    double p = (double)k / n, z2 = MC_Z95 * MC_Z95, nn = (double)n;
+    double centre = (p + z2 / (2.0 * nn)) / (1.0 + z2 / nn);
+    double half = MC_Z95 * sqrt(p * (1.0 - p) / nn + z2 / (4.0 * nn * nn)) / (1.0 + z2 / nn);
+    *rate = p;
+    /* Exactly 0 and 1 at the ends, where rounding would leave a few ulps. */
+    *low = k == 0 || centre - half < 0 ? 0 : centre - half;
+    *high = k == n || centre + half > 1 ? 1 : centre + half;
+}
+
+/* Summarises the count results of one size; x: room for count doubles. */
+static void summarise(const coavoid_mc_result_t *results, uint32_t count,
+                      const coavoid_mc_size_t *size, double *x, mc_summary_t *s)
+{
+    memset(s, 0, sizeof *s);
+    s->size = *size;
+    s->encounters = count;
+    for (uint32_t j = 0; j < count; j++) {
+        s->redraws += results[j].redraws;
+    }
+    for (int m = 0; m < COAVOID_MC_METHODS; m++) {
+        mc_method_summary_t *ms = &s->m[m];
+        for (uint32_t j = 0; j < count; j++) {
+            coa_plan_status_t st = results[j].m[m].status;
+            ms->solved += st == COA_PLAN_SOLVED;
+            ms->infeasible += st == COA_PLAN_INFEASIBLE;
+            ms->budget += st == COA_PLAN_BUDGET_EXHAUSTED;
+            x[j] = results[j].m[m].time_us * 1e-3;
+        }
+        wilson(ms->solved, count, &ms->rate, &ms->low, &ms->high);
+        ms->time_ms = distribution(x, count, 0u);
+        for (uint32_t j = 0; j < count; j++) {
+            x[j] = (double)results[j].m[m].expanded;
+        }
+        ms->expanded = distribution(x, count, 0u);
+        if (m == COAVOID_MC_CENTRALISED) {
+            continue;
+        }
+        uint32_t both = 0, equal = 0;
+        double dev = 0, cdev = 0;
+        for (uint32_t j = 0; j < count; j++) {
+            const coavoid_mc_outcome_t *c = &results[j].m[COAVOID_MC_CENTRALISED],
+                                       *d = &results[j].m[m];
+            bool cs = c->status == COA_PLAN_SOLVED, ds = d->status == COA_PLAN_SOLVED;
+            ms->fails_where_central_solves += cs && !ds;
+            ms->solves_where_central_fails += ds && !cs;
+            if (cs && ds) {
+                x[both++] = coavoid_mc_cost_real(d->units) / coavoid_mc_cost_real(c->units);
+                equal += coa_cost_compare(d->units, c->units) == 0;
+                dev += d->deviation;
+                cdev += c->deviation;
+            }
+        }
+        ms->mean_deviation_both = both > 0 ? dev / both : 0;
+        ms->central_mean_deviation_both = both > 0 ? cdev / both : 0;
+        ms->ratio = distribution(x, both, equal);
+    }
+}
+
+static void text_summary(FILE *f, const coavoid_montecarlo_config_t *o, const mc_summary_t *s,
+                         uint32_t sizes)
+{
+    const coavoid_encounter_design_t *d = &coavoid_encounter_montecarlo;
+    fprintf(f, "montecarlo: seed %llu, %lu encounters per UAV count, %u steps of %g s\n",
+            (unsigned long long)o->seed, (unsigned long)o->count, d->horizon, d->dt);
+    for (uint32_t k = 0; k < sizes; k++) {
+        const mc_summary_t *z = &s[k];
+        fprintf(f, "\n%lu UAVs: %lu encounters (%lu redraws), beta %lu, max orders %lu\n",
+                (unsigned long)z->size.n, (unsigned long)z->encounters, (unsigned long)z->redraws,
+                (unsigned long)z->size.beta, (unsigned long)z->size.max_orders);
+        fprintf(f, "  %-20s %7s %10s %7s %8s %16s %10s %10s %10s %12s\n", "method", "solved",
+                "infeasible", "budget", "success", "95% Wilson", "median_ms", "p90_ms", "max_ms",
+                "median_nodes");
+        for (int m = 0; m < COAVOID_MC_METHODS; m++) {
+            const mc_method_summary_t *ms = &z->m[m];
+            fprintf(f,
+                    "  %-20s %7lu %10lu %7lu %7.1f%% %7.1f-%5.1f%% %10.3f %10.3f %10.3f %12.0f\n",
+                    coavoid_mc_method_names[m], (unsigned long)ms->solved,
+                    (unsigned long)ms->infeasible, (unsigned long)ms->budget, 100 * ms->rate,
+                    100 * ms->low, 100 * ms->high, ms->time_ms.median, ms->time_ms.p90,
+                    ms->time_ms.max, ms->expanded.median);
+        }
+        fprintf(f, "  deviation ratio to centralised, over the encounters both solve:\n");
+        fprintf(f, "  %-20s %6s %7s %7s %7s %7s %7s %7s %7s %7s %9s %9s\n", "method", "both", "min",
+                "p25", "median", "p75", "p90", "max", "mean", "=1", "fails*", "solves*");
+        for (int m = COAVOID_MC_FIXED; m < COAVOID_MC_METHODS; m++) {
+            const mc_method_summary_t *ms = &z->m[m];
+            const mc_dist_t *r = &ms->ratio;
+            double fails = 100.0 * ms->fails_where_central_solves / z->encounters;
+            double solves = 100.0 * ms->solves_where_central_fails / z->encounters;
+            if (r->count == 0) {
+                /* No ratio at all, not ratios of 0 (a ratio is at least 1). */
+                fprintf(f, "  %-20s %6lu %7s %7s %7s %7s %7s %7s %7s %7s %8.1f%% %8.1f%%\n",
+                        coavoid_mc_method_names[m], 0ul, "-", "-", "-", "-", "-", "-", "-", "-",
+                        fails, solves);
+                continue;
+            }
+            fprintf(f,
+                    "  %-20s %6lu %7.3f %7.3f %7.3f %7.3f %7.3f %7.3f %7.3f %6.1f%% %8.1f%% "
+                    "%8.1f%%\n",
+                    coavoid_mc_method_names[m], (unsigned long)r->count, r->min, r->p25, r->median,
+                    r->p75, r->p90, r->max, r->mean, 100 * r->equal_share, fails, solves);
+        }
+    }
+    fprintf(f, "\nbudget: beta exhausted (nothing proven); =1: the same exact deviation as "
+               "centralised;\nfails*: share of encounters it fails and centralised solves; "
+               "solves*: it solves and centralised fails\n");
+}
+
+static bool add_dist(cJSON *parent, const char *name, const mc_dist_t *d, bool with_equal)
+{
+    cJSON *o = cJSON_AddObjectToObject(parent, name);
+    bool ok = o != NULL && cJSON_AddNumberToObject(o, "count", d->count) != NULL;
+    if (ok && d->count > 0) {
+        ok = cJSON_AddNumberToObject(o, "min", d->min) != NULL &&
+             cJSON_AddNumberToObject(o, "p25", d->p25) != NULL &&
+             cJSON_AddNumberToObject(o, "median", d->median) != NULL &&
+             cJSON_AddNumberToObject(o, "p75", d->p75) != NULL &&
+             cJSON_AddNumberToObject(o, "p90", d->p90) != NULL &&
+             cJSON_AddNumberToObject(o, "max", d->max) != NULL &&
+             cJSON_AddNumberToObject(o, "mean", d->mean) != NULL;
+    }
+    if (ok && with_equal) {
+        ok = cJSON_AddNumberToObject(o, "equal_share", d->count > 0 ? d->equal_share : 0) != NULL;
+    }
+    return ok;
+}
+
+static int json_summary(FILE *f, const coavoid_montecarlo_config_t *o, const mc_summary_t *s,
+                        uint32_t sizes)
+{
+    char seed[32];
+    snprintf(seed, sizeof seed, "%llu", (unsigned long long)o->seed);
+    cJSON *root = cJSON_CreateObject();
+    cJSON *list = NULL;
+    bool ok =
+        root != NULL && cJSON_AddStringToObject(root, "command", "montecarlo") != NULL &&
+        cJSON_AddRawToObject(root, "seed", seed) != NULL &&
+        cJSON_AddNumberToObject(root, "count", o->count) != NULL &&
+        cJSON_AddNumberToObject(root, "horizon", coavoid_encounter_montecarlo.horizon) != NULL &&
+        cJSON_AddNumberToObject(root, "dt", coavoid_encounter_montecarlo.dt) != NULL &&
+        (list = cJSON_AddArrayToObject(root, "sizes")) != NULL;
+    for (uint32_t k = 0; ok && k < sizes; k++) {
+        const mc_summary_t *z = &s[k];
+        cJSON *item = cJSON_CreateObject();
+        cJSON *methods = NULL;
+        ok = item != NULL && cJSON_AddItemToArray(list, item) &&
+             cJSON_AddNumberToObject(item, "vehicles", z->size.n) != NULL &&
+             cJSON_AddNumberToObject(item, "encounters", z->encounters) != NULL &&
+             cJSON_AddNumberToObject(item, "redraws", z->redraws) != NULL &&
+             cJSON_AddNumberToObject(item, "beta", z->size.beta) != NULL &&
+             cJSON_AddNumberToObject(item, "max_orders", z->size.max_orders) != NULL &&
+             (methods = cJSON_AddArrayToObject(item, "methods")) != NULL;
+        for (int m = 0; ok && m < COAVOID_MC_METHODS; m++) {
+            const mc_method_summary_t *ms = &z->m[m];
+            cJSON *mo = cJSON_CreateObject();
+            ok = mo != NULL && cJSON_AddItemToArray(methods, mo) &&
+                 cJSON_AddStringToObject(mo, "method", coavoid_mc_method_names[m]) != NULL &&
+                 cJSON_AddNumberToObject(mo, "solved", ms->solved) != NULL &&
+                 cJSON_AddNumberToObject(mo, "infeasible", ms->infeasible) != NULL &&
+                 cJSON_AddNumberToObject(mo, "budget_exhausted", ms->budget) != NULL &&
+                 cJSON_AddNumberToObject(mo, "success_rate", ms->rate) != NULL &&
+                 cJSON_AddNumberToObject(mo, "wilson_low", ms->low) != NULL &&
+                 cJSON_AddNumberToObject(mo, "wilson_high", ms->high) != NULL &&
+                 add_dist(mo, "time_ms", &ms->time_ms, false) &&
+                 add_dist(mo, "nodes_expanded", &ms->expanded, false);
+            if (ok && m != COAVOID_MC_CENTRALISED) {
+                ok = add_dist(mo, "deviation_ratio", &ms->ratio, true) &&
+                     cJSON_AddNumberToObject(mo, "fails_where_centralised_solves",
+                                             ms->fails_where_central_solves) != NULL &&
+                     cJSON_AddNumberToObject(mo, "solves_where_centralised_fails",
+                                             ms->solves_where_central_fails) != NULL &&
+                     cJSON_AddNumberToObject(mo, "mean_deviation_both_solved",
+                                             ms->mean_deviation_both) != NULL &&
+                     cJSON_AddNumberToObject(mo, "centralised_mean_deviation_both_solved",
+                                             ms->central_mean_deviation_both) != NULL;
+            }
+        }
+    }
+    if (!ok) {
+        cJSON_Delete(root);
+        return -1;
+    }
+    return coavoid_output_json(f, root, NULL, 0);
+}
+
+/* ---- the figure ---- */
+
+#define SVG_W 960.0
+#define SVG_H 420.0
+#define SVG_PANEL_TOP 60.0
+#define SVG_PANEL_H 260.0
+#define SVG_BAR_LEFT 70.0
+#define SVG_BAR_W 330.0
+#define SVG_CDF_LEFT 520.0
+#define SVG_CDF_W 400.0
+
+static const char *const method_colours[COAVOID_MC_METHODS] = {"#1f77b4", "#ff7f0e", "#2ca02c"};
+static const char *const size_colours[COAVOID_MONTECARLO_MAX_SIZES] = {
+    "#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#8c564b"};
+
+/* The ratio axis, logarithmic: from 1 to the largest ratio seen, at least 2 and at most
+ * 10 (a longer tail is drawn against the edge and said in the caption). */
+static double cdf_right(const mc_summary_t *s, uint32_t sizes)
+{
+    double right = 2.0;
+    for (uint32_t k = 0; k < sizes; k++) {
+        for (int m = COAVOID_MC_FIXED; m < COAVOID_MC_METHODS; m++) {
+            if (s[k].m[m].ratio.count > 0 && s[k].m[m].ratio.max > right) {
+                right = s[k].m[m].ratio.max;
+            }
+        }
+    }
+    return right > 10.0 ? 10.0 : right;
+}
+
+static double cdf_x(double v, double right)
+{
+    v = v > right ? right : v;
+    return SVG_CDF_LEFT + log(v) / log(right) * SVG_CDF_W;
+}
+
+/* The step function of the ratio's CDF of one size and method, merging steps closer than
+ * half a pixel so that 1000 encounters stay a few hundred points. */
+static void svg_cdf(FILE *f, const coavoid_mc_result_t *results, uint32_t count, int m,
+                    double right, double *x, const char *colour, bool dashed)
+{
+    uint32_t both = 0;
+    for (uint32_t j = 0; j < count; j++) {
+        const coavoid_mc_outcome_t *c = &results[j].m[COAVOID_MC_CENTRALISED],
+                                   *d = &results[j].m[m];
+        if (c->status == COA_PLAN_SOLVED && d->status == COA_PLAN_SOLVED) {
+            x[both++] = coavoid_mc_cost_real(d->units) / coavoid_mc_cost_real(c->units);
+        }
+    }
+    if (both == 0) {
+        return;
+    }
+    qsort(x, both, sizeof *x, coavoid_timing_compare);
+    const double y0 = SVG_PANEL_TOP + SVG_PANEL_H;
+    fprintf(f, "<polyline fill=\"none\" stroke=\"%s\" stroke-width=\"1.8\"%s points=\"", colour,
+            dashed ? " stroke-dasharray=\"6 4\"" : "");
+    double last_px = SVG_CDF_LEFT, last_py = y0;
+    fprintf(f, "%.1f,%.1f", last_px, last_py);
+    for (uint32_t j = 0; j < both;) {
+        uint32_t k = j;
+        while (k < both && x[k] == x[j]) {
+            k++;
+        }
+        double px = cdf_x(x[j], right);
+        double py = y0 - (double)k / both * SVG_PANEL_H;
+        if (px - last_px >= 0.5 || k == both) {
+            fprintf(f, " %.1f,%.1f %.1f,%.1f", px, last_py, px, py);
+            last_px = px;
+        }
+        last_py = py;
+        j = k;
+    }
+    fprintf(f, " %.1f,%.1f\"/>\n", SVG_CDF_LEFT + SVG_CDF_W, last_py);
+}
+
+/* The figure's header and title (seed, count, the betas used). */
+static void svg_head(FILE *f, const coavoid_montecarlo_config_t *o, const mc_summary_t *s,
+                     uint32_t sizes)
+{
+    fprintf(f,
+            "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+            "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" "
+            "viewBox=\"0 0 %.0f %.0f\" font-family=\"sans-serif\" font-size=\"13\">\n"
+            "<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n",
+            SVG_W, SVG_H, SVG_W, SVG_H);
+    char betas[64] = "";
+    for (uint32_t k = 0, used = 0; k < sizes && used < sizeof betas; k++) {
+        if (k == 0 || s[k].size.beta != s[k - 1].size.beta) {
+            int w = snprintf(betas + used, sizeof betas - used, "%s%lu", k == 0 ? "" : "/",
+                             (unsigned long)s[k].size.beta);
+            used += w > 0 ? (uint32_t)w : 0u;
+        }
+    }
+    fprintf(f,
+            "<text x=\"%.0f\" y=\"24\" font-size=\"15\" font-weight=\"bold\">coavoid "
+            "montecarlo: seed %llu, %lu encounters per UAV count, beta %s</text>\n",
+            SVG_BAR_LEFT, (unsigned long long)o->seed, (unsigned long)o->count, betas);
+}
+
+/* Left: success rates, a group of three bars per UAV count, with Wilson intervals; budget
+ * exhausted shown pale above a bar (unknown, not failed). */
+static void svg_rates(FILE *f, const mc_summary_t *s, uint32_t sizes)
+{
+    const double y0 = SVG_PANEL_TOP + SVG_PANEL_H;
+    fprintf(f,
+            "<text x=\"%.0f\" y=\"%.0f\" font-weight=\"bold\">success rate (95%% Wilson "
+            "interval)</text>\n",
+            SVG_BAR_LEFT, SVG_PANEL_TOP - 10);
+    for (int t = 0; t <= 10; t += 2) {
+        double py = y0 - t / 10.0 * SVG_PANEL_H;
+        fprintf(f,
+                "<line x1=\"%.0f\" y1=\"%.1f\" x2=\"%.0f\" y2=\"%.1f\" stroke=\"#ddd\"/>\n"
+                "<text x=\"%.0f\" y=\"%.1f\" text-anchor=\"end\">%d%%</text>\n",
+                SVG_BAR_LEFT, py, SVG_BAR_LEFT + SVG_BAR_W, py, SVG_BAR_LEFT - 6, py + 4, t * 10);
+    }
+    double group = SVG_BAR_W / sizes, bar = group / (COAVOID_MC_METHODS + 1.5);
+    for (uint32_t k = 0; k < sizes; k++) {
+        double gx = SVG_BAR_LEFT + k * group + 0.75 * bar;
+        for (int m = 0; m < COAVOID_MC_METHODS; m++) {
+            const mc_method_summary_t *ms = &s[k].m[m];
+            double bx = gx + m * bar, top = y0 - ms->rate * SVG_PANEL_H;
+            double cx = bx + 0.45 * bar;
+            if (ms->budget > 0) { /* above the bar, pale: unknown, not failed */
+                double h = (double)ms->budget / s[k].encounters * SVG_PANEL_H;
+                fprintf(f,
+                        "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" "
+                        "fill=\"%s\" fill-opacity=\"0.3\"/>\n",
+                        bx, top - h, 0.9 * bar, h, method_colours[m]);
+            }
+            fprintf(f,
+                    "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" "
+                    "fill=\"%s\"/>\n"
+                    "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"black\"/>\n",
+                    bx, top, 0.9 * bar, y0 - top, method_colours[m], cx, y0 - ms->low * SVG_PANEL_H,
+                    cx, y0 - ms->high * SVG_PANEL_H);
+        }
+        fprintf(f, "<text x=\"%.1f\" y=\"%.0f\" text-anchor=\"middle\">%lu UAVs</text>\n",
+                gx + 1.5 * bar, y0 + 18, (unsigned long)s[k].size.n);
+    }
+    fprintf(f, "<line x1=\"%.0f\" y1=\"%.0f\" x2=\"%.0f\" y2=\"%.0f\" stroke=\"black\"/>\n",
+            SVG_BAR_LEFT, y0, SVG_BAR_LEFT + SVG_BAR_W, y0);
+    for (int m = 0; m < COAVOID_MC_METHODS; m++) {
+        double ly = y0 + 44 + 16 * m;
+        fprintf(f,
+                "<rect x=\"%.0f\" y=\"%.0f\" width=\"12\" height=\"12\" fill=\"%s\"/>"
+                "<text x=\"%.0f\" y=\"%.0f\">%s</text>\n",
+                SVG_BAR_LEFT, ly - 10, method_colours[m], SVG_BAR_LEFT + 18, ly,
+                coavoid_mc_method_names[m]);
+    }
+    fprintf(f, "<text x=\"%.0f\" y=\"%.0f\">pale above a bar: budget exhausted</text>\n",
+            SVG_BAR_LEFT + 170, y0 + 44);
+}
+
+/* Right: the CDF of the deviation ratio per UAV count, fixed solid, reordered dashed. */
+static void svg_ratios(FILE *f, const coavoid_montecarlo_config_t *o,
+                       const coavoid_montecarlo_t *run, const mc_summary_t *s, uint32_t sizes,
+                       double *x)
+{
+    const double y0 = SVG_PANEL_TOP + SVG_PANEL_H;
+    double right = cdf_right(s, sizes);
+    fprintf(f,
+            "<text x=\"%.0f\" y=\"%.0f\" font-weight=\"bold\">decoupled / centralised "
+            "deviation, both solved (CDF)</text>\n",
+            SVG_CDF_LEFT, SVG_PANEL_TOP - 10);
+    for (int t = 0; t <= 4; t++) {
+        double py = y0 - t / 4.0 * SVG_PANEL_H;
+        fprintf(f,
+                "<line x1=\"%.0f\" y1=\"%.1f\" x2=\"%.0f\" y2=\"%.1f\" stroke=\"#ddd\"/>\n"
+                "<text x=\"%.0f\" y=\"%.1f\" text-anchor=\"end\">%.2f</text>\n",
+                SVG_CDF_LEFT, py, SVG_CDF_LEFT + SVG_CDF_W, py, SVG_CDF_LEFT - 6, py + 4, t / 4.0);
+    }
+    static const double ticks[] = {1.0, 1.25, 1.5, 2.0, 3.0, 5.0, 10.0};
+    for (size_t t = 0; t < sizeof ticks / sizeof ticks[0] && ticks[t] <= right * 1.0001; t++) {
+        double px = cdf_x(ticks[t], right);
+        fprintf(f,
+                "<line x1=\"%.1f\" y1=\"%.0f\" x2=\"%.1f\" y2=\"%.0f\" stroke=\"#ddd\"/>\n"
+                "<text x=\"%.1f\" y=\"%.0f\" text-anchor=\"middle\">%g</text>\n",
+                px, SVG_PANEL_TOP, px, y0, px, y0 + 18, ticks[t]);
+    }
+    fprintf(f,
+            "<text x=\"%.0f\" y=\"%.0f\" text-anchor=\"middle\">deviation ratio "
+            "(log scale)</text>\n",
+            SVG_CDF_LEFT + SVG_CDF_W / 2, y0 + 34);
+    fprintf(f,
+            "<text transform=\"translate(%.0f %.0f) rotate(-90)\" text-anchor=\"middle\">"
+            "share of encounters</text>\n",
+            SVG_CDF_LEFT - 44, SVG_PANEL_TOP + SVG_PANEL_H / 2);
+    fprintf(f,
+            "<rect x=\"%.0f\" y=\"%.0f\" width=\"%.0f\" height=\"%.0f\" fill=\"none\" "
+            "stroke=\"black\"/>\n",
+            SVG_CDF_LEFT, SVG_PANEL_TOP, SVG_CDF_W, SVG_PANEL_H);
+    for (uint32_t k = 0; k < sizes; k++) {
+        const coavoid_mc_result_t *first = &run->results[k * o->count];
+        const char *colour = size_colours[(s[k].size.n - COAVOID_ENCOUNTER_MIN_VEHICLES) %
+                                          COAVOID_MONTECARLO_MAX_SIZES];
+        svg_cdf(f, first, o->count, COAVOID_MC_FIXED, right, x, colour, false);
+        svg_cdf(f, first, o->count, COAVOID_MC_REORDERED, right, x, colour, true);
+        double ly = y0 + 56 + 16 * k;
+        fprintf(f,
+                "<line x1=\"%.0f\" y1=\"%.0f\" x2=\"%.0f\" y2=\"%.0f\" stroke=\"%s\" "
+                "stroke-width=\"2\"/><text x=\"%.0f\" y=\"%.0f\">%lu UAVs</text>\n",
+                SVG_CDF_LEFT, ly - 4, SVG_CDF_LEFT + 24, ly - 4, colour, SVG_CDF_LEFT + 30, ly,
+                (unsigned long)s[k].size.n);
+    }
+    fprintf(f,
+            "<text x=\"%.0f\" y=\"%.0f\">solid: decoupled_fixed</text>\n"
+            "<text x=\"%.0f\" y=\"%.0f\">dashed: decoupled_reordered</text>\n",
+            SVG_CDF_LEFT + 110, y0 + 56, SVG_CDF_LEFT + 110, y0 + 72);
+    if (right >= 10.0) {
+        fprintf(f, "<text x=\"%.0f\" y=\"%.0f\">ratios above 10 at the right edge</text>\n",
+                SVG_CDF_LEFT + 110, y0 + 88);
+    }
+}
+
+static int write_svg(const char *path, const coavoid_montecarlo_config_t *o,
+                     const coavoid_montecarlo_t *run, const mc_summary_t *s, uint32_t sizes,
+                     double *x)
+{
+    FILE *f = fopen(path, "w");
+    if (f == NULL) {
+        return -1;
+    }
+    svg_head(f, o, s, sizes);
+    svg_rates(f, s, sizes);
+    svg_ratios(f, o, run, s, sizes, x);
+    fprintf(f, "</svg>\n");
+    bool ok = !ferror(f);
+    return fclose(f) == 0 && ok ? 0 : -1;
+}
+
+/* The summaries of every UAV count, the figure and the table; the exit status. */
+int coavoid_montecarlo_report(coavoid_montecarlo_t *mc, FILE *out, bool json, char *err,
+                              size_t err_size)
+{
+    const coavoid_montecarlo_config_t *o = &mc->config;
+    bool defects = false;
+    for (uint32_t j = 0; j < mc->total; j++) {
+        defects = defects || mc->results[j].defect[0] != '\0';
+    }
+    mc_summary_t summary[COAVOID_MONTECARLO_MAX_SIZES];
+    for (uint32_t k = 0; k < o->size_count; k++) {
+        summarise(&mc->results[k * o->count], o->count, &mc->sizes[k], mc->x, &summary[k]);
+    }
+    if (o->svg != NULL && write_svg(o->svg, o, mc, summary, o->size_count, mc->x) != 0) {
+        return coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INTERNAL,
+                                       "--svg: cannot write '%.200s'", o->svg);
+    }
+    int rc = 0;
+    if (json) {
+        rc = json_summary(out, o, summary, o->size_count);
+    } else {
+        text_summary(out, o, summary, o->size_count);
+    }
+    if (rc != 0 || fflush(out) != 0 || ferror(out)) {
+        return coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INTERNAL,
+                                       "cannot write the summary");
+    }
+    return defects ? coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INTERNAL,
+                                             "montecarlo: defects found (above)")
+                   : COAVOID_EVALUATION_OK;
+}
