@@ -14,7 +14,6 @@
 #include "cli.h"
 #include "coavoid/coavoid.h"
 #include "commands.h"
-#include "evaluation.h"
 
 #define BENCH_DEFAULT_SEED 1u
 #define BENCH_DEFAULT_REPEAT 21u
@@ -159,11 +158,10 @@ static int bench_predict(int argc, char **argv)
     config.side_km = o.side_text != NULL ? o.side_km : 0.0; /* 0: sized for the density */
     config.all_pairs = o.all_pairs;
     coavoid_bench_predict_result_t result;
-    char err[COAVOID_EVALUATION_ERROR_MAX];
-    int rc = coavoid_bench_predict_run(&config, &result, err, sizeof err);
-    if (rc != COAVOID_EVALUATION_OK) {
-        return coavoid_cli_fail(
-            rc == COAVOID_EVALUATION_INVALID ? CLI_EXIT_INVALID : CLI_EXIT_INTERNAL, "%s", err);
+    coavoid_run_error_t e;
+    int rc = coavoid_bench_predict_run(&config, &result, &e);
+    if (rc != COAVOID_RUN_DONE) {
+        return coavoid_cli_run_status(rc, &e);
     }
     return coavoid_bench_predict_report(stdout, &config, &result, o.json) == 0
                ? CLI_EXIT_OK

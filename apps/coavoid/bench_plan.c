@@ -14,7 +14,6 @@
 #include "cli.h"
 #include "commands.h"
 #include "encounter.h"
-#include "evaluation.h"
 #include "scenario.h"
 
 #define BP_DEFAULT_SEED 1u
@@ -181,11 +180,10 @@ int coavoid_bench_plan(int argc, char **argv)
     config.repeat = o.repeat;
     config.beta = o.beta_text != NULL ? o.beta : 0u; /* 0: the scenario's, or the default */
     coavoid_bench_plan_result_t result;
-    char err[COAVOID_EVALUATION_ERROR_MAX];
-    int rc = coavoid_bench_plan_run(&config, &result, err, sizeof err);
-    if (rc != COAVOID_EVALUATION_OK) {
-        return coavoid_cli_fail(
-            rc == COAVOID_EVALUATION_INVALID ? CLI_EXIT_INVALID : CLI_EXIT_INTERNAL, "%s", err);
+    coavoid_run_error_t e;
+    int rc = coavoid_bench_plan_run(&config, &result, &e);
+    if (rc != COAVOID_RUN_DONE) {
+        return coavoid_cli_run_status(rc, &e);
     }
     return coavoid_bench_plan_report(stdout, &config, &result, o.json) == 0
                ? CLI_EXIT_OK

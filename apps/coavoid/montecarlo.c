@@ -12,7 +12,6 @@
 #include "cli.h"
 #include "commands.h"
 #include "encounter.h"
-#include "evaluation.h"
 #include "montecarlo.h"
 #include "scenario.h"
 
@@ -236,16 +235,12 @@ int coavoid_command_montecarlo(int argc, char **argv)
         return status;
     }
     const coavoid_montecarlo_config_t config = mc_engine_config(&o);
-    char err[COAVOID_EVALUATION_ERROR_MAX];
+    coavoid_run_error_t e;
     coavoid_montecarlo_t *mc = NULL;
-    int rc = coavoid_montecarlo_run(&config, &mc, err, sizeof err);
-    if (rc == COAVOID_EVALUATION_OK) {
-        rc = coavoid_montecarlo_report(mc, stdout, o.json, err, sizeof err);
+    int rc = coavoid_montecarlo_run(&config, &mc, &e);
+    if (rc == COAVOID_RUN_DONE) {
+        rc = coavoid_montecarlo_report(mc, stdout, o.json, &e);
     }
     coavoid_montecarlo_free(mc);
-    if (rc == COAVOID_EVALUATION_OK) {
-        return CLI_EXIT_OK;
-    }
-    return coavoid_cli_fail(rc == COAVOID_EVALUATION_INVALID ? CLI_EXIT_INVALID : CLI_EXIT_INTERNAL,
-                            "%s", err);
+    return coavoid_cli_run_status(rc, &e);
 }

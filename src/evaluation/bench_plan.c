@@ -20,6 +20,7 @@
 #include "encounter.h"
 #include "evaluation_internal.h"
 #include "output.h"
+#include "run.h"
 #include "scenario.h"
 
 /* ---- the sets ---- */
@@ -41,15 +42,14 @@ static void set_free(bp_set_t *set)
 }
 
 static int build_random_set(const coavoid_bench_plan_config_t *o, uint32_t n, bp_set_t *set,
-                            char *err, size_t err_size)
+                            coavoid_run_error_t *e)
 {
     snprintf(set->label, sizeof set->label, "%u UAVs", n);
     set->vehicles = n;
     set->problems = calloc(o->count, sizeof *set->problems);
     if (set->problems == NULL) {
-        return coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INVALID,
-                                       "--count: out of memory for %lu problems",
-                                       (unsigned long)o->count);
+        return coavoid_run_fail(e, COAVOID_RUN_ERR_INPUT, "--count: out of memory for %lu problems",
+                                (unsigned long)o->count);
     }
     for (uint32_t j = 0; j < o->count; j++) {
         char json[COAVOID_ENCOUNTER_JSON_MAX];
@@ -57,46 +57,42 @@ static int build_random_set(const coavoid_bench_plan_config_t *o, uint32_t n, bp
         set->count = j + 1u; /* so set_free frees this one too */
         if (!coavoid_encounter_json(&coavoid_encounter_bench, o->seed, n, j, 0u, json, sizeof json,
                                     NULL)) {
-            return coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INTERNAL,
-                                           "internal error: encounter %u of %u UAVs does "
-                                           "not fit %u bytes",
-                                           j, n, COAVOID_ENCOUNTER_JSON_MAX);
+            return coavoid_run_fail(e, COAVOID_RUN_ERR_INTERNAL,
+                                    "internal error: encounter %u of %u UAVs does "
+                                    "not fit %u bytes",
+                                    j, n, COAVOID_ENCOUNTER_JSON_MAX);
         }
         if (coavoid_scenario_parse(json, strlen(json), &set->problems[j], why, sizeof why) != 0 ||
             coavoid_scenario_sample(&set->problems[j], why, sizeof why) != 0) {
-            return coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INTERNAL,
-                                           "internal error: encounter %u of %u UAVs: %s", j, n,
-                                           why);
+            return coavoid_run_fail(e, COAVOID_RUN_ERR_INTERNAL,
+                                    "internal error: encounter %u of %u UAVs: %s", j, n, why);
         }
     }
-    return COAVOID_EVALUATION_OK;
+    return COAVOID_RUN_DONE;
 }
 
 /* The scenario file as the set "paper": loaded, sampled and refused as `coavoid plan`
  * would ("FILE: field: reason"). */
-static int build_paper_set(const coavoid_bench_plan_config_t *o, bp_set_t *set, char *err,
-                           size_t err_size)
+static int build_paper_set(const coavoid_bench_plan_config_t *o, bp_set_t *set,
+                           coavoid_run_error_t *e)
 {
     snprintf(set->label, sizeof set->label, "paper");
     set->problems = calloc(1u, sizeof *set->problems);
     if (set->problems == NULL) {
-        return coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INVALID,
-                                       "--scenario: out of memory");
+        return coavoid_run_fail(e, COAVOID_RUN_ERR_INPUT, "--scenario: out of memory");
     }
     set->count = 1u;
     char why[SCENARIO_ERROR_MAX];
-    int status = COAVOID_EVALUATION_OK;
+    int status = COAVOID_RUN_DONE;
     if (coavoid_scenario_load(o->scenario, &set->problems[0], why, sizeof why) != 0 ||
         coavoid_scenario_sample(&set->problems[0], why, sizeof why) != 0) {
-        status = coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INVALID, "%s: %s",
-                                         o->scenario, why);
+        status = coavoid_run_fail(e, COAVOID_RUN_ERR_INPUT, "%s: %s", o->scenario, why);
     }
-    if (status == COAVOID_EVALUATION_OK && set->problems[0].vehicle_count > COA_MAX_CENTRALISED) {
-        status = coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INVALID,
-                                         "%s: %zu vehicles, at most %u can be planned "
-                                         "centrally",
-                                         o->scenario, set->problems[0].vehicle_count,
-                                         COA_MAX_CENTRALISED);
+    if (status == COAVOID_RUN_DONE && set->problems[0].vehicle_count > COA_MAX_CENTRALISED) {
+        status = coavoid_run_fail(e, COAVOID_RUN_ERR_INPUT,
+                                  "%s: %zu vehicles, at most %u can be planned "
+                                  "centrally",
+                                  o->scenario, set->problems[0].vehicle_count, COA_MAX_CENTRALISED);
     }
     set->vehicles = (uint32_t)set->problems[0].vehicle_count;
     return status;
@@ -124,7 +120,7 @@ static coa_planner_config_t set_planner(const bp_set_t *set, size_t searched, ui
 
 /* One run over the set: adds the time (ms) and fills the tallies of row. */
 static int run_once(coa_planner_t *planner, const bp_set_t *set, bool decoupled, int32_t *offsets,
-                    double *ms, coavoid_bench_plan_row_t *row, char *err, size_t err_size)
+                    double *ms, coavoid_bench_plan_row_t *row, coavoid_run_error_t *e)
 {
     *ms = 0;
     row->nodes_expanded = row->nodes_generated = 0;
@@ -139,9 +135,8 @@ static int run_once(coa_planner_t *planner, const bp_set_t *set, bool decoupled,
                            : coa_plan_centralised(planner, &problem, offsets, &result);
         clock_gettime(CLOCK_MONOTONIC, &end);
         if (rc != COA_OK) {
-            return coavoid_evaluation_fail(
-                err, err_size,
-                rc == COA_ERR_RANGE ? COAVOID_EVALUATION_INVALID : COAVOID_EVALUATION_INTERNAL,
+            return coavoid_run_fail(
+                e, rc == COA_ERR_RANGE ? COAVOID_RUN_ERR_INPUT : COAVOID_RUN_ERR_INTERNAL,
                 "%s, problem %u: the planner failed (%s)", set->label, j, coa_status_name(rc));
         }
         *ms += coavoid_timing_elapsed_ms(&start, &end);
@@ -151,11 +146,11 @@ static int run_once(coa_planner_t *planner, const bp_set_t *set, bool decoupled,
         row->infeasible += result.status == COA_PLAN_INFEASIBLE;
         row->budget_exhausted += result.status == COA_PLAN_BUDGET_EXHAUSTED;
     }
-    return COAVOID_EVALUATION_OK;
+    return COAVOID_RUN_DONE;
 }
 
 static int run_set(const coavoid_bench_plan_config_t *o, const bp_set_t *set, bool decoupled,
-                   coavoid_bench_plan_row_t *row, char *err, size_t err_size)
+                   coavoid_bench_plan_row_t *row, coavoid_run_error_t *e)
 {
     memset(row, 0, sizeof *row);
     memcpy(row->set, set->label, sizeof row->set);
@@ -173,37 +168,36 @@ static int run_set(const coavoid_bench_plan_config_t *o, const bp_set_t *set, bo
     void *workspace = size != 0 ? malloc(size) : NULL;
     int32_t *offsets = calloc((size_t)set->vehicles * (COA_MAX_HORIZON + 1u), sizeof *offsets);
     double *times = calloc(o->repeat, sizeof *times);
-    int status = COAVOID_EVALUATION_OK;
+    int status = COAVOID_RUN_DONE;
     coa_planner_t *planner = NULL;
     if (workspace == NULL || offsets == NULL || times == NULL) {
-        status = coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INVALID,
-                                         "%s: out of memory for %zu bytes of workspace", set->label,
-                                         size);
+        status = coavoid_run_fail(e, COAVOID_RUN_ERR_INPUT,
+                                  "%s: out of memory for %zu bytes of workspace", set->label, size);
     } else if ((planner = coa_planner_init(workspace, size, &config)) == NULL) {
-        status = coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INTERNAL,
-                                         "internal error: the planner refused its workspace");
+        status = coavoid_run_fail(e, COAVOID_RUN_ERR_INTERNAL,
+                                  "internal error: the planner refused its workspace");
     }
     row->workspace_bytes = size;
     coavoid_bench_plan_row_t first;
     memset(&first, 0, sizeof first);
     double ms = 0;
-    if (status == COAVOID_EVALUATION_OK) { /* untimed: warms caches and the workspace's pages */
+    if (status == COAVOID_RUN_DONE) { /* untimed: warms caches and the workspace's pages */
         first = *row;
-        status = run_once(planner, set, decoupled, offsets, &ms, &first, err, err_size);
+        status = run_once(planner, set, decoupled, offsets, &ms, &first, e);
     }
-    for (uint32_t k = 0; status == COAVOID_EVALUATION_OK && k < o->repeat; k++) {
-        status = run_once(planner, set, decoupled, offsets, &times[k], row, err, err_size);
-        if (status == COAVOID_EVALUATION_OK &&
+    for (uint32_t k = 0; status == COAVOID_RUN_DONE && k < o->repeat; k++) {
+        status = run_once(planner, set, decoupled, offsets, &times[k], row, e);
+        if (status == COAVOID_RUN_DONE &&
             (row->nodes_expanded != first.nodes_expanded ||
              row->nodes_generated != first.nodes_generated || row->solved != first.solved ||
              row->budget_exhausted != first.budget_exhausted)) {
-            status = coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INTERNAL,
-                                             "internal error: %s, run %lu differs from the "
-                                             "first",
-                                             set->label, (unsigned long)k + 1u);
+            status = coavoid_run_fail(e, COAVOID_RUN_ERR_INTERNAL,
+                                      "internal error: %s, run %lu differs from the "
+                                      "first",
+                                      set->label, (unsigned long)k + 1u);
         }
     }
-    if (status == COAVOID_EVALUATION_OK) {
+    if (status == COAVOID_RUN_DONE) {
         coavoid_timing_summarise(times, o->repeat, &row->median_ms, &row->min_ms, &row->max_ms);
     }
     free(times);
@@ -296,37 +290,35 @@ int coavoid_bench_plan_report(FILE *f, const coavoid_bench_plan_config_t *config
 /* Every set, loaded or drawn before anything is timed: the scenario's, then one per UAV
  * count. *set_count counts the sets begun, which set_free must free. */
 static int build_sets(const coavoid_bench_plan_config_t *o, bp_set_t *sets, size_t *set_count,
-                      char *err, size_t err_size)
+                      coavoid_run_error_t *e)
 {
-    int status = COAVOID_EVALUATION_OK;
+    int status = COAVOID_RUN_DONE;
     if (o->scenario != NULL) {
-        status = build_paper_set(o, &sets[(*set_count)++], err, err_size);
+        status = build_paper_set(o, &sets[(*set_count)++], e);
     }
-    for (uint32_t n = o->min_vehicles; status == COAVOID_EVALUATION_OK && n <= o->max_vehicles;
-         n++) {
-        status = build_random_set(o, n, &sets[(*set_count)++], err, err_size);
+    for (uint32_t n = o->min_vehicles; status == COAVOID_RUN_DONE && n <= o->max_vehicles; n++) {
+        status = build_random_set(o, n, &sets[(*set_count)++], e);
     }
     return status;
 }
 
 int coavoid_bench_plan_run(const coavoid_bench_plan_config_t *config,
-                           coavoid_bench_plan_result_t *out, char *err, size_t err_size)
+                           coavoid_bench_plan_result_t *out, coavoid_run_error_t *e)
 {
     memset(out, 0, sizeof *out);
     if (config->count == 0 || config->repeat == 0 ||
         config->min_vehicles < COAVOID_ENCOUNTER_MIN_VEHICLES ||
         config->max_vehicles > COAVOID_ENCOUNTER_MAX_VEHICLES) {
-        return coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INVALID,
-                                       "bench plan: --count, --repeat or --vehicles out of range");
+        return coavoid_run_fail(e, COAVOID_RUN_ERR_INPUT,
+                                "bench plan: --count, --repeat or --vehicles out of range");
     }
     bp_set_t sets[COAVOID_BENCH_PLAN_MAX_SETS];
     memset(sets, 0, sizeof sets);
     size_t set_count = 0;
-    int status = build_sets(config, sets, &set_count, err, err_size);
-    for (size_t i = 0; status == COAVOID_EVALUATION_OK && i < set_count; i++) {
-        for (int mode = 0; status == COAVOID_EVALUATION_OK && mode < 2; mode++) {
-            status =
-                run_set(config, &sets[i], mode == 1, &out->rows[out->row_count++], err, err_size);
+    int status = build_sets(config, sets, &set_count, e);
+    for (size_t i = 0; status == COAVOID_RUN_DONE && i < set_count; i++) {
+        for (int mode = 0; status == COAVOID_RUN_DONE && mode < 2; mode++) {
+            status = run_set(config, &sets[i], mode == 1, &out->rows[out->row_count++], e);
         }
     }
     for (size_t i = 0; i < set_count; i++) {

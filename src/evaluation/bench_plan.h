@@ -32,7 +32,7 @@
 #include <stdio.h>
 
 #include "encounter.h"
-#include "evaluation.h"
+#include "run.h"
 
 /* The scenario's set and one per UAV count of the encounters. */
 #define COAVOID_BENCH_PLAN_MAX_SETS \
@@ -77,15 +77,15 @@ typedef struct {
 } coavoid_bench_plan_result_t;
 
 /* Loads the scenario and draws the encounters (all before any timing), then times each
- * set centralised and decoupled. Returns COAVOID_EVALUATION_OK with *out filled, or a
- * status of evaluation.h with one line in err[err_size]: COAVOID_EVALUATION_INVALID when
- * the scenario does not load ("FILE: field: reason") or has too many UAVs, memory is short
- * or the planner refuses a problem's range, COAVOID_EVALUATION_INTERNAL when an encounter
- * or the planner fails or a run differs from the first. Memory: the sampled problems and
- * one planner workspace at a time (as beta sizes it), all freed before it returns. Cost:
- * (repeat + 1) runs over every set in both modes. */
+ * set centralised and decoupled. Returns COAVOID_RUN_DONE with *out filled, or an error
+ * (evaluation.h, "Errors") with e set: COAVOID_RUN_ERR_INPUT when the scenario does not
+ * load ("FILE: field: reason") or has too many UAVs, memory is short or the planner
+ * refuses a problem's range, COAVOID_RUN_ERR_INTERNAL when an encounter or the planner
+ * fails or a run differs from the first. Memory: the sampled problems and one planner
+ * workspace at a time (as beta sizes it), all freed before it returns. Cost: (repeat + 1)
+ * runs over every set in both modes. */
 int coavoid_bench_plan_run(const coavoid_bench_plan_config_t *config,
-                           coavoid_bench_plan_result_t *out, char *err, size_t err_size);
+                           coavoid_bench_plan_result_t *out, coavoid_run_error_t *e);
 
 /* Prints the config's seed, repeat and count and the rows on f as a table or, with json,
  * a JSON object (the keys of docs/benchmarks.md). Returns 0, or -1 when a write (or

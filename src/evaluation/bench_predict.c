@@ -21,6 +21,7 @@
 #include "coavoid/predict.h"
 #include "evaluation_internal.h"
 #include "output.h"
+#include "run.h"
 #include "prng.h"
 
 /* The plans' samples are refused beyond this (N * H bounds them), before anything is
@@ -111,9 +112,9 @@ static size_t plan_samples(uint32_t horizon, double step)
     return (size_t)ceil((double)horizon * COAVOID_BENCH_PREDICT_DT / step) + 2u;
 }
 
-/* Builds the airspace. Returns COAVOID_EVALUATION_OK, or a status with err set. */
-static int build_airspace(const coavoid_bench_predict_config_t *o, airspace_t *a, char *err,
-                          size_t err_size)
+/* Builds the airspace. Returns COAVOID_RUN_DONE, or an error with e set. */
+static int build_airspace(const coavoid_bench_predict_config_t *o, airspace_t *a,
+                          coavoid_run_error_t *e)
 {
     memset(a, 0, sizeof *a);
     a->vehicles = o->vehicles;
@@ -126,8 +127,8 @@ static int build_airspace(const coavoid_bench_predict_config_t *o, airspace_t *a
     size_t per_plan = plan_samples(o->horizon, BENCH_STEPS[0]);
     size_t bytes_per_plan = per_plan * sizeof(coa_vec3_t);
     if (bytes_per_plan > BENCH_MAX_SAMPLE_BYTES / o->vehicles) {
-        return coavoid_evaluation_fail(
-            err, err_size, COAVOID_EVALUATION_INVALID,
+        return coavoid_run_fail(
+            e, COAVOID_RUN_ERR_INPUT,
             "--vehicles, --horizon: %lu UAVs over %lu steps need up to %zu MiB of "
             "plans, more than the benchmark's %zu MiB",
             (unsigned long)o->vehicles, (unsigned long)o->horizon,
@@ -138,8 +139,8 @@ static int build_airspace(const coavoid_bench_predict_config_t *o, airspace_t *a
     a->tracks = calloc(a->track_count + 1u, sizeof *a->tracks);
     if (a->plans == NULL || a->samples == NULL || a->tracks == NULL) {
         airspace_free(a);
-        return coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INVALID,
-                                       "--vehicles, --horizon: out of memory for the plans");
+        return coavoid_run_fail(e, COAVOID_RUN_ERR_INPUT,
+                                "--vehicles, --horizon: out of memory for the plans");
     }
 
     coavoid_prng_t r = {o->seed};
@@ -181,7 +182,7 @@ static int build_airspace(const coavoid_bench_predict_config_t *o, airspace_t *a
         t->sigma_horizontal = (coa_real_t)coavoid_prng_uniform(&r, 5.0, 25.0);
         t->sigma_vertical = (coa_real_t)coavoid_prng_uniform(&r, 2.0, 8.0);
     }
-    return COAVOID_EVALUATION_OK;
+    return COAVOID_RUN_DONE;
 }
 
 /* ---- the run ---- */
@@ -195,34 +196,34 @@ typedef struct {
     size_t capacity;
 } bench_memory_t;
 
-/* (Re)builds the predictor for max_pairs. Returns COAVOID_EVALUATION_OK, or a status with
- * err set. */
-static int size_predictor(const airspace_t *a, uint32_t horizon, bench_memory_t *m, char *err,
-                          size_t err_size)
+/* (Re)builds the predictor for max_pairs. Returns COAVOID_RUN_DONE, or an error
+ * with e set. */
+static int size_predictor(const airspace_t *a, uint32_t horizon, bench_memory_t *m,
+                          coavoid_run_error_t *e)
 {
     free(m->workspace);
     m->workspace = NULL;
     m->size = coa_predictor_workspace_size(a->vehicles, a->track_count, horizon, m->max_pairs);
     if (m->size == 0 || m->size > BENCH_MAX_WORKSPACE_BYTES) {
-        return coavoid_evaluation_fail(
-            err, err_size, COAVOID_EVALUATION_INVALID,
+        return coavoid_run_fail(
+            e, COAVOID_RUN_ERR_INPUT,
             "--vehicles, --horizon: the predictor's workspace for %zu candidate "
             "pairs would exceed the benchmark's %zu MiB",
             m->max_pairs, BENCH_MAX_WORKSPACE_BYTES >> 20);
     }
     m->workspace = malloc(m->size);
     if (m->workspace == NULL) {
-        return coavoid_evaluation_fail(
-            err, err_size, COAVOID_EVALUATION_INVALID,
-            "--vehicles, --horizon: out of memory for %zu bytes of workspace", m->size);
+        return coavoid_run_fail(e, COAVOID_RUN_ERR_INPUT,
+                                "--vehicles, --horizon: out of memory for %zu bytes of workspace",
+                                m->size);
     }
     m->predictor = coa_predictor_init(m->workspace, m->size, a->vehicles, a->track_count, horizon,
                                       m->max_pairs);
     if (m->predictor == NULL) {
-        return coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INTERNAL,
-                                       "internal error: the predictor refused its workspace");
+        return coavoid_run_fail(e, COAVOID_RUN_ERR_INTERNAL,
+                                "internal error: the predictor refused its workspace");
     }
-    return COAVOID_EVALUATION_OK;
+    return COAVOID_RUN_DONE;
 }
 
 static int predict_once(const airspace_t *a, const coa_predict_config_t *config, bench_memory_t *m,
@@ -234,41 +235,40 @@ static int predict_once(const airspace_t *a, const coa_predict_config_t *config,
 }
 
 /* The untimed first cycle: grows the pair set and the conflict array until the cycle
- * fits. Returns COAVOID_EVALUATION_OK, or a status with err set. */
+ * fits. Returns COAVOID_RUN_DONE, or an error with e set. */
 static int first_cycle(const airspace_t *a, const coa_predict_config_t *config, bench_memory_t *m,
-                       coa_predict_result_t *result, char *err, size_t err_size)
+                       coa_predict_result_t *result, coavoid_run_error_t *e)
 {
     for (;;) {
         int rc = predict_once(a, config, m, result);
         if (rc == COA_ERR_WORKSPACE && m->max_pairs <= SIZE_MAX / 2u) {
             m->max_pairs *= 2u;
-            int status = size_predictor(a, config->horizon, m, err, err_size);
-            if (status != COAVOID_EVALUATION_OK) {
+            int status = size_predictor(a, config->horizon, m, e);
+            if (status != COAVOID_RUN_DONE) {
                 return status;
             }
             continue;
         }
         if (rc != COA_OK) {
-            return coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INTERNAL,
-                                           "internal error: the predictor failed (%s)",
-                                           coa_status_name(rc));
+            return coavoid_run_fail(e, COAVOID_RUN_ERR_INTERNAL,
+                                    "internal error: the predictor failed (%s)",
+                                    coa_status_name(rc));
         }
         if (!result->overflow) {
-            return COAVOID_EVALUATION_OK;
+            return COAVOID_RUN_DONE;
         }
         free(m->conflicts);
         m->capacity = result->conflicts_found;
         m->conflicts = calloc(m->capacity, sizeof *m->conflicts);
         if (m->conflicts == NULL) {
-            return coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INVALID,
-                                           "--vehicles: out of memory for %zu conflicts",
-                                           m->capacity);
+            return coavoid_run_fail(e, COAVOID_RUN_ERR_INPUT,
+                                    "--vehicles: out of memory for %zu conflicts", m->capacity);
         }
     }
 }
 
 static int run(const coavoid_bench_predict_config_t *o, const airspace_t *a,
-               coavoid_bench_predict_result_t *out, char *err, size_t err_size)
+               coavoid_bench_predict_result_t *out, coavoid_run_error_t *e)
 {
     coa_predict_config_t config;
     memset(&config, 0, sizeof config);
@@ -287,19 +287,18 @@ static int run(const coavoid_bench_predict_config_t *o, const airspace_t *a,
     m.capacity = 1024u;
     m.conflicts = calloc(m.capacity, sizeof *m.conflicts);
     double *times = calloc(o->repeat, sizeof *times);
-    int status = COAVOID_EVALUATION_OK;
+    int status = COAVOID_RUN_DONE;
     if (m.conflicts == NULL || times == NULL) {
-        status = coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INVALID,
-                                         "--repeat: out of memory");
+        status = coavoid_run_fail(e, COAVOID_RUN_ERR_INPUT, "--repeat: out of memory");
     }
-    if (status == COAVOID_EVALUATION_OK) {
-        status = size_predictor(a, o->horizon, &m, err, err_size);
+    if (status == COAVOID_RUN_DONE) {
+        status = size_predictor(a, o->horizon, &m, e);
     }
     coa_predict_result_t first;
-    if (status == COAVOID_EVALUATION_OK) {
-        status = first_cycle(a, &config, &m, &first, err, err_size);
+    if (status == COAVOID_RUN_DONE) {
+        status = first_cycle(a, &config, &m, &first, e);
     }
-    for (uint32_t k = 0; status == COAVOID_EVALUATION_OK && k < o->repeat; k++) {
+    for (uint32_t k = 0; status == COAVOID_RUN_DONE && k < o->repeat; k++) {
         coa_predict_result_t result;
         struct timespec start, end;
         clock_gettime(CLOCK_MONOTONIC, &start);
@@ -310,13 +309,12 @@ static int run(const coavoid_bench_predict_config_t *o, const airspace_t *a,
         if (rc != COA_OK || result.overflow || result.pair_tests != first.pair_tests ||
             result.candidate_pairs != first.candidate_pairs ||
             result.conflicts_found != first.conflicts_found) {
-            status =
-                coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INTERNAL,
-                                        "internal error: cycle %lu differs from the first (%s)",
-                                        (unsigned long)k + 1u, coa_status_name(rc));
+            status = coavoid_run_fail(e, COAVOID_RUN_ERR_INTERNAL,
+                                      "internal error: cycle %lu differs from the first (%s)",
+                                      (unsigned long)k + 1u, coa_status_name(rc));
         }
     }
-    if (status == COAVOID_EVALUATION_OK) {
+    if (status == COAVOID_RUN_DONE) {
         coavoid_timing_summarise(times, o->repeat, &out->median_ms, &out->min_ms, &out->max_ms);
         out->result = first;
         out->workspace_bytes = m.size;
@@ -393,18 +391,18 @@ int coavoid_bench_predict_report(FILE *f, const coavoid_bench_predict_config_t *
 }
 
 int coavoid_bench_predict_run(const coavoid_bench_predict_config_t *config,
-                              coavoid_bench_predict_result_t *out, char *err, size_t err_size)
+                              coavoid_bench_predict_result_t *out, coavoid_run_error_t *e)
 {
     memset(out, 0, sizeof *out);
     airspace_t airspace;
-    int status = build_airspace(config, &airspace, err, err_size);
-    if (status != COAVOID_EVALUATION_OK) {
+    int status = build_airspace(config, &airspace, e);
+    if (status != COAVOID_RUN_DONE) {
         return status;
     }
     out->vehicles = airspace.vehicles;
     out->tracks = airspace.track_count;
     out->side_m = airspace.side_m;
-    status = run(config, &airspace, out, err, err_size);
+    status = run(config, &airspace, out, e);
     airspace_free(&airspace);
     return status;
 }

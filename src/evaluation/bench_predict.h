@@ -36,7 +36,7 @@
 
 #include "coavoid/coavoid.h"
 #include "coavoid/predict.h"
-#include "evaluation.h"
+#include "run.h"
 
 #define COAVOID_BENCH_PREDICT_MAX_VEHICLES 65535u /* UAV ids are 16-bit */
 /* UAVs per km^2 when side_km is 0: 1,000 UAVs over 10 km x 10 km. */
@@ -64,16 +64,16 @@ typedef struct {
     size_t max_pairs; /* the pair set the workspace was sized for */
 } coavoid_bench_predict_result_t;
 
-/* Builds the airspace and times the cycles. Returns COAVOID_EVALUATION_OK with *out
- * filled, or a status of evaluation.h with one line in err[err_size]:
- * COAVOID_EVALUATION_INVALID when the plans would pass 2 GiB or the predictor's workspace
- * 8 GiB (before anything that size is allocated: a benchmark should not page a machine to
- * death) or memory is short, COAVOID_EVALUATION_INTERNAL when the predictor fails or a
- * cycle differs from the first. Memory: the plans (N x up to 2 H + 2 samples), the
- * predictor's workspace and the conflicts found, all freed before it returns. Cost: the
- * sizing cycles and repeat + 1 cycles of coa_predict. */
+/* Builds the airspace and times the cycles. Returns COAVOID_RUN_DONE with *out filled,
+ * or an error (evaluation.h, "Errors") with e set: COAVOID_RUN_ERR_INPUT when the plans
+ * would pass 2 GiB or the predictor's workspace 8 GiB (before anything that size is
+ * allocated: a benchmark should not page a machine to death) or memory is short,
+ * COAVOID_RUN_ERR_INTERNAL when the predictor fails or a cycle differs from the first.
+ * Memory: the plans (N x up to 2 H + 2 samples), the predictor's workspace and the
+ * conflicts found, all freed before it returns. Cost: the sizing cycles and repeat + 1
+ * cycles of coa_predict. */
 int coavoid_bench_predict_run(const coavoid_bench_predict_config_t *config,
-                              coavoid_bench_predict_result_t *out, char *err, size_t err_size);
+                              coavoid_bench_predict_result_t *out, coavoid_run_error_t *e);
 
 /* Prints the config and the result on f, one "key: value" per line or, with json, a JSON
  * object (the keys of docs/benchmarks.md). Returns 0, or -1 when a write (or cJSON's

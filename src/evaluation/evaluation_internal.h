@@ -1,40 +1,22 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * evaluation_internal.h: what the harnesses of coavoid::evaluation share and its callers
- * do not need: the error line of evaluation.h, and the timing of a benchmark (the
- * monotonic clock's milliseconds, and the median, least and largest of the repeats). Not
- * part of the library's interface.
+ * evaluation_internal.h: what the harnesses of coavoid::evaluation share and their callers
+ * do not need: the timing of a benchmark (the monotonic clock's milliseconds, and the
+ * median, least and largest of the repeats) and the printf check of the encounters'
+ * writer. Not part of the library's interface.
  */
 #ifndef COAVOID_EVALUATION_INTERNAL_H
 #define COAVOID_EVALUATION_INTERNAL_H
 
-#include <stdarg.h>
 #include <stdint.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <time.h>
-
-#include "evaluation.h"
 
 #if defined(__GNUC__)
 #define COAVOID_EVALUATION_PRINTF_LIKE(fmt, args) __attribute__((format(printf, fmt, args)))
 #else
 #define COAVOID_EVALUATION_PRINTF_LIKE(fmt, args)
 #endif
-
-/* Writes the error line into err[size] and returns status, so that every check reads
- * `return coavoid_evaluation_fail(...)`. */
-static inline int coavoid_evaluation_fail(char *err, size_t size, int status, const char *fmt, ...)
-    COAVOID_EVALUATION_PRINTF_LIKE(4, 5);
-
-static inline int coavoid_evaluation_fail(char *err, size_t size, int status, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(err, size, fmt, ap);
-    va_end(ap);
-    return status;
-}
 
 static inline double coavoid_timing_elapsed_ms(const struct timespec *start,
                                                const struct timespec *end)

@@ -23,6 +23,7 @@
 #include "evaluation_internal.h"
 #include "montecarlo_internal.h"
 #include "output.h"
+#include "run.h"
 #include "scenario.h"
 
 #define MC_MAX_ATTEMPTS 1000u /* draws per encounter before giving up (a design bug) */
@@ -477,7 +478,7 @@ static void write_ready(mc_run_t *run, FILE *csv, mc_progress_t *prog, uint32_t 
                 fputc('\n', prog->f);
                 prog->line_open = false;
             }
-            char line[COAVOID_EVALUATION_ERROR_MAX];
+            char line[COAVOID_RUN_ERROR_MAX];
             snprintf(line, sizeof line,
                      "montecarlo: defect: seed %llu, %lu UAVs, "
                      "encounter %lu: %s",
@@ -491,8 +492,8 @@ static void write_ready(mc_run_t *run, FILE *csv, mc_progress_t *prog, uint32_t 
 }
 
 /* Runs every item; writes CSV rows (when csv is not NULL) in order as they complete.
- * Returns COAVOID_EVALUATION_OK, or a status with err set. */
-static int run_all(mc_run_t *run, FILE *csv, char *err, size_t err_size)
+ * Returns COAVOID_RUN_DONE, or an error with e set. */
+static int run_all(mc_run_t *run, FILE *csv, coavoid_run_error_t *e)
 {
     const coavoid_montecarlo_config_t *c = &run->mc->config;
     const uint32_t total = run->mc->total;
@@ -507,8 +508,7 @@ static int run_all(mc_run_t *run, FILE *csv, char *err, size_t err_size)
     }
     if (started == 0) {
         pthread_mutex_destroy(&run->lock);
-        return coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INTERNAL,
-                                       "cannot start a worker thread");
+        return coavoid_run_fail(e, COAVOID_RUN_ERR_INTERNAL, "cannot start a worker thread");
     }
     mc_progress_t prog = {c->progress, c->progress != NULL && isatty(fileno(c->progress)) == 1, 0u,
                           0.0, false};
@@ -541,26 +541,26 @@ static int run_all(mc_run_t *run, FILE *csv, char *err, size_t err_size)
     }
     pthread_mutex_destroy(&run->lock);
     if (run->stop) {
-        return coavoid_evaluation_fail(err, err_size,
-                                       strncmp(run->error, "internal error", 14) == 0
-                                           ? COAVOID_EVALUATION_INTERNAL
-                                           : COAVOID_EVALUATION_INVALID,
-                                       "montecarlo: %s", run->error);
+        return coavoid_run_fail(e,
+                                strncmp(run->error, "internal error", 14) == 0
+                                    ? COAVOID_RUN_ERR_INTERNAL
+                                    : COAVOID_RUN_ERR_INPUT,
+                                "montecarlo: %s", run->error);
     }
-    return COAVOID_EVALUATION_OK;
+    return COAVOID_RUN_DONE;
 }
 
 /* ---- the run's set-up ---- */
 
 /* What the app's option parser already refuses, checked again because the library trusts
  * no caller with its arrays' bounds. */
-static int check_config(const coavoid_montecarlo_config_t *c, char *err, size_t err_size)
+static int check_config(const coavoid_montecarlo_config_t *c, coavoid_run_error_t *e)
 {
     if (c->size_count == 0 || c->size_count > COAVOID_MONTECARLO_MAX_SIZES || c->count == 0 ||
         c->jobs == 0 || c->jobs > COAVOID_MONTECARLO_MAX_JOBS ||
         c->count > UINT32_MAX / COAVOID_MONTECARLO_MAX_SIZES) {
-        return coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INVALID,
-                                       "montecarlo: UAV counts, --count or --jobs out of range");
+        return coavoid_run_fail(e, COAVOID_RUN_ERR_INPUT,
+                                "montecarlo: UAV counts, --count or --jobs out of range");
     }
     for (uint32_t k = 0; k < c->size_count; k++) {
         bool repeated = false;
@@ -569,20 +569,19 @@ static int check_config(const coavoid_montecarlo_config_t *c, char *err, size_t 
         }
         if (repeated || c->vehicles[k] < COAVOID_ENCOUNTER_MIN_VEHICLES ||
             c->vehicles[k] > COAVOID_ENCOUNTER_MAX_VEHICLES) {
-            return coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INVALID,
-                                           "--vehicles: each entry must be an integer from %u to "
-                                           "%u, each once",
-                                           COAVOID_ENCOUNTER_MIN_VEHICLES,
-                                           COAVOID_ENCOUNTER_MAX_VEHICLES);
+            return coavoid_run_fail(e, COAVOID_RUN_ERR_INPUT,
+                                    "--vehicles: each entry must be an integer from %u to "
+                                    "%u, each once",
+                                    COAVOID_ENCOUNTER_MIN_VEHICLES, COAVOID_ENCOUNTER_MAX_VEHICLES);
         }
     }
-    return COAVOID_EVALUATION_OK;
+    return COAVOID_RUN_DONE;
 }
 
 /* Each UAV count's beta and order limit; refused when its centralised planner cannot be
  * sized. */
-static int mc_sizes(const coavoid_montecarlo_config_t *c, coavoid_mc_size_t *sizes, char *err,
-                    size_t err_size)
+static int mc_sizes(const coavoid_montecarlo_config_t *c, coavoid_mc_size_t *sizes,
+                    coavoid_run_error_t *e)
 {
     for (uint32_t k = 0; k < c->size_count; k++) {
         uint32_t n = c->vehicles[k];
@@ -592,52 +591,50 @@ static int mc_sizes(const coavoid_montecarlo_config_t *c, coavoid_mc_size_t *siz
         sizes[k].max_orders = c->max_orders != 0 ? c->max_orders : factorial(n);
         shape.beta = sizes[k].beta;
         if (coa_planner_workspace_size(&shape) == 0) {
-            return coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INVALID,
-                                           "--beta: %lu is too large for %lu UAVs "
-                                           "centralised (the node pool would pass 2^30)",
-                                           (unsigned long)sizes[k].beta, (unsigned long)n);
+            return coavoid_run_fail(e, COAVOID_RUN_ERR_INPUT,
+                                    "--beta: %lu is too large for %lu UAVs "
+                                    "centralised (the node pool would pass 2^30)",
+                                    (unsigned long)sizes[k].beta, (unsigned long)n);
         }
     }
-    return COAVOID_EVALUATION_OK;
+    return COAVOID_RUN_DONE;
 }
 
 /* The output files, checked before an hour's run rather than after: save's directory,
  * csv opened (in *csv) and svg writable. */
-static int mc_outputs(const coavoid_montecarlo_config_t *c, FILE **csv, char *err, size_t err_size)
+static int mc_outputs(const coavoid_montecarlo_config_t *c, FILE **csv, coavoid_run_error_t *e)
 {
     struct stat info;
     if (c->save != NULL && (stat(c->save, &info) != 0 || !S_ISDIR(info.st_mode) ||
                             access(c->save, W_OK | X_OK) != 0)) {
-        return coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INVALID,
-                                       "--save: '%.200s' is not a directory we can write in",
-                                       c->save);
+        return coavoid_run_fail(e, COAVOID_RUN_ERR_INPUT,
+                                "--save: '%.200s' is not a directory we can write in", c->save);
     }
     if (c->csv != NULL && (*csv = fopen(c->csv, "w")) == NULL) {
-        return coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INVALID,
-                                       "--csv: cannot write '%.200s'", c->csv);
+        return coavoid_run_fail(e, COAVOID_RUN_ERR_INPUT, "--csv: cannot write '%.200s'", c->csv);
     }
     if (c->svg != NULL) {
         FILE *probe = fopen(c->svg, "w");
         if (probe == NULL) {
-            return coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INVALID,
-                                           "--svg: cannot write '%.200s'", c->svg);
+            return coavoid_run_fail(e, COAVOID_RUN_ERR_INPUT, "--svg: cannot write '%.200s'",
+                                    c->svg);
         }
         fclose(probe);
     }
-    return COAVOID_EVALUATION_OK;
+    return COAVOID_RUN_DONE;
 }
 
 /* Closes csv's file; a write that failed is an error unless one came first. */
-static int mc_close_csv(const coavoid_montecarlo_config_t *c, FILE *csv, int status, char *err,
-                        size_t err_size)
+static int mc_close_csv(const coavoid_montecarlo_config_t *c, FILE *csv, int status,
+                        coavoid_run_error_t *e)
 {
     if (csv == NULL) {
         return status;
     }
     bool ok = !ferror(csv);
-    if ((fclose(csv) != 0 || !ok) && status == COAVOID_EVALUATION_OK) {
-        return coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INTERNAL,
-                                       "--csv: cannot write '%.200s'", c->csv);
+    if ((fclose(csv) != 0 || !ok) && status == COAVOID_RUN_DONE) {
+        return coavoid_run_fail(e, COAVOID_RUN_ERR_INTERNAL, "--csv: cannot write '%.200s'",
+                                c->csv);
     }
     return status;
 }
@@ -663,19 +660,19 @@ static coavoid_montecarlo_t *mc_new(const coavoid_montecarlo_config_t *c,
 }
 
 int coavoid_montecarlo_run(const coavoid_montecarlo_config_t *config, coavoid_montecarlo_t **out,
-                           char *err, size_t err_size)
+                           coavoid_run_error_t *e)
 {
     *out = NULL;
     coavoid_mc_size_t sizes[COAVOID_MONTECARLO_MAX_SIZES];
     FILE *csv = NULL;
-    int status = check_config(config, err, err_size);
-    if (status == COAVOID_EVALUATION_OK) {
-        status = mc_sizes(config, sizes, err, err_size);
+    int status = check_config(config, e);
+    if (status == COAVOID_RUN_DONE) {
+        status = mc_sizes(config, sizes, e);
     }
-    if (status == COAVOID_EVALUATION_OK) {
-        status = mc_outputs(config, &csv, err, err_size);
+    if (status == COAVOID_RUN_DONE) {
+        status = mc_outputs(config, &csv, e);
     }
-    if (status != COAVOID_EVALUATION_OK) {
+    if (status != COAVOID_RUN_DONE) {
         if (csv != NULL) {
             fclose(csv);
         }
@@ -685,29 +682,29 @@ int coavoid_montecarlo_run(const coavoid_montecarlo_config_t *config, coavoid_mo
     const uint32_t total = config->count * config->size_count;
     bool *done = calloc(total, sizeof *done);
     if (mc == NULL || done == NULL) {
-        status = coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INVALID,
-                                         "--count: out of memory for %lu encounters",
-                                         (unsigned long)total);
+        status =
+            coavoid_run_fail(e, COAVOID_RUN_ERR_INPUT, "--count: out of memory for %lu encounters",
+                             (unsigned long)total);
     }
-    if (status == COAVOID_EVALUATION_OK && csv != NULL && fputs(MC_CSV_HEADER, csv) < 0) {
-        status = coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INTERNAL,
-                                         "--csv: cannot write '%.200s'", config->csv);
+    if (status == COAVOID_RUN_DONE && csv != NULL && fputs(MC_CSV_HEADER, csv) < 0) {
+        status = coavoid_run_fail(e, COAVOID_RUN_ERR_INTERNAL, "--csv: cannot write '%.200s'",
+                                  config->csv);
     }
-    if (status == COAVOID_EVALUATION_OK) {
+    if (status == COAVOID_RUN_DONE) {
         mc_run_t run;
         memset(&run, 0, sizeof run);
         run.mc = mc;
         run.done = done;
-        status = run_all(&run, csv, err, err_size);
+        status = run_all(&run, csv, e);
     }
-    status = mc_close_csv(config, csv, status, err, err_size);
+    status = mc_close_csv(config, csv, status, e);
     free(done);
-    if (status != COAVOID_EVALUATION_OK) {
+    if (status != COAVOID_RUN_DONE) {
         coavoid_montecarlo_free(mc);
         return status;
     }
     *out = mc;
-    return COAVOID_EVALUATION_OK;
+    return COAVOID_RUN_DONE;
 }
 
 void coavoid_montecarlo_free(coavoid_montecarlo_t *mc)

@@ -20,7 +20,7 @@
  * conflict-free by coa_plan_find_conflict, and must move someone (the reference
  * conflicts). A violation is a defect of the planner: it is handed to the config's defect
  * callback as it is found, and coavoid_montecarlo_report returns
- * COAVOID_EVALUATION_INTERNAL after writing everything else.
+ * COAVOID_RUN_ERR_INTERNAL after writing everything else.
  *
  * Jobs. Encounters are independent: `jobs` worker threads take them in order, each with
  * its own planner workspaces, while the calling thread writes the CSV rows in encounter
@@ -40,7 +40,7 @@
 #include <stdio.h>
 
 #include "encounter.h"
-#include "evaluation.h"
+#include "run.h"
 
 /* UAV counts one run compares: each of COAVOID_ENCOUNTER_MIN_VEHICLES..MAX once. */
 #define COAVOID_MONTECARLO_MAX_SIZES \
@@ -81,25 +81,25 @@ typedef struct coavoid_montecarlo coavoid_montecarlo_t;
 /* Checks the config (every UAV count's centralised planner can be sized) and the outputs
  * before the run rather than after an hour of it (save is a directory we can write in,
  * csv is created, svg can be created), then draws, solves and cross-checks every
- * encounter, writing csv's rows as they complete. Returns COAVOID_EVALUATION_OK with
- * *out set, or a status of evaluation.h with one line in err[err_size] and *out NULL
+ * encounter, writing csv's rows as they complete. Returns COAVOID_RUN_DONE with *out
+ * set, or an error (evaluation.h, "Errors") with e set and *out NULL
  * (csv may then be partly written). Memory: a result of about 500 bytes per encounter,
  * kept until coavoid_montecarlo_free, and per job two planner workspaces (as beta sizes
  * them) and two offset tables of about 240 KB, freed before it returns. Cost: count times
  * size_count encounters, each a centralised search and up to 1 + max_orders decoupled
  * ones, spread over the jobs. */
 int coavoid_montecarlo_run(const coavoid_montecarlo_config_t *config, coavoid_montecarlo_t **out,
-                           char *err, size_t err_size);
+                           coavoid_run_error_t *e);
 
 /* Summarises the run per UAV count and method (outcomes, the success rate and its 95 %
  * Wilson interval, the distribution of the decoupled/centralised deviation ratio over the
  * encounters both solve, times, nodes), writes the config's svg and prints the summary on
  * out as text or, with json, a JSON object (docs/evaluation.md). Returns
- * COAVOID_EVALUATION_OK, or COAVOID_EVALUATION_INTERNAL with err set when a write failed
+ * COAVOID_RUN_DONE, or COAVOID_RUN_ERR_INTERNAL with e set when a write failed
  * or the run found defects (after writing everything). Cost O(count log count) per UAV
  * count and method; no memory beyond cJSON's tree for json. */
-int coavoid_montecarlo_report(coavoid_montecarlo_t *mc, FILE *out, bool json, char *err,
-                              size_t err_size);
+int coavoid_montecarlo_report(coavoid_montecarlo_t *mc, FILE *out, bool json,
+                              coavoid_run_error_t *e);
 
 /* Frees a run (NULL is fine). */
 void coavoid_montecarlo_free(coavoid_montecarlo_t *mc);

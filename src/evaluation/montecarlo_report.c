@@ -21,6 +21,7 @@
 #include "evaluation_internal.h"
 #include "montecarlo_internal.h"
 #include "output.h"
+#include "run.h"
 
 #define MC_Z95 1.959963984540054 /* the normal quantile of a two-sided 95 % interval */
 
@@ -502,8 +503,8 @@ static int write_svg(const char *path, const coavoid_montecarlo_config_t *o,
 }
 
 /* The summaries of every UAV count, the figure and the table; the exit status. */
-int coavoid_montecarlo_report(coavoid_montecarlo_t *mc, FILE *out, bool json, char *err,
-                              size_t err_size)
+int coavoid_montecarlo_report(coavoid_montecarlo_t *mc, FILE *out, bool json,
+                              coavoid_run_error_t *e)
 {
     const coavoid_montecarlo_config_t *o = &mc->config;
     bool defects = false;
@@ -515,8 +516,8 @@ int coavoid_montecarlo_report(coavoid_montecarlo_t *mc, FILE *out, bool json, ch
         summarise(&mc->results[k * o->count], o->count, &mc->sizes[k], mc->x, &summary[k]);
     }
     if (o->svg != NULL && write_svg(o->svg, o, mc, summary, o->size_count, mc->x) != 0) {
-        return coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INTERNAL,
-                                       "--svg: cannot write '%.200s'", o->svg);
+        return coavoid_run_fail(e, COAVOID_RUN_ERR_INTERNAL, "--svg: cannot write '%.200s'",
+                                o->svg);
     }
     int rc = 0;
     if (json) {
@@ -525,10 +526,9 @@ int coavoid_montecarlo_report(coavoid_montecarlo_t *mc, FILE *out, bool json, ch
         text_summary(out, o, summary, o->size_count);
     }
     if (rc != 0 || fflush(out) != 0 || ferror(out)) {
-        return coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INTERNAL,
-                                       "cannot write the summary");
+        return coavoid_run_fail(e, COAVOID_RUN_ERR_INTERNAL, "cannot write the summary");
     }
-    return defects ? coavoid_evaluation_fail(err, err_size, COAVOID_EVALUATION_INTERNAL,
-                                             "montecarlo: defects found (above)")
-                   : COAVOID_EVALUATION_OK;
+    return defects
+               ? coavoid_run_fail(e, COAVOID_RUN_ERR_INTERNAL, "montecarlo: defects found (above)")
+               : COAVOID_RUN_DONE;
 }
