@@ -742,7 +742,7 @@ static int write_log(int argc, char **argv)
     }
 
     coavoid_scenario_t s;
-    char err[SCENARIO_ERROR_MAX];
+    char err[COAVOID_SCENARIO_ERROR_MAX];
     if (coavoid_scenario_load(argv[3], &s, err, sizeof err) != 0 ||
         coavoid_scenario_sample(&s, err, sizeof err) != 0) {
         coavoid_scenario_free(&s);

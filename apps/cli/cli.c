@@ -203,7 +203,7 @@ int64_t coavoid_cli_elapsed_us(const struct timespec *start, const struct timesp
 
 int coavoid_cli_load_scenario(const char *path, coavoid_scenario_t *s)
 {
-    char err[SCENARIO_ERROR_MAX];
+    char err[COAVOID_SCENARIO_ERROR_MAX];
     if (coavoid_scenario_load(path, s, err, sizeof err) != 0) {
         return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: %s", path, err);
     }
@@ -212,7 +212,7 @@ int coavoid_cli_load_scenario(const char *path, coavoid_scenario_t *s)
 
 int coavoid_cli_sample_scenario(const char *path, coavoid_scenario_t *s)
 {
-    char err[SCENARIO_ERROR_MAX];
+    char err[COAVOID_SCENARIO_ERROR_MAX];
     if (coavoid_scenario_sample(s, err, sizeof err) != 0) {
         return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: %s", path, err);
     }

@@ -131,15 +131,6 @@ bool coavoid_cli_parse_index(const char *text, uint64_t max, uint64_t *out);
  * "inf" and hexadecimal, which in an option are more likely a mistake than meant. */
 bool coavoid_cli_parse_real(const char *text, double *out);
 
-/* The sizing policy moved to coavoid::scenario (scenario.h); these names stay until the
- * last callers under apps/ use the library's. */
-#define CLI_DEFAULT_BETA COAVOID_DEFAULT_BETA
-#define CLI_DEFAULT_WORKSPACE_MAX COAVOID_DEFAULT_WORKSPACE_MAX
-#define coavoid_cli_planner_config coavoid_scenario_planner_config
-#define coavoid_cli_planner_config_widen coavoid_planner_config_widen
-#define coavoid_cli_workspace_fits coavoid_workspace_fits
-#define coavoid_cli_default_beta coavoid_default_beta
-
 /* Microseconds from start to end. */
 int64_t coavoid_cli_elapsed_us(const struct timespec *start, const struct timespec *end);
 

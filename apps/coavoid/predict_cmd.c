@@ -67,7 +67,7 @@ static bool parse_growth(const char *text, double *horizontal, double *vertical)
 
 static void predict_help(void)
 {
-    printf(PREDICT_USAGE, SCENARIO_MAX_BYTES / (1024u * 1024u), COAVOID_DEFAULT_THRESHOLD);
+    printf(PREDICT_USAGE, COAVOID_SCENARIO_MAX_BYTES / (1024u * 1024u), COAVOID_DEFAULT_THRESHOLD);
 }
 
 static int predict_option(int argc, char **argv, int *i, void *options)

@@ -53,7 +53,7 @@ static int build_random_set(const coavoid_bench_plan_config_t *o, uint32_t n, bp
     }
     for (uint32_t j = 0; j < o->count; j++) {
         char json[COAVOID_ENCOUNTER_JSON_MAX];
-        char why[SCENARIO_ERROR_MAX];
+        char why[COAVOID_SCENARIO_ERROR_MAX];
         set->count = j + 1u; /* so set_free frees this one too */
         if (!coavoid_encounter_json(&coavoid_encounter_bench, o->seed, n, j, 0u, json, sizeof json,
                                     NULL)) {
@@ -82,7 +82,7 @@ static int build_paper_set(const coavoid_bench_plan_config_t *o, bp_set_t *set,
         return coavoid_run_fail(e, COAVOID_RUN_ERR_INPUT, "--scenario: out of memory");
     }
     set->count = 1u;
-    char why[SCENARIO_ERROR_MAX];
+    char why[COAVOID_SCENARIO_ERROR_MAX];
     int status = COAVOID_RUN_DONE;
     if (coavoid_scenario_load(o->scenario, &set->problems[0], why, sizeof why) != 0 ||
         coavoid_scenario_sample(&set->problems[0], why, sizeof why) != 0) {

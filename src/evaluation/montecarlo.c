@@ -153,7 +153,7 @@ static int draw_encounter(uint64_t seed, const coavoid_mc_size_t *size, uint32_t
     }
     for (uint32_t attempt = 0; attempt < MC_MAX_ATTEMPTS; attempt++) {
         char json[COAVOID_ENCOUNTER_JSON_MAX];
-        char why[SCENARIO_ERROR_MAX];
+        char why[COAVOID_SCENARIO_ERROR_MAX];
         if (!coavoid_encounter_json(&coavoid_encounter_montecarlo, seed, n, index, attempt, json,
                                     sizeof json, &r->info)) {
             snprintf(err, err_size,
@@ -329,7 +329,7 @@ typedef struct {
     pthread_mutex_t lock;
     uint32_t next; /* the next item a worker takes */
     bool stop;     /* an error: workers take nothing more */
-    char error[SCENARIO_ERROR_MAX + 128];
+    char error[COAVOID_SCENARIO_ERROR_MAX + 128];
 } mc_run_t;
 
 static const coavoid_mc_size_t *item_size(const mc_run_t *run, uint32_t item)

@@ -17,8 +17,8 @@
  * Memory: the record's arrays are the caller's; evaluate and svg allocate only their own
  * scratch (apps layer), and free it before returning.
  */
-#ifndef COAVOID_APP_FLIGHT_H
-#define COAVOID_APP_FLIGHT_H
+#ifndef COAVOID_FLIGHT_H
+#define COAVOID_FLIGHT_H
 
 #include <stdbool.h>
 #include <stddef.h>
@@ -146,4 +146,4 @@ int coavoid_flight_json_extra(const coavoid_flight_t *flight, const coavoid_flig
 int coavoid_flight_text(const coavoid_flight_t *flight, const coavoid_flight_eval_t *eval,
                         FILE *out);
 
-#endif /* COAVOID_APP_FLIGHT_H */
+#endif /* COAVOID_FLIGHT_H */

@@ -4,8 +4,8 @@
  * `coavoid sim` (from its nodes' states) and `coavoid summary` (from a log's intents) both
  * do with the samples they gathered, so that the two judge a run alike.
  */
-#ifndef COAVOID_APP_JUDGE_H
-#define COAVOID_APP_JUDGE_H
+#ifndef COAVOID_FLIGHT_JUDGE_H
+#define COAVOID_FLIGHT_JUDGE_H
 
 #include <stdbool.h>
 #include <stdint.h>
@@ -31,4 +31,4 @@ int coavoid_judge_run(coavoid_judged_t *j, const coavoid_scenario_t *s, const ch
                       uint32_t steps, uint32_t replans, coa_vec3_t *reference, int32_t *offsets,
                       bool *known);
 
-#endif /* COAVOID_APP_JUDGE_H */
+#endif /* COAVOID_FLIGHT_JUDGE_H */

@@ -107,8 +107,8 @@
  * Errors: negative codes (COA_ERR_*, COAVOID_LCM_ERR_*); a failed planning call is not an
  * error of the node (it keeps its plan, reports HEALTH_DEGRADED and the outcome).
  */
-#ifndef COAVOID_APP_NODE_H
-#define COAVOID_APP_NODE_H
+#ifndef COAVOID_NODE_H
+#define COAVOID_NODE_H
 
 #include <stdbool.h>
 #include <stddef.h>
@@ -323,4 +323,4 @@ void coavoid_world_destroy(coavoid_world_t *node);
  * path). No memory. */
 int coavoid_world_cycle(coavoid_world_t *node, int64_t now);
 
-#endif /* COAVOID_APP_NODE_H */
+#endif /* COAVOID_NODE_H */

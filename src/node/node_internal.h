@@ -11,8 +11,8 @@
  *     our code (LCM's provider may allocate inside lcm_publish: that is LCM's).
  * Not part of the nodes' API: a driver includes node.h only.
  */
-#ifndef COAVOID_APP_NODE_INTERNAL_H
-#define COAVOID_APP_NODE_INTERNAL_H
+#ifndef COAVOID_NODE_INTERNAL_H
+#define COAVOID_NODE_INTERNAL_H
 
 #include <stdbool.h>
 #include <stddef.h>
@@ -299,4 +299,4 @@ int coavoid_node_publish_intent(coavoid_node_inbox_t *in, const coavoid_intent_t
 /* The common stopwatch's reading (us), 0 without one: durations are differences. O(1). */
 int64_t coavoid_node_stopwatch(const coavoid_node_common_t *c);
 
-#endif /* COAVOID_APP_NODE_INTERNAL_H */
+#endif /* COAVOID_NODE_INTERNAL_H */

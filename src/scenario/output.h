@@ -3,8 +3,8 @@
  * output.h: the result objects of docs/scenario-format.md ("Plan result", "Prediction result"),
  * printed as JSON.
  */
-#ifndef COAVOID_APP_OUTPUT_H
-#define COAVOID_APP_OUTPUT_H
+#ifndef COAVOID_SCENARIO_OUTPUT_H
+#define COAVOID_SCENARIO_OUTPUT_H
 
 #include <stdbool.h>
 #include <stddef.h>
@@ -74,4 +74,4 @@ bool coavoid_output_append(cJSON *array, cJSON *item);
  * err_size 0 when the caller words its own message. */
 int coavoid_output_json(FILE *out, cJSON *root, char *err, size_t err_size);
 
-#endif /* COAVOID_APP_OUTPUT_H */
+#endif /* COAVOID_SCENARIO_OUTPUT_H */

@@ -99,7 +99,7 @@ static int plan_allocate(coavoid_run_error_t *e, const char *file, const char *b
 static int plan_problem(coavoid_run_error_t *e, const char *file, coavoid_scenario_t *s,
                         coa_problem_t *problem)
 {
-    char err[SCENARIO_ERROR_MAX];
+    char err[COAVOID_SCENARIO_ERROR_MAX];
     if (coavoid_scenario_sample(s, err, sizeof err) != 0) {
         return coavoid_run_fail(e, COAVOID_RUN_ERR_INPUT, "%s: %s", file, err);
     }
@@ -122,7 +122,7 @@ static int plan_search(const coavoid_plan_config_t *c, const coavoid_scenario_t 
                        const coa_problem_t *problem, coa_planner_t *planner, int32_t *offsets,
                        uint32_t beta, FILE *out, coavoid_run_error_t *e)
 {
-    char err[SCENARIO_ERROR_MAX];
+    char err[COAVOID_SCENARIO_ERROR_MAX];
     coa_plan_result_t result;
     memset(&result, 0, sizeof result);
     struct timespec start, end;
@@ -163,7 +163,7 @@ int coavoid_scenario_plan(const coavoid_plan_config_t *c, coavoid_scenario_t *s,
             n, COA_MAX_CENTRALISED);
     }
     const size_t searched = c->decoupled ? 1u : n;
-    char beta_source[SCENARIO_ERROR_MAX];
+    char beta_source[COAVOID_SCENARIO_ERROR_MAX];
     uint32_t beta = choose_beta(c, s, searched, beta_source, sizeof beta_source);
     coa_problem_t problem;
     int status = plan_problem(e, file, s, &problem);

@@ -282,7 +282,7 @@ static int predict_report(const coavoid_scenario_t *s, predict_memory_t *m,
 {
     const size_t n = s->vehicle_count;
     size_t cluster_labels = 0;
-    char err[SCENARIO_ERROR_MAX];
+    char err[COAVOID_SCENARIO_ERROR_MAX];
     if (coa_predict_clusters(m->conflicts, result->conflict_count, n, m->label, &cluster_labels) !=
             COA_OK ||
         cluster_labels > n) {
@@ -360,7 +360,7 @@ int coavoid_scenario_predict(const coavoid_predict_config_t *c, coavoid_scenario
                              coavoid_run_error_t *e)
 {
     const char *file = c->scenario_path;
-    char err[SCENARIO_ERROR_MAX];
+    char err[COAVOID_SCENARIO_ERROR_MAX];
     e->text[0] = '\0';
     if (coavoid_scenario_sample(s, err, sizeof err) != 0) {
         return coavoid_run_fail(e, COAVOID_RUN_ERR_INPUT, "%s: %s", file, err);

@@ -1000,14 +1000,14 @@ int coavoid_scenario_load(const char *path, coavoid_scenario_t *s, char *err, si
     }
     /* Read one byte past the cap so that an oversized file is recognised without
      * trusting a size reported by stat (pipes and special files have none). */
-    char *text = malloc((size_t)SCENARIO_MAX_BYTES + 1u);
+    char *text = malloc((size_t)COAVOID_SCENARIO_MAX_BYTES + 1u);
     if (text == NULL) {
         fclose(f);
         set_error(err, err_size, "out of memory");
         return -1;
     }
     errno = 0;
-    size_t length = fread(text, 1, (size_t)SCENARIO_MAX_BYTES + 1u, f);
+    size_t length = fread(text, 1, (size_t)COAVOID_SCENARIO_MAX_BYTES + 1u, f);
     int read_error = errno;
     bool failed = ferror(f) != 0;
     fclose(f);
@@ -1017,10 +1017,10 @@ int coavoid_scenario_load(const char *path, coavoid_scenario_t *s, char *err, si
                   read_error != 0 ? strerror(read_error) : "read error");
         return -1;
     }
-    if (length > SCENARIO_MAX_BYTES) {
+    if (length > COAVOID_SCENARIO_MAX_BYTES) {
         free(text);
         set_error(err, err_size, "larger than the %u MiB a scenario may have",
-                  SCENARIO_MAX_BYTES / (1024u * 1024u));
+                  COAVOID_SCENARIO_MAX_BYTES / (1024u * 1024u));
         return -1;
     }
     int rc = coavoid_scenario_parse(text, length, s, err, err_size);

@@ -12,8 +12,8 @@
  *
  * Everything a coavoid_scenario_t points to is owned by it and released by coavoid_scenario_free.
  */
-#ifndef COAVOID_APP_SCENARIO_H
-#define COAVOID_APP_SCENARIO_H
+#ifndef COAVOID_SCENARIO_H
+#define COAVOID_SCENARIO_H
 
 #include <stdbool.h>
 #include <stddef.h>
@@ -23,10 +23,10 @@
 
 /* Larger files are refused before parsing: a scenario is a few kilobytes, and the cap
  * bounds the memory an input can make us allocate. */
-#define SCENARIO_MAX_BYTES (16u * 1024u * 1024u)
+#define COAVOID_SCENARIO_MAX_BYTES (16u * 1024u * 1024u)
 
 /* Room for one error message ("path: reason"). */
-#define SCENARIO_ERROR_MAX 512u
+#define COAVOID_SCENARIO_ERROR_MAX 512u
 
 typedef struct {
     char *name;
@@ -103,4 +103,4 @@ uint32_t coavoid_default_beta(const coa_planner_config_t *config);
 
 void coavoid_scenario_free(coavoid_scenario_t *s);
 
-#endif /* COAVOID_APP_SCENARIO_H */
+#endif /* COAVOID_SCENARIO_H */

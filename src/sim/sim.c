@@ -438,7 +438,7 @@ static int sim_check(sim_run_t *r, coavoid_scenario_t *s)
                                 "--coordinator-stops: step %lu is after the last, %lu",
                                 (unsigned long)r->o->stop_step, (unsigned long)r->steps);
     }
-    char sample_err[SCENARIO_ERROR_MAX];
+    char sample_err[COAVOID_SCENARIO_ERROR_MAX];
     if (coavoid_scenario_sample(s, sample_err, sizeof sample_err) != 0) {
         return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT, "%s: %s", file, sample_err);
     }

@@ -20,8 +20,8 @@
  * Memory: heap, for the run's record (UAVs x steps) and the nodes' planners (their betas),
  * released before return. Time: the run's, dominated by the planners.
  */
-#ifndef COAVOID_SIM_SIM_H
-#define COAVOID_SIM_SIM_H
+#ifndef COAVOID_SIM_H
+#define COAVOID_SIM_H
 
 #include <stdbool.h>
 #include <stdint.h>
@@ -77,4 +77,4 @@ typedef struct {
 int coavoid_sim_summarise(const coavoid_sim_log_config_t *c, coavoid_scenario_t *s, FILE *out,
                           coavoid_run_error_t *e);
 
-#endif /* COAVOID_SIM_SIM_H */
+#endif /* COAVOID_SIM_H */

@@ -114,7 +114,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     coavoid_scenario_t s;
-    char err[SCENARIO_ERROR_MAX];
+    char err[COAVOID_SCENARIO_ERROR_MAX];
     if (coavoid_scenario_parse((const char *)data, size, &s, err, sizeof err) == 0 &&
         s.horizon <= 64u && coavoid_scenario_sample(&s, err, sizeof err) == 0) {
         const coa_problem_t problem = coavoid_scenario_problem(&s);
