@@ -368,10 +368,9 @@ END_TEST
 
 /* A plan is checked against the terrain (and tracks) the UAV knows before it is adopted:
  * a forged plan that dives into a box below is refused, the real one is adopted. */
-START_TEST(test_plan_into_terrain_refused)
+/* Terrain 2 km wide up to 90 m, under a UAV at 100 m. */
+static coa_obstacle_t terrain_box(void)
 {
-    rig_t r;
-    rig_init(&r, 10);
     coa_obstacle_t box;
     memset(&box, 0, sizeof box);
     box.kind = COA_OBSTACLE_BOX;
@@ -381,6 +380,46 @@ START_TEST(test_plan_into_terrain_refused)
     box.box.max.x = 1000;
     box.box.max.y = 1000;
     box.box.max.z = 90;
+    return box;
+}
+
+/* A coordinator's plan for UAV 1 (a forged plan_id near the top) that dives steeply from
+ * 100 m: its bottom is below terrain_box's top from sample 3 on. It must be refused as
+ * flying into terrain the UAV knows. */
+static void dive_into_terrain(rig_t *r, const coavoid_vehicle_node_state_t *s)
+{
+    coavoid_plan_t m;
+    memset(&m, 0, sizeof m);
+    m.utime = r->now;
+    m.coordinator_id = COAVOID_NODE_COORDINATOR_ID;
+    m.plan_id = INT64_MAX - 5;
+    m.valid_from_utime = cycle(0);
+    m.valid_until_utime = cycle(1);
+    m.dt = 1.0;
+    m.horizon = 10;
+    m.mode = COAVOID_PLAN_T_MODE_CENTRALISED;
+    m.status = COAVOID_PLAN_T_STATUS_SOLVED;
+    m.vehicle_count = 1;
+    m.planned_count = 1;
+    m.uav_ids[0] = 1;
+    for (int32_t k = 0; k <= 10; k++) {
+        m.offsets[0][k] = -2 * k;
+    }
+    const uint32_t adopted = s->plans_adopted;
+    const int64_t rejected = s->rx.rejected;
+    ck_assert_int_eq(coavoid_plan_t_publish(r->lcm, COAVOID_CHANNEL_PLAN, &m), 0);
+    drain(r->lcm);
+    ck_assert_int_eq(s->plans_adopted, adopted);
+    ck_assert_int_eq(s->rx.rejected, rejected + 1);
+    ck_assert_int_eq(s->rx.last_reject_code, COAVOID_LCM_ERR_VALUE);
+    ck_assert_str_eq(s->rx.last_reason, "plan: flies this UAV into an obstacle or track it knows");
+}
+
+START_TEST(test_plan_into_terrain_refused)
+{
+    rig_t r;
+    rig_init(&r, 10);
+    coa_obstacle_t box = terrain_box();
     coavoid_world_config_t wc;
     memset(&wc, 0, sizeof wc);
     wc.common = r.common;
@@ -400,31 +439,8 @@ START_TEST(test_plan_into_terrain_refused)
     r.now = cycle(0) + DT_US / 4;
     heartbeat(r.lcm, r.now, 0);
     drain(r.lcm);
-    /* Steep dives from 100 m: its bottom is below the box's top (90 m) from sample 3 on. */
-    coavoid_plan_t m;
-    memset(&m, 0, sizeof m);
-    m.utime = r.now;
-    m.coordinator_id = COAVOID_NODE_COORDINATOR_ID;
-    m.plan_id = INT64_MAX - 5;
-    m.valid_from_utime = cycle(0);
-    m.valid_until_utime = cycle(1);
-    m.dt = 1.0;
-    m.horizon = 10;
-    m.mode = COAVOID_PLAN_T_MODE_CENTRALISED;
-    m.status = COAVOID_PLAN_T_STATUS_SOLVED;
-    m.vehicle_count = 1;
-    m.planned_count = 1;
-    m.uav_ids[0] = 1;
-    for (int32_t k = 0; k <= 10; k++) {
-        m.offsets[0][k] = -2 * k;
-    }
     const int64_t rejected = s->rx.rejected;
-    ck_assert_int_eq(coavoid_plan_t_publish(r.lcm, COAVOID_CHANNEL_PLAN, &m), 0);
-    drain(r.lcm);
-    ck_assert_int_eq(s->plans_adopted, 0);
-    ck_assert_int_eq(s->rx.rejected, rejected + 1);
-    ck_assert_int_eq(s->rx.last_reject_code, COAVOID_LCM_ERR_VALUE);
-    ck_assert_str_eq(s->rx.last_reason, "plan: flies this UAV into an obstacle or track it knows");
+    dive_into_terrain(&r, s);
     /* The real coordinator's plan (a climb) is adopted, although its plan_id is lower. */
     plan_msg(r.lcm, r.now, 0, cycle(0), 1, 10, 0);
     drain(r.lcm);
@@ -440,6 +456,53 @@ START_TEST(test_plan_into_terrain_refused)
     }
     coavoid_vehicle_node_destroy(a);
     coavoid_world_destroy(w);
+    lcm_destroy(r.lcm);
+}
+END_TEST
+
+/* A UAV keeps the terrain it was configured with: a forged map (the world's id, the
+ * largest version, no obstacles) takes nothing away, and the real map, refused afterwards
+ * as older, is not needed to refuse a plan into that terrain. A map still adds: another
+ * box it carries is avoided too. */
+START_TEST(test_forged_map_keeps_terrain)
+{
+    rig_t r;
+    rig_init(&r, 10);
+    const coa_obstacle_t box = terrain_box();
+    r.common.obstacles = &box;
+    r.common.obstacle_count = 1;
+    coa_vec3_t route[2];
+    coavoid_vehicle_node_t *a =
+        vehicle_node(&r, uav(1, 1, route, 0, 500, 0, 100), COAVOID_NODE_CENTRALISED);
+    const coavoid_vehicle_node_state_t *s = coavoid_vehicle_node_state(a);
+    coavoid_obstacle_map_t map;
+    memset(&map, 0, sizeof map);
+    map.utime = r.now;
+    map.map_id = COAVOID_NODE_WORLD_ID;
+    map.version = INT64_MAX;
+    ck_assert_int_eq(coavoid_obstacle_map_t_publish(r.lcm, COAVOID_CHANNEL_OBSTACLES, &map), 0);
+    drain(r.lcm);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
+    drain(r.lcm);
+    r.now = cycle(0) + DT_US / 4;
+    heartbeat(r.lcm, r.now, 0);
+    drain(r.lcm);
+    dive_into_terrain(&r, s);
+    /* A map of another publisher adds a lid from 107 m: a climb of 2 steps (2 m each:
+     * its top from 105 to 109 m) is refused now; the UAV's own hold is still clear. */
+    map.map_id = 7;
+    map.version = 1;
+    map.box_count = 1;
+    const double lid_min[3] = {-1000, -1000, 107}, lid_max[3] = {1000, 1000, 200};
+    memcpy(map.box_min[0], lid_min, sizeof lid_min);
+    memcpy(map.box_max[0], lid_max, sizeof lid_max);
+    ck_assert_int_eq(coavoid_obstacle_map_t_publish(r.lcm, COAVOID_CHANNEL_OBSTACLES, &map), 0);
+    drain(r.lcm);
+    plan_msg(r.lcm, r.now, 0, cycle(0), 1, 10, 0);
+    drain(r.lcm);
+    ck_assert_int_eq(s->plans_adopted, 0);
+    ck_assert_str_eq(s->rx.last_reason, "plan: flies this UAV into an obstacle or track it knows");
+    coavoid_vehicle_node_destroy(a);
     lcm_destroy(r.lcm);
 }
 END_TEST
@@ -1221,6 +1284,27 @@ START_TEST(test_bad_configs_refused)
     ck_assert_ptr_null(coavoid_vehicle_node_create(&vc, NULL, &error));
     vc.priority_wait_us = -1;
     ck_assert_ptr_null(coavoid_vehicle_node_create(&vc, r.lcm, &error));
+    vc.priority_wait_us = 0;
+    /* Its own obstacles: at most COAVOID_NODE_MAX_CONFIGURED_OBSTACLES, each valid. */
+    coa_obstacle_t own[COAVOID_NODE_MAX_CONFIGURED_OBSTACLES + 1u];
+    for (size_t i = 0; i <= COAVOID_NODE_MAX_CONFIGURED_OBSTACLES; i++) {
+        own[i] = terrain_box();
+    }
+    vc.common.obstacles = own;
+    vc.common.obstacle_count = COAVOID_NODE_MAX_CONFIGURED_OBSTACLES + 1u;
+    ck_assert_ptr_null(coavoid_vehicle_node_create(&vc, r.lcm, &error));
+    own[0].box.max.z = -1; /* below its min */
+    vc.common.obstacle_count = 1;
+    ck_assert_ptr_null(coavoid_vehicle_node_create(&vc, r.lcm, &error));
+    vc.common.obstacles = NULL;
+    ck_assert_ptr_null(coavoid_vehicle_node_create(&vc, r.lcm, &error));
+    vc.common.obstacles = own + 1;
+    vc.common.obstacle_count = COAVOID_NODE_MAX_CONFIGURED_OBSTACLES;
+    coavoid_vehicle_node_t *fits = coavoid_vehicle_node_create(&vc, r.lcm, &error);
+    ck_assert_ptr_nonnull(fits);
+    coavoid_vehicle_node_destroy(fits);
+    vc.common.obstacles = NULL;
+    vc.common.obstacle_count = 0;
 
     coavoid_coordinator_config_t cc;
     memset(&cc, 0, sizeof cc);
@@ -1262,6 +1346,7 @@ static Suite *node_suite(void)
     tcase_add_test(tc, test_plan_adoption_rules);
     tcase_add_test(tc, test_plan_ids_do_not_lock_out);
     tcase_add_test(tc, test_plan_into_terrain_refused);
+    tcase_add_test(tc, test_forged_map_keeps_terrain);
     tcase_add_test(tc, test_duplicate_id_reported);
     tcase_add_test(tc, test_refusals_degrade_health);
     tcase_add_test(tc, test_fallback_and_return);

@@ -124,6 +124,15 @@ int coavoid_rt_setup(const char *path, coavoid_scenario_t *s, coavoid_rt_options
     if (s->has_beta) {
         common->beta = s->beta;
     }
+    /* Every node keeps the scenario's obstacles as its own terrain database: the world's
+     * map may add to them, never take them away. */
+    if (s->obstacle_count > COAVOID_NODE_MAX_CONFIGURED_OBSTACLES) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                "%s: obstacles: %zu, a node holds at most %u of its own", path,
+                                s->obstacle_count, COAVOID_NODE_MAX_CONFIGURED_OBSTACLES);
+    }
+    common->obstacles = s->obstacles;
+    common->obstacle_count = s->obstacle_count;
     return CLI_CONTINUE;
 }
 

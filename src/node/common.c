@@ -63,6 +63,15 @@ int coavoid_node_common_check(const coavoid_node_common_t *c)
         !rate_ok(c->stale_sigma_rate) || c->stale_after_us < 1 || c->beta < 1u) {
         return COA_ERR_ARGUMENT;
     }
+    if (c->obstacle_count > COAVOID_NODE_MAX_CONFIGURED_OBSTACLES ||
+        (c->obstacle_count > 0u && c->obstacles == NULL)) {
+        return COA_ERR_ARGUMENT;
+    }
+    for (size_t i = 0; i < c->obstacle_count; i++) {
+        if (coa_obstacle_check(&c->obstacles[i]) != COA_OK) {
+            return COA_ERR_ARGUMENT;
+        }
+    }
     /* Cycle arithmetic stays far from overflow for any run a node can make. */
     if (c->epoch_utime > INT64_MAX / 4) {
         return COA_ERR_ARGUMENT;
@@ -296,6 +305,53 @@ static void on_track(const lcm_recv_buf_t *rbuf, const char *channel, void *user
     in->tracks[slot].msg = *msg;
 }
 
+static bool same_vec3(coa_vec3_t a, coa_vec3_t b)
+{
+    return a.x == b.x && a.y == b.y && a.z == b.z;
+}
+
+static bool same_obstacle(const coa_obstacle_t *a, const coa_obstacle_t *b)
+{
+    if (a->kind != b->kind) {
+        return false;
+    }
+    if (a->kind == COA_OBSTACLE_BOX) {
+        return same_vec3(a->box.min, b->box.min) && same_vec3(a->box.max, b->box.max);
+    }
+    if (a->polytope.count != b->polytope.count) {
+        return false;
+    }
+    for (size_t i = 0; i < a->polytope.count; i++) {
+        if (!same_vec3(a->polytope.vertices[i], b->polytope.vertices[i])) {
+            return false;
+        }
+    }
+    return true;
+}
+
+/* The configured obstacles, then the map's that are not one of them: a map adds terrain
+ * and never takes any away, and the world's copy of the same database adds nothing (so
+ * an honest run avoids exactly the configured obstacles, in their order). O(configured x
+ * map x vertices), at most once per map received. */
+static void obstacles_merge(coavoid_node_inbox_t *in)
+{
+    const size_t own = in->common.obstacle_count;
+    for (size_t i = 0; i < own; i++) {
+        in->obstacles[i] = in->common.obstacles[i];
+    }
+    size_t count = own;
+    for (size_t j = 0; j < in->map_obstacle_count; j++) {
+        bool known = false;
+        for (size_t i = 0; i < own && !known; i++) {
+            known = same_obstacle(&in->map_obstacles[j], &in->obstacles[i]);
+        }
+        if (!known) {
+            in->obstacles[count++] = in->map_obstacles[j];
+        }
+    }
+    in->obstacle_count = count;
+}
+
 static void on_map(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
 {
     coavoid_node_inbox_t *in = user;
@@ -313,16 +369,17 @@ static void on_map(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
     const char *reason = NULL;
     /* The conversion checks everything before it writes, so a refused map leaves the
      * one in use untouched. */
-    int rc = coavoid_lcm_obstacle_map_to_core(msg, &ctx, &in->map_seq.table, in->obstacles,
-                                              COAVOID_NODE_MAX_OBSTACLES, &count, in->vertices,
+    int rc = coavoid_lcm_obstacle_map_to_core(msg, &ctx, &in->map_seq.table, in->map_obstacles,
+                                              COAVOID_NODE_MAX_MAP_OBSTACLES, &count, in->vertices,
                                               COAVOID_NODE_MAX_VERTICES, &reason);
     coavoid_lcm_rx_count(in->rx, rc, reason);
     if (rc != COA_OK) {
         return;
     }
     senders_heard(&in->map_seq, (uint32_t)msg->map_id, now);
-    in->obstacle_count = count;
+    in->map_obstacle_count = count;
     in->have_map = true;
+    obstacles_merge(in);
 }
 
 static void on_status(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
@@ -432,7 +489,8 @@ int coavoid_node_inbox_init(coavoid_node_inbox_t *in, const coavoid_node_common_
     memset(in->peers, 0, sizeof in->peers);
     memset(in->tracks, 0, sizeof in->tracks);
     in->have_map = false;
-    in->obstacle_count = 0;
+    in->map_obstacle_count = 0;
+    obstacles_merge(in);
     memset(in->own_hash, 0, sizeof in->own_hash);
     memset(in->own_size, 0, sizeof in->own_size);
     in->own_next = 0;

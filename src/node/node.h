@@ -130,6 +130,7 @@
 #define COAVOID_NODE_MAX_PEERS 64u    /* co-operative UAVs a node tracks, itself included */
 #define COAVOID_NODE_MAX_TRACKS 32u   /* non-cooperative tracks */
 #define COAVOID_NODE_MAX_HORIZON 127u /* N: intent_t carries N + 1 samples */
+#define COAVOID_NODE_MAX_CONFIGURED_OBSTACLES 80u /* a node's own terrain database */
 
 /* The world's id (map_id of the obstacle map, source_id of tracks) by default. */
 #define COAVOID_NODE_WORLD_ID 65000u
@@ -163,6 +164,13 @@ typedef struct {
     coa_real_t stale_sigma_rate;
     int64_t stale_after_us; /* peer intent older than this: a track (default 2.5 dt) */
     uint32_t beta;          /* closed-set bound of the node's planner */
+    /* The obstacles the node was configured with (its terrain database; the caller's,
+     * outliving the node; none by default), at most COAVOID_NODE_MAX_CONFIGURED_OBSTACLES.
+     * They are always part of what it avoids and checks: an obstacle map received adds
+     * its obstacles to them and never removes one, so a forged or stale map cannot take
+     * terrain away. */
+    const coa_obstacle_t *obstacles;
+    size_t obstacle_count;
 } coavoid_node_common_t;
 
 /* Fills c with the defaults for (epoch, dt, horizon, clock): threshold 0.01, no sigma

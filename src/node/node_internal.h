@@ -28,8 +28,11 @@ _Static_assert(COAVOID_NODE_MAX_SAMPLES == (unsigned)COAVOID_INTENT_T_MAX_SAMPLE
                "an intent and a plan carry N + 1 samples of the node's largest horizon");
 
 /* Room for one obstacle map (boxes, then polytopes) and its vertices. */
-#define COAVOID_NODE_MAX_OBSTACLES \
+#define COAVOID_NODE_MAX_MAP_OBSTACLES \
     ((size_t)COAVOID_OBSTACLE_MAP_T_MAX_BOXES + (size_t)COAVOID_OBSTACLE_MAP_T_MAX_POLYTOPES)
+/* What a node avoids: its configured obstacles, then the map's that are not among them. */
+#define COAVOID_NODE_MAX_OBSTACLES \
+    ((size_t)COAVOID_NODE_MAX_CONFIGURED_OBSTACLES + COAVOID_NODE_MAX_MAP_OBSTACLES)
 #define COAVOID_NODE_MAX_VERTICES \
     ((size_t)COAVOID_OBSTACLE_MAP_T_MAX_POLYTOPES * (size_t)COAVOID_OBSTACLE_MAP_T_MAX_VERTICES)
 
@@ -108,6 +111,9 @@ struct coavoid_node_inbox {
     coavoid_node_track_slot_t tracks[COAVOID_NODE_MAX_TRACKS];
 
     bool have_map;
+    coa_obstacle_t map_obstacles[COAVOID_NODE_MAX_MAP_OBSTACLES]; /* the latest map's */
+    size_t map_obstacle_count;
+    /* What the node avoids (obstacles_merge): common.obstacles, then the map's others. */
     coa_obstacle_t obstacles[COAVOID_NODE_MAX_OBSTACLES];
     size_t obstacle_count;
     coa_vec3_t vertices[COAVOID_NODE_MAX_VERTICES];

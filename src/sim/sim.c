@@ -555,6 +555,10 @@ static int sim_world(sim_run_t *r)
         return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INTERNAL,
                                 "internal error: out of memory for the world node");
     }
+    /* The UAVs and the coordinator keep the scenario's obstacles as their own (they fit:
+     * the world's map holds them all); the world's map adds to them. */
+    r->common.obstacles = s->obstacles;
+    r->common.obstacle_count = s->obstacle_count;
     return SIM_GO_ON;
 }
 
