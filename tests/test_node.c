@@ -460,6 +460,58 @@ START_TEST(test_plan_into_terrain_refused)
 }
 END_TEST
 
+/* A coordinator's plan is checked against the other UAVs too: a row that climbs UAV 1
+ * into UAV 2 (flying 12 m above it on the same track) is refused while UAV 2 keeps its
+ * intent, and adopted when the same plan moves UAV 2 out of the way (its row in the
+ * plan, not its intent, is what UAV 2 will fly). */
+START_TEST(test_plan_into_other_uav_refused)
+{
+    rig_t r;
+    rig_init(&r, 10);
+    coa_vec3_t route_a[2], route_b[2];
+    coavoid_vehicle_node_t *a =
+        vehicle_node(&r, uav(1, 1, route_a, 0, 500, 0, 100), COAVOID_NODE_CENTRALISED);
+    coavoid_vehicle_node_t *b =
+        vehicle_node(&r, uav(2, 2, route_b, 0, 500, 0, 112), COAVOID_NODE_CENTRALISED);
+    const coavoid_vehicle_node_state_t *s = coavoid_vehicle_node_state(a);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, cycle(0)), COA_OK);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(b, cycle(0)), COA_OK);
+    drain(r.lcm);
+    r.now = cycle(0) + DT_US / 4;
+    plan_msg(r.lcm, r.now, 1, cycle(0), 1, 10, 0); /* 2 steps up: its top at 109 m */
+    drain(r.lcm);
+    ck_assert_int_eq(s->plans_adopted, 0);
+    ck_assert_int_eq(s->rx.last_reject_code, COAVOID_LCM_ERR_VALUE);
+    ck_assert_str_eq(s->rx.last_reason, "plan: flies this UAV into another UAV's plan or intent");
+    coavoid_plan_t m;
+    memset(&m, 0, sizeof m);
+    m.utime = r.now;
+    m.coordinator_id = COAVOID_NODE_COORDINATOR_ID;
+    m.plan_id = 2;
+    m.valid_from_utime = cycle(0);
+    m.valid_until_utime = cycle(1);
+    m.dt = 1.0;
+    m.horizon = 10;
+    m.mode = COAVOID_PLAN_T_MODE_CENTRALISED;
+    m.status = COAVOID_PLAN_T_STATUS_SOLVED;
+    m.vehicle_count = 2;
+    m.planned_count = 2;
+    m.uav_ids[0] = 1;
+    m.uav_ids[1] = 2;
+    for (int32_t k = 0; k <= 10; k++) {
+        m.offsets[0][k] = k < 2 ? k : 2;
+        m.offsets[1][k] = k < 4 ? k : 4; /* UAV 2 climbs 8 m, ahead of UAV 1 */
+    }
+    ck_assert_int_eq(coavoid_plan_t_publish(r.lcm, COAVOID_CHANNEL_PLAN, &m), 0);
+    drain(r.lcm);
+    ck_assert_int_eq(s->plans_adopted, 1);
+    ck_assert_int_eq(coavoid_vehicle_node_state(b)->plans_adopted, 1);
+    coavoid_vehicle_node_destroy(a);
+    coavoid_vehicle_node_destroy(b);
+    lcm_destroy(r.lcm);
+}
+END_TEST
+
 /* A UAV keeps the terrain it was configured with: a forged map (the world's id, the
  * largest version, no obstacles) takes nothing away, and the real map, refused afterwards
  * as older, is not needed to refuse a plan into that terrain. A map still adds: another
@@ -1347,6 +1399,7 @@ static Suite *node_suite(void)
     tcase_add_test(tc, test_plan_ids_do_not_lock_out);
     tcase_add_test(tc, test_plan_into_terrain_refused);
     tcase_add_test(tc, test_forged_map_keeps_terrain);
+    tcase_add_test(tc, test_plan_into_other_uav_refused);
     tcase_add_test(tc, test_duplicate_id_reported);
     tcase_add_test(tc, test_refusals_degrade_health);
     tcase_add_test(tc, test_fallback_and_return);

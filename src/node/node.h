@@ -76,9 +76,13 @@
  *      greater than that of any plan it adopted in this cycle (so that a later plan of
  *      the cycle supersedes), starts at the offset the UAV flies now, and over this
  *      cycle's samples k..k+N runs into none of the obstacles and tracks (silent UAVs
- *      included) the UAV knows (coa_plan_find_conflict: a coordinator may know less
- *      terrain, or be an impostor); anything else is not adopted (counted in status as
- *      rejected with the reason). Plan ids are not compared across cycles: valid_from
+ *      included) the UAV knows, nor into any other live UAV, taken on its row of this
+ *      cycle's latest solved plan that lists it (what it will fly) or else on its
+ *      latest intent (coa_plan_find_conflict: a coordinator may know less terrain, or
+ *      be an impostor); anything else is not adopted (counted in status as rejected
+ *      with the reason). Its own plans get the same check against what their search
+ *      avoided before they are flown (one that fails is a planner bug: not flown, and
+ *      the heartbeat says HEALTH_FAULT). Plan ids are not compared across cycles: valid_from
  *      already ties a plan to its cycle, and a rule across cycles would let one forged
  *      plan_id INT64_MAX, or a coordinator restarted with its numbering at 0, lock every
  *      later plan out.

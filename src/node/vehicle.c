@@ -32,6 +32,14 @@ struct coavoid_vehicle_node {
     bool cycle_plan_adopted;
     int64_t cycle_plan_id;
     bool cycle_plan_failed; /* one listed it, in time, but was not solved */
+    /* The other UAVs' rows in this cycle's solved plans (the latest plan_id each): what
+     * each is to fly from this cycle's start, which a plan for this UAV is checked
+     * against instead of their intents (record_rows). */
+    size_t row_count;
+    uint16_t row_id[COAVOID_NODE_MAX_PEERS];
+    int64_t row_plan_id[COAVOID_NODE_MAX_PEERS];
+    uint32_t row_samples[COAVOID_NODE_MAX_PEERS];
+    int32_t row_offsets[COAVOID_NODE_MAX_PEERS][COAVOID_NODE_MAX_SAMPLES];
 
     /* The adopted plan: offsets of samples plan_start .. plan_start + plan_count - 1; past
      * its end the last offset holds. */
@@ -247,6 +255,28 @@ static int search_self(coavoid_vehicle_node_t *node, int64_t now, coa_plan_resul
     return COA_OK;
 }
 
+static int plan_hits_known(coavoid_vehicle_node_t *node, const int32_t *offsets, size_t count,
+                           int64_t now, bool own);
+
+/* Adopts its own solved plan (node->plan_out) once the check every plan gets before it is
+ * flown finds it clear of what its search avoided; a plan that fails it is a planner
+ * bug: not flown, and the node reports a fault this cycle. Returns COA_OK or a negative
+ * error. */
+static int own_plan_checked(coavoid_vehicle_node_t *node, int64_t now)
+{
+    const uint32_t samples = node->config.common.horizon + 1u;
+    int hit = plan_hits_known(node, node->plan_out, samples, now, true);
+    if (hit < 0) {
+        return hit;
+    }
+    if (hit > 0) {
+        node->fault = true;
+        return COA_OK;
+    }
+    adopt(node, node->plan_out, samples);
+    return COA_OK;
+}
+
 /* Plans for itself against obstacles, tracks, stale UAVs and every live UAV that is not a
  * lower-priority member of its cluster (my = its cluster label), and adopts a solved
  * plan. Returns COA_OK (whatever the outcome) or a negative error. */
@@ -276,7 +306,7 @@ static int plan_self(coavoid_vehicle_node_t *node, int64_t now, uint32_t my)
         rc = search_self(node, now, &result);
     }
     if (rc == COA_OK && result.status == COA_PLAN_SOLVED) {
-        adopt(node, node->plan_out, node->config.common.horizon + 1u);
+        rc = own_plan_checked(node, now);
     }
     return rc;
 }
@@ -458,30 +488,94 @@ static void reject(coavoid_vehicle_node_t *node, int code, const char *reason)
     coavoid_lcm_rx_count(&node->state.rx, code, reason);
 }
 
+/* Keeps the other UAVs' rows of a solved plan of this cycle, unless a later plan of the
+ * cycle (a larger plan_id) already gave one: the coordinator's newest word on what each
+ * will fly. O(rows * (peers + N)). */
+static void record_rows(coavoid_vehicle_node_t *node, const coavoid_plan_t *msg,
+                        const coavoid_lcm_plan_info_t *info, const coa_plan_result_t *result,
+                        const int32_t *offsets)
+{
+    const size_t samples = (size_t)info->horizon + 1u;
+    for (size_t i = 0; i < result->planned_count && i < info->vehicle_count; i++) {
+        const uint16_t id = info->uav_ids[i];
+        size_t slot = 0;
+        while (slot < node->row_count && node->row_id[slot] != id) {
+            slot++;
+        }
+        if (id == node->config.vehicle.id || slot == COAVOID_NODE_MAX_PEERS ||
+            (slot < node->row_count && node->row_plan_id[slot] >= msg->plan_id)) {
+            continue;
+        }
+        node->row_count += slot == node->row_count ? 1u : 0u;
+        node->row_id[slot] = id;
+        node->row_plan_id[slot] = msg->plan_id;
+        node->row_samples[slot] = (uint32_t)samples;
+        memcpy(node->row_offsets[slot], offsets + i * samples, samples * sizeof *offsets);
+    }
+}
+
+/* Moves live UAV i of the view onto its row from this cycle's plans, when it has one and
+ * its intent is of this cycle (the same samples): reference + row offset * its dh, as it
+ * will fly them if it adopts the plan. */
+static void apply_row(coavoid_vehicle_node_t *node, size_t i)
+{
+    coavoid_node_view_t *view = &node->view;
+    size_t slot = 0;
+    while (slot < node->row_count && node->row_id[slot] != view->live_id[i]) {
+        slot++;
+    }
+    if (slot == node->row_count || !view->live_current[i]) {
+        return;
+    }
+    const coa_real_t dh = coa_climb_step(&view->live_vehicle[i], node->config.common.dt);
+    coavoid_lcm_intent_arrays_t *a = &view->live_arrays[i];
+    const uint32_t count = node->row_samples[slot];
+    for (size_t j = 0; j < view->live_plan[i].count; j++) {
+        a->offsets[j] = node->row_offsets[slot][j < count ? j : count - 1u];
+        a->samples[j] = lifted(a->reference[j], a->offsets[j], dh);
+    }
+}
+
 /* Whether flying `offsets` (a plan's row from this cycle's start, `count` samples; past its
- * end the last offset holds) over this cycle's window runs into an obstacle or a track it
- * knows (real tracks and silent UAVs; the live UAVs are the coordinator's to plan around,
- * with plans this UAV has not seen). A coordinator may know less terrain than the UAV, or
- * be an impostor: what the UAV knows it can check before it flies. Returns 0 (clear), 1
- * (a conflict) or a negative error (it cannot tell). */
+ * end the last offset holds) over this cycle's window runs into what the UAV knows: 1 an
+ * obstacle or a track (real tracks and silent UAVs), 2 another live UAV (a coordinator's
+ * plan: every live UAV, on its row of this cycle's plans, else on its intent, since a
+ * plan must not rely on a move nobody was told to make; its own plan (own): the live UAVs
+ * node->include marks, those its search avoided). A coordinator may know less terrain
+ * than the UAV, or be an impostor, and a search may have a bug: what the UAV knows it
+ * checks before it flies. Returns 0 (clear), 1, 2, or a negative error (it cannot tell).
+ * Cost: two conflict checks, O(N * (obstacles + tracks + peers)). */
 static int plan_hits_known(coavoid_vehicle_node_t *node, const int32_t *offsets, size_t count,
-                           int64_t now)
+                           int64_t now, bool own)
 {
     const coavoid_node_common_t *c = &node->config.common;
+    bool searched[COAVOID_NODE_MAX_PEERS];
+    memcpy(searched, node->include, sizeof searched);
     const size_t n = (size_t)c->horizon + 1u;
     for (size_t j = 0; j < n; j++) {
         node->checked[j] = offsets[j < count ? j : count - 1u];
     }
     coavoid_node_view_build(&node->view, &node->inbox, node->cycle_start, now);
-    int rc = coavoid_node_problem_tracks(&node->problem_tracks, &node->view, NULL, c);
-    if (rc != COA_OK) {
-        return rc;
-    }
     coa_vehicle_t vehicle;
     const coa_vec3_t *references[1];
-    coa_problem_t problem = own_problem(node, &vehicle, references);
     const size_t which[1] = {0};
-    return coa_plan_find_conflict(&problem, node->checked, which, 1, NULL, NULL);
+    int hit = 0;
+    for (int pass = 1; pass <= 2 && hit == 0; pass++) {
+        for (size_t i = 0; i < node->view.live_count; i++) {
+            node->include[i] = pass == 2 && (!own || searched[i]);
+            if (pass == 2 && !own) {
+                apply_row(node, i);
+            }
+        }
+        int rc = coavoid_node_problem_tracks(&node->problem_tracks, &node->view, node->include, c);
+        if (rc != COA_OK) {
+            return rc;
+        }
+        coa_problem_t problem = own_problem(node, &vehicle, references);
+        rc = coa_plan_find_conflict(&problem, node->checked, which, 1, NULL, NULL);
+        hit = rc > 0 ? pass : rc;
+    }
+    return hit;
 }
 
 /* Step 4 of node.h: a coordinator's plan that lists it. */
@@ -503,6 +597,10 @@ static void on_plan(void *owner, const coavoid_plan_t *msg, const coavoid_lcm_pl
          * itself would not do better than the coordinator's search over the same UAVs,
          * and would take it out of the coordinator's next, larger ones. */
         node->cycle_plan_failed = true;
+    }
+    if (result->status == COA_PLAN_SOLVED && node->started &&
+        msg->valid_from_utime == node->cycle_start && now < msg->valid_until_utime) {
+        record_rows(node, msg, info, result, offsets);
     }
     if (row == SIZE_MAX || result->status != COA_PLAN_SOLVED || row >= result->planned_count) {
         coavoid_lcm_rx_count(&node->state.rx, COA_OK, NULL); /* not a plan for it */
@@ -541,11 +639,12 @@ static void on_plan(void *owner, const coavoid_plan_t *msg, const coavoid_lcm_pl
             return;
         }
     }
-    int hit = plan_hits_known(node, mine, samples, now);
+    int hit = plan_hits_known(node, mine, samples, now, false);
     if (hit != 0) {
         reject(node, hit > 0 ? COAVOID_LCM_ERR_VALUE : hit,
-               hit > 0 ? "plan: flies this UAV into an obstacle or track it knows"
-                       : "plan: cannot be checked against the obstacles and tracks it knows");
+               hit == 1   ? "plan: flies this UAV into an obstacle or track it knows"
+               : hit == 2 ? "plan: flies this UAV into another UAV's plan or intent"
+                          : "plan: cannot be checked against the obstacles and tracks it knows");
         return;
     }
     adopt(node, mine, (uint32_t)samples);
@@ -653,6 +752,7 @@ int coavoid_vehicle_node_cycle(coavoid_vehicle_node_t *node, int64_t now)
     const bool previous_answered = previous_adopted || node->cycle_plan_failed;
     node->cycle_plan_adopted = false;
     node->cycle_plan_failed = false;
+    node->row_count = 0;
     node->state.cycle = k;
     node->cycle_start = coavoid_node_cycle_utime(c, k);
     coavoid_node_inbox_expire(&node->inbox, now);
