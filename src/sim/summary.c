@@ -13,13 +13,32 @@
  *     scenario's reference is used with the offset held (the initial offset before the
  *     first intent, the last covered one after): that sample is marked not known, counted,
  *     and drawn as such.
- *   - The epoch (cycle 0's start) is the earliest plan_utime of the scenario's UAVs unless
- *     --epoch gives it; the step is the scenario's dt, which every intent must agree with.
+ *   - The epoch (cycle 0's start) is, unless --epoch gives it, the earliest plan_utime of
+ *     the scenario's UAVs on the run's cycle grid: the grid (plan_utime modulo dt) that
+ *     most of their accepted intents are on. Every intent of a run is on one grid; an
+ *     intent off it (a bit flip in plan_utime that still validates) is counted off the
+ *     grid instead of moving the epoch off it. The step is the scenario's dt.
  *   - K, the last sample judged, is the last cycle for which the log holds every UAV's own
  *     intent ("complete"), and at most the scenario's 2N (the default length of a sim).
  *   - Replans: every node's heartbeat (status_t) carries plans_run, its planning calls
- *     since it started; the replans of a run are the sum over nodes of the largest
- *     plans_run among their heartbeats up to cycle K, which is what `coavoid sim` counts.
+ *     since it started; the replans of a run are the sum over its nodes (the scenario's
+ *     UAVs and the run's coordinator) of the largest plans_run among their accepted
+ *     heartbeats up to cycle K, which is what `coavoid sim` counts.
+ *
+ * Valid messages that cannot be this run's are ignored, counted, and the first one's
+ * reason reported, so that one such message (a forgery, a bit flip that still validates)
+ * neither refuses the whole log nor inflates a count:
+ *   - an intent of a scenario UAV whose step, performance or volume disagrees with the
+ *     scenario. The log is not a run of the
+ *     scenario only when some scenario UAV has no accepted intent at all: that is an
+ *     error naming the first disagreement when its intents were all ignored;
+ *   - a heartbeat of a UAV not in the scenario, or of a coordinator other than the run's
+ *     (the coordinator id that sent the most heartbeats);
+ *   - a heartbeat whose plans_run goes back from the node's last accepted heartbeat, or
+ *     grows from it by more than the node can plan in the cycles between them
+ *     (PLANS_PER_CYCLE, cycles_between). A node restarted mid-run counts from 0 again:
+ *     its heartbeats are ignored until its new count passes the old one, so its replans
+ *     are the larger of the two.
  *
  * The log is untrusted. LCM 1.3.1's reader skips anything until it finds an event's
  * magic number, reports truncation as a normal end, prints its own complaints on stderr
@@ -35,6 +54,7 @@
 #include <errno.h>
 #include <inttypes.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stdbool.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -64,6 +84,33 @@
 /* Larger events are taken as corruption: the biggest message of ours is about 17 kB, and
  * the reader allocates what the header claims before it reads. */
 #define LOG_MAX_DATA (64 * 1024 * 1024)
+/* The first ignored message's reason, as text. */
+#define IGNORED_REASON_MAX 200
+/* uav_id and node_id are 1..65535 (src/lcm). */
+#define MAX_NODE_ID 65535u
+
+/*
+ * PLANS_PER_CYCLE: the most planning calls (plans_run increments) a node makes in one of its
+ * cycles, from src/node:
+ *   - a UAV (vehicle.c): it plans in decide() only, through plan_self(), which is followed
+ *     at once by finish() (its intent and the cycle's heartbeat); after that the cycle
+ *     is over for it (poll() does nothing unless it waits, and a second call of the same
+ *     cycle returns at once). plan_self() searches once (search_self) and, when that
+ *     fails with lower priorities outside its cluster in the way, once more around the
+ *     higher priorities only: 2 a cycle;
+ *   - the coordinator (coordinator.c, coavoid_coordinator_cycle): cluster_plan() counts
+ *     1, or 2 when the joint search ran out of beta and the cluster is planned again
+ *     decoupled; plan_clusters() plans each cluster that has a member once, and
+ *     escalate() at most twice more (every clustered UAV, then every UAV): 2 x clusters
+ *     + 4 a cycle. Clusters are disjoint and each has a UAV that published an intent of
+ *     the cycle, at most COAVOID_NODE_MAX_PEERS in its view: so 2 x U + 4, U the UAVs
+ *     whose valid intents the log holds (the scenario's and others), at most that.
+ * Both publish exactly one heartbeat (sequence + 1) per cycle they run, after its
+ * planning, so a node's plans_run grows by at most PLANS_PER_CYCLE per heartbeat.
+ */
+#define VEHICLE_PLANS_PER_CYCLE 2
+#define COORDINATOR_PLANS_PER_CLUSTER 2
+#define COORDINATOR_ESCALATION_PLANS 4
 
 /* ---- reading the log ---- */
 
@@ -292,6 +339,40 @@ static bool planning_add(planning_list_t *list, planning_t item)
     return true;
 }
 
+/* A valid heartbeat, kept in log order. */
+typedef struct {
+    int64_t utime;
+    int64_t sequence;
+    int32_t plans_run;
+    uint16_t node;
+    int8_t kind;
+} heartbeat_t;
+
+typedef struct {
+    heartbeat_t *items;
+    size_t count;
+    size_t capacity;
+} heartbeat_list_t;
+
+static bool heartbeat_add(heartbeat_list_t *list, heartbeat_t item)
+{
+    heartbeat_t *items = room_for_one(list->items, list->count, &list->capacity, sizeof item);
+    if (items == NULL) {
+        return false;
+    }
+    list->items = items;
+    list->items[list->count++] = item;
+    return true;
+}
+
+/* The first field of an intent that disagrees with its UAV in the scenario (field NULL:
+ * none). */
+typedef struct {
+    const char *field;
+    double theirs;
+    double ours;
+} disagreement_t;
+
 /* One accepted intent's place on the time line. */
 typedef struct {
     size_t vehicle;
@@ -340,18 +421,81 @@ typedef struct {
     int64_t plans_refused;
     const char *other_reason; /* the first refusal of a status or plan */
 
-    intent_list_t seen;         /* accepted intents of the scenario's UAVs */
-    planning_list_t heartbeats; /* (node, utime, plans_run) of accepted heartbeats */
-    planning_list_t plan_list;  /* (coordinator, valid_from, plan_id) of accepted plans */
-    int64_t first_plan_utime[COA_MAX_VEHICLES];
+    /* Valid intents of the scenario's UAVs that disagree with it: ignored. */
+    int64_t intents_ignored;
+    char intent_ignored[IGNORED_REASON_MAX]; /* the first one's reason ("": none) */
+    int64_t ignored_of[COA_MAX_VEHICLES];
+    disagreement_t disagreement_of[COA_MAX_VEHICLES]; /* each UAV's first */
+    /* The UAVs not in the scenario that sent valid intents (a bit per id) and how many. */
+    uint8_t other_uav[(MAX_NODE_ID + 1u) / 8u];
+    size_t other_uavs;
+    /* Valid heartbeats ignored (judge_heartbeats), by reason. */
+    int64_t heartbeats_other_node; /* of a node that is not one of the run's */
+    int64_t heartbeats_backwards;  /* plans_run below the node's last accepted one */
+    int64_t heartbeats_too_fast;   /* plans_run beyond what the node can plan */
+    char heartbeat_ignored[IGNORED_REASON_MAX];
+
+    intent_list_t seen;          /* accepted intents of the scenario's UAVs */
+    heartbeat_list_t heartbeats; /* valid heartbeats, in log order */
+    planning_list_t plan_list;   /* (coordinator, valid_from, plan_id) of accepted plans */
     int64_t intents_of[COA_MAX_VEHICLES];
 } log_summary_t;
 
 static const coavoid_lcm_context_t no_clock = {0, 0, 0, 0};
 
+/* The first field of intent m that disagrees with UAV v of the scenario: its step (the
+ * scenario's dt), performance and volume. An intent of another scenario (or another dt)
+ * cannot be judged against this one. */
+static disagreement_t disagreement(const log_summary_t *ls, const coavoid_intent_t *m,
+                                   const coa_vehicle_t *v)
+{
+    disagreement_t d = {NULL, 0.0, 0.0};
+    if (llround(m->step * 1e6) != ls->dt_us) {
+        d = (disagreement_t){"step (the scenario's dt)", m->step, (double)ls->s->dt};
+    } else if ((coa_real_t)m->climb_rate != v->climb_rate) {
+        d = (disagreement_t){"climb_rate", m->climb_rate, (double)v->climb_rate};
+    } else if ((coa_real_t)m->cruise_speed != v->cruise_speed) {
+        d = (disagreement_t){"cruise_speed", m->cruise_speed, (double)v->cruise_speed};
+    } else if ((coa_real_t)m->radius != v->volume.radius) {
+        d = (disagreement_t){"radius", m->radius, (double)v->volume.radius};
+    } else if ((coa_real_t)m->half_height != v->volume.half_height) {
+        d = (disagreement_t){"half_height", m->half_height, (double)v->volume.half_height};
+    } else if ((uint32_t)m->steep_factor != v->steep_factor) {
+        d = (disagreement_t){"steep_factor", m->steep_factor, v->steep_factor};
+    }
+    return d;
+}
+
+/* Counts an ignored intent of scenario UAV `index` (id uav), disagreeing as d. */
+static void ignore_intent(log_summary_t *ls, size_t index, long uav, const disagreement_t *d)
+{
+    ls->intents_ignored++;
+    if (ls->ignored_of[index]++ == 0) {
+        ls->disagreement_of[index] = *d;
+    }
+    if (ls->intent_ignored[0] == '\0') {
+        snprintf(ls->intent_ignored, sizeof ls->intent_ignored,
+                 "intent: UAV %ld's %s %.17g disagrees with the scenario (%.17g)", uav, d->field,
+                 d->theirs, d->ours);
+    }
+}
+
+/* Counts a valid intent of a UAV not in the scenario, and its id once. */
+static void note_other_uav(log_summary_t *ls, int32_t uav)
+{
+    /* uav_id is 1..65535 once the intent is valid. */
+    uint8_t *byte = &ls->other_uav[(uint32_t)uav / 8u];
+    const uint8_t bit = (uint8_t)(1u << ((uint32_t)uav % 8u));
+    ls->intents_foreign++;
+    if ((*byte & bit) == 0u) {
+        *byte |= bit;
+        ls->other_uavs++;
+    }
+}
+
 /* Decodes and validates an intent. Returns the scenario's index of its UAV (>= 0), -1
- * refused (counted), -2 a valid intent of another UAV (counted), or -3 after an error
- * message (the log is not this scenario's run). */
+ * refused, -2 a valid intent of another UAV, or -3 a valid intent of a scenario UAV that
+ * disagrees with the scenario (ignored); each counted when `count`. */
 static long accept_intent(log_summary_t *ls, const lcm_eventlog_event_t *e, bool count)
 {
     const char *reason = "intent: does not decode (wrong type or truncated)";
@@ -377,46 +521,15 @@ static long accept_intent(log_summary_t *ls, const lcm_eventlog_event_t *e, bool
     long index = coavoid_scenario_vehicle_index(ls->s, (long)m->uav_id);
     if (index < 0) {
         if (count) {
-            ls->intents_foreign++;
+            note_other_uav(ls, m->uav_id);
         }
         return -2;
     }
-    /* Intents of another scenario (or another dt) cannot be judged against this one. */
-    const coa_vehicle_t *v = &ls->s->vehicles[index];
-    const char *field = NULL;
-    double theirs = 0.0;
-    double ours = 0.0;
-    if (llround(m->step * 1e6) != ls->dt_us) {
-        field = "step (the scenario's dt)";
-        theirs = m->step;
-        ours = (double)ls->s->dt;
-    } else if ((coa_real_t)m->climb_rate != v->climb_rate) {
-        field = "climb_rate";
-        theirs = m->climb_rate;
-        ours = (double)v->climb_rate;
-    } else if ((coa_real_t)m->cruise_speed != v->cruise_speed) {
-        field = "cruise_speed";
-        theirs = m->cruise_speed;
-        ours = (double)v->cruise_speed;
-    } else if ((coa_real_t)m->radius != v->volume.radius) {
-        field = "radius";
-        theirs = m->radius;
-        ours = (double)v->volume.radius;
-    } else if ((coa_real_t)m->half_height != v->volume.half_height) {
-        field = "half_height";
-        theirs = m->half_height;
-        ours = (double)v->volume.half_height;
-    } else if ((uint32_t)m->steep_factor != v->steep_factor) {
-        field = "steep_factor";
-        theirs = m->steep_factor;
-        ours = v->steep_factor;
-    }
-    if (field != NULL) {
-        coavoid_run_fail(ls->err, COAVOID_RUN_ERR_INPUT,
-                         "%s: UAV %ld's intents have %s %.17g, %s says %.17g: not a run of this "
-                         "scenario",
-                         ls->o->log_path, (long)m->uav_id, field, theirs, ls->o->scenario_path,
-                         ours);
+    disagreement_t d = disagreement(ls, m, &ls->s->vehicles[index]);
+    if (d.field != NULL) {
+        if (count) {
+            ignore_intent(ls, (size_t)index, (long)m->uav_id, &d);
+        }
         return -3;
     }
     return index;
@@ -429,12 +542,52 @@ static void note_other(log_summary_t *ls, const char *reason)
     }
 }
 
+/* An event on the heartbeat channel: counted, and kept when valid. False out of memory. */
+static bool read_status(log_summary_t *ls, const lcm_eventlog_event_t *e)
+{
+    const char *reason = "status: does not decode (wrong type or truncated)";
+    coavoid_status_t *m = &ls->status;
+    int used = coavoid_status_t_decode(e->data, 0, e->datalen, m);
+    int rc = used == e->datalen ? coavoid_lcm_status_check(m, &no_clock, &reason)
+                                : COAVOID_LCM_ERR_DECODE;
+    if (used >= 0) {
+        coavoid_status_t_decode_cleanup(m);
+    }
+    ls->statuses++;
+    if (rc != COA_OK) {
+        ls->statuses_refused++;
+        note_other(ls, reason);
+        return true;
+    }
+    /* node_id is 1..65535 once the heartbeat is valid. */
+    heartbeat_t item = {m->utime, m->sequence, m->plans_run, (uint16_t)m->node_id, m->node_kind};
+    return heartbeat_add(&ls->heartbeats, item);
+}
+
+/* An event on the plan channel: counted, and kept when valid. False out of memory. */
+static bool read_plan(log_summary_t *ls, const lcm_eventlog_event_t *e)
+{
+    const char *reason = "plan: does not decode (wrong type or truncated)";
+    int used = coavoid_plan_t_decode(e->data, 0, e->datalen, &ls->plan);
+    int rc = used == e->datalen ? coavoid_lcm_plan_check(&ls->plan, &no_clock, &reason)
+                                : COAVOID_LCM_ERR_DECODE;
+    if (used >= 0) {
+        coavoid_plan_t_decode_cleanup(&ls->plan);
+    }
+    ls->plans++;
+    if (rc != COA_OK) {
+        ls->plans_refused++;
+        note_other(ls, reason);
+        return true;
+    }
+    planning_t item = {(uint32_t)ls->plan.coordinator_id, COAVOID_STATUS_T_NODE_COORDINATOR,
+                       ls->plan.valid_from_utime, ls->plan.plan_id};
+    return planning_add(&ls->plan_list, item);
+}
+
 /* Pass 1: every event of the log. Returns SIM_GO_ON or the exit status. */
 static int read_log(log_summary_t *ls, log_reader_t *r)
 {
-    for (size_t i = 0; i < ls->s->vehicle_count; i++) {
-        ls->first_plan_utime[i] = INT64_MAX;
-    }
     for (;;) {
         lcm_eventlog_event_t *e = NULL;
         int rc = log_next(r, &e);
@@ -448,55 +601,16 @@ static int read_log(log_summary_t *ls, log_reader_t *r)
         bool ok = true;
         if (strcmp(e->channel, COAVOID_CHANNEL_INTENT) == 0) {
             long index = accept_intent(ls, e, true);
-            if (index == -3) {
-                lcm_eventlog_free_event(e);
-                return COAVOID_RUN_ERR_INPUT;
-            }
             if (index >= 0) {
                 size_t i = (size_t)index;
-                int64_t p = ls->intent.plan_utime;
                 ls->intents_of[i]++;
-                if (p < ls->first_plan_utime[i]) {
-                    ls->first_plan_utime[i] = p;
-                }
-                intent_seen_t seen = {i, p};
+                intent_seen_t seen = {i, ls->intent.plan_utime};
                 ok = intent_add(&ls->seen, seen);
             }
         } else if (strcmp(e->channel, COAVOID_CHANNEL_STATUS) == 0) {
-            const char *reason = "status: does not decode (wrong type or truncated)";
-            int used = coavoid_status_t_decode(e->data, 0, e->datalen, &ls->status);
-            int vrc = used == e->datalen ? coavoid_lcm_status_check(&ls->status, &no_clock, &reason)
-                                         : COAVOID_LCM_ERR_DECODE;
-            if (used >= 0) {
-                coavoid_status_t_decode_cleanup(&ls->status);
-            }
-            ls->statuses++;
-            if (vrc != COA_OK) {
-                ls->statuses_refused++;
-                note_other(ls, reason);
-            } else if (ls->status.plans_run > 0) {
-                planning_t item = {(uint32_t)ls->status.node_id, ls->status.node_kind,
-                                   ls->status.utime, ls->status.plans_run};
-                ok = planning_add(&ls->heartbeats, item);
-            }
+            ok = read_status(ls, e);
         } else if (strcmp(e->channel, COAVOID_CHANNEL_PLAN) == 0) {
-            const char *reason = "plan: does not decode (wrong type or truncated)";
-            int used = coavoid_plan_t_decode(e->data, 0, e->datalen, &ls->plan);
-            int vrc = used == e->datalen ? coavoid_lcm_plan_check(&ls->plan, &no_clock, &reason)
-                                         : COAVOID_LCM_ERR_DECODE;
-            if (used >= 0) {
-                coavoid_plan_t_decode_cleanup(&ls->plan);
-            }
-            ls->plans++;
-            if (vrc != COA_OK) {
-                ls->plans_refused++;
-                note_other(ls, reason);
-            } else {
-                planning_t item = {(uint32_t)ls->plan.coordinator_id,
-                                   COAVOID_STATUS_T_NODE_COORDINATOR, ls->plan.valid_from_utime,
-                                   ls->plan.plan_id};
-                ok = planning_add(&ls->plan_list, item);
-            }
+            ok = read_plan(ls, e);
         } else {
             ls->other_events++;
         }
@@ -509,42 +623,165 @@ static int read_log(log_summary_t *ls, log_reader_t *r)
     return SIM_GO_ON;
 }
 
-static int planning_compare(const void *a, const void *b)
+/* ---- the heartbeats: replans ---- */
+
+/* The run's coordinator: the coordinator id that sent the most valid heartbeats (ties: the
+ * smallest), 0 when none did. -1 out of memory. */
+static long run_coordinator(const log_summary_t *ls)
 {
-    const planning_t *p = a;
-    const planning_t *q = b;
-    if (p->node != q->node) {
-        return p->node < q->node ? -1 : 1;
+    uint32_t *count = calloc(MAX_NODE_ID + 1u, sizeof *count);
+    if (count == NULL) {
+        return -1;
     }
-    if (p->id != q->id) {
-        return p->id < q->id ? -1 : 1;
+    long best = 0;
+    for (size_t h = 0; h < ls->heartbeats.count; h++) {
+        const heartbeat_t *hb = &ls->heartbeats.items[h];
+        if (hb->kind != COAVOID_STATUS_T_NODE_COORDINATOR) {
+            continue;
+        }
+        count[hb->node]++;
+        if (best == 0 || count[hb->node] > count[best] ||
+            (count[hb->node] == count[best] && hb->node < best)) {
+            best = hb->node;
+        }
     }
-    if (p->utime != q->utime) {
-        return p->utime < q->utime ? -1 : 1;
-    }
-    return 0;
+    free(count);
+    return best;
 }
 
-/* Planning calls up to `to`: per node, the largest plans_run of its heartbeats stamped
- * before `to`, summed over the nodes. */
-static uint32_t count_replans(log_summary_t *ls, int64_t to)
+/* Where a node of the run stands: its last accepted heartbeat (none before its first),
+ * and the largest plans_run of its accepted heartbeats stamped before the end of the
+ * judged cycles. */
+typedef struct {
+    bool heard;
+    heartbeat_t last;
+    int32_t most;
+} node_count_t;
+
+/* A heartbeat's node in the run: what it is called, and the planning calls it can make
+ * in a cycle. */
+typedef struct {
+    const char *name; /* "UAV" or "coordinator" */
+    int64_t per_cycle;
+} node_kind_t;
+
+/* Clamps a count of cycles to +-2^40: enough for any log, and no product overflows. */
+static int64_t clamp_cycles(int64_t n)
 {
-    planning_list_t *hb = &ls->heartbeats;
-    uint64_t total = 0;
-    if (hb->count > 0u) {
-        qsort(hb->items, hb->count, sizeof *hb->items, planning_compare);
+    const int64_t most = INT64_C(1) << 40;
+    return n > most ? most : (n < -most ? -most : n);
+}
+
+/* The cycles node c can have run from its last accepted heartbeat to h, whose planning
+ * h's plans_run can include: as many as their sequence numbers say (one heartbeat per cycle
+ * the node runs), but no more than their times allow (the cycle starts between them, plus
+ * one: a heartbeat can be stamped just after its cycle's end), and by their times alone
+ * when the sequence did not move forward (a restart, a corrupt sequence number); at least
+ * one, so that a heartbeat with a corrupt time blocks none after it. Before its first
+ * heartbeat: sequence + 1, the cycles up to h's. */
+static int64_t cycles_between(const log_summary_t *ls, const node_count_t *c, const heartbeat_t *h)
+{
+    if (!c->heard) {
+        return clamp_cycles(h->sequence) + 1;
     }
-    for (size_t h = 0; h < hb->count;) {
-        uint32_t node = hb->items[h].node;
-        int64_t most = 0;
-        for (; h < hb->count && hb->items[h].node == node; h++) {
-            if (hb->items[h].utime < to && hb->items[h].id > most) {
-                most = hb->items[h].id;
+    /* Times and sequence numbers are positive: the differences do not overflow. */
+    int64_t d = h->utime - c->last.utime;
+    int64_t by_time = d >= 0 ? clamp_cycles(d / ls->dt_us) + (d % ls->dt_us != 0 ? 1 : 0) + 1
+                             : 1 - clamp_cycles(-d / ls->dt_us);
+    int64_t by_sequence = clamp_cycles(h->sequence - c->last.sequence);
+    int64_t n = by_sequence >= 1 && by_sequence < by_time ? by_sequence : by_time;
+    return n > 1 ? n : 1;
+}
+
+static void note_heartbeat(log_summary_t *ls, int64_t *counter, const char *format, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+/* Counts an ignored heartbeat in *counter, with the reason when it is the first. */
+static void note_heartbeat(log_summary_t *ls, int64_t *counter, const char *format, ...)
+{
+    (*counter)++;
+    if (ls->heartbeat_ignored[0] == '\0') {
+        va_list args;
+        va_start(args, format);
+        vsnprintf(ls->heartbeat_ignored, sizeof ls->heartbeat_ignored, format, args);
+        va_end(args);
+    }
+}
+
+/* Judges heartbeat h of node c (kind k): accepted, or ignored when its plans_run goes back
+ * from c's last accepted one or grows from it by more than k.per_cycle a cycle. */
+static void count_heartbeat(log_summary_t *ls, node_count_t *c, node_kind_t k, const heartbeat_t *h,
+                            int64_t to)
+{
+    const int32_t from = c->heard ? c->last.plans_run : 0;
+    const int64_t cycles = cycles_between(ls, c, h);
+    if (h->plans_run < from) {
+        note_heartbeat(ls, &ls->heartbeats_backwards,
+                       "heartbeat: %s %u's plans_run goes back from %ld to %ld", k.name,
+                       (unsigned)h->node, (long)from, (long)h->plans_run);
+        return;
+    }
+    if ((int64_t)h->plans_run - from > cycles * k.per_cycle) {
+        note_heartbeat(ls, &ls->heartbeats_too_fast,
+                       "heartbeat: %s %u's plans_run goes from %ld to %ld in %lld cycles; it "
+                       "plans at most %lld times a cycle",
+                       k.name, (unsigned)h->node, (long)from, (long)h->plans_run, (long long)cycles,
+                       (long long)k.per_cycle);
+        return;
+    }
+    c->last = *h;
+    c->heard = true;
+    if (h->utime < to && h->plans_run > c->most) {
+        c->most = h->plans_run;
+    }
+}
+
+/* Replans up to `to` in *replans: per node of the run, the largest plans_run of its
+ * accepted heartbeats stamped before `to`, summed over the nodes. The nodes of the run are
+ * the scenario's UAVs and the run's coordinator; every heartbeat is judged in log order
+ * (count_heartbeat). Returns SIM_GO_ON or the exit status. */
+static int judge_heartbeats(log_summary_t *ls, int64_t to, uint32_t *replans)
+{
+    const size_t n = ls->s->vehicle_count;
+    long coordinator = run_coordinator(ls);
+    if (coordinator < 0) {
+        return coavoid_run_fail(ls->err, COAVOID_RUN_ERR_INTERNAL, "out of memory");
+    }
+    size_t uavs = n + ls->other_uavs;
+    uavs = uavs < COAVOID_NODE_MAX_PEERS ? uavs : COAVOID_NODE_MAX_PEERS;
+    const node_kind_t vehicle = {"UAV", VEHICLE_PLANS_PER_CYCLE};
+    const node_kind_t coord = {"coordinator", COORDINATOR_PLANS_PER_CLUSTER * (int64_t)uavs +
+                                                  COORDINATOR_ESCALATION_PLANS};
+    node_count_t counts[COA_MAX_VEHICLES + 1u];
+    memset(counts, 0, sizeof counts);
+    for (size_t q = 0; q < ls->heartbeats.count; q++) {
+        const heartbeat_t *h = &ls->heartbeats.items[q];
+        if (h->kind == COAVOID_STATUS_T_NODE_COORDINATOR && h->node == coordinator) {
+            count_heartbeat(ls, &counts[n], coord, h, to);
+        } else if (h->kind == COAVOID_STATUS_T_NODE_COORDINATOR) {
+            note_heartbeat(ls, &ls->heartbeats_other_node,
+                           "heartbeat: coordinator %u is not the run's (%ld, which sent the most "
+                           "heartbeats)",
+                           (unsigned)h->node, coordinator);
+        } else {
+            long i = coavoid_scenario_vehicle_index(ls->s, (long)h->node);
+            if (i >= 0) {
+                count_heartbeat(ls, &counts[i], vehicle, h, to);
+            } else {
+                note_heartbeat(ls, &ls->heartbeats_other_node,
+                               "heartbeat: UAV %u is not in the scenario", (unsigned)h->node);
             }
         }
-        total += (uint64_t)most;
     }
-    return total > UINT32_MAX ? UINT32_MAX : (uint32_t)total;
+    uint64_t total = 0;
+    for (size_t i = 0; i <= n; i++) {
+        total += (uint64_t)counts[i].most;
+    }
+    *replans = total > UINT32_MAX ? UINT32_MAX : (uint32_t)total;
+    return SIM_GO_ON;
 }
 
 /* ---- the flight ---- */
@@ -636,11 +873,7 @@ static int fill_samples(log_summary_t *ls, log_reader_t *r, rebuilt_t *b, int64_
             return rc;
         }
         if (strcmp(e->channel, COAVOID_CHANNEL_INTENT) == 0) {
-            long index = accept_intent(ls, e, false);
-            if (index == -3) {
-                lcm_eventlog_free_event(e);
-                return COAVOID_RUN_ERR_INPUT;
-            }
+            long index = accept_intent(ls, e, false); /* ignored ones (-3) too are skipped */
             const coavoid_intent_t *m = &ls->intent;
             for (int32_t j = 0; index >= 0 && j < m->sample_count; j++) {
                 /* The check bounds plan_utime to within an hour of a positive utime and j
@@ -704,6 +937,33 @@ static int fill_gaps(const coavoid_scenario_t *s, rebuilt_t *b)
 
 /* ---- output ---- */
 
+static int64_t heartbeats_ignored(const log_summary_t *ls)
+{
+    return ls->heartbeats_other_node + ls->heartbeats_backwards + ls->heartbeats_too_fast;
+}
+
+/* What was ignored, after the log's other lines and only when something was. */
+static void print_ignored_text(const log_summary_t *ls)
+{
+    if (ls->intents_ignored == 0 && heartbeats_ignored(ls) == 0) {
+        return;
+    }
+    fprintf(ls->out,
+            "ignored: %" PRId64
+            " intents (of scenario UAVs, disagreeing with the scenario); %" PRId64
+            " heartbeats (%" PRId64 " of nodes not in the run, %" PRId64
+            " with plans_run going back, %" PRId64
+            " with plans_run growing faster than the node can plan)\n",
+            ls->intents_ignored, heartbeats_ignored(ls), ls->heartbeats_other_node,
+            ls->heartbeats_backwards, ls->heartbeats_too_fast);
+    if (ls->intent_ignored[0] != '\0') {
+        fprintf(ls->out, "first ignored intent: %s\n", ls->intent_ignored);
+    }
+    if (ls->heartbeat_ignored[0] != '\0') {
+        fprintf(ls->out, "first ignored heartbeat: %s\n", ls->heartbeat_ignored);
+    }
+}
+
 static void print_log_text(const log_summary_t *ls, const rebuilt_t *b, int64_t epoch)
 {
     fprintf(ls->out,
@@ -727,6 +987,7 @@ static void print_log_text(const log_summary_t *ls, const rebuilt_t *b, int64_t 
             " from an earlier plan, %" PRId64 " not covered by any intent (scenario reference, "
             "offset held)\n",
             b->own_samples, b->earlier_samples, b->missing_samples);
+    print_ignored_text(ls);
 }
 
 /* An integer printed as one: cJSON would print a microsecond time as 1.7e+15. */
@@ -735,6 +996,20 @@ static bool add_count(cJSON *obj, const char *key, int64_t value)
     char text[24];
     snprintf(text, sizeof text, "%" PRId64, value);
     return cJSON_AddRawToObject(obj, key, text) != NULL;
+}
+
+/* The counts of what was ignored, and the first reasons, into the log object. */
+static bool add_ignored(cJSON *log, const log_summary_t *ls)
+{
+    return add_count(log, "intents_ignored", ls->intents_ignored) &&
+           add_count(log, "heartbeats_ignored", heartbeats_ignored(ls)) &&
+           add_count(log, "heartbeats_ignored_other_nodes", ls->heartbeats_other_node) &&
+           add_count(log, "heartbeats_ignored_backwards", ls->heartbeats_backwards) &&
+           add_count(log, "heartbeats_ignored_too_fast", ls->heartbeats_too_fast) &&
+           (ls->intent_ignored[0] == '\0' ||
+            cJSON_AddStringToObject(log, "first_ignored_intent", ls->intent_ignored) != NULL) &&
+           (ls->heartbeat_ignored[0] == '\0' ||
+            cJSON_AddStringToObject(log, "first_ignored_heartbeat", ls->heartbeat_ignored) != NULL);
 }
 
 /* The flight's JSON with a "log" object added. The log object holds only integers and
@@ -757,7 +1032,8 @@ static int print_json(const log_summary_t *ls, const rebuilt_t *b, int64_t epoch
               add_count(log, "samples_earlier_plan", b->earlier_samples) &&
               add_count(log, "samples_missing", b->missing_samples) &&
               (ls->intent_reason == NULL ||
-               cJSON_AddStringToObject(log, "first_refused_intent", ls->intent_reason) != NULL);
+               cJSON_AddStringToObject(log, "first_refused_intent", ls->intent_reason) != NULL) &&
+              add_ignored(log, ls);
     char *log_text = ok ? cJSON_PrintUnformatted(log) : NULL;
     cJSON_Delete(log);
     if (log_text == NULL) {
@@ -846,8 +1122,91 @@ static int summary_check(log_summary_t *ls)
     return SIM_GO_ON;
 }
 
-/* Pass 1: counts, who was seen, the epoch (the earliest plan time unless --epoch), the
- * log's size (pass 2 reads the same bytes) and the last cycle every UAV's intent covers. */
+/* Every scenario UAV has an accepted intent, else the log is not a run of the scenario:
+ * SIM_GO_ON, or the exit status after naming the first UAV without one (and why, when
+ * its intents were all ignored). */
+static int check_every_uav(log_summary_t *ls)
+{
+    const coavoid_sim_log_config_t *o = ls->o;
+    const coavoid_scenario_t *s = ls->s;
+    for (size_t i = 0; i < s->vehicle_count; i++) {
+        if (ls->intents_of[i] > 0) {
+            continue;
+        }
+        const disagreement_t *d = &ls->disagreement_of[i];
+        if (ls->ignored_of[i] == 0) {
+            return coavoid_run_fail(ls->err, COAVOID_RUN_ERR_INPUT,
+                                    "%s: UAV %u of %s never published an accepted intent "
+                                    "(%" PRId64 " intents in the log, %" PRId64 " refused)",
+                                    o->log_path, (unsigned)s->vehicles[i].id, o->scenario_path,
+                                    ls->intents, ls->intents_refused);
+        }
+        return coavoid_run_fail(
+            ls->err, COAVOID_RUN_ERR_INPUT,
+            "%s: UAV %u of %s never published an accepted intent: its intents have %s %.17g, "
+            "%s says %.17g: not a run of this scenario (%" PRId64 " intents in the log, %" PRId64
+            " refused, %" PRId64 " ignored)",
+            o->log_path, (unsigned)s->vehicles[i].id, o->scenario_path, d->field, d->theirs,
+            o->scenario_path, d->ours, ls->intents, ls->intents_refused, ls->intents_ignored);
+    }
+    return SIM_GO_ON;
+}
+
+/* An accepted intent's plan_utime and its residue modulo dt: which cycle grid it is on. */
+typedef struct {
+    int64_t residue;
+    int64_t plan_utime;
+} grid_point_t;
+
+static int grid_point_compare(const void *a, const void *b)
+{
+    const grid_point_t *p = a;
+    const grid_point_t *q = b;
+    if (p->residue != q->residue) {
+        return p->residue < q->residue ? -1 : 1;
+    }
+    if (p->plan_utime != q->plan_utime) {
+        return p->plan_utime < q->plan_utime ? -1 : 1;
+    }
+    return 0;
+}
+
+/* The epoch the log shows: the earliest plan_utime of the scenario's UAVs' accepted intents
+ * on the run's cycle grid, the residue of plan_utime modulo dt that most of them have (ties:
+ * the grid that starts earliest). -1 out of memory. */
+static int64_t run_epoch(const log_summary_t *ls)
+{
+    const size_t count = ls->seen.count; /* > 0: every UAV has one */
+    grid_point_t *grid = malloc(count * sizeof *grid);
+    if (grid == NULL) {
+        return -1;
+    }
+    for (size_t q = 0; q < count; q++) {
+        int64_t p = ls->seen.items[q].plan_utime; /* positive */
+        grid[q] = (grid_point_t){p % ls->dt_us, p};
+    }
+    qsort(grid, count, sizeof *grid, grid_point_compare);
+    size_t best_count = 0;
+    int64_t best = INT64_MAX;
+    for (size_t q = 0; q < count;) {
+        size_t end = q;
+        while (end < count && grid[end].residue == grid[q].residue) {
+            end++;
+        }
+        /* grid[q] is the earliest on its grid. */
+        if (end - q > best_count || (end - q == best_count && grid[q].plan_utime < best)) {
+            best_count = end - q;
+            best = grid[q].plan_utime;
+        }
+        q = end;
+    }
+    free(grid);
+    return best;
+}
+
+/* Pass 1: counts, who was seen, the epoch (the earliest plan time on the run's grid unless
+ * --epoch), the log's size (pass 2 reads the same bytes) and the last cycle every UAV's
+ * intent covers. */
 static int summary_pass1(log_summary_t *ls, rebuilt_t *b, int64_t *epoch, int64_t *size)
 {
     const coavoid_sim_log_config_t *o = ls->o;
@@ -860,21 +1219,16 @@ static int summary_pass1(log_summary_t *ls, rebuilt_t *b, int64_t *epoch, int64_
     }
     *size = r.size;
     log_close(&r);
-    int64_t earliest = INT64_MAX;
-    for (size_t i = 0; i < s->vehicle_count && status == SIM_GO_ON; i++) {
-        if (ls->intents_of[i] == 0) {
-            status = coavoid_run_fail(ls->err, COAVOID_RUN_ERR_INPUT,
-                                      "%s: UAV %u of %s never published an accepted intent "
-                                      "(%" PRId64 " intents in the log, %" PRId64 " refused)",
-                                      o->log_path, (unsigned)s->vehicles[i].id, o->scenario_path,
-                                      ls->intents, ls->intents_refused);
-        }
-        earliest = ls->first_plan_utime[i] < earliest ? ls->first_plan_utime[i] : earliest;
+    if (status == SIM_GO_ON) {
+        status = check_every_uav(ls);
     }
     if (status != SIM_GO_ON) {
         return status;
     }
-    *epoch = !o->has_epoch ? earliest : o->epoch;
+    *epoch = o->has_epoch ? o->epoch : run_epoch(ls);
+    if (*epoch < 0) {
+        return coavoid_run_fail(ls->err, COAVOID_RUN_ERR_INTERNAL, "out of memory");
+    }
     uint32_t cap = s->horizon > COA_MAX_HORIZON / 2u ? COA_MAX_HORIZON : 2u * s->horizon;
     int64_t k = last_complete_cycle(ls, *epoch, cap, &b->off_grid);
     if (k < 0) {
@@ -929,7 +1283,11 @@ static int summary_report(log_summary_t *ls, rebuilt_t *b, int64_t epoch)
     const coavoid_flight_t *flight = &judged.flight;
     const coavoid_flight_eval_t *eval = &judged.eval;
     int status = SIM_GO_ON;
-    uint32_t replans = count_replans(ls, epoch + ((int64_t)b->steps + 1) * ls->dt_us);
+    uint32_t replans = 0;
+    status = judge_heartbeats(ls, epoch + ((int64_t)b->steps + 1) * ls->dt_us, &replans);
+    if (status != SIM_GO_ON) {
+        return status;
+    }
     int rc = coavoid_judge_run(&judged, ls->s, o->mode, b->steps, replans, b->reference, b->offsets,
                                b->known);
     if (rc == COA_ERR_ARGUMENT) {

@@ -4,7 +4,9 @@
 # test_flight --write-log (the paper scenario planned, a head-on encounter flown without
 # manoeuvre, logs with intents missing, an abandoned plan logged late, refused and foreign
 # messages), the result follows the simulation result's contract and its numbers check out
-# against an independent recomputation here; truncated, corrupt and foreign files and every
+# against an independent recomputation here; valid messages that cannot be the run's (an
+# intent that disagrees with the scenario, a bit-flipped plans_run, a heartbeat of another
+# node) are ignored and counted, and the verdict, costs and replans are the clean log's; truncated, corrupt and foreign files and every
 # bad argument exit 2 with one line; the figure is well-formed XML. When lcm-logger and
 # UDP multicast are available, a log written by the real logger gives the same answer.
 #
@@ -177,6 +179,167 @@ for va, vb in zip(a["vehicles"], b["vehicles"]):
         else
             fail "--epoch: $(tail -n 2 "$tmp/py.err")"
         fi
+    fi
+fi
+
+# ---- valid messages that cannot be the run's: ignored and counted, the verdict kept ----
+# Copies of the paper log's messages, changed and inserted after the original (a forgery,
+# or a bit flip that still validates), encoded with the types lcm-gen generates for
+# Python. Each log is judged as the clean one ($tmp/paper.json): same verdict, steps,
+# replans, costs and flight; the log object counts what was ignored, and why.
+if [ -f "$tmp/paper.json" ] && ! lcm-gen -p --ppath "$tmp/py" "$src"/lcmtypes/*.lcm >/dev/null 2>&1; then
+    fail "lcm-gen -p failed: cannot write changed messages"
+elif [ -f "$tmp/paper.json" ]; then
+    # mutate.py IN OUT EDIT...: OUT is IN with, per EDIT, a changed copy of a message
+    # inserted right after it, or every intent of a UAV changed in place:
+    #   intent:UAV:CYCLE:CHANGES   a copy of UAV's intent of cycle CYCLE (its sequence)
+    #   status:NODE:SEQ:CHANGES    a copy of node NODE's heartbeat with sequence SEQ
+    #   every-intent:UAV:CHANGES   every intent of UAV changed
+    # CHANGES: field=value or field+=delta, comma-separated.
+    cat >"$tmp/mutate.py" <<'PY'
+import struct, sys
+sys.path.insert(0, sys.argv[1])
+from coavoid import intent_t, status_t
+src, out, edits = sys.argv[2], sys.argv[3], [e.split(":") for e in sys.argv[4:]]
+data = open(src, "rb").read()
+events, i = [], 0
+while i < len(data):
+    magic, number, utime, clen, dlen = struct.unpack_from(">Iqqii", data, i)
+    channel = data[i + 28:i + 28 + clen]
+    payload = data[i + 28 + clen:i + 28 + clen + dlen]
+    events.append([utime, channel, payload])
+    i += 28 + clen + dlen
+
+def change(m, changes):
+    for c in changes.split(","):
+        if "+=" in c:
+            field, value = c.split("+=")
+            setattr(m, field, getattr(m, field) + type(getattr(m, field))(value))
+        else:
+            field, value = c.split("=")
+            setattr(m, field, type(getattr(m, field))(value))
+    return m.encode()
+
+done, result = set(), []
+for utime, channel, payload in events:
+    result.append([utime, channel, payload])
+    for n, e in enumerate(edits):
+        if channel == b"COAVOID_INTENT" and e[0] in ("intent", "every-intent"):
+            m = intent_t.decode(payload)
+            if m.uav_id != int(e[1]) or (e[0] == "intent" and m.sequence != int(e[2])):
+                continue
+            if e[0] == "intent":
+                result.append([utime + 1, channel, change(m, e[3])])
+            else:
+                result[-1][2] = change(m, e[2])
+            done.add(n)
+        elif channel == b"COAVOID_STATUS" and e[0] == "status":
+            m = status_t.decode(payload)
+            if m.node_id == int(e[1]) and m.sequence == int(e[2]):
+                result.append([utime + 1, channel, change(m, e[3])])
+                done.add(n)
+assert done == set(range(len(edits))), f"no message for {[edits[n] for n in range(len(edits)) if n not in done]}"
+with open(out, "wb") as f:
+    for number, (utime, channel, payload) in enumerate(result):
+        f.write(struct.pack(">Iqqii", 0xEDA1DA01, number, utime, len(channel), len(payload)))
+        f.write(channel + payload)
+PY
+    # same_run DESCRIPTION LOG EXPECT_JSON: LOG's JSON result is the clean log's but for
+    # the log object, which has EXPECT_JSON's values.
+    same_run() {
+        local what=$1 log=$2 expect=$3
+        if expect_status "$what: json" 0 summary "$log" "$paper" --mode centralised --json; then
+            if python3 - "$tmp/paper.json" "$tmp/out" "$expect" 2>"$tmp/py.err" <<'PY'; then
+import json, sys
+a, b = (json.load(open(p)) for p in sys.argv[1:3])
+for k in ("steps", "replans", "loss_of_separation", "deviation", "effort"):
+    assert a[k] == b[k], (k, a[k], b[k])
+assert [v["flown"] for v in a["vehicles"]] == [v["flown"] for v in b["vehicles"]]
+assert list(b["log"])[:len(a["log"])] == list(a["log"]), "the log object's keys moved"
+for k, v in json.loads(sys.argv[3]).items():
+    got = b["log"].get(k)
+    ok = v in got if isinstance(v, str) and k.startswith("first_") else got == v
+    assert ok, f"log.{k}: {got!r}, expected {v!r}"
+PY
+                pass
+            else
+                fail "$what: $(tail -n 2 "$tmp/py.err")"
+            fi
+        fi
+    }
+    # write_mutated NAME EDIT...: $tmp/NAME.log from the paper log.
+    write_mutated() {
+        local name=$1
+        shift
+        if python3 "$tmp/mutate.py" "$tmp/py" "$tmp/paper.log" "$tmp/$name.log" "$@" 2>"$tmp/py.err"; then
+            return 0
+        fi
+        fail "writing $name.log: $(tail -n 2 "$tmp/py.err")"
+        return 1
+    }
+    # 1. An intent of UAV 2 at cycle 24 with another cruise speed: one ignored intent.
+    if write_mutated odd_intent intent:2:24:cruise_speed+=1; then
+        same_run "an odd intent" "$tmp/odd_intent.log" '{"intents": 150, "intents_refused": 1,
+            "intents_other_uavs": 1, "intents_ignored": 1, "heartbeats_ignored": 0,
+            "samples_own_intent": 147, "first_ignored_intent": "UAV 2'"'"'s cruise_speed"}'
+        if expect_status "an odd intent: text" 0 summary "$tmp/odd_intent.log" "$paper" --mode centralised; then
+            for line in "ignored: 1 intents (of scenario UAVs, disagreeing with the scenario); 0 heartbeats" \
+                "first ignored intent: intent: UAV 2's cruise_speed" "loss of separation: no"; do
+                if grep -qF -- "$line" "$tmp/out"; then pass; else fail "odd intent text lacks '$line'"; fi
+            done
+        fi
+    fi
+    # ... and one of UAV 1 at cycle 0 with another radius.
+    if write_mutated odd_radius intent:1:0:radius+=5; then
+        same_run "an odd radius" "$tmp/odd_radius.log" '{"intents_ignored": 1,
+            "first_ignored_intent": "UAV 1'"'"'s radius"}'
+    fi
+    # 2. The coordinator's heartbeat of cycle 20 again with bit 30 of plans_run (1) set:
+    # 1073741824 more planning calls than in its heartbeat just before, when it makes at
+    # most 2 x 4 + 4 a cycle (2 per cluster, a cluster per UAV: the scenario's 3 and the
+    # junk's UAV 4242; 4 more when it escalates).
+    if write_mutated flipped_heartbeat status:65001:20:plans_run=1073741825; then
+        same_run "a bit-flipped plans_run" "$tmp/flipped_heartbeat.log" '{"heartbeats": 197,
+            "heartbeats_refused": 0, "heartbeats_ignored": 1, "heartbeats_ignored_too_fast": 1,
+            "intents_ignored": 0,
+            "first_ignored_heartbeat": "coordinator 65001'"'"'s plans_run goes from 1 to 1073741825 in 1 cycles; it plans at most 12 times a cycle"}'
+        if expect_status "a bit-flipped plans_run: text" 0 summary "$tmp/flipped_heartbeat.log" "$paper" --mode centralised; then
+            if grep -qxF "replans: 1" "$tmp/out"; then pass; else fail "bit-flipped plans_run: $(grep replans "$tmp/out")"; fi
+            for line in "197 heartbeats (0 refused)" \
+                "ignored: 0 intents (of scenario UAVs, disagreeing with the scenario); 1 heartbeats (0 of nodes not in the run, 0 with plans_run going back, 1 with plans_run growing faster than the node can plan)" \
+                "first ignored heartbeat: heartbeat: coordinator 65001's plans_run goes from 1 to 1073741825"; do
+                if grep -qF -- "$line" "$tmp/out"; then pass; else fail "bit-flipped plans_run text lacks '$line'"; fi
+            done
+        fi
+    fi
+    # Other heartbeats that would have added to the replans: 3257807038 (plans_run is an
+    # int32: negative, refused by validation), another coordinator id (a flipped node_id)
+    # and a UAV that is not in the scenario, each with a plans_run of their own; one that
+    # goes back; a UAV's first heartbeat with more than its 2 planning calls.
+    if write_mutated odd_heartbeats status:65001:21:plans_run=-1037160258 \
+        status:65001:22:node_id=65003 status:1:5:node_id=77,plans_run=2 \
+        status:65001:30:plans_run=0 status:2:0:plans_run=3; then
+        same_run "odd heartbeats" "$tmp/odd_heartbeats.log" '{"heartbeats": 201,
+            "heartbeats_refused": 1, "heartbeats_ignored": 4, "heartbeats_ignored_other_nodes": 2,
+            "heartbeats_ignored_backwards": 1, "heartbeats_ignored_too_fast": 1,
+            "first_ignored_heartbeat": "heartbeat: UAV 2'"'"'s plans_run goes from 0 to 3 in 1 cycles"}'
+    fi
+    # 3. An intent of a UAV that is not in the scenario: counted as such, not ignored.
+    if write_mutated other_uav intent:2:10:uav_id=77; then
+        same_run "an intent of UAV 77" "$tmp/other_uav.log" '{"intents": 150,
+            "intents_other_uavs": 2, "intents_ignored": 0, "intents_refused": 1}'
+    fi
+    # An intent with bit 20 of plan_utime flipped (2^20 us earlier): off the run's cycle
+    # grid, it neither becomes the epoch nor spoils the cycles.
+    if write_mutated off_grid intent:1:0:plan_utime+=-1048576; then
+        same_run "an intent off the grid" "$tmp/off_grid.log" '{"intents_off_grid": 1,
+            "epoch_utime": 1700000000000000, "intents_ignored": 0}'
+    fi
+    # Every intent of UAV 2 with another radius: not a run of the scenario.
+    if write_mutated all_odd every-intent:2:radius+=1; then
+        also="not a run of this scenario" expect_bad "every intent of a UAV odd" \
+            "UAV 2 of $paper never published an accepted intent: its intents have radius" \
+            summary "$tmp/all_odd.log" "$paper" --mode centralised
     fi
 fi
 
