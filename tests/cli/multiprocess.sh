@@ -26,6 +26,8 @@ scenarios=$src/scenarios
 apps=$(dirname "$bin")
 coordinator=$apps/coavoid-coordinator
 vehicle=$apps/coavoid-vehicle
+# The attacker (tests/forge/forge.c), argument 3.
+forge=${3:-}
 if [ ! -x "$coordinator" ] || [ ! -x "$vehicle" ]; then
     echo "FAIL: no coavoid-coordinator/coavoid-vehicle beside $bin (CMake adds this test only with LCM)" >&2
     exit 1
@@ -139,6 +141,13 @@ fleet() {
         "$coordinator" --scenario "$scenario" "${common[@]}" "$@" 2>"$dir/coordinator.txt" &
         cpid=$!
         pids+=("$cpid") names+=(coordinator)
+    fi
+    if [ -n "${attack:-}" ]; then
+        local seconds
+        seconds=$(awk -v l="$lead_us" -v n="$steps" -v s="$speed" 'BEGIN { print l / 1e6 + n / s + 1 }')
+        "$forge" --lcm-url "$url" --attack "$attack" --seconds "$seconds" --target 1 --other 2 \
+            >"$dir/forge.txt" 2>&1 &
+        pids+=($!) names+=(forge)
     fi
     local id
     for id in $(ids "$scenario"); do
@@ -356,5 +365,35 @@ s['replans'] == sum(num(f'vehicle-{i}', 'plans run') for i in (1, 2, 3))
 (lambda m: (s['deviation'], s['effort'], s['replans']) == (m['deviation'], m['effort'], m['replans']))(json.load(open(os.path.join(d, 'sim.json'))))
 [v['flown'] for v in s['vehicles']] == [v['flown'] for v in json.load(open(os.path.join(d, 'sim.json')))['vehicles']]
 "
+
+# ---- d) an attacker on the group: forged maps and plans (tests/forge/forge.c) ----
+
+# Each flight of the paper's encounter ends with no loss of separation and the forgery
+# reported by the vehicles it reached:
+#   map      an empty map with the world's id and the largest version (it would erase
+#            the terrain under UAV 1 and lock the real map out as older): every node keeps
+#            the scenario's terrain, and refuses the real maps as older;
+#   collide  a plan for UAV 1 from the configured coordinator's id that flies it to UAV
+#            2's altitude: refused, as flying into another UAV.
+# (A plan into the terrain is refused the same way: test_node's test_plan_into_terrain_refused.)
+if [ -z "$forge" ] || [ ! -x "$forge" ]; then
+    fail "no attacker program (argument 3: coavoid_test_forge): the attacks are not flown"
+else
+    speed=${SPEED:-4}
+    for attack in map collide; do
+        fleet "attack-$attack" "$tmp/paper_lead_in.json" centralised 48 -
+    done
+    speed=$speed_decoupled
+    attack=map fleet attack-map-decoupled "$tmp/paper_lead_in.json" decoupled 48 -
+    attack=
+    survived="s is not None and s['loss_of_separation'] is False
+rc['summary'] == 0 and rc['forge'] == 0 and num('forge', 'forged') >= 5"
+    check attack-map "$survived
+all(num(f'vehicle-{i}', 'rejected') >= 1 for i in (1, 2, 3)) and num('coordinator', 'rejected') >= 1"
+    check attack-map-decoupled "$survived
+all(num(f'vehicle-{i}', 'rejected') >= 1 for i in (1, 2, 3))"
+    check attack-collide "$survived
+num('vehicle-1', 'rejected') >= 1 and 'another UAV' in text['vehicle-1']"
+fi
 
 finish
