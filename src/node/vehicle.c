@@ -730,6 +730,18 @@ void coavoid_vehicle_node_destroy(coavoid_vehicle_node_t *node)
     free(node);
 }
 
+/* Enters cycle k at `now`: the inbox aged, and the UAV at sample k of its plan. */
+static void fly_to(coavoid_vehicle_node_t *node, int64_t k, int64_t now)
+{
+    node->state.cycle = k;
+    node->cycle_start = coavoid_node_cycle_utime(&node->config.common, k);
+    coavoid_node_inbox_expire(&node->inbox, now);
+    build_own(node, k);
+    node->state.offset = node->own_offsets[0];
+    node->state.reference = node->own_reference[0];
+    node->state.position = node->own_samples[0];
+}
+
 int coavoid_vehicle_node_cycle(coavoid_vehicle_node_t *node, int64_t now)
 {
     if (node == NULL) {
@@ -753,14 +765,7 @@ int coavoid_vehicle_node_cycle(coavoid_vehicle_node_t *node, int64_t now)
     node->cycle_plan_adopted = false;
     node->cycle_plan_failed = false;
     node->row_count = 0;
-    node->state.cycle = k;
-    node->cycle_start = coavoid_node_cycle_utime(c, k);
-    coavoid_node_inbox_expire(&node->inbox, now);
-
-    build_own(node, k);
-    node->state.offset = node->own_offsets[0];
-    node->state.reference = node->own_reference[0];
-    node->state.position = node->own_samples[0];
+    fly_to(node, k, now);
 
     /* A coordinator answers, within its cycle, for the conflicts of the UAVs that follow
      * it. One that followed it, had a conflict of its own and got no answer in that cycle
