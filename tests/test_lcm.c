@@ -1007,6 +1007,28 @@ START_TEST(test_reject_status)
     EXPECT(coavoid_status_t, status, m_.messages_rejected = 1001, COAVOID_LCM_ERR_COUNT);
     EXPECT(coavoid_status_t, status, m_.messages_received = -1, COAVOID_LCM_ERR_COUNT);
     EXPECT(coavoid_status_t, status, m_.last_reject_code = 1, COAVOID_LCM_ERR_VALUE);
+    /* reasons: known bits only, none exactly when OK, a fatal one exactly when FAULT. */
+    EXPECT(coavoid_status_t, status, m_.reasons = COAVOID_STATUS_T_REASON_NO_MAP,
+           COAVOID_LCM_ERR_VALUE);
+    EXPECT(coavoid_status_t, status, (m_.health = COAVOID_STATUS_T_HEALTH_DEGRADED, m_.reasons = 0),
+           COAVOID_LCM_ERR_VALUE);
+    EXPECT(coavoid_status_t, status,
+           (m_.health = COAVOID_STATUS_T_HEALTH_DEGRADED, m_.reasons = 512), COAVOID_LCM_ERR_VALUE);
+    EXPECT(coavoid_status_t, status,
+           (m_.health = COAVOID_STATUS_T_HEALTH_DEGRADED,
+            m_.reasons = COAVOID_STATUS_T_REASON_DUPLICATE_ID),
+           COAVOID_LCM_ERR_VALUE);
+    EXPECT(coavoid_status_t, status,
+           (m_.health = COAVOID_STATUS_T_HEALTH_FAULT, m_.reasons = COAVOID_STATUS_T_REASON_NO_MAP),
+           COAVOID_LCM_ERR_VALUE);
+    EXPECT(coavoid_status_t, status,
+           (m_.health = COAVOID_STATUS_T_HEALTH_FAULT,
+            m_.reasons = COAVOID_STATUS_T_REASON_INTERNAL_ERROR | COAVOID_STATUS_T_REASON_NO_MAP),
+           COA_OK);
+    EXPECT(coavoid_status_t, status,
+           (m_.health = COAVOID_STATUS_T_HEALTH_DEGRADED,
+            m_.reasons = COAVOID_STATUS_T_REASON_NO_PLAN | COAVOID_STATUS_T_REASON_STALE_PEERS),
+           COA_OK);
 }
 END_TEST
 

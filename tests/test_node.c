@@ -113,6 +113,10 @@ static void heartbeat_from(lcm_t *lcm, int64_t now, int64_t sequence, int32_t no
     m.node_kind = COAVOID_STATUS_T_NODE_COORDINATOR;
     m.sequence = sequence;
     m.health = health;
+    m.reasons = health == COAVOID_STATUS_T_HEALTH_FAULT ? COAVOID_STATUS_T_REASON_INTERNAL_ERROR
+                : health == COAVOID_STATUS_T_HEALTH_DEGRADED
+                    ? COAVOID_STATUS_T_REASON_PLANNING_FAILED
+                    : 0;
     m.mode = COAVOID_STATUS_T_MODE_CENTRALISED;
     m.outcome = COAVOID_STATUS_T_OUTCOME_NONE;
     ck_assert_int_eq(coavoid_status_t_publish(lcm, COAVOID_CHANNEL_STATUS, &m), 0);
@@ -163,6 +167,18 @@ static void plan_msg(lcm_t *lcm, int64_t now, int64_t plan_id, int64_t valid_fro
 {
     plan_msg_from(lcm, now, (int32_t)COAVOID_NODE_COORDINATOR_ID, plan_id, valid_from, id, horizon,
                   shift);
+}
+
+/* An obstacle map with no obstacles from the world: a node that has none reports
+ * REASON_NO_MAP, so the health tests give theirs one first. */
+static void empty_map(lcm_t *lcm, int64_t now)
+{
+    coavoid_obstacle_map_t m;
+    memset(&m, 0, sizeof m);
+    m.utime = now;
+    m.map_id = (int32_t)COAVOID_NODE_WORLD_ID;
+    m.version = 1;
+    ck_assert_int_eq(coavoid_obstacle_map_t_publish(lcm, COAVOID_CHANNEL_OBSTACLES, &m), 0);
 }
 
 /* ---- counting ---- */
@@ -564,6 +580,7 @@ typedef struct {
     int32_t node_id;
     int count;
     int8_t health;
+    int32_t reasons;
 } health_probe_t;
 
 static void on_status_probe(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
@@ -575,6 +592,7 @@ static void on_status_probe(const lcm_recv_buf_t *rbuf, const char *channel, voi
     if (m.node_id == p->node_id) {
         p->count++;
         p->health = m.health;
+        p->reasons = m.reasons;
     }
 }
 
@@ -585,23 +603,25 @@ START_TEST(test_duplicate_id_reported)
 {
     rig_t r;
     rig_init(&r, 10);
-    health_probe_t probe = {1, 0, -1};
+    health_probe_t probe = {1, 0, -1, 0};
     lcm_subscription_t *sub = lcm_subscribe(r.lcm, COAVOID_CHANNEL_STATUS, on_status_probe, &probe);
     coa_vec3_t r1[2], r2[2];
     coavoid_vehicle_node_t *a =
         vehicle_node(&r, uav(1, 1, r1, 0, 500, 0, 100), COAVOID_NODE_DECOUPLED);
     const coavoid_vehicle_node_state_t *s = coavoid_vehicle_node_state(a);
+    empty_map(r.lcm, r.now);
+    drain(r.lcm);
     ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
     drain(r.lcm);
     ck_assert_int_eq(probe.health, COAVOID_STATUS_T_HEALTH_OK);
-    ck_assert_int_eq(s->rx.received, 0); /* its own intent came back: not counted */
+    ck_assert_int_eq(s->rx.received, 1); /* the map; its own intent came back: not counted */
     /* Its twin starts in the same cycle, on the same clock: the same utime and sequence. */
     coavoid_vehicle_node_t *b =
         vehicle_node(&r, uav(1, 1, r2, 0, 500, 800, 100), COAVOID_NODE_DECOUPLED);
     ck_assert_int_eq(coavoid_vehicle_node_cycle(b, r.now), COA_OK);
     drain(r.lcm);
     coavoid_vehicle_node_destroy(b);
-    ck_assert_int_eq(s->rx.received, 1);
+    ck_assert_int_eq(s->rx.received, 2);
     ck_assert_int_eq(s->rx.rejected, 1);
     ck_assert_int_eq(s->rx.last_reject_code, COAVOID_LCM_ERR_ID);
     ck_assert_str_eq(s->rx.last_reason, "intent: another UAV uses this node's id");
@@ -609,12 +629,51 @@ START_TEST(test_duplicate_id_reported)
     ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
     drain(r.lcm);
     ck_assert_int_eq(probe.health, COAVOID_STATUS_T_HEALTH_FAULT);
+    ck_assert(probe.reasons & COAVOID_STATUS_T_REASON_DUPLICATE_ID);
     /* The twin is gone: no fault any more. */
     r.now = cycle(2);
     ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
     drain(r.lcm);
     ck_assert_int_ne(probe.health, COAVOID_STATUS_T_HEALTH_FAULT);
-    ck_assert_int_eq(s->rx.received, 1);
+    ck_assert_int_eq(s->rx.received, 2);
+    lcm_unsubscribe(r.lcm, sub);
+    coavoid_vehicle_node_destroy(a);
+    lcm_destroy(r.lcm);
+}
+END_TEST
+
+/* A heartbeat says why it is not OK: no map yet (REASON_NO_MAP), then a refused plan for
+ * it (REASON_PLAN_REFUSED, in the next cycle's heartbeat, which comes before that cycle's
+ * plans), and OK once neither holds. */
+START_TEST(test_health_reasons)
+{
+    rig_t r;
+    rig_init(&r, 10);
+    health_probe_t probe = {1, 0, -1, 0};
+    lcm_subscription_t *sub = lcm_subscribe(r.lcm, COAVOID_CHANNEL_STATUS, on_status_probe, &probe);
+    coa_vec3_t route[2];
+    coavoid_vehicle_node_t *a =
+        vehicle_node(&r, uav(1, 1, route, 0, 500, 0, 100), COAVOID_NODE_CENTRALISED);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, cycle(0)), COA_OK);
+    drain(r.lcm);
+    ck_assert_int_eq(probe.health, COAVOID_STATUS_T_HEALTH_DEGRADED);
+    ck_assert_int_eq(probe.reasons, COAVOID_STATUS_T_REASON_NO_MAP);
+    empty_map(r.lcm, cycle(0));
+    drain(r.lcm);
+    r.now = cycle(0) + DT_US / 4;
+    plan_msg(r.lcm, r.now, 1, cycle(0), 1, 10, 3); /* not from the offset it flies: refused */
+    drain(r.lcm);
+    r.now = cycle(1);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
+    drain(r.lcm);
+    ck_assert_int_eq(probe.health, COAVOID_STATUS_T_HEALTH_DEGRADED);
+    ck_assert_int_eq(probe.reasons, COAVOID_STATUS_T_REASON_PLAN_REFUSED |
+                                        COAVOID_STATUS_T_REASON_MESSAGES_REFUSED);
+    r.now = cycle(2);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
+    drain(r.lcm);
+    ck_assert_int_eq(probe.health, COAVOID_STATUS_T_HEALTH_OK);
+    ck_assert_int_eq(probe.reasons, 0);
     lcm_unsubscribe(r.lcm, sub);
     coavoid_vehicle_node_destroy(a);
     lcm_destroy(r.lcm);
@@ -628,8 +687,8 @@ START_TEST(test_refusals_degrade_health)
 {
     rig_t r;
     rig_init(&r, 10);
-    health_probe_t pa = {1, 0, -1};
-    health_probe_t pc = {(int32_t)COAVOID_NODE_COORDINATOR_ID, 0, -1};
+    health_probe_t pa = {1, 0, -1, 0};
+    health_probe_t pc = {(int32_t)COAVOID_NODE_COORDINATOR_ID, 0, -1, 0};
     lcm_subscription_t *sa = lcm_subscribe(r.lcm, COAVOID_CHANNEL_STATUS, on_status_probe, &pa);
     lcm_subscription_t *sc = lcm_subscribe(r.lcm, COAVOID_CHANNEL_STATUS, on_status_probe, &pc);
     coa_vec3_t r1[2], r2[2];
@@ -656,6 +715,8 @@ START_TEST(test_refusals_degrade_health)
     const char junk[3] = {1, 2, 3};
     for (int64_t k = 0; k <= 3; k++) {
         r.now = cycle(k);
+        empty_map(r.lcm, r.now);
+        drain(r.lcm);
         ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
         drain(r.lcm);
         ck_assert_int_eq(coavoid_coordinator_cycle(co, r.now + DT_US / 4), COA_OK);
@@ -1402,6 +1463,7 @@ static Suite *node_suite(void)
     tcase_add_test(tc, test_plan_into_other_uav_refused);
     tcase_add_test(tc, test_duplicate_id_reported);
     tcase_add_test(tc, test_refusals_degrade_health);
+    tcase_add_test(tc, test_health_reasons);
     tcase_add_test(tc, test_fallback_and_return);
     tcase_add_test(tc, test_configured_coordinator_only);
     tcase_add_test(tc, test_faulty_coordinator_not_followed);

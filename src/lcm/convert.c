@@ -1196,6 +1196,27 @@ int coavoid_lcm_conflict_report_accept(const coavoid_conflict_report_t *msg,
 
 /* ---- status ---- */
 
+/* Known REASON_* bits only, none exactly when OK, and a FAULT exactly when a fatal one is
+ * set. */
+static bool status_reasons_ok(const coavoid_status_t *msg)
+{
+    const int32_t known = 2 * COAVOID_STATUS_T_REASON_NO_PLAN - 1;
+    const int32_t fatal =
+        COAVOID_STATUS_T_REASON_INTERNAL_ERROR | COAVOID_STATUS_T_REASON_DUPLICATE_ID;
+    const int32_t r = msg->reasons;
+    if (r < 0 || (r & ~known) != 0) {
+        return false;
+    }
+    switch (msg->health) {
+    case COAVOID_STATUS_T_HEALTH_OK:
+        return r == 0;
+    case COAVOID_STATUS_T_HEALTH_FAULT:
+        return (r & fatal) != 0;
+    default:
+        return r != 0 && (r & fatal) == 0;
+    }
+}
+
 int coavoid_lcm_status_check(const coavoid_status_t *msg, const coavoid_lcm_context_t *ctx,
                              const char **reason)
 {
@@ -1246,6 +1267,9 @@ int coavoid_lcm_status_check(const coavoid_status_t *msg, const coavoid_lcm_cont
     }
     if (msg->last_reject_code > 0) {
         REJECT(COAVOID_LCM_ERR_VALUE, "status: last_reject_code positive");
+    }
+    if (!status_reasons_ok(msg)) {
+        REJECT(COAVOID_LCM_ERR_VALUE, "status: reasons unknown, or not what its health says");
     }
     OK_REASON();
     return COA_OK;

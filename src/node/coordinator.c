@@ -125,19 +125,21 @@ static int publish_report(coavoid_coordinator_t *node, int64_t now, int64_t cycl
 static int publish_status(coavoid_coordinator_t *node, int64_t now, int64_t cycle_start)
 {
     const coavoid_coordinator_state_t *s = &node->state;
-    const coavoid_node_heartbeat_t h = {node->config.id,
-                                        COAVOID_STATUS_T_NODE_COORDINATOR,
-                                        node->status_sequence++,
-                                        node->fault,
-                                        node->degraded || node->view.stale_count > 0u,
-                                        COAVOID_STATUS_T_MODE_CENTRALISED,
-                                        node->last_plan_utime,
-                                        s->last_plan_duration_us,
-                                        s->last_nodes_expanded,
-                                        s->last_outcome,
-                                        s->conflicts,
-                                        s->plans_run,
-                                        &s->rx};
+    const coavoid_node_heartbeat_t h = {
+        node->config.id,
+        COAVOID_STATUS_T_NODE_COORDINATOR,
+        node->status_sequence++,
+        (node->fault ? COAVOID_STATUS_T_REASON_INTERNAL_ERROR : 0) |
+            (node->degraded ? COAVOID_STATUS_T_REASON_PLANNING_FAILED : 0) |
+            (node->view.stale_count > 0u ? COAVOID_STATUS_T_REASON_STALE_PEERS : 0),
+        COAVOID_STATUS_T_MODE_CENTRALISED,
+        node->last_plan_utime,
+        s->last_plan_duration_us,
+        s->last_nodes_expanded,
+        s->last_outcome,
+        s->conflicts,
+        s->plans_run,
+        &s->rx};
     return coavoid_node_publish_heartbeat(&node->inbox, &node->tx_status, now, cycle_start, &h);
 }
 

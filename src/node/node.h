@@ -91,7 +91,10 @@
  * after an internal error (a UAV: also while another UAV uses its id), else
  * HEALTH_DEGRADED when messages were refused since its previous heartbeat (a clock that
  * disagrees, more peers than it holds, a bad sender), a planning call failed, a peer is
- * stale, or (a centralised UAV) it is not following the coordinator; else HEALTH_OK.
+ * stale, no obstacle map has arrived, or (a UAV) it is not following the coordinator
+ * while centralised, it refused a plan for it in its last cycle, or a conflict of its own
+ * went unanswered; else HEALTH_OK. The heartbeat's reasons field names each of these
+ * (status_t's REASON_* bits).
  *
  * A peer whose last intent is older than stale_after_us is no longer a co-operative UAV
  * to its receivers: they treat it as a non-cooperative track, extrapolated at constant

@@ -195,9 +195,11 @@ typedef struct {
     uint16_t node_id;
     int8_t node_kind; /* COAVOID_STATUS_T_NODE_* */
     int64_t sequence;
-    bool fault;    /* an internal error: HEALTH_FAULT */
-    bool degraded; /* otherwise HEALTH_DEGRADED, else HEALTH_OK */
-    int8_t mode;   /* COAVOID_STATUS_T_MODE_* */
+    /* COAVOID_STATUS_T_REASON_* bits (refused messages are added when sent): the health
+     * follows from them, HEALTH_FAULT for INTERNAL_ERROR or DUPLICATE_ID, DEGRADED for
+     * any other, else OK. */
+    int32_t reasons;
+    int8_t mode; /* COAVOID_STATUS_T_MODE_* */
     int64_t last_plan_utime;
     int64_t last_plan_duration_us;
     uint64_t last_nodes_expanded;

@@ -31,7 +31,10 @@ struct coavoid_vehicle_node {
      * the last one. Plans are ordered within a cycle only (node.h, step 4). */
     bool cycle_plan_adopted;
     int64_t cycle_plan_id;
-    bool cycle_plan_failed; /* one listed it, in time, but was not solved */
+    bool cycle_plan_failed;  /* one listed it, in time, but was not solved */
+    bool cycle_plan_refused; /* one listed it and was refused (on_plan) */
+    bool last_cycle_refused; /* the same, of the cycle before (its heartbeat comes first) */
+    bool unanswered;         /* had a conflict of its own in the last cycle and no plan came */
     /* The other UAVs' rows in this cycle's solved plans (the latest plan_id each): what
      * each is to fly from this cycle's start, which a plan for this UAV is checked
      * against instead of their intents (record_rows). */
@@ -129,6 +132,23 @@ static bool stale_inputs(const coavoid_vehicle_node_t *node, int64_t now)
     return false;
 }
 
+/* Why its health is not OK (status_t's REASON_* bits). */
+static int32_t health_reasons(const coavoid_vehicle_node_t *node, int64_t now, bool twin)
+{
+    const coavoid_vehicle_node_state_t *s = &node->state;
+    int32_t r = 0;
+    r |= node->fault ? COAVOID_STATUS_T_REASON_INTERNAL_ERROR : 0;
+    r |= twin ? COAVOID_STATUS_T_REASON_DUPLICATE_ID : 0;
+    r |= s->last_outcome > 0 ? COAVOID_STATUS_T_REASON_PLANNING_FAILED : 0;
+    r |= stale_inputs(node, now) ? COAVOID_STATUS_T_REASON_STALE_PEERS : 0;
+    r |= node->config.mode == COAVOID_NODE_CENTRALISED && !s->coordinated
+             ? COAVOID_STATUS_T_REASON_NOT_FOLLOWING
+             : 0;
+    r |= node->last_cycle_refused ? COAVOID_STATUS_T_REASON_PLAN_REFUSED : 0;
+    r |= node->unanswered ? COAVOID_STATUS_T_REASON_NO_PLAN : 0;
+    return r;
+}
+
 static int publish_status(coavoid_vehicle_node_t *node, int64_t now)
 {
     const coavoid_vehicle_node_state_t *s = &node->state;
@@ -136,21 +156,19 @@ static int publish_status(coavoid_vehicle_node_t *node, int64_t now)
      * as that UAV's intents keep coming. */
     const bool twin = node->inbox.foreign_intents > 0u;
     node->inbox.foreign_intents = 0;
-    const coavoid_node_heartbeat_t h = {
-        node->config.vehicle.id,
-        COAVOID_STATUS_T_NODE_VEHICLE,
-        node->status_sequence++,
-        node->fault || twin,
-        s->last_outcome > 0 || stale_inputs(node, now) ||
-            (node->config.mode == COAVOID_NODE_CENTRALISED && !s->coordinated),
-        s->coordinated ? COAVOID_STATUS_T_MODE_CENTRALISED : COAVOID_STATUS_T_MODE_DECOUPLED,
-        node->last_plan_utime,
-        s->last_plan_duration_us,
-        s->last_nodes_expanded,
-        s->last_outcome,
-        s->conflicts,
-        s->plans_run,
-        &s->rx};
+    const coavoid_node_heartbeat_t h = {node->config.vehicle.id,
+                                        COAVOID_STATUS_T_NODE_VEHICLE,
+                                        node->status_sequence++,
+                                        health_reasons(node, now, twin),
+                                        s->coordinated ? COAVOID_STATUS_T_MODE_CENTRALISED
+                                                       : COAVOID_STATUS_T_MODE_DECOUPLED,
+                                        node->last_plan_utime,
+                                        s->last_plan_duration_us,
+                                        s->last_nodes_expanded,
+                                        s->last_outcome,
+                                        s->conflicts,
+                                        s->plans_run,
+                                        &s->rx};
     return coavoid_node_publish_heartbeat(&node->inbox, &node->tx_status, now, node->cycle_start,
                                           &h);
 }
@@ -488,6 +506,13 @@ static void reject(coavoid_vehicle_node_t *node, int code, const char *reason)
     coavoid_lcm_rx_count(&node->state.rx, code, reason);
 }
 
+/* A plan for it refused: counted, and said in its next heartbeat. */
+static void reject_plan(coavoid_vehicle_node_t *node, int code, const char *reason)
+{
+    node->cycle_plan_refused = true;
+    reject(node, code, reason);
+}
+
 /* Keeps the other UAVs' rows of a solved plan of this cycle, unless a later plan of the
  * cycle (a larger plan_id) already gave one: the coordinator's newest word on what each
  * will fly. O(rows * (peers + N)). */
@@ -607,44 +632,46 @@ static void on_plan(void *owner, const coavoid_plan_t *msg, const coavoid_lcm_pl
         return;
     }
     if (!node->started || msg->valid_from_utime != node->cycle_start) {
-        reject(node, COAVOID_LCM_ERR_TIME, "plan: valid_from is not this cycle's start");
+        reject_plan(node, COAVOID_LCM_ERR_TIME, "plan: valid_from is not this cycle's start");
         return;
     }
     if (now >= msg->valid_until_utime) {
-        reject(node, COAVOID_LCM_ERR_TIME, "plan: arrived after valid_until");
+        reject_plan(node, COAVOID_LCM_ERR_TIME, "plan: arrived after valid_until");
         return;
     }
     if (node->cycle_plan_adopted && msg->plan_id <= node->cycle_plan_id) {
-        reject(node, COAVOID_LCM_ERR_SEQUENCE,
-               "plan: plan_id not after the one adopted this cycle");
+        reject_plan(node, COAVOID_LCM_ERR_SEQUENCE,
+                    "plan: plan_id not after the one adopted this cycle");
         return;
     }
     if (msg->dt != (double)node->config.common.dt) {
-        reject(node, COAVOID_LCM_ERR_VALUE, "plan: dt is not this UAV's");
+        reject_plan(node, COAVOID_LCM_ERR_VALUE, "plan: dt is not this UAV's");
         return;
     }
     const size_t samples = (size_t)info->horizon + 1u;
     const int32_t *mine = offsets + row * samples;
     if (mine[0] != node->state.offset) {
-        reject(node, COAVOID_LCM_ERR_VALUE, "plan: does not start at the offset flown now");
+        reject_plan(node, COAVOID_LCM_ERR_VALUE, "plan: does not start at the offset flown now");
         return;
     }
     for (size_t j = 0; j < samples; j++) {
         if (self->max_offset >= 0 && (mine[j] > self->max_offset || mine[j] < -self->max_offset)) {
-            reject(node, COAVOID_LCM_ERR_VALUE, "plan: an offset beyond this UAV's max_offset");
+            reject_plan(node, COAVOID_LCM_ERR_VALUE,
+                        "plan: an offset beyond this UAV's max_offset");
             return;
         }
         if (j > 0 && coa_action_between(mine[j - 1], mine[j], self->steep_factor) < 0) {
-            reject(node, COAVOID_LCM_ERR_VALUE, "plan: a step this UAV cannot fly");
+            reject_plan(node, COAVOID_LCM_ERR_VALUE, "plan: a step this UAV cannot fly");
             return;
         }
     }
     int hit = plan_hits_known(node, mine, samples, now, false);
     if (hit != 0) {
-        reject(node, hit > 0 ? COAVOID_LCM_ERR_VALUE : hit,
-               hit == 1   ? "plan: flies this UAV into an obstacle or track it knows"
-               : hit == 2 ? "plan: flies this UAV into another UAV's plan or intent"
-                          : "plan: cannot be checked against the obstacles and tracks it knows");
+        reject_plan(node, hit > 0 ? COAVOID_LCM_ERR_VALUE : hit,
+                    hit == 1 ? "plan: flies this UAV into an obstacle or track it knows"
+                    : hit == 2
+                        ? "plan: flies this UAV into another UAV's plan or intent"
+                        : "plan: cannot be checked against the obstacles and tracks it knows");
         return;
     }
     adopt(node, mine, (uint32_t)samples);
@@ -730,9 +757,15 @@ void coavoid_vehicle_node_destroy(coavoid_vehicle_node_t *node)
     free(node);
 }
 
-/* Enters cycle k at `now`: the inbox aged, and the UAV at sample k of its plan. */
+/* Enters cycle k at `now`: the last cycle's plan outcomes cleared (its refusals kept for
+ * the heartbeat), the inbox aged, and the UAV at sample k of its plan. */
 static void fly_to(coavoid_vehicle_node_t *node, int64_t k, int64_t now)
 {
+    node->cycle_plan_adopted = false;
+    node->cycle_plan_failed = false;
+    node->last_cycle_refused = node->cycle_plan_refused;
+    node->cycle_plan_refused = false;
+    node->row_count = 0;
     node->state.cycle = k;
     node->cycle_start = coavoid_node_cycle_utime(&node->config.common, k);
     coavoid_node_inbox_expire(&node->inbox, now);
@@ -762,9 +795,6 @@ int coavoid_vehicle_node_cycle(coavoid_vehicle_node_t *node, int64_t now)
     node->fault = false;
     const bool previous_adopted = node->cycle_plan_adopted;
     const bool previous_answered = previous_adopted || node->cycle_plan_failed;
-    node->cycle_plan_adopted = false;
-    node->cycle_plan_failed = false;
-    node->row_count = 0;
     fly_to(node, k, now);
 
     /* A coordinator answers, within its cycle, for the conflicts of the UAVs that follow
@@ -783,7 +813,8 @@ int coavoid_vehicle_node_cycle(coavoid_vehicle_node_t *node, int64_t now)
             conflict = false; /* cannot tell: the error is reported */
         }
     }
-    if (node->was_coordinated && conflict && !previous_answered) {
+    node->unanswered = node->was_coordinated && conflict && !previous_answered;
+    if (node->unanswered) {
         node->distrust = true;
     } else if (node->distrust && (previous_adopted || !conflict)) {
         node->distrust = false;

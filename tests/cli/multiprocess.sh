@@ -78,7 +78,7 @@ types = {"COAVOID_INTENT": intent_t, "COAVOID_PLAN": plan_t, "COAVOID_TRACK": tr
          "COAVOID_STATUS": status_t}
 data = open(sys.argv[1], "rb").read()
 i, n = 0, 0
-counts, intents, statuses, plans, reports = {}, {}, {}, [], []
+counts, intents, statuses, plans, reports, rejected = {}, {}, {}, [], [], {}
 while i < len(data):
     magic, _, _, clen, dlen = struct.unpack_from(">IqqII", data, i)
     assert magic == 0xEDA1DA01, f"event {n}: bad magic at byte {i}"
@@ -98,13 +98,14 @@ while i < len(data):
         intents[m.uav_id] = intents.get(m.uav_id, 0) + 1
     elif channel == "COAVOID_STATUS":
         statuses.setdefault(m.node_id, []).append(m.mode)
+        rejected[m.node_id] = max(rejected.get(m.node_id, 0), m.messages_rejected)
     elif channel == "COAVOID_PLAN":
         plans.append({"status": m.status, "ids": list(m.uav_ids[:m.vehicle_count])})
     elif channel == "COAVOID_CONFLICTS":
         reports.append(m.conflict_count)
     n += 1
 print(json.dumps({"events": n, "counts": counts, "intents": intents, "statuses": statuses,
-                  "plans": plans, "reports": reports}))
+                  "plans": plans, "reports": reports, "rejected": rejected}))
 PY
 
 # ids SCENARIO: the scenario's vehicle ids.
@@ -388,12 +389,13 @@ else
     attack=
     survived="s is not None and s['loss_of_separation'] is False
 rc['summary'] == 0 and rc['forge'] == 0 and num('forge', 'forged') >= 5"
+    # Reported: the refusals are in the heartbeats of the log.
     check attack-map "$survived
-all(num(f'vehicle-{i}', 'rejected') >= 1 for i in (1, 2, 3)) and num('coordinator', 'rejected') >= 1"
+all(log['rejected'][str(i)] >= 1 for i in (1, 2, 3, 65001))"
     check attack-map-decoupled "$survived
-all(num(f'vehicle-{i}', 'rejected') >= 1 for i in (1, 2, 3))"
+all(log['rejected'][str(i)] >= 1 for i in (1, 2, 3))"
     check attack-collide "$survived
-num('vehicle-1', 'rejected') >= 1 and 'another UAV' in text['vehicle-1']"
+log['rejected']['1'] >= 1"
 fi
 
 finish
