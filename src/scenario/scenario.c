@@ -205,7 +205,10 @@ static const char *plural(const char *noun_singular, const char *noun_plural, si
     return n == 1 ? noun_singular : noun_plural;
 }
 
-/* An array of min..max elements; `what` names one element in messages ("point"). */
+/* An array of min..max elements; `what` names one element in messages ("point") and
+ * `max_name` the constant behind max. Every caller checks the count here, before it
+ * allocates or reads a single element, so an array past its limit costs only this count
+ * (cJSON has already parsed the text, within COAVOID_SCENARIO_MAX_BYTES). */
 static bool read_array(parser_t *p, const cJSON *item, const char *path, size_t min, size_t max,
                        const char *what, const char *max_name, size_t *count)
 {
@@ -217,9 +220,7 @@ static bool read_array(parser_t *p, const cJSON *item, const char *path, size_t 
         return fail(p, path, "needs at least %zu %s%s, got %zu", min, what, min == 1 ? "" : "s", n);
     }
     if (n > max) {
-        return fail(p, path, "at most %zu %ss%s%s%s are supported, got %zu", max, what,
-                    max_name != NULL ? " (" : "", max_name != NULL ? max_name : "",
-                    max_name != NULL ? ")" : "", n);
+        return fail(p, path, "at most %zu %ss are supported (%s), got %zu", max, what, max_name, n);
     }
     *count = n;
     return true;
@@ -479,7 +480,8 @@ static bool parse_route(parser_t *p, const cJSON *obj, const char *obj_path, coa
     size_t n;
     coa_real_t total = 0;
     if (!get_field(p, obj, obj_path, "route", REQUIRED, &route, path) ||
-        !read_array(p, route, path, 2, SIZE_MAX, "point", NULL, &n)) {
+        !read_array(p, route, path, 2, COAVOID_SCENARIO_MAX_ROUTE_POINTS, "point",
+                    "COAVOID_SCENARIO_MAX_ROUTE_POINTS", &n)) {
         return false;
     }
     coa_vec3_t *points = scenario_alloc(p->s, n, sizeof *points);
@@ -726,7 +728,8 @@ static bool parse_obstacles(parser_t *p, const cJSON *root)
     if (array == NULL) {
         return true;
     }
-    if (!read_array(p, array, path, 0, SIZE_MAX, "obstacle", NULL, &n)) {
+    if (!read_array(p, array, path, 0, COAVOID_SCENARIO_MAX_OBSTACLES, "obstacle",
+                    "COAVOID_SCENARIO_MAX_OBSTACLES", &n)) {
         return false;
     }
     coavoid_scenario_t *s = p->s;
@@ -784,7 +787,8 @@ static bool check_track_leg(parser_t *p, const coa_track_point_t *prev,
 static bool parse_track_path(parser_t *p, const cJSON *array, const char *path, coa_track_t *t)
 {
     size_t n;
-    if (!read_array(p, array, path, 1, SIZE_MAX, "point", NULL, &n)) {
+    if (!read_array(p, array, path, 1, COAVOID_SCENARIO_MAX_TRACK_POINTS, "point",
+                    "COAVOID_SCENARIO_MAX_TRACK_POINTS", &n)) {
         return false;
     }
     coa_track_point_t *points = scenario_alloc(p->s, n, sizeof *points);
@@ -876,7 +880,8 @@ static bool parse_tracks(parser_t *p, const cJSON *root)
     if (array == NULL) {
         return true;
     }
-    if (!read_array(p, array, path, 0, SIZE_MAX, "track", NULL, &n)) {
+    if (!read_array(p, array, path, 0, COAVOID_SCENARIO_MAX_TRACKS, "track",
+                    "COAVOID_SCENARIO_MAX_TRACKS", &n)) {
         return false;
     }
     coavoid_scenario_t *s = p->s;

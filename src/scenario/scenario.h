@@ -28,6 +28,42 @@
 /* Room for one error message ("path: reason"). */
 #define COAVOID_SCENARIO_ERROR_MAX 512u
 
+/* ---- how much a scenario may carry ----
+ * Counts beyond these are refused, before any element of the array is read, with one line
+ * such as "obstacles: at most 256 obstacles are supported (COAVOID_SCENARIO_MAX_OBSTACLES),
+ * got 100000" (docs/scenario-format.md, "Limits"). The other counts are the core's:
+ * vehicles COA_MAX_VEHICLES, polytope vertices COA_POLYTOPE_MAX_VERTICES. `coavoid plan`
+ * takes up to these; the simulation and the real-time drivers refuse, with their own
+ * messages, more than a node holds (COAVOID_NODE_MAX_CONFIGURED_OBSTACLES 80, an obstacle
+ * map's 64 boxes and 16 polytopes, COAVOID_NODE_MAX_TRACKS 32). */
+
+/* Every table the planner builds tests each obstacle against every step the UAV could
+ * take (filtered by boxes first), so planning time grows in proportion to the obstacles,
+ * to each polytope's vertices and to the tables' size. 256, three times a node's 80,
+ * leaves room for terrain studies with `coavoid plan`; 256 polytopes of 256 vertices
+ * beside the routes of 6 UAVs, the dearest case measured, plan in about 30 s over 24 steps
+ * and 130 s over 48 (docs/security.md: only COAVOID_DEFAULT_WORKSPACE_MAX bounds the
+ * tables). */
+#define COAVOID_SCENARIO_MAX_OBSTACLES 256u
+
+/* Tests against a track are closed-form cylinder tests, far cheaper than a polytope's,
+ * and the track samples take horizon + 1 points each. 64, twice what a node holds
+ * (COAVOID_NODE_MAX_TRACKS 32): 64 tracks beside the routes of 6 UAVs over 24 steps plan
+ * in 0.1 s. */
+#define COAVOID_SCENARIO_MAX_TRACKS 64u
+
+/* Per vehicle. A reference position is found by walking the route from its first point
+ * (coa_reference_at, in every cycle of the nodes and for every check of the simulation),
+ * so each costs O(route points). The scenarios and encounters use 2 or 3 points; 256
+ * leaves room for survey patterns and keeps each walk short. */
+#define COAVOID_SCENARIO_MAX_ROUTE_POINTS 256u
+
+/* Per track path. As for routes, a track's position is found by walking its path
+ * (coa_track_at) and the simulation checks it leg by leg. A track message carries at most
+ * 16 points of it (track_t.MAX_PATH, resampled over the horizon by the world); 256 holds
+ * a tracker's prediction at one point per second for over four minutes. */
+#define COAVOID_SCENARIO_MAX_TRACK_POINTS 256u
+
 typedef struct {
     char *name;
     coa_real_t dt;

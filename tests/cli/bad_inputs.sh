@@ -233,6 +233,42 @@ bad_scenario_double track_path_velocity_overflow_later 'tracks[1].path[2]' \
 bad_scenario sigma_negative 'tracks[1].sigma[1]' 's["tracks"][1]["sigma"][1] = -2'
 bad_scenario sigma_short 'tracks[1].sigma' 's["tracks"][1]["sigma"] = [1]'
 
+# ---- how much a scenario may carry (COAVOID_SCENARIO_MAX_* in src/scenario/scenario.h) ----
+# limit NAME FIELD WHAT MAX CONSTANT PYTHON: PYTHON sets the array at FIELD to
+# items(lambda i: ELEMENT). With MAX elements the scenario is accepted and planned
+# (solved: what is added is far from the UAVs, and the horizon is 6 steps); with MAX + 1 it
+# is refused in both modes with exactly the line "coavoid: FILE: FIELD: at most MAX WHATs
+# are supported (CONSTANT), got MAX+1"; and so it is with MAX + 1 nulls, which no element
+# check would pass: the count is checked before any element is read.
+limit() {
+    local name=$1 field=$2 what=$3 max=$4 constant=$5 build=$6 mode file want
+    local items='items = lambda f: [None] * n if unread else [f(i) for i in range(n)]'
+    mutate "${name}_at_limit" "n = $max; unread = False; $items; $build"
+    for mode in decoupled centralised; do
+        expect_ok "$name: $max accepted ($mode)" plan "$tmp/${name}_at_limit.json" --mode "$mode"
+    done
+    mutate "${name}_over" "n = $max + 1; unread = False; $items; $build"
+    mutate "${name}_over_nulls" "n = $max + 1; unread = True; $items; $build"
+    for file in "$tmp/${name}_over.json" "$tmp/${name}_over_nulls.json"; do
+        want="coavoid: $file: $field: at most $max ${what}s are supported ($constant), got $((max + 1))"
+        for mode in decoupled centralised; do
+            expect_bad "$name: $((max + 1)) refused (${file##*/}, $mode)" "$want" \
+                plan "$file" --mode "$mode"
+            if [ "$(cat "$tmp/err")" != "$want" ]; then
+                fail "$name: not exactly '$want': $(cat "$tmp/err")"
+            fi
+        done
+    done
+}
+limit obstacles obstacles obstacle 256 COAVOID_SCENARIO_MAX_OBSTACLES \
+    's["obstacles"] = items(lambda i: {"type": "box", "min": [5000 + 10 * i, 5000, 0], "max": [5005 + 10 * i, 5005, 50]} if i % 2 else {"type": "polytope", "vertices": [[-5000, 10 * i, 0], [-4990, 10 * i, 0], [-5000, 10 * i + 5, 0], [-5000, 10 * i, 10]]})'
+limit tracks tracks track 64 COAVOID_SCENARIO_MAX_TRACKS \
+    's["tracks"] = items(lambda i: dict(s["tracks"][i % 2], id=i))'
+limit route_points 'vehicles[1].route' point 256 COAVOID_SCENARIO_MAX_ROUTE_POINTS \
+    's["vehicles"][1]["route"] = items(lambda i: [i, 500, 100])'
+limit track_points 'tracks[1].path' point 256 COAVOID_SCENARIO_MAX_TRACK_POINTS \
+    's["tracks"][1]["path"] = items(lambda i: [i, -4000, i, 300])'
+
 # ---- text-level problems ----
 bad_text duplicate_key 'dt: ' '{"name": "x", "dt": 1, "dt": 2, "horizon": 3, "vehicles": []}'
 bad_text invalid_json 'invalid JSON near line 1, column' '{"name": "x", "dt": 1,, "horizon": 3}'
