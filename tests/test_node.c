@@ -987,6 +987,7 @@ typedef struct {
     int plans;
     int32_t rows;
     int32_t ids[4];
+    int8_t status; /* the last plan's */
 } plan_probe_t;
 
 static void on_plan_probe(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
@@ -997,6 +998,7 @@ static void on_plan_probe(const lcm_recv_buf_t *rbuf, const char *channel, void 
     REQUIRE(coavoid_plan_t_decode(rbuf->data, 0, (int)rbuf->data_size, &m) >= 0);
     p->plans++;
     p->rows = m.vehicle_count;
+    p->status = m.status;
     for (int32_t i = 0; i < m.vehicle_count && i < 4; i++) {
         p->ids[i] = m.uav_ids[i];
     }
@@ -1034,6 +1036,70 @@ START_TEST(test_coordinator_skips_decoupled_uav)
     ck_assert_int_eq(probe.rows, 1);
     ck_assert_int_eq(probe.ids[0], 2);
     ck_assert_uint_eq(coavoid_vehicle_node_state(b)->plans_adopted, 1);
+    lcm_unsubscribe(r.lcm, sub);
+    coavoid_coordinator_destroy(co);
+    coavoid_vehicle_node_destroy(b);
+    coavoid_vehicle_node_destroy(a);
+    lcm_destroy(r.lcm);
+}
+END_TEST
+
+/* A stopwatch that moves 10 ms each time it is read: any planning runs over a 5 ms budget. */
+static int64_t slow_stopwatch(void *user)
+{
+    int64_t *t = user;
+    *t += 10000;
+    return *t;
+}
+
+/* Past its planning budget the coordinator abandons a cluster instead of sending a plan
+ * late: a plan_t with STATUS_ABANDONED lists its UAVs, which adopt nothing, are not taken
+ * as answered, and plan for themselves from the next cycle (the heartbeat says
+ * REASON_NO_PLAN). */
+START_TEST(test_coordinator_abandons_past_budget)
+{
+    rig_t r;
+    rig_init(&r, 24);
+    plan_probe_t probe;
+    memset(&probe, 0, sizeof probe);
+    lcm_subscription_t *sub = lcm_subscribe(r.lcm, COAVOID_CHANNEL_PLAN, on_plan_probe, &probe);
+    coa_vec3_t r1[2], r2[2];
+    coavoid_vehicle_node_t *a =
+        vehicle_node(&r, uav(1, 1, r1, 0, 600, 0, 100), COAVOID_NODE_CENTRALISED);
+    coavoid_vehicle_node_t *b =
+        vehicle_node(&r, uav(2, 2, r2, 300, -300, 0, 100), COAVOID_NODE_CENTRALISED);
+    int64_t watch = 0;
+    coavoid_coordinator_config_t cc;
+    memset(&cc, 0, sizeof cc);
+    cc.common = r.common;
+    cc.common.beta = 5000;
+    cc.common.stopwatch_us = slow_stopwatch;
+    cc.common.stopwatch_user = &watch;
+    cc.plan_budget_us = 5000;
+    int error = -99;
+    coavoid_coordinator_t *co = coavoid_coordinator_create(&cc, r.lcm, &error);
+    ck_assert_ptr_nonnull(co);
+    for (int64_t k = 0; k <= 1; k++) {
+        r.now = cycle(k);
+        ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
+        ck_assert_int_eq(coavoid_vehicle_node_cycle(b, r.now), COA_OK);
+        drain(r.lcm);
+        if (k == 0) {
+            heartbeat(r.lcm, r.now, 0);
+            r.now = cycle(0) + DT_US / 4;
+            ck_assert_int_eq(coavoid_coordinator_cycle(co, r.now), COA_OK);
+            drain(r.lcm);
+            ck_assert_int_eq(probe.plans, 1);
+            ck_assert_int_eq(probe.status, COAVOID_PLAN_T_STATUS_ABANDONED);
+            ck_assert_int_eq(probe.rows, 2);
+            ck_assert_uint_eq(coavoid_coordinator_state(co)->plans_abandoned, 1);
+            ck_assert_uint_eq(coavoid_coordinator_state(co)->plans_run, 0);
+        }
+    }
+    /* No plan came: both plan for themselves from cycle 1 (the higher priority at once). */
+    ck_assert_uint_eq(coavoid_vehicle_node_state(a)->fallbacks, 1);
+    ck_assert_uint_eq(coavoid_vehicle_node_state(b)->fallbacks, 1);
+    ck_assert_uint_ge(coavoid_vehicle_node_state(a)->plans_run, 1);
     lcm_unsubscribe(r.lcm, sub);
     coavoid_coordinator_destroy(co);
     coavoid_vehicle_node_destroy(b);
@@ -1470,6 +1536,7 @@ static Suite *node_suite(void)
     tcase_add_test(tc, test_late_plans_fall_back);
     tcase_add_test(tc, test_failed_plan_is_an_answer);
     tcase_add_test(tc, test_coordinator_skips_decoupled_uav);
+    tcase_add_test(tc, test_coordinator_abandons_past_budget);
     tcase_add_test(tc, test_lower_priority_waits);
     tcase_add_test(tc, test_waits_for_near_higher_priority);
     tcase_add_test(tc, test_wait_ends_at_deadline);

@@ -151,6 +151,12 @@ static int run(void *options, coavoid_scenario_t *s)
             "--collect: must be above 0 and below the scenario's dt (%g s), got %g", (double)s->dt,
             o->collect);
     }
+    /* Plans must reach the vehicles before the cycle ends: of the wall time left after
+     * collecting, ((dt - collect) / speed), planning may take three quarters; the rest is
+     * for the messages. */
+    config.plan_budget_us =
+        (int64_t)llround(0.75 * (double)(dt_us - config.collect_us) / o->rt.speed);
+    config.plan_budget_us = config.plan_budget_us > 0 ? config.plan_budget_us : 1;
     const char *beta_source;
     if (o->beta_text != NULL) {
         config.common.beta = o->beta;

@@ -176,6 +176,10 @@ typedef struct {
     int8_t mode; /* COAVOID_PLAN_T_MODE_* */
     size_t vehicle_count;
     uint16_t uav_ids[COAVOID_PLAN_T_MAX_VEHICLES];
+    /* STATUS_ABANDONED: the coordinator gave up on these UAVs this cycle (no rows; the
+     * result's status is then COA_PLAN_BUDGET_EXHAUSTED, nothing proven). From core: set
+     * it to send one. */
+    bool abandoned;
 } coavoid_lcm_plan_info_t;
 
 int coavoid_lcm_plan_check(const coavoid_plan_t *msg, const coavoid_lcm_context_t *ctx,

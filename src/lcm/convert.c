@@ -555,7 +555,8 @@ static int plan_header_check(const coavoid_plan_t *msg, const coavoid_lcm_contex
     }
     if (msg->status != COAVOID_PLAN_T_STATUS_SOLVED &&
         msg->status != COAVOID_PLAN_T_STATUS_INFEASIBLE &&
-        msg->status != COAVOID_PLAN_T_STATUS_BUDGET_EXHAUSTED) {
+        msg->status != COAVOID_PLAN_T_STATUS_BUDGET_EXHAUSTED &&
+        msg->status != COAVOID_PLAN_T_STATUS_ABANDONED) {
         REJECT(COAVOID_LCM_ERR_ENUM, "plan: unknown status");
     }
     if ((rc = number_rule(msg->deviation, 1.0e300)) != COA_OK || msg->deviation < 0.0) {
@@ -581,9 +582,11 @@ static int plan_vehicles_check(const coavoid_plan_t *msg, const char **reason)
         REJECT(COAVOID_LCM_ERR_COUNT, "plan: vehicle_count not in 1..MAX_VEHICLES");
     }
     if (msg->planned_count < 0 || msg->planned_count > msg->vehicle_count ||
-        (msg->status == COAVOID_PLAN_T_STATUS_SOLVED && msg->planned_count != msg->vehicle_count)) {
-        REJECT(COAVOID_LCM_ERR_COUNT,
-               "plan: planned_count not in 0..vehicle_count (all when solved)");
+        (msg->status == COAVOID_PLAN_T_STATUS_SOLVED && msg->planned_count != msg->vehicle_count) ||
+        (msg->status == COAVOID_PLAN_T_STATUS_ABANDONED && msg->planned_count != 0)) {
+        REJECT(
+            COAVOID_LCM_ERR_COUNT,
+            "plan: planned_count not in 0..vehicle_count (all when solved, none when abandoned)");
     }
     for (i = 0; i < msg->vehicle_count; ++i) {
         if (!id_ok(msg->uav_ids[i])) {
@@ -672,7 +675,8 @@ int coavoid_lcm_plan_to_core(const coavoid_plan_t *msg, const coavoid_lcm_contex
             offsets[i * samples + k] = (i < (size_t)msg->planned_count) ? msg->offsets[i][k] : 0;
         }
     }
-    result->status = (coa_plan_status_t)msg->status;
+    info->abandoned = msg->status == COAVOID_PLAN_T_STATUS_ABANDONED;
+    result->status = info->abandoned ? COA_PLAN_BUDGET_EXHAUSTED : (coa_plan_status_t)msg->status;
     result->deviation = msg->deviation;
     result->effort = (uint32_t)msg->effort;
     result->nodes_expanded = (uint64_t)msg->nodes_expanded;
@@ -714,19 +718,19 @@ int coavoid_lcm_plan_from_core(const coavoid_lcm_plan_info_t *info, const coa_pl
     msg->dt = (double)info->dt;
     msg->horizon = (int32_t)info->horizon;
     msg->mode = info->mode;
-    msg->status = (int8_t)result->status;
+    msg->status = info->abandoned ? COAVOID_PLAN_T_STATUS_ABANDONED : (int8_t)result->status;
     msg->deviation = result->deviation;
     msg->effort = (int32_t)result->effort;
     msg->nodes_expanded = (int64_t)result->nodes_expanded;
     msg->vehicle_count = (int32_t)n;
-    msg->planned_count = (int32_t)result->planned_count;
+    msg->planned_count = info->abandoned ? 0 : (int32_t)result->planned_count;
     for (i = 0; i < n; ++i) {
         size_t v = result->order[i];
         if (v >= n) {
             REJECT(COA_ERR_ARGUMENT, "plan: result order names no vehicle");
         }
         msg->uav_ids[i] = info->uav_ids[v];
-        if (i < result->planned_count) {
+        if (i < (size_t)msg->planned_count) {
             for (k = 0; k < samples; ++k) {
                 msg->offsets[i][k] = offsets[v * samples + k];
             }

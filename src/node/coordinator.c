@@ -22,6 +22,7 @@ struct coavoid_coordinator {
     int64_t report_sequence;
     int64_t status_sequence;
     int64_t last_plan_utime;
+    int64_t cycle_stopwatch; /* its stopwatch when the cycle's planning began */
 
     uint32_t labels[COAVOID_NODE_MAX_PEERS];
     bool include[COAVOID_NODE_MAX_PEERS];
@@ -49,7 +50,7 @@ coavoid_coordinator_t *coavoid_coordinator_create(const coavoid_coordinator_conf
     *error = COA_ERR_ARGUMENT;
     if (config == NULL || lcm == NULL || coavoid_node_common_check(&config->common) != COA_OK ||
         config->max_centralised > COA_MAX_CENTRALISED || config->collect_us < 0 ||
-        config->collect_us >= config->common.dt_us) {
+        config->collect_us >= config->common.dt_us || config->plan_budget_us < 0) {
         return NULL;
     }
     const coavoid_node_common_t *c = &config->common;
@@ -273,7 +274,7 @@ static int cluster_plan(coavoid_coordinator_t *node, int64_t now, const coa_prob
  * when it fails), then published (what publishing returned in *published). */
 static int cluster_publish(coavoid_coordinator_t *node, int64_t now, int64_t cycle_start,
                            size_t count, bool centralised, const coa_plan_result_t *result,
-                           int *published)
+                           bool abandoned, int *published)
 {
     const coavoid_node_common_t *c = &node->config.common;
     coavoid_lcm_plan_info_t info;
@@ -287,6 +288,7 @@ static int cluster_publish(coavoid_coordinator_t *node, int64_t now, int64_t cyc
     info.horizon = c->horizon;
     info.mode = centralised ? COAVOID_PLAN_T_MODE_CENTRALISED : COAVOID_PLAN_T_MODE_DECOUPLED;
     info.vehicle_count = count;
+    info.abandoned = abandoned;
     for (size_t m = 0; m < count; m++) {
         info.uav_ids[m] = node->vehicles[m].id;
     }
@@ -305,6 +307,14 @@ static int cluster_publish(coavoid_coordinator_t *node, int64_t now, int64_t cyc
     return COA_OK;
 }
 
+/* Whether the cycle's planning has run past its budget (config.plan_budget_us). */
+static bool over_budget(const coavoid_coordinator_t *node)
+{
+    const int64_t budget = node->config.plan_budget_us;
+    return budget > 0 &&
+           coavoid_node_stopwatch(&node->config.common) - node->cycle_stopwatch > budget;
+}
+
 static int plan_cluster(coavoid_coordinator_t *node, int64_t now, int64_t cycle_start, size_t count,
                         bool *solved)
 {
@@ -318,17 +328,29 @@ static int plan_cluster(coavoid_coordinator_t *node, int64_t now, int64_t cycle_
     if (rc != COA_OK) {
         return rc;
     }
-    rc = cluster_plan(node, now, &problem, &centralised, &result);
-    if (rc != COA_OK) {
-        return rc;
+    /* Past the budget the plan would come late: the cluster is abandoned, before its
+     * search or after it. */
+    memset(&result, 0, sizeof result);
+    result.status = COA_PLAN_BUDGET_EXHAUSTED;
+    for (size_t m = 0; m < count; m++) {
+        result.order[m] = m;
     }
+    bool abandoned = over_budget(node);
+    if (!abandoned) {
+        rc = cluster_plan(node, now, &problem, &centralised, &result);
+        if (rc != COA_OK) {
+            return rc;
+        }
+        abandoned = over_budget(node);
+    }
+    node->state.plans_abandoned += abandoned ? 1u : 0u;
     int published = COA_OK;
-    if (cluster_publish(node, now, cycle_start, count, centralised, &result, &published) !=
-        COA_OK) {
+    if (cluster_publish(node, now, cycle_start, count, centralised, &result, abandoned,
+                        &published) != COA_OK) {
         return COA_ERR_ARGUMENT;
     }
     rc = published;
-    if (result.status != COA_PLAN_SOLVED) {
+    if (abandoned || result.status != COA_PLAN_SOLVED) {
         return rc;
     }
     *solved = true;
@@ -380,7 +402,8 @@ static size_t escalate(coavoid_coordinator_t *node, int64_t now, int64_t cycle_s
                        size_t failed_size, int *first_error)
 {
     const uint32_t escalation[2] = {GROUP_CLUSTERED, GROUP_ALL};
-    for (size_t e = 0; e < 2u && failed_size > 0u && *first_error == COA_OK; e++) {
+    for (size_t e = 0; e < 2u && failed_size > 0u && *first_error == COA_OK && !over_budget(node);
+         e++) {
         size_t count = cluster_members(node, escalation[e]);
         if (count <= failed_size) {
             continue;
@@ -437,6 +460,7 @@ int coavoid_coordinator_cycle(coavoid_coordinator_t *node, int64_t now)
     if (first_error == COA_OK) {
         first_error = rc;
     }
+    node->cycle_stopwatch = coavoid_node_stopwatch(c);
     size_t failed_size = plan_clusters(node, now, cycle_start, clusters, &first_error);
     failed_size = escalate(node, now, cycle_start, failed_size, &first_error);
     node->degraded = failed_size > 0u;

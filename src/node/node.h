@@ -66,7 +66,9 @@
  *      clusters in ascending order, each later cluster treating the new plans of the
  *      earlier ones as moving obstacles; publishes one plan_t per cluster (valid_from =
  *      cycle_utime(k), valid_until = cycle_utime(k + 1)), the conflict report, and its
- *      heartbeat. A cluster is only who conflicts now, and its way out can be blocked by
+ *      heartbeat. Past its planning budget (plan_budget_us) a cluster is abandoned
+ *      instead: a plan_t with STATUS_ABANDONED lists its UAVs, which are not answered by
+ *      it and plan for themselves. A cluster is only who conflicts now, and its way out can be blocked by
  *      UAVs that do not (a UAV that must climb over terrain into the altitude of passing
  *      traffic): when a cluster's plan fails, every clustered UAV is planned again as one
  *      group, and failing that every UAV, from the intents as they came; that plan_t
@@ -276,6 +278,13 @@ typedef struct {
                                         are planned decoupled by the coordinator */
     int64_t collect_us;     /* after the cycle start, when it plans, < dt (0: the
                                         default, dt / 4) */
+    /* Its stopwatch's microseconds (common.stopwatch_us: wall time) it may spend planning
+     * in one cycle; 0: no budget (a simulation, whose stopwatch reads 0, never runs over).
+     * A cluster it comes to past the budget, or whose search ends past it, is abandoned:
+     * a plan_t with STATUS_ABANDONED tells its UAVs, which then plan for themselves
+     * rather than wait for a plan that would come late. One search is bounded by beta, so
+     * the overrun is at most one search. */
+    int64_t plan_budget_us;
 } coavoid_coordinator_config_t;
 
 typedef struct {
@@ -284,6 +293,7 @@ typedef struct {
     uint32_t clusters_planned; /* planning calls in the last cycle */
     uint32_t plans_run;        /* planning calls since start */
     uint32_t plans_published;  /* solved plans published since start */
+    uint32_t plans_abandoned;  /* clusters abandoned past the planning budget since start */
     int last_outcome;
     uint64_t last_nodes_expanded;
     int64_t last_plan_duration_us;

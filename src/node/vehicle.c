@@ -616,7 +616,7 @@ static void on_plan(void *owner, const coavoid_plan_t *msg, const coavoid_lcm_pl
             row = i;
         }
     }
-    if (row != SIZE_MAX && result->status != COA_PLAN_SOLVED && node->started &&
+    if (row != SIZE_MAX && result->status != COA_PLAN_SOLVED && !info->abandoned && node->started &&
         msg->valid_from_utime == node->cycle_start && now < msg->valid_until_utime) {
         /* The coordinator tried this cycle and found nothing: it answered. Planning for
          * itself would not do better than the coordinator's search over the same UAVs,
