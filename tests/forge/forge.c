@@ -153,7 +153,8 @@ int main(int argc, char **argv)
         fprintf(stderr, "forge: cannot open %s\n", url != NULL ? url : "(default)");
         return 2;
     }
-    coavoid_intent_t_subscribe(f.lcm, COAVOID_CHANNEL_INTENT, on_intent, &f);
+    coavoid_intent_t_subscription_t *sub =
+        coavoid_intent_t_subscribe(f.lcm, COAVOID_CHANNEL_INTENT, on_intent, &f);
     const int64_t end = wall_us() + (int64_t)(seconds * 1e6);
     int64_t next_map = 0;
     while (wall_us() < end) {
@@ -164,6 +165,7 @@ int main(int argc, char **argv)
         lcm_handle_timeout(f.lcm, 50);
     }
     printf("forged %lld\n", (long long)f.forged);
+    coavoid_intent_t_unsubscribe(f.lcm, sub);
     lcm_destroy(f.lcm);
     return 0;
 }
