@@ -136,15 +136,15 @@ static void heartbeat(lcm_t *lcm, int64_t now, int64_t sequence)
     ck_assert_int_eq(coavoid_status_t_publish(lcm, COAVOID_CHANNEL_STATUS, &m), 0);
 }
 
-/* A one-UAV plan_t from coordinator `from`: offsets 0, 1, 2, then level at 2, plus
- * `shift`. */
-static void plan_msg_from(lcm_t *lcm, int64_t now, int32_t from, int64_t plan_id,
-                          int64_t valid_from, uint16_t id, int32_t horizon, int32_t shift)
+/* A solved plan_t's header from the default coordinator for the cycle starting at
+ * valid_from, for `count` UAVs (the caller fills their ids and rows). */
+static coavoid_plan_t solved_plan(int64_t now, int64_t plan_id, int64_t valid_from, int32_t horizon,
+                                  int32_t count)
 {
     coavoid_plan_t m;
     memset(&m, 0, sizeof m);
     m.utime = now;
-    m.coordinator_id = from;
+    m.coordinator_id = (int32_t)COAVOID_NODE_COORDINATOR_ID;
     m.plan_id = plan_id;
     m.valid_from_utime = valid_from;
     m.valid_until_utime = valid_from + DT_US;
@@ -152,8 +152,18 @@ static void plan_msg_from(lcm_t *lcm, int64_t now, int32_t from, int64_t plan_id
     m.horizon = horizon;
     m.mode = COAVOID_PLAN_T_MODE_CENTRALISED;
     m.status = COAVOID_PLAN_T_STATUS_SOLVED;
-    m.vehicle_count = 1;
-    m.planned_count = 1;
+    m.vehicle_count = count;
+    m.planned_count = count;
+    return m;
+}
+
+/* A one-UAV plan_t from coordinator `from`: offsets 0, 1, 2, then level at 2, plus
+ * `shift`. */
+static void plan_msg_from(lcm_t *lcm, int64_t now, int32_t from, int64_t plan_id,
+                          int64_t valid_from, uint16_t id, int32_t horizon, int32_t shift)
+{
+    coavoid_plan_t m = solved_plan(now, plan_id, valid_from, horizon, 1);
+    m.coordinator_id = from;
     m.uav_ids[0] = id;
     for (int32_t k = 0; k <= horizon; k++) {
         m.offsets[0][k] = (k < 2 ? k : 2) + shift;
@@ -404,19 +414,7 @@ static coa_obstacle_t terrain_box(void)
  * flying into terrain the UAV knows. */
 static void dive_into_terrain(rig_t *r, const coavoid_vehicle_node_state_t *s)
 {
-    coavoid_plan_t m;
-    memset(&m, 0, sizeof m);
-    m.utime = r->now;
-    m.coordinator_id = COAVOID_NODE_COORDINATOR_ID;
-    m.plan_id = INT64_MAX - 5;
-    m.valid_from_utime = cycle(0);
-    m.valid_until_utime = cycle(1);
-    m.dt = 1.0;
-    m.horizon = 10;
-    m.mode = COAVOID_PLAN_T_MODE_CENTRALISED;
-    m.status = COAVOID_PLAN_T_STATUS_SOLVED;
-    m.vehicle_count = 1;
-    m.planned_count = 1;
+    coavoid_plan_t m = solved_plan(r->now, INT64_MAX - 5, cycle(0), 10, 1);
     m.uav_ids[0] = 1;
     for (int32_t k = 0; k <= 10; k++) {
         m.offsets[0][k] = -2 * k;
@@ -499,19 +497,7 @@ START_TEST(test_plan_into_other_uav_refused)
     ck_assert_int_eq(s->plans_adopted, 0);
     ck_assert_int_eq(s->rx.last_reject_code, COAVOID_LCM_ERR_VALUE);
     ck_assert_str_eq(s->rx.last_reason, "plan: flies this UAV into another UAV's plan or intent");
-    coavoid_plan_t m;
-    memset(&m, 0, sizeof m);
-    m.utime = r.now;
-    m.coordinator_id = COAVOID_NODE_COORDINATOR_ID;
-    m.plan_id = 2;
-    m.valid_from_utime = cycle(0);
-    m.valid_until_utime = cycle(1);
-    m.dt = 1.0;
-    m.horizon = 10;
-    m.mode = COAVOID_PLAN_T_MODE_CENTRALISED;
-    m.status = COAVOID_PLAN_T_STATUS_SOLVED;
-    m.vehicle_count = 2;
-    m.planned_count = 2;
+    coavoid_plan_t m = solved_plan(r.now, 2, cycle(0), 10, 2);
     m.uav_ids[0] = 1;
     m.uav_ids[1] = 2;
     for (int32_t k = 0; k <= 10; k++) {
