@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "auth.h"
 #include "coavoid_lcm.h"
 #include "lcm_examples.h"
 #include "test_support.h"
@@ -1140,6 +1141,107 @@ START_TEST(test_random_bytes)
 }
 END_TEST
 
+/* ---- signed messages (auth.h) ---- */
+
+/* A signer and a trust list that knows it as `role` for `node`, key id 7. */
+static void auth_pair(coavoid_auth_signer_t *signer, coavoid_auth_trust_t *trust,
+                      coavoid_auth_role_t role, uint16_t node)
+{
+    coavoid_auth_key_t key;
+    memset(&key, 0, sizeof key);
+    memset(signer, 0, sizeof *signer);
+    key.key_id = 7;
+    key.role = role;
+    key.node_id = node;
+    ck_assert_int_eq(coavoid_auth_keypair(key.public_key, signer->secret_key), COA_OK);
+    signer->key_id = 7;
+    coavoid_auth_trust_init(trust);
+    ck_assert_int_eq(coavoid_auth_trust_add(trust, &key), COA_OK);
+    ck_assert_int_eq(coavoid_auth_trust_add(trust, &key), COA_ERR_ARGUMENT); /* repeated */
+}
+
+/* The good status, signed at `now` into buf; its size. */
+static int signed_status(coavoid_auth_signer_t *signer, int64_t now, unsigned char *buf, int cap)
+{
+    coavoid_status_t m = good_status();
+    coavoid_auth_next(signer, now, &m.auth.key_id, &m.auth.timestamp_us, &m.auth.sequence);
+    int size = coavoid_status_t_encode(buf, 0, cap, &m);
+    ck_assert_int_gt(size, 0);
+    ck_assert_int_eq(coavoid_auth_sign(signer, buf, (size_t)size), COA_OK);
+    return size;
+}
+
+/* A signed datagram verifies with its key, and any changed byte (the fingerprint, a
+ * field, the key id, the time, the signature) makes it fail; unsigned and unknown keys
+ * are told apart. */
+START_TEST(test_auth_sign_verify)
+{
+    coavoid_auth_signer_t signer;
+    coavoid_auth_trust_t trust;
+    auth_pair(&signer, &trust, COAVOID_AUTH_COORDINATOR, 1);
+    unsigned char buf[512];
+    const int size = signed_status(&signer, T0, buf, (int)sizeof buf);
+    ck_assert_int_eq(size, coavoid_status_t_encoded_size(&(coavoid_status_t){0}));
+    size_t key = 99;
+    ck_assert_int_eq(coavoid_auth_verify(&trust, buf, (size_t)size, &key), COA_OK);
+    ck_assert_uint_eq(key, 0);
+    for (int at = 0; at < size; at++) {
+        buf[at] ^= 0x01;
+        int rc = coavoid_auth_verify(&trust, buf, (size_t)size, &key);
+        ck_assert_msg(rc == COAVOID_AUTH_ERR_SIGNATURE || rc == COAVOID_AUTH_ERR_KEY ||
+                          rc == COAVOID_AUTH_ERR_UNSIGNED,
+                      "byte %d changed, verify %d", at, rc);
+        buf[at] ^= 0x01;
+    }
+    coavoid_status_t m = good_status(); /* unsigned: key_id 0 */
+    unsigned char plain[512];
+    int n = coavoid_status_t_encode(plain, 0, (int)sizeof plain, &m);
+    ck_assert_int_eq(coavoid_auth_verify(&trust, plain, (size_t)n, &key),
+                     COAVOID_AUTH_ERR_UNSIGNED);
+    ck_assert_int_eq(coavoid_auth_verify(&trust, plain, 10, &key), COAVOID_AUTH_ERR_UNSIGNED);
+    signer.key_id = 8; /* a key the receiver does not know */
+    n = signed_status(&signer, T0, plain, (int)sizeof plain);
+    ck_assert_int_eq(coavoid_auth_verify(&trust, plain, (size_t)n, &key), COAVOID_AUTH_ERR_KEY);
+}
+END_TEST
+
+/* Roles: a key speaks only for its role and node. Freshness: a copy or a replay is
+ * refused, as is a time outside the window; a restarted sender (a later clock, its
+ * sequence from 0) is accepted at once. */
+START_TEST(test_auth_roles_and_freshness)
+{
+    coavoid_auth_signer_t signer;
+    coavoid_auth_trust_t trust;
+    auth_pair(&signer, &trust, COAVOID_AUTH_VEHICLE, 3);
+    ck_assert_int_eq(coavoid_auth_may_send(&trust, 0, COAVOID_AUTH_VEHICLE, 3), COA_OK);
+    ck_assert_int_eq(coavoid_auth_may_send(&trust, 0, COAVOID_AUTH_VEHICLE, 4),
+                     COAVOID_AUTH_ERR_ROLE);
+    ck_assert_int_eq(coavoid_auth_may_send(&trust, 0, COAVOID_AUTH_COORDINATOR, 0),
+                     COAVOID_AUTH_ERR_ROLE);
+    ck_assert_int_eq(coavoid_auth_may_send(&trust, 1, COAVOID_AUTH_VEHICLE, 3),
+                     COAVOID_AUTH_ERR_ROLE);
+    const int64_t window = 2000000;
+    ck_assert_int_eq(coavoid_auth_fresh(&trust, 0, T0, 0, T0, window), COA_OK);
+    ck_assert_int_eq(coavoid_auth_fresh(&trust, 0, T0, 0, T0, window), COAVOID_AUTH_ERR_REPLAY);
+    ck_assert_int_eq(coavoid_auth_fresh(&trust, 0, T0, 1, T0, window), COA_OK);
+    ck_assert_int_eq(coavoid_auth_fresh(&trust, 0, T0 - 5, 9, T0, window), COAVOID_AUTH_ERR_REPLAY);
+    ck_assert_int_eq(coavoid_auth_fresh(&trust, 0, T0 + 3 * window, 0, T0, window),
+                     COAVOID_AUTH_ERR_CLOCK);
+    ck_assert_int_eq(coavoid_auth_fresh(&trust, 0, T0 - 3 * window, 0, T0, window),
+                     COAVOID_AUTH_ERR_CLOCK);
+    ck_assert_int_eq(coavoid_auth_fresh(&trust, 0, T0 + 10, 0, T0 + 10, window), COA_OK);
+    /* The signer's numbers: the clock, then a sequence while it stands still. */
+    int32_t id;
+    int64_t ts, seq;
+    coavoid_auth_next(&signer, T0, &id, &ts, &seq);
+    ck_assert(id == 7 && ts == T0 && seq == 0);
+    coavoid_auth_next(&signer, T0, &id, &ts, &seq);
+    ck_assert(ts == T0 && seq == 1);
+    coavoid_auth_next(&signer, T0 + 1, &id, &ts, &seq);
+    ck_assert(ts == T0 + 1 && seq == 0);
+}
+END_TEST
+
 static Suite *lcm_suite(void)
 {
     Suite *s = suite_create("lcm");
@@ -1162,6 +1264,8 @@ static Suite *lcm_suite(void)
     tcase_add_test(tc, test_rx_count);
     tcase_add_test(tc, test_truncated_bytes);
     tcase_add_test(tc, test_random_bytes);
+    tcase_add_test(tc, test_auth_sign_verify);
+    tcase_add_test(tc, test_auth_roles_and_freshness);
     suite_add_tcase(s, tc);
     return s;
 }

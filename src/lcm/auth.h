@@ -1,0 +1,119 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * auth.h: signed messages. Every message type ends with an auth_t (lcmtypes/auth_t.lcm):
+ * the sender's key id, its clock when it signed, a sequence, and an Ed25519 signature. As
+ * the last field of every type it is the last COAVOID_AUTH_TAIL_BYTES of every datagram,
+ * the signature the last COAVOID_AUTH_SIGNATURE_BYTES, so that signing and checking work
+ * on the datagram's bytes whatever its type:
+ *
+ *   signed bytes = the datagram before its signature: the type's fingerprint, every field
+ *                  in LCM's encoding, then key_id, timestamp_us and sequence.
+ *
+ * (docs/messages.md, "Signed messages", defines it for other implementations.) The
+ * fingerprint binds the type, and with it the channel, since each type has one.
+ *
+ * A receiver holds a trust list: the public keys it accepts, each with the role it may
+ * speak for (the coordinator, the world, or one vehicle by id). coavoid_auth_verify
+ * checks a datagram's signature against the key its key_id names; coavoid_auth_fresh
+ * then accepts it only when it is newer than the last accepted from that key (timestamp,
+ * then sequence) and within a window of the receiver's clock, so a copied or replayed
+ * message is refused, and a sender that restarts (a later clock, its sequence from 0) is
+ * accepted at once: nobody is locked out.
+ *
+ * Ed25519 by libsodium (crypto_sign_detached / crypto_sign_verify_detached). Memory: the
+ * caller's structs; nothing is allocated. Cost: one signature or verification over the
+ * datagram (tens of microseconds; docs/benchmarks.md).
+ */
+#ifndef COAVOID_LCM_AUTH_H
+#define COAVOID_LCM_AUTH_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#define COAVOID_AUTH_SIGNATURE_BYTES 64u
+#define COAVOID_AUTH_TAIL_BYTES (4u + 8u + 8u + COAVOID_AUTH_SIGNATURE_BYTES)
+#define COAVOID_AUTH_PUBLIC_BYTES 32u
+#define COAVOID_AUTH_SECRET_BYTES 64u
+/* Keys one receiver trusts: a coordinator, a world and every UAV a node holds, with room. */
+#define COAVOID_AUTH_MAX_KEYS 128u
+
+/* What a key may speak for. */
+typedef enum {
+    COAVOID_AUTH_COORDINATOR = 1, /* plans, the conflict report and coordinator heartbeats */
+    COAVOID_AUTH_WORLD = 2,       /* obstacle maps and tracks */
+    COAVOID_AUTH_VEHICLE = 3      /* the intents and heartbeats of one UAV (node_id) */
+} coavoid_auth_role_t;
+
+typedef struct {
+    uint32_t key_id; /* 1..2^31-1, unique in a trust list */
+    coavoid_auth_role_t role;
+    uint16_t node_id; /* the node it speaks for: a UAV's id, the coordinator's, the world's */
+    unsigned char public_key[COAVOID_AUTH_PUBLIC_BYTES];
+} coavoid_auth_key_t;
+
+/* A receiver's trust list and, per key, the newest message accepted from it. */
+typedef struct {
+    coavoid_auth_key_t keys[COAVOID_AUTH_MAX_KEYS];
+    size_t count;
+    int64_t last_timestamp[COAVOID_AUTH_MAX_KEYS];
+    int64_t last_sequence[COAVOID_AUTH_MAX_KEYS];
+} coavoid_auth_trust_t;
+
+/* A sender's key, with the numbers of its next signature. */
+typedef struct {
+    uint32_t key_id;
+    unsigned char secret_key[COAVOID_AUTH_SECRET_BYTES];
+    int64_t last_timestamp;
+    int64_t sequence;
+} coavoid_auth_signer_t;
+
+/* Errors beyond the core's (COA_ERR_*): negative, after COAVOID_LCM_ERR_* (-100..-109). */
+#define COAVOID_AUTH_ERR_UNSIGNED (-120)  /* key_id 0, or too short to carry an auth_t */
+#define COAVOID_AUTH_ERR_KEY (-121)       /* key_id not in the trust list */
+#define COAVOID_AUTH_ERR_SIGNATURE (-122) /* the signature does not verify */
+#define COAVOID_AUTH_ERR_ROLE (-123)      /* the key may not send this (role or node) */
+#define COAVOID_AUTH_ERR_REPLAY (-124)    /* not newer than the last from that key */
+#define COAVOID_AUTH_ERR_CLOCK (-125)     /* timestamp outside the receiver's window */
+
+/* Initialises libsodium; call once before anything else here (thread-safe, idempotent).
+ * Returns COA_OK or COA_ERR_ARGUMENT when the library cannot start. */
+int coavoid_auth_init(void);
+
+/* A new key pair from the system's random source. Returns COA_OK or COA_ERR_ARGUMENT. */
+int coavoid_auth_keypair(unsigned char public_key[COAVOID_AUTH_PUBLIC_BYTES],
+                         unsigned char secret_key[COAVOID_AUTH_SECRET_BYTES]);
+
+/* Empties a trust list; adds a key (COA_ERR_ARGUMENT: list full, key_id 0 or repeated). */
+void coavoid_auth_trust_init(coavoid_auth_trust_t *t);
+int coavoid_auth_trust_add(coavoid_auth_trust_t *t, const coavoid_auth_key_t *key);
+
+/* The auth_t numbers of the next message signed with s at the sender's clock `now`
+ * (microseconds): its key_id, now (or one more than the last, when the clock did not
+ * move on), and a sequence that starts again at 0 with each new timestamp. O(1). */
+void coavoid_auth_next(coavoid_auth_signer_t *s, int64_t now, int32_t *key_id,
+                       int64_t *timestamp_us, int64_t *sequence);
+
+/* Signs an encoded datagram of `size` bytes whose auth_t already holds the signer's
+ * key_id and numbers (coavoid_auth_next): writes the signature into its last 64 bytes.
+ * Returns COA_OK or COA_ERR_ARGUMENT (NULL, or too short to end with an auth_t). */
+int coavoid_auth_sign(const coavoid_auth_signer_t *s, unsigned char *datagram, size_t size);
+
+/* Checks a received datagram's signature against the key its key_id names in t. Returns
+ * COA_OK with *key (its index in t) or a COAVOID_AUTH_ERR_*; reads only the datagram. */
+int coavoid_auth_verify(const coavoid_auth_trust_t *t, const unsigned char *datagram, size_t size,
+                        size_t *key);
+
+/* Whether key `key` of t may send as `role` for node `node_id` (0: any node of the role,
+ * for types without a sender id). COA_OK or COAVOID_AUTH_ERR_ROLE. O(1). */
+int coavoid_auth_may_send(const coavoid_auth_trust_t *t, size_t key, coavoid_auth_role_t role,
+                          uint16_t node_id);
+
+/* Accepts the (timestamp, sequence) of a verified message from key `key` at the
+ * receiver's clock `now`: it must be within `window_us` of now and after the last
+ * accepted from that key (a later timestamp, or the same with a larger sequence); then
+ * it becomes the last. COA_OK, COAVOID_AUTH_ERR_CLOCK or COAVOID_AUTH_ERR_REPLAY. O(1). */
+int coavoid_auth_fresh(coavoid_auth_trust_t *t, size_t key, int64_t timestamp_us, int64_t sequence,
+                       int64_t now, int64_t window_us);
+
+#endif /* COAVOID_LCM_AUTH_H */
