@@ -1242,6 +1242,57 @@ START_TEST(test_auth_roles_and_freshness)
 }
 END_TEST
 
+/* Keys as text: a trust file's lines and a secret key file round-trip; a bad line is
+ * refused with its number and why, whatever else the file holds. */
+START_TEST(test_auth_key_files)
+{
+    coavoid_auth_signer_t signer;
+    coavoid_auth_trust_t trust;
+    auth_pair(&signer, &trust, COAVOID_AUTH_VEHICLE, 3);
+    char text[4 * COAVOID_AUTH_LINE_MAX] = "# the fleet\n\n";
+    char key_line[COAVOID_AUTH_LINE_MAX], line[COAVOID_AUTH_LINE_MAX];
+    ck_assert_int_eq(coavoid_auth_key_line(&trust.keys[0], key_line, sizeof key_line), COA_OK);
+    strcat(text, key_line);
+    coavoid_auth_trust_t back;
+    char err[128] = "";
+    ck_assert_int_eq(coavoid_auth_trust_parse(&back, text, strlen(text), err, sizeof err), COA_OK);
+    ck_assert_uint_eq(back.count, 1);
+    ck_assert_int_eq(memcmp(&back.keys[0], &trust.keys[0], sizeof back.keys[0]), 0);
+    ck_assert_int_eq(coavoid_auth_signer_line(&signer, line, sizeof line), COA_OK);
+    coavoid_auth_signer_t read;
+    ck_assert_int_eq(coavoid_auth_signer_parse(&read, line, strlen(line), err, sizeof err), COA_OK);
+    ck_assert(read.key_id == signer.key_id &&
+              memcmp(read.secret_key, signer.secret_key, sizeof read.secret_key) == 0);
+    const char *bad[][2] = {
+        {"7 pilot 3 00", "line 1: ROLE must be coordinator, world or vehicle"},
+        {"# ok\n7 vehicle 3 00ff", "line 2: PUBLIC_KEY_HEX must be 64 hex digits"},
+        {"0 vehicle 3 00", "line 1: KEY_ID must be in 1..2147483647 and NODE_ID in 1..65535"},
+        {"7 vehicle 70000 00", "line 1: KEY_ID must be in 1..2147483647 and NODE_ID in 1..65535"},
+        {"7 vehicle 3", "line 1: expected KEY_ID ROLE NODE_ID PUBLIC_KEY_HEX"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        ck_assert_int_eq(
+            coavoid_auth_trust_parse(&back, bad[i][0], strlen(bad[i][0]), err, sizeof err),
+            COA_ERR_ARGUMENT);
+        ck_assert_str_eq(err, bad[i][1]);
+    }
+    strcat(text, key_line); /* the same key twice */
+    ck_assert_int_eq(coavoid_auth_trust_parse(&back, text, strlen(text), err, sizeof err),
+                     COA_ERR_ARGUMENT);
+    ck_assert_str_eq(err, "line 4: KEY_ID repeated, or more than 128 keys");
+    char long_line[400];
+    memset(long_line, '1', sizeof long_line - 1u);
+    long_line[sizeof long_line - 1u] = '\0';
+    ck_assert_int_eq(coavoid_auth_trust_parse(&back, long_line, strlen(long_line), err, sizeof err),
+                     COA_ERR_ARGUMENT);
+    ck_assert_str_eq(err, "line 1: longer than 255 characters");
+    ck_assert_int_eq(
+        coavoid_auth_signer_parse(&read, "coavoid-secret-key 7 abc", 24, err, sizeof err),
+        COA_ERR_ARGUMENT);
+    ck_assert_str_eq(err, "line 1: SECRET_KEY_HEX must be 128 hex digits");
+}
+END_TEST
+
 static Suite *lcm_suite(void)
 {
     Suite *s = suite_create("lcm");
@@ -1266,6 +1317,7 @@ static Suite *lcm_suite(void)
     tcase_add_test(tc, test_random_bytes);
     tcase_add_test(tc, test_auth_sign_verify);
     tcase_add_test(tc, test_auth_roles_and_freshness);
+    tcase_add_test(tc, test_auth_key_files);
     suite_add_tcase(s, tc);
     return s;
 }

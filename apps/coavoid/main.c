@@ -22,7 +22,7 @@
 #include "cli.h"
 #include "commands.h"
 
-/* sim, summary and world run the nodes over LCM: they are built, and listed, only with
+/* sim, summary, world and keygen run the nodes over LCM or make their keys: they are built, and listed, only with
  * the node library (COAVOID_BUILD_LCM, which gives this program COAVOID_HAVE_NODE). This is
  * the one place where that option reaches the code: their sources are left out of the
  * build otherwise, not replaced by stubs. */
@@ -30,7 +30,8 @@
 #define USAGE_NODES                                                                 \
     "  sim         fly a scenario in closed loop over the nodes (deterministic)\n"  \
     "  summary     judge a real-time run from its lcm-logger log (costs, figure)\n" \
-    "  world       publish a scenario's terrain and tracks to a real-time run\n"
+    "  world       publish a scenario's terrain and tracks to a real-time run\n"    \
+    "  keygen      write fresh signing keys and the trust file for a scenario's fleet\n"
 #else
 #define USAGE_NODES ""
 #endif
@@ -77,6 +78,9 @@ int main(int argc, char **argv)
     }
     if (strcmp(command, "world") == 0) {
         return coavoid_command_world(argc, argv);
+    }
+    if (strcmp(command, "keygen") == 0) {
+        return coavoid_command_keygen(argc, argv);
     }
 #endif
     if (command[0] == '-') {

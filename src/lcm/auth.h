@@ -116,4 +116,28 @@ int coavoid_auth_may_send(const coavoid_auth_trust_t *t, size_t key, coavoid_aut
 int coavoid_auth_fresh(coavoid_auth_trust_t *t, size_t key, int64_t timestamp_us, int64_t sequence,
                        int64_t now, int64_t window_us);
 
+/* ---- keys as text ----
+ * A trust file lists the keys a receiver accepts, one per line:
+ *     KEY_ID ROLE NODE_ID PUBLIC_KEY_HEX
+ * with ROLE coordinator, world or vehicle, NODE_ID the node it speaks for (1..65535) and
+ * the public key as 64 hex digits; blank lines and lines starting with '#' are skipped.
+ * A secret key file is one line: "coavoid-secret-key KEY_ID SECRET_KEY_HEX" (128 digits).
+ * Both are files a user hands us: every line is bounded (COAVOID_AUTH_LINE_MAX) and
+ * checked, and the first problem is reported as "line N: why". */
+#define COAVOID_AUTH_LINE_MAX 256u
+
+/* Parses `length` bytes of a trust file into t (emptied first). COA_OK, or
+ * COA_ERR_ARGUMENT with the reason in err. O(length * keys). */
+int coavoid_auth_trust_parse(coavoid_auth_trust_t *t, const char *text, size_t length, char *err,
+                             size_t err_size);
+
+/* Parses a secret key file into s (its numbers zeroed). COA_OK or COA_ERR_ARGUMENT with err. */
+int coavoid_auth_signer_parse(coavoid_auth_signer_t *s, const char *text, size_t length, char *err,
+                              size_t err_size);
+
+/* The trust line of k and the secret file line of s, each ending in '\n', into out[size]
+ * (COAVOID_AUTH_LINE_MAX is enough). COA_OK or COA_ERR_ARGUMENT (too small, bad role). */
+int coavoid_auth_key_line(const coavoid_auth_key_t *k, char *out, size_t size);
+int coavoid_auth_signer_line(const coavoid_auth_signer_t *s, char *out, size_t size);
+
 #endif /* COAVOID_LCM_AUTH_H */

@@ -408,4 +408,26 @@ sim_json runaway-short "$tmp/limit_runaway.json" decoupled 0 '
 r["steps"] == 20
 ' --steps 20
 
+# ---- coavoid keygen: the fleet's signing keys ----
+
+# A secret key file per node, for its owner only, and a trust file with every public key
+# and its role; two runs give different keys.
+mkdir -p "$tmp/keys" "$tmp/keys2"
+if expect_status "keygen" 0 keygen "$scenarios/paper.json" --dir "$tmp/keys" &&
+    "$bin" keygen "$scenarios/paper.json" --dir "$tmp/keys2" 2>/dev/null; then
+    if [ "$(stat -c %a "$tmp/keys/coordinator.key" "$tmp/keys/world.key" "$tmp/keys/vehicle-1.key" \
+        "$tmp/keys/vehicle-2.key" "$tmp/keys/vehicle-3.key" | sort -u)" = 600 ] &&
+        grep -Eq '^coavoid-secret-key 101 [0-9a-f]{128}$' "$tmp/keys/vehicle-1.key" &&
+        [ "$(grep -Ec '^(1 coordinator 65001|2 world 65000|10[123] vehicle [123]) [0-9a-f]{64}$' \
+            "$tmp/keys/trust.txt")" = 5 ] &&
+        ! cmp -s "$tmp/keys/trust.txt" "$tmp/keys2/trust.txt"; then
+        pass
+    else
+        fail "keygen: unexpected files: $(ls -l "$tmp/keys") $(cat "$tmp/keys/trust.txt")"
+    fi
+fi
+expect_bad "keygen without --dir" "--dir" keygen "$scenarios/paper.json"
+expect_bad "keygen into a missing directory" "not a directory" keygen "$scenarios/paper.json" \
+    --dir "$tmp/none"
+
 finish
