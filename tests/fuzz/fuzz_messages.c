@@ -9,12 +9,15 @@
  * of a valid message of that type (tests/lcm_examples.h) after its 8-byte fingerprint, so
  * that the type hash holds and
  * the fuzzer reaches every field's validation instead of stopping at it.
- * Nothing may crash, leak or trip a sanitizer, whatever the bytes.
+ * Every datagram also goes through the signature check (auth.h) against a trust list of one
+ * key, and kind 6 feeds the bytes to the trust and secret key file parsers. Nothing may
+ * crash, leak or trip a sanitizer, whatever the bytes.
  */
 #include <stddef.h>
 #include <stdint.h>
 #include <string.h>
 
+#include "auth.h"
 #include "coavoid_lcm.h"
 #include "lcm_examples.h"
 
@@ -123,6 +126,37 @@ static void receive_map(const unsigned char *buf, size_t size, coavoid_lcm_conte
                                                  &why));
 }
 
+/* The signature check of any datagram, against a trust list of one known key. */
+static void check_signature(const unsigned char *buf, size_t n)
+{
+    static coavoid_auth_trust_t trust;
+    static int ready;
+    if (!ready) {
+        coavoid_auth_key_t key = {7, COAVOID_AUTH_VEHICLE, 3, {0}};
+        unsigned char secret[COAVOID_AUTH_SECRET_BYTES];
+        coavoid_auth_trust_init(&trust);
+        if (coavoid_auth_keypair(key.public_key, secret) != COA_OK ||
+            coavoid_auth_trust_add(&trust, &key) != COA_OK) {
+            __builtin_trap();
+        }
+        ready = 1;
+    }
+    size_t key = 0;
+    if (coavoid_auth_verify(&trust, buf, n, &key) == COA_OK) {
+        (void)coavoid_auth_fresh(&trust, key, T0, 0, T0, 1000000);
+    }
+}
+
+/* The text parsers of the key files a user hands over. */
+static void parse_key_files(const char *text, size_t n)
+{
+    static coavoid_auth_trust_t trust;
+    coavoid_auth_signer_t signer;
+    char err[128];
+    (void)coavoid_auth_trust_parse(&trust, text, n, err, sizeof err);
+    (void)coavoid_auth_signer_parse(&signer, text, n, err, sizeof err);
+}
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     static unsigned char buf[FUZZ_BUF];
@@ -130,7 +164,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (size < 1u || size > FUZZ_BUF) {
         return 0;
     }
-    const unsigned kind = (data[0] & 0x7fu) % 6u;
+    const unsigned kind = (data[0] & 0x7fu) % 7u;
+    if (kind == 6u) {
+        parse_key_files((const char *)data + 1, size - 1u);
+        return 0;
+    }
     const int raw = (data[0] & 0x80u) != 0;
     size_t n = size - 1u;
     if (raw) {
@@ -142,6 +180,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         }
         n = base;
     }
+    check_signature(buf, n);
     coavoid_lcm_context_t ctx = ctx_now();
     coavoid_lcm_sequence_table_t seq;
     coavoid_lcm_sequence_init(&seq, senders, sizeof senders / sizeof senders[0]);

@@ -11,14 +11,17 @@ trap 'rm -rf "$work"' EXIT
 command -v clang >/dev/null || { echo "fuzz: clang is not installed" >&2; exit 1; }
 clang -std=c11 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all \
   -I"$src/include" -I"$src/src/lcm" -I"$src/tests" -I"$types/include" \
-  "$src/tests/fuzz/fuzz_messages.c" "$src/src/lcm/convert.c" "$src"/src/core/*.c \
-  "$types"/c/*.c -llcm -lccd -lm -o "$work/fuzz_messages"
+  "$src/tests/fuzz/fuzz_messages.c" "$src/src/lcm/convert.c" "$src/src/lcm/auth.c" \
+  "$src"/src/core/*.c "$types"/c/*.c -llcm -lsodium -lccd -lm -o "$work/fuzz_messages"
 mkdir -p "$work/corpus"
-# The six valid examples unchanged (mode byte 0-5), and raw bytes of each type (0x80-0x85).
+# The six valid examples unchanged (mode byte 0-5), and raw bytes of each type (0x80-0x85);
+# and a trust file and a secret key file for the key file parsers (kind 6).
 for kind in 0 1 2 3 4 5; do
   printf "\\x0$kind" >"$work/corpus/example-$kind"
   printf "\\x8$kind" >"$work/corpus/raw-$kind"
 done
+printf '\x06# fleet\n1 coordinator 65001 %064d\n101 vehicle 1 %064d\n' 0 0 >"$work/corpus/trust"
+printf '\x06coavoid-secret-key 101 %0128d\n' 0 >"$work/corpus/secret"
 "$work/fuzz_messages" -runs="$runs" -max_len=20000 -seed=1 "$work/corpus" 2>"$work/log" ||
   { tail -n 60 "$work/log"; exit 1; }
 grep -E "DONE" "$work/log" || tail -n 3 "$work/log"
