@@ -255,6 +255,11 @@ int coavoid_lcm_conflict_report_from_core(const coa_conflict_t *conflicts, size_
 int coavoid_lcm_status_check(const coavoid_status_t *msg, const coavoid_lcm_context_t *ctx,
                              const char **reason);
 
+/* The health that status_t's REASON_* bits give: HEALTH_FAULT with INTERNAL_ERROR or
+ * DUPLICATE_ID, HEALTH_DEGRADED with any other, HEALTH_OK with none. One rule for the
+ * nodes that send heartbeats and for the check of those received. O(1). */
+int8_t coavoid_lcm_health_of(int32_t reasons);
+
 /* Check + sequence rule for the two types that have no core counterpart to convert to. */
 int coavoid_lcm_conflict_report_accept(const coavoid_conflict_report_t *msg,
                                        const coavoid_lcm_context_t *ctx,

@@ -1200,25 +1200,21 @@ int coavoid_lcm_conflict_report_accept(const coavoid_conflict_report_t *msg,
 
 /* ---- status ---- */
 
-/* Known REASON_* bits only, none exactly when OK, and a FAULT exactly when a fatal one is
- * set. */
+int8_t coavoid_lcm_health_of(int32_t reasons)
+{
+    const int32_t fatal =
+        COAVOID_STATUS_T_REASON_INTERNAL_ERROR | COAVOID_STATUS_T_REASON_DUPLICATE_ID;
+    return (reasons & fatal) != 0 ? COAVOID_STATUS_T_HEALTH_FAULT
+           : reasons != 0         ? COAVOID_STATUS_T_HEALTH_DEGRADED
+                                  : COAVOID_STATUS_T_HEALTH_OK;
+}
+
+/* Known REASON_* bits only, and the health they give. */
 static bool status_reasons_ok(const coavoid_status_t *msg)
 {
     const int32_t known = 2 * COAVOID_STATUS_T_REASON_NO_PLAN - 1;
-    const int32_t fatal =
-        COAVOID_STATUS_T_REASON_INTERNAL_ERROR | COAVOID_STATUS_T_REASON_DUPLICATE_ID;
     const int32_t r = msg->reasons;
-    if (r < 0 || (r & ~known) != 0) {
-        return false;
-    }
-    switch (msg->health) {
-    case COAVOID_STATUS_T_HEALTH_OK:
-        return r == 0;
-    case COAVOID_STATUS_T_HEALTH_FAULT:
-        return (r & fatal) != 0;
-    default:
-        return r != 0 && (r & fatal) == 0;
-    }
+    return r >= 0 && (r & ~known) == 0 && msg->health == coavoid_lcm_health_of(r);
 }
 
 int coavoid_lcm_status_check(const coavoid_status_t *msg, const coavoid_lcm_context_t *ctx,

@@ -870,13 +870,9 @@ int coavoid_node_publish_heartbeat(coavoid_node_inbox_t *in, coavoid_status_t *m
     m->sequence = h->sequence;
     const bool refused = h->rx->rejected > in->rejected_at_heartbeat;
     in->rejected_at_heartbeat = h->rx->rejected;
-    const int32_t fatal =
-        COAVOID_STATUS_T_REASON_INTERNAL_ERROR | COAVOID_STATUS_T_REASON_DUPLICATE_ID;
     m->reasons = h->reasons | (refused ? COAVOID_STATUS_T_REASON_MESSAGES_REFUSED : 0) |
                  (in->have_map ? 0 : COAVOID_STATUS_T_REASON_NO_MAP);
-    m->health = (m->reasons & fatal) != 0 ? COAVOID_STATUS_T_HEALTH_FAULT
-                : m->reasons != 0         ? COAVOID_STATUS_T_HEALTH_DEGRADED
-                                          : COAVOID_STATUS_T_HEALTH_OK;
+    m->health = coavoid_lcm_health_of(m->reasons);
     m->mode = h->mode;
     m->last_plan_utime = h->last_plan_utime;
     m->last_plan_duration_us = h->last_plan_duration_us;

@@ -513,6 +513,16 @@ static void reject_plan(coavoid_vehicle_node_t *node, int code, const char *reas
     reject(node, code, reason);
 }
 
+/* The slot of UAV id's row of this cycle's plans: row_count when it has none. O(rows). */
+static size_t row_slot(const coavoid_vehicle_node_t *node, uint16_t id)
+{
+    size_t slot = 0;
+    while (slot < node->row_count && node->row_id[slot] != id) {
+        slot++;
+    }
+    return slot;
+}
+
 /* Keeps the other UAVs' rows of a solved plan of this cycle, unless a later plan of the
  * cycle (a larger plan_id) already gave one: the coordinator's newest word on what each
  * will fly. O(rows * (peers + N)). */
@@ -523,10 +533,7 @@ static void record_rows(coavoid_vehicle_node_t *node, const coavoid_plan_t *msg,
     const size_t samples = (size_t)info->horizon + 1u;
     for (size_t i = 0; i < result->planned_count && i < info->vehicle_count; i++) {
         const uint16_t id = info->uav_ids[i];
-        size_t slot = 0;
-        while (slot < node->row_count && node->row_id[slot] != id) {
-            slot++;
-        }
+        const size_t slot = row_slot(node, id);
         if (id == node->config.vehicle.id || slot == COAVOID_NODE_MAX_PEERS ||
             (slot < node->row_count && node->row_plan_id[slot] >= msg->plan_id)) {
             continue;
@@ -545,10 +552,7 @@ static void record_rows(coavoid_vehicle_node_t *node, const coavoid_plan_t *msg,
 static void apply_row(coavoid_vehicle_node_t *node, size_t i)
 {
     coavoid_node_view_t *view = &node->view;
-    size_t slot = 0;
-    while (slot < node->row_count && node->row_id[slot] != view->live_id[i]) {
-        slot++;
-    }
+    const size_t slot = row_slot(node, view->live_id[i]);
     if (slot == node->row_count || !view->live_current[i]) {
         return;
     }
