@@ -829,7 +829,8 @@ START_TEST(test_reject_status)
     EXPECT(coavoid_status_t, status, (m_.health = COAVOID_STATUS_T_HEALTH_DEGRADED, m_.reasons = 0),
            COAVOID_LCM_ERR_VALUE);
     EXPECT(coavoid_status_t, status,
-           (m_.health = COAVOID_STATUS_T_HEALTH_DEGRADED, m_.reasons = 512), COAVOID_LCM_ERR_VALUE);
+           (m_.health = COAVOID_STATUS_T_HEALTH_DEGRADED, m_.reasons = 1024),
+           COAVOID_LCM_ERR_VALUE);
     EXPECT(coavoid_status_t, status,
            (m_.health = COAVOID_STATUS_T_HEALTH_DEGRADED,
             m_.reasons = COAVOID_STATUS_T_REASON_DUPLICATE_ID),
@@ -1221,15 +1222,34 @@ START_TEST(test_auth_roles_and_freshness)
     ck_assert_int_eq(coavoid_auth_may_send(&trust, 1, COAVOID_AUTH_VEHICLE, 3),
                      COAVOID_AUTH_ERR_ROLE);
     const int64_t window = 2000000;
-    ck_assert_int_eq(coavoid_auth_fresh(&trust, 0, T0, 0, T0, window), COA_OK);
-    ck_assert_int_eq(coavoid_auth_fresh(&trust, 0, T0, 0, T0, window), COAVOID_AUTH_ERR_REPLAY);
-    ck_assert_int_eq(coavoid_auth_fresh(&trust, 0, T0, 1, T0, window), COA_OK);
-    ck_assert_int_eq(coavoid_auth_fresh(&trust, 0, T0 - 5, 9, T0, window), COAVOID_AUTH_ERR_REPLAY);
-    ck_assert_int_eq(coavoid_auth_fresh(&trust, 0, T0 + 3 * window, 0, T0, window),
+    const size_t st = COAVOID_AUTH_STREAM_STATUS;
+    ck_assert_int_eq(coavoid_auth_fresh(&trust, 0, st, T0, 0, T0, window, window), COA_OK);
+    ck_assert_int_eq(coavoid_auth_fresh(&trust, 0, st, T0, 0, T0, window, window),
+                     COAVOID_AUTH_ERR_REPLAY);
+    ck_assert_int_eq(coavoid_auth_fresh(&trust, 0, st, T0, 1, T0, window, window), COA_OK);
+    ck_assert_int_eq(coavoid_auth_fresh(&trust, 0, st, T0 - 5, 9, T0, window, window),
+                     COAVOID_AUTH_ERR_REPLAY);
+    ck_assert_int_eq(coavoid_auth_fresh(&trust, 0, st, T0 + 3 * window, 0, T0, window, window),
                      COAVOID_AUTH_ERR_CLOCK);
-    ck_assert_int_eq(coavoid_auth_fresh(&trust, 0, T0 - 3 * window, 0, T0, window),
+    ck_assert_int_eq(coavoid_auth_fresh(&trust, 0, st, T0 - 3 * window, 0, T0, window, window),
                      COAVOID_AUTH_ERR_CLOCK);
-    ck_assert_int_eq(coavoid_auth_fresh(&trust, 0, T0 + 10, 0, T0 + 10, window), COA_OK);
+    ck_assert_int_eq(coavoid_auth_fresh(&trust, 0, st, T0 + 10, 0, T0 + 10, window, window),
+                     COA_OK);
+    /* The window is lopsided: old messages up to max_age, but little ahead (a replay from a
+     * clock running ahead must not outrank the sender's next messages). */
+    ck_assert_int_eq(
+        coavoid_auth_fresh(&trust, 0, st, T0 + 100 + window / 2, 0, T0 + 100, window, window / 4),
+        COAVOID_AUTH_ERR_CLOCK);
+    /* Streams are apart: an intent sent before that heartbeat but delivered after it is
+     * not a replay; a bad stream or key is never fresh. */
+    ck_assert_int_eq(coavoid_auth_fresh(&trust, 0, COAVOID_AUTH_STREAM_INTENT, T0 + 5, 0, T0 + 10,
+                                        window, window),
+                     COA_OK);
+    ck_assert_int_eq(
+        coavoid_auth_fresh(&trust, 0, COAVOID_AUTH_STREAMS, T0 + 20, 0, T0, window, window),
+        COAVOID_AUTH_ERR_REPLAY);
+    ck_assert_int_eq(coavoid_auth_fresh(&trust, 1, st, T0 + 20, 0, T0, window, window),
+                     COAVOID_AUTH_ERR_REPLAY);
     /* The signer's numbers: the clock, then a sequence while it stands still. */
     int32_t id;
     int64_t ts, seq;
@@ -1239,6 +1259,38 @@ START_TEST(test_auth_roles_and_freshness)
     ck_assert(ts == T0 && seq == 1);
     coavoid_auth_next(&signer, T0 + 1, &id, &ts, &seq);
     ck_assert(ts == T0 + 1 && seq == 0);
+}
+END_TEST
+
+/* Stamping works on the datagram alone: the numbers land where LCM decodes them, the
+ * signature verifies, and seeded keys are repeatable. */
+START_TEST(test_auth_stamp)
+{
+    coavoid_auth_signer_t signer;
+    coavoid_auth_trust_t trust;
+    auth_pair(&signer, &trust, COAVOID_AUTH_VEHICLE, 3);
+    coavoid_status_t m = good_status();
+    unsigned char buf[512];
+    const int size = coavoid_status_t_encode(buf, 0, (int)sizeof buf, &m);
+    ck_assert_int_gt(size, 0);
+    ck_assert_int_eq(coavoid_auth_stamp(&signer, T0 + 7, buf, (size_t)size), COA_OK);
+    ck_assert_int_eq(coavoid_auth_stamp(&signer, T0 + 7, buf, (size_t)size), COA_OK);
+    coavoid_status_t back;
+    ck_assert_int_eq(coavoid_status_t_decode(buf, 0, size, &back), size);
+    ck_assert(back.auth.key_id == 7 && back.auth.timestamp_us == T0 + 7 && back.auth.sequence == 1);
+    size_t key = 99;
+    ck_assert_int_eq(coavoid_auth_verify(&trust, buf, (size_t)size, &key), COA_OK);
+    ck_assert_int_eq(coavoid_auth_stamp(&signer, T0, buf, 20), COA_ERR_ARGUMENT);
+    ck_assert(signer.last_timestamp == T0 + 7 && signer.sequence == 1);
+    unsigned char seed[COAVOID_AUTH_SEED_BYTES] = {1, 2, 3};
+    unsigned char pk1[COAVOID_AUTH_PUBLIC_BYTES], pk2[COAVOID_AUTH_PUBLIC_BYTES];
+    unsigned char sk1[COAVOID_AUTH_SECRET_BYTES], sk2[COAVOID_AUTH_SECRET_BYTES];
+    ck_assert_int_eq(coavoid_auth_keypair_seed(seed, pk1, sk1), COA_OK);
+    ck_assert_int_eq(coavoid_auth_keypair_seed(seed, pk2, sk2), COA_OK);
+    ck_assert(memcmp(pk1, pk2, sizeof pk1) == 0 && memcmp(sk1, sk2, sizeof sk1) == 0);
+    seed[0] = 9;
+    ck_assert_int_eq(coavoid_auth_keypair_seed(seed, pk2, sk2), COA_OK);
+    ck_assert(memcmp(pk1, pk2, sizeof pk1) != 0);
 }
 END_TEST
 
@@ -1317,6 +1369,7 @@ static Suite *lcm_suite(void)
     tcase_add_test(tc, test_random_bytes);
     tcase_add_test(tc, test_auth_sign_verify);
     tcase_add_test(tc, test_auth_roles_and_freshness);
+    tcase_add_test(tc, test_auth_stamp);
     tcase_add_test(tc, test_auth_key_files);
     suite_add_tcase(s, tc);
     return s;

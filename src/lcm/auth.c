@@ -27,6 +27,16 @@ int coavoid_auth_keypair(unsigned char public_key[COAVOID_AUTH_PUBLIC_BYTES],
     return crypto_sign_keypair(public_key, secret_key) == 0 ? COA_OK : COA_ERR_ARGUMENT;
 }
 
+int coavoid_auth_keypair_seed(const unsigned char seed[COAVOID_AUTH_SEED_BYTES],
+                              unsigned char public_key[COAVOID_AUTH_PUBLIC_BYTES],
+                              unsigned char secret_key[COAVOID_AUTH_SECRET_BYTES])
+{
+    if (seed == NULL || public_key == NULL || secret_key == NULL || coavoid_auth_init() != COA_OK) {
+        return COA_ERR_ARGUMENT;
+    }
+    return crypto_sign_seed_keypair(public_key, secret_key, seed) == 0 ? COA_OK : COA_ERR_ARGUMENT;
+}
+
 void coavoid_auth_trust_init(coavoid_auth_trust_t *t)
 {
     memset(t, 0, sizeof *t);
@@ -44,8 +54,10 @@ int coavoid_auth_trust_add(coavoid_auth_trust_t *t, const coavoid_auth_key_t *ke
         }
     }
     t->keys[t->count] = *key;
-    t->last_timestamp[t->count] = INT64_MIN;
-    t->last_sequence[t->count] = INT64_MIN;
+    for (size_t stream = 0; stream < COAVOID_AUTH_STREAMS; stream++) {
+        t->last_timestamp[t->count][stream] = INT64_MIN;
+        t->last_sequence[t->count][stream] = INT64_MIN;
+    }
     t->count++;
     return COA_OK;
 }
@@ -66,6 +78,33 @@ void coavoid_auth_next(coavoid_auth_signer_t *s, int64_t now, int32_t *key_id,
     *sequence = s->sequence;
 }
 
+int coavoid_auth_signer_matches(const coavoid_auth_trust_t *t, const coavoid_auth_signer_t *s,
+                                coavoid_auth_role_t role, uint16_t node_id)
+{
+    if (t == NULL || s == NULL) {
+        return COAVOID_AUTH_ERR_KEY;
+    }
+    unsigned char public_key[COAVOID_AUTH_PUBLIC_BYTES];
+    crypto_sign_ed25519_sk_to_pk(public_key, s->secret_key);
+    for (size_t i = 0; i < t->count; i++) {
+        if (t->keys[i].key_id != s->key_id) {
+            continue;
+        }
+        if (sodium_memcmp(t->keys[i].public_key, public_key, sizeof public_key) != 0) {
+            return COAVOID_AUTH_ERR_KEY;
+        }
+        return coavoid_auth_may_send(t, i, role, node_id);
+    }
+    return COAVOID_AUTH_ERR_KEY;
+}
+
+void coavoid_auth_signer_clear(coavoid_auth_signer_t *s)
+{
+    if (s != NULL) {
+        sodium_memzero(s, sizeof *s);
+    }
+}
+
 int coavoid_auth_sign(const coavoid_auth_signer_t *s, unsigned char *datagram, size_t size)
 {
     if (s == NULL || datagram == NULL || size < COAVOID_AUTH_TAIL_BYTES + 8u) {
@@ -76,6 +115,35 @@ int coavoid_auth_sign(const coavoid_auth_signer_t *s, unsigned char *datagram, s
                                 s->secret_key) == 0
                ? COA_OK
                : COA_ERR_ARGUMENT;
+}
+
+static void put_be(unsigned char *p, uint64_t v, size_t bytes)
+{
+    for (size_t i = 0; i < bytes; i++) {
+        p[i] = (unsigned char)(v >> (8u * (bytes - 1u - i)));
+    }
+}
+
+int coavoid_auth_stamp(coavoid_auth_signer_t *s, int64_t now, unsigned char *datagram, size_t size)
+{
+    if (s == NULL || datagram == NULL || size < COAVOID_AUTH_TAIL_BYTES + 8u) {
+        return COA_ERR_ARGUMENT;
+    }
+    coavoid_auth_signer_t next = *s;
+    int32_t key_id = 0;
+    int64_t timestamp = 0, sequence = 0;
+    coavoid_auth_next(&next, now, &key_id, &timestamp, &sequence);
+    unsigned char *tail = datagram + size - COAVOID_AUTH_TAIL_BYTES;
+    put_be(tail, (uint32_t)key_id, 4u);
+    put_be(tail + 4, (uint64_t)timestamp, 8u);
+    put_be(tail + 12, (uint64_t)sequence, 8u);
+    int rc = coavoid_auth_sign(&next, datagram, size);
+    if (rc == COA_OK) {
+        s->last_timestamp = next.last_timestamp;
+        s->sequence = next.sequence;
+    }
+    sodium_memzero(next.secret_key, sizeof next.secret_key);
+    return rc;
 }
 
 /* The key_id of a datagram's auth_t: the 4 big-endian bytes before its two int64s and
@@ -123,21 +191,23 @@ int coavoid_auth_may_send(const coavoid_auth_trust_t *t, size_t key, coavoid_aut
                                                                        : COAVOID_AUTH_ERR_ROLE;
 }
 
-int coavoid_auth_fresh(coavoid_auth_trust_t *t, size_t key, int64_t timestamp_us, int64_t sequence,
-                       int64_t now, int64_t window_us)
+int coavoid_auth_fresh(coavoid_auth_trust_t *t, size_t key, size_t stream, int64_t timestamp_us,
+                       int64_t sequence, int64_t now, int64_t max_age_us, int64_t max_ahead_us)
 {
-    if (t == NULL || key >= t->count) {
+    if (t == NULL || key >= t->count || stream >= COAVOID_AUTH_STREAMS) {
         return COAVOID_AUTH_ERR_REPLAY;
     }
-    if (timestamp_us < now - window_us || timestamp_us > now + window_us) {
+    if (timestamp_us < now - max_age_us || timestamp_us > now + max_ahead_us) {
         return COAVOID_AUTH_ERR_CLOCK;
     }
-    if (timestamp_us < t->last_timestamp[key] ||
-        (timestamp_us == t->last_timestamp[key] && sequence <= t->last_sequence[key])) {
+    int64_t *last_timestamp = &t->last_timestamp[key][stream];
+    int64_t *last_sequence = &t->last_sequence[key][stream];
+    if (timestamp_us < *last_timestamp ||
+        (timestamp_us == *last_timestamp && sequence <= *last_sequence)) {
         return COAVOID_AUTH_ERR_REPLAY;
     }
-    t->last_timestamp[key] = timestamp_us;
-    t->last_sequence[key] = sequence;
+    *last_timestamp = timestamp_us;
+    *last_sequence = sequence;
     return COA_OK;
 }
 

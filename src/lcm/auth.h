@@ -37,6 +37,16 @@
 #define COAVOID_AUTH_SECRET_BYTES 64u
 /* Keys one receiver trusts: a coordinator, a world and every UAV a node holds, with room. */
 #define COAVOID_AUTH_MAX_KEYS 128u
+/* Freshness is kept per key and per stream (one stream per message type, numbered by the
+ * caller: COAVOID_AUTH_STREAM_*), since UDP may reorder one sender's datagrams of
+ * different types, and a heartbeat overtaken by the intent sent after it is no replay. */
+#define COAVOID_AUTH_STREAMS 6u
+#define COAVOID_AUTH_STREAM_INTENT 0u
+#define COAVOID_AUTH_STREAM_PLAN 1u
+#define COAVOID_AUTH_STREAM_TRACK 2u
+#define COAVOID_AUTH_STREAM_MAP 3u
+#define COAVOID_AUTH_STREAM_CONFLICTS 4u
+#define COAVOID_AUTH_STREAM_STATUS 5u
 
 /* What a key may speak for. */
 typedef enum {
@@ -45,6 +55,12 @@ typedef enum {
     COAVOID_AUTH_VEHICLE = 3      /* the intents and heartbeats of one UAV (node_id) */
 } coavoid_auth_role_t;
 
+/* A fleet's key ids, as `coavoid keygen` writes them and `coavoid sim` uses them: any
+ * numbering works as long as each is unique in a trust list. */
+#define COAVOID_AUTH_KEY_ID_COORDINATOR 1u
+#define COAVOID_AUTH_KEY_ID_WORLD 2u
+#define COAVOID_AUTH_KEY_ID_VEHICLE_BASE 100u /* + the UAV's id */
+
 typedef struct {
     uint32_t key_id; /* 1..2^31-1, unique in a trust list */
     coavoid_auth_role_t role;
@@ -52,12 +68,13 @@ typedef struct {
     unsigned char public_key[COAVOID_AUTH_PUBLIC_BYTES];
 } coavoid_auth_key_t;
 
-/* A receiver's trust list and, per key, the newest message accepted from it. */
+/* A receiver's trust list and, per key and stream, the newest message accepted from it
+ * (about 21 kB). */
 typedef struct {
     coavoid_auth_key_t keys[COAVOID_AUTH_MAX_KEYS];
     size_t count;
-    int64_t last_timestamp[COAVOID_AUTH_MAX_KEYS];
-    int64_t last_sequence[COAVOID_AUTH_MAX_KEYS];
+    int64_t last_timestamp[COAVOID_AUTH_MAX_KEYS][COAVOID_AUTH_STREAMS];
+    int64_t last_sequence[COAVOID_AUTH_MAX_KEYS][COAVOID_AUTH_STREAMS];
 } coavoid_auth_trust_t;
 
 /* A sender's key, with the numbers of its next signature. */
@@ -84,6 +101,14 @@ int coavoid_auth_init(void);
 int coavoid_auth_keypair(unsigned char public_key[COAVOID_AUTH_PUBLIC_BYTES],
                          unsigned char secret_key[COAVOID_AUTH_SECRET_BYTES]);
 
+/* The key pair derived from a 32-byte seed (libsodium's crypto_sign_seed_keypair): the
+ * same seed, the same keys. For repeatable simulations and tests only: a flying node's
+ * keys come from coavoid_auth_keypair. Returns COA_OK or COA_ERR_ARGUMENT. */
+#define COAVOID_AUTH_SEED_BYTES 32u
+int coavoid_auth_keypair_seed(const unsigned char seed[COAVOID_AUTH_SEED_BYTES],
+                              unsigned char public_key[COAVOID_AUTH_PUBLIC_BYTES],
+                              unsigned char secret_key[COAVOID_AUTH_SECRET_BYTES]);
+
 /* Empties a trust list; adds a key (COA_ERR_ARGUMENT: list full, key_id 0 or repeated). */
 void coavoid_auth_trust_init(coavoid_auth_trust_t *t);
 int coavoid_auth_trust_add(coavoid_auth_trust_t *t, const coavoid_auth_key_t *key);
@@ -94,10 +119,28 @@ int coavoid_auth_trust_add(coavoid_auth_trust_t *t, const coavoid_auth_key_t *ke
 void coavoid_auth_next(coavoid_auth_signer_t *s, int64_t now, int32_t *key_id,
                        int64_t *timestamp_us, int64_t *sequence);
 
+/* Whether t lists s's key as speaking for (role, node_id), with the public key that s's
+ * secret key gives: a node checks at start that its key file is its own. COA_OK,
+ * COAVOID_AUTH_ERR_KEY (not listed, or another public key) or COAVOID_AUTH_ERR_ROLE.
+ * O(keys). */
+int coavoid_auth_signer_matches(const coavoid_auth_trust_t *t, const coavoid_auth_signer_t *s,
+                                coavoid_auth_role_t role, uint16_t node_id);
+
+/* Zeroes s, its secret key in a way the compiler keeps (sodium_memzero): for a signer
+ * that goes out of use. NULL is fine. O(1). */
+void coavoid_auth_signer_clear(coavoid_auth_signer_t *s);
+
 /* Signs an encoded datagram of `size` bytes whose auth_t already holds the signer's
  * key_id and numbers (coavoid_auth_next): writes the signature into its last 64 bytes.
  * Returns COA_OK or COA_ERR_ARGUMENT (NULL, or too short to end with an auth_t). */
 int coavoid_auth_sign(const coavoid_auth_signer_t *s, unsigned char *datagram, size_t size);
+
+/* Stamps and signs an encoded datagram of `size` bytes in place, whatever its type: writes
+ * the next numbers of s at `now` (coavoid_auth_next) into its auth_t, big-endian as LCM
+ * encodes them, then the signature (coavoid_auth_sign). So a publisher needs no access to
+ * the message's struct. Returns COA_OK or COA_ERR_ARGUMENT (NULL, or too short); s's
+ * numbers move on only on success. Cost: one Ed25519 signature over size - 64 bytes. */
+int coavoid_auth_stamp(coavoid_auth_signer_t *s, int64_t now, unsigned char *datagram, size_t size);
 
 /* Checks a received datagram's signature against the key its key_id names in t. Returns
  * COA_OK with *key (its index in t) or a COAVOID_AUTH_ERR_*; reads only the datagram. */
@@ -109,12 +152,15 @@ int coavoid_auth_verify(const coavoid_auth_trust_t *t, const unsigned char *data
 int coavoid_auth_may_send(const coavoid_auth_trust_t *t, size_t key, coavoid_auth_role_t role,
                           uint16_t node_id);
 
-/* Accepts the (timestamp, sequence) of a verified message from key `key` at the
- * receiver's clock `now`: it must be within `window_us` of now and after the last
- * accepted from that key (a later timestamp, or the same with a larger sequence); then
- * it becomes the last. COA_OK, COAVOID_AUTH_ERR_CLOCK or COAVOID_AUTH_ERR_REPLAY. O(1). */
-int coavoid_auth_fresh(coavoid_auth_trust_t *t, size_t key, int64_t timestamp_us, int64_t sequence,
-                       int64_t now, int64_t window_us);
+/* Accepts the (timestamp, sequence) of a verified message of `stream`
+ * (< COAVOID_AUTH_STREAMS) from key `key` at the receiver's clock `now`: it must be at
+ * most max_age_us old and max_ahead_us ahead of now (clock skew: keep it small, or a
+ * replayed message from a clock running ahead would lock its sender out until then), and
+ * after the last accepted from that key on that stream (a later timestamp, or the same
+ * with a larger sequence); then it becomes the last. COA_OK, COAVOID_AUTH_ERR_CLOCK or
+ * COAVOID_AUTH_ERR_REPLAY (also for a bad key or stream). O(1). */
+int coavoid_auth_fresh(coavoid_auth_trust_t *t, size_t key, size_t stream, int64_t timestamp_us,
+                       int64_t sequence, int64_t now, int64_t max_age_us, int64_t max_ahead_us);
 
 /* ---- keys as text ----
  * A trust file lists the keys a receiver accepts, one per line:

@@ -143,7 +143,8 @@ static void check_signature(const unsigned char *buf, size_t n)
     }
     size_t key = 0;
     if (coavoid_auth_verify(&trust, buf, n, &key) == COA_OK) {
-        (void)coavoid_auth_fresh(&trust, key, T0, 0, T0, 1000000);
+        (void)coavoid_auth_fresh(&trust, key, COAVOID_AUTH_STREAM_STATUS, T0, 0, T0, 1000000,
+                                 1000000);
     }
 }
 
