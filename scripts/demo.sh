@@ -3,7 +3,9 @@
 # The coavoid demo: the ground coordinator, the world (terrain and tracks) and one vehicle
 # process per UAV of a scenario, exchanging intents and plans over LCM's UDP multicast on
 # this host, recorded by lcm-logger; then `coavoid summary` of the log: loss of
-# separation or not, costs, replans, and the figure.
+# separation or not, costs, replans, and the figure. Every message is signed: the demo
+# makes fresh keys for its run (`coavoid keygen`, in OUT/keys) and every process signs
+# with its own and checks the others' against OUT/keys/trust.txt.
 #
 # usage: scripts/demo.sh [--mode centralised|decoupled] [--scenario FILE] [--speed S]
 #                        [--out DIR] [--build DIR] [--netns]
@@ -127,6 +129,14 @@ print(", %d cycles at speed %s: about %.0f s" % (2 * s["horizon"], sys.argv[2],
       2 + 2 * s["horizon"] * s["dt"] / float(sys.argv[2])))' "$scenario" "$speed" 2>/dev/null || true)
 fi
 
+# Fresh keys for this run: one secret key per process, and the trust file they all share.
+keys=$out/keys
+rm -rf "$keys"
+mkdir -p "$keys"
+chmod 700 "$keys"
+"$coavoid" keygen "$scenario" --dir "$keys" || die "coavoid keygen failed"
+key() { echo --key "$keys/$1.key" --trust "$keys/trust.txt"; }
+
 pids=()
 logger=
 cleanup() {
@@ -143,20 +153,24 @@ logger=$!
 epoch=$(($(date +%s%N) / 1000 + 2000000))
 common=(--lcm-url "$url" --epoch "$epoch" --speed "$speed")
 names=()
-"$coavoid" world "$scenario" "${common[@]}" 2>"$out/world.txt" &
+# shellcheck disable=SC2046 # key's words are options
+"$coavoid" world "$scenario" "${common[@]}" $(key world) 2>"$out/world.txt" &
 pids+=($!) names+=(world)
 if [ "$mode" = centralised ]; then
-    "$coordinator" --scenario "$scenario" "${common[@]}" 2>"$out/coordinator.txt" &
+    # shellcheck disable=SC2046
+    "$coordinator" --scenario "$scenario" "${common[@]}" $(key coordinator) \
+        2>"$out/coordinator.txt" &
     pids+=($!) names+=(coordinator)
 fi
 for id in "${ids[@]}"; do
+    # shellcheck disable=SC2046
     "$vehicle" --scenario "$scenario" --id "$id" --mode "$mode" "${common[@]}" \
-        2>"$out/vehicle-$id.txt" &
+        $(key "vehicle-$id") 2>"$out/vehicle-$id.txt" &
     pids+=($!) names+=("vehicle-$id")
 done
 if [ "$mode" = centralised ]; then who="world, coordinator"; else who="world, no coordinator"; fi
 echo "demo: $(basename "$scenario"), $mode: $who, ${#ids[@]} vehicles (ids ${ids[*]})$duration"
-echo "      (epoch $epoch, $url)"
+echo "      (epoch $epoch, $url; every message signed, keys in $keys)"
 
 failed=0
 for i in "${!pids[@]}"; do
@@ -182,7 +196,8 @@ for name in "${names[@]}"; do
     fi
 done
 echo
-"$coavoid" summary "$log" "$scenario" --mode "$mode" --svg "$svg" --epoch "$epoch" || failed=1
+"$coavoid" summary "$log" "$scenario" --mode "$mode" --svg "$svg" --epoch "$epoch" \
+    --trust "$keys/trust.txt" || failed=1
 echo
 echo "log:    $log ($(wc -c <"$log") bytes; replay it with lcm-logplayer, watch it with lcm-spy)"
 echo "figure: $svg"

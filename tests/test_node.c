@@ -49,6 +49,8 @@ static void rig_init(rig_t *r, uint32_t horizon)
     r->now = EPOCH;
     ck_assert_int_eq(
         coavoid_node_common_defaults(&r->common, EPOCH, (coa_real_t)1, horizon, &r->now), COA_OK);
+    /* The rig injects unsigned messages; signed nodes are tested apart (test_signed_*). */
+    r->common.insecure = true;
 }
 
 static void drain(lcm_t *lcm)
@@ -576,9 +578,12 @@ static void on_status_probe(const lcm_recv_buf_t *rbuf, const char *channel, voi
     coavoid_status_t m;
     REQUIRE(coavoid_status_t_decode(rbuf->data, 0, (int)rbuf->data_size, &m) >= 0);
     if (m.node_id == p->node_id) {
+        /* The rig's nodes are insecure and say so in every heartbeat: the tests judge the
+         * other reasons, and the health those give. */
+        REQUIRE(m.reasons & COAVOID_STATUS_T_REASON_INSECURE);
         p->count++;
-        p->health = m.health;
-        p->reasons = m.reasons;
+        p->reasons = m.reasons & ~COAVOID_STATUS_T_REASON_INSECURE;
+        p->health = coavoid_lcm_health_of(p->reasons);
     }
 }
 
@@ -1501,6 +1506,248 @@ START_TEST(test_bad_configs_refused)
 }
 END_TEST
 
+/* ---- signed messages ---- */
+
+/* The signed tests' fleet: key ids as coavoid keygen numbers them (the coordinator 1, the
+ * world 2, UAV i 100 + i), from fixed seeds; every node trusts every key. */
+typedef struct {
+    coavoid_auth_trust_t trust;
+    coavoid_auth_signer_t coordinator, world, uav[2]; /* uav[i]: UAV i + 1 */
+} fleet_keys_t;
+
+static void fleet_key(fleet_keys_t *k, coavoid_auth_signer_t *s, uint32_t id,
+                      coavoid_auth_role_t role, uint16_t node)
+{
+    unsigned char seed[COAVOID_AUTH_SEED_BYTES] = {(unsigned char)id, 7};
+    coavoid_auth_key_t key = {id, role, node, {0}};
+    memset(s, 0, sizeof *s);
+    s->key_id = id;
+    ck_assert_int_eq(coavoid_auth_keypair_seed(seed, key.public_key, s->secret_key), COA_OK);
+    ck_assert_int_eq(coavoid_auth_trust_add(&k->trust, &key), COA_OK);
+}
+
+static void fleet_keys(fleet_keys_t *k)
+{
+    coavoid_auth_trust_init(&k->trust);
+    fleet_key(k, &k->coordinator, 1, COAVOID_AUTH_COORDINATOR,
+              (uint16_t)COAVOID_NODE_COORDINATOR_ID);
+    fleet_key(k, &k->world, 2, COAVOID_AUTH_WORLD, (uint16_t)COAVOID_NODE_WORLD_ID);
+    fleet_key(k, &k->uav[0], 101, COAVOID_AUTH_VEHICLE, 1);
+    fleet_key(k, &k->uav[1], 102, COAVOID_AUTH_VEHICLE, 2);
+}
+
+/* A UAV node of the signed fleet: it signs with its key and checks every message. */
+static coavoid_vehicle_node_t *signed_vehicle(rig_t *r, fleet_keys_t *k, coa_vehicle_t v,
+                                              coavoid_node_mode_t mode)
+{
+    r->common.insecure = false;
+    r->common.trust = &k->trust;
+    r->common.signer = &k->uav[v.id - 1u];
+    coavoid_vehicle_node_t *node = vehicle_node(r, v, mode);
+    r->common.signer = NULL; /* copied by the node */
+    return node;
+}
+
+/* Publishes size encoded bytes in buf, first signed at `now` by signer (NULL: as they
+ * are). */
+static void publish_bytes(lcm_t *lcm, const char *channel, unsigned char *buf, int size,
+                          coavoid_auth_signer_t *signer, int64_t now)
+{
+    ck_assert_int_gt(size, 0);
+    if (signer != NULL) {
+        ck_assert_int_eq(coavoid_auth_stamp(signer, now, buf, (size_t)size), COA_OK);
+    }
+    ck_assert_int_eq(lcm_publish(lcm, channel, buf, (unsigned)size), 0);
+}
+
+/* Room for any datagram of the node's types. */
+#define TAP_BYTES 20000
+
+/* The latest intent datagram of one UAV, and the latest heartbeat reasons of one node. */
+typedef struct {
+    int32_t uav;
+    int size;
+    unsigned char bytes[TAP_BYTES];
+    int32_t node;
+    int32_t reasons;
+} wiretap_t;
+
+static void on_tapped_intent(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
+{
+    wiretap_t *t = user;
+    static coavoid_intent_t m;
+    (void)channel;
+    if (coavoid_intent_t_decode(rbuf->data, 0, (int)rbuf->data_size, &m) > 0 &&
+        m.uav_id == t->uav && rbuf->data_size <= sizeof t->bytes) {
+        t->size = (int)rbuf->data_size;
+        memcpy(t->bytes, rbuf->data, rbuf->data_size);
+    }
+}
+
+static void on_tapped_status(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
+{
+    wiretap_t *t = user;
+    coavoid_status_t m;
+    (void)channel;
+    if (coavoid_status_t_decode(rbuf->data, 0, (int)rbuf->data_size, &m) > 0 &&
+        m.node_id == t->node) {
+        t->reasons = m.reasons;
+    }
+}
+
+/* One forgery heard by a signed node: refused with `code`, counted once. */
+static void expect_refused(rig_t *r, const coavoid_vehicle_node_state_t *s, int code,
+                           const char *what)
+{
+    const int64_t before = s->rx.rejected;
+    drain(r->lcm);
+    ck_assert_msg(s->rx.rejected == before + 1 && s->rx.last_reject_code == code,
+                  "%s: rejected %lld -> %lld, code %d (want %d)", what, (long long)before,
+                  (long long)s->rx.rejected, s->rx.last_reject_code, code);
+}
+
+/* Signed nodes accept each other's messages and say they are secure; every forgery is
+ * refused with its own code: a replay, a changed byte, no signature, a key of another role
+ * (the world's on an intent, a UAV's on a plan or a map), an unknown key, a time ahead of
+ * the window. A UAV that restarts (its sequence from 0 again) is heard again at once. */
+START_TEST(test_signed_messages)
+{
+    static fleet_keys_t k;
+    fleet_keys(&k);
+    rig_t r;
+    rig_init(&r, 10);
+    static wiretap_t tap;
+    tap.uav = 2;
+    tap.node = 1;
+    lcm_subscription_t *si = lcm_subscribe(r.lcm, COAVOID_CHANNEL_INTENT, on_tapped_intent, &tap);
+    lcm_subscription_t *ss = lcm_subscribe(r.lcm, COAVOID_CHANNEL_STATUS, on_tapped_status, &tap);
+    coa_vec3_t r1[2], r2[2];
+    coavoid_vehicle_node_t *a =
+        signed_vehicle(&r, &k, uav(1, 1, r1, 0, 500, 0, 100), COAVOID_NODE_CENTRALISED);
+    coavoid_vehicle_node_t *b =
+        signed_vehicle(&r, &k, uav(2, 2, r2, 0, 500, 800, 100), COAVOID_NODE_DECOUPLED);
+    coavoid_world_config_t wc;
+    memset(&wc, 0, sizeof wc);
+    wc.common = r.common;
+    wc.common.signer = &k.world;
+    int error = -99;
+    coavoid_world_t *w = coavoid_world_create(&wc, r.lcm, &error);
+    ck_assert_ptr_nonnull(w);
+    ck_assert_int_eq(coavoid_world_cycle(w, r.now), COA_OK);
+    drain(r.lcm);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(b, r.now), COA_OK);
+    drain(r.lcm);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
+    drain(r.lcm);
+    const coavoid_vehicle_node_state_t *s = coavoid_vehicle_node_state(a);
+    ck_assert_int_eq(s->rx.rejected, 0);
+    ck_assert_int_ge(s->rx.received, 3); /* the map, UAV 2's intent and heartbeat */
+    ck_assert_int_eq(tap.reasons & COAVOID_STATUS_T_REASON_INSECURE, 0);
+    ck_assert_int_gt(tap.size, 0);
+
+    static unsigned char buf[TAP_BYTES];
+    memcpy(buf, tap.bytes, (size_t)tap.size);
+    publish_bytes(r.lcm, COAVOID_CHANNEL_INTENT, buf, tap.size, NULL, 0);
+    expect_refused(&r, s, COAVOID_AUTH_ERR_REPLAY, "UAV 2's intent again");
+    buf[(size_t)tap.size - COAVOID_AUTH_TAIL_BYTES + 19u] ^= 1; /* its auth sequence, one higher */
+    publish_bytes(r.lcm, COAVOID_CHANNEL_INTENT, buf, tap.size, NULL, 0);
+    expect_refused(&r, s, COAVOID_AUTH_ERR_SIGNATURE, "a copy numbered higher");
+    static coavoid_intent_t m;
+    ck_assert_int_gt(coavoid_intent_t_decode(tap.bytes, 0, tap.size, &m), 0);
+    m.sequence++;
+    memset(&m.auth, 0, sizeof m.auth);
+    const int size = coavoid_intent_t_encode(buf, 0, (int)sizeof buf, &m);
+    publish_bytes(r.lcm, COAVOID_CHANNEL_INTENT, buf, size, NULL, 0);
+    expect_refused(&r, s, COAVOID_AUTH_ERR_UNSIGNED, "unsigned");
+    publish_bytes(r.lcm, COAVOID_CHANNEL_INTENT, buf, size, &k.world, r.now);
+    expect_refused(&r, s, COAVOID_AUTH_ERR_ROLE, "UAV 2's intent signed by the world");
+    coavoid_auth_signer_t stranger = k.uav[1];
+    stranger.key_id = 999;
+    publish_bytes(r.lcm, COAVOID_CHANNEL_INTENT, buf, size, &stranger, r.now);
+    expect_refused(&r, s, COAVOID_AUTH_ERR_KEY, "an unknown key");
+    coavoid_auth_signer_t uav2 = k.uav[1];
+    publish_bytes(r.lcm, COAVOID_CHANNEL_INTENT, buf, size, &uav2, r.now + 2 * DT_US);
+    expect_refused(&r, s, COAVOID_AUTH_ERR_CLOCK, "signed two cycles ahead");
+    coavoid_plan_t plan = solved_plan(r.now, 1, r.now, 10, 1);
+    plan.uav_ids[0] = 1;
+    int n = coavoid_plan_t_encode(buf, 0, (int)sizeof buf, &plan);
+    publish_bytes(r.lcm, COAVOID_CHANNEL_PLAN, buf, n, &uav2, r.now);
+    expect_refused(&r, s, COAVOID_AUTH_ERR_ROLE, "a plan signed by UAV 2");
+    static coavoid_obstacle_map_t map;
+    memset(&map, 0, sizeof map);
+    map.utime = r.now;
+    map.map_id = (int32_t)COAVOID_NODE_WORLD_ID;
+    map.version = INT64_MAX;
+    n = coavoid_obstacle_map_t_encode(buf, 0, (int)sizeof buf, &map);
+    publish_bytes(r.lcm, COAVOID_CHANNEL_OBSTACLES, buf, n, &uav2, r.now);
+    expect_refused(&r, s, COAVOID_AUTH_ERR_ROLE, "a map signed by UAV 2");
+
+    /* UAV 2 restarts a cycle later: a new node, its numbering from 0, the same key. */
+    coavoid_vehicle_node_destroy(b);
+    r.now = cycle(1);
+    b = signed_vehicle(&r, &k, uav(2, 2, r2, 10, 500, 800, 100), COAVOID_NODE_DECOUPLED);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(b, r.now), COA_OK);
+    const int64_t rejected = s->rx.rejected, received = s->rx.received;
+    drain(r.lcm);
+    ck_assert_int_gt(coavoid_intent_t_decode(tap.bytes, 0, tap.size, &m), 0);
+    ck_assert_int_eq(m.sequence, 0);
+    ck_assert_int_eq(s->rx.rejected, rejected);
+    ck_assert_int_eq(s->rx.received, received + 2); /* its intent and heartbeat */
+
+    lcm_unsubscribe(r.lcm, si);
+    lcm_unsubscribe(r.lcm, ss);
+    coavoid_world_destroy(w);
+    coavoid_vehicle_node_destroy(b);
+    coavoid_vehicle_node_destroy(a);
+    lcm_destroy(r.lcm);
+}
+END_TEST
+
+/* A node refuses to start without its keys unless told it is insecure; an insecure node
+ * says so in every heartbeat. */
+START_TEST(test_keys_required)
+{
+    static fleet_keys_t k;
+    fleet_keys(&k);
+    rig_t r;
+    rig_init(&r, 10);
+    r.common.insecure = false;
+    coa_vec3_t route[2];
+    coavoid_vehicle_node_config_t config;
+    memset(&config, 0, sizeof config);
+    config.common = r.common;
+    config.vehicle = uav(1, 1, route, 0, 500, 0, 100);
+    config.mode = COAVOID_NODE_DECOUPLED;
+    int error = -99;
+    ck_assert_ptr_null(coavoid_vehicle_node_create(&config, r.lcm, &error)); /* no key */
+    ck_assert_int_eq(error, COA_ERR_ARGUMENT);
+    config.common.signer = &k.uav[0];
+    ck_assert_ptr_null(coavoid_vehicle_node_create(&config, r.lcm, &error)); /* no trust */
+    ck_assert_int_eq(error, COA_ERR_ARGUMENT);
+    coavoid_world_config_t wc;
+    memset(&wc, 0, sizeof wc);
+    wc.common = r.common;
+    ck_assert_ptr_null(coavoid_world_create(&wc, r.lcm, &error));
+    wc.common.signer = &k.world; /* the world receives nothing: a key is enough */
+    coavoid_world_t *w = coavoid_world_create(&wc, r.lcm, &error);
+    ck_assert_ptr_nonnull(w);
+    coavoid_world_destroy(w);
+    static wiretap_t tap;
+    tap.node = 1;
+    lcm_subscription_t *ss = lcm_subscribe(r.lcm, COAVOID_CHANNEL_STATUS, on_tapped_status, &tap);
+    config.common.signer = NULL;
+    config.common.insecure = true;
+    coavoid_vehicle_node_t *a = coavoid_vehicle_node_create(&config, r.lcm, &error);
+    ck_assert_ptr_nonnull(a);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
+    drain(r.lcm);
+    ck_assert(tap.reasons & COAVOID_STATUS_T_REASON_INSECURE);
+    lcm_unsubscribe(r.lcm, ss);
+    coavoid_vehicle_node_destroy(a);
+    lcm_destroy(r.lcm);
+}
+END_TEST
+
 static Suite *node_suite(void)
 {
     Suite *s = suite_create("node");
@@ -1530,6 +1777,8 @@ static Suite *node_suite(void)
     tcase_add_test(tc, test_silent_uav_avoided_as_track);
     tcase_add_test(tc, test_world_track_estimates);
     tcase_add_test(tc, test_bad_configs_refused);
+    tcase_add_test(tc, test_signed_messages);
+    tcase_add_test(tc, test_keys_required);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -101,16 +101,18 @@ static int keygen(void *options, coavoid_scenario_t *s)
     static char trust[COA_MAX_VEHICLES * COAVOID_AUTH_LINE_MAX + 3u * COAVOID_AUTH_LINE_MAX];
     char name[32];
     strcpy(trust, "# coavoid trust file: KEY_ID ROLE NODE_ID PUBLIC_KEY_HEX\n");
-    int rc = one_key(o, "coordinator.key", 1u, COAVOID_AUTH_COORDINATOR,
-                     (uint16_t)COAVOID_NODE_COORDINATOR_ID, trust, sizeof trust);
+    int rc =
+        one_key(o, "coordinator.key", COAVOID_AUTH_KEY_ID_COORDINATOR, COAVOID_AUTH_COORDINATOR,
+                (uint16_t)COAVOID_NODE_COORDINATOR_ID, trust, sizeof trust);
     if (rc == CLI_CONTINUE) {
-        rc = one_key(o, "world.key", 2u, COAVOID_AUTH_WORLD, (uint16_t)COAVOID_NODE_WORLD_ID, trust,
-                     sizeof trust);
+        rc = one_key(o, "world.key", COAVOID_AUTH_KEY_ID_WORLD, COAVOID_AUTH_WORLD,
+                     (uint16_t)COAVOID_NODE_WORLD_ID, trust, sizeof trust);
     }
     for (size_t i = 0; i < s->vehicle_count && rc == CLI_CONTINUE; i++) {
         const uint16_t id = s->vehicles[i].id;
         snprintf(name, sizeof name, "vehicle-%u.key", (unsigned)id);
-        rc = one_key(o, name, 100u + id, COAVOID_AUTH_VEHICLE, id, trust, sizeof trust);
+        rc = one_key(o, name, COAVOID_AUTH_KEY_ID_VEHICLE_BASE + id, COAVOID_AUTH_VEHICLE, id,
+                     trust, sizeof trust);
     }
     if (rc == CLI_CONTINUE) {
         rc = write_private(o->dir, "trust.txt", trust);

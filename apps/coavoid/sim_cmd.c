@@ -16,36 +16,38 @@
 #include "scenario.h"
 #include "sim.h"
 
-#define SIM_USAGE                                                                              \
-    "usage: coavoid sim SCENARIO.json --mode centralised|decoupled [--steps K] [--json]\n"     \
-    "                   [--svg FILE] [--coordinator-stops STEP]\n"                             \
-    "\n"                                                                                       \
-    "Flies the scenario in closed loop: every step each UAV publishes its intent, conflicts\n" \
-    "are predicted and planned for (by the coordinator, or by each UAV in priority order),\n"  \
-    "and every UAV flies one step of its plan. The nodes are those of the real-time apps,\n"   \
-    "over LCM's in-process provider on a simulated clock: the output is repeatable.\n"         \
-    "\n"                                                                                       \
-    "options:\n"                                                                               \
-    "  --mode centralised   a coordinator plans each conflicting cluster; the UAVs follow\n"   \
-    "                       it, and plan for themselves when its heartbeat stops\n"            \
-    "  --mode decoupled     no coordinator: each UAV plans for itself in priority order\n"     \
-    "  --steps K            fly K steps (samples 0..K), K >= 1; default 2 * horizon\n"         \
-    "  --json               print the simulation result as JSON (default: text)\n"             \
-    "  --svg FILE           write the figure (top view, altitude profiles) to FILE\n"          \
-    "  --coordinator-stops STEP\n"                                                             \
-    "                       centralised: stop the coordinator before step STEP (0..K)\n"       \
-    "  -h, --help           show this help\n"                                                  \
-    "\n"                                                                                       \
-    "Beyond the contract's fields the result has \"fallbacks\" (times a UAV went from\n"       \
-    "following the coordinator to planning for itself) and, with --coordinator-stops,\n"       \
-    "\"coordinator_stopped_at\".\n"                                                            \
-    "\n"                                                                                       \
-    "The scenario's horizon may be at most %u steps (an intent carries N + 1 samples) and\n"   \
-    "it may have at most %u UAVs. What its messages carry over the run (references and\n"      \
-    "tracks up to t = (K + N) dt, with the climbs a UAV can make) must stay within their\n"    \
-    "bounds: positions %g m, speeds %g m/s, sizes and sigmas %g m.\n"                          \
-    "\n"                                                                                       \
-    "exit status: 0 no loss of separation, 1 a loss of separation, 2 invalid input or\n"       \
+#define SIM_USAGE                                                                               \
+    "usage: coavoid sim SCENARIO.json --mode centralised|decoupled [--steps K] [--json]\n"      \
+    "                   [--svg FILE] [--coordinator-stops STEP] [--insecure]\n"                 \
+    "\n"                                                                                        \
+    "Flies the scenario in closed loop: every step each UAV publishes its intent, conflicts\n"  \
+    "are predicted and planned for (by the coordinator, or by each UAV in priority order),\n"   \
+    "and every UAV flies one step of its plan. The nodes are those of the real-time apps,\n"    \
+    "over LCM's in-process provider on a simulated clock: the output is repeatable.\n"          \
+    "\n"                                                                                        \
+    "options:\n"                                                                                \
+    "  --mode centralised   a coordinator plans each conflicting cluster; the UAVs follow\n"    \
+    "                       it, and plan for themselves when its heartbeat stops\n"             \
+    "  --mode decoupled     no coordinator: each UAV plans for itself in priority order\n"      \
+    "  --steps K            fly K steps (samples 0..K), K >= 1; default 2 * horizon\n"          \
+    "  --json               print the simulation result as JSON (default: text)\n"              \
+    "  --svg FILE           write the figure (top view, altitude profiles) to FILE\n"           \
+    "  --coordinator-stops STEP\n"                                                              \
+    "                       centralised: stop the coordinator before step STEP (0..K)\n"        \
+    "  --insecure           the nodes neither sign nor check their messages (by default they\n" \
+    "                       do, with the simulation's fixed keys; the flight is the same)\n"    \
+    "  -h, --help           show this help\n"                                                   \
+    "\n"                                                                                        \
+    "Beyond the contract's fields the result has \"fallbacks\" (times a UAV went from\n"        \
+    "following the coordinator to planning for itself) and, with --coordinator-stops,\n"        \
+    "\"coordinator_stopped_at\".\n"                                                             \
+    "\n"                                                                                        \
+    "The scenario's horizon may be at most %u steps (an intent carries N + 1 samples) and\n"    \
+    "it may have at most %u UAVs. What its messages carry over the run (references and\n"       \
+    "tracks up to t = (K + N) dt, with the climbs a UAV can make) must stay within their\n"     \
+    "bounds: positions %g m, speeds %g m/s, sizes and sigmas %g m.\n"                           \
+    "\n"                                                                                        \
+    "exit status: 0 no loss of separation, 1 a loss of separation, 2 invalid input or\n"        \
     "usage (one line on stderr naming the input and why), 3 internal error\n"
 
 typedef struct {
@@ -58,6 +60,7 @@ typedef struct {
     const char *svg_path;
     const char *stop_text;
     uint32_t stop_step;
+    bool insecure;
 } sim_options_t;
 
 static void sim_help(void)
@@ -80,6 +83,8 @@ static int sim_option(int argc, char **argv, int *i, void *options)
         o->steps = (uint32_t)value;
     } else if (coavoid_cli_option_is(arg, "--json")) {
         status = coavoid_cli_flag_option(arg, "--json", &o->json);
+    } else if (coavoid_cli_option_is(arg, "--insecure")) {
+        status = coavoid_cli_flag_option(arg, "--insecure", &o->insecure);
     } else if (coavoid_cli_option_is(arg, "--svg")) {
         status =
             coavoid_cli_text_option(argc, argv, i, "--svg", "a file to write", false, &o->svg_path);
@@ -131,6 +136,7 @@ static int sim(void *options, coavoid_scenario_t *s)
         .stop_step = o->stop_step,
         .json = o->json,
         .svg_path = o->svg_path,
+        .insecure = o->insecure,
     };
     coavoid_run_error_t e;
     int rc = coavoid_sim_run(&config, s, stdout, &e);

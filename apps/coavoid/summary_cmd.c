@@ -14,13 +14,14 @@
 #include "cli.h"
 #include "coavoid_lcm.h"
 #include "commands.h"
+#include "drivers.h"
 #include "node.h"
 #include "scenario.h"
 #include "sim.h"
 
 #define SUMMARY_USAGE                                                                             \
     "usage: coavoid summary LOGFILE SCENARIO.json --mode centralised|decoupled\n"                 \
-    "                       [--json] [--svg FILE] [--epoch UTIME]\n"                              \
+    "                       [--json] [--svg FILE] [--epoch UTIME] [--trust FILE]\n"               \
     "\n"                                                                                          \
     "Rebuilds what each UAV of the scenario flew from an lcm-logger log of a real-time\n"         \
     "run (the intents on " COAVOID_CHANNEL_INTENT "), judges it as 'coavoid sim' does (loss of\n" \
@@ -33,6 +34,9 @@
     "  --svg FILE      write the figure (top view, altitude per UAV) to FILE\n"                   \
     "  --epoch UTIME   cycle 0's start, in microseconds; default: the earliest\n"                 \
     "                  plan_utime of the scenario's UAVs in the log\n"                            \
+    "  --trust FILE    the run's trust file: only intents, plans and heartbeats signed\n"         \
+    "                  by a key that may send them, and newer than the last from that\n"          \
+    "                  key, count; the others are ignored and counted as unauthenticated\n"       \
     "  -h, --help      show this help\n"                                                          \
     "\n"                                                                                          \
     "Replans are the planning calls of every node up to the last sample, from the\n"              \
@@ -54,6 +58,8 @@ typedef struct {
     const char *svg_path;
     const char *epoch_text;
     int64_t epoch;
+    const char *trust_path;
+    coavoid_auth_trust_t trust;
 } summary_options_t;
 
 static void summary_help(void)
@@ -73,6 +79,9 @@ static int summary_option(int argc, char **argv, int *i, void *options)
     } else if (coavoid_cli_option_is(arg, "--svg")) {
         status =
             coavoid_cli_text_option(argc, argv, i, "--svg", "a file to write", false, &o->svg_path);
+    } else if (coavoid_cli_option_is(arg, "--trust")) {
+        status = coavoid_cli_text_option(argc, argv, i, "--trust", "a trust file", false,
+                                         &o->trust_path);
     } else if (coavoid_cli_option_is(arg, "--epoch")) {
         uint64_t epoch = 0;
         status = coavoid_cli_text_option(argc, argv, i, "--epoch", "microseconds, an integer >= 1",
@@ -106,6 +115,9 @@ static int parse_summary_options(int argc, char **argv, summary_options_t *o)
     if (o->mode == NULL) {
         return coavoid_cli_fail(CLI_EXIT_INVALID, "--mode: required (centralised or decoupled)");
     }
+    if (o->trust_path != NULL) {
+        return coavoid_rt_load_trust(o->trust_path, &o->trust);
+    }
     return CLI_CONTINUE;
 }
 
@@ -120,6 +132,7 @@ static int summarise(void *options, coavoid_scenario_t *s)
         .svg_path = o->svg_path,
         .has_epoch = o->epoch_text != NULL,
         .epoch = o->epoch,
+        .trust = o->trust_path != NULL ? &o->trust : NULL,
     };
     coavoid_run_error_t e;
     return coavoid_cli_run_status(coavoid_sim_summarise(&config, s, stdout, &e), &e);
@@ -127,7 +140,7 @@ static int summarise(void *options, coavoid_scenario_t *s)
 
 int coavoid_command_summary(int argc, char **argv)
 {
-    summary_options_t options;
+    static summary_options_t options; /* a trust list: 21 kB */
     int status = parse_summary_options(argc, argv, &options);
     if (status != CLI_CONTINUE) {
         return status;

@@ -25,6 +25,7 @@
 #define COORDINATOR_USAGE                                                                         \
     "usage: coavoid-coordinator --scenario FILE [--lcm-url URL] [--epoch UTIME] [--speed S]\n"    \
     "                           [--steps K] [--beta B] [--max-centralised N] [--collect S]\n"     \
+    "                           (--key FILE --trust FILE | --insecure)\n"                         \
     "\n"                                                                                          \
     "The ground coordinator of a real-time run: plans the conflicting clusters of the\n"          \
     "vehicles it hears over LCM centrally and publishes the plans. The scenario gives dt,\n"      \
@@ -130,6 +131,36 @@ static void coordinator_report(void *user, const char *name, const coavoid_rt_re
             st->rx.last_reason != NULL ? st->rx.last_reason : "none", tail);
 }
 
+/* The planner's beta (--beta, the scenario's, or the default for max_centralised UAVs)
+ * into config, what chose it and the workspace's size. CLI_CONTINUE, or CLI_EXIT_INVALID
+ * after the line when that workspace cannot be sized. */
+static int choose_beta(const coordinator_options_t *o, const coavoid_scenario_t *s,
+                       coavoid_coordinator_config_t *config, const char **beta_source, size_t *size)
+{
+    if (o->beta_text != NULL) {
+        config->common.beta = o->beta;
+        *beta_source = "--beta";
+    } else if (s->has_beta) {
+        *beta_source = "the scenario's beta";
+    } else {
+        coa_planner_config_t shape = coavoid_node_planner_config(
+            config->common.horizon, o->max_centralised, COAVOID_DEFAULT_BETA);
+        config->common.beta = coavoid_default_beta(&shape);
+        *beta_source = "the default beta";
+    }
+    coa_planner_config_t planner_config = coavoid_node_planner_config(
+        config->common.horizon, o->max_centralised, config->common.beta);
+    *size = coa_planner_workspace_size(&planner_config);
+    if (*size == 0) {
+        return coavoid_cli_fail(
+            CLI_EXIT_INVALID,
+            "%s %lu: the workspace for %zu vehicles would not fit in memory (lower "
+            "--beta or --max-centralised)",
+            *beta_source, (unsigned long)config->common.beta, o->max_centralised);
+    }
+    return CLI_CONTINUE;
+}
+
 /* Everything after the options. Returns the exit status. */
 static int run(void *options, coavoid_scenario_t *s)
 {
@@ -138,6 +169,11 @@ static int run(void *options, coavoid_scenario_t *s)
     coavoid_coordinator_config_t config;
     memset(&config, 0, sizeof config);
     int status = coavoid_rt_setup(o->scenario_path, s, &o->rt, &now, &config.common);
+    if (status != CLI_CONTINUE) {
+        return status;
+    }
+    status = coavoid_rt_keys(&o->rt, COAVOID_AUTH_COORDINATOR,
+                             (uint16_t)COAVOID_NODE_COORDINATOR_ID, true, &config.common);
     if (status != CLI_CONTINUE) {
         return status;
     }
@@ -157,29 +193,12 @@ static int run(void *options, coavoid_scenario_t *s)
     config.plan_budget_us =
         (int64_t)llround(0.75 * (double)(dt_us - config.collect_us) / o->rt.speed);
     config.plan_budget_us = config.plan_budget_us > 0 ? config.plan_budget_us : 1;
-    const char *beta_source;
-    if (o->beta_text != NULL) {
-        config.common.beta = o->beta;
-        beta_source = "--beta";
-    } else if (s->has_beta) {
-        beta_source = "the scenario's beta";
-    } else {
-        coa_planner_config_t shape = coavoid_node_planner_config(
-            config.common.horizon, o->max_centralised, COAVOID_DEFAULT_BETA);
-        config.common.beta = coavoid_default_beta(&shape);
-        beta_source = "the default beta";
+    const char *beta_source = NULL;
+    size_t size = 0;
+    status = choose_beta(o, s, &config, &beta_source, &size);
+    if (status != CLI_CONTINUE) {
+        return status;
     }
-    coa_planner_config_t planner_config =
-        coavoid_node_planner_config(config.common.horizon, o->max_centralised, config.common.beta);
-    size_t size = coa_planner_workspace_size(&planner_config);
-    if (size == 0) {
-        return coavoid_cli_fail(
-            CLI_EXIT_INVALID,
-            "%s %lu: the workspace for %zu vehicles would not fit in memory (lower "
-            "--beta or --max-centralised)",
-            beta_source, (unsigned long)config.common.beta, o->max_centralised);
-    }
-
     char err[512];
     lcm_t *lcm = coavoid_rt_lcm_create(o->rt.lcm_url, err, sizeof err);
     if (lcm == NULL) {

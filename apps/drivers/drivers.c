@@ -11,6 +11,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "cli.h"
 
@@ -59,8 +60,108 @@ int coavoid_rt_parse_option(int argc, char **argv, int *i, coavoid_rt_options_t 
         status = coavoid_cli_count_option(argc, argv, i, "--steps", "an integer >= 1", false,
                                           RT_MAX_STEPS, &o->steps_text, &value);
         o->steps = (int64_t)value;
+    } else if (coavoid_cli_option_is(arg, "--key")) {
+        status = coavoid_cli_text_option(argc, argv, i, "--key", "a secret key file", false,
+                                         &o->key_path);
+    } else if (coavoid_cli_option_is(arg, "--trust")) {
+        status = coavoid_cli_text_option(argc, argv, i, "--trust", "a trust file", false,
+                                         &o->trust_path);
+    } else if (coavoid_cli_option_is(arg, "--insecure")) {
+        status = coavoid_cli_flag_option(arg, "--insecure", &o->insecure);
     }
     return status;
+}
+
+/* ---- keys ---- */
+
+/* Reads the file at path (at most COAVOID_RT_KEY_FILE_MAX bytes) into buf; its length, or
+ * -1 after the one-line error. A secret key must be readable by its owner only. */
+static long read_key_file(const char *option, const char *path, bool secret, char *buf)
+{
+    FILE *f = fopen(path, "rb");
+    if (f == NULL) {
+        coavoid_cli_fail(CLI_EXIT_INVALID, "%s: cannot read '%.200s': %s", option, path,
+                         strerror(errno));
+        return -1;
+    }
+    struct stat st;
+    if (secret && fstat(fileno(f), &st) == 0 && (st.st_mode & (S_IRWXG | S_IRWXO)) != 0) {
+        fclose(f);
+        coavoid_cli_fail(CLI_EXIT_INVALID,
+                         "%s: '%.200s' is readable by others (mode %03o): a secret key must be "
+                         "its owner's only (chmod 600)",
+                         option, path, (unsigned)(st.st_mode & 0777));
+        return -1;
+    }
+    size_t n = fread(buf, 1, COAVOID_RT_KEY_FILE_MAX, f);
+    const bool more = n == COAVOID_RT_KEY_FILE_MAX && fgetc(f) != EOF;
+    const bool failed = ferror(f) != 0;
+    fclose(f);
+    if (more || failed) {
+        coavoid_cli_fail(CLI_EXIT_INVALID, "%s: '%.200s': %s", option, path,
+                         more ? "larger than 64 KiB" : "read error");
+        return -1;
+    }
+    return (long)n;
+}
+
+int coavoid_rt_load_trust(const char *path, coavoid_auth_trust_t *t)
+{
+    static char text[COAVOID_RT_KEY_FILE_MAX];
+    char why[COAVOID_AUTH_LINE_MAX];
+    long n = read_key_file("--trust", path, false, text);
+    if (n < 0) {
+        return CLI_EXIT_INVALID;
+    }
+    if (coavoid_auth_trust_parse(t, text, (size_t)n, why, sizeof why) != COA_OK) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "--trust: %.200s: %s", path, why);
+    }
+    return CLI_CONTINUE;
+}
+
+int coavoid_rt_keys(coavoid_rt_options_t *o, coavoid_auth_role_t role, uint16_t node_id,
+                    bool needs_trust, coavoid_node_common_t *common)
+{
+    if (o->insecure) {
+        if (o->key_path != NULL || o->trust_path != NULL) {
+            return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                    "--insecure: cannot go with --key or --trust (choose one)");
+        }
+        common->insecure = true;
+        return CLI_CONTINUE;
+    }
+    if (o->key_path == NULL || (needs_trust && o->trust_path == NULL)) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                "%s: required: every message is signed and checked "
+                                "(coavoid keygen writes keys), or --insecure to run without",
+                                o->key_path == NULL ? "--key" : "--trust");
+    }
+    static char text[COAVOID_RT_KEY_FILE_MAX];
+    char why[COAVOID_AUTH_LINE_MAX];
+    long n = read_key_file("--key", o->key_path, true, text);
+    if (n < 0) {
+        return CLI_EXIT_INVALID;
+    }
+    int rc = coavoid_auth_signer_parse(&o->signer, text, (size_t)n, why, sizeof why);
+    memset(text, 0, sizeof text);
+    if (rc != COA_OK) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "--key: %.200s: %s", o->key_path, why);
+    }
+    common->signer = &o->signer;
+    if (o->trust_path == NULL) {
+        return CLI_CONTINUE;
+    }
+    if (coavoid_rt_load_trust(o->trust_path, &o->trust) != CLI_CONTINUE) {
+        return CLI_EXIT_INVALID;
+    }
+    if (coavoid_auth_signer_matches(&o->trust, &o->signer, role, node_id) != COA_OK) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                "--key: key %lu is not this node's in %.200s (its role, node id "
+                                "%u, and public key must be listed there)",
+                                (unsigned long)o->signer.key_id, o->trust_path, (unsigned)node_id);
+    }
+    common->trust = &o->trust;
+    return CLI_CONTINUE;
 }
 
 int coavoid_rt_options_finish(coavoid_rt_options_t *o, int64_t dt_us, uint32_t horizon)

@@ -21,12 +21,20 @@ typedef struct {
     double speed;
     const char *steps_text; /* NULL: 2N */
     int64_t steps;          /* K >= 1 */
+    const char *key_path;   /* --key: its secret key file */
+    const char *trust_path; /* --trust: the keys it accepts */
+    bool insecure;          /* --insecure: neither */
+    /* What --key and --trust hold once read (coavoid_rt_keys); common.signer and
+     * common.trust point here. */
+    coavoid_auth_signer_t signer;
+    coavoid_auth_trust_t trust;
 } coavoid_rt_options_t;
 
 /* Sets the defaults (no epoch yet, speed 1, steps unset, the default URL). */
 void coavoid_rt_options_init(coavoid_rt_options_t *o);
 
-/* Whether argv[*i] is one of --lcm-url, --epoch, --speed, --steps; if so consumes it
+/* Whether argv[*i] is one of --lcm-url, --epoch, --speed, --steps, --key, --trust,
+ * --insecure; if so consumes it
  * (and its value) and returns CLI_CONTINUE, or returns CLI_EXIT_INVALID after the one-line
  * error (missing or bad value, given twice). Returns CLI_UNKNOWN_OPTION for any other
  * argument (cli.h's option parser contract). */
@@ -49,6 +57,26 @@ int coavoid_rt_options_finish(coavoid_rt_options_t *o, int64_t dt_us, uint32_t h
 int coavoid_rt_setup(const char *path, coavoid_scenario_t *s, coavoid_rt_options_t *o,
                      const int64_t *now, coavoid_node_common_t *common);
 
+/* The largest key or trust file read: 128 keys of one 255-character line each, with room
+ * for comments. */
+#define COAVOID_RT_KEY_FILE_MAX 65536u
+
+/* Reads the trust file at path (at most COAVOID_RT_KEY_FILE_MAX bytes) into t, for --trust.
+ * Returns CLI_CONTINUE, or CLI_EXIT_INVALID after one line ("--trust: PATH: line N: why",
+ * unreadable, too large). */
+int coavoid_rt_load_trust(const char *path, coavoid_auth_trust_t *t);
+
+/* After coavoid_rt_setup: reads --key (a secret key file, readable by its owner only) and,
+ * when the node receives (needs_trust) or it is given, --trust; checks that the trust file
+ * lists this key as the node's (role and node_id, the same public key), so that a key
+ * file of another node is refused at start, not by every receiver; and points
+ * common->signer and common->trust at them. Or, with --insecure (and neither file),
+ * sets common->insecure. Returns CLI_CONTINUE, or CLI_EXIT_INVALID after one line naming
+ * the option and why (missing, unreadable, too large, a bad line, not this node's key).
+ * Cost: reading two files of at most COAVOID_RT_KEY_FILE_MAX bytes; no memory. */
+int coavoid_rt_keys(coavoid_rt_options_t *o, coavoid_auth_role_t role, uint16_t node_id,
+                    bool needs_trust, coavoid_node_common_t *common);
+
 /* The usage lines of the shared options (for each driver's --help). */
 #define COAVOID_RT_OPTIONS_USAGE                                                          \
     "  --lcm-url URL       LCM provider; default " COAVOID_RT_DEFAULT_LCM_URL "\n"        \
@@ -57,7 +85,11 @@ int coavoid_rt_setup(const char *path, coavoid_scenario_t *s, coavoid_rt_options
     "                      every process of a run must be given the same value;\n"        \
     "                      default: now\n"                                                \
     "  --speed S           scenario seconds per wall second, 0 < S <= 1000; default 1\n"  \
-    "  --steps K           run K cycles, flying samples 0..K; default 2 * horizon\n"
+    "  --steps K           run K cycles, flying samples 0..K; default 2 * horizon\n"      \
+    "  --key FILE          its secret key (coavoid keygen): it signs every message\n"     \
+    "  --trust FILE        the keys it accepts messages from, with their roles\n"         \
+    "  --insecure          neither sign nor check signatures (tests only; its\n"          \
+    "                      heartbeat says so); else --key and --trust are required\n"
 
 /* Sets the loop's fields every driver sets alike: the clock (epoch, speed) and steps from
  * the finished options, lcm, now, common, name, and warnings on stderr; the rest (the

@@ -23,7 +23,7 @@
     "usage: coavoid-vehicle --scenario FILE --id ID [--mode centralised|decoupled]\n"             \
     "                       [--lcm-url URL] [--epoch UTIME] [--speed S] [--steps K]\n"            \
     "                       [--coordinator-timeout S] [--coordinator-id ID]\n"                    \
-    "                       [--priority-wait S]\n"                                                \
+    "                       [--priority-wait S] (--key FILE --trust FILE | --insecure)\n"         \
     "       coavoid-vehicle --scenario FILE --list-ids\n"                                         \
     "\n"                                                                                          \
     "Flies the UAV with this id from the scenario in real time, exchanging intents and\n"         \
@@ -215,6 +215,10 @@ static int run(void *options, coavoid_scenario_t *s)
     if (index < 0) {
         return coavoid_cli_fail(CLI_EXIT_INVALID, "--id: %s has no vehicle %u", o->scenario_path,
                                 (unsigned)o->id);
+    }
+    status = coavoid_rt_keys(&o->rt, COAVOID_AUTH_VEHICLE, o->id, true, &config.common);
+    if (status != CLI_CONTINUE) {
+        return status;
     }
     const int64_t dt_us = config.common.dt_us;
     config.vehicle = s->vehicles[index];

@@ -4,6 +4,7 @@
  * Every rule is a REJECT(code, reason) with a reason naming the field, so a refusal
  * in a log says exactly what was wrong.
  */
+#include "auth.h"
 #include "coavoid_lcm.h"
 
 #include <math.h>
@@ -203,6 +204,18 @@ const char *coavoid_lcm_error_name(int status)
         return "too many senders";
     case COAVOID_LCM_ERR_CAPACITY:
         return "output too small";
+    case COAVOID_AUTH_ERR_UNSIGNED:
+        return "not signed";
+    case COAVOID_AUTH_ERR_KEY:
+        return "unknown key";
+    case COAVOID_AUTH_ERR_SIGNATURE:
+        return "bad signature";
+    case COAVOID_AUTH_ERR_ROLE:
+        return "key may not send this";
+    case COAVOID_AUTH_ERR_REPLAY:
+        return "replayed or copied";
+    case COAVOID_AUTH_ERR_CLOCK:
+        return "signed outside the clock window";
     default:
         return coa_status_name(status);
     }
@@ -1212,7 +1225,7 @@ int8_t coavoid_lcm_health_of(int32_t reasons)
 /* Known REASON_* bits only, and the health they give. */
 static bool status_reasons_ok(const coavoid_status_t *msg)
 {
-    const int32_t known = 2 * COAVOID_STATUS_T_REASON_NO_PLAN - 1;
+    const int32_t known = 2 * COAVOID_STATUS_T_REASON_INSECURE - 1;
     const int32_t r = msg->reasons;
     return r >= 0 && (r & ~known) == 0 && msg->health == coavoid_lcm_health_of(r);
 }

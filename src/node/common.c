@@ -63,6 +63,9 @@ int coavoid_node_common_check(const coavoid_node_common_t *c)
         !rate_ok(c->stale_sigma_rate) || c->stale_after_us < 1 || c->beta < 1u) {
         return COA_ERR_ARGUMENT;
     }
+    if (!c->insecure && c->signer == NULL) {
+        return COA_ERR_ARGUMENT;
+    }
     if (c->obstacle_count > COAVOID_NODE_MAX_CONFIGURED_OBSTACLES ||
         (c->obstacle_count > 0u && c->obstacles == NULL)) {
         return COA_ERR_ARGUMENT;
@@ -171,6 +174,71 @@ static void count_undecodable(coavoid_node_inbox_t *in, const char *reason)
     coavoid_lcm_rx_count(in->rx, COAVOID_LCM_ERR_DECODE, reason);
 }
 
+/* Why a message's signature or sender was refused (docs/messages.md, "Signed messages"). */
+static const char *auth_reason(int rc)
+{
+    switch (rc) {
+    case COAVOID_AUTH_ERR_UNSIGNED:
+        return "auth: not signed";
+    case COAVOID_AUTH_ERR_KEY:
+        return "auth: signed by a key not in the trust list";
+    case COAVOID_AUTH_ERR_SIGNATURE:
+        return "auth: the signature does not verify";
+    case COAVOID_AUTH_ERR_ROLE:
+        return "auth: the key may not send this message";
+    case COAVOID_AUTH_ERR_REPLAY:
+        return "auth: not newer than the last from that key (a copy or a replay)";
+    default:
+        return "auth: signed at a time outside the receiver's window";
+    }
+}
+
+/* A received datagram's signature, over its raw bytes before anything decodes them (a
+ * secure inbox only): true with the key's index in *key, else counted as refused. */
+static bool signature_ok(coavoid_node_inbox_t *in, const lcm_recv_buf_t *rbuf, size_t *key)
+{
+    *key = 0;
+    if (!in->secure) {
+        return true;
+    }
+    int rc = coavoid_auth_verify(&in->trust, rbuf->data, rbuf->data_size, key);
+    if (rc != COA_OK) {
+        coavoid_lcm_rx_count(in->rx, rc, auth_reason(rc));
+        return false;
+    }
+    return true;
+}
+
+/* The decoded sender of a verified message: key may speak as role for node `id`, and the
+ * message is newer than the last of its stream from that key, within the window. True,
+ * or counted as refused. Always true in an insecure inbox. */
+static bool sender_ok(coavoid_node_inbox_t *in, size_t key, size_t stream, coavoid_auth_role_t role,
+                      int32_t id, const coavoid_auth_t *auth)
+{
+    if (!in->secure) {
+        return true;
+    }
+    int rc = (id >= 1 && id <= 65535) ? coavoid_auth_may_send(&in->trust, key, role, (uint16_t)id)
+                                      : COAVOID_AUTH_ERR_ROLE;
+    if (rc == COA_OK) {
+        rc = coavoid_auth_fresh(&in->trust, key, stream, auth->timestamp_us, auth->sequence,
+                                *in->common.clock, in->max_age_us, in->common.dt_us);
+    }
+    if (rc != COA_OK) {
+        coavoid_lcm_rx_count(in->rx, rc, auth_reason(rc));
+        return false;
+    }
+    return true;
+}
+
+/* The sequence table of a stream: none in a secure inbox, where freshness is the
+ * signature's (and a restarted sender is accepted at once). */
+static coavoid_lcm_sequence_table_t *sequence_table(coavoid_node_inbox_t *in,
+                                                    coavoid_node_senders_t *s)
+{
+    return in->secure ? NULL : &s->table;
+}
+
 /* FNV-1a (64 bits) of a message's bytes. */
 static uint64_t fingerprint(const void *data, size_t size)
 {
@@ -198,9 +266,19 @@ static void on_intent(const lcm_recv_buf_t *rbuf, const char *channel, void *use
     coavoid_node_inbox_t *in = user;
     coavoid_intent_t *msg = &in->rx_msg.intent;
     int size = 0;
+    size_t key = 0;
     (void)channel;
-    if (!received_size(rbuf, &size) || coavoid_intent_t_decode(rbuf->data, 0, size, msg) < 0) {
+    if (!received_size(rbuf, &size) || !signature_ok(in, rbuf, &key)) {
+        return;
+    }
+    if (coavoid_intent_t_decode(rbuf->data, 0, size, msg) < 0) {
         count_undecodable(in, "intent: does not decode");
+        return;
+    }
+    /* Before its own echo is recognised: a forged intent under its id must not pass for
+     * a twin (a fault) when it is not even signed by that UAV. */
+    if (!sender_ok(in, key, COAVOID_AUTH_STREAM_INTENT, COAVOID_AUTH_VEHICLE, msg->uav_id,
+                   &msg->auth)) {
         return;
     }
     if (in->self_uav != 0u && msg->uav_id == (int32_t)in->self_uav) {
@@ -245,8 +323,8 @@ static void on_intent(const lcm_recv_buf_t *rbuf, const char *channel, void *use
     coa_vehicle_t vehicle;
     coa_intent_plan_t plan;
     const char *reason = NULL;
-    int rc = coavoid_lcm_intent_to_core(msg, &ctx, &in->intent_seq.table, &info, &vehicle, &plan,
-                                        &in->rx_arrays, &reason);
+    int rc = coavoid_lcm_intent_to_core(msg, &ctx, sequence_table(in, &in->intent_seq), &info,
+                                        &vehicle, &plan, &in->rx_arrays, &reason);
     coavoid_lcm_rx_count(in->rx, rc, reason);
     if (rc != COA_OK) {
         return;
@@ -262,9 +340,17 @@ static void on_track(const lcm_recv_buf_t *rbuf, const char *channel, void *user
     coavoid_node_inbox_t *in = user;
     coavoid_track_t *msg = &in->rx_msg.track;
     int size = 0;
+    size_t key = 0;
     (void)channel;
-    if (!received_size(rbuf, &size) || coavoid_track_t_decode(rbuf->data, 0, size, msg) < 0) {
+    if (!received_size(rbuf, &size) || !signature_ok(in, rbuf, &key)) {
+        return;
+    }
+    if (coavoid_track_t_decode(rbuf->data, 0, size, msg) < 0) {
         count_undecodable(in, "track: does not decode");
+        return;
+    }
+    if (!sender_ok(in, key, COAVOID_AUTH_STREAM_TRACK, COAVOID_AUTH_WORLD, msg->source_id,
+                   &msg->auth)) {
         return;
     }
     const int64_t now = *in->common.clock;
@@ -294,8 +380,8 @@ static void on_track(const lcm_recv_buf_t *rbuf, const char *channel, void *user
     coa_track_t track;
     coa_track_point_t path[COAVOID_TRACK_T_MAX_PATH];
     const char *reason = NULL;
-    int rc = coavoid_lcm_track_to_core(msg, &ctx, &in->track_seq.table, &info, &track, path,
-                                       COAVOID_TRACK_T_MAX_PATH, &reason);
+    int rc = coavoid_lcm_track_to_core(msg, &ctx, sequence_table(in, &in->track_seq), &info, &track,
+                                       path, COAVOID_TRACK_T_MAX_PATH, &reason);
     coavoid_lcm_rx_count(in->rx, rc, reason);
     if (rc != COA_OK) {
         return;
@@ -357,10 +443,16 @@ static void on_map(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
     coavoid_node_inbox_t *in = user;
     coavoid_obstacle_map_t *msg = &in->rx_msg.map;
     int size = 0;
+    size_t key = 0;
     (void)channel;
-    if (!received_size(rbuf, &size) ||
-        coavoid_obstacle_map_t_decode(rbuf->data, 0, size, msg) < 0) {
+    if (!received_size(rbuf, &size) || !signature_ok(in, rbuf, &key)) {
+        return;
+    }
+    if (coavoid_obstacle_map_t_decode(rbuf->data, 0, size, msg) < 0) {
         count_undecodable(in, "obstacle_map: does not decode");
+        return;
+    }
+    if (!sender_ok(in, key, COAVOID_AUTH_STREAM_MAP, COAVOID_AUTH_WORLD, msg->map_id, &msg->auth)) {
         return;
     }
     const int64_t now = *in->common.clock;
@@ -369,9 +461,9 @@ static void on_map(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
     const char *reason = NULL;
     /* The conversion checks everything before it writes, so a refused map leaves the
      * one in use untouched. */
-    int rc = coavoid_lcm_obstacle_map_to_core(msg, &ctx, &in->map_seq.table, in->map_obstacles,
-                                              COAVOID_NODE_MAX_MAP_OBSTACLES, &count, in->vertices,
-                                              COAVOID_NODE_MAX_VERTICES, &reason);
+    int rc = coavoid_lcm_obstacle_map_to_core(
+        msg, &ctx, sequence_table(in, &in->map_seq), in->map_obstacles,
+        COAVOID_NODE_MAX_MAP_OBSTACLES, &count, in->vertices, COAVOID_NODE_MAX_VERTICES, &reason);
     coavoid_lcm_rx_count(in->rx, rc, reason);
     if (rc != COA_OK) {
         return;
@@ -387,12 +479,22 @@ static void on_status(const lcm_recv_buf_t *rbuf, const char *channel, void *use
     coavoid_node_inbox_t *in = user;
     coavoid_status_t *msg = &in->rx_msg.status;
     int size = 0;
+    size_t key = 0;
     (void)channel;
-    if (!received_size(rbuf, &size) || coavoid_status_t_decode(rbuf->data, 0, size, msg) < 0) {
+    if (!received_size(rbuf, &size) || !signature_ok(in, rbuf, &key)) {
+        return;
+    }
+    if (coavoid_status_t_decode(rbuf->data, 0, size, msg) < 0) {
         count_undecodable(in, "status: does not decode");
         return;
     }
     if (msg->node_id == (int32_t)in->self_node) {
+        return;
+    }
+    const coavoid_auth_role_t role = msg->node_kind == COAVOID_STATUS_T_NODE_COORDINATOR
+                                         ? COAVOID_AUTH_COORDINATOR
+                                         : COAVOID_AUTH_VEHICLE;
+    if (!sender_ok(in, key, COAVOID_AUTH_STREAM_STATUS, role, msg->node_id, &msg->auth)) {
         return;
     }
     /* Before the sequence rule, so that impostors take no room in its table. */
@@ -405,7 +507,7 @@ static void on_status(const lcm_recv_buf_t *rbuf, const char *channel, void *use
     const int64_t now = *in->common.clock;
     coavoid_lcm_context_t ctx = coavoid_node_context(in, now, now);
     const char *reason = NULL;
-    int rc = coavoid_lcm_status_accept(msg, &ctx, &in->status_seq.table, &reason);
+    int rc = coavoid_lcm_status_accept(msg, &ctx, sequence_table(in, &in->status_seq), &reason);
     coavoid_lcm_rx_count(in->rx, rc, reason);
     if (rc != COA_OK) {
         return;
@@ -424,14 +526,22 @@ static void on_plan(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
     coavoid_node_inbox_t *in = user;
     coavoid_plan_t *msg = &in->rx_msg.plan;
     int size = 0;
+    size_t key = 0;
     (void)channel;
-    if (!received_size(rbuf, &size) || coavoid_plan_t_decode(rbuf->data, 0, size, msg) < 0) {
+    if (!received_size(rbuf, &size) || !signature_ok(in, rbuf, &key)) {
+        return;
+    }
+    if (coavoid_plan_t_decode(rbuf->data, 0, size, msg) < 0) {
         count_undecodable(in, "plan: does not decode");
         return;
     }
     if (msg->coordinator_id != (int32_t)in->coordinator_id) {
         coavoid_lcm_rx_count(in->rx, COAVOID_LCM_ERR_ID,
                              "plan: from a coordinator that is not this UAV's");
+        return;
+    }
+    if (!sender_ok(in, key, COAVOID_AUTH_STREAM_PLAN, COAVOID_AUTH_COORDINATOR, msg->coordinator_id,
+                   &msg->auth)) {
         return;
     }
     const int64_t now = *in->common.clock;
@@ -479,8 +589,20 @@ int coavoid_node_inbox_init(coavoid_node_inbox_t *in, const coavoid_node_common_
      * track's path and a plan's samples around their stamps. */
     int64_t horizon_us = ((int64_t)common->horizon + 2) * common->dt_us;
     in->max_age_us = common->stale_after_us + horizon_us;
-    in->tx.lcm = lcm;
+    coavoid_node_tx_init(&in->tx, lcm, common);
     in->sub_count = 0;
+    in->secure = !common->insecure;
+    if (in->secure && common->trust == NULL) {
+        coavoid_node_tx_fini(&in->tx);
+        return COA_ERR_ARGUMENT;
+    }
+    if (in->secure) {
+        in->trust = *common->trust;
+    } else {
+        coavoid_auth_trust_init(&in->trust);
+    }
+    in->common.signer = NULL; /* copied: the caller's may go */
+    in->common.trust = NULL;
     coavoid_lcm_rx_init(in->rx);
     senders_init(&in->intent_seq);
     senders_init(&in->track_seq);
@@ -525,6 +647,7 @@ void coavoid_node_inbox_fini(coavoid_node_inbox_t *in)
         lcm_unsubscribe(in->tx.lcm, in->subs[i]);
     }
     in->sub_count = 0;
+    coavoid_node_tx_fini(&in->tx);
 }
 
 static int64_t drop_after(const coavoid_node_inbox_t *in)
@@ -871,7 +994,8 @@ int coavoid_node_publish_heartbeat(coavoid_node_inbox_t *in, coavoid_status_t *m
     const bool refused = h->rx->rejected > in->rejected_at_heartbeat;
     in->rejected_at_heartbeat = h->rx->rejected;
     m->reasons = h->reasons | (refused ? COAVOID_STATUS_T_REASON_MESSAGES_REFUSED : 0) |
-                 (in->have_map ? 0 : COAVOID_STATUS_T_REASON_NO_MAP);
+                 (in->have_map ? 0 : COAVOID_STATUS_T_REASON_NO_MAP) |
+                 (in->secure ? 0 : COAVOID_STATUS_T_REASON_INSECURE);
     m->health = coavoid_lcm_health_of(m->reasons);
     m->mode = h->mode;
     m->last_plan_utime = h->last_plan_utime;
@@ -893,16 +1017,54 @@ int coavoid_node_publish_heartbeat(coavoid_node_inbox_t *in, coavoid_status_t *m
 
 /* ---- publishing ---- */
 
-#define COAVOID_NODE_DEFINE_PUBLISH(function, type, channel)                                       \
-    int function(coavoid_node_tx_t *tx, const type *msg)                                           \
-    {                                                                                              \
-        int size = type##_encoded_size(msg);                                                       \
-        if (size <= 0 || (size_t)size > sizeof tx->buf ||                                          \
-            type##_encode(tx->buf, 0, size, msg) != size) {                                        \
-            return COA_ERR_WORKSPACE;                                                              \
-        }                                                                                          \
-        return lcm_publish(tx->lcm, channel, tx->buf, (unsigned int)size) == 0 ? COA_OK            \
-                                                                               : COA_ERR_ARGUMENT; \
+void coavoid_node_tx_init(coavoid_node_tx_t *tx, lcm_t *lcm, const coavoid_node_common_t *c)
+{
+    tx->lcm = lcm;
+    tx->clock = c->clock;
+    tx->sign = !c->insecure && c->signer != NULL;
+    memset(&tx->signer, 0, sizeof tx->signer);
+    if (tx->sign) {
+        tx->signer = *c->signer;
+    }
+}
+
+void coavoid_node_tx_fini(coavoid_node_tx_t *tx)
+{
+    coavoid_auth_signer_clear(&tx->signer);
+    tx->sign = false;
+}
+
+/* Encodes msg into tx->buf with the type's functions and signs it; its size, or a
+ * negative error. */
+#define COAVOID_NODE_SEAL(tx, type, msg) \
+    (seal((tx), type##_encoded_size(msg), type##_encode((tx)->buf, 0, (int)sizeof(tx)->buf, (msg))))
+
+/* The size of the message encoded into tx->buf (encoded: the encoder's return, expected
+ * to be `size`), signed unless the node is insecure; or a negative error. */
+static int seal(coavoid_node_tx_t *tx, int size, int encoded)
+{
+    if (size <= 0 || (size_t)size > sizeof tx->buf || encoded != size) {
+        return COA_ERR_WORKSPACE;
+    }
+    if (tx->sign && coavoid_auth_stamp(&tx->signer, *tx->clock, tx->buf, (size_t)size) != COA_OK) {
+        return COA_ERR_ARGUMENT;
+    }
+    return size;
+}
+
+static int send_sealed(coavoid_node_tx_t *tx, const char *channel, int size)
+{
+    if (size < 0) {
+        return size;
+    }
+    return lcm_publish(tx->lcm, channel, tx->buf, (unsigned int)size) == 0 ? COA_OK
+                                                                           : COA_ERR_ARGUMENT;
+}
+
+#define COAVOID_NODE_DEFINE_PUBLISH(function, type, channel)               \
+    int function(coavoid_node_tx_t *tx, const type *msg)                   \
+    {                                                                      \
+        return send_sealed(tx, channel, COAVOID_NODE_SEAL(tx, type, msg)); \
     }
 
 COAVOID_NODE_DEFINE_PUBLISH(coavoid_node_publish_plan, coavoid_plan_t, COAVOID_CHANNEL_PLAN)
@@ -916,16 +1078,14 @@ COAVOID_NODE_DEFINE_PUBLISH(coavoid_node_publish_status, coavoid_status_t, COAVO
 int coavoid_node_publish_intent(coavoid_node_inbox_t *in, const coavoid_intent_t *msg)
 {
     coavoid_node_tx_t *tx = &in->tx;
-    int size = coavoid_intent_t_encoded_size(msg);
-    if (size <= 0 || (size_t)size > sizeof tx->buf ||
-        coavoid_intent_t_encode(tx->buf, 0, size, msg) != size) {
-        return COA_ERR_WORKSPACE;
+    const int size = COAVOID_NODE_SEAL(tx, coavoid_intent_t, msg);
+    if (size < 0) {
+        return size;
     }
-    /* Remembered before it is sent: a provider may hand it back within lcm_publish. */
+    /* Remembered before it is sent (signed, as it will come back): a provider may hand it
+     * back within lcm_publish. */
     in->own_hash[in->own_next] = fingerprint(tx->buf, (size_t)size);
     in->own_size[in->own_next] = size;
     in->own_next = (in->own_next + 1u) % COAVOID_NODE_OWN_INTENTS;
-    return lcm_publish(tx->lcm, COAVOID_CHANNEL_INTENT, tx->buf, (unsigned int)size) == 0
-               ? COA_OK
-               : COA_ERR_ARGUMENT;
+    return send_sealed(tx, COAVOID_CHANNEL_INTENT, size);
 }

@@ -87,6 +87,8 @@ coavoid_coordinator_t *coavoid_coordinator_create(const coavoid_coordinator_conf
         *error = rc;
         return NULL;
     }
+    node->config.common.signer = NULL; /* copied by the inbox: the caller's may go */
+    node->config.common.trust = NULL;
     *error = COA_OK;
     return node;
 }

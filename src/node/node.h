@@ -125,6 +125,7 @@
 
 #include <lcm/lcm.h>
 
+#include "auth.h"
 #include "coavoid/coavoid.h"
 #include "coavoid_lcm.h"
 
@@ -180,10 +181,23 @@ typedef struct {
      * terrain away. */
     const coa_obstacle_t *obstacles;
     size_t obstacle_count;
+    /* Signed messages (auth.h, docs/messages.md): the key it signs everything it publishes
+     * with, and the keys it accepts messages from, each with its role. Both the caller's,
+     * copied at create. Unless `insecure`, both are required (the world, which receives
+     * nothing, needs no trust list), and a message is accepted only when signed by a key
+     * of the trust list whose role may send it, and fresh (coavoid_auth_fresh per key and
+     * message type, within the validation window): the per-sender sequence rule is then
+     * the signature's. `insecure`: it neither signs (auth all zero) nor checks, accepts
+     * what validates as before, and every heartbeat says so (REASON_INSECURE, so
+     * HEALTH_DEGRADED): for a one-process simulation and tests, never for flight. */
+    const coavoid_auth_signer_t *signer;
+    const coavoid_auth_trust_t *trust;
+    bool insecure;
 } coavoid_node_common_t;
 
 /* Fills c with the defaults for (epoch, dt, horizon, clock): threshold 0.01, no sigma
- * growth, stale_after 2.5 cycles, stale_sigma_rate 1 m/s, beta 20000. Returns COA_OK or
+ * growth, stale_after 2.5 cycles, stale_sigma_rate 1 m/s, beta 20000, no keys and not
+ * insecure (so a node is not created until the caller sets keys or insecure). Returns COA_OK or
  * COA_ERR_ARGUMENT (dt, horizon, epoch or clock invalid). */
 int coavoid_node_common_defaults(coavoid_node_common_t *c, int64_t epoch_utime, coa_real_t dt,
                                  uint32_t horizon, const int64_t *clock);

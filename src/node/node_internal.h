@@ -54,9 +54,12 @@ _Static_assert(COAVOID_NODE_MAX_SAMPLES == (unsigned)COAVOID_INTENT_T_MAX_SAMPLE
 /* How many of its latest intents a node remembers, to tell them when they come back. */
 #define COAVOID_NODE_OWN_INTENTS 4u
 
-/* Where a node encodes what it publishes. */
+/* Where a node encodes what it publishes, and the key it signs it with. */
 typedef struct {
     lcm_t *lcm;
+    bool sign;                    /* false only for an insecure node */
+    coavoid_auth_signer_t signer; /* a copy of common.signer, zeroed at fini */
+    const int64_t *clock;         /* the driver's: the signatures' timestamps */
     uint8_t buf[COAVOID_NODE_TX_BYTES];
 } coavoid_node_tx_t;
 
@@ -98,6 +101,10 @@ struct coavoid_node_inbox {
     uint16_t coordinator_id; /* the only coordinator it hears (0: none) */
     size_t peer_capacity;    /* other UAVs it keeps (vehicle: MAX_PEERS - 1) */
     int64_t max_age_us;      /* validation window (context max_age) */
+    /* Unless insecure: the trust list (a copy of common.trust, with its freshness marks);
+     * every message must verify against it before it is decoded further. */
+    bool secure;
+    coavoid_auth_trust_t trust;
     lcm_subscription_t *subs[6];
     size_t sub_count;
     coavoid_lcm_rx_stats_t *rx; /* the owner's counters (its state's rx) */
@@ -209,7 +216,8 @@ typedef struct {
     const coavoid_lcm_rx_stats_t *rx;
 } coavoid_node_heartbeat_t;
 
-/* Checks a common configuration (node.h's ranges). COA_OK or COA_ERR_ARGUMENT. O(1). */
+/* Checks a common configuration (node.h's ranges; a signer unless insecure). COA_OK or
+ * COA_ERR_ARGUMENT. O(1). */
 int coavoid_node_common_check(const coavoid_node_common_t *c);
 
 /* The validation context at `now` with t = 0 at `epoch`: messages up to a horizon and
@@ -220,10 +228,13 @@ coavoid_lcm_context_t coavoid_node_context(const coavoid_node_inbox_t *in, int64
 /* Initialises the inbox and subscribes to intents, tracks and the obstacle map, and to
  * heartbeats (want_status) and plans (plan_handler non-NULL) when asked; counts into rx.
  * A coordinator's heartbeat or a plan from another node than coordinator_id is refused
- * (COAVOID_LCM_ERR_ID).
- * Returns COA_OK, or COA_ERR_ARGUMENT when LCM refused a subscription (everything
- * subscribed so far is unsubscribed). The handlers cost O(message) each (decoding and
- * validation, O(senders) for the sequence rule) and allocate nothing. */
+ * (COAVOID_LCM_ERR_ID). Unless common->insecure, every message must carry a signature
+ * of a key in common->trust whose role may send it, and be fresh (COAVOID_AUTH_ERR_*
+ * otherwise, counted as refused).
+ * Returns COA_OK, or COA_ERR_ARGUMENT when LCM refused a subscription or a secure node
+ * has no trust list (everything subscribed so far is unsubscribed). The handlers cost
+ * O(message) each (one signature verification, decoding and validation, O(senders) for
+ * the sequence rule) and allocate nothing. */
 int coavoid_node_inbox_init(coavoid_node_inbox_t *in, const coavoid_node_common_t *common,
                             uint16_t self_uav, uint16_t self_node, uint16_t coordinator_id,
                             size_t peer_capacity, lcm_t *lcm, coavoid_lcm_rx_stats_t *rx,
@@ -291,7 +302,14 @@ void coavoid_node_solver_fini(coavoid_node_solver_t *s);
 int coavoid_node_publish_heartbeat(coavoid_node_inbox_t *in, coavoid_status_t *m, int64_t now,
                                    int64_t cycle_start, const coavoid_node_heartbeat_t *h);
 
-/* Publishing: encodes into tx->buf and publishes on the type's channel. COA_OK, or
+/* Prepares tx for publishing on lcm as c says: signing with a copy of c->signer at c's
+ * clock, unless c->insecure. fini zeroes the copy of the secret key. O(1); cannot fail
+ * (c was checked). */
+void coavoid_node_tx_init(coavoid_node_tx_t *tx, lcm_t *lcm, const coavoid_node_common_t *c);
+void coavoid_node_tx_fini(coavoid_node_tx_t *tx);
+
+/* Publishing: encodes into tx->buf, signs it (coavoid_auth_stamp: one Ed25519 signature)
+ * and publishes on the type's channel. COA_OK, or
  * COA_ERR_WORKSPACE (does not encode into the buffer) or COA_ERR_ARGUMENT (LCM refused
  * it). O(message); our code allocates nothing (the provider may, inside lcm_publish). */
 int coavoid_node_publish_plan(coavoid_node_tx_t *tx, const coavoid_plan_t *msg);

@@ -747,6 +747,8 @@ coavoid_vehicle_node_t *coavoid_vehicle_node_create(const coavoid_vehicle_node_c
         *error = rc;
         return NULL;
     }
+    node->config.common.signer = NULL; /* copied by the inbox: the caller's may go */
+    node->config.common.trust = NULL;
     *error = COA_OK;
     return node;
 }

@@ -128,7 +128,9 @@ coavoid_world_t *coavoid_world_create(const coavoid_world_config_t *config, lcm_
     if (w->config.id == 0u) {
         w->config.id = (uint16_t)COAVOID_NODE_WORLD_ID;
     }
-    w->tx.lcm = lcm;
+    coavoid_node_tx_init(&w->tx, lcm, &w->config.common);
+    w->config.common.signer = NULL; /* copied: the caller's may go */
+    w->config.common.trust = NULL;
     w->cycle = -1;
     w->max_age_us = config->common.stale_after_us +
                     ((int64_t)config->common.horizon + 2) * config->common.dt_us;
@@ -137,7 +139,7 @@ coavoid_world_t *coavoid_world_create(const coavoid_world_config_t *config, lcm_
     if (coavoid_lcm_obstacle_map_from_core(config->obstacles, config->obstacle_count,
                                            config->common.epoch_utime, w->config.id, 1, &ctx,
                                            &w->map_msg, NULL) != COA_OK) {
-        free(w);
+        coavoid_world_destroy(w);
         return NULL;
     }
     *error = COA_OK;
@@ -146,6 +148,9 @@ coavoid_world_t *coavoid_world_create(const coavoid_world_config_t *config, lcm_
 
 void coavoid_world_destroy(coavoid_world_t *node)
 {
+    if (node != NULL) {
+        coavoid_node_tx_fini(&node->tx);
+    }
     free(node);
 }
 

@@ -52,6 +52,10 @@ typedef struct {
     coa_track_t *tracks; /* the world's copy when the scenario's ids do not fit */
     coavoid_judged_t judged;
     FILE *svg;
+    /* The fleet's keys (sim_keys): every node trusts every key; signers by key, the
+     * coordinator's, the world's, then each UAV's in scenario order. */
+    coavoid_auth_trust_t trust;
+    coavoid_auth_signer_t *signers;
 } sim_run_t;
 
 static void sim_run_free(sim_run_t *r, size_t n)
@@ -71,6 +75,12 @@ static void sim_run_free(sim_run_t *r, size_t n)
     free(r->references);
     free(r->offsets);
     free(r->tracks);
+    if (r->signers != NULL) {
+        for (size_t j = 0; j < n + 2u; j++) {
+            coavoid_auth_signer_clear(&r->signers[j]);
+        }
+    }
+    free(r->signers);
     if (r->svg != NULL) {
         fclose(r->svg);
     }
@@ -507,6 +517,62 @@ static int sim_open(sim_run_t *r)
     return SIM_GO_ON;
 }
 
+/* One fleet key of the simulation into signer and the trust list: its seed is a fixed text
+ * and the key id, so every run signs alike. */
+static int sim_key(sim_run_t *r, coavoid_auth_signer_t *signer, uint32_t key_id,
+                   coavoid_auth_role_t role, uint16_t node)
+{
+    unsigned char seed[COAVOID_AUTH_SEED_BYTES] = "coavoid simulation key";
+    seed[COAVOID_AUTH_SEED_BYTES - 4u] = (unsigned char)(key_id >> 24);
+    seed[COAVOID_AUTH_SEED_BYTES - 3u] = (unsigned char)(key_id >> 16);
+    seed[COAVOID_AUTH_SEED_BYTES - 2u] = (unsigned char)(key_id >> 8);
+    seed[COAVOID_AUTH_SEED_BYTES - 1u] = (unsigned char)key_id;
+    coavoid_auth_key_t key = {key_id, role, node, {0}};
+    memset(signer, 0, sizeof *signer);
+    signer->key_id = key_id;
+    if (coavoid_auth_keypair_seed(seed, key.public_key, signer->secret_key) != COA_OK ||
+        coavoid_auth_trust_add(&r->trust, &key) != COA_OK) {
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INTERNAL,
+                                "internal error: no simulation key (libsodium)");
+    }
+    return SIM_GO_ON;
+}
+
+/* The fleet's keys, as coavoid keygen numbers them, unless the run is insecure. */
+static int sim_keys(sim_run_t *r)
+{
+    r->common.insecure = r->o->insecure;
+    if (r->o->insecure) {
+        return SIM_GO_ON;
+    }
+    r->signers = calloc(r->n + 2u, sizeof *r->signers);
+    if (r->signers == NULL) {
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INTERNAL,
+                                "internal error: out of memory for the keys");
+    }
+    coavoid_auth_trust_init(&r->trust);
+    r->common.trust = &r->trust;
+    int rc = sim_key(r, &r->signers[0], COAVOID_AUTH_KEY_ID_COORDINATOR, COAVOID_AUTH_COORDINATOR,
+                     (uint16_t)COAVOID_NODE_COORDINATOR_ID);
+    if (rc == SIM_GO_ON) {
+        rc = sim_key(r, &r->signers[1], COAVOID_AUTH_KEY_ID_WORLD, COAVOID_AUTH_WORLD,
+                     (uint16_t)COAVOID_NODE_WORLD_ID);
+    }
+    for (size_t i = 0; i < r->n && rc == SIM_GO_ON; i++) {
+        const uint16_t id = r->s->vehicles[i].id;
+        rc = sim_key(r, &r->signers[2u + i], COAVOID_AUTH_KEY_ID_VEHICLE_BASE + id,
+                     COAVOID_AUTH_VEHICLE, id);
+    }
+    return rc;
+}
+
+/* A node's signer: NULL when insecure; else the coordinator's (0), the world's (1) or the
+ * UAV's of scenario index i (2 + i). */
+static const coavoid_auth_signer_t *sim_signer(const sim_run_t *r, size_t which)
+{
+    return r->signers != NULL ? &r->signers[which] : NULL;
+}
+
 /* The world node. A track message numbers tracks 1..2^31-1, once each; the scenario may
  * use any integer, so then the world's tracks are numbered by position instead (the ids
  * only name tracks in the messages: the flight is judged on the scenario's own tracks). */
@@ -537,6 +603,7 @@ static int sim_world(sim_run_t *r)
     coavoid_world_config_t world;
     memset(&world, 0, sizeof world);
     world.common = r->common;
+    world.common.signer = sim_signer(r, 1u);
     world.id = COAVOID_NODE_WORLD_ID;
     world.obstacles = s->obstacles;
     world.obstacle_count = s->obstacle_count;
@@ -580,6 +647,7 @@ static int sim_vehicles(sim_run_t *r)
         memset(&config, 0, sizeof config);
         config.common = r->common;
         config.common.beta = r->vehicle_beta;
+        config.common.signer = sim_signer(r, 2u + i);
         config.vehicle = s->vehicles[i];
         config.mode = r->o->decoupled ? COAVOID_NODE_DECOUPLED : COAVOID_NODE_CENTRALISED;
         r->vehicles[j] = coavoid_vehicle_node_create(&config, r->lcm, &error);
@@ -608,6 +676,7 @@ static int sim_coordinator(sim_run_t *r)
     memset(&config, 0, sizeof config);
     config.common = r->common;
     config.common.beta = r->coordinator_beta;
+    config.common.signer = sim_signer(r, 0u);
     config.id = COAVOID_NODE_COORDINATOR_ID;
     config.max_centralised = r->max_centralised;
     config.collect_us = r->collect_us;
@@ -791,6 +860,9 @@ int coavoid_sim_run(const coavoid_sim_config_t *c, coavoid_scenario_t *s, FILE *
     }
     if (rc == SIM_GO_ON) {
         rc = sim_open(&r);
+    }
+    if (rc == SIM_GO_ON) {
+        rc = sim_keys(&r);
     }
     if (rc == SIM_GO_ON) {
         rc = sim_world(&r);

@@ -50,6 +50,10 @@ typedef struct {
     uint32_t stop_step;   /* 0..steps */
     bool json;            /* the result as JSON (default: text) */
     const char *svg_path; /* NULL, or where the figure goes */
+    /* The nodes sign and check every message (default), with the simulation's fixed keys
+     * (fixed, public, derived from the key ids: they make a run repeatable and protect nothing, as
+     * nothing but the run's own nodes is on its in-process bus), or, insecure, neither: the flight is the same either way. */
+    bool insecure;
 } coavoid_sim_config_t;
 
 /* The largest --steps, and with it --coordinator-stops: more is more likely a typo than a
@@ -70,6 +74,11 @@ typedef struct {
     const char *svg_path; /* NULL, or where the figure goes */
     bool has_epoch;       /* cycle 0's start given; otherwise the earliest plan_utime */
     int64_t epoch;        /* microseconds, >= 1 */
+    /* The run's trust list (the caller's), or NULL: then signatures are not checked. With
+     * one, an intent, heartbeat or plan counts only when signed by a key that may send it
+     * and newer (timestamp, sequence) than the last one of its type from that key in log
+     * order; the others are ignored and counted as unauthenticated. */
+    const coavoid_auth_trust_t *trust;
 } coavoid_sim_log_config_t;
 
 /* Judges the run of scenario s (loaded) that the lcm-logger log c->log_path recorded, and

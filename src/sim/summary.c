@@ -40,6 +40,11 @@
  *     its heartbeats are ignored until its new count passes the old one, so its replans
  *     are the larger of the two.
  *
+ * With a trust list (--trust) every intent, heartbeat and plan must also be signed by a key
+ * that may send it and be newer than the last of its type from that key, in log order (as
+ * the nodes judge them, without their clock window: the logger's clock is not the run's):
+ * the others (forgeries, copies, replays) are ignored and counted as unauthenticated.
+ *
  * The log is untrusted. LCM 1.3.1's reader skips anything until it finds an event's
  * magic number, reports truncation as a normal end, prints its own complaints on stderr
  * (bad lengths; no magic right after an event) and, for a data length near 2^31, hands a
@@ -435,6 +440,14 @@ typedef struct {
     int64_t heartbeats_too_fast;   /* plans_run beyond what the node can plan */
     char heartbeat_ignored[IGNORED_REASON_MAX];
 
+    /* Signatures (o->trust given): the trust list with the freshness marks of the pass
+     * under way (each pass starts from o->trust's), and what was not authentic. */
+    coavoid_auth_trust_t trust;
+    int64_t intents_unauthenticated;
+    int64_t plans_unauthenticated;
+    int64_t statuses_unauthenticated;
+    const char *unauthenticated_reason; /* the first one's */
+
     intent_list_t seen;          /* accepted intents of the scenario's UAVs */
     heartbeat_list_t heartbeats; /* valid heartbeats, in log order */
     planning_list_t plan_list;   /* (coordinator, valid_from, plan_id) of accepted plans */
@@ -493,9 +506,48 @@ static void note_other_uav(log_summary_t *ls, int32_t uav)
     }
 }
 
+/* Where every pass over the log starts: no message accepted from any key yet. */
+static void auth_restart(log_summary_t *ls)
+{
+    if (ls->o->trust != NULL) {
+        ls->trust = *ls->o->trust;
+    }
+}
+
+/* Whether a valid message (its raw bytes in e, its decoded auth) is authentic: signed by a
+ * key of the trust list that may send it as (role, id), and newer than the last of its
+ * stream from that key. Always true without a trust list. Counts into *counter (when
+ * `count`) what is not. */
+static bool authentic(log_summary_t *ls, const lcm_eventlog_event_t *e, size_t stream,
+                      coavoid_auth_role_t role, int32_t id, const coavoid_auth_t *auth,
+                      int64_t *counter, bool count)
+{
+    if (ls->o->trust == NULL) {
+        return true;
+    }
+    size_t key = 0;
+    int rc = coavoid_auth_verify(&ls->trust, e->data, (size_t)e->datalen, &key);
+    if (rc == COA_OK) {
+        rc = (id >= 1 && id <= 65535) ? coavoid_auth_may_send(&ls->trust, key, role, (uint16_t)id)
+                                      : COAVOID_AUTH_ERR_ROLE;
+    }
+    if (rc == COA_OK) {
+        /* Order only: the logger's clock is not the nodes' (a run may be sped up). */
+        rc = coavoid_auth_fresh(&ls->trust, key, stream, auth->timestamp_us, auth->sequence,
+                                auth->timestamp_us, 0, 0);
+    }
+    if (rc != COA_OK && count) {
+        (*counter)++;
+        if (ls->unauthenticated_reason == NULL) {
+            ls->unauthenticated_reason = coavoid_lcm_error_name(rc);
+        }
+    }
+    return rc == COA_OK;
+}
+
 /* Decodes and validates an intent. Returns the scenario's index of its UAV (>= 0), -1
- * refused, -2 a valid intent of another UAV, or -3 a valid intent of a scenario UAV that
- * disagrees with the scenario (ignored); each counted when `count`. */
+ * refused, -2 a valid intent of another UAV, -3 a valid intent of a scenario UAV that
+ * disagrees with the scenario, or -4 not authentic (ignored); each counted when `count`. */
 static long accept_intent(log_summary_t *ls, const lcm_eventlog_event_t *e, bool count)
 {
     const char *reason = "intent: does not decode (wrong type or truncated)";
@@ -517,6 +569,10 @@ static long accept_intent(log_summary_t *ls, const lcm_eventlog_event_t *e, bool
             }
         }
         return -1;
+    }
+    if (!authentic(ls, e, COAVOID_AUTH_STREAM_INTENT, COAVOID_AUTH_VEHICLE, m->uav_id, &m->auth,
+                   &ls->intents_unauthenticated, count)) {
+        return -4;
     }
     long index = coavoid_scenario_vehicle_index(ls->s, (long)m->uav_id);
     if (index < 0) {
@@ -559,6 +615,13 @@ static bool read_status(log_summary_t *ls, const lcm_eventlog_event_t *e)
         note_other(ls, reason);
         return true;
     }
+    const coavoid_auth_role_t role = m->node_kind == COAVOID_STATUS_T_NODE_COORDINATOR
+                                         ? COAVOID_AUTH_COORDINATOR
+                                         : COAVOID_AUTH_VEHICLE;
+    if (!authentic(ls, e, COAVOID_AUTH_STREAM_STATUS, role, m->node_id, &m->auth,
+                   &ls->statuses_unauthenticated, true)) {
+        return true;
+    }
     /* node_id is 1..65535 once the heartbeat is valid. */
     heartbeat_t item = {m->utime, m->sequence, m->plans_run, (uint16_t)m->node_id, m->node_kind};
     return heartbeat_add(&ls->heartbeats, item);
@@ -580,6 +643,10 @@ static bool read_plan(log_summary_t *ls, const lcm_eventlog_event_t *e)
         note_other(ls, reason);
         return true;
     }
+    if (!authentic(ls, e, COAVOID_AUTH_STREAM_PLAN, COAVOID_AUTH_COORDINATOR,
+                   ls->plan.coordinator_id, &ls->plan.auth, &ls->plans_unauthenticated, true)) {
+        return true;
+    }
     planning_t item = {(uint32_t)ls->plan.coordinator_id, COAVOID_STATUS_T_NODE_COORDINATOR,
                        ls->plan.valid_from_utime, ls->plan.plan_id};
     return planning_add(&ls->plan_list, item);
@@ -588,6 +655,7 @@ static bool read_plan(log_summary_t *ls, const lcm_eventlog_event_t *e)
 /* Pass 1: every event of the log. Returns SIM_GO_ON or the exit status. */
 static int read_log(log_summary_t *ls, log_reader_t *r)
 {
+    auth_restart(ls);
     for (;;) {
         lcm_eventlog_event_t *e = NULL;
         int rc = log_next(r, &e);
@@ -863,6 +931,7 @@ static int64_t last_complete_cycle(const log_summary_t *ls, int64_t epoch, uint3
 static int fill_samples(log_summary_t *ls, log_reader_t *r, rebuilt_t *b, int64_t epoch)
 {
     const size_t row = (size_t)b->steps + 1u;
+    auth_restart(ls);
     for (;;) {
         lcm_eventlog_event_t *e = NULL;
         int rc = log_next(r, &e);
@@ -988,6 +1057,14 @@ static void print_log_text(const log_summary_t *ls, const rebuilt_t *b, int64_t 
             "offset held)\n",
             b->own_samples, b->earlier_samples, b->missing_samples);
     print_ignored_text(ls);
+    if (ls->o->trust != NULL) {
+        fprintf(ls->out,
+                "signatures: checked; unauthenticated (ignored): %" PRId64 " intents, %" PRId64
+                " plans, %" PRId64 " heartbeats%s%s\n",
+                ls->intents_unauthenticated, ls->plans_unauthenticated,
+                ls->statuses_unauthenticated, ls->unauthenticated_reason != NULL ? "; first: " : "",
+                ls->unauthenticated_reason != NULL ? ls->unauthenticated_reason : "");
+    }
 }
 
 /* An integer printed as one: cJSON would print a microsecond time as 1.7e+15. */
@@ -1009,7 +1086,15 @@ static bool add_ignored(cJSON *log, const log_summary_t *ls)
            (ls->intent_ignored[0] == '\0' ||
             cJSON_AddStringToObject(log, "first_ignored_intent", ls->intent_ignored) != NULL) &&
            (ls->heartbeat_ignored[0] == '\0' ||
-            cJSON_AddStringToObject(log, "first_ignored_heartbeat", ls->heartbeat_ignored) != NULL);
+            cJSON_AddStringToObject(log, "first_ignored_heartbeat", ls->heartbeat_ignored) !=
+                NULL) &&
+           (ls->o->trust == NULL ||
+            (add_count(log, "intents_unauthenticated", ls->intents_unauthenticated) &&
+             add_count(log, "plans_unauthenticated", ls->plans_unauthenticated) &&
+             add_count(log, "heartbeats_unauthenticated", ls->statuses_unauthenticated) &&
+             (ls->unauthenticated_reason == NULL ||
+              cJSON_AddStringToObject(log, "first_unauthenticated", ls->unauthenticated_reason) !=
+                  NULL)));
 }
 
 /* The flight's JSON with a "log" object added. The log object holds only integers and

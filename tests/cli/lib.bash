@@ -13,7 +13,12 @@ bin=${1:?usage: $(basename "$0") COAVOID SOURCE_DIR}
 # shellcheck disable=SC2034
 src=${2:-}
 tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
+# KEEP_TMP=1 keeps the scratch directory (its path is printed) to look into a failure.
+if [ -n "${KEEP_TMP:-}" ]; then
+    echo "scratch: $tmp" >&2
+else
+    trap 'rm -rf "$tmp"' EXIT
+fi
 passed=0
 failed=0
 

@@ -10,9 +10,13 @@
 #      vehicles fall back to planning for themselves and stay separated;
 #   c) decoupled without a coordinator: no loss of separation, and the same flight and
 #      planning calls as `coavoid sim`;
-# (the flights: late_encounter.json for a and b, paper.json with a lead-in for c)
+#   d) an attacker on the group (tests/forge/forge.c, lcm-logplayer), both modes: forged
+#      maps, plans and intents signed with a stolen vehicle key, copies with higher
+#      sequence numbers, replays of the run's own traffic and of an earlier run's log;
+# (the flights: late_encounter.json for a and b, paper.json with a lead-in for c and d)
 # and every bad option or input of the drivers exits 2 with one line, the missing
-# multicast route included.
+# multicast route included. Every process signs and checks with keys from
+# `coavoid keygen`; `--insecure` runs are named as such.
 #
 # Where no namespace can be made (a container without CAP_SYS_ADMIN) it runs on the host's
 # multicast route instead, on a port of its own, and says so.
@@ -79,6 +83,7 @@ types = {"COAVOID_INTENT": intent_t, "COAVOID_PLAN": plan_t, "COAVOID_TRACK": tr
 data = open(sys.argv[1], "rb").read()
 i, n = 0, 0
 counts, intents, statuses, plans, reports, rejected = {}, {}, {}, [], [], {}
+codes, reasons = {}, {}
 while i < len(data):
     magic, _, _, clen, dlen = struct.unpack_from(">IqqII", data, i)
     assert magic == 0xEDA1DA01, f"event {n}: bad magic at byte {i}"
@@ -99,14 +104,27 @@ while i < len(data):
     elif channel == "COAVOID_STATUS":
         statuses.setdefault(m.node_id, []).append(m.mode)
         rejected[m.node_id] = max(rejected.get(m.node_id, 0), m.messages_rejected)
+        codes.setdefault(m.node_id, set()).add(m.last_reject_code)
+        reasons[m.node_id] = reasons.get(m.node_id, 0) | m.reasons
     elif channel == "COAVOID_PLAN":
         plans.append({"status": m.status, "ids": list(m.uav_ids[:m.vehicle_count])})
     elif channel == "COAVOID_CONFLICTS":
         reports.append(m.conflict_count)
     n += 1
 print(json.dumps({"events": n, "counts": counts, "intents": intents, "statuses": statuses,
-                  "plans": plans, "reports": reports, "rejected": rejected}))
+                  "plans": plans, "reports": reports, "rejected": rejected,
+                  "codes": {k: sorted(v) for k, v in codes.items()}, "reasons": reasons}))
 PY
+
+# The fleet's keys, for every run (late_encounter.json and paper.json fly UAVs 1, 2, 3):
+# the same keys across runs, so that an earlier run's log is a real replay.
+keys=$tmp/keys
+mkdir -p "$keys"
+if ! "$bin" keygen "$scenarios/paper.json" --dir "$keys" >"$tmp/keygen.out" 2>&1; then
+    fail "coavoid keygen: $(cat "$tmp/keygen.out")"
+fi
+# key NODE: a process's key options (NODE coordinator, world or vehicle-ID).
+key() { echo --key "$keys/$1.key" --trust "$keys/trust.txt"; }
 
 # ids SCENARIO: the scenario's vehicle ids.
 ids() { "$vehicle" --scenario "$1" --list-ids; }
@@ -122,7 +140,9 @@ sleep_until_cycle() {
 
 # fleet NAME SCENARIO MODE STEPS KILL_AT [COORDINATOR_ARGS...]: lcm-logger, the world, the
 # coordinator (centralised) and one vehicle per UAV, on one epoch; with KILL_AT (a number
-# of cycles, or -), the coordinator gets SIGTERM then. Leaves in $tmp/NAME: log.lcm, each
+# of cycles, or -), the coordinator gets SIGTERM then. With $attack set, the attacker too
+# (forge.c's attack, its options in $forge_args; "replay-log" replays $replay_log with
+# lcm-logplayer instead). Leaves in $tmp/NAME: log.lcm, each
 # process's stderr (NAME.txt) and exit status (NAME.rc), log.json (log.py's summary) and
 # summary.json (`coavoid summary --json` of the log).
 fleet() {
@@ -136,24 +156,32 @@ fleet() {
     echo "$epoch" >"$dir/epoch"
     local common=(--lcm-url "$url" --epoch "$epoch" --speed "$speed" --steps "$steps")
     local pids=() names=() cpid=
-    "$bin" world "$scenario" "${common[@]}" 2>"$dir/world.txt" &
+    # shellcheck disable=SC2046 # key's words are options
+    "$bin" world "$scenario" "${common[@]}" $(key world) 2>"$dir/world.txt" &
     pids+=($!) names+=(world)
     if [ "$mode" = centralised ]; then
-        "$coordinator" --scenario "$scenario" "${common[@]}" "$@" 2>"$dir/coordinator.txt" &
+        # shellcheck disable=SC2046
+        "$coordinator" --scenario "$scenario" "${common[@]}" $(key coordinator) "$@" \
+            2>"$dir/coordinator.txt" &
         cpid=$!
         pids+=("$cpid") names+=(coordinator)
     fi
-    if [ -n "${attack:-}" ]; then
+    if [ "${attack:-}" = replay-log ]; then
+        lcm-logplayer --lcm-url="$url" "$replay_log" >"$dir/forge.txt" 2>&1 &
+        pids+=($!) names+=(forge)
+    elif [ -n "${attack:-}" ]; then
         local seconds
         seconds=$(awk -v l="$lead_us" -v n="$steps" -v s="$speed" 'BEGIN { print l / 1e6 + n / s + 1 }')
+        # shellcheck disable=SC2086 # forge_args are options
         "$forge" --lcm-url "$url" --attack "$attack" --seconds "$seconds" --target 1 --other 2 \
-            >"$dir/forge.txt" 2>&1 &
+            ${forge_args:-} >"$dir/forge.txt" 2>&1 &
         pids+=($!) names+=(forge)
     fi
     local id
     for id in $(ids "$scenario"); do
+        # shellcheck disable=SC2046
         "$vehicle" --scenario "$scenario" --id "$id" --mode "$mode" "${common[@]}" \
-            2>"$dir/vehicle-$id.txt" &
+            $(key "vehicle-$id") 2>"$dir/vehicle-$id.txt" &
         pids+=($!) names+=("vehicle-$id")
     done
     if [ "$kill_at" != - ]; then
@@ -170,7 +198,7 @@ fleet() {
     wait "$logger"
     python3 "$tmp/log.py" "$dir/log.lcm" "$tmp/py" >"$dir/log.json" 2>"$dir/log.err"
     "$bin" summary "$dir/log.lcm" "$scenario" --mode "$mode" --json --epoch "$epoch" \
-        >"$dir/summary.json" 2>"$dir/summary.err"
+        --trust "$keys/trust.txt" >"$dir/summary.json" 2>"$dir/summary.err"
     echo $? >"$dir/summary.rc"
     if [ -n "${VERBOSE:-}" ]; then
         tail -n 3 "$dir"/*.txt "$dir/log.json" "$dir/summary.err"
@@ -246,21 +274,41 @@ bin=$vehicle expect_bad "vehicle, a run that has ended" "ended" --scenario "$hea
 bin=$vehicle expect_bad "vehicle, epoch given twice" "more than once" --scenario "$headon" --id 1 \
     --epoch 1 --epoch 2
 bin=$vehicle expect_bad "vehicle, priority wait of a whole cycle" "--priority-wait" \
-    --scenario "$headon" --id 1 --mode decoupled --priority-wait 1
+    --scenario "$headon" --id 1 --mode decoupled --priority-wait 1 --insecure
 bin=$vehicle expect_bad "vehicle, coordinator timeout when decoupled" "--coordinator-timeout" \
     --scenario "$headon" --id 1 --mode decoupled --coordinator-timeout 2
 bin=$vehicle expect_bad "vehicle, an unknown LCM provider" "--lcm-url" --scenario "$headon" --id 1 \
-    --lcm-url "nope://"
+    --lcm-url "nope://" --insecure
 bin=$vehicle expect_bad "vehicle, a stray argument" "unexpected argument" "$headon"
 bin=$coordinator expect_bad "coordinator, --max-centralised 7" "--max-centralised" \
     --scenario "$headon" --max-centralised 7
 bin=$coordinator expect_bad "coordinator, --beta 0" "--beta" --scenario "$headon" --beta 0
 bin=$coordinator expect_bad "coordinator, --collect of a whole cycle" "--collect" \
-    --scenario "$headon" --collect 1
+    --scenario "$headon" --collect 1 --insecure
 bin=$coordinator expect_bad "coordinator, an unknown option" "unknown option" \
     --scenario "$headon" --id 1
 expect_bad "world without a scenario" "SCENARIO" world
 expect_bad "world, bad speed" "--speed" world "$headon" --speed -1
+# Keys: required unless --insecure, never both; a key file must be the node's own, its
+# owner's only, and every line of a trust file is checked.
+bin=$vehicle expect_bad "vehicle without --key" "--key: required" --scenario "$paper" --id 1
+bin=$vehicle expect_bad "vehicle without --trust" "--trust: required" --scenario "$paper" --id 1 \
+    --key "$keys/vehicle-1.key"
+bin=$vehicle expect_bad "vehicle, --insecure with --key" "--insecure" --scenario "$paper" --id 1 \
+    --insecure --key "$keys/vehicle-1.key"
+bin=$vehicle expect_bad "vehicle 2 with vehicle 1's key" "not this node's" --scenario "$paper" \
+    --id 2 --key "$keys/vehicle-1.key" --trust "$keys/trust.txt"
+bin=$coordinator expect_bad "coordinator with the world's key" "not this node's" \
+    --scenario "$paper" --key "$keys/world.key" --trust "$keys/trust.txt"
+cp "$keys/vehicle-1.key" "$tmp/open.key" && chmod 644 "$tmp/open.key"
+bin=$vehicle expect_bad "vehicle, a key readable by others" "readable by others" \
+    --scenario "$paper" --id 1 --key "$tmp/open.key" --trust "$keys/trust.txt"
+printf '1 coordinator 65001 00\n' >"$tmp/bad-trust.txt"
+bin=$vehicle expect_bad "vehicle, a bad trust line" "line 1: PUBLIC_KEY_HEX" \
+    --scenario "$paper" --id 1 --key "$keys/vehicle-1.key" --trust "$tmp/bad-trust.txt"
+bin=$vehicle expect_bad "vehicle, a missing key file" "cannot read" \
+    --scenario "$paper" --id 1 --key "$tmp/none.key" --trust "$keys/trust.txt"
+expect_bad "world without --key" "--key: required" world "$paper"
 # Without a multicast route (a fresh namespace inside this one) LCM cannot start; the
 # drivers say so in one line with the fix.
 if [ -n "$netns" ]; then
@@ -268,9 +316,9 @@ if [ -n "$netns" ]; then
     if [ "$(id -u)" -eq 0 ]; then how=--net; fi
     also="ip route add 224.0.0.0/4 dev lo" bin=unshare expect_bad \
         "vehicle without a multicast route" "no multicast route" \
-        "$how" "$vehicle" --scenario "$headon" --id 1
+        "$how" "$vehicle" --scenario "$headon" --id 1 --insecure
     also="ip route add 224.0.0.0/4 dev lo" bin=unshare expect_bad \
-        "world without a multicast route" "no multicast route" "$how" "$coavoid" world "$headon"
+        "world without a multicast route" "no multicast route" "$how" "$coavoid" world "$headon" --insecure
 fi
 if "$vehicle" --scenario "$paper" --list-ids >"$tmp/ids" 2>&1 &&
     [ "$(tr '\n' ' ' <"$tmp/ids")" = "1 2 3 " ]; then
@@ -367,35 +415,69 @@ s['replans'] == sum(num(f'vehicle-{i}', 'plans run') for i in (1, 2, 3))
 [v['flown'] for v in s['vehicles']] == [v['flown'] for v in json.load(open(os.path.join(d, 'sim.json')))['vehicles']]
 "
 
-# ---- d) an attacker on the group: forged maps and plans (tests/forge/forge.c) ----
+# ---- d) an attacker on the group (tests/forge/forge.c, lcm-logplayer) ----
 
 # Each flight of the paper's encounter ends with no loss of separation and the forgery
-# reported by the vehicles it reached:
-#   map      an empty map with the world's id and the largest version (it would erase
-#            the terrain under UAV 1 and lock the real map out as older): every node keeps
-#            the scenario's terrain, and refuses the real maps as older;
-#   collide  a plan for UAV 1 from the configured coordinator's id that flies it to UAV
-#            2's altitude: refused, as flying into another UAV.
-# (A plan into the terrain is refused the same way: test_node's test_plan_into_terrain_refused.)
+# reported in the heartbeats of the nodes it reached (their refusals, with the last
+# refusal's code). Four attackers, one flight each, both modes:
+#   stolen      the attacker holds vehicle 3's secret key (a stolen vehicle) and signs with
+#               it: an empty map with the world's id and the largest version (unsigned, it
+#               would erase the terrain and lock the real map out as older); a plan for
+#               UAV 1 from the coordinator's id flying it to UAV 2's altitude (centralised
+#               only: decoupled vehicles take no plans); UAV 2's intents 300 m higher. All
+#               refused: that key may not send them (-123);
+#   copy        UAV 2's real intents again with sequences 1000 higher: the signature fails
+#               (-122);
+#   replay      every message heard sent again 1.5 s later: not newer than the last from
+#               its key (-124);
+#   replay-log  the log of flight (a), an earlier run with the same keys, played back with
+#               lcm-logplayer.
+# (test_node covers each refusal alone, unsigned messages included; a plan of the
+# coordinator's own that flies a UAV into another is refused as such there too.)
 if [ -z "$forge" ] || [ ! -x "$forge" ]; then
     fail "no attacker program (argument 3: coavoid_test_forge): the attacks are not flown"
 else
-    speed=${SPEED:-4}
-    for attack in map collide; do
-        fleet "attack-$attack" "$tmp/paper_lead_in.json" centralised 48 -
-    done
-    speed=$speed_decoupled
-    attack=map fleet attack-map-decoupled "$tmp/paper_lead_in.json" decoupled 48 -
-    attack=
+    replay_log=$tmp/centralised/log.lcm
     survived="s is not None and s['loss_of_separation'] is False
-rc['summary'] == 0 and rc['forge'] == 0 and num('forge', 'forged') >= 5"
-    # Reported: the refusals are in the heartbeats of the log.
-    check attack-map "$survived
-all(log['rejected'][str(i)] >= 1 for i in (1, 2, 3, 65001))"
-    check attack-map-decoupled "$survived
-all(log['rejected'][str(i)] >= 1 for i in (1, 2, 3))"
-    check attack-collide "$survived
-log['rejected']['1'] >= 1"
+rc['summary'] == 0 and rc['forge'] == 0"
+    forged="num('forge', 'forged') >= 5"
+    # reported CODE NODES: each node's heartbeats counted refusals, CODE among their codes.
+    reported() { echo "all(log['rejected'][str(i)] >= 1 and $1 in log['codes'][str(i)] for i in ($2,))"; }
+    for mode in centralised decoupled; do
+        if [ "$mode" = centralised ]; then
+            speed=${SPEED:-4} all="1, 2, 3, 65001" stolen=map,collide,intent
+        else
+            speed=$speed_decoupled all="1, 2, 3" stolen=map,intent
+        fi
+        forge_args="--key $keys/vehicle-3.key" attack=$stolen \
+            fleet "attack-stolen-$mode" "$tmp/paper_lead_in.json" "$mode" 48 -
+        for attack in copy replay replay-log; do
+            forge_args= fleet "attack-$attack-$mode" "$tmp/paper_lead_in.json" "$mode" 48 -
+        done
+        attack=
+        # Decoupled, the attacked flights are `coavoid sim`'s to the step, as in (c): the
+        # attacker changed nothing.
+        same=True
+        if [ "$mode" = decoupled ]; then
+            same="[v['flown'] for v in s['vehicles']] == [v['flown'] for v in json.load(open('$tmp/decoupled/sim.json'))['vehicles']]"
+        fi
+        check "attack-stolen-$mode" "$survived
+$same
+$forged
+$(reported -123 "$all")
+set(log['codes']['1']) <= {0, -123}"
+        check "attack-copy-$mode" "$survived
+$same
+$forged
+$(reported -122 "$all")"
+        check "attack-replay-$mode" "$survived
+$same
+$forged
+$(reported -124 "$all")"
+        check "attack-replay-log-$mode" "$survived
+$same
+all(log['rejected'][str(i)] >= 1 for i in ($all,))"
+    done
 fi
 
 finish
