@@ -103,8 +103,9 @@
  * velocity from the state in its last intent, with its sigma grown by
  * stale_sigma_rate * age (the predictor then grows it further with look-ahead).
  *
- * Messages arrive through LCM subscriptions made at init; each is decoded and validated
- * (src/lcm) with the driver's clock, counted, and stored (the latest intent per UAV, per
+ * Messages arrive through LCM subscriptions made at init; each is verified (its signature
+ * over the raw bytes, then its key's role and freshness: common.trust, auth.h), decoded
+ * and validated (src/lcm) with the driver's clock, counted, and stored (the latest intent per UAV, per
  * track, the obstacle map, the coordinator's heartbeat); a refused message is counted in
  * the node's status and otherwise ignored, never fatal. A node's own messages come back
  * to it and are not counted; but an intent with a UAV's own id that it did not publish
