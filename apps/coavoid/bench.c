@@ -3,7 +3,8 @@
  * coavoid bench: the dispatcher of the benchmarks, and `coavoid bench predict`'s options
  * (BENCH_USAGE below). The harness, which builds the random airspace, times the
  * prediction cycles and reports, is coavoid::evaluation's (bench_predict.h,
- * docs/benchmarks.md); `coavoid bench plan` is bench_plan.c.
+ * docs/benchmarks.md); `coavoid bench plan` is bench_plan.c, `coavoid bench auth`
+ * bench_auth.c (built with the messaging library only: COAVOID_HAVE_LCM).
  */
 #include <stdbool.h>
 #include <stdint.h>
@@ -14,6 +15,13 @@
 #include "cli.h"
 #include "coavoid/coavoid.h"
 #include "commands.h"
+
+/* The benchmarks built: auth only with the messaging library. */
+#ifdef COAVOID_HAVE_LCM
+#define BENCH_NAMES "predict, plan or auth"
+#else
+#define BENCH_NAMES "predict or plan"
+#endif
 
 #define BENCH_DEFAULT_SEED 1u
 #define BENCH_DEFAULT_REPEAT 21u
@@ -171,22 +179,28 @@ static int bench_predict(int argc, char **argv)
 int coavoid_command_bench(int argc, char **argv)
 {
     if (argc < 3) {
-        return coavoid_cli_fail(
-            CLI_EXIT_INVALID,
-            "bench: missing benchmark (predict or plan; see 'coavoid bench --help')");
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "bench: missing benchmark (" BENCH_NAMES
+                                                  "; see 'coavoid bench --help')");
     }
     const char *name = argv[2];
     if (strcmp(name, "-h") == 0 || strcmp(name, "--help") == 0) {
-        /* Two benchmarks with their own options: name both, each one's help has the rest. */
+        /* Benchmarks with their own options: name each, each one's help has the rest. */
         printf("usage: coavoid bench predict --vehicles N --horizon H [options]\n"
                "       coavoid bench plan [--vehicles N] [--count C] [options]\n"
+#ifdef COAVOID_HAVE_LCM
+               "       coavoid bench auth [--vehicles N[,N...]] [--repeat R] [--json]\n"
+#endif
                "\n"
                "  predict  times the conflict prediction cycle on a random airspace\n"
                "  plan     times the planner, centralised and decoupled, on the paper\n"
                "           scenario and random encounters\n"
+#ifdef COAVOID_HAVE_LCM
+               "  auth     times signing and checking each message type, per message\n"
+               "           and per cycle of a fleet's nodes\n"
+#endif
                "\n"
-               "Run 'coavoid bench predict --help' or 'coavoid bench plan --help' for the\n"
-               "options. See docs/benchmarks.md.\n");
+               "Run 'coavoid bench NAME --help' for a benchmark's options.\n"
+               "See docs/benchmarks.md.\n");
         return CLI_EXIT_OK;
     }
     if (strcmp(name, "predict") == 0) {
@@ -195,9 +209,13 @@ int coavoid_command_bench(int argc, char **argv)
     if (strcmp(name, "plan") == 0) {
         return coavoid_bench_plan(argc, argv);
     }
-    return coavoid_cli_fail(
-        CLI_EXIT_INVALID,
-        "bench: unknown benchmark '%.40s' (expected predict or plan; see 'coavoid bench "
-        "--help')",
-        name);
+#ifdef COAVOID_HAVE_LCM
+    if (strcmp(name, "auth") == 0) {
+        return coavoid_bench_auth(argc, argv);
+    }
+#endif
+    return coavoid_cli_fail(CLI_EXIT_INVALID,
+                            "bench: unknown benchmark '%.40s' (expected " BENCH_NAMES
+                            "; see 'coavoid bench --help')",
+                            name);
 }

@@ -11,6 +11,7 @@ int coavoid_command_plan(int argc, char **argv);       /* plan_cmd.c */
 int coavoid_command_predict(int argc, char **argv);    /* predict_cmd.c */
 int coavoid_command_bench(int argc, char **argv);      /* bench.c */
 int coavoid_bench_plan(int argc, char **argv);         /* bench_plan.c: coavoid bench plan */
+int coavoid_bench_auth(int argc, char **argv);         /* bench_auth.c: needs the LCM library */
 int coavoid_command_montecarlo(int argc, char **argv); /* montecarlo.c */
 int coavoid_command_world(int argc, char **argv);      /* world_cmd.c: needs the node library */
 int coavoid_command_sim(int argc, char **argv);        /* sim_cmd.c: needs the node library */

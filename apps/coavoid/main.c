@@ -8,6 +8,7 @@
  *   coavoid predict SCENARIO.json [--threshold P] [...]             predict_cmd.c
  *   coavoid bench predict --vehicles N --horizon H [...]            bench.c
  *   coavoid bench plan [--vehicles N] [--count C] [...]              bench_plan.c
+ *   coavoid bench auth [--vehicles N[,N...]] [--repeat R] [--json]  bench_auth.c (LCM)
  *   coavoid montecarlo --vehicles N[,N...] [--count C] [...]        montecarlo.c
  *   coavoid world SCENARIO.json [--lcm-url URL] [--epoch UTIME] [...] world_cmd.c
  *   coavoid sim SCENARIO.json --mode centralised|decoupled [...]    sim_cmd.c
@@ -36,15 +37,22 @@
 #define USAGE_NODES ""
 #endif
 
-#define USAGE                                                                      \
-    "usage: coavoid <command> [options]\n"                                         \
-    "\n"                                                                           \
-    "commands:\n"                                                                  \
-    "  plan        plan collision-free altitude manoeuvres for a scenario\n"       \
-    "  predict     predict the conflicts of a scenario's reference trajectories\n" \
-    "  bench       time the core: bench predict, bench plan\n"                     \
-    "  montecarlo  compare centralised and decoupled planning over random "        \
-    "encounters\n" USAGE_NODES "\n"                                                \
+/* bench auth times the messaging library's signatures: offered only when it is built
+ * (COAVOID_HAVE_LCM, from coavoid::evaluation), like the commands above. */
+#ifdef COAVOID_HAVE_LCM
+#define USAGE_BENCH "  bench       time the core and signed messages: bench predict, plan, auth\n"
+#else
+#define USAGE_BENCH "  bench       time the core: bench predict, bench plan\n"
+#endif
+
+#define USAGE                                                                                  \
+    "usage: coavoid <command> [options]\n"                                                     \
+    "\n"                                                                                       \
+    "commands:\n"                                                                              \
+    "  plan        plan collision-free altitude manoeuvres for a scenario\n"                   \
+    "  predict     predict the conflicts of a scenario's reference trajectories\n" USAGE_BENCH \
+    "  montecarlo  compare centralised and decoupled planning over random "                    \
+    "encounters\n" USAGE_NODES "\n"                                                            \
     "Run 'coavoid <command> --help' for the options of a command.\n"
 
 int main(int argc, char **argv)
