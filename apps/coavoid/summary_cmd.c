@@ -140,7 +140,7 @@ static int summarise(void *options, coavoid_scenario_t *s)
 
 int coavoid_command_summary(int argc, char **argv)
 {
-    static summary_options_t options; /* a trust list: 21 kB */
+    static summary_options_t options; /* a trust list: 18 kB */
     int status = parse_summary_options(argc, argv, &options);
     if (status != CLI_CONTINUE) {
         return status;
