@@ -136,9 +136,9 @@
 #define COAVOID_CHANNEL_STATUS "COAVOID_STATUS"
 
 /* Capacities of one node's view of the airspace. */
-#define COAVOID_NODE_MAX_PEERS 64u    /* co-operative UAVs a node tracks, itself included */
-#define COAVOID_NODE_MAX_TRACKS 32u   /* non-cooperative tracks */
-#define COAVOID_NODE_MAX_HORIZON 127u /* N: intent_t carries N + 1 samples */
+#define COAVOID_NODE_MAX_PEERS 64u   /* co-operative UAVs a node tracks, itself included */
+#define COAVOID_NODE_MAX_TRACKS 32u  /* non-cooperative tracks */
+#define COAVOID_NODE_MAX_HORIZON 40u /* N: intent_t carries N + 1 samples, in one datagram */
 #define COAVOID_NODE_MAX_CONFIGURED_OBSTACLES 80u /* a node's own terrain database */
 
 /* The world's id (map_id of the obstacle map, source_id of tracks) by default. */

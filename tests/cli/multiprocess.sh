@@ -259,6 +259,16 @@ bin=$coordinator expect_bad "coordinator, --collect of a whole cycle" "--collect
     --scenario "$headon" --collect 1
 bin=$coordinator expect_bad "coordinator, an unknown option" "unknown option" \
     --scenario "$headon" --id 1
+# A horizon whose intents would not fit one datagram (docs/messages.md).
+python3 - "$headon" "$tmp/long.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+s["horizon"] = 41
+json.dump(s, open(sys.argv[2], "w"))
+PY
+bin=$vehicle expect_bad "vehicle, horizon 41" "at most 40" --scenario "$tmp/long.json" --id 1
+bin=$coordinator expect_bad "coordinator, horizon 41" "at most 40" --scenario "$tmp/long.json"
+expect_bad "world, horizon 41" "at most 40" world "$tmp/long.json"
 expect_bad "world without a scenario" "SCENARIO" world
 expect_bad "world, bad speed" "--speed" world "$headon" --speed -1
 # Without a multicast route (a fresh namespace inside this one) LCM cannot start; the
