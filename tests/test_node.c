@@ -590,6 +590,126 @@ static void on_status_probe(const lcm_recv_buf_t *rbuf, const char *channel, voi
     }
 }
 
+/* Tile `index` of `count` of the world's map `version`: with `lid`, a box over everything
+ * from 107 m up (a UAV at 100 m whose top is at 105 m climbs into it with 2 steps). */
+static void map_tile(lcm_t *lcm, int64_t now, int64_t version, int32_t index, int32_t count,
+                     bool lid)
+{
+    coavoid_obstacle_map_t m;
+    memset(&m, 0, sizeof m);
+    m.utime = now;
+    m.map_id = (int32_t)COAVOID_NODE_WORLD_ID;
+    m.version = version;
+    m.tile_index = index;
+    m.tile_count = count;
+    if (lid) {
+        const double lo[3] = {-1000, -1000, 107}, hi[3] = {1000, 1000, 200};
+        m.box_count = 1;
+        memcpy(m.box_min[0], lo, sizeof lo);
+        memcpy(m.box_max[0], hi, sizeof hi);
+    }
+    ck_assert_int_eq(coavoid_obstacle_map_t_publish(lcm, COAVOID_CHANNEL_OBSTACLES, &m), 0);
+}
+
+/* A map is used only whole: until every tile of a version has come, the node has no map
+ * (REASON_NO_MAP) or keeps the one it has, so a half map never replaces a whole one. A
+ * tile whose tile_count is not its version's is refused. */
+START_TEST(test_map_used_only_whole)
+{
+    rig_t r;
+    rig_init(&r, 10);
+    health_probe_t probe = {1, 0, -1, 0};
+    lcm_subscription_t *sub = lcm_subscribe(r.lcm, COAVOID_CHANNEL_STATUS, on_status_probe, &probe);
+    coa_vec3_t route[2];
+    coavoid_vehicle_node_t *a =
+        vehicle_node(&r, uav(1, 1, route, 0, 500, 0, 100), COAVOID_NODE_CENTRALISED);
+    const coavoid_vehicle_node_state_t *s = coavoid_vehicle_node_state(a);
+    map_tile(r.lcm, r.now, 1, 0, 2, true);
+    drain(r.lcm);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, cycle(0)), COA_OK);
+    drain(r.lcm);
+    ck_assert_int_ne(probe.reasons & COAVOID_STATUS_T_REASON_NO_MAP, 0);
+    map_tile(r.lcm, r.now, 1, 1, 2, false);
+    drain(r.lcm);
+    r.now = cycle(1);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
+    drain(r.lcm);
+    ck_assert_int_eq(probe.reasons & COAVOID_STATUS_T_REASON_NO_MAP, 0);
+    /* Version 1 has the lid: a climb of 2 steps is refused. */
+    r.now = cycle(1) + DT_US / 4;
+    plan_msg(r.lcm, r.now, 1, cycle(1), 1, 10, 0);
+    drain(r.lcm);
+    ck_assert_str_eq(s->rx.last_reason, "plan: flies this UAV into an obstacle or track it knows");
+    /* Half of version 2, without the lid, changes nothing. */
+    map_tile(r.lcm, r.now, 2, 0, 2, false);
+    drain(r.lcm);
+    plan_msg(r.lcm, r.now, 2, cycle(1), 1, 10, 0);
+    drain(r.lcm);
+    ck_assert_int_eq(s->plans_adopted, 0);
+    ck_assert_str_eq(s->rx.last_reason, "plan: flies this UAV into an obstacle or track it knows");
+    const int64_t rejected = s->rx.rejected;
+    map_tile(r.lcm, r.now, 2, 1, 3, false);
+    drain(r.lcm);
+    ck_assert_int_eq(s->rx.rejected, rejected + 1);
+    ck_assert_int_eq(s->rx.last_reject_code, COAVOID_LCM_ERR_COUNT);
+    /* The whole of version 2 replaces version 1: the climb is clear now. */
+    map_tile(r.lcm, r.now, 2, 1, 2, false);
+    drain(r.lcm);
+    plan_msg(r.lcm, r.now, 3, cycle(1), 1, 10, 0);
+    drain(r.lcm);
+    ck_assert_int_eq(s->plans_adopted, 1);
+    ck_assert_int_eq(s->rx.rejected, rejected + 1);
+    lcm_unsubscribe(r.lcm, sub);
+    coavoid_vehicle_node_destroy(a);
+    lcm_destroy(r.lcm);
+}
+END_TEST
+
+/* A plan is decided on only whole: a UAV holding its own row but not its sibling's adopts
+ * nothing and refuses nothing (unanswered, as if the plan had not come); the sibling's
+ * row completes it. A row that disagrees with its plan's other rows is refused. */
+START_TEST(test_plan_adopted_only_whole)
+{
+    rig_t r;
+    rig_init(&r, 10);
+    coa_vec3_t route[2];
+    coavoid_vehicle_node_t *a =
+        vehicle_node(&r, uav(1, 1, route, 0, 500, 0, 100), COAVOID_NODE_CENTRALISED);
+    const coavoid_vehicle_node_state_t *s = coavoid_vehicle_node_state(a);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, cycle(0)), COA_OK);
+    drain(r.lcm);
+    r.now = cycle(0) + DT_US / 4;
+    const int64_t rejected = s->rx.rejected;
+    coavoid_plan_t m = solved_plan(r.now, 4, cycle(0), 10, 2);
+    m.uav_ids[0] = 1;
+    m.uav_ids[1] = 9; /* far away: not in its view */
+    m.row_uav_id = 1;
+    for (int32_t k = 0; k <= 10; k++) {
+        m.offsets[k] = k < 2 ? k : 2;
+    }
+    ck_assert_int_eq(coavoid_plan_t_publish(r.lcm, COAVOID_CHANNEL_PLAN, &m), 0);
+    drain(r.lcm);
+    ck_assert_int_eq(s->plans_adopted, 0);
+    ck_assert_int_eq(s->rx.rejected, rejected);
+    coavoid_plan_t other = m;
+    other.row_uav_id = 9;
+    memset(other.offsets, 0, sizeof other.offsets);
+    other.deviation = 5.0; /* not what its sibling said */
+    ck_assert_int_eq(coavoid_plan_t_publish(r.lcm, COAVOID_CHANNEL_PLAN, &other), 0);
+    drain(r.lcm);
+    ck_assert_int_eq(s->plans_adopted, 0);
+    ck_assert_int_eq(s->rx.rejected, rejected + 1);
+    ck_assert_int_eq(s->rx.last_reject_code, COAVOID_LCM_ERR_VALUE);
+    other.deviation = m.deviation;
+    ck_assert_int_eq(coavoid_plan_t_publish(r.lcm, COAVOID_CHANNEL_PLAN, &other), 0);
+    drain(r.lcm);
+    ck_assert_int_eq(s->plans_adopted, 1);
+    ck_assert_int_eq(s->rx.rejected, rejected + 1);
+    coavoid_vehicle_node_destroy(a);
+    lcm_destroy(r.lcm);
+}
+END_TEST
+
 /* Another UAV with this node's id: its intents are not this node's own looped back, even
  * at the same times and sequence numbers; they are refused and the node reports a fault
  * while they come. */
@@ -1637,6 +1757,8 @@ static Suite *node_suite(void)
     tcase_add_test(tc, test_undecodable_counted_own_ignored);
     tcase_add_test(tc, test_restarted_peer_accepted_after_silence);
     tcase_add_test(tc, test_plan_adoption_rules);
+    tcase_add_test(tc, test_plan_adopted_only_whole);
+    tcase_add_test(tc, test_map_used_only_whole);
     tcase_add_test(tc, test_plan_ids_do_not_lock_out);
     tcase_add_test(tc, test_plan_into_terrain_refused);
     tcase_add_test(tc, test_forged_map_keeps_terrain);
