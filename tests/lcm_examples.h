@@ -53,7 +53,7 @@ static inline coavoid_intent_t good_intent(void)
     m.max_offset = 40;
     m.plan_utime = T0 - 500000;
     m.step = 0.9;
-    m.sample_count = 61;
+    m.sample_count = 31; /* room past it: what is not part of the message */
     for (j = 0; j < m.sample_count; ++j) {
         m.reference[j][0] = 100.0 + 16.2 * j;
         m.reference[j][1] = -50.0 + 0.1 * j;
@@ -65,6 +65,7 @@ static inline coavoid_intent_t good_intent(void)
     return m;
 }
 
+/* The message of UAV 11, the second of three, of a solved plan over 40 steps. */
 static inline coavoid_plan_t good_plan(void)
 {
     coavoid_plan_t m;
@@ -77,7 +78,7 @@ static inline coavoid_plan_t good_plan(void)
     m.valid_from_utime = T0;
     m.valid_until_utime = T0 + 5000000;
     m.dt = 1.0;
-    m.horizon = 60;
+    m.horizon = 40;
     m.mode = COAVOID_PLAN_T_MODE_CENTRALISED;
     m.status = COAVOID_PLAN_T_STATUS_SOLVED;
     m.deviation = 1234.5;
@@ -87,9 +88,22 @@ static inline coavoid_plan_t good_plan(void)
     m.planned_count = 3;
     for (i = 0; i < 3; ++i) {
         m.uav_ids[i] = 10 + i;
-        for (k = 0; k <= m.horizon; ++k) {
-            m.offsets[i][k] = (k < 10) ? k * (i - 1) : 9 * (i - 1);
-        }
+    }
+    m.row_uav_id = 11;
+    for (k = 0; k <= m.horizon; ++k) {
+        m.offsets[k] = (k < 10) ? -k : -9;
+    }
+    return m;
+}
+
+/* The same plan's message for uav_ids[row]: row i's offsets are k * (i - 1) up to 9 steps. */
+static inline coavoid_plan_t good_plan_row(int32_t row)
+{
+    coavoid_plan_t m = good_plan();
+    int32_t k;
+    m.row_uav_id = m.uav_ids[row];
+    for (k = 0; k <= m.horizon; ++k) {
+        m.offsets[k] = (k < 10) ? k * (row - 1) : 9 * (row - 1);
     }
     return m;
 }
@@ -123,6 +137,7 @@ static inline coavoid_track_t good_track(void)
     return m;
 }
 
+/* Tile 0 of a map of two tiles: two boxes and a pyramid of five vertices. */
 static inline coavoid_obstacle_map_t good_map(void)
 {
     coavoid_obstacle_map_t m;
@@ -131,6 +146,8 @@ static inline coavoid_obstacle_map_t good_map(void)
     m.utime = T0;
     m.map_id = 2;
     m.version = 4;
+    m.tile_index = 0;
+    m.tile_count = 2;
     m.box_count = 2;
     m.box_min[0][0] = 0.0;
     m.box_max[0][0] = 100.0;
@@ -143,10 +160,28 @@ static inline coavoid_obstacle_map_t good_map(void)
     m.polytope_count = 1;
     m.vertex_count[0] = 5;
     for (j = 0; j < 5; ++j) {
-        m.vertices[0][j][0] = 1000.0 + 50.0 * (j % 2);
-        m.vertices[0][j][1] = 50.0 * (j / 2);
-        m.vertices[0][j][2] = (j == 4) ? 90.0 : 0.0;
+        m.vertices[j][0] = 1000.0 + 50.0 * (j % 2);
+        m.vertices[j][1] = 50.0 * (j / 2);
+        m.vertices[j][2] = (j == 4) ? 90.0 : 0.0;
     }
+    return m;
+}
+
+/* Tile 1 of that map: one box. */
+static inline coavoid_obstacle_map_t good_map_tile1(void)
+{
+    coavoid_obstacle_map_t m;
+    memset(&m, 0, sizeof m);
+    m.utime = T0;
+    m.map_id = 2;
+    m.version = 4;
+    m.tile_index = 1;
+    m.tile_count = 2;
+    m.box_count = 1;
+    m.box_min[0][0] = 500.0;
+    m.box_max[0][0] = 600.0;
+    m.box_max[0][1] = 60.0;
+    m.box_max[0][2] = 70.0;
     return m;
 }
 

@@ -899,15 +899,19 @@ static int write_log(int argc, char **argv)
             plan_msg->planned_count = (int32_t)n;
             for (size_t i = 0; i < n; i++) {
                 plan_msg->uav_ids[i] = s.vehicles[i].id;
-                for (size_t k = 0; k < row; k++) {
-                    plan_msg->offsets[i][k] = plan[i * row + k];
-                }
             }
-            if (coavoid_lcm_plan_check(plan_msg, &ctx, &reason) != COA_OK ||
-                put_event(w, plan_msg->utime, COAVOID_CHANNEL_PLAN,
-                          coavoid_plan_t_encode(w->buffer, 0, (int)sizeof w->buffer, plan_msg)) !=
-                    0) {
-                status = fail_writer(reason);
+            /* One message per UAV, as the coordinator sends a plan. */
+            for (size_t i = 0; i < n && status == 0; i++) {
+                plan_msg->row_uav_id = s.vehicles[i].id;
+                for (size_t k = 0; k < row; k++) {
+                    plan_msg->offsets[k] = plan[i * row + k];
+                }
+                if (coavoid_lcm_plan_check(plan_msg, &ctx, &reason) != COA_OK ||
+                    put_event(w, plan_msg->utime, COAVOID_CHANNEL_PLAN,
+                              coavoid_plan_t_encode(w->buffer, 0, (int)sizeof w->buffer,
+                                                    plan_msg)) != 0) {
+                    status = fail_writer(reason);
+                }
             }
         }
         if (publish) {

@@ -139,7 +139,7 @@ START_TEST(test_round_trip_intent_core)
     ck_assert_int_eq(v->vehicle.max_offset, 40);
     ck_assert_int_eq(v->vehicle.initial_offset, -2);
     ck_assert_ptr_eq(v->vehicle.route, v->arrays.reference);
-    ck_assert_uint_eq(v->vehicle.route_count, 61u);
+    ck_assert_uint_eq(v->vehicle.route_count, 31u);
     ck_assert_int_eq(coa_vehicle_check(&v->vehicle), COA_OK);
 
     ck_assert(v->info.utime == m.utime);
@@ -153,7 +153,7 @@ START_TEST(test_round_trip_intent_core)
     ck_assert(v->info.sigma_vertical == (coa_real_t)2.5);
 
     ck_assert_uint_eq(v->plan.id, 7u);
-    ck_assert_uint_eq(v->plan.count, 61u);
+    ck_assert_uint_eq(v->plan.count, 31u);
     ck_assert_ptr_eq(v->plan.samples, v->arrays.samples);
     ck_assert(fabs((double)v->plan.t0 - 4.5) < 1e-6);
     ck_assert(v->plan.step == v->info.step);
@@ -215,10 +215,10 @@ START_TEST(test_round_trip_intent_core)
                                                   v->arrays.offsets, 1, &ctx, &back, &why),
                      COAVOID_LCM_ERR_COUNT);
     ck_assert_int_eq(coavoid_lcm_intent_from_core(&v->vehicle, &v->info, v->arrays.reference,
-                                                  v->arrays.offsets, 129, &ctx, &back, &why),
+                                                  v->arrays.offsets, 42, &ctx, &back, &why),
                      COAVOID_LCM_ERR_COUNT);
     ck_assert_int_eq(coavoid_lcm_intent_from_core(&v->vehicle, &v->info, NULL, v->arrays.offsets,
-                                                  61, &ctx, &back, &why),
+                                                  31, &ctx, &back, &why),
                      COA_ERR_ARGUMENT);
     unbounded.id = 0;
     ck_assert_int_eq(coavoid_lcm_intent_from_core(&unbounded, &v->info, v->arrays.reference,
@@ -292,7 +292,7 @@ START_TEST(test_plan_from_intent)
     ck_assert_int_eq(coa_plan_centralised(ws.planner, &problem, offsets, &result), COA_OK);
     ck_assert_int_eq(result.status, COA_PLAN_SOLVED);
     ck_assert_int_eq(offsets[0], -2);
-    ck_assert_int_eq(offsets[60], 0);
+    ck_assert_int_eq(offsets[30], 0);
     ck_assert(result.deviation > 0.0);
     ck_assert_int_eq(coavoid_lcm_intent_from_core(&v->vehicle, &v->info, v->arrays.reference,
                                                   offsets, v->plan.count, &ctx, &replanned, &why),
@@ -404,7 +404,7 @@ START_TEST(test_accepted_intent_is_plannable)
         int c;
         const char *why = NULL;
         for (c = 0; c < changes; ++c) {
-            int32_t j = 1 + (int32_t)pick(&rng_state, 60u);
+            int32_t j = 1 + (int32_t)pick(&rng_state, 30u); /* a leg of the 31 samples */
             switch (pick(&rng_state, 6u)) {
             case 0:
                 m.cruise_speed = wild();
@@ -439,27 +439,107 @@ START_TEST(test_accepted_intent_is_plannable)
 }
 END_TEST
 
+/* Collects rows[order[0..n)] into c; returns the last call's status, *whole its output. */
+static int collect_rows(coavoid_lcm_plan_rows_t *c, const coavoid_plan_t *rows, const int *order,
+                        size_t n, const coavoid_plan_t **whole, coavoid_lcm_plan_info_t *info,
+                        coa_plan_result_t *result, int32_t *offsets, size_t capacity)
+{
+    coavoid_lcm_context_t ctx = ctx_now();
+    int rc = COA_OK;
+    size_t i;
+    for (i = 0; i < n && rc == COA_OK; ++i) {
+        ck_assert_ptr_null(i > 0 ? *whole : NULL);
+        rc = coavoid_lcm_plan_collect(c, &rows[order[i]], &ctx, whole, info, result, offsets,
+                                      capacity, NULL);
+    }
+    return rc;
+}
+
 START_TEST(test_round_trip_plan_core)
 {
-    coavoid_plan_t m = good_plan();
+    coavoid_plan_t rows[4];
     coavoid_plan_t back;
     coavoid_lcm_context_t ctx = ctx_now();
     coavoid_lcm_plan_info_t info;
     coa_plan_result_t result;
-    int32_t offsets[COAVOID_PLAN_T_MAX_VEHICLES * COAVOID_PLAN_T_MAX_SAMPLES];
+    static int32_t offsets[COAVOID_PLAN_T_MAX_VEHICLES * COAVOID_PLAN_T_MAX_SAMPLES];
+    const size_t cap = sizeof offsets / sizeof offsets[0];
+    static coavoid_lcm_plan_slot_t slots[2];
+    coavoid_lcm_plan_rows_t c;
+    const coavoid_plan_t *whole = NULL;
     const char *why = NULL;
-    ck_assert_int_eq(coavoid_lcm_plan_to_core(&m, &ctx, NULL, &info, &result, offsets,
-                                              sizeof offsets / sizeof offsets[0], &why),
-                     COA_OK);
+    size_t i;
+    for (i = 0; i < 3; ++i) {
+        rows[i] = good_plan_row((int32_t)i);
+    }
+    /* Rows in any order, one twice: the plan is whole with the third UAV's. */
+    coavoid_lcm_plan_rows_init(&c, slots, 2);
+    ck_assert_int_eq(
+        collect_rows(&c, rows, (const int[]){2, 0, 0}, 3, &whole, &info, &result, offsets, cap),
+        COA_OK);
+    ck_assert_ptr_null(whole);
+    ck_assert_int_eq(
+        collect_rows(&c, rows, (const int[]){1}, 1, &whole, &info, &result, offsets, cap), COA_OK);
+    ck_assert_ptr_nonnull(whole);
+    ck_assert_int_eq((int)whole->plan_id, 9);
     ck_assert_int_eq(result.status, COA_PLAN_SOLVED);
     ck_assert_uint_eq(result.planned_count, 3u);
-    ck_assert_int_eq(offsets[2 * 61 + 60], 9);
-    ck_assert_int_eq(coavoid_lcm_plan_from_core(&info, &result, offsets, &ctx, &back, &why),
-                     COA_OK);
-    ck_assert_int_eq(memcmp(&back, &m, sizeof m), 0);
+    ck_assert_uint_eq(info.vehicle_count, 3u);
+    ck_assert_int_eq(offsets[2 * 41 + 40], 9);
+    ck_assert_int_eq(offsets[0 * 41 + 5], -5);
+    /* And back: each UAV's message, bit for bit. */
+    for (i = 0; i < 3; ++i) {
+        ck_assert_int_eq(coavoid_lcm_plan_from_core(&info, &result, offsets, i, &ctx, &back, &why),
+                         COA_OK);
+        ck_assert_int_eq(memcmp(&back, &rows[i], sizeof back), 0);
+    }
+    ck_assert_int_eq(coavoid_lcm_plan_from_core(&info, &result, offsets, 3, &ctx, &back, &why),
+                     COAVOID_LCM_ERR_COUNT);
+    /* The slot was freed: the same rows again make the plan again. */
     ck_assert_int_eq(
-        coavoid_lcm_plan_to_core(&m, &ctx, NULL, &info, &result, offsets, 3 * 61 - 1, &why),
+        collect_rows(&c, rows, (const int[]){0, 1, 2}, 3, &whole, &info, &result, offsets, cap),
+        COA_OK);
+    ck_assert_ptr_nonnull(whole);
+    /* Too small an array for the whole plan. */
+    ck_assert_int_eq(
+        collect_rows(&c, rows, (const int[]){0}, 1, &whole, &info, &result, offsets, 3 * 41 - 1),
         COAVOID_LCM_ERR_CAPACITY);
+    /* A row that says something else of its plan than the rows before it: refused, and
+     * the plan is still whole with the right row. */
+    coavoid_lcm_plan_rows_init(&c, slots, 2);
+    rows[3] = rows[1];
+    rows[3].deviation = 1.0;
+    ck_assert_int_eq(
+        collect_rows(&c, rows, (const int[]){0, 3}, 2, &whole, &info, &result, offsets, cap),
+        COAVOID_LCM_ERR_VALUE);
+    ck_assert_int_eq(
+        collect_rows(&c, rows, (const int[]){2, 1}, 2, &whole, &info, &result, offsets, cap),
+        COA_OK);
+    ck_assert_ptr_nonnull(whole);
+    /* With the slots full, a new plan drops the oldest unfinished one: it never completes. */
+    coavoid_lcm_plan_rows_init(&c, slots, 1);
+    rows[3] = good_plan_row(0);
+    rows[3].plan_id = 10;
+    ck_assert_int_eq(
+        collect_rows(&c, rows, (const int[]){0, 3, 1, 2}, 4, &whole, &info, &result, offsets, cap),
+        COA_OK);
+    ck_assert_ptr_null(whole);
+    /* A failed plan is whole too: a message for each UAV, without rows. */
+    coavoid_lcm_plan_rows_init(&c, slots, 2);
+    for (i = 0; i < 3; ++i) {
+        rows[i].status = COAVOID_PLAN_T_STATUS_INFEASIBLE;
+        rows[i].planned_count = 0;
+        memset(rows[i].offsets, 0, sizeof rows[i].offsets);
+    }
+    ck_assert_int_eq(
+        collect_rows(&c, rows, (const int[]){0, 1, 2}, 3, &whole, &info, &result, offsets, cap),
+        COA_OK);
+    ck_assert_ptr_nonnull(whole);
+    ck_assert_int_eq(result.status, COA_PLAN_INFEASIBLE);
+    ck_assert_uint_eq(result.planned_count, 0u);
+    ck_assert_int_eq(
+        coavoid_lcm_plan_collect(NULL, &rows[0], &ctx, &whole, &info, &result, offsets, cap, &why),
+        COA_ERR_ARGUMENT);
 }
 END_TEST
 
@@ -490,31 +570,179 @@ END_TEST
 
 START_TEST(test_round_trip_map_core)
 {
-    coavoid_obstacle_map_t m = good_map();
+    coavoid_obstacle_map_t tiles[2] = {good_map(), good_map_tile1()};
     coavoid_obstacle_map_t back;
     coavoid_lcm_context_t ctx = ctx_now();
-    coa_obstacle_t
-        obstacles[COAVOID_OBSTACLE_MAP_T_MAX_BOXES + COAVOID_OBSTACLE_MAP_T_MAX_POLYTOPES];
-    coa_vec3_t vertices[COAVOID_OBSTACLE_MAP_T_MAX_POLYTOPES * COAVOID_OBSTACLE_MAP_T_MAX_VERTICES];
+    coa_obstacle_t obstacles[COAVOID_LCM_MAP_MAX_OBSTACLES];
+    coa_obstacle_t again[COAVOID_LCM_MAP_MAX_OBSTACLES];
+    coa_vec3_t vertices[512];
+    coa_vec3_t vertices2[512];
     size_t n = 0;
+    size_t m = 0;
+    size_t count = 0;
     size_t i;
     const char *why = NULL;
     ck_assert_int_eq(
-        coavoid_lcm_obstacle_map_to_core(&m, &ctx, NULL, obstacles, 80, &n, vertices, 512, &why),
+        coavoid_lcm_obstacle_map_to_core(tiles, 2, &ctx, obstacles, 80, &n, vertices, 512, &why),
         COA_OK);
-    ck_assert_uint_eq(n, 3u);
+    /* Every box, then every polytope, in tile order. */
+    ck_assert_uint_eq(n, 4u);
     for (i = 0; i < n; ++i) {
         ck_assert_int_eq(coa_obstacle_check(&obstacles[i]), COA_OK);
+        ck_assert_int_eq(obstacles[i].kind, i < 3 ? COA_OBSTACLE_BOX : COA_OBSTACLE_POLYTOPE);
+    }
+    ck_assert(obstacles[2].box.min.x == (coa_real_t)500.0);
+    /* Back: the four fit one tile, which gives the same obstacles. */
+    ck_assert_int_eq(coavoid_lcm_obstacle_map_tiles(obstacles, n, &count, &why), COA_OK);
+    ck_assert_uint_eq(count, 1u);
+    ck_assert_int_eq(
+        coavoid_lcm_obstacle_map_from_core(obstacles, n, T0, 2, 4, 0, &ctx, &back, &why), COA_OK);
+    ck_assert_int_eq(back.tile_count, 1);
+    ck_assert_int_eq(back.box_count, 3);
+    ck_assert_int_eq(
+        coavoid_lcm_obstacle_map_to_core(&back, 1, &ctx, again, 80, &m, vertices2, 512, &why),
+        COA_OK);
+    ck_assert_uint_eq(m, n);
+    ck_assert_int_eq(memcmp(vertices, vertices2, 5 * sizeof vertices[0]), 0);
+    ck_assert_int_eq(
+        coavoid_lcm_obstacle_map_from_core(obstacles, n, T0, 2, 4, 1, &ctx, &back, &why),
+        COAVOID_LCM_ERR_COUNT);
+    /* Not one whole version: a tile missing, out of order, of another version or map. */
+    ck_assert_int_eq(
+        coavoid_lcm_obstacle_map_to_core(tiles, 1, &ctx, obstacles, 80, &n, vertices, 512, &why),
+        COAVOID_LCM_ERR_COUNT);
+    back = tiles[0];
+    tiles[0] = tiles[1];
+    tiles[1] = back;
+    ck_assert_int_eq(
+        coavoid_lcm_obstacle_map_to_core(tiles, 2, &ctx, obstacles, 80, &n, vertices, 512, &why),
+        COAVOID_LCM_ERR_COUNT);
+    tiles[1] = tiles[0];
+    tiles[0] = back;
+    tiles[1].version = 5;
+    ck_assert_int_eq(
+        coavoid_lcm_obstacle_map_to_core(tiles, 2, &ctx, obstacles, 80, &n, vertices, 512, &why),
+        COAVOID_LCM_ERR_COUNT);
+    tiles[1].version = 4;
+    tiles[1].map_id = 3;
+    ck_assert_int_eq(
+        coavoid_lcm_obstacle_map_to_core(tiles, 2, &ctx, obstacles, 80, &n, vertices, 512, &why),
+        COAVOID_LCM_ERR_COUNT);
+    tiles[1].map_id = 2;
+    /* The caller's arrays. */
+    ck_assert_int_eq(
+        coavoid_lcm_obstacle_map_to_core(tiles, 2, &ctx, obstacles, 3, &n, vertices, 512, &why),
+        COAVOID_LCM_ERR_CAPACITY);
+    ck_assert_int_eq(
+        coavoid_lcm_obstacle_map_to_core(tiles, 2, &ctx, obstacles, 80, &n, vertices, 4, &why),
+        COAVOID_LCM_ERR_CAPACITY);
+    tiles[1].box_count = 11;
+    ck_assert_int_eq(
+        coavoid_lcm_obstacle_map_to_core(tiles, 2, &ctx, obstacles, 80, &n, vertices, 512, &why),
+        COAVOID_LCM_ERR_COUNT);
+}
+END_TEST
+
+/* The tiling: today's whole capacity (64 boxes, 16 polytopes of 32 vertices) in at most
+ * MAX_TILES tiles, each within one datagram; beyond it, refused. */
+START_TEST(test_map_tiles)
+{
+    static coa_obstacle_t obstacles[COAVOID_LCM_MAP_MAX_OBSTACLES + 1u];
+    static coa_vec3_t points[32];
+    static coavoid_obstacle_map_t tiles[COAVOID_OBSTACLE_MAP_T_MAX_TILES];
+    static coa_obstacle_t back[COAVOID_LCM_MAP_MAX_OBSTACLES];
+    static coa_vec3_t vertices[512];
+    coavoid_lcm_context_t ctx = ctx_now();
+    size_t count = 0;
+    size_t n = 0;
+    size_t i;
+    const char *why = NULL;
+    for (i = 0; i < 32u; ++i) {
+        points[i].x = (coa_real_t)(i % 2u) * 10;
+        points[i].y = (coa_real_t)((i / 2u) % 2u) * 10;
+        points[i].z = (coa_real_t)i;
+    }
+    /* Boxes and polytopes interleaved, as a scenario may list them. */
+    for (i = 0; i < 80u; ++i) {
+        coa_obstacle_t *o = &obstacles[i];
+        memset(o, 0, sizeof *o);
+        if (i % 5u == 4u) {
+            o->kind = COA_OBSTACLE_POLYTOPE;
+            o->polytope.vertices = points;
+            o->polytope.count = 32u;
+        } else {
+            o->kind = COA_OBSTACLE_BOX;
+            o->box.min.x = (coa_real_t)i;
+            o->box.max.x = (coa_real_t)i + 1;
+            o->box.max.y = 1;
+            o->box.max.z = 1;
+        }
+    }
+    ck_assert_int_eq(coavoid_lcm_obstacle_map_tiles(obstacles, 80, &count, &why), COA_OK);
+    ck_assert_uint_eq(count, 16u);
+    for (i = 0; i < count; ++i) {
+        ck_assert_int_eq(
+            coavoid_lcm_obstacle_map_from_core(obstacles, 80, T0, 2, 1, i, &ctx, &tiles[i], &why),
+            COA_OK);
+        ck_assert_int_le(coavoid_obstacle_map_t_encoded_size(&tiles[i]),
+                         COAVOID_LCM_MAX_DATAGRAM_BYTES);
     }
     ck_assert_int_eq(
-        coavoid_lcm_obstacle_map_from_core(obstacles, n, m.utime, 2, 4, &ctx, &back, &why), COA_OK);
-    ck_assert_int_eq(memcmp(&back, &m, sizeof m), 0);
-    ck_assert_int_eq(
-        coavoid_lcm_obstacle_map_to_core(&m, &ctx, NULL, obstacles, 2, &n, vertices, 512, &why),
-        COAVOID_LCM_ERR_CAPACITY);
-    ck_assert_int_eq(
-        coavoid_lcm_obstacle_map_to_core(&m, &ctx, NULL, obstacles, 80, &n, vertices, 4, &why),
-        COAVOID_LCM_ERR_CAPACITY);
+        coavoid_lcm_obstacle_map_to_core(tiles, count, &ctx, back, 80, &n, vertices, 512, &why),
+        COA_OK);
+    /* The boxes, then the polytopes, each in the list's order. */
+    ck_assert_uint_eq(n, 80u);
+    ck_assert(back[0].box.min.x == 0 && back[4].box.min.x == 5 && back[63].box.min.x == 78);
+    ck_assert_int_eq(back[64].kind, COA_OBSTACLE_POLYTOPE);
+    /* One box more, or one polytope more, is more than a map holds. */
+    obstacles[80] = obstacles[0];
+    ck_assert_int_eq(coavoid_lcm_obstacle_map_tiles(obstacles, 81, &count, &why),
+                     COAVOID_LCM_ERR_COUNT);
+    obstacles[80] = obstacles[4];
+    ck_assert_int_eq(coavoid_lcm_obstacle_map_tiles(obstacles, 81, &count, &why),
+                     COAVOID_LCM_ERR_COUNT);
+    ck_assert_int_eq(coavoid_lcm_obstacle_map_tiles(&obstacles[4], 77, &count, &why),
+                     COAVOID_LCM_ERR_COUNT);
+    /* Small polytopes share a tile, four to a tile. */
+    for (i = 0; i < 5u; ++i) {
+        obstacles[i] = obstacles[4];
+        obstacles[i].polytope.count = 8u;
+    }
+    ck_assert_int_eq(coavoid_lcm_obstacle_map_tiles(obstacles, 5, &count, &why), COA_OK);
+    ck_assert_uint_eq(count, 2u);
+    /* A polytope beyond a tile's vertices, an unknown kind. */
+    obstacles[0].polytope.count = 33u;
+    ck_assert_int_eq(coavoid_lcm_obstacle_map_tiles(obstacles, 1, &count, &why),
+                     COAVOID_LCM_ERR_COUNT);
+    obstacles[0].kind = (coa_obstacle_kind_t)7;
+    ck_assert_int_eq(coavoid_lcm_obstacle_map_tiles(obstacles, 1, &count, &why),
+                     COAVOID_LCM_ERR_ENUM);
+    /* No obstacles: one empty tile. */
+    ck_assert_int_eq(coavoid_lcm_obstacle_map_tiles(NULL, 0, &count, &why), COA_OK);
+    ck_assert_uint_eq(count, 1u);
+}
+END_TEST
+
+/* Every type's encoded size, the same for every message of it (fixed-size arrays), fits
+ * one datagram: the examples are of the largest size there is. */
+START_TEST(test_datagram_sizes)
+{
+    coavoid_intent_t intent = good_intent();
+    coavoid_plan_t plan = good_plan();
+    coavoid_track_t track = good_track();
+    coavoid_obstacle_map_t map = good_map();
+    coavoid_conflict_report_t report = good_report();
+    coavoid_status_t status = good_status();
+    ck_assert_int_eq(coavoid_intent_t_encoded_size(&intent), 1389);
+    ck_assert_int_eq(coavoid_plan_t_encoded_size(&plan), 466);
+    ck_assert_int_eq(coavoid_track_t_encoded_size(&track), 720);
+    ck_assert_int_eq(coavoid_obstacle_map_t_encoded_size(&map), 1392);
+    ck_assert_int_eq(coavoid_conflict_report_t_encoded_size(&report), 1370);
+    ck_assert_int_eq(coavoid_status_t_encoded_size(&status), 172);
+    ck_assert_int_le(coavoid_intent_t_encoded_size(&intent), COAVOID_LCM_MAX_DATAGRAM_BYTES);
+    ck_assert_int_le(coavoid_obstacle_map_t_encoded_size(&map), COAVOID_LCM_MAX_DATAGRAM_BYTES);
+    ck_assert_int_le(coavoid_conflict_report_t_encoded_size(&report),
+                     COAVOID_LCM_MAX_DATAGRAM_BYTES);
 }
 END_TEST
 
@@ -646,13 +874,13 @@ START_TEST(test_reject_intent)
 
     /* Sample count. */
     EXPECT_INTENT(m_.sample_count = 1, COAVOID_LCM_ERR_COUNT, "sample_count");
-    EXPECT_INTENT(m_.sample_count = 129, COAVOID_LCM_ERR_COUNT, "sample_count");
+    EXPECT_INTENT(m_.sample_count = 42, COAVOID_LCM_ERR_COUNT, "sample_count");
     EXPECT_INTENT(m_.sample_count = 0, COAVOID_LCM_ERR_COUNT, "sample_count");
     EXPECT_INTENT(m_.sample_count = -5, COAVOID_LCM_ERR_COUNT, "sample_count");
     EXPECT_INTENT(m_.sample_count = 2, COA_OK, "ok");
 
     /* The reference. */
-    EXPECT_INTENT(m_.reference[60][0] = NAN, COAVOID_LCM_ERR_NONFINITE, "reference point");
+    EXPECT_INTENT(m_.reference[30][0] = NAN, COAVOID_LCM_ERR_NONFINITE, "reference point");
     EXPECT_INTENT(m_.reference[0][2] = INFINITY, COAVOID_LCM_ERR_NONFINITE, "reference point");
     EXPECT_INTENT(m_.reference[10][1] = -2e7, COAVOID_LCM_ERR_VALUE, "reference point");
     EXPECT_INTENT(
@@ -668,8 +896,8 @@ START_TEST(test_reject_intent)
                    m_.reference[5][1] = 0.0),
                   COAVOID_LCM_ERR_VALUE, "horizontal separation");
     /* A point past sample_count is not part of the message. */
-    EXPECT_INTENT(m_.reference[61][0] = NAN, COA_OK, "ok");
-    EXPECT_INTENT(m_.offsets[61] = 99999, COA_OK, "ok");
+    EXPECT_INTENT(m_.reference[31][0] = NAN, COA_OK, "ok");
+    EXPECT_INTENT(m_.offsets[31] = 99999, COA_OK, "ok");
 
     /* Offsets. The good intent's offsets reach -5. */
     EXPECT_INTENT(m_.max_offset = 4, COAVOID_LCM_ERR_VALUE, "offset beyond max_offset");
@@ -681,7 +909,7 @@ START_TEST(test_reject_intent)
     /* +3 is a steep climb for steep factor 3, no action for 2; +2 is none for 3. */
     EXPECT_INTENT(m_.steep_factor = 2, COAVOID_LCM_ERR_VALUE, "no action");
     EXPECT_INTENT(m_.offsets[1] = m_.offsets[0] + 2, COAVOID_LCM_ERR_VALUE, "no action");
-    EXPECT_INTENT(m_.offsets[60] = m_.offsets[59] - 4, COAVOID_LCM_ERR_VALUE, "no action");
+    EXPECT_INTENT(m_.offsets[30] = m_.offsets[29] - 4, COAVOID_LCM_ERR_VALUE, "no action");
 
     /* A planned position out of range although its reference point is in range: offset 3
      * at sample 6 climbs 3 * 1e4 * 0.9 m above 9.99e6 m; offset -5 at sample 1 dives
@@ -709,14 +937,19 @@ START_TEST(test_reject_plan)
     EXPECT(coavoid_plan_t, plan, m_.dt = -1.0, COAVOID_LCM_ERR_VALUE);
     EXPECT(coavoid_plan_t, plan, m_.dt = NAN, COAVOID_LCM_ERR_NONFINITE);
     EXPECT(coavoid_plan_t, plan, m_.horizon = 0, COAVOID_LCM_ERR_COUNT);
-    EXPECT(coavoid_plan_t, plan, m_.horizon = 128, COAVOID_LCM_ERR_COUNT);
+    EXPECT(coavoid_plan_t, plan, m_.horizon = 41, COAVOID_LCM_ERR_COUNT);
     EXPECT(coavoid_plan_t, plan, m_.mode = 2, COAVOID_LCM_ERR_ENUM);
     EXPECT(coavoid_plan_t, plan, m_.status = 4, COAVOID_LCM_ERR_ENUM);
-    /* Abandoned: no rows. */
+    /* Abandoned: no rows, so no offsets in any message. */
     EXPECT(coavoid_plan_t, plan, m_.status = COAVOID_PLAN_T_STATUS_ABANDONED,
            COAVOID_LCM_ERR_COUNT);
     EXPECT(coavoid_plan_t, plan,
-           (m_.status = COAVOID_PLAN_T_STATUS_ABANDONED, m_.planned_count = 0), COA_OK);
+           (m_.status = COAVOID_PLAN_T_STATUS_ABANDONED, m_.planned_count = 0),
+           COAVOID_LCM_ERR_VALUE);
+    EXPECT(coavoid_plan_t, plan,
+           (m_.status = COAVOID_PLAN_T_STATUS_ABANDONED, m_.planned_count = 0,
+            memset(m_.offsets, 0, sizeof m_.offsets)),
+           COA_OK);
     EXPECT(coavoid_plan_t, plan, m_.deviation = -1.0, COAVOID_LCM_ERR_VALUE);
     EXPECT(coavoid_plan_t, plan, m_.deviation = NAN, COAVOID_LCM_ERR_NONFINITE);
     EXPECT(coavoid_plan_t, plan, m_.effort = -1, COAVOID_LCM_ERR_VALUE);
@@ -727,10 +960,22 @@ START_TEST(test_reject_plan)
     EXPECT(coavoid_plan_t, plan, m_.planned_count = -1, COAVOID_LCM_ERR_COUNT);
     EXPECT(coavoid_plan_t, plan, m_.uav_ids[2] = 0, COAVOID_LCM_ERR_ID);
     EXPECT(coavoid_plan_t, plan, m_.uav_ids[2] = m_.uav_ids[0], COAVOID_LCM_ERR_ID);
-    EXPECT(coavoid_plan_t, plan, m_.offsets[1][5] = 40000, COAVOID_LCM_ERR_VALUE);
-    EXPECT(coavoid_plan_t, plan, m_.offsets[1][5] = 11, COAVOID_LCM_ERR_VALUE);
-    /* Not solved: fewer rows are plans. */
-    EXPECT(coavoid_plan_t, plan, (m_.status = 2, m_.planned_count = 1), COA_OK);
+    /* The row: a listed UAV's, within bounds, steps some action makes. */
+    EXPECT(coavoid_plan_t, plan, m_.row_uav_id = 13, COAVOID_LCM_ERR_ID);
+    EXPECT(coavoid_plan_t, plan, m_.row_uav_id = 0, COAVOID_LCM_ERR_ID);
+    EXPECT(coavoid_plan_t, plan, (m_.vehicle_count = 1, m_.planned_count = 1), COAVOID_LCM_ERR_ID);
+    EXPECT(coavoid_plan_t, plan, m_.row_uav_id = 12, COA_OK);
+    EXPECT(coavoid_plan_t, plan, m_.offsets[5] = 40000, COAVOID_LCM_ERR_VALUE);
+    EXPECT(coavoid_plan_t, plan, m_.offsets[5] = 11, COAVOID_LCM_ERR_VALUE);
+    /* Past the horizon, nothing. */
+    EXPECT(coavoid_plan_t, plan, m_.horizon = 20, COAVOID_LCM_ERR_VALUE);
+    EXPECT(coavoid_plan_t, plan,
+           (m_.horizon = 20, memset(&m_.offsets[21], 0, 20 * sizeof(int32_t))), COA_OK);
+    /* Not solved: fewer rows are plans; a UAV without one gets no offsets. */
+    EXPECT(coavoid_plan_t, plan, (m_.status = 2, m_.planned_count = 2), COA_OK);
+    EXPECT(coavoid_plan_t, plan, (m_.status = 2, m_.planned_count = 1), COAVOID_LCM_ERR_VALUE);
+    EXPECT(coavoid_plan_t, plan,
+           (m_.status = 2, m_.planned_count = 1, memset(m_.offsets, 0, sizeof m_.offsets)), COA_OK);
 }
 END_TEST
 
@@ -763,16 +1008,30 @@ START_TEST(test_reject_obstacle_map)
     EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.utime = T0 - 3600000000, COA_OK);
     EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.map_id = 70000, COAVOID_LCM_ERR_ID);
     EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.version = -1, COAVOID_LCM_ERR_VALUE);
-    EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.box_count = 65, COAVOID_LCM_ERR_COUNT);
+    EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.box_count = 11, COAVOID_LCM_ERR_COUNT);
     EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.box_count = -1, COAVOID_LCM_ERR_COUNT);
     EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.box_min[1][2] = NAN, COAVOID_LCM_ERR_NONFINITE);
     EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.box_max[0][0] = 1e8, COAVOID_LCM_ERR_VALUE);
     EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.box_min[0][1] = 200.0, COAVOID_LCM_ERR_VALUE);
-    EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.polytope_count = 17, COAVOID_LCM_ERR_COUNT);
+    EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.polytope_count = 5, COAVOID_LCM_ERR_COUNT);
     EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.vertex_count[0] = 3, COAVOID_LCM_ERR_COUNT);
     EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.vertex_count[0] = 33, COAVOID_LCM_ERR_COUNT);
-    EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.vertices[0][4][1] = -INFINITY,
+    EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.vertices[4][1] = -INFINITY,
            COAVOID_LCM_ERR_NONFINITE);
+    /* The tile's polytopes share MAX_VERTICES. */
+    EXPECT(coavoid_obstacle_map_t, obstacle_map, (m_.polytope_count = 2, m_.vertex_count[1] = 27),
+           COA_OK);
+    EXPECT(coavoid_obstacle_map_t, obstacle_map, (m_.polytope_count = 2, m_.vertex_count[1] = 28),
+           COAVOID_LCM_ERR_COUNT);
+    EXPECT(coavoid_obstacle_map_t, obstacle_map,
+           (m_.polytope_count = 2, m_.vertex_count[1] = 27, m_.vertices[31][0] = NAN),
+           COAVOID_LCM_ERR_NONFINITE);
+    /* Tiles: index below count, count 1..MAX_TILES. */
+    EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.tile_index = 2, COAVOID_LCM_ERR_COUNT);
+    EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.tile_index = -1, COAVOID_LCM_ERR_COUNT);
+    EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.tile_count = 0, COAVOID_LCM_ERR_COUNT);
+    EXPECT(coavoid_obstacle_map_t, obstacle_map, m_.tile_count = 17, COAVOID_LCM_ERR_COUNT);
+    EXPECT(coavoid_obstacle_map_t, obstacle_map, (m_.tile_count = 16, m_.tile_index = 15), COA_OK);
 }
 END_TEST
 
@@ -785,7 +1044,7 @@ START_TEST(test_reject_conflict_report)
            COAVOID_LCM_ERR_TIME);
     EXPECT(coavoid_conflict_report_t, conflict_report, m_.dt = 0.0, COAVOID_LCM_ERR_VALUE);
     EXPECT(coavoid_conflict_report_t, conflict_report, m_.horizon = 0, COAVOID_LCM_ERR_COUNT);
-    EXPECT(coavoid_conflict_report_t, conflict_report, m_.conflict_count = 65,
+    EXPECT(coavoid_conflict_report_t, conflict_report, m_.conflict_count = 31,
            COAVOID_LCM_ERR_COUNT);
     EXPECT(coavoid_conflict_report_t, conflict_report, m_.conflicts_found = 1,
            COAVOID_LCM_ERR_COUNT);
@@ -857,9 +1116,6 @@ START_TEST(test_sequence_rules)
     coavoid_intent_t m = good_intent();
     intent_view_t *v = malloc(sizeof *v);
     coavoid_obstacle_map_t map = good_map();
-    coa_obstacle_t obstacles[80];
-    coa_vec3_t vertices[512];
-    size_t n;
     const char *why = NULL;
     ck_assert_ptr_nonnull(v);
 #define INTENT_IN() \
@@ -891,15 +1147,10 @@ START_TEST(test_sequence_rules)
     free(v);
     /* A map may be republished with the same version, never an older one. */
     coavoid_lcm_sequence_init(&table, entries, 2);
-    ck_assert_int_eq(coavoid_lcm_obstacle_map_to_core(&map, &ctx, &table, obstacles, 80, &n,
-                                                      vertices, 512, &why),
-                     COA_OK);
-    ck_assert_int_eq(coavoid_lcm_obstacle_map_to_core(&map, &ctx, &table, obstacles, 80, &n,
-                                                      vertices, 512, &why),
-                     COA_OK);
+    ck_assert_int_eq(coavoid_lcm_obstacle_map_accept(&map, &ctx, &table, &why), COA_OK);
+    ck_assert_int_eq(coavoid_lcm_obstacle_map_accept(&map, &ctx, &table, &why), COA_OK);
     map.version = 3;
-    ck_assert_int_eq(coavoid_lcm_obstacle_map_to_core(&map, &ctx, &table, obstacles, 80, &n,
-                                                      vertices, 512, &why),
+    ck_assert_int_eq(coavoid_lcm_obstacle_map_accept(&map, &ctx, &table, &why),
                      COAVOID_LCM_ERR_SEQUENCE);
     ck_assert_str_eq(coavoid_lcm_error_name(COAVOID_LCM_ERR_SEQUENCE), "sequence went backwards");
 }
@@ -1356,6 +1607,8 @@ static Suite *lcm_suite(void)
     tcase_add_test(tc, test_round_trip_plan_core);
     tcase_add_test(tc, test_round_trip_track_core);
     tcase_add_test(tc, test_round_trip_map_core);
+    tcase_add_test(tc, test_map_tiles);
+    tcase_add_test(tc, test_datagram_sizes);
     tcase_add_test(tc, test_round_trip_report_core);
     tcase_add_test(tc, test_reject_intent);
     tcase_add_test(tc, test_reject_plan);

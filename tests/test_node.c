@@ -139,7 +139,8 @@ static void heartbeat(lcm_t *lcm, int64_t now, int64_t sequence)
 }
 
 /* A solved plan_t's header from the default coordinator for the cycle starting at
- * valid_from, for `count` UAVs (the caller fills their ids and rows). */
+ * valid_from, for `count` UAVs (the caller fills their ids and, in each UAV's message,
+ * row_uav_id and its offsets). */
 static coavoid_plan_t solved_plan(int64_t now, int64_t plan_id, int64_t valid_from, int32_t horizon,
                                   int32_t count)
 {
@@ -167,8 +168,9 @@ static void plan_msg_from(lcm_t *lcm, int64_t now, int32_t from, int64_t plan_id
     coavoid_plan_t m = solved_plan(now, plan_id, valid_from, horizon, 1);
     m.coordinator_id = from;
     m.uav_ids[0] = id;
+    m.row_uav_id = id;
     for (int32_t k = 0; k <= horizon; k++) {
-        m.offsets[0][k] = (k < 2 ? k : 2) + shift;
+        m.offsets[k] = (k < 2 ? k : 2) + shift;
     }
     ck_assert_int_eq(coavoid_plan_t_publish(lcm, COAVOID_CHANNEL_PLAN, &m), 0);
 }
@@ -190,6 +192,7 @@ static void empty_map(lcm_t *lcm, int64_t now)
     m.utime = now;
     m.map_id = (int32_t)COAVOID_NODE_WORLD_ID;
     m.version = 1;
+    m.tile_count = 1;
     ck_assert_int_eq(coavoid_obstacle_map_t_publish(lcm, COAVOID_CHANNEL_OBSTACLES, &m), 0);
 }
 
@@ -418,8 +421,9 @@ static void dive_into_terrain(rig_t *r, const coavoid_vehicle_node_state_t *s)
 {
     coavoid_plan_t m = solved_plan(r->now, INT64_MAX - 5, cycle(0), 10, 1);
     m.uav_ids[0] = 1;
+    m.row_uav_id = 1;
     for (int32_t k = 0; k <= 10; k++) {
-        m.offsets[0][k] = -2 * k;
+        m.offsets[k] = -2 * k;
     }
     const uint32_t adopted = s->plans_adopted;
     const int64_t rejected = s->rx.rejected;
@@ -502,11 +506,14 @@ START_TEST(test_plan_into_other_uav_refused)
     coavoid_plan_t m = solved_plan(r.now, 2, cycle(0), 10, 2);
     m.uav_ids[0] = 1;
     m.uav_ids[1] = 2;
-    for (int32_t k = 0; k <= 10; k++) {
-        m.offsets[0][k] = k < 2 ? k : 2;
-        m.offsets[1][k] = k < 4 ? k : 4; /* UAV 2 climbs 8 m, ahead of UAV 1 */
+    /* One message per UAV; UAV 2 climbs 8 m, ahead of UAV 1. */
+    for (int32_t row = 0; row < 2; row++) {
+        m.row_uav_id = m.uav_ids[row];
+        for (int32_t k = 0; k <= 10; k++) {
+            m.offsets[k] = row == 0 ? (k < 2 ? k : 2) : (k < 4 ? k : 4);
+        }
+        ck_assert_int_eq(coavoid_plan_t_publish(r.lcm, COAVOID_CHANNEL_PLAN, &m), 0);
     }
-    ck_assert_int_eq(coavoid_plan_t_publish(r.lcm, COAVOID_CHANNEL_PLAN, &m), 0);
     drain(r.lcm);
     ck_assert_int_eq(s->plans_adopted, 1);
     ck_assert_int_eq(coavoid_vehicle_node_state(b)->plans_adopted, 1);
@@ -536,6 +543,7 @@ START_TEST(test_forged_map_keeps_terrain)
     map.utime = r.now;
     map.map_id = COAVOID_NODE_WORLD_ID;
     map.version = INT64_MAX;
+    map.tile_count = 1;
     ck_assert_int_eq(coavoid_obstacle_map_t_publish(r.lcm, COAVOID_CHANNEL_OBSTACLES, &map), 0);
     drain(r.lcm);
     ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
@@ -586,6 +594,126 @@ static void on_status_probe(const lcm_recv_buf_t *rbuf, const char *channel, voi
         p->health = coavoid_lcm_health_of(p->reasons);
     }
 }
+
+/* Tile `index` of `count` of the world's map `version`: with `lid`, a box over everything
+ * from 107 m up (a UAV at 100 m whose top is at 105 m climbs into it with 2 steps). */
+static void map_tile(lcm_t *lcm, int64_t now, int64_t version, int32_t index, int32_t count,
+                     bool lid)
+{
+    coavoid_obstacle_map_t m;
+    memset(&m, 0, sizeof m);
+    m.utime = now;
+    m.map_id = (int32_t)COAVOID_NODE_WORLD_ID;
+    m.version = version;
+    m.tile_index = index;
+    m.tile_count = count;
+    if (lid) {
+        const double lo[3] = {-1000, -1000, 107}, hi[3] = {1000, 1000, 200};
+        m.box_count = 1;
+        memcpy(m.box_min[0], lo, sizeof lo);
+        memcpy(m.box_max[0], hi, sizeof hi);
+    }
+    ck_assert_int_eq(coavoid_obstacle_map_t_publish(lcm, COAVOID_CHANNEL_OBSTACLES, &m), 0);
+}
+
+/* A map is used only whole: until every tile of a version has come, the node has no map
+ * (REASON_NO_MAP) or keeps the one it has, so a half map never replaces a whole one. A
+ * tile whose tile_count is not its version's is refused. */
+START_TEST(test_map_used_only_whole)
+{
+    rig_t r;
+    rig_init(&r, 10);
+    health_probe_t probe = {1, 0, -1, 0};
+    lcm_subscription_t *sub = lcm_subscribe(r.lcm, COAVOID_CHANNEL_STATUS, on_status_probe, &probe);
+    coa_vec3_t route[2];
+    coavoid_vehicle_node_t *a =
+        vehicle_node(&r, uav(1, 1, route, 0, 500, 0, 100), COAVOID_NODE_CENTRALISED);
+    const coavoid_vehicle_node_state_t *s = coavoid_vehicle_node_state(a);
+    map_tile(r.lcm, r.now, 1, 0, 2, true);
+    drain(r.lcm);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, cycle(0)), COA_OK);
+    drain(r.lcm);
+    ck_assert_int_ne(probe.reasons & COAVOID_STATUS_T_REASON_NO_MAP, 0);
+    map_tile(r.lcm, r.now, 1, 1, 2, false);
+    drain(r.lcm);
+    r.now = cycle(1);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
+    drain(r.lcm);
+    ck_assert_int_eq(probe.reasons & COAVOID_STATUS_T_REASON_NO_MAP, 0);
+    /* Version 1 has the lid: a climb of 2 steps is refused. */
+    r.now = cycle(1) + DT_US / 4;
+    plan_msg(r.lcm, r.now, 1, cycle(1), 1, 10, 0);
+    drain(r.lcm);
+    ck_assert_str_eq(s->rx.last_reason, "plan: flies this UAV into an obstacle or track it knows");
+    /* Half of version 2, without the lid, changes nothing. */
+    map_tile(r.lcm, r.now, 2, 0, 2, false);
+    drain(r.lcm);
+    plan_msg(r.lcm, r.now, 2, cycle(1), 1, 10, 0);
+    drain(r.lcm);
+    ck_assert_int_eq(s->plans_adopted, 0);
+    ck_assert_str_eq(s->rx.last_reason, "plan: flies this UAV into an obstacle or track it knows");
+    const int64_t rejected = s->rx.rejected;
+    map_tile(r.lcm, r.now, 2, 1, 3, false);
+    drain(r.lcm);
+    ck_assert_int_eq(s->rx.rejected, rejected + 1);
+    ck_assert_int_eq(s->rx.last_reject_code, COAVOID_LCM_ERR_COUNT);
+    /* The whole of version 2 replaces version 1: the climb is clear now. */
+    map_tile(r.lcm, r.now, 2, 1, 2, false);
+    drain(r.lcm);
+    plan_msg(r.lcm, r.now, 3, cycle(1), 1, 10, 0);
+    drain(r.lcm);
+    ck_assert_int_eq(s->plans_adopted, 1);
+    ck_assert_int_eq(s->rx.rejected, rejected + 1);
+    lcm_unsubscribe(r.lcm, sub);
+    coavoid_vehicle_node_destroy(a);
+    lcm_destroy(r.lcm);
+}
+END_TEST
+
+/* A plan is decided on only whole: a UAV holding its own row but not its sibling's adopts
+ * nothing and refuses nothing (unanswered, as if the plan had not come); the sibling's
+ * row completes it. A row that disagrees with its plan's other rows is refused. */
+START_TEST(test_plan_adopted_only_whole)
+{
+    rig_t r;
+    rig_init(&r, 10);
+    coa_vec3_t route[2];
+    coavoid_vehicle_node_t *a =
+        vehicle_node(&r, uav(1, 1, route, 0, 500, 0, 100), COAVOID_NODE_CENTRALISED);
+    const coavoid_vehicle_node_state_t *s = coavoid_vehicle_node_state(a);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, cycle(0)), COA_OK);
+    drain(r.lcm);
+    r.now = cycle(0) + DT_US / 4;
+    const int64_t rejected = s->rx.rejected;
+    coavoid_plan_t m = solved_plan(r.now, 4, cycle(0), 10, 2);
+    m.uav_ids[0] = 1;
+    m.uav_ids[1] = 9; /* far away: not in its view */
+    m.row_uav_id = 1;
+    for (int32_t k = 0; k <= 10; k++) {
+        m.offsets[k] = k < 2 ? k : 2;
+    }
+    ck_assert_int_eq(coavoid_plan_t_publish(r.lcm, COAVOID_CHANNEL_PLAN, &m), 0);
+    drain(r.lcm);
+    ck_assert_int_eq(s->plans_adopted, 0);
+    ck_assert_int_eq(s->rx.rejected, rejected);
+    coavoid_plan_t other = m;
+    other.row_uav_id = 9;
+    memset(other.offsets, 0, sizeof other.offsets);
+    other.deviation = 5.0; /* not what its sibling said */
+    ck_assert_int_eq(coavoid_plan_t_publish(r.lcm, COAVOID_CHANNEL_PLAN, &other), 0);
+    drain(r.lcm);
+    ck_assert_int_eq(s->plans_adopted, 0);
+    ck_assert_int_eq(s->rx.rejected, rejected + 1);
+    ck_assert_int_eq(s->rx.last_reject_code, COAVOID_LCM_ERR_VALUE);
+    other.deviation = m.deviation;
+    ck_assert_int_eq(coavoid_plan_t_publish(r.lcm, COAVOID_CHANNEL_PLAN, &other), 0);
+    drain(r.lcm);
+    ck_assert_int_eq(s->plans_adopted, 1);
+    ck_assert_int_eq(s->rx.rejected, rejected + 1);
+    coavoid_vehicle_node_destroy(a);
+    lcm_destroy(r.lcm);
+}
+END_TEST
 
 /* Another UAV with this node's id: its intents are not this node's own looped back, even
  * at the same times and sequence numbers; they are refused and the node reports a fault
@@ -960,7 +1088,10 @@ START_TEST(test_failed_plan_is_an_answer)
         m.planned_count = 0;
         m.uav_ids[0] = 1;
         m.uav_ids[1] = 2;
-        ck_assert_int_eq(coavoid_plan_t_publish(r.lcm, COAVOID_CHANNEL_PLAN, &m), 0);
+        for (int32_t row = 0; row < 2; row++) { /* one message per UAV, no rows */
+            m.row_uav_id = m.uav_ids[row];
+            ck_assert_int_eq(coavoid_plan_t_publish(r.lcm, COAVOID_CHANNEL_PLAN, &m), 0);
+        }
         drain(r.lcm);
     }
     for (int i = 0; i < 2; i++) {
@@ -973,9 +1104,11 @@ START_TEST(test_failed_plan_is_an_answer)
 }
 END_TEST
 
-/* The UAV rows of the plans a coordinator publishes. */
+/* The UAVs of the plans a coordinator publishes (one message per UAV: a plan is counted
+ * at its first UAV's). */
 typedef struct {
     int plans;
+    int messages;
     int32_t rows;
     int32_t ids[4];
     int8_t status; /* the last plan's */
@@ -987,7 +1120,8 @@ static void on_plan_probe(const lcm_recv_buf_t *rbuf, const char *channel, void 
     (void)channel;
     coavoid_plan_t m;
     REQUIRE(coavoid_plan_t_decode(rbuf->data, 0, (int)rbuf->data_size, &m) >= 0);
-    p->plans++;
+    p->messages++;
+    p->plans += m.row_uav_id == m.uav_ids[0] ? 1 : 0;
     p->rows = m.vehicle_count;
     p->status = m.status;
     for (int32_t i = 0; i < m.vehicle_count && i < 4; i++) {
@@ -1417,6 +1551,120 @@ END_TEST
 
 /* ---- configuration ---- */
 
+/* Every datagram the nodes publish, by channel: how many and the largest. */
+typedef struct {
+    int count[6];
+    int largest;
+} datagram_probe_t;
+
+static void on_any_datagram(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
+{
+    static const char *const channels[6] = {COAVOID_CHANNEL_INTENT,    COAVOID_CHANNEL_PLAN,
+                                            COAVOID_CHANNEL_TRACK,     COAVOID_CHANNEL_OBSTACLES,
+                                            COAVOID_CHANNEL_CONFLICTS, COAVOID_CHANNEL_STATUS};
+    datagram_probe_t *p = user;
+    for (int i = 0; i < 6; i++) {
+        p->count[i] += strcmp(channel, channels[i]) == 0;
+    }
+    p->largest = (int)rbuf->data_size > p->largest ? (int)rbuf->data_size : p->largest;
+}
+
+/* The busiest traffic the nodes make fits one datagram each (COAVOID_LCM_MAX_DATAGRAM_BYTES):
+ * the largest horizon, a full map (64 boxes, 16 polytopes of 32 vertices: 16 tiles), a
+ * track, and three head-on pairs of UAVs under a coordinator (plans of two rows each).
+ * The UAVs still assemble the map and the plans. */
+START_TEST(test_every_datagram_fits)
+{
+    rig_t r;
+    rig_init(&r, COAVOID_NODE_MAX_HORIZON);
+    static coa_obstacle_t obstacles[80];
+    static coa_vec3_t points[32];
+    for (int j = 0; j < 32; j++) {
+        double a = 2.0 * 3.141592653589793 * (j % 16) / 16.0;
+        points[j] = (coa_vec3_t){(coa_real_t)(50000 + 100 * cos(a)), (coa_real_t)(100 * sin(a)),
+                                 (coa_real_t)(j < 16 ? 0 : 50)};
+    }
+    for (int i = 0; i < 80; i++) {
+        memset(&obstacles[i], 0, sizeof obstacles[i]);
+        if (i < 64) {
+            obstacles[i].kind = COA_OBSTACLE_BOX;
+            obstacles[i].box.min = (coa_vec3_t){(coa_real_t)(60000 + 10 * i), 0, 0};
+            obstacles[i].box.max = (coa_vec3_t){(coa_real_t)(60005 + 10 * i), 5, 5};
+        } else {
+            obstacles[i].kind = COA_OBSTACLE_POLYTOPE;
+            obstacles[i].polytope.vertices = points;
+            obstacles[i].polytope.count = 32;
+        }
+    }
+    coa_track_t track;
+    memset(&track, 0, sizeof track);
+    track.id = 5;
+    track.volume.radius = 20;
+    track.volume.half_height = 8;
+    track.position = (coa_vec3_t){-30000, 0, 100};
+    coavoid_world_config_t wc;
+    memset(&wc, 0, sizeof wc);
+    wc.common = r.common;
+    wc.obstacles = obstacles;
+    wc.obstacle_count = 80;
+    wc.tracks = &track;
+    wc.track_count = 1;
+    int error = -99;
+    coavoid_world_t *w = coavoid_world_create(&wc, r.lcm, &error);
+    ck_assert_ptr_nonnull(w);
+    coavoid_coordinator_config_t cc;
+    memset(&cc, 0, sizeof cc);
+    cc.common = r.common;
+    cc.common.beta = 5000;
+    coavoid_coordinator_t *co = coavoid_coordinator_create(&cc, r.lcm, &error);
+    ck_assert_ptr_nonnull(co);
+    static coa_vec3_t routes[6][2];
+    coavoid_vehicle_node_t *v[6];
+    for (int i = 0; i < 6; i++) {
+        const coa_real_t y = (coa_real_t)(i / 2) * 100;
+        v[i] = vehicle_node(
+            &r,
+            uav((uint16_t)(i + 1), 1, routes[i], i % 2 ? 200 : -200, i % 2 ? -400 : 400, y, 100),
+            COAVOID_NODE_CENTRALISED);
+    }
+    datagram_probe_t probe;
+    memset(&probe, 0, sizeof probe);
+    lcm_subscription_t *sub = lcm_subscribe(r.lcm, "COAVOID_.*", on_any_datagram, &probe);
+    for (int64_t k = 0; k < 3; k++) {
+        r.now = cycle(k);
+        ck_assert_int_eq(coavoid_world_cycle(w, r.now), COA_OK);
+        drain(r.lcm);
+        for (int i = 0; i < 6; i++) {
+            ck_assert_int_eq(coavoid_vehicle_node_cycle(v[i], r.now), COA_OK);
+            drain(r.lcm);
+        }
+        r.now = cycle(k) + DT_US / 4;
+        ck_assert_int_eq(coavoid_coordinator_cycle(co, r.now), COA_OK);
+        drain(r.lcm);
+    }
+    ck_assert_int_le(probe.largest, COAVOID_LCM_MAX_DATAGRAM_BYTES);
+    ck_assert_int_eq(probe.count[3], 3 * 16); /* 16 tiles a cycle */
+    ck_assert_int_eq(probe.count[2], 3);
+    ck_assert_int_ge(probe.count[1], 2); /* a plan is a message per UAV */
+    for (int c = 0; c < 6; c++) {
+        ck_assert_int_gt(probe.count[c], 0);
+    }
+    uint32_t adopted = 0;
+    for (int i = 0; i < 6; i++) {
+        adopted += coavoid_vehicle_node_state(v[i])->plans_adopted;
+        ck_assert_int_eq(coavoid_vehicle_node_state(v[i])->rx.rejected, 0);
+        coavoid_vehicle_node_destroy(v[i]);
+    }
+    ck_assert_msg(adopted > 0u, "published %u, outcome %d, plan messages %d",
+                  coavoid_coordinator_state(co)->plans_published,
+                  coavoid_coordinator_state(co)->last_outcome, probe.count[1]);
+    lcm_unsubscribe(r.lcm, sub);
+    coavoid_coordinator_destroy(co);
+    coavoid_world_destroy(w);
+    lcm_destroy(r.lcm);
+}
+END_TEST
+
 START_TEST(test_bad_configs_refused)
 {
     rig_t r;
@@ -1756,6 +2004,8 @@ static Suite *node_suite(void)
     tcase_add_test(tc, test_undecodable_counted_own_ignored);
     tcase_add_test(tc, test_restarted_peer_accepted_after_silence);
     tcase_add_test(tc, test_plan_adoption_rules);
+    tcase_add_test(tc, test_plan_adopted_only_whole);
+    tcase_add_test(tc, test_map_used_only_whole);
     tcase_add_test(tc, test_plan_ids_do_not_lock_out);
     tcase_add_test(tc, test_plan_into_terrain_refused);
     tcase_add_test(tc, test_forged_map_keeps_terrain);
@@ -1776,6 +2026,7 @@ static Suite *node_suite(void)
     tcase_add_test(tc, test_higher_priority_replans_in_cluster);
     tcase_add_test(tc, test_silent_uav_avoided_as_track);
     tcase_add_test(tc, test_world_track_estimates);
+    tcase_add_test(tc, test_every_datagram_fits);
     tcase_add_test(tc, test_bad_configs_refused);
     tcase_add_test(tc, test_signed_messages);
     tcase_add_test(tc, test_keys_required);

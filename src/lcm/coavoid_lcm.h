@@ -62,6 +62,15 @@ extern "C" {
 #define COAVOID_LCM_MAX_STEP 3600.0      /* s: plan step or dt */
 #define COAVOID_LCM_MAX_ID 65535         /* UAV and node ids are 1..65535 (coa_vehicle_t.id) */
 
+/* The most bytes one message may take encoded (fingerprint and signature included). LCM's
+ * UDP multicast sends a message as one datagram of LCM's header (8 bytes), the channel name
+ * (at most 18 bytes with its NUL for ours) and the message; with the IP and UDP headers
+ * (28 bytes) that is at most 1,454 bytes, within a 1,500-byte MTU: no message is
+ * fragmented by the kernel, so a path that drops datagrams over 1,500 bytes (or loses IP
+ * fragments) loses none (docs/messages.md, "One datagram"). Every type's fixed size is
+ * at most this, and the nodes refuse to publish more. */
+#define COAVOID_LCM_MAX_DATAGRAM_BYTES 1400
+
 /* How the receiver judges times. All microseconds. */
 typedef struct {
     int64_t now_utime;     /* receiver's clock; 0 disables the age and future checks */
@@ -165,6 +174,7 @@ int coavoid_lcm_intent_from_core(const coa_vehicle_t *vehicle,
 
 /* ---- plan ---- */
 
+/* A plan as one whole: what a complete set of its messages (one per UAV) says. */
 typedef struct {
     int64_t utime;
     uint32_t coordinator_id;
@@ -182,19 +192,60 @@ typedef struct {
     bool abandoned;
 } coavoid_lcm_plan_info_t;
 
+/* Every rule of one plan_t message: header (times, ids, horizon, mode, status, costs),
+ * vehicle list (count, planned_count, ids in 1..65535 and distinct), and its row
+ * (row_uav_id one of uav_ids; offsets within COA_MAX_OFFSET whose steps some action
+ * makes for a planned UAV, all zero otherwise and past horizon). Returns COA_OK or a
+ * COAVOID_LCM_ERR_* with *reason naming the field. O(vehicle_count^2 + MAX_SAMPLES). */
 int coavoid_lcm_plan_check(const coavoid_plan_t *msg, const coavoid_lcm_context_t *ctx,
                            const char **reason);
-/* offsets: capacity >= vehicle_count * (horizon + 1) int32, row i = uav_ids[i] (the
- * layout the planner writes); result's status, costs, nodes_expanded and planned_count
- * are set, order is 0..n-1. */
-int coavoid_lcm_plan_to_core(const coavoid_plan_t *msg, const coavoid_lcm_context_t *ctx,
-                             coavoid_lcm_sequence_table_t *seq, coavoid_lcm_plan_info_t *info,
-                             coa_plan_result_t *result, int32_t *offsets, size_t capacity,
-                             const char **reason);
-/* offsets as the planner wrote them for info->vehicle_count vehicles (rows in vehicle
- * index order; the message lists them in result->order). */
+
+/* The rows of the plans a receiver is collecting, in the caller's slots (one slot per
+ * plan in progress, 5.8 kB each): a plan is whole when a message of each of its
+ * vehicle_count UAVs has come. */
+typedef struct {
+    bool used;
+    coavoid_plan_t first; /* the first message of the plan: its header */
+    uint32_t have;        /* bit i: the row of first.uav_ids[i] has come */
+    int32_t offsets[COAVOID_PLAN_T_MAX_VEHICLES][COAVOID_PLAN_T_MAX_SAMPLES];
+} coavoid_lcm_plan_slot_t;
+
+typedef struct {
+    coavoid_lcm_plan_slot_t *slots;
+    size_t capacity;
+} coavoid_lcm_plan_rows_t;
+
+/* Empties the collection over slots[0..capacity-1]. Cannot fail on non-NULL arguments. */
+void coavoid_lcm_plan_rows_init(coavoid_lcm_plan_rows_t *rows, coavoid_lcm_plan_slot_t *slots,
+                                size_t capacity);
+
+/* Checks msg and adds its row to the plan it belongs to (coordinator_id, plan_id,
+ * valid_from_utime); when no slot holds that plan, a free one, else the oldest plan's
+ * (valid_from, then plan_id) is dropped unfinished. When this completes the plan (every
+ * listed UAV's row has come), *whole points to the plan's first message (its header, in
+ * the freed slot: valid until the next call), and info, result and offsets describe the
+ * whole plan: offsets (capacity >= vehicle_count * (horizon + 1)
+ * int32) row i = uav_ids[i] (the layout the planner writes), zero for UAVs without a plan;
+ * result's status, costs, nodes_expanded and planned_count are set, order is 0..n-1.
+ * Otherwise *whole is NULL and the other outputs are untouched. No sequence rule: the
+ * caller orders plans. Returns COA_OK, the check's refusal, COAVOID_LCM_ERR_VALUE (a
+ * message that disagrees with the header of its plan's earlier rows: nothing kept),
+ * COAVOID_LCM_ERR_CAPACITY (offsets too small) or COA_ERR_ARGUMENT (NULL). Cost
+ * O(check + slots + MAX_SAMPLES), and O(vehicle_count * horizon) to complete. No memory. */
+int coavoid_lcm_plan_collect(coavoid_lcm_plan_rows_t *rows, const coavoid_plan_t *msg,
+                             const coavoid_lcm_context_t *ctx, const coavoid_plan_t **whole,
+                             coavoid_lcm_plan_info_t *info, coa_plan_result_t *result,
+                             int32_t *offsets, size_t capacity, const char **reason);
+
+/* The message of row `row` (0..vehicle_count-1, in the message's order: result->order)
+ * of a plan: offsets as the planner wrote them for info->vehicle_count vehicles (rows in
+ * vehicle index order; the message lists them in result->order). A plan goes out as the
+ * messages of rows 0..vehicle_count-1. Returns COA_OK, COA_ERR_ARGUMENT (NULL, an order
+ * naming no vehicle), COAVOID_LCM_ERR_COUNT (counts, horizon or row out of range),
+ * COAVOID_LCM_ERR_VALUE (a number too large) or the check's refusal. O(vehicle_count +
+ * horizon + check). */
 int coavoid_lcm_plan_from_core(const coavoid_lcm_plan_info_t *info, const coa_plan_result_t *result,
-                               const int32_t *offsets, const coavoid_lcm_context_t *ctx,
+                               const int32_t *offsets, size_t row, const coavoid_lcm_context_t *ctx,
                                coavoid_plan_t *msg, const char **reason);
 
 /* ---- track ---- */
@@ -219,18 +270,46 @@ int coavoid_lcm_track_from_core(const coa_track_t *track, const coavoid_lcm_trac
 
 /* ---- obstacle map ---- */
 
+/* The most obstacles one map (all its tiles) holds: boxes and polytopes. */
+#define COAVOID_LCM_MAP_MAX_OBSTACLES               \
+    ((size_t)COAVOID_OBSTACLE_MAP_T_MAX_MAP_BOXES + \
+     (size_t)COAVOID_OBSTACLE_MAP_T_MAX_MAP_POLYTOPES)
+
+/* Every rule of one tile: time, map_id, version, tile_index < tile_count <= MAX_TILES,
+ * box and polytope counts within the tile's capacity, each polytope >= 4 vertices and
+ * their sum <= MAX_VERTICES, every number finite and within range, box_min <= box_max.
+ * Returns COA_OK or a COAVOID_LCM_ERR_* with *reason. O(tile). */
 int coavoid_lcm_obstacle_map_check(const coavoid_obstacle_map_t *msg,
                                    const coavoid_lcm_context_t *ctx, const char **reason);
-/* Boxes first, then polytopes. obstacles: capacity >= box_count + polytope_count;
- * vertices: vertex_capacity >= the sum of vertex_count. Equal versions are accepted
- * (a republished map). */
-int coavoid_lcm_obstacle_map_to_core(const coavoid_obstacle_map_t *msg,
-                                     const coavoid_lcm_context_t *ctx,
-                                     coavoid_lcm_sequence_table_t *seq, coa_obstacle_t *obstacles,
+/* The check, then the version rule (seq may be NULL: none): a version lower than one
+ * already seen from this map_id is refused (COAVOID_LCM_ERR_SEQUENCE), an equal one is
+ * accepted (a republished map). O(tile + senders). */
+int coavoid_lcm_obstacle_map_accept(const coavoid_obstacle_map_t *msg,
+                                    const coavoid_lcm_context_t *ctx,
+                                    coavoid_lcm_sequence_table_t *seq, const char **reason);
+/* A whole map from its tiles (tiles[i] is tile i of tile_count, all of one map_id and
+ * version, each passing the check): every box, then every polytope, in tile order.
+ * obstacles: capacity >= the map's boxes + polytopes; vertices: vertex_capacity >= the sum
+ * of vertex_count. Returns COA_OK, the check's refusal, COAVOID_LCM_ERR_COUNT (tiles that
+ * are not one whole version, or more than MAX_MAP_BOXES boxes or MAX_MAP_POLYTOPES
+ * polytopes), COAVOID_LCM_ERR_CAPACITY or COA_ERR_ARGUMENT; nothing is written unless it
+ * returns COA_OK. O(map). No memory. */
+int coavoid_lcm_obstacle_map_to_core(const coavoid_obstacle_map_t *tiles, size_t tile_count,
+                                     const coavoid_lcm_context_t *ctx, coa_obstacle_t *obstacles,
                                      size_t capacity, size_t *count, coa_vec3_t *vertices,
                                      size_t vertex_capacity, const char **reason);
+/* How many tiles a map of these obstacles takes: boxes MAX_BOXES to a tile in order;
+ * polytopes in order, a new tile when MAX_POLYTOPES or MAX_VERTICES would be passed.
+ * Returns COA_OK, COAVOID_LCM_ERR_COUNT (more than the map's capacity or MAX_TILES
+ * tiles, a polytope beyond MAX_VERTICES), COAVOID_LCM_ERR_ENUM or COA_ERR_ARGUMENT.
+ * O(count). */
+int coavoid_lcm_obstacle_map_tiles(const coa_obstacle_t *obstacles, size_t count,
+                                   size_t *tile_count, const char **reason);
+/* Tile tile_index of that tiling, checked. Errors as coavoid_lcm_obstacle_map_tiles, and
+ * COAVOID_LCM_ERR_COUNT for a tile_index past the last tile, COAVOID_LCM_ERR_ID for
+ * map_id. O(count + tile). */
 int coavoid_lcm_obstacle_map_from_core(const coa_obstacle_t *obstacles, size_t count, int64_t utime,
-                                       uint32_t map_id, int64_t version,
+                                       uint32_t map_id, int64_t version, size_t tile_index,
                                        const coavoid_lcm_context_t *ctx,
                                        coavoid_obstacle_map_t *msg, const char **reason);
 

@@ -584,13 +584,11 @@ static int plan_header_check(const coavoid_plan_t *msg, const coavoid_lcm_contex
     return COA_OK;
 }
 
-/* The plan's vehicles: counts, ids (each once) and the planned offsets, each within the
- * bound and each step one that some action makes. */
+/* The plan's vehicles: counts and ids (each once). */
 static int plan_vehicles_check(const coavoid_plan_t *msg, const char **reason)
 {
     int32_t i;
     int32_t j;
-    int32_t k;
     if (msg->vehicle_count < 1 || msg->vehicle_count > COAVOID_PLAN_T_MAX_VEHICLES) {
         REJECT(COAVOID_LCM_ERR_COUNT, "plan: vehicle_count not in 1..MAX_VEHICLES");
     }
@@ -611,18 +609,47 @@ static int plan_vehicles_check(const coavoid_plan_t *msg, const char **reason)
             }
         }
     }
-    for (i = 0; i < msg->planned_count; ++i) {
-        for (k = 0; k <= msg->horizon; ++k) {
-            int32_t o = msg->offsets[i][k];
-            if (o > COA_MAX_OFFSET || o < -COA_MAX_OFFSET) {
-                REJECT(COAVOID_LCM_ERR_VALUE, "plan: an offset beyond COA_MAX_OFFSET");
+    return COA_OK;
+}
+
+/* Where the row's UAV is in uav_ids, or -1. */
+static int32_t plan_row_index(const coavoid_plan_t *msg)
+{
+    int32_t i;
+    for (i = 0; i < msg->vehicle_count && i < COAVOID_PLAN_T_MAX_VEHICLES; ++i) {
+        if (msg->uav_ids[i] == msg->row_uav_id) {
+            return i;
+        }
+    }
+    return -1;
+}
+
+/* The message's row: a listed UAV; a plan's offsets each within the bound and each step
+ * one that some action makes; no offsets at all when its UAV has no plan. */
+static int plan_row_check(const coavoid_plan_t *msg, const char **reason)
+{
+    int32_t k;
+    const int32_t row = plan_row_index(msg);
+    if (row < 0) {
+        REJECT(COAVOID_LCM_ERR_ID, "plan: row_uav_id is not one of uav_ids");
+    }
+    for (k = 0; k < COAVOID_PLAN_T_MAX_SAMPLES; ++k) {
+        int32_t o = msg->offsets[k];
+        if (row >= msg->planned_count || k > msg->horizon) {
+            if (o != 0) {
+                REJECT(COAVOID_LCM_ERR_VALUE,
+                       "plan: offsets where there is no plan (a UAV not planned, past horizon)");
             }
-            /* No action moves more than the largest steep factor in one step. */
-            if (k > 0) {
-                int32_t d = o - msg->offsets[i][k - 1];
-                if (d > (int32_t)COA_MAX_STEEP_FACTOR || d < -(int32_t)COA_MAX_STEEP_FACTOR) {
-                    REJECT(COAVOID_LCM_ERR_VALUE, "plan: an offset step no action makes");
-                }
+            continue;
+        }
+        if (o > COA_MAX_OFFSET || o < -COA_MAX_OFFSET) {
+            REJECT(COAVOID_LCM_ERR_VALUE, "plan: an offset beyond COA_MAX_OFFSET");
+        }
+        /* No action moves more than the largest steep factor in one step. */
+        if (k > 0) {
+            int32_t d = o - msg->offsets[k - 1];
+            if (d > (int32_t)COA_MAX_STEEP_FACTOR || d < -(int32_t)COA_MAX_STEEP_FACTOR) {
+                REJECT(COAVOID_LCM_ERR_VALUE, "plan: an offset step no action makes");
             }
         }
     }
@@ -637,39 +664,84 @@ int coavoid_lcm_plan_check(const coavoid_plan_t *msg, const coavoid_lcm_context_
         REJECT(COA_ERR_ARGUMENT, "plan: NULL");
     }
     if ((rc = plan_header_check(msg, ctx, reason)) != COA_OK ||
-        (rc = plan_vehicles_check(msg, reason)) != COA_OK) {
+        (rc = plan_vehicles_check(msg, reason)) != COA_OK ||
+        (rc = plan_row_check(msg, reason)) != COA_OK) {
         return rc;
     }
     OK_REASON();
     return COA_OK;
 }
 
-int coavoid_lcm_plan_to_core(const coavoid_plan_t *msg, const coavoid_lcm_context_t *ctx,
-                             coavoid_lcm_sequence_table_t *seq, coavoid_lcm_plan_info_t *info,
-                             coa_plan_result_t *result, int32_t *offsets, size_t capacity,
-                             const char **reason)
+void coavoid_lcm_plan_rows_init(coavoid_lcm_plan_rows_t *rows, coavoid_lcm_plan_slot_t *slots,
+                                size_t capacity)
 {
-    int rc;
+    size_t i;
+    rows->slots = slots;
+    rows->capacity = capacity;
+    for (i = 0; i < capacity; ++i) {
+        slots[i].used = false;
+        slots[i].have = 0u;
+    }
+}
+
+/* Whether two rows' messages say the same of their plan (everything but utime, the row
+ * and auth). */
+static bool plan_same_header(const coavoid_plan_t *a, const coavoid_plan_t *b)
+{
+    int32_t i;
+    if (a->coordinator_id != b->coordinator_id || a->plan_id != b->plan_id ||
+        a->valid_from_utime != b->valid_from_utime ||
+        a->valid_until_utime != b->valid_until_utime || a->dt != b->dt ||
+        a->horizon != b->horizon || a->mode != b->mode || a->status != b->status ||
+        a->deviation != b->deviation || a->effort != b->effort ||
+        a->nodes_expanded != b->nodes_expanded || a->vehicle_count != b->vehicle_count ||
+        a->planned_count != b->planned_count) {
+        return false;
+    }
+    for (i = 0; i < a->vehicle_count; ++i) {
+        if (a->uav_ids[i] != b->uav_ids[i]) {
+            return false;
+        }
+    }
+    return true;
+}
+
+/* The slot collecting msg's plan (coordinator, plan_id, valid_from); else a free one; else
+ * the one with the oldest plan (valid_from, then plan_id), which is dropped. */
+static coavoid_lcm_plan_slot_t *plan_slot(coavoid_lcm_plan_rows_t *rows, const coavoid_plan_t *msg)
+{
+    size_t i;
+    coavoid_lcm_plan_slot_t *free_slot = NULL;
+    coavoid_lcm_plan_slot_t *oldest = &rows->slots[0];
+    for (i = 0; i < rows->capacity; ++i) {
+        coavoid_lcm_plan_slot_t *s = &rows->slots[i];
+        if (!s->used) {
+            free_slot = (free_slot == NULL) ? s : free_slot;
+            continue;
+        }
+        if (s->first.coordinator_id == msg->coordinator_id && s->first.plan_id == msg->plan_id &&
+            s->first.valid_from_utime == msg->valid_from_utime) {
+            return s;
+        }
+        if (oldest->used && (s->first.valid_from_utime < oldest->first.valid_from_utime ||
+                             (s->first.valid_from_utime == oldest->first.valid_from_utime &&
+                              s->first.plan_id < oldest->first.plan_id))) {
+            oldest = s;
+        }
+    }
+    return (free_slot != NULL) ? free_slot : oldest;
+}
+
+/* A complete plan in the core's terms, as one message of the whole cluster would give it. */
+static void plan_complete(const coavoid_lcm_plan_slot_t *s, const coavoid_lcm_context_t *ctx,
+                          coavoid_lcm_plan_info_t *info, coa_plan_result_t *result,
+                          int32_t *offsets)
+{
+    const coavoid_plan_t *msg = &s->first;
+    const size_t n = (size_t)msg->vehicle_count;
+    const size_t samples = (size_t)msg->horizon + 1u;
     size_t i;
     size_t k;
-    size_t n;
-    size_t samples;
-    if (info == NULL || result == NULL || offsets == NULL) {
-        REJECT(COA_ERR_ARGUMENT, "plan: NULL output");
-    }
-    if ((rc = coavoid_lcm_plan_check(msg, ctx, reason)) != COA_OK) {
-        return rc;
-    }
-    n = (size_t)msg->vehicle_count;
-    samples = (size_t)msg->horizon + 1u;
-    if (n * samples > capacity) {
-        REJECT(COAVOID_LCM_ERR_CAPACITY, "plan: more offsets than the caller's array holds");
-    }
-    if ((rc = sequence_rule(seq, msg->coordinator_id, msg->plan_id, false, reason,
-                            "plan: plan_id not after the last one from this coordinator",
-                            "plan: sequence table full")) != COA_OK) {
-        return rc;
-    }
     memset(info, 0, sizeof *info);
     memset(result, 0, sizeof *result);
     info->utime = msg->utime;
@@ -685,7 +757,7 @@ int coavoid_lcm_plan_to_core(const coavoid_plan_t *msg, const coavoid_lcm_contex
         info->uav_ids[i] = (uint16_t)msg->uav_ids[i];
         result->order[i] = i;
         for (k = 0; k < samples; ++k) {
-            offsets[i * samples + k] = (i < (size_t)msg->planned_count) ? msg->offsets[i][k] : 0;
+            offsets[i * samples + k] = s->offsets[i][k];
         }
     }
     info->abandoned = msg->status == COAVOID_PLAN_T_STATUS_ABANDONED;
@@ -695,12 +767,54 @@ int coavoid_lcm_plan_to_core(const coavoid_plan_t *msg, const coavoid_lcm_contex
     result->nodes_expanded = (uint64_t)msg->nodes_expanded;
     result->planned_count = (size_t)msg->planned_count;
     result->failed_vehicle = (result->planned_count < n) ? result->planned_count : COA_NO_VEHICLE;
+}
+
+int coavoid_lcm_plan_collect(coavoid_lcm_plan_rows_t *rows, const coavoid_plan_t *msg,
+                             const coavoid_lcm_context_t *ctx, const coavoid_plan_t **whole,
+                             coavoid_lcm_plan_info_t *info, coa_plan_result_t *result,
+                             int32_t *offsets, size_t capacity, const char **reason)
+{
+    int rc;
+    int32_t row;
+    coavoid_lcm_plan_slot_t *s;
+    if (rows == NULL || rows->slots == NULL || rows->capacity == 0u || whole == NULL ||
+        info == NULL || result == NULL || offsets == NULL) {
+        REJECT(COA_ERR_ARGUMENT, "plan: NULL output");
+    }
+    *whole = NULL;
+    if ((rc = coavoid_lcm_plan_check(msg, ctx, reason)) != COA_OK) {
+        return rc;
+    }
+    if ((size_t)msg->vehicle_count * ((size_t)msg->horizon + 1u) > capacity) {
+        REJECT(COAVOID_LCM_ERR_CAPACITY, "plan: more offsets than the caller's array holds");
+    }
+    s = plan_slot(rows, msg);
+    if (s->used && s->first.plan_id == msg->plan_id &&
+        s->first.coordinator_id == msg->coordinator_id &&
+        s->first.valid_from_utime == msg->valid_from_utime && !plan_same_header(&s->first, msg)) {
+        REJECT(COAVOID_LCM_ERR_VALUE, "plan: a row that disagrees with its plan's other rows");
+    }
+    if (!s->used || s->first.plan_id != msg->plan_id ||
+        s->first.coordinator_id != msg->coordinator_id ||
+        s->first.valid_from_utime != msg->valid_from_utime) {
+        s->used = true;
+        s->first = *msg;
+        s->have = 0u;
+    }
+    row = plan_row_index(msg);
+    memcpy(s->offsets[row], msg->offsets, sizeof s->offsets[row]);
+    s->have |= UINT32_C(1) << (uint32_t)row;
+    if (s->have == (UINT32_MAX >> (32u - (uint32_t)msg->vehicle_count))) {
+        plan_complete(s, ctx, info, result, offsets);
+        s->used = false;
+        *whole = &s->first;
+    }
     OK_REASON();
     return COA_OK;
 }
 
 int coavoid_lcm_plan_from_core(const coavoid_lcm_plan_info_t *info, const coa_plan_result_t *result,
-                               const int32_t *offsets, const coavoid_lcm_context_t *ctx,
+                               const int32_t *offsets, size_t row, const coavoid_lcm_context_t *ctx,
                                coavoid_plan_t *msg, const char **reason)
 {
     size_t i;
@@ -711,8 +825,9 @@ int coavoid_lcm_plan_from_core(const coavoid_lcm_plan_info_t *info, const coa_pl
         REJECT(COA_ERR_ARGUMENT, "plan: NULL argument");
     }
     n = info->vehicle_count;
-    if (n < 1u || n > (size_t)COAVOID_PLAN_T_MAX_VEHICLES || result->planned_count > n) {
-        REJECT(COAVOID_LCM_ERR_COUNT, "plan: vehicle_count not in 1..MAX_VEHICLES");
+    if (n < 1u || n > (size_t)COAVOID_PLAN_T_MAX_VEHICLES || result->planned_count > n ||
+        row >= n) {
+        REJECT(COAVOID_LCM_ERR_COUNT, "plan: vehicle_count not in 1..MAX_VEHICLES, or no such row");
     }
     if (info->horizon < 1u || info->horizon > (uint32_t)COAVOID_PLAN_T_MAX_SAMPLES - 1u) {
         REJECT(COAVOID_LCM_ERR_COUNT, "plan: horizon not in 1..MAX_SAMPLES-1");
@@ -743,9 +858,10 @@ int coavoid_lcm_plan_from_core(const coavoid_lcm_plan_info_t *info, const coa_pl
             REJECT(COA_ERR_ARGUMENT, "plan: result order names no vehicle");
         }
         msg->uav_ids[i] = info->uav_ids[v];
-        if (i < (size_t)msg->planned_count) {
-            for (k = 0; k < samples; ++k) {
-                msg->offsets[i][k] = offsets[v * samples + k];
+        if (i == row) {
+            msg->row_uav_id = msg->uav_ids[i];
+            for (k = 0; i < (size_t)msg->planned_count && k < samples; ++k) {
+                msg->offsets[k] = offsets[v * samples + k];
             }
         }
     }
@@ -906,12 +1022,38 @@ int coavoid_lcm_track_from_core(const coa_track_t *track, const coavoid_lcm_trac
 
 /* ---- obstacle map ---- */
 
+/* One tile's polytopes: counts within the tile's capacity, every vertex finite and within
+ * range. */
+static int map_polytopes_check(const coavoid_obstacle_map_t *msg, const char **reason)
+{
+    int32_t i;
+    int32_t j;
+    int32_t used = 0;
+    int rc;
+    if (msg->polytope_count < 0 || msg->polytope_count > COAVOID_OBSTACLE_MAP_T_MAX_POLYTOPES) {
+        REJECT(COAVOID_LCM_ERR_COUNT, "obstacle_map: polytope_count not in 0..MAX_POLYTOPES");
+    }
+    for (i = 0; i < msg->polytope_count; ++i) {
+        if (msg->vertex_count[i] < 4 ||
+            msg->vertex_count[i] > COAVOID_OBSTACLE_MAP_T_MAX_VERTICES - used) {
+            REJECT(COAVOID_LCM_ERR_COUNT,
+                   "obstacle_map: a vertex_count below 4, or the tile's beyond MAX_VERTICES");
+        }
+        used += msg->vertex_count[i];
+    }
+    for (j = 0; j < used; ++j) {
+        if ((rc = vec_rule(msg->vertices[j], COAVOID_LCM_MAX_COORDINATE)) != COA_OK) {
+            REJECT(rc, "obstacle_map: a vertex non-finite or out of range");
+        }
+    }
+    return COA_OK;
+}
+
 int coavoid_lcm_obstacle_map_check(const coavoid_obstacle_map_t *msg,
                                    const coavoid_lcm_context_t *ctx, const char **reason)
 {
     int rc;
     int32_t i;
-    int32_t j;
     int a;
     if (msg == NULL) {
         REJECT(COA_ERR_ARGUMENT, "obstacle_map: NULL");
@@ -930,6 +1072,12 @@ int coavoid_lcm_obstacle_map_check(const coavoid_obstacle_map_t *msg,
     if (msg->version < 0) {
         REJECT(COAVOID_LCM_ERR_VALUE, "obstacle_map: version negative");
     }
+    if (msg->tile_count < 1 || msg->tile_count > COAVOID_OBSTACLE_MAP_T_MAX_TILES) {
+        REJECT(COAVOID_LCM_ERR_COUNT, "obstacle_map: tile_count not in 1..MAX_TILES");
+    }
+    if (msg->tile_index < 0 || msg->tile_index >= msg->tile_count) {
+        REJECT(COAVOID_LCM_ERR_COUNT, "obstacle_map: tile_index not in 0..tile_count-1");
+    }
     if (msg->box_count < 0 || msg->box_count > COAVOID_OBSTACLE_MAP_T_MAX_BOXES) {
         REJECT(COAVOID_LCM_ERR_COUNT, "obstacle_map: box_count not in 0..MAX_BOXES");
     }
@@ -944,67 +1092,110 @@ int coavoid_lcm_obstacle_map_check(const coavoid_obstacle_map_t *msg,
             }
         }
     }
-    if (msg->polytope_count < 0 || msg->polytope_count > COAVOID_OBSTACLE_MAP_T_MAX_POLYTOPES) {
-        REJECT(COAVOID_LCM_ERR_COUNT, "obstacle_map: polytope_count not in 0..MAX_POLYTOPES");
-    }
-    for (i = 0; i < msg->polytope_count; ++i) {
-        if (msg->vertex_count[i] < 4 ||
-            msg->vertex_count[i] > COAVOID_OBSTACLE_MAP_T_MAX_VERTICES) {
-            REJECT(COAVOID_LCM_ERR_COUNT, "obstacle_map: a vertex_count not in 4..MAX_VERTICES");
-        }
-        for (j = 0; j < msg->vertex_count[i]; ++j) {
-            if ((rc = vec_rule(msg->vertices[i][j], COAVOID_LCM_MAX_COORDINATE)) != COA_OK) {
-                REJECT(rc, "obstacle_map: a vertex non-finite or out of range");
-            }
-        }
+    if ((rc = map_polytopes_check(msg, reason)) != COA_OK) {
+        return rc;
     }
     OK_REASON();
     return COA_OK;
 }
 
-int coavoid_lcm_obstacle_map_to_core(const coavoid_obstacle_map_t *msg,
-                                     const coavoid_lcm_context_t *ctx,
-                                     coavoid_lcm_sequence_table_t *seq, coa_obstacle_t *obstacles,
-                                     size_t capacity, size_t *count, coa_vec3_t *vertices,
-                                     size_t vertex_capacity, const char **reason)
+int coavoid_lcm_obstacle_map_accept(const coavoid_obstacle_map_t *msg,
+                                    const coavoid_lcm_context_t *ctx,
+                                    coavoid_lcm_sequence_table_t *seq, const char **reason)
 {
     int rc;
-    int32_t i;
-    int32_t j;
-    size_t n = 0;
-    size_t used = 0;
-    size_t need = 0;
-    if (obstacles == NULL || count == NULL || (vertices == NULL && vertex_capacity > 0u)) {
-        REJECT(COA_ERR_ARGUMENT, "obstacle_map: NULL output");
-    }
     if ((rc = coavoid_lcm_obstacle_map_check(msg, ctx, reason)) != COA_OK) {
         return rc;
-    }
-    for (i = 0; i < msg->polytope_count; ++i) {
-        need += (size_t)msg->vertex_count[i];
-    }
-    if ((size_t)msg->box_count + (size_t)msg->polytope_count > capacity || need > vertex_capacity) {
-        REJECT(COAVOID_LCM_ERR_CAPACITY,
-               "obstacle_map: more obstacles than the caller's arrays hold");
     }
     if ((rc = sequence_rule(seq, msg->map_id, msg->version, true, reason,
                             "obstacle_map: version lower than one already seen",
                             "obstacle_map: sequence table full")) != COA_OK) {
         return rc;
     }
-    for (i = 0; i < msg->box_count; ++i, ++n) {
-        memset(&obstacles[n], 0, sizeof obstacles[n]);
-        obstacles[n].kind = COA_OBSTACLE_BOX;
-        obstacles[n].box.min = vec_of(msg->box_min[i]);
-        obstacles[n].box.max = vec_of(msg->box_max[i]);
+    OK_REASON();
+    return COA_OK;
+}
+
+/* Whether tiles[0..n) are tiles 0..n-1 of one map version of n tiles, within the map's
+ * capacity and the caller's. */
+static int map_tiles_check(const coavoid_obstacle_map_t *tiles, size_t n,
+                           const coavoid_lcm_context_t *ctx, size_t capacity,
+                           size_t vertex_capacity, const char **reason)
+{
+    size_t t;
+    int32_t i;
+    int rc;
+    size_t boxes = 0;
+    size_t polytopes = 0;
+    size_t vertices = 0;
+    if (n < 1u || n > (size_t)COAVOID_OBSTACLE_MAP_T_MAX_TILES) {
+        REJECT(COAVOID_LCM_ERR_COUNT, "obstacle_map: tile_count not in 1..MAX_TILES");
     }
-    for (i = 0; i < msg->polytope_count; ++i, ++n) {
-        memset(&obstacles[n], 0, sizeof obstacles[n]);
-        obstacles[n].kind = COA_OBSTACLE_POLYTOPE;
-        obstacles[n].polytope.vertices = &vertices[used];
-        obstacles[n].polytope.count = (size_t)msg->vertex_count[i];
-        for (j = 0; j < msg->vertex_count[i]; ++j) {
-            vertices[used++] = vec_of(msg->vertices[i][j]);
+    for (t = 0; t < n; ++t) {
+        if ((rc = coavoid_lcm_obstacle_map_check(&tiles[t], ctx, reason)) != COA_OK) {
+            return rc;
+        }
+        if (tiles[t].tile_index != (int32_t)t || tiles[t].tile_count != (int32_t)n ||
+            tiles[t].map_id != tiles[0].map_id || tiles[t].version != tiles[0].version) {
+            REJECT(COAVOID_LCM_ERR_COUNT,
+                   "obstacle_map: tiles not 0..tile_count-1 of one map_id and version");
+        }
+        boxes += (size_t)tiles[t].box_count;
+        polytopes += (size_t)tiles[t].polytope_count;
+        for (i = 0; i < tiles[t].polytope_count; ++i) {
+            vertices += (size_t)tiles[t].vertex_count[i];
+        }
+    }
+    if (boxes > (size_t)COAVOID_OBSTACLE_MAP_T_MAX_MAP_BOXES ||
+        polytopes > (size_t)COAVOID_OBSTACLE_MAP_T_MAX_MAP_POLYTOPES) {
+        REJECT(COAVOID_LCM_ERR_COUNT,
+               "obstacle_map: more than MAX_MAP_BOXES boxes or MAX_MAP_POLYTOPES polytopes");
+    }
+    if (boxes + polytopes > capacity || vertices > vertex_capacity) {
+        REJECT(COAVOID_LCM_ERR_CAPACITY,
+               "obstacle_map: more obstacles than the caller's arrays hold");
+    }
+    return COA_OK;
+}
+
+int coavoid_lcm_obstacle_map_to_core(const coavoid_obstacle_map_t *tiles, size_t tile_count,
+                                     const coavoid_lcm_context_t *ctx, coa_obstacle_t *obstacles,
+                                     size_t capacity, size_t *count, coa_vec3_t *vertices,
+                                     size_t vertex_capacity, const char **reason)
+{
+    int rc;
+    size_t t;
+    int32_t i;
+    int32_t j;
+    size_t n = 0;
+    size_t used = 0;
+    if (tiles == NULL || obstacles == NULL || count == NULL ||
+        (vertices == NULL && vertex_capacity > 0u)) {
+        REJECT(COA_ERR_ARGUMENT, "obstacle_map: NULL argument");
+    }
+    if ((rc = map_tiles_check(tiles, tile_count, ctx, capacity, vertex_capacity, reason)) !=
+        COA_OK) {
+        return rc;
+    }
+    /* Every box, then every polytope, in tile order: the order the world's list had. */
+    for (t = 0; t < tile_count; ++t) {
+        for (i = 0; i < tiles[t].box_count; ++i, ++n) {
+            memset(&obstacles[n], 0, sizeof obstacles[n]);
+            obstacles[n].kind = COA_OBSTACLE_BOX;
+            obstacles[n].box.min = vec_of(tiles[t].box_min[i]);
+            obstacles[n].box.max = vec_of(tiles[t].box_max[i]);
+        }
+    }
+    for (t = 0; t < tile_count; ++t) {
+        int32_t k = 0;
+        for (i = 0; i < tiles[t].polytope_count; ++i, ++n) {
+            memset(&obstacles[n], 0, sizeof obstacles[n]);
+            obstacles[n].kind = COA_OBSTACLE_POLYTOPE;
+            obstacles[n].polytope.vertices = &vertices[used];
+            obstacles[n].polytope.count = (size_t)tiles[t].vertex_count[i];
+            for (j = 0; j < tiles[t].vertex_count[i]; ++j) {
+                vertices[used++] = vec_of(tiles[t].vertices[k++]);
+            }
         }
     }
     *count = n;
@@ -1012,51 +1203,124 @@ int coavoid_lcm_obstacle_map_to_core(const coavoid_obstacle_map_t *msg,
     return COA_OK;
 }
 
+/* The tiling of a list of obstacles: box b goes to tile b / MAX_BOXES (b counting boxes
+ * only); polytopes fill tiles in order, the next tile when MAX_POLYTOPES or MAX_VERTICES
+ * would be passed. So the boxes, then the polytopes, of tiles 0, 1, ... are the list's in
+ * its order. *tile_of[i] is obstacle i's tile. Returns the tile count (>= 1), or a
+ * negative refusal. */
+static int map_tiling(const coa_obstacle_t *obstacles, size_t count, int32_t *tile_of,
+                      const char **reason)
+{
+    size_t i;
+    int32_t boxes = 0;
+    int32_t polys = 0;
+    int32_t poly_tile = 0;
+    int32_t poly_in_tile = 0;
+    int32_t vertices_in_tile = 0;
+    int32_t tiles = 1;
+    for (i = 0; i < count; ++i) {
+        const coa_obstacle_t *o = &obstacles[i];
+        if (o->kind == COA_OBSTACLE_BOX) {
+            tile_of[i] = boxes++ / COAVOID_OBSTACLE_MAP_T_MAX_BOXES;
+        } else if (o->kind == COA_OBSTACLE_POLYTOPE) {
+            if (o->polytope.count > (size_t)COAVOID_OBSTACLE_MAP_T_MAX_VERTICES ||
+                o->polytope.vertices == NULL) {
+                REJECT(COAVOID_LCM_ERR_COUNT, "obstacle_map: a polytope beyond MAX_VERTICES");
+            }
+            if (poly_in_tile == COAVOID_OBSTACLE_MAP_T_MAX_POLYTOPES ||
+                vertices_in_tile + (int32_t)o->polytope.count >
+                    COAVOID_OBSTACLE_MAP_T_MAX_VERTICES) {
+                poly_tile++;
+                poly_in_tile = 0;
+                vertices_in_tile = 0;
+            }
+            tile_of[i] = poly_tile;
+            poly_in_tile++;
+            vertices_in_tile += (int32_t)o->polytope.count;
+            polys++;
+        } else {
+            REJECT(COAVOID_LCM_ERR_ENUM, "obstacle_map: unknown obstacle kind");
+        }
+        tiles = (tile_of[i] + 1 > tiles) ? tile_of[i] + 1 : tiles;
+    }
+    if (boxes > COAVOID_OBSTACLE_MAP_T_MAX_MAP_BOXES ||
+        polys > COAVOID_OBSTACLE_MAP_T_MAX_MAP_POLYTOPES ||
+        tiles > COAVOID_OBSTACLE_MAP_T_MAX_TILES) {
+        REJECT(COAVOID_LCM_ERR_COUNT,
+               "obstacle_map: more than MAX_MAP_BOXES boxes, MAX_MAP_POLYTOPES polytopes or "
+               "MAX_TILES tiles");
+    }
+    return tiles;
+}
+
+int coavoid_lcm_obstacle_map_tiles(const coa_obstacle_t *obstacles, size_t count,
+                                   size_t *tile_count, const char **reason)
+{
+    int32_t tile_of[COAVOID_LCM_MAP_MAX_OBSTACLES];
+    int rc;
+    if ((obstacles == NULL && count > 0u) || tile_count == NULL) {
+        REJECT(COA_ERR_ARGUMENT, "obstacle_map: NULL argument");
+    }
+    if (count > COAVOID_LCM_MAP_MAX_OBSTACLES) {
+        REJECT(COAVOID_LCM_ERR_COUNT,
+               "obstacle_map: more than MAX_MAP_BOXES boxes and MAX_MAP_POLYTOPES polytopes");
+    }
+    if ((rc = map_tiling(obstacles, count, tile_of, reason)) < 0) {
+        return rc;
+    }
+    *tile_count = (size_t)rc;
+    OK_REASON();
+    return COA_OK;
+}
+
 int coavoid_lcm_obstacle_map_from_core(const coa_obstacle_t *obstacles, size_t count, int64_t utime,
-                                       uint32_t map_id, int64_t version,
+                                       uint32_t map_id, int64_t version, size_t tile_index,
                                        const coavoid_lcm_context_t *ctx,
                                        coavoid_obstacle_map_t *msg, const char **reason)
 {
+    int32_t tile_of[COAVOID_LCM_MAP_MAX_OBSTACLES];
     size_t i;
     size_t j;
-    int32_t boxes = 0;
-    int32_t polys = 0;
+    int tiles;
+    int32_t used = 0;
     if ((obstacles == NULL && count > 0u) || msg == NULL) {
         REJECT(COA_ERR_ARGUMENT, "obstacle_map: NULL argument");
     }
     if (map_id > (uint32_t)COAVOID_LCM_MAX_ID) {
         REJECT(COAVOID_LCM_ERR_ID, "obstacle_map: map_id not in 1..65535");
     }
+    if (count > COAVOID_LCM_MAP_MAX_OBSTACLES) {
+        REJECT(COAVOID_LCM_ERR_COUNT,
+               "obstacle_map: more than MAX_MAP_BOXES boxes and MAX_MAP_POLYTOPES polytopes");
+    }
+    if ((tiles = map_tiling(obstacles, count, tile_of, reason)) < 0) {
+        return tiles;
+    }
+    if (tile_index >= (size_t)tiles) {
+        REJECT(COAVOID_LCM_ERR_COUNT, "obstacle_map: tile_index not in 0..tile_count-1");
+    }
     memset(msg, 0, sizeof *msg);
     msg->utime = utime;
     msg->map_id = (int32_t)map_id;
     msg->version = version;
+    msg->tile_index = (int32_t)tile_index;
+    msg->tile_count = tiles;
     for (i = 0; i < count; ++i) {
         const coa_obstacle_t *o = &obstacles[i];
+        if (tile_of[i] != (int32_t)tile_index) {
+            continue;
+        }
         if (o->kind == COA_OBSTACLE_BOX) {
-            if (boxes >= COAVOID_OBSTACLE_MAP_T_MAX_BOXES) {
-                REJECT(COAVOID_LCM_ERR_COUNT, "obstacle_map: more than MAX_BOXES boxes");
-            }
-            vec_to(o->box.min, msg->box_min[boxes]);
-            vec_to(o->box.max, msg->box_max[boxes]);
-            boxes++;
-        } else if (o->kind == COA_OBSTACLE_POLYTOPE) {
-            if (polys >= COAVOID_OBSTACLE_MAP_T_MAX_POLYTOPES ||
-                o->polytope.count > (size_t)COAVOID_OBSTACLE_MAP_T_MAX_VERTICES ||
-                o->polytope.vertices == NULL) {
-                REJECT(COAVOID_LCM_ERR_COUNT, "obstacle_map: too many polytopes or vertices");
-            }
-            msg->vertex_count[polys] = (int32_t)o->polytope.count;
-            for (j = 0; j < o->polytope.count; ++j) {
-                vec_to(o->polytope.vertices[j], msg->vertices[polys][j]);
-            }
-            polys++;
+            vec_to(o->box.min, msg->box_min[msg->box_count]);
+            vec_to(o->box.max, msg->box_max[msg->box_count]);
+            msg->box_count++;
         } else {
-            REJECT(COAVOID_LCM_ERR_ENUM, "obstacle_map: unknown obstacle kind");
+            msg->vertex_count[msg->polytope_count++] = (int32_t)o->polytope.count;
+            for (j = 0; j < o->polytope.count; ++j) {
+                vec_to(o->polytope.vertices[j], msg->vertices[used++]);
+            }
         }
     }
-    msg->box_count = boxes;
-    msg->polytope_count = polys;
     return coavoid_lcm_obstacle_map_check(msg, ctx, reason);
 }
 
@@ -1123,8 +1387,8 @@ int coavoid_lcm_conflict_report_check(const coavoid_conflict_report_t *msg,
         if (msg->probability[i] < 0.0 || msg->probability[i] > 1.0) {
             REJECT(COAVOID_LCM_ERR_VALUE, "conflict_report: a probability outside [0, 1]");
         }
-        if (msg->cluster[i] < -1 ||
-            msg->cluster[i] >= COAVOID_CONFLICT_REPORT_T_MAX_CONFLICTS * 2) {
+        /* A label numbers a cluster of UAVs, fewer than there are UAV ids. */
+        if (msg->cluster[i] < -1 || msg->cluster[i] >= COAVOID_LCM_MAX_ID) {
             REJECT(COAVOID_LCM_ERR_VALUE, "conflict_report: a cluster label out of range");
         }
     }

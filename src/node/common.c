@@ -442,6 +442,52 @@ static void obstacles_merge(coavoid_node_inbox_t *in)
     in->obstacle_count = count;
 }
 
+/* Keeps an accepted tile; when it completes a version other than the one in use, that
+ * version replaces it (the conversion checks the whole before it writes, so a version
+ * that does not convert leaves the map in use untouched). Returns COA_OK or the refusal
+ * that counts against this tile. */
+static int map_tile_keep(coavoid_node_inbox_t *in, const coavoid_obstacle_map_t *msg,
+                         const coavoid_lcm_context_t *ctx, const char **reason)
+{
+    if (in->have_map && msg->map_id == in->map_id && msg->version == in->map_version) {
+        return COA_OK; /* the map in use, republished */
+    }
+    const coavoid_obstacle_map_t *first = &in->map_tiles[0];
+    bool same = false;
+    for (size_t i = 0; i < COAVOID_OBSTACLE_MAP_T_MAX_TILES && !same; i++) {
+        const coavoid_obstacle_map_t *t = &in->map_tiles[i];
+        same = (in->map_tiles_have & (UINT32_C(1) << i)) != 0u && t->map_id == msg->map_id &&
+               t->version == msg->version;
+        first = same ? t : first;
+    }
+    if (same && first->tile_count != msg->tile_count) {
+        *reason = "obstacle_map: tile_count differs from the other tiles of its version";
+        return COAVOID_LCM_ERR_COUNT;
+    }
+    if (!same) {
+        in->map_tiles_have = 0u; /* a newer version, or another map: start over */
+    }
+    in->map_tiles[msg->tile_index] = *msg;
+    in->map_tiles_have |= UINT32_C(1) << (uint32_t)msg->tile_index;
+    if (in->map_tiles_have != UINT32_MAX >> (32u - (uint32_t)msg->tile_count)) {
+        return COA_OK;
+    }
+    in->map_tiles_have = 0u;
+    size_t count = 0;
+    int rc = coavoid_lcm_obstacle_map_to_core(
+        in->map_tiles, (size_t)msg->tile_count, ctx, in->map_obstacles,
+        COAVOID_NODE_MAX_MAP_OBSTACLES, &count, in->vertices, COAVOID_NODE_MAX_VERTICES, reason);
+    if (rc != COA_OK) {
+        return rc;
+    }
+    in->map_obstacle_count = count;
+    in->map_id = msg->map_id;
+    in->map_version = msg->version;
+    in->have_map = true;
+    obstacles_merge(in);
+    return COA_OK;
+}
+
 static void on_map(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
 {
     coavoid_node_inbox_t *in = user;
@@ -461,21 +507,13 @@ static void on_map(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
     }
     const int64_t now = *in->common.clock;
     coavoid_lcm_context_t ctx = coavoid_node_context(in, now, now);
-    size_t count = 0;
     const char *reason = NULL;
-    /* The conversion checks everything before it writes, so a refused map leaves the
-     * one in use untouched. */
-    int rc = coavoid_lcm_obstacle_map_to_core(
-        msg, &ctx, sequence_table(in, &in->map_seq), in->map_obstacles,
-        COAVOID_NODE_MAX_MAP_OBSTACLES, &count, in->vertices, COAVOID_NODE_MAX_VERTICES, &reason);
-    coavoid_lcm_rx_count(in->rx, rc, reason);
-    if (rc != COA_OK) {
-        return;
+    int rc = coavoid_lcm_obstacle_map_accept(msg, &ctx, sequence_table(in, &in->map_seq), &reason);
+    if (rc == COA_OK) {
+        senders_heard(&in->map_seq, (uint32_t)msg->map_id, now);
+        rc = map_tile_keep(in, msg, &ctx, &reason);
     }
-    senders_heard(&in->map_seq, (uint32_t)msg->map_id, now);
-    in->map_obstacle_count = count;
-    in->have_map = true;
-    obstacles_merge(in);
+    coavoid_lcm_rx_count(in->rx, rc, reason);
 }
 
 static void on_status(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
@@ -556,14 +594,17 @@ static void on_plan(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
     /* No sequence rule across cycles: a plan is only ever adopted in the cycle its
      * valid_from names, and the vehicle orders the plans of one cycle itself. A table
      * remembering plan_ids would let one forged INT64_MAX, or a coordinator restarted
-     * while its heartbeat kept the entry alive, lock every later plan out. */
-    int rc = coavoid_lcm_plan_to_core(msg, &ctx, NULL, &info, &result, in->rx_offsets,
-                                      sizeof in->rx_offsets / sizeof in->rx_offsets[0], &reason);
-    if (rc != COA_OK) {
-        coavoid_lcm_rx_count(in->rx, rc, reason);
+     * while its heartbeat kept the entry alive, lock every later plan out. A plan is
+     * decided on only once all its rows (one message per UAV) have come. */
+    const coavoid_plan_t *whole = NULL;
+    int rc =
+        coavoid_lcm_plan_collect(&in->plan_rows, msg, &ctx, &whole, &info, &result, in->rx_offsets,
+                                 sizeof in->rx_offsets / sizeof in->rx_offsets[0], &reason);
+    if (rc != COA_OK || whole == NULL) {
+        coavoid_lcm_rx_count(in->rx, rc, reason); /* refused, or a row kept */
         return;
     }
-    in->on_plan(in->owner, msg, &info, &result, in->rx_offsets);
+    in->on_plan(in->owner, whole, &info, &result, in->rx_offsets);
 }
 
 static int subscribe(coavoid_node_inbox_t *in, const char *channel, lcm_msg_handler_t handler)
@@ -615,7 +656,11 @@ int coavoid_node_inbox_init(coavoid_node_inbox_t *in, const coavoid_node_common_
     memset(in->peers, 0, sizeof in->peers);
     memset(in->tracks, 0, sizeof in->tracks);
     in->have_map = false;
+    in->map_id = 0;
+    in->map_version = 0;
+    in->map_tiles_have = 0u;
     in->map_obstacle_count = 0;
+    coavoid_lcm_plan_rows_init(&in->plan_rows, in->plan_slots, COAVOID_NODE_PLAN_SLOTS);
     obstacles_merge(in);
     memset(in->own_hash, 0, sizeof in->own_hash);
     memset(in->own_size, 0, sizeof in->own_size);
@@ -1043,11 +1088,21 @@ void coavoid_node_tx_fini(coavoid_node_tx_t *tx)
 #define COAVOID_NODE_SEAL(tx, type, msg) \
     (seal((tx), type##_encoded_size(msg), type##_encode((tx)->buf, 0, (int)sizeof(tx)->buf, (msg))))
 
+/* Whether an encoded message of `size` bytes may go out: at most one datagram
+ * (COAVOID_LCM_MAX_DATAGRAM_BYTES), so that no message is fragmented on the way; every type
+ * fits, so a larger one is a bug, refused rather than sent. O(1). */
+static bool fits_datagram(int size)
+{
+    return size > 0 && size <= COAVOID_LCM_MAX_DATAGRAM_BYTES &&
+           (size_t)size <= COAVOID_NODE_TX_BYTES;
+}
+
 /* The size of the message encoded into tx->buf (encoded: the encoder's return, expected
- * to be `size`), signed unless the node is insecure; or a negative error. */
+ * to be `size`), signed unless the node is insecure; or a negative error. Nothing over
+ * one datagram is encoded. */
 static int seal(coavoid_node_tx_t *tx, int size, int encoded)
 {
-    if (size <= 0 || (size_t)size > sizeof tx->buf || encoded != size) {
+    if (!fits_datagram(size) || encoded != size) {
         return COA_ERR_WORKSPACE;
     }
     if (tx->sign && coavoid_auth_stamp(&tx->signer, *tx->clock, tx->buf, (size_t)size) != COA_OK) {

@@ -30,7 +30,7 @@ struct coavoid_coordinator {
     coa_vehicle_t vehicles[COA_MAX_VEHICLES];
     const coa_vec3_t *references[COA_MAX_VEHICLES];
     int32_t offsets[(size_t)COA_MAX_VEHICLES * COAVOID_NODE_MAX_SAMPLES];
-    coavoid_plan_t tx_plan;
+    coavoid_plan_t tx_plan[COA_MAX_VEHICLES]; /* one message per UAV of a plan */
     coavoid_conflict_report_t tx_report;
     coavoid_status_t tx_status;
 
@@ -272,8 +272,9 @@ static int cluster_plan(coavoid_coordinator_t *node, int64_t now, const coa_prob
     return rc;
 }
 
-/* The plan message of the cluster's result, checked as a receiver would (COA_ERR_ARGUMENT
- * when it fails), then published (what publishing returned in *published). */
+/* The plan messages of the cluster's result, one per UAV in the result's order, each
+ * checked as a receiver would (COA_ERR_ARGUMENT when one fails: none is sent), then
+ * published back to back (the first publishing error in *published). */
 static int cluster_publish(coavoid_coordinator_t *node, int64_t now, int64_t cycle_start,
                            size_t count, bool centralised, const coa_plan_result_t *result,
                            bool abandoned, int *published)
@@ -295,17 +296,24 @@ static int cluster_publish(coavoid_coordinator_t *node, int64_t now, int64_t cyc
         info.uav_ids[m] = node->vehicles[m].id;
     }
     coavoid_lcm_context_t ctx = coavoid_node_context(&node->inbox, now, cycle_start);
-    int rc = coavoid_lcm_plan_from_core(&info, result, node->offsets, &ctx, &node->tx_plan, NULL);
-    if (rc == COA_OK) {
-        /* The validity window in exact microseconds, whatever the core's precision. */
-        node->tx_plan.valid_from_utime = cycle_start;
-        node->tx_plan.valid_until_utime = cycle_start + c->dt_us;
-        rc = coavoid_lcm_plan_check(&node->tx_plan, &ctx, NULL);
+    for (size_t row = 0; row < count; row++) {
+        coavoid_plan_t *msg = &node->tx_plan[row];
+        int rc = coavoid_lcm_plan_from_core(&info, result, node->offsets, row, &ctx, msg, NULL);
+        if (rc == COA_OK) {
+            /* The validity window in exact microseconds, whatever the core's precision. */
+            msg->valid_from_utime = cycle_start;
+            msg->valid_until_utime = cycle_start + c->dt_us;
+            rc = coavoid_lcm_plan_check(msg, &ctx, NULL);
+        }
+        if (rc != COA_OK) {
+            return COA_ERR_ARGUMENT;
+        }
     }
-    if (rc != COA_OK) {
-        return COA_ERR_ARGUMENT;
+    *published = COA_OK;
+    for (size_t row = 0; row < count; row++) {
+        int rc = coavoid_node_publish_plan(&node->inbox.tx, &node->tx_plan[row]);
+        *published = (*published == COA_OK) ? rc : *published;
     }
-    *published = coavoid_node_publish_plan(&node->inbox.tx, &node->tx_plan);
     return COA_OK;
 }
 

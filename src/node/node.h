@@ -15,8 +15,10 @@
  * which is scenario time t_k = k * dt (a UAV's reference is sampled at k * dt exactly).
  *
  * One cycle (the closed loop of docs/scenario-format.md, "Simulation result"):
- *   1. At cycle_utime(k) the world publishes the obstacle map and every track's estimate
- *      (in real time a quarter cycle ahead, so that they are there when the UAVs decide).
+ *   1. At cycle_utime(k) the world publishes every tile of the obstacle map and every
+ *      track's estimate (in real time a quarter cycle ahead, so that they are there when
+ *      the UAVs decide). Every message fits one datagram (COAVOID_LCM_MAX_DATAGRAM_BYTES,
+ *      docs/messages.md): a map is tiles, a plan one message per UAV.
  *   2. At cycle_utime(k) every UAV steps its simulated flight to sample k (the offset its
  *      adopted plan gives for k; a plan past its end holds its last offset).
  *      - centralised (a heartbeat of its coordinator heard within
@@ -64,16 +66,22 @@
  *      (decoupled, in the coordinator, for a cluster larger than its workspace holds, or
  *      when the composite search runs out of beta before proving anything),
  *      clusters in ascending order, each later cluster treating the new plans of the
- *      earlier ones as moving obstacles; publishes one plan_t per cluster (valid_from =
- *      cycle_utime(k), valid_until = cycle_utime(k + 1)), the conflict report, and its
- *      heartbeat. Past its planning budget (plan_budget_us) a cluster is abandoned
- *      instead: a plan_t with STATUS_ABANDONED lists its UAVs, which are not answered by
- *      it and plan for themselves. A cluster is only who conflicts now, and its way out can be blocked by
+ *      earlier ones as moving obstacles; publishes one plan per cluster (valid_from =
+ *      cycle_utime(k), valid_until = cycle_utime(k + 1)) as one plan_t per UAV of the
+ *      cluster, back to back (each with the plan's header, its UAV list and that UAV's
+ *      row), the conflict report, and its heartbeat. Past its planning budget
+ *      (plan_budget_us) a cluster is abandoned instead: a plan with STATUS_ABANDONED
+ *      lists its UAVs (a message to each, no rows), which are not answered by it and plan
+ *      for themselves. A cluster is only who conflicts now, and its way out can be blocked by
  *      UAVs that do not (a UAV that must climb over terrain into the altitude of passing
  *      traffic): when a cluster's plan fails, every clustered UAV is planned again as one
  *      group, and failing that every UAV, from the intents as they came; that plan_t
  *      (a newer plan_id) supersedes the cycle's earlier ones for its UAVs.
- *   4. A UAV adopts a plan_t that lists it among the planned rows, is solved, arrives
+ *   4. A UAV collects the messages of each plan (every plan, for it or not) and decides on
+ *      a plan only once it holds the row of every UAV the plan lists: a plan missing a row
+ *      is never adopted, nor refused (it did not come: the UAV is unanswered, above), and
+ *      a message that disagrees with the rest of its plan is refused. It adopts a whole
+ *      plan that lists it among the planned rows, is solved, arrives
  *      before valid_until, has valid_from == the current cycle's start, has a plan_id
  *      greater than that of any plan it adopted in this cycle (so that a later plan of
  *      the cycle supersedes), starts at the offset the UAV flies now, and over this
@@ -105,8 +113,11 @@
  *
  * Messages arrive through LCM subscriptions made at init; each is verified (its signature
  * over the raw bytes, then its key's role and freshness: common.trust, auth.h), decoded
- * and validated (src/lcm) with the driver's clock, counted, and stored (the latest intent per UAV, per
- * track, the obstacle map, the coordinator's heartbeat); a refused message is counted in
+ * and validated (src/lcm) with the driver's clock, counted, and stored (the latest intent
+ * per UAV, per track, the obstacle map, the coordinator's heartbeat). A map's tiles are
+ * assembled per version, and a version replaces the map in use only once every one of its
+ * tiles has come (a half map never replaces a whole one; the configured obstacles always
+ * stay); a refused message is counted in
  * the node's status and otherwise ignored, never fatal. A node's own messages come back
  * to it and are not counted; but an intent with a UAV's own id that it did not publish
  * (not byte for byte one of its latest) is another UAV using the same id: refused
@@ -138,9 +149,9 @@
 #define COAVOID_CHANNEL_STATUS "COAVOID_STATUS"
 
 /* Capacities of one node's view of the airspace. */
-#define COAVOID_NODE_MAX_PEERS 64u    /* co-operative UAVs a node tracks, itself included */
-#define COAVOID_NODE_MAX_TRACKS 32u   /* non-cooperative tracks */
-#define COAVOID_NODE_MAX_HORIZON 127u /* N: intent_t carries N + 1 samples */
+#define COAVOID_NODE_MAX_PEERS 64u   /* co-operative UAVs a node tracks, itself included */
+#define COAVOID_NODE_MAX_TRACKS 32u  /* non-cooperative tracks */
+#define COAVOID_NODE_MAX_HORIZON 40u /* N: intent_t carries N + 1 samples, in one datagram */
 #define COAVOID_NODE_MAX_CONFIGURED_OBSTACLES 80u /* a node's own terrain database */
 
 /* The world's id (map_id of the obstacle map, source_id of tracks) by default. */
@@ -348,14 +359,15 @@ typedef struct {
 typedef struct coavoid_world coavoid_world_t;
 
 /* Creates the world node (about 40 kB; it subscribes to nothing). NULL with
- * COA_ERR_ARGUMENT when the obstacles do not fit one obstacle_map_t, there are more than
+ * COA_ERR_ARGUMENT when the obstacles do not fit one map's tiles (64 boxes, 16 polytopes
+ * of up to 32 vertices: coavoid_lcm_obstacle_map_tiles), there are more than
  * COAVOID_NODE_MAX_TRACKS tracks, or a track is invalid or its id not unique in
  * 1..2^31-1; COA_ERR_WORKSPACE when out of memory. */
 coavoid_world_t *coavoid_world_create(const coavoid_world_config_t *config, lcm_t *lcm, int *error);
 /* Frees. NULL is fine. */
 void coavoid_world_destroy(coavoid_world_t *node);
-/* Step 1 of the file comment: the obstacle map (version 1, republished every cycle so that
- * late joiners get it) and every track's estimate at the cycle's start (its position and
+/* Step 1 of the file comment: every tile of the obstacle map (version 1, republished every
+ * cycle so that late joiners get it) and every track's estimate at the cycle's start (its position and
  * velocity there; a path track also with its path over the next horizon: its position
  * now, the path's points within N dt, and its position where the message's 16 points
  * end or the horizon does). Once per cycle. Returns COA_OK or the first error (a message

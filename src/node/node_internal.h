@@ -27,14 +27,13 @@ _Static_assert(COAVOID_NODE_MAX_SAMPLES == (unsigned)COAVOID_INTENT_T_MAX_SAMPLE
                    COAVOID_NODE_MAX_SAMPLES == (unsigned)COAVOID_PLAN_T_MAX_SAMPLES,
                "an intent and a plan carry N + 1 samples of the node's largest horizon");
 
-/* Room for one obstacle map (boxes, then polytopes) and its vertices. */
-#define COAVOID_NODE_MAX_MAP_OBSTACLES \
-    ((size_t)COAVOID_OBSTACLE_MAP_T_MAX_BOXES + (size_t)COAVOID_OBSTACLE_MAP_T_MAX_POLYTOPES)
+/* Room for one obstacle map (all its tiles: boxes, then polytopes) and its vertices. */
+#define COAVOID_NODE_MAX_MAP_OBSTACLES COAVOID_LCM_MAP_MAX_OBSTACLES
 /* What a node avoids: its configured obstacles, then the map's that are not among them. */
 #define COAVOID_NODE_MAX_OBSTACLES \
     ((size_t)COAVOID_NODE_MAX_CONFIGURED_OBSTACLES + COAVOID_NODE_MAX_MAP_OBSTACLES)
 #define COAVOID_NODE_MAX_VERTICES \
-    ((size_t)COAVOID_OBSTACLE_MAP_T_MAX_POLYTOPES * (size_t)COAVOID_OBSTACLE_MAP_T_MAX_VERTICES)
+    ((size_t)COAVOID_OBSTACLE_MAP_T_MAX_MAP_POLYTOPES * (size_t)COAVOID_OBSTACLE_MAP_T_MAX_VERTICES)
 
 /* Tracks one cycle can hold: the real ones plus every UAV as a moving obstacle (live or
  * stale: together at most MAX_PEERS). */
@@ -47,9 +46,13 @@ _Static_assert(COAVOID_NODE_MAX_SAMPLES == (unsigned)COAVOID_INTENT_T_MAX_SAMPLE
  * velocity guess is meaningless by then. */
 #define COAVOID_NODE_DROP_HORIZONS 1
 
-/* Encoded messages are written here before lcm_publish: the largest type (plan_t) is
- * about 16.6 kB. */
-#define COAVOID_NODE_TX_BYTES 20000u
+/* Encoded messages are written here before lcm_publish: one datagram at most. */
+#define COAVOID_NODE_TX_BYTES ((size_t)COAVOID_LCM_MAX_DATAGRAM_BYTES)
+
+/* Plans whose rows a UAV collects at once: the coordinator sends a plan's rows back to
+ * back, so one is usually enough; more keep a plan whole when rows of another (a late
+ * one, a forger's) come between. */
+#define COAVOID_NODE_PLAN_SLOTS 4u
 
 /* How many of its latest intents a node remembers, to tell them when they come back. */
 #define COAVOID_NODE_OWN_INTENTS 4u
@@ -86,9 +89,10 @@ typedef struct {
 
 typedef struct coavoid_node_inbox coavoid_node_inbox_t;
 
-/* Called for a plan_t that decoded, is not the node's own and passed validation; no
- * sequence rule is applied to plans (vehicle.c orders those of one cycle, decides on
- * adoption and counts the outcome itself). */
+/* Called for a whole plan: the message that completed it (every listed UAV's row decoded
+ * and passed validation, from its coordinator); msg is the plan's first message, its
+ * header. No sequence rule is applied to plans (vehicle.c orders those of one cycle,
+ * decides on adoption and counts the outcome itself). */
 typedef void (*coavoid_node_plan_handler_t)(void *owner, const coavoid_plan_t *msg,
                                             const coavoid_lcm_plan_info_t *info,
                                             const coa_plan_result_t *result,
@@ -118,7 +122,13 @@ struct coavoid_node_inbox {
     coavoid_node_track_slot_t tracks[COAVOID_NODE_MAX_TRACKS];
 
     bool have_map;
-    coa_obstacle_t map_obstacles[COAVOID_NODE_MAX_MAP_OBSTACLES]; /* the latest map's */
+    int32_t map_id; /* the map in use (have_map) */
+    int64_t map_version;
+    /* The tiles of the version being assembled (map_tiles_have: bit i, tile i has come):
+     * it replaces the map in use once every tile has come, never before. */
+    coavoid_obstacle_map_t map_tiles[COAVOID_OBSTACLE_MAP_T_MAX_TILES];
+    uint32_t map_tiles_have;
+    coa_obstacle_t map_obstacles[COAVOID_NODE_MAX_MAP_OBSTACLES]; /* the map in use */
     size_t map_obstacle_count;
     /* What the node avoids (obstacles_merge): common.obstacles, then the map's others. */
     coa_obstacle_t obstacles[COAVOID_NODE_MAX_OBSTACLES];
@@ -150,6 +160,9 @@ struct coavoid_node_inbox {
         coavoid_status_t status;
     } rx_msg;
     coavoid_lcm_intent_arrays_t rx_arrays;
+    /* The plans whose rows are being collected, and a whole plan's offsets. */
+    coavoid_lcm_plan_slot_t plan_slots[COAVOID_NODE_PLAN_SLOTS];
+    coavoid_lcm_plan_rows_t plan_rows;
     int32_t rx_offsets[(size_t)COAVOID_PLAN_T_MAX_VEHICLES * COAVOID_NODE_MAX_SAMPLES];
     coavoid_node_tx_t tx;
 };
@@ -309,9 +322,10 @@ void coavoid_node_tx_init(coavoid_node_tx_t *tx, lcm_t *lcm, const coavoid_node_
 void coavoid_node_tx_fini(coavoid_node_tx_t *tx);
 
 /* Publishing: encodes into tx->buf, signs it (coavoid_auth_stamp: one Ed25519 signature)
- * and publishes on the type's channel. COA_OK, or
- * COA_ERR_WORKSPACE (does not encode into the buffer) or COA_ERR_ARGUMENT (LCM refused
- * it). O(message); our code allocates nothing (the provider may, inside lcm_publish). */
+ * and publishes on the type's channel. COA_OK, or COA_ERR_WORKSPACE (over
+ * COAVOID_LCM_MAX_DATAGRAM_BYTES: never sent, or does not encode) or COA_ERR_ARGUMENT (LCM
+ * refused it, or it could not be signed). O(message); our code allocates nothing (the
+ * provider may, inside lcm_publish). */
 int coavoid_node_publish_plan(coavoid_node_tx_t *tx, const coavoid_plan_t *msg);
 int coavoid_node_publish_track(coavoid_node_tx_t *tx, const coavoid_track_t *msg);
 int coavoid_node_publish_map(coavoid_node_tx_t *tx, const coavoid_obstacle_map_t *msg);

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /*
  * The world node (node.h): a scenario's terrain database and tracker. Every cycle it
- * republishes the obstacle map (so that a node that joins late gets it) and each track's
+ * republishes every tile of the obstacle map (so that a node that joins late gets it) and each track's
  * estimate at the cycle's start.
  */
 #include "node_internal.h"
@@ -17,6 +17,7 @@ struct coavoid_world {
     int64_t cycle;
     int64_t track_sequence;
     int64_t max_age_us;
+    size_t map_tiles; /* the map's tiles, each published every cycle */
     coavoid_obstacle_map_t map_msg;
     coavoid_track_t track_msg;
 };
@@ -134,11 +135,16 @@ coavoid_world_t *coavoid_world_create(const coavoid_world_config_t *config, lcm_
     w->cycle = -1;
     w->max_age_us = config->common.stale_after_us +
                     ((int64_t)config->common.horizon + 2) * config->common.dt_us;
-    /* The map must fit the message and pass its check: find out now, not every cycle. */
+    /* The map must fit its tiles and each pass its check: find out now, not every cycle. */
     coavoid_lcm_context_t ctx = world_context(w, 0, config->common.epoch_utime);
-    if (coavoid_lcm_obstacle_map_from_core(config->obstacles, config->obstacle_count,
-                                           config->common.epoch_utime, w->config.id, 1, &ctx,
-                                           &w->map_msg, NULL) != COA_OK) {
+    int rc = coavoid_lcm_obstacle_map_tiles(config->obstacles, config->obstacle_count,
+                                            &w->map_tiles, NULL);
+    for (size_t i = 0; rc == COA_OK && i < w->map_tiles; i++) {
+        rc = coavoid_lcm_obstacle_map_from_core(config->obstacles, config->obstacle_count,
+                                                config->common.epoch_utime, w->config.id, 1, i,
+                                                &ctx, &w->map_msg, NULL);
+    }
+    if (rc != COA_OK) {
         coavoid_world_destroy(w);
         return NULL;
     }
@@ -171,13 +177,16 @@ int coavoid_world_cycle(coavoid_world_t *node, int64_t now)
     node->cycle = k;
     const int64_t cycle_start = coavoid_node_cycle_utime(c, k);
     coavoid_lcm_context_t ctx = world_context(node, now, cycle_start);
-    int rc =
-        coavoid_lcm_obstacle_map_from_core(node->config.obstacles, node->config.obstacle_count, now,
-                                           node->config.id, 1, &ctx, &node->map_msg, NULL);
-    if (rc == COA_OK) {
-        rc = coavoid_node_publish_map(&node->tx, &node->map_msg);
+    int first_error = COA_OK;
+    for (size_t i = 0; i < node->map_tiles; i++) {
+        int rc = coavoid_lcm_obstacle_map_from_core(
+            node->config.obstacles, node->config.obstacle_count, now, node->config.id, 1, i, &ctx,
+            &node->map_msg, NULL);
+        if (rc == COA_OK) {
+            rc = coavoid_node_publish_map(&node->tx, &node->map_msg);
+        }
+        first_error = (first_error == COA_OK) ? rc : first_error;
     }
-    int first_error = rc;
 
     const coa_real_t t = (coa_real_t)k * c->dt;
     const coa_real_t window = (coa_real_t)c->horizon * c->dt;
@@ -197,7 +206,7 @@ int coavoid_world_cycle(coavoid_world_t *node, int64_t now)
         info.utime = now;
         info.source_id = node->config.id;
         info.sequence = node->track_sequence++;
-        rc = coavoid_lcm_track_from_core(&estimate, &info, &ctx, &node->track_msg, NULL);
+        int rc = coavoid_lcm_track_from_core(&estimate, &info, &ctx, &node->track_msg, NULL);
         if (rc == COA_OK) {
             rc = coavoid_node_publish_track(&node->tx, &node->track_msg);
         }

@@ -612,10 +612,10 @@ static int sim_world(sim_run_t *r)
     r->world = coavoid_world_create(&world, r->lcm, &error);
     if (r->world == NULL && error == COA_ERR_ARGUMENT) {
         return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT,
-                                "%s: obstacles: more than an obstacle map message holds (%d boxes, "
+                                "%s: obstacles: more than an obstacle map holds (%d boxes, "
                                 "%d polytopes of at most %d vertices)",
-                                r->file, COAVOID_OBSTACLE_MAP_T_MAX_BOXES,
-                                COAVOID_OBSTACLE_MAP_T_MAX_POLYTOPES,
+                                r->file, COAVOID_OBSTACLE_MAP_T_MAX_MAP_BOXES,
+                                COAVOID_OBSTACLE_MAP_T_MAX_MAP_POLYTOPES,
                                 COAVOID_OBSTACLE_MAP_T_MAX_VERTICES);
     }
     if (r->world == NULL) {

@@ -13,7 +13,10 @@
 #   d) an attacker on the group (tests/forge/forge.c, lcm-logplayer), both modes: forged
 #      maps, plans and intents signed with a stolen vehicle key, copies with higher
 #      sequence numbers, replays of the run's own traffic and of an earlier run's log;
-# (the flights: late_encounter.json for a and b, paper.json with a lead-in for c and d)
+#   e) a path that drops every IP datagram over 1,500 bytes (an nftables rule in the
+#      namespace): every message fits one datagram, so the flight is the same as with no
+#      loss, and as `coavoid sim`'s;
+# (the flights: late_encounter.json for a and b, paper.json with a lead-in for c, d, e)
 # and every bad option or input of the drivers exits 2 with one line, the missing
 # multicast route included. Every process signs and checks with keys from
 # `coavoid keygen`; `--insecure` runs are named as such.
@@ -71,8 +74,9 @@ if ! lcm-gen -p --ppath "$tmp/py" "$src"/lcmtypes/*.lcm >/dev/null 2>&1; then
 fi
 
 # Every event of an lcm-logger log, decoded with the generated types by its channel;
-# prints a JSON summary (counts per channel, what the plans, statuses and conflict reports
-# say) or exits non-zero naming the first event that does not decode.
+# prints a JSON summary (counts per channel, what the plans (one message per UAV: gathered
+# by plan_id), statuses and conflict reports say, each node's last heartbeat reasons, the
+# largest event) or exits non-zero naming the first event that does not decode.
 cat >"$tmp/log.py" <<'PY'
 import json, struct, sys
 sys.path.insert(0, sys.argv[2])
@@ -82,8 +86,8 @@ types = {"COAVOID_INTENT": intent_t, "COAVOID_PLAN": plan_t, "COAVOID_TRACK": tr
          "COAVOID_STATUS": status_t}
 data = open(sys.argv[1], "rb").read()
 i, n = 0, 0
-counts, intents, statuses, plans, reports, rejected = {}, {}, {}, [], [], {}
-codes, reasons = {}, {}
+counts, intents, statuses, plans, reports, rejected = {}, {}, {}, {}, [], {}
+codes, reasons, largest = {}, {}, 0
 while i < len(data):
     magic, _, _, clen, dlen = struct.unpack_from(">IqqII", data, i)
     assert magic == 0xEDA1DA01, f"event {n}: bad magic at byte {i}"
@@ -99,21 +103,25 @@ while i < len(data):
     except Exception as e:
         sys.exit(f"event {n} on {channel} does not decode: {e!r}")
     counts[channel] = counts.get(channel, 0) + 1
+    largest = max(largest, dlen)
     if channel == "COAVOID_INTENT":
         intents[m.uav_id] = intents.get(m.uav_id, 0) + 1
     elif channel == "COAVOID_STATUS":
         statuses.setdefault(m.node_id, []).append(m.mode)
         rejected[m.node_id] = max(rejected.get(m.node_id, 0), m.messages_rejected)
         codes.setdefault(m.node_id, set()).add(m.last_reject_code)
-        reasons[m.node_id] = reasons.get(m.node_id, 0) | m.reasons
+        reasons[m.node_id] = m.reasons
     elif channel == "COAVOID_PLAN":
-        plans.append({"status": m.status, "ids": list(m.uav_ids[:m.vehicle_count])})
+        p = plans.setdefault((m.coordinator_id, m.plan_id), {
+            "status": m.status, "ids": list(m.uav_ids[:m.vehicle_count]), "rows": []})
+        p["rows"].append(m.row_uav_id)
     elif channel == "COAVOID_CONFLICTS":
         reports.append(m.conflict_count)
     n += 1
 print(json.dumps({"events": n, "counts": counts, "intents": intents, "statuses": statuses,
-                  "plans": plans, "reports": reports, "rejected": rejected,
-                  "codes": {k: sorted(v) for k, v in codes.items()}, "reasons": reasons}))
+                  "plans": list(plans.values()), "reports": reports, "rejected": rejected,
+                  "codes": {k: sorted(v) for k, v in codes.items()}, "reasons": reasons,
+                  "largest": largest}))
 PY
 
 # The fleet's keys, for every run (late_encounter.json and paper.json fly UAVs 1, 2, 3):
@@ -287,6 +295,16 @@ bin=$coordinator expect_bad "coordinator, --collect of a whole cycle" "--collect
     --scenario "$headon" --collect 1 --insecure
 bin=$coordinator expect_bad "coordinator, an unknown option" "unknown option" \
     --scenario "$headon" --id 1
+# A horizon whose intents would not fit one datagram (docs/messages.md).
+python3 - "$headon" "$tmp/long.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+s["horizon"] = 41
+json.dump(s, open(sys.argv[2], "w"))
+PY
+bin=$vehicle expect_bad "vehicle, horizon 41" "at most 40" --scenario "$tmp/long.json" --id 1
+bin=$coordinator expect_bad "coordinator, horizon 41" "at most 40" --scenario "$tmp/long.json"
+expect_bad "world, horizon 41" "at most 40" world "$tmp/long.json"
 expect_bad "world without a scenario" "SCENARIO" world
 expect_bad "world, bad speed" "--speed" world "$headon" --speed -1
 # Keys: required unless --insecure, never both; a key file must be the node's own, its
@@ -352,6 +370,8 @@ all(num(f'vehicle-{i}', 'plans run') == 0 for i in (1, 2, 3))
 all(num(p, 'rejected') == 0 for p in ('coordinator', 'vehicle-1', 'vehicle-2', 'vehicle-3'))
 num('coordinator', 'plans published') >= 2
 sum(p['status'] == 0 for p in log['plans']) >= 2
+all(sorted(p['rows']) == sorted(p['ids']) for p in log['plans'])
+log['largest'] <= 1400
 set(log['counts']) == {'COAVOID_INTENT', 'COAVOID_PLAN', 'COAVOID_STATUS', 'COAVOID_OBSTACLES', 'COAVOID_CONFLICTS'}
 log['intents'] == {str(i): 41 for i in (1, 2, 3)}
 all(len(log['statuses'][str(i)]) == 41 and set(log['statuses'][str(i)]) == {0} for i in (1, 2, 3))
@@ -478,6 +498,84 @@ $(reported -124 "$all")"
 $same
 all(log['rejected'][str(i)] >= 1 for i in ($all,))"
     done
+fi
+
+# ---- e) a path that drops every datagram over 1,500 bytes ----
+
+# Every message fits one datagram (docs/messages.md, "One datagram"): a message over
+# about 1,470 bytes would leave as one large UDP datagram for the kernel to fragment, and
+# a path with a 1,500-byte MTU that does not fragment (or loses a fragment) drops it. The
+# namespace's own rule does that to everything its processes receive (the senders do not
+# notice, as on such a path): the paper's flight, centralised and decoupled, must be the
+# flight of `coavoid sim`, with and without the rule, every plan whole and the map in use
+# everywhere (no REASON_NO_MAP, 64, in the last heartbeats).
+if [ -z "$netns" ]; then
+    echo "note: no private network namespace: the case of a path that drops large datagrams is not flown"
+elif ! command -v nft >/dev/null; then
+    fail "no nft (install nftables): the case of a path that drops large datagrams is not flown"
+else
+    speed=${SPEED:-4}
+    "$bin" sim "$tmp/paper_lead_in.json" --mode centralised --steps 48 --json >"$tmp/sim-centralised.json"
+    same_as_sim="rc == {'world': 0, 'coordinator': 0, 'vehicle-1': 0, 'vehicle-2': 0, 'vehicle-3': 0, 'summary': 0}
+all(num(p, 'rejected') == 0 for p in ('coordinator', 'vehicle-1', 'vehicle-2', 'vehicle-3'))
+all(num(f'vehicle-{i}', 'fallbacks') == 0 for i in (1, 2, 3))
+log['intents'] == {str(i): 49 for i in (1, 2, 3)}
+sum(p['status'] == 0 for p in log['plans']) >= 1
+all(sorted(p['rows']) == sorted(p['ids']) for p in log['plans'])
+all(log['reasons'][str(i)] & 64 == 0 for i in (1, 2, 3, 65001))
+log['largest'] <= 1400
+s is not None and s['loss_of_separation'] is False and s['steps'] == 48
+(lambda m: (s['deviation'], s['effort'], s['replans']) == (m['deviation'], m['effort'], m['replans']))(json.load(open('$tmp/sim-centralised.json')))
+[v['flown'] for v in s['vehicles']] == [v['flown'] for v in json.load(open('$tmp/sim-centralised.json'))['vehicles']]"
+    fleet lossless "$tmp/paper_lead_in.json" centralised 48 -
+    check lossless "$same_as_sim"
+    if ! nft add table inet coavoid_mtu ||
+        ! nft add chain inet coavoid_mtu in '{ type filter hook input priority 0; }' ||
+        ! nft add rule inet coavoid_mtu in meta length gt 1500 counter drop; then
+        fail "cannot install the nftables rule that drops datagrams over 1,500 bytes"
+    else
+        # The rule does drop: of two datagrams to the group, 2,000 and 1,000 bytes, only the
+        # second arrives (and the rule counts the first).
+        if python3 - <<'PY' >"$tmp/probe.out" 2>&1; then
+import socket, struct, sys
+group, port = "239.255.76.67", 7699
+rx = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+rx.bind(("", port))
+rx.setsockopt(socket.IPPROTO_IP, socket.IP_ADD_MEMBERSHIP,
+              struct.pack("4s4s", socket.inet_aton(group), socket.inet_aton("0.0.0.0")))
+rx.settimeout(0.5)
+tx = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+tx.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_TTL, 0)
+for size in (2000, 1000):
+    tx.sendto(b"x" * size, (group, port))
+got = []
+try:
+    while True:
+        got.append(len(rx.recv(4000)))
+except socket.timeout:
+    pass
+sys.exit(0 if got == [1000] else f"received {got}, expected [1000]")
+PY
+            pass
+        else
+            fail "the rule does not drop large datagrams: $(cat "$tmp/probe.out")"
+        fi
+        fleet dropping "$tmp/paper_lead_in.json" centralised 48 -
+        nft list table inet coavoid_mtu >"$tmp/dropping/rule.txt" 2>&1
+        check dropping "$same_as_sim
+int(re.search(r'packets (\\d+)', open(os.path.join(d, 'rule.txt')).read()).group(1)) >= 1"
+        # Decoupled, through the same rule: the flight of (c), `coavoid sim`'s.
+        speed=$speed_decoupled
+        fleet dropping-decoupled "$tmp/paper_lead_in.json" decoupled 48 -
+        check dropping-decoupled "rc == {'world': 0, 'vehicle-1': 0, 'vehicle-2': 0, 'vehicle-3': 0, 'summary': 0}
+all(num(f'vehicle-{i}', 'rejected') == 0 for i in (1, 2, 3))
+log['intents'] == {str(i): 49 for i in (1, 2, 3)}
+all(log['reasons'][str(i)] & 64 == 0 for i in (1, 2, 3))
+log['largest'] <= 1400
+s is not None and s['loss_of_separation'] is False and s['steps'] == 48
+[v['flown'] for v in s['vehicles']] == [v['flown'] for v in json.load(open('$tmp/decoupled/sim.json'))['vehicles']]"
+        nft delete table inet coavoid_mtu
+    fi
 fi
 
 finish

@@ -333,10 +333,11 @@ expect_bad "truncated file" "truncated.json" sim "$tmp/truncated.json" --mode ce
 python3 - "$h" "$tmp/long.json" <<'PY'
 import json, sys
 s = json.load(open(sys.argv[1]))
-s["horizon"] = 128
+s["horizon"] = 41
 json.dump(s, open(sys.argv[2], "w"))
 PY
-expect_bad "horizon 128" "horizon" sim "$tmp/long.json" --mode decoupled
+# An intent of 41 samples is what one datagram holds: a horizon of 40 steps.
+expect_bad "horizon 41" "at most 40" sim "$tmp/long.json" --mode decoupled
 python3 - "$h" "$tmp/crowd.json" <<'PY'
 import json, sys
 s = json.load(open(sys.argv[1]))

@@ -119,7 +119,7 @@ check_json() {
     fi
 }
 
-# ---- the paper scenario, planned centrally once at cycle 0 ----
+# ---- the paper scenario, planned centrally once at cycle 0 (one plan: a message per UAV) ----
 paper=$scenarios/paper.json
 if write paper "$paper" planned junk; then
     if expect_status "paper: text" 0 summary "$tmp/paper.log" "$paper" --mode centralised; then
@@ -134,7 +134,7 @@ if write paper "$paper" planned junk; then
         --json --svg "$tmp/paper.svg"; then
         check_json "paper json" "$paper" '{"mode": "centralised", "steps": 48, "replans": 1,
             "loss_of_separation": false, "log.intents": 149, "log.intents_refused": 1,
-            "log.intents_other_uavs": 1, "log.plans": 1, "log.samples_own_intent": 147,
+            "log.intents_other_uavs": 1, "log.plans": 3, "log.samples_own_intent": 147,
             "log.samples_missing": 0, "log.epoch_utime": 1700000000000000}'
         cp "$tmp/out" "$tmp/paper.json"
         if python3 -c 'import xml.dom.minidom,sys

@@ -145,6 +145,7 @@ static void forge_map(forger_t *f)
     m.utime = f->clock_utime;
     m.map_id = (int32_t)COAVOID_NODE_WORLD_ID;
     m.version = INT64_MAX;
+    m.tile_count = 1; /* a whole map in one tile */
     FORGE_SEND(f, coavoid_obstacle_map_t, COAVOID_CHANNEL_OBSTACLES, &m);
 }
 
@@ -178,9 +179,10 @@ static void forge_plan(forger_t *f, const coavoid_intent_t *t)
     m.vehicle_count = 1;
     m.planned_count = 1;
     m.uav_ids[0] = f->target;
+    m.row_uav_id = f->target; /* a whole plan of one UAV in one message */
     for (int32_t k = 0; k <= m.horizon; k++) {
         int32_t o = forged_offset(f, t, k);
-        m.offsets[0][k] = o > 32767 ? 32767 : (o < -32767 ? -32767 : o);
+        m.offsets[k] = o > 32767 ? 32767 : (o < -32767 ? -32767 : o);
     }
     FORGE_SEND(f, coavoid_plan_t, COAVOID_CHANNEL_PLAN, &m);
 }

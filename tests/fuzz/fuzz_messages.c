@@ -2,7 +2,8 @@
 /*
  * fuzz_messages.c: libFuzzer target for what a node does with a datagram from the network:
  * LCM's generated decoder, then src/lcm's check and conversion to the core's types (the
- * sequence rule included), for each of the six message types.
+ * sequence rule included; a plan's rows and a map's tiles collected across inputs), for
+ * each of the six message types.
  *
  * The first input byte picks the type (low bits) and the mode (high bit): raw, the rest of
  * the input is the datagram as it came; or mutated, the rest is XORed over the encoding
@@ -85,15 +86,22 @@ static void receive_intent(const unsigned char *buf, size_t size, coavoid_lcm_co
                 coavoid_lcm_intent_to_core(&m, ctx, seq, &info, &vehicle, &plan, &arrays, &why));
 }
 
-static void receive_plan(const unsigned char *buf, size_t size, coavoid_lcm_context_t *ctx,
-                         coavoid_lcm_sequence_table_t *seq)
+/* A plan's rows are collected across inputs, as a receiver collects them across
+ * datagrams, so that fuzzed rows also complete (or disagree with) a plan. */
+static void receive_plan(const unsigned char *buf, size_t size, coavoid_lcm_context_t *ctx)
 {
     static int32_t offsets[COAVOID_PLAN_T_MAX_VEHICLES * COAVOID_PLAN_T_MAX_SAMPLES];
+    static coavoid_lcm_plan_slot_t slots[2];
+    static coavoid_lcm_plan_rows_t rows;
     coavoid_lcm_plan_info_t info;
     coa_plan_result_t result;
+    const coavoid_plan_t *whole = NULL;
     const char *why = NULL;
+    if (rows.slots == NULL) {
+        coavoid_lcm_plan_rows_init(&rows, slots, 2);
+    }
     FUZZ_DECODE(coavoid_plan_t, m, buf, size,
-                coavoid_lcm_plan_to_core(&m, ctx, seq, &info, &result, offsets,
+                coavoid_lcm_plan_collect(&rows, &m, ctx, &whole, &info, &result, offsets,
                                          sizeof offsets / sizeof offsets[0], &why));
 }
 
@@ -109,21 +117,26 @@ static void receive_track(const unsigned char *buf, size_t size, coavoid_lcm_con
                                           COAVOID_TRACK_T_MAX_PATH, &why));
 }
 
+/* Accepted tiles are kept across inputs by index, as a receiver keeps them, and every
+ * tile count's worth of them is assembled (whatever versions they are of: the assembly
+ * judges that). */
 static void receive_map(const unsigned char *buf, size_t size, coavoid_lcm_context_t *ctx,
                         coavoid_lcm_sequence_table_t *seq)
 {
-    enum {
-        BOXES = COAVOID_OBSTACLE_MAP_T_MAX_BOXES,
-        POLYTOPES = COAVOID_OBSTACLE_MAP_T_MAX_POLYTOPES
-    };
-    static coa_obstacle_t obstacles[BOXES + POLYTOPES];
-    static coa_vec3_t vertices[POLYTOPES * COAVOID_OBSTACLE_MAP_T_MAX_VERTICES];
+    static coavoid_obstacle_map_t tiles[COAVOID_OBSTACLE_MAP_T_MAX_TILES];
+    static coa_obstacle_t obstacles[COAVOID_LCM_MAP_MAX_OBSTACLES];
+    static coa_vec3_t
+        vertices[COAVOID_OBSTACLE_MAP_T_MAX_MAP_POLYTOPES * COAVOID_OBSTACLE_MAP_T_MAX_VERTICES];
     size_t count = 0;
     const char *why = NULL;
-    FUZZ_DECODE(coavoid_obstacle_map_t, m, buf, size,
-                coavoid_lcm_obstacle_map_to_core(&m, ctx, seq, obstacles, BOXES + POLYTOPES, &count,
-                                                 vertices, sizeof vertices / sizeof vertices[0],
-                                                 &why));
+    FUZZ_DECODE(
+        coavoid_obstacle_map_t, m, buf, size,
+        if (coavoid_lcm_obstacle_map_accept(&m, ctx, seq, &why) == COA_OK) {
+            tiles[m.tile_index] = m;
+            (void)coavoid_lcm_obstacle_map_to_core(tiles, (size_t)m.tile_count, ctx, obstacles,
+                                                   COAVOID_LCM_MAP_MAX_OBSTACLES, &count, vertices,
+                                                   sizeof vertices / sizeof vertices[0], &why);
+        });
 }
 
 /* The signature check of any datagram, against a trust list of one known key. */
@@ -191,7 +204,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         receive_intent(buf, n, &ctx, &seq);
         break;
     case 1:
-        receive_plan(buf, n, &ctx, &seq);
+        receive_plan(buf, n, &ctx);
         break;
     case 2:
         receive_track(buf, n, &ctx, &seq);
