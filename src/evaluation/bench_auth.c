@@ -235,8 +235,10 @@ static void count_messages(const coavoid_bench_auth_fleet_t *f, size_t node, uin
         sent[COAVOID_AUTH_STREAM_TRACK] = f->tracks;
         return;
     }
-    /* Every node that listens hears every intent, map and track. */
-    received[COAVOID_AUTH_STREAM_INTENT] = f->vehicles;
+    /* Every node that listens hears every intent, map and track; a vehicle knows its own
+     * intent when it comes back before checking it (common.c). */
+    received[COAVOID_AUTH_STREAM_INTENT] =
+        node == COAVOID_BENCH_AUTH_VEHICLE ? f->vehicles - 1u : f->vehicles;
     received[COAVOID_AUTH_STREAM_MAP] = f->maps;
     received[COAVOID_AUTH_STREAM_TRACK] = f->tracks;
     if (node == COAVOID_BENCH_AUTH_VEHICLE) {
@@ -279,7 +281,7 @@ static void derive_fleet(const coavoid_bench_auth_result_t *r, uint32_t vehicles
 {
     f->vehicles = vehicles;
     f->tracks = vehicles / COAVOID_BENCH_AUTH_TRACKS_PER_VEHICLE;
-    f->maps = COAVOID_BENCH_AUTH_MAPS_PER_CYCLE;
+    f->maps = COAVOID_BENCH_AUTH_MAPS_PER_CYCLE; /* the worst case: a full map */
     f->plans = vehicles; /* the worst case: one plan message per UAV */
     for (size_t node = 0; node < COAVOID_BENCH_AUTH_NODES; node++) {
         derive_node(r, f, node, &f->nodes[node]);

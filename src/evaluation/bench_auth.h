@@ -17,13 +17,13 @@
  * Per cycle, for a fleet of N UAVs on one channel: the messages each node signs and checks
  * in one cycle of node.h's protocol, times the median costs above. Per cycle there are
  * N intents and N + 1 heartbeats (each UAV's, the coordinator's), the world's
- * COAVOID_BENCH_AUTH_MAPS_PER_CYCLE obstacle maps and one message per track (N / 50
+ * COAVOID_BENCH_AUTH_MAPS_PER_CYCLE obstacle map tiles and one message per track (N / 50
  * tracks, bench_predict.h's traffic; none for the demo's 3 UAVs, as in
  * scenarios/paper.json), one conflict report and, in the worst case, one plan per UAV
  * (the coordinator plans every UAV in a cluster of its own). A node checks every datagram
- * on the channels it subscribes to, its own looped-back ones included (the signature is
- * checked before anything is decoded):
- *   - a vehicle (centralised) sends 1 intent and 1 heartbeat, and checks the N intents,
+ * on the channels it subscribes to, its own looped-back heartbeat included (the signature
+ * is checked before anything is decoded; its own intent is known by its bytes first):
+ *   - a vehicle (centralised) sends 1 intent and 1 heartbeat, and checks the N - 1 intents,
  *     N + 1 heartbeats, N plans, the maps and the tracks;
  *   - the coordinator sends its heartbeat, the conflict report and N plans, and checks
  *     the N intents, the maps and the tracks;
@@ -51,9 +51,9 @@
 #define COAVOID_BENCH_AUTH_MAX_VEHICLES 65535u /* UAV ids are 16-bit */
 #define COAVOID_BENCH_AUTH_DEMO_VEHICLES 3u    /* scenarios/paper.json, the demo's fleet */
 #define COAVOID_BENCH_AUTH_LARGE_VEHICLES 100u
-/* Obstacle-map messages the world publishes per cycle (src/node/world.c: the whole map in
- * one message). Update it with the world's publishing code if the map is ever split. */
-#define COAVOID_BENCH_AUTH_MAPS_PER_CYCLE 1u
+/* Obstacle-map messages the world publishes per cycle in the worst case: a full map, every
+ * tile of it (src/node/world.c republishes every tile every cycle). */
+#define COAVOID_BENCH_AUTH_MAPS_PER_CYCLE ((uint32_t)COAVOID_OBSTACLE_MAP_T_MAX_TILES)
 #define COAVOID_BENCH_AUTH_TRACKS_PER_VEHICLE 50u /* one track per 50 UAVs, as bench predict */
 #define COAVOID_BENCH_AUTH_DT_US 1000000.0        /* the scenarios' cycle: dt = 1 s */
 
