@@ -282,7 +282,7 @@ static void derive_fleet(const coavoid_bench_auth_result_t *r, uint32_t vehicles
     f->vehicles = vehicles;
     f->tracks = vehicles / COAVOID_BENCH_AUTH_TRACKS_PER_VEHICLE;
     f->maps = COAVOID_BENCH_AUTH_MAPS_PER_CYCLE; /* the worst case: a full map */
-    f->plans = vehicles; /* the worst case: one plan message per UAV */
+    f->plans = vehicles;                         /* the worst case: one plan message per UAV */
     for (size_t node = 0; node < COAVOID_BENCH_AUTH_NODES; node++) {
         derive_node(r, f, node, &f->nodes[node]);
     }
