@@ -302,19 +302,6 @@ static int log_next(log_reader_t *r, lcm_eventlog_event_t **event)
 
 /* ---- what the log says ---- */
 
-typedef struct {
-    uint32_t node;
-    int8_t kind;
-    int64_t utime; /* the heartbeat's utime, or a plan's valid_from */
-    int64_t id;    /* plan_id for plans, plans_run for heartbeats */
-} planning_t;
-
-typedef struct {
-    planning_t *items;
-    size_t count;
-    size_t capacity;
-} planning_list_t;
-
 /* items, of *capacity items of item_size bytes, holding count, with room for one more:
  * doubled (from 256) when full. NULL out of memory, items then unchanged. */
 static void *room_for_one(void *items, size_t count, size_t *capacity, size_t item_size)
@@ -331,17 +318,6 @@ static void *room_for_one(void *items, size_t count, size_t *capacity, size_t it
         *capacity = grown;
     }
     return moved;
-}
-
-static bool planning_add(planning_list_t *list, planning_t item)
-{
-    planning_t *items = room_for_one(list->items, list->count, &list->capacity, sizeof item);
-    if (items == NULL) {
-        return false;
-    }
-    list->items = items;
-    list->items[list->count++] = item;
-    return true;
 }
 
 /* A valid heartbeat, kept in log order. */
@@ -450,7 +426,6 @@ typedef struct {
 
     intent_list_t seen;          /* accepted intents of the scenario's UAVs */
     heartbeat_list_t heartbeats; /* valid heartbeats, in log order */
-    planning_list_t plan_list;   /* (coordinator, valid_from, plan_id) of accepted plans */
     int64_t intents_of[COA_MAX_VEHICLES];
 } log_summary_t;
 
@@ -627,7 +602,8 @@ static bool read_status(log_summary_t *ls, const lcm_eventlog_event_t *e)
     return heartbeat_add(&ls->heartbeats, item);
 }
 
-/* An event on the plan channel: counted, and kept when valid. False out of memory. */
+/* An event on the plan channel: counted (refused, unauthenticated or accepted). Always
+ * true: a plan keeps nothing (replans come from the heartbeats). */
 static bool read_plan(log_summary_t *ls, const lcm_eventlog_event_t *e)
 {
     const char *reason = "plan: does not decode (wrong type or truncated)";
@@ -643,13 +619,9 @@ static bool read_plan(log_summary_t *ls, const lcm_eventlog_event_t *e)
         note_other(ls, reason);
         return true;
     }
-    if (!authentic(ls, e, COAVOID_AUTH_STREAM_PLAN, COAVOID_AUTH_COORDINATOR,
-                   ls->plan.coordinator_id, &ls->plan.auth, &ls->plans_unauthenticated, true)) {
-        return true;
-    }
-    planning_t item = {(uint32_t)ls->plan.coordinator_id, COAVOID_STATUS_T_NODE_COORDINATOR,
-                       ls->plan.valid_from_utime, ls->plan.plan_id};
-    return planning_add(&ls->plan_list, item);
+    (void)authentic(ls, e, COAVOID_AUTH_STREAM_PLAN, COAVOID_AUTH_COORDINATOR,
+                    ls->plan.coordinator_id, &ls->plan.auth, &ls->plans_unauthenticated, true);
+    return true;
 }
 
 /* Pass 1: every event of the log. Returns SIM_GO_ON or the exit status. */
@@ -1427,7 +1399,6 @@ int coavoid_sim_summarise(const coavoid_sim_log_config_t *c, coavoid_scenario_t 
     rebuilt_free(&b);
     free(ls->seen.items);
     free(ls->heartbeats.items);
-    free(ls->plan_list.items);
     free(ls);
     return status;
 }
