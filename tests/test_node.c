@@ -1996,6 +1996,66 @@ START_TEST(test_keys_required)
 }
 END_TEST
 
+/* A UAV that goes silent is avoided along the last plan it announced, not on a straight
+ * line: 2 announced a climb (2 m a second) into the altitude of 1, which it will
+ * meet head-on at t = 12 s, and fell silent; 1 starts at t = 3 s, when 2 is already stale,
+ * and hears that intent. Without sigma growth a straight line at 2's altitude misses 1 by
+ * 24 m; 2's plan does not: 1 has to get out of the way of the climb. */
+START_TEST(test_silent_uav_avoided_along_its_plan)
+{
+    rig_t r;
+    rig_init(&r, 24);
+    r.common.stale_sigma_rate = 0;
+    static wiretap_t tap;
+    tap.uav = 2;
+    lcm_subscription_t *si = lcm_subscribe(r.lcm, COAVOID_CHANNEL_INTENT, on_tapped_intent, &tap);
+    coa_vec3_t r1[2], r2[2];
+    coa_vehicle_t v2 = uav(2, 1, r2, 240, -1760, 0, 100);
+    coavoid_vehicle_node_t *b = vehicle_node(&r, v2, COAVOID_NODE_DECOUPLED);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(b, cycle(0)), COA_OK);
+    drain(r.lcm);
+    coavoid_vehicle_node_destroy(b);
+    static coavoid_intent_t m;
+    ck_assert_int_gt(coavoid_intent_t_decode(tap.bytes, 0, tap.size, &m), 0);
+    for (int32_t j = 0; j < m.sample_count; j++) {
+        m.offsets[j] = j; /* a climb: one step of 2 m a sample */
+    }
+    const coa_real_t dh = coa_climb_step(&v2, (coa_real_t)1);
+    ck_assert(dh == (coa_real_t)2);
+    r.now = cycle(3);
+    coavoid_vehicle_node_t *a =
+        vehicle_node(&r, uav(1, 2, r1, -30, 1970, 0, 124), COAVOID_NODE_DECOUPLED);
+    const coavoid_vehicle_node_state_t *sa = coavoid_vehicle_node_state(a);
+    ck_assert_int_eq(coavoid_intent_t_publish(r.lcm, COAVOID_CHANNEL_INTENT, &m), 0);
+    drain(r.lcm);
+    coa_vec3_t pa[31], q[31];
+    for (int64_t k = 3; k <= 30; k++) {
+        q[k] = coa_reference_at(&v2, (coa_real_t)k);
+        q[k].z += dh * (coa_real_t)k; /* it flies the climb it announced, and on */
+        r.now = cycle(k);
+        coavoid_vehicle_node_cycle(a, r.now);
+        drain(r.lcm);
+        while (coavoid_vehicle_node_deadline(a) != INT64_MAX) {
+            r.now = coavoid_vehicle_node_deadline(a);
+            coavoid_vehicle_node_poll(a, r.now);
+            drain(r.lcm);
+        }
+        pa[k] = sa->position;
+    }
+    ck_assert_uint_gt(sa->plans_run, 0);
+    for (int64_t k = 3; k < 30; k++) {
+        coa_sweep_t x = {{15, 5}, pa[k], pa[k + 1]};
+        coa_sweep_t y = {{15, 5}, q[k], q[k + 1]};
+        ck_assert_msg(!coa_conflict_volumes(&x, &y),
+                      "conflict over step %d: 1 at (%.0f, %.1f), 2 at (%.0f, %.1f)", (int)k,
+                      (double)pa[k].x, (double)pa[k].z, (double)q[k].x, (double)q[k].z);
+    }
+    lcm_unsubscribe(r.lcm, si);
+    coavoid_vehicle_node_destroy(a);
+    lcm_destroy(r.lcm);
+}
+END_TEST
+
 static Suite *node_suite(void)
 {
     Suite *s = suite_create("node");
@@ -2025,6 +2085,7 @@ static Suite *node_suite(void)
     tcase_add_test(tc, test_wait_ends_at_deadline);
     tcase_add_test(tc, test_higher_priority_replans_in_cluster);
     tcase_add_test(tc, test_silent_uav_avoided_as_track);
+    tcase_add_test(tc, test_silent_uav_avoided_along_its_plan);
     tcase_add_test(tc, test_world_track_estimates);
     tcase_add_test(tc, test_every_datagram_fits);
     tcase_add_test(tc, test_bad_configs_refused);

@@ -772,6 +772,38 @@ static bool stale_track(const coavoid_intent_t *msg, const coavoid_node_common_t
            isfinite((double)tr->sigma_vertical) && coa_track_check(tr) == COA_OK;
 }
 
+/* A stale UAV's track along the last plan it announced: its intent's positions at their
+ * own times (a UAV that has gone silent most likely flies what it said), then the
+ * velocity of the plan's last leg (coa_track_t's rule), with stale_track's volume and
+ * sigma. False when the intent no longer converts on this clock, or the path is refused:
+ * then the caller keeps stale_track's straight line. O(samples); no memory. */
+static bool stale_plan_track(const coavoid_intent_t *msg, const coavoid_lcm_context_t *ctx,
+                             coavoid_lcm_intent_arrays_t *scratch, coa_track_point_t *path,
+                             coa_track_t *tr)
+{
+    coavoid_lcm_intent_info_t info;
+    coa_vehicle_t vehicle;
+    coa_intent_plan_t plan;
+    if (coavoid_lcm_intent_to_core(msg, ctx, NULL, &info, &vehicle, &plan, scratch, NULL) !=
+            COA_OK ||
+        plan.count > COAVOID_NODE_MAX_SAMPLES) {
+        return false;
+    }
+    for (size_t j = 0; j < plan.count; j++) {
+        path[j].t = plan.t0 + (coa_real_t)j * plan.step;
+        path[j].p = plan.samples[j];
+    }
+    coa_track_t planned = *tr;
+    planned.position = plan.samples[0];
+    planned.path = path;
+    planned.path_count = plan.count;
+    if (coa_track_check(&planned) != COA_OK) {
+        return false;
+    }
+    *tr = planned;
+    return true;
+}
+
 /* The UAVs heard, by ascending id, so that plan indices (and the clusters' order) do not
  * depend on the order intents arrived in. Returns how many. */
 static size_t peers_by_id(const coavoid_node_inbox_t *in, size_t *order)
@@ -871,7 +903,7 @@ void coavoid_node_view_build(coavoid_node_view_t *view, const coavoid_node_inbox
         view->track_count++;
     }
     view->real_track_count = view->track_count;
-    /* The silent UAVs, until they are dropped: tracks extrapolated from their last intent. */
+    /* The silent UAVs, until they are dropped: tracks along the last plan they announced. */
     for (size_t s = 0; s < n; s++) {
         const coavoid_intent_t *msg = &in->peers[order[s]].msg;
         if (!stale[s] || now - msg->utime > drop) {
@@ -881,6 +913,8 @@ void coavoid_node_view_build(coavoid_node_view_t *view, const coavoid_node_inbox
         if (!stale_track(msg, c, cycle_start, now, &view->tracks[i])) {
             continue;
         }
+        (void)stale_plan_track(msg, &ctx, &view->stale_arrays, view->stale_paths[s],
+                               &view->tracks[i]);
         view->track_ids[i] = (uint32_t)msg->uav_id;
         view->track_count++;
         view->stale_count++;

@@ -107,9 +107,11 @@
  * (status_t's REASON_* bits).
  *
  * A peer whose last intent is older than stale_after_us is no longer a co-operative UAV
- * to its receivers: they treat it as a non-cooperative track, extrapolated at constant
- * velocity from the state in its last intent, with its sigma grown by
- * stale_sigma_rate * age (the predictor then grows it further with look-ahead).
+ * to its receivers: they treat it as a non-cooperative track along the last plan it
+ * announced (its intent's positions at their own times, then the velocity of the plan's
+ * last leg; constant velocity from its last state if that intent no longer converts),
+ * with its sigma grown by stale_sigma_rate * age (the predictor then grows it further
+ * with look-ahead): a UAV that has gone silent most likely flies what it said.
  *
  * Messages arrive through LCM subscriptions made at init; each is verified (its signature
  * over the raw bytes, then its key's role and freshness: common.trust, auth.h), decoded

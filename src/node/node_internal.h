@@ -168,7 +168,9 @@ struct coavoid_node_inbox {
 };
 
 /* The cycle's view: live UAVs (ascending id) and tracks (real ones first, by source and
- * id, then the stale UAVs by id), on the clock whose t = 0 is cycle_start. */
+ * id, then the stale UAVs by id), on the clock whose t = 0 is cycle_start. A stale UAV's
+ * track is the last plan it announced (its intent's positions at their own times, then
+ * the velocity of its last leg), its sigma grown with its silence. */
 typedef struct {
     int64_t cycle_start;
     size_t live_count;
@@ -186,6 +188,9 @@ typedef struct {
     uint32_t track_ids[COAVOID_NODE_TRACK_CAPACITY];
     coa_track_point_t real_paths[COAVOID_NODE_MAX_TRACKS][COAVOID_TRACK_T_MAX_PATH];
     size_t stale_count; /* tracks[real_track_count ..] are stale UAVs */
+    /* A stale UAV's last plan as its track's path, and the conversion's scratch. */
+    coa_track_point_t stale_paths[COAVOID_NODE_MAX_PEERS][COAVOID_NODE_MAX_SAMPLES];
+    coavoid_lcm_intent_arrays_t stale_arrays;
 } coavoid_node_view_t;
 
 /* The tracks of one planning problem, sampled over the horizon. */
