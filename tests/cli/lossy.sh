@@ -1,0 +1,36 @@
+#!/bin/bash
+# SPDX-License-Identifier: MIT
+# scripts/lossy.sh, the real processes each in a network namespace of its own with a share
+# of every receiver's datagrams dropped, works: with no loss the paper's flight is the
+# one-shot plan's (3240 m^2, effort 40, no fallback); with every datagram dropped nobody
+# hears anybody, the UAVs fly their references into each other, and the log (the logger
+# loses nothing) says so. Its figures at 30 % loss are measurements (docs/evaluation.md),
+# not a test: today's protocol does not yet tolerate that loss (issue 14).
+#
+# usage: bash lossy.sh <path-to-coavoid> <source-dir>   (needs root for the namespaces;
+# without them it says so and skips)
+set -u
+# shellcheck source=tests/cli/lib.bash
+. "$(dirname "${BASH_SOURCE[0]}")/lib.bash" "$@"
+build=$(cd "$(dirname "$bin")/.." && pwd)
+if [ "$(id -u)" -ne 0 ] || ! unshare --net --mount true 2>/dev/null || ! command -v nft >/dev/null; then
+    echo "note: needs root, network namespaces and nftables: not flown"
+    finish
+    exit
+fi
+speed=${SPEED:-4}
+run() { "$src/scripts/lossy.sh" --runs 1 --speed "$speed" --build "$build" --out "$tmp/$1" "${@:2}"; }
+if run none --loss 0 >"$tmp/none.out" 2>&1 &&
+    grep -q "loss of separation: no, deviation 3240 m^2, effort 40, replans 3, fallbacks 0, samples from an earlier plan 0" "$tmp/none.out" &&
+    grep -q ": 0 lost separation" "$tmp/none.out"; then
+    pass
+else
+    fail "no loss: $(tail -n 3 "$tmp/none.out")"
+fi
+if run all --loss 100 >"$tmp/all.out" 2>&1 &&
+    grep -q "loss of separation: yes" "$tmp/all.out" && grep -q ": 1 lost separation" "$tmp/all.out"; then
+    pass
+else
+    fail "all lost: $(tail -n 3 "$tmp/all.out")"
+fi
+finish
