@@ -797,7 +797,7 @@ static bool sim_waits(sim_run_t *r, int64_t until, int *node_error)
             deadline = d < deadline ? d : deadline;
         }
         const int64_t due = coavoid_sim_net_next(r->net);
-        if (due <= until || due <= deadline) {
+        if (due <= until || (deadline != INT64_MAX && due <= deadline)) {
             deadline = due;
         }
         if (deadline == INT64_MAX || !lcm_ok) {

@@ -202,6 +202,51 @@ for args in "paper.json --mode centralised" "late_encounter.json --mode decouple
     if [ -s "$tmp/run1" ] && cmp -s "$tmp/run1" "$tmp/run2"; then pass; else fail "two runs of sim $args differ"; fi
 done
 
+# ---- the simulated network (--loss, --delay, --jitter, --seed) ----
+
+# Zero loss, delay and jitter given: the same flight as without them, plus the network's
+# object; given a loss, a seed gives one run, another seed other deliveries; a delay
+# leaves copies in flight at the end; every copy is delivered, dropped or in flight.
+p=$scenarios/paper.json
+"$bin" sim "$p" --mode centralised --json --insecure >"$tmp/net-none.json" 2>&1
+"$bin" sim "$p" --mode centralised --json --insecure --loss 0 --delay 0 --jitter 0 >"$tmp/net-zero.json" 2>&1
+if python3 - "$tmp/net-none.json" "$tmp/net-zero.json" <<'PY'; then pass; else fail "sim with a zero network is not the run without one"; fi
+import json, sys
+a, b = (json.load(open(f)) for f in sys.argv[1:3])
+assert "network" not in a
+n = b.pop("network")
+assert a == b, "flights differ"
+assert n["loss"] == 0 and n["delay"] == 0 and n["jitter"] == 0 and n["seed"] == 1, n
+assert n["dropped"] == 0 and n["in_flight"] == 0 and n["delivered"] > n["sent"] > 0, n
+PY
+for m in centralised decoupled; do
+    for run in a:5 b:5 c:6; do
+        "$bin" sim "$p" --mode $m --json --insecure --loss 0.3 --jitter 0.2 --seed "${run#*:}" >"$tmp/net-$m-${run%:*}" 2>&1
+    done
+done
+if python3 - "$tmp"/net-centralised-[abc] "$tmp"/net-decoupled-[abc] <<'PY'; then pass; else fail "sim --loss: one seed is not one run, or another seed the same"; fi
+import json, sys
+for a, b, c in (sys.argv[1:4], sys.argv[4:7]):
+    A, B, C = (open(f).read() for f in (a, b, c))
+    assert A == B, f"{a} and {b} differ"
+    na, nc = json.loads(A)["network"], json.loads(C)["network"]
+    assert na["seed"] == 5 and nc["seed"] == 6
+    assert na != nc, "seeds 5 and 6 dropped the same copies"
+    for n in (na, nc):
+        assert 0.2 < n["dropped"] / (n["dropped"] + n["delivered"] + n["in_flight"]) < 0.4, n
+PY
+"$bin" sim "$p" --mode decoupled --insecure --delay 0.3 >"$tmp/net-delay.txt" 2>&1
+if grep -q '^network: loss 0, delay 0.3 s, jitter 0 s, seed 1: [0-9]* messages sent, copies to other nodes [0-9]* delivered, 0 dropped, [1-9][0-9]* in flight$' "$tmp/net-delay.txt"; then pass; else fail "sim --delay: no network line with copies in flight"; fi
+expect_bad "loss 1" "--loss" sim "$p" --mode decoupled --loss 1
+expect_bad "loss negative" "--loss" sim "$p" --mode decoupled --loss=-0.1
+expect_bad "loss word" "--loss" sim "$p" --mode decoupled --loss some
+expect_bad "loss twice" "--loss" sim "$p" --mode decoupled --loss 0.1 --loss 0.2
+expect_bad "delay negative" "--delay" sim "$p" --mode decoupled --delay=-1
+expect_bad "delay nan" "--delay" sim "$p" --mode decoupled --delay nan
+expect_bad "jitter missing" "--jitter" sim "$p" --mode decoupled --jitter
+expect_bad "delay a cycle" "--delay" sim "$p" --mode decoupled --delay 0.5 --jitter 0.5
+expect_bad "seed word" "--seed" sim "$p" --mode decoupled --loss 0.1 --seed x
+
 # ---- the coordinator stops ----
 
 # Stopped before cycle 0: the UAVs wait out its heartbeat timeout from their start, then
