@@ -27,6 +27,7 @@
 #include <stdint.h>
 #include <stdio.h>
 
+#include "auth.h"
 #include "run.h"
 #include "scenario.h"
 
