@@ -274,3 +274,50 @@ int coavoid_cli_run_scenario(const char *path, int (*run)(void *options, coavoid
     coavoid_scenario_free(&scenario);
     return status;
 }
+
+/* A real option's value into *out when check(value) holds: CLI_CONTINUE, or the error
+ * "NAME: must be WHAT, got 'VALUE'". */
+static int real_option(int argc, char **argv, int *i, const char *name, const char *what,
+                       double max, const char **text, double *out)
+{
+    const char *value = *text;
+    int status = coavoid_cli_text_option(argc, argv, i, name, what, false, &value);
+    if (status != CLI_CONTINUE) {
+        return status;
+    }
+    if (!coavoid_cli_parse_real(value, out) || !(*out >= 0.0 && *out < max)) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: must be %s, got '%.40s'", name, what, value);
+    }
+    *text = value;
+    return CLI_CONTINUE;
+}
+
+int coavoid_cli_network_option(int argc, char **argv, int *i, bool with_seed,
+                               coavoid_cli_network_t *n)
+{
+    const char *arg = argv[*i];
+    /* Seconds beyond an hour are a typo: no cycle is that long. */
+    const double max_s = 3600.0;
+    if (coavoid_cli_option_is(arg, "--loss")) {
+        return real_option(argc, argv, i, "--loss", "a probability from 0 to below 1", 1.0,
+                           &n->loss_text, &n->loss);
+    }
+    if (coavoid_cli_option_is(arg, "--delay")) {
+        return real_option(argc, argv, i, "--delay", "a time in seconds, 0 or more (below 3600)",
+                           max_s, &n->delay_text, &n->delay);
+    }
+    if (coavoid_cli_option_is(arg, "--jitter")) {
+        return real_option(argc, argv, i, "--jitter", "a time in seconds, 0 or more (below 3600)",
+                           max_s, &n->jitter_text, &n->jitter);
+    }
+    if (with_seed && coavoid_cli_option_is(arg, "--seed")) {
+        return coavoid_cli_count_option(argc, argv, i, "--seed", NULL, true, UINT64_MAX,
+                                        &n->seed_text, &n->seed);
+    }
+    return CLI_UNKNOWN_OPTION;
+}
+
+bool coavoid_cli_network_given(const coavoid_cli_network_t *n)
+{
+    return n->loss_text != NULL || n->delay_text != NULL || n->jitter_text != NULL;
+}

@@ -119,6 +119,26 @@ int coavoid_cli_flag_option(const char *arg, const char *name, bool *flag);
  * decoupled)". Sets *mode (NULL until given) and, unless NULL, *decoupled. */
 int coavoid_cli_mode_option(int argc, char **argv, int *i, const char **mode, bool *decoupled);
 
+/* The simulated network's options of `coavoid sim` and `coavoid montecarlo --fly`:
+ * --loss P (0 <= P < 1), --delay S and --jitter S (seconds, >= 0; the simulation checks
+ * them against the scenario's dt) and, with_seed, --seed N (an integer >= 0). Each *_text
+ * is NULL until given. */
+typedef struct {
+    const char *loss_text, *delay_text, *jitter_text, *seed_text;
+    double loss, delay, jitter;
+    uint64_t seed;
+} coavoid_cli_network_t;
+
+/* One of those options at argv[*i] into *n, as the other option parsers (CLI_CONTINUE or
+ * CLI_EXIT_INVALID after one line: "--loss: must be a probability from 0 to below 1, got
+ * 'VALUE'", "--delay: must be a time in seconds, 0 or more, got 'VALUE'"), or
+ * CLI_UNKNOWN_OPTION when it is none of them. O(length of the value), no memory. */
+int coavoid_cli_network_option(int argc, char **argv, int *i, bool with_seed,
+                               coavoid_cli_network_t *n);
+
+/* Whether any of --loss, --delay, --jitter was given. */
+bool coavoid_cli_network_given(const coavoid_cli_network_t *n);
+
 /* `length` characters of decimal digits only (no sign, no spaces) whose value is in
  * 1..max. */
 bool coavoid_cli_parse_count(const char *text, size_t length, uint64_t max, uint64_t *out);

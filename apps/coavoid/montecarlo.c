@@ -23,6 +23,7 @@
     "usage: coavoid montecarlo --vehicles N[,N...] [--count C] [--seed S] [--beta B]\n"     \
     "                          [--max-orders M] [--csv FILE] [--svg FILE] [--json]\n"       \
     "                          [--save DIR] [--jobs J] [--quiet]\n"                         \
+    "                          [--fly [--loss P] [--delay S] [--jitter S]]\n"               \
     "\n"                                                                                    \
     "Draws C random encounters of N UAVs (for each N listed) converging on a point over\n"  \
     "hills, with 0 to 2 non-cooperative tracks crossing (%u steps of %g s), and solves\n"   \
@@ -48,6 +49,18 @@
     "  --jobs J          worker threads, 1..%u; default 1; results do not depend on it\n"   \
     "  --quiet           no progress on stderr (otherwise: a line updated every second\n"   \
     "                    on a terminal, a line every 10%% when stderr is not one)\n"        \
+    "  --fly             also fly each encounter in closed loop, centralised and\n"         \
+    "                    decoupled, by the nodes of `coavoid sim` (insecure: nothing\n"     \
+    "                    else is on its bus) over a simulated network, and report\n"        \
+    "                    per N and mode the loss-of-separation rate, also over the\n"       \
+    "                    encounters the one-shot centralised plan, or some priority\n"      \
+    "                    order, solves\n"                                                   \
+    "  --loss P          with --fly: each message reaches each other node with\n"           \
+    "                    probability 1 - P (0 <= P < 1); default 0\n"                       \
+    "  --delay S         with --fly: ... after S seconds; default 0\n"                      \
+    "  --jitter S        with --fly: ... plus a uniform time in [0, S] seconds; default\n"  \
+    "                    0; delay + jitter must be under dt. The network's random\n"        \
+    "                    stream comes from --seed and the encounter\n"                      \
     "  -h, --help        show this help\n"                                                  \
     "\n"                                                                                    \
     "A seed gives the same encounters and results on every machine with the same C\n"       \
@@ -86,6 +99,8 @@ typedef struct {
     const char *jobs_text;
     uint32_t jobs;
     bool quiet;
+    bool fly;
+    coavoid_cli_network_t network;
 } mc_options_t;
 
 /* "2,3,4": each 2..6, each once. */
@@ -124,7 +139,10 @@ static int mc_option(int argc, char **argv, int *i, void *options)
     mc_options_t *o = options;
     const char *arg = argv[*i];
     uint64_t value = 0;
-    int status = CLI_UNKNOWN_OPTION;
+    int status = coavoid_cli_network_option(argc, argv, i, false, &o->network);
+    if (status != CLI_UNKNOWN_OPTION) {
+        return status;
+    }
     if (coavoid_cli_option_is(arg, "--vehicles")) {
         status =
             coavoid_cli_text_option(argc, argv, i, "--vehicles",
@@ -162,6 +180,8 @@ static int mc_option(int argc, char **argv, int *i, void *options)
         o->jobs = (uint32_t)value;
     } else if (coavoid_cli_option_is(arg, "--quiet")) {
         status = coavoid_cli_flag_option(arg, "--quiet", &o->quiet);
+    } else if (coavoid_cli_option_is(arg, "--fly")) {
+        status = coavoid_cli_flag_option(arg, "--fly", &o->fly);
     }
     return status;
 }
@@ -186,6 +206,19 @@ static int parse_mc_options(int argc, char **argv, mc_options_t *o)
     if (o->csv != NULL && o->svg != NULL && strcmp(o->csv, o->svg) == 0) {
         return coavoid_cli_fail(CLI_EXIT_INVALID, "--svg: the same file as --csv ('%.200s')",
                                 o->csv);
+    }
+    if (coavoid_cli_network_given(&o->network) && !o->fly) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: only with --fly (the closed loop)",
+                                o->network.loss_text != NULL    ? "--loss"
+                                : o->network.delay_text != NULL ? "--delay"
+                                                                : "--jitter");
+    }
+    if (o->network.delay + o->network.jitter >= coavoid_encounter_montecarlo.dt) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                "--delay: %g s plus --jitter %g s must be less than the "
+                                "encounters' dt (%g s): a message may be at most a cycle late",
+                                o->network.delay, o->network.jitter,
+                                coavoid_encounter_montecarlo.dt);
     }
     if (o->count_text == NULL) {
         o->count = MC_DEFAULT_COUNT;
@@ -224,6 +257,10 @@ static coavoid_montecarlo_config_t mc_engine_config(const mc_options_t *o)
     c.save = o->save;
     c.progress = o->quiet ? NULL : stderr;
     c.defect = print_defect;
+    c.fly = o->fly;
+    c.loss = o->network.loss;
+    c.delay = o->network.delay;
+    c.jitter = o->network.jitter;
     return c;
 }
 

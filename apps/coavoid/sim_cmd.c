@@ -19,6 +19,7 @@
 #define SIM_USAGE                                                                               \
     "usage: coavoid sim SCENARIO.json --mode centralised|decoupled [--steps K] [--json]\n"      \
     "                   [--svg FILE] [--coordinator-stops STEP] [--insecure]\n"                 \
+    "                   [--loss P] [--delay S] [--jitter S] [--seed N]\n"                       \
     "\n"                                                                                        \
     "Flies the scenario in closed loop: every step each UAV publishes its intent, conflicts\n"  \
     "are predicted and planned for (by the coordinator, or by each UAV in priority order),\n"   \
@@ -36,11 +37,18 @@
     "                       centralised: stop the coordinator before step STEP (0..K)\n"        \
     "  --insecure           the nodes neither sign nor check their messages (by default they\n" \
     "                       do, with the simulation's fixed keys; the flight is the same)\n"    \
+    "  --loss P             each message reaches each other node with probability 1 - P,\n"     \
+    "                       independently (0 <= P < 1); default 0\n"                            \
+    "  --delay S            ... after S seconds (>= 0); default 0\n"                            \
+    "  --jitter S           ... plus a uniform time in [0, S] seconds; default 0. A node\n"     \
+    "                       hears its own at once; delay + jitter must be less than dt\n"       \
+    "  --seed N             the network's random seed, an integer >= 0; default 1\n"            \
     "  -h, --help           show this help\n"                                                   \
     "\n"                                                                                        \
     "Beyond the contract's fields the result has \"fallbacks\" (times a UAV went from\n"        \
-    "following the coordinator to planning for itself) and, with --coordinator-stops,\n"        \
-    "\"coordinator_stopped_at\".\n"                                                             \
+    "following the coordinator to planning for itself), with --coordinator-stops,\n"            \
+    "\"coordinator_stopped_at\", and with --loss, --delay or --jitter, \"network\" (those\n"    \
+    "settings and the messages sent, copies delivered, dropped and in flight at the end).\n"    \
     "\n"                                                                                        \
     "The scenario's horizon may be at most %u steps (an intent carries N + 1 samples) and\n"    \
     "it may have at most %u UAVs. What its messages carry over the run (references and\n"       \
@@ -49,6 +57,8 @@
     "\n"                                                                                        \
     "exit status: 0 no loss of separation, 1 a loss of separation, 2 invalid input or\n"        \
     "usage (one line on stderr naming the input and why), 3 internal error\n"
+
+#define SIM_DEFAULT_SEED 1u
 
 typedef struct {
     const char *scenario_path;
@@ -61,6 +71,7 @@ typedef struct {
     const char *stop_text;
     uint32_t stop_step;
     bool insecure;
+    coavoid_cli_network_t network;
 } sim_options_t;
 
 static void sim_help(void)
@@ -74,7 +85,10 @@ static int sim_option(int argc, char **argv, int *i, void *options)
     sim_options_t *o = options;
     const char *arg = argv[*i];
     uint64_t value = 0;
-    int status = CLI_UNKNOWN_OPTION;
+    int status = coavoid_cli_network_option(argc, argv, i, true, &o->network);
+    if (status != CLI_UNKNOWN_OPTION) {
+        return status;
+    }
     if (coavoid_cli_option_is(arg, "--mode")) {
         status = coavoid_cli_mode_option(argc, argv, i, &o->mode, &o->decoupled);
     } else if (coavoid_cli_option_is(arg, "--steps")) {
@@ -137,6 +151,11 @@ static int sim(void *options, coavoid_scenario_t *s)
         .json = o->json,
         .svg_path = o->svg_path,
         .insecure = o->insecure,
+        .network = coavoid_cli_network_given(&o->network),
+        .loss = o->network.loss,
+        .delay = o->network.delay,
+        .jitter = o->network.jitter,
+        .seed = o->network.seed_text != NULL ? o->network.seed : SIM_DEFAULT_SEED,
     };
     coavoid_run_error_t e;
     int rc = coavoid_sim_run(&config, s, stdout, &e);

@@ -30,6 +30,7 @@
 
 const char *const coavoid_mc_method_names[COAVOID_MC_METHODS] = {"centralised", "decoupled_fixed",
                                                                  "decoupled_reordered"};
+const char *const coavoid_mc_fly_mode_names[COAVOID_MC_FLY_MODES] = {"centralised", "decoupled"};
 
 /* ---- one encounter ---- */
 
@@ -321,6 +322,21 @@ static int solve_encounter(uint64_t seed, const coavoid_mc_size_t *size, uint32_
     return status;
 }
 
+/* The closed loop of the encounter just solved (config fly), when the library has it. */
+static int fly_encounter(const coavoid_montecarlo_config_t *c, const coavoid_mc_size_t *size,
+                         coavoid_mc_result_t *r, char *err, size_t err_size)
+{
+#ifdef COAVOID_HAVE_LCM
+    return coavoid_mc_fly(c, size, r, err, err_size);
+#else
+    (void)c;
+    (void)size;
+    (void)r;
+    snprintf(err, err_size, "--fly: this build has no simulation (no messaging library)");
+    return -1;
+#endif
+}
+
 /* ---- the run: workers and the main thread's writing and progress ---- */
 
 typedef struct {
@@ -358,6 +374,9 @@ static void *worker(void *arg)
         const coavoid_montecarlo_config_t *c = &run->mc->config;
         int rc = solve_encounter(c->seed, item_size(run, item), item % c->count, c->save, &planners,
                                  &result, err, sizeof err);
+        if (rc == 0 && c->fly) {
+            rc = fly_encounter(c, item_size(run, item), &result, err, sizeof err);
+        }
         pthread_mutex_lock(&run->lock);
         if (rc != 0) {
             if (!run->stop) {
@@ -428,6 +447,19 @@ static void csv_rows(FILE *f, uint64_t seed, const coavoid_mc_result_t *r)
     }
 }
 
+/* With fly: a row per closed-loop mode, method flown_MODE, status separated or
+ * loss_of_separation (the plan's columns empty). */
+static void csv_flown_rows(FILE *f, uint64_t seed, const coavoid_mc_result_t *r)
+{
+    for (int mode = 0; mode < COAVOID_MC_FLY_MODES; mode++) {
+        fprintf(f, "%llu,%lu,%lu,%lu,%lu,%lu,%lu,flown_%s,%s,,,,,,,\n", (unsigned long long)seed,
+                (unsigned long)r->vehicles, (unsigned long)r->index, (unsigned long)r->redraws,
+                (unsigned long)r->info.hills, (unsigned long)r->info.tracks,
+                (unsigned long)r->first_conflict_step, coavoid_mc_fly_mode_names[mode],
+                r->flown[mode].loss_of_separation ? "loss_of_separation" : "separated");
+    }
+}
+
 static double seconds_since(const struct timespec *start)
 {
     struct timespec now;
@@ -472,6 +504,9 @@ static void write_ready(mc_run_t *run, FILE *csv, mc_progress_t *prog, uint32_t 
         const coavoid_mc_result_t *r = &run->mc->results[*written];
         if (csv != NULL) {
             csv_rows(csv, c->seed, r);
+        }
+        if (csv != NULL && c->fly) {
+            csv_flown_rows(csv, c->seed, r);
         }
         if (r->defect[0] != '\0') {
             if (prog->line_open) {
@@ -562,6 +597,20 @@ static int check_config(const coavoid_montecarlo_config_t *c, coavoid_run_error_
         return coavoid_run_fail(e, COAVOID_RUN_ERR_INPUT,
                                 "montecarlo: UAV counts, --count or --jobs out of range");
     }
+    const double dt = coavoid_encounter_montecarlo.dt;
+    if (c->fly && (!(c->loss >= 0.0 && c->loss < 1.0) || !(c->delay >= 0.0) ||
+                   !(c->jitter >= 0.0) || !(c->delay + c->jitter < dt))) {
+        return coavoid_run_fail(e, COAVOID_RUN_ERR_INPUT,
+                                "--loss, --delay, --jitter: a loss from 0 to below 1, and a "
+                                "delay plus jitter (s, each >= 0) under the encounters' dt of %g s",
+                                dt);
+    }
+#ifndef COAVOID_HAVE_LCM
+    if (c->fly) {
+        return coavoid_run_fail(e, COAVOID_RUN_ERR_INPUT,
+                                "--fly: this build has no simulation (no messaging library)");
+    }
+#endif
     for (uint32_t k = 0; k < c->size_count; k++) {
         bool repeated = false;
         for (uint32_t j = 0; j < k; j++) {

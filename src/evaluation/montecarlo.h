@@ -73,6 +73,18 @@ typedef struct {
      * NULL: defects are only counted. */
     void (*defect)(void *context, const char *line);
     void *context;
+    /* The closed loop (built with the messaging library only): each encounter is also
+     * flown by the nodes (sim.h's coavoid_sim_fly, as `coavoid sim` flies it), once
+     * centralised and once decoupled, over the simulated network with these settings
+     * (loss 0 <= loss < 1, delay and jitter in seconds, >= 0, together under the
+     * design's dt), its random stream seeded from (seed, UAV count, index): the same for
+     * both modes, so that they meet the same draws. The nodes run insecure: signatures
+     * cost a millisecond a cycle and protect nothing on an in-process bus that only the
+     * run's own nodes are on; the flight is the same either way. The report then gives,
+     * per UAV count and mode, the rate of loss of separation, overall and over the
+     * encounters that the one-shot centralised plan, or some priority order, solves. */
+    bool fly;
+    double loss, delay, jitter;
 } coavoid_montecarlo_config_t;
 
 /* The encounters of a run and their outcomes; opaque. */
@@ -85,9 +97,12 @@ typedef struct coavoid_montecarlo coavoid_montecarlo_t;
  * set, or an error (evaluation.h, "Errors") with e set and *out NULL
  * (csv may then be partly written). Memory: a result of about 500 bytes per encounter,
  * kept until coavoid_montecarlo_free, and per job two planner workspaces (as beta sizes
- * them) and two offset tables of about 240 KB, freed before it returns. Cost: count times
- * size_count encounters, each a centralised search and up to 1 + max_orders decoupled
- * ones, spread over the jobs. */
+ * them) and two offset tables of about 240 KB, freed before it returns; flying, per job a
+ * simulation's nodes at a time (about 3 MB a UAV and the coordinator's planner). Cost:
+ * count times size_count encounters, each a centralised search and up to 1 + max_orders
+ * decoupled ones, and with fly two closed-loop runs of 2 * horizon cycles (a planning
+ * call per conflicting cluster per cycle), spread over the jobs. Without the messaging
+ * library, fly is an input error. */
 int coavoid_montecarlo_run(const coavoid_montecarlo_config_t *config, coavoid_montecarlo_t **out,
                            coavoid_run_error_t *e);
 

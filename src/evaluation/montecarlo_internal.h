@@ -29,13 +29,25 @@ typedef struct {
     double time_us;
 } coavoid_mc_outcome_t;
 
+/* The two closed-loop modes of fly, in the order of every report. */
+enum { COAVOID_MC_FLY_CENTRALISED, COAVOID_MC_FLY_DECOUPLED, COAVOID_MC_FLY_MODES };
+extern const char *const coavoid_mc_fly_mode_names[COAVOID_MC_FLY_MODES];
+
+/* One closed-loop run of one encounter (montecarlo fly). */
+typedef struct {
+    bool loss_of_separation;
+    uint32_t fallbacks;
+    uint64_t sent, delivered, dropped;
+} coavoid_mc_flown_t;
+
 typedef struct {
     uint32_t vehicles, index;
     uint32_t redraws;
     coavoid_encounter_info_t info;
     uint32_t first_conflict_step;
     coavoid_mc_outcome_t m[COAVOID_MC_METHODS];
-    char defect[256]; /* empty unless a check failed */
+    coavoid_mc_flown_t flown[COAVOID_MC_FLY_MODES]; /* with fly */
+    char defect[256];                               /* empty unless a check failed */
 } coavoid_mc_result_t;
 
 /* A UAV count and the planners' limits for it. */
@@ -52,6 +64,13 @@ struct coavoid_montecarlo {
     coavoid_mc_result_t *results;
     double *x; /* room for count doubles: the reports sort a size's values in it */
 };
+
+/* Flies encounter (size, index) of seed, drawn as r says (r->redraws), in both modes as
+ * c says, into r->flown. Returns 0, or -1 with err (a simulation error: of the tool, not
+ * of the flight). Memory and cost: two simulations (sim.h), freed before return.
+ * Defined only with the messaging library (COAVOID_HAVE_LCM). */
+int coavoid_mc_fly(const coavoid_montecarlo_config_t *c, const coavoid_mc_size_t *size,
+                   coavoid_mc_result_t *r, char *err, size_t err_size);
 
 /* A 128-bit cost as a double, for ratios: exact enough for them, and it never overflows. */
 static inline double coavoid_mc_cost_real(coa_cost_t c)

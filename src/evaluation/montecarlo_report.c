@@ -79,10 +79,22 @@ typedef struct {
     double central_mean_deviation_both;
 } mc_method_summary_t;
 
+/* One closed-loop mode (fly) over a UAV count's encounters. */
+typedef struct {
+    uint32_t losses;
+    double rate, low, high; /* loss-of-separation rate and its 95 % Wilson interval */
+    /* The encounters the one-shot centralised plan solves, and those that some priority
+     * order solves (decoupled_reordered), and the losses among each. */
+    uint32_t central_solved, losses_central_solved;
+    uint32_t order_solved, losses_order_solved;
+    uint64_t fallbacks, sent, delivered, dropped;
+} mc_fly_summary_t;
+
 typedef struct {
     coavoid_mc_size_t size;
     uint32_t encounters, redraws;
     mc_method_summary_t m[COAVOID_MC_METHODS];
+    mc_fly_summary_t fly[COAVOID_MC_FLY_MODES];
 } mc_summary_t;
 
 static void wilson(uint32_t k, uint32_t n, double *rate, double *low, double *high)
@@ -94,6 +106,31 @@ static void wilson(uint32_t k, uint32_t n, double *rate, double *low, double *hi
     /* Exactly 0 and 1 at the ends, where rounding would leave a few ulps. */
     *low = k == 0 || centre - half < 0 ? 0 : centre - half;
     *high = k == n || centre + half > 1 ? 1 : centre + half;
+}
+
+/* The closed-loop modes of count results (config fly) into s->fly. */
+static void summarise_fly(const coavoid_mc_result_t *results, uint32_t count, mc_summary_t *s)
+{
+    for (int mode = 0; mode < COAVOID_MC_FLY_MODES; mode++) {
+        mc_fly_summary_t *f = &s->fly[mode];
+        for (uint32_t j = 0; j < count; j++) {
+            const coavoid_mc_result_t *r = &results[j];
+            const coavoid_mc_flown_t *flown = &r->flown[mode];
+            const bool lost = flown->loss_of_separation;
+            const bool central = r->m[COAVOID_MC_CENTRALISED].status == COA_PLAN_SOLVED;
+            const bool order = r->m[COAVOID_MC_REORDERED].status == COA_PLAN_SOLVED;
+            f->losses += lost;
+            f->central_solved += central;
+            f->losses_central_solved += central && lost;
+            f->order_solved += order;
+            f->losses_order_solved += order && lost;
+            f->fallbacks += flown->fallbacks;
+            f->sent += flown->sent;
+            f->delivered += flown->delivered;
+            f->dropped += flown->dropped;
+        }
+        wilson(f->losses, count, &f->rate, &f->low, &f->high);
+    }
 }
 
 /* Summarises the count results of one size; x: room for count doubles. */
@@ -195,6 +232,36 @@ static void text_summary(FILE *f, const coavoid_montecarlo_config_t *o, const mc
                "solves*: it solves and centralised fails\n");
 }
 
+/* The closed loop's table (config fly). */
+static void text_fly(FILE *f, const coavoid_montecarlo_config_t *o, const mc_summary_t *s,
+                     uint32_t sizes)
+{
+    fprintf(f,
+            "\nclosed loop: each encounter flown by the nodes (insecure) over a network with "
+            "loss %g, delay %g s, jitter %g s\n",
+            o->loss, o->delay, o->jitter);
+    fprintf(f, "  %4s %-12s %7s %7s %16s %9s %7s %9s %7s %10s %8s\n", "UAVs", "mode", "losses",
+            "rate", "95% Wilson", "c-solved", "losses", "o-solved", "losses", "fallbacks",
+            "dropped");
+    for (uint32_t k = 0; k < sizes; k++) {
+        for (int mode = 0; mode < COAVOID_MC_FLY_MODES; mode++) {
+            const mc_fly_summary_t *z = &s[k].fly[mode];
+            const uint64_t copies = z->delivered + z->dropped;
+            fprintf(f,
+                    "  %4lu %-12s %7lu %6.1f%% %7.1f-%5.1f%% %9lu %7lu %9lu %7lu %10.2f %7.1f%%\n",
+                    (unsigned long)s[k].size.n, coavoid_mc_fly_mode_names[mode],
+                    (unsigned long)z->losses, 100 * z->rate, 100 * z->low, 100 * z->high,
+                    (unsigned long)z->central_solved, (unsigned long)z->losses_central_solved,
+                    (unsigned long)z->order_solved, (unsigned long)z->losses_order_solved,
+                    (double)z->fallbacks / s[k].encounters,
+                    copies > 0 ? 100.0 * (double)z->dropped / (double)copies : 0.0);
+        }
+    }
+    fprintf(f, "losses: encounters with a loss of separation; c-solved, o-solved: encounters the "
+               "one-shot\ncentralised plan, or some priority order, solves, and the losses among "
+               "them;\nfallbacks: per encounter; dropped: share of the copies to other nodes\n");
+}
+
 static bool add_dist(cJSON *parent, const char *name, const mc_dist_t *d, bool with_equal)
 {
     cJSON *o = cJSON_AddObjectToObject(parent, name);
@@ -212,6 +279,44 @@ static bool add_dist(cJSON *parent, const char *name, const mc_dist_t *d, bool w
         ok = cJSON_AddNumberToObject(o, "equal_share", d->count > 0 ? d->equal_share : 0) != NULL;
     }
     return ok;
+}
+
+/* A UAV count's closed loop (config fly): "closed_loop", one object per mode. */
+static bool json_fly(cJSON *item, const mc_summary_t *z)
+{
+    cJSON *list = cJSON_AddArrayToObject(item, "closed_loop");
+    bool ok = list != NULL;
+    for (int mode = 0; ok && mode < COAVOID_MC_FLY_MODES; mode++) {
+        const mc_fly_summary_t *f = &z->fly[mode];
+        cJSON *m = cJSON_CreateObject();
+        ok = m != NULL && cJSON_AddItemToArray(list, m) &&
+             cJSON_AddStringToObject(m, "mode", coavoid_mc_fly_mode_names[mode]) != NULL &&
+             cJSON_AddNumberToObject(m, "losses", f->losses) != NULL &&
+             cJSON_AddNumberToObject(m, "loss_rate", f->rate) != NULL &&
+             cJSON_AddNumberToObject(m, "wilson_low", f->low) != NULL &&
+             cJSON_AddNumberToObject(m, "wilson_high", f->high) != NULL &&
+             cJSON_AddNumberToObject(m, "centralised_solved", f->central_solved) != NULL &&
+             cJSON_AddNumberToObject(m, "losses_where_centralised_solved",
+                                     f->losses_central_solved) != NULL &&
+             cJSON_AddNumberToObject(m, "some_order_solved", f->order_solved) != NULL &&
+             cJSON_AddNumberToObject(m, "losses_where_some_order_solved", f->losses_order_solved) !=
+                 NULL &&
+             cJSON_AddNumberToObject(m, "fallbacks", (double)f->fallbacks) != NULL &&
+             cJSON_AddNumberToObject(m, "sent", (double)f->sent) != NULL &&
+             cJSON_AddNumberToObject(m, "delivered", (double)f->delivered) != NULL &&
+             cJSON_AddNumberToObject(m, "dropped", (double)f->dropped) != NULL;
+    }
+    return ok;
+}
+
+/* The closed loop's network settings (config fly): "network". */
+static bool json_network(cJSON *root, const coavoid_montecarlo_config_t *o)
+{
+    cJSON *n = cJSON_AddObjectToObject(root, "network");
+    return n != NULL && cJSON_AddNumberToObject(n, "loss", o->loss) != NULL &&
+           cJSON_AddNumberToObject(n, "delay", o->delay) != NULL &&
+           cJSON_AddNumberToObject(n, "jitter", o->jitter) != NULL &&
+           cJSON_AddBoolToObject(n, "insecure", true) != NULL;
 }
 
 static int json_summary(FILE *f, const coavoid_montecarlo_config_t *o, const mc_summary_t *s,
@@ -264,7 +369,9 @@ static int json_summary(FILE *f, const coavoid_montecarlo_config_t *o, const mc_
                                              ms->central_mean_deviation_both) != NULL;
             }
         }
+        ok = ok && (!o->fly || json_fly(item, z));
     }
+    ok = ok && (!o->fly || json_network(root, o));
     if (!ok) {
         cJSON_Delete(root);
         return -1;
@@ -514,6 +621,9 @@ int coavoid_montecarlo_report(coavoid_montecarlo_t *mc, FILE *out, bool json,
     mc_summary_t summary[COAVOID_MONTECARLO_MAX_SIZES];
     for (uint32_t k = 0; k < o->size_count; k++) {
         summarise(&mc->results[k * o->count], o->count, &mc->sizes[k], mc->x, &summary[k]);
+        if (o->fly) {
+            summarise_fly(&mc->results[k * o->count], o->count, &summary[k]);
+        }
     }
     if (o->svg != NULL && write_svg(o->svg, o, mc, summary, o->size_count, mc->x) != 0) {
         return coavoid_run_fail(e, COAVOID_RUN_ERR_INTERNAL, "--svg: cannot write '%.200s'",
@@ -524,6 +634,9 @@ int coavoid_montecarlo_report(coavoid_montecarlo_t *mc, FILE *out, bool json,
         rc = json_summary(out, o, summary, o->size_count);
     } else {
         text_summary(out, o, summary, o->size_count);
+        if (o->fly) {
+            text_fly(out, o, summary, o->size_count);
+        }
     }
     if (rc != 0 || fflush(out) != 0 || ferror(out)) {
         return coavoid_run_fail(e, COAVOID_RUN_ERR_INTERNAL, "cannot write the summary");

@@ -609,7 +609,7 @@ static void on_plan(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
 
 static int subscribe(coavoid_node_inbox_t *in, const char *channel, lcm_msg_handler_t handler)
 {
-    lcm_subscription_t *sub = lcm_subscribe(in->tx.lcm, channel, handler, in);
+    lcm_subscription_t *sub = lcm_subscribe(in->rx_lcm, channel, handler, in);
     if (sub == NULL) {
         return COA_ERR_ARGUMENT;
     }
@@ -635,6 +635,7 @@ int coavoid_node_inbox_init(coavoid_node_inbox_t *in, const coavoid_node_common_
     int64_t horizon_us = ((int64_t)common->horizon + 2) * common->dt_us;
     in->max_age_us = common->stale_after_us + horizon_us;
     coavoid_node_tx_init(&in->tx, lcm, common);
+    in->rx_lcm = common->rx_lcm != NULL ? common->rx_lcm : lcm;
     in->sub_count = 0;
     in->secure = !common->insecure;
     if (in->secure && common->trust == NULL) {
@@ -693,7 +694,7 @@ int coavoid_node_inbox_init(coavoid_node_inbox_t *in, const coavoid_node_common_
 void coavoid_node_inbox_fini(coavoid_node_inbox_t *in)
 {
     for (size_t i = 0; i < in->sub_count; i++) {
-        lcm_unsubscribe(in->tx.lcm, in->subs[i]);
+        lcm_unsubscribe(in->rx_lcm, in->subs[i]);
     }
     in->sub_count = 0;
     coavoid_node_tx_fini(&in->tx);

@@ -109,6 +109,7 @@ struct coavoid_node_inbox {
      * every message must verify against it before it is decoded further. */
     bool secure;
     coavoid_auth_trust_t trust;
+    lcm_t *rx_lcm; /* where subs are: common.rx_lcm, or else the lcm it publishes on */
     lcm_subscription_t *subs[6];
     size_t sub_count;
     coavoid_lcm_rx_stats_t *rx; /* the owner's counters (its state's rx) */
@@ -245,6 +246,7 @@ coavoid_lcm_context_t coavoid_node_context(const coavoid_node_inbox_t *in, int64
 
 /* Initialises the inbox and subscribes to intents, tracks and the obstacle map, and to
  * heartbeats (want_status) and plans (plan_handler non-NULL) when asked; counts into rx.
+ * It publishes on lcm and subscribes on common->rx_lcm, or on lcm when that is NULL.
  * A coordinator's heartbeat or a plan from another node than coordinator_id is refused
  * (COAVOID_LCM_ERR_ID). Unless common->insecure, every message must carry a signature
  * of a key in common->trust whose role may send it, and be fresh (COAVOID_AUTH_ERR_*

@@ -17,6 +17,7 @@
 
 #include "flight.h"
 #include "judge.h"
+#include "net.h"
 #include "node.h"
 #include "sim.h"
 #include "sim_internal.h"
@@ -24,6 +25,19 @@
 /* Cycle 0's utime: a fixed constant (2001-09-09), never the wall clock, so that every
  * run stamps its messages alike and prints the same result. */
 #define SIM_EPOCH_UTIME INT64_C(1000000000000000)
+
+/* The nodes' numbers on the network (net.h): the world, the coordinator, then the UAVs in
+ * priority order. */
+#define SIM_NET_WORLD 0u
+#define SIM_NET_COORDINATOR 1u
+#define SIM_NET_VEHICLE(j) (2u + (j))
+/* Messages a node publishes in a cycle at most, for the network's queue: a UAV its
+ * intent and heartbeat (twice that, for margin); the coordinator its report, heartbeat
+ * and the rows of at most three plans per UAV (its clusters', the regrouped one's, the
+ * whole fleet's) or their abandonment (4 per UAV + 4, with margin); the world every
+ * tile and track. More would be a queue overflow: an error of the run, never a loss. */
+#define SIM_NET_VEHICLE_MESSAGES 4u
+#define SIM_NET_COORDINATOR_MESSAGES(n) (4u * (n) + 4u)
 typedef struct {
     /* The run's parameters (sim_check, sim_planner_sizes). */
     const coavoid_sim_config_t *o;
@@ -42,7 +56,8 @@ typedef struct {
     size_t max_centralised;
     uint32_t coordinator_plans; /* plans the coordinator ran, when it stopped or at the end */
     /* What the run holds (sim_run_free releases it). */
-    lcm_t *lcm;
+    coavoid_sim_net_t *net;
+    int net_error; /* the network's first error (coavoid_sim_net_pump) */
     coavoid_world_t *world;
     coavoid_coordinator_t *coordinator;
     coavoid_vehicle_node_t **vehicles; /* in priority order: the order they run in */
@@ -67,9 +82,7 @@ static void sim_run_free(sim_run_t *r, size_t n)
         }
     }
     coavoid_world_destroy(r->world);
-    if (r->lcm != NULL) {
-        lcm_destroy(r->lcm);
-    }
+    coavoid_sim_net_destroy(r->net);
     free(r->vehicles);
     free(r->index);
     free(r->references);
@@ -404,18 +417,38 @@ static int check_message_limits(coavoid_run_error_t *err, const char *file,
     return rc;
 }
 
-/* Handles every queued message. false when LCM failed. */
-static bool drain(lcm_t *lcm)
+/* Hands the nodes what they published and what is due by now. false when the network
+ * failed (r->net_error says how). */
+static bool drain(sim_run_t *r)
 {
-    for (;;) {
-        int rc = lcm_handle_timeout(lcm, 0);
-        if (rc == 0) {
-            return true;
-        }
-        if (rc < 0) {
-            return false;
-        }
+    int rc = coavoid_sim_net_pump(r->net, r->now);
+    r->net_error = r->net_error != COA_OK ? r->net_error : rc;
+    return rc == COA_OK;
+}
+
+/* The network's settings (the program checks them too, but the library trusts no caller):
+ * a message at most less than a cycle late. */
+static int check_network(sim_run_t *r)
+{
+    const coavoid_sim_config_t *o = r->o;
+    if (!(o->loss >= 0.0 && o->loss < 1.0)) {
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT,
+                                "--loss: must be a probability from 0 to below 1, got %g", o->loss);
     }
+    if (!(o->delay >= 0.0 && o->delay <= COAVOID_LCM_MAX_STEP) ||
+        !(o->jitter >= 0.0 && o->jitter <= COAVOID_LCM_MAX_STEP)) {
+        return coavoid_run_fail(
+            r->err, COAVOID_RUN_ERR_INPUT, "--%s: must be a time in seconds, 0 or more, got %g",
+            o->delay >= 0.0 && o->delay <= COAVOID_LCM_MAX_STEP ? "jitter" : "delay",
+            o->delay >= 0.0 && o->delay <= COAVOID_LCM_MAX_STEP ? o->jitter : o->delay);
+    }
+    if (llround(o->delay * 1e6) + llround(o->jitter * 1e6) >= r->common.dt_us) {
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT,
+                                "--delay: %g s plus --jitter %g s must be less than the "
+                                "scenario's dt (%g s): a message may be at most a cycle late",
+                                o->delay, o->jitter, (double)r->s->dt);
+    }
+    return SIM_GO_ON;
 }
 
 /* The scenario's limits for a simulation, then its samples and the nodes' common config. */
@@ -460,7 +493,8 @@ static int sim_check(sim_run_t *r, coavoid_scenario_t *s)
                                 file, (double)s->dt, COAVOID_LCM_MAX_STEP);
     }
     r->collect_us = r->common.dt_us / 4 > 0 ? r->common.dt_us / 4 : 1;
-    return check_message_limits(r->err, file, s, r->steps);
+    int rc = check_network(r);
+    return rc == SIM_GO_ON ? check_message_limits(r->err, file, s, r->steps) : rc;
 }
 
 /* Planner sizes: each UAV plans alone; the coordinator searches up to max_centralised UAVs
@@ -489,7 +523,43 @@ static int sim_planner_sizes(sim_run_t *r)
     return SIM_GO_ON;
 }
 
-/* The flight record, the figure's file and LCM's in-process provider. */
+/* The network between the nodes (net.h), on LCM's in-process provider: its queue holds
+ * two cycles of every node's messages, as a message is less than a cycle late. */
+static int sim_net(sim_run_t *r)
+{
+    const coavoid_sim_config_t *o = r->o;
+    const size_t n = r->n;
+    coavoid_sim_net_config_t c;
+    memset(&c, 0, sizeof c);
+    c.loss = o->loss;
+    c.delay_us = (int64_t)llround(o->delay * 1e6);
+    c.jitter_us = (int64_t)llround(o->jitter * 1e6);
+    c.seed = o->seed;
+    if (c.delay_us > 0 || c.jitter_us > 0) {
+        const size_t per_cycle = COAVOID_OBSTACLE_MAP_T_MAX_TILES + r->s->track_count +
+                                 SIM_NET_VEHICLE_MESSAGES * n + SIM_NET_COORDINATOR_MESSAGES(n);
+        c.message_capacity = 2u * per_cycle;
+        c.copy_capacity = 2u * per_cycle * (n + 1u);
+    }
+    bool receives[COAVOID_NODE_MAX_PEERS + 2u];
+    receives[SIM_NET_WORLD] = false;
+    receives[SIM_NET_COORDINATOR] = !o->decoupled;
+    for (size_t j = 0; j < n; j++) {
+        receives[SIM_NET_VEHICLE(j)] = true;
+    }
+    int error = COA_OK;
+    r->net_error = COA_OK;
+    r->net = coavoid_sim_net_create(&c, n + 2u, receives, &error);
+    if (r->net == NULL) {
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INTERNAL,
+                                "internal error: no simulated network (%s: LCM's memq provider "
+                                "or memory)",
+                                coa_status_name(error));
+    }
+    return SIM_GO_ON;
+}
+
+/* The flight record, the figure's file and the network. */
 static int sim_open(sim_run_t *r)
 {
     const size_t n = r->n;
@@ -509,12 +579,7 @@ static int sim_open(sim_run_t *r)
                                     r->o->svg_path);
         }
     }
-    r->lcm = lcm_create("memq://");
-    if (r->lcm == NULL) {
-        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INTERNAL,
-                                "internal error: LCM's memq provider is unavailable");
-    }
-    return SIM_GO_ON;
+    return sim_net(r);
 }
 
 /* One fleet key of the simulation into signer and the trust list: its seed is a fixed text
@@ -609,7 +674,7 @@ static int sim_world(sim_run_t *r)
     world.obstacle_count = s->obstacle_count;
     world.tracks = world_tracks;
     world.track_count = s->track_count;
-    r->world = coavoid_world_create(&world, r->lcm, &error);
+    r->world = coavoid_world_create(&world, coavoid_sim_net_tx(r->net, SIM_NET_WORLD), &error);
     if (r->world == NULL && error == COA_ERR_ARGUMENT) {
         return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT,
                                 "%s: obstacles: more than an obstacle map holds (%d boxes, "
@@ -650,7 +715,9 @@ static int sim_vehicles(sim_run_t *r)
         config.common.signer = sim_signer(r, 2u + i);
         config.vehicle = s->vehicles[i];
         config.mode = r->o->decoupled ? COAVOID_NODE_DECOUPLED : COAVOID_NODE_CENTRALISED;
-        r->vehicles[j] = coavoid_vehicle_node_create(&config, r->lcm, &error);
+        config.common.rx_lcm = coavoid_sim_net_rx(r->net, SIM_NET_VEHICLE(j));
+        r->vehicles[j] = coavoid_vehicle_node_create(
+            &config, coavoid_sim_net_tx(r->net, SIM_NET_VEHICLE(j)), &error);
         if (r->vehicles[j] == NULL && error == COA_ERR_ARGUMENT) {
             return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT,
                                     "%s: vehicles[%zu]: cannot run as a node (%s)", r->file, i,
@@ -685,7 +752,9 @@ static int sim_coordinator(sim_run_t *r)
                                 "%s: dt: %g s leaves the coordinator no time within a cycle",
                                 r->file, (double)r->s->dt);
     }
-    r->coordinator = coavoid_coordinator_create(&config, r->lcm, &error);
+    config.common.rx_lcm = coavoid_sim_net_rx(r->net, SIM_NET_COORDINATOR);
+    r->coordinator = coavoid_coordinator_create(
+        &config, coavoid_sim_net_tx(r->net, SIM_NET_COORDINATOR), &error);
     if (r->coordinator == NULL && error == COA_ERR_ARGUMENT) {
         return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT,
                                 "%s: beta: %lu cannot size the coordinator's planner", r->file,
@@ -700,9 +769,12 @@ static int sim_coordinator(sim_run_t *r)
     return SIM_GO_ON;
 }
 
-/* The UAVs' waits of one cycle: poll until nobody moves on, then the clock jumps to the
- * first deadline, until none is left. Keeps the first node error in *node_error. */
-static bool sim_waits(sim_run_t *r, int *node_error)
+/* The UAVs' waits, and the network's deliveries in time order with them: poll until
+ * nobody moves on, then the clock jumps to the first deadline or delivery, until no
+ * deadline is left and no delivery is due by `until` (one due later but before a UAV's
+ * deadline comes first: the clock never goes back). Keeps the first node error in
+ * *node_error. False when the network failed. */
+static bool sim_waits(sim_run_t *r, int64_t until, int *node_error)
 {
     bool lcm_ok = true;
     for (;;) {
@@ -715,7 +787,7 @@ static bool sim_waits(sim_run_t *r, int *node_error)
                     *node_error = *node_error != COA_OK ? *node_error : rc;
                 } else if (rc > 0) {
                     changed = true;
-                    lcm_ok = drain(r->lcm);
+                    lcm_ok = drain(r);
                 }
             }
         }
@@ -724,40 +796,48 @@ static bool sim_waits(sim_run_t *r, int *node_error)
             int64_t d = coavoid_vehicle_node_deadline(r->vehicles[j]);
             deadline = d < deadline ? d : deadline;
         }
+        const int64_t due = coavoid_sim_net_next(r->net);
+        if (due <= until || (deadline != INT64_MAX && due <= deadline)) {
+            deadline = due;
+        }
         if (deadline == INT64_MAX || !lcm_ok) {
             return lcm_ok;
         }
         r->now = deadline > r->now ? deadline : r->now;
+        lcm_ok = drain(r);
     }
 }
 
-/* Cycle k of the loop of node.h: world, then the UAVs in priority order, their waits, then
- * the coordinator at cycle start + collect; each message is handled as soon as it is
- * published, as on a quiet network. False when LCM failed. */
+/* Cycle k of the loop of node.h: what the network still carries up to its start, then
+ * the world, the UAVs in priority order, their waits, then the coordinator at cycle start
+ * + collect; each message reaches its receivers when the network says (at once, with
+ * neither delay nor jitter, as on a quiet network). False when the network failed. */
 static bool sim_cycle(sim_run_t *r, uint32_t k, int *node_error)
 {
+    const int64_t cycle_start = coavoid_node_cycle_utime(&r->common, (int64_t)k);
+    bool lcm_ok = k == 0u || sim_waits(r, cycle_start, node_error);
     if (r->coordinator != NULL && r->o->has_stop && k == r->o->stop_step) {
         r->coordinator_plans = coavoid_coordinator_state(r->coordinator)->plans_run;
         coavoid_coordinator_destroy(r->coordinator);
         r->coordinator = NULL;
+        coavoid_sim_net_stop(r->net, SIM_NET_COORDINATOR);
     }
-    const int64_t cycle_start = coavoid_node_cycle_utime(&r->common, (int64_t)k);
     r->now = cycle_start;
     int rc = coavoid_world_cycle(r->world, r->now);
     *node_error = *node_error != COA_OK ? *node_error : rc;
-    bool lcm_ok = drain(r->lcm);
+    lcm_ok = lcm_ok && drain(r);
     for (size_t j = 0; j < r->n && lcm_ok; j++) {
         rc = coavoid_vehicle_node_cycle(r->vehicles[j], r->now);
         *node_error = *node_error != COA_OK ? *node_error : rc;
-        lcm_ok = drain(r->lcm);
+        lcm_ok = drain(r);
     }
-    lcm_ok = lcm_ok && sim_waits(r, node_error);
+    lcm_ok = lcm_ok && sim_waits(r, cycle_start + r->collect_us, node_error);
     /* The coordinator plans cycles 0..K-1: cycle K only flies the last sample. */
     if (r->coordinator != NULL && k < r->steps && lcm_ok) {
         r->now = cycle_start + r->collect_us > r->now ? cycle_start + r->collect_us : r->now;
         rc = coavoid_coordinator_cycle(r->coordinator, r->now);
         *node_error = *node_error != COA_OK ? *node_error : rc;
-        lcm_ok = drain(r->lcm);
+        lcm_ok = drain(r);
     }
     for (size_t j = 0; j < r->n; j++) {
         const coavoid_vehicle_node_state_t *st = coavoid_vehicle_node_state(r->vehicles[j]);
@@ -779,6 +859,11 @@ static int sim_fly(sim_run_t *r)
     if (r->coordinator != NULL) {
         r->coordinator_plans = coavoid_coordinator_state(r->coordinator)->plans_run;
     }
+    if (!lcm_ok && r->net_error == COA_ERR_WORKSPACE) {
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INTERNAL,
+                                "internal error: the simulated network's queue overflowed (more "
+                                "messages in flight than two cycles of the fleet's)");
+    }
     if (!lcm_ok) {
         return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INTERNAL,
                                 "internal error: LCM failed while handling messages");
@@ -791,8 +876,59 @@ static int sim_fly(sim_run_t *r)
     return SIM_GO_ON;
 }
 
-/* Judges the flight and writes the figure and the result; the exit status. */
-static int sim_report(sim_run_t *r)
+/* The network's settings and counts: a JSON object, or (json false) a line of text. */
+static void network_text(const sim_run_t *r, bool json, char *buf, size_t size)
+{
+    const coavoid_sim_config_t *o = r->o;
+    const coavoid_sim_net_stats_t st = coavoid_sim_net_stats(r->net);
+    snprintf(buf, size,
+             json ? "{\"loss\": %.15g, \"delay\": %.15g, \"jitter\": %.15g, \"seed\": %llu, "
+                    "\"sent\": %llu, \"delivered\": %llu, \"dropped\": %llu, \"in_flight\": "
+                    "%llu}"
+                  : "network: loss %.15g, delay %.15g s, jitter %.15g s, seed %llu: %llu messages "
+                    "sent, copies to other nodes %llu delivered, %llu dropped, %llu in flight\n",
+             o->loss, o->delay, o->jitter, (unsigned long long)o->seed, (unsigned long long)st.sent,
+             (unsigned long long)st.delivered, (unsigned long long)st.dropped,
+             (unsigned long long)st.in_flight);
+}
+
+/* Writes the result (text or JSON) to r->out. COA_OK or an error. */
+static int sim_write(const sim_run_t *r, uint32_t fallbacks)
+{
+    const coavoid_sim_config_t *o = r->o;
+    const coavoid_flight_t *flight = &r->judged.flight;
+    const coavoid_flight_eval_t *eval = &r->judged.eval;
+    char network[512];
+    network_text(r, o->json, network, sizeof network);
+    int rc = COA_OK;
+    if (o->json) {
+        char fallbacks_text[16];
+        char stopped_text[16];
+        snprintf(fallbacks_text, sizeof fallbacks_text, "%lu", (unsigned long)fallbacks);
+        snprintf(stopped_text, sizeof stopped_text, "%lu", (unsigned long)o->stop_step);
+        coavoid_flight_extra_t extra[3] = {
+            {"fallbacks", fallbacks_text}, {NULL, NULL}, {NULL, NULL}};
+        size_t count = 1u;
+        if (o->has_stop) {
+            extra[count++] = (coavoid_flight_extra_t){"coordinator_stopped_at", stopped_text};
+        }
+        if (o->network) {
+            extra[count++] = (coavoid_flight_extra_t){"network", network};
+        }
+        rc = coavoid_flight_json_extra(flight, eval, extra, count, r->out);
+    } else {
+        rc = coavoid_flight_text(flight, eval, r->out);
+        if (rc == COA_OK && (fprintf(r->out, "fallbacks: %lu\n", (unsigned long)fallbacks) < 0 ||
+                             (o->network && fputs(network, r->out) < 0) || fflush(r->out) != 0)) {
+            rc = COA_ERR_WORKSPACE;
+        }
+    }
+    return rc;
+}
+
+/* Judges the flight and writes the figure and the result (unless there is no r->out);
+ * the exit status, and *outcome when not NULL. */
+static int sim_report(sim_run_t *r, coavoid_sim_outcome_t *outcome)
 {
     const coavoid_sim_config_t *o = r->o;
     uint32_t replans = r->coordinator_plans;
@@ -804,7 +940,6 @@ static int sim_report(sim_run_t *r)
     }
     int rc = coavoid_judge_run(&r->judged, r->s, o->mode, r->steps, replans, r->references,
                                r->offsets, NULL);
-    const coavoid_flight_t *flight = &r->judged.flight;
     const coavoid_flight_eval_t *eval = &r->judged.eval;
     if (rc != COA_OK) {
         return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INTERNAL,
@@ -812,7 +947,7 @@ static int sim_report(sim_run_t *r)
                                 coa_status_name(rc));
     }
     if (r->svg != NULL) {
-        rc = coavoid_flight_svg(flight, eval, r->svg);
+        rc = coavoid_flight_svg(&r->judged.flight, eval, r->svg);
         int closed = fclose(r->svg);
         r->svg = NULL;
         if (rc != COA_OK || closed != 0) {
@@ -820,30 +955,30 @@ static int sim_report(sim_run_t *r)
                                     "--svg: writing '%.200s' failed", o->svg_path);
         }
     }
-    if (o->json) {
-        char fallbacks_text[16];
-        char stopped_text[16];
-        snprintf(fallbacks_text, sizeof fallbacks_text, "%lu", (unsigned long)fallbacks);
-        snprintf(stopped_text, sizeof stopped_text, "%lu", (unsigned long)o->stop_step);
-        const coavoid_flight_extra_t extra[2] = {{"fallbacks", fallbacks_text},
-                                                 {"coordinator_stopped_at", stopped_text}};
-        rc = coavoid_flight_json_extra(flight, eval, extra, o->has_stop ? 2u : 1u, r->out);
-    } else {
-        rc = coavoid_flight_text(flight, eval, r->out);
-        if (rc == COA_OK && (fprintf(r->out, "fallbacks: %lu\n", (unsigned long)fallbacks) < 0 ||
-                             fflush(r->out) != 0)) {
-            rc = COA_ERR_WORKSPACE;
-        }
-    }
-    if (rc != COA_OK) {
+    if (r->out != NULL && sim_write(r, fallbacks) != COA_OK) {
         return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INTERNAL,
                                 "internal error: the result could not be written");
+    }
+    if (outcome != NULL) {
+        const coavoid_sim_net_stats_t st = coavoid_sim_net_stats(r->net);
+        outcome->loss_of_separation = eval->loss_of_separation;
+        outcome->fallbacks = fallbacks;
+        outcome->sent = st.sent;
+        outcome->delivered = st.delivered;
+        outcome->dropped = st.dropped;
+        outcome->in_flight = st.in_flight;
     }
     return eval->loss_of_separation ? COAVOID_SIM_LOSS : COAVOID_SIM_SEPARATED;
 }
 
 int coavoid_sim_run(const coavoid_sim_config_t *c, coavoid_scenario_t *s, FILE *out,
                     coavoid_run_error_t *e)
+{
+    return coavoid_sim_fly(c, s, out, NULL, e);
+}
+
+int coavoid_sim_fly(const coavoid_sim_config_t *c, coavoid_scenario_t *s, FILE *out,
+                    coavoid_sim_outcome_t *outcome, coavoid_run_error_t *e)
 {
     sim_run_t r;
     memset(&r, 0, sizeof r);
@@ -877,7 +1012,7 @@ int coavoid_sim_run(const coavoid_sim_config_t *c, coavoid_scenario_t *s, FILE *
         rc = sim_fly(&r);
     }
     if (rc == SIM_GO_ON) {
-        rc = sim_report(&r);
+        rc = sim_report(&r, outcome);
     }
     sim_run_free(&r, r.n);
     return rc;

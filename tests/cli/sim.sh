@@ -7,7 +7,8 @@
 # conflict; the flown costs are at least the one-shot plan's; a run is repeatable byte for
 # byte; the UAVs fall back to planning for themselves when the coordinator stops, and stay
 # separated; a scenario already in conflict reports its loss (exit 1) instead of crashing;
-# UAVs decide in priority order whatever their ids; bad arguments and inputs, and numbers
+# UAVs decide in priority order whatever their ids; the simulated network (--loss, --delay,
+# --jitter, --seed) and montecarlo's closed loop (--fly) over it; bad arguments and inputs, and numbers
 # beyond what a message carries anywhere in the run, exit 2 with one line.
 #
 # usage: bash sim.sh <path-to-coavoid> <source-dir>   (VERBOSE=1 prints each result)
@@ -201,6 +202,91 @@ for args in "paper.json --mode centralised" "late_encounter.json --mode decouple
     "$bin" sim "$scenarios/${a[0]}" "${a[@]:1}" >"$tmp/run2" 2>&1
     if [ -s "$tmp/run1" ] && cmp -s "$tmp/run1" "$tmp/run2"; then pass; else fail "two runs of sim $args differ"; fi
 done
+
+# ---- the simulated network (--loss, --delay, --jitter, --seed) ----
+
+# Zero loss, delay and jitter given: the same flight as without them, plus the network's
+# object; given a loss, a seed gives one run, another seed other deliveries; a delay
+# leaves copies in flight at the end; every copy is delivered, dropped or in flight.
+p=$scenarios/paper.json
+"$bin" sim "$p" --mode centralised --json --insecure >"$tmp/net-none.json" 2>&1
+"$bin" sim "$p" --mode centralised --json --insecure --loss 0 --delay 0 --jitter 0 >"$tmp/net-zero.json" 2>&1
+if python3 - "$tmp/net-none.json" "$tmp/net-zero.json" <<'PY'; then pass; else fail "sim with a zero network is not the run without one"; fi
+import json, sys
+a, b = (json.load(open(f)) for f in sys.argv[1:3])
+assert "network" not in a
+n = b.pop("network")
+assert a == b, "flights differ"
+assert n["loss"] == 0 and n["delay"] == 0 and n["jitter"] == 0 and n["seed"] == 1, n
+assert n["dropped"] == 0 and n["in_flight"] == 0 and n["delivered"] > n["sent"] > 0, n
+PY
+for m in centralised decoupled; do
+    for run in a:5 b:5 c:6; do
+        "$bin" sim "$p" --mode $m --json --insecure --loss 0.3 --jitter 0.2 --seed "${run#*:}" >"$tmp/net-$m-${run%:*}" 2>&1
+    done
+done
+if python3 - "$tmp"/net-centralised-[abc] "$tmp"/net-decoupled-[abc] <<'PY'; then pass; else fail "sim --loss: one seed is not one run, or another seed the same"; fi
+import json, sys
+for a, b, c in (sys.argv[1:4], sys.argv[4:7]):
+    A, B, C = (open(f).read() for f in (a, b, c))
+    assert A == B, f"{a} and {b} differ"
+    na, nc = json.loads(A)["network"], json.loads(C)["network"]
+    assert na["seed"] == 5 and nc["seed"] == 6
+    assert na != nc, "seeds 5 and 6 dropped the same copies"
+    for n in (na, nc):
+        assert 0.2 < n["dropped"] / (n["dropped"] + n["delivered"] + n["in_flight"]) < 0.4, n
+PY
+"$bin" sim "$p" --mode decoupled --insecure --delay 0.3 >"$tmp/net-delay.txt" 2>&1
+if grep -q '^network: loss 0, delay 0.3 s, jitter 0 s, seed 1: [0-9]* messages sent, copies to other nodes [0-9]* delivered, 0 dropped, [1-9][0-9]* in flight$' "$tmp/net-delay.txt"; then pass; else fail "sim --delay: no network line with copies in flight"; fi
+expect_bad "loss 1" "--loss" sim "$p" --mode decoupled --loss 1
+expect_bad "loss negative" "--loss" sim "$p" --mode decoupled --loss=-0.1
+expect_bad "loss word" "--loss" sim "$p" --mode decoupled --loss some
+expect_bad "loss twice" "--loss" sim "$p" --mode decoupled --loss 0.1 --loss 0.2
+expect_bad "delay negative" "--delay" sim "$p" --mode decoupled --delay=-1
+expect_bad "delay nan" "--delay" sim "$p" --mode decoupled --delay nan
+expect_bad "jitter missing" "--jitter" sim "$p" --mode decoupled --jitter
+expect_bad "delay a cycle" "--delay" sim "$p" --mode decoupled --delay 0.5 --jitter 0.5
+expect_bad "seed word" "--seed" sim "$p" --mode decoupled --loss 0.1 --seed x
+
+# ---- montecarlo --fly: the closed loop of the random encounters ----
+
+# Each encounter flown as `coavoid sim` flies it (the saved encounter, flown by sim, has
+# the verdict of its flown_* CSV row); deterministic whatever --jobs; the network's options
+# only with --fly, and under dt.
+mkdir -p "$tmp/mc"
+"$bin" montecarlo --vehicles 2,3 --count 4 --fly --loss 0.2 --quiet --jobs 1 --csv "$tmp/fly1.csv" --save "$tmp/mc" --json >"$tmp/fly1.json" 2>&1
+"$bin" montecarlo --vehicles 2,3 --count 4 --fly --loss 0.2 --quiet --jobs 2 --csv "$tmp/fly2.csv" --json >"$tmp/fly2.json" 2>&1
+"$bin" montecarlo --vehicles 3 --count 4 --fly --quiet --csv "$tmp/fly0.csv" --save "$tmp/mc" >/dev/null 2>&1
+if python3 - "$tmp/fly1.json" "$tmp/fly2.json" "$tmp/fly1.csv" "$tmp/fly2.csv" <<'PY'; then pass; else fail "montecarlo --fly: report or CSV wrong, or depends on --jobs"; fi
+import csv, json, sys
+a, b = (json.load(open(f)) for f in sys.argv[1:3])
+assert a["network"] == {"loss": 0.2, "delay": 0, "jitter": 0, "insecure": True}, a["network"]
+for z, y in zip(a["sizes"], b["sizes"]):
+    assert z["closed_loop"] == y["closed_loop"], "depends on --jobs"
+    assert [m["mode"] for m in z["closed_loop"]] == ["centralised", "decoupled"]
+    for m in z["closed_loop"]:
+        assert 0 <= m["losses_where_centralised_solved"] <= m["centralised_solved"] <= 4
+        assert m["dropped"] > 0 and m["delivered"] > 0, m
+rows = [[r[:15] for r in csv.reader(open(f))] for f in sys.argv[3:5]]
+assert rows[0] == rows[1], "CSV depends on --jobs"
+flown = [r for r in rows[0] if r[7].startswith("flown_")]
+assert len(flown) == 16 and {r[8] for r in flown} <= {"separated", "loss_of_separation"}
+PY
+# At loss 0 each flown row is what coavoid sim says of the saved encounter.
+ok=1 seen=0
+while IFS=, read -r seed n index _ _ _ _ method status _; do
+    case $method in flown_*) ;; *) continue ;; esac
+    seen=$((seen + 1))
+    "$bin" sim "$tmp/mc/montecarlo-$seed-$n-$index.json" --mode "${method#flown_}" --insecure >/dev/null 2>&1
+    rc=$?
+    want=0; [ "$status" = loss_of_separation ] && want=1
+    [ "$rc" = "$want" ] || { ok=0; echo "montecarlo-$seed-$n-$index ${method#flown_}: sim exits $rc, CSV says $status"; }
+done < <(tail -n +2 "$tmp/fly0.csv")
+if [ $ok = 1 ] && [ $seen = 8 ]; then pass; else fail "montecarlo --fly: a flown verdict differs from coavoid sim's ($seen rows)"; fi
+expect_bad "mc loss without fly" "--loss" montecarlo --vehicles 2 --count 1 --loss 0.1
+expect_bad "mc loss 1" "--loss" montecarlo --vehicles 2 --count 1 --fly --loss 1
+expect_bad "mc delay a cycle" "--delay" montecarlo --vehicles 2 --count 1 --fly --delay 0.6 --jitter 0.4
+expect_bad "mc fly value" "--fly" montecarlo --vehicles 2 --count 1 --fly=yes
 
 # ---- the coordinator stops ----
 
