@@ -10,6 +10,7 @@
 
 #include "coavoid/coavoid.h"
 #include "coavoid_lcm.h"
+#include "prng.h"
 
 /* Channels are the nodes' own (COAVOID_CHANNEL_*): far shorter. */
 #define NET_CHANNEL_MAX 64u
@@ -43,7 +44,7 @@ struct coavoid_sim_net {
     coavoid_sim_net_config_t config;
     size_t count;
     net_node_t *nodes;
-    uint64_t prng;
+    coavoid_prng_t prng;
     int64_t now;
     int error; /* the first error inside a handler */
     net_message_t *messages;
@@ -55,19 +56,10 @@ struct coavoid_sim_net {
     coavoid_sim_net_stats_t stats;
 };
 
-/* splitmix64 (as src/evaluation/prng.h): the same stream for a seed on every machine. */
-static uint64_t net_next(coavoid_sim_net_t *net)
-{
-    uint64_t z = (net->prng += 0x9e3779b97f4a7c15u);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9u;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebu;
-    return z ^ (z >> 31);
-}
-
-/* Uniform in [0, 1). */
+/* Uniform in [0, 1), from the seeded stream (prng.h: the same for a seed everywhere). */
 static double net_uniform(coavoid_sim_net_t *net)
 {
-    return (double)(net_next(net) >> 11) * (1.0 / 9007199254740992.0);
+    return coavoid_prng_uniform(&net->prng, 0.0, 1.0);
 }
 
 static bool copy_before(const net_copy_t *a, const net_copy_t *b)
@@ -343,7 +335,7 @@ coavoid_sim_net_t *coavoid_sim_net_create(const coavoid_sim_net_config_t *config
         return NULL;
     }
     net->config = *config;
-    net->prng = config->seed;
+    net->prng.state = config->seed;
     net->error = COA_OK;
     net->nodes = calloc(nodes, sizeof *net->nodes);
     const size_t m = config->message_capacity, c = config->copy_capacity;

@@ -1,15 +1,17 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * prng.h: the seeded pseudo-random numbers behind every random problem of coavoid::evaluation
- * (the encounters of encounter.h, bench predict's airspace). splitmix64 (Steele, Lea, Flood
+ * prng.h: the seeded pseudo-random numbers behind every random problem of coavoid (the
+ * encounters of src/evaluation/encounter.h, bench predict's airspace) and the simulated
+ * network's losses and delays (src/sim/net.c). In coavoid::scenario, the layer both of
+ * those libraries build on. splitmix64 (Steele, Lea, Flood
  * 2014): tiny, fast, and the same sequence on every machine for a seed, which is what makes
  * a benchmark or an evaluation repeatable from its seed alone; rand() and random() give
  * no such promise across C libraries. Not for anything that must be unpredictable.
  *
  * Each call is O(1), uses no memory besides the 8-byte state and cannot fail.
  */
-#ifndef COAVOID_EVALUATION_PRNG_H
-#define COAVOID_EVALUATION_PRNG_H
+#ifndef COAVOID_SCENARIO_PRNG_H
+#define COAVOID_SCENARIO_PRNG_H
 
 #include <stdint.h>
 
@@ -41,4 +43,4 @@ static inline uint32_t coavoid_prng_below(coavoid_prng_t *r, uint32_t n)
     return (uint32_t)(coavoid_prng_next(r) % n);
 }
 
-#endif /* COAVOID_EVALUATION_PRNG_H */
+#endif /* COAVOID_SCENARIO_PRNG_H */
