@@ -1501,6 +1501,21 @@ START_TEST(test_auth_roles_and_freshness)
         COAVOID_AUTH_ERR_REPLAY);
     ck_assert_int_eq(coavoid_auth_fresh(&trust, 1, st, T0 + 20, 0, T0, window, window),
                      COAVOID_AUTH_ERR_REPLAY);
+    /* The receiver's rule in one call: the role for the message's own id (out of range:
+     * none), then freshness. */
+    const size_t in = COAVOID_AUTH_STREAM_INTENT;
+    ck_assert_int_eq(coavoid_auth_accept(&trust, 0, in, COAVOID_AUTH_VEHICLE, 0, T0 + 50, 0,
+                                         T0 + 50, window, window),
+                     COAVOID_AUTH_ERR_ROLE);
+    ck_assert_int_eq(coavoid_auth_accept(&trust, 0, in, COAVOID_AUTH_VEHICLE, 65539, T0 + 50, 0,
+                                         T0 + 50, window, window),
+                     COAVOID_AUTH_ERR_ROLE);
+    ck_assert_int_eq(coavoid_auth_accept(&trust, 0, in, COAVOID_AUTH_VEHICLE, 3, T0 + 50, 0,
+                                         T0 + 50, window, window),
+                     COA_OK);
+    ck_assert_int_eq(coavoid_auth_accept(&trust, 0, in, COAVOID_AUTH_VEHICLE, 3, T0 + 50, 0,
+                                         T0 + 50, window, window),
+                     COAVOID_AUTH_ERR_REPLAY);
     /* The signer's numbers: the clock, then a sequence while it stands still. */
     int32_t id;
     int64_t ts, seq;

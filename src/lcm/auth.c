@@ -211,6 +211,19 @@ int coavoid_auth_fresh(coavoid_auth_trust_t *t, size_t key, size_t stream, int64
     return COA_OK;
 }
 
+int coavoid_auth_accept(coavoid_auth_trust_t *t, size_t key, size_t stream,
+                        coavoid_auth_role_t role, int32_t id, int64_t timestamp_us,
+                        int64_t sequence, int64_t now, int64_t max_age_us, int64_t max_ahead_us)
+{
+    if (id < 1 || id > 65535) {
+        return COAVOID_AUTH_ERR_ROLE;
+    }
+    int rc = coavoid_auth_may_send(t, key, role, (uint16_t)id);
+    return rc == COA_OK ? coavoid_auth_fresh(t, key, stream, timestamp_us, sequence, now,
+                                             max_age_us, max_ahead_us)
+                        : rc;
+}
+
 /* ---- keys as text ---- */
 
 static const char *const ROLE_NAMES[4] = {NULL, "coordinator", "world", "vehicle"};

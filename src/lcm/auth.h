@@ -162,6 +162,15 @@ int coavoid_auth_may_send(const coavoid_auth_trust_t *t, size_t key, coavoid_aut
 int coavoid_auth_fresh(coavoid_auth_trust_t *t, size_t key, size_t stream, int64_t timestamp_us,
                        int64_t sequence, int64_t now, int64_t max_age_us, int64_t max_ahead_us);
 
+/* What a receiver checks once coavoid_auth_verify found the datagram's key `key` and the
+ * message decoded: the key may send as `role` for the sender id the message names (any
+ * int32: outside 1..65535 it may not: COAVOID_AUTH_ERR_ROLE), and the message is fresh
+ * on its stream (coavoid_auth_fresh, which marks it). The nodes and `coavoid summary`
+ * apply the same rule through it. COA_OK or COAVOID_AUTH_ERR_ROLE, _REPLAY, _CLOCK. O(1). */
+int coavoid_auth_accept(coavoid_auth_trust_t *t, size_t key, size_t stream,
+                        coavoid_auth_role_t role, int32_t id, int64_t timestamp_us,
+                        int64_t sequence, int64_t now, int64_t max_age_us, int64_t max_ahead_us);
+
 /* ---- keys as text ----
  * A trust file lists the keys a receiver accepts, one per line:
  *     KEY_ID ROLE NODE_ID PUBLIC_KEY_HEX

@@ -27,6 +27,7 @@
 #include "coavoid/plan.h"
 #include "coavoid/predict.h"
 #include "coavoid/trajectory.h"
+#include "auth.h"
 
 #include <coavoid_lcmtypes/coavoid_conflict_report_t.h>
 #include <coavoid_lcmtypes/coavoid_intent_t.h>
@@ -333,6 +334,10 @@ int coavoid_lcm_conflict_report_from_core(const coa_conflict_t *conflicts, size_
 
 int coavoid_lcm_status_check(const coavoid_status_t *msg, const coavoid_lcm_context_t *ctx,
                              const char **reason);
+
+/* The role whose key may sign a heartbeat of this node_kind: the coordinator's for
+ * NODE_COORDINATOR, else a vehicle's. O(1). */
+coavoid_auth_role_t coavoid_lcm_status_role(int8_t node_kind);
 
 /* The health that status_t's REASON_* bits give: HEALTH_FAULT with INTERNAL_ERROR or
  * DUPLICATE_ID, HEALTH_DEGRADED with any other, HEALTH_OK with none. One rule for the

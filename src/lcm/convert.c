@@ -1477,6 +1477,12 @@ int coavoid_lcm_conflict_report_accept(const coavoid_conflict_report_t *msg,
 
 /* ---- status ---- */
 
+coavoid_auth_role_t coavoid_lcm_status_role(int8_t node_kind)
+{
+    return node_kind == COAVOID_STATUS_T_NODE_COORDINATOR ? COAVOID_AUTH_COORDINATOR
+                                                          : COAVOID_AUTH_VEHICLE;
+}
+
 int8_t coavoid_lcm_health_of(int32_t reasons)
 {
     const int32_t fatal =

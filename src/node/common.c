@@ -218,12 +218,9 @@ static bool sender_ok(coavoid_node_inbox_t *in, size_t key, size_t stream, coavo
     if (!in->secure) {
         return true;
     }
-    int rc = (id >= 1 && id <= 65535) ? coavoid_auth_may_send(&in->trust, key, role, (uint16_t)id)
-                                      : COAVOID_AUTH_ERR_ROLE;
-    if (rc == COA_OK) {
-        rc = coavoid_auth_fresh(&in->trust, key, stream, auth->timestamp_us, auth->sequence,
-                                *in->common.clock, in->max_age_us, in->common.dt_us);
-    }
+    const int rc =
+        coavoid_auth_accept(&in->trust, key, stream, role, id, auth->timestamp_us, auth->sequence,
+                            *in->common.clock, in->max_age_us, in->common.dt_us);
     if (rc != COA_OK) {
         coavoid_lcm_rx_count(in->rx, rc, auth_reason(rc));
         return false;
@@ -533,10 +530,8 @@ static void on_status(const lcm_recv_buf_t *rbuf, const char *channel, void *use
     if (msg->node_id == (int32_t)in->self_node) {
         return;
     }
-    const coavoid_auth_role_t role = msg->node_kind == COAVOID_STATUS_T_NODE_COORDINATOR
-                                         ? COAVOID_AUTH_COORDINATOR
-                                         : COAVOID_AUTH_VEHICLE;
-    if (!sender_ok(in, key, COAVOID_AUTH_STREAM_STATUS, role, msg->node_id, &msg->auth)) {
+    if (!sender_ok(in, key, COAVOID_AUTH_STREAM_STATUS, coavoid_lcm_status_role(msg->node_kind),
+                   msg->node_id, &msg->auth)) {
         return;
     }
     /* Before the sequence rule, so that impostors take no room in its table. */

@@ -503,13 +503,10 @@ static bool authentic(log_summary_t *ls, const lcm_eventlog_event_t *e, size_t s
     size_t key = 0;
     int rc = coavoid_auth_verify(&ls->trust, e->data, (size_t)e->datalen, &key);
     if (rc == COA_OK) {
-        rc = (id >= 1 && id <= 65535) ? coavoid_auth_may_send(&ls->trust, key, role, (uint16_t)id)
-                                      : COAVOID_AUTH_ERR_ROLE;
-    }
-    if (rc == COA_OK) {
-        /* Order only: the logger's clock is not the nodes' (a run may be sped up). */
-        rc = coavoid_auth_fresh(&ls->trust, key, stream, auth->timestamp_us, auth->sequence,
-                                auth->timestamp_us, 0, 0);
+        /* Order only (now = its own time, no window): the logger's clock is not the
+         * nodes' (a run may be sped up). */
+        rc = coavoid_auth_accept(&ls->trust, key, stream, role, id, auth->timestamp_us,
+                                 auth->sequence, auth->timestamp_us, 0, 0);
     }
     if (rc != COA_OK && count) {
         (*counter)++;
@@ -590,11 +587,8 @@ static bool read_status(log_summary_t *ls, const lcm_eventlog_event_t *e)
         note_other(ls, reason);
         return true;
     }
-    const coavoid_auth_role_t role = m->node_kind == COAVOID_STATUS_T_NODE_COORDINATOR
-                                         ? COAVOID_AUTH_COORDINATOR
-                                         : COAVOID_AUTH_VEHICLE;
-    if (!authentic(ls, e, COAVOID_AUTH_STREAM_STATUS, role, m->node_id, &m->auth,
-                   &ls->statuses_unauthenticated, true)) {
+    if (!authentic(ls, e, COAVOID_AUTH_STREAM_STATUS, coavoid_lcm_status_role(m->node_kind),
+                   m->node_id, &m->auth, &ls->statuses_unauthenticated, true)) {
         return true;
     }
     /* node_id is 1..65535 once the heartbeat is valid. */
