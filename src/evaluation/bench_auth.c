@@ -149,7 +149,8 @@ static int64_t read_be64(const unsigned char *p)
 }
 
 /* What a receiving node does with a datagram of `type` before it uses it (common.c,
- * signature_ok and sender_ok): the signature, the key's role, freshness at its clock
+ * signature_ok and sender_ok): the signature, then coavoid_auth_accept (the key's role,
+ * freshness) at its clock
  * `now`. The numbers are read from the auth_t's bytes, where a node decodes them: the
  * decoding is the same with or without signatures, so it is not part of their cost. */
 static int receive(coavoid_auth_trust_t *trust, size_t type, const unsigned char *d, size_t size,
@@ -159,13 +160,10 @@ static int receive(coavoid_auth_trust_t *trust, size_t type, const unsigned char
     size_t key = 0;
     int rc = coavoid_auth_verify(trust, d, size, &key);
     if (rc == COA_OK) {
-        rc = coavoid_auth_may_send(trust, key, senders[kinds[type].sender].role,
-                                   senders[kinds[type].sender].node_id);
-    }
-    if (rc == COA_OK) {
-        rc = coavoid_auth_fresh(trust, key, type, read_be64(d + tail + 4u),
-                                read_be64(d + tail + 12u), now, BENCH_AUTH_WINDOW_US,
-                                BENCH_AUTH_WINDOW_US);
+        rc = coavoid_auth_accept(trust, key, type, senders[kinds[type].sender].role,
+                                 (int32_t)senders[kinds[type].sender].node_id,
+                                 read_be64(d + tail + 4u), read_be64(d + tail + 12u), now,
+                                 BENCH_AUTH_WINDOW_US, BENCH_AUTH_WINDOW_US);
     }
     return rc;
 }

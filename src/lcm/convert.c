@@ -205,17 +205,17 @@ const char *coavoid_lcm_error_name(int status)
     case COAVOID_LCM_ERR_CAPACITY:
         return "output too small";
     case COAVOID_AUTH_ERR_UNSIGNED:
-        return "not signed";
+        return "auth: not signed";
     case COAVOID_AUTH_ERR_KEY:
-        return "unknown key";
+        return "auth: signed by a key not in the trust list";
     case COAVOID_AUTH_ERR_SIGNATURE:
-        return "bad signature";
+        return "auth: the signature does not verify";
     case COAVOID_AUTH_ERR_ROLE:
-        return "key may not send this";
+        return "auth: the key may not send this message";
     case COAVOID_AUTH_ERR_REPLAY:
-        return "replayed or copied";
+        return "auth: not newer than the last from that key (a copy or a replay)";
     case COAVOID_AUTH_ERR_CLOCK:
-        return "signed outside the clock window";
+        return "auth: signed at a time outside the receiver's window";
     default:
         return coa_status_name(status);
     }

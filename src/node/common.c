@@ -174,25 +174,6 @@ static void count_undecodable(coavoid_node_inbox_t *in, const char *reason)
     coavoid_lcm_rx_count(in->rx, COAVOID_LCM_ERR_DECODE, reason);
 }
 
-/* Why a message's signature or sender was refused (docs/messages.md, "Signed messages"). */
-static const char *auth_reason(int rc)
-{
-    switch (rc) {
-    case COAVOID_AUTH_ERR_UNSIGNED:
-        return "auth: not signed";
-    case COAVOID_AUTH_ERR_KEY:
-        return "auth: signed by a key not in the trust list";
-    case COAVOID_AUTH_ERR_SIGNATURE:
-        return "auth: the signature does not verify";
-    case COAVOID_AUTH_ERR_ROLE:
-        return "auth: the key may not send this message";
-    case COAVOID_AUTH_ERR_REPLAY:
-        return "auth: not newer than the last from that key (a copy or a replay)";
-    default:
-        return "auth: signed at a time outside the receiver's window";
-    }
-}
-
 /* A received datagram's signature, over its raw bytes before anything decodes them (a
  * secure inbox only): true with the key's index in *key, else counted as refused. */
 static bool signature_ok(coavoid_node_inbox_t *in, const lcm_recv_buf_t *rbuf, size_t *key)
@@ -203,7 +184,7 @@ static bool signature_ok(coavoid_node_inbox_t *in, const lcm_recv_buf_t *rbuf, s
     }
     int rc = coavoid_auth_verify(&in->trust, rbuf->data, rbuf->data_size, key);
     if (rc != COA_OK) {
-        coavoid_lcm_rx_count(in->rx, rc, auth_reason(rc));
+        coavoid_lcm_rx_count(in->rx, rc, coavoid_lcm_error_name(rc));
         return false;
     }
     return true;
@@ -222,7 +203,7 @@ static bool sender_ok(coavoid_node_inbox_t *in, size_t key, size_t stream, coavo
         coavoid_auth_accept(&in->trust, key, stream, role, id, auth->timestamp_us, auth->sequence,
                             *in->common.clock, in->max_age_us, in->common.dt_us);
     if (rc != COA_OK) {
-        coavoid_lcm_rx_count(in->rx, rc, auth_reason(rc));
+        coavoid_lcm_rx_count(in->rx, rc, coavoid_lcm_error_name(rc));
         return false;
     }
     return true;
