@@ -160,8 +160,23 @@ static coavoid_plan_t solved_plan(int64_t now, int64_t plan_id, int64_t valid_fr
     return m;
 }
 
+/* Coordinator `from`'s COMMIT of a plan (docs/protocol.md): the rig plays the
+ * coordinator, which commits once every UAV of the plan accepted. */
+static void commit_msg(lcm_t *lcm, int64_t now, int32_t from, int64_t plan_id, int64_t valid_from)
+{
+    coavoid_agreement_t m;
+    memset(&m, 0, sizeof m);
+    m.utime = now;
+    m.kind = COAVOID_AGREEMENT_T_KIND_COMMIT;
+    m.node_id = from;
+    m.coordinator_id = from;
+    m.plan_id = plan_id;
+    m.valid_from_utime = valid_from;
+    ck_assert_int_eq(coavoid_agreement_t_publish(lcm, COAVOID_CHANNEL_AGREEMENT, &m), 0);
+}
+
 /* A one-UAV plan_t from coordinator `from`: offsets 0, 1, 2, then level at 2, plus
- * `shift`. */
+ * `shift`; then its commit (what the coordinator sends once the UAV accepted). */
 static void plan_msg_from(lcm_t *lcm, int64_t now, int32_t from, int64_t plan_id,
                           int64_t valid_from, uint16_t id, int32_t horizon, int32_t shift)
 {
@@ -173,6 +188,7 @@ static void plan_msg_from(lcm_t *lcm, int64_t now, int32_t from, int64_t plan_id
         m.offsets[k] = (k < 2 ? k : 2) + shift;
     }
     ck_assert_int_eq(coavoid_plan_t_publish(lcm, COAVOID_CHANNEL_PLAN, &m), 0);
+    commit_msg(lcm, now, from, plan_id, valid_from);
 }
 
 /* The same from the default coordinator. */
@@ -319,8 +335,14 @@ START_TEST(test_plan_adoption_rules)
     drain(r.lcm);
     ck_assert_int_eq(s->rx.rejected, rejected);
     ck_assert_int_eq(s->plans_adopted, 1);
-    /* An older plan_id: refused. */
+    /* The same plan again (the coordinator sends again what it heard no answer to):
+     * answered again, neither refused nor adopted twice. */
     plan_msg(r.lcm, r.now, 4, cycle(0), 1, 10, 0);
+    drain(r.lcm);
+    ck_assert_int_eq(s->rx.rejected, rejected);
+    ck_assert_int_eq(s->plans_adopted, 1);
+    /* An older plan_id: refused. */
+    plan_msg(r.lcm, r.now, 3, cycle(0), 1, 10, 0);
     drain(r.lcm);
     ck_assert_int_eq(s->rx.rejected, ++rejected);
     ck_assert_int_eq(s->rx.last_reject_code, COAVOID_LCM_ERR_SEQUENCE);
@@ -515,6 +537,10 @@ START_TEST(test_plan_into_other_uav_refused)
         ck_assert_int_eq(coavoid_plan_t_publish(r.lcm, COAVOID_CHANNEL_PLAN, &m), 0);
     }
     drain(r.lcm);
+    ck_assert_int_eq(s->plans_adopted, 0); /* accepted, not flown before the commit */
+    ck_assert_int_eq(s->plans_accepted, 1);
+    commit_msg(r.lcm, r.now, (int32_t)COAVOID_NODE_COORDINATOR_ID, 2, cycle(0));
+    drain(r.lcm);
     ck_assert_int_eq(s->plans_adopted, 1);
     ck_assert_int_eq(coavoid_vehicle_node_state(b)->plans_adopted, 1);
     coavoid_vehicle_node_destroy(a);
@@ -707,6 +733,7 @@ START_TEST(test_plan_adopted_only_whole)
     ck_assert_int_eq(s->rx.last_reject_code, COAVOID_LCM_ERR_VALUE);
     other.deviation = m.deviation;
     ck_assert_int_eq(coavoid_plan_t_publish(r.lcm, COAVOID_CHANNEL_PLAN, &other), 0);
+    commit_msg(r.lcm, r.now, (int32_t)COAVOID_NODE_COORDINATOR_ID, 4, cycle(0));
     drain(r.lcm);
     ck_assert_int_eq(s->plans_adopted, 1);
     ck_assert_int_eq(s->rx.rejected, rejected + 1);
@@ -941,8 +968,10 @@ START_TEST(test_configured_coordinator_only)
         plan_msg_from(r.lcm, r.now, from, k, cycle(k), 1, 10, s->offset);
         drain(r.lcm);
         if (k <= 5) {
-            ck_assert_int_eq(s->rx.rejected, rejected + 2);
-            ck_assert_str_eq(s->rx.last_reason, "plan: from a coordinator that is not this UAV's");
+            /* Its heartbeat, its plan and its commit. */
+            ck_assert_int_eq(s->rx.rejected, rejected + 3);
+            ck_assert_str_eq(s->rx.last_reason,
+                             "agreement: on a plan of a coordinator that is not this node's");
             ck_assert_int_eq(s->plans_adopted, 0);
         }
     }

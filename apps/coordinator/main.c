@@ -181,6 +181,7 @@ static int run(void *options, coavoid_scenario_t *s)
     config.id = COAVOID_NODE_COORDINATOR_ID;
     config.max_centralised = o->max_centralised;
     config.collect_us = o->collect_text != NULL ? llround(o->collect * 1e6) : dt_us / 4;
+    config.heartbeat_copies = COAVOID_NODE_DEFAULT_COPIES;
     if (config.collect_us < 1 || config.collect_us >= dt_us) {
         return coavoid_cli_fail(
             CLI_EXIT_INVALID,

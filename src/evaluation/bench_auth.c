@@ -6,6 +6,7 @@
 /* clock_gettime */
 #define _POSIX_C_SOURCE 200809L
 #include "bench_auth.h"
+#include "node.h"
 
 #include <stdbool.h>
 #include <stdint.h>
@@ -16,6 +17,7 @@
 
 #include <cjson/cJSON.h>
 
+#include <coavoid_lcmtypes/coavoid_agreement_t.h>
 #include <coavoid_lcmtypes/coavoid_conflict_report_t.h>
 #include <coavoid_lcmtypes/coavoid_intent_t.h>
 #include <coavoid_lcmtypes/coavoid_obstacle_map_t.h>
@@ -58,6 +60,7 @@ BENCH_AUTH_DEFINE_ENCODE(encode_track, coavoid_track_t)
 BENCH_AUTH_DEFINE_ENCODE(encode_map, coavoid_obstacle_map_t)
 BENCH_AUTH_DEFINE_ENCODE(encode_conflicts, coavoid_conflict_report_t)
 BENCH_AUTH_DEFINE_ENCODE(encode_status, coavoid_status_t)
+BENCH_AUTH_DEFINE_ENCODE(encode_agreement, coavoid_agreement_t)
 
 /* The three senders: who signs which type, as node.h's roles say. */
 enum { SENDER_VEHICLE, SENDER_COORDINATOR, SENDER_WORLD, SENDERS };
@@ -84,6 +87,7 @@ static const struct {
     [COAVOID_AUTH_STREAM_MAP] = {"obstacle_map", encode_map, SENDER_WORLD},
     [COAVOID_AUTH_STREAM_CONFLICTS] = {"conflict_report", encode_conflicts, SENDER_COORDINATOR},
     [COAVOID_AUTH_STREAM_STATUS] = {"status", encode_status, SENDER_VEHICLE},
+    [COAVOID_AUTH_STREAM_AGREEMENT] = {"agreement", encode_agreement, SENDER_VEHICLE},
 };
 
 /* ---- keys ---- */
@@ -233,21 +237,29 @@ static void count_messages(const coavoid_bench_auth_fleet_t *f, size_t node, uin
         sent[COAVOID_AUTH_STREAM_TRACK] = f->tracks;
         return;
     }
-    /* Every node that listens hears every intent, map and track; a vehicle knows its own
-     * intent when it comes back before checking it (common.c). */
+    /* Every node that listens hears every intent (each sent 1 + COPIES times), map and
+     * track; a vehicle knows its own intent when it comes back before checking it
+     * (common.c). Every plan (one UAV each, the worst case) is agreed on: its UAV's
+     * ACCEPT and SWITCHED (sent 1 + COPIES times), the coordinator's COMMIT; every node
+     * that subscribes checks them all, its own looped back included. */
+    const uint32_t sends = 1u + COAVOID_NODE_DEFAULT_COPIES;
     received[COAVOID_AUTH_STREAM_INTENT] =
-        node == COAVOID_BENCH_AUTH_VEHICLE ? f->vehicles - 1u : f->vehicles;
+        (node == COAVOID_BENCH_AUTH_VEHICLE ? f->vehicles - 1u : f->vehicles) * sends;
     received[COAVOID_AUTH_STREAM_MAP] = f->maps;
     received[COAVOID_AUTH_STREAM_TRACK] = f->tracks;
+    received[COAVOID_AUTH_STREAM_AGREEMENT] = f->plans * (1u + sends);
     if (node == COAVOID_BENCH_AUTH_VEHICLE) {
-        sent[COAVOID_AUTH_STREAM_INTENT] = 1u;
+        sent[COAVOID_AUTH_STREAM_INTENT] = sends;
         sent[COAVOID_AUTH_STREAM_STATUS] = 1u;
+        sent[COAVOID_AUTH_STREAM_AGREEMENT] = 1u + sends;
         received[COAVOID_AUTH_STREAM_STATUS] = f->vehicles + 1u; /* the UAVs', the coordinator's */
         received[COAVOID_AUTH_STREAM_PLAN] = f->plans;
+        received[COAVOID_AUTH_STREAM_AGREEMENT] += f->plans; /* the commits */
     } else {
         sent[COAVOID_AUTH_STREAM_STATUS] = 1u;
         sent[COAVOID_AUTH_STREAM_CONFLICTS] = 1u;
         sent[COAVOID_AUTH_STREAM_PLAN] = f->plans;
+        sent[COAVOID_AUTH_STREAM_AGREEMENT] = f->plans; /* the commits */
     }
 }
 

@@ -16,17 +16,21 @@
  *
  * Per cycle, for a fleet of N UAVs on one channel: the messages each node signs and checks
  * in one cycle of node.h's protocol, times the median costs above. Per cycle there are
- * N intents and N + 1 heartbeats (each UAV's, the coordinator's), the world's
+ * N intents, each sent 1 + C times (C = COAVOID_NODE_DEFAULT_COPIES, 2), and N + 1
+ * heartbeats (each UAV's, the coordinator's), the world's
  * COAVOID_BENCH_AUTH_MAPS_PER_CYCLE obstacle map tiles and one message per track (N / 50
  * tracks, bench_predict.h's traffic; none for the demo's 3 UAVs, as in
  * scenarios/paper.json), one conflict report and, in the worst case, one plan per UAV
  * (the coordinator plans every UAV in a cluster of its own). A node checks every datagram
  * on the channels it subscribes to, its own looped-back heartbeat included (the signature
  * is checked before anything is decoded; its own intent is known by its bytes first):
- *   - a vehicle (centralised) sends 1 intent and 1 heartbeat, and checks the N - 1 intents,
- *     N + 1 heartbeats, N plans, the maps and the tracks;
- *   - the coordinator sends its heartbeat, the conflict report and N plans, and checks
- *     the N intents, the maps and the tracks;
+ * Each plan is agreed on (docs/protocol.md): its UAV's ACCEPT and SWITCHED (sent 1 + C
+ * times) and the coordinator's COMMIT, each checked by every node that subscribes:
+ *   - a vehicle (centralised) sends 1 + C intents, 1 heartbeat and 2 + C agreements, and
+ *     checks the (N - 1)(1 + C) intents, N + 1 heartbeats, N plans, N (3 + C)
+ *     agreements, the maps and the tracks;
+ *   - the coordinator sends its heartbeat, the conflict report, N plans and N commits,
+ *     and checks the N (1 + C) intents, N (2 + C) agreements, the maps and the tracks;
  *   - the world sends the maps and the tracks and checks nothing.
  * A conflict report is subscribed by none of the nodes (monitoring only).
  *

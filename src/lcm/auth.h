@@ -40,13 +40,14 @@
 /* Freshness is kept per key and per stream (one stream per message type, numbered by the
  * caller: COAVOID_AUTH_STREAM_*), since UDP may reorder one sender's datagrams of
  * different types, and a heartbeat overtaken by the intent sent after it is no replay. */
-#define COAVOID_AUTH_STREAMS 6u
+#define COAVOID_AUTH_STREAMS 7u
 #define COAVOID_AUTH_STREAM_INTENT 0u
 #define COAVOID_AUTH_STREAM_PLAN 1u
 #define COAVOID_AUTH_STREAM_TRACK 2u
 #define COAVOID_AUTH_STREAM_MAP 3u
 #define COAVOID_AUTH_STREAM_CONFLICTS 4u
 #define COAVOID_AUTH_STREAM_STATUS 5u
+#define COAVOID_AUTH_STREAM_AGREEMENT 6u
 
 /* What a key may speak for. */
 typedef enum {

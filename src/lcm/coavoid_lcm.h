@@ -29,6 +29,7 @@
 #include "coavoid/trajectory.h"
 #include "auth.h"
 
+#include <coavoid_lcmtypes/coavoid_agreement_t.h>
 #include <coavoid_lcmtypes/coavoid_conflict_report_t.h>
 #include <coavoid_lcmtypes/coavoid_intent_t.h>
 #include <coavoid_lcmtypes/coavoid_obstacle_map_t.h>
@@ -350,6 +351,20 @@ int coavoid_lcm_conflict_report_accept(const coavoid_conflict_report_t *msg,
                                        coavoid_lcm_sequence_table_t *seq, const char **reason);
 int coavoid_lcm_status_accept(const coavoid_status_t *msg, const coavoid_lcm_context_t *ctx,
                               coavoid_lcm_sequence_table_t *seq, const char **reason);
+
+/* ---- agreement on a plan ---- */
+
+/* Every rule of one agreement_t: utime, a known kind, ids in 1..65535 (node_id ==
+ * coordinator_id for the coordinator's kinds), plan_id >= 0, valid_from_utime > 0. No
+ * sequence rule: an agreement is idempotent (the same answer again changes nothing), and
+ * a signed one is fresh by its signature. Returns COA_OK or a COAVOID_LCM_ERR_* with
+ * *reason naming the field. O(1). */
+int coavoid_lcm_agreement_check(const coavoid_agreement_t *msg, const coavoid_lcm_context_t *ctx,
+                                const char **reason);
+
+/* The role whose key may sign an agreement of this kind: the coordinator's for COMMIT and
+ * ABORT, else a vehicle's (node_id's). O(1). */
+coavoid_auth_role_t coavoid_lcm_agreement_role(int8_t kind);
 
 /* ---- counting what arrives ---- */
 

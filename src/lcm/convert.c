@@ -1570,6 +1570,45 @@ int coavoid_lcm_status_accept(const coavoid_status_t *msg, const coavoid_lcm_con
                          "status: sequence table full");
 }
 
+/* ---- agreement on a plan ---- */
+
+static bool agreement_from_coordinator(int8_t kind)
+{
+    return kind == COAVOID_AGREEMENT_T_KIND_COMMIT || kind == COAVOID_AGREEMENT_T_KIND_ABORT;
+}
+
+coavoid_auth_role_t coavoid_lcm_agreement_role(int8_t kind)
+{
+    return agreement_from_coordinator(kind) ? COAVOID_AUTH_COORDINATOR : COAVOID_AUTH_VEHICLE;
+}
+
+int coavoid_lcm_agreement_check(const coavoid_agreement_t *msg, const coavoid_lcm_context_t *ctx,
+                                const char **reason)
+{
+    int rc;
+    if (msg == NULL) {
+        REJECT(COA_ERR_ARGUMENT, "agreement: NULL");
+    }
+    if ((rc = utime_rule(msg->utime, ctx)) != COA_OK) {
+        REJECT(rc, "agreement: utime stale, in the future or not positive");
+    }
+    if (msg->kind < COAVOID_AGREEMENT_T_KIND_ACCEPT || msg->kind > COAVOID_AGREEMENT_T_KIND_ABORT) {
+        REJECT(COAVOID_LCM_ERR_ENUM, "agreement: unknown kind");
+    }
+    if (!id_ok(msg->node_id) || !id_ok(msg->coordinator_id)) {
+        REJECT(COAVOID_LCM_ERR_ID, "agreement: node_id or coordinator_id not in 1..65535");
+    }
+    if (agreement_from_coordinator(msg->kind) && msg->node_id != msg->coordinator_id) {
+        REJECT(COAVOID_LCM_ERR_ID, "agreement: a commit or abort not from the plan's coordinator");
+    }
+    if (msg->plan_id < 0 || msg->valid_from_utime <= 0) {
+        REJECT(COAVOID_LCM_ERR_VALUE,
+               "agreement: plan_id negative or valid_from_utime not positive");
+    }
+    OK_REASON();
+    return COA_OK;
+}
+
 /* ---- counting what arrives ---- */
 
 void coavoid_lcm_rx_init(coavoid_lcm_rx_stats_t *stats)

@@ -494,6 +494,14 @@ static void on_map(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
     coavoid_lcm_rx_count(in->rx, rc, reason);
 }
 
+/* Any message its coordinator signed (or, insecure, sent) shows that it is alive: with
+ * loss, a heartbeat alone may not come for a while when its plans and commits do. */
+static void coordinator_heard(coavoid_node_inbox_t *in, int64_t now)
+{
+    in->heard_coordinator = true;
+    in->coordinator_utime = now;
+}
+
 static void on_status(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
 {
     coavoid_node_inbox_t *in = user;
@@ -534,8 +542,7 @@ static void on_status(const lcm_recv_buf_t *rbuf, const char *channel, void *use
     /* A coordinator that reports a fault is not one to follow. */
     if (msg->node_kind == COAVOID_STATUS_T_NODE_COORDINATOR &&
         msg->health != COAVOID_STATUS_T_HEALTH_FAULT) {
-        in->heard_coordinator = true;
-        in->coordinator_utime = now;
+        coordinator_heard(in, now);
     }
 }
 
@@ -563,6 +570,7 @@ static void on_plan(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
         return;
     }
     const int64_t now = *in->common.clock;
+    coordinator_heard(in, now);
     coavoid_lcm_context_t ctx = coavoid_node_context(in, now, now);
     coavoid_lcm_plan_info_t info;
     coa_plan_result_t result;
@@ -581,6 +589,45 @@ static void on_plan(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
         return;
     }
     in->on_plan(in->owner, whole, &info, &result, in->rx_offsets);
+}
+
+static void on_agreement(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
+{
+    coavoid_node_inbox_t *in = user;
+    coavoid_agreement_t *msg = &in->rx_msg.agreement;
+    int size = 0;
+    size_t key = 0;
+    (void)channel;
+    if (!received_size(rbuf, &size) || !signature_ok(in, rbuf, &key)) {
+        return;
+    }
+    if (coavoid_agreement_t_decode(rbuf->data, 0, size, msg) < 0) {
+        count_undecodable(in, "agreement: does not decode");
+        return;
+    }
+    if (msg->node_id == (int32_t)in->self_node) {
+        return; /* its own, back */
+    }
+    if (msg->coordinator_id != (int32_t)in->coordinator_id) {
+        coavoid_lcm_rx_count(in->rx, COAVOID_LCM_ERR_ID,
+                             "agreement: on a plan of a coordinator that is not this node's");
+        return;
+    }
+    if (!sender_ok(in, key, COAVOID_AUTH_STREAM_AGREEMENT, coavoid_lcm_agreement_role(msg->kind),
+                   msg->node_id, &msg->auth)) {
+        return;
+    }
+    const int64_t now = *in->common.clock;
+    coavoid_lcm_context_t ctx = coavoid_node_context(in, now, now);
+    const char *reason = NULL;
+    int rc = coavoid_lcm_agreement_check(msg, &ctx, &reason);
+    if (rc == COA_OK && coavoid_lcm_agreement_role(msg->kind) == COAVOID_AUTH_COORDINATOR) {
+        coordinator_heard(in, now);
+    }
+    if (rc == COA_OK) {
+        rc = in->on_agreement(in->owner, msg);
+    }
+    coavoid_lcm_rx_count(in->rx, rc, rc == COA_OK ? NULL : reason);
 }
 
 static int subscribe(coavoid_node_inbox_t *in, const char *channel, lcm_msg_handler_t handler)
@@ -647,6 +694,7 @@ int coavoid_node_inbox_init(coavoid_node_inbox_t *in, const coavoid_node_common_
     in->heard_coordinator = false;
     in->coordinator_utime = 0;
     in->on_plan = plan_handler;
+    in->on_agreement = NULL;
     in->owner = owner;
     int rc = subscribe(in, COAVOID_CHANNEL_INTENT, on_intent);
     if (rc == COA_OK) {
@@ -665,6 +713,13 @@ int coavoid_node_inbox_init(coavoid_node_inbox_t *in, const coavoid_node_common_
         coavoid_node_inbox_fini(in);
     }
     return rc;
+}
+
+int coavoid_node_inbox_agreements(coavoid_node_inbox_t *in,
+                                  coavoid_node_agreement_handler_t handler)
+{
+    in->on_agreement = handler;
+    return subscribe(in, COAVOID_CHANNEL_AGREEMENT, on_agreement);
 }
 
 void coavoid_node_inbox_fini(coavoid_node_inbox_t *in)
@@ -1144,6 +1199,8 @@ COAVOID_NODE_DEFINE_PUBLISH(coavoid_node_publish_map, coavoid_obstacle_map_t,
 COAVOID_NODE_DEFINE_PUBLISH(coavoid_node_publish_conflicts, coavoid_conflict_report_t,
                             COAVOID_CHANNEL_CONFLICTS)
 COAVOID_NODE_DEFINE_PUBLISH(coavoid_node_publish_status, coavoid_status_t, COAVOID_CHANNEL_STATUS)
+COAVOID_NODE_DEFINE_PUBLISH(coavoid_node_publish_agreement, coavoid_agreement_t,
+                            COAVOID_CHANNEL_AGREEMENT)
 
 int coavoid_node_publish_intent(coavoid_node_inbox_t *in, const coavoid_intent_t *msg)
 {

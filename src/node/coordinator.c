@@ -12,6 +12,29 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* A solved plan's agreement (docs/protocol.md): proposed to its UAVs (its rows sent, and
+ * sent again until every UAV accepted), committed once every one has (COMMIT sent, and
+ * sent again until every UAV said SWITCHED), or aborted (a UAV refused, did not answer
+ * by the deadline, or a newer plan of the cycle took one of its UAVs). Members are
+ * indexed as the plan's vehicles (info.uav_ids). */
+typedef enum { AGREEMENT_PROPOSED, AGREEMENT_COMMITTED, AGREEMENT_ABORTED } agreement_state_t;
+
+typedef struct {
+    agreement_state_t state;
+    coavoid_lcm_plan_info_t info;
+    coa_plan_result_t result;
+    int32_t offsets[(size_t)COA_MAX_VEHICLES * COAVOID_NODE_MAX_SAMPLES];
+    uint32_t accepted; /* bit m: info.uav_ids[m] accepted */
+    uint32_t refused;
+    uint32_t switched;
+    int64_t deadline;  /* proposed: every accept must have come by then */
+    int64_t next_send; /* when the rows (proposed) or the commit (committed) go again */
+} coordinator_agreement_t;
+
+/* The solved plans of one cycle: every cluster's, the escalations' and the re-plans after
+ * an abort; clusters have two UAVs or more, so MAX_PEERS / 2 plus a few. */
+#define COORDINATOR_MAX_AGREEMENTS (COAVOID_NODE_MAX_PEERS / 2u + 8u)
+
 struct coavoid_coordinator {
     coavoid_coordinator_config_t config;
     coavoid_coordinator_state_t state;
@@ -34,11 +57,21 @@ struct coavoid_coordinator {
     coavoid_conflict_report_t tx_report;
     coavoid_status_t tx_status;
 
+    /* The agreements of the current cycle (cycle_start): count in use. */
+    int64_t cycle_start;
+    uint32_t heartbeat_copies_left;
+    int64_t heartbeat_copy_at;
+    size_t agreement_count;
+    coordinator_agreement_t agreements[COORDINATOR_MAX_AGREEMENTS];
+    coavoid_agreement_t tx_agreement;
+
     coavoid_node_solver_t solver;
     coavoid_node_inbox_t inbox;
     coavoid_node_view_t view;
     coavoid_node_problem_tracks_t problem_tracks;
 };
+
+static int on_agreement(void *owner, const coavoid_agreement_t *msg);
 
 coavoid_coordinator_t *coavoid_coordinator_create(const coavoid_coordinator_config_t *config,
                                                   lcm_t *lcm, int *error)
@@ -76,11 +109,24 @@ coavoid_coordinator_t *coavoid_coordinator_create(const coavoid_coordinator_conf
     if (node->config.collect_us == 0) {
         node->config.collect_us = c->dt_us / 4;
     }
+    if (node->config.ack_timeout_us <= 0) {
+        node->config.ack_timeout_us = c->dt_us / 4 > 0 ? c->dt_us / 4 : 1;
+    }
+    if (node->config.resend_us <= 0) {
+        node->config.resend_us = c->dt_us / 20 > 0 ? c->dt_us / 20 : 1;
+    }
     node->state.cycle = -1;
     node->state.last_outcome = -1;
     /* No UAV is its own: intents are all others'. */
     rc = coavoid_node_inbox_init(&node->inbox, c, 0u, node->config.id, 0u, COAVOID_NODE_MAX_PEERS,
                                  lcm, &node->state.rx, false, NULL, node);
+    if (rc == COA_OK) {
+        node->inbox.coordinator_id = node->config.id; /* the agreements on its own plans */
+        rc = coavoid_node_inbox_agreements(&node->inbox, on_agreement);
+        if (rc != COA_OK) {
+            coavoid_node_inbox_fini(&node->inbox);
+        }
+    }
     if (rc != COA_OK) {
         coavoid_node_solver_fini(&node->solver);
         free(node);
@@ -272,12 +318,41 @@ static int cluster_plan(coavoid_coordinator_t *node, int64_t now, const coa_prob
     return rc;
 }
 
-/* The plan messages of the cluster's result, one per UAV in the result's order, each
- * checked as a receiver would (COA_ERR_ARGUMENT when one fails: none is sent), then
- * published back to back (the first publishing error in *published). */
-static int cluster_publish(coavoid_coordinator_t *node, int64_t now, int64_t cycle_start,
-                           size_t count, bool centralised, const coa_plan_result_t *result,
-                           bool abandoned, int *published)
+/* The messages of a plan, one per UAV in the result's order, each checked as a receiver
+ * would (COA_ERR_ARGUMENT when one fails: none is sent), stamped `now`, then published
+ * back to back (the first publishing error in *published). */
+static int publish_rows(coavoid_coordinator_t *node, int64_t now, int64_t cycle_start,
+                        const coavoid_lcm_plan_info_t *plan, const coa_plan_result_t *result,
+                        const int32_t *offsets, int *published)
+{
+    const coavoid_node_common_t *c = &node->config.common;
+    coavoid_lcm_plan_info_t info = *plan;
+    info.utime = now;
+    coavoid_lcm_context_t ctx = coavoid_node_context(&node->inbox, now, cycle_start);
+    for (size_t row = 0; row < info.vehicle_count; row++) {
+        coavoid_plan_t *msg = &node->tx_plan[row];
+        int rc = coavoid_lcm_plan_from_core(&info, result, offsets, row, &ctx, msg, NULL);
+        if (rc == COA_OK) {
+            /* The validity window in exact microseconds, whatever the core's precision. */
+            msg->valid_from_utime = cycle_start;
+            msg->valid_until_utime = cycle_start + c->dt_us;
+            rc = coavoid_lcm_plan_check(msg, &ctx, NULL);
+        }
+        if (rc != COA_OK) {
+            return COA_ERR_ARGUMENT;
+        }
+    }
+    *published = COA_OK;
+    for (size_t row = 0; row < info.vehicle_count; row++) {
+        int rc = coavoid_node_publish_plan(&node->inbox.tx, &node->tx_plan[row]);
+        *published = (*published == COA_OK) ? rc : *published;
+    }
+    return COA_OK;
+}
+
+/* The header of the cluster's plan (node->vehicles[0..count)), with the next plan_id. */
+static coavoid_lcm_plan_info_t cluster_info(coavoid_coordinator_t *node, int64_t now, size_t count,
+                                            bool centralised, bool abandoned)
 {
     const coavoid_node_common_t *c = &node->config.common;
     coavoid_lcm_plan_info_t info;
@@ -295,26 +370,7 @@ static int cluster_publish(coavoid_coordinator_t *node, int64_t now, int64_t cyc
     for (size_t m = 0; m < count; m++) {
         info.uav_ids[m] = node->vehicles[m].id;
     }
-    coavoid_lcm_context_t ctx = coavoid_node_context(&node->inbox, now, cycle_start);
-    for (size_t row = 0; row < count; row++) {
-        coavoid_plan_t *msg = &node->tx_plan[row];
-        int rc = coavoid_lcm_plan_from_core(&info, result, node->offsets, row, &ctx, msg, NULL);
-        if (rc == COA_OK) {
-            /* The validity window in exact microseconds, whatever the core's precision. */
-            msg->valid_from_utime = cycle_start;
-            msg->valid_until_utime = cycle_start + c->dt_us;
-            rc = coavoid_lcm_plan_check(msg, &ctx, NULL);
-        }
-        if (rc != COA_OK) {
-            return COA_ERR_ARGUMENT;
-        }
-    }
-    *published = COA_OK;
-    for (size_t row = 0; row < count; row++) {
-        int rc = coavoid_node_publish_plan(&node->inbox.tx, &node->tx_plan[row]);
-        *published = (*published == COA_OK) ? rc : *published;
-    }
-    return COA_OK;
+    return info;
 }
 
 /* Whether the cycle's planning has run past its budget (config.plan_budget_us). */
@@ -325,11 +381,154 @@ static bool over_budget(const coavoid_coordinator_t *node)
            coavoid_node_stopwatch(&node->config.common) - node->cycle_stopwatch > budget;
 }
 
-static int plan_cluster(coavoid_coordinator_t *node, int64_t now, int64_t cycle_start, size_t count,
-                        bool *solved)
+/* Live UAV i of the view flies row m of `offsets` from now on: so that later plans of the
+ * cycle plan around it. */
+static void view_fly_row(coavoid_coordinator_t *node, size_t i, const int32_t *offsets, size_t m)
 {
     const coavoid_node_common_t *c = &node->config.common;
     coavoid_node_view_t *view = &node->view;
+    const size_t samples = (size_t)c->horizon + 1u;
+    coavoid_lcm_intent_arrays_t *a = &view->live_arrays[i];
+    coa_real_t dh = coa_climb_step(&view->live_vehicle[i], c->dt);
+    for (size_t j = 0; j < samples; j++) {
+        a->offsets[j] = offsets[m * samples + j];
+        a->samples[j] = a->reference[j];
+        a->samples[j].z += (coa_real_t)a->offsets[j] * dh;
+    }
+}
+
+/* ---- agreement on a plan (docs/protocol.md) ---- */
+
+static uint32_t all_members(const coordinator_agreement_t *a)
+{
+    return UINT32_MAX >> (32u - (uint32_t)a->info.vehicle_count);
+}
+
+/* The member index of UAV id in a's plan, or vehicle_count. */
+static size_t member_of(const coordinator_agreement_t *a, int32_t id)
+{
+    size_t m = 0;
+    while (m < a->info.vehicle_count && (int32_t)a->info.uav_ids[m] != id) {
+        m++;
+    }
+    return m;
+}
+
+static int send_decision(coavoid_coordinator_t *node, int64_t now, const coordinator_agreement_t *a)
+{
+    coavoid_agreement_t *msg = &node->tx_agreement;
+    memset(msg, 0, sizeof *msg);
+    msg->utime = now;
+    msg->kind = a->state == AGREEMENT_COMMITTED ? COAVOID_AGREEMENT_T_KIND_COMMIT
+                                                : COAVOID_AGREEMENT_T_KIND_ABORT;
+    msg->node_id = node->config.id;
+    msg->coordinator_id = node->config.id;
+    msg->plan_id = a->info.plan_id;
+    msg->valid_from_utime = node->cycle_start;
+    return coavoid_node_publish_agreement(&node->inbox.tx, msg);
+}
+
+/* Ends a proposal: committed (every member accepted) or aborted. The decision goes out at
+ * once; a commit again every resend_us until every member switched. */
+static int agreement_decide(coavoid_coordinator_t *node, int64_t now, coordinator_agreement_t *a,
+                            agreement_state_t state)
+{
+    a->state = state;
+    a->next_send = now + node->config.resend_us;
+    node->state.plans_committed += state == AGREEMENT_COMMITTED ? 1u : 0u;
+    node->state.plans_aborted += state == AGREEMENT_ABORTED ? 1u : 0u;
+    return send_decision(node, now, a);
+}
+
+/* A newer plan of the cycle takes its UAVs from every proposal that lists one of them. */
+static void agreement_supersede(coavoid_coordinator_t *node, int64_t now,
+                                const coavoid_lcm_plan_info_t *newer)
+{
+    for (size_t i = 0; i < node->agreement_count; i++) {
+        coordinator_agreement_t *a = &node->agreements[i];
+        bool shared = false;
+        for (size_t m = 0; m < newer->vehicle_count && !shared; m++) {
+            shared = member_of(a, (int32_t)newer->uav_ids[m]) < a->info.vehicle_count;
+        }
+        if (shared && a->state == AGREEMENT_PROPOSED) {
+            (void)agreement_decide(node, now, a, AGREEMENT_ABORTED);
+        }
+    }
+}
+
+/* Proposes a solved plan just published: its UAVs fly it only once all have accepted. A
+ * cycle with more plans than room (it cannot happen with MAX_PEERS UAVs) leaves the
+ * extra plan unproposed: never committed, so never flown. */
+static void agreement_open(coavoid_coordinator_t *node, int64_t now,
+                           const coavoid_lcm_plan_info_t *info, const coa_plan_result_t *result)
+{
+    agreement_supersede(node, now, info);
+    if (node->agreement_count == COORDINATOR_MAX_AGREEMENTS) {
+        node->fault = true;
+        return;
+    }
+    coordinator_agreement_t *a = &node->agreements[node->agreement_count++];
+    const size_t samples = (size_t)node->config.common.horizon + 1u;
+    a->state = AGREEMENT_PROPOSED;
+    a->info = *info;
+    a->result = *result;
+    memcpy(a->offsets, node->offsets, info->vehicle_count * samples * sizeof a->offsets[0]);
+    a->accepted = 0u;
+    a->refused = 0u;
+    a->switched = 0u;
+    a->deadline = now + node->config.ack_timeout_us;
+    a->next_send = now + node->config.resend_us;
+    node->state.plans_proposed++;
+}
+
+static coordinator_agreement_t *agreement_find(coavoid_coordinator_t *node, int64_t plan_id,
+                                               int64_t valid_from)
+{
+    if (valid_from != node->cycle_start) {
+        return NULL;
+    }
+    for (size_t i = 0; i < node->agreement_count; i++) {
+        if (node->agreements[i].info.plan_id == plan_id) {
+            return &node->agreements[i];
+        }
+    }
+    return NULL;
+}
+
+/* A UAV's answer. Answers on plans of other cycles, or unknown ones, are late or stray:
+ * accepted as messages and ignored. A kind only the coordinator sends, from another
+ * node, was refused before (role). */
+static int on_agreement(void *owner, const coavoid_agreement_t *msg)
+{
+    coavoid_coordinator_t *node = owner;
+    const int64_t now = *node->config.common.clock;
+    coordinator_agreement_t *a = agreement_find(node, msg->plan_id, msg->valid_from_utime);
+    if (a == NULL) {
+        return COA_OK;
+    }
+    const size_t m = member_of(a, msg->node_id);
+    if (m == a->info.vehicle_count) {
+        return COAVOID_LCM_ERR_ID; /* not a UAV of this plan */
+    }
+    const uint32_t bit = UINT32_C(1) << (uint32_t)m;
+    if (msg->kind == COAVOID_AGREEMENT_T_KIND_ACCEPT) {
+        a->accepted |= bit;
+    } else if (msg->kind == COAVOID_AGREEMENT_T_KIND_REFUSE) {
+        a->refused |= bit;
+        a->deadline = a->state == AGREEMENT_PROPOSED ? now : a->deadline; /* abort at once */
+    } else if (msg->kind == COAVOID_AGREEMENT_T_KIND_SWITCHED) {
+        a->switched |= bit;
+        a->accepted |= bit;
+    }
+    if (a->state == AGREEMENT_PROPOSED && a->accepted == all_members(a)) {
+        (void)agreement_decide(node, now, a, AGREEMENT_COMMITTED);
+    }
+    return COA_OK;
+}
+
+static int plan_cluster(coavoid_coordinator_t *node, int64_t now, int64_t cycle_start, size_t count,
+                        bool *solved)
+{
     coa_problem_t problem;
     coa_plan_result_t result;
     bool centralised = false;
@@ -355,26 +554,19 @@ static int plan_cluster(coavoid_coordinator_t *node, int64_t now, int64_t cycle_
     }
     node->state.plans_abandoned += abandoned ? 1u : 0u;
     int published = COA_OK;
-    if (cluster_publish(node, now, cycle_start, count, centralised, &result, abandoned,
-                        &published) != COA_OK) {
+    const coavoid_lcm_plan_info_t info = cluster_info(node, now, count, centralised, abandoned);
+    if (publish_rows(node, now, cycle_start, &info, &result, node->offsets, &published) != COA_OK) {
         return COA_ERR_ARGUMENT;
     }
     rc = published;
     if (abandoned || result.status != COA_PLAN_SOLVED) {
         return rc;
     }
+    agreement_open(node, now, &info, &result);
     *solved = true;
     node->state.plans_published++;
-    const size_t samples = (size_t)c->horizon + 1u;
     for (size_t m = 0; m < count; m++) {
-        size_t i = node->member[m];
-        coavoid_lcm_intent_arrays_t *a = &view->live_arrays[i];
-        coa_real_t dh = coa_climb_step(&view->live_vehicle[i], c->dt);
-        for (size_t j = 0; j < samples; j++) {
-            a->offsets[j] = node->offsets[m * samples + j];
-            a->samples[j] = a->reference[j];
-            a->samples[j].z += (coa_real_t)a->offsets[j] * dh;
-        }
+        view_fly_row(node, node->member[m], node->offsets, m);
     }
     return rc;
 }
@@ -430,6 +622,152 @@ static size_t escalate(coavoid_coordinator_t *node, int64_t now, int64_t cycle_s
     return failed_size;
 }
 
+/* The live index of UAV id in the view, with an intent of this cycle that follows the
+ * coordinator; or live_count. */
+static size_t live_follower(const coavoid_node_view_t *view, uint16_t id)
+{
+    for (size_t i = 0; i < view->live_count; i++) {
+        if (view->live_id[i] == id) {
+            return view->live_current[i] &&
+                           view->live_info[i].mode == COAVOID_INTENT_T_MODE_CENTRALISED
+                       ? i
+                       : view->live_count;
+        }
+    }
+    return view->live_count;
+}
+
+/* The view of now, each UAV of the cycle's other live plans (proposed or committed) on
+ * its row. */
+static void view_with_plans(coavoid_coordinator_t *node, int64_t now,
+                            const coordinator_agreement_t *skip)
+{
+    coavoid_node_view_t *view = &node->view;
+    coavoid_node_view_build(view, &node->inbox, node->cycle_start, now);
+    for (size_t k = 0; k < node->agreement_count; k++) {
+        const coordinator_agreement_t *a = &node->agreements[k];
+        if (a == skip || a->state == AGREEMENT_ABORTED) {
+            continue;
+        }
+        for (size_t m = 0; m < a->info.vehicle_count; m++) {
+            size_t i = live_follower(view, a->info.uav_ids[m]);
+            if (i < view->live_count) {
+                view_fly_row(node, i, a->offsets, m);
+            }
+        }
+    }
+}
+
+/* After an abort for a refusal or silence: the UAVs that accepted are planned again, in
+ * the same cycle when there is time for another round, around the others as they fly
+ * now (a UAV that did not accept never switches: no commit can come for it). The new
+ * plan is proposed as any other. Returns COA_OK or the planning call's error. */
+static int replan_accepted(coavoid_coordinator_t *node, int64_t now, size_t index)
+{
+    const coavoid_coordinator_config_t *cf = &node->config;
+    const int64_t end = node->cycle_start + cf->common.dt_us;
+    if (now + cf->ack_timeout_us + 2 * cf->resend_us > end) {
+        return COA_OK; /* no time to agree again: they are unanswered, and plan themselves */
+    }
+    const coordinator_agreement_t *a = &node->agreements[index];
+    const uint32_t keep = a->accepted & ~a->refused;
+    view_with_plans(node, now, a);
+    size_t count = 0;
+    for (size_t m = 0; m < a->info.vehicle_count; m++) {
+        size_t i = live_follower(&node->view, a->info.uav_ids[m]);
+        if ((keep & (UINT32_C(1) << (uint32_t)m)) != 0u && i < node->view.live_count) {
+            node->member[count++] = i;
+        }
+    }
+    if (count == 0u) {
+        return COA_OK;
+    }
+    node->state.plans_replanned++;
+    node->cycle_stopwatch = coavoid_node_stopwatch(&cf->common);
+    bool solved = false;
+    return plan_cluster(node, now, node->cycle_start, count, &solved);
+}
+
+/* One proposal or commit at `now`: decided, sent again, or left. Returns 1 when it
+ * published, 0 when not, or a negative error. */
+static int agreement_step(coavoid_coordinator_t *node, int64_t now, size_t index)
+{
+    coordinator_agreement_t *a = &node->agreements[index];
+    const int64_t resend = node->config.resend_us;
+    if (a->state == AGREEMENT_PROPOSED && (now >= a->deadline || a->refused != 0u)) {
+        int rc = agreement_decide(node, now, a, AGREEMENT_ABORTED);
+        int replanned = replan_accepted(node, now, index);
+        rc = rc != COA_OK ? rc : replanned;
+        return rc != COA_OK ? rc : 1;
+    }
+    if (now < a->next_send) {
+        return 0;
+    }
+    if (a->state == AGREEMENT_PROPOSED) {
+        int published = COA_OK;
+        a->next_send = now + resend;
+        node->state.plans_resent++;
+        int rc = publish_rows(node, now, node->cycle_start, &a->info, &a->result, a->offsets,
+                              &published);
+        rc = rc != COA_OK ? rc : published;
+        return rc != COA_OK ? rc : 1;
+    }
+    if (a->state == AGREEMENT_COMMITTED && a->switched != all_members(a)) {
+        a->next_send = now + resend;
+        int rc = send_decision(node, now, a);
+        return rc != COA_OK ? rc : 1;
+    }
+    return 0;
+}
+
+int coavoid_coordinator_poll(coavoid_coordinator_t *node, int64_t now)
+{
+    if (node == NULL) {
+        return COA_ERR_ARGUMENT;
+    }
+    if (!node->started || now >= node->cycle_start + node->config.common.dt_us) {
+        return 0;
+    }
+    int result = 0;
+    if (node->heartbeat_copies_left > 0u && now >= node->heartbeat_copy_at) {
+        node->heartbeat_copies_left--;
+        node->heartbeat_copy_at = now + node->config.resend_us;
+        result = publish_status(node, now, node->cycle_start);
+        result = result < 0 ? result : 1;
+    }
+    /* A re-plan appends to the list: it is stepped in this same pass. */
+    for (size_t i = 0; i < node->agreement_count; i++) {
+        int rc = agreement_step(node, now, i);
+        if (rc < 0) {
+            node->fault = true;
+            result = result < 0 ? result : rc;
+        } else if (rc > 0 && result == 0) {
+            result = 1;
+        }
+    }
+    return result;
+}
+
+int64_t coavoid_coordinator_deadline(const coavoid_coordinator_t *node)
+{
+    if (node == NULL || !node->started) {
+        return INT64_MAX;
+    }
+    const int64_t end = node->cycle_start + node->config.common.dt_us;
+    int64_t deadline = node->heartbeat_copies_left > 0u ? node->heartbeat_copy_at : INT64_MAX;
+    for (size_t i = 0; i < node->agreement_count; i++) {
+        const coordinator_agreement_t *a = &node->agreements[i];
+        int64_t t = INT64_MAX;
+        if (a->state == AGREEMENT_PROPOSED) {
+            t = a->deadline < a->next_send ? a->deadline : a->next_send;
+        } else if (a->state == AGREEMENT_COMMITTED && a->switched != all_members(a)) {
+            t = a->next_send;
+        }
+        deadline = t < deadline ? t : deadline;
+    }
+    return deadline < end ? deadline : INT64_MAX;
+}
+
 int coavoid_coordinator_cycle(coavoid_coordinator_t *node, int64_t now)
 {
     if (node == NULL) {
@@ -449,6 +787,8 @@ int coavoid_coordinator_cycle(coavoid_coordinator_t *node, int64_t now)
     node->degraded = false;
     node->fault = false;
     const int64_t cycle_start = coavoid_node_cycle_utime(c, k);
+    node->cycle_start = cycle_start;
+    node->agreement_count = 0; /* the last cycle's plans can no longer be adopted */
     coavoid_node_inbox_expire(&node->inbox, now);
     coavoid_node_view_t *view = &node->view;
     coavoid_node_view_build(view, &node->inbox, cycle_start, now);
@@ -475,6 +815,8 @@ int coavoid_coordinator_cycle(coavoid_coordinator_t *node, int64_t now)
     failed_size = escalate(node, now, cycle_start, failed_size, &first_error);
     node->degraded = failed_size > 0u;
     rc = publish_status(node, now, cycle_start);
+    node->heartbeat_copies_left = node->config.heartbeat_copies;
+    node->heartbeat_copy_at = now + node->config.resend_us;
     if (first_error == COA_OK) {
         first_error = rc;
     }

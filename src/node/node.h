@@ -149,6 +149,7 @@
 #define COAVOID_CHANNEL_OBSTACLES "COAVOID_OBSTACLES"
 #define COAVOID_CHANNEL_CONFLICTS "COAVOID_CONFLICTS"
 #define COAVOID_CHANNEL_STATUS "COAVOID_STATUS"
+#define COAVOID_CHANNEL_AGREEMENT "COAVOID_AGREEMENT"
 
 /* Capacities of one node's view of the airspace. */
 #define COAVOID_NODE_MAX_PEERS 64u   /* co-operative UAVs a node tracks, itself included */
@@ -159,6 +160,12 @@
 /* The world's id (map_id of the obstacle map, source_id of tracks) by default. */
 #define COAVOID_NODE_WORLD_ID 65000u
 #define COAVOID_NODE_COORDINATOR_ID 65001u
+
+/* Copies of every intent a vehicle sends, and of every heartbeat the coordinator sends,
+ * by default in the drivers and the simulation (intent_copies, heartbeat_copies): with
+ * each receiver losing a share p of datagrams, a cycle's intent or heartbeat is lost to
+ * it with p^3 (2.7 % at 30 %) rather than p. */
+#define COAVOID_NODE_DEFAULT_COPIES 2u
 
 typedef enum {
     COAVOID_NODE_CENTRALISED = 0, /* follow the coordinator; plan for itself when it is silent */
@@ -240,6 +247,12 @@ typedef struct {
     uint16_t coordinator_id; /* the only node whose heartbeats and plans it follows
                                        (0: the default, COAVOID_NODE_COORDINATOR_ID); not its
                                        own id */
+    /* Against loss (docs/protocol.md): every intent it publishes goes out again
+     * intent_copies times (freshly stamped), resend_us apart, and so does its SWITCHED
+     * when it switches to a committed plan (resend_us 0: the default, dt / 20;
+     * intent_copies 0: none, which is also the default). */
+    int64_t resend_us;
+    uint32_t intent_copies;
 } coavoid_vehicle_node_config_t;
 
 /* What a vehicle did; read by drivers, the simulation and tests. */
@@ -258,6 +271,11 @@ typedef struct {
     int64_t last_plan_duration_us; /* measured by the driver's clock: 0 in simulation */
     uint32_t conflicts;            /* conflicts in its last prediction */
     uint32_t fallbacks;            /* switches from coordinated to own planning */
+    uint32_t plans_accepted;       /* coordinator's plans it accepted (docs/protocol.md) */
+    uint32_t plans_refused;        /* ... it refused (a REFUSE answer) */
+    uint32_t plans_switched;       /* ... it switched to on a commit (or a sibling's word) */
+    uint32_t plans_aborted;        /* ... accepted, then aborted by the coordinator */
+    uint32_t plans_in_doubt;       /* ... accepted, and no decision came within the cycle */
     coavoid_lcm_rx_stats_t rx;
 } coavoid_vehicle_node_state_t;
 
@@ -318,6 +336,15 @@ typedef struct {
      * rather than wait for a plan that would come late. One search is bounded by beta, so
      * the overrun is at most one search. */
     int64_t plan_budget_us;
+    /* The agreement on a plan (docs/protocol.md): how long after proposing a plan it
+     * waits for every UAV's accept before it aborts the plan and plans the UAVs that
+     * accepted again (0: the default, dt / 4), and how often it sends again what was not
+     * answered: a proposal's rows, a commit (0: the default, dt / 20). */
+    int64_t ack_timeout_us;
+    int64_t resend_us;
+    /* Its heartbeat goes out again this many times a cycle, resend_us apart (0: none,
+     * the default): UAVs fall back after coordinator_timeout without one. */
+    uint32_t heartbeat_copies;
 } coavoid_coordinator_config_t;
 
 typedef struct {
@@ -327,6 +354,11 @@ typedef struct {
     uint32_t plans_run;        /* planning calls since start */
     uint32_t plans_published;  /* solved plans published since start */
     uint32_t plans_abandoned;  /* clusters abandoned past the planning budget since start */
+    uint32_t plans_proposed;   /* solved plans proposed to their UAVs since start */
+    uint32_t plans_committed;  /* of them, accepted by every UAV and committed */
+    uint32_t plans_aborted;    /* refused, unanswered in time, or superseded */
+    uint32_t plans_replanned;  /* re-plans of the UAVs that accepted an aborted plan */
+    uint32_t plans_resent;     /* proposals sent again for want of an accept */
     int last_outcome;
     uint64_t last_nodes_expanded;
     int64_t last_plan_duration_us;
@@ -350,6 +382,16 @@ void coavoid_coordinator_destroy(coavoid_coordinator_t *node);
  * most beta expansions each (centralised: independence detection's searches), and when one fails at most two
  * more over larger groups. No memory is allocated. */
 int coavoid_coordinator_cycle(coavoid_coordinator_t *node, int64_t now);
+/* The agreement steps due at `now` (docs/protocol.md): a proposal whose accepts are all in
+ * is committed as soon as the last arrives (in the message handler); here, a proposal
+ * past its ack deadline, or refused, is aborted and its accepting UAVs planned again
+ * when the cycle leaves time; unanswered proposals and commits are sent again every
+ * resend_us. Call it when coavoid_coordinator_deadline says. Returns 1 when it published,
+ * 0 when nothing was due, or a negative error. Cost: a re-plan costs as one cluster of
+ * the cycle; a resend O(rows). No memory. */
+int coavoid_coordinator_poll(coavoid_coordinator_t *node, int64_t now);
+/* When poll must run next (before the cycle ends), or INT64_MAX. O(plans of the cycle). */
+int64_t coavoid_coordinator_deadline(const coavoid_coordinator_t *node);
 const coavoid_coordinator_state_t *coavoid_coordinator_state(const coavoid_coordinator_t *node);
 
 /* ---- world: the terrain database and the tracker of a scenario ---- */

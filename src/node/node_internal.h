@@ -98,6 +98,10 @@ typedef void (*coavoid_node_plan_handler_t)(void *owner, const coavoid_plan_t *m
                                             const coa_plan_result_t *result,
                                             const int32_t *offsets);
 
+/* Called for an agreement that passed its checks (signature, role, coavoid_lcm_agreement_check)
+ * and is not the node's own; returns COA_OK, or the refusal to count against it. */
+typedef int (*coavoid_node_agreement_handler_t)(void *owner, const coavoid_agreement_t *msg);
+
 struct coavoid_node_inbox {
     coavoid_node_common_t common;
     uint16_t self_uav;       /* intents from this UAV are the node's own (0: none) */
@@ -110,7 +114,7 @@ struct coavoid_node_inbox {
     bool secure;
     coavoid_auth_trust_t trust;
     lcm_t *rx_lcm; /* where subs are: common.rx_lcm, or else the lcm it publishes on */
-    lcm_subscription_t *subs[6];
+    lcm_subscription_t *subs[7];
     size_t sub_count;
     coavoid_lcm_rx_stats_t *rx; /* the owner's counters (its state's rx) */
 
@@ -150,6 +154,7 @@ struct coavoid_node_inbox {
     int64_t coordinator_utime; /* when (driver clock) */
 
     coavoid_node_plan_handler_t on_plan;
+    coavoid_node_agreement_handler_t on_agreement;
     void *owner;
 
     /* Decoding buffers (LCM dispatches one message at a time) and the transmit buffer. */
@@ -159,6 +164,7 @@ struct coavoid_node_inbox {
         coavoid_track_t track;
         coavoid_obstacle_map_t map;
         coavoid_status_t status;
+        coavoid_agreement_t agreement;
     } rx_msg;
     coavoid_lcm_intent_arrays_t rx_arrays;
     /* The plans whose rows are being collected, and a whole plan's offsets. */
@@ -261,6 +267,14 @@ int coavoid_node_inbox_init(coavoid_node_inbox_t *in, const coavoid_node_common_
                             bool want_status, coavoid_node_plan_handler_t plan_handler,
                             void *owner);
 
+/* Subscribes to the agreements on plans (COAVOID_AGREEMENT) of the inbox's coordinator:
+ * each that verifies, may be sent by its signer's role and passes
+ * coavoid_lcm_agreement_check goes to handler (its own, come back, do not). Returns COA_OK
+ * or COA_ERR_ARGUMENT (LCM refused; the caller finis the inbox). Handler cost: one
+ * signature verification plus the handler's. */
+int coavoid_node_inbox_agreements(coavoid_node_inbox_t *in,
+                                  coavoid_node_agreement_handler_t handler);
+
 /* Unsubscribes everything. O(subscriptions). */
 void coavoid_node_inbox_fini(coavoid_node_inbox_t *in);
 
@@ -338,6 +352,7 @@ int coavoid_node_publish_track(coavoid_node_tx_t *tx, const coavoid_track_t *msg
 int coavoid_node_publish_map(coavoid_node_tx_t *tx, const coavoid_obstacle_map_t *msg);
 int coavoid_node_publish_conflicts(coavoid_node_tx_t *tx, const coavoid_conflict_report_t *msg);
 int coavoid_node_publish_status(coavoid_node_tx_t *tx, const coavoid_status_t *msg);
+int coavoid_node_publish_agreement(coavoid_node_tx_t *tx, const coavoid_agreement_t *msg);
 
 /* Publishes the node's own intent as the functions above do, and remembers it so that the
  * inbox knows it when it comes back (node_internal.h, own_hash). Same returns and cost. */

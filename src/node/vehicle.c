@@ -44,6 +44,21 @@ struct coavoid_vehicle_node {
     uint32_t row_samples[COAVOID_NODE_MAX_PEERS];
     int32_t row_offsets[COAVOID_NODE_MAX_PEERS][COAVOID_NODE_MAX_SAMPLES];
 
+    /* The coordinator's plan it accepted this cycle and flies once it is committed
+     * (docs/protocol.md): its row, and the plan's UAVs, whose SWITCHED is a commit too. */
+    bool pending;
+    int64_t pending_plan_id;
+    uint32_t pending_count;
+    int32_t pending_offsets[COAVOID_NODE_MAX_SAMPLES];
+    size_t pending_members;
+    uint16_t pending_ids[COA_MAX_VEHICLES];
+    /* Copies still to send, and when the next goes: its intent, its SWITCHED. */
+    uint32_t intent_copies_left;
+    int64_t intent_copy_at;
+    uint32_t switched_copies_left;
+    int64_t switched_copy_at;
+    coavoid_agreement_t tx_agreement;
+
     /* The adopted plan: offsets of samples plan_start .. plan_start + plan_count - 1; past
      * its end the last offset holds. */
     int64_t plan_start;
@@ -173,9 +188,9 @@ static int publish_status(coavoid_vehicle_node_t *node, int64_t now)
                                           &h);
 }
 
-/* Publishes this cycle's intent and heartbeat; the wait, if any, is over. Returns 1 or a
- * negative error. */
-static int finish(coavoid_vehicle_node_t *node, int64_t now)
+/* Publishes its intent of this cycle as it stands at `now` (its state moved on, the same
+ * plan), and schedules its copies. COA_OK or a negative error (a fault). */
+static int publish_intent(coavoid_vehicle_node_t *node, int64_t now)
 {
     const coavoid_node_common_t *c = &node->config.common;
     coavoid_lcm_intent_info_t info;
@@ -211,6 +226,16 @@ static int finish(coavoid_vehicle_node_t *node, int64_t now)
     if (rc != COA_OK) {
         node->fault = true;
     }
+    node->intent_copies_left = node->config.intent_copies;
+    node->intent_copy_at = now + node->config.resend_us;
+    return rc;
+}
+
+/* Publishes this cycle's intent and heartbeat; the wait, if any, is over. Returns 1 or a
+ * negative error. */
+static int finish(coavoid_vehicle_node_t *node, int64_t now)
+{
+    int rc = publish_intent(node, now);
     node->state.waiting = false;
     node->state.published = rc == COA_OK;
     node->wait_deadline = INT64_MAX;
@@ -513,6 +538,18 @@ static void reject_plan(coavoid_vehicle_node_t *node, int code, const char *reas
     reject(node, code, reason);
 }
 
+static int answer(coavoid_vehicle_node_t *node, int64_t now, int8_t kind, int64_t plan_id);
+
+/* A plan of this cycle for it that it will not fly: refused, and the coordinator told
+ * (REFUSE), so that it plans the others again without waiting for its answer. */
+static void refuse_plan(coavoid_vehicle_node_t *node, int64_t now, int64_t plan_id, int code,
+                        const char *reason)
+{
+    reject_plan(node, code, reason);
+    node->state.plans_refused++;
+    (void)answer(node, now, COAVOID_AGREEMENT_T_KIND_REFUSE, plan_id);
+}
+
 /* The slot of UAV id's row of this cycle's plans: row_count when it has none. O(rows). */
 static size_t row_slot(const coavoid_vehicle_node_t *node, uint16_t id)
 {
@@ -607,6 +644,110 @@ static int plan_hits_known(coavoid_vehicle_node_t *node, const int32_t *offsets,
     return hit;
 }
 
+/* ---- the agreement on a coordinator's plan (docs/protocol.md) ---- */
+
+static int answer(coavoid_vehicle_node_t *node, int64_t now, int8_t kind, int64_t plan_id)
+{
+    coavoid_agreement_t *msg = &node->tx_agreement;
+    memset(msg, 0, sizeof *msg);
+    msg->utime = now;
+    msg->kind = kind;
+    msg->node_id = node->config.vehicle.id;
+    msg->coordinator_id = node->config.coordinator_id;
+    msg->plan_id = plan_id;
+    msg->valid_from_utime = node->cycle_start;
+    int rc = coavoid_node_publish_agreement(&node->inbox.tx, msg);
+    node->fault = node->fault || rc != COA_OK;
+    return rc;
+}
+
+/* Holds its row of a whole, checked plan until the plan is committed, and says so. */
+static void hold(coavoid_vehicle_node_t *node, int64_t now, const coavoid_lcm_plan_info_t *info,
+                 const int32_t *row, size_t samples)
+{
+    node->pending = true;
+    node->pending_plan_id = info->plan_id;
+    node->pending_count = (uint32_t)samples;
+    memcpy(node->pending_offsets, row, samples * sizeof row[0]);
+    node->pending_members = info->vehicle_count;
+    for (size_t i = 0; i < info->vehicle_count; i++) {
+        node->pending_ids[i] = info->uav_ids[i];
+    }
+    node->state.plans_accepted++;
+    (void)answer(node, now, COAVOID_AGREEMENT_T_KIND_ACCEPT, info->plan_id);
+}
+
+/* Flies the plan it holds from now on: committed by the coordinator, or a sibling's
+ * SWITCHED says it was. Says SWITCHED (again resend_us later, intent_copies times) and
+ * announces its new intent at once, so that every node learns of the change this cycle. */
+static void switch_to_pending(coavoid_vehicle_node_t *node, int64_t now)
+{
+    node->pending = false;
+    adopt(node, node->pending_offsets, node->pending_count);
+    node->cycle_plan_adopted = true;
+    node->cycle_plan_id = node->pending_plan_id;
+    node->state.plans_switched++;
+    (void)answer(node, now, COAVOID_AGREEMENT_T_KIND_SWITCHED, node->cycle_plan_id);
+    node->switched_copies_left = node->config.intent_copies;
+    node->switched_copy_at = now + node->config.resend_us;
+    if (node->state.published) {
+        (void)publish_intent(node, now);
+    }
+}
+
+static bool pending_member(const coavoid_vehicle_node_t *node, int32_t id)
+{
+    for (size_t i = 0; i < node->pending_members; i++) {
+        if ((int32_t)node->pending_ids[i] == id) {
+            return true;
+        }
+    }
+    return false;
+}
+
+/* A word on a plan of its coordinator's (the inbox checked signature, role and fields). */
+static int on_agreement(void *owner, const coavoid_agreement_t *msg)
+{
+    coavoid_vehicle_node_t *node = owner;
+    const int64_t now = *node->config.common.clock;
+    const bool this_cycle = node->started && msg->valid_from_utime == node->cycle_start &&
+                            now < node->cycle_start + node->config.common.dt_us;
+    if (!this_cycle) {
+        return COA_OK; /* late, or of a plan it never held */
+    }
+    const bool held = node->pending && msg->plan_id == node->pending_plan_id;
+    const bool flown = node->cycle_plan_adopted && msg->plan_id == node->cycle_plan_id;
+    if (msg->kind == COAVOID_AGREEMENT_T_KIND_COMMIT && flown) {
+        (void)answer(node, now, COAVOID_AGREEMENT_T_KIND_SWITCHED, msg->plan_id); /* unheard */
+    } else if (held && (msg->kind == COAVOID_AGREEMENT_T_KIND_COMMIT ||
+                        (msg->kind == COAVOID_AGREEMENT_T_KIND_SWITCHED &&
+                         pending_member(node, msg->node_id)))) {
+        switch_to_pending(node, now);
+    } else if (held && msg->kind == COAVOID_AGREEMENT_T_KIND_ABORT) {
+        node->pending = false;
+        node->state.plans_aborted++;
+    }
+    return COA_OK;
+}
+
+/* A plan of this cycle it already answered, sent again because its answer was lost:
+ * answered again, as before. */
+static bool again(coavoid_vehicle_node_t *node, int64_t now, const coavoid_plan_t *msg)
+{
+    if (!node->started || msg->valid_from_utime != node->cycle_start) {
+        return false;
+    }
+    if (node->pending && msg->plan_id == node->pending_plan_id) {
+        (void)answer(node, now, COAVOID_AGREEMENT_T_KIND_ACCEPT, msg->plan_id);
+        return true;
+    }
+    if (node->cycle_plan_adopted && msg->plan_id == node->cycle_plan_id) {
+        (void)answer(node, now, COAVOID_AGREEMENT_T_KIND_SWITCHED, msg->plan_id);
+        return true;
+    }
+    return false;
+}
+
 /* Step 4 of node.h: a coordinator's plan that lists it. */
 static void on_plan(void *owner, const coavoid_plan_t *msg, const coavoid_lcm_plan_info_t *info,
                     const coa_plan_result_t *result, const int32_t *offsets)
@@ -635,6 +776,10 @@ static void on_plan(void *owner, const coavoid_plan_t *msg, const coavoid_lcm_pl
         coavoid_lcm_rx_count(&node->state.rx, COA_OK, NULL); /* not a plan for it */
         return;
     }
+    if (again(node, now, msg)) {
+        coavoid_lcm_rx_count(&node->state.rx, COA_OK, NULL); /* sent again: answered again */
+        return;
+    }
     if (!node->started || msg->valid_from_utime != node->cycle_start) {
         reject_plan(node, COAVOID_LCM_ERR_TIME, "plan: valid_from is not this cycle's start");
         return;
@@ -644,43 +789,43 @@ static void on_plan(void *owner, const coavoid_plan_t *msg, const coavoid_lcm_pl
         return;
     }
     if (node->cycle_plan_adopted && msg->plan_id <= node->cycle_plan_id) {
-        reject_plan(node, COAVOID_LCM_ERR_SEQUENCE,
+        refuse_plan(node, now, msg->plan_id, COAVOID_LCM_ERR_SEQUENCE,
                     "plan: plan_id not after the one adopted this cycle");
         return;
     }
     if (msg->dt != (double)node->config.common.dt) {
-        reject_plan(node, COAVOID_LCM_ERR_VALUE, "plan: dt is not this UAV's");
+        refuse_plan(node, now, msg->plan_id, COAVOID_LCM_ERR_VALUE, "plan: dt is not this UAV's");
         return;
     }
     const size_t samples = (size_t)info->horizon + 1u;
     const int32_t *mine = offsets + row * samples;
     if (mine[0] != node->state.offset) {
-        reject_plan(node, COAVOID_LCM_ERR_VALUE, "plan: does not start at the offset flown now");
+        refuse_plan(node, now, msg->plan_id, COAVOID_LCM_ERR_VALUE,
+                    "plan: does not start at the offset flown now");
         return;
     }
     for (size_t j = 0; j < samples; j++) {
         if (self->max_offset >= 0 && (mine[j] > self->max_offset || mine[j] < -self->max_offset)) {
-            reject_plan(node, COAVOID_LCM_ERR_VALUE,
+            refuse_plan(node, now, msg->plan_id, COAVOID_LCM_ERR_VALUE,
                         "plan: an offset beyond this UAV's max_offset");
             return;
         }
         if (j > 0 && coa_action_between(mine[j - 1], mine[j], self->steep_factor) < 0) {
-            reject_plan(node, COAVOID_LCM_ERR_VALUE, "plan: a step this UAV cannot fly");
+            refuse_plan(node, now, msg->plan_id, COAVOID_LCM_ERR_VALUE,
+                        "plan: a step this UAV cannot fly");
             return;
         }
     }
     int hit = plan_hits_known(node, mine, samples, now, false);
     if (hit != 0) {
-        reject_plan(node, hit > 0 ? COAVOID_LCM_ERR_VALUE : hit,
+        refuse_plan(node, now, msg->plan_id, hit > 0 ? COAVOID_LCM_ERR_VALUE : hit,
                     hit == 1 ? "plan: flies this UAV into an obstacle or track it knows"
                     : hit == 2
                         ? "plan: flies this UAV into another UAV's plan or intent"
                         : "plan: cannot be checked against the obstacles and tracks it knows");
         return;
     }
-    adopt(node, mine, (uint32_t)samples);
-    node->cycle_plan_adopted = true;
-    node->cycle_plan_id = msg->plan_id;
+    hold(node, now, info, mine, samples);
     coavoid_lcm_rx_count(&node->state.rx, COA_OK, NULL);
 }
 
@@ -729,6 +874,9 @@ coavoid_vehicle_node_t *coavoid_vehicle_node_create(const coavoid_vehicle_node_c
     if (node->config.priority_wait_us == 0) {
         node->config.priority_wait_us = c->dt_us / 2 > 0 ? c->dt_us / 2 : 1;
     }
+    if (node->config.resend_us <= 0) {
+        node->config.resend_us = c->dt_us / 20 > 0 ? c->dt_us / 20 : 1;
+    }
     node->dh = coa_climb_step(&node->config.vehicle, c->dt);
     node->plan_start = 0;
     node->plan_count = 1;
@@ -741,6 +889,12 @@ coavoid_vehicle_node_t *coavoid_vehicle_node_create(const coavoid_vehicle_node_c
     rc = coavoid_node_inbox_init(&node->inbox, c, node->config.vehicle.id, node->config.vehicle.id,
                                  coordinator_id, COAVOID_NODE_MAX_PEERS - 1u, lcm, &node->state.rx,
                                  centralised, centralised ? on_plan : NULL, node);
+    if (rc == COA_OK && centralised) {
+        rc = coavoid_node_inbox_agreements(&node->inbox, on_agreement);
+        if (rc != COA_OK) {
+            coavoid_node_inbox_fini(&node->inbox);
+        }
+    }
     if (rc != COA_OK) {
         coavoid_node_solver_fini(&node->solver);
         free(node);
@@ -767,6 +921,13 @@ void coavoid_vehicle_node_destroy(coavoid_vehicle_node_t *node)
  * the heartbeat), the inbox aged, and the UAV at sample k of its plan. */
 static void fly_to(coavoid_vehicle_node_t *node, int64_t k, int64_t now)
 {
+    /* A plan accepted and neither committed nor aborted within its cycle is not flown:
+     * the coordinator commits only what every UAV accepted, so flying it on a guess
+     * could split the plan; flying on as before is what an abort would have said. */
+    node->state.plans_in_doubt += node->pending ? 1u : 0u;
+    node->pending = false;
+    node->switched_copies_left = 0;
+    node->intent_copies_left = 0;
     node->cycle_plan_adopted = false;
     node->cycle_plan_failed = false;
     node->last_cycle_refused = node->cycle_plan_refused;
@@ -854,21 +1015,55 @@ int coavoid_vehicle_node_cycle(coavoid_vehicle_node_t *node, int64_t now)
     return rc < 0 ? rc : COA_OK;
 }
 
+/* The copies due at `now`: 1 when it sent one, 0 when none was due. */
+static int send_copies(coavoid_vehicle_node_t *node, int64_t now)
+{
+    int sent = 0;
+    if (node->intent_copies_left > 0u && now >= node->intent_copy_at && node->state.published) {
+        uint32_t left = node->intent_copies_left - 1u;
+        (void)publish_intent(node, now);
+        node->intent_copies_left = left;
+        sent = 1;
+    }
+    if (node->switched_copies_left > 0u && now >= node->switched_copy_at) {
+        node->switched_copies_left--;
+        node->switched_copy_at = now + node->config.resend_us;
+        (void)answer(node, now, COAVOID_AGREEMENT_T_KIND_SWITCHED, node->cycle_plan_id);
+        sent = 1;
+    }
+    return sent;
+}
+
 int coavoid_vehicle_node_poll(coavoid_vehicle_node_t *node, int64_t now)
 {
     if (node == NULL) {
         return COA_ERR_ARGUMENT;
     }
+    if (!node->started || now >= node->cycle_start + node->config.common.dt_us) {
+        return 0; /* copies belong to their cycle */
+    }
+    int sent = send_copies(node, now);
     if (!node->state.waiting) {
-        return 0;
+        return sent;
     }
     int rc = decide(node, now);
-    return rc;
+    return rc == 0 ? sent : rc;
 }
 
 int64_t coavoid_vehicle_node_deadline(const coavoid_vehicle_node_t *node)
 {
-    return (node != NULL && node->state.waiting) ? node->wait_deadline : INT64_MAX;
+    if (node == NULL) {
+        return INT64_MAX;
+    }
+    int64_t deadline = node->state.waiting ? node->wait_deadline : INT64_MAX;
+    const int64_t end = node->cycle_start + node->config.common.dt_us;
+    if (node->intent_copies_left > 0u && node->state.published && node->intent_copy_at < end) {
+        deadline = node->intent_copy_at < deadline ? node->intent_copy_at : deadline;
+    }
+    if (node->switched_copies_left > 0u && node->switched_copy_at < end) {
+        deadline = node->switched_copy_at < deadline ? node->switched_copy_at : deadline;
+    }
+    return deadline;
 }
 
 const coavoid_vehicle_node_state_t *coavoid_vehicle_node_state(const coavoid_vehicle_node_t *node)

@@ -423,6 +423,22 @@ static bool rt_due_collect(const rt_run_t *r, rt_sched_t *sc, int64_t now)
     return true;
 }
 
+/* Runs the coordinator's agreement steps that are due (resends, aborts, commits
+ * re-sends); the time its next one is due, or INT64_MAX. */
+static int64_t rt_coordinator_poll(const rt_run_t *r, int64_t now)
+{
+    const coavoid_rt_loop_t *loop = r->loop;
+    if (coavoid_coordinator_deadline(loop->coordinator) <= now) {
+        *loop->now = now;
+        int rc = coavoid_coordinator_poll(loop->coordinator, now);
+        if (rc < 0) {
+            rt_error(r, "the coordinator's agreements", coavoid_node_cycle_of(loop->common, now),
+                     rc);
+        }
+    }
+    return coavoid_coordinator_deadline(loop->coordinator);
+}
+
 /* Polls the vehicles whose deadline has come; the next time anything is due (INT64_MAX:
  * nothing is left to do). */
 static int64_t rt_next_wake(const rt_run_t *r, rt_sched_t *sc, int64_t now)
@@ -444,6 +460,10 @@ static int64_t rt_next_wake(const rt_run_t *r, rt_sched_t *sc, int64_t now)
     }
     if (sc->next_collect < sc->K) {
         int64_t t = coavoid_node_cycle_utime(c, sc->next_collect) + loop->collect_us;
+        wake = t < wake ? t : wake;
+    }
+    if (loop->coordinator != NULL) {
+        int64_t t = rt_coordinator_poll(r, now);
         wake = t < wake ? t : wake;
     }
     return wake;

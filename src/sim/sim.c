@@ -715,6 +715,7 @@ static int sim_vehicles(sim_run_t *r)
         config.common.signer = sim_signer(r, 2u + i);
         config.vehicle = s->vehicles[i];
         config.mode = r->o->decoupled ? COAVOID_NODE_DECOUPLED : COAVOID_NODE_CENTRALISED;
+        config.intent_copies = COAVOID_NODE_DEFAULT_COPIES;
         config.common.rx_lcm = coavoid_sim_net_rx(r->net, SIM_NET_VEHICLE(j));
         r->vehicles[j] = coavoid_vehicle_node_create(
             &config, coavoid_sim_net_tx(r->net, SIM_NET_VEHICLE(j)), &error);
@@ -747,6 +748,7 @@ static int sim_coordinator(sim_run_t *r)
     config.id = COAVOID_NODE_COORDINATOR_ID;
     config.max_centralised = r->max_centralised;
     config.collect_us = r->collect_us;
+    config.heartbeat_copies = COAVOID_NODE_DEFAULT_COPIES;
     if (config.collect_us >= r->common.dt_us) {
         return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT,
                                 "%s: dt: %g s leaves the coordinator no time within a cycle",
@@ -774,26 +776,40 @@ static int sim_coordinator(sim_run_t *r)
  * deadline is left and no delivery is due by `until` (one due later but before a UAV's
  * deadline comes first: the clock never goes back). Keeps the first node error in
  * *node_error. False when the network failed. */
+/* Polls every node once at r->now, draining what each published. True when one did. */
+static bool sim_poll(sim_run_t *r, int *node_error, bool *lcm_ok)
+{
+    bool changed = false;
+    for (size_t j = 0; j <= r->n && *lcm_ok; j++) {
+        int rc = 0;
+        if (j < r->n) {
+            rc = coavoid_vehicle_node_poll(r->vehicles[j], r->now);
+        } else if (r->coordinator != NULL) {
+            rc = coavoid_coordinator_poll(r->coordinator, r->now);
+        }
+        if (rc < 0) {
+            *node_error = *node_error != COA_OK ? *node_error : rc;
+        } else if (rc > 0) {
+            changed = true;
+            *lcm_ok = drain(r);
+        }
+    }
+    return changed;
+}
+
 static bool sim_waits(sim_run_t *r, int64_t until, int *node_error)
 {
     bool lcm_ok = true;
     for (;;) {
-        bool changed = true;
-        while (changed && lcm_ok) {
-            changed = false;
-            for (size_t j = 0; j < r->n && lcm_ok; j++) {
-                int rc = coavoid_vehicle_node_poll(r->vehicles[j], r->now);
-                if (rc < 0) {
-                    *node_error = *node_error != COA_OK ? *node_error : rc;
-                } else if (rc > 0) {
-                    changed = true;
-                    lcm_ok = drain(r);
-                }
-            }
+        while (lcm_ok && sim_poll(r, node_error, &lcm_ok)) {
         }
         int64_t deadline = INT64_MAX;
         for (size_t j = 0; j < r->n; j++) {
             int64_t d = coavoid_vehicle_node_deadline(r->vehicles[j]);
+            deadline = d < deadline ? d : deadline;
+        }
+        if (r->coordinator != NULL) {
+            int64_t d = coavoid_coordinator_deadline(r->coordinator);
             deadline = d < deadline ? d : deadline;
         }
         const int64_t due = coavoid_sim_net_next(r->net);

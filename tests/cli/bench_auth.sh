@@ -24,7 +24,7 @@ assert kv.pop("benchmark") == "auth", kv
 v = {k: float(x) for k, x in kv.items()}
 assert v["repeat"] == 3 and v["verify_failures"] == 0 and v["auth_bytes_per_message"] == 84, v
 assert v["signer_bytes"] > 64 and v["trust_list_bytes"] > 0, v
-types = ["intent", "plan", "track", "obstacle_map", "conflict_report", "status"]
+types = ["intent", "plan", "track", "obstacle_map", "conflict_report", "status", "agreement"]
 for t in types:
     assert v[t + "_bytes"] > 84, t
     for what in ("sign", "verify"):
@@ -41,13 +41,16 @@ for n in (3, 100):
             assert q + k in v, q + k
         assert v[q + "auth_bytes"] == 84 * (v[q + "sent"] + v[q + "received"]), q
         assert abs(v[q + "us_per_cycle"] - v[q + "sign_us"] - v[q + "verify_us"]) < 0.2, q
-    # node.h's cycle: a vehicle sends an intent and a heartbeat and hears every intent,
-    # heartbeat (the coordinator's too), plan, map and track; the coordinator sends its
-    # heartbeat, the report and a plan per UAV; the world sends the maps and tracks.
+    # node.h's cycle: a vehicle sends its intent 3 times (2 copies), a heartbeat, and
+    # ACCEPT and SWITCHED (3 times) on its plan, and hears every intent, heartbeat (the
+    # coordinator's too), plan, agreement (5 a plan: 4 of its UAV's, the commit), map and
+    # track; the coordinator sends its heartbeat, the report, a plan and a commit per
+    # UAV; the world sends the maps and tracks.
     maps, tracks = v[p + "maps"], v[p + "tracks"]
-    assert v[p + "vehicle_sent"] == 2, n
-    assert v[p + "vehicle_received"] == (n - 1) + (n + 1) + n + maps + tracks, n
-    assert v[p + "coordinator_sent"] == 2 + n and v[p + "coordinator_received"] == n + maps + tracks, n
+    assert v[p + "vehicle_sent"] == 3 + 1 + 4, n
+    assert v[p + "vehicle_received"] == 3 * (n - 1) + (n + 1) + n + 5 * n + maps + tracks, n
+    assert v[p + "coordinator_sent"] == 2 + 2 * n, n
+    assert v[p + "coordinator_received"] == 3 * n + 4 * n + maps + tracks, n
     assert v[p + "world_sent"] == maps + tracks and v[p + "world_received"] == 0, n
     assert v[p + "world_memory_bytes"] == v["signer_bytes"], n
     assert v[p + "vehicle_memory_bytes"] == v["signer_bytes"] + v["trust_list_bytes"], n
@@ -61,14 +64,16 @@ import json, sys
 b = json.load(open(sys.argv[1]))
 assert b["benchmark"] == "auth" and b["repeat"] == 3 and b["verify_failures"] == 0, b
 assert [t["type"] for t in b["types"]] == ["intent", "plan", "track", "obstacle_map",
-                                          "conflict_report", "status"], b["types"]
+                                          "conflict_report", "status", "agreement"], b["types"]
 for t in b["types"]:
     assert t["bytes"] > 84 and 0 < t["sign_min_us"] <= t["sign_median_us"] <= t["sign_max_us"], t
     assert 0 < t["verify_min_us"] <= t["verify_median_us"] <= t["verify_max_us"], t
 assert len(b["fleets"]) == 1 and b["fleets"][0]["vehicles"] == 5, b["fleets"]
 nodes = b["fleets"][0]["nodes"]
 assert [n["node"] for n in nodes] == ["vehicle", "coordinator", "world"], nodes
-assert nodes[0]["received"] == 4 + 6 + 5 + 16 and nodes[1]["sent"] == 7, nodes
+# A vehicle: 4 intents x 3 sends, 6 heartbeats, 5 plans, 16 map tiles, 5 x 5 agreements;
+# the coordinator: heartbeat, report, 5 plans, 5 commits.
+assert nodes[0]["received"] == 12 + 6 + 5 + 16 + 25 and nodes[1]["sent"] == 12, nodes
 PY
 fi
 
