@@ -78,6 +78,7 @@ static int world(void *options, coavoid_scenario_t *s)
     config.obstacle_count = s->obstacle_count;
     config.tracks = s->tracks;
     config.track_count = s->track_count;
+    config.copies = COAVOID_NODE_DEFAULT_COPIES;
 
     char err[512];
     lcm_t *lcm = coavoid_rt_lcm_create(o->rt.lcm_url, err, sizeof err);

@@ -571,6 +571,10 @@ static void on_plan(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
     }
     const int64_t now = *in->common.clock;
     coordinator_heard(in, now);
+    if (in->on_plan_row != NULL && in->on_plan_row(in->owner, msg)) {
+        coavoid_lcm_rx_count(in->rx, COA_OK, NULL); /* a plan it holds, sent again */
+        return;
+    }
     coavoid_lcm_context_t ctx = coavoid_node_context(in, now, now);
     coavoid_lcm_plan_info_t info;
     coa_plan_result_t result;
@@ -695,6 +699,7 @@ int coavoid_node_inbox_init(coavoid_node_inbox_t *in, const coavoid_node_common_
     in->coordinator_utime = 0;
     in->on_plan = plan_handler;
     in->on_agreement = NULL;
+    in->on_plan_row = NULL;
     in->owner = owner;
     int rc = subscribe(in, COAVOID_CHANNEL_INTENT, on_intent);
     if (rc == COA_OK) {

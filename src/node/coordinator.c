@@ -113,7 +113,7 @@ coavoid_coordinator_t *coavoid_coordinator_create(const coavoid_coordinator_conf
         node->config.ack_timeout_us = c->dt_us / 4 > 0 ? c->dt_us / 4 : 1;
     }
     if (node->config.resend_us <= 0) {
-        node->config.resend_us = c->dt_us / 20 > 0 ? c->dt_us / 20 : 1;
+        node->config.resend_us = c->dt_us / 40 > 0 ? c->dt_us / 40 : 1;
     }
     node->state.cycle = -1;
     node->state.last_outcome = -1;

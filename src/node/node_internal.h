@@ -155,6 +155,11 @@ struct coavoid_node_inbox {
 
     coavoid_node_plan_handler_t on_plan;
     coavoid_node_agreement_handler_t on_agreement;
+    /* Optional: shown every plan message of its coordinator (signature and role checked,
+     * not yet collected); true when the owner already holds that plan (it answers again),
+     * so that the message is not collected: one row of a plan sent again is enough to
+     * tell that an answer was lost. */
+    bool (*on_plan_row)(void *owner, const coavoid_plan_t *msg);
     void *owner;
 
     /* Decoding buffers (LCM dispatches one message at a time) and the transmit buffer. */

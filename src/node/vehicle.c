@@ -21,9 +21,10 @@ struct coavoid_vehicle_node {
     int64_t cycle_start;
     int64_t wait_deadline;
     bool was_coordinated;
-    bool cycle_conflict; /* a conflict of its own in this cycle's prediction */
-    bool distrust;       /* not following a coordinator it hears (cycle()) */
-    bool fault;          /* an internal error in this cycle */
+    bool cycle_conflict;    /* a conflict of its own in this cycle's prediction */
+    bool distrust;          /* not following a coordinator it hears (cycle()) */
+    int64_t distrust_cycle; /* the cycle it began */
+    bool fault;             /* an internal error in this cycle */
     int64_t intent_sequence;
     int64_t status_sequence;
     int64_t last_plan_utime;
@@ -55,8 +56,10 @@ struct coavoid_vehicle_node {
     /* Copies still to send, and when the next goes: its intent, its SWITCHED. */
     uint32_t intent_copies_left;
     int64_t intent_copy_at;
-    uint32_t switched_copies_left;
-    int64_t switched_copy_at;
+    uint32_t answer_copies_left; /* of its last answer: ACCEPT or SWITCHED */
+    int64_t answer_copy_at;
+    int8_t answer_kind;
+    int64_t answer_plan_id;
     coavoid_agreement_t tx_agreement;
 
     /* The adopted plan: offsets of samples plan_start .. plan_start + plan_count - 1; past
@@ -539,6 +542,8 @@ static void reject_plan(coavoid_vehicle_node_t *node, int code, const char *reas
 }
 
 static int answer(coavoid_vehicle_node_t *node, int64_t now, int8_t kind, int64_t plan_id);
+static void answer_with_copies(coavoid_vehicle_node_t *node, int64_t now, int8_t kind,
+                               int64_t plan_id);
 
 /* A plan of this cycle for it that it will not fly: refused, and the coordinator told
  * (REFUSE), so that it plans the others again without waiting for its answer. */
@@ -547,7 +552,7 @@ static void refuse_plan(coavoid_vehicle_node_t *node, int64_t now, int64_t plan_
 {
     reject_plan(node, code, reason);
     node->state.plans_refused++;
-    (void)answer(node, now, COAVOID_AGREEMENT_T_KIND_REFUSE, plan_id);
+    answer_with_copies(node, now, COAVOID_AGREEMENT_T_KIND_REFUSE, plan_id);
 }
 
 /* The slot of UAV id's row of this cycle's plans: row_count when it has none. O(rows). */
@@ -646,6 +651,19 @@ static int plan_hits_known(coavoid_vehicle_node_t *node, const int32_t *offsets,
 
 /* ---- the agreement on a coordinator's plan (docs/protocol.md) ---- */
 
+/* Says `kind` on plan_id now, and again intent_copies times, resend_us apart, unless a
+ * later answer replaces it: an answer lost stalls the plan until the coordinator sends
+ * the plan again. */
+static void answer_with_copies(coavoid_vehicle_node_t *node, int64_t now, int8_t kind,
+                               int64_t plan_id)
+{
+    (void)answer(node, now, kind, plan_id);
+    node->answer_kind = kind;
+    node->answer_plan_id = plan_id;
+    node->answer_copies_left = node->config.intent_copies;
+    node->answer_copy_at = now + node->config.resend_us;
+}
+
 static int answer(coavoid_vehicle_node_t *node, int64_t now, int8_t kind, int64_t plan_id)
 {
     coavoid_agreement_t *msg = &node->tx_agreement;
@@ -674,7 +692,7 @@ static void hold(coavoid_vehicle_node_t *node, int64_t now, const coavoid_lcm_pl
         node->pending_ids[i] = info->uav_ids[i];
     }
     node->state.plans_accepted++;
-    (void)answer(node, now, COAVOID_AGREEMENT_T_KIND_ACCEPT, info->plan_id);
+    answer_with_copies(node, now, COAVOID_AGREEMENT_T_KIND_ACCEPT, info->plan_id);
 }
 
 /* Flies the plan it holds from now on: committed by the coordinator, or a sibling's
@@ -687,9 +705,7 @@ static void switch_to_pending(coavoid_vehicle_node_t *node, int64_t now)
     node->cycle_plan_adopted = true;
     node->cycle_plan_id = node->pending_plan_id;
     node->state.plans_switched++;
-    (void)answer(node, now, COAVOID_AGREEMENT_T_KIND_SWITCHED, node->cycle_plan_id);
-    node->switched_copies_left = node->config.intent_copies;
-    node->switched_copy_at = now + node->config.resend_us;
+    answer_with_copies(node, now, COAVOID_AGREEMENT_T_KIND_SWITCHED, node->cycle_plan_id);
     if (node->state.published) {
         (void)publish_intent(node, now);
     }
@@ -725,13 +741,15 @@ static int on_agreement(void *owner, const coavoid_agreement_t *msg)
         switch_to_pending(node, now);
     } else if (held && msg->kind == COAVOID_AGREEMENT_T_KIND_ABORT) {
         node->pending = false;
+        node->answer_copies_left = 0;
         node->state.plans_aborted++;
     }
     return COA_OK;
 }
 
 /* A plan of this cycle it already answered, sent again because its answer was lost:
- * answered again, as before. */
+ * answered again, as before (its own copies of the answer were all lost, or are not yet
+ * sent). */
 static bool again(coavoid_vehicle_node_t *node, int64_t now, const coavoid_plan_t *msg)
 {
     if (!node->started || msg->valid_from_utime != node->cycle_start) {
@@ -746,6 +764,13 @@ static bool again(coavoid_vehicle_node_t *node, int64_t now, const coavoid_plan_
         return true;
     }
     return false;
+}
+
+/* The inbox's row hook: any one message of a plan it holds or flies is an answer lost. */
+static bool on_plan_row(void *owner, const coavoid_plan_t *msg)
+{
+    coavoid_vehicle_node_t *node = owner;
+    return again(node, *node->config.common.clock, msg);
 }
 
 /* Step 4 of node.h: a coordinator's plan that lists it. */
@@ -875,7 +900,7 @@ coavoid_vehicle_node_t *coavoid_vehicle_node_create(const coavoid_vehicle_node_c
         node->config.priority_wait_us = c->dt_us / 2 > 0 ? c->dt_us / 2 : 1;
     }
     if (node->config.resend_us <= 0) {
-        node->config.resend_us = c->dt_us / 20 > 0 ? c->dt_us / 20 : 1;
+        node->config.resend_us = c->dt_us / 40 > 0 ? c->dt_us / 40 : 1;
     }
     node->dh = coa_climb_step(&node->config.vehicle, c->dt);
     node->plan_start = 0;
@@ -890,6 +915,7 @@ coavoid_vehicle_node_t *coavoid_vehicle_node_create(const coavoid_vehicle_node_c
                                  coordinator_id, COAVOID_NODE_MAX_PEERS - 1u, lcm, &node->state.rx,
                                  centralised, centralised ? on_plan : NULL, node);
     if (rc == COA_OK && centralised) {
+        node->inbox.on_plan_row = on_plan_row;
         rc = coavoid_node_inbox_agreements(&node->inbox, on_agreement);
         if (rc != COA_OK) {
             coavoid_node_inbox_fini(&node->inbox);
@@ -926,7 +952,7 @@ static void fly_to(coavoid_vehicle_node_t *node, int64_t k, int64_t now)
      * could split the plan; flying on as before is what an abort would have said. */
     node->state.plans_in_doubt += node->pending ? 1u : 0u;
     node->pending = false;
-    node->switched_copies_left = 0;
+    node->answer_copies_left = 0;
     node->intent_copies_left = 0;
     node->cycle_plan_adopted = false;
     node->cycle_plan_failed = false;
@@ -983,7 +1009,12 @@ int coavoid_vehicle_node_cycle(coavoid_vehicle_node_t *node, int64_t now)
     node->unanswered = node->was_coordinated && conflict && !previous_answered;
     if (node->unanswered) {
         node->distrust = true;
-    } else if (node->distrust && (previous_adopted || !conflict)) {
+        node->distrust_cycle = k;
+    } else if (node->distrust && (previous_adopted || !conflict || k > node->distrust_cycle)) {
+        /* One cycle of its own planning, then it follows again: one unanswered cycle
+         * (its plan or its answer lost) must not keep it out of the coordinator's plans
+         * for the rest of a conflict, since the coordinator plans no UAV that says it
+         * plans for itself. Unanswered again, it falls back again. */
         node->distrust = false;
     }
     node->cycle_conflict = false;
@@ -1025,10 +1056,10 @@ static int send_copies(coavoid_vehicle_node_t *node, int64_t now)
         node->intent_copies_left = left;
         sent = 1;
     }
-    if (node->switched_copies_left > 0u && now >= node->switched_copy_at) {
-        node->switched_copies_left--;
-        node->switched_copy_at = now + node->config.resend_us;
-        (void)answer(node, now, COAVOID_AGREEMENT_T_KIND_SWITCHED, node->cycle_plan_id);
+    if (node->answer_copies_left > 0u && now >= node->answer_copy_at) {
+        node->answer_copies_left--;
+        node->answer_copy_at = now + node->config.resend_us;
+        (void)answer(node, now, node->answer_kind, node->answer_plan_id);
         sent = 1;
     }
     return sent;
@@ -1060,8 +1091,8 @@ int64_t coavoid_vehicle_node_deadline(const coavoid_vehicle_node_t *node)
     if (node->intent_copies_left > 0u && node->state.published && node->intent_copy_at < end) {
         deadline = node->intent_copy_at < deadline ? node->intent_copy_at : deadline;
     }
-    if (node->switched_copies_left > 0u && node->switched_copy_at < end) {
-        deadline = node->switched_copy_at < deadline ? node->switched_copy_at : deadline;
+    if (node->answer_copies_left > 0u && node->answer_copy_at < end) {
+        deadline = node->answer_copy_at < deadline ? node->answer_copy_at : deadline;
     }
     return deadline;
 }

@@ -160,23 +160,13 @@ void coavoid_world_destroy(coavoid_world_t *node)
     free(node);
 }
 
-int coavoid_world_cycle(coavoid_world_t *node, int64_t now)
+/* Every tile of the map and every track's estimate at cycle k, once. COA_OK or the first
+ * error. */
+static int world_send(coavoid_world_t *node, int64_t now, int64_t k,
+                      const coavoid_lcm_context_t *ctx_in)
 {
-    if (node == NULL) {
-        return COA_ERR_ARGUMENT;
-    }
     const coavoid_node_common_t *c = &node->config.common;
-    int64_t k = coavoid_node_cycle_of(c, now);
-    if (k < 0) {
-        return COA_ERR_ARGUMENT;
-    }
-    if (node->started && k <= node->cycle) {
-        return COA_OK;
-    }
-    node->started = true;
-    node->cycle = k;
-    const int64_t cycle_start = coavoid_node_cycle_utime(c, k);
-    coavoid_lcm_context_t ctx = world_context(node, now, cycle_start);
+    coavoid_lcm_context_t ctx = *ctx_in;
     int first_error = COA_OK;
     for (size_t i = 0; i < node->map_tiles; i++) {
         int rc = coavoid_lcm_obstacle_map_from_core(
@@ -213,6 +203,33 @@ int coavoid_world_cycle(coavoid_world_t *node, int64_t now)
         if (first_error == COA_OK) {
             first_error = rc;
         }
+    }
+    return first_error;
+}
+
+int coavoid_world_cycle(coavoid_world_t *node, int64_t now)
+{
+    if (node == NULL) {
+        return COA_ERR_ARGUMENT;
+    }
+    const coavoid_node_common_t *c = &node->config.common;
+    int64_t k = coavoid_node_cycle_of(c, now);
+    if (k < 0) {
+        return COA_ERR_ARGUMENT;
+    }
+    if (node->started && k <= node->cycle) {
+        return COA_OK;
+    }
+    node->started = true;
+    node->cycle = k;
+    const int64_t cycle_start = coavoid_node_cycle_utime(c, k);
+    coavoid_lcm_context_t ctx = world_context(node, now, cycle_start);
+    int first_error = COA_OK;
+    /* Each message goes out 1 + copies times, each freshly stamped: a track lost to the
+     * coordinator in the first cycles is one it cannot plan around. */
+    for (uint32_t send = 0; send <= node->config.copies; send++) {
+        int rc = world_send(node, now, k, &ctx);
+        first_error = first_error == COA_OK ? rc : first_error;
     }
     return first_error;
 }

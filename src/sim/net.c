@@ -163,7 +163,10 @@ static void on_sent(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
         if (j == from->index || to->rx == NULL || to->stopped) {
             continue;
         }
-        if (to->loss > 0.0 && net_uniform(net) < to->loss) {
+        if ((to->loss > 0.0 && net_uniform(net) < to->loss) ||
+            (net->config.drop != NULL &&
+             net->config.drop(net->config.drop_user, channel, from->index, j, rbuf->data,
+                              (size_t)rbuf->data_size, net->now))) {
             net->stats.dropped++;
             continue;
         }

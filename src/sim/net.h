@@ -36,6 +36,13 @@ typedef struct {
      * ever delayed (delay and jitter 0). */
     size_t message_capacity;
     size_t copy_capacity;
+    /* Optional (scripted loss, for tests): asked about every copy to another receiver
+     * that the random loss spared, with its channel, its sender's and receiver's node
+     * numbers, its bytes and the time it is sent; true drops it (counted as dropped). It
+     * must not publish. NULL: nothing more is dropped. */
+    bool (*drop)(void *user, const char *channel, size_t from, size_t to, const void *data,
+                 size_t size, int64_t now);
+    void *drop_user;
 } coavoid_sim_net_config_t;
 
 /* What the network did since create. Every copy to another receiver is delivered,

@@ -32,12 +32,14 @@
 #define SIM_NET_COORDINATOR 1u
 #define SIM_NET_VEHICLE(j) (2u + (j))
 /* Messages a node publishes in a cycle at most, for the network's queue: a UAV its
- * intent and heartbeat (twice that, for margin); the coordinator its report, heartbeat
- * and the rows of at most three plans per UAV (its clusters', the regrouped one's, the
- * whole fleet's) or their abandonment (4 per UAV + 4, with margin); the world every
- * tile and track. More would be a queue overflow: an error of the run, never a loss. */
-#define SIM_NET_VEHICLE_MESSAGES 4u
-#define SIM_NET_COORDINATOR_MESSAGES(n) (4u * (n) + 4u)
+ * intent and heartbeat with their copies, and its answers on plans (each answer again
+ * when a plan comes again, every resend_us: dt/20); the coordinator its report, heartbeat
+ * and copies, and the rows of at most three plans per UAV (its clusters', the regrouped
+ * one's, the whole fleet's) or their abandonment, each sent again while unanswered, and
+ * its commits (32 per UAV + 32, with margin); the world every tile and track. More would
+ * be a queue overflow: an error of the run, never a loss. */
+#define SIM_NET_VEHICLE_MESSAGES 32u
+#define SIM_NET_COORDINATOR_MESSAGES(n) (32u * (n) + 32u)
 typedef struct {
     /* The run's parameters (sim_check, sim_planner_sizes). */
     const coavoid_sim_config_t *o;
@@ -55,6 +57,7 @@ typedef struct {
     uint32_t coordinator_beta;
     size_t max_centralised;
     uint32_t coordinator_plans; /* plans the coordinator ran, when it stopped or at the end */
+    coavoid_coordinator_state_t coordinator_final; /* its state then */
     /* What the run holds (sim_run_free releases it). */
     coavoid_sim_net_t *net;
     int net_error; /* the network's first error (coavoid_sim_net_pump) */
@@ -523,6 +526,27 @@ static int sim_planner_sizes(sim_run_t *r)
     return SIM_GO_ON;
 }
 
+/* A node's id from its number on the network (net.h). */
+static uint32_t sim_node_id(const sim_run_t *r, size_t index)
+{
+    if (index == SIM_NET_WORLD) {
+        return COAVOID_NODE_WORLD_ID;
+    }
+    if (index == SIM_NET_COORDINATOR) {
+        return COAVOID_NODE_COORDINATOR_ID;
+    }
+    return r->s->vehicles[r->index[index - SIM_NET_VEHICLE(0)]].id;
+}
+
+/* The caller's script of losses (coavoid_sim_config_t.drop), asked with node ids. */
+static bool sim_drop(void *user, const char *channel, size_t from, size_t to, const void *data,
+                     size_t size, int64_t now)
+{
+    const sim_run_t *r = user;
+    return r->o->drop(r->o->drop_user, channel, sim_node_id(r, from), sim_node_id(r, to), data,
+                      size, now);
+}
+
 /* The network between the nodes (net.h), on LCM's in-process provider: its queue holds
  * two cycles of every node's messages, as a message is less than a cycle late. */
 static int sim_net(sim_run_t *r)
@@ -535,8 +559,11 @@ static int sim_net(sim_run_t *r)
     c.delay_us = (int64_t)llround(o->delay * 1e6);
     c.jitter_us = (int64_t)llround(o->jitter * 1e6);
     c.seed = o->seed;
+    c.drop = o->drop != NULL ? sim_drop : NULL;
+    c.drop_user = r;
     if (c.delay_us > 0 || c.jitter_us > 0) {
-        const size_t per_cycle = COAVOID_OBSTACLE_MAP_T_MAX_TILES + r->s->track_count +
+        const size_t per_cycle = (COAVOID_OBSTACLE_MAP_T_MAX_TILES + r->s->track_count) *
+                                     (1u + COAVOID_NODE_DEFAULT_COPIES) +
                                  SIM_NET_VEHICLE_MESSAGES * n + SIM_NET_COORDINATOR_MESSAGES(n);
         c.message_capacity = 2u * per_cycle;
         c.copy_capacity = 2u * per_cycle * (n + 1u);
@@ -674,6 +701,7 @@ static int sim_world(sim_run_t *r)
     world.obstacle_count = s->obstacle_count;
     world.tracks = world_tracks;
     world.track_count = s->track_count;
+    world.copies = COAVOID_NODE_DEFAULT_COPIES;
     r->world = coavoid_world_create(&world, coavoid_sim_net_tx(r->net, SIM_NET_WORLD), &error);
     if (r->world == NULL && error == COA_ERR_ARGUMENT) {
         return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT,
@@ -834,6 +862,7 @@ static bool sim_cycle(sim_run_t *r, uint32_t k, int *node_error)
     bool lcm_ok = k == 0u || sim_waits(r, cycle_start, node_error);
     if (r->coordinator != NULL && r->o->has_stop && k == r->o->stop_step) {
         r->coordinator_plans = coavoid_coordinator_state(r->coordinator)->plans_run;
+        r->coordinator_final = *coavoid_coordinator_state(r->coordinator);
         coavoid_coordinator_destroy(r->coordinator);
         r->coordinator = NULL;
         coavoid_sim_net_stop(r->net, SIM_NET_COORDINATOR);
@@ -874,6 +903,7 @@ static int sim_fly(sim_run_t *r)
     }
     if (r->coordinator != NULL) {
         r->coordinator_plans = coavoid_coordinator_state(r->coordinator)->plans_run;
+        r->coordinator_final = *coavoid_coordinator_state(r->coordinator);
     }
     if (!lcm_ok && r->net_error == COA_ERR_WORKSPACE) {
         return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INTERNAL,
@@ -942,6 +972,24 @@ static int sim_write(const sim_run_t *r, uint32_t fallbacks)
     return rc;
 }
 
+/* The agreement counts of the run (the coordinator's, the UAVs' sums). */
+static void sim_agreement_counts(const sim_run_t *r, coavoid_sim_outcome_t *outcome)
+{
+    const coavoid_coordinator_state_t *c = &r->coordinator_final;
+    outcome->plans_proposed = c->plans_proposed;
+    outcome->plans_committed = c->plans_committed;
+    outcome->plans_aborted = c->plans_aborted;
+    outcome->plans_replanned = c->plans_replanned;
+    outcome->plans_resent = c->plans_resent;
+    outcome->plans_switched = 0;
+    outcome->plans_in_doubt = 0;
+    for (size_t j = 0; j < r->n; j++) {
+        const coavoid_vehicle_node_state_t *st = coavoid_vehicle_node_state(r->vehicles[j]);
+        outcome->plans_switched += st->plans_switched;
+        outcome->plans_in_doubt += st->plans_in_doubt;
+    }
+}
+
 /* Judges the flight and writes the figure and the result (unless there is no r->out);
  * the exit status, and *outcome when not NULL. */
 static int sim_report(sim_run_t *r, coavoid_sim_outcome_t *outcome)
@@ -983,6 +1031,7 @@ static int sim_report(sim_run_t *r, coavoid_sim_outcome_t *outcome)
         outcome->delivered = st.delivered;
         outcome->dropped = st.dropped;
         outcome->in_flight = st.in_flight;
+        sim_agreement_counts(r, outcome);
     }
     return eval->loss_of_separation ? COAVOID_SIM_LOSS : COAVOID_SIM_SEPARATED;
 }

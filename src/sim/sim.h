@@ -68,6 +68,13 @@ typedef struct {
     double delay;  /* s */
     double jitter; /* s */
     uint64_t seed;
+    /* Optional (scripted loss, for tests): asked about every copy of a message the network
+     * would deliver to another node, with the sender's and receiver's node ids (a UAV's
+     * id, COAVOID_NODE_COORDINATOR_ID or COAVOID_NODE_WORLD_ID), the channel, the bytes
+     * and the time; true drops it. It must not publish. NULL: none. */
+    bool (*drop)(void *user, const char *channel, uint32_t from_id, uint32_t to_id,
+                 const void *data, size_t size, int64_t now);
+    void *drop_user;
 } coavoid_sim_config_t;
 
 /* What a run did, for a caller that tabulates runs rather than prints them. */
@@ -78,6 +85,15 @@ typedef struct {
     uint64_t delivered; /* copies that reached another node */
     uint64_t dropped;   /* copies lost */
     uint64_t in_flight; /* copies still on their way when the run ended */
+    /* The agreement on the coordinator's plans (docs/protocol.md): the coordinator's
+     * counts (node.h's coavoid_coordinator_state_t; 0 decoupled) and the UAVs' sums. */
+    uint32_t plans_proposed;
+    uint32_t plans_committed;
+    uint32_t plans_aborted;
+    uint32_t plans_replanned;
+    uint32_t plans_resent;
+    uint32_t plans_switched; /* UAVs that switched to a committed plan */
+    uint32_t plans_in_doubt; /* UAVs whose accepted plan got no decision in its cycle */
 } coavoid_sim_outcome_t;
 
 /* The largest --steps, and with it --coordinator-stops: more is more likely a typo than a
