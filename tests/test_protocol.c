@@ -1,0 +1,351 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * test_protocol.c: each rule of the loss-tolerant protocol (docs/protocol.md) under a
+ * scripted loss, flown by the real nodes in the simulation (coavoid_sim_fly with a
+ * drop script, src/sim): the paper's encounter, centralised, where the coordinator's
+ * first plan lists several UAVs. Each script drops chosen copies around that first plan:
+ *   - a UAV's intent lost to the coordinator: its copies carry it, the flight is the
+ *     lossless one;
+ *   - the plan's rows lost to one UAV once: sent again, the flight is the lossless one;
+ *   - the rows never reaching one UAV: nobody flies that plan, the UAVs that accepted
+ *     are planned again around it, separation is kept;
+ *   - one UAV's ACCEPT lost once: its copy carries it, the flight is the lossless one;
+ *   - every answer of one UAV lost: the plan is aborted, nobody flies it;
+ *   - the coordinator gone right after proposing: nobody switches, every UAV falls back,
+ *     separation is kept;
+ *   - the coordinator gone after one COMMIT reached one UAV only: that UAV's SWITCHED
+ *     makes every other UAV of the plan switch too: the plan is flown by all.
+ * Separation is judged by the simulation, as `coavoid sim` does.
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <coavoid_lcmtypes/coavoid_agreement_t.h>
+#include <coavoid_lcmtypes/coavoid_plan_t.h>
+
+#include "coavoid/coavoid.h"
+#include "node.h"
+#include "scenario.h"
+#include "sim.h"
+#include "test_support.h"
+
+#ifndef COAVOID_TEST_SCENARIOS
+#error "COAVOID_TEST_SCENARIOS: the scenarios/ directory (tests/CMakeLists.txt)"
+#endif
+
+#define PAPER COAVOID_TEST_SCENARIOS "/paper.json"
+#define DT_US INT64_C(1000000) /* paper.json's dt */
+#define OUT_BYTES 65536u
+#define PLANS_NOTED 4096
+
+typedef enum {
+    SCRIPT_NONE,
+    SCRIPT_INTENT_FIRST_SENDS,
+    SCRIPT_ROWS_ONCE,
+    SCRIPT_ROWS_NEVER,
+    SCRIPT_ACCEPT_ONCE,
+    SCRIPT_ANSWERS_NEVER,
+    SCRIPT_GONE_AFTER_PROPOSAL,
+    SCRIPT_GONE_AFTER_ONE_COMMIT
+} script_kind_t;
+
+typedef struct {
+    script_kind_t kind;
+    int64_t first_plan_at; /* when the plan picked on went out (0: not yet) */
+    int64_t first_plan_id;
+    uint32_t plan_members[PLANS_NOTED]; /* by plan_id */
+    bool committed[PLANS_NOTED];
+    uint32_t switched_before; /* switches to the plans committed before it */
+    uint64_t holders;         /* UAVs (id % 64) of the solved plans sent with it: they all accept */
+    uint32_t target_switches; /* SWITCHED on the plan picked on, heard going out */
+    uint32_t members;         /* its UAVs */
+    uint32_t ids[COAVOID_PLAN_T_MAX_VEHICLES];
+    uint32_t victim;          /* the UAV the script picks on: the plan's second */
+    int64_t first_commit_at;  /* when its first COMMIT went out (0: not yet) */
+    uint32_t commit_receiver; /* the one UAV that COMMIT may reach */
+    uint32_t dropped;
+} script_t;
+
+static bool is(const char *channel, const char *want)
+{
+    return strcmp(channel, want) == 0;
+}
+
+/* Notes each plan's size as its first row goes out, and the plan the scripts pick on: the
+ * last solved plan of two UAVs or more sent at the time of the first one (its time and
+ * UAVs). */
+static void note_plan(script_t *s, const void *data, size_t size, int64_t now)
+{
+    coavoid_plan_t m;
+    if (coavoid_plan_t_decode(data, 0, (int)size, &m) < 0 || m.plan_id < 0 ||
+        m.plan_id >= PLANS_NOTED) {
+        return;
+    }
+    s->plan_members[m.plan_id] = (uint32_t)m.vehicle_count;
+    if (s->first_plan_at != 0 && now == s->first_plan_at &&
+        m.status == COAVOID_PLAN_T_STATUS_SOLVED) {
+        for (int32_t i = 0; i < m.vehicle_count; i++) {
+            s->holders |= UINT64_C(1) << ((uint32_t)m.uav_ids[i] % 64u);
+        }
+    }
+    /* The last such plan sent at that time: a later plan of a cycle supersedes. */
+    if ((s->first_plan_at != 0 && now != s->first_plan_at) || m.vehicle_count < 2 ||
+        m.status != COAVOID_PLAN_T_STATUS_SOLVED) {
+        return;
+    }
+    s->first_plan_at = now;
+    s->first_plan_id = m.plan_id;
+    s->members = (uint32_t)m.vehicle_count;
+    for (uint32_t i = 0; i < s->members; i++) {
+        s->ids[i] = (uint32_t)m.uav_ids[i];
+    }
+    s->victim = s->ids[1];
+}
+
+/* Counts the switches a COMMIT of an earlier plan brings (before the scripts act). */
+static void note_commit(script_t *s, const void *data, size_t size)
+{
+    coavoid_agreement_t m;
+    if (s->first_plan_at != 0 || coavoid_agreement_t_decode(data, 0, (int)size, &m) < 0 ||
+        m.kind != COAVOID_AGREEMENT_T_KIND_COMMIT || m.plan_id < 0 || m.plan_id >= PLANS_NOTED ||
+        s->committed[m.plan_id]) {
+        return;
+    }
+    s->committed[m.plan_id] = true;
+    s->switched_before += s->plan_members[m.plan_id];
+}
+
+/* A UAV's SWITCHED on the plan picked on: it flies that plan. */
+static void note_switch(script_t *s, const char *channel, const void *data, size_t size)
+{
+    coavoid_agreement_t m;
+    if (s->first_plan_at != 0 && is(channel, COAVOID_CHANNEL_AGREEMENT) &&
+        coavoid_agreement_t_decode(data, 0, (int)size, &m) >= 0 &&
+        m.kind == COAVOID_AGREEMENT_T_KIND_SWITCHED && m.plan_id == s->first_plan_id) {
+        s->target_switches++;
+    }
+}
+
+static int8_t agreement_kind(const void *data, size_t size)
+{
+    coavoid_agreement_t m;
+    return coavoid_agreement_t_decode(data, 0, (int)size, &m) < 0 ? (int8_t)-1 : m.kind;
+}
+
+/* Within the first plan's cycle (it goes out a quarter cycle after the cycle starts). */
+static bool first_cycle(const script_t *s, int64_t now)
+{
+    return s->first_plan_at != 0 && now < s->first_plan_at + (DT_US * 3) / 4;
+}
+
+static bool from_coordinator_dropped(script_t *s, const char *channel, const void *data,
+                                     size_t size, uint32_t to, int64_t now)
+{
+    if (s->kind == SCRIPT_GONE_AFTER_PROPOSAL) {
+        /* Its rows of the first plan go out, then nothing more. */
+        return s->first_plan_at != 0 &&
+               !(is(channel, COAVOID_CHANNEL_PLAN) && now == s->first_plan_at);
+    }
+    if (s->kind == SCRIPT_GONE_AFTER_ONE_COMMIT) {
+        if (s->first_commit_at != 0 && now > s->first_commit_at) {
+            return true;
+        }
+        if (is(channel, COAVOID_CHANNEL_AGREEMENT) &&
+            agreement_kind(data, size) == COAVOID_AGREEMENT_T_KIND_COMMIT) {
+            s->first_commit_at = now;
+            s->commit_receiver = s->commit_receiver != 0u ? s->commit_receiver : to;
+            return to != s->commit_receiver;
+        }
+        return s->first_commit_at != 0 && !is(channel, COAVOID_CHANNEL_PLAN);
+    }
+    if (is(channel, COAVOID_CHANNEL_PLAN) && to == s->victim) {
+        return (s->kind == SCRIPT_ROWS_ONCE && now == s->first_plan_at) ||
+               (s->kind == SCRIPT_ROWS_NEVER && first_cycle(s, now));
+    }
+    return false;
+}
+
+static bool to_coordinator_dropped(script_t *s, const char *channel, const void *data, size_t size,
+                                   uint32_t from, int64_t now)
+{
+    if (s->kind == SCRIPT_INTENT_FIRST_SENDS) {
+        /* Every intent's first send (at its cycle's start) from UAV 1: its copies remain. */
+        return from == 1u && is(channel, COAVOID_CHANNEL_INTENT) && now % DT_US == 0;
+    }
+    if (from != s->victim || !is(channel, COAVOID_CHANNEL_AGREEMENT)) {
+        return false;
+    }
+    if (s->kind == SCRIPT_ACCEPT_ONCE) {
+        return now == s->first_plan_at &&
+               agreement_kind(data, size) == COAVOID_AGREEMENT_T_KIND_ACCEPT;
+    }
+    return s->kind == SCRIPT_ANSWERS_NEVER && first_cycle(s, now);
+}
+
+static bool drop(void *user, const char *channel, uint32_t from, uint32_t to, const void *data,
+                 size_t size, int64_t now)
+{
+    script_t *s = user;
+    bool dropped = false;
+    if (from == COAVOID_NODE_COORDINATOR_ID) {
+        if (is(channel, COAVOID_CHANNEL_PLAN)) {
+            note_plan(s, data, size, now);
+        } else if (is(channel, COAVOID_CHANNEL_AGREEMENT)) {
+            note_commit(s, data, size);
+        }
+        dropped = from_coordinator_dropped(s, channel, data, size, to, now);
+    } else if (to == COAVOID_NODE_COORDINATOR_ID) {
+        note_switch(s, channel, data, size);
+        dropped = to_coordinator_dropped(s, channel, data, size, from, now);
+    }
+    s->dropped += dropped ? 1u : 0u;
+    return dropped;
+}
+
+typedef struct {
+    int verdict;
+    coavoid_sim_outcome_t outcome;
+    char text[OUT_BYTES];
+} flight_t;
+
+/* Flies paper.json centralised under the script; the result's text in f->text. */
+static void fly(script_t *s, flight_t *f)
+{
+    coavoid_scenario_t sc;
+    char err[256];
+    ck_assert_msg(coavoid_scenario_load(PAPER, &sc, err, sizeof err) == COA_OK, "%s", err);
+    coavoid_sim_config_t c;
+    memset(&c, 0, sizeof c);
+    c.scenario_path = PAPER;
+    c.mode = "centralised";
+    c.drop = drop;
+    c.drop_user = s;
+    FILE *out = tmpfile();
+    ck_assert_ptr_nonnull(out);
+    coavoid_run_error_t e;
+    memset(&e, 0, sizeof e);
+    f->verdict = coavoid_sim_fly(&c, &sc, out, &f->outcome, &e);
+    rewind(out);
+    size_t n = fread(f->text, 1, sizeof f->text - 1u, out);
+    f->text[n] = '\0';
+    ck_assert_int_eq(fclose(out), 0);
+    coavoid_scenario_free(&sc);
+    ck_assert_msg(f->verdict == COAVOID_SIM_SEPARATED, "verdict %d (%s)", f->verdict, e.text);
+    ck_assert(!f->outcome.loss_of_separation);
+}
+
+static flight_t lossless, scripted;
+
+static script_t run(script_kind_t kind)
+{
+    script_t none;
+    memset(&none, 0, sizeof none);
+    fly(&none, &lossless);
+    ck_assert_uint_eq(none.dropped, 0);
+    ck_assert_uint_ge(none.members, 2); /* the paper's encounter has a joint plan */
+    /* Without loss every plan is committed, or superseded by a larger one of its cycle. */
+    ck_assert_uint_eq(lossless.outcome.plans_committed + lossless.outcome.plans_aborted,
+                      lossless.outcome.plans_proposed);
+    ck_assert_uint_eq(lossless.outcome.plans_replanned, 0);
+    ck_assert_uint_eq(lossless.outcome.plans_in_doubt, 0);
+    script_t s;
+    memset(&s, 0, sizeof s);
+    s.kind = kind;
+    memset(&scripted, 0, sizeof scripted);
+    fly(&s, &scripted);
+    ck_assert_uint_gt(s.dropped, 0);
+    return s;
+}
+
+START_TEST(test_intent_lost_copy_carries_it)
+{
+    run(SCRIPT_INTENT_FIRST_SENDS);
+    ck_assert_str_eq(scripted.text, lossless.text);
+}
+END_TEST
+
+START_TEST(test_rows_lost_once_are_sent_again)
+{
+    run(SCRIPT_ROWS_ONCE);
+    ck_assert_uint_ge(scripted.outcome.plans_resent, 1);
+    ck_assert_str_eq(scripted.text, lossless.text);
+}
+END_TEST
+
+START_TEST(test_rows_never_reach_one_uav)
+{
+    script_t s = run(SCRIPT_ROWS_NEVER);
+    /* The first plan is never committed; the UAVs that accepted it are planned again
+     * around the one that never had it. */
+    ck_assert_uint_ge(scripted.outcome.plans_aborted, 1);
+    ck_assert_uint_eq(s.target_switches, 0);
+    ck_assert_uint_ge(scripted.outcome.plans_replanned, s.members > 2u ? 1u : 0u);
+    ck_assert_uint_eq(scripted.outcome.plans_in_doubt, 0);
+}
+END_TEST
+
+START_TEST(test_accept_lost_once_its_copy_carries_it)
+{
+    run(SCRIPT_ACCEPT_ONCE);
+    ck_assert_str_eq(scripted.text, lossless.text);
+}
+END_TEST
+
+START_TEST(test_answers_never_arrive)
+{
+    script_t s = run(SCRIPT_ANSWERS_NEVER);
+    ck_assert_uint_eq(s.target_switches, 0);
+    /* Aborted at its deadline: nobody flies it; the UAV whose answers were lost heard
+     * the abort, so none is left in doubt. */
+    ck_assert_uint_ge(scripted.outcome.plans_aborted, 1);
+    ck_assert_uint_lt(scripted.outcome.plans_committed, scripted.outcome.plans_proposed);
+}
+END_TEST
+
+START_TEST(test_coordinator_gone_after_proposal)
+{
+    script_t s = run(SCRIPT_GONE_AFTER_PROPOSAL);
+    /* Every UAV accepted and none switched: the plan is flown by none, and they fall
+     * back to planning for themselves. */
+    ck_assert_uint_eq(scripted.outcome.plans_switched, s.switched_before);
+    ck_assert_uint_eq(scripted.outcome.plans_in_doubt, (uint32_t)__builtin_popcountll(s.holders));
+    ck_assert_uint_ge(scripted.outcome.fallbacks, s.members);
+}
+END_TEST
+
+START_TEST(test_coordinator_gone_after_one_commit)
+{
+    script_t s = run(SCRIPT_GONE_AFTER_ONE_COMMIT);
+    /* One COMMIT reached one UAV; its SWITCHED made the others switch: all or none. */
+    ck_assert_uint_ne(s.commit_receiver, 0);
+    ck_assert_uint_eq(scripted.outcome.plans_switched,
+                      s.switched_before + (uint32_t)__builtin_popcountll(s.holders));
+    ck_assert_uint_eq(scripted.outcome.plans_in_doubt, 0);
+}
+END_TEST
+
+static Suite *protocol_suite(void)
+{
+    Suite *suite = suite_create("protocol");
+    TCase *tc = tcase_create("scripted loss");
+    tcase_set_timeout(tc, 120);
+    tcase_add_test(tc, test_intent_lost_copy_carries_it);
+    tcase_add_test(tc, test_rows_lost_once_are_sent_again);
+    tcase_add_test(tc, test_rows_never_reach_one_uav);
+    tcase_add_test(tc, test_accept_lost_once_its_copy_carries_it);
+    tcase_add_test(tc, test_answers_never_arrive);
+    tcase_add_test(tc, test_coordinator_gone_after_proposal);
+    tcase_add_test(tc, test_coordinator_gone_after_one_commit);
+    suite_add_tcase(suite, tc);
+    return suite;
+}
+
+int main(void)
+{
+    SRunner *sr = srunner_create(protocol_suite());
+    srunner_run_all(sr, CK_NORMAL);
+    int failed = srunner_ntests_failed(sr);
+    srunner_free(sr);
+    return failed == 0 ? EXIT_SUCCESS : EXIT_FAILURE;
+}
