@@ -36,8 +36,9 @@
  *        latest). When it has a conflict of its own that begins within cycle k's horizon
  *        (first step < N - 1 on the new clock; one that only now enters the horizon is
  *        the coordinator's to plan in k + 1), it plans for itself as in decoupled mode
- *        from cycle k + 1 on (counted in fallbacks), until a cycle in which it adopts a
- *        coordinator's plan or has no conflict of its own;
+ *        in cycle k + 1 (counted in fallbacks), and follows again from cycle k + 2 (one
+ *        unanswered cycle, a lost answer, must not keep it out of the coordinator's
+ *        plans: the coordinator plans no UAV whose intent says it plans for itself);
  *      - decoupled: first it waits (until priority_wait_us has passed) for this cycle's
  *        intents of the higher-priority UAVs whose paths pass near its own horizontally
  *        within the horizon (the predictor's test with unbounded heights): only their
@@ -80,8 +81,14 @@
  *   4. A UAV collects the messages of each plan (every plan, for it or not) and decides on
  *      a plan only once it holds the row of every UAV the plan lists: a plan missing a row
  *      is never adopted, nor refused (it did not come: the UAV is unanswered, above), and
- *      a message that disagrees with the rest of its plan is refused. It adopts a whole
- *      plan that lists it among the planned rows, is solved, arrives
+ *      a message that disagrees with the rest of its plan is refused. Adopting is agreed
+ *      on (docs/protocol.md, agreement_t on COAVOID_AGREEMENT): the UAV answers ACCEPT
+ *      and holds its row; it flies it only on the coordinator's COMMIT (sent once every
+ *      UAV of the plan accepted) or a sibling's SWITCHED, answering SWITCHED; an ABORT,
+ *      or no decision by the cycle's end, and it flies on as before; a plan it refuses it
+ *      answers REFUSE (the coordinator then plans the others again, coavoid_coordinator_poll).
+ *      Answers go out with intent_copies copies, and again on any row of the plan sent
+ *      again. It accepts a whole plan that lists it among the planned rows, is solved, arrives
  *      before valid_until, has valid_from == the current cycle's start, has a plan_id
  *      greater than that of any plan it adopted in this cycle (so that a later plan of
  *      the cycle supersedes), starts at the offset the UAV flies now, and over this
