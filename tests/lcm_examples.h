@@ -237,4 +237,17 @@ static inline coavoid_status_t good_status(void)
     return m;
 }
 
+static inline coavoid_agreement_t good_agreement(void)
+{
+    coavoid_agreement_t m;
+    memset(&m, 0, sizeof m);
+    m.utime = T0;
+    m.kind = COAVOID_AGREEMENT_T_KIND_ACCEPT;
+    m.node_id = 2;
+    m.coordinator_id = 65001;
+    m.plan_id = 7;
+    m.valid_from_utime = T0 - 250000;
+    return m;
+}
+
 #endif /* COAVOID_TESTS_LCM_EXAMPLES_H */

@@ -1611,6 +1611,45 @@ START_TEST(test_auth_key_files)
 }
 END_TEST
 
+/* An agreement on a plan: every field checked; who may sign each kind. */
+START_TEST(test_agreement_check)
+{
+    coavoid_lcm_context_t ctx = ctx_now();
+    const char *why = NULL;
+    coavoid_agreement_t m = good_agreement();
+    ck_assert_int_eq(coavoid_lcm_agreement_check(&m, &ctx, &why), COA_OK);
+    m.kind = 5;
+    ck_assert_int_eq(coavoid_lcm_agreement_check(&m, &ctx, &why), COAVOID_LCM_ERR_ENUM);
+    m = good_agreement();
+    m.node_id = 0;
+    ck_assert_int_eq(coavoid_lcm_agreement_check(&m, &ctx, &why), COAVOID_LCM_ERR_ID);
+    m = good_agreement();
+    m.coordinator_id = 65536;
+    ck_assert_int_eq(coavoid_lcm_agreement_check(&m, &ctx, &why), COAVOID_LCM_ERR_ID);
+    /* A COMMIT names its coordinator as its sender. */
+    m = good_agreement();
+    m.kind = COAVOID_AGREEMENT_T_KIND_COMMIT;
+    ck_assert_int_eq(coavoid_lcm_agreement_check(&m, &ctx, &why), COAVOID_LCM_ERR_ID);
+    m.node_id = m.coordinator_id;
+    ck_assert_int_eq(coavoid_lcm_agreement_check(&m, &ctx, &why), COA_OK);
+    m = good_agreement();
+    m.plan_id = -1;
+    ck_assert_int_eq(coavoid_lcm_agreement_check(&m, &ctx, &why), COAVOID_LCM_ERR_VALUE);
+    m = good_agreement();
+    m.valid_from_utime = 0;
+    ck_assert_int_eq(coavoid_lcm_agreement_check(&m, &ctx, &why), COAVOID_LCM_ERR_VALUE);
+    m = good_agreement();
+    m.utime = 0;
+    ck_assert_int_lt(coavoid_lcm_agreement_check(&m, &ctx, &why), 0);
+    ck_assert_int_eq(coavoid_lcm_agreement_role(COAVOID_AGREEMENT_T_KIND_ACCEPT),
+                     COAVOID_AUTH_VEHICLE);
+    ck_assert_int_eq(coavoid_lcm_agreement_role(COAVOID_AGREEMENT_T_KIND_SWITCHED),
+                     COAVOID_AUTH_VEHICLE);
+    ck_assert_int_eq(coavoid_lcm_agreement_role(COAVOID_AGREEMENT_T_KIND_ABORT),
+                     COAVOID_AUTH_COORDINATOR);
+}
+END_TEST
+
 static Suite *lcm_suite(void)
 {
     Suite *s = suite_create("lcm");
@@ -1639,6 +1678,7 @@ static Suite *lcm_suite(void)
     tcase_add_test(tc, test_auth_roles_and_freshness);
     tcase_add_test(tc, test_auth_stamp);
     tcase_add_test(tc, test_auth_key_files);
+    tcase_add_test(tc, test_agreement_check);
     suite_add_tcase(s, tc);
     return s;
 }

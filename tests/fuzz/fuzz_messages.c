@@ -44,6 +44,7 @@ static size_t example(unsigned kind, unsigned char *buf)
     coavoid_track_t t;
     coavoid_conflict_report_t c;
     coavoid_status_t s;
+    coavoid_agreement_t a;
     int n = -1;
     switch (kind) {
     case 0:
@@ -66,9 +67,13 @@ static size_t example(unsigned kind, unsigned char *buf)
         c = good_report();
         n = coavoid_conflict_report_t_encode(buf, 0, FUZZ_BUF, &c);
         break;
-    default:
+    case 5:
         s = good_status();
         n = coavoid_status_t_encode(buf, 0, FUZZ_BUF, &s);
+        break;
+    default:
+        a = good_agreement();
+        n = coavoid_agreement_t_encode(buf, 0, FUZZ_BUF, &a);
         break;
     }
     return n > 0 ? (size_t)n : 0u;
@@ -178,8 +183,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (size < 1u || size > FUZZ_BUF) {
         return 0;
     }
-    const unsigned kind = (data[0] & 0x7fu) % 7u;
-    if (kind == 6u) {
+    const unsigned kind = (data[0] & 0x7fu) % 8u;
+    if (kind == 7u) {
         parse_key_files((const char *)data + 1, size - 1u);
         return 0;
     }
@@ -216,8 +221,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         FUZZ_DECODE(coavoid_conflict_report_t, m, buf, n,
                     coavoid_lcm_conflict_report_check(&m, &ctx, &why));
         break;
-    default:
+    case 5:
         FUZZ_DECODE(coavoid_status_t, m, buf, n, coavoid_lcm_status_check(&m, &ctx, &why));
+        break;
+    default:
+        FUZZ_DECODE(coavoid_agreement_t, m, buf, n, coavoid_lcm_agreement_check(&m, &ctx, &why));
         break;
     }
     return 0;
