@@ -36,9 +36,10 @@
  *        latest). When it has a conflict of its own that begins within cycle k's horizon
  *        (first step < N - 1 on the new clock; one that only now enters the horizon is
  *        the coordinator's to plan in k + 1), it plans for itself as in decoupled mode
- *        in cycle k + 1 (counted in fallbacks), and follows again from cycle k + 2 (one
- *        unanswered cycle, a lost answer, must not keep it out of the coordinator's
- *        plans: the coordinator plans no UAV whose intent says it plans for itself);
+ *        in cycle k + 1 (counted in fallbacks), and follows again from cycle k + 2 if it
+ *        has heard the coordinator since (one unanswered cycle, a lost answer, must not
+ *        keep it out of the coordinator's plans: the coordinator plans no UAV whose
+ *        intent says it plans for itself);
  *      - decoupled: first it waits (until priority_wait_us has passed) for this cycle's
  *        intents of the higher-priority UAVs whose paths pass near its own horizontally
  *        within the horizon (the predictor's test with unbounded heights): only their

@@ -24,6 +24,7 @@ struct coavoid_vehicle_node {
     bool cycle_conflict;    /* a conflict of its own in this cycle's prediction */
     bool distrust;          /* not following a coordinator it hears (cycle()) */
     int64_t distrust_cycle; /* the cycle it began */
+    int64_t distrust_utime; /* and when */
     bool fault;             /* an internal error in this cycle */
     int64_t intent_sequence;
     int64_t status_sequence;
@@ -968,6 +969,13 @@ static void fly_to(coavoid_vehicle_node_t *node, int64_t k, int64_t now)
     node->state.position = node->own_samples[0];
 }
 
+/* Whether a cycle of distrust has passed and the coordinator was heard since it began. */
+static bool heard_since_distrust(const coavoid_vehicle_node_t *node, int64_t k)
+{
+    return k > node->distrust_cycle && node->inbox.heard_coordinator &&
+           node->inbox.coordinator_utime > node->distrust_utime;
+}
+
 int coavoid_vehicle_node_cycle(coavoid_vehicle_node_t *node, int64_t now)
 {
     if (node == NULL) {
@@ -1010,11 +1018,13 @@ int coavoid_vehicle_node_cycle(coavoid_vehicle_node_t *node, int64_t now)
     if (node->unanswered) {
         node->distrust = true;
         node->distrust_cycle = k;
-    } else if (node->distrust && (previous_adopted || !conflict || k > node->distrust_cycle)) {
-        /* One cycle of its own planning, then it follows again: one unanswered cycle
-         * (its plan or its answer lost) must not keep it out of the coordinator's plans
-         * for the rest of a conflict, since the coordinator plans no UAV that says it
-         * plans for itself. Unanswered again, it falls back again. */
+        node->distrust_utime = now;
+    } else if (node->distrust && (previous_adopted || !conflict || heard_since_distrust(node, k))) {
+        /* One cycle of its own planning, then it follows again if the coordinator is
+         * still there: one unanswered cycle (its plan or its answer lost) must not keep it
+         * out of the coordinator's plans for the rest of a conflict, since the coordinator
+         * plans no UAV that says it plans for itself. Unanswered again, it falls back
+         * again; a coordinator it no longer hears it does not go back to. */
         node->distrust = false;
     }
     node->cycle_conflict = false;
