@@ -377,7 +377,8 @@ typedef struct coavoid_coordinator coavoid_coordinator_t;
 
 /* As coavoid_vehicle_node_create, with a planner for max_centralised UAVs at once
  * (the workspace of coavoid_node_planner_config(N, max_centralised, beta): 1.3 MB for 3 UAVs
- * at N = 24 and beta 20,000). Errors as there (collect_us >= dt, max_centralised >
+ * at N = 24 and beta 20,000), and room for the agreements of one cycle's plans (40 plans
+ * of up to 32 rows: 0.23 MB). Errors as there (collect_us >= dt, max_centralised >
  * COA_MAX_CENTRALISED: COA_ERR_ARGUMENT). */
 coavoid_coordinator_t *coavoid_coordinator_create(const coavoid_coordinator_config_t *config,
                                                   lcm_t *lcm, int *error);
