@@ -16,7 +16,7 @@
  *
  * Per cycle, for a fleet of N UAVs on one channel: the messages each node signs and checks
  * in one cycle of node.h's protocol, times the median costs above. Per cycle there are
- * N intents, each sent 1 + C times (C = COAVOID_NODE_DEFAULT_COPIES, 2), and N + 1
+ * N intents, each sent 1 + C times (C = COAVOID_NODE_DEFAULT_COPIES, 4), and N + 1
  * heartbeats (each UAV's, the coordinator's), the world's
  * COAVOID_BENCH_AUTH_MAPS_PER_CYCLE obstacle map tiles and one message per track (N / 50
  * tracks, bench_predict.h's traffic; none for the demo's 3 UAVs, as in

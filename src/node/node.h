@@ -172,8 +172,10 @@
 /* Copies of every intent a vehicle sends, and of every heartbeat the coordinator sends,
  * by default in the drivers and the simulation (intent_copies, heartbeat_copies): with
  * each receiver losing a share p of datagrams, a cycle's intent or heartbeat is lost to
- * it with p^3 (2.7 % at 30 %) rather than p. */
-#define COAVOID_NODE_DEFAULT_COPIES 2u
+ * it with p^5 rather than p: a UAV the coordinator does not hear of in cycle 0 is one its
+ * first plan cannot include, and a conflict one step ahead leaves no second cycle
+ * (docs/evaluation.md measures the count). */
+#define COAVOID_NODE_DEFAULT_COPIES 4u
 
 typedef enum {
     COAVOID_NODE_CENTRALISED = 0, /* follow the coordinator; plan for itself when it is silent */

@@ -41,16 +41,17 @@ for n in (3, 100):
             assert q + k in v, q + k
         assert v[q + "auth_bytes"] == 84 * (v[q + "sent"] + v[q + "received"]), q
         assert abs(v[q + "us_per_cycle"] - v[q + "sign_us"] - v[q + "verify_us"]) < 0.2, q
-    # node.h's cycle: a vehicle sends its intent 3 times (2 copies), a heartbeat, and
-    # ACCEPT and SWITCHED (3 times) on its plan, and hears every intent, heartbeat (the
-    # coordinator's too), plan, agreement (5 a plan: 4 of its UAV's, the commit), map and
-    # track; the coordinator sends its heartbeat, the report, a plan and a commit per
-    # UAV; the world sends the maps and tracks.
-    maps, tracks = v[p + "maps"], v[p + "tracks"]
-    assert v[p + "vehicle_sent"] == 3 + 1 + 4, n
-    assert v[p + "vehicle_received"] == 3 * (n - 1) + (n + 1) + n + 5 * n + maps + tracks, n
+    # node.h's cycle, with C = 4 copies (COAVOID_NODE_DEFAULT_COPIES): a vehicle sends
+    # its intent 1 + C times, a heartbeat, and ACCEPT and SWITCHED (1 + C times) on its
+    # plan, and hears every intent, heartbeat (the coordinator's too), plan, agreement
+    # (3 + C a plan: its UAV's ACCEPT and SWITCHED, the commit), map and track; the
+    # coordinator sends its heartbeat, the report, a plan and a commit per UAV; the world
+    # sends the maps and tracks.
+    maps, tracks, sends = v[p + "maps"], v[p + "tracks"], 5
+    assert v[p + "vehicle_sent"] == sends + 1 + (1 + sends), n
+    assert v[p + "vehicle_received"] == sends * (n - 1) + (n + 1) + n + (2 + sends) * n + maps + tracks, n
     assert v[p + "coordinator_sent"] == 2 + 2 * n, n
-    assert v[p + "coordinator_received"] == 3 * n + 4 * n + maps + tracks, n
+    assert v[p + "coordinator_received"] == sends * n + (1 + sends) * n + maps + tracks, n
     assert v[p + "world_sent"] == maps + tracks and v[p + "world_received"] == 0, n
     assert v[p + "world_memory_bytes"] == v["signer_bytes"], n
     assert v[p + "vehicle_memory_bytes"] == v["signer_bytes"] + v["trust_list_bytes"], n
@@ -71,9 +72,9 @@ for t in b["types"]:
 assert len(b["fleets"]) == 1 and b["fleets"][0]["vehicles"] == 5, b["fleets"]
 nodes = b["fleets"][0]["nodes"]
 assert [n["node"] for n in nodes] == ["vehicle", "coordinator", "world"], nodes
-# A vehicle: 4 intents x 3 sends, 6 heartbeats, 5 plans, 16 map tiles, 5 x 5 agreements;
+# A vehicle: 4 intents x 5 sends, 6 heartbeats, 5 plans, 16 map tiles, 5 x 7 agreements;
 # the coordinator: heartbeat, report, 5 plans, 5 commits.
-assert nodes[0]["received"] == 12 + 6 + 5 + 16 + 25 and nodes[1]["sent"] == 12, nodes
+assert nodes[0]["received"] == 20 + 6 + 5 + 16 + 35 and nodes[1]["sent"] == 12, nodes
 PY
 fi
 
