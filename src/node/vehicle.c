@@ -361,14 +361,13 @@ static int plan_in_order(coavoid_vehicle_node_t *node, int64_t now, uint32_t my,
     return rc;
 }
 
-/* The highest rank of the members of its cluster before it, -1 when there are none.
- * O(peers). */
-static int32_t top_rank(const coavoid_vehicle_node_t *node, uint32_t my)
+/* The highest rank of the live UAVs before it, -1 when there are none. O(peers). */
+static int32_t top_rank(const coavoid_vehicle_node_t *node)
 {
     const coavoid_node_view_t *view = &node->view;
     int32_t top = -1;
     for (size_t i = 0; i < view->live_count; i++) {
-        if (node->labels[i + 1u] == my && peer_first(node, i) && view->live_info[i].rank > top) {
+        if (peer_first(node, i) && view->live_info[i].rank > top) {
             top = view->live_info[i].rank;
         }
     }
@@ -376,9 +375,9 @@ static int32_t top_rank(const coavoid_vehicle_node_t *node, uint32_t my)
 }
 
 /* The next rank above `from` worth trying, for a UAV at rank `old` that found no plan:
- * each rank of a member of its cluster before it (where its priority may win the tie) or
- * one above it (just above that member), else `ceiling`. O(peers). */
-static int32_t next_rank(const coavoid_vehicle_node_t *node, uint32_t my, int32_t old, int32_t from,
+ * each rank of a live UAV before it (where its priority may win the tie) or one above it
+ * (just above that UAV), else `ceiling`. O(peers). */
+static int32_t next_rank(const coavoid_vehicle_node_t *node, int32_t old, int32_t from,
                          int32_t ceiling)
 {
     const coa_vehicle_t *self = &node->config.vehicle;
@@ -387,8 +386,7 @@ static int32_t next_rank(const coavoid_vehicle_node_t *node, uint32_t my, int32_
     for (size_t i = 0; i < view->live_count; i++) {
         const coa_vehicle_t *peer = &view->live_vehicle[i];
         const int32_t r = view->live_info[i].rank;
-        if (node->labels[i + 1u] != my ||
-            !coavoid_node_precedes(r, peer->priority, peer->id, old, self->priority, self->id)) {
+        if (!coavoid_node_precedes(r, peer->priority, peer->id, old, self->priority, self->id)) {
             continue;
         }
         next = r > from && r < next ? r : next;
@@ -397,10 +395,12 @@ static int32_t next_rank(const coavoid_vehicle_node_t *node, uint32_t my, int32_
     return next;
 }
 
-/* After a search found no plan below the members of its cluster that come before it: it
- * raises its rank to the lowest that gives it a plan (trying each rank next_rank offers,
- * upwards), or else to one above every such member, where it plans against only what
- * stays before it (others must then avoid it: it cannot avoid them). At most MAX_RANK,
+/* After a search found no plan below the UAVs that come before it (those of its cluster,
+ * and those outside it its search avoided, which may be what blocks it: a track's
+ * conflict makes a cluster of one): it raises its rank to the lowest that gives it a plan
+ * (trying each rank next_rank offers, upwards), or else to one above all of them, where
+ * it plans against only what stays before it (others must then avoid it: it cannot
+ * avoid them). At most MAX_RANK,
  * and at most RAISES_MAX times an episode (until its rank is back to 0), so that UAVs
  * that each fail below another cannot take turns for ever. *result is the last search.
  * Returns COA_OK or a negative error. Cost: at most 2 * peers + 1 plan_in_order. */
@@ -408,7 +408,7 @@ static int raise_rank(coavoid_vehicle_node_t *node, int64_t now, uint32_t my,
                       coa_plan_result_t *result)
 {
     const int32_t old = node->state.rank;
-    const int32_t top = top_rank(node, my);
+    const int32_t top = top_rank(node);
     const int32_t ceiling = top < 0 ? -1 : (top < COAVOID_INTENT_T_MAX_RANK ? top + 1 : top);
     if (node->raises >= RAISES_MAX || ceiling <= old) {
         return COA_OK;
@@ -419,7 +419,7 @@ static int raise_rank(coavoid_vehicle_node_t *node, int64_t now, uint32_t my,
      * later raise stop between two members. */
     int32_t r = node->raises == 0u ? ceiling - 1 : old;
     do {
-        r = next_rank(node, my, old, r, ceiling);
+        r = next_rank(node, old, r, ceiling);
         node->state.rank = r;
         rc = plan_in_order(node, now, my, result);
     } while (rc == COA_OK && result->status != COA_PLAN_SOLVED && r < ceiling);
