@@ -62,6 +62,7 @@ static inline coavoid_intent_t good_intent(void)
     }
     m.sigma_horizontal = 5.0;
     m.sigma_vertical = 2.5;
+    m.rank = 3; /* a raised precedence, so that a round trip shows it is carried */
     return m;
 }
 

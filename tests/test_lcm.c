@@ -151,6 +151,7 @@ START_TEST(test_round_trip_intent_core)
     ck_assert(v->info.step == (coa_real_t)0.9);
     ck_assert(v->info.sigma_horizontal == (coa_real_t)5.0);
     ck_assert(v->info.sigma_vertical == (coa_real_t)2.5);
+    ck_assert_int_eq(v->info.rank, 3);
 
     ck_assert_uint_eq(v->plan.id, 7u);
     ck_assert_uint_eq(v->plan.count, 31u);
@@ -191,6 +192,7 @@ START_TEST(test_round_trip_intent_core)
     ck_assert(w->info.step == v->info.step);
     ck_assert(w->info.sigma_horizontal == v->info.sigma_horizontal);
     ck_assert(w->info.sigma_vertical == v->info.sigma_vertical);
+    ck_assert(w->info.rank == v->info.rank);
     ck_assert(w->vehicle.id == v->vehicle.id && w->vehicle.priority == v->vehicle.priority);
     ck_assert(w->vehicle.cruise_speed == v->vehicle.cruise_speed);
     ck_assert(w->vehicle.climb_rate == v->vehicle.climb_rate);
@@ -733,7 +735,7 @@ START_TEST(test_datagram_sizes)
     coavoid_obstacle_map_t map = good_map();
     coavoid_conflict_report_t report = good_report();
     coavoid_status_t status = good_status();
-    ck_assert_int_eq(coavoid_intent_t_encoded_size(&intent), 1389);
+    ck_assert_int_eq(coavoid_intent_t_encoded_size(&intent), 1390);
     ck_assert_int_eq(coavoid_plan_t_encoded_size(&plan), 466);
     ck_assert_int_eq(coavoid_track_t_encoded_size(&track), 720);
     ck_assert_int_eq(coavoid_obstacle_map_t_encoded_size(&map), 1392);
@@ -924,6 +926,9 @@ START_TEST(test_reject_intent)
 
     EXPECT_INTENT(m_.sigma_horizontal = -0.1, COAVOID_LCM_ERR_VALUE, "sigma_horizontal");
     EXPECT_INTENT(m_.sigma_vertical = INFINITY, COAVOID_LCM_ERR_NONFINITE, "sigma_vertical");
+    EXPECT_INTENT(m_.rank = -1, COAVOID_LCM_ERR_VALUE, "rank");
+    EXPECT_INTENT(m_.rank = COAVOID_INTENT_T_MAX_RANK + 1, COAVOID_LCM_ERR_VALUE, "rank");
+    EXPECT_INTENT(m_.rank = COAVOID_INTENT_T_MAX_RANK, COA_OK, "ok");
 }
 END_TEST
 

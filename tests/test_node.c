@@ -17,6 +17,9 @@
  *     no UAV that plans for itself;
  *   - a lower priority waits for the higher, up to its deadline; every member of a
  *     cluster in conflict plans, the highest priority too;
+ *   - priority negotiation: a UAV with no plan below a higher priority raises its rank,
+ *     the other plans around it in the same cycle, or in the next one when the raise
+ *     was lost to it, and the rank returns to 0 after the encounter;
  *   - a silent UAV is avoided as a track;
  *   - the world's track estimates reproduce the scenario's path over the horizon;
  *   - bad configurations are refused.
@@ -30,6 +33,7 @@
 
 #include <lcm/lcm.h>
 
+#include "net.h"
 #include "node.h"
 #include "test_support.h"
 
@@ -1441,6 +1445,179 @@ START_TEST(test_higher_priority_replans_in_cluster)
 }
 END_TEST
 
+/* ---- decoupled: priority negotiation ---- */
+
+/* Decoupled vehicles over the simulation's network (net.h), so that a message can be lost
+ * to one receiver: vehicle i publishes on the network's tx i and listens on its rx i. */
+typedef struct {
+    coavoid_sim_net_t *net;
+    int64_t now;
+    coavoid_node_common_t common;
+    coavoid_vehicle_node_t *v[2];
+} net_rig_t;
+
+static void net_rig_init(net_rig_t *r, const coa_vehicle_t *vehicles)
+{
+    coavoid_sim_net_config_t nc;
+    memset(&nc, 0, sizeof nc);
+    nc.seed = 1;
+    const bool receives[2] = {true, true};
+    int error = -99;
+    r->net = coavoid_sim_net_create(&nc, 2, receives, &error);
+    ck_assert_ptr_nonnull(r->net);
+    r->now = EPOCH;
+    ck_assert_int_eq(coavoid_node_common_defaults(&r->common, EPOCH, (coa_real_t)1, 24, &r->now),
+                     COA_OK);
+    r->common.insecure = true;
+    for (size_t i = 0; i < 2; i++) {
+        coavoid_vehicle_node_config_t config;
+        memset(&config, 0, sizeof config);
+        config.common = r->common;
+        config.common.rx_lcm = coavoid_sim_net_rx(r->net, i);
+        config.vehicle = vehicles[i];
+        config.mode = COAVOID_NODE_DECOUPLED;
+        r->v[i] = coavoid_vehicle_node_create(&config, coavoid_sim_net_tx(r->net, i), &error);
+        ck_assert_ptr_nonnull(r->v[i]);
+    }
+}
+
+static void net_rig_fini(net_rig_t *r)
+{
+    for (size_t i = 0; i < 2; i++) {
+        coavoid_vehicle_node_destroy(r->v[i]);
+    }
+    coavoid_sim_net_destroy(r->net);
+}
+
+/* The rest of a cycle, as coavoid sim runs it: every vehicle polled (a wait ends, or an
+ * overtaken vehicle decides again) until none moves on, then the clock to the next
+ * deadline, until none is left. */
+static void net_rig_settle(net_rig_t *r)
+{
+    for (;;) {
+        bool changed = true;
+        while (changed) {
+            changed = false;
+            for (size_t i = 0; i < 2; i++) {
+                int rc = coavoid_vehicle_node_poll(r->v[i], r->now);
+                ck_assert_int_ge(rc, 0);
+                changed = changed || rc > 0;
+                ck_assert_int_eq(coavoid_sim_net_pump(r->net, r->now), COA_OK);
+            }
+        }
+        int64_t d = coavoid_vehicle_node_deadline(r->v[0]);
+        int64_t d1 = coavoid_vehicle_node_deadline(r->v[1]);
+        d = d1 < d ? d1 : d;
+        if (d == INT64_MAX) {
+            return;
+        }
+        r->now = d;
+    }
+}
+
+/* Cycle k: each vehicle in turn starts it and its messages go out, vehicle `deaf` (0 or
+ * 1; 2: none) hearing nothing the other sends before the rest of the cycle. */
+static void net_rig_cycle(net_rig_t *r, int64_t k, size_t deaf)
+{
+    r->now = cycle(k);
+    for (size_t i = 0; i < 2; i++) {
+        ck_assert_int_eq(coavoid_vehicle_node_cycle(r->v[i], r->now), COA_OK);
+        if (deaf < 2) {
+            coavoid_sim_net_set_loss(r->net, deaf, 1.0);
+        }
+        ck_assert_int_eq(coavoid_sim_net_pump(r->net, r->now), COA_OK);
+        coavoid_sim_net_set_loss(r->net, deaf < 2 ? deaf : 0, 0.0);
+    }
+    net_rig_settle(r);
+}
+
+/* Head-on at one altitude: 1 has priority and may climb; 2 is held to its level
+ * (max_offset 0, an altitude block), so in the configured order, 1 first, 2 has no plan:
+ * 1 keeps its reference, as nothing it must avoid is in its way. */
+static void held_pair(coa_vehicle_t *v, coa_vec3_t *r1, coa_vec3_t *r2)
+{
+    v[0] = uav(1, 1, r1, 0, 600, 0, 100);
+    v[1] = uav(2, 2, r2, 300, -300, 0, 100);
+    v[1].max_offset = 0;
+}
+
+/* Flies cycles 0..40 with vehicle `deaf` hearing nothing from the other in cycle
+ * deaf_cycle, and checks that they stay separated. */
+static void fly_held_pair(net_rig_t *r, size_t deaf, int64_t deaf_cycle)
+{
+    coa_vec3_t p[2][41];
+    for (int64_t k = 0; k <= 40; k++) {
+        net_rig_cycle(r, k, k == deaf_cycle ? deaf : 2u);
+        for (size_t i = 0; i < 2; i++) {
+            p[i][k] = coavoid_vehicle_node_state(r->v[i])->position;
+        }
+    }
+    ck_assert_msg(!flown_conflict(p[0], p[1], 40), "loss of separation");
+}
+
+/* The fixed order has no plan, the reverse has: 2 finds none below 1, raises its rank in
+ * cycle 0 and plans first; 1, overtaken after it decided, decides again in the same
+ * cycle and climbs around 2. Every later cycle 1 waits for 2, which comes first now; once
+ * they have passed, 2's rank returns to 0. */
+START_TEST(test_raise_reorders)
+{
+    coa_vec3_t r1[2], r2[2];
+    coa_vehicle_t v[2];
+    held_pair(v, r1, r2);
+    net_rig_t r;
+    net_rig_init(&r, v);
+    const coavoid_vehicle_node_state_t *sa = coavoid_vehicle_node_state(r.v[0]);
+    const coavoid_vehicle_node_state_t *sb = coavoid_vehicle_node_state(r.v[1]);
+    net_rig_cycle(&r, 0, 2);
+    ck_assert_int_eq(sb->rank, 1);
+    ck_assert_uint_eq(sb->rank_raises, 1);
+    ck_assert_int_eq(sa->rank, 0);
+    /* 1 decided first, before it had heard of 2 (no conflict, no plan); overtaken, it
+     * decided again and planned. */
+    ck_assert_uint_eq(sa->plans_run, 1);
+    ck_assert_uint_eq(sa->plans_adopted, 1);
+    /* Cycle 1: 2's intent of cycle 0 announced its rank, so 1 waits for it. */
+    r.now = cycle(1);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(r.v[0], r.now), COA_OK);
+    ck_assert(sa->waiting);
+    ck_assert_int_eq(coavoid_sim_net_pump(r.net, r.now), COA_OK);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(r.v[1], r.now), COA_OK);
+    ck_assert_int_eq(coavoid_sim_net_pump(r.net, r.now), COA_OK);
+    net_rig_settle(&r);
+    ck_assert(!sa->waiting && sa->published);
+    fly_held_pair(&r, 2, -1);
+    ck_assert_uint_eq(sb->rank_raises, 1);
+    ck_assert_int_eq(sb->rank, 0);
+    ck_assert_int_eq(sa->rank, 0);
+    net_rig_fini(&r);
+}
+END_TEST
+
+/* The raise is lost to the UAV it overtakes: in cycle 0, 1 hears nothing from 2, so it
+ * neither knows 2's rank nor decides again. In cycle 1 it hears 2's next intent, with
+ * the rank (an intent announces it every cycle), decides again and climbs around 2: the
+ * new order comes a cycle late, and they stay separated. */
+START_TEST(test_lost_raise_heard_next_cycle)
+{
+    coa_vec3_t r1[2], r2[2];
+    coa_vehicle_t v[2];
+    held_pair(v, r1, r2);
+    net_rig_t r;
+    net_rig_init(&r, v);
+    const coavoid_vehicle_node_state_t *sa = coavoid_vehicle_node_state(r.v[0]);
+    const coavoid_vehicle_node_state_t *sb = coavoid_vehicle_node_state(r.v[1]);
+    net_rig_cycle(&r, 0, 0);
+    ck_assert_int_eq(sb->rank, 1);
+    ck_assert_uint_eq(sa->plans_run, 0);
+    ck_assert_int_eq(sa->offset, 0);
+    net_rig_cycle(&r, 1, 2);
+    ck_assert_uint_ge(sa->plans_adopted, 1);
+    fly_held_pair(&r, 2, -1);
+    ck_assert_uint_eq(sb->rank_raises, 1);
+    net_rig_fini(&r);
+}
+END_TEST
+
 /* ---- a silent UAV is a track ---- */
 
 START_TEST(test_silent_uav_avoided_as_track)
@@ -2113,6 +2290,8 @@ static Suite *node_suite(void)
     tcase_add_test(tc, test_waits_for_near_higher_priority);
     tcase_add_test(tc, test_wait_ends_at_deadline);
     tcase_add_test(tc, test_higher_priority_replans_in_cluster);
+    tcase_add_test(tc, test_raise_reorders);
+    tcase_add_test(tc, test_lost_raise_heard_next_cycle);
     tcase_add_test(tc, test_silent_uav_avoided_as_track);
     tcase_add_test(tc, test_silent_uav_avoided_along_its_plan);
     tcase_add_test(tc, test_world_track_estimates);

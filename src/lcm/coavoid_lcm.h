@@ -125,6 +125,9 @@ typedef struct {
     coa_real_t step;    /* s */
     coa_real_t sigma_horizontal;
     coa_real_t sigma_vertical;
+    /* The sender's precedence in the decoupled order, 0..COAVOID_INTENT_T_MAX_RANK
+     * (docs/protocol.md, "Priority negotiation"); 0 unless it raised it. */
+    int8_t rank;
 } coavoid_lcm_intent_info_t;
 
 /* The arrays an intent's core view points into (9.7 kB in double): the caller's, so that
@@ -138,8 +141,8 @@ typedef struct {
 /* Every rule of intent_t (its .lcm file): times, id, priority, mode, finite and bounded
  * state, volume and performance, sample count 2..MAX_SAMPLES, reference points that differ
  * horizontally, offsets within |32767| and max_offset whose consecutive changes are
- * actions, and positions that stay finite and bounded once the offsets are applied.
- * Speeds, step, volume and route legs are also judged as the core sees them, in its
+ * actions, positions that stay finite and bounded once the offsets are applied, and a
+ * rank in 0..MAX_RANK. Speeds, step, volume and route legs are also judged as the core sees them, in its
  * precision (coa_vehicle_check, a positive deviation weight and climb step), so every
  * accepted intent gives a vehicle the planner accepts.
  * Returns COA_OK or a COAVOID_LCM_ERR_* with *reason naming the field. Cost O(sample_count). */

@@ -438,6 +438,9 @@ int coavoid_lcm_intent_check(const coavoid_intent_t *msg, const coavoid_lcm_cont
     if ((rc = size_rule(msg->sigma_vertical, false)) != COA_OK) {
         REJECT(rc, "intent: sigma_vertical not in [0, 1e5] m");
     }
+    if (msg->rank < 0 || msg->rank > COAVOID_INTENT_T_MAX_RANK) {
+        REJECT(COAVOID_LCM_ERR_VALUE, "intent: rank not in 0..MAX_RANK");
+    }
     OK_REASON();
     return COA_OK;
 }
@@ -486,6 +489,7 @@ int coavoid_lcm_intent_to_core(const coavoid_intent_t *msg, const coavoid_lcm_co
     info->step = (coa_real_t)msg->step;
     info->sigma_horizontal = plan->sigma_horizontal;
     info->sigma_vertical = plan->sigma_vertical;
+    info->rank = msg->rank;
     OK_REASON();
     return COA_OK;
 }
@@ -529,6 +533,7 @@ int coavoid_lcm_intent_from_core(const coa_vehicle_t *vehicle,
     }
     msg->sigma_horizontal = (double)info->sigma_horizontal;
     msg->sigma_vertical = (double)info->sigma_vertical;
+    msg->rank = info->rank;
     return coavoid_lcm_intent_check(msg, ctx, reason);
 }
 

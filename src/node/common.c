@@ -107,6 +107,13 @@ bool coavoid_node_outranks(uint32_t priority_a, uint16_t id_a, uint32_t priority
     return priority_a < priority_b || (priority_a == priority_b && id_a < id_b);
 }
 
+bool coavoid_node_precedes(int32_t rank_a, uint32_t priority_a, uint16_t id_a, int32_t rank_b,
+                           uint32_t priority_b, uint16_t id_b)
+{
+    return rank_a > rank_b ||
+           (rank_a == rank_b && coavoid_node_outranks(priority_a, id_a, priority_b, id_b));
+}
+
 /* ---- senders ---- */
 
 static void senders_init(coavoid_node_senders_t *s)

@@ -286,6 +286,11 @@ typedef struct {
     uint32_t plans_switched;       /* ... it switched to on a commit (or a sibling's word) */
     uint32_t plans_aborted;        /* ... accepted, then aborted by the coordinator */
     uint32_t plans_in_doubt;       /* ... accepted, and no decision came within the cycle */
+    /* Its precedence in the decoupled order, announced in its intents (0..
+     * COAVOID_INTENT_T_MAX_RANK; docs/protocol.md, "Priority negotiation"), and how many
+     * times it raised it since start. */
+    int32_t rank;
+    uint32_t rank_raises;
     coavoid_lcm_rx_stats_t rx;
 } coavoid_vehicle_node_state_t;
 
@@ -318,10 +323,15 @@ void coavoid_vehicle_node_destroy(coavoid_vehicle_node_t *node);
 int coavoid_vehicle_node_cycle(coavoid_vehicle_node_t *node, int64_t now);
 
 /* Completes a decoupled wait once its condition holds at `now` (the intents arrived, or
- * priority_wait_us has passed since the cycle began). Returns 1 when it planned and
- * published, 0 when there was nothing to do or it still waits, negative on error. Cost
- * while waiting: one prediction (it looks again with the intents that came); then as
- * coavoid_vehicle_node_cycle. No memory. */
+ * priority_wait_us has passed since the cycle began). After a decoupled vehicle has
+ * published, it decides again (and publishes again) when a UAV with a raised rank now
+ * comes before it with an intent of this cycle it did not decide on (docs/protocol.md,
+ * "Priority negotiation"), at most 4 times a cycle: call it whenever messages arrive,
+ * not only while it waits. Returns 1 when it planned and published, 0 when there was
+ * nothing to do or it still waits, negative on error. Cost while waiting: one
+ * prediction (it looks again with the intents that came); then as
+ * coavoid_vehicle_node_cycle; otherwise O(peers^2) to find it has nothing to do. No
+ * memory. */
 int coavoid_vehicle_node_poll(coavoid_vehicle_node_t *node, int64_t now);
 
 /* The utime by which poll must be called again (the end of a wait), or INT64_MAX. O(1). */

@@ -295,6 +295,11 @@ void coavoid_node_view_build(coavoid_node_view_t *view, const coavoid_node_inbox
 /* Whether a outranks b in the decoupled order (ascending priority, ties by ascending id).
  * O(1). */
 bool coavoid_node_outranks(uint32_t priority_a, uint16_t id_a, uint32_t priority_b, uint16_t id_b);
+/* Whether a comes before b in the decoupled order the vehicles negotiate (docs/protocol.md,
+ * "Priority negotiation"): the higher announced rank first, then coavoid_node_outranks.
+ * With every rank 0 it is coavoid_node_outranks, the configured order. O(1). */
+bool coavoid_node_precedes(int32_t rank_a, uint32_t priority_a, uint16_t id_a, int32_t rank_b,
+                           uint32_t priority_b, uint16_t id_b);
 
 /* Fills out with the planner's tracks: every real and stale track of the view and each
  * live UAV i with include[i] (its positions as a path; exactly its samples when the intent

@@ -12,6 +12,20 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* Decided cycles without a conflict of its own after which a raised rank returns to 0
+ * (docs/protocol.md, "Priority negotiation"). */
+#define RANK_HOLD_CYCLES 3u
+/* Decisions again within one cycle after being overtaken (poll), at most: each follows a
+ * raise, and each UAV raises at most RAISES_MAX times an episode, so a cascade through a
+ * cluster ends anyway; the bound keeps a cycle's work bounded whatever peers announce. */
+#define REDECISIONS_MAX 4u
+/* Raises of its rank per episode (raise_rank), at most: the first above every UAV before
+ * it, the others only as far as they must. Over 100 encounters (seed 1, no loss, while
+ * raises counted only the members of its cluster), 1, 2 and 3 left 8, 6 and 5 of the 60
+ * four-UAV encounters some order solves with a loss of separation; with 5 UAVs 3 and 5
+ * left 12 and 11 of 29. More turns help little, and each reorders the cluster again. */
+#define RAISES_MAX 3u
+
 struct coavoid_vehicle_node {
     coavoid_vehicle_node_config_t config;
     coavoid_vehicle_node_state_t state;
@@ -37,6 +51,19 @@ struct coavoid_vehicle_node {
     bool cycle_plan_refused; /* one listed it and was refused (on_plan) */
     bool last_cycle_refused; /* the same, of the cycle before (its heartbeat comes first) */
     bool unanswered;         /* had a conflict of its own in the last cycle and no plan came */
+    /* Priority negotiation (docs/protocol.md): how many times it raised its rank
+     * (state.rank) in this episode, and for how many decided cycles in a row it has had
+     * no conflict. */
+    uint32_t raises;
+    uint32_t calm_cycles;
+    int64_t settled_cycle; /* the cycle whose conflict settle_rank counted */
+    /* The UAVs before it when it last decided in this cycle, with the sequence of the
+     * intent it had of each, and how many times it decided again in redecided_cycle. */
+    size_t decided_count;
+    uint16_t decided_id[COAVOID_NODE_MAX_PEERS];
+    int64_t decided_sequence[COAVOID_NODE_MAX_PEERS];
+    int64_t redecided_cycle;
+    uint32_t redecisions;
     /* The other UAVs' rows in this cycle's solved plans (the latest plan_id each): what
      * each is to fly from this cycle's start, which a plan for this UAV is checked
      * against instead of their intents (record_rows). */
@@ -218,6 +245,7 @@ static int publish_intent(coavoid_vehicle_node_t *node, int64_t now)
     info.step = c->dt;
     info.sigma_horizontal = node->config.sigma_horizontal;
     info.sigma_vertical = node->config.sigma_vertical;
+    info.rank = (int8_t)node->state.rank;
     coavoid_lcm_context_t ctx = coavoid_node_context(&node->inbox, now, node->cycle_start);
     int rc = coavoid_lcm_intent_from_core(&node->config.vehicle, &info, node->own_reference,
                                           node->own_offsets, (size_t)c->horizon + 1u, &ctx,
@@ -324,33 +352,147 @@ static int own_plan_checked(coavoid_vehicle_node_t *node, int64_t now)
     return COA_OK;
 }
 
-/* Plans for itself against obstacles, tracks, stale UAVs and every live UAV that is not a
- * lower-priority member of its cluster (my = its cluster label), and adopts a solved
- * plan. Returns COA_OK (whatever the outcome) or a negative error. */
-static int plan_self(coavoid_vehicle_node_t *node, int64_t now, uint32_t my)
+/* Whether live UAV i of the view comes before this UAV in the decoupled order: i's rank as
+ * its latest intent announces it, its own as it announces it now (coavoid_node_precedes).
+ * Every node orders two UAVs alike once it has both their latest intents. O(1). */
+static bool peer_first(const coavoid_vehicle_node_t *node, size_t i)
 {
     const coa_vehicle_t *self = &node->config.vehicle;
+    const coa_vehicle_t *peer = &node->view.live_vehicle[i];
+    return coavoid_node_precedes(node->view.live_info[i].rank, peer->priority, peer->id,
+                                 node->state.rank, self->priority, self->id);
+}
+
+/* One search in the decoupled order as it stands: against obstacles, tracks, stale UAVs
+ * and every live UAV that is not a later member of its cluster (my = its cluster label).
+ * Returns COA_OK with *result, or a negative error. */
+static int plan_in_order(coavoid_vehicle_node_t *node, int64_t now, uint32_t my,
+                         coa_plan_result_t *result)
+{
     const coavoid_node_view_t *view = &node->view;
     bool lower_outside = false;
     for (size_t i = 0; i < view->live_count; i++) {
-        const coa_vehicle_t *peer = &view->live_vehicle[i];
-        bool lower = coavoid_node_outranks(self->priority, self->id, peer->priority, peer->id);
+        bool lower = !peer_first(node, i);
         node->include[i] = !(lower && node->labels[i + 1u] == my);
         lower_outside = lower_outside || (lower && node->include[i]);
     }
-    coa_plan_result_t result;
-    int rc = search_self(node, now, &result);
-    /* Lower-priority UAVs outside its cluster are kept clear of while that is possible;
-     * when it is not (its way out of a conflict crosses their paths), it plans as
-     * coa_plan_decoupled orders it, around the higher priorities only: the others then
-     * see the conflict and plan around it. */
-    if (rc == COA_OK && result.status != COA_PLAN_SOLVED && lower_outside) {
+    int rc = search_self(node, now, result);
+    /* Later UAVs outside its cluster are kept clear of while that is possible; when it is
+     * not (its way out of a conflict crosses their paths), it plans as
+     * coa_plan_decoupled orders it, around the earlier ones only: the others then see the
+     * conflict and plan around it. */
+    if (rc == COA_OK && result->status != COA_PLAN_SOLVED && lower_outside) {
         for (size_t i = 0; i < view->live_count; i++) {
-            const coa_vehicle_t *peer = &view->live_vehicle[i];
-            node->include[i] =
-                !coavoid_node_outranks(self->priority, self->id, peer->priority, peer->id);
+            node->include[i] = peer_first(node, i);
         }
-        rc = search_self(node, now, &result);
+        rc = search_self(node, now, result);
+    }
+    return rc;
+}
+
+/* The highest rank of the live UAVs before it, -1 when there are none. O(peers). */
+static int32_t top_rank(const coavoid_vehicle_node_t *node)
+{
+    const coavoid_node_view_t *view = &node->view;
+    int32_t top = -1;
+    for (size_t i = 0; i < view->live_count; i++) {
+        if (peer_first(node, i) && view->live_info[i].rank > top) {
+            top = view->live_info[i].rank;
+        }
+    }
+    return top;
+}
+
+/* The next rank above `from` worth trying, for a UAV at rank `old` that found no plan:
+ * each rank of a live UAV before it (where its priority may win the tie) or one above it
+ * (just above that UAV), else `ceiling`. O(peers). */
+static int32_t next_rank(const coavoid_vehicle_node_t *node, int32_t old, int32_t from,
+                         int32_t ceiling)
+{
+    const coa_vehicle_t *self = &node->config.vehicle;
+    const coavoid_node_view_t *view = &node->view;
+    int32_t next = ceiling;
+    for (size_t i = 0; i < view->live_count; i++) {
+        const coa_vehicle_t *peer = &view->live_vehicle[i];
+        const int32_t r = view->live_info[i].rank;
+        if (!coavoid_node_precedes(r, peer->priority, peer->id, old, self->priority, self->id)) {
+            continue;
+        }
+        next = r > from && r < next ? r : next;
+        next = r + 1 > from && r + 1 < next ? r + 1 : next;
+    }
+    return next;
+}
+
+/* After a search found no plan below the UAVs that come before it (those of its cluster,
+ * and those outside it its search avoided, which may be what blocks it: a track's
+ * conflict makes a cluster of one): it raises its rank to the lowest that gives it a plan
+ * (trying each rank next_rank offers, upwards), or else to one above all of them, where
+ * it plans against only what stays before it (others must then avoid it: it cannot
+ * avoid them). At most MAX_RANK,
+ * and at most RAISES_MAX times an episode (until its rank is back to 0), so that UAVs
+ * that each fail below another cannot take turns for ever. *result is the last search.
+ * Returns COA_OK or a negative error. Cost: at most 2 * peers + 1 plan_in_order. */
+static int raise_rank(coavoid_vehicle_node_t *node, int64_t now, uint32_t my,
+                      coa_plan_result_t *result)
+{
+    const int32_t old = node->state.rank;
+    const int32_t top = top_rank(node);
+    const int32_t ceiling = top < 0 ? -1 : (top < COAVOID_INTENT_T_MAX_RANK ? top + 1 : top);
+    if (node->raises >= RAISES_MAX || ceiling <= old) {
+        return COA_OK;
+    }
+    int rc = COA_OK;
+    /* The first raise of an episode goes above them all, as coa_plan_decoupled's
+     * reordering first moves a failing UAV to the front; the ranks it leaves apart let a
+     * later raise stop between two members. */
+    int32_t r = node->raises == 0u ? ceiling - 1 : old;
+    do {
+        r = next_rank(node, old, r, ceiling);
+        node->state.rank = r;
+        rc = plan_in_order(node, now, my, result);
+    } while (rc == COA_OK && result->status != COA_PLAN_SOLVED && r < ceiling);
+    node->state.rank_raises++;
+    node->raises++;
+    node->calm_cycles = 0;
+    return rc;
+}
+
+/* A raised rank returns to 0 once it has had no conflict of its own (conflict false) for
+ * RANK_HOLD_CYCLES decided cycles in a row: the encounter it was raised for is over, and
+ * the configured order holds again. O(1). */
+static void settle_rank(coavoid_vehicle_node_t *node, bool conflict)
+{
+    if (node->settled_cycle == node->state.cycle) {
+        return; /* decided again in the same cycle (poll): counted once */
+    }
+    node->settled_cycle = node->state.cycle;
+    node->calm_cycles = conflict ? 0u : node->calm_cycles + 1u;
+    if (node->state.rank != 0 && node->calm_cycles >= RANK_HOLD_CYCLES) {
+        node->state.rank = 0;
+        node->raises = 0;
+    }
+}
+
+/* While it follows the coordinator, which plans in its own order, it claims no
+ * precedence among the decoupled UAVs: its rank returns to 0 at once. O(1). */
+static void drop_rank(coavoid_vehicle_node_t *node)
+{
+    node->state.rank = 0;
+    node->raises = 0;
+    node->calm_cycles = 0;
+}
+
+/* Plans for itself in the decoupled order (plan_in_order); when it finds no plan there, it
+ * raises its rank and, if it did, plans again at once, now against only the UAVs still
+ * before it; adopts a solved plan. Returns COA_OK (whatever the outcome) or a negative
+ * error. */
+static int plan_self(coavoid_vehicle_node_t *node, int64_t now, uint32_t my)
+{
+    coa_plan_result_t result;
+    int rc = plan_in_order(node, now, my, &result);
+    if (rc == COA_OK && result.status != COA_PLAN_SOLVED) {
+        rc = raise_rank(node, now, my, &result);
     }
     if (rc == COA_OK && result.status == COA_PLAN_SOLVED) {
         rc = own_plan_checked(node, now);
@@ -427,25 +569,23 @@ static int missed_conflict(coavoid_vehicle_node_t *node, int64_t now, bool *conf
     return COA_OK;
 }
 
-/* Whether a higher-priority UAV that may still publish this cycle's intent passes near it
- * horizontally within the horizon. A UAV changes only its altitude, so such a UAV is the
- * only one whose new plan can bring a conflict it does not see yet: it waits for those
- * (until the deadline), as it would wait in a cluster. Without this it would decide on
- * their previous intents and react a cycle late, which the simulation, where the intents
- * of higher priorities happen to arrive first, would never show. The test is the
+/* Whether a UAV before it in the decoupled order (peer_first: ranks, then priorities) that
+ * may still publish this cycle's intent passes near it horizontally within the horizon. A
+ * UAV changes only its altitude, so such a UAV is the only one whose new plan can bring a
+ * conflict it does not see yet: it waits for those (until the deadline), as it would wait
+ * in a cluster. Without this it would decide on their previous intents and react a cycle
+ * late, which the simulation, where the intents of higher priorities happen to arrive
+ * first, would never show. The test is the
  * predictor's own, with every volume made as tall as a message allows, so that only the
  * horizontal distance (and its uncertainty) decides. Cost: one coa_predict over the live
  * UAVs, no obstacles or tracks. */
 static bool near_pending(coavoid_vehicle_node_t *node, size_t n)
 {
     const coavoid_node_common_t *c = &node->config.common;
-    const coa_vehicle_t *self = &node->config.vehicle;
     const coavoid_node_view_t *view = &node->view;
     bool any = false;
     for (size_t i = 0; i < view->live_count; i++) {
-        const coa_vehicle_t *peer = &view->live_vehicle[i];
-        if (!view->live_current[i] &&
-            coavoid_node_outranks(peer->priority, peer->id, self->priority, self->id)) {
+        if (!view->live_current[i] && peer_first(node, i)) {
             any = true;
         }
     }
@@ -471,27 +611,67 @@ static bool near_pending(coavoid_vehicle_node_t *node, size_t n)
             break;
         }
         size_t i = cf->b - 1u;
-        const coa_vehicle_t *peer = &view->live_vehicle[i];
-        if (!view->live_current[i] &&
-            coavoid_node_outranks(peer->priority, peer->id, self->priority, self->id)) {
+        if (!view->live_current[i] && peer_first(node, i)) {
             return true;
         }
     }
     return result.overflow && result.conflict_count == 0u;
 }
 
-/* The decoupled step: predict with what it has; publish at once without a conflict;
- * otherwise wait for the higher-priority members of its cluster (until the deadline),
- * then plan and publish. Returns 1 when it published, 0 while it waits, or an error. */
-static int decide(coavoid_vehicle_node_t *node, int64_t now)
+/* Remembers which live UAVs come before it as it decides, and the sequence of the intent
+ * it has of each (overtaken). O(peers). */
+static void note_order(coavoid_vehicle_node_t *node)
+{
+    const coavoid_node_view_t *view = &node->view;
+    node->decided_count = 0;
+    for (size_t i = 0; i < view->live_count; i++) {
+        if (peer_first(node, i)) {
+            node->decided_id[node->decided_count] = view->live_id[i];
+            node->decided_sequence[node->decided_count] = view->live_info[i].sequence;
+            node->decided_count++;
+        }
+    }
+}
+
+/* Whether, since it decided in this cycle, a UAV with a raised rank that comes before it
+ * now published an intent of this cycle it did not decide on: one that raised its rank
+ * above it after it decided, or one before it that planned again. Only raised ranks
+ * count, so that with every rank 0 a UAV decides once per cycle, as before priority
+ * negotiation. O(peers^2). */
+static bool overtaken(const coavoid_vehicle_node_t *node)
 {
     const coa_vehicle_t *self = &node->config.vehicle;
+    for (size_t i = 0; i < COAVOID_NODE_MAX_PEERS; i++) {
+        const coavoid_intent_t *m = &node->inbox.peers[i].msg;
+        if (!node->inbox.peers[i].used || m->plan_utime != node->cycle_start || m->rank <= 0 ||
+            !coavoid_node_precedes(m->rank, (uint32_t)m->priority, (uint16_t)m->uav_id,
+                                   node->state.rank, self->priority, self->id)) {
+            continue;
+        }
+        size_t j = 0;
+        while (j < node->decided_count && node->decided_id[j] != (uint16_t)m->uav_id) {
+            j++;
+        }
+        if (j == node->decided_count || node->decided_sequence[j] < m->sequence) {
+            return true;
+        }
+    }
+    return false;
+}
+
+/* The decoupled step: predict with what it has; publish at once without a conflict;
+ * otherwise wait for the members of its cluster before it in the decoupled order (until
+ * the deadline), then plan (raising its rank if it must) and publish. Returns 1 when it
+ * published, 0 while it waits, or an error. */
+static int decide(coavoid_vehicle_node_t *node, int64_t now)
+{
     const coavoid_node_view_t *view = &node->view;
     const size_t n = gather(node, now);
     if (now < node->wait_deadline && near_pending(node, n)) {
         node->state.waiting = true;
         return 0;
     }
+    note_order(node);
     coa_predict_result_t result;
     int rc = predict(node, n, &result);
     if (rc != COA_OK) {
@@ -501,14 +681,13 @@ static int decide(coavoid_vehicle_node_t *node, int64_t now)
     }
     const uint32_t my = node->labels[0];
     node->cycle_conflict = my != COA_NO_CLUSTER;
+    settle_rank(node, node->cycle_conflict);
     if (my == COA_NO_CLUSTER) {
         return finish(node, now);
     }
     bool pending = false;
     for (size_t i = 0; i < view->live_count; i++) {
-        const coa_vehicle_t *peer = &view->live_vehicle[i];
-        if (node->labels[i + 1u] == my && !view->live_current[i] &&
-            coavoid_node_outranks(peer->priority, peer->id, self->priority, self->id)) {
+        if (node->labels[i + 1u] == my && !view->live_current[i] && peer_first(node, i)) {
             pending = true;
         }
     }
@@ -516,7 +695,7 @@ static int decide(coavoid_vehicle_node_t *node, int64_t now)
         node->state.waiting = true;
         return 0;
     }
-    /* Every member of a cluster in conflict plans, in priority order, as
+    /* Every member of a cluster in conflict plans, in the decoupled order, as
      * coa_plan_decoupled orders it, even one whose only conflicts are with lower
      * priorities: ignoring them, it plans around what it must avoid and returns towards
      * its reference where it can. Holding an old offset instead can leave a lower
@@ -528,6 +707,28 @@ static int decide(coavoid_vehicle_node_t *node, int64_t now)
         return published < 0 ? published : rc;
     }
     return finish(node, now);
+}
+
+/* After it published this cycle's intent on its own decision: when it has been overtaken
+ * (overtaken()), it decides again at once, waiting as before (until the cycle's priority
+ * wait ends) and publishing its intent again, at most REDECISIONS_MAX times a cycle, so
+ * that a raise reorders its cluster within the cycle it is made in rather than the next.
+ * Returns as decide, 0 when there is nothing to do. */
+static int reconsider(coavoid_vehicle_node_t *node, int64_t now)
+{
+    if (!node->started || node->state.coordinated || !node->state.published) {
+        return 0;
+    }
+    if (node->redecided_cycle != node->state.cycle) {
+        node->redecided_cycle = node->state.cycle;
+        node->redecisions = 0;
+    }
+    if (node->redecisions >= REDECISIONS_MAX || !overtaken(node)) {
+        return 0;
+    }
+    node->redecisions++;
+    node->wait_deadline = node->cycle_start + node->config.priority_wait_us;
+    return decide(node, now);
 }
 
 static void reject(coavoid_vehicle_node_t *node, int code, const char *reason)
@@ -908,6 +1109,8 @@ coavoid_vehicle_node_t *coavoid_vehicle_node_create(const coavoid_vehicle_node_c
     node->plan_count = 1;
     node->plan_offsets[0] = node->config.vehicle.initial_offset;
     node->state.cycle = -1;
+    node->settled_cycle = -1;
+    node->redecided_cycle = -1;
     node->state.offset = node->config.vehicle.initial_offset;
     node->state.last_outcome = -1;
     node->wait_deadline = INT64_MAX;
@@ -1045,6 +1248,7 @@ int coavoid_vehicle_node_cycle(coavoid_vehicle_node_t *node, int64_t now)
 
     int rc;
     if (coordinated) {
+        drop_rank(node);
         rc = finish(node, now);
     } else {
         node->wait_deadline = node->cycle_start + node->config.priority_wait_us;
@@ -1085,7 +1289,8 @@ int coavoid_vehicle_node_poll(coavoid_vehicle_node_t *node, int64_t now)
     }
     int sent = send_copies(node, now);
     if (!node->state.waiting) {
-        return sent;
+        int again = reconsider(node, now);
+        return again == 0 ? sent : again;
     }
     int rc = decide(node, now);
     return rc == 0 ? sent : rc;

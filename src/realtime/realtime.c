@@ -481,12 +481,10 @@ static int rt_wait_messages(const rt_run_t *r, rt_sched_t *sc, int fd, int64_t w
     if (rc < 0) {
         return rc;
     }
-    /* A message may be the intent a waiting vehicle needed. */
+    /* A message may be the intent a waiting vehicle needed, or a raised rank that
+     * overtakes a vehicle that already decided (it decides again: node.h, poll). */
     for (size_t i = 0; i < loop->vehicle_count; i++) {
-        const coavoid_vehicle_node_state_t *s = coavoid_vehicle_node_state(loop->vehicles[i]);
-        if (s != NULL && s->waiting) {
-            rt_poll(r, i, &sc->polled[i]);
-        }
+        rt_poll(r, i, &sc->polled[i]);
     }
     return COA_OK;
 }
