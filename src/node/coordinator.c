@@ -521,7 +521,9 @@ static int on_agreement(void *owner, const coavoid_agreement_t *msg)
         a->accepted |= bit;
     }
     if (a->state == AGREEMENT_PROPOSED && a->accepted == all_members(a)) {
-        (void)agreement_decide(node, now, a, AGREEMENT_COMMITTED);
+        a->next_send = now; /* committed by the poll that follows at once: the coordinator
+                               publishes from its own calls only, never from inside a
+                               message handler, so that its messages follow its calls */
     }
     return COA_OK;
 }
@@ -694,6 +696,10 @@ static int agreement_step(coavoid_coordinator_t *node, int64_t now, size_t index
 {
     coordinator_agreement_t *a = &node->agreements[index];
     const int64_t resend = node->config.resend_us;
+    if (a->state == AGREEMENT_PROPOSED && a->accepted == all_members(a)) {
+        int rc = agreement_decide(node, now, a, AGREEMENT_COMMITTED);
+        return rc != COA_OK ? rc : 1;
+    }
     if (a->state == AGREEMENT_PROPOSED && (now >= a->deadline || a->refused != 0u)) {
         int rc = agreement_decide(node, now, a, AGREEMENT_ABORTED);
         int replanned = replan_accepted(node, now, index);

@@ -404,7 +404,8 @@ void coavoid_coordinator_destroy(coavoid_coordinator_t *node);
  * more over larger groups. No memory is allocated. */
 int coavoid_coordinator_cycle(coavoid_coordinator_t *node, int64_t now);
 /* The agreement steps due at `now` (docs/protocol.md): a proposal whose accepts are all in
- * is committed as soon as the last arrives (in the message handler); here, a proposal
+ * is committed (the last accept makes the deadline now: the coordinator publishes from
+ * its calls only, never inside a message handler); a proposal
  * past its ack deadline, or refused, is aborted and its accepting UAVs planned again
  * when the cycle leaves time; unanswered proposals and commits are sent again every
  * resend_us. Call it when coavoid_coordinator_deadline says. Returns 1 when it published,
