@@ -63,6 +63,19 @@ static void drain(lcm_t *lcm)
     }
 }
 
+/* The coordinator's cycle at `now` and the agreement it leads (docs/protocol.md): its
+ * plans, the UAVs' answers, and every poll that is then due, each answer delivered, until
+ * nothing more is due at `now` (a commit included). */
+static void coordinate(lcm_t *lcm, coavoid_coordinator_t *co, int64_t now)
+{
+    ck_assert_int_eq(coavoid_coordinator_cycle(co, now), COA_OK);
+    drain(lcm);
+    while (coavoid_coordinator_deadline(co) <= now) {
+        ck_assert_int_ge(coavoid_coordinator_poll(co, now), 0);
+        drain(lcm);
+    }
+}
+
 static int64_t cycle(int64_t k)
 {
     return EPOCH + k * DT_US;
@@ -869,8 +882,7 @@ START_TEST(test_refusals_degrade_health)
         drain(r.lcm);
         ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
         drain(r.lcm);
-        ck_assert_int_eq(coavoid_coordinator_cycle(co, r.now + DT_US / 4), COA_OK);
-        drain(r.lcm);
+        coordinate(r.lcm, co, r.now + DT_US / 4);
         const int8_t want =
             k == 0 || k == 3 ? COAVOID_STATUS_T_HEALTH_OK : COAVOID_STATUS_T_HEALTH_DEGRADED;
         ck_assert_msg(pa.health == want, "cycle %d: vehicle health %d", (int)k, pa.health);
@@ -1188,8 +1200,7 @@ START_TEST(test_coordinator_skips_decoupled_uav)
     ck_assert_int_eq(coavoid_vehicle_node_cycle(b, r.now), COA_OK);
     drain(r.lcm);
     r.now = cycle(0) + DT_US / 4;
-    ck_assert_int_eq(coavoid_coordinator_cycle(co, r.now), COA_OK);
-    drain(r.lcm);
+    coordinate(r.lcm, co, r.now);
     ck_assert_int_eq(probe.plans, 1);
     ck_assert_int_eq(probe.rows, 1);
     ck_assert_int_eq(probe.ids[0], 2);
@@ -1245,8 +1256,7 @@ START_TEST(test_coordinator_abandons_past_budget)
         if (k == 0) {
             heartbeat(r.lcm, r.now, 0);
             r.now = cycle(0) + DT_US / 4;
-            ck_assert_int_eq(coavoid_coordinator_cycle(co, r.now), COA_OK);
-            drain(r.lcm);
+            coordinate(r.lcm, co, r.now);
             ck_assert_int_eq(probe.plans, 1);
             ck_assert_int_eq(probe.status, COAVOID_PLAN_T_STATUS_ABANDONED);
             ck_assert_int_eq(probe.rows, 2);
@@ -1845,8 +1855,7 @@ START_TEST(test_every_datagram_fits)
             drain(r.lcm);
         }
         r.now = cycle(k) + DT_US / 4;
-        ck_assert_int_eq(coavoid_coordinator_cycle(co, r.now), COA_OK);
-        drain(r.lcm);
+        coordinate(r.lcm, co, r.now);
     }
     ck_assert_int_le(probe.largest, COAVOID_LCM_MAX_DATAGRAM_BYTES);
     ck_assert_int_eq(probe.count[3], 3 * 16); /* 16 tiles a cycle */
