@@ -37,6 +37,9 @@ typedef struct {
     lcm_t *rx; /* NULL: it receives nothing */
     lcm_subscription_t *heard;
     bool stopped;
+    bool limited; /* coavoid_sim_net_stop_after: only `allowance` more go out */
+    uint64_t allowance;
+    uint64_t sent; /* its messages that went out */
     double loss;
 } net_node_t;
 
@@ -153,6 +156,13 @@ static void on_sent(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
 {
     net_node_t *from = user;
     coavoid_sim_net_t *net = from->net;
+    /* A cut link: the message never leaves the node, and nothing is drawn for it. */
+    if (from->limited && from->allowance == 0u) {
+        net->stats.cut++;
+        return;
+    }
+    from->allowance -= from->limited ? 1u : 0u;
+    from->sent++;
     net->stats.sent++;
     if (from->rx != NULL && !from->stopped) {
         hand(net, from->index, channel, rbuf->data, rbuf->data_size);
@@ -272,6 +282,22 @@ void coavoid_sim_net_set_loss(coavoid_sim_net_t *net, size_t i, double loss)
 void coavoid_sim_net_stop(coavoid_sim_net_t *net, size_t i)
 {
     net->nodes[i].stopped = true;
+}
+
+void coavoid_sim_net_stop_after(coavoid_sim_net_t *net, size_t i, uint64_t count)
+{
+    net->nodes[i].limited = true;
+    net->nodes[i].allowance = count;
+}
+
+bool coavoid_sim_net_cut(const coavoid_sim_net_t *net, size_t i)
+{
+    return net->nodes[i].limited && net->nodes[i].allowance == 0u;
+}
+
+uint64_t coavoid_sim_net_sent_by(const coavoid_sim_net_t *net, size_t i)
+{
+    return net->nodes[i].sent;
 }
 
 void coavoid_sim_net_destroy(coavoid_sim_net_t *net)
