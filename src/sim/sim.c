@@ -55,6 +55,8 @@ typedef struct {
     uint32_t coordinator_beta;
     size_t max_centralised;
     uint32_t coordinator_plans; /* plans the coordinator ran, when it stopped or at the end */
+    uint64_t coordinator_sent;  /* its messages out at the start of the cycle (config's record) */
+    uint32_t stop_cycle_sent;   /* --coordinator-stops: its messages out in the cycle it stopped */
     /* What the run holds (sim_run_free releases it). */
     coavoid_sim_net_t *net;
     int net_error; /* the network's first error (coavoid_sim_net_pump) */
@@ -419,10 +421,25 @@ static int check_message_limits(coavoid_run_error_t *err, const char *file,
 
 /* Hands the nodes what they published and what is due by now. false when the network
  * failed (r->net_error says how). */
+/* --coordinator-stops: once the network has cut the coordinator's link (sim_stop_cycle),
+ * it is gone; checked after every pump, so that it makes no further call whichever of its
+ * calls published its last message. */
+static void sim_stop_if_cut(sim_run_t *r)
+{
+    if (r->coordinator == NULL || !coavoid_sim_net_cut(r->net, SIM_NET_COORDINATOR)) {
+        return;
+    }
+    r->coordinator_plans = coavoid_coordinator_state(r->coordinator)->plans_run;
+    coavoid_coordinator_destroy(r->coordinator);
+    r->coordinator = NULL;
+    coavoid_sim_net_stop(r->net, SIM_NET_COORDINATOR);
+}
+
 static bool drain(sim_run_t *r)
 {
     int rc = coavoid_sim_net_pump(r->net, r->now);
     r->net_error = r->net_error != COA_OK ? r->net_error : rc;
+    sim_stop_if_cut(r);
     return rc == COA_OK;
 }
 
@@ -808,6 +825,36 @@ static bool sim_waits(sim_run_t *r, int64_t until, int *node_error)
     }
 }
 
+/* The coordinator's messages of the cycle that ends now (config's record). */
+static void sim_count_coordinator(sim_run_t *r, uint32_t ended)
+{
+    const uint64_t sent = coavoid_sim_net_sent_by(r->net, SIM_NET_COORDINATOR);
+    const uint32_t count = (uint32_t)(sent - r->coordinator_sent);
+    if (r->o->coordinator_messages != NULL && ended < r->o->coordinator_messages_size) {
+        r->o->coordinator_messages[ended] = count;
+    }
+    if (r->o->has_stop && ended == r->o->stop_step) {
+        r->stop_cycle_sent = count;
+    }
+    r->coordinator_sent = sent;
+}
+
+/* At cycle k's start: the last cycle's count; then, from cycle STEP of --coordinator-stops
+ * STEP[:M], the coordinator's link is cut after M more messages (after none past STEP:
+ * it is gone by the next cycle whatever it sent), and it is gone once it is cut. */
+static void sim_stop_cycle(sim_run_t *r, uint32_t k)
+{
+    if (k > 0u) {
+        sim_count_coordinator(r, k - 1u);
+    }
+    if (r->coordinator == NULL || !r->o->has_stop || k < r->o->stop_step) {
+        return;
+    }
+    coavoid_sim_net_stop_after(r->net, SIM_NET_COORDINATOR,
+                               k == r->o->stop_step ? r->o->stop_messages : 0u);
+    sim_stop_if_cut(r);
+}
+
 /* Cycle k of the loop of node.h: what the network still carries up to its start, then
  * the world, the UAVs in priority order, their waits, then the coordinator at cycle start
  * + collect; each message reaches its receivers when the network says (at once, with
@@ -816,12 +863,7 @@ static bool sim_cycle(sim_run_t *r, uint32_t k, int *node_error)
 {
     const int64_t cycle_start = coavoid_node_cycle_utime(&r->common, (int64_t)k);
     bool lcm_ok = k == 0u || sim_waits(r, cycle_start, node_error);
-    if (r->coordinator != NULL && r->o->has_stop && k == r->o->stop_step) {
-        r->coordinator_plans = coavoid_coordinator_state(r->coordinator)->plans_run;
-        coavoid_coordinator_destroy(r->coordinator);
-        r->coordinator = NULL;
-        coavoid_sim_net_stop(r->net, SIM_NET_COORDINATOR);
-    }
+    sim_stop_cycle(r, k);
     r->now = cycle_start;
     int rc = coavoid_world_cycle(r->world, r->now);
     *node_error = *node_error != COA_OK ? *node_error : rc;
@@ -856,6 +898,7 @@ static int sim_fly(sim_run_t *r)
     for (uint32_t k = 0; k <= r->steps && lcm_ok; k++) {
         lcm_ok = sim_cycle(r, k, &node_error);
     }
+    sim_count_coordinator(r, r->steps);
     if (r->coordinator != NULL) {
         r->coordinator_plans = coavoid_coordinator_state(r->coordinator)->plans_run;
     }
@@ -900,17 +943,25 @@ static int sim_write(const sim_run_t *r, uint32_t fallbacks)
     const coavoid_flight_eval_t *eval = &r->judged.eval;
     char network[512];
     network_text(r, o->json, network, sizeof network);
+    const unsigned long cut = (unsigned long)coavoid_sim_net_stats(r->net).cut;
     int rc = COA_OK;
     if (o->json) {
         char fallbacks_text[16];
-        char stopped_text[16];
+        char stopped_text[16], after_text[16], sent_text[16], cut_text[24];
         snprintf(fallbacks_text, sizeof fallbacks_text, "%lu", (unsigned long)fallbacks);
         snprintf(stopped_text, sizeof stopped_text, "%lu", (unsigned long)o->stop_step);
-        coavoid_flight_extra_t extra[3] = {
-            {"fallbacks", fallbacks_text}, {NULL, NULL}, {NULL, NULL}};
+        snprintf(after_text, sizeof after_text, "%lu", (unsigned long)o->stop_messages);
+        snprintf(sent_text, sizeof sent_text, "%lu", (unsigned long)r->stop_cycle_sent);
+        snprintf(cut_text, sizeof cut_text, "%lu", cut);
+        coavoid_flight_extra_t extra[6] = {{"fallbacks", fallbacks_text}};
         size_t count = 1u;
         if (o->has_stop) {
             extra[count++] = (coavoid_flight_extra_t){"coordinator_stopped_at", stopped_text};
+        }
+        if (o->has_stop && o->has_stop_messages) {
+            extra[count++] = (coavoid_flight_extra_t){"coordinator_stopped_after", after_text};
+            extra[count++] = (coavoid_flight_extra_t){"coordinator_messages_sent", sent_text};
+            extra[count++] = (coavoid_flight_extra_t){"coordinator_messages_cut", cut_text};
         }
         if (o->network) {
             extra[count++] = (coavoid_flight_extra_t){"network", network};
@@ -919,9 +970,18 @@ static int sim_write(const sim_run_t *r, uint32_t fallbacks)
     } else {
         rc = coavoid_flight_text(flight, eval, r->out);
         if (rc == COA_OK && (fprintf(r->out, "fallbacks: %lu\n", (unsigned long)fallbacks) < 0 ||
-                             (o->network && fputs(network, r->out) < 0) || fflush(r->out) != 0)) {
+                             (o->network && fputs(network, r->out) < 0))) {
             rc = COA_ERR_WORKSPACE;
         }
+        if (rc == COA_OK && o->has_stop && o->has_stop_messages &&
+            fprintf(r->out,
+                    "coordinator: stopped in cycle %lu after %lu of its messages (%lu went out "
+                    "in it, %lu more were cut)\n",
+                    (unsigned long)o->stop_step, (unsigned long)o->stop_messages,
+                    (unsigned long)r->stop_cycle_sent, cut) < 0) {
+            rc = COA_ERR_WORKSPACE;
+        }
+        rc = rc == COA_OK && fflush(r->out) != 0 ? COA_ERR_WORKSPACE : rc;
     }
     return rc;
 }

@@ -6,7 +6,7 @@
 # by a whole number of climb steps that change by actions; planning runs where there is a
 # conflict; the flown costs are at least the one-shot plan's; a run is repeatable byte for
 # byte; the UAVs fall back to planning for themselves when the coordinator stops, and stay
-# separated; a scenario already in conflict reports its loss (exit 1) instead of crashing;
+# separated; the coordinator cut after M messages of a cycle (STEP:M); a scenario already in conflict reports its loss (exit 1) instead of crashing;
 # UAVs decide in priority order whatever their ids; the simulated network (--loss, --delay,
 # --jitter, --seed) and montecarlo's closed loop (--fly) over it; bad arguments and inputs, and numbers
 # beyond what a message carries anywhere in the run, exit 2 with one line.
@@ -328,6 +328,55 @@ p, q = at(v[1], 35.0), at(v[3], 35.0)
 sys.exit(0 if math.hypot(p[0] - q[0], p[1] - q[1]) < 30 and abs(p[2] - q[2]) < 10 else 1)
 PY
 
+# --coordinator-stops STEP:M, the coordinator cut after M of its messages of cycle STEP
+# (whatever they are). STEP:0 is STEP (plus the count's keys). Head-on's cycle 0 is the
+# conflict report, the plan's two rows, the heartbeat: cut after the rows, the UAVs fly
+# the coordinator's plan (500 m^2, 18) though it is gone before its heartbeat; cut after
+# the report, they fall back and plan for themselves (580 m^2, 20, as when it stops at 0).
+# The paper's cycle 0 has 8 messages (report, 1 + 2 + 3 plan rows, heartbeat).
+"$bin" sim "$scenarios/headon.json" --mode centralised --json --coordinator-stops 0 >"$tmp/stop0.json" 2>&1
+"$bin" sim "$scenarios/headon.json" --mode centralised --json --coordinator-stops 0:0 >"$tmp/stop00.json" 2>&1
+if python3 - "$tmp/stop0.json" "$tmp/stop00.json" <<'PY'; then pass; else fail "--coordinator-stops 0:0 is not --coordinator-stops 0"; fi
+import json, sys
+a, b = (json.load(open(f)) for f in sys.argv[1:3])
+extra = {k: b.pop(k) for k in ("coordinator_stopped_after", "coordinator_messages_sent",
+                               "coordinator_messages_cut")}
+assert a == b and extra == {"coordinator_stopped_after": 0, "coordinator_messages_sent": 0,
+                            "coordinator_messages_cut": 0}, extra
+PY
+sim_json headon-cut3 "$scenarios/headon.json" centralised 0 '
+r["loss_of_separation"] is False
+(r["deviation"], r["effort"]) == (500, 18)
+r["coordinator_stopped_at"] == 0 and r["coordinator_stopped_after"] == 3
+r["coordinator_messages_sent"] == 3 and r["coordinator_messages_cut"] == 1
+r["fallbacks"] == 2
+' --coordinator-stops 0:3
+sim_json headon-cut1 "$scenarios/headon.json" centralised 0 '
+r["loss_of_separation"] is False
+(r["deviation"], r["effort"]) == (580, 20)
+r["coordinator_messages_sent"] == 1 and r["coordinator_messages_cut"] == 3
+' --coordinator-stops 0:1
+sim_json paper-cut-all "$scenarios/paper.json" centralised 0 '
+r["coordinator_messages_sent"] == 8 and r["coordinator_messages_cut"] == 0
+' --coordinator-stops 0:8
+sim_json paper-cut-beyond "$scenarios/paper.json" centralised 0 '
+r["coordinator_stopped_after"] == 20 and r["coordinator_messages_sent"] == 8
+' --coordinator-stops 0:20
+# With loss the cut is the same mechanism (the network's): a run repeats byte for byte.
+for run in 1 2; do
+    "$bin" sim "$scenarios/paper.json" --mode centralised --coordinator-stops 0:4 --loss 0.3 \
+        --delay 0.2 --seed 5 >"$tmp/cut-loss$run.txt" 2>&1
+done
+if grep -Eq '^coordinator: stopped in cycle 0 after 4 of its messages \(4 went out in it, [0-9]+ more were cut\)$' "$tmp/cut-loss1.txt" \
+    && grep -q '^network: ' "$tmp/cut-loss1.txt" && cmp -s "$tmp/cut-loss1.txt" "$tmp/cut-loss2.txt"; then
+    pass
+else
+    fail "sim --coordinator-stops 0:4 with loss: $(tail -n 2 "$tmp/cut-loss1.txt")"
+fi
+# Without :M the text is as before the cut existed: no coordinator line.
+"$bin" sim "$scenarios/headon.json" --mode centralised --coordinator-stops 0 >"$tmp/stop0.txt" 2>&1
+if ! grep -q '^coordinator:' "$tmp/stop0.txt"; then pass; else fail "--coordinator-stops 0 prints a coordinator line"; fi
+
 # A joint search that runs out of beta is not the end: the coordinator plans the cluster
 # decoupled instead. Head-on's joint search stores more than 20 nodes, while decoupled
 # plans store none, so with beta 20 the one-shot centralised plan gives up and the loop
@@ -411,6 +460,9 @@ expect_bad "svg unwritable" "--svg" sim "$h" --mode decoupled --svg "$tmp/no/suc
 expect_bad "stop decoupled" "--coordinator-stops" sim "$h" --mode decoupled --coordinator-stops 1
 expect_bad "stop after K" "--coordinator-stops" sim "$h" --mode centralised --steps 4 --coordinator-stops 5
 expect_bad "stop word" "--coordinator-stops" sim "$h" --mode centralised --coordinator-stops soon
+for bad in 1:x :1 1: 1:2:3 1:-1 -1:0 1:1000001 "1 :2"; do
+    expect_bad "stop $bad" "--coordinator-stops" sim "$h" --mode centralised --coordinator-stops "$bad"
+done
 expect_bad "unknown option" "--fast" sim "$h" --mode decoupled --fast
 expect_bad "two scenarios" "unexpected argument" sim "$h" "$h" --mode decoupled
 expect_bad "missing file" "no-such.json" sim "$tmp/no-such.json" --mode decoupled
