@@ -19,56 +19,65 @@
 #define MC_DEFAULT_COUNT 100u
 #define MC_MAX_COUNT 100000u
 
-#define MONTECARLO_USAGE                                                                    \
-    "usage: coavoid montecarlo --vehicles N[,N...] [--count C] [--seed S] [--beta B]\n"     \
-    "                          [--max-orders M] [--csv FILE] [--svg FILE] [--json]\n"       \
-    "                          [--save DIR] [--jobs J] [--quiet]\n"                         \
-    "                          [--fly [--loss P] [--delay S] [--jitter S]]\n"               \
-    "\n"                                                                                    \
-    "Draws C random encounters of N UAVs (for each N listed) converging on a point over\n"  \
-    "hills, with 0 to 2 non-cooperative tracks crossing (%u steps of %g s), and solves\n"   \
-    "each one centralised, decoupled in the fixed priority order and decoupled with\n"      \
-    "reordering. Prints per N and method the outcomes, the success rate with its 95%%\n"    \
-    "Wilson interval, the distribution of the decoupled/centralised deviation ratio\n"      \
-    "over the encounters both solve, and the planning times (a text summary, or a JSON\n"   \
-    "object with --json). See docs/evaluation.md.\n"                                        \
-    "\n"                                                                                    \
-    "options:\n"                                                                            \
-    "  --vehicles N,...  UAVs per encounter, each %u..%u, e.g. 2,3,4 (required)\n"          \
-    "  --count C         encounters per N, 1..%u; default %u\n"                             \
-    "  --seed S          the encounters' random seed, an integer >= 0; default %u\n"        \
-    "  --beta B          closed-set bound, B >= 1, for every search; default %u, lowered\n" \
-    "                    per N where the centralised workspace would pass 1 GiB\n"          \
-    "  --max-orders M    reordering: at most M priority orders, M >= 1; default N!\n"       \
-    "                    (every order)\n"                                                   \
-    "  --csv FILE        one row per encounter and method (times in time_us)\n"             \
-    "  --svg FILE        success rates and the ratio's cumulative distribution\n"           \
-    "  --save DIR        write each encounter as DIR/montecarlo-SEED-N-INDEX.json (an\n"    \
-    "                    existing directory), for `coavoid plan` to replay\n"               \
-    "  --json            print the summary as a JSON object\n"                              \
-    "  --jobs J          worker threads, 1..%u; default 1; results do not depend on it\n"   \
-    "  --quiet           no progress on stderr (otherwise: a line updated every second\n"   \
-    "                    on a terminal, a line every 10%% when stderr is not one)\n"        \
-    "  --fly             also fly each encounter in closed loop, centralised and\n"         \
-    "                    decoupled, by the nodes of `coavoid sim` (insecure: nothing\n"     \
-    "                    else is on its bus) over a simulated network, and report\n"        \
-    "                    per N and mode the loss-of-separation rate, also over the\n"       \
-    "                    encounters the one-shot centralised plan, or some priority\n"      \
-    "                    order, solves\n"                                                   \
-    "  --loss P          with --fly: each message reaches each other node with\n"           \
-    "                    probability 1 - P (0 <= P < 1); default 0\n"                       \
-    "  --delay S         with --fly: ... after S seconds; default 0\n"                      \
-    "  --jitter S        with --fly: ... plus a uniform time in [0, S] seconds; default\n"  \
-    "                    0; delay + jitter must be under dt. The network's random\n"        \
-    "                    stream comes from --seed and the encounter\n"                      \
-    "  -h, --help        show this help\n"                                                  \
-    "\n"                                                                                    \
-    "A seed gives the same encounters and results on every machine with the same C\n"       \
-    "maths library (headings use cos and sin), except the times.\n"                         \
-    "\n"                                                                                    \
-    "exit status: 0 done (whatever the plans' outcomes), 2 invalid usage (one line on\n"    \
-    "stderr naming the option and why), 3 internal error or a defect of the planner (a\n"   \
-    "decoupled plan cheaper than the optimal centralised one or where it proved none, a\n"  \
+#define MONTECARLO_USAGE                                                                     \
+    "usage: coavoid montecarlo --vehicles N[,N...] [--count C] [--seed S] [--beta B]\n"      \
+    "                          [--max-orders M] [--csv FILE] [--svg FILE] [--json]\n"        \
+    "                          [--save DIR] [--jobs J] [--quiet]\n"                          \
+    "                          [--fly [--loss P] [--delay S] [--jitter S] [--net-seed N]\n"  \
+    "                                 [--coordinator-stops-sweep all|ends]]\n"               \
+    "\n"                                                                                     \
+    "Draws C random encounters of N UAVs (for each N listed) converging on a point over\n"   \
+    "hills, with 0 to 2 non-cooperative tracks crossing (%u steps of %g s), and solves\n"    \
+    "each one centralised, decoupled in the fixed priority order and decoupled with\n"       \
+    "reordering. Prints per N and method the outcomes, the success rate with its 95%%\n"     \
+    "Wilson interval, the distribution of the decoupled/centralised deviation ratio\n"       \
+    "over the encounters both solve, and the planning times (a text summary, or a JSON\n"    \
+    "object with --json). See docs/evaluation.md.\n"                                         \
+    "\n"                                                                                     \
+    "options:\n"                                                                             \
+    "  --vehicles N,...  UAVs per encounter, each %u..%u, e.g. 2,3,4 (required)\n"           \
+    "  --count C         encounters per N, 1..%u; default %u\n"                              \
+    "  --seed S          the encounters' random seed, an integer >= 0; default %u\n"         \
+    "  --beta B          closed-set bound, B >= 1, for every search; default %u, lowered\n"  \
+    "                    per N where the centralised workspace would pass 1 GiB\n"           \
+    "  --max-orders M    reordering: at most M priority orders, M >= 1; default N!\n"        \
+    "                    (every order)\n"                                                    \
+    "  --csv FILE        one row per encounter and method (times in time_us)\n"              \
+    "  --svg FILE        success rates and the ratio's cumulative distribution\n"            \
+    "  --save DIR        write each encounter as DIR/montecarlo-SEED-N-INDEX.json (an\n"     \
+    "                    existing directory), for `coavoid plan` to replay\n"                \
+    "  --json            print the summary as a JSON object\n"                               \
+    "  --jobs J          worker threads, 1..%u; default 1; results do not depend on it\n"    \
+    "  --quiet           no progress on stderr (otherwise: a line updated every second\n"    \
+    "                    on a terminal, a line every 10%% when stderr is not one)\n"         \
+    "  --fly             also fly each encounter in closed loop, centralised and\n"          \
+    "                    decoupled, by the nodes of `coavoid sim` (insecure: nothing\n"      \
+    "                    else is on its bus) over a simulated network, and report\n"         \
+    "                    per N and mode the loss-of-separation rate, also over the\n"        \
+    "                    encounters the one-shot centralised plan, or some priority\n"       \
+    "                    order, solves\n"                                                    \
+    "  --loss P          with --fly: each message reaches each other node with\n"            \
+    "                    probability 1 - P (0 <= P < 1); default 0\n"                        \
+    "  --delay S         with --fly: ... after S seconds; default 0\n"                       \
+    "  --jitter S        with --fly: ... plus a uniform time in [0, S] seconds; default\n"   \
+    "                    0; delay + jitter must be under dt. The network's random\n"         \
+    "                    stream comes from --net-seed and the encounter\n"                   \
+    "  --net-seed N      with --fly: the network's seed, an integer >= 0, apart from the\n"  \
+    "                    encounters' --seed; default: --seed (as before the option)\n"       \
+    "  --coordinator-stops-sweep all|ends\n"                                                 \
+    "                    with --fly: also fly each encounter centralised with the\n"         \
+    "                    coordinator stopped at every cycle and, in it, after each number\n" \
+    "                    of its messages it sent there unstopped (all), or after 0, 1,\n"    \
+    "                    half and all but one of them (ends); report the runs that lose\n"   \
+    "                    separation, and those where decoupled keeps it (issue 14)\n"        \
+    "  -h, --help        show this help\n"                                                   \
+    "\n"                                                                                     \
+    "A seed gives the same encounters and results on every machine with the same C\n"        \
+    "maths library (headings use cos and sin), except the times.\n"                          \
+    "\n"                                                                                     \
+    "exit status: 0 done (whatever the plans' outcomes), 2 invalid usage (one line on\n"     \
+    "stderr naming the option and why), 3 internal error or a defect of the planner (a\n"    \
+    "decoupled plan cheaper than the optimal centralised one or where it proved none, a\n"   \
     "solved plan in conflict or with no deviation: one line each on stderr)\n"
 
 static void montecarlo_help(void)
@@ -101,6 +110,9 @@ typedef struct {
     bool quiet;
     bool fly;
     coavoid_cli_network_t network;
+    const char *net_seed_text;
+    uint64_t net_seed;
+    const char *sweep_text; /* --coordinator-stops-sweep: all or ends */
 } mc_options_t;
 
 /* "2,3,4": each 2..6, each once. */
@@ -182,6 +194,18 @@ static int mc_option(int argc, char **argv, int *i, void *options)
         status = coavoid_cli_flag_option(arg, "--quiet", &o->quiet);
     } else if (coavoid_cli_option_is(arg, "--fly")) {
         status = coavoid_cli_flag_option(arg, "--fly", &o->fly);
+    } else if (coavoid_cli_option_is(arg, "--net-seed")) {
+        status = coavoid_cli_count_option(argc, argv, i, "--net-seed", NULL, true, UINT64_MAX,
+                                          &o->net_seed_text, &o->net_seed);
+    } else if (coavoid_cli_option_is(arg, "--coordinator-stops-sweep")) {
+        status = coavoid_cli_text_option(argc, argv, i, "--coordinator-stops-sweep", "all or ends",
+                                         false, &o->sweep_text);
+        if (status == CLI_CONTINUE && strcmp(o->sweep_text, "all") != 0 &&
+            strcmp(o->sweep_text, "ends") != 0) {
+            status = coavoid_cli_fail(CLI_EXIT_INVALID,
+                                      "--coordinator-stops-sweep: must be all or ends, got '%.40s'",
+                                      o->sweep_text);
+        }
     }
     return status;
 }
@@ -212,6 +236,11 @@ static int parse_mc_options(int argc, char **argv, mc_options_t *o)
                                 o->network.loss_text != NULL    ? "--loss"
                                 : o->network.delay_text != NULL ? "--delay"
                                                                 : "--jitter");
+    }
+    if ((o->net_seed_text != NULL || o->sweep_text != NULL) && !o->fly) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: only with --fly (the closed loop)",
+                                o->net_seed_text != NULL ? "--net-seed"
+                                                         : "--coordinator-stops-sweep");
     }
     if (o->network.delay + o->network.jitter >= coavoid_encounter_montecarlo.dt) {
         return coavoid_cli_fail(CLI_EXIT_INVALID,
@@ -261,6 +290,10 @@ static coavoid_montecarlo_config_t mc_engine_config(const mc_options_t *o)
     c.loss = o->network.loss;
     c.delay = o->network.delay;
     c.jitter = o->network.jitter;
+    c.has_net_seed = o->net_seed_text != NULL;
+    c.net_seed = o->net_seed;
+    c.stops_sweep = o->sweep_text != NULL;
+    c.stops_ends = c.stops_sweep && strcmp(o->sweep_text, "ends") == 0;
     return c;
 }
 

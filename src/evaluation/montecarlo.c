@@ -424,9 +424,29 @@ static void cost_text(coa_cost_t c, char *buf, size_t size)
 #define MC_CSV_HEADER                                                             \
     "seed,vehicles,index,redraws,hills,tracks,first_conflict_step,method,status," \
     "deviation,deviation_units,effort,expanded,generated,orders_tried,time_us\n"
+#define MC_CSV_HEADER_FLY                                                         \
+    "seed,vehicles,index,redraws,hills,tracks,first_conflict_step,method,status," \
+    "deviation,deviation_units,effort,expanded,generated,orders_tried,time_us,"   \
+    "loss,delay,jitter,net_seed\n"
 
-static void csv_rows(FILE *f, uint64_t seed, const coavoid_mc_result_t *r)
+/* With fly, every row ends with the network (loss, delay, jitter) and the encounter's
+ * network seed: a file says what it measured (montecarlo --figure-from reads the loss),
+ * and `coavoid sim --seed` replays a run. Without, the rows are as before fly existed. */
+static void csv_network(const coavoid_montecarlo_config_t *c, const coavoid_mc_result_t *r,
+                        char *buf, size_t size)
 {
+    buf[0] = '\0';
+    if (c->fly) {
+        snprintf(buf, size, ",%.15g,%.15g,%.15g,%llu", c->loss, c->delay, c->jitter,
+                 (unsigned long long)r->net_seed);
+    }
+}
+
+static void csv_rows(FILE *f, const coavoid_montecarlo_config_t *c, const coavoid_mc_result_t *r)
+{
+    const uint64_t seed = c->seed;
+    char network[128];
+    csv_network(c, r, network, sizeof network);
     for (int m = 0; m < COAVOID_MC_METHODS; m++) {
         const coavoid_mc_outcome_t *o = &r->m[m];
         /* Costs only of a plan: a failed decoupled attempt's partial costs are not one. */
@@ -437,26 +457,36 @@ static void csv_rows(FILE *f, uint64_t seed, const coavoid_mc_result_t *r)
             snprintf(costs, sizeof costs, "%.6f,%s,%lu", o->deviation, units,
                      (unsigned long)o->effort);
         }
-        fprintf(f, "%llu,%lu,%lu,%lu,%lu,%lu,%lu,%s,%s,%s,%llu,%llu,%lu,%.1f\n",
+        fprintf(f, "%llu,%lu,%lu,%lu,%lu,%lu,%lu,%s,%s,%s,%llu,%llu,%lu,%.1f%s\n",
                 (unsigned long long)seed, (unsigned long)r->vehicles, (unsigned long)r->index,
                 (unsigned long)r->redraws, (unsigned long)r->info.hills,
                 (unsigned long)r->info.tracks, (unsigned long)r->first_conflict_step,
                 coavoid_mc_method_names[m], coavoid_output_status_name(o->status), costs,
                 (unsigned long long)o->expanded, (unsigned long long)o->generated,
-                (unsigned long)o->orders_tried, o->time_us);
+                (unsigned long)o->orders_tried, o->time_us, network);
     }
 }
 
 /* With fly: a row per closed-loop mode, method flown_MODE, status separated or
- * loss_of_separation (the plan's columns empty). */
-static void csv_flown_rows(FILE *f, uint64_t seed, const coavoid_mc_result_t *r)
+ * loss_of_separation (the plan's columns empty); with the sweep, a row
+ * flown_centralised_stops, loss_of_separation when any stopped run lost it. */
+static void csv_flown_rows(FILE *f, const coavoid_montecarlo_config_t *c,
+                           const coavoid_mc_result_t *r)
 {
-    for (int mode = 0; mode < COAVOID_MC_FLY_MODES; mode++) {
-        fprintf(f, "%llu,%lu,%lu,%lu,%lu,%lu,%lu,flown_%s,%s,,,,,,,\n", (unsigned long long)seed,
-                (unsigned long)r->vehicles, (unsigned long)r->index, (unsigned long)r->redraws,
-                (unsigned long)r->info.hills, (unsigned long)r->info.tracks,
-                (unsigned long)r->first_conflict_step, coavoid_mc_fly_mode_names[mode],
-                r->flown[mode].loss_of_separation ? "loss_of_separation" : "separated");
+    char network[128];
+    csv_network(c, r, network, sizeof network);
+    for (int mode = 0; mode <= COAVOID_MC_FLY_MODES; mode++) {
+        if (mode == COAVOID_MC_FLY_MODES && !c->stops_sweep) {
+            break;
+        }
+        const bool lost =
+            mode < COAVOID_MC_FLY_MODES ? r->flown[mode].loss_of_separation : r->sweep.losses > 0u;
+        fprintf(f, "%llu,%lu,%lu,%lu,%lu,%lu,%lu,flown_%s,%s,,,,,,,%s\n",
+                (unsigned long long)c->seed, (unsigned long)r->vehicles, (unsigned long)r->index,
+                (unsigned long)r->redraws, (unsigned long)r->info.hills,
+                (unsigned long)r->info.tracks, (unsigned long)r->first_conflict_step,
+                mode < COAVOID_MC_FLY_MODES ? coavoid_mc_fly_mode_names[mode] : "centralised_stops",
+                lost ? "loss_of_separation" : "separated", network);
     }
 }
 
@@ -503,10 +533,10 @@ static void write_ready(mc_run_t *run, FILE *csv, mc_progress_t *prog, uint32_t 
     for (; *written < ready; (*written)++) {
         const coavoid_mc_result_t *r = &run->mc->results[*written];
         if (csv != NULL) {
-            csv_rows(csv, c->seed, r);
+            csv_rows(csv, c, r);
         }
         if (csv != NULL && c->fly) {
-            csv_flown_rows(csv, c->seed, r);
+            csv_flown_rows(csv, c, r);
         }
         if (r->defect[0] != '\0') {
             if (prog->line_open) {
@@ -604,6 +634,10 @@ static int check_config(const coavoid_montecarlo_config_t *c, coavoid_run_error_
                                 "--loss, --delay, --jitter: a loss from 0 to below 1, and a "
                                 "delay plus jitter (s, each >= 0) under the encounters' dt of %g s",
                                 dt);
+    }
+    if (!c->fly && (c->stops_sweep || c->has_net_seed)) {
+        return coavoid_run_fail(e, COAVOID_RUN_ERR_INPUT, "%s: only with --fly (the closed loop)",
+                                c->stops_sweep ? "--coordinator-stops-sweep" : "--net-seed");
     }
 #ifndef COAVOID_HAVE_LCM
     if (c->fly) {
@@ -735,7 +769,8 @@ int coavoid_montecarlo_run(const coavoid_montecarlo_config_t *config, coavoid_mo
             coavoid_run_fail(e, COAVOID_RUN_ERR_INPUT, "--count: out of memory for %lu encounters",
                              (unsigned long)total);
     }
-    if (status == COAVOID_RUN_DONE && csv != NULL && fputs(MC_CSV_HEADER, csv) < 0) {
+    if (status == COAVOID_RUN_DONE && csv != NULL &&
+        fputs(config->fly ? MC_CSV_HEADER_FLY : MC_CSV_HEADER, csv) < 0) {
         status = coavoid_run_fail(e, COAVOID_RUN_ERR_INTERNAL, "--csv: cannot write '%.200s'",
                                   config->csv);
     }

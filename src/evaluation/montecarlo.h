@@ -85,6 +85,21 @@ typedef struct {
      * encounters that the one-shot centralised plan, or some priority order, solves. */
     bool fly;
     double loss, delay, jitter;
+    /* The network's seed (fly): each encounter's stream is drawn from (net_seed, UAV
+     * count, index), so that one set of encounters can meet other networks; has_net_seed
+     * false: from seed, as before there was a choice (the same numbers). */
+    bool has_net_seed;
+    uint64_t net_seed;
+    /* With fly, issue 14 item 4: each encounter is also flown centralised with the
+     * coordinator stopped at every cycle s = 0..2N and, in each, at every cut point
+     * M = 0..C(s)-1 (C(s): the messages it sent in cycle s of the unstopped run; the run
+     * is that run up to the cut, so these are all the places it can stop; M = C(s) is
+     * s+1:0), or with stops_ends only M = 0, 1, C(s)/2 and C(s)-1; a cycle it sent nothing
+     * in, M = 0 (sim.h, stop_step and stop_messages). The same network seed as the other
+     * runs. The report counts the runs that lose separation, and those in encounters the
+     * decoupled closed loop keeps separated. */
+    bool stops_sweep;
+    bool stops_ends;
 } coavoid_montecarlo_config_t;
 
 /* The encounters of a run and their outcomes; opaque. */

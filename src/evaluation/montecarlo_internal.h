@@ -40,6 +40,13 @@ typedef struct {
     uint64_t sent, delivered, dropped;
 } coavoid_mc_flown_t;
 
+/* An encounter's coordinator-stop sweep (config stops_sweep). */
+typedef struct {
+    uint32_t runs, losses; /* stopped runs, and those that lost separation */
+    /* The first stop point (cycle, messages) that lost separation, when losses > 0. */
+    uint32_t loss_step, loss_messages;
+} coavoid_mc_sweep_t;
+
 typedef struct {
     uint32_t vehicles, index;
     uint32_t redraws;
@@ -47,7 +54,9 @@ typedef struct {
     uint32_t first_conflict_step;
     coavoid_mc_outcome_t m[COAVOID_MC_METHODS];
     coavoid_mc_flown_t flown[COAVOID_MC_FLY_MODES]; /* with fly */
-    char defect[256];                               /* empty unless a check failed */
+    uint64_t net_seed; /* with fly: its runs' network seed (coavoid sim --seed replays them) */
+    coavoid_mc_sweep_t sweep; /* with stops_sweep */
+    char defect[256];         /* empty unless a check failed */
 } coavoid_mc_result_t;
 
 /* A UAV count and the planners' limits for it. */
