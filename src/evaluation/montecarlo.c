@@ -427,17 +427,18 @@ static void cost_text(coa_cost_t c, char *buf, size_t size)
 #define MC_CSV_HEADER_FLY                                                         \
     "seed,vehicles,index,redraws,hills,tracks,first_conflict_step,method,status," \
     "deviation,deviation_units,effort,expanded,generated,orders_tried,time_us,"   \
-    "loss,delay,jitter,net_seed\n"
+    "loss,delay,jitter,net_seed,stop_step,stop_messages\n"
 
-/* With fly, every row ends with the network (loss, delay, jitter) and the encounter's
- * network seed: a file says what it measured (montecarlo --figure-from reads the loss),
- * and `coavoid sim --seed` replays a run. Without, the rows are as before fly existed. */
+/* With fly, every row ends with the network (loss, delay, jitter), the encounter's
+ * network seed and the stop point (empty but on flown_centralised_stop rows): a file says
+ * what it measured (montecarlo --figure-from reads the loss), and `coavoid sim --seed
+ * --coordinator-stops` replays a run. Without fly the rows are as before fly existed. */
 static void csv_network(const coavoid_montecarlo_config_t *c, const coavoid_mc_result_t *r,
                         char *buf, size_t size)
 {
     buf[0] = '\0';
     if (c->fly) {
-        snprintf(buf, size, ",%.15g,%.15g,%.15g,%llu", c->loss, c->delay, c->jitter,
+        snprintf(buf, size, "%.15g,%.15g,%.15g,%llu", c->loss, c->delay, c->jitter,
                  (unsigned long long)r->net_seed);
     }
 }
@@ -445,8 +446,12 @@ static void csv_network(const coavoid_montecarlo_config_t *c, const coavoid_mc_r
 static void csv_rows(FILE *f, const coavoid_montecarlo_config_t *c, const coavoid_mc_result_t *r)
 {
     const uint64_t seed = c->seed;
-    char network[128];
-    csv_network(c, r, network, sizeof network);
+    char network[128] = "";
+    if (c->fly) {
+        network[0] = ',';
+        csv_network(c, r, network + 1, sizeof network - 4u);
+        strcat(network, ",,");
+    }
     for (int m = 0; m < COAVOID_MC_METHODS; m++) {
         const coavoid_mc_outcome_t *o = &r->m[m];
         /* Costs only of a plan: a failed decoupled attempt's partial costs are not one. */
@@ -467,26 +472,44 @@ static void csv_rows(FILE *f, const coavoid_montecarlo_config_t *c, const coavoi
     }
 }
 
-/* With fly: a row per closed-loop mode, method flown_MODE, status separated or
- * loss_of_separation (the plan's columns empty); with the sweep, a row
- * flown_centralised_stops, loss_of_separation when any stopped run lost it. */
+/* A closed-loop row: method flown_NAME, status separated or loss_of_separation, the
+ * plan's columns empty, the network's, and the stop point's (stop: "S,M", or ","). */
+static void csv_flown_row(FILE *f, const coavoid_montecarlo_config_t *c,
+                          const coavoid_mc_result_t *r, const char *name, bool lost,
+                          const char *network, const char *stop)
+{
+    fprintf(f, "%llu,%lu,%lu,%lu,%lu,%lu,%lu,flown_%s,%s,,,,,,,,%s,%s\n",
+            (unsigned long long)c->seed, (unsigned long)r->vehicles, (unsigned long)r->index,
+            (unsigned long)r->redraws, (unsigned long)r->info.hills, (unsigned long)r->info.tracks,
+            (unsigned long)r->first_conflict_step, name, lost ? "loss_of_separation" : "separated",
+            network, stop);
+}
+
+/* With fly: a row per closed-loop mode; with the sweep, a row flown_centralised_stop per
+ * stop point (stop_step, stop_messages: `coavoid sim --coordinator-stops S:M`). */
 static void csv_flown_rows(FILE *f, const coavoid_montecarlo_config_t *c,
                            const coavoid_mc_result_t *r)
 {
     char network[128];
     csv_network(c, r, network, sizeof network);
-    for (int mode = 0; mode <= COAVOID_MC_FLY_MODES; mode++) {
-        if (mode == COAVOID_MC_FLY_MODES && !c->stops_sweep) {
-            break;
+    for (int mode = 0; mode < COAVOID_MC_FLY_MODES; mode++) {
+        csv_flown_row(f, c, r, coavoid_mc_fly_mode_names[mode], r->flown[mode].loss_of_separation,
+                      network, ",");
+    }
+    const coavoid_mc_sweep_t *w = &r->sweep;
+    uint32_t j = 0;
+    for (uint32_t k = 0; c->stops_sweep && k < w->cycles; k++) {
+        const uint32_t points = w->sent[k] > 0u ? w->sent[k] : 1u;
+        for (uint32_t m = 0; m < points && j < w->runs; m++) {
+            if (!coavoid_mc_stop_flown(m, w->sent[k], c->stops_ends)) {
+                continue;
+            }
+            char stop[32];
+            snprintf(stop, sizeof stop, "%lu,%lu", (unsigned long)k, (unsigned long)m);
+            csv_flown_row(f, c, r, "centralised_stop", (w->lost[j / 8u] >> (j % 8u)) & 1u, network,
+                          stop);
+            j++;
         }
-        const bool lost =
-            mode < COAVOID_MC_FLY_MODES ? r->flown[mode].loss_of_separation : r->sweep.losses > 0u;
-        fprintf(f, "%llu,%lu,%lu,%lu,%lu,%lu,%lu,flown_%s,%s,,,,,,,%s\n",
-                (unsigned long long)c->seed, (unsigned long)r->vehicles, (unsigned long)r->index,
-                (unsigned long)r->redraws, (unsigned long)r->info.hills,
-                (unsigned long)r->info.tracks, (unsigned long)r->first_conflict_step,
-                mode < COAVOID_MC_FLY_MODES ? coavoid_mc_fly_mode_names[mode] : "centralised_stops",
-                lost ? "loss_of_separation" : "separated", network);
     }
 }
 

@@ -40,12 +40,29 @@ typedef struct {
     uint64_t sent, delivered, dropped;
 } coavoid_mc_flown_t;
 
+/* The cycles a closed-loop run may fly (2N + 1 of the design), and the stop points of a
+ * sweep, at most: far more than the design's 25 cycles of at most a few dozen messages. */
+#define COAVOID_MC_MAX_CYCLES 64u
+#define COAVOID_MC_MAX_STOPS 4096u
+
 /* An encounter's coordinator-stop sweep (config stops_sweep). */
 typedef struct {
     uint32_t runs, losses; /* stopped runs, and those that lost separation */
     /* The first stop point (cycle, messages) that lost separation, when losses > 0. */
     uint32_t loss_step, loss_messages;
+    uint32_t cycles;                        /* cycles of the unstopped centralised run */
+    uint16_t sent[COAVOID_MC_MAX_CYCLES];   /* its messages in each */
+    uint8_t lost[COAVOID_MC_MAX_STOPS / 8]; /* bit j: stop point j (coavoid_mc_stop_flown) lost */
 } coavoid_mc_sweep_t;
+
+/* Whether the sweep flies cut point m of a cycle in which the coordinator sent `sent`
+ * messages unstopped (m < sent, or m = 0 when it sent none): every one, or with ends only
+ * the first two, the middle and the last. Stop points are numbered in order of cycle,
+ * then m, over the flown ones. */
+static inline bool coavoid_mc_stop_flown(uint32_t m, uint32_t sent, bool ends)
+{
+    return !ends || m <= 1u || m == sent / 2u || m + 1u == sent;
+}
 
 typedef struct {
     uint32_t vehicles, index;

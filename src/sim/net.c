@@ -40,6 +40,8 @@ typedef struct {
     bool limited; /* coavoid_sim_net_stop_after: only `allowance` more go out */
     uint64_t allowance;
     uint64_t sent; /* its messages that went out */
+    coavoid_sim_net_tap_t tap;
+    void *tap_user;
     double loss;
 } net_node_t;
 
@@ -57,7 +59,20 @@ struct coavoid_sim_net {
     size_t heap_count;
     uint64_t order;
     coavoid_sim_net_stats_t stats;
+    uint64_t digest;
 };
+
+#define NET_FNV_OFFSET UINT64_C(14695981039346656037)
+#define NET_FNV_PRIME UINT64_C(1099511628211)
+
+static uint64_t fnv(uint64_t h, const void *data, size_t size)
+{
+    const uint8_t *b = data;
+    for (size_t k = 0; k < size; k++) {
+        h = (h ^ b[k]) * NET_FNV_PRIME;
+    }
+    return h;
+}
 
 /* Uniform in [0, 1), from the seeded stream (prng.h: the same for a seed everywhere). */
 static double net_uniform(coavoid_sim_net_t *net)
@@ -164,6 +179,13 @@ static void on_sent(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
     from->allowance -= from->limited ? 1u : 0u;
     from->sent++;
     net->stats.sent++;
+    const uint32_t sender = (uint32_t)from->index;
+    net->digest = fnv(net->digest, &sender, sizeof sender);
+    net->digest = fnv(net->digest, channel, strlen(channel) + 1u);
+    net->digest = fnv(net->digest, rbuf->data, rbuf->data_size);
+    if (from->tap != NULL) {
+        from->tap(from->tap_user, channel, rbuf->data, rbuf->data_size);
+    }
     if (from->rx != NULL && !from->stopped) {
         hand(net, from->index, channel, rbuf->data, rbuf->data_size);
     }
@@ -300,6 +322,17 @@ uint64_t coavoid_sim_net_sent_by(const coavoid_sim_net_t *net, size_t i)
     return net->nodes[i].sent;
 }
 
+void coavoid_sim_net_tap(coavoid_sim_net_t *net, size_t i, coavoid_sim_net_tap_t tap, void *user)
+{
+    net->nodes[i].tap = tap;
+    net->nodes[i].tap_user = user;
+}
+
+uint64_t coavoid_sim_net_digest(const coavoid_sim_net_t *net)
+{
+    return net->digest;
+}
+
 void coavoid_sim_net_destroy(coavoid_sim_net_t *net)
 {
     if (net == NULL) {
@@ -362,6 +395,7 @@ coavoid_sim_net_t *coavoid_sim_net_create(const coavoid_sim_net_config_t *config
     }
     net->config = *config;
     net->prng.state = config->seed;
+    net->digest = NET_FNV_OFFSET;
     net->error = COA_OK;
     net->nodes = calloc(nodes, sizeof *net->nodes);
     const size_t m = config->message_capacity, c = config->copy_capacity;

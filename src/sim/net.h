@@ -81,6 +81,16 @@ bool coavoid_sim_net_cut(const coavoid_sim_net_t *net, size_t i);
 /* Messages node i published that went out (the cut ones not). O(1). */
 uint64_t coavoid_sim_net_sent_by(const coavoid_sim_net_t *net, size_t i);
 
+/* Node i's tap: tap(user, channel, data, size) sees every message of node i that goes out,
+ * as it goes out (NULL: none). O(1). */
+typedef void (*coavoid_sim_net_tap_t)(void *user, const char *channel, const void *data,
+                                      uint32_t size);
+void coavoid_sim_net_tap(coavoid_sim_net_t *net, size_t i, coavoid_sim_net_tap_t tap, void *user);
+/* A digest (64-bit FNV-1a) of every message that went out so far, sender, channel and
+ * bytes, in order: two runs of the same nodes whose digests differ have sent different
+ * things (a replay checks that it still is the run it replays). O(1). */
+uint64_t coavoid_sim_net_digest(const coavoid_sim_net_t *net);
+
 /* At `now` (the nodes' clock, which must not go back between calls): takes every
  * message the nodes published since the last call (each sent at `now`), makes its copies,
  * hands the receivers every copy due at or before now, and lets their handlers run, until

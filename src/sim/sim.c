@@ -57,6 +57,8 @@ typedef struct {
     uint32_t coordinator_plans; /* plans the coordinator ran, when it stopped or at the end */
     uint64_t coordinator_sent;  /* its messages out at the start of the cycle (config's record) */
     uint32_t stop_cycle_sent;   /* --coordinator-stops: its messages out in the cycle it stopped */
+    bool replaying;             /* config's tape replayed in the coordinator's place */
+    size_t coordinator_calls;   /* its calls so far, recorded or replayed */
     /* What the run holds (sim_run_free releases it). */
     coavoid_sim_net_t *net;
     int net_error; /* the network's first error (coavoid_sim_net_pump) */
@@ -426,12 +428,16 @@ static int check_message_limits(coavoid_run_error_t *err, const char *file,
  * calls published its last message. */
 static void sim_stop_if_cut(sim_run_t *r)
 {
-    if (r->coordinator == NULL || !coavoid_sim_net_cut(r->net, SIM_NET_COORDINATOR)) {
+    if ((r->coordinator == NULL && !r->replaying) ||
+        !coavoid_sim_net_cut(r->net, SIM_NET_COORDINATOR)) {
         return;
     }
-    r->coordinator_plans = coavoid_coordinator_state(r->coordinator)->plans_run;
+    if (r->coordinator != NULL) {
+        r->coordinator_plans = coavoid_coordinator_state(r->coordinator)->plans_run;
+    }
     coavoid_coordinator_destroy(r->coordinator);
     r->coordinator = NULL;
+    r->replaying = false;
     coavoid_sim_net_stop(r->net, SIM_NET_COORDINATOR);
 }
 
@@ -769,6 +775,17 @@ static int sim_coordinator(sim_run_t *r)
                                 "%s: dt: %g s leaves the coordinator no time within a cycle",
                                 r->file, (double)r->s->dt);
     }
+    if (r->o->tape != NULL && r->o->replay) {
+        /* Replayed (sim_coordinator_cycle): the node itself is never needed. */
+        r->replaying = r->o->has_stop;
+        return r->replaying ? SIM_GO_ON
+                            : coavoid_run_fail(r->err, COAVOID_RUN_ERR_INTERNAL,
+                                               "internal error: a replay without a stop");
+    }
+    if (r->o->tape != NULL) {
+        coavoid_sim_tape_clear(r->o->tape);
+        coavoid_sim_net_tap(r->net, SIM_NET_COORDINATOR, coavoid_sim_tape_message, r->o->tape);
+    }
     config.common.rx_lcm = coavoid_sim_net_rx(r->net, SIM_NET_COORDINATOR);
     r->coordinator = coavoid_coordinator_create(
         &config, coavoid_sim_net_tx(r->net, SIM_NET_COORDINATOR), &error);
@@ -847,12 +864,33 @@ static void sim_stop_cycle(sim_run_t *r, uint32_t k)
     if (k > 0u) {
         sim_count_coordinator(r, k - 1u);
     }
-    if (r->coordinator == NULL || !r->o->has_stop || k < r->o->stop_step) {
+    if ((r->coordinator == NULL && !r->replaying) || !r->o->has_stop || k < r->o->stop_step) {
         return;
     }
     coavoid_sim_net_stop_after(r->net, SIM_NET_COORDINATOR,
                                k == r->o->stop_step ? r->o->stop_messages : 0u);
     sim_stop_if_cut(r);
+}
+
+/* The coordinator's cycle, or with a tape (config's) recorded or replayed: its messages
+ * of the call as the tape has them. */
+static int sim_coordinator_cycle(sim_run_t *r)
+{
+    const coavoid_sim_config_t *o = r->o;
+    const uint64_t digest = coavoid_sim_net_digest(r->net);
+    if (r->replaying) {
+        return coavoid_sim_tape_play(o->tape, r->coordinator_calls++, digest,
+                                     coavoid_sim_net_tx(r->net, SIM_NET_COORDINATOR),
+                                     &r->coordinator_plans);
+    }
+    if (o->tape != NULL && !coavoid_sim_tape_begin(o->tape, digest)) {
+        return COA_ERR_WORKSPACE;
+    }
+    int rc = coavoid_coordinator_cycle(r->coordinator, r->now);
+    if (o->tape != NULL) {
+        coavoid_sim_tape_end(o->tape, coavoid_coordinator_state(r->coordinator)->plans_run);
+    }
+    return rc;
 }
 
 /* Cycle k of the loop of node.h: what the network still carries up to its start, then
@@ -875,9 +913,9 @@ static bool sim_cycle(sim_run_t *r, uint32_t k, int *node_error)
     }
     lcm_ok = lcm_ok && sim_waits(r, cycle_start + r->collect_us, node_error);
     /* The coordinator plans cycles 0..K-1: cycle K only flies the last sample. */
-    if (r->coordinator != NULL && k < r->steps && lcm_ok) {
+    if ((r->coordinator != NULL || r->replaying) && k < r->steps && lcm_ok) {
         r->now = cycle_start + r->collect_us > r->now ? cycle_start + r->collect_us : r->now;
-        rc = coavoid_coordinator_cycle(r->coordinator, r->now);
+        rc = sim_coordinator_cycle(r);
         *node_error = *node_error != COA_OK ? *node_error : rc;
         lcm_ok = drain(r);
     }

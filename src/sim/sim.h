@@ -30,6 +30,7 @@
 #include "auth.h"
 #include "run.h"
 #include "scenario.h"
+#include "tape.h"
 
 /* What both return: the run's verdict (the values of run.h's verdicts, so that one mapping
  * to exit statuses serves every program), or run.h's COAVOID_RUN_ERR_INPUT (the scenario,
@@ -62,6 +63,15 @@ typedef struct {
      * messages the coordinator put on the network in it (a sweep's cut points). */
     uint32_t *coordinator_messages;
     size_t coordinator_messages_size;
+    /* NULL, or a tape (tape.h) of the coordinator. replay false: this run's coordinator is
+     * recorded on it (cleared first). replay true, with has_stop: the coordinator is not
+     * run; the tape's messages, recorded in a run of the same scenario and settings
+     * without the stop, are published at its calls instead, until the cut. The run is the
+     * same (the stopped run is the unstopped one up to the cut) without repeating the
+     * coordinator's searches; a run that is not the recorded one (the network's digest
+     * before a call is not the tape's) is an internal error, never a silent difference. */
+    coavoid_sim_tape_t *tape;
+    bool replay;
     bool json;            /* the result as JSON (default: text) */
     const char *svg_path; /* NULL, or where the figure goes */
     /* The nodes sign and check every message (default), with the simulation's fixed keys

@@ -283,6 +283,72 @@ while IFS=, read -r seed n index _ _ _ _ method status _; do
     [ "$rc" = "$want" ] || { ok=0; echo "montecarlo-$seed-$n-$index ${method#flown_}: sim exits $rc, CSV says $status"; }
 done < <(tail -n +2 "$tmp/fly0.csv")
 if [ $ok = 1 ] && [ $seen = 8 ]; then pass; else fail "montecarlo --fly: a flown verdict differs from coavoid sim's ($seen rows)"; fi
+# The coordinator-stop sweep (--coordinator-stops-sweep), at loss 0.2 with its own network
+# seed: every stopped run's verdict is what coavoid sim says of the saved encounter
+# stopped there, with the row's network seed (so the sweep's replay of the coordinator is
+# the real stopped run), and so are the unstopped rows'; the summary is the CSV's counts.
+"$bin" montecarlo --vehicles 2,3 --count 2 --fly --loss 0.2 --net-seed 7 --coordinator-stops-sweep all \
+    --quiet --csv "$tmp/sweep.csv" --save "$tmp/mc" --json >"$tmp/sweep.json" 2>&1
+ok=1 seen=0
+while IFS=, read -r seed n index _ _ _ _ method status _ _ _ _ _ _ _ loss _ _ net s m; do
+    case $method in flown_*) ;; *) continue ;; esac
+    seen=$((seen + 1))
+    mode=${method#flown_} stop=()
+    [ "$mode" = centralised_stop ] && mode=centralised stop=(--coordinator-stops "$s:$m")
+    "$bin" sim "$tmp/mc/montecarlo-$seed-$n-$index.json" --mode "$mode" --insecure --loss "$loss" \
+        --seed "$net" "${stop[@]}" >/dev/null 2>&1
+    rc=$?
+    want=0; [ "$status" = loss_of_separation ] && want=1
+    [ "$rc" = "$want" ] || { ok=0; echo "montecarlo-$seed-$n-$index $method ${stop[*]}: sim exits $rc, CSV says $status"; }
+done < <(tail -n +2 "$tmp/sweep.csv")
+if [ $ok = 1 ] && [ $seen -gt 100 ]; then pass; else fail "montecarlo sweep: a stopped run's verdict differs from coavoid sim's ($seen rows)"; fi
+if python3 - "$tmp/sweep.json" "$tmp/sweep.csv" <<'PY'; then pass; else fail "montecarlo sweep: the summary is not the CSV's"; fi
+import csv, json, sys
+j = json.load(open(sys.argv[1]))
+rows = list(csv.DictReader(open(sys.argv[2])))
+assert j["network"]["net_seed"] == 7 and j["network"]["coordinator_stops"] == "all", j["network"]
+for z in j["sizes"]:
+    n = str(z["vehicles"])
+    kept = {r["index"] for r in rows if r["vehicles"] == n and r["method"] == "flown_decoupled"
+            and r["status"] == "separated"}
+    stops = [r for r in rows if r["vehicles"] == n and r["method"] == "flown_centralised_stop"]
+    lost = [r for r in stops if r["status"] == "loss_of_separation"]
+    want = {"runs": len(stops), "losses": len(lost),
+            "encounters_with_losses": len({r["index"] for r in lost}),
+            "decoupled_separated": len(kept),
+            "losses_where_decoupled_separated": len([r for r in lost if r["index"] in kept]),
+            "encounters_with_losses_where_decoupled_separated":
+                len({r["index"] for r in lost if r["index"] in kept})}
+    assert z["coordinator_stops"] == want, (z["coordinator_stops"], want)
+    # Every cycle is swept, at m = 0 at least, and the cut points of a cycle are 0, 1, ...
+    widest = 0
+    for i in {r["index"] for r in stops}:
+        cuts = {}
+        for r in stops:
+            if r["index"] == i:
+                cuts.setdefault(int(r["stop_step"]), []).append(int(r["stop_messages"]))
+        assert sorted(cuts) == list(range(25)), sorted(cuts)
+        assert all(v == list(range(len(v))) for v in cuts.values()), cuts
+        widest = max([widest] + [len(v) for v in cuts.values()])
+    assert widest >= 3, "no cycle with a plan: the cuts between plan rows are not swept"
+PY
+# --net-seed given as --seed is the default; another one draws another network.
+"$bin" montecarlo --vehicles 2 --count 3 --fly --loss 0.3 --quiet --csv "$tmp/ns-default.csv" >/dev/null 2>&1
+"$bin" montecarlo --vehicles 2 --count 3 --fly --loss 0.3 --net-seed 1 --quiet --csv "$tmp/ns-1.csv" >/dev/null 2>&1
+"$bin" montecarlo --vehicles 2 --count 3 --fly --loss 0.3 --net-seed 2 --quiet --csv "$tmp/ns-2.csv" >/dev/null 2>&1
+if python3 - "$tmp/ns-default.csv" "$tmp/ns-1.csv" "$tmp/ns-2.csv" <<'PY'; then pass; else fail "montecarlo --net-seed: default or effect wrong"; fi
+import csv, sys
+a, b, c = ([r[:15] + r[16:] for r in csv.reader(open(f))] for f in sys.argv[1:4])
+assert a == b
+seeds = lambda rows: {r[18] for r in rows[1:]}  # net_seed, time_us left out
+assert seeds(a).isdisjoint(seeds(c))
+assert [r[:7] for r in a] == [r[:7] for r in c], "--net-seed changed the encounters"
+PY
+expect_bad "mc net seed without fly" "--net-seed" montecarlo --vehicles 2 --count 1 --net-seed 3
+expect_bad "mc net seed word" "--net-seed" montecarlo --vehicles 2 --count 1 --fly --net-seed x
+expect_bad "mc sweep without fly" "--coordinator-stops-sweep" montecarlo --vehicles 2 --count 1 --coordinator-stops-sweep all
+expect_bad "mc sweep kind" "--coordinator-stops-sweep" montecarlo --vehicles 2 --count 1 --fly --coordinator-stops-sweep some
+expect_bad "mc sweep missing" "--coordinator-stops-sweep" montecarlo --vehicles 2 --count 1 --fly --coordinator-stops-sweep
 expect_bad "mc loss without fly" "--loss" montecarlo --vehicles 2 --count 1 --loss 0.1
 expect_bad "mc loss 1" "--loss" montecarlo --vehicles 2 --count 1 --fly --loss 1
 expect_bad "mc delay a cycle" "--delay" montecarlo --vehicles 2 --count 1 --fly --delay 0.6 --jitter 0.4
