@@ -19,37 +19,41 @@
 #define MC_DEFAULT_COUNT 100u
 #define MC_MAX_COUNT 100000u
 
-#define MONTECARLO_USAGE                                                                     \
-    "usage: coavoid montecarlo --vehicles N[,N...] [--count C] [--seed S] [--beta B]\n"      \
-    "                          [--max-orders M] [--csv FILE] [--svg FILE] [--json]\n"        \
-    "                          [--save DIR] [--jobs J] [--quiet]\n"                          \
-    "                          [--fly [--loss P] [--delay S] [--jitter S] [--net-seed N]\n"  \
-    "                                 [--coordinator-stops-sweep all|ends]]\n"               \
-    "\n"                                                                                     \
-    "Draws C random encounters of N UAVs (for each N listed) converging on a point over\n"   \
-    "hills, with 0 to 2 non-cooperative tracks crossing (%u steps of %g s), and solves\n"    \
-    "each one centralised, decoupled in the fixed priority order and decoupled with\n"       \
-    "reordering. Prints per N and method the outcomes, the success rate with its 95%%\n"     \
-    "Wilson interval, the distribution of the decoupled/centralised deviation ratio\n"       \
-    "over the encounters both solve, and the planning times (a text summary, or a JSON\n"    \
-    "object with --json). See docs/evaluation.md.\n"                                         \
-    "\n"                                                                                     \
-    "options:\n"                                                                             \
-    "  --vehicles N,...  UAVs per encounter, each %u..%u, e.g. 2,3,4 (required)\n"           \
-    "  --count C         encounters per N, 1..%u; default %u\n"                              \
-    "  --seed S          the encounters' random seed, an integer >= 0; default %u\n"         \
-    "  --beta B          closed-set bound, B >= 1, for every search; default %u, lowered\n"  \
-    "                    per N where the centralised workspace would pass 1 GiB\n"           \
-    "  --max-orders M    reordering: at most M priority orders, M >= 1; default N!\n"        \
-    "                    (every order)\n"                                                    \
-    "  --csv FILE        one row per encounter and method (times in time_us)\n"              \
-    "  --svg FILE        success rates and the ratio's cumulative distribution\n"            \
-    "  --save DIR        write each encounter as DIR/montecarlo-SEED-N-INDEX.json (an\n"     \
-    "                    existing directory), for `coavoid plan` to replay\n"                \
-    "  --json            print the summary as a JSON object\n"                               \
-    "  --jobs J          worker threads, 1..%u; default 1; results do not depend on it\n"    \
-    "  --quiet           no progress on stderr (otherwise: a line updated every second\n"    \
-    "                    on a terminal, a line every 10%% when stderr is not one)\n"         \
+#define MONTECARLO_USAGE                                                                    \
+    "usage: coavoid montecarlo --vehicles N[,N...] [--count C] [--seed S] [--beta B]\n"     \
+    "                          [--max-orders M] [--csv FILE] [--svg FILE] [--json]\n"       \
+    "                          [--save DIR] [--jobs J] [--quiet]\n"                         \
+    "                          [--fly [--loss P] [--delay S] [--jitter S] [--net-seed N]\n" \
+    "                                 [--coordinator-stops-sweep all|ends]]\n"              \
+    "       coavoid montecarlo --figure-from A.csv,B.csv,... --svg FILE\n"                  \
+    "\n"                                                                                    \
+    "Draws C random encounters of N UAVs (for each N listed) converging on a point over\n"  \
+    "hills, with 0 to 2 non-cooperative tracks crossing (%u steps of %g s), and solves\n"   \
+    "each one centralised, decoupled in the fixed priority order and decoupled with\n"      \
+    "reordering. Prints per N and method the outcomes, the success rate with its 95%%\n"    \
+    "Wilson interval, the distribution of the decoupled/centralised deviation ratio\n"      \
+    "over the encounters both solve, and the planning times (a text summary, or a JSON\n"   \
+    "object with --json). See docs/evaluation.md.\n"                                        \
+    "\n"                                                                                    \
+    "options:\n"                                                                            \
+    "  --vehicles N,...  UAVs per encounter, each %u..%u, e.g. 2,3,4 (required)\n"          \
+    "  --count C         encounters per N, 1..%u; default %u\n"                             \
+    "  --seed S          the encounters' random seed, an integer >= 0; default %u\n"        \
+    "  --beta B          closed-set bound, B >= 1, for every search; default %u, lowered\n" \
+    "                    per N where the centralised workspace would pass 1 GiB\n"          \
+    "  --max-orders M    reordering: at most M priority orders, M >= 1; default N!\n"       \
+    "                    (every order)\n"                                                   \
+    "  --csv FILE        one row per encounter and method (times in time_us)\n"             \
+    "  --svg FILE        success rates and the ratio's cumulative distribution\n"           \
+    "  --save DIR        write each encounter as DIR/montecarlo-SEED-N-INDEX.json (an\n"    \
+    "                    existing directory), for `coavoid plan` to replay\n"               \
+    "  --json            print the summary as a JSON object\n"                              \
+    "  --jobs J          worker threads, 1..%u; default 1; results do not depend on it\n"   \
+    "  --quiet           no progress on stderr (otherwise: a line updated every second\n"   \
+    "                    on a terminal, a line every 10%% when stderr is not one)\n"
+
+/* The rest of the usage: one string literal is at most 4095 characters in C11. */
+#define MONTECARLO_USAGE_FLY                                                                 \
     "  --fly             also fly each encounter in closed loop, centralised and\n"          \
     "                    decoupled, by the nodes of `coavoid sim` (insecure: nothing\n"      \
     "                    else is on its bus) over a simulated network, and report\n"         \
@@ -70,6 +74,11 @@
     "                    of its messages it sent there unstopped (all), or after 0, 1,\n"    \
     "                    half and all but one of them (ends); report the runs that lose\n"   \
     "                    separation, and those where decoupled keeps it (issue 14)\n"        \
+    "  --figure-from A.csv,...\n"                                                            \
+    "                    runs nothing: reads the CSVs of montecarlo --fly runs (one loss\n"  \
+    "                    each, up to %u files) and writes with --svg the closed loop's\n"    \
+    "                    loss-of-separation rate against loss per N and mode; prints the\n"  \
+    "                    points\n"                                                           \
     "  -h, --help        show this help\n"                                                   \
     "\n"                                                                                     \
     "A seed gives the same encounters and results on every machine with the same C\n"        \
@@ -85,6 +94,7 @@ static void montecarlo_help(void)
     printf(MONTECARLO_USAGE, coavoid_encounter_montecarlo.horizon, coavoid_encounter_montecarlo.dt,
            COAVOID_ENCOUNTER_MIN_VEHICLES, COAVOID_ENCOUNTER_MAX_VEHICLES, MC_MAX_COUNT,
            MC_DEFAULT_COUNT, MC_DEFAULT_SEED, COAVOID_DEFAULT_BETA, COAVOID_MONTECARLO_MAX_JOBS);
+    printf(MONTECARLO_USAGE_FLY, COAVOID_MC_FIGURE_MAX_FILES);
 }
 
 /* ---- options ---- */
@@ -112,7 +122,11 @@ typedef struct {
     coavoid_cli_network_t network;
     const char *net_seed_text;
     uint64_t net_seed;
-    const char *sweep_text; /* --coordinator-stops-sweep: all or ends */
+    const char *sweep_text;  /* --coordinator-stops-sweep: all or ends */
+    const char *figure_text; /* --figure-from: the list as given */
+    char figure_list[4096];  /* its copy, cut at the commas */
+    const char *figures[COAVOID_MC_FIGURE_MAX_FILES];
+    size_t figure_count;
 } mc_options_t;
 
 /* "2,3,4": each 2..6, each once. */
@@ -143,6 +157,32 @@ static int parse_sizes(mc_options_t *o)
             return CLI_CONTINUE;
         }
         token = comma + 1;
+    }
+}
+
+/* --figure-from A.csv,B.csv,...: 1 to COAVOID_MC_FIGURE_MAX_FILES paths, none empty. */
+static int parse_figures(mc_options_t *o)
+{
+    if (strlen(o->figure_text) >= sizeof o->figure_list) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "--figure-from: longer than %zu characters",
+                                sizeof o->figure_list - 1u);
+    }
+    strcpy(o->figure_list, o->figure_text);
+    for (char *p = o->figure_list;;) {
+        char *comma = strchr(p, ',');
+        if (comma != NULL) {
+            *comma = '\0';
+        }
+        if (*p == '\0' || o->figure_count == COAVOID_MC_FIGURE_MAX_FILES) {
+            return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                    "--figure-from: 1 to %u CSV files, comma-separated, none empty",
+                                    COAVOID_MC_FIGURE_MAX_FILES);
+        }
+        o->figures[o->figure_count++] = p;
+        if (comma == NULL) {
+            return CLI_CONTINUE;
+        }
+        p = comma + 1;
     }
 }
 
@@ -194,6 +234,10 @@ static int mc_option(int argc, char **argv, int *i, void *options)
         status = coavoid_cli_flag_option(arg, "--quiet", &o->quiet);
     } else if (coavoid_cli_option_is(arg, "--fly")) {
         status = coavoid_cli_flag_option(arg, "--fly", &o->fly);
+    } else if (coavoid_cli_option_is(arg, "--figure-from")) {
+        status = coavoid_cli_text_option(argc, argv, i, "--figure-from", "CSV files, A.csv,B.csv",
+                                         false, &o->figure_text);
+        status = status == CLI_CONTINUE ? parse_figures(o) : status;
     } else if (coavoid_cli_option_is(arg, "--net-seed")) {
         status = coavoid_cli_count_option(argc, argv, i, "--net-seed", NULL, true, UINT64_MAX,
                                           &o->net_seed_text, &o->net_seed);
@@ -214,12 +258,32 @@ static const coavoid_cli_command_t montecarlo_command = {
     "montecarlo", "coavoid montecarlo", 2, {NULL, NULL}, "it takes options only", montecarlo_help,
     mc_option};
 
+/* --figure-from runs nothing: only --svg goes with it. */
+static int figure_options(const mc_options_t *o)
+{
+    if (o->svg == NULL) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "--figure-from: needs --svg FILE");
+    }
+    if (o->vehicles_text != NULL || o->count_text != NULL || o->seed_text != NULL ||
+        o->beta_text != NULL || o->max_orders_text != NULL || o->csv != NULL || o->save != NULL ||
+        o->json || o->jobs_text != NULL || o->quiet || o->fly ||
+        coavoid_cli_network_given(&o->network) || o->net_seed_text != NULL ||
+        o->sweep_text != NULL) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                "--figure-from: takes --svg only (it runs no encounters)");
+    }
+    return CLI_CONTINUE;
+}
+
 static int parse_mc_options(int argc, char **argv, mc_options_t *o)
 {
     memset(o, 0, sizeof *o);
     int status = coavoid_cli_parse_args(&montecarlo_command, argc, argv, o, NULL);
     if (status != CLI_CONTINUE) {
         return status;
+    }
+    if (o->figure_text != NULL) {
+        return figure_options(o);
     }
     if (o->vehicles_text == NULL) {
         return coavoid_cli_fail(CLI_EXIT_INVALID,
@@ -304,8 +368,12 @@ int coavoid_command_montecarlo(int argc, char **argv)
     if (status != CLI_CONTINUE) {
         return status;
     }
-    const coavoid_montecarlo_config_t config = mc_engine_config(&o);
     coavoid_run_error_t e;
+    if (o.figure_text != NULL) {
+        int rc = coavoid_montecarlo_figure(o.figures, o.figure_count, o.svg, stdout, &e);
+        return coavoid_cli_run_status(rc, &e);
+    }
+    const coavoid_montecarlo_config_t config = mc_engine_config(&o);
     coavoid_montecarlo_t *mc = NULL;
     int rc = coavoid_montecarlo_run(&config, &mc, &e);
     if (rc == COAVOID_RUN_DONE) {

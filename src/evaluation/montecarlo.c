@@ -424,10 +424,7 @@ static void cost_text(coa_cost_t c, char *buf, size_t size)
 #define MC_CSV_HEADER                                                             \
     "seed,vehicles,index,redraws,hills,tracks,first_conflict_step,method,status," \
     "deviation,deviation_units,effort,expanded,generated,orders_tried,time_us\n"
-#define MC_CSV_HEADER_FLY                                                         \
-    "seed,vehicles,index,redraws,hills,tracks,first_conflict_step,method,status," \
-    "deviation,deviation_units,effort,expanded,generated,orders_tried,time_us,"   \
-    "loss,delay,jitter,net_seed,stop_step,stop_messages\n"
+#define MC_CSV_HEADER_FLY COAVOID_MC_CSV_HEADER_FLY_LINE "\n"
 
 /* With fly, every row ends with the network (loss, delay, jitter), the encounter's
  * network seed and the stop point (empty but on flown_centralised_stop rows): a file says

@@ -98,6 +98,15 @@ struct coavoid_montecarlo {
 int coavoid_mc_fly(const coavoid_montecarlo_config_t *c, const coavoid_mc_size_t *size,
                    coavoid_mc_result_t *r, char *err, size_t err_size);
 
+/* The header of a montecarlo --fly CSV (without its newline): the figure checks it. */
+#define COAVOID_MC_CSV_HEADER_FLY_LINE                                            \
+    "seed,vehicles,index,redraws,hills,tracks,first_conflict_step,method,status," \
+    "deviation,deviation_units,effort,expanded,generated,orders_tried,time_us,"   \
+    "loss,delay,jitter,net_seed,stop_step,stop_messages"
+
+/* k successes of n (n >= 1): the rate and its 95 % Wilson interval. */
+void coavoid_mc_wilson(uint32_t k, uint32_t n, double *rate, double *low, double *high);
+
 /* A 128-bit cost as a double, for ratios: exact enough for them, and it never overflows. */
 static inline double coavoid_mc_cost_real(coa_cost_t c)
 {

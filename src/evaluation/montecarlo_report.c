@@ -106,7 +106,7 @@ typedef struct {
     mc_sweep_summary_t sweep;
 } mc_summary_t;
 
-static void wilson(uint32_t k, uint32_t n, double *rate, double *low, double *high)
+void coavoid_mc_wilson(uint32_t k, uint32_t n, double *rate, double *low, double *high)
 {
     double p = (double)k / n, z2 = MC_Z95 * MC_Z95, nn = (double)n;
     double centre = (p + z2 / (2.0 * nn)) / (1.0 + z2 / nn);
@@ -138,7 +138,7 @@ static void summarise_fly(const coavoid_mc_result_t *results, uint32_t count, mc
             f->delivered += flown->delivered;
             f->dropped += flown->dropped;
         }
-        wilson(f->losses, count, &f->rate, &f->low, &f->high);
+        coavoid_mc_wilson(f->losses, count, &f->rate, &f->low, &f->high);
     }
 }
 
@@ -177,7 +177,7 @@ static void summarise(const coavoid_mc_result_t *results, uint32_t count,
             ms->budget += st == COA_PLAN_BUDGET_EXHAUSTED;
             x[j] = results[j].m[m].time_us * 1e-3;
         }
-        wilson(ms->solved, count, &ms->rate, &ms->low, &ms->high);
+        coavoid_mc_wilson(ms->solved, count, &ms->rate, &ms->low, &ms->high);
         ms->time_ms = distribution(x, count, 0u);
         for (uint32_t j = 0; j < count; j++) {
             x[j] = (double)results[j].m[m].expanded;
