@@ -421,8 +421,6 @@ static int check_message_limits(coavoid_run_error_t *err, const char *file,
     return rc;
 }
 
-/* Hands the nodes what they published and what is due by now. false when the network
- * failed (r->net_error says how). */
 /* --coordinator-stops: once the network has cut the coordinator's link (sim_stop_cycle),
  * it is gone; checked after every pump, so that it makes no further call whichever of its
  * calls published its last message. */
@@ -441,6 +439,8 @@ static void sim_stop_if_cut(sim_run_t *r)
     coavoid_sim_net_stop(r->net, SIM_NET_COORDINATOR);
 }
 
+/* Hands the nodes what they published and what is due by now. false when the network
+ * failed (r->net_error says how). */
 static bool drain(sim_run_t *r)
 {
     int rc = coavoid_sim_net_pump(r->net, r->now);
