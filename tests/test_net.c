@@ -4,7 +4,8 @@
  * what reaches them and when: without loss or delay every message reaches every node at
  * once in the order sent; a node hears its own at once even when it hears nobody else;
  * one seed gives one run and another seed other deliveries; a delay holds a copy until
- * its time; the counts add up; and a full queue is an error, not a loss.
+ * its time; the counts add up; a full queue is an error, not a loss; and a node cut after
+ * M messages gets exactly those M out, whatever is in flight.
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -240,6 +241,72 @@ START_TEST(test_full_queue_is_an_error)
 }
 END_TEST
 
+/* Node 1 cut after 2 messages amid others' traffic: its first 2 reach every node (itself
+ * too), the rest none; the others go on; copies already in flight still arrive. */
+static void cut_run(int64_t delay)
+{
+    world_t *w = malloc(sizeof *w);
+    ear_t ears[NODES];
+    coavoid_sim_net_config_t c = settings(0.0, delay, 0, 3u);
+    open_world(w, ears, &c);
+    ck_assert_int_eq(send_at(w, 1u, 100u, 0), COA_OK); /* before the count starts */
+    coavoid_sim_net_stop_after(w->net, 1u, 2u);
+    ck_assert(!coavoid_sim_net_cut(w->net, 1u));
+    for (uint32_t id = 0; id < 10u; id++) {
+        ck_assert_int_eq(send_at(w, id % 2u == 0u ? 1u : 2u, id, 10 * (int64_t)id), COA_OK);
+        ck_assert(coavoid_sim_net_cut(w->net, 1u) == (id >= 2u));
+    }
+    finish(w);
+    size_t from1[NODES] = {0}, from2 = 0;
+    for (size_t k = 0; k < w->count; k++) {
+        if (w->log[k].sender == 1u) {
+            ck_assert(w->log[k].id == 100u || w->log[k].id == 0u || w->log[k].id == 2u);
+            from1[w->log[k].receiver]++;
+        } else {
+            from2++;
+        }
+    }
+    for (uint32_t i = 0; i < NODES; i++) {
+        ck_assert_uint_eq(from1[i], 3u);
+    }
+    ck_assert_uint_eq(from2, 5u * NODES);
+    coavoid_sim_net_stats_t st = coavoid_sim_net_stats(w->net);
+    ck_assert_uint_eq(st.sent, 3u + 5u);
+    ck_assert_uint_eq(st.cut, 3u);
+    ck_assert_uint_eq(coavoid_sim_net_sent_by(w->net, 1u), 3u);
+    ck_assert_uint_eq(coavoid_sim_net_sent_by(w->net, 2u), 5u);
+    ck_assert_uint_eq(st.delivered, 8u * (NODES - 1u));
+    coavoid_sim_net_destroy(w->net);
+    free(w);
+}
+
+START_TEST(test_cut_after_m_messages)
+{
+    cut_run(0);
+    cut_run(25); /* 2.5 messages' time: the last ones out are in flight at the cut */
+}
+END_TEST
+
+START_TEST(test_cut_at_zero_sends_nothing)
+{
+    world_t *w = malloc(sizeof *w);
+    ear_t ears[NODES];
+    coavoid_sim_net_config_t c = settings(0.5, 0, 0, 9u);
+    open_world(w, ears, &c);
+    coavoid_sim_net_stop_after(w->net, 3u, 0u);
+    ck_assert(coavoid_sim_net_cut(w->net, 3u));
+    for (uint32_t id = 0; id < 20u; id++) {
+        ck_assert_int_eq(send_at(w, 3u, id, id), COA_OK);
+    }
+    ck_assert_uint_eq(w->count, 0u);
+    coavoid_sim_net_stats_t st = coavoid_sim_net_stats(w->net);
+    ck_assert_uint_eq(st.sent + st.dropped + st.delivered, 0u);
+    ck_assert_uint_eq(st.cut, 20u);
+    coavoid_sim_net_destroy(w->net);
+    free(w);
+}
+END_TEST
+
 static Suite *net_suite(void)
 {
     Suite *s = suite_create("net");
@@ -249,6 +316,8 @@ static Suite *net_suite(void)
     tcase_add_test(tc, test_one_seed_one_run);
     tcase_add_test(tc, test_delay_holds_a_copy_until_its_time);
     tcase_add_test(tc, test_full_queue_is_an_error);
+    tcase_add_test(tc, test_cut_after_m_messages);
+    tcase_add_test(tc, test_cut_at_zero_sends_nothing);
     suite_add_tcase(s, tc);
     return s;
 }

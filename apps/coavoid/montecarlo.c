@@ -23,7 +23,9 @@
     "usage: coavoid montecarlo --vehicles N[,N...] [--count C] [--seed S] [--beta B]\n"     \
     "                          [--max-orders M] [--csv FILE] [--svg FILE] [--json]\n"       \
     "                          [--save DIR] [--jobs J] [--quiet]\n"                         \
-    "                          [--fly [--loss P] [--delay S] [--jitter S]]\n"               \
+    "                          [--fly [--loss P] [--delay S] [--jitter S] [--net-seed N]\n" \
+    "                                 [--coordinator-stops-sweep all|ends]]\n"              \
+    "       coavoid montecarlo --figure-from A.csv,B.csv,... --svg FILE\n"                  \
     "\n"                                                                                    \
     "Draws C random encounters of N UAVs (for each N listed) converging on a point over\n"  \
     "hills, with 0 to 2 non-cooperative tracks crossing (%u steps of %g s), and solves\n"   \
@@ -48,27 +50,43 @@
     "  --json            print the summary as a JSON object\n"                              \
     "  --jobs J          worker threads, 1..%u; default 1; results do not depend on it\n"   \
     "  --quiet           no progress on stderr (otherwise: a line updated every second\n"   \
-    "                    on a terminal, a line every 10%% when stderr is not one)\n"        \
-    "  --fly             also fly each encounter in closed loop, centralised and\n"         \
-    "                    decoupled, by the nodes of `coavoid sim` (insecure: nothing\n"     \
-    "                    else is on its bus) over a simulated network, and report\n"        \
-    "                    per N and mode the loss-of-separation rate, also over the\n"       \
-    "                    encounters the one-shot centralised plan, or some priority\n"      \
-    "                    order, solves\n"                                                   \
-    "  --loss P          with --fly: each message reaches each other node with\n"           \
-    "                    probability 1 - P (0 <= P < 1); default 0\n"                       \
-    "  --delay S         with --fly: ... after S seconds; default 0\n"                      \
-    "  --jitter S        with --fly: ... plus a uniform time in [0, S] seconds; default\n"  \
-    "                    0; delay + jitter must be under dt. The network's random\n"        \
-    "                    stream comes from --seed and the encounter\n"                      \
-    "  -h, --help        show this help\n"                                                  \
-    "\n"                                                                                    \
-    "A seed gives the same encounters and results on every machine with the same C\n"       \
-    "maths library (headings use cos and sin), except the times.\n"                         \
-    "\n"                                                                                    \
-    "exit status: 0 done (whatever the plans' outcomes), 2 invalid usage (one line on\n"    \
-    "stderr naming the option and why), 3 internal error or a defect of the planner (a\n"   \
-    "decoupled plan cheaper than the optimal centralised one or where it proved none, a\n"  \
+    "                    on a terminal, a line every 10%% when stderr is not one)\n"
+
+/* The rest of the usage: one string literal is at most 4095 characters in C11. */
+#define MONTECARLO_USAGE_FLY                                                                 \
+    "  --fly             also fly each encounter in closed loop, centralised and\n"          \
+    "                    decoupled, by the nodes of `coavoid sim` (insecure: nothing\n"      \
+    "                    else is on its bus) over a simulated network, and report\n"         \
+    "                    per N and mode the loss-of-separation rate, also over the\n"        \
+    "                    encounters the one-shot centralised plan, or some priority\n"       \
+    "                    order, solves\n"                                                    \
+    "  --loss P          with --fly: each message reaches each other node with\n"            \
+    "                    probability 1 - P (0 <= P < 1); default 0\n"                        \
+    "  --delay S         with --fly: ... after S seconds; default 0\n"                       \
+    "  --jitter S        with --fly: ... plus a uniform time in [0, S] seconds; default\n"   \
+    "                    0; delay + jitter must be under dt. The network's random\n"         \
+    "                    stream comes from --net-seed and the encounter\n"                   \
+    "  --net-seed N      with --fly: the network's seed, an integer >= 0, apart from the\n"  \
+    "                    encounters' --seed; default: --seed (as before the option)\n"       \
+    "  --coordinator-stops-sweep all|ends\n"                                                 \
+    "                    with --fly: also fly each encounter centralised with the\n"         \
+    "                    coordinator stopped at every cycle and, in it, after each number\n" \
+    "                    of its messages it sent there unstopped (all), or after 0, 1,\n"    \
+    "                    half and all but one of them (ends); report the runs that lose\n"   \
+    "                    separation, and those where decoupled keeps it (issue 14)\n"        \
+    "  --figure-from A.csv,...\n"                                                            \
+    "                    runs nothing: reads the CSVs of montecarlo --fly runs (one loss\n"  \
+    "                    each, up to %u files) and writes with --svg the closed loop's\n"    \
+    "                    loss-of-separation rate against loss per N and mode; prints the\n"  \
+    "                    points\n"                                                           \
+    "  -h, --help        show this help\n"                                                   \
+    "\n"                                                                                     \
+    "A seed gives the same encounters and results on every machine with the same C\n"        \
+    "maths library (headings use cos and sin), except the times.\n"                          \
+    "\n"                                                                                     \
+    "exit status: 0 done (whatever the plans' outcomes), 2 invalid usage (one line on\n"     \
+    "stderr naming the option and why), 3 internal error or a defect of the planner (a\n"    \
+    "decoupled plan cheaper than the optimal centralised one or where it proved none, a\n"   \
     "solved plan in conflict or with no deviation: one line each on stderr)\n"
 
 static void montecarlo_help(void)
@@ -76,6 +94,7 @@ static void montecarlo_help(void)
     printf(MONTECARLO_USAGE, coavoid_encounter_montecarlo.horizon, coavoid_encounter_montecarlo.dt,
            COAVOID_ENCOUNTER_MIN_VEHICLES, COAVOID_ENCOUNTER_MAX_VEHICLES, MC_MAX_COUNT,
            MC_DEFAULT_COUNT, MC_DEFAULT_SEED, COAVOID_DEFAULT_BETA, COAVOID_MONTECARLO_MAX_JOBS);
+    printf(MONTECARLO_USAGE_FLY, COAVOID_MC_FIGURE_MAX_FILES);
 }
 
 /* ---- options ---- */
@@ -101,6 +120,13 @@ typedef struct {
     bool quiet;
     bool fly;
     coavoid_cli_network_t network;
+    const char *net_seed_text;
+    uint64_t net_seed;
+    const char *sweep_text;  /* --coordinator-stops-sweep: all or ends */
+    const char *figure_text; /* --figure-from: the list as given */
+    char figure_list[4096];  /* its copy, cut at the commas */
+    const char *figures[COAVOID_MC_FIGURE_MAX_FILES];
+    size_t figure_count;
 } mc_options_t;
 
 /* "2,3,4": each 2..6, each once. */
@@ -131,6 +157,32 @@ static int parse_sizes(mc_options_t *o)
             return CLI_CONTINUE;
         }
         token = comma + 1;
+    }
+}
+
+/* --figure-from A.csv,B.csv,...: 1 to COAVOID_MC_FIGURE_MAX_FILES paths, none empty. */
+static int parse_figures(mc_options_t *o)
+{
+    if (strlen(o->figure_text) >= sizeof o->figure_list) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "--figure-from: longer than %zu characters",
+                                sizeof o->figure_list - 1u);
+    }
+    strcpy(o->figure_list, o->figure_text);
+    for (char *p = o->figure_list;;) {
+        char *comma = strchr(p, ',');
+        if (comma != NULL) {
+            *comma = '\0';
+        }
+        if (*p == '\0' || o->figure_count == COAVOID_MC_FIGURE_MAX_FILES) {
+            return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                    "--figure-from: 1 to %u CSV files, comma-separated, none empty",
+                                    COAVOID_MC_FIGURE_MAX_FILES);
+        }
+        o->figures[o->figure_count++] = p;
+        if (comma == NULL) {
+            return CLI_CONTINUE;
+        }
+        p = comma + 1;
     }
 }
 
@@ -182,6 +234,22 @@ static int mc_option(int argc, char **argv, int *i, void *options)
         status = coavoid_cli_flag_option(arg, "--quiet", &o->quiet);
     } else if (coavoid_cli_option_is(arg, "--fly")) {
         status = coavoid_cli_flag_option(arg, "--fly", &o->fly);
+    } else if (coavoid_cli_option_is(arg, "--figure-from")) {
+        status = coavoid_cli_text_option(argc, argv, i, "--figure-from", "CSV files, A.csv,B.csv",
+                                         false, &o->figure_text);
+        status = status == CLI_CONTINUE ? parse_figures(o) : status;
+    } else if (coavoid_cli_option_is(arg, "--net-seed")) {
+        status = coavoid_cli_count_option(argc, argv, i, "--net-seed", NULL, true, UINT64_MAX,
+                                          &o->net_seed_text, &o->net_seed);
+    } else if (coavoid_cli_option_is(arg, "--coordinator-stops-sweep")) {
+        status = coavoid_cli_text_option(argc, argv, i, "--coordinator-stops-sweep", "all or ends",
+                                         false, &o->sweep_text);
+        if (status == CLI_CONTINUE && strcmp(o->sweep_text, "all") != 0 &&
+            strcmp(o->sweep_text, "ends") != 0) {
+            status = coavoid_cli_fail(CLI_EXIT_INVALID,
+                                      "--coordinator-stops-sweep: must be all or ends, got '%.40s'",
+                                      o->sweep_text);
+        }
     }
     return status;
 }
@@ -190,12 +258,32 @@ static const coavoid_cli_command_t montecarlo_command = {
     "montecarlo", "coavoid montecarlo", 2, {NULL, NULL}, "it takes options only", montecarlo_help,
     mc_option};
 
+/* --figure-from runs nothing: only --svg goes with it. */
+static int figure_options(const mc_options_t *o)
+{
+    if (o->svg == NULL) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "--figure-from: needs --svg FILE");
+    }
+    if (o->vehicles_text != NULL || o->count_text != NULL || o->seed_text != NULL ||
+        o->beta_text != NULL || o->max_orders_text != NULL || o->csv != NULL || o->save != NULL ||
+        o->json || o->jobs_text != NULL || o->quiet || o->fly ||
+        coavoid_cli_network_given(&o->network) || o->net_seed_text != NULL ||
+        o->sweep_text != NULL) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                "--figure-from: takes --svg only (it runs no encounters)");
+    }
+    return CLI_CONTINUE;
+}
+
 static int parse_mc_options(int argc, char **argv, mc_options_t *o)
 {
     memset(o, 0, sizeof *o);
     int status = coavoid_cli_parse_args(&montecarlo_command, argc, argv, o, NULL);
     if (status != CLI_CONTINUE) {
         return status;
+    }
+    if (o->figure_text != NULL) {
+        return figure_options(o);
     }
     if (o->vehicles_text == NULL) {
         return coavoid_cli_fail(CLI_EXIT_INVALID,
@@ -212,6 +300,11 @@ static int parse_mc_options(int argc, char **argv, mc_options_t *o)
                                 o->network.loss_text != NULL    ? "--loss"
                                 : o->network.delay_text != NULL ? "--delay"
                                                                 : "--jitter");
+    }
+    if ((o->net_seed_text != NULL || o->sweep_text != NULL) && !o->fly) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: only with --fly (the closed loop)",
+                                o->net_seed_text != NULL ? "--net-seed"
+                                                         : "--coordinator-stops-sweep");
     }
     if (o->network.delay + o->network.jitter >= coavoid_encounter_montecarlo.dt) {
         return coavoid_cli_fail(CLI_EXIT_INVALID,
@@ -261,6 +354,10 @@ static coavoid_montecarlo_config_t mc_engine_config(const mc_options_t *o)
     c.loss = o->network.loss;
     c.delay = o->network.delay;
     c.jitter = o->network.jitter;
+    c.has_net_seed = o->net_seed_text != NULL;
+    c.net_seed = o->net_seed;
+    c.stops_sweep = o->sweep_text != NULL;
+    c.stops_ends = c.stops_sweep && strcmp(o->sweep_text, "ends") == 0;
     return c;
 }
 
@@ -271,8 +368,12 @@ int coavoid_command_montecarlo(int argc, char **argv)
     if (status != CLI_CONTINUE) {
         return status;
     }
-    const coavoid_montecarlo_config_t config = mc_engine_config(&o);
     coavoid_run_error_t e;
+    if (o.figure_text != NULL) {
+        int rc = coavoid_montecarlo_figure(o.figures, o.figure_count, o.svg, stdout, &e);
+        return coavoid_cli_run_status(rc, &e);
+    }
+    const coavoid_montecarlo_config_t config = mc_engine_config(&o);
     coavoid_montecarlo_t *mc = NULL;
     int rc = coavoid_montecarlo_run(&config, &mc, &e);
     if (rc == COAVOID_RUN_DONE) {

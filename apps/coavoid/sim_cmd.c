@@ -18,7 +18,7 @@
 
 #define SIM_USAGE                                                                               \
     "usage: coavoid sim SCENARIO.json --mode centralised|decoupled [--steps K] [--json]\n"      \
-    "                   [--svg FILE] [--coordinator-stops STEP] [--insecure]\n"                 \
+    "                   [--svg FILE] [--coordinator-stops STEP[:M]] [--insecure]\n"             \
     "                   [--loss P] [--delay S] [--jitter S] [--seed N]\n"                       \
     "\n"                                                                                        \
     "Flies the scenario in closed loop: every step each UAV publishes its intent, conflicts\n"  \
@@ -33,8 +33,10 @@
     "  --steps K            fly K steps (samples 0..K), K >= 1; default 2 * horizon\n"          \
     "  --json               print the simulation result as JSON (default: text)\n"              \
     "  --svg FILE           write the figure (top view, altitude profiles) to FILE\n"           \
-    "  --coordinator-stops STEP\n"                                                              \
-    "                       centralised: stop the coordinator before step STEP (0..K)\n"        \
+    "  --coordinator-stops STEP[:M]\n"                                                          \
+    "                       centralised: stop the coordinator in cycle STEP (0..K): its\n"      \
+    "                       first M messages of that cycle go out (whatever they are),\n"       \
+    "                       then nothing more; STEP alone: before it sends any (M = 0)\n"       \
     "  --insecure           the nodes neither sign nor check their messages (by default they\n" \
     "                       do, with the simulation's fixed keys; the flight is the same)\n"    \
     "  --loss P             each message reaches each other node with probability 1 - P,\n"     \
@@ -47,7 +49,9 @@
     "\n"                                                                                        \
     "Beyond the contract's fields the result has \"fallbacks\" (times a UAV went from\n"        \
     "following the coordinator to planning for itself), with --coordinator-stops,\n"            \
-    "\"coordinator_stopped_at\", and with --loss, --delay or --jitter, \"network\" (those\n"    \
+    "\"coordinator_stopped_at\" (with :M also \"coordinator_stopped_after\", M, and\n"          \
+    "\"coordinator_messages_cut\", what it published after them that no one got; in\n"          \
+    "text a \"coordinator:\" line), and with --loss, --delay or --jitter, \"network\" (those\n" \
     "settings and the messages sent, copies delivered, dropped and in flight at the end).\n"    \
     "\n"                                                                                        \
     "The scenario's horizon may be at most %u steps (an intent carries N + 1 samples) and\n"    \
@@ -70,6 +74,8 @@ typedef struct {
     const char *svg_path;
     const char *stop_text;
     uint32_t stop_step;
+    bool has_stop_messages;
+    uint32_t stop_messages;
     bool insecure;
     coavoid_cli_network_t network;
 } sim_options_t;
@@ -78,6 +84,35 @@ static void sim_help(void)
 {
     printf(SIM_USAGE, COAVOID_NODE_MAX_HORIZON, COA_MAX_VEHICLES, COAVOID_LCM_MAX_COORDINATE,
            COAVOID_LCM_MAX_SPEED, COAVOID_LCM_MAX_SIZE);
+}
+
+/* --coordinator-stops STEP or STEP:M, each a whole number from 0 (M: messages, at most
+ * COAVOID_SIM_MAX_STEPS too: far more than a coordinator sends in a cycle). */
+static int parse_stop(sim_options_t *o)
+{
+    const char *text = o->stop_text;
+    const char *colon = strchr(text, ':');
+    char step[16];
+    uint64_t value = 0, messages = 0;
+    size_t length = colon != NULL ? (size_t)(colon - text) : strlen(text);
+    bool ok = length < sizeof step;
+    if (ok) {
+        memcpy(step, text, length);
+        step[length] = '\0';
+        ok =
+            coavoid_cli_parse_index(step, COAVOID_SIM_MAX_STEPS, &value) &&
+            (colon == NULL || coavoid_cli_parse_index(colon + 1, COAVOID_SIM_MAX_STEPS, &messages));
+    }
+    if (!ok) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                "--coordinator-stops: must be STEP or STEP:M, a step from 0 to %u "
+                                "and a message count from 0 to %u, got '%.40s'",
+                                COAVOID_SIM_MAX_STEPS, COAVOID_SIM_MAX_STEPS, text);
+    }
+    o->stop_step = (uint32_t)value;
+    o->has_stop_messages = colon != NULL;
+    o->stop_messages = (uint32_t)messages;
+    return CLI_CONTINUE;
 }
 
 static int sim_option(int argc, char **argv, int *i, void *options)
@@ -105,13 +140,7 @@ static int sim_option(int argc, char **argv, int *i, void *options)
     } else if (coavoid_cli_option_is(arg, "--coordinator-stops")) {
         status = coavoid_cli_text_option(argc, argv, i, "--coordinator-stops", "a step, 0 or more",
                                          true, &o->stop_text);
-        if (status == CLI_CONTINUE &&
-            !coavoid_cli_parse_index(o->stop_text, COAVOID_SIM_MAX_STEPS, &value)) {
-            status = coavoid_cli_fail(
-                CLI_EXIT_INVALID, "--coordinator-stops: must be a step from 0 to %u, got '%.40s'",
-                COAVOID_SIM_MAX_STEPS, o->stop_text);
-        }
-        o->stop_step = (uint32_t)value;
+        status = status == CLI_CONTINUE ? parse_stop(o) : status;
     }
     return status;
 }
@@ -148,6 +177,8 @@ static int sim(void *options, coavoid_scenario_t *s)
         .steps = o->steps,
         .has_stop = o->stop_text != NULL,
         .stop_step = o->stop_step,
+        .has_stop_messages = o->has_stop_messages,
+        .stop_messages = o->stop_messages,
         .json = o->json,
         .svg_path = o->svg_path,
         .insecure = o->insecure,

@@ -424,9 +424,31 @@ static void cost_text(coa_cost_t c, char *buf, size_t size)
 #define MC_CSV_HEADER                                                             \
     "seed,vehicles,index,redraws,hills,tracks,first_conflict_step,method,status," \
     "deviation,deviation_units,effort,expanded,generated,orders_tried,time_us\n"
+#define MC_CSV_HEADER_FLY COAVOID_MC_CSV_HEADER_FLY_LINE "\n"
 
-static void csv_rows(FILE *f, uint64_t seed, const coavoid_mc_result_t *r)
+/* With fly, every row ends with the network (loss, delay, jitter), the encounter's
+ * network seed and the stop point (empty but on flown_centralised_stop rows): a file says
+ * what it measured (montecarlo --figure-from reads the loss), and `coavoid sim --seed
+ * --coordinator-stops` replays a run. Without fly the rows are as before fly existed. */
+static void csv_network(const coavoid_montecarlo_config_t *c, const coavoid_mc_result_t *r,
+                        char *buf, size_t size)
 {
+    buf[0] = '\0';
+    if (c->fly) {
+        snprintf(buf, size, "%.15g,%.15g,%.15g,%llu", c->loss, c->delay, c->jitter,
+                 (unsigned long long)r->net_seed);
+    }
+}
+
+static void csv_rows(FILE *f, const coavoid_montecarlo_config_t *c, const coavoid_mc_result_t *r)
+{
+    const uint64_t seed = c->seed;
+    char network[128] = "";
+    if (c->fly) {
+        network[0] = ',';
+        csv_network(c, r, network + 1, sizeof network - 4u);
+        strcat(network, ",,");
+    }
     for (int m = 0; m < COAVOID_MC_METHODS; m++) {
         const coavoid_mc_outcome_t *o = &r->m[m];
         /* Costs only of a plan: a failed decoupled attempt's partial costs are not one. */
@@ -437,26 +459,54 @@ static void csv_rows(FILE *f, uint64_t seed, const coavoid_mc_result_t *r)
             snprintf(costs, sizeof costs, "%.6f,%s,%lu", o->deviation, units,
                      (unsigned long)o->effort);
         }
-        fprintf(f, "%llu,%lu,%lu,%lu,%lu,%lu,%lu,%s,%s,%s,%llu,%llu,%lu,%.1f\n",
+        fprintf(f, "%llu,%lu,%lu,%lu,%lu,%lu,%lu,%s,%s,%s,%llu,%llu,%lu,%.1f%s\n",
                 (unsigned long long)seed, (unsigned long)r->vehicles, (unsigned long)r->index,
                 (unsigned long)r->redraws, (unsigned long)r->info.hills,
                 (unsigned long)r->info.tracks, (unsigned long)r->first_conflict_step,
                 coavoid_mc_method_names[m], coavoid_output_status_name(o->status), costs,
                 (unsigned long long)o->expanded, (unsigned long long)o->generated,
-                (unsigned long)o->orders_tried, o->time_us);
+                (unsigned long)o->orders_tried, o->time_us, network);
     }
 }
 
-/* With fly: a row per closed-loop mode, method flown_MODE, status separated or
- * loss_of_separation (the plan's columns empty). */
-static void csv_flown_rows(FILE *f, uint64_t seed, const coavoid_mc_result_t *r)
+/* A closed-loop row: method flown_NAME, status separated or loss_of_separation, the
+ * plan's columns empty, the network's, and the stop point's (stop: "S,M", or ","). */
+static void csv_flown_row(FILE *f, const coavoid_montecarlo_config_t *c,
+                          const coavoid_mc_result_t *r, const char *name, bool lost,
+                          const char *network, const char *stop)
 {
+    fprintf(f, "%llu,%lu,%lu,%lu,%lu,%lu,%lu,flown_%s,%s,,,,,,,,%s,%s\n",
+            (unsigned long long)c->seed, (unsigned long)r->vehicles, (unsigned long)r->index,
+            (unsigned long)r->redraws, (unsigned long)r->info.hills, (unsigned long)r->info.tracks,
+            (unsigned long)r->first_conflict_step, name, lost ? "loss_of_separation" : "separated",
+            network, stop);
+}
+
+/* With fly: a row per closed-loop mode; with the sweep, a row flown_centralised_stop per
+ * stop point (stop_step, stop_messages: `coavoid sim --coordinator-stops S:M`). */
+static void csv_flown_rows(FILE *f, const coavoid_montecarlo_config_t *c,
+                           const coavoid_mc_result_t *r)
+{
+    char network[128];
+    csv_network(c, r, network, sizeof network);
     for (int mode = 0; mode < COAVOID_MC_FLY_MODES; mode++) {
-        fprintf(f, "%llu,%lu,%lu,%lu,%lu,%lu,%lu,flown_%s,%s,,,,,,,\n", (unsigned long long)seed,
-                (unsigned long)r->vehicles, (unsigned long)r->index, (unsigned long)r->redraws,
-                (unsigned long)r->info.hills, (unsigned long)r->info.tracks,
-                (unsigned long)r->first_conflict_step, coavoid_mc_fly_mode_names[mode],
-                r->flown[mode].loss_of_separation ? "loss_of_separation" : "separated");
+        csv_flown_row(f, c, r, coavoid_mc_fly_mode_names[mode], r->flown[mode].loss_of_separation,
+                      network, ",");
+    }
+    const coavoid_mc_sweep_t *w = &r->sweep;
+    uint32_t j = 0;
+    for (uint32_t k = 0; c->stops_sweep && k < w->cycles; k++) {
+        const uint32_t points = w->sent[k] > 0u ? w->sent[k] : 1u;
+        for (uint32_t m = 0; m < points && j < w->runs; m++) {
+            if (!coavoid_mc_stop_flown(m, w->sent[k], c->stops_ends)) {
+                continue;
+            }
+            char stop[32];
+            snprintf(stop, sizeof stop, "%lu,%lu", (unsigned long)k, (unsigned long)m);
+            csv_flown_row(f, c, r, "centralised_stop", (w->lost[j / 8u] >> (j % 8u)) & 1u, network,
+                          stop);
+            j++;
+        }
     }
 }
 
@@ -503,10 +553,10 @@ static void write_ready(mc_run_t *run, FILE *csv, mc_progress_t *prog, uint32_t 
     for (; *written < ready; (*written)++) {
         const coavoid_mc_result_t *r = &run->mc->results[*written];
         if (csv != NULL) {
-            csv_rows(csv, c->seed, r);
+            csv_rows(csv, c, r);
         }
         if (csv != NULL && c->fly) {
-            csv_flown_rows(csv, c->seed, r);
+            csv_flown_rows(csv, c, r);
         }
         if (r->defect[0] != '\0') {
             if (prog->line_open) {
@@ -604,6 +654,10 @@ static int check_config(const coavoid_montecarlo_config_t *c, coavoid_run_error_
                                 "--loss, --delay, --jitter: a loss from 0 to below 1, and a "
                                 "delay plus jitter (s, each >= 0) under the encounters' dt of %g s",
                                 dt);
+    }
+    if (!c->fly && (c->stops_sweep || c->has_net_seed)) {
+        return coavoid_run_fail(e, COAVOID_RUN_ERR_INPUT, "%s: only with --fly (the closed loop)",
+                                c->stops_sweep ? "--coordinator-stops-sweep" : "--net-seed");
     }
 #ifndef COAVOID_HAVE_LCM
     if (c->fly) {
@@ -735,7 +789,8 @@ int coavoid_montecarlo_run(const coavoid_montecarlo_config_t *config, coavoid_mo
             coavoid_run_fail(e, COAVOID_RUN_ERR_INPUT, "--count: out of memory for %lu encounters",
                              (unsigned long)total);
     }
-    if (status == COAVOID_RUN_DONE && csv != NULL && fputs(MC_CSV_HEADER, csv) < 0) {
+    if (status == COAVOID_RUN_DONE && csv != NULL &&
+        fputs(config->fly ? MC_CSV_HEADER_FLY : MC_CSV_HEADER, csv) < 0) {
         status = coavoid_run_fail(e, COAVOID_RUN_ERR_INTERNAL, "--csv: cannot write '%.200s'",
                                   config->csv);
     }

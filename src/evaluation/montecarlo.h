@@ -85,6 +85,21 @@ typedef struct {
      * encounters that the one-shot centralised plan, or some priority order, solves. */
     bool fly;
     double loss, delay, jitter;
+    /* The network's seed (fly): each encounter's stream is drawn from (net_seed, UAV
+     * count, index), so that one set of encounters can meet other networks; has_net_seed
+     * false: from seed, as before there was a choice (the same numbers). */
+    bool has_net_seed;
+    uint64_t net_seed;
+    /* With fly, issue 14 item 4: each encounter is also flown centralised with the
+     * coordinator stopped at every cycle s = 0..2N and, in each, at every cut point
+     * M = 0..C(s)-1 (C(s): the messages it sent in cycle s of the unstopped run; the run
+     * is that run up to the cut, so these are all the places it can stop; M = C(s) is
+     * s+1:0), or with stops_ends only M = 0, 1, C(s)/2 and C(s)-1; a cycle it sent nothing
+     * in, M = 0 (sim.h, stop_step and stop_messages). The same network seed as the other
+     * runs. The report counts the runs that lose separation, and those in encounters the
+     * decoupled closed loop keeps separated. */
+    bool stops_sweep;
+    bool stops_ends;
 } coavoid_montecarlo_config_t;
 
 /* The encounters of a run and their outcomes; opaque. */
@@ -115,6 +130,20 @@ int coavoid_montecarlo_run(const coavoid_montecarlo_config_t *config, coavoid_mo
  * count and method; no memory beyond cJSON's tree for json. */
 int coavoid_montecarlo_report(coavoid_montecarlo_t *mc, FILE *out, bool json,
                               coavoid_run_error_t *e);
+
+/* CSV files montecarlo_figure reads at most: one run per loss level. */
+#define COAVOID_MC_FIGURE_MAX_FILES 16u
+
+/* The closed loop's figure across runs: reads the CSV files of montecarlo --fly runs
+ * (each at one loss; those at the same loss add up; every one with the first's delay and
+ * jitter) and writes svg_path: per UAV count (colour) and mode (solid centralised, dashed
+ * decoupled) the rate of encounters that lose separation, with its 95 % Wilson interval,
+ * against the loss; prints the points as a table on out. The files are untrusted: each is
+ * checked line by line (the --fly header, 22 fields, the UAV count, status and network of
+ * every flown row, lines of at most 1,023 bytes and 5e7 lines), and the first problem is
+ * COAVOID_RUN_ERR_INPUT with e naming the file and line. Memory: about 6 kB. */
+int coavoid_montecarlo_figure(const char *const *csv_paths, size_t count, const char *svg_path,
+                              FILE *out, coavoid_run_error_t *e);
 
 /* Frees a run (NULL is fine). */
 void coavoid_montecarlo_free(coavoid_montecarlo_t *mc);

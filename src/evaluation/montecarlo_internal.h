@@ -40,6 +40,30 @@ typedef struct {
     uint64_t sent, delivered, dropped;
 } coavoid_mc_flown_t;
 
+/* The cycles a closed-loop run may fly (2N + 1 of the design), and the stop points of a
+ * sweep, at most: far more than the design's 25 cycles of at most a few dozen messages. */
+#define COAVOID_MC_MAX_CYCLES 64u
+#define COAVOID_MC_MAX_STOPS 4096u
+
+/* An encounter's coordinator-stop sweep (config stops_sweep). */
+typedef struct {
+    uint32_t runs, losses; /* stopped runs, and those that lost separation */
+    /* The first stop point (cycle, messages) that lost separation, when losses > 0. */
+    uint32_t loss_step, loss_messages;
+    uint32_t cycles;                        /* cycles of the unstopped centralised run */
+    uint16_t sent[COAVOID_MC_MAX_CYCLES];   /* its messages in each */
+    uint8_t lost[COAVOID_MC_MAX_STOPS / 8]; /* bit j: stop point j (coavoid_mc_stop_flown) lost */
+} coavoid_mc_sweep_t;
+
+/* Whether the sweep flies cut point m of a cycle in which the coordinator sent `sent`
+ * messages unstopped (m < sent, or m = 0 when it sent none): every one, or with ends only
+ * the first two, the middle and the last. Stop points are numbered in order of cycle,
+ * then m, over the flown ones. */
+static inline bool coavoid_mc_stop_flown(uint32_t m, uint32_t sent, bool ends)
+{
+    return !ends || m <= 1u || m == sent / 2u || m + 1u == sent;
+}
+
 typedef struct {
     uint32_t vehicles, index;
     uint32_t redraws;
@@ -47,7 +71,9 @@ typedef struct {
     uint32_t first_conflict_step;
     coavoid_mc_outcome_t m[COAVOID_MC_METHODS];
     coavoid_mc_flown_t flown[COAVOID_MC_FLY_MODES]; /* with fly */
-    char defect[256];                               /* empty unless a check failed */
+    uint64_t net_seed; /* with fly: its runs' network seed (coavoid sim --seed replays them) */
+    coavoid_mc_sweep_t sweep; /* with stops_sweep */
+    char defect[256];         /* empty unless a check failed */
 } coavoid_mc_result_t;
 
 /* A UAV count and the planners' limits for it. */
@@ -71,6 +97,15 @@ struct coavoid_montecarlo {
  * Defined only with the messaging library (COAVOID_HAVE_LCM). */
 int coavoid_mc_fly(const coavoid_montecarlo_config_t *c, const coavoid_mc_size_t *size,
                    coavoid_mc_result_t *r, char *err, size_t err_size);
+
+/* The header of a montecarlo --fly CSV (without its newline): the figure checks it. */
+#define COAVOID_MC_CSV_HEADER_FLY_LINE                                            \
+    "seed,vehicles,index,redraws,hills,tracks,first_conflict_step,method,status," \
+    "deviation,deviation_units,effort,expanded,generated,orders_tried,time_us,"   \
+    "loss,delay,jitter,net_seed,stop_step,stop_messages"
+
+/* k successes of n (n >= 1): the rate and its 95 % Wilson interval. */
+void coavoid_mc_wilson(uint32_t k, uint32_t n, double *rate, double *low, double *high);
 
 /* A 128-bit cost as a double, for ratios: exact enough for them, and it never overflows. */
 static inline double coavoid_mc_cost_real(coa_cost_t c)

@@ -90,14 +90,23 @@ typedef struct {
     uint64_t fallbacks, sent, delivered, dropped;
 } mc_fly_summary_t;
 
+/* The coordinator-stop sweep (config stops_sweep) over a UAV count's encounters. */
+typedef struct {
+    uint32_t runs, losses, encounters_lost;
+    /* The encounters the decoupled closed loop (same network) keeps separated, and the
+     * stopped runs and encounters that lose separation among them: the target is none. */
+    uint32_t kept, kept_losses, kept_encounters_lost;
+} mc_sweep_summary_t;
+
 typedef struct {
     coavoid_mc_size_t size;
     uint32_t encounters, redraws;
     mc_method_summary_t m[COAVOID_MC_METHODS];
     mc_fly_summary_t fly[COAVOID_MC_FLY_MODES];
+    mc_sweep_summary_t sweep;
 } mc_summary_t;
 
-static void wilson(uint32_t k, uint32_t n, double *rate, double *low, double *high)
+void coavoid_mc_wilson(uint32_t k, uint32_t n, double *rate, double *low, double *high)
 {
     double p = (double)k / n, z2 = MC_Z95 * MC_Z95, nn = (double)n;
     double centre = (p + z2 / (2.0 * nn)) / (1.0 + z2 / nn);
@@ -129,7 +138,23 @@ static void summarise_fly(const coavoid_mc_result_t *results, uint32_t count, mc
             f->delivered += flown->delivered;
             f->dropped += flown->dropped;
         }
-        wilson(f->losses, count, &f->rate, &f->low, &f->high);
+        coavoid_mc_wilson(f->losses, count, &f->rate, &f->low, &f->high);
+    }
+}
+
+/* The coordinator-stop sweeps of count results (config stops_sweep) into s->sweep. */
+static void summarise_sweep(const coavoid_mc_result_t *results, uint32_t count, mc_summary_t *s)
+{
+    mc_sweep_summary_t *w = &s->sweep;
+    for (uint32_t j = 0; j < count; j++) {
+        const coavoid_mc_sweep_t *r = &results[j].sweep;
+        const bool kept = !results[j].flown[COAVOID_MC_FLY_DECOUPLED].loss_of_separation;
+        w->runs += r->runs;
+        w->losses += r->losses;
+        w->encounters_lost += r->losses > 0u;
+        w->kept += kept;
+        w->kept_losses += kept ? r->losses : 0u;
+        w->kept_encounters_lost += kept && r->losses > 0u;
     }
 }
 
@@ -152,7 +177,7 @@ static void summarise(const coavoid_mc_result_t *results, uint32_t count,
             ms->budget += st == COA_PLAN_BUDGET_EXHAUSTED;
             x[j] = results[j].m[m].time_us * 1e-3;
         }
-        wilson(ms->solved, count, &ms->rate, &ms->low, &ms->high);
+        coavoid_mc_wilson(ms->solved, count, &ms->rate, &ms->low, &ms->high);
         ms->time_ms = distribution(x, count, 0u);
         for (uint32_t j = 0; j < count; j++) {
             x[j] = (double)results[j].m[m].expanded;
@@ -238,8 +263,12 @@ static void text_fly(FILE *f, const coavoid_montecarlo_config_t *o, const mc_sum
 {
     fprintf(f,
             "\nclosed loop: each encounter flown by the nodes (insecure) over a network with "
-            "loss %g, delay %g s, jitter %g s\n",
+            "loss %g, delay %g s, jitter %g s",
             o->loss, o->delay, o->jitter);
+    if (o->has_net_seed) {
+        fprintf(f, ", network seed %llu", (unsigned long long)o->net_seed);
+    }
+    fputc('\n', f);
     fprintf(f, "  %4s %-12s %7s %7s %16s %9s %7s %9s %7s %10s %8s\n", "UAVs", "mode", "losses",
             "rate", "95% Wilson", "c-solved", "losses", "o-solved", "losses", "fallbacks",
             "dropped");
@@ -260,6 +289,44 @@ static void text_fly(FILE *f, const coavoid_montecarlo_config_t *o, const mc_sum
     fprintf(f, "losses: encounters with a loss of separation; c-solved, o-solved: encounters the "
                "one-shot\ncentralised plan, or some priority order, solves, and the losses among "
                "them;\nfallbacks: per encounter; dropped: share of the copies to other nodes\n");
+}
+
+/* The sweep's table (config stops_sweep), and the first stop points that lost separation
+ * where decoupled kept it, each with what replays it. */
+static void text_sweep(FILE *f, const coavoid_montecarlo_t *mc, const mc_summary_t *s)
+{
+    const coavoid_montecarlo_config_t *o = &mc->config;
+    fprintf(f,
+            "\ncoordinator stopped (centralised, same network): at every cycle and %s\n"
+            "  %4s %10s %8s %7s %10s %10s %10s %10s\n",
+            o->stops_ends ? "cut points 0, 1, middle, last of its messages"
+                          : "every cut point of its messages",
+            "UAVs", "runs", "losses", "rate", "enc_lost", "d-kept", "losses", "enc_lost");
+    for (uint32_t k = 0; k < o->size_count; k++) {
+        const mc_sweep_summary_t *w = &s[k].sweep;
+        fprintf(f, "  %4lu %10lu %8lu %6.2f%% %10lu %10lu %10lu %10lu\n",
+                (unsigned long)s[k].size.n, (unsigned long)w->runs, (unsigned long)w->losses,
+                w->runs > 0u ? 100.0 * w->losses / w->runs : 0.0, (unsigned long)w->encounters_lost,
+                (unsigned long)w->kept, (unsigned long)w->kept_losses,
+                (unsigned long)w->kept_encounters_lost);
+    }
+    fprintf(f, "losses, rate: stopped runs that lost separation; enc_lost: encounters with one; "
+               "d-kept: encounters\nthe decoupled closed loop keeps separated, then the runs and "
+               "encounters lost among them\n");
+    uint32_t listed = 0;
+    for (uint32_t j = 0; j < mc->total && listed < 10u; j++) {
+        const coavoid_mc_result_t *r = &mc->results[j];
+        if (r->sweep.losses == 0u || r->flown[COAVOID_MC_FLY_DECOUPLED].loss_of_separation) {
+            continue;
+        }
+        fprintf(f,
+                "  %lu UAVs, encounter %lu: %lu runs lost, first --coordinator-stops %lu:%lu "
+                "(coavoid sim --insecure --seed %llu)\n",
+                (unsigned long)r->vehicles, (unsigned long)r->index, (unsigned long)r->sweep.losses,
+                (unsigned long)r->sweep.loss_step, (unsigned long)r->sweep.loss_messages,
+                (unsigned long long)r->net_seed);
+        listed++;
+    }
 }
 
 static bool add_dist(cJSON *parent, const char *name, const mc_dist_t *d, bool with_equal)
@@ -309,14 +376,33 @@ static bool json_fly(cJSON *item, const mc_summary_t *z)
     return ok;
 }
 
+/* A UAV count's coordinator-stop sweep (config stops_sweep): "coordinator_stops". */
+static bool json_sweep(cJSON *item, const mc_summary_t *z)
+{
+    const mc_sweep_summary_t *w = &z->sweep;
+    cJSON *o = cJSON_AddObjectToObject(item, "coordinator_stops");
+    return o != NULL && cJSON_AddNumberToObject(o, "runs", w->runs) != NULL &&
+           cJSON_AddNumberToObject(o, "losses", w->losses) != NULL &&
+           cJSON_AddNumberToObject(o, "encounters_with_losses", w->encounters_lost) != NULL &&
+           cJSON_AddNumberToObject(o, "decoupled_separated", w->kept) != NULL &&
+           cJSON_AddNumberToObject(o, "losses_where_decoupled_separated", w->kept_losses) != NULL &&
+           cJSON_AddNumberToObject(o, "encounters_with_losses_where_decoupled_separated",
+                                   w->kept_encounters_lost) != NULL;
+}
+
 /* The closed loop's network settings (config fly): "network". */
 static bool json_network(cJSON *root, const coavoid_montecarlo_config_t *o)
 {
     cJSON *n = cJSON_AddObjectToObject(root, "network");
+    char seed[32];
+    snprintf(seed, sizeof seed, "%llu", (unsigned long long)o->net_seed);
     return n != NULL && cJSON_AddNumberToObject(n, "loss", o->loss) != NULL &&
            cJSON_AddNumberToObject(n, "delay", o->delay) != NULL &&
            cJSON_AddNumberToObject(n, "jitter", o->jitter) != NULL &&
-           cJSON_AddBoolToObject(n, "insecure", true) != NULL;
+           cJSON_AddBoolToObject(n, "insecure", true) != NULL &&
+           (!o->has_net_seed || cJSON_AddRawToObject(n, "net_seed", seed) != NULL) &&
+           (!o->stops_sweep || cJSON_AddStringToObject(n, "coordinator_stops",
+                                                       o->stops_ends ? "ends" : "all") != NULL);
 }
 
 static int json_summary(FILE *f, const coavoid_montecarlo_config_t *o, const mc_summary_t *s,
@@ -369,7 +455,7 @@ static int json_summary(FILE *f, const coavoid_montecarlo_config_t *o, const mc_
                                              ms->central_mean_deviation_both) != NULL;
             }
         }
-        ok = ok && (!o->fly || json_fly(item, z));
+        ok = ok && (!o->fly || json_fly(item, z)) && (!o->stops_sweep || json_sweep(item, z));
     }
     ok = ok && (!o->fly || json_network(root, o));
     if (!ok) {
@@ -624,6 +710,9 @@ int coavoid_montecarlo_report(coavoid_montecarlo_t *mc, FILE *out, bool json,
         if (o->fly) {
             summarise_fly(&mc->results[k * o->count], o->count, &summary[k]);
         }
+        if (o->stops_sweep) {
+            summarise_sweep(&mc->results[k * o->count], o->count, &summary[k]);
+        }
     }
     if (o->svg != NULL && write_svg(o->svg, o, mc, summary, o->size_count, mc->x) != 0) {
         return coavoid_run_fail(e, COAVOID_RUN_ERR_INTERNAL, "--svg: cannot write '%.200s'",
@@ -636,6 +725,9 @@ int coavoid_montecarlo_report(coavoid_montecarlo_t *mc, FILE *out, bool json,
         text_summary(out, o, summary, o->size_count);
         if (o->fly) {
             text_fly(out, o, summary, o->size_count);
+        }
+        if (o->stops_sweep) {
+            text_sweep(out, mc, summary);
         }
     }
     if (rc != 0 || fflush(out) != 0 || ferror(out)) {

@@ -37,6 +37,11 @@ typedef struct {
     lcm_t *rx; /* NULL: it receives nothing */
     lcm_subscription_t *heard;
     bool stopped;
+    bool limited; /* coavoid_sim_net_stop_after: only `allowance` more go out */
+    uint64_t allowance;
+    uint64_t sent; /* its messages that went out */
+    coavoid_sim_net_tap_t tap;
+    void *tap_user;
     double loss;
 } net_node_t;
 
@@ -54,7 +59,20 @@ struct coavoid_sim_net {
     size_t heap_count;
     uint64_t order;
     coavoid_sim_net_stats_t stats;
+    uint64_t digest;
 };
+
+#define NET_FNV_OFFSET UINT64_C(14695981039346656037)
+#define NET_FNV_PRIME UINT64_C(1099511628211)
+
+static uint64_t fnv(uint64_t h, const void *data, size_t size)
+{
+    const uint8_t *b = data;
+    for (size_t k = 0; k < size; k++) {
+        h = (h ^ b[k]) * NET_FNV_PRIME;
+    }
+    return h;
+}
 
 /* Uniform in [0, 1), from the seeded stream (prng.h: the same for a seed everywhere). */
 static double net_uniform(coavoid_sim_net_t *net)
@@ -153,7 +171,21 @@ static void on_sent(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
 {
     net_node_t *from = user;
     coavoid_sim_net_t *net = from->net;
+    /* A cut link: the message never leaves the node, and nothing is drawn for it. */
+    if (from->limited && from->allowance == 0u) {
+        net->stats.cut++;
+        return;
+    }
+    from->allowance -= from->limited ? 1u : 0u;
+    from->sent++;
     net->stats.sent++;
+    const uint32_t sender = (uint32_t)from->index;
+    net->digest = fnv(net->digest, &sender, sizeof sender);
+    net->digest = fnv(net->digest, channel, strlen(channel) + 1u);
+    net->digest = fnv(net->digest, rbuf->data, rbuf->data_size);
+    if (from->tap != NULL) {
+        from->tap(from->tap_user, channel, rbuf->data, rbuf->data_size);
+    }
     if (from->rx != NULL && !from->stopped) {
         hand(net, from->index, channel, rbuf->data, rbuf->data_size);
     }
@@ -277,6 +309,33 @@ void coavoid_sim_net_stop(coavoid_sim_net_t *net, size_t i)
     net->nodes[i].stopped = true;
 }
 
+void coavoid_sim_net_stop_after(coavoid_sim_net_t *net, size_t i, uint64_t count)
+{
+    net->nodes[i].limited = true;
+    net->nodes[i].allowance = count;
+}
+
+bool coavoid_sim_net_cut(const coavoid_sim_net_t *net, size_t i)
+{
+    return net->nodes[i].limited && net->nodes[i].allowance == 0u;
+}
+
+uint64_t coavoid_sim_net_sent_by(const coavoid_sim_net_t *net, size_t i)
+{
+    return net->nodes[i].sent;
+}
+
+void coavoid_sim_net_tap(coavoid_sim_net_t *net, size_t i, coavoid_sim_net_tap_t tap, void *user)
+{
+    net->nodes[i].tap = tap;
+    net->nodes[i].tap_user = user;
+}
+
+uint64_t coavoid_sim_net_digest(const coavoid_sim_net_t *net)
+{
+    return net->digest;
+}
+
 void coavoid_sim_net_destroy(coavoid_sim_net_t *net)
 {
     if (net == NULL) {
@@ -339,6 +398,7 @@ coavoid_sim_net_t *coavoid_sim_net_create(const coavoid_sim_net_config_t *config
     }
     net->config = *config;
     net->prng.state = config->seed;
+    net->digest = NET_FNV_OFFSET;
     net->error = COA_OK;
     net->nodes = calloc(nodes, sizeof *net->nodes);
     const size_t m = config->message_capacity, c = config->copy_capacity;

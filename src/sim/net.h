@@ -48,10 +48,11 @@ typedef struct {
 /* What the network did since create. Every copy to another receiver is delivered,
  * dropped, or still in flight. Loopback copies are not counted. */
 typedef struct {
-    uint64_t sent;      /* messages published by the nodes */
+    uint64_t sent;      /* messages published by the nodes and put on the network */
     uint64_t delivered; /* copies handed to another node */
     uint64_t dropped;   /* copies lost */
     uint64_t in_flight; /* copies still waiting for their time */
+    uint64_t cut;       /* messages published after their node's cut: never copied, not sent */
 } coavoid_sim_net_stats_t;
 
 typedef struct coavoid_sim_net coavoid_sim_net_t;
@@ -75,6 +76,27 @@ lcm_t *coavoid_sim_net_rx(const coavoid_sim_net_t *net, size_t i);
 void coavoid_sim_net_set_loss(coavoid_sim_net_t *net, size_t i, double loss);
 /* Node i is gone (a coordinator stopped): no copy is made for it any more. O(1). */
 void coavoid_sim_net_stop(coavoid_sim_net_t *net, size_t i);
+/* Node i's link is cut after `count` more messages: counted from this call on, the first
+ * count it publishes go out as any other, and every later one is never copied, to no node
+ * (itself included). Whatever the messages' kinds: a node that dies between any two of its
+ * messages, mid-cycle too, with or without loss and delay (copies already made still
+ * travel). A later call sets a new count. O(1). */
+void coavoid_sim_net_stop_after(coavoid_sim_net_t *net, size_t i, uint64_t count);
+/* True once node i's count (coavoid_sim_net_stop_after) is spent: nothing more it
+ * publishes reaches anyone. O(1). */
+bool coavoid_sim_net_cut(const coavoid_sim_net_t *net, size_t i);
+/* Messages node i published that went out (the cut ones not). O(1). */
+uint64_t coavoid_sim_net_sent_by(const coavoid_sim_net_t *net, size_t i);
+
+/* Node i's tap: tap(user, channel, data, size) sees every message of node i that goes out,
+ * as it goes out (NULL: none). O(1). */
+typedef void (*coavoid_sim_net_tap_t)(void *user, const char *channel, const void *data,
+                                      uint32_t size);
+void coavoid_sim_net_tap(coavoid_sim_net_t *net, size_t i, coavoid_sim_net_tap_t tap, void *user);
+/* A digest (64-bit FNV-1a) of every message that went out so far, sender, channel and
+ * bytes, in order: two runs of the same nodes whose digests differ have sent different
+ * things (a replay checks that it still is the run it replays). O(1). */
+uint64_t coavoid_sim_net_digest(const coavoid_sim_net_t *net);
 
 /* At `now` (the nodes' clock, which must not go back between calls): takes every
  * message the nodes published since the last call (each sent at `now`), makes its copies,

@@ -58,6 +58,10 @@ typedef struct {
     size_t max_centralised;
     uint32_t coordinator_plans; /* plans the coordinator ran, when it stopped or at the end */
     coavoid_coordinator_state_t coordinator_final; /* its state then */
+    uint64_t coordinator_sent; /* its messages out at the start of the cycle (config's record) */
+    uint32_t stop_cycle_sent;  /* --coordinator-stops: its messages out in the cycle it stopped */
+    bool replaying;            /* config's tape replayed in the coordinator's place */
+    size_t coordinator_calls;  /* its calls so far, recorded or replayed */
     /* What the run holds (sim_run_free releases it). */
     coavoid_sim_net_t *net;
     int net_error; /* the network's first error (coavoid_sim_net_pump) */
@@ -420,12 +424,32 @@ static int check_message_limits(coavoid_run_error_t *err, const char *file,
     return rc;
 }
 
+/* --coordinator-stops: once the network has cut the coordinator's link (sim_stop_cycle),
+ * it is gone; checked after every pump, so that it makes no further call whichever of its
+ * calls published its last message. */
+static void sim_stop_if_cut(sim_run_t *r)
+{
+    if ((r->coordinator == NULL && !r->replaying) ||
+        !coavoid_sim_net_cut(r->net, SIM_NET_COORDINATOR)) {
+        return;
+    }
+    if (r->coordinator != NULL) {
+        r->coordinator_plans = coavoid_coordinator_state(r->coordinator)->plans_run;
+        r->coordinator_final = *coavoid_coordinator_state(r->coordinator);
+    }
+    coavoid_coordinator_destroy(r->coordinator);
+    r->coordinator = NULL;
+    r->replaying = false;
+    coavoid_sim_net_stop(r->net, SIM_NET_COORDINATOR);
+}
+
 /* Hands the nodes what they published and what is due by now. false when the network
  * failed (r->net_error says how). */
 static bool drain(sim_run_t *r)
 {
     int rc = coavoid_sim_net_pump(r->net, r->now);
     r->net_error = r->net_error != COA_OK ? r->net_error : rc;
+    sim_stop_if_cut(r);
     return rc == COA_OK;
 }
 
@@ -782,6 +806,17 @@ static int sim_coordinator(sim_run_t *r)
                                 "%s: dt: %g s leaves the coordinator no time within a cycle",
                                 r->file, (double)r->s->dt);
     }
+    if (r->o->tape != NULL && r->o->replay) {
+        /* Replayed (sim_coordinator_cycle): the node itself is never needed. */
+        r->replaying = r->o->has_stop;
+        return r->replaying ? SIM_GO_ON
+                            : coavoid_run_fail(r->err, COAVOID_RUN_ERR_INTERNAL,
+                                               "internal error: a replay without a stop");
+    }
+    if (r->o->tape != NULL) {
+        coavoid_sim_tape_clear(r->o->tape);
+        coavoid_sim_net_tap(r->net, SIM_NET_COORDINATOR, coavoid_sim_tape_message, r->o->tape);
+    }
     config.common.rx_lcm = coavoid_sim_net_rx(r->net, SIM_NET_COORDINATOR);
     r->coordinator = coavoid_coordinator_create(
         &config, coavoid_sim_net_tx(r->net, SIM_NET_COORDINATOR), &error);
@@ -804,6 +839,9 @@ static int sim_coordinator(sim_run_t *r)
  * deadline is left and no delivery is due by `until` (one due later but before a UAV's
  * deadline comes first: the clock never goes back). Keeps the first node error in
  * *node_error. False when the network failed. */
+static int64_t sim_coordinator_deadline(const sim_run_t *r);
+static int sim_coordinator_poll(sim_run_t *r);
+
 /* Polls every node once at r->now, draining what each published. True when one did. */
 static bool sim_poll(sim_run_t *r, int *node_error, bool *lcm_ok)
 {
@@ -812,8 +850,8 @@ static bool sim_poll(sim_run_t *r, int *node_error, bool *lcm_ok)
         int rc = 0;
         if (j < r->n) {
             rc = coavoid_vehicle_node_poll(r->vehicles[j], r->now);
-        } else if (r->coordinator != NULL) {
-            rc = coavoid_coordinator_poll(r->coordinator, r->now);
+        } else if (r->coordinator != NULL || r->replaying) {
+            rc = sim_coordinator_poll(r);
         }
         if (rc < 0) {
             *node_error = *node_error != COA_OK ? *node_error : rc;
@@ -836,10 +874,8 @@ static bool sim_waits(sim_run_t *r, int64_t until, int *node_error)
             int64_t d = coavoid_vehicle_node_deadline(r->vehicles[j]);
             deadline = d < deadline ? d : deadline;
         }
-        if (r->coordinator != NULL) {
-            int64_t d = coavoid_coordinator_deadline(r->coordinator);
-            deadline = d < deadline ? d : deadline;
-        }
+        const int64_t d = sim_coordinator_deadline(r);
+        deadline = d < deadline ? d : deadline;
         const int64_t due = coavoid_sim_net_next(r->net);
         if (due <= until || (deadline != INT64_MAX && due <= deadline)) {
             deadline = due;
@@ -852,6 +888,97 @@ static bool sim_waits(sim_run_t *r, int64_t until, int *node_error)
     }
 }
 
+/* The coordinator's messages of the cycle that ends now (config's record). */
+static void sim_count_coordinator(sim_run_t *r, uint32_t ended)
+{
+    const uint64_t sent = coavoid_sim_net_sent_by(r->net, SIM_NET_COORDINATOR);
+    const uint32_t count = (uint32_t)(sent - r->coordinator_sent);
+    if (r->o->coordinator_messages != NULL && ended < r->o->coordinator_messages_size) {
+        r->o->coordinator_messages[ended] = count;
+    }
+    if (r->o->has_stop && ended == r->o->stop_step) {
+        r->stop_cycle_sent = count;
+    }
+    r->coordinator_sent = sent;
+}
+
+/* At cycle k's start: the last cycle's count; then, from cycle STEP of --coordinator-stops
+ * STEP[:M], the coordinator's link is cut after M more messages (after none past STEP:
+ * it is gone by the next cycle whatever it sent), and it is gone once it is cut. */
+static void sim_stop_cycle(sim_run_t *r, uint32_t k)
+{
+    if (k > 0u) {
+        sim_count_coordinator(r, k - 1u);
+    }
+    if ((r->coordinator == NULL && !r->replaying) || !r->o->has_stop || k < r->o->stop_step) {
+        return;
+    }
+    coavoid_sim_net_stop_after(r->net, SIM_NET_COORDINATOR,
+                               k == r->o->stop_step ? r->o->stop_messages : 0u);
+    sim_stop_if_cut(r);
+}
+
+/* When the coordinator's next poll is due: its deadline, or replaying, the time of the
+ * tape's next call when that is a poll. INT64_MAX: none. */
+static int64_t sim_coordinator_deadline(const sim_run_t *r)
+{
+    if (r->replaying) {
+        int64_t at = INT64_MAX;
+        bool poll = false;
+        return coavoid_sim_tape_next(r->o->tape, r->coordinator_calls, &at, &poll) && poll
+                   ? at
+                   : INT64_MAX;
+    }
+    return r->coordinator != NULL ? coavoid_coordinator_deadline(r->coordinator) : INT64_MAX;
+}
+
+/* The coordinator's poll when it is due (its agreement steps: docs/protocol.md), recorded
+ * on or replayed from the tape as its cycles are. 1 when it published, 0 when nothing was
+ * due, or a negative error. */
+static int sim_coordinator_poll(sim_run_t *r)
+{
+    const coavoid_sim_config_t *o = r->o;
+    if (sim_coordinator_deadline(r) > r->now) {
+        return 0;
+    }
+    const uint64_t digest = coavoid_sim_net_digest(r->net);
+    if (r->replaying) {
+        int rc = coavoid_sim_tape_play(o->tape, r->coordinator_calls++, digest,
+                                       coavoid_sim_net_tx(r->net, SIM_NET_COORDINATOR),
+                                       &r->coordinator_plans);
+        return rc != COA_OK ? rc : 1;
+    }
+    if (o->tape != NULL && !coavoid_sim_tape_begin(o->tape, digest, r->now, true)) {
+        return COA_ERR_WORKSPACE;
+    }
+    int rc = coavoid_coordinator_poll(r->coordinator, r->now);
+    if (o->tape != NULL) {
+        coavoid_sim_tape_end(o->tape, coavoid_coordinator_state(r->coordinator)->plans_run);
+    }
+    return rc < 0 ? rc : 1;
+}
+
+/* The coordinator's cycle, or with a tape (config's) recorded or replayed: its messages
+ * of the call as the tape has them. */
+static int sim_coordinator_cycle(sim_run_t *r)
+{
+    const coavoid_sim_config_t *o = r->o;
+    const uint64_t digest = coavoid_sim_net_digest(r->net);
+    if (r->replaying) {
+        return coavoid_sim_tape_play(o->tape, r->coordinator_calls++, digest,
+                                     coavoid_sim_net_tx(r->net, SIM_NET_COORDINATOR),
+                                     &r->coordinator_plans);
+    }
+    if (o->tape != NULL && !coavoid_sim_tape_begin(o->tape, digest, r->now, false)) {
+        return COA_ERR_WORKSPACE;
+    }
+    int rc = coavoid_coordinator_cycle(r->coordinator, r->now);
+    if (o->tape != NULL) {
+        coavoid_sim_tape_end(o->tape, coavoid_coordinator_state(r->coordinator)->plans_run);
+    }
+    return rc;
+}
+
 /* Cycle k of the loop of node.h: what the network still carries up to its start, then
  * the world, the UAVs in priority order, their waits, then the coordinator at cycle start
  * + collect; each message reaches its receivers when the network says (at once, with
@@ -860,13 +987,7 @@ static bool sim_cycle(sim_run_t *r, uint32_t k, int *node_error)
 {
     const int64_t cycle_start = coavoid_node_cycle_utime(&r->common, (int64_t)k);
     bool lcm_ok = k == 0u || sim_waits(r, cycle_start, node_error);
-    if (r->coordinator != NULL && r->o->has_stop && k == r->o->stop_step) {
-        r->coordinator_plans = coavoid_coordinator_state(r->coordinator)->plans_run;
-        r->coordinator_final = *coavoid_coordinator_state(r->coordinator);
-        coavoid_coordinator_destroy(r->coordinator);
-        r->coordinator = NULL;
-        coavoid_sim_net_stop(r->net, SIM_NET_COORDINATOR);
-    }
+    sim_stop_cycle(r, k);
     r->now = cycle_start;
     int rc = coavoid_world_cycle(r->world, r->now);
     *node_error = *node_error != COA_OK ? *node_error : rc;
@@ -878,9 +999,9 @@ static bool sim_cycle(sim_run_t *r, uint32_t k, int *node_error)
     }
     lcm_ok = lcm_ok && sim_waits(r, cycle_start + r->collect_us, node_error);
     /* The coordinator plans cycles 0..K-1: cycle K only flies the last sample. */
-    if (r->coordinator != NULL && k < r->steps && lcm_ok) {
+    if ((r->coordinator != NULL || r->replaying) && k < r->steps && lcm_ok) {
         r->now = cycle_start + r->collect_us > r->now ? cycle_start + r->collect_us : r->now;
-        rc = coavoid_coordinator_cycle(r->coordinator, r->now);
+        rc = sim_coordinator_cycle(r);
         *node_error = *node_error != COA_OK ? *node_error : rc;
         lcm_ok = drain(r);
     }
@@ -901,6 +1022,7 @@ static int sim_fly(sim_run_t *r)
     for (uint32_t k = 0; k <= r->steps && lcm_ok; k++) {
         lcm_ok = sim_cycle(r, k, &node_error);
     }
+    sim_count_coordinator(r, r->steps);
     if (r->coordinator != NULL) {
         r->coordinator_plans = coavoid_coordinator_state(r->coordinator)->plans_run;
         r->coordinator_final = *coavoid_coordinator_state(r->coordinator);
@@ -946,17 +1068,25 @@ static int sim_write(const sim_run_t *r, uint32_t fallbacks)
     const coavoid_flight_eval_t *eval = &r->judged.eval;
     char network[512];
     network_text(r, o->json, network, sizeof network);
+    const unsigned long cut = (unsigned long)coavoid_sim_net_stats(r->net).cut;
     int rc = COA_OK;
     if (o->json) {
         char fallbacks_text[16];
-        char stopped_text[16];
+        char stopped_text[16], after_text[16], sent_text[16], cut_text[24];
         snprintf(fallbacks_text, sizeof fallbacks_text, "%lu", (unsigned long)fallbacks);
         snprintf(stopped_text, sizeof stopped_text, "%lu", (unsigned long)o->stop_step);
-        coavoid_flight_extra_t extra[3] = {
-            {"fallbacks", fallbacks_text}, {NULL, NULL}, {NULL, NULL}};
+        snprintf(after_text, sizeof after_text, "%lu", (unsigned long)o->stop_messages);
+        snprintf(sent_text, sizeof sent_text, "%lu", (unsigned long)r->stop_cycle_sent);
+        snprintf(cut_text, sizeof cut_text, "%lu", cut);
+        coavoid_flight_extra_t extra[6] = {{"fallbacks", fallbacks_text}};
         size_t count = 1u;
         if (o->has_stop) {
             extra[count++] = (coavoid_flight_extra_t){"coordinator_stopped_at", stopped_text};
+        }
+        if (o->has_stop && o->has_stop_messages) {
+            extra[count++] = (coavoid_flight_extra_t){"coordinator_stopped_after", after_text};
+            extra[count++] = (coavoid_flight_extra_t){"coordinator_messages_sent", sent_text};
+            extra[count++] = (coavoid_flight_extra_t){"coordinator_messages_cut", cut_text};
         }
         if (o->network) {
             extra[count++] = (coavoid_flight_extra_t){"network", network};
@@ -965,9 +1095,18 @@ static int sim_write(const sim_run_t *r, uint32_t fallbacks)
     } else {
         rc = coavoid_flight_text(flight, eval, r->out);
         if (rc == COA_OK && (fprintf(r->out, "fallbacks: %lu\n", (unsigned long)fallbacks) < 0 ||
-                             (o->network && fputs(network, r->out) < 0) || fflush(r->out) != 0)) {
+                             (o->network && fputs(network, r->out) < 0))) {
             rc = COA_ERR_WORKSPACE;
         }
+        if (rc == COA_OK && o->has_stop && o->has_stop_messages &&
+            fprintf(r->out,
+                    "coordinator: stopped in cycle %lu after %lu of its messages (%lu went out "
+                    "in it, %lu more were cut)\n",
+                    (unsigned long)o->stop_step, (unsigned long)o->stop_messages,
+                    (unsigned long)r->stop_cycle_sent, cut) < 0) {
+            rc = COA_ERR_WORKSPACE;
+        }
+        rc = rc == COA_OK && fflush(r->out) != 0 ? COA_ERR_WORKSPACE : rc;
     }
     return rc;
 }

@@ -30,6 +30,7 @@
 #include "auth.h"
 #include "run.h"
 #include "scenario.h"
+#include "tape.h"
 
 /* What both return: the run's verdict (the values of run.h's verdicts, so that one mapping
  * to exit statuses serves every program), or run.h's COAVOID_RUN_ERR_INPUT (the scenario,
@@ -45,10 +46,32 @@ typedef struct {
     const char *scenario_path; /* names the scenario in reports */
     const char *mode;          /* "centralised" or "decoupled", as the result names it */
     bool decoupled;
-    bool has_steps;       /* steps given; otherwise 2 * horizon */
-    uint32_t steps;       /* samples 0..steps are flown, >= 1 */
-    bool has_stop;        /* centralised: the coordinator stops before step stop_step */
-    uint32_t stop_step;   /* 0..steps */
+    bool has_steps;     /* steps given; otherwise 2 * horizon */
+    uint32_t steps;     /* samples 0..steps are flown, >= 1 */
+    bool has_stop;      /* centralised: the coordinator stops in cycle stop_step */
+    uint32_t stop_step; /* 0..steps */
+    /* With has_stop: the coordinator's first stop_messages messages published in cycle
+     * stop_step go out (to whom the network delivers them), whatever their kinds, and then
+     * it is gone: the network copies nothing more of it (net.h, coavoid_sim_net_stop_after)
+     * and it is destroyed. 0 (and has_stop_messages false: `--coordinator-stops STEP`):
+     * before it publishes anything in the cycle. A cycle runs from its start to the next's
+     * (what a node publishes while the clock runs up to the next start is of this cycle);
+     * has_stop_messages only adds the count to the result. */
+    bool has_stop_messages;
+    uint32_t stop_messages;
+    /* NULL, or where to record, for each cycle k < coordinator_messages_size, how many
+     * messages the coordinator put on the network in it (a sweep's cut points). */
+    uint32_t *coordinator_messages;
+    size_t coordinator_messages_size;
+    /* NULL, or a tape (tape.h) of the coordinator. replay false: this run's coordinator is
+     * recorded on it (cleared first). replay true, with has_stop: the coordinator is not
+     * run; the tape's messages, recorded in a run of the same scenario and settings
+     * without the stop, are published at its calls instead, until the cut. The run is the
+     * same (the stopped run is the unstopped one up to the cut) without repeating the
+     * coordinator's searches; a run that is not the recorded one (the network's digest
+     * before a call is not the tape's) is an internal error, never a silent difference. */
+    coavoid_sim_tape_t *tape;
+    bool replay;
     bool json;            /* the result as JSON (default: text) */
     const char *svg_path; /* NULL, or where the figure goes */
     /* The nodes sign and check every message (default), with the simulation's fixed keys

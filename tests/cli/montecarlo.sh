@@ -236,6 +236,82 @@ else
     fail "montecarlo --help: $(head -c 300 "$tmp/help")"
 fi
 
+# --figure-from: the closed loop's figure from several --fly runs' CSVs (written here, so
+# that the test needs no simulation): the table's counts are the files', the same loss in
+# two files adds up, the SVG is well formed with a series per UAV count and mode.
+python3 - "$tmp" <<'PY'
+import random, sys
+head = ("seed,vehicles,index,redraws,hills,tracks,first_conflict_step,method,status,"
+        "deviation,deviation_units,effort,expanded,generated,orders_tried,time_us,"
+        "loss,delay,jitter,net_seed,stop_step,stop_messages")
+rng = random.Random(5)
+def write(path, loss, rows, delay="0"):
+    with open(path, "w") as f:
+        f.write(head + "\n")
+        for n, i, mode, lost in rows:
+            f.write(f"1,{n},{i},0,1,0,3,centralised,solved,1.0,8,1,5,5,1,3.0,{loss},{delay},0,9,,\n")
+            f.write(f"1,{n},{i},0,1,0,3,flown_{mode},{'loss_of_separation' if lost else 'separated'}"
+                    f",,,,,,,,{loss},{delay},0,9,,\n")
+            f.write(f"1,{n},{i},0,1,0,3,flown_centralised_stop,loss_of_separation,,,,,,,,{loss},{delay},0,9,0,0\n")
+for name, loss in (("f0", "0"), ("f3", "0.3"), ("f3b", "0.3"), ("f5", "0.5")):
+    write(f"{sys.argv[1]}/{name}.csv", loss,
+          [(n, i, m, rng.random() < 0.4) for n in (2, 4) for i in range(7) for m in ("centralised", "decoupled")])
+write(f"{sys.argv[1]}/delay.csv", "0.3", [(2, 0, "centralised", False)], delay="0.1")
+PY
+if "$bin" montecarlo --figure-from "$tmp/f0.csv,$tmp/f3.csv,$tmp/f5.csv,$tmp/f3b.csv" --svg "$tmp/fig.svg" >"$tmp/fig.txt" 2>"$tmp/err" && [ ! -s "$tmp/err" ]; then
+    if python3 - "$tmp" <<'PY'; then pass; else fail "--figure-from: table or figure wrong"; fi
+import csv, re, sys
+import xml.dom.minidom
+d = sys.argv[1]
+want = {}
+for name in ("f0", "f3", "f5", "f3b"):
+    for r in csv.DictReader(open(f"{d}/{name}.csv")):
+        if r["method"] in ("flown_centralised", "flown_decoupled"):
+            k = (int(r["vehicles"]), r["method"][6:], float(r["loss"]))
+            e, l = want.get(k, (0, 0))
+            want[k] = (e + 1, l + (r["status"] == "loss_of_separation"))
+got = {}
+for line in open(f"{d}/fig.txt").read().splitlines()[2:]:
+    n, mode, loss, enc, lost = line.split()[:5]
+    got[(int(n), mode, float(loss.rstrip("%")) / 100)] = (int(enc), int(lost))
+assert got == want, (got, want)
+svg = xml.dom.minidom.parse(f"{d}/fig.svg")
+polylines = svg.getElementsByTagName("polyline")
+assert len(polylines) == 4  # 2 sizes x 2 modes
+assert len(svg.getElementsByTagName("circle")) == 12   # x 3 losses
+PY
+else
+    fail "--figure-from: exit $?: $(head -c 300 "$tmp/err")"
+fi
+head -n 5 "$tmp/f0.csv" >"$tmp/two.csv"; tail -n 3 "$tmp/f3.csv" >>"$tmp/two.csv"
+head -n 3 "$tmp/f0.csv" >"$tmp/short.csv"; printf '1,2,0,0,1,0,3,flown_decoupled,separated' >>"$tmp/short.csv"
+{ head -n 1 "$tmp/f0.csv"; echo "1,2,0,0,1,0,3,flown_decoupled,separated,,,,,,,,0,0,0,9,,,"; } >"$tmp/fields.csv"
+{ head -n 1 "$tmp/f0.csv"; echo "1,7,0,0,1,0,3,flown_decoupled,separated,,,,,,,,0,0,0,9,,"; } >"$tmp/seven.csv"
+{ head -n 1 "$tmp/f0.csv"; echo "1,2,0,0,1,0,3,flown_decoupled,crashed,,,,,,,,0,0,0,9,,"; } >"$tmp/status.csv"
+{ head -n 1 "$tmp/f0.csv"; echo "1,2,0,0,1,0,3,flown_decoupled,separated,,,,,,,,1,0,0,9,,"; } >"$tmp/loss1.csv"
+{ head -n 1 "$tmp/f0.csv"; echo "1,2,0,0,1,0,3,flown_decoupled,separated,,,,,,,,nan,0,0,9,,"; } >"$tmp/nan.csv"
+{ head -n 1 "$tmp/f0.csv"; python3 -c 'print("x" * 5000)'; } >"$tmp/long.csv"
+head -n 1 "$tmp/f0.csv" >"$tmp/empty.csv"
+"$bin" montecarlo --vehicles 2 --count 1 --quiet --csv "$tmp/plain.csv" >/dev/null 2>&1
+many=$(printf "$tmp/f0.csv,%.0s" $(seq 17)); many=${many%,}
+expect_bad "figure without svg" "--svg" montecarlo --figure-from "$tmp/f0.csv"
+expect_bad "figure with vehicles" "--figure-from" montecarlo --figure-from "$tmp/f0.csv" --svg "$tmp/g.svg" --vehicles 2
+expect_bad "figure missing file" "no-such.csv" montecarlo --figure-from "$tmp/no-such.csv" --svg "$tmp/g.svg"
+expect_bad "figure empty entry" "--figure-from" montecarlo --figure-from "$tmp/f0.csv,,$tmp/f3.csv" --svg "$tmp/g.svg"
+expect_bad "figure 17 files" "--figure-from" montecarlo --figure-from "$many" --svg "$tmp/g.svg"
+expect_bad "figure plain csv" "plain.csv:1: not the header" montecarlo --figure-from "$tmp/plain.csv" --svg "$tmp/g.svg"
+expect_bad "figure two losses" "two.csv:7: a second loss" montecarlo --figure-from "$tmp/two.csv" --svg "$tmp/g.svg"
+expect_bad "figure other delay" "delay.csv:3: delay or jitter" montecarlo --figure-from "$tmp/f3.csv,$tmp/delay.csv" --svg "$tmp/g.svg"
+expect_bad "figure no newline" "short.csv:4: a line too long, or no newline" montecarlo --figure-from "$tmp/short.csv" --svg "$tmp/g.svg"
+expect_bad "figure long line" "long.csv:2: a line too long" montecarlo --figure-from "$tmp/long.csv" --svg "$tmp/g.svg"
+expect_bad "figure fields" "fields.csv:2: not 22 fields" montecarlo --figure-from "$tmp/fields.csv" --svg "$tmp/g.svg"
+expect_bad "figure vehicles" "seven.csv:2: vehicles" montecarlo --figure-from "$tmp/seven.csv" --svg "$tmp/g.svg"
+expect_bad "figure status" "status.csv:2: a flown row's status" montecarlo --figure-from "$tmp/status.csv" --svg "$tmp/g.svg"
+expect_bad "figure loss 1" "loss1.csv:2: loss, delay or jitter" montecarlo --figure-from "$tmp/loss1.csv" --svg "$tmp/g.svg"
+expect_bad "figure nan" "nan.csv:2: loss, delay or jitter" montecarlo --figure-from "$tmp/nan.csv" --svg "$tmp/g.svg"
+expect_bad "figure no rows" "empty.csv:1: no flown rows" montecarlo --figure-from "$tmp/empty.csv" --svg "$tmp/g.svg"
+expect_bad "figure svg unwritable" "--svg" montecarlo --figure-from "$tmp/f0.csv" --svg "$tmp/none/g.svg"
+
 expect_bad "vehicles missing" "--vehicles: required" montecarlo --count 2
 also="from 2 to 6"
 expect_bad "vehicles 1" "--vehicles" montecarlo --vehicles 1

@@ -6,7 +6,7 @@
 # by a whole number of climb steps that change by actions; planning runs where there is a
 # conflict; the flown costs are at least the one-shot plan's; a run is repeatable byte for
 # byte; the UAVs fall back to planning for themselves when the coordinator stops, and stay
-# separated; a scenario already in conflict reports its loss (exit 1) instead of crashing;
+# separated; the coordinator cut after M messages of a cycle (STEP:M); a scenario already in conflict reports its loss (exit 1) instead of crashing;
 # UAVs decide in priority order whatever their ids; the simulated network (--loss, --delay,
 # --jitter, --seed) and montecarlo's closed loop (--fly) over it; bad arguments and inputs, and numbers
 # beyond what a message carries anywhere in the run, exit 2 with one line.
@@ -283,6 +283,72 @@ while IFS=, read -r seed n index _ _ _ _ method status _; do
     [ "$rc" = "$want" ] || { ok=0; echo "montecarlo-$seed-$n-$index ${method#flown_}: sim exits $rc, CSV says $status"; }
 done < <(tail -n +2 "$tmp/fly0.csv")
 if [ $ok = 1 ] && [ $seen = 8 ]; then pass; else fail "montecarlo --fly: a flown verdict differs from coavoid sim's ($seen rows)"; fi
+# The coordinator-stop sweep (--coordinator-stops-sweep), at loss 0.2 with its own network
+# seed: every stopped run's verdict is what coavoid sim says of the saved encounter
+# stopped there, with the row's network seed (so the sweep's replay of the coordinator is
+# the real stopped run), and so are the unstopped rows'; the summary is the CSV's counts.
+"$bin" montecarlo --vehicles 2,3 --count 2 --fly --loss 0.2 --net-seed 7 --coordinator-stops-sweep all \
+    --quiet --csv "$tmp/sweep.csv" --save "$tmp/mc" --json >"$tmp/sweep.json" 2>&1
+ok=1 seen=0
+while IFS=, read -r seed n index _ _ _ _ method status _ _ _ _ _ _ _ loss _ _ net s m; do
+    case $method in flown_*) ;; *) continue ;; esac
+    seen=$((seen + 1))
+    mode=${method#flown_} stop=()
+    [ "$mode" = centralised_stop ] && mode=centralised stop=(--coordinator-stops "$s:$m")
+    "$bin" sim "$tmp/mc/montecarlo-$seed-$n-$index.json" --mode "$mode" --insecure --loss "$loss" \
+        --seed "$net" "${stop[@]}" >/dev/null 2>&1
+    rc=$?
+    want=0; [ "$status" = loss_of_separation ] && want=1
+    [ "$rc" = "$want" ] || { ok=0; echo "montecarlo-$seed-$n-$index $method ${stop[*]}: sim exits $rc, CSV says $status"; }
+done < <(tail -n +2 "$tmp/sweep.csv")
+if [ $ok = 1 ] && [ $seen -gt 100 ]; then pass; else fail "montecarlo sweep: a stopped run's verdict differs from coavoid sim's ($seen rows)"; fi
+if python3 - "$tmp/sweep.json" "$tmp/sweep.csv" <<'PY'; then pass; else fail "montecarlo sweep: the summary is not the CSV's"; fi
+import csv, json, sys
+j = json.load(open(sys.argv[1]))
+rows = list(csv.DictReader(open(sys.argv[2])))
+assert j["network"]["net_seed"] == 7 and j["network"]["coordinator_stops"] == "all", j["network"]
+for z in j["sizes"]:
+    n = str(z["vehicles"])
+    kept = {r["index"] for r in rows if r["vehicles"] == n and r["method"] == "flown_decoupled"
+            and r["status"] == "separated"}
+    stops = [r for r in rows if r["vehicles"] == n and r["method"] == "flown_centralised_stop"]
+    lost = [r for r in stops if r["status"] == "loss_of_separation"]
+    want = {"runs": len(stops), "losses": len(lost),
+            "encounters_with_losses": len({r["index"] for r in lost}),
+            "decoupled_separated": len(kept),
+            "losses_where_decoupled_separated": len([r for r in lost if r["index"] in kept]),
+            "encounters_with_losses_where_decoupled_separated":
+                len({r["index"] for r in lost if r["index"] in kept})}
+    assert z["coordinator_stops"] == want, (z["coordinator_stops"], want)
+    # Every cycle is swept, at m = 0 at least, and the cut points of a cycle are 0, 1, ...
+    widest = 0
+    for i in {r["index"] for r in stops}:
+        cuts = {}
+        for r in stops:
+            if r["index"] == i:
+                cuts.setdefault(int(r["stop_step"]), []).append(int(r["stop_messages"]))
+        assert sorted(cuts) == list(range(25)), sorted(cuts)
+        assert all(v == list(range(len(v))) for v in cuts.values()), cuts
+        widest = max([widest] + [len(v) for v in cuts.values()])
+    assert widest >= 3, "no cycle with a plan: the cuts between plan rows are not swept"
+PY
+# --net-seed given as --seed is the default; another one draws another network.
+"$bin" montecarlo --vehicles 2 --count 3 --fly --loss 0.3 --quiet --csv "$tmp/ns-default.csv" >/dev/null 2>&1
+"$bin" montecarlo --vehicles 2 --count 3 --fly --loss 0.3 --net-seed 1 --quiet --csv "$tmp/ns-1.csv" >/dev/null 2>&1
+"$bin" montecarlo --vehicles 2 --count 3 --fly --loss 0.3 --net-seed 2 --quiet --csv "$tmp/ns-2.csv" >/dev/null 2>&1
+if python3 - "$tmp/ns-default.csv" "$tmp/ns-1.csv" "$tmp/ns-2.csv" <<'PY'; then pass; else fail "montecarlo --net-seed: default or effect wrong"; fi
+import csv, sys
+a, b, c = ([r[:15] + r[16:] for r in csv.reader(open(f))] for f in sys.argv[1:4])
+assert a == b
+seeds = lambda rows: {r[18] for r in rows[1:]}  # net_seed, time_us left out
+assert seeds(a).isdisjoint(seeds(c))
+assert [r[:7] for r in a] == [r[:7] for r in c], "--net-seed changed the encounters"
+PY
+expect_bad "mc net seed without fly" "--net-seed" montecarlo --vehicles 2 --count 1 --net-seed 3
+expect_bad "mc net seed word" "--net-seed" montecarlo --vehicles 2 --count 1 --fly --net-seed x
+expect_bad "mc sweep without fly" "--coordinator-stops-sweep" montecarlo --vehicles 2 --count 1 --coordinator-stops-sweep all
+expect_bad "mc sweep kind" "--coordinator-stops-sweep" montecarlo --vehicles 2 --count 1 --fly --coordinator-stops-sweep some
+expect_bad "mc sweep missing" "--coordinator-stops-sweep" montecarlo --vehicles 2 --count 1 --fly --coordinator-stops-sweep
 expect_bad "mc loss without fly" "--loss" montecarlo --vehicles 2 --count 1 --loss 0.1
 expect_bad "mc loss 1" "--loss" montecarlo --vehicles 2 --count 1 --fly --loss 1
 expect_bad "mc delay a cycle" "--delay" montecarlo --vehicles 2 --count 1 --fly --delay 0.6 --jitter 0.4
@@ -328,6 +394,71 @@ def at(u, t):
 p, q = at(v[1], 35.0), at(v[3], 35.0)
 sys.exit(0 if math.hypot(p[0] - q[0], p[1] - q[1]) < 30 and abs(p[2] - q[2]) < 10 else 1)
 PY
+
+# --coordinator-stops STEP:M, the coordinator cut after M of its messages of cycle STEP
+# (whatever they are). STEP:0 is STEP (plus the count's keys). Head-on's cycle 0 is the
+# conflict report, the plan's two rows, the heartbeat: cut after the rows, the UAVs fly
+# the coordinator's plan (500 m^2, 18) though it is gone before its heartbeat; cut after
+# the report, they fall back and plan for themselves (580 m^2, 20, as when it stops at 0).
+# The paper's cycle 0 has 8 messages (report, 1 + 2 + 3 plan rows, heartbeat).
+"$bin" sim "$scenarios/headon.json" --mode centralised --json --coordinator-stops 0 >"$tmp/stop0.json" 2>&1
+"$bin" sim "$scenarios/headon.json" --mode centralised --json --coordinator-stops 0:0 >"$tmp/stop00.json" 2>&1
+if python3 - "$tmp/stop0.json" "$tmp/stop00.json" <<'PY'; then pass; else fail "--coordinator-stops 0:0 is not --coordinator-stops 0"; fi
+import json, sys
+a, b = (json.load(open(f)) for f in sys.argv[1:3])
+extra = {k: b.pop(k) for k in ("coordinator_stopped_after", "coordinator_messages_sent",
+                               "coordinator_messages_cut")}
+assert a == b and extra == {"coordinator_stopped_after": 0, "coordinator_messages_sent": 0,
+                            "coordinator_messages_cut": 0}, extra
+PY
+# Cycle 0 of the head-on: the report, the plan's two rows, the heartbeat, then (its poll)
+# the COMMIT. Stopped after the rows, or after the heartbeat, no UAV flies the plan (all
+# or none: no COMMIT came) and the flight is that of planning alone (as stopped after
+# the report); stopped after the COMMIT, both fly it.
+sim_json headon-cut3 "$scenarios/headon.json" centralised 0 '
+r["loss_of_separation"] is False
+(r["deviation"], r["effort"]) == (580, 20)
+r["coordinator_stopped_at"] == 0 and r["coordinator_stopped_after"] == 3
+r["coordinator_messages_sent"] == 3 and r["coordinator_messages_cut"] == 1
+r["fallbacks"] == 2
+' --coordinator-stops 0:3
+sim_json headon-cut4 "$scenarios/headon.json" centralised 0 '
+r["loss_of_separation"] is False
+(r["deviation"], r["effort"]) == (580, 20)
+r["coordinator_messages_sent"] == 4
+' --coordinator-stops 0:4
+sim_json headon-cut5 "$scenarios/headon.json" centralised 0 '
+r["loss_of_separation"] is False
+(r["deviation"], r["effort"]) == (500, 18)
+r["coordinator_messages_sent"] == 5
+' --coordinator-stops 0:5
+sim_json headon-cut1 "$scenarios/headon.json" centralised 0 '
+r["loss_of_separation"] is False
+(r["deviation"], r["effort"]) == (580, 20)
+r["coordinator_messages_sent"] == 1 and r["coordinator_messages_cut"] == 3
+' --coordinator-stops 0:1
+# Cycle 0 of the paper's encounter: 14 messages (its plans, their commits, the heartbeat
+# and its copies).
+sim_json paper-cut-all "$scenarios/paper.json" centralised 0 '
+r["coordinator_messages_sent"] == 14 and r["coordinator_messages_cut"] == 0
+' --coordinator-stops 0:14
+sim_json paper-cut-beyond "$scenarios/paper.json" centralised 0 '
+r["coordinator_stopped_after"] == 20 and r["coordinator_messages_sent"] == 14
+' --coordinator-stops 0:20
+# With loss the cut is the same mechanism (the network's): a run repeats byte for byte.
+for run in 1 2; do
+    "$bin" sim "$scenarios/paper.json" --mode centralised --coordinator-stops 0:4 --loss 0.3 \
+        --delay 0.2 --seed 5 >"$tmp/cut-loss$run.txt" 2>&1
+done
+if grep -Eq '^coordinator: stopped in cycle 0 after 4 of its messages \(4 went out in it, [0-9]+ more were cut\)$' "$tmp/cut-loss1.txt" \
+    && grep -q '^network: ' "$tmp/cut-loss1.txt" && cmp -s "$tmp/cut-loss1.txt" "$tmp/cut-loss2.txt"; then
+    pass
+else
+    fail "sim --coordinator-stops 0:4 with loss: $(tail -n 2 "$tmp/cut-loss1.txt")"
+fi
+# Without :M the text is as before the cut existed: no coordinator line.
+"$bin" sim "$scenarios/headon.json" --mode centralised --coordinator-stops 0 >"$tmp/stop0.txt" 2>&1
+if ! grep -q '^coordinator:' "$tmp/stop0.txt"; then pass; else fail "--coordinator-stops 0 prints a coordinator line"; fi
 
 # A joint search that runs out of beta is not the end: the coordinator plans the cluster
 # decoupled instead. Head-on's joint search stores more than 20 nodes, while decoupled
@@ -412,6 +543,9 @@ expect_bad "svg unwritable" "--svg" sim "$h" --mode decoupled --svg "$tmp/no/suc
 expect_bad "stop decoupled" "--coordinator-stops" sim "$h" --mode decoupled --coordinator-stops 1
 expect_bad "stop after K" "--coordinator-stops" sim "$h" --mode centralised --steps 4 --coordinator-stops 5
 expect_bad "stop word" "--coordinator-stops" sim "$h" --mode centralised --coordinator-stops soon
+for bad in 1:x :1 1: 1:2:3 1:-1 -1:0 1:1000001 "1 :2"; do
+    expect_bad "stop $bad" "--coordinator-stops" sim "$h" --mode centralised --coordinator-stops "$bad"
+done
 expect_bad "unknown option" "--fast" sim "$h" --mode decoupled --fast
 expect_bad "two scenarios" "unexpected argument" sim "$h" "$h" --mode decoupled
 expect_bad "missing file" "no-such.json" sim "$tmp/no-such.json" --mode decoupled
