@@ -503,8 +503,8 @@ static void csv_flown_rows(FILE *f, const coavoid_montecarlo_config_t *c,
             }
             char stop[32];
             snprintf(stop, sizeof stop, "%lu,%lu", (unsigned long)k, (unsigned long)m);
-            csv_flown_row(f, c, r, "centralised_stop", (w->lost[j / 8u] >> (j % 8u)) & 1u, network,
-                          stop);
+            const bool lost = (((unsigned)w->lost[j / 8u] >> (j % 8u)) & 1u) != 0u;
+            csv_flown_row(f, c, r, "centralised_stop", lost, network, stop);
             j++;
         }
     }
