@@ -232,9 +232,10 @@ static void count_messages(const coavoid_bench_auth_fleet_t *f, size_t node, uin
 {
     memset(sent, 0, COAVOID_BENCH_AUTH_TYPES * sizeof *sent);
     memset(received, 0, COAVOID_BENCH_AUTH_TYPES * sizeof *received);
+    const uint32_t sends = 1u + COAVOID_NODE_DEFAULT_COPIES;
     if (node == COAVOID_BENCH_AUTH_WORLD) {
-        sent[COAVOID_AUTH_STREAM_MAP] = f->maps;
-        sent[COAVOID_AUTH_STREAM_TRACK] = f->tracks;
+        sent[COAVOID_AUTH_STREAM_MAP] = f->maps * sends;
+        sent[COAVOID_AUTH_STREAM_TRACK] = f->tracks * sends;
         return;
     }
     /* Every node that listens hears every intent (each sent 1 + COPIES times), map and
@@ -242,11 +243,10 @@ static void count_messages(const coavoid_bench_auth_fleet_t *f, size_t node, uin
      * (common.c). Every plan (one UAV each, the worst case) is agreed on: its UAV's
      * ACCEPT and SWITCHED (sent 1 + COPIES times), the coordinator's COMMIT; every node
      * that subscribes checks them all, its own looped back included. */
-    const uint32_t sends = 1u + COAVOID_NODE_DEFAULT_COPIES;
     received[COAVOID_AUTH_STREAM_INTENT] =
         (node == COAVOID_BENCH_AUTH_VEHICLE ? f->vehicles - 1u : f->vehicles) * sends;
-    received[COAVOID_AUTH_STREAM_MAP] = f->maps;
-    received[COAVOID_AUTH_STREAM_TRACK] = f->tracks;
+    received[COAVOID_AUTH_STREAM_MAP] = f->maps * sends;
+    received[COAVOID_AUTH_STREAM_TRACK] = f->tracks * sends;
     received[COAVOID_AUTH_STREAM_AGREEMENT] = f->plans * (1u + sends);
     if (node == COAVOID_BENCH_AUTH_VEHICLE) {
         sent[COAVOID_AUTH_STREAM_INTENT] = sends;

@@ -31,7 +31,8 @@
  *     agreements, the maps and the tracks;
  *   - the coordinator sends its heartbeat, the conflict report, N plans and N commits,
  *     and checks the N (1 + C) intents, N (2 + C) agreements, the maps and the tracks;
- *   - the world sends the maps and the tracks and checks nothing.
+ *   - the world sends the maps and the tracks, each 1 + C times, and checks nothing (every
+ *     node that listens checks all of them).
  * A conflict report is subscribed by none of the nodes (monitoring only).
  *
  * Memory: every node holds one signer (its key) and, unless it only publishes (the world),

@@ -49,10 +49,10 @@ for n in (3, 100):
     # sends the maps and tracks.
     maps, tracks, sends = v[p + "maps"], v[p + "tracks"], 5
     assert v[p + "vehicle_sent"] == sends + 1 + (1 + sends), n
-    assert v[p + "vehicle_received"] == sends * (n - 1) + (n + 1) + n + (2 + sends) * n + maps + tracks, n
+    assert v[p + "vehicle_received"] == sends * (n - 1) + (n + 1) + n + (2 + sends) * n + sends * (maps + tracks), n
     assert v[p + "coordinator_sent"] == 2 + 2 * n, n
-    assert v[p + "coordinator_received"] == sends * n + (1 + sends) * n + maps + tracks, n
-    assert v[p + "world_sent"] == maps + tracks and v[p + "world_received"] == 0, n
+    assert v[p + "coordinator_received"] == sends * n + (1 + sends) * n + sends * (maps + tracks), n
+    assert v[p + "world_sent"] == sends * (maps + tracks) and v[p + "world_received"] == 0, n
     assert v[p + "world_memory_bytes"] == v["signer_bytes"], n
     assert v[p + "vehicle_memory_bytes"] == v["signer_bytes"] + v["trust_list_bytes"], n
 assert len(v) == 6 + 7 * len(types) + 2 * (4 + 3 * 9), len(v)
@@ -72,9 +72,9 @@ for t in b["types"]:
 assert len(b["fleets"]) == 1 and b["fleets"][0]["vehicles"] == 5, b["fleets"]
 nodes = b["fleets"][0]["nodes"]
 assert [n["node"] for n in nodes] == ["vehicle", "coordinator", "world"], nodes
-# A vehicle: 4 intents x 5 sends, 6 heartbeats, 5 plans, 16 map tiles, 5 x 7 agreements;
+# A vehicle: 4 intents x 5 sends, 6 heartbeats, 5 plans, 16 map tiles x 5, 5 x 7 agreements;
 # the coordinator: heartbeat, report, 5 plans, 5 commits.
-assert nodes[0]["received"] == 20 + 6 + 5 + 16 + 35 and nodes[1]["sent"] == 12, nodes
+assert nodes[0]["received"] == 20 + 6 + 5 + 5 * 16 + 35 and nodes[1]["sent"] == 12, nodes
 PY
 fi
 

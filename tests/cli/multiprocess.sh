@@ -80,14 +80,20 @@ fi
 cat >"$tmp/log.py" <<'PY'
 import json, struct, sys
 sys.path.insert(0, sys.argv[2])
-from coavoid import intent_t, plan_t, track_t, obstacle_map_t, conflict_report_t, status_t
+from coavoid import intent_t, plan_t, track_t, obstacle_map_t, conflict_report_t, status_t, \
+    agreement_t
 types = {"COAVOID_INTENT": intent_t, "COAVOID_PLAN": plan_t, "COAVOID_TRACK": track_t,
          "COAVOID_OBSTACLES": obstacle_map_t, "COAVOID_CONFLICTS": conflict_report_t,
-         "COAVOID_STATUS": status_t}
+         "COAVOID_STATUS": status_t, "COAVOID_AGREEMENT": agreement_t}
 data = open(sys.argv[1], "rb").read()
 i, n = 0, 0
 counts, intents, statuses, plans, reports, rejected = {}, {}, {}, {}, [], {}
 codes, reasons, largest = {}, {}, 0
+# Against loss every intent and the coordinator's heartbeat go out with copies, and a plan
+# may go out again (docs/protocol.md): intents are counted once per UAV and cycle
+# (plan_utime), heartbeats once per node and cycle (a copy follows within half a cycle),
+# plan rows once per row.
+intent_cycles, last_status = set(), {}
 while i < len(data):
     magic, _, _, clen, dlen = struct.unpack_from(">IqqII", data, i)
     assert magic == 0xEDA1DA01, f"event {n}: bad magic at byte {i}"
@@ -105,16 +111,21 @@ while i < len(data):
     counts[channel] = counts.get(channel, 0) + 1
     largest = max(largest, dlen)
     if channel == "COAVOID_INTENT":
-        intents[m.uav_id] = intents.get(m.uav_id, 0) + 1
+        if (m.uav_id, m.plan_utime) not in intent_cycles:
+            intent_cycles.add((m.uav_id, m.plan_utime))
+            intents[m.uav_id] = intents.get(m.uav_id, 0) + 1
     elif channel == "COAVOID_STATUS":
-        statuses.setdefault(m.node_id, []).append(m.mode)
+        if m.utime - last_status.get(m.node_id, -10**18) >= 500000:
+            statuses.setdefault(m.node_id, []).append(m.mode)
+        last_status[m.node_id] = m.utime
         rejected[m.node_id] = max(rejected.get(m.node_id, 0), m.messages_rejected)
         codes.setdefault(m.node_id, set()).add(m.last_reject_code)
         reasons[m.node_id] = m.reasons
     elif channel == "COAVOID_PLAN":
         p = plans.setdefault((m.coordinator_id, m.plan_id), {
             "status": m.status, "ids": list(m.uav_ids[:m.vehicle_count]), "rows": []})
-        p["rows"].append(m.row_uav_id)
+        if m.row_uav_id not in p["rows"]:
+            p["rows"].append(m.row_uav_id)
     elif channel == "COAVOID_CONFLICTS":
         reports.append(m.conflict_count)
     n += 1
@@ -372,7 +383,7 @@ num('coordinator', 'plans published') >= 2
 sum(p['status'] == 0 for p in log['plans']) >= 2
 all(sorted(p['rows']) == sorted(p['ids']) for p in log['plans'])
 log['largest'] <= 1400
-set(log['counts']) == {'COAVOID_INTENT', 'COAVOID_PLAN', 'COAVOID_STATUS', 'COAVOID_OBSTACLES', 'COAVOID_CONFLICTS'}
+set(log['counts']) == {'COAVOID_INTENT', 'COAVOID_PLAN', 'COAVOID_STATUS', 'COAVOID_OBSTACLES', 'COAVOID_CONFLICTS', 'COAVOID_AGREEMENT'}
 log['intents'] == {str(i): 41 for i in (1, 2, 3)}
 all(len(log['statuses'][str(i)]) == 41 and set(log['statuses'][str(i)]) == {0} for i in (1, 2, 3))
 len(log['statuses']['65001']) == 40 and log['counts']['COAVOID_CONFLICTS'] == 40
