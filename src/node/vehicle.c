@@ -1003,10 +1003,6 @@ static void on_plan(void *owner, const coavoid_plan_t *msg, const coavoid_lcm_pl
         coavoid_lcm_rx_count(&node->state.rx, COA_OK, NULL); /* not a plan for it */
         return;
     }
-    if (again(node, now, msg)) {
-        coavoid_lcm_rx_count(&node->state.rx, COA_OK, NULL); /* sent again: answered again */
-        return;
-    }
     if (!node->started || msg->valid_from_utime != node->cycle_start) {
         reject_plan(node, COAVOID_LCM_ERR_TIME, "plan: valid_from is not this cycle's start");
         return;
