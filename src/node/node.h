@@ -291,6 +291,9 @@ typedef struct {
      * times it raised it since start. */
     int32_t rank;
     uint32_t rank_raises;
+    /* Times its order search found a new order for its cluster and it took its place in
+     * it (docs/protocol.md, "Priority negotiation"). */
+    uint32_t orders_agreed;
     coavoid_lcm_rx_stats_t rx;
 } coavoid_vehicle_node_state_t;
 

@@ -25,6 +25,11 @@
  * four-UAV encounters some order solves with a loss of separation; with 5 UAVs 3 and 5
  * left 12 and 11 of 29. More turns help little, and each reorders the cluster again. */
 #define RAISES_MAX 3u
+/* The order search (search_order): clusters of at most ORDER_MEMBERS_MAX UAVs, and at
+ * most ORDER_TRIES_MAX priority orders a search (5!, every order of 5 UAVs). Past that a
+ * search could take n! orders of n single-UAV searches each: the greedy raise remains. */
+#define ORDER_MEMBERS_MAX 8u
+#define ORDER_TRIES_MAX 120u
 
 struct coavoid_vehicle_node {
     coavoid_vehicle_node_config_t config;
@@ -109,6 +114,20 @@ struct coavoid_vehicle_node {
     bool include[COAVOID_NODE_MAX_PEERS];
     coavoid_intent_t tx_intent;
     coavoid_status_t tx_status;
+
+    /* The order search of this cycle (search_order): the cluster's members (indices into
+     * the view of the cycle's start), their problem, and the ranks it agreed for each
+     * member (agreed_cycle: the cycle they hold for, until each member's own intent of
+     * the cycle says its rank). */
+    size_t order_member[ORDER_MEMBERS_MAX];
+    coa_vehicle_t order_vehicles[ORDER_MEMBERS_MAX];
+    coa_vec3_t order_reference[ORDER_MEMBERS_MAX][COAVOID_NODE_MAX_SAMPLES];
+    const coa_vec3_t *order_references[ORDER_MEMBERS_MAX];
+    int32_t order_offsets[ORDER_MEMBERS_MAX * COAVOID_NODE_MAX_SAMPLES];
+    int64_t agreed_cycle;
+    size_t agreed_count;
+    uint16_t agreed_id[ORDER_MEMBERS_MAX];
+    int32_t agreed_rank[ORDER_MEMBERS_MAX];
 
     coavoid_node_solver_t solver;
     coavoid_node_inbox_t inbox;
@@ -500,6 +519,24 @@ static int plan_self(coavoid_vehicle_node_t *node, int64_t now, uint32_t my)
     return rc;
 }
 
+/* The ranks its order search agreed this cycle (search_order), for the members whose
+ * intent of the cycle has not come yet: those still announce the order of the cycle
+ * before, and it must wait for the members before it in the new one. O(peers * members). */
+static void apply_agreed(coavoid_vehicle_node_t *node)
+{
+    coavoid_node_view_t *view = &node->view;
+    if (node->agreed_cycle != node->state.cycle) {
+        return;
+    }
+    for (size_t i = 0; i < view->live_count; i++) {
+        for (size_t a = 0; a < node->agreed_count && !view->live_current[i]; a++) {
+            if (node->agreed_id[a] == view->live_id[i]) {
+                view->live_info[i].rank = (int8_t)node->agreed_rank[a];
+            }
+        }
+    }
+}
+
 /* Builds the cycle's view at `now` and the plans to predict: its own intent first, then
  * the live UAVs' (view order). Returns their count. */
 static size_t gather(coavoid_vehicle_node_t *node, int64_t now)
@@ -508,6 +545,7 @@ static size_t gather(coavoid_vehicle_node_t *node, int64_t now)
     const coa_vehicle_t *self = &node->config.vehicle;
     coavoid_node_view_t *view = &node->view;
     coavoid_node_view_build(view, &node->inbox, node->cycle_start, now);
+    apply_agreed(node);
     coa_intent_plan_t *own = &node->plans[0];
     memset(own, 0, sizeof *own);
     own->id = self->id;
@@ -633,6 +671,17 @@ static void note_order(coavoid_vehicle_node_t *node)
     }
 }
 
+/* The rank its order search agreed this cycle for UAV id, -1 when none. O(members). */
+static int32_t agreed_rank_of(const coavoid_vehicle_node_t *node, uint16_t id)
+{
+    for (size_t a = 0; a < node->agreed_count && node->agreed_cycle == node->state.cycle; a++) {
+        if (node->agreed_id[a] == id) {
+            return node->agreed_rank[a];
+        }
+    }
+    return -1;
+}
+
 /* Whether, since it decided in this cycle, a UAV with a raised rank that comes before it
  * now published an intent of this cycle it did not decide on: one that raised its rank
  * above it after it decided, or one before it that planned again. Only raised ranks
@@ -648,6 +697,9 @@ static bool overtaken(const coavoid_vehicle_node_t *node)
                                    node->state.rank, self->priority, self->id)) {
             continue;
         }
+        if (agreed_rank_of(node, (uint16_t)m->uav_id) == m->rank) {
+            continue; /* a member of its agreed order, where it was expected */
+        }
         size_t j = 0;
         while (j < node->decided_count && node->decided_id[j] != (uint16_t)m->uav_id) {
             j++;
@@ -657,6 +709,264 @@ static bool overtaken(const coavoid_vehicle_node_t *node)
         }
     }
     return false;
+}
+
+/* ---- the order search (docs/protocol.md, "Priority negotiation") ---- */
+
+/* Adds itself to the view of the cycle's start (node->view, built by the caller) as its
+ * peers have it: its last intent of the cycle before (previous), converted as they
+ * convert it, so that every member builds the same problem. Returns its index, or
+ * live_count when it has no such intent (it followed a coordinator, or it just started).
+ * O(N). */
+static size_t snapshot_self(coavoid_vehicle_node_t *node, int64_t previous)
+{
+    coavoid_node_view_t *view = &node->view;
+    const coavoid_intent_t *own = &node->tx_intent;
+    const size_t i = view->live_count;
+    if (node->intent_sequence == 0 || own->plan_utime != previous || i >= COAVOID_NODE_MAX_PEERS) {
+        return i;
+    }
+    const coavoid_lcm_context_t ctx =
+        coavoid_node_context(&node->inbox, node->cycle_start, node->cycle_start);
+    if (coavoid_lcm_intent_to_core(own, &ctx, NULL, &view->live_info[i], &view->live_vehicle[i],
+                                   &view->live_plan[i], &view->live_arrays[i], NULL) != COA_OK) {
+        return i;
+    }
+    view->live_id[i] = node->config.vehicle.id;
+    view->live_current[i] = false;
+    view->live_count++;
+    return i;
+}
+
+/* Whether live UAV i of the view of the cycle's start can be searched: its intent is of
+ * the cycle before, says it plans for itself, and spans the horizon. O(1). */
+static bool order_eligible(const coavoid_vehicle_node_t *node, size_t i, int64_t previous)
+{
+    const coavoid_node_common_t *c = &node->config.common;
+    const coavoid_lcm_intent_info_t *info = &node->view.live_info[i];
+    return info->plan_utime == previous && info->mode == COAVOID_INTENT_T_MODE_DECOUPLED &&
+           info->step == c->dt && node->view.live_plan[i].count == (size_t)c->horizon + 1u;
+}
+
+/* Labels the view of the cycle's start (node->plans) as near_pending judges nearness:
+ * UAVs whose paths pass near each other horizontally within the horizon, with every
+ * volume as tall as a message allows, joined into groups (coa_predict_clusters). Returns
+ * COA_OK or an error. Cost: one coa_predict over the live UAVs. */
+static int label_near(coavoid_vehicle_node_t *node, size_t n)
+{
+    coavoid_node_solver_t *sv = &node->solver;
+    for (size_t i = 0; i < n; i++) {
+        node->tall[i] = node->plans[i];
+        node->tall[i].volume.half_height = (coa_real_t)COAVOID_LCM_MAX_SIZE;
+    }
+    const coa_predict_config_t config = coavoid_node_predict_config(&node->config.common);
+    coa_predict_result_t result;
+    int rc = coa_predict(sv->predictor, &config, node->tall, n, NULL, 0, NULL, 0, sv->conflicts,
+                         sv->conflict_capacity, &result);
+    if (rc == COA_OK && result.overflow) {
+        rc = COA_ERR_WORKSPACE;
+    }
+    size_t groups = 0;
+    return rc != COA_OK ? rc
+                        : coa_predict_clusters(sv->conflicts, result.conflict_count, n,
+                                               node->labels, &groups);
+}
+
+/* The UAVs its order search plans (self: its index in the view of the cycle's start),
+ * into node->order_member by ascending id: its group of UAVs near each other
+ * (label_near), when one of them has a conflict there (its prediction). Not its cluster
+ * alone: a UAV outside it whose plan leaves a member no room may have to plan around
+ * that member, and only a UAV near can. Returns their count; 0 when none of them has a
+ * conflict, or one of them cannot be searched (the greedy raise remains). Cost: two
+ * coa_predict. */
+static size_t order_members(coavoid_vehicle_node_t *node, size_t self, int64_t previous)
+{
+    const coavoid_node_view_t *view = &node->view;
+    coavoid_node_solver_t *sv = &node->solver;
+    const size_t n = view->live_count;
+    for (size_t i = 0; i < n; i++) {
+        node->plans[i] = view->live_plan[i];
+    }
+    coa_predict_result_t result;
+    size_t clusters = 0;
+    if (coavoid_node_predict(sv->predictor, &node->config.common, node->plans, n, view,
+                             &node->inbox, sv->conflicts, sv->conflict_capacity, &result,
+                             node->labels, &clusters) != COA_OK) {
+        return 0;
+    }
+    for (size_t i = 0; i < n; i++) {
+        node->include[i] = node->labels[i] != COA_NO_CLUSTER; /* in conflict */
+    }
+    if (label_near(node, n) != COA_OK || node->labels[self] == COA_NO_CLUSTER) {
+        return 0;
+    }
+    size_t count = 0;
+    bool conflict = false;
+    for (size_t i = 0; i < n; i++) {
+        if (node->labels[i] != node->labels[self]) {
+            continue;
+        }
+        if (!order_eligible(node, i, previous) || count == ORDER_MEMBERS_MAX) {
+            return 0;
+        }
+        conflict = conflict || node->include[i];
+        size_t m = count++;
+        while (m > 0 && view->live_id[node->order_member[m - 1]] > view->live_id[i]) {
+            node->order_member[m] = node->order_member[m - 1];
+            m--;
+        }
+        node->order_member[m] = i;
+    }
+    return count >= 2u && conflict ? count : 0u;
+}
+
+/* The members' problem: each from the offset its intent of the cycle before flies at the
+ * cycle's start, along that intent's reference from there (its last sample, which that
+ * intent does not reach, carried on along its last leg: every member extrapolates alike),
+ * around everything else of the view (coavoid_node_problem). Returns its error. */
+static int order_problem(coavoid_vehicle_node_t *node, size_t count, coa_problem_t *problem)
+{
+    const uint32_t n = node->config.common.horizon;
+    const coavoid_node_view_t *view = &node->view;
+    for (size_t i = 0; i < view->live_count; i++) {
+        node->include[i] = true;
+    }
+    for (size_t m = 0; m < count; m++) {
+        const size_t i = node->order_member[m];
+        const coavoid_lcm_intent_arrays_t *a = &view->live_arrays[i];
+        coa_vec3_t *r = node->order_reference[m];
+        node->include[i] = false;
+        node->order_vehicles[m] = view->live_vehicle[i];
+        node->order_vehicles[m].initial_offset = a->offsets[1];
+        memcpy(r, &a->reference[1], n * sizeof r[0]);
+        r[n].x = a->reference[n].x + (a->reference[n].x - a->reference[n - 1u].x);
+        r[n].y = a->reference[n].y + (a->reference[n].y - a->reference[n - 1u].y);
+        r[n].z = a->reference[n].z + (a->reference[n].z - a->reference[n - 1u].z);
+        node->order_references[m] = r;
+    }
+    return coavoid_node_problem(problem, &node->problem_tracks, view, node->include, &node->inbox,
+                                node->order_vehicles, node->order_references, count);
+}
+
+/* The members' decoupled order as the intents of the cycle's start announce it (rank,
+ * priority, id), as indices into order_member. O(count^2). */
+static void order_current(const coavoid_vehicle_node_t *node, size_t count, size_t *order)
+{
+    const coavoid_node_view_t *view = &node->view;
+    for (size_t m = 0; m < count; m++) {
+        const size_t x = node->order_member[m];
+        size_t p = m;
+        while (p > 0) {
+            const size_t y = node->order_member[order[p - 1]];
+            if (!coavoid_node_precedes(view->live_info[x].rank, view->live_vehicle[x].priority,
+                                       view->live_id[x], view->live_info[y].rank,
+                                       view->live_vehicle[y].priority, view->live_id[y])) {
+                break;
+            }
+            order[p] = order[p - 1];
+            p--;
+        }
+        order[p] = m;
+    }
+}
+
+/* The ranks of a solving order: count - p at position p, above every UAV at rank 0. Its
+ * own at once; the others' it uses (apply_agreed) until each member's own intent of the
+ * cycle announces its rank. Its row of the solving plan goes to node->plan_out
+ * (fly_agreed). A new episode of raises begins. O(count + N). */
+static void order_agree(coavoid_vehicle_node_t *node, size_t count, const size_t *order,
+                        size_t self)
+{
+    node->agreed_cycle = node->state.cycle;
+    node->agreed_count = count;
+    for (size_t p = 0; p < count; p++) {
+        const size_t i = node->order_member[order[p]];
+        node->agreed_id[p] = node->view.live_id[i];
+        node->agreed_rank[p] = (int32_t)(count - p);
+        if (i == self) {
+            const size_t samples = (size_t)node->config.common.horizon + 1u;
+            memcpy(node->plan_out, &node->order_offsets[order[p] * samples],
+                   samples * sizeof node->plan_out[0]);
+            node->state.rank = (int32_t)(count - p);
+            node->raises = 0;
+            node->calm_cycles = 0;
+        }
+    }
+    node->state.orders_agreed++;
+}
+
+/* At the start of a decoupled cycle, before it decides: the order search. From the
+ * intents as they stood when the cycle began (each UAV's last of the cycle before,
+ * its own included, whatever came since: coavoid_node_view_build_before), it predicts,
+ * and when it has a conflict, plans its whole cluster as coa_plan_decoupled would, first
+ * in the order the ranks announce; only when that order fails it tries the others
+ * (coa_plan_decoupled's reordering, at most ORDER_TRIES_MAX orders), and when one solves
+ * takes its place in it (order_agree). Every member of the cluster has the same intents
+ * when none was lost, so each computes the same problem and the same order without a
+ * message or a central node, and the ranks they then announce make the order hold for
+ * anyone who did not. Changes nothing when the current order solves (or none does).
+ * Returns 1 when it agreed a new order, 0 when not, or an error of the search (then
+ * nothing changed: the greedy raise remains). Cost: one view and one prediction; in conflict, at most ORDER_TRIES_MAX
+ * orders of at most ORDER_MEMBERS_MAX single-UAV searches (coa_plan_decoupled's cost);
+ * memory: the node's own (order_*), the planner workspace of its solver. */
+static int search_order(coavoid_vehicle_node_t *node)
+{
+    const int64_t start = node->cycle_start;
+    const int64_t previous = start - node->config.common.dt_us;
+    coavoid_node_view_build_before(&node->view, &node->inbox, start, start, start);
+    const size_t self = snapshot_self(node, previous);
+    if (self == node->view.live_count) {
+        return COA_OK;
+    }
+    const size_t count = order_members(node, self, previous);
+    if (count == 0u) {
+        return COA_OK;
+    }
+    coa_problem_t problem;
+    int rc = order_problem(node, count, &problem);
+    if (rc != COA_OK) {
+        return rc;
+    }
+    size_t order[ORDER_MEMBERS_MAX];
+    order_current(node, count, order);
+    coa_plan_result_t result;
+    rc = coa_plan_decoupled(node->solver.planner, &problem, order, ORDER_TRIES_MAX,
+                            node->order_offsets, &result);
+
+    if (rc != COA_OK || result.orders_tried <= 1u) {
+        return rc != COA_OK ? rc : 0; /* the order holds: a check, not a plan of its own */
+    }
+    node->state.plans_run++;
+    if (result.status != COA_PLAN_SOLVED) {
+        return 0;
+    }
+    order_agree(node, count, result.order, self);
+    return 1;
+}
+
+static int decide(coavoid_vehicle_node_t *node, int64_t now);
+
+/* In a cycle whose order search agreed a new order: it flies its row of the solving plan
+ * (node->plan_out) at once, as every other member does with its own, once the check every
+ * plan gets finds it clear of the obstacles and tracks it knows (its row was planned
+ * around the others' intents of the cycle's start, which their rows replace), and
+ * publishes it with its new rank. A row that fails the check is left: it decides as any
+ * cycle (decide), in the agreed order. Returns as decide. */
+static int fly_agreed(coavoid_vehicle_node_t *node, int64_t now)
+{
+    (void)gather(node, now);
+    note_order(node);
+    memset(node->include, 0, sizeof node->include);
+    const uint32_t samples = node->config.common.horizon + 1u;
+    int hit = plan_hits_known(node, node->plan_out, samples, now, true);
+    if (hit != 0) {
+        return decide(node, now);
+    }
+    adopt(node, node->plan_out, samples);
+    node->state.last_outcome = (int)COA_PLAN_SOLVED;
+    node->cycle_conflict = true;
+    settle_rank(node, true);
+    return finish(node, now);
 }
 
 /* The decoupled step: predict with what it has; publish at once without a conflict;
@@ -1106,7 +1416,7 @@ coavoid_vehicle_node_t *coavoid_vehicle_node_create(const coavoid_vehicle_node_c
     node->plan_offsets[0] = node->config.vehicle.initial_offset;
     node->state.cycle = -1;
     node->settled_cycle = -1;
-    node->redecided_cycle = -1;
+    node->redecided_cycle = node->agreed_cycle = -1;
     node->state.offset = node->config.vehicle.initial_offset;
     node->state.last_outcome = -1;
     node->wait_deadline = INT64_MAX;
@@ -1166,6 +1476,17 @@ static void fly_to(coavoid_vehicle_node_t *node, int64_t k, int64_t now)
     node->state.offset = node->own_offsets[0];
     node->state.reference = node->own_reference[0];
     node->state.position = node->own_samples[0];
+}
+
+/* A cycle it decides for itself: the order search (decoupled by configuration: one that
+ * falls back from a coordinator keeps to the greedy raise), then its own decision. An
+ * error of the search leaves the order as it was: the greedy raise still applies.
+ * Returns as decide. */
+static int decide_own(coavoid_vehicle_node_t *node, int64_t now)
+{
+    const bool agreed = node->config.mode == COAVOID_NODE_DECOUPLED && search_order(node) == 1;
+    node->wait_deadline = node->cycle_start + node->config.priority_wait_us;
+    return agreed ? fly_agreed(node, now) : decide(node, now);
 }
 
 /* Whether a cycle of distrust has passed and the coordinator was heard since it began. */
@@ -1247,8 +1568,7 @@ int coavoid_vehicle_node_cycle(coavoid_vehicle_node_t *node, int64_t now)
         drop_rank(node);
         rc = finish(node, now);
     } else {
-        node->wait_deadline = node->cycle_start + node->config.priority_wait_us;
-        rc = decide(node, now);
+        rc = decide_own(node, now);
     }
     if (rc >= 0 && predicted != COA_OK) {
         rc = predicted;
