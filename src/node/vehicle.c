@@ -29,6 +29,12 @@
  * most ORDER_TRIES_MAX priority orders a search (5!, every order of 5 UAVs). Past that a
  * search could take n! orders of n single-UAV searches each: the greedy raise remains. */
 #define ORDER_MEMBERS_MAX 8u
+/* How a UAV enters the view of a cycle's start (snapshot): not at all, by its intent of
+ * the cycle before, or, in its first cycle, by its first intent with the offset it starts
+ * at held (what it flew before it planned anything). */
+#define SNAPSHOT_NONE 0u
+#define SNAPSHOT_PREVIOUS 1u
+#define SNAPSHOT_FIRST 2u
 #define ORDER_TRIES_MAX 120u
 
 struct coavoid_vehicle_node {
@@ -119,6 +125,9 @@ struct coavoid_vehicle_node {
      * the view of the cycle's start), their problem, and the ranks it agreed for each
      * member (agreed_cycle: the cycle they hold for, until each member's own intent of
      * the cycle says its rank). */
+    coavoid_intent_t order_own; /* itself as its peers have it when the cycle began */
+    uint8_t order_own_kind;     /* SNAPSHOT_* */
+    uint8_t order_kind[COAVOID_NODE_MAX_PEERS];
     size_t order_member[ORDER_MEMBERS_MAX];
     coa_vehicle_t order_vehicles[ORDER_MEMBERS_MAX];
     coa_vec3_t order_reference[ORDER_MEMBERS_MAX][COAVOID_NODE_MAX_SAMPLES];
@@ -240,13 +249,15 @@ static int publish_status(coavoid_vehicle_node_t *node, int64_t now)
 
 /* Publishes its intent of this cycle as it stands at `now` (its state moved on, the same
  * plan), and schedules its copies. COA_OK or a negative error (a fault). */
-static int publish_intent(coavoid_vehicle_node_t *node, int64_t now)
+/* Its intent's fields of this cycle at `now` beyond the samples, numbered `sequence`. */
+static coavoid_lcm_intent_info_t intent_info(const coavoid_vehicle_node_t *node, int64_t now,
+                                             int64_t sequence)
 {
     const coavoid_node_common_t *c = &node->config.common;
     coavoid_lcm_intent_info_t info;
     memset(&info, 0, sizeof info);
     info.utime = now;
-    info.sequence = node->intent_sequence++;
+    info.sequence = sequence;
     info.mode = node->state.coordinated ? COAVOID_INTENT_T_MODE_CENTRALISED
                                         : COAVOID_INTENT_T_MODE_DECOUPLED;
     /* The state at `now`: it moves straight from sample k to sample k + 1. */
@@ -265,6 +276,13 @@ static int publish_intent(coavoid_vehicle_node_t *node, int64_t now)
     info.sigma_horizontal = node->config.sigma_horizontal;
     info.sigma_vertical = node->config.sigma_vertical;
     info.rank = (int8_t)node->state.rank;
+    return info;
+}
+
+static int publish_intent(coavoid_vehicle_node_t *node, int64_t now)
+{
+    const coavoid_node_common_t *c = &node->config.common;
+    const coavoid_lcm_intent_info_t info = intent_info(node, now, node->intent_sequence++);
     coavoid_lcm_context_t ctx = coavoid_node_context(&node->inbox, now, node->cycle_start);
     int rc = coavoid_lcm_intent_from_core(&node->config.vehicle, &info, node->own_reference,
                                           node->own_offsets, (size_t)c->horizon + 1u, &ctx,
@@ -713,38 +731,102 @@ static bool overtaken(const coavoid_vehicle_node_t *node)
 
 /* ---- the order search (docs/protocol.md, "Priority negotiation") ---- */
 
-/* Adds itself to the view of the cycle's start (node->view, built by the caller) as its
- * peers have it: its last intent of the cycle before (previous), converted as they
- * convert it, so that every member builds the same problem. Returns its index, or
- * live_count when it has no such intent (it followed a coordinator, or it just started).
- * O(N). */
-static size_t snapshot_self(coavoid_vehicle_node_t *node, int64_t previous)
+/* Adds `msg` to the view of the cycle's start (node->view) as `kind`: converted as every
+ * node converts it; SNAPSHOT_FIRST with its first offset held and rank 0. Returns false
+ * when it does not fit or convert. O(N). */
+static bool snapshot_add(coavoid_vehicle_node_t *node, const coavoid_intent_t *msg, uint8_t kind)
 {
     coavoid_node_view_t *view = &node->view;
-    const coavoid_intent_t *own = &node->tx_intent;
     const size_t i = view->live_count;
-    if (node->intent_sequence == 0 || own->plan_utime != previous || i >= COAVOID_NODE_MAX_PEERS) {
-        return i;
-    }
     const coavoid_lcm_context_t ctx =
         coavoid_node_context(&node->inbox, node->cycle_start, node->cycle_start);
-    if (coavoid_lcm_intent_to_core(own, &ctx, NULL, &view->live_info[i], &view->live_vehicle[i],
+    if (i >= COAVOID_NODE_MAX_PEERS ||
+        coavoid_lcm_intent_to_core(msg, &ctx, NULL, &view->live_info[i], &view->live_vehicle[i],
                                    &view->live_plan[i], &view->live_arrays[i], NULL) != COA_OK) {
-        return i;
+        return false;
     }
-    view->live_id[i] = node->config.vehicle.id;
+    if (kind == SNAPSHOT_FIRST) {
+        coavoid_lcm_intent_arrays_t *a = &view->live_arrays[i];
+        const coa_real_t dh = coa_climb_step(&view->live_vehicle[i], node->config.common.dt);
+        for (size_t j = 0; j < view->live_plan[i].count; j++) {
+            a->offsets[j] = a->offsets[0];
+            a->samples[j] = lifted(a->reference[j], a->offsets[0], dh);
+        }
+        view->live_info[i].rank = 0;
+    }
+    view->live_id[i] = (uint16_t)msg->uav_id;
     view->live_current[i] = false;
+    node->order_kind[i] = kind;
     view->live_count++;
-    return i;
+    return true;
 }
 
-/* Whether live UAV i of the view of the cycle's start can be searched: its intent is of
- * the cycle before, says it plans for itself, and spans the horizon. O(1). */
-static bool order_eligible(const coavoid_vehicle_node_t *node, size_t i, int64_t previous)
+/* At the cycle's start (fly_to): itself as its peers will have it when they search
+ * (node->order_own): its last intent of the cycle before, or in its first cycle its
+ * intent with the offset it starts at held, encoded as it would publish it. */
+static void snapshot_own(coavoid_vehicle_node_t *node)
+{
+    const coavoid_node_common_t *c = &node->config.common;
+    const coavoid_intent_t *last = &node->tx_intent;
+    node->order_own_kind = SNAPSHOT_NONE;
+    if (node->config.mode != COAVOID_NODE_DECOUPLED) {
+        return; /* it never searches (decide_own) */
+    }
+    if (node->intent_sequence > 0 && last->plan_utime == node->cycle_start - c->dt_us) {
+        node->order_own = *last;
+        node->order_own_kind = SNAPSHOT_PREVIOUS;
+    } else if (node->first_cycle_start == node->cycle_start) {
+        coavoid_lcm_intent_info_t info = intent_info(node, node->cycle_start, 0);
+        info.mode = COAVOID_INTENT_T_MODE_DECOUPLED;
+        info.rank = 0;
+        const coavoid_lcm_context_t ctx =
+            coavoid_node_context(&node->inbox, node->cycle_start, node->cycle_start);
+        node->order_own_kind =
+            coavoid_lcm_intent_from_core(&node->config.vehicle, &info, node->own_reference,
+                                         node->own_offsets, (size_t)c->horizon + 1u, &ctx,
+                                         &node->order_own, NULL) == COA_OK
+                ? SNAPSHOT_FIRST
+                : SNAPSHOT_NONE;
+    }
+}
+
+/* The view of the cycle's start in node->view: every UAV by its intent of an earlier
+ * cycle (SNAPSHOT_PREVIOUS when of the cycle before), a UAV whose first intent is of
+ * this cycle as SNAPSHOT_FIRST, and itself last (snapshot_own), whatever came since the
+ * cycle began: every member builds it alike. Returns its own index, or live_count when it
+ * is not in it. O(peers * N). */
+static size_t snapshot(coavoid_vehicle_node_t *node, int64_t previous)
+{
+    coavoid_node_view_t *view = &node->view;
+    const int64_t start = node->cycle_start;
+    coavoid_node_view_build_before(view, &node->inbox, start, start, start);
+    for (size_t i = 0; i < view->live_count; i++) {
+        node->order_kind[i] =
+            view->live_info[i].plan_utime == previous ? SNAPSHOT_PREVIOUS : SNAPSHOT_NONE;
+    }
+    for (size_t p = 0; p < COAVOID_NODE_MAX_PEERS; p++) {
+        const coavoid_node_peer_t *peer = &node->inbox.peers[p];
+        if (peer->used && peer->msg.plan_utime == start &&
+            !(peer->has_prev && peer->prev.plan_utime < start)) {
+            (void)snapshot_add(node, &peer->msg, SNAPSHOT_FIRST);
+        }
+    }
+    if (node->order_own_kind == SNAPSHOT_NONE ||
+        !snapshot_add(node, &node->order_own, node->order_own_kind)) {
+        return view->live_count;
+    }
+    view->live_id[view->live_count - 1u] = node->config.vehicle.id;
+    return view->live_count - 1u;
+}
+
+/* Whether live UAV i of the view of the cycle's start can be searched: it is in it by an
+ * intent of the cycle before or its first one (snapshot), says it plans for itself, and
+ * spans the horizon. O(1). */
+static bool order_eligible(const coavoid_vehicle_node_t *node, size_t i)
 {
     const coavoid_node_common_t *c = &node->config.common;
     const coavoid_lcm_intent_info_t *info = &node->view.live_info[i];
-    return info->plan_utime == previous && info->mode == COAVOID_INTENT_T_MODE_DECOUPLED &&
+    return node->order_kind[i] != SNAPSHOT_NONE && info->mode == COAVOID_INTENT_T_MODE_DECOUPLED &&
            info->step == c->dt && node->view.live_plan[i].count == (size_t)c->horizon + 1u;
 }
 
@@ -779,7 +861,7 @@ static int label_near(coavoid_vehicle_node_t *node, size_t n)
  * that member, and only a UAV near can. Returns their count; 0 when none of them has a
  * conflict, or one of them cannot be searched (the greedy raise remains). Cost: two
  * coa_predict. */
-static size_t order_members(coavoid_vehicle_node_t *node, size_t self, int64_t previous)
+static size_t order_members(coavoid_vehicle_node_t *node, size_t self)
 {
     const coavoid_node_view_t *view = &node->view;
     coavoid_node_solver_t *sv = &node->solver;
@@ -806,7 +888,7 @@ static size_t order_members(coavoid_vehicle_node_t *node, size_t self, int64_t p
         if (node->labels[i] != node->labels[self]) {
             continue;
         }
-        if (!order_eligible(node, i, previous) || count == ORDER_MEMBERS_MAX) {
+        if (!order_eligible(node, i) || count == ORDER_MEMBERS_MAX) {
             return 0;
         }
         conflict = conflict || node->include[i];
@@ -823,7 +905,8 @@ static size_t order_members(coavoid_vehicle_node_t *node, size_t self, int64_t p
 /* The members' problem: each from the offset its intent of the cycle before flies at the
  * cycle's start, along that intent's reference from there (its last sample, which that
  * intent does not reach, carried on along its last leg: every member extrapolates alike),
- * around everything else of the view (coavoid_node_problem). Returns its error. */
+ * or in its first cycle from its first intent's offset along its reference; around
+ * everything else of the view (coavoid_node_problem). Returns its error. */
 static int order_problem(coavoid_vehicle_node_t *node, size_t count, coa_problem_t *problem)
 {
     const uint32_t n = node->config.common.horizon;
@@ -837,12 +920,16 @@ static int order_problem(coavoid_vehicle_node_t *node, size_t count, coa_problem
         coa_vec3_t *r = node->order_reference[m];
         node->include[i] = false;
         node->order_vehicles[m] = view->live_vehicle[i];
+        node->order_references[m] = r;
+        if (node->order_kind[i] == SNAPSHOT_FIRST) {
+            memcpy(r, a->reference, ((size_t)n + 1u) * sizeof r[0]); /* of this cycle */
+            continue;
+        }
         node->order_vehicles[m].initial_offset = a->offsets[1];
         memcpy(r, &a->reference[1], n * sizeof r[0]);
         r[n].x = a->reference[n].x + (a->reference[n].x - a->reference[n - 1u].x);
         r[n].y = a->reference[n].y + (a->reference[n].y - a->reference[n - 1u].y);
         r[n].z = a->reference[n].z + (a->reference[n].z - a->reference[n - 1u].z);
-        node->order_references[m] = r;
     }
     return coavoid_node_problem(problem, &node->problem_tracks, view, node->include, &node->inbox,
                                 node->order_vehicles, node->order_references, count);
@@ -911,14 +998,11 @@ static void order_agree(coavoid_vehicle_node_t *node, size_t count, const size_t
  * memory: the node's own (order_*), the planner workspace of its solver. */
 static int search_order(coavoid_vehicle_node_t *node)
 {
-    const int64_t start = node->cycle_start;
-    const int64_t previous = start - node->config.common.dt_us;
-    coavoid_node_view_build_before(&node->view, &node->inbox, start, start, start);
-    const size_t self = snapshot_self(node, previous);
+    const size_t self = snapshot(node, node->cycle_start - node->config.common.dt_us);
     if (self == node->view.live_count) {
         return COA_OK;
     }
-    const size_t count = order_members(node, self, previous);
+    const size_t count = order_members(node, self);
     if (count == 0u) {
         return COA_OK;
     }
@@ -945,6 +1029,7 @@ static int search_order(coavoid_vehicle_node_t *node)
 }
 
 static int decide(coavoid_vehicle_node_t *node, int64_t now);
+static int decide_own(coavoid_vehicle_node_t *node, int64_t now);
 
 /* In a cycle whose order search agreed a new order: it flies its row of the solving plan
  * (node->plan_out) at once, as every other member does with its own, once the check every
@@ -1037,8 +1122,7 @@ static int reconsider(coavoid_vehicle_node_t *node, int64_t now)
         return 0;
     }
     node->redecisions++;
-    node->wait_deadline = node->cycle_start + node->config.priority_wait_us;
-    return decide(node, now);
+    return decide_own(node, now);
 }
 
 static void reject(coavoid_vehicle_node_t *node, int code, const char *reason)
@@ -1476,6 +1560,7 @@ static void fly_to(coavoid_vehicle_node_t *node, int64_t k, int64_t now)
     node->state.offset = node->own_offsets[0];
     node->state.reference = node->own_reference[0];
     node->state.position = node->own_samples[0];
+    snapshot_own(node);
 }
 
 /* A cycle it decides for itself: the order search (decoupled by configuration: one that
@@ -1484,8 +1569,8 @@ static void fly_to(coavoid_vehicle_node_t *node, int64_t k, int64_t now)
  * Returns as decide. */
 static int decide_own(coavoid_vehicle_node_t *node, int64_t now)
 {
-    const bool agreed = node->config.mode == COAVOID_NODE_DECOUPLED && search_order(node) == 1;
     node->wait_deadline = node->cycle_start + node->config.priority_wait_us;
+    const bool agreed = node->config.mode == COAVOID_NODE_DECOUPLED && search_order(node) == 1;
     return agreed ? fly_agreed(node, now) : decide(node, now);
 }
 
