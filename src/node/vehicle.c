@@ -126,7 +126,8 @@ struct coavoid_vehicle_node {
      * member (agreed_cycle: the cycle they hold for, until each member's own intent of
      * the cycle says its rank). */
     coavoid_intent_t order_own; /* itself as its peers have it when the cycle began */
-    uint8_t order_own_kind;     /* SNAPSHOT_* */
+    int32_t start_offsets[COAVOID_NODE_MAX_SAMPLES]; /* its plan when the cycle began */
+    uint8_t order_own_kind;                          /* SNAPSHOT_* */
     uint8_t order_kind[COAVOID_NODE_MAX_PEERS];
     size_t order_member[ORDER_MEMBERS_MAX];
     coa_vehicle_t order_vehicles[ORDER_MEMBERS_MAX];
@@ -134,6 +135,7 @@ struct coavoid_vehicle_node {
     const coa_vec3_t *order_references[ORDER_MEMBERS_MAX];
     int32_t order_offsets[ORDER_MEMBERS_MAX * COAVOID_NODE_MAX_SAMPLES];
     int64_t agreed_cycle;
+    size_t searched_first; /* first intents of the cycle its last search saw (first_intents) */
     size_t agreed_count;
     uint16_t agreed_id[ORDER_MEMBERS_MAX];
     int32_t agreed_rank[ORDER_MEMBERS_MAX];
@@ -790,6 +792,25 @@ static void snapshot_own(coavoid_vehicle_node_t *node)
     }
 }
 
+/* Whether a peer is in the view of the cycle's start by its first intent, of this cycle:
+ * the only way that view grows within a cycle. O(1). */
+static bool first_intent(const coavoid_vehicle_node_t *node, const coavoid_node_peer_t *peer)
+{
+    const int64_t start = node->cycle_start;
+    return peer->used && peer->msg.plan_utime == start &&
+           !(peer->has_prev && peer->prev.plan_utime < start);
+}
+
+/* How many peers are in the view of the cycle's start by their first intent. O(peers). */
+static size_t first_intents(const coavoid_vehicle_node_t *node)
+{
+    size_t n = 0;
+    for (size_t p = 0; p < COAVOID_NODE_MAX_PEERS; p++) {
+        n += first_intent(node, &node->inbox.peers[p]) ? 1u : 0u;
+    }
+    return n;
+}
+
 /* The view of the cycle's start in node->view: every UAV by its intent of an earlier
  * cycle (SNAPSHOT_PREVIOUS when of the cycle before), a UAV whose first intent is of
  * this cycle as SNAPSHOT_FIRST, and itself last (snapshot_own), whatever came since the
@@ -804,10 +825,11 @@ static size_t snapshot(coavoid_vehicle_node_t *node, int64_t previous)
         node->order_kind[i] =
             view->live_info[i].plan_utime == previous ? SNAPSHOT_PREVIOUS : SNAPSHOT_NONE;
     }
+    node->searched_first = 0;
     for (size_t p = 0; p < COAVOID_NODE_MAX_PEERS; p++) {
         const coavoid_node_peer_t *peer = &node->inbox.peers[p];
-        if (peer->used && peer->msg.plan_utime == start &&
-            !(peer->has_prev && peer->prev.plan_utime < start)) {
+        if (first_intent(node, peer)) {
+            node->searched_first++;
             (void)snapshot_add(node, &peer->msg, SNAPSHOT_FIRST);
         }
     }
@@ -982,6 +1004,23 @@ static void order_agree(coavoid_vehicle_node_t *node, size_t count, const size_t
     node->state.orders_agreed++;
 }
 
+/* A search that no longer agrees the order an earlier one of this cycle agreed (its view
+ * of the cycle's start grew since: a UAV's first intent came, in its first cycle or
+ * after its intents were lost): that order is withdrawn, and its rank and plan are again
+ * those it began the cycle with, which the others' searches assume. O(N). */
+static void order_withdraw(coavoid_vehicle_node_t *node)
+{
+    if (node->agreed_cycle == node->state.cycle) {
+        node->agreed_cycle = -1;
+        node->state.rank = node->order_own.rank;
+        /* Back on the plan it began the cycle with. */
+        memcpy(node->plan_offsets, node->start_offsets, sizeof node->plan_offsets);
+        node->plan_start = node->state.cycle;
+        node->plan_count = node->config.common.horizon + 1u;
+        build_own(node, node->state.cycle);
+    }
+}
+
 /* At the start of a decoupled cycle, before it decides: the order search. From the
  * intents as they stood when the cycle began (each UAV's last of the cycle before,
  * its own included, whatever came since: coavoid_node_view_build_before), it predicts,
@@ -1004,6 +1043,7 @@ static int search_order(coavoid_vehicle_node_t *node)
     }
     const size_t count = order_members(node, self);
     if (count == 0u) {
+        order_withdraw(node);
         return COA_OK;
     }
     coa_problem_t problem;
@@ -1018,10 +1058,12 @@ static int search_order(coavoid_vehicle_node_t *node)
                             node->order_offsets, &result);
 
     if (rc != COA_OK || result.orders_tried <= 1u) {
+        order_withdraw(node);
         return rc != COA_OK ? rc : 0; /* the order holds: a check, not a plan of its own */
     }
     node->state.plans_run++;
     if (result.status != COA_PLAN_SOLVED) {
+        order_withdraw(node);
         return 0;
     }
     order_agree(node, count, result.order, self);
@@ -1104,6 +1146,23 @@ static int decide(coavoid_vehicle_node_t *node, int64_t now)
     return finish(node, now);
 }
 
+/* After it published this cycle's intent: a UAV's first intent came since its last
+ * search (in cycle 0 each UAV hears the others' one by one, some only by a copy), so its
+ * view of the cycle's start grew. It searches again: when that agrees an order it flies
+ * its row; when it withdraws an order it agreed earlier in the cycle it decides again;
+ * otherwise nothing changes (a flight whose order holds flies as before). At most once per
+ * such intent. Returns as decide, 0 when there is nothing to do. */
+static int search_again(coavoid_vehicle_node_t *node, int64_t now)
+{
+    const bool agreed = node->agreed_cycle == node->state.cycle;
+    const int found = search_order(node);
+    if (found != 1 && !(agreed && node->agreed_cycle != node->state.cycle)) {
+        return 0;
+    }
+    node->wait_deadline = node->cycle_start + node->config.priority_wait_us;
+    return found == 1 ? fly_agreed(node, now) : decide(node, now);
+}
+
 /* After it published this cycle's intent on its own decision: when it has been overtaken
  * (overtaken()), it decides again at once, waiting as before (until the cycle's priority
  * wait ends) and publishing its intent again, at most REDECISIONS_MAX times a cycle, so
@@ -1117,6 +1176,12 @@ static int reconsider(coavoid_vehicle_node_t *node, int64_t now)
     if (node->redecided_cycle != node->state.cycle) {
         node->redecided_cycle = node->state.cycle;
         node->redecisions = 0;
+    }
+    if (node->config.mode == COAVOID_NODE_DECOUPLED && first_intents(node) > node->searched_first) {
+        const int again = search_again(node, now);
+        if (again != 0) {
+            return again;
+        }
     }
     if (node->redecisions >= REDECISIONS_MAX || !overtaken(node)) {
         return 0;
@@ -1560,6 +1625,7 @@ static void fly_to(coavoid_vehicle_node_t *node, int64_t k, int64_t now)
     node->state.offset = node->own_offsets[0];
     node->state.reference = node->own_reference[0];
     node->state.position = node->own_samples[0];
+    memcpy(node->start_offsets, node->plan_offsets, sizeof node->start_offsets);
     snapshot_own(node);
 }
 
