@@ -345,8 +345,10 @@ int coavoid_vehicle_node_cycle(coavoid_vehicle_node_t *node, int64_t now);
  * priority_wait_us has passed since the cycle began). After a decoupled vehicle has
  * published, it decides again (and publishes again) when a UAV with a raised rank now
  * comes before it with an intent of this cycle it did not decide on (docs/protocol.md,
- * "Priority negotiation"), at most 4 times a cycle: call it whenever messages arrive,
- * not only while it waits. Returns 1 when it planned and published, 0 when there was
+ * "Priority negotiation"), at most 4 times a cycle, and it searches the order again when
+ * a UAV's first intent came after its last search (flying its row, or deciding again,
+ * only when that changes the order it agreed): call it whenever messages arrive, not only
+ * while it waits. Returns 1 when it planned and published, 0 when there was
  * nothing to do or it still waits, negative on error. Cost while waiting: one
  * prediction (it looks again with the intents that came); then as
  * coavoid_vehicle_node_cycle; otherwise O(peers^2) to find it has nothing to do. No
