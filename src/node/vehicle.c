@@ -29,13 +29,13 @@
  * most ORDER_TRIES_MAX priority orders a search (5!, every order of 5 UAVs). Past that a
  * search could take n! orders of n single-UAV searches each: the greedy raise remains. */
 #define ORDER_MEMBERS_MAX 8u
+#define ORDER_TRIES_MAX 120u
 /* How a UAV enters the view of a cycle's start (snapshot): not at all, by its intent of
  * the cycle before, or, in its first cycle, by its first intent with the offset it starts
  * at held (what it flew before it planned anything). */
 #define SNAPSHOT_NONE 0u
 #define SNAPSHOT_PREVIOUS 1u
 #define SNAPSHOT_FIRST 2u
-#define ORDER_TRIES_MAX 120u
 
 struct coavoid_vehicle_node {
     coavoid_vehicle_node_config_t config;
@@ -121,10 +121,10 @@ struct coavoid_vehicle_node {
     coavoid_intent_t tx_intent;
     coavoid_status_t tx_status;
 
-    /* The order search of this cycle (search_order): the cluster's members (indices into
-     * the view of the cycle's start), their problem, and the ranks it agreed for each
-     * member (agreed_cycle: the cycle they hold for, until each member's own intent of
-     * the cycle says its rank). */
+    /* The order search of this cycle (search_order): what it started the cycle as, the
+     * group's members (indices into the view of the cycle's start) and their problem, and
+     * the ranks it agreed for each member (agreed_cycle: the cycle they hold for, until
+     * each member's own intent of the cycle says its rank). */
     coavoid_intent_t order_own; /* itself as its peers have it when the cycle began */
     int32_t start_offsets[COAVOID_NODE_MAX_SAMPLES]; /* its plan when the cycle began */
     uint8_t order_own_kind;                          /* SNAPSHOT_* */
@@ -249,8 +249,6 @@ static int publish_status(coavoid_vehicle_node_t *node, int64_t now)
                                           &h);
 }
 
-/* Publishes its intent of this cycle as it stands at `now` (its state moved on, the same
- * plan), and schedules its copies. COA_OK or a negative error (a fault). */
 /* Its intent's fields of this cycle at `now` beyond the samples, numbered `sequence`. */
 static coavoid_lcm_intent_info_t intent_info(const coavoid_vehicle_node_t *node, int64_t now,
                                              int64_t sequence)
@@ -281,6 +279,8 @@ static coavoid_lcm_intent_info_t intent_info(const coavoid_vehicle_node_t *node,
     return info;
 }
 
+/* Publishes its intent of this cycle as it stands at `now` (its state moved on, the same
+ * plan), and schedules its copies. COA_OK or a negative error (a fault). */
 static int publish_intent(coavoid_vehicle_node_t *node, int64_t now)
 {
     const coavoid_node_common_t *c = &node->config.common;
@@ -1021,20 +1021,21 @@ static void order_withdraw(coavoid_vehicle_node_t *node)
     }
 }
 
-/* At the start of a decoupled cycle, before it decides: the order search. From the
- * intents as they stood when the cycle began (each UAV's last of the cycle before,
- * its own included, whatever came since: coavoid_node_view_build_before), it predicts,
- * and when it has a conflict, plans its whole cluster as coa_plan_decoupled would, first
- * in the order the ranks announce; only when that order fails it tries the others
- * (coa_plan_decoupled's reordering, at most ORDER_TRIES_MAX orders), and when one solves
- * takes its place in it (order_agree). Every member of the cluster has the same intents
- * when none was lost, so each computes the same problem and the same order without a
- * message or a central node, and the ranks they then announce make the order hold for
- * anyone who did not. Changes nothing when the current order solves (or none does).
- * Returns 1 when it agreed a new order, 0 when not, or an error of the search (then
- * nothing changed: the greedy raise remains). Cost: one view and one prediction; in conflict, at most ORDER_TRIES_MAX
- * orders of at most ORDER_MEMBERS_MAX single-UAV searches (coa_plan_decoupled's cost);
- * memory: the node's own (order_*), the planner workspace of its solver. */
+/* The order search, at the start of a decoupled cycle and again within it (decide_own,
+ * search_again). From the intents as they stood when the cycle began (snapshot: each
+ * UAV's last of the cycle before, its own included, whatever came since), it predicts, and
+ * when its group of UAVs near each other has a conflict (order_members), plans the group
+ * as coa_plan_decoupled does, first in the order the ranks announce; only when that order
+ * fails it tries the others (at most ORDER_TRIES_MAX), and when one solves takes its
+ * place in it (order_agree). Every member has the same intents when none was lost, so
+ * each finds the same order and rows without a message or a central node, and the ranks
+ * they announce make the order hold for anyone who did not. Changes nothing when the
+ * current order solves or none does (but withdraws an order it agreed earlier in the
+ * cycle: order_withdraw). Returns 1 when it agreed a new order, 0 when not, or an error
+ * of the search (then the greedy raise remains). Cost: one view, two predictions; with a
+ * conflict, a decoupled plan of at most ORDER_MEMBERS_MAX UAVs, and when the order fails
+ * at most ORDER_TRIES_MAX orders of at most ORDER_MEMBERS_MAX single-UAV searches each
+ * (coa_plan_decoupled's cost). Memory: the node's (order_*) and its solver's workspace. */
 static int search_order(coavoid_vehicle_node_t *node)
 {
     const size_t self = snapshot(node, node->cycle_start - node->config.common.dt_us);
@@ -1056,7 +1057,6 @@ static int search_order(coavoid_vehicle_node_t *node)
     coa_plan_result_t result;
     rc = coa_plan_decoupled(node->solver.planner, &problem, order, ORDER_TRIES_MAX,
                             node->order_offsets, &result);
-
     if (rc != COA_OK || result.orders_tried <= 1u) {
         order_withdraw(node);
         return rc != COA_OK ? rc : 0; /* the order holds: a check, not a plan of its own */
