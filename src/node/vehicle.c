@@ -702,17 +702,23 @@ static int32_t agreed_rank_of(const coavoid_vehicle_node_t *node, uint16_t id)
     return -1;
 }
 
+static bool first_intent(const coavoid_vehicle_node_t *node, const coavoid_node_peer_t *peer);
+
 /* Whether, since it decided in this cycle, a UAV with a raised rank that comes before it
  * now published an intent of this cycle it did not decide on: one that raised its rank
  * above it after it decided, or one before it that planned again. Only raised ranks
  * count, so that with every rank 0 a UAV decides once per cycle, as before priority
- * negotiation. O(peers^2). */
+ * negotiation; but for a UAV before it whose first intent it had not heard when it
+ * decided (lost, and come by a copy): it would have waited for it. Without loss that
+ * never happens (each decides after the UAVs before it published). O(peers^2). */
 static bool overtaken(const coavoid_vehicle_node_t *node)
 {
     const coa_vehicle_t *self = &node->config.vehicle;
     for (size_t i = 0; i < COAVOID_NODE_MAX_PEERS; i++) {
         const coavoid_intent_t *m = &node->inbox.peers[i].msg;
-        if (!node->inbox.peers[i].used || m->plan_utime != node->cycle_start || m->rank <= 0 ||
+        const bool newcomer = m->rank <= 0 && first_intent(node, &node->inbox.peers[i]);
+        if (!node->inbox.peers[i].used || m->plan_utime != node->cycle_start ||
+            (m->rank <= 0 && !newcomer) ||
             !coavoid_node_precedes(m->rank, (uint32_t)m->priority, (uint16_t)m->uav_id,
                                    node->state.rank, self->priority, self->id)) {
             continue;
@@ -724,7 +730,7 @@ static bool overtaken(const coavoid_vehicle_node_t *node)
         while (j < node->decided_count && node->decided_id[j] != (uint16_t)m->uav_id) {
             j++;
         }
-        if (j == node->decided_count || node->decided_sequence[j] < m->sequence) {
+        if (j == node->decided_count || (!newcomer && node->decided_sequence[j] < m->sequence)) {
             return true;
         }
     }
