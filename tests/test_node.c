@@ -21,6 +21,9 @@
  *     reverse by their order search (from cycle 0, on their first intents), each flying
  *     its row and announcing its rank, in the same cycle, or in the next one when the
  *     rank was lost to the UAV it overtakes; the ranks return to 0 after the encounter;
+ *     and with greedy_negotiation, the greedy raise alone does the same as before the
+ *     search: 2 raises its rank, 1 climbs around it (the same cycle, or the next when
+ *     the raise was lost to it);
  *   - a silent UAV is avoided as a track;
  *   - the world's track estimates reproduce the scenario's path over the horizon;
  *   - bad configurations are refused.
@@ -1467,7 +1470,7 @@ typedef struct {
     coavoid_vehicle_node_t *v[2];
 } net_rig_t;
 
-static void net_rig_init(net_rig_t *r, const coa_vehicle_t *vehicles)
+static void net_rig_init_as(net_rig_t *r, const coa_vehicle_t *vehicles, bool greedy)
 {
     coavoid_sim_net_config_t nc;
     memset(&nc, 0, sizeof nc);
@@ -1487,9 +1490,16 @@ static void net_rig_init(net_rig_t *r, const coa_vehicle_t *vehicles)
         config.common.rx_lcm = coavoid_sim_net_rx(r->net, i);
         config.vehicle = vehicles[i];
         config.mode = COAVOID_NODE_DECOUPLED;
+        config.greedy_negotiation = greedy;
         r->v[i] = coavoid_vehicle_node_create(&config, coavoid_sim_net_tx(r->net, i), &error);
         ck_assert_ptr_nonnull(r->v[i]);
     }
+}
+
+/* Vehicles that search their order (the default). */
+static void net_rig_init(net_rig_t *r, const coa_vehicle_t *vehicles)
+{
+    net_rig_init_as(r, vehicles, false);
 }
 
 static void net_rig_fini(net_rig_t *r)
@@ -1634,6 +1644,70 @@ START_TEST(test_lost_raise_heard_next_cycle)
     ck_assert_int_eq(sa->rank, 1);
     fly_held_pair(&r, 2, -1);
     ck_assert_uint_eq(sb->rank_raises, 0);
+    net_rig_fini(&r);
+}
+END_TEST
+
+/* The greedy raise alone (greedy_negotiation: what the order search falls back on). The
+ * fixed order has no plan, the reverse has: 2 finds none below 1, raises its rank in
+ * cycle 0 and plans first; 1, overtaken after it decided, decides again in the same
+ * cycle and climbs around 2. Every later cycle 1 waits for 2, which comes first now; once
+ * they have passed, 2's rank returns to 0. */
+START_TEST(test_greedy_raise_reorders)
+{
+    coa_vec3_t r1[2], r2[2];
+    coa_vehicle_t v[2];
+    held_pair(v, r1, r2);
+    net_rig_t r;
+    net_rig_init_as(&r, v, true);
+    const coavoid_vehicle_node_state_t *sa = coavoid_vehicle_node_state(r.v[0]);
+    const coavoid_vehicle_node_state_t *sb = coavoid_vehicle_node_state(r.v[1]);
+    net_rig_cycle(&r, 0, 2);
+    ck_assert_int_eq(sb->rank, 1);
+    ck_assert_uint_eq(sb->rank_raises, 1);
+    ck_assert_int_eq(sa->rank, 0);
+    /* 1 decided first, before it had heard of 2 (no conflict, no plan); overtaken, it
+     * decided again and planned. */
+    ck_assert_uint_eq(sa->plans_run, 1);
+    ck_assert_uint_eq(sa->plans_adopted, 1);
+    /* Cycle 1: 2's intent of cycle 0 announced its rank, so 1 waits for it. */
+    r.now = cycle(1);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(r.v[0], r.now), COA_OK);
+    ck_assert(sa->waiting);
+    ck_assert_int_eq(coavoid_sim_net_pump(r.net, r.now), COA_OK);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(r.v[1], r.now), COA_OK);
+    ck_assert_int_eq(coavoid_sim_net_pump(r.net, r.now), COA_OK);
+    net_rig_settle(&r);
+    ck_assert(!sa->waiting && sa->published);
+    fly_held_pair(&r, 2, -1);
+    ck_assert_uint_eq(sb->rank_raises, 1);
+    ck_assert_int_eq(sb->rank, 0);
+    ck_assert_int_eq(sa->rank, 0);
+    net_rig_fini(&r);
+}
+END_TEST
+
+/* The greedy raise alone, lost to the UAV it overtakes: in cycle 0, 1 hears nothing from 2, so it
+ * neither knows 2's rank nor decides again. In cycle 1 it hears 2's next intent, with
+ * the rank (an intent announces it every cycle), decides again and climbs around 2: the
+ * new order comes a cycle late, and they stay separated. */
+START_TEST(test_lost_greedy_raise_heard_next_cycle)
+{
+    coa_vec3_t r1[2], r2[2];
+    coa_vehicle_t v[2];
+    held_pair(v, r1, r2);
+    net_rig_t r;
+    net_rig_init_as(&r, v, true);
+    const coavoid_vehicle_node_state_t *sa = coavoid_vehicle_node_state(r.v[0]);
+    const coavoid_vehicle_node_state_t *sb = coavoid_vehicle_node_state(r.v[1]);
+    net_rig_cycle(&r, 0, 0);
+    ck_assert_int_eq(sb->rank, 1);
+    ck_assert_uint_eq(sa->plans_run, 0);
+    ck_assert_int_eq(sa->offset, 0);
+    net_rig_cycle(&r, 1, 2);
+    ck_assert_uint_ge(sa->plans_adopted, 1);
+    fly_held_pair(&r, 2, -1);
+    ck_assert_uint_eq(sb->rank_raises, 1);
     net_rig_fini(&r);
 }
 END_TEST
@@ -2311,6 +2385,8 @@ static Suite *node_suite(void)
     tcase_add_test(tc, test_higher_priority_replans_in_cluster);
     tcase_add_test(tc, test_raise_reorders);
     tcase_add_test(tc, test_lost_raise_heard_next_cycle);
+    tcase_add_test(tc, test_greedy_raise_reorders);
+    tcase_add_test(tc, test_lost_greedy_raise_heard_next_cycle);
     tcase_add_test(tc, test_silent_uav_avoided_as_track);
     tcase_add_test(tc, test_silent_uav_avoided_along_its_plan);
     tcase_add_test(tc, test_world_track_estimates);

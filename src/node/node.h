@@ -274,6 +274,10 @@ typedef struct {
      * intent_copies 0: none, which is also the default). */
     int64_t resend_us;
     uint32_t intent_copies;
+    /* Decoupled: negotiate the order by the greedy raise alone, without the order search
+     * (docs/protocol.md, "Priority negotiation"): no search's cost, and the negotiation as
+     * it was before the search. false (the default): search. */
+    bool greedy_negotiation;
 } coavoid_vehicle_node_config_t;
 
 /* What a vehicle did; read by drivers, the simulation and tests. */

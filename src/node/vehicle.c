@@ -703,6 +703,7 @@ static int32_t agreed_rank_of(const coavoid_vehicle_node_t *node, uint16_t id)
 }
 
 static bool first_intent(const coavoid_vehicle_node_t *node, const coavoid_node_peer_t *peer);
+static bool searches(const coavoid_vehicle_node_t *node);
 
 /* Whether, since it decided in this cycle, a UAV with a raised rank that comes before it
  * now published an intent of this cycle it did not decide on: one that raised its rank
@@ -716,7 +717,8 @@ static bool overtaken(const coavoid_vehicle_node_t *node)
     const coa_vehicle_t *self = &node->config.vehicle;
     for (size_t i = 0; i < COAVOID_NODE_MAX_PEERS; i++) {
         const coavoid_intent_t *m = &node->inbox.peers[i].msg;
-        const bool newcomer = m->rank <= 0 && first_intent(node, &node->inbox.peers[i]);
+        const bool newcomer =
+            m->rank <= 0 && searches(node) && first_intent(node, &node->inbox.peers[i]);
         if (!node->inbox.peers[i].used || m->plan_utime != node->cycle_start ||
             (m->rank <= 0 && !newcomer) ||
             !coavoid_node_precedes(m->rank, (uint32_t)m->priority, (uint16_t)m->uav_id,
@@ -769,6 +771,13 @@ static bool snapshot_add(coavoid_vehicle_node_t *node, const coavoid_intent_t *m
     return true;
 }
 
+/* Whether it runs the order search: configured decoupled (one that falls back from a
+ * coordinator keeps to the greedy raise) and not told to negotiate greedily. O(1). */
+static bool searches(const coavoid_vehicle_node_t *node)
+{
+    return node->config.mode == COAVOID_NODE_DECOUPLED && !node->config.greedy_negotiation;
+}
+
 /* At the cycle's start (fly_to): itself as its peers will have it when they search
  * (node->order_own): its last intent of the cycle before, or in its first cycle its
  * intent with the offset it starts at held, encoded as it would publish it. */
@@ -777,7 +786,7 @@ static void snapshot_own(coavoid_vehicle_node_t *node)
     const coavoid_node_common_t *c = &node->config.common;
     const coavoid_intent_t *last = &node->tx_intent;
     node->order_own_kind = SNAPSHOT_NONE;
-    if (node->config.mode != COAVOID_NODE_DECOUPLED) {
+    if (!searches(node)) {
         return; /* it never searches (decide_own) */
     }
     if (node->intent_sequence > 0 && last->plan_utime == node->cycle_start - c->dt_us) {
@@ -1183,7 +1192,7 @@ static int reconsider(coavoid_vehicle_node_t *node, int64_t now)
         node->redecided_cycle = node->state.cycle;
         node->redecisions = 0;
     }
-    if (node->config.mode == COAVOID_NODE_DECOUPLED && first_intents(node) > node->searched_first) {
+    if (searches(node) && first_intents(node) > node->searched_first) {
         const int again = search_again(node, now);
         if (again != 0) {
             return again;
@@ -1642,7 +1651,7 @@ static void fly_to(coavoid_vehicle_node_t *node, int64_t k, int64_t now)
 static int decide_own(coavoid_vehicle_node_t *node, int64_t now)
 {
     node->wait_deadline = node->cycle_start + node->config.priority_wait_us;
-    const bool agreed = node->config.mode == COAVOID_NODE_DECOUPLED && search_order(node) == 1;
+    const bool agreed = searches(node) && search_order(node) == 1;
     return agreed ? fly_agreed(node, now) : decide(node, now);
 }
 
