@@ -17,9 +17,13 @@
  *     no UAV that plans for itself;
  *   - a lower priority waits for the higher, up to its deadline; every member of a
  *     cluster in conflict plans, the highest priority too;
- *   - priority negotiation: a UAV with no plan below a higher priority raises its rank,
- *     the other plans around it in the same cycle, or in the next one when the raise
- *     was lost to it, and the rank returns to 0 after the encounter;
+ *   - priority negotiation: a pair with no plan in the configured order agree the
+ *     reverse by their order search (from cycle 0, on their first intents), each flying
+ *     its row and announcing its rank, in the same cycle, or in the next one when the
+ *     rank was lost to the UAV it overtakes; the ranks return to 0 after the encounter;
+ *     and with greedy_negotiation, the greedy raise alone does the same as before the
+ *     search: 2 raises its rank, 1 climbs around it (the same cycle, or the next when
+ *     the raise was lost to it);
  *   - a silent UAV is avoided as a track;
  *   - the world's track estimates reproduce the scenario's path over the horizon;
  *   - bad configurations are refused.
@@ -1466,7 +1470,7 @@ typedef struct {
     coavoid_vehicle_node_t *v[2];
 } net_rig_t;
 
-static void net_rig_init(net_rig_t *r, const coa_vehicle_t *vehicles)
+static void net_rig_init_as(net_rig_t *r, const coa_vehicle_t *vehicles, bool greedy)
 {
     coavoid_sim_net_config_t nc;
     memset(&nc, 0, sizeof nc);
@@ -1486,9 +1490,16 @@ static void net_rig_init(net_rig_t *r, const coa_vehicle_t *vehicles)
         config.common.rx_lcm = coavoid_sim_net_rx(r->net, i);
         config.vehicle = vehicles[i];
         config.mode = COAVOID_NODE_DECOUPLED;
+        config.greedy_negotiation = greedy;
         r->v[i] = coavoid_vehicle_node_create(&config, coavoid_sim_net_tx(r->net, i), &error);
         ck_assert_ptr_nonnull(r->v[i]);
     }
+}
+
+/* Vehicles that search their order (the default). */
+static void net_rig_init(net_rig_t *r, const coa_vehicle_t *vehicles)
+{
+    net_rig_init_as(r, vehicles, false);
 }
 
 static void net_rig_fini(net_rig_t *r)
@@ -1565,10 +1576,13 @@ static void fly_held_pair(net_rig_t *r, size_t deaf, int64_t deaf_cycle)
     ck_assert_msg(!flown_conflict(p[0], p[1], 40), "loss of separation");
 }
 
-/* The fixed order has no plan, the reverse has: 2 finds none below 1, raises its rank in
- * cycle 0 and plans first; 1, overtaken after it decided, decides again in the same
- * cycle and climbs around 2. Every later cycle 1 waits for 2, which comes first now; once
- * they have passed, 2's rank returns to 0. */
+/* The fixed order has no plan, the reverse has. In cycle 0, 2 decides second, with 1's
+ * first intent: its order search, from their first intents (each at the offset it starts
+ * at), finds that 1 first fails and 2 first solves; 2 flies its row of that plan and
+ * announces rank 2. 1, overtaken after it decided (before it had heard of 2: no
+ * conflict, no plan), searches the same view, finds the same order and flies its row
+ * (rank 1) in the same cycle; nobody raises greedily. Every later cycle 1 waits for 2,
+ * which comes first now; once they have passed, the ranks return to 0. */
 START_TEST(test_raise_reorders)
 {
     coa_vec3_t r1[2], r2[2];
@@ -1576,6 +1590,76 @@ START_TEST(test_raise_reorders)
     held_pair(v, r1, r2);
     net_rig_t r;
     net_rig_init(&r, v);
+    const coavoid_vehicle_node_state_t *sa = coavoid_vehicle_node_state(r.v[0]);
+    const coavoid_vehicle_node_state_t *sb = coavoid_vehicle_node_state(r.v[1]);
+    net_rig_cycle(&r, 0, 2);
+    ck_assert_int_eq(sb->rank, 2);
+    ck_assert_uint_eq(sb->orders_agreed, 1);
+    ck_assert_uint_eq(sb->rank_raises, 0);
+    ck_assert_int_eq(sa->rank, 1);
+    ck_assert_uint_eq(sa->orders_agreed, 1);
+    ck_assert_uint_eq(sa->plans_run, 1);
+    ck_assert_uint_eq(sa->plans_adopted, 1);
+    /* Cycle 1: 2's intent of cycle 0 announced its rank, so 1 waits for it. */
+    r.now = cycle(1);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(r.v[0], r.now), COA_OK);
+    ck_assert(sa->waiting);
+    ck_assert_int_eq(coavoid_sim_net_pump(r.net, r.now), COA_OK);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(r.v[1], r.now), COA_OK);
+    ck_assert_int_eq(coavoid_sim_net_pump(r.net, r.now), COA_OK);
+    net_rig_settle(&r);
+    ck_assert(!sa->waiting && sa->published);
+    fly_held_pair(&r, 2, -1);
+    ck_assert_uint_eq(sb->rank_raises, 0);
+    ck_assert_uint_eq(sb->orders_agreed, 1); /* the order held from then on */
+    ck_assert_int_eq(sb->rank, 0);
+    ck_assert_int_eq(sa->rank, 0);
+    net_rig_fini(&r);
+}
+END_TEST
+
+/* The raise is lost to the UAV it overtakes: in cycle 0, 1 hears nothing from 2, so it
+ * neither knows 2's rank nor decides again (2 agreed the order 2, 1 by its search, alone).
+ * In cycle 1 it hears 2's next intent, with the rank (an intent announces it every
+ * cycle), and is overtaken: it searches, with 2 in its view as a UAV in its first cycle
+ * (it has no intent of 2 from before), finds the same order, flies its row of it and
+ * takes rank 1, under 2: the new order comes a cycle late, and they stay separated. */
+START_TEST(test_lost_raise_heard_next_cycle)
+{
+    coa_vec3_t r1[2], r2[2];
+    coa_vehicle_t v[2];
+    held_pair(v, r1, r2);
+    net_rig_t r;
+    net_rig_init(&r, v);
+    const coavoid_vehicle_node_state_t *sa = coavoid_vehicle_node_state(r.v[0]);
+    const coavoid_vehicle_node_state_t *sb = coavoid_vehicle_node_state(r.v[1]);
+    net_rig_cycle(&r, 0, 0);
+    ck_assert_int_eq(sb->rank, 2);
+    ck_assert_uint_eq(sb->orders_agreed, 1);
+    ck_assert_uint_eq(sa->plans_run, 0);
+    ck_assert_int_eq(sa->offset, 0);
+    net_rig_cycle(&r, 1, 2);
+    ck_assert_uint_ge(sa->plans_adopted, 1);
+    ck_assert_uint_eq(sa->orders_agreed, 1);
+    ck_assert_int_eq(sa->rank, 1);
+    fly_held_pair(&r, 2, -1);
+    ck_assert_uint_eq(sb->rank_raises, 0);
+    net_rig_fini(&r);
+}
+END_TEST
+
+/* The greedy raise alone (greedy_negotiation: what the order search falls back on). The
+ * fixed order has no plan, the reverse has: 2 finds none below 1, raises its rank in
+ * cycle 0 and plans first; 1, overtaken after it decided, decides again in the same
+ * cycle and climbs around 2. Every later cycle 1 waits for 2, which comes first now; once
+ * they have passed, 2's rank returns to 0. */
+START_TEST(test_greedy_raise_reorders)
+{
+    coa_vec3_t r1[2], r2[2];
+    coa_vehicle_t v[2];
+    held_pair(v, r1, r2);
+    net_rig_t r;
+    net_rig_init_as(&r, v, true);
     const coavoid_vehicle_node_state_t *sa = coavoid_vehicle_node_state(r.v[0]);
     const coavoid_vehicle_node_state_t *sb = coavoid_vehicle_node_state(r.v[1]);
     net_rig_cycle(&r, 0, 2);
@@ -1603,17 +1687,17 @@ START_TEST(test_raise_reorders)
 }
 END_TEST
 
-/* The raise is lost to the UAV it overtakes: in cycle 0, 1 hears nothing from 2, so it
+/* The greedy raise alone, lost to the UAV it overtakes: in cycle 0, 1 hears nothing from 2, so it
  * neither knows 2's rank nor decides again. In cycle 1 it hears 2's next intent, with
  * the rank (an intent announces it every cycle), decides again and climbs around 2: the
  * new order comes a cycle late, and they stay separated. */
-START_TEST(test_lost_raise_heard_next_cycle)
+START_TEST(test_lost_greedy_raise_heard_next_cycle)
 {
     coa_vec3_t r1[2], r2[2];
     coa_vehicle_t v[2];
     held_pair(v, r1, r2);
     net_rig_t r;
-    net_rig_init(&r, v);
+    net_rig_init_as(&r, v, true);
     const coavoid_vehicle_node_state_t *sa = coavoid_vehicle_node_state(r.v[0]);
     const coavoid_vehicle_node_state_t *sb = coavoid_vehicle_node_state(r.v[1]);
     net_rig_cycle(&r, 0, 0);
@@ -2301,6 +2385,8 @@ static Suite *node_suite(void)
     tcase_add_test(tc, test_higher_priority_replans_in_cluster);
     tcase_add_test(tc, test_raise_reorders);
     tcase_add_test(tc, test_lost_raise_heard_next_cycle);
+    tcase_add_test(tc, test_greedy_raise_reorders);
+    tcase_add_test(tc, test_lost_greedy_raise_heard_next_cycle);
     tcase_add_test(tc, test_silent_uav_avoided_as_track);
     tcase_add_test(tc, test_silent_uav_avoided_along_its_plan);
     tcase_add_test(tc, test_world_track_estimates);

@@ -15,6 +15,9 @@
  *     separation is kept;
  *   - the coordinator gone after one COMMIT reached one UAV only: that UAV's SWITCHED
  *     makes every other UAV of the plan switch too: the plan is flown by all.
+ * And, decoupled, the order search: two random encounters (tests/encounters/) that the
+ * greedy priority negotiation alone flies into a loss of separation, one of them from
+ * cycle 0, and that an order found in flight keeps separated.
  * Separation is judged by the simulation, as `coavoid sim` does.
  */
 #include <stdio.h>
@@ -32,6 +35,10 @@
 
 #ifndef COAVOID_TEST_SCENARIOS
 #error "COAVOID_TEST_SCENARIOS: the scenarios/ directory (tests/CMakeLists.txt)"
+#endif
+
+#ifndef COAVOID_TEST_ENCOUNTERS
+#error "COAVOID_TEST_ENCOUNTERS: the tests/encounters/ directory (tests/CMakeLists.txt)"
 #endif
 
 #define PAPER COAVOID_TEST_SCENARIOS "/paper.json"
@@ -325,6 +332,50 @@ START_TEST(test_coordinator_gone_after_one_commit)
 }
 END_TEST
 
+/* ---- decoupled: the order search (docs/protocol.md, "Priority negotiation") ---- */
+
+/* Flies an encounter decoupled without loss; its verdict. */
+static int fly_decoupled(const char *path)
+{
+    coavoid_scenario_t sc;
+    char err[256];
+    ck_assert_msg(coavoid_scenario_load(path, &sc, err, sizeof err) == COA_OK, "%s", err);
+    coavoid_sim_config_t c;
+    memset(&c, 0, sizeof c);
+    c.scenario_path = path;
+    c.mode = "decoupled";
+    c.decoupled = true;
+    coavoid_sim_outcome_t outcome;
+    coavoid_run_error_t e;
+    memset(&e, 0, sizeof e);
+    const int verdict = coavoid_sim_fly(&c, &sc, NULL, &outcome, &e);
+    coavoid_scenario_free(&sc);
+    ck_assert_msg(verdict == COAVOID_SIM_SEPARATED || verdict == COAVOID_SIM_LOSS,
+                  "verdict %d (%s)", verdict, e.text);
+    return verdict;
+}
+
+/* Encounter 140 of 3 UAVs (montecarlo, seed 1): with the greedy raise alone UAVs 2 and 3
+ * lose separation at t = 4 s; `coavoid plan --reorder` solves it in order 3, 2, 1. The
+ * members search the order at a cycle's start and fly their rows of its plan. */
+START_TEST(test_order_search_keeps_separation)
+{
+    ck_assert_int_eq(fly_decoupled(COAVOID_TEST_ENCOUNTERS "/order_search_140.json"),
+                     COAVOID_SIM_SEPARATED);
+}
+END_TEST
+
+/* Encounter 345 of 3 UAVs (order 2, 1, 3 solves it): the greedy raises of cycle 0, where
+ * nobody has an intent of the cycle before, left no order that solves it by cycle 1, and
+ * UAVs 1 and 3 lost separation at t = 2 s. The UAVs search from their first intents, each
+ * with the offset it starts at held. */
+START_TEST(test_order_search_in_the_first_cycle)
+{
+    ck_assert_int_eq(fly_decoupled(COAVOID_TEST_ENCOUNTERS "/order_search_345.json"),
+                     COAVOID_SIM_SEPARATED);
+}
+END_TEST
+
 static Suite *protocol_suite(void)
 {
     Suite *suite = suite_create("protocol");
@@ -338,6 +389,11 @@ static Suite *protocol_suite(void)
     tcase_add_test(tc, test_coordinator_gone_after_proposal);
     tcase_add_test(tc, test_coordinator_gone_after_one_commit);
     suite_add_tcase(suite, tc);
+    TCase *order = tcase_create("decoupled order search");
+    tcase_set_timeout(order, 120);
+    tcase_add_test(order, test_order_search_keeps_separation);
+    tcase_add_test(order, test_order_search_in_the_first_cycle);
+    suite_add_tcase(suite, order);
     return suite;
 }
 

@@ -246,6 +246,20 @@ static bool sent_by_self(const coavoid_node_inbox_t *in, const void *data, size_
     return false;
 }
 
+/* Stores a UAV's new intent in its slot, keeping its last one of an earlier cycle. */
+static void peer_keep(coavoid_node_peer_t *peer, const coavoid_intent_t *msg)
+{
+    if (peer->used && peer->msg.plan_utime < msg->plan_utime) {
+        peer->has_prev = true; /* its last word on the cycle before */
+        peer->prev = peer->msg;
+    } else if (!peer->used) {
+        peer->has_prev = false;
+    }
+    peer->used = true;
+    peer->forgotten = false;
+    peer->msg = *msg;
+}
+
 static void on_intent(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
 {
     coavoid_node_inbox_t *in = user;
@@ -319,9 +333,7 @@ static void on_intent(const lcm_recv_buf_t *rbuf, const char *channel, void *use
         return;
     }
     senders_heard(&in->intent_seq, (uint32_t)msg->uav_id, now);
-    in->peers[slot].used = true;
-    in->peers[slot].forgotten = false;
-    in->peers[slot].msg = *msg;
+    peer_keep(&in->peers[slot], msg);
 }
 
 static void on_track(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
@@ -848,6 +860,17 @@ static bool stale_plan_track(const coavoid_intent_t *msg, const coavoid_lcm_cont
     return true;
 }
 
+/* Peer i's latest intent of a cycle that began before `before`: its latest, or the one
+ * before it; NULL when it has none. O(1). */
+static const coavoid_intent_t *peer_intent(const coavoid_node_inbox_t *in, size_t i, int64_t before)
+{
+    const coavoid_node_peer_t *p = &in->peers[i];
+    if (p->msg.plan_utime < before) {
+        return &p->msg;
+    }
+    return p->has_prev && p->prev.plan_utime < before ? &p->prev : NULL;
+}
+
 /* The UAVs heard, by ascending id, so that plan indices (and the clusters' order) do not
  * depend on the order intents arrived in. Returns how many. */
 static size_t peers_by_id(const coavoid_node_inbox_t *in, size_t *order)
@@ -894,11 +917,15 @@ static size_t tracks_by_id(const coavoid_node_inbox_t *in, int64_t now, size_t *
 /* The live UAVs' plans (those whose intent is fresh and converts), marking the stale ones. */
 static void view_live(coavoid_node_view_t *view, const coavoid_node_inbox_t *in,
                       const coavoid_lcm_context_t *ctx, const size_t *order, size_t n, bool *stale,
-                      int64_t cycle_start, int64_t now)
+                      int64_t cycle_start, int64_t now, int64_t before)
 {
     const coavoid_node_common_t *c = &in->common;
     for (size_t s = 0; s < n; s++) {
-        const coavoid_intent_t *msg = &in->peers[order[s]].msg;
+        const coavoid_intent_t *msg = peer_intent(in, order[s], before);
+        stale[s] = false;
+        if (msg == NULL) {
+            continue;
+        }
         int64_t age = now - msg->utime;
         stale[s] = age > c->stale_after_us;
         if (stale[s]) {
@@ -920,6 +947,12 @@ static void view_live(coavoid_node_view_t *view, const coavoid_node_inbox_t *in,
 void coavoid_node_view_build(coavoid_node_view_t *view, const coavoid_node_inbox_t *in,
                              int64_t cycle_start, int64_t now)
 {
+    coavoid_node_view_build_before(view, in, cycle_start, now, INT64_MAX);
+}
+
+void coavoid_node_view_build_before(coavoid_node_view_t *view, const coavoid_node_inbox_t *in,
+                                    int64_t cycle_start, int64_t now, int64_t before)
+{
     const coavoid_node_common_t *c = &in->common;
     const coavoid_lcm_context_t ctx = coavoid_node_context(in, now, cycle_start);
     const int64_t drop = drop_after(in);
@@ -933,7 +966,7 @@ void coavoid_node_view_build(coavoid_node_view_t *view, const coavoid_node_inbox
     view->real_track_count = 0;
     view->stale_count = 0;
     const size_t n = peers_by_id(in, order);
-    view_live(view, in, &ctx, order, n, stale, cycle_start, now);
+    view_live(view, in, &ctx, order, n, stale, cycle_start, now, before);
     const size_t m = tracks_by_id(in, now, torder);
     for (size_t s = 0; s < m; s++) {
         const coavoid_track_t *msg = &in->tracks[torder[s]].msg;
@@ -949,7 +982,7 @@ void coavoid_node_view_build(coavoid_node_view_t *view, const coavoid_node_inbox
     view->real_track_count = view->track_count;
     /* The silent UAVs, until they are dropped: tracks along the last plan they announced. */
     for (size_t s = 0; s < n; s++) {
-        const coavoid_intent_t *msg = &in->peers[order[s]].msg;
+        const coavoid_intent_t *msg = peer_intent(in, order[s], before);
         if (!stale[s] || now - msg->utime > drop) {
             continue;
         }
@@ -1013,6 +1046,30 @@ int coavoid_node_problem_tracks(coavoid_node_problem_tracks_t *out, const coavoi
         out->samples[n] = out->storage[n];
     }
     out->count = n;
+    return COA_OK;
+}
+
+int coavoid_node_problem(coa_problem_t *problem, coavoid_node_problem_tracks_t *tracks,
+                         const coavoid_node_view_t *view, const bool *include,
+                         const coavoid_node_inbox_t *in, const coa_vehicle_t *vehicles,
+                         const coa_vec3_t *const *references, size_t count)
+{
+    const coavoid_node_common_t *c = &in->common;
+    int rc = coavoid_node_problem_tracks(tracks, view, include, c);
+    if (rc != COA_OK) {
+        return rc;
+    }
+    memset(problem, 0, sizeof *problem);
+    problem->dt = c->dt;
+    problem->horizon = c->horizon;
+    problem->vehicles = vehicles;
+    problem->vehicle_count = count;
+    problem->references = references;
+    problem->obstacles = in->obstacles;
+    problem->obstacle_count = in->obstacle_count;
+    problem->tracks = tracks->tracks;
+    problem->track_count = tracks->count;
+    problem->track_samples = tracks->samples;
     return COA_OK;
 }
 

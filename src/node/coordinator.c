@@ -253,7 +253,6 @@ static size_t cluster_members(coavoid_coordinator_t *node, uint32_t group)
  * view has as tracks. */
 static int cluster_problem(coavoid_coordinator_t *node, size_t count, coa_problem_t *problem)
 {
-    const coavoid_node_common_t *c = &node->config.common;
     coavoid_node_view_t *view = &node->view;
     for (size_t i = 0; i < view->live_count; i++) {
         node->include[i] = true;
@@ -264,22 +263,8 @@ static int cluster_problem(coavoid_coordinator_t *node, size_t count, coa_proble
         node->vehicles[m] = view->live_vehicle[i];
         node->references[m] = view->live_arrays[i].reference;
     }
-    int rc = coavoid_node_problem_tracks(&node->problem_tracks, view, node->include, c);
-    if (rc != COA_OK) {
-        return rc;
-    }
-    memset(problem, 0, sizeof *problem);
-    problem->dt = c->dt;
-    problem->horizon = c->horizon;
-    problem->vehicles = node->vehicles;
-    problem->vehicle_count = count;
-    problem->references = node->references;
-    problem->obstacles = node->inbox.obstacles;
-    problem->obstacle_count = node->inbox.obstacle_count;
-    problem->tracks = node->problem_tracks.tracks;
-    problem->track_count = node->problem_tracks.count;
-    problem->track_samples = node->problem_tracks.samples;
-    return COA_OK;
+    return coavoid_node_problem(problem, &node->problem_tracks, view, node->include, &node->inbox,
+                                node->vehicles, node->references, count);
 }
 
 /* Plans the cluster, centralised when it is small enough. A joint search can fill its beta

@@ -61,6 +61,17 @@
  *        and lower-priority UAVs outside its cluster were in it, it searches again
  *        around the higher priorities only (coa_plan_decoupled's rule), and the others
  *        plan around it in turn.
+ *        Before all this (configured decoupled: not a UAV fallen back from a
+ *        coordinator), the order search: from the intents as they stood when the cycle
+ *        began (each UAV's last of cycle k - 1, or in its first cycle its first intent
+ *        with the offset it starts at held; its own included), it predicts, and when its
+ *        group of UAVs that pass near each other has a conflict it plans that group as
+ *        coa_plan_decoupled does, first in the order the ranks announce. Only when that
+ *        order fails does it try the others (at most 120), and when one solves it flies
+ *        its own row of that plan and announces its place in the order as its rank
+ *        (docs/protocol.md, "Priority negotiation"). Every member has the same inputs
+ *        when nothing was lost, so each finds the same order and rows by itself;
+ *        otherwise the ranks announced and the greedy raise settle the order.
  *   3. At cycle_utime(k) + collect_us the coordinator predicts over samples k..k+N from the
  *      intents for this cycle, plans each conflicting cluster (of the UAVs whose intent
  *      says they follow it: one that plans for itself is a moving obstacle, since the
@@ -263,6 +274,10 @@ typedef struct {
      * intent_copies 0: none, which is also the default). */
     int64_t resend_us;
     uint32_t intent_copies;
+    /* Decoupled: negotiate the order by the greedy raise alone, without the order search
+     * (docs/protocol.md, "Priority negotiation"): no search's cost, and the negotiation as
+     * it was before the search. false (the default): search. */
+    bool greedy_negotiation;
 } coavoid_vehicle_node_config_t;
 
 /* What a vehicle did; read by drivers, the simulation and tests. */
@@ -291,6 +306,9 @@ typedef struct {
      * times it raised it since start. */
     int32_t rank;
     uint32_t rank_raises;
+    /* Times its order search found a new order for its cluster and it took its place in
+     * it (docs/protocol.md, "Priority negotiation"). */
+    uint32_t orders_agreed;
     coavoid_lcm_rx_stats_t rx;
 } coavoid_vehicle_node_state_t;
 
@@ -304,7 +322,10 @@ coa_planner_config_t coavoid_node_planner_config(uint32_t horizon, size_t search
 /* Creates a vehicle node publishing and subscribing on lcm (not owned). Allocates the node,
  * its one-UAV planner (beta) and its predictor once: about 1.4 MB of node, 1.2 MB of
  * predictor and conflicts at N = 24, and the workspace of coavoid_node_planner_config(N, 1,
- * beta) (1.1 MB at N = 24 and beta 20000). Returns NULL on bad config (invalid vehicle, horizon >
+ * beta) (1.1 MB at N = 24 and beta 20000). The order search's share of the node is 0.1 MB
+ * (each peer's intent of the cycle before, 90 kB, kept in the inbox, which a coordinator's
+ * holds too; its problem's UAVs and references, 12 kB), fixed like the rest. Returns NULL
+ * on bad config (invalid vehicle, horizon >
  * COAVOID_NODE_MAX_HORIZON, ...: COA_ERR_ARGUMENT, also when LCM refuses a subscription) or
  * out of memory (COA_ERR_WORKSPACE), with *error set (error may be NULL). */
 coavoid_vehicle_node_t *coavoid_vehicle_node_create(const coavoid_vehicle_node_config_t *config,
@@ -319,15 +340,19 @@ void coavoid_vehicle_node_destroy(coavoid_vehicle_node_t *node);
  * heartbeat even then, when it can. Cost: O(N + route) to fly; after a coordinated cycle
  * without an adopted plan, one prediction over its peers, tracks and obstacles
  * (coa_predict); decoupled, one more and at most two one-UAV searches of beta
- * expansions. No memory is allocated. */
+ * expansions, and (configured decoupled) the order search: two predictions, and with a
+ * conflict near it one decoupled plan of at most 8 UAVs, or when the order fails at most
+ * 120 orders of at most 8 one-UAV searches each. No memory is allocated. */
 int coavoid_vehicle_node_cycle(coavoid_vehicle_node_t *node, int64_t now);
 
 /* Completes a decoupled wait once its condition holds at `now` (the intents arrived, or
  * priority_wait_us has passed since the cycle began). After a decoupled vehicle has
  * published, it decides again (and publishes again) when a UAV with a raised rank now
  * comes before it with an intent of this cycle it did not decide on (docs/protocol.md,
- * "Priority negotiation"), at most 4 times a cycle: call it whenever messages arrive,
- * not only while it waits. Returns 1 when it planned and published, 0 when there was
+ * "Priority negotiation"), at most 4 times a cycle, and it searches the order again when
+ * a UAV's first intent came after its last search (flying its row, or deciding again,
+ * only when that changes the order it agreed): call it whenever messages arrive, not only
+ * while it waits. Returns 1 when it planned and published, 0 when there was
  * nothing to do or it still waits, negative on error. Cost while waiting: one
  * prediction (it looks again with the intents that came); then as
  * coavoid_vehicle_node_cycle; otherwise O(peers^2) to find it has nothing to do. No

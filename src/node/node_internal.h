@@ -80,6 +80,11 @@ typedef struct {
     bool used;
     bool forgotten;       /* its sequence was forgotten when it went stale */
     coavoid_intent_t msg; /* validated on arrival */
+    /* The latest intent of an earlier cycle than msg's (has_prev): what a vehicle's order
+     * search reads as the intents of a cycle's start, whether or not the UAV has already
+     * published its intent of the cycle (vehicle.c, search_order). */
+    bool has_prev;
+    coavoid_intent_t prev;
 } coavoid_node_peer_t;
 
 typedef struct {
@@ -291,6 +296,24 @@ void coavoid_node_inbox_expire(coavoid_node_inbox_t *in, int64_t now);
  * tracks). Cannot fail: a stored message that no longer converts is left out. */
 void coavoid_node_view_build(coavoid_node_view_t *view, const coavoid_node_inbox_t *in,
                              int64_t cycle_start, int64_t now);
+
+/* The same from each UAV's latest intent of a cycle that began before `before` (its
+ * latest, or the one before it: coavoid_node_peer_t's prev); a UAV with none is left out.
+ * With before = cycle_start = now, the view of the intents as they stood when the cycle
+ * began, whatever came since. Same cost. */
+void coavoid_node_view_build_before(coavoid_node_view_t *view, const coavoid_node_inbox_t *in,
+                                    int64_t cycle_start, int64_t now, int64_t before);
+
+/* The planning problem of `count` UAVs (vehicles and references[i], horizon + 1 samples
+ * each: the caller's, and the problem points to them) around the inbox's obstacles, the
+ * view's tracks and the live UAVs `include` marks as moving obstacles (tracks, filled in
+ * *tracks): what the coordinator plans a cluster in, and a vehicle's order search.
+ * Returns COA_OK or COA_ERR_ARGUMENT (a track that cannot be sampled). Cost as
+ * coavoid_node_problem_tracks. */
+int coavoid_node_problem(coa_problem_t *problem, coavoid_node_problem_tracks_t *tracks,
+                         const coavoid_node_view_t *view, const bool *include,
+                         const coavoid_node_inbox_t *in, const coa_vehicle_t *vehicles,
+                         const coa_vec3_t *const *references, size_t count);
 
 /* Whether a outranks b in the decoupled order (ascending priority, ties by ascending id).
  * O(1). */

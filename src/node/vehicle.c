@@ -25,6 +25,17 @@
  * four-UAV encounters some order solves with a loss of separation; with 5 UAVs 3 and 5
  * left 12 and 11 of 29. More turns help little, and each reorders the cluster again. */
 #define RAISES_MAX 3u
+/* The order search (search_order): clusters of at most ORDER_MEMBERS_MAX UAVs, and at
+ * most ORDER_TRIES_MAX priority orders a search (5!, every order of 5 UAVs). Past that a
+ * search could take n! orders of n single-UAV searches each: the greedy raise remains. */
+#define ORDER_MEMBERS_MAX 8u
+#define ORDER_TRIES_MAX 120u
+/* How a UAV enters the view of a cycle's start (snapshot): not at all, by its intent of
+ * the cycle before, or, in its first cycle, by its first intent with the offset it starts
+ * at held (what it flew before it planned anything). */
+#define SNAPSHOT_NONE 0u
+#define SNAPSHOT_PREVIOUS 1u
+#define SNAPSHOT_FIRST 2u
 
 struct coavoid_vehicle_node {
     coavoid_vehicle_node_config_t config;
@@ -109,6 +120,25 @@ struct coavoid_vehicle_node {
     bool include[COAVOID_NODE_MAX_PEERS];
     coavoid_intent_t tx_intent;
     coavoid_status_t tx_status;
+
+    /* The order search of this cycle (search_order): what it started the cycle as, the
+     * group's members (indices into the view of the cycle's start) and their problem, and
+     * the ranks it agreed for each member (agreed_cycle: the cycle they hold for, until
+     * each member's own intent of the cycle says its rank). */
+    coavoid_intent_t order_own; /* itself as its peers have it when the cycle began */
+    int32_t start_offsets[COAVOID_NODE_MAX_SAMPLES]; /* its plan when the cycle began */
+    uint8_t order_own_kind;                          /* SNAPSHOT_* */
+    uint8_t order_kind[COAVOID_NODE_MAX_PEERS];
+    size_t order_member[ORDER_MEMBERS_MAX];
+    coa_vehicle_t order_vehicles[ORDER_MEMBERS_MAX];
+    coa_vec3_t order_reference[ORDER_MEMBERS_MAX][COAVOID_NODE_MAX_SAMPLES];
+    const coa_vec3_t *order_references[ORDER_MEMBERS_MAX];
+    int32_t order_offsets[ORDER_MEMBERS_MAX * COAVOID_NODE_MAX_SAMPLES];
+    int64_t agreed_cycle;
+    size_t searched_first; /* first intents of the cycle its last search saw (first_intents) */
+    size_t agreed_count;
+    uint16_t agreed_id[ORDER_MEMBERS_MAX];
+    int32_t agreed_rank[ORDER_MEMBERS_MAX];
 
     coavoid_node_solver_t solver;
     coavoid_node_inbox_t inbox;
@@ -219,15 +249,15 @@ static int publish_status(coavoid_vehicle_node_t *node, int64_t now)
                                           &h);
 }
 
-/* Publishes its intent of this cycle as it stands at `now` (its state moved on, the same
- * plan), and schedules its copies. COA_OK or a negative error (a fault). */
-static int publish_intent(coavoid_vehicle_node_t *node, int64_t now)
+/* Its intent's fields of this cycle at `now` beyond the samples, numbered `sequence`. */
+static coavoid_lcm_intent_info_t intent_info(const coavoid_vehicle_node_t *node, int64_t now,
+                                             int64_t sequence)
 {
     const coavoid_node_common_t *c = &node->config.common;
     coavoid_lcm_intent_info_t info;
     memset(&info, 0, sizeof info);
     info.utime = now;
-    info.sequence = node->intent_sequence++;
+    info.sequence = sequence;
     info.mode = node->state.coordinated ? COAVOID_INTENT_T_MODE_CENTRALISED
                                         : COAVOID_INTENT_T_MODE_DECOUPLED;
     /* The state at `now`: it moves straight from sample k to sample k + 1. */
@@ -246,6 +276,15 @@ static int publish_intent(coavoid_vehicle_node_t *node, int64_t now)
     info.sigma_horizontal = node->config.sigma_horizontal;
     info.sigma_vertical = node->config.sigma_vertical;
     info.rank = (int8_t)node->state.rank;
+    return info;
+}
+
+/* Publishes its intent of this cycle as it stands at `now` (its state moved on, the same
+ * plan), and schedules its copies. COA_OK or a negative error (a fault). */
+static int publish_intent(coavoid_vehicle_node_t *node, int64_t now)
+{
+    const coavoid_node_common_t *c = &node->config.common;
+    const coavoid_lcm_intent_info_t info = intent_info(node, now, node->intent_sequence++);
     coavoid_lcm_context_t ctx = coavoid_node_context(&node->inbox, now, node->cycle_start);
     int rc = coavoid_lcm_intent_from_core(&node->config.vehicle, &info, node->own_reference,
                                           node->own_offsets, (size_t)c->horizon + 1u, &ctx,
@@ -500,6 +539,24 @@ static int plan_self(coavoid_vehicle_node_t *node, int64_t now, uint32_t my)
     return rc;
 }
 
+/* The ranks its order search agreed this cycle (search_order), for the members whose
+ * intent of the cycle has not come yet: those still announce the order of the cycle
+ * before, and it must wait for the members before it in the new one. O(peers * members). */
+static void apply_agreed(coavoid_vehicle_node_t *node)
+{
+    coavoid_node_view_t *view = &node->view;
+    if (node->agreed_cycle != node->state.cycle) {
+        return;
+    }
+    for (size_t i = 0; i < view->live_count; i++) {
+        for (size_t a = 0; a < node->agreed_count && !view->live_current[i]; a++) {
+            if (node->agreed_id[a] == view->live_id[i]) {
+                view->live_info[i].rank = (int8_t)node->agreed_rank[a];
+            }
+        }
+    }
+}
+
 /* Builds the cycle's view at `now` and the plans to predict: its own intent first, then
  * the live UAVs' (view order). Returns their count. */
 static size_t gather(coavoid_vehicle_node_t *node, int64_t now)
@@ -508,6 +565,7 @@ static size_t gather(coavoid_vehicle_node_t *node, int64_t now)
     const coa_vehicle_t *self = &node->config.vehicle;
     coavoid_node_view_t *view = &node->view;
     coavoid_node_view_build(view, &node->inbox, node->cycle_start, now);
+    apply_agreed(node);
     coa_intent_plan_t *own = &node->plans[0];
     memset(own, 0, sizeof *own);
     own->id = self->id;
@@ -633,30 +691,424 @@ static void note_order(coavoid_vehicle_node_t *node)
     }
 }
 
+/* The rank its order search agreed this cycle for UAV id, -1 when none. O(members). */
+static int32_t agreed_rank_of(const coavoid_vehicle_node_t *node, uint16_t id)
+{
+    for (size_t a = 0; a < node->agreed_count && node->agreed_cycle == node->state.cycle; a++) {
+        if (node->agreed_id[a] == id) {
+            return node->agreed_rank[a];
+        }
+    }
+    return -1;
+}
+
+static bool first_intent(const coavoid_vehicle_node_t *node, const coavoid_node_peer_t *peer);
+static bool searches(const coavoid_vehicle_node_t *node);
+
 /* Whether, since it decided in this cycle, a UAV with a raised rank that comes before it
  * now published an intent of this cycle it did not decide on: one that raised its rank
  * above it after it decided, or one before it that planned again. Only raised ranks
  * count, so that with every rank 0 a UAV decides once per cycle, as before priority
- * negotiation. O(peers^2). */
+ * negotiation; but for a UAV before it whose first intent it had not heard when it
+ * decided (lost, and come by a copy): it would have waited for it. Without loss that
+ * never happens (each decides after the UAVs before it published). O(peers^2). */
 static bool overtaken(const coavoid_vehicle_node_t *node)
 {
     const coa_vehicle_t *self = &node->config.vehicle;
     for (size_t i = 0; i < COAVOID_NODE_MAX_PEERS; i++) {
         const coavoid_intent_t *m = &node->inbox.peers[i].msg;
-        if (!node->inbox.peers[i].used || m->plan_utime != node->cycle_start || m->rank <= 0 ||
+        const bool newcomer =
+            m->rank <= 0 && searches(node) && first_intent(node, &node->inbox.peers[i]);
+        if (!node->inbox.peers[i].used || m->plan_utime != node->cycle_start ||
+            (m->rank <= 0 && !newcomer) ||
             !coavoid_node_precedes(m->rank, (uint32_t)m->priority, (uint16_t)m->uav_id,
                                    node->state.rank, self->priority, self->id)) {
             continue;
+        }
+        if (agreed_rank_of(node, (uint16_t)m->uav_id) == m->rank) {
+            continue; /* a member of its agreed order, where it was expected */
         }
         size_t j = 0;
         while (j < node->decided_count && node->decided_id[j] != (uint16_t)m->uav_id) {
             j++;
         }
-        if (j == node->decided_count || node->decided_sequence[j] < m->sequence) {
+        if (j == node->decided_count || (!newcomer && node->decided_sequence[j] < m->sequence)) {
             return true;
         }
     }
     return false;
+}
+
+/* ---- the order search (docs/protocol.md, "Priority negotiation") ---- */
+
+/* Adds `msg` to the view of the cycle's start (node->view) as `kind`: converted as every
+ * node converts it; SNAPSHOT_FIRST with its first offset held and rank 0. Returns false
+ * when it does not fit or convert. O(N). */
+static bool snapshot_add(coavoid_vehicle_node_t *node, const coavoid_intent_t *msg, uint8_t kind)
+{
+    coavoid_node_view_t *view = &node->view;
+    const size_t i = view->live_count;
+    const coavoid_lcm_context_t ctx =
+        coavoid_node_context(&node->inbox, node->cycle_start, node->cycle_start);
+    if (i >= COAVOID_NODE_MAX_PEERS ||
+        coavoid_lcm_intent_to_core(msg, &ctx, NULL, &view->live_info[i], &view->live_vehicle[i],
+                                   &view->live_plan[i], &view->live_arrays[i], NULL) != COA_OK) {
+        return false;
+    }
+    if (kind == SNAPSHOT_FIRST) {
+        coavoid_lcm_intent_arrays_t *a = &view->live_arrays[i];
+        const coa_real_t dh = coa_climb_step(&view->live_vehicle[i], node->config.common.dt);
+        for (size_t j = 0; j < view->live_plan[i].count; j++) {
+            a->offsets[j] = a->offsets[0];
+            a->samples[j] = lifted(a->reference[j], a->offsets[0], dh);
+        }
+        view->live_info[i].rank = 0;
+    }
+    view->live_id[i] = (uint16_t)msg->uav_id;
+    view->live_current[i] = false;
+    node->order_kind[i] = kind;
+    view->live_count++;
+    return true;
+}
+
+/* Whether it runs the order search: configured decoupled (one that falls back from a
+ * coordinator keeps to the greedy raise) and not told to negotiate greedily. O(1). */
+static bool searches(const coavoid_vehicle_node_t *node)
+{
+    return node->config.mode == COAVOID_NODE_DECOUPLED && !node->config.greedy_negotiation;
+}
+
+/* At the cycle's start (fly_to): itself as its peers will have it when they search
+ * (node->order_own): its last intent of the cycle before, or in its first cycle its
+ * intent with the offset it starts at held, encoded as it would publish it. */
+static void snapshot_own(coavoid_vehicle_node_t *node)
+{
+    const coavoid_node_common_t *c = &node->config.common;
+    const coavoid_intent_t *last = &node->tx_intent;
+    node->order_own_kind = SNAPSHOT_NONE;
+    if (!searches(node)) {
+        return; /* it never searches (decide_own) */
+    }
+    if (node->intent_sequence > 0 && last->plan_utime == node->cycle_start - c->dt_us) {
+        node->order_own = *last;
+        node->order_own_kind = SNAPSHOT_PREVIOUS;
+    } else if (node->first_cycle_start == node->cycle_start) {
+        coavoid_lcm_intent_info_t info = intent_info(node, node->cycle_start, 0);
+        info.mode = COAVOID_INTENT_T_MODE_DECOUPLED;
+        info.rank = 0;
+        const coavoid_lcm_context_t ctx =
+            coavoid_node_context(&node->inbox, node->cycle_start, node->cycle_start);
+        node->order_own_kind =
+            coavoid_lcm_intent_from_core(&node->config.vehicle, &info, node->own_reference,
+                                         node->own_offsets, (size_t)c->horizon + 1u, &ctx,
+                                         &node->order_own, NULL) == COA_OK
+                ? SNAPSHOT_FIRST
+                : SNAPSHOT_NONE;
+    }
+}
+
+/* Whether a peer is in the view of the cycle's start by its first intent, of this cycle:
+ * the only way that view grows within a cycle. O(1). */
+static bool first_intent(const coavoid_vehicle_node_t *node, const coavoid_node_peer_t *peer)
+{
+    const int64_t start = node->cycle_start;
+    return peer->used && peer->msg.plan_utime == start &&
+           !(peer->has_prev && peer->prev.plan_utime < start);
+}
+
+/* How many peers are in the view of the cycle's start by their first intent. O(peers). */
+static size_t first_intents(const coavoid_vehicle_node_t *node)
+{
+    size_t n = 0;
+    for (size_t p = 0; p < COAVOID_NODE_MAX_PEERS; p++) {
+        n += first_intent(node, &node->inbox.peers[p]) ? 1u : 0u;
+    }
+    return n;
+}
+
+/* The view of the cycle's start in node->view: every UAV by its intent of an earlier
+ * cycle (SNAPSHOT_PREVIOUS when of the cycle before), a UAV whose first intent is of
+ * this cycle as SNAPSHOT_FIRST, and itself last (snapshot_own), whatever came since the
+ * cycle began: every member builds it alike. Returns its own index, or live_count when it
+ * is not in it. O(peers * N). */
+static size_t snapshot(coavoid_vehicle_node_t *node, int64_t previous)
+{
+    coavoid_node_view_t *view = &node->view;
+    const int64_t start = node->cycle_start;
+    coavoid_node_view_build_before(view, &node->inbox, start, start, start);
+    for (size_t i = 0; i < view->live_count; i++) {
+        node->order_kind[i] =
+            view->live_info[i].plan_utime == previous ? SNAPSHOT_PREVIOUS : SNAPSHOT_NONE;
+    }
+    node->searched_first = 0;
+    for (size_t p = 0; p < COAVOID_NODE_MAX_PEERS; p++) {
+        const coavoid_node_peer_t *peer = &node->inbox.peers[p];
+        if (first_intent(node, peer)) {
+            node->searched_first++;
+            (void)snapshot_add(node, &peer->msg, SNAPSHOT_FIRST);
+        }
+    }
+    if (node->order_own_kind == SNAPSHOT_NONE ||
+        !snapshot_add(node, &node->order_own, node->order_own_kind)) {
+        return view->live_count;
+    }
+    view->live_id[view->live_count - 1u] = node->config.vehicle.id;
+    return view->live_count - 1u;
+}
+
+/* Whether live UAV i of the view of the cycle's start can be searched: it is in it by an
+ * intent of the cycle before or its first one (snapshot), says it plans for itself, and
+ * spans the horizon. O(1). */
+static bool order_eligible(const coavoid_vehicle_node_t *node, size_t i)
+{
+    const coavoid_node_common_t *c = &node->config.common;
+    const coavoid_lcm_intent_info_t *info = &node->view.live_info[i];
+    return node->order_kind[i] != SNAPSHOT_NONE && info->mode == COAVOID_INTENT_T_MODE_DECOUPLED &&
+           info->step == c->dt && node->view.live_plan[i].count == (size_t)c->horizon + 1u;
+}
+
+/* Labels the view of the cycle's start (node->plans) as near_pending judges nearness:
+ * UAVs whose paths pass near each other horizontally within the horizon, with every
+ * volume as tall as a message allows, joined into groups (coa_predict_clusters). Returns
+ * COA_OK or an error. Cost: one coa_predict over the live UAVs. */
+static int label_near(coavoid_vehicle_node_t *node, size_t n)
+{
+    coavoid_node_solver_t *sv = &node->solver;
+    for (size_t i = 0; i < n; i++) {
+        node->tall[i] = node->plans[i];
+        node->tall[i].volume.half_height = (coa_real_t)COAVOID_LCM_MAX_SIZE;
+    }
+    const coa_predict_config_t config = coavoid_node_predict_config(&node->config.common);
+    coa_predict_result_t result;
+    int rc = coa_predict(sv->predictor, &config, node->tall, n, NULL, 0, NULL, 0, sv->conflicts,
+                         sv->conflict_capacity, &result);
+    if (rc == COA_OK && result.overflow) {
+        rc = COA_ERR_WORKSPACE;
+    }
+    size_t groups = 0;
+    return rc != COA_OK ? rc
+                        : coa_predict_clusters(sv->conflicts, result.conflict_count, n,
+                                               node->labels, &groups);
+}
+
+/* The UAVs its order search plans (self: its index in the view of the cycle's start),
+ * into node->order_member by ascending id: its group of UAVs near each other
+ * (label_near), when one of them has a conflict there (its prediction). Not its cluster
+ * alone: a UAV outside it whose plan leaves a member no room may have to plan around
+ * that member, and only a UAV near can. Returns their count; 0 when none of them has a
+ * conflict, or one of them cannot be searched (the greedy raise remains). Cost: two
+ * coa_predict. */
+static size_t order_members(coavoid_vehicle_node_t *node, size_t self)
+{
+    const coavoid_node_view_t *view = &node->view;
+    coavoid_node_solver_t *sv = &node->solver;
+    const size_t n = view->live_count;
+    for (size_t i = 0; i < n; i++) {
+        node->plans[i] = view->live_plan[i];
+    }
+    coa_predict_result_t result;
+    size_t clusters = 0;
+    if (coavoid_node_predict(sv->predictor, &node->config.common, node->plans, n, view,
+                             &node->inbox, sv->conflicts, sv->conflict_capacity, &result,
+                             node->labels, &clusters) != COA_OK) {
+        return 0;
+    }
+    for (size_t i = 0; i < n; i++) {
+        node->include[i] = node->labels[i] != COA_NO_CLUSTER; /* in conflict */
+    }
+    if (label_near(node, n) != COA_OK || node->labels[self] == COA_NO_CLUSTER) {
+        return 0;
+    }
+    size_t count = 0;
+    bool conflict = false;
+    for (size_t i = 0; i < n; i++) {
+        if (node->labels[i] != node->labels[self]) {
+            continue;
+        }
+        if (!order_eligible(node, i) || count == ORDER_MEMBERS_MAX) {
+            return 0;
+        }
+        conflict = conflict || node->include[i];
+        size_t m = count++;
+        while (m > 0 && view->live_id[node->order_member[m - 1]] > view->live_id[i]) {
+            node->order_member[m] = node->order_member[m - 1];
+            m--;
+        }
+        node->order_member[m] = i;
+    }
+    return count >= 2u && conflict ? count : 0u;
+}
+
+/* The members' problem: each from the offset its intent of the cycle before flies at the
+ * cycle's start, along that intent's reference from there (its last sample, which that
+ * intent does not reach, carried on along its last leg: every member extrapolates alike),
+ * or in its first cycle from its first intent's offset along its reference; around
+ * everything else of the view (coavoid_node_problem). Returns its error. */
+static int order_problem(coavoid_vehicle_node_t *node, size_t count, coa_problem_t *problem)
+{
+    const uint32_t n = node->config.common.horizon;
+    const coavoid_node_view_t *view = &node->view;
+    for (size_t i = 0; i < view->live_count; i++) {
+        node->include[i] = true;
+    }
+    for (size_t m = 0; m < count; m++) {
+        const size_t i = node->order_member[m];
+        const coavoid_lcm_intent_arrays_t *a = &view->live_arrays[i];
+        coa_vec3_t *r = node->order_reference[m];
+        node->include[i] = false;
+        node->order_vehicles[m] = view->live_vehicle[i];
+        node->order_references[m] = r;
+        if (node->order_kind[i] == SNAPSHOT_FIRST) {
+            memcpy(r, a->reference, ((size_t)n + 1u) * sizeof r[0]); /* of this cycle */
+            continue;
+        }
+        node->order_vehicles[m].initial_offset = a->offsets[1];
+        memcpy(r, &a->reference[1], n * sizeof r[0]);
+        r[n].x = a->reference[n].x + (a->reference[n].x - a->reference[n - 1u].x);
+        r[n].y = a->reference[n].y + (a->reference[n].y - a->reference[n - 1u].y);
+        r[n].z = a->reference[n].z + (a->reference[n].z - a->reference[n - 1u].z);
+    }
+    return coavoid_node_problem(problem, &node->problem_tracks, view, node->include, &node->inbox,
+                                node->order_vehicles, node->order_references, count);
+}
+
+/* The members' decoupled order as the intents of the cycle's start announce it (rank,
+ * priority, id), as indices into order_member. O(count^2). */
+static void order_current(const coavoid_vehicle_node_t *node, size_t count, size_t *order)
+{
+    const coavoid_node_view_t *view = &node->view;
+    for (size_t m = 0; m < count; m++) {
+        const size_t x = node->order_member[m];
+        size_t p = m;
+        while (p > 0) {
+            const size_t y = node->order_member[order[p - 1]];
+            if (!coavoid_node_precedes(view->live_info[x].rank, view->live_vehicle[x].priority,
+                                       view->live_id[x], view->live_info[y].rank,
+                                       view->live_vehicle[y].priority, view->live_id[y])) {
+                break;
+            }
+            order[p] = order[p - 1];
+            p--;
+        }
+        order[p] = m;
+    }
+}
+
+/* The ranks of a solving order: count - p at position p, above every UAV at rank 0. Its
+ * own at once; the others' it uses (apply_agreed) until each member's own intent of the
+ * cycle announces its rank. Its row of the solving plan goes to node->plan_out
+ * (fly_agreed). A new episode of raises begins. O(count + N). */
+static void order_agree(coavoid_vehicle_node_t *node, size_t count, const size_t *order,
+                        size_t self)
+{
+    node->agreed_cycle = node->state.cycle;
+    node->agreed_count = count;
+    for (size_t p = 0; p < count; p++) {
+        const size_t i = node->order_member[order[p]];
+        node->agreed_id[p] = node->view.live_id[i];
+        node->agreed_rank[p] = (int32_t)(count - p);
+        if (i == self) {
+            const size_t samples = (size_t)node->config.common.horizon + 1u;
+            memcpy(node->plan_out, &node->order_offsets[order[p] * samples],
+                   samples * sizeof node->plan_out[0]);
+            node->state.rank = (int32_t)(count - p);
+            node->raises = 0;
+            node->calm_cycles = 0;
+        }
+    }
+    node->state.orders_agreed++;
+}
+
+/* A search that no longer agrees the order an earlier one of this cycle agreed (its view
+ * of the cycle's start grew since: a UAV's first intent came, in its first cycle or
+ * after its intents were lost): that order is withdrawn, and its rank and plan are again
+ * those it began the cycle with, which the others' searches assume. O(N). */
+static void order_withdraw(coavoid_vehicle_node_t *node)
+{
+    if (node->agreed_cycle == node->state.cycle) {
+        node->agreed_cycle = -1;
+        node->state.rank = node->order_own.rank;
+        /* Back on the plan it began the cycle with. */
+        memcpy(node->plan_offsets, node->start_offsets, sizeof node->plan_offsets);
+        node->plan_start = node->state.cycle;
+        node->plan_count = node->config.common.horizon + 1u;
+        build_own(node, node->state.cycle);
+    }
+}
+
+/* The order search, at the start of a decoupled cycle and again within it (decide_own,
+ * search_again). From the intents as they stood when the cycle began (snapshot: each
+ * UAV's last of the cycle before, its own included, whatever came since), it predicts, and
+ * when its group of UAVs near each other has a conflict (order_members), plans the group
+ * as coa_plan_decoupled does, first in the order the ranks announce; only when that order
+ * fails it tries the others (at most ORDER_TRIES_MAX), and when one solves takes its
+ * place in it (order_agree). Every member has the same intents when none was lost, so
+ * each finds the same order and rows without a message or a central node, and the ranks
+ * they announce make the order hold for anyone who did not. Changes nothing when the
+ * current order solves or none does (but withdraws an order it agreed earlier in the
+ * cycle: order_withdraw). Returns 1 when it agreed a new order, 0 when not, or an error
+ * of the search (then the greedy raise remains). Cost: one view, two predictions; with a
+ * conflict, a decoupled plan of at most ORDER_MEMBERS_MAX UAVs, and when the order fails
+ * at most ORDER_TRIES_MAX orders of at most ORDER_MEMBERS_MAX single-UAV searches each
+ * (coa_plan_decoupled's cost). Memory: the node's (order_*) and its solver's workspace. */
+static int search_order(coavoid_vehicle_node_t *node)
+{
+    const size_t self = snapshot(node, node->cycle_start - node->config.common.dt_us);
+    if (self == node->view.live_count) {
+        return COA_OK;
+    }
+    const size_t count = order_members(node, self);
+    if (count == 0u) {
+        order_withdraw(node);
+        return COA_OK;
+    }
+    coa_problem_t problem;
+    int rc = order_problem(node, count, &problem);
+    if (rc != COA_OK) {
+        return rc;
+    }
+    size_t order[ORDER_MEMBERS_MAX];
+    order_current(node, count, order);
+    coa_plan_result_t result;
+    rc = coa_plan_decoupled(node->solver.planner, &problem, order, ORDER_TRIES_MAX,
+                            node->order_offsets, &result);
+    if (rc != COA_OK || result.orders_tried <= 1u) {
+        order_withdraw(node);
+        return rc != COA_OK ? rc : 0; /* the order holds: a check, not a plan of its own */
+    }
+    node->state.plans_run++;
+    if (result.status != COA_PLAN_SOLVED) {
+        order_withdraw(node);
+        return 0;
+    }
+    order_agree(node, count, result.order, self);
+    return 1;
+}
+
+static int decide(coavoid_vehicle_node_t *node, int64_t now);
+static int decide_own(coavoid_vehicle_node_t *node, int64_t now);
+
+/* In a cycle whose order search agreed a new order: it flies its row of the solving plan
+ * (node->plan_out) at once, as every other member does with its own, once the check every
+ * plan gets finds it clear of the obstacles and tracks it knows (its row was planned
+ * around the others' intents of the cycle's start, which their rows replace), and
+ * publishes it with its new rank. A row that fails the check is left: it decides as any
+ * cycle (decide), in the agreed order. Returns as decide. */
+static int fly_agreed(coavoid_vehicle_node_t *node, int64_t now)
+{
+    (void)gather(node, now);
+    note_order(node);
+    memset(node->include, 0, sizeof node->include);
+    const uint32_t samples = node->config.common.horizon + 1u;
+    int hit = plan_hits_known(node, node->plan_out, samples, now, true);
+    if (hit != 0) {
+        return decide(node, now);
+    }
+    adopt(node, node->plan_out, samples);
+    node->state.last_outcome = (int)COA_PLAN_SOLVED;
+    node->cycle_conflict = true;
+    settle_rank(node, true);
+    return finish(node, now);
 }
 
 /* The decoupled step: predict with what it has; publish at once without a conflict;
@@ -709,6 +1161,23 @@ static int decide(coavoid_vehicle_node_t *node, int64_t now)
     return finish(node, now);
 }
 
+/* After it published this cycle's intent: a UAV's first intent came since its last
+ * search (in cycle 0 each UAV hears the others' one by one, some only by a copy), so its
+ * view of the cycle's start grew. It searches again: when that agrees an order it flies
+ * its row; when it withdraws an order it agreed earlier in the cycle it decides again;
+ * otherwise nothing changes (a flight whose order holds flies as before). At most once per
+ * such intent. Returns as decide, 0 when there is nothing to do. */
+static int search_again(coavoid_vehicle_node_t *node, int64_t now)
+{
+    const bool agreed = node->agreed_cycle == node->state.cycle;
+    const int found = search_order(node);
+    if (found != 1 && !(agreed && node->agreed_cycle != node->state.cycle)) {
+        return 0;
+    }
+    node->wait_deadline = node->cycle_start + node->config.priority_wait_us;
+    return found == 1 ? fly_agreed(node, now) : decide(node, now);
+}
+
 /* After it published this cycle's intent on its own decision: when it has been overtaken
  * (overtaken()), it decides again at once, waiting as before (until the cycle's priority
  * wait ends) and publishing its intent again, at most REDECISIONS_MAX times a cycle, so
@@ -723,12 +1192,17 @@ static int reconsider(coavoid_vehicle_node_t *node, int64_t now)
         node->redecided_cycle = node->state.cycle;
         node->redecisions = 0;
     }
+    if (searches(node) && first_intents(node) > node->searched_first) {
+        const int again = search_again(node, now);
+        if (again != 0) {
+            return again;
+        }
+    }
     if (node->redecisions >= REDECISIONS_MAX || !overtaken(node)) {
         return 0;
     }
     node->redecisions++;
-    node->wait_deadline = node->cycle_start + node->config.priority_wait_us;
-    return decide(node, now);
+    return decide_own(node, now);
 }
 
 static void reject(coavoid_vehicle_node_t *node, int code, const char *reason)
@@ -1106,7 +1580,7 @@ coavoid_vehicle_node_t *coavoid_vehicle_node_create(const coavoid_vehicle_node_c
     node->plan_offsets[0] = node->config.vehicle.initial_offset;
     node->state.cycle = -1;
     node->settled_cycle = -1;
-    node->redecided_cycle = -1;
+    node->redecided_cycle = node->agreed_cycle = -1;
     node->state.offset = node->config.vehicle.initial_offset;
     node->state.last_outcome = -1;
     node->wait_deadline = INT64_MAX;
@@ -1166,6 +1640,19 @@ static void fly_to(coavoid_vehicle_node_t *node, int64_t k, int64_t now)
     node->state.offset = node->own_offsets[0];
     node->state.reference = node->own_reference[0];
     node->state.position = node->own_samples[0];
+    memcpy(node->start_offsets, node->plan_offsets, sizeof node->start_offsets);
+    snapshot_own(node);
+}
+
+/* A cycle it decides for itself: the order search (decoupled by configuration: one that
+ * falls back from a coordinator keeps to the greedy raise), then its own decision. An
+ * error of the search leaves the order as it was: the greedy raise still applies.
+ * Returns as decide. */
+static int decide_own(coavoid_vehicle_node_t *node, int64_t now)
+{
+    node->wait_deadline = node->cycle_start + node->config.priority_wait_us;
+    const bool agreed = searches(node) && search_order(node) == 1;
+    return agreed ? fly_agreed(node, now) : decide(node, now);
 }
 
 /* Whether a cycle of distrust has passed and the coordinator was heard since it began. */
@@ -1247,8 +1734,7 @@ int coavoid_vehicle_node_cycle(coavoid_vehicle_node_t *node, int64_t now)
         drop_rank(node);
         rc = finish(node, now);
     } else {
-        node->wait_deadline = node->cycle_start + node->config.priority_wait_us;
-        rc = decide(node, now);
+        rc = decide_own(node, now);
     }
     if (rc >= 0 && predicted != COA_OK) {
         rc = predicted;
