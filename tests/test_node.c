@@ -111,19 +111,29 @@ static coa_vehicle_t uav(uint16_t id, uint32_t priority, coa_vec3_t *route, coa_
     return v;
 }
 
-static coavoid_vehicle_node_t *vehicle_node(const rig_t *r, coa_vehicle_t v,
-                                            coavoid_node_mode_t mode)
+/* A vehicle node on the rig's bus; answer_wait_us as coavoid_vehicle_node_config_t's
+ * (0: the default). */
+static coavoid_vehicle_node_t *vehicle_node_waiting(const rig_t *r, coa_vehicle_t v,
+                                                    coavoid_node_mode_t mode,
+                                                    int64_t answer_wait_us)
 {
     coavoid_vehicle_node_config_t config;
     memset(&config, 0, sizeof config);
     config.common = r->common;
     config.vehicle = v;
     config.mode = mode;
+    config.answer_wait_us = answer_wait_us;
     int error = -99;
     coavoid_vehicle_node_t *node = coavoid_vehicle_node_create(&config, r->lcm, &error);
     ck_assert_ptr_nonnull(node);
     ck_assert_int_eq(error, COA_OK);
     return node;
+}
+
+static coavoid_vehicle_node_t *vehicle_node(const rig_t *r, coa_vehicle_t v,
+                                            coavoid_node_mode_t mode)
+{
+    return vehicle_node_waiting(r, v, mode, 0);
 }
 
 static void heartbeat_from(lcm_t *lcm, int64_t now, int64_t sequence, int32_t node_id,
@@ -1031,6 +1041,75 @@ START_TEST(test_faulty_coordinator_not_followed)
 }
 END_TEST
 
+/* Polls the n vehicles at their deadlines, in time order, up to (not at) `until`. */
+static void poll_until(rig_t *r, coavoid_vehicle_node_t *const *v, size_t n, int64_t until)
+{
+    for (;;) {
+        size_t first = n;
+        int64_t at = until;
+        for (size_t i = 0; i < n; i++) {
+            const int64_t d = coavoid_vehicle_node_deadline(v[i]);
+            if (d < at) {
+                at = d;
+                first = i;
+            }
+        }
+        if (first == n) {
+            return;
+        }
+        r->now = at > r->now ? at : r->now;
+        ck_assert_int_ge(coavoid_vehicle_node_poll(v[first], r->now), 0);
+        drain(r->lcm);
+    }
+}
+
+/* Flies a head-on pair 90 m apart (their volumes meet 3 s ahead) under a coordinator that
+ * sends heartbeats and never a plan (one stopped after its heartbeat in cycle 0), with the
+ * given answer_wait_us; fills p with the flown positions of cycles 0..8. */
+static void fly_unanswered(int64_t answer_wait_us, coa_vec3_t p[2][9])
+{
+    rig_t r;
+    rig_init(&r, 24);
+    coa_vec3_t r1[2], r2[2];
+    coavoid_vehicle_node_t *v[2];
+    v[0] = vehicle_node_waiting(&r, uav(1, 1, r1, 0, 600, 0, 100), COAVOID_NODE_CENTRALISED,
+                                answer_wait_us);
+    v[1] = vehicle_node_waiting(&r, uav(2, 2, r2, 90, -510, 0, 100), COAVOID_NODE_CENTRALISED,
+                                answer_wait_us);
+    for (int64_t k = 0; k <= 8; k++) {
+        r.now = cycle(k);
+        for (int i = 0; i < 2; i++) {
+            ck_assert_int_eq(coavoid_vehicle_node_cycle(v[i], r.now), COA_OK);
+            drain(r.lcm);
+            p[i][k] = coavoid_vehicle_node_state(v[i])->position;
+        }
+        r.now = cycle(k) + DT_US / 4;
+        heartbeat_from(r.lcm, r.now, k, (int32_t)COAVOID_NODE_COORDINATOR_ID,
+                       COAVOID_STATUS_T_HEALTH_OK);
+        drain(r.lcm);
+        poll_until(&r, v, 2, cycle(k + 1));
+    }
+    coavoid_vehicle_node_destroy(v[1]);
+    coavoid_vehicle_node_destroy(v[0]);
+    lcm_destroy(r.lcm);
+}
+
+static bool flown_conflict(const coa_vec3_t *pa, const coa_vec3_t *pb, int64_t n);
+
+/* A UAV following a coordinator that has a conflict of its own and no answer (no plan it
+ * holds, flies, or was told failed) by answer_wait_us plans for itself within the cycle:
+ * with a conflict 3 s ahead that one UAV alone can climb clear of only from cycle 0, the
+ * pair keeps separation; waiting for the next cycle's fallback, it does not. */
+START_TEST(test_unanswered_conflict_planned_within_cycle)
+{
+    coa_vec3_t p[2][9];
+    fly_unanswered(0, p);
+    ck_assert_msg(!flown_conflict(p[0], p[1], 8), "loss of separation with the rule");
+    fly_unanswered(2 * DT_US, p);
+    ck_assert_msg(flown_conflict(p[0], p[1], 8), "the encounter needs the rule");
+}
+END_TEST
+
 /* Whether two UAVs' flown positions (samples 0..n) conflict over any step. */
 static bool flown_conflict(const coa_vec3_t *pa, const coa_vec3_t *pb, int64_t n)
 {
@@ -1054,8 +1133,11 @@ START_TEST(test_late_plans_fall_back)
     rig_init(&r, 24);
     coa_vec3_t r1[2], r2[2];
     coavoid_vehicle_node_t *v[2];
-    v[0] = vehicle_node(&r, uav(1, 1, r1, 0, 600, 0, 100), COAVOID_NODE_CENTRALISED);
-    v[1] = vehicle_node(&r, uav(2, 2, r2, 300, -300, 0, 100), COAVOID_NODE_CENTRALISED);
+    /* Waiting a cycle for an answer: the fallback of the next cycle is what is tested. */
+    v[0] = vehicle_node_waiting(&r, uav(1, 1, r1, 0, 600, 0, 100), COAVOID_NODE_CENTRALISED,
+                                2 * DT_US);
+    v[1] = vehicle_node_waiting(&r, uav(2, 2, r2, 300, -300, 0, 100), COAVOID_NODE_CENTRALISED,
+                                2 * DT_US);
     const coavoid_vehicle_node_state_t *s[2] = {coavoid_vehicle_node_state(v[0]),
                                                 coavoid_vehicle_node_state(v[1])};
     coavoid_coordinator_config_t cc;
@@ -1084,6 +1166,7 @@ START_TEST(test_late_plans_fall_back)
             ck_assert(!s[0]->coordinated && !s[1]->coordinated);
             ck_assert_uint_ge(s[1]->plans_run, 1);
         }
+
         r.now = cycle(k) + DT_US / 4;
         ck_assert_int_eq(coavoid_coordinator_cycle(co, r.now), COA_OK);
         for (int i = 0; i < 2; i++) {
@@ -2376,6 +2459,7 @@ static Suite *node_suite(void)
     tcase_add_test(tc, test_configured_coordinator_only);
     tcase_add_test(tc, test_faulty_coordinator_not_followed);
     tcase_add_test(tc, test_late_plans_fall_back);
+    tcase_add_test(tc, test_unanswered_conflict_planned_within_cycle);
     tcase_add_test(tc, test_failed_plan_is_an_answer);
     tcase_add_test(tc, test_coordinator_skips_decoupled_uav);
     tcase_add_test(tc, test_coordinator_abandons_past_budget);

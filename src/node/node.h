@@ -270,7 +270,7 @@ typedef struct {
                                        own id */
     /* Against loss (docs/protocol.md): every intent it publishes goes out again
      * intent_copies times (freshly stamped), resend_us apart, and so does its SWITCHED
-     * when it switches to a committed plan (resend_us 0: the default, dt / 20;
+     * when it switches to a committed plan (resend_us 0: the default, dt / 40;
      * intent_copies 0: none, which is also the default). */
     int64_t resend_us;
     uint32_t intent_copies;
@@ -278,6 +278,11 @@ typedef struct {
      * (docs/protocol.md, "Priority negotiation"): no search's cost, and the negotiation as
      * it was before the search. false (the default): search. */
     bool greedy_negotiation;
+    /* Following the coordinator, how long into a cycle it waits for an answer to a
+     * conflict of its own (a plan it accepts, or one saying the search failed) before it
+     * plans for itself within that cycle (0: the default, dt / 2: the coordinator plans at
+     * dt / 4 and gives its UAVs dt / 4 to accept). */
+    int64_t answer_wait_us;
 } coavoid_vehicle_node_config_t;
 
 /* What a vehicle did; read by drivers, the simulation and tests. */
@@ -301,6 +306,9 @@ typedef struct {
     uint32_t plans_switched;       /* ... it switched to on a commit (or a sibling's word) */
     uint32_t plans_aborted;        /* ... accepted, then aborted by the coordinator */
     uint32_t plans_in_doubt;       /* ... accepted, and no decision came within the cycle */
+    uint32_t plans_self_committed; /* ... switched to at the answer wait, every UAV of it
+                                      heard accepting and no decision come (coordinator
+                                      stopped): docs/protocol.md */
     /* Its precedence in the decoupled order, announced in its intents (0..
      * COAVOID_INTENT_T_MAX_RANK; docs/protocol.md, "Priority negotiation"), and how many
      * times it raised it since start. */

@@ -45,6 +45,12 @@ struct coavoid_vehicle_node {
     int64_t first_cycle_start;
     int64_t cycle_start;
     int64_t wait_deadline;
+    /* Following: when a conflict of its own with no answer yet makes it plan for itself
+     * within the cycle (answer_overdue), and whether that check has run this cycle. */
+    int64_t answer_deadline;
+    bool answer_checked;
+    bool answering;     /* deciding for itself since the answer wait of this cycle */
+    bool self_answered; /* it answered its own conflict in the cycle before (distrust) */
     bool was_coordinated;
     bool cycle_conflict;    /* a conflict of its own in this cycle's prediction */
     bool distrust;          /* not following a coordinator it hears (cycle()) */
@@ -73,6 +79,7 @@ struct coavoid_vehicle_node {
     size_t decided_count;
     uint16_t decided_id[COAVOID_NODE_MAX_PEERS];
     int64_t decided_sequence[COAVOID_NODE_MAX_PEERS];
+    uint32_t decided_digest[COAVOID_NODE_MAX_PEERS]; /* intent_digest of what it decided on */
     int64_t redecided_cycle;
     uint32_t redecisions;
     /* The other UAVs' rows in this cycle's solved plans (the latest plan_id each): what
@@ -92,6 +99,8 @@ struct coavoid_vehicle_node {
     int32_t pending_offsets[COAVOID_NODE_MAX_SAMPLES];
     size_t pending_members;
     uint16_t pending_ids[COA_MAX_VEHICLES];
+    bool pending_accepted[COA_MAX_VEHICLES]; /* an ACCEPT heard from that UAV (own: sent) */
+    int64_t pending_since;                   /* when it accepted */
     /* Copies still to send, and when the next goes: its intent, its SWITCHED. */
     uint32_t intent_copies_left;
     int64_t intent_copy_at;
@@ -627,6 +636,15 @@ static int missed_conflict(coavoid_vehicle_node_t *node, int64_t now, bool *conf
     return COA_OK;
 }
 
+/* Whether live UAV i has published what it decided for this cycle: an intent of this
+ * cycle, which, when it decides at the answer wait itself (answering), must also say the
+ * UAV plans for itself (one still following may be about to answer itself too). O(1). */
+static bool decided_peer(const coavoid_vehicle_node_t *node, size_t i)
+{
+    return node->view.live_current[i] &&
+           !(node->answering && node->view.live_info[i].mode == COAVOID_INTENT_T_MODE_CENTRALISED);
+}
+
 /* Whether a UAV before it in the decoupled order (peer_first: ranks, then priorities) that
  * may still publish this cycle's intent passes near it horizontally within the horizon. A
  * UAV changes only its altitude, so such a UAV is the only one whose new plan can bring a
@@ -643,7 +661,7 @@ static bool near_pending(coavoid_vehicle_node_t *node, size_t n)
     const coavoid_node_view_t *view = &node->view;
     bool any = false;
     for (size_t i = 0; i < view->live_count; i++) {
-        if (!view->live_current[i] && peer_first(node, i)) {
+        if (!decided_peer(node, i) && peer_first(node, i)) {
             any = true;
         }
     }
@@ -669,25 +687,55 @@ static bool near_pending(coavoid_vehicle_node_t *node, size_t n)
             break;
         }
         size_t i = cf->b - 1u;
-        if (!view->live_current[i] && peer_first(node, i)) {
+        if (!decided_peer(node, i) && peer_first(node, i)) {
             return true;
         }
     }
     return result.overflow && result.conflict_count == 0u;
 }
 
-/* Remembers which live UAVs come before it as it decides, and the sequence of the intent
- * it has of each (overtaken). O(peers). */
+/* A digest of what an intent says the UAV will fly (its plan's time and offsets, FNV-1a):
+ * the copies of one intent, each stamped afresh, have the same. O(samples). */
+static uint32_t intent_digest(const coavoid_intent_t *m)
+{
+    uint32_t h = 2166136261u;
+    const int32_t n = m->sample_count < COAVOID_INTENT_T_MAX_SAMPLES ? m->sample_count
+                                                                     : COAVOID_INTENT_T_MAX_SAMPLES;
+    const uint64_t words[2] = {(uint64_t)m->plan_utime, (uint64_t)(uint32_t)n};
+    for (size_t w = 0; w < 2u; w++) {
+        for (unsigned b = 0; b < 64u; b += 8u) {
+            h = (h ^ (uint32_t)((words[w] >> b) & 0xffu)) * 16777619u;
+        }
+    }
+    for (int32_t j = 0; j < n; j++) {
+        for (unsigned b = 0; b < 32u; b += 8u) {
+            h = (h ^ (((uint32_t)m->offsets[j] >> b) & 0xffu)) * 16777619u;
+        }
+    }
+    return h;
+}
+
+/* Remembers which live UAVs come before it as it decides, and a digest of the intent it
+ * has of each (overtaken). O(peers^2 + peers * samples). */
 static void note_order(coavoid_vehicle_node_t *node)
 {
     const coavoid_node_view_t *view = &node->view;
     node->decided_count = 0;
     for (size_t i = 0; i < view->live_count; i++) {
-        if (peer_first(node, i)) {
-            node->decided_id[node->decided_count] = view->live_id[i];
-            node->decided_sequence[node->decided_count] = view->live_info[i].sequence;
-            node->decided_count++;
+        if (!peer_first(node, i)) {
+            continue;
         }
+        uint32_t digest = 0;
+        for (size_t p = 0; p < COAVOID_NODE_MAX_PEERS; p++) {
+            const coavoid_intent_t *m = &node->inbox.peers[p].msg;
+            if (node->inbox.peers[p].used && (uint16_t)m->uav_id == view->live_id[i]) {
+                digest = intent_digest(m);
+            }
+        }
+        node->decided_id[node->decided_count] = view->live_id[i];
+        node->decided_sequence[node->decided_count] = view->live_info[i].sequence;
+        node->decided_digest[node->decided_count] = digest;
+        node->decided_count++;
     }
 }
 
@@ -711,7 +759,10 @@ static bool searches(const coavoid_vehicle_node_t *node);
  * count, so that with every rank 0 a UAV decides once per cycle, as before priority
  * negotiation; but for a UAV before it whose first intent it had not heard when it
  * decided (lost, and come by a copy): it would have waited for it. Without loss that
- * never happens (each decides after the UAVs before it published). O(peers^2). */
+ * never happens (each decides after the UAVs before it published). Started centralised,
+ * it also decides again on a UAV before it that answered its own conflict at the answer
+ * wait (rank 0, mode decoupled) with another plan than the one it decided on
+ * (intent_digest: a copy is not another plan). O(peers^2 + peers * samples). */
 static bool overtaken(const coavoid_vehicle_node_t *node)
 {
     const coa_vehicle_t *self = &node->config.vehicle;
@@ -719,8 +770,10 @@ static bool overtaken(const coavoid_vehicle_node_t *node)
         const coavoid_intent_t *m = &node->inbox.peers[i].msg;
         const bool newcomer =
             m->rank <= 0 && searches(node) && first_intent(node, &node->inbox.peers[i]);
+        const bool answered = node->config.mode == COAVOID_NODE_CENTRALISED && m->rank <= 0 &&
+                              m->mode == COAVOID_INTENT_T_MODE_DECOUPLED;
         if (!node->inbox.peers[i].used || m->plan_utime != node->cycle_start ||
-            (m->rank <= 0 && !newcomer) ||
+            (m->rank <= 0 && !newcomer && !answered) ||
             !coavoid_node_precedes(m->rank, (uint32_t)m->priority, (uint16_t)m->uav_id,
                                    node->state.rank, self->priority, self->id)) {
             continue;
@@ -732,7 +785,12 @@ static bool overtaken(const coavoid_vehicle_node_t *node)
         while (j < node->decided_count && node->decided_id[j] != (uint16_t)m->uav_id) {
             j++;
         }
-        if (j == node->decided_count || (!newcomer && node->decided_sequence[j] < m->sequence)) {
+        if (j == node->decided_count) {
+            return true;
+        }
+        const bool changed = answered ? node->decided_digest[j] != intent_digest(m)
+                                      : node->decided_sequence[j] < m->sequence;
+        if (!newcomer && changed) {
             return true;
         }
     }
@@ -1111,6 +1169,98 @@ static int fly_agreed(coavoid_vehicle_node_t *node, int64_t now)
     return finish(node, now);
 }
 
+/* With a plan of the coordinator's it accepted and holds undecided at the answer wait: a
+ * standby plan, flown at t_{k+1} only if no COMMIT (nor a sibling's SWITCHED) comes, which
+ * would switch it to the held row. The standby avoids every live UAV on its intent (the
+ * future of a sibling that never switches) and, checked as a coordinator's plan is, every
+ * sibling on its row (the future of one that switches); without such a plan it keeps
+ * the one it flies, as before. Returns COA_OK (whatever the outcome) or a negative error;
+ * *adopted tells whether it has a standby. Cost: one search and one plan check. */
+static int standby(coavoid_vehicle_node_t *node, int64_t now, bool *adopted)
+{
+    *adopted = false;
+    for (size_t i = 0; i < node->view.live_count; i++) {
+        node->include[i] = true;
+    }
+    coa_plan_result_t result;
+    int rc = search_self(node, now, &result);
+    if (rc != COA_OK || result.status != COA_PLAN_SOLVED) {
+        return rc;
+    }
+    const uint32_t samples = node->config.common.horizon + 1u;
+    int hit = plan_hits_known(node, node->plan_out, samples, now, false);
+    if (hit != 0) {
+        return hit < 0 ? hit : COA_OK;
+    }
+    adopt(node, node->plan_out, samples);
+    *adopted = true;
+    return COA_OK;
+}
+
+/* Following its coordinator, answer_wait_us into the cycle, with a conflict of its own and
+ * no answer adopted (no plan of the coordinator's it flies, or was told failed): it plans
+ * for itself in this cycle and announces it. Holding no plan, it accepted none, so no
+ * COMMIT can include it: it decides as a decoupled UAV (decide()), waiting up to a quarter
+ * cycle for the UAVs before it that answer themselves at the same time. Holding an
+ * undecided one, it plans a standby (standby()). Waiting for the next cycle's fallback
+ * instead could leave a conflict one step ahead unsolved (a coordinator that stops in
+ * cycle 0 before its first plan is agreed). Returns 1 when it published, 0 when there was
+ * nothing to do or it waits, or a negative error. Cost: one prediction, then as decide or
+ * standby. */
+static int decide(coavoid_vehicle_node_t *node, int64_t now);
+static void switch_to_pending(coavoid_vehicle_node_t *node, int64_t now);
+static bool all_accepted(const coavoid_vehicle_node_t *node);
+
+static int answer_overdue(coavoid_vehicle_node_t *node, int64_t now)
+{
+    node->answer_checked = true;
+    if (node->cycle_plan_adopted || node->cycle_plan_failed) {
+        return 0;
+    }
+    coa_predict_result_t result;
+    int rc = predict(node, gather(node, now), &result);
+    if (rc != COA_OK) {
+        node->fault = true;
+        return rc;
+    }
+    if (node->labels[0] == COA_NO_CLUSTER) {
+        return 0;
+    }
+    node->cycle_conflict = true;
+    if (!node->pending) {
+        /* Distrusted as an unanswered UAV's: it decides for itself in the next cycle too,
+         * unless it hears the coordinator again by then. */
+        node->distrust = true;
+        node->distrust_cycle = node->state.cycle;
+        node->distrust_utime = now;
+        node->self_answered = true;
+        node->state.coordinated = false;
+        node->answering = true;
+        const int64_t last = node->cycle_start + node->config.common.dt_us - 1;
+        const int64_t until = now + node->config.answer_wait_us / 2;
+        node->wait_deadline = until < last ? until : last; /* decided within its cycle */
+        return decide(node, now);
+    }
+    if (all_accepted(node) && now >= node->pending_since + node->config.answer_wait_us / 2) {
+        /* Every UAV of the plan holds it and said so, and no decision came a quarter cycle
+         * after it accepted: a coordinator that heard those answers would have committed,
+         * so it stopped (or its decision was lost). It commits as the coordinator would:
+         * it switches and says SWITCHED, which its siblings take as the commit. */
+        node->state.plans_self_committed++;
+        switch_to_pending(node, now);
+        node->state.coordinated = false;
+        return 1;
+    }
+    bool planned = false;
+    rc = standby(node, now, &planned);
+    if (rc == COA_OK && planned) {
+        node->state.coordinated = false; /* it flies the standby unless one is committed */
+        rc = publish_intent(node, now);
+    }
+    node->fault = node->fault || rc != COA_OK;
+    return rc != COA_OK ? rc : (planned ? 1 : 0);
+}
+
 /* The decoupled step: predict with what it has; publish at once without a conflict;
  * otherwise wait for the members of its cluster before it in the decoupled order (until
  * the deadline), then plan (raising its rank if it must) and publish. Returns 1 when it
@@ -1139,7 +1289,7 @@ static int decide(coavoid_vehicle_node_t *node, int64_t now)
     }
     bool pending = false;
     for (size_t i = 0; i < view->live_count; i++) {
-        if (node->labels[i + 1u] == my && !view->live_current[i] && peer_first(node, i)) {
+        if (node->labels[i + 1u] == my && !decided_peer(node, i) && peer_first(node, i)) {
             pending = true;
         }
     }
@@ -1364,8 +1514,10 @@ static void hold(coavoid_vehicle_node_t *node, int64_t now, const coavoid_lcm_pl
     node->pending_count = (uint32_t)samples;
     memcpy(node->pending_offsets, row, samples * sizeof row[0]);
     node->pending_members = info->vehicle_count;
+    node->pending_since = now;
     for (size_t i = 0; i < info->vehicle_count; i++) {
         node->pending_ids[i] = info->uav_ids[i];
+        node->pending_accepted[i] = info->uav_ids[i] == node->config.vehicle.id;
     }
     node->state.plans_accepted++;
     answer_with_copies(node, now, COAVOID_AGREEMENT_T_KIND_ACCEPT, info->plan_id);
@@ -1397,6 +1549,26 @@ static bool pending_member(const coavoid_vehicle_node_t *node, int32_t id)
     return false;
 }
 
+/* Notes a sibling's ACCEPT of the plan it holds. O(members). */
+static void note_accept(coavoid_vehicle_node_t *node, int32_t id)
+{
+    for (size_t i = 0; i < node->pending_members; i++) {
+        node->pending_accepted[i] =
+            node->pending_accepted[i] || (int32_t)node->pending_ids[i] == id;
+    }
+}
+
+/* Whether every UAV of the plan it holds has accepted it, as far as it heard. O(members). */
+static bool all_accepted(const coavoid_vehicle_node_t *node)
+{
+    for (size_t i = 0; i < node->pending_members; i++) {
+        if (!node->pending_accepted[i]) {
+            return false;
+        }
+    }
+    return true;
+}
+
 /* A word on a plan of its coordinator's (the inbox checked signature, role and fields). */
 static int on_agreement(void *owner, const coavoid_agreement_t *msg)
 {
@@ -1415,6 +1587,8 @@ static int on_agreement(void *owner, const coavoid_agreement_t *msg)
                         (msg->kind == COAVOID_AGREEMENT_T_KIND_SWITCHED &&
                          pending_member(node, msg->node_id)))) {
         switch_to_pending(node, now);
+    } else if (held && msg->kind == COAVOID_AGREEMENT_T_KIND_ACCEPT) {
+        note_accept(node, msg->node_id);
     } else if (held && msg->kind == COAVOID_AGREEMENT_T_KIND_ABORT) {
         node->pending = false;
         node->answer_copies_left = 0;
@@ -1526,6 +1700,26 @@ static void on_plan(void *owner, const coavoid_plan_t *msg, const coavoid_lcm_pl
     coavoid_lcm_rx_count(&node->state.rx, COA_OK, NULL);
 }
 
+/* The configured times left 0 (or, for the answer wait and copies, negative) take their
+ * defaults (node.h). O(1). */
+static void fill_defaults(coavoid_vehicle_node_config_t *config)
+{
+    const int64_t dt_us = config->common.dt_us;
+    const int64_t half = dt_us / 2 > 0 ? dt_us / 2 : 1;
+    if (config->coordinator_timeout_us == 0) {
+        config->coordinator_timeout_us = (int64_t)llround(2.5 * (double)dt_us);
+    }
+    if (config->priority_wait_us == 0) {
+        config->priority_wait_us = half;
+    }
+    if (config->answer_wait_us <= 0) {
+        config->answer_wait_us = half;
+    }
+    if (config->resend_us <= 0) {
+        config->resend_us = dt_us / 40 > 0 ? dt_us / 40 : 1;
+    }
+}
+
 coavoid_vehicle_node_t *coavoid_vehicle_node_create(const coavoid_vehicle_node_config_t *config,
                                                     lcm_t *lcm, int *error)
 {
@@ -1564,16 +1758,8 @@ coavoid_vehicle_node_t *coavoid_vehicle_node_create(const coavoid_vehicle_node_c
     }
     node->solver = solver;
     node->config = *config;
-    if (node->config.coordinator_timeout_us == 0) {
-        node->config.coordinator_timeout_us = (int64_t)llround(2.5 * (double)c->dt_us);
-    }
     node->config.coordinator_id = coordinator_id;
-    if (node->config.priority_wait_us == 0) {
-        node->config.priority_wait_us = c->dt_us / 2 > 0 ? c->dt_us / 2 : 1;
-    }
-    if (node->config.resend_us <= 0) {
-        node->config.resend_us = c->dt_us / 40 > 0 ? c->dt_us / 40 : 1;
-    }
+    fill_defaults(&node->config);
     node->dh = coa_climb_step(&node->config.vehicle, c->dt);
     node->plan_start = 0;
     node->plan_count = 1;
@@ -1662,6 +1848,46 @@ static bool heard_since_distrust(const coavoid_vehicle_node_t *node, int64_t k)
            node->inbox.coordinator_utime > node->distrust_utime;
 }
 
+/* At the start of cycle k. A coordinator answers, within its cycle, for the conflicts of
+ * the UAVs that follow it. One that followed it, had a conflict of its own and got no
+ * answer in that cycle (no plan for it adopted, nor one that says the coordinator's search
+ * failed: plans late, an impostor's or a dead coordinator's heartbeat, a plan it refused)
+ * plans for itself instead, until a cycle in which it adopts one of the coordinator's
+ * plans or has no conflict of its own: a heartbeat alone keeps no UAV safe. Decoupled
+ * cycles tell their conflicts in decide(). Returns COA_OK or the prediction's error (the
+ * node then trusts as if it had no conflict, and reports the fault). */
+static int update_trust(coavoid_vehicle_node_t *node, int64_t k, int64_t now, bool previous_adopted,
+                        bool previous_answered)
+{
+    int predicted = COA_OK;
+    bool conflict = node->cycle_conflict;
+    const bool self_answered = node->self_answered;
+    node->self_answered = false;
+    if (node->was_coordinated && !previous_answered) {
+        predicted = missed_conflict(node, now, &conflict);
+        if (predicted != COA_OK) {
+            node->fault = true;
+            conflict = false; /* cannot tell: the error is reported */
+        }
+    }
+    node->unanswered = node->was_coordinated && conflict && !previous_answered;
+    if (node->unanswered) {
+        node->distrust = true;
+        node->distrust_cycle = k;
+        node->distrust_utime = now;
+    } else if (node->distrust && (previous_adopted || (!conflict && !self_answered) ||
+                                  heard_since_distrust(node, k))) {
+        /* One cycle of its own planning, then it follows again if the coordinator is
+         * still there: one unanswered cycle (its plan or its answer lost) must not keep it
+         * out of the coordinator's plans for the rest of a conflict, since the coordinator
+         * plans no UAV that says it plans for itself. Unanswered again, it falls back
+         * again; a coordinator it no longer hears it does not go back to. */
+        node->distrust = false;
+    }
+    node->cycle_conflict = false;
+    return predicted;
+}
+
 int coavoid_vehicle_node_cycle(coavoid_vehicle_node_t *node, int64_t now)
 {
     if (node == NULL) {
@@ -1683,37 +1909,7 @@ int coavoid_vehicle_node_cycle(coavoid_vehicle_node_t *node, int64_t now)
     const bool previous_adopted = node->cycle_plan_adopted;
     const bool previous_answered = previous_adopted || node->cycle_plan_failed;
     fly_to(node, k, now);
-
-    /* A coordinator answers, within its cycle, for the conflicts of the UAVs that follow
-     * it. One that followed it, had a conflict of its own and got no answer in that cycle
-     * (no plan for it adopted, nor one that says the coordinator's search failed: plans
-     * late, an impostor's or a dead coordinator's heartbeat, a plan it refused) plans
-     * for itself instead, until a cycle in which it adopts one of the coordinator's plans
-     * or has no conflict of its own: a heartbeat alone keeps no UAV safe. Decoupled
-     * cycles tell their conflicts in decide(). */
-    int predicted = COA_OK;
-    bool conflict = node->cycle_conflict;
-    if (node->was_coordinated && !previous_answered) {
-        predicted = missed_conflict(node, now, &conflict);
-        if (predicted != COA_OK) {
-            node->fault = true;
-            conflict = false; /* cannot tell: the error is reported */
-        }
-    }
-    node->unanswered = node->was_coordinated && conflict && !previous_answered;
-    if (node->unanswered) {
-        node->distrust = true;
-        node->distrust_cycle = k;
-        node->distrust_utime = now;
-    } else if (node->distrust && (previous_adopted || !conflict || heard_since_distrust(node, k))) {
-        /* One cycle of its own planning, then it follows again if the coordinator is
-         * still there: one unanswered cycle (its plan or its answer lost) must not keep it
-         * out of the coordinator's plans for the rest of a conflict, since the coordinator
-         * plans no UAV that says it plans for itself. Unanswered again, it falls back
-         * again; a coordinator it no longer hears it does not go back to. */
-        node->distrust = false;
-    }
-    node->cycle_conflict = false;
+    const int predicted = update_trust(node, k, now, previous_adopted, previous_answered);
 
     const int64_t timeout = node->config.coordinator_timeout_us;
     const bool coordinated =
@@ -1730,6 +1926,9 @@ int coavoid_vehicle_node_cycle(coavoid_vehicle_node_t *node, int64_t now)
     node->wait_deadline = INT64_MAX;
 
     int rc;
+    node->answer_checked = false;
+    node->answering = false;
+    node->answer_deadline = node->cycle_start + node->config.answer_wait_us;
     if (coordinated) {
         drop_rank(node);
         rc = finish(node, now);
@@ -1770,6 +1969,12 @@ int coavoid_vehicle_node_poll(coavoid_vehicle_node_t *node, int64_t now)
         return 0; /* copies belong to their cycle */
     }
     int sent = send_copies(node, now);
+    if (node->state.coordinated && !node->answer_checked && now >= node->answer_deadline) {
+        int overdue = answer_overdue(node, now);
+        if (overdue != 0) {
+            return overdue;
+        }
+    }
     if (!node->state.waiting) {
         int again = reconsider(node, now);
         return again == 0 ? sent : again;
@@ -1785,13 +1990,17 @@ int64_t coavoid_vehicle_node_deadline(const coavoid_vehicle_node_t *node)
     }
     int64_t deadline = node->state.waiting ? node->wait_deadline : INT64_MAX;
     const int64_t end = node->cycle_start + node->config.common.dt_us;
+    if (node->state.coordinated && !node->answer_checked && node->answer_deadline < end &&
+        node->answer_deadline < deadline) {
+        deadline = node->answer_deadline;
+    }
     if (node->intent_copies_left > 0u && node->state.published && node->intent_copy_at < end) {
         deadline = node->intent_copy_at < deadline ? node->intent_copy_at : deadline;
     }
     if (node->answer_copies_left > 0u && node->answer_copy_at < end) {
         deadline = node->answer_copy_at < deadline ? node->answer_copy_at : deadline;
     }
-    return deadline;
+    return deadline < end ? deadline : INT64_MAX; /* poll does nothing from the cycle's end */
 }
 
 const coavoid_vehicle_node_state_t *coavoid_vehicle_node_state(const coavoid_vehicle_node_t *node)

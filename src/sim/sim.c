@@ -876,8 +876,13 @@ static bool sim_waits(sim_run_t *r, int64_t until, int *node_error)
         }
         const int64_t d = sim_coordinator_deadline(r);
         deadline = d < deadline ? d : deadline;
+        /* The nodes' deadlines and the deliveries in time order (a delivery first on a
+         * tie), up to `until`: what is due later comes after the caller's event at `until`
+         * (the coordinator's cycle), and a node polled after its deadline's cycle ended
+         * would not act on it. */
+        deadline = deadline <= until ? deadline : INT64_MAX;
         const int64_t due = coavoid_sim_net_next(r->net);
-        if (due <= until || (deadline != INT64_MAX && due <= deadline)) {
+        if (due <= until && due <= deadline) {
             deadline = due;
         }
         if (deadline == INT64_MAX || !lcm_ok) {
