@@ -27,8 +27,10 @@ typedef struct {
     uint32_t accepted; /* bit m: info.uav_ids[m] accepted */
     uint32_t refused;
     uint32_t switched;
-    int64_t deadline;  /* proposed: every accept must have come by then */
-    int64_t next_send; /* when the rows (proposed) or the commit (committed) go again */
+    int64_t deadline;     /* proposed: every accept must have come by then */
+    int64_t next_send;    /* when the rows (proposed), the commit (committed) or the abort
+                          (aborted, aborts_left > 0) go again */
+    uint32_t aborts_left; /* copies of the ABORT still to send */
 } coordinator_agreement_t;
 
 /* The solved plans of one cycle: every cluster's, the escalations' and the re-plans after
@@ -420,6 +422,9 @@ static int agreement_decide(coavoid_coordinator_t *node, int64_t now, coordinato
 {
     a->state = state;
     a->next_send = now + node->config.resend_us;
+    /* An ABORT goes out with copies: a UAV that heard every member accept and no
+     * decision commits the plan itself at its answer wait (docs/protocol.md). */
+    a->aborts_left = state == AGREEMENT_ABORTED ? node->config.heartbeat_copies : 0u;
     node->state.plans_committed += state == AGREEMENT_COMMITTED ? 1u : 0u;
     node->state.plans_aborted += state == AGREEMENT_ABORTED ? 1u : 0u;
     return send_decision(node, now, a);
@@ -703,8 +708,10 @@ static int agreement_step(coavoid_coordinator_t *node, int64_t now, size_t index
         rc = rc != COA_OK ? rc : published;
         return rc != COA_OK ? rc : 1;
     }
-    if (a->state == AGREEMENT_COMMITTED && a->switched != all_members(a)) {
+    if ((a->state == AGREEMENT_COMMITTED && a->switched != all_members(a)) ||
+        (a->state == AGREEMENT_ABORTED && a->aborts_left > 0u)) {
         a->next_send = now + resend;
+        a->aborts_left -= a->state == AGREEMENT_ABORTED ? 1u : 0u;
         int rc = send_decision(node, now, a);
         return rc != COA_OK ? rc : 1;
     }
@@ -751,7 +758,8 @@ int64_t coavoid_coordinator_deadline(const coavoid_coordinator_t *node)
         int64_t t = INT64_MAX;
         if (a->state == AGREEMENT_PROPOSED) {
             t = a->deadline < a->next_send ? a->deadline : a->next_send;
-        } else if (a->state == AGREEMENT_COMMITTED && a->switched != all_members(a)) {
+        } else if ((a->state == AGREEMENT_COMMITTED && a->switched != all_members(a)) ||
+                   (a->state == AGREEMENT_ABORTED && a->aborts_left > 0u)) {
             t = a->next_send;
         }
         deadline = t < deadline ? t : deadline;

@@ -1241,11 +1241,15 @@ static int answer_overdue(coavoid_vehicle_node_t *node, int64_t now)
         node->wait_deadline = until < last ? until : last; /* decided within its cycle */
         return decide(node, now);
     }
-    if (all_accepted(node) && now >= node->pending_since + node->config.answer_wait_us / 2) {
-        /* Every UAV of the plan holds it and said so, and no decision came a quarter cycle
-         * after it accepted: a coordinator that heard those answers would have committed,
-         * so it stopped (or its decision was lost). It commits as the coordinator would:
-         * it switches and says SWITCHED, which its siblings take as the commit. */
+    const int64_t decided_by =
+        node->pending_since + node->config.common.dt_us / 4 + 4 * node->config.resend_us;
+    if (all_accepted(node) && now >= decided_by) {
+        /* Every UAV of the plan holds it and said so, and no decision came by the
+         * coordinator's ack timeout (dt / 4 by default) after it accepted, plus four
+         * resends (an ABORT goes out with four copies): a coordinator that heard those
+         * answers would have committed, so it stopped, or every copy of its decision was
+         * lost. It commits as the coordinator would: it switches and says SWITCHED, which
+         * its siblings take as the commit. */
         node->state.plans_self_committed++;
         switch_to_pending(node, now);
         node->state.coordinated = false;
@@ -1712,11 +1716,11 @@ static void fill_defaults(coavoid_vehicle_node_config_t *config)
     if (config->priority_wait_us == 0) {
         config->priority_wait_us = half;
     }
-    if (config->answer_wait_us <= 0) {
-        config->answer_wait_us = half;
-    }
     if (config->resend_us <= 0) {
         config->resend_us = dt_us / 40 > 0 ? dt_us / 40 : 1;
+    }
+    if (config->answer_wait_us <= 0) {
+        config->answer_wait_us = half + 4 * config->resend_us;
     }
 }
 

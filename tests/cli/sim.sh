@@ -356,11 +356,12 @@ expect_bad "mc fly value" "--fly" montecarlo --vehicles 2 --count 1 --fly=yes
 
 # ---- the coordinator stops ----
 
-# Stopped before cycle 0: the UAVs, unanswered in cycle 0, plan for themselves from
-# cycle 1 (a UAV that distrusts its coordinator follows it again only once it hears it).
+# Stopped before cycle 0: the UAVs, unanswered at the answer wait of cycle 0, plan for
+# themselves there; each falls back twice (after that answer, and for good once the
+# coordinator's silence outlasts coordinator_timeout).
 sim_json headon-stop0 "$scenarios/headon.json" centralised 0 '
 r["loss_of_separation"] is False
-r["fallbacks"] == 2
+r["fallbacks"] == 4
 r["deviation"] == 580
 r["coordinator_stopped_at"] == 0
 r["replans"] >= 1
@@ -412,19 +413,19 @@ assert a == b and extra == {"coordinator_stopped_after": 0, "coordinator_message
                             "coordinator_messages_cut": 0}, extra
 PY
 # Cycle 0 of the head-on: the report, the plan's two rows, the heartbeat, then (its poll)
-# the COMMIT. Stopped after the rows, or after the heartbeat, no UAV flies the plan (all
-# or none: no COMMIT came) and the flight is that of planning alone (as stopped after
-# the report); stopped after the COMMIT, both fly it.
+# the COMMIT. Stopped after the rows, or after the heartbeat, no COMMIT comes, but each UAV
+# heard the other accept: at the answer wait both commit the plan themselves (all or
+# none) and fly it as if the COMMIT had come; stopped after the COMMIT, both fly it.
 sim_json headon-cut3 "$scenarios/headon.json" centralised 0 '
 r["loss_of_separation"] is False
-(r["deviation"], r["effort"]) == (580, 20)
+(r["deviation"], r["effort"]) == (500, 18)
 r["coordinator_stopped_at"] == 0 and r["coordinator_stopped_after"] == 3
 r["coordinator_messages_sent"] == 3 and r["coordinator_messages_cut"] == 1
 r["fallbacks"] == 2
 ' --coordinator-stops 0:3
 sim_json headon-cut4 "$scenarios/headon.json" centralised 0 '
 r["loss_of_separation"] is False
-(r["deviation"], r["effort"]) == (580, 20)
+(r["deviation"], r["effort"]) == (500, 18)
 r["coordinator_messages_sent"] == 4
 ' --coordinator-stops 0:4
 sim_json headon-cut5 "$scenarios/headon.json" centralised 0 '
@@ -437,14 +438,14 @@ r["loss_of_separation"] is False
 (r["deviation"], r["effort"]) == (580, 20)
 r["coordinator_messages_sent"] == 1 and r["coordinator_messages_cut"] == 3
 ' --coordinator-stops 0:1
-# Cycle 0 of the paper's encounter: 14 messages (its plans, their commits, the heartbeat
-# and its copies).
+# Cycle 0 of the paper's encounter: 18 messages (its plans, their commits, the ABORT of
+# a proposal a newer plan superseded with its 4 copies, the heartbeat and its copies).
 sim_json paper-cut-all "$scenarios/paper.json" centralised 0 '
-r["coordinator_messages_sent"] == 14 and r["coordinator_messages_cut"] == 0
-' --coordinator-stops 0:14
+r["coordinator_messages_sent"] == 18 and r["coordinator_messages_cut"] == 0
+' --coordinator-stops 0:18
 sim_json paper-cut-beyond "$scenarios/paper.json" centralised 0 '
-r["coordinator_stopped_after"] == 20 and r["coordinator_messages_sent"] == 14
-' --coordinator-stops 0:20
+r["coordinator_stopped_after"] == 24 and r["coordinator_messages_sent"] == 18
+' --coordinator-stops 0:24
 # With loss the cut is the same mechanism (the network's): a run repeats byte for byte.
 for run in 1 2; do
     "$bin" sim "$scenarios/paper.json" --mode centralised --coordinator-stops 0:4 --loss 0.3 \
