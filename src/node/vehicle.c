@@ -306,7 +306,12 @@ static int publish_intent(coavoid_vehicle_node_t *node, int64_t now)
     if (rc != COA_OK) {
         node->fault = true;
     }
-    node->intent_copies_left = node->config.intent_copies;
+    /* Its first cycle's intent goes out with twice the copies: every peer's order search
+     * starts from the intents as the cycle began (docs/protocol.md, "Priority
+     * negotiation"), and a peer that lost every copy of one UAV's first one plans the
+     * group without it while the others plan it in. */
+    const bool first = node->cycle_start == node->first_cycle_start;
+    node->intent_copies_left = node->config.intent_copies * (first ? 2u : 1u);
     node->intent_copy_at = now + node->config.resend_us;
     return rc;
 }
