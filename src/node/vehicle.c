@@ -725,16 +725,19 @@ static uint32_t intent_digest(const coavoid_intent_t *m)
 static void note_order(coavoid_vehicle_node_t *node)
 {
     const coavoid_node_view_t *view = &node->view;
+    const bool centralised = node->config.mode == COAVOID_NODE_CENTRALISED;
     node->decided_count = 0;
     for (size_t i = 0; i < view->live_count; i++) {
         if (!peer_first(node, i)) {
             continue;
         }
+        /* Only overtaken()'s answered peers use the digest: UAVs started centralised. */
         uint32_t digest = 0;
-        for (size_t p = 0; p < COAVOID_NODE_MAX_PEERS; p++) {
+        for (size_t p = 0; p < COAVOID_NODE_MAX_PEERS && centralised; p++) {
             const coavoid_intent_t *m = &node->inbox.peers[p].msg;
             if (node->inbox.peers[p].used && (uint16_t)m->uav_id == view->live_id[i]) {
                 digest = intent_digest(m);
+                break; /* one slot per UAV */
             }
         }
         node->decided_id[node->decided_count] = view->live_id[i];
@@ -1150,6 +1153,8 @@ static int search_order(coavoid_vehicle_node_t *node)
 
 static int decide(coavoid_vehicle_node_t *node, int64_t now);
 static int decide_own(coavoid_vehicle_node_t *node, int64_t now);
+static void switch_to_pending(coavoid_vehicle_node_t *node, int64_t now);
+static bool all_accepted(const coavoid_vehicle_node_t *node);
 
 /* In a cycle whose order search agreed a new order: it flies its row of the solving plan
  * (node->plan_out) at once, as every other member does with its own, once the check every
@@ -1202,6 +1207,15 @@ static int standby(coavoid_vehicle_node_t *node, int64_t now, bool *adopted)
     return COA_OK;
 }
 
+/* It distrusts its coordinator from cycle k (at `now`): it plans for itself until
+ * update_trust() lets it follow again. O(1). */
+static void distrust_from(coavoid_vehicle_node_t *node, int64_t k, int64_t now)
+{
+    node->distrust = true;
+    node->distrust_cycle = k;
+    node->distrust_utime = now;
+}
+
 /* Following its coordinator, answer_wait_us into the cycle, with a conflict of its own and
  * no answer adopted (no plan of the coordinator's it flies, or was told failed): it plans
  * for itself in this cycle and announces it. Holding no plan, it accepted none, so no
@@ -1212,10 +1226,6 @@ static int standby(coavoid_vehicle_node_t *node, int64_t now, bool *adopted)
  * cycle 0 before its first plan is agreed). Returns 1 when it published, 0 when there was
  * nothing to do or it waits, or a negative error. Cost: one prediction, then as decide or
  * standby. */
-static int decide(coavoid_vehicle_node_t *node, int64_t now);
-static void switch_to_pending(coavoid_vehicle_node_t *node, int64_t now);
-static bool all_accepted(const coavoid_vehicle_node_t *node);
-
 static int answer_overdue(coavoid_vehicle_node_t *node, int64_t now)
 {
     node->answer_checked = true;
@@ -1235,9 +1245,7 @@ static int answer_overdue(coavoid_vehicle_node_t *node, int64_t now)
     if (!node->pending) {
         /* Distrusted as an unanswered UAV's: it decides for itself in the next cycle too,
          * unless it hears the coordinator again by then. */
-        node->distrust = true;
-        node->distrust_cycle = node->state.cycle;
-        node->distrust_utime = now;
+        distrust_from(node, node->state.cycle, now);
         node->self_answered = true;
         node->state.coordinated = false;
         node->answering = true;
@@ -1881,9 +1889,7 @@ static int update_trust(coavoid_vehicle_node_t *node, int64_t k, int64_t now, bo
     }
     node->unanswered = node->was_coordinated && conflict && !previous_answered;
     if (node->unanswered) {
-        node->distrust = true;
-        node->distrust_cycle = k;
-        node->distrust_utime = now;
+        distrust_from(node, k, now);
     } else if (node->distrust && (previous_adopted || (!conflict && !self_answered) ||
                                   heard_since_distrust(node, k))) {
         /* One cycle of its own planning, then it follows again if the coordinator is
@@ -1999,8 +2005,7 @@ int64_t coavoid_vehicle_node_deadline(const coavoid_vehicle_node_t *node)
     }
     int64_t deadline = node->state.waiting ? node->wait_deadline : INT64_MAX;
     const int64_t end = node->cycle_start + node->config.common.dt_us;
-    if (node->state.coordinated && !node->answer_checked && node->answer_deadline < end &&
-        node->answer_deadline < deadline) {
+    if (node->state.coordinated && !node->answer_checked && node->answer_deadline < deadline) {
         deadline = node->answer_deadline;
     }
     if (node->intent_copies_left > 0u && node->state.published && node->intent_copy_at < end) {
