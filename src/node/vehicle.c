@@ -45,6 +45,9 @@ struct coavoid_vehicle_node {
     int64_t first_cycle_start;
     int64_t cycle_start;
     int64_t wait_deadline;
+    /* While waiting: when its first cycle's intents have gathered (plan_self), or
+     * INT64_MAX. */
+    int64_t gather_until;
     /* Following: when a conflict of its own with no answer yet makes it plan for itself
      * within the cycle (answer_overdue), and whether that check has run this cycle. */
     int64_t answer_deadline;
@@ -324,6 +327,7 @@ static int finish(coavoid_vehicle_node_t *node, int64_t now)
     node->state.waiting = false;
     node->state.published = rc == COA_OK;
     node->wait_deadline = INT64_MAX;
+    node->gather_until = INT64_MAX;
     int status_rc = publish_status(node, now);
     if (rc != COA_OK) {
         return rc;
@@ -536,14 +540,31 @@ static void drop_rank(coavoid_vehicle_node_t *node)
     node->calm_cycles = 0;
 }
 
+/* Whether, in its first cycle, the copies of the first intents its peers published as the
+ * cycle began may still come: until the last of them is due (publish_intent). Before
+ * that a UAV that finds no plan below those before it may only be missing some of them
+ * (lost, a copy on its way), and a raise made then reorders the cluster for nothing. */
+static bool gathering(const coavoid_vehicle_node_t *node, int64_t now)
+{
+    const int64_t copies = 2 * (int64_t)node->config.intent_copies;
+    return node->cycle_start == node->first_cycle_start &&
+           now < node->first_cycle_start + copies * node->config.resend_us;
+}
+
 /* Plans for itself in the decoupled order (plan_in_order); when it finds no plan there, it
  * raises its rank and, if it did, plans again at once, now against only the UAVs still
- * before it; adopts a solved plan. Returns COA_OK (whatever the outcome) or a negative
- * error. */
+ * before it; adopts a solved plan. Returns COA_OK (whatever the outcome), 1 when it found
+ * no plan while its first cycle's intents are still gathering (it waits until then, and
+ * decides again on what comes meanwhile: decide), or a negative error. */
 static int plan_self(coavoid_vehicle_node_t *node, int64_t now, uint32_t my)
 {
     coa_plan_result_t result;
     int rc = plan_in_order(node, now, my, &result);
+    if (rc == COA_OK && result.status != COA_PLAN_SOLVED && gathering(node, now)) {
+        const int64_t copies = 2 * (int64_t)node->config.intent_copies;
+        node->gather_until = node->first_cycle_start + copies * node->config.resend_us;
+        return 1;
+    }
     if (rc == COA_OK && result.status != COA_PLAN_SOLVED) {
         rc = raise_rank(node, now, my, &result);
     }
@@ -720,6 +741,9 @@ static uint32_t intent_digest(const coavoid_intent_t *m)
     return h;
 }
 
+static bool first_intent(const coavoid_vehicle_node_t *node, const coavoid_node_peer_t *peer);
+static bool searches(const coavoid_vehicle_node_t *node);
+
 /* Remembers which live UAVs come before it as it decides, and a digest of the intent it
  * has of each (overtaken). O(peers^2 + peers * samples). */
 static void note_order(coavoid_vehicle_node_t *node)
@@ -731,12 +755,14 @@ static void note_order(coavoid_vehicle_node_t *node)
         if (!peer_first(node, i)) {
             continue;
         }
-        /* Only overtaken()'s answered peers use the digest: UAVs started centralised. */
+        /* Only overtaken()'s answered peers (UAVs started centralised) and newcomers use
+         * the digest. */
         uint32_t digest = 0;
-        for (size_t p = 0; p < COAVOID_NODE_MAX_PEERS && centralised; p++) {
+        for (size_t p = 0; p < COAVOID_NODE_MAX_PEERS; p++) {
             const coavoid_intent_t *m = &node->inbox.peers[p].msg;
             if (node->inbox.peers[p].used && (uint16_t)m->uav_id == view->live_id[i]) {
-                digest = intent_digest(m);
+                const bool newcomer = searches(node) && first_intent(node, &node->inbox.peers[p]);
+                digest = centralised || newcomer ? intent_digest(m) : 0u;
                 break; /* one slot per UAV */
             }
         }
@@ -758,16 +784,15 @@ static int32_t agreed_rank_of(const coavoid_vehicle_node_t *node, uint16_t id)
     return -1;
 }
 
-static bool first_intent(const coavoid_vehicle_node_t *node, const coavoid_node_peer_t *peer);
-static bool searches(const coavoid_vehicle_node_t *node);
-
 /* Whether, since it decided in this cycle, a UAV with a raised rank that comes before it
  * now published an intent of this cycle it did not decide on: one that raised its rank
  * above it after it decided, or one before it that planned again. Only raised ranks
  * count, so that with every rank 0 a UAV decides once per cycle, as before priority
- * negotiation; but for a UAV before it whose first intent it had not heard when it
- * decided (lost, and come by a copy): it would have waited for it. Without loss that
- * never happens (each decides after the UAVs before it published). Started centralised,
+ * negotiation; but for a UAV before it in its first cycle (a newcomer) whose first intent
+ * it had not heard when it decided (lost, and come by a copy: it would have waited for
+ * it), or which published another plan since (it had decided from fewer first intents
+ * than came later; intent_digest: a copy is not another plan). Without loss that never
+ * happens (each decides after the UAVs before it published, on all of theirs). Started centralised,
  * it also decides again on a UAV before it that answered its own conflict at the answer
  * wait (rank 0, mode decoupled) with another plan than the one it decided on
  * (intent_digest: a copy is not another plan). O(peers^2 + peers * samples). */
@@ -796,9 +821,9 @@ static bool overtaken(const coavoid_vehicle_node_t *node)
         if (j == node->decided_count) {
             return true;
         }
-        const bool changed = answered ? node->decided_digest[j] != intent_digest(m)
-                                      : node->decided_sequence[j] < m->sequence;
-        if (!newcomer && changed) {
+        const bool changed = answered || newcomer ? node->decided_digest[j] != intent_digest(m)
+                                                  : node->decided_sequence[j] < m->sequence;
+        if (changed) {
             return true;
         }
     }
@@ -837,11 +862,14 @@ static bool snapshot_add(coavoid_vehicle_node_t *node, const coavoid_intent_t *m
     return true;
 }
 
-/* Whether it runs the order search: configured decoupled (one that falls back from a
- * coordinator keeps to the greedy raise) and not told to negotiate greedily. O(1). */
+/* Whether it runs the order search when it decides for itself: unless told to negotiate
+ * greedily. One configured centralised decides for itself only while it distrusts its
+ * coordinator or answers its own conflict (reconsider() and decide() skip it while it
+ * follows), and the search's group leaves out every UAV whose intent says it follows
+ * (order_eligible), so no search hands a row to a UAV that flies the coordinator's. O(1). */
 static bool searches(const coavoid_vehicle_node_t *node)
 {
-    return node->config.mode == COAVOID_NODE_DECOUPLED && !node->config.greedy_negotiation;
+    return !node->config.greedy_negotiation;
 }
 
 /* At the cycle's start (fly_to): itself as its peers will have it when they search
@@ -1320,6 +1348,10 @@ static int decide(coavoid_vehicle_node_t *node, int64_t now)
      * its reference where it can. Holding an old offset instead can leave a lower
      * priority no way out. */
     rc = plan_self(node, now, my);
+    if (rc == 1) {
+        node->state.waiting = true;
+        return 0;
+    }
     if (rc != COA_OK) {
         node->fault = true;
         int published = finish(node, now);
@@ -1787,6 +1819,7 @@ coavoid_vehicle_node_t *coavoid_vehicle_node_create(const coavoid_vehicle_node_c
     node->state.offset = node->config.vehicle.initial_offset;
     node->state.last_outcome = -1;
     node->wait_deadline = INT64_MAX;
+    node->gather_until = INT64_MAX;
     const bool centralised = node->config.mode == COAVOID_NODE_CENTRALISED;
     rc = coavoid_node_inbox_init(&node->inbox, c, node->config.vehicle.id, node->config.vehicle.id,
                                  coordinator_id, COAVOID_NODE_MAX_PEERS - 1u, lcm, &node->state.rx,
@@ -1847,9 +1880,8 @@ static void fly_to(coavoid_vehicle_node_t *node, int64_t k, int64_t now)
     snapshot_own(node);
 }
 
-/* A cycle it decides for itself: the order search (decoupled by configuration: one that
- * falls back from a coordinator keeps to the greedy raise), then its own decision. An
- * error of the search leaves the order as it was: the greedy raise still applies.
+/* A cycle it decides for itself: the order search (searches()), then its own decision.
+ * An error of the search leaves the order as it was: the greedy raise still applies.
  * Returns as decide. */
 static int decide_own(coavoid_vehicle_node_t *node, int64_t now)
 {
@@ -1939,6 +1971,7 @@ int coavoid_vehicle_node_cycle(coavoid_vehicle_node_t *node, int64_t now)
     node->state.published = false;
     node->state.waiting = false;
     node->wait_deadline = INT64_MAX;
+    node->gather_until = INT64_MAX;
 
     int rc;
     node->answer_checked = false;
@@ -2004,6 +2037,9 @@ int64_t coavoid_vehicle_node_deadline(const coavoid_vehicle_node_t *node)
         return INT64_MAX;
     }
     int64_t deadline = node->state.waiting ? node->wait_deadline : INT64_MAX;
+    if (node->state.waiting && node->gather_until < deadline) {
+        deadline = node->gather_until;
+    }
     const int64_t end = node->cycle_start + node->config.common.dt_us;
     if (node->state.coordinated && !node->answer_checked && node->answer_deadline < deadline) {
         deadline = node->answer_deadline;
