@@ -61,15 +61,16 @@
  *        and lower-priority UAVs outside its cluster were in it, it searches again
  *        around the higher priorities only (coa_plan_decoupled's rule), and the others
  *        plan around it in turn.
- *        Before all this (configured decoupled: not a UAV fallen back from a
- *        coordinator), the order search: from the intents as they stood when the cycle
- *        began (each UAV's last of cycle k - 1, or in its first cycle its first intent
- *        with the offset it starts at held; its own included), it predicts, and when its
- *        group of UAVs that pass near each other has a conflict it plans that group as
- *        coa_plan_decoupled does, first in the order the ranks announce. Only when that
- *        order fails does it try the others (at most 120), and when one solves it flies
- *        its own row of that plan and announces its place in the order as its rank
- *        (docs/protocol.md, "Priority negotiation"). Every member has the same inputs
+ *        Before all this (unless configured with greedy_negotiation), the order search
+ *        (its group leaves out every UAV whose intent says it follows a coordinator):
+ *        from the intents as they stood when the cycle began (each UAV's last of
+ *        cycle k - 1, or in its first cycle its first intent with the offset it starts
+ *        at held; its own included), it predicts, and when its group of UAVs that pass
+ *        near each other has a conflict it plans that group as coa_plan_decoupled does,
+ *        first in the order the ranks announce. Only when that order fails does it try
+ *        the others (at most 120), and when one solves it flies its own row of that
+ *        plan and announces its place in the order as its rank (docs/protocol.md,
+ *        "Priority negotiation", "The first cycle"). Every member has the same inputs
  *        when nothing was lost, so each finds the same order and rows by itself;
  *        otherwise the ranks announced and the greedy raise settle the order.
  *   3. At cycle_utime(k) + collect_us the coordinator predicts over samples k..k+N from the
@@ -274,9 +275,9 @@ typedef struct {
      * intent_copies 0: none, which is also the default). */
     int64_t resend_us;
     uint32_t intent_copies;
-    /* Decoupled: negotiate the order by the greedy raise alone, without the order search
-     * (docs/protocol.md, "Priority negotiation"): no search's cost, and the negotiation as
-     * it was before the search. false (the default): search. */
+    /* Deciding for itself: negotiate the order by the greedy raise alone, without the search
+     * of the order (docs/protocol.md, "Priority negotiation"): no search's cost, and the
+     * negotiation as it was before the search. false (the default): search. */
     bool greedy_negotiation;
     /* Following the coordinator, how long into a cycle it waits for an answer to a
      * conflict of its own (a plan committed, or one saying the search failed) before it
@@ -350,7 +351,7 @@ void coavoid_vehicle_node_destroy(coavoid_vehicle_node_t *node);
  * heartbeat even then, when it can. Cost: O(N + route) to fly; after a coordinated cycle
  * without an adopted plan, one prediction over its peers, tracks and obstacles
  * (coa_predict); decoupled, one more and at most two one-UAV searches of beta
- * expansions, and (configured decoupled) the order search: two predictions, and with a
+ * expansions, and (without greedy_negotiation) the order search: two predictions, and with a
  * conflict near it one decoupled plan of at most 8 UAVs, or when the order fails at most
  * 120 orders of at most 8 one-UAV searches each. No memory is allocated. */
 int coavoid_vehicle_node_cycle(coavoid_vehicle_node_t *node, int64_t now);
