@@ -14,7 +14,10 @@
  *   - the coordinator gone right after proposing: nobody switches, every UAV falls back,
  *     separation is kept;
  *   - the coordinator gone after one COMMIT reached one UAV only: that UAV's SWITCHED
- *     makes every other UAV of the plan switch too: the plan is flown by all.
+ *     makes every other UAV of the plan switch too: the plan is flown by all;
+ *   - the coordinator gone after proposing, and one UAV's answers never reaching its
+ *     siblings: it commits the plan itself, they cannot, and one of them flies the
+ *     standby it planned at the answer wait; separation is kept.
  * And, decoupled, the order search: two random encounters (tests/encounters/) that the
  * greedy priority negotiation alone flies into a loss of separation, one of them from
  * cycle 0, and that an order found in flight keeps separated. And the first cycle, where
@@ -61,7 +64,8 @@ typedef enum {
     SCRIPT_ACCEPT_ONCE,
     SCRIPT_ANSWERS_NEVER,
     SCRIPT_GONE_AFTER_PROPOSAL,
-    SCRIPT_GONE_AFTER_ONE_COMMIT
+    SCRIPT_GONE_AFTER_ONE_COMMIT,
+    SCRIPT_STANDBY
 } script_kind_t;
 
 typedef struct {
@@ -156,7 +160,7 @@ static bool first_cycle(const script_t *s, int64_t now)
 static bool from_coordinator_dropped(script_t *s, const char *channel, const void *data,
                                      size_t size, uint32_t to, int64_t now)
 {
-    if (s->kind == SCRIPT_GONE_AFTER_PROPOSAL) {
+    if (s->kind == SCRIPT_GONE_AFTER_PROPOSAL || s->kind == SCRIPT_STANDBY) {
         /* Its rows of the first plan go out, then nothing more. */
         return s->first_plan_at != 0 &&
                !(is(channel, COAVOID_CHANNEL_PLAN) && now == s->first_plan_at);
@@ -212,6 +216,10 @@ static bool drop(void *user, const char *channel, uint32_t from, uint32_t to, co
     } else if (to == COAVOID_NODE_COORDINATOR_ID) {
         note_switch(s, channel, data, size);
         dropped = to_coordinator_dropped(s, channel, data, size, from, now);
+    } else if (s->kind == SCRIPT_STANDBY) {
+        /* The victim's answers never reach its siblings (its ACCEPT, then its SWITCHED). */
+        dropped =
+            from == s->victim && is(channel, COAVOID_CHANNEL_AGREEMENT) && first_cycle(s, now);
     }
     s->dropped += dropped ? 1u : 0u;
     return dropped;
@@ -337,6 +345,24 @@ START_TEST(test_coordinator_gone_after_one_commit)
     ck_assert_uint_eq(scripted.outcome.plans_switched,
                       s.switched_before + (uint32_t)__builtin_popcountll(s.holders));
     ck_assert_uint_eq(scripted.outcome.plans_in_doubt, 0);
+}
+END_TEST
+
+START_TEST(test_standby_when_an_accept_is_unheard)
+{
+    script_t s = run(SCRIPT_STANDBY);
+    /* The victim heard every sibling accept and commits the plan itself; its siblings
+     * never heard its ACCEPT nor its SWITCHED: each holds the plan undecided, and at the
+     * cycle's end it is in doubt. One that reaches the answer wait with a conflict of its
+     * own flies a standby, clear of the victim whether it switched or not (in this
+     * encounter UAV 3; UAV 1 was told of a failed search earlier in the cycle, which
+     * counts as its answer, and flies on as before). Separation is kept (fly). */
+    ck_assert_uint_eq(scripted.outcome.plans_switched, s.switched_before + 1u);
+    ck_assert_uint_eq(scripted.outcome.plans_in_doubt,
+                      (uint32_t)__builtin_popcountll(s.holders) - 1u);
+    ck_assert_uint_ge(scripted.outcome.plans_standby, 1);
+    ck_assert_uint_le(scripted.outcome.plans_standby, scripted.outcome.plans_in_doubt);
+    ck_assert_uint_eq(lossless.outcome.plans_standby, 0);
 }
 END_TEST
 
@@ -513,6 +539,7 @@ static Suite *protocol_suite(void)
     tcase_add_test(tc, test_answers_never_arrive);
     tcase_add_test(tc, test_coordinator_gone_after_proposal);
     tcase_add_test(tc, test_coordinator_gone_after_one_commit);
+    tcase_add_test(tc, test_standby_when_an_accept_is_unheard);
     suite_add_tcase(suite, tc);
     TCase *order = tcase_create("decoupled order search");
     tcase_set_timeout(order, 120);

@@ -312,6 +312,8 @@ typedef struct {
     uint32_t plans_self_committed; /* ... switched to at the answer wait, every UAV of it
                                       heard accepting and no decision come (coordinator
                                       stopped): docs/protocol.md */
+    uint32_t plans_standby;        /* ... held undecided at the answer wait, and in doubt
+                                      at the cycle's end: it flew its standby instead */
     /* Its precedence in the decoupled order, announced in its intents (0..
      * COAVOID_INTENT_T_MAX_RANK; docs/protocol.md, "Priority negotiation"), and how many
      * times it raised it since start. */

@@ -48,6 +48,7 @@ struct coavoid_vehicle_node {
     /* While waiting: when its first cycle's intents have gathered (plan_self), or
      * INT64_MAX. */
     int64_t gather_until;
+    bool standby_held; /* it planned a standby at the answer wait of this cycle */
     /* Following: when a conflict of its own with no answer yet makes it plan for itself
      * within the cycle (answer_overdue), and whether that check has run this cycle. */
     int64_t answer_deadline;
@@ -1300,6 +1301,7 @@ static int answer_overdue(coavoid_vehicle_node_t *node, int64_t now)
     rc = standby(node, now, &planned);
     if (rc == COA_OK && planned) {
         node->state.coordinated = false; /* it flies the standby unless one is committed */
+        node->standby_held = true;
         rc = publish_intent(node, now);
     }
     node->fault = node->fault || rc != COA_OK;
@@ -1861,6 +1863,8 @@ static void fly_to(coavoid_vehicle_node_t *node, int64_t k, int64_t now)
      * the coordinator commits only what every UAV accepted, so flying it on a guess
      * could split the plan; flying on as before is what an abort would have said. */
     node->state.plans_in_doubt += node->pending ? 1u : 0u;
+    node->state.plans_standby += node->pending && node->standby_held ? 1u : 0u;
+    node->standby_held = false;
     node->pending = false;
     node->answer_copies_left = 0;
     node->intent_copies_left = 0;

@@ -1127,10 +1127,12 @@ static void sim_agreement_counts(const sim_run_t *r, coavoid_sim_outcome_t *outc
     outcome->plans_resent = c->plans_resent;
     outcome->plans_switched = 0;
     outcome->plans_in_doubt = 0;
+    outcome->plans_standby = 0;
     for (size_t j = 0; j < r->n; j++) {
         const coavoid_vehicle_node_state_t *st = coavoid_vehicle_node_state(r->vehicles[j]);
         outcome->plans_switched += st->plans_switched;
         outcome->plans_in_doubt += st->plans_in_doubt;
+        outcome->plans_standby += st->plans_standby;
     }
 }
 

@@ -117,6 +117,7 @@ typedef struct {
     uint32_t plans_resent;
     uint32_t plans_switched; /* UAVs that switched to a committed plan */
     uint32_t plans_in_doubt; /* UAVs whose accepted plan got no decision in its cycle */
+    uint32_t plans_standby;  /* ... of which flew the standby they planned at the answer wait */
 } coavoid_sim_outcome_t;
 
 /* The largest --steps, and with it --coordinator-stops: more is more likely a typo than a
