@@ -231,23 +231,18 @@ typedef struct {
     char text[OUT_BYTES];
 } flight_t;
 
-/* Flies paper.json centralised under the script; the result's text in f->text. */
-static void fly(script_t *s, flight_t *f)
+/* Flies c's scenario as c says; the result's text in f->text. Separation must be kept. */
+static void fly_config(const coavoid_sim_config_t *c, flight_t *f)
 {
     coavoid_scenario_t sc;
     char err[256];
-    ck_assert_msg(coavoid_scenario_load(PAPER, &sc, err, sizeof err) == COA_OK, "%s", err);
-    coavoid_sim_config_t c;
-    memset(&c, 0, sizeof c);
-    c.scenario_path = PAPER;
-    c.mode = "centralised";
-    c.drop = drop;
-    c.drop_user = s;
+    ck_assert_msg(coavoid_scenario_load(c->scenario_path, &sc, err, sizeof err) == COA_OK, "%s",
+                  err);
     FILE *out = tmpfile();
     ck_assert_ptr_nonnull(out);
     coavoid_run_error_t e;
     memset(&e, 0, sizeof e);
-    f->verdict = coavoid_sim_fly(&c, &sc, out, &f->outcome, &e);
+    f->verdict = coavoid_sim_fly(c, &sc, out, &f->outcome, &e);
     rewind(out);
     size_t n = fread(f->text, 1, sizeof f->text - 1u, out);
     f->text[n] = '\0';
@@ -255,6 +250,18 @@ static void fly(script_t *s, flight_t *f)
     coavoid_scenario_free(&sc);
     ck_assert_msg(f->verdict == COAVOID_SIM_SEPARATED, "verdict %d (%s)", f->verdict, e.text);
     ck_assert(!f->outcome.loss_of_separation);
+}
+
+/* Flies paper.json centralised under the script. */
+static void fly(script_t *s, flight_t *f)
+{
+    coavoid_sim_config_t c;
+    memset(&c, 0, sizeof c);
+    c.scenario_path = PAPER;
+    c.mode = "centralised";
+    c.drop = drop;
+    c.drop_user = s;
+    fly_config(&c, f);
 }
 
 static flight_t lossless, scripted;
@@ -452,9 +459,6 @@ static bool drop_first_send(void *user, const char *channel, uint32_t from, uint
 /* Flies an encounter decoupled, with `script` (NULL: no loss); its text in f->text. */
 static void fly_first_cycle(const char *path, first_send_t *script, flight_t *f)
 {
-    coavoid_scenario_t sc;
-    char err[256];
-    ck_assert_msg(coavoid_scenario_load(path, &sc, err, sizeof err) == COA_OK, "%s", err);
     coavoid_sim_config_t c;
     memset(&c, 0, sizeof c);
     c.scenario_path = path;
@@ -463,17 +467,7 @@ static void fly_first_cycle(const char *path, first_send_t *script, flight_t *f)
     c.drop = script != NULL ? drop_first_send : NULL;
     c.drop_user = script;
     c.json = true; /* every sample flown */
-    FILE *out = tmpfile();
-    ck_assert_ptr_nonnull(out);
-    coavoid_run_error_t e;
-    memset(&e, 0, sizeof e);
-    f->verdict = coavoid_sim_fly(&c, &sc, out, &f->outcome, &e);
-    rewind(out);
-    size_t n = fread(f->text, 1, sizeof f->text - 1u, out);
-    f->text[n] = '\0';
-    ck_assert_int_eq(fclose(out), 0);
-    coavoid_scenario_free(&sc);
-    ck_assert_msg(f->verdict == COAVOID_SIM_SEPARATED, "verdict %d (%s)", f->verdict, e.text);
+    fly_config(&c, f);
 }
 
 /* The result's "replans" count blanked out: the flight alone. */
