@@ -864,10 +864,11 @@ static bool snapshot_add(coavoid_vehicle_node_t *node, const coavoid_intent_t *m
 }
 
 /* Whether it runs the order search when it decides for itself: unless told to negotiate
- * greedily. One configured centralised decides for itself only while it distrusts its
- * coordinator or answers its own conflict (reconsider() and decide() skip it while it
- * follows), and the search's group leaves out every UAV whose intent says it follows
- * (order_eligible), so no search hands a row to a UAV that flies the coordinator's. O(1). */
+ * greedily. One configured centralised searches only in the cycles it distrusts its
+ * coordinator (decide_own; at the answer wait it decides without a search, and
+ * reconsider() skips it while it follows), and the search's group leaves out every UAV
+ * whose intent says it follows (order_eligible), so no search hands a row to a UAV that
+ * flies the coordinator's. O(1). */
 static bool searches(const coavoid_vehicle_node_t *node)
 {
     return !node->config.greedy_negotiation;
