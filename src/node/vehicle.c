@@ -545,11 +545,15 @@ static void drop_rank(coavoid_vehicle_node_t *node)
  * cycle began may still come: until the last of them is due (publish_intent). Before
  * that a UAV that finds no plan below those before it may only be missing some of them
  * (lost, a copy on its way), and a raise made then reorders the cluster for nothing. */
-static bool gathering(const coavoid_vehicle_node_t *node, int64_t now)
+static int64_t gather_end(const coavoid_vehicle_node_t *node)
 {
     const int64_t copies = 2 * (int64_t)node->config.intent_copies;
-    return node->cycle_start == node->first_cycle_start &&
-           now < node->first_cycle_start + copies * node->config.resend_us;
+    return node->first_cycle_start + copies * node->config.resend_us;
+}
+
+static bool gathering(const coavoid_vehicle_node_t *node, int64_t now)
+{
+    return node->cycle_start == node->first_cycle_start && now < gather_end(node);
 }
 
 /* Plans for itself in the decoupled order (plan_in_order); when it finds no plan there, it
@@ -562,8 +566,7 @@ static int plan_self(coavoid_vehicle_node_t *node, int64_t now, uint32_t my)
     coa_plan_result_t result;
     int rc = plan_in_order(node, now, my, &result);
     if (rc == COA_OK && result.status != COA_PLAN_SOLVED && gathering(node, now)) {
-        const int64_t copies = 2 * (int64_t)node->config.intent_copies;
-        node->gather_until = node->first_cycle_start + copies * node->config.resend_us;
+        node->gather_until = gather_end(node);
         return 1;
     }
     if (rc == COA_OK && result.status != COA_PLAN_SOLVED) {
@@ -793,8 +796,8 @@ static int32_t agreed_rank_of(const coavoid_vehicle_node_t *node, uint16_t id)
  * it had not heard when it decided (lost, and come by a copy: it would have waited for
  * it), or which published another plan since (it had decided from fewer first intents
  * than came later; intent_digest: a copy is not another plan). Without loss that never
- * happens (each decides after the UAVs before it published, on all of theirs). Started centralised,
- * it also decides again on a UAV before it that answered its own conflict at the answer
+ * happens (each decides after the UAVs before it published, on all of theirs). Started
+ * centralised, it also decides again on a UAV before it that answered its own conflict at the answer
  * wait (rank 0, mode decoupled) with another plan than the one it decided on
  * (intent_digest: a copy is not another plan). O(peers^2 + peers * samples). */
 static bool overtaken(const coavoid_vehicle_node_t *node)
