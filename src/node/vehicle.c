@@ -45,9 +45,9 @@ struct coavoid_vehicle_node {
     int64_t first_cycle_start;
     int64_t cycle_start;
     int64_t wait_deadline;
-    /* While waiting: when its first cycle's intents have gathered (plan_self), or
-     * INT64_MAX. */
-    int64_t gather_until;
+    /* While waiting: it waits for its first cycle's intents to gather (plan_self), until
+     * gather_end(). */
+    bool gather_wait;
     bool standby_held; /* it planned a standby at the answer wait of this cycle */
     /* Following: when a conflict of its own with no answer yet makes it plan for itself
      * within the cycle (answer_overdue), and whether that check has run this cycle. */
@@ -328,7 +328,7 @@ static int finish(coavoid_vehicle_node_t *node, int64_t now)
     node->state.waiting = false;
     node->state.published = rc == COA_OK;
     node->wait_deadline = INT64_MAX;
-    node->gather_until = INT64_MAX;
+    node->gather_wait = false;
     int status_rc = publish_status(node, now);
     if (rc != COA_OK) {
         return rc;
@@ -541,16 +541,18 @@ static void drop_rank(coavoid_vehicle_node_t *node)
     node->calm_cycles = 0;
 }
 
-/* Whether, in its first cycle, the copies of the first intents its peers published as the
- * cycle began may still come: until the last of them is due (publish_intent). Before
- * that a UAV that finds no plan below those before it may only be missing some of them
- * (lost, a copy on its way), and a raise made then reorders the cluster for nothing. */
+/* When the last copy of the first intents published as the first cycle began is due
+ * (publish_intent: twice intent_copies, resend_us apart). */
 static int64_t gather_end(const coavoid_vehicle_node_t *node)
 {
     const int64_t copies = 2 * (int64_t)node->config.intent_copies;
     return node->first_cycle_start + copies * node->config.resend_us;
 }
 
+/* Whether, in its first cycle, the copies of the first intents its peers published as the
+ * cycle began may still come. Before gather_end() a UAV that finds no plan below those
+ * before it may only be missing some of them (lost, a copy on its way), and a raise made
+ * then reorders the cluster for nothing. */
 static bool gathering(const coavoid_vehicle_node_t *node, int64_t now)
 {
     return node->cycle_start == node->first_cycle_start && now < gather_end(node);
@@ -566,7 +568,7 @@ static int plan_self(coavoid_vehicle_node_t *node, int64_t now, uint32_t my)
     coa_plan_result_t result;
     int rc = plan_in_order(node, now, my, &result);
     if (rc == COA_OK && result.status != COA_PLAN_SOLVED && gathering(node, now)) {
-        node->gather_until = gather_end(node);
+        node->gather_wait = true;
         return 1;
     }
     if (rc == COA_OK && result.status != COA_PLAN_SOLVED) {
@@ -748,6 +750,13 @@ static uint32_t intent_digest(const coavoid_intent_t *m)
 static bool first_intent(const coavoid_vehicle_node_t *node, const coavoid_node_peer_t *peer);
 static bool searches(const coavoid_vehicle_node_t *node);
 
+/* Whether peer's intent is a first intent that a searching UAV counts as a newcomer's
+ * (overtaken; note_order keeps its digest). O(1). */
+static bool newcomer(const coavoid_vehicle_node_t *node, const coavoid_node_peer_t *peer)
+{
+    return searches(node) && first_intent(node, peer);
+}
+
 /* Remembers which live UAVs come before it as it decides, and a digest of the intent it
  * has of each (overtaken). O(peers^2 + peers * samples). */
 static void note_order(coavoid_vehicle_node_t *node)
@@ -765,8 +774,8 @@ static void note_order(coavoid_vehicle_node_t *node)
         for (size_t p = 0; p < COAVOID_NODE_MAX_PEERS; p++) {
             const coavoid_intent_t *m = &node->inbox.peers[p].msg;
             if (node->inbox.peers[p].used && (uint16_t)m->uav_id == view->live_id[i]) {
-                const bool newcomer = searches(node) && first_intent(node, &node->inbox.peers[p]);
-                digest = centralised || newcomer ? intent_digest(m) : 0u;
+                const bool digested = centralised || newcomer(node, &node->inbox.peers[p]);
+                digest = digested ? intent_digest(m) : 0u;
                 break; /* one slot per UAV */
             }
         }
@@ -797,20 +806,19 @@ static int32_t agreed_rank_of(const coavoid_vehicle_node_t *node, uint16_t id)
  * it), or which published another plan since (it had decided from fewer first intents
  * than came later; intent_digest: a copy is not another plan). Without loss that never
  * happens (each decides after the UAVs before it published, on all of theirs). Started
- * centralised, it also decides again on a UAV before it that answered its own conflict at the answer
- * wait (rank 0, mode decoupled) with another plan than the one it decided on
+ * centralised, it also decides again on a UAV before it that answered its own conflict
+ * at the answer wait (rank 0, mode decoupled) with another plan than the one it decided on
  * (intent_digest: a copy is not another plan). O(peers^2 + peers * samples). */
 static bool overtaken(const coavoid_vehicle_node_t *node)
 {
     const coa_vehicle_t *self = &node->config.vehicle;
     for (size_t i = 0; i < COAVOID_NODE_MAX_PEERS; i++) {
         const coavoid_intent_t *m = &node->inbox.peers[i].msg;
-        const bool newcomer =
-            m->rank <= 0 && searches(node) && first_intent(node, &node->inbox.peers[i]);
+        const bool first = m->rank <= 0 && newcomer(node, &node->inbox.peers[i]);
         const bool answered = node->config.mode == COAVOID_NODE_CENTRALISED && m->rank <= 0 &&
                               m->mode == COAVOID_INTENT_T_MODE_DECOUPLED;
         if (!node->inbox.peers[i].used || m->plan_utime != node->cycle_start ||
-            (m->rank <= 0 && !newcomer && !answered) ||
+            (m->rank <= 0 && !first && !answered) ||
             !coavoid_node_precedes(m->rank, (uint32_t)m->priority, (uint16_t)m->uav_id,
                                    node->state.rank, self->priority, self->id)) {
             continue;
@@ -825,8 +833,8 @@ static bool overtaken(const coavoid_vehicle_node_t *node)
         if (j == node->decided_count) {
             return true;
         }
-        const bool changed = answered || newcomer ? node->decided_digest[j] != intent_digest(m)
-                                                  : node->decided_sequence[j] < m->sequence;
+        const bool changed = answered || first ? node->decided_digest[j] != intent_digest(m)
+                                               : node->decided_sequence[j] < m->sequence;
         if (changed) {
             return true;
         }
@@ -1825,7 +1833,6 @@ coavoid_vehicle_node_t *coavoid_vehicle_node_create(const coavoid_vehicle_node_c
     node->state.offset = node->config.vehicle.initial_offset;
     node->state.last_outcome = -1;
     node->wait_deadline = INT64_MAX;
-    node->gather_until = INT64_MAX;
     const bool centralised = node->config.mode == COAVOID_NODE_CENTRALISED;
     rc = coavoid_node_inbox_init(&node->inbox, c, node->config.vehicle.id, node->config.vehicle.id,
                                  coordinator_id, COAVOID_NODE_MAX_PEERS - 1u, lcm, &node->state.rx,
@@ -1979,7 +1986,7 @@ int coavoid_vehicle_node_cycle(coavoid_vehicle_node_t *node, int64_t now)
     node->state.published = false;
     node->state.waiting = false;
     node->wait_deadline = INT64_MAX;
-    node->gather_until = INT64_MAX;
+    node->gather_wait = false;
 
     int rc;
     node->answer_checked = false;
@@ -2045,8 +2052,8 @@ int64_t coavoid_vehicle_node_deadline(const coavoid_vehicle_node_t *node)
         return INT64_MAX;
     }
     int64_t deadline = node->state.waiting ? node->wait_deadline : INT64_MAX;
-    if (node->state.waiting && node->gather_until < deadline) {
-        deadline = node->gather_until;
+    if (node->state.waiting && node->gather_wait && gather_end(node) < deadline) {
+        deadline = gather_end(node);
     }
     const int64_t end = node->cycle_start + node->config.common.dt_us;
     if (node->state.coordinated && !node->answer_checked && node->answer_deadline < deadline) {
