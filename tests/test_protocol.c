@@ -375,25 +375,22 @@ END_TEST
 
 /* ---- decoupled: the order search (docs/protocol.md, "Priority negotiation") ---- */
 
-/* Flies an encounter decoupled without loss; its verdict. */
-static int fly_decoupled(const char *path)
+/* Flies an encounter decoupled, with the drop script `script` (NULL: no loss), as JSON
+ * (every sample flown) in f->text; fly_config asserts separation. */
+static void fly_decoupled(const char *path,
+                          bool (*script)(void *user, const char *channel, uint32_t from,
+                                         uint32_t to, const void *data, size_t size, int64_t now),
+                          void *drop_user, flight_t *f)
 {
-    coavoid_scenario_t sc;
-    char err[256];
-    ck_assert_msg(coavoid_scenario_load(path, &sc, err, sizeof err) == COA_OK, "%s", err);
     coavoid_sim_config_t c;
     memset(&c, 0, sizeof c);
     c.scenario_path = path;
     c.mode = "decoupled";
     c.decoupled = true;
-    coavoid_sim_outcome_t outcome;
-    coavoid_run_error_t e;
-    memset(&e, 0, sizeof e);
-    const int verdict = coavoid_sim_fly(&c, &sc, NULL, &outcome, &e);
-    coavoid_scenario_free(&sc);
-    ck_assert_msg(verdict == COAVOID_SIM_SEPARATED || verdict == COAVOID_SIM_LOSS,
-                  "verdict %d (%s)", verdict, e.text);
-    return verdict;
+    c.drop = script;
+    c.drop_user = drop_user;
+    c.json = true;
+    fly_config(&c, f);
 }
 
 /* Encounter 140 of 3 UAVs (montecarlo, seed 1): with the greedy raise alone UAVs 2 and 3
@@ -401,8 +398,8 @@ static int fly_decoupled(const char *path)
  * members search the order at a cycle's start and fly their rows of its plan. */
 START_TEST(test_order_search_keeps_separation)
 {
-    ck_assert_int_eq(fly_decoupled(COAVOID_TEST_ENCOUNTERS "/order_search_140.json"),
-                     COAVOID_SIM_SEPARATED);
+    fly_decoupled(COAVOID_TEST_ENCOUNTERS "/order_search_140.json", NULL, NULL, &scripted);
+    ck_assert_int_eq(scripted.verdict, COAVOID_SIM_SEPARATED);
 }
 END_TEST
 
@@ -412,8 +409,8 @@ END_TEST
  * with the offset it starts at held. */
 START_TEST(test_order_search_in_the_first_cycle)
 {
-    ck_assert_int_eq(fly_decoupled(COAVOID_TEST_ENCOUNTERS "/order_search_345.json"),
-                     COAVOID_SIM_SEPARATED);
+    fly_decoupled(COAVOID_TEST_ENCOUNTERS "/order_search_345.json", NULL, NULL, &scripted);
+    ck_assert_int_eq(scripted.verdict, COAVOID_SIM_SEPARATED);
 }
 END_TEST
 
@@ -456,20 +453,6 @@ static bool drop_first_send(void *user, const char *channel, uint32_t from, uint
     return dropped;
 }
 
-/* Flies an encounter decoupled, with `script` (NULL: no loss); its text in f->text. */
-static void fly_first_cycle(const char *path, first_send_t *script, flight_t *f)
-{
-    coavoid_sim_config_t c;
-    memset(&c, 0, sizeof c);
-    c.scenario_path = path;
-    c.mode = "decoupled";
-    c.decoupled = true;
-    c.drop = script != NULL ? drop_first_send : NULL;
-    c.drop_user = script;
-    c.json = true; /* every sample flown */
-    fly_config(&c, f);
-}
-
 /* The result's "replans" count blanked out: the flight alone. */
 static void without_replans(char *text)
 {
@@ -484,10 +467,10 @@ static void without_replans(char *text)
 /* The flight, sample for sample, is the lossless one (the UAVs decide more often). */
 static void first_send_lost(const char *path, uint32_t from, uint32_t to)
 {
-    fly_first_cycle(path, NULL, &lossless);
+    fly_decoupled(path, NULL, NULL, &lossless);
     first_send_t s = {.from = from, .to = to};
     memset(&scripted, 0, sizeof scripted);
-    fly_first_cycle(path, &s, &scripted);
+    fly_decoupled(path, drop_first_send, &s, &scripted);
     ck_assert_uint_gt(s.dropped, 0);
     without_replans(lossless.text);
     without_replans(scripted.text);
@@ -506,7 +489,7 @@ START_TEST(test_first_cycle_waits_for_copies)
     const char *path = COAVOID_TEST_ENCOUNTERS "/first_cycle_40.json";
     first_send_t s = {.pattern = 15u};
     memset(&scripted, 0, sizeof scripted);
-    fly_first_cycle(path, &s, &scripted);
+    fly_decoupled(path, drop_first_send, &s, &scripted);
     ck_assert_uint_gt(s.dropped, 0);
 }
 END_TEST
