@@ -421,17 +421,38 @@ static bool peer_first(const coavoid_vehicle_node_t *node, size_t i)
                                  node->state.rank, self->priority, self->id);
 }
 
+/* When the last copy of the first intents published as the first cycle began is due
+ * (publish_intent: twice intent_copies, resend_us apart). */
+static int64_t gather_end(const coavoid_vehicle_node_t *node)
+{
+    const int64_t copies = 2 * (int64_t)node->config.intent_copies;
+    return node->first_cycle_start + copies * node->config.resend_us;
+}
+
+/* Whether, in its first cycle, the copies of the first intents its peers published as the
+ * cycle began may still come. Before gather_end() a UAV that finds no plan below those
+ * before it may only be missing some of them (lost, a copy on its way), and a raise made
+ * then reorders the cluster for nothing. */
+static bool gathering(const coavoid_vehicle_node_t *node, int64_t now)
+{
+    return node->cycle_start == node->first_cycle_start && now < gather_end(node);
+}
+
 /* One search in the decoupled order as it stands: against obstacles, tracks, stale UAVs
  * and every live UAV that is not a later member of its cluster (my = its cluster label).
- * Returns COA_OK with *result, or a negative error. */
+ * While the first intents are gathering it keeps clear of no later UAV at all: a later
+ * UAV's first plan may have been made before it heard this one (or others before it), so
+ * keeping clear of it can take that UAV's only way out; the later UAV plans around this
+ * one's intent once it hears it. Returns COA_OK with *result, or a negative error. */
 static int plan_in_order(coavoid_vehicle_node_t *node, int64_t now, uint32_t my,
                          coa_plan_result_t *result)
 {
     const coavoid_node_view_t *view = &node->view;
+    const bool first = gathering(node, now);
     bool lower_outside = false;
     for (size_t i = 0; i < view->live_count; i++) {
         bool lower = !peer_first(node, i);
-        node->include[i] = !(lower && node->labels[i + 1u] == my);
+        node->include[i] = !(lower && (first || node->labels[i + 1u] == my));
         lower_outside = lower_outside || (lower && node->include[i]);
     }
     int rc = search_self(node, now, result);
@@ -539,23 +560,6 @@ static void drop_rank(coavoid_vehicle_node_t *node)
     node->state.rank = 0;
     node->raises = 0;
     node->calm_cycles = 0;
-}
-
-/* When the last copy of the first intents published as the first cycle began is due
- * (publish_intent: twice intent_copies, resend_us apart). */
-static int64_t gather_end(const coavoid_vehicle_node_t *node)
-{
-    const int64_t copies = 2 * (int64_t)node->config.intent_copies;
-    return node->first_cycle_start + copies * node->config.resend_us;
-}
-
-/* Whether, in its first cycle, the copies of the first intents its peers published as the
- * cycle began may still come. Before gather_end() a UAV that finds no plan below those
- * before it may only be missing some of them (lost, a copy on its way), and a raise made
- * then reorders the cluster for nothing. */
-static bool gathering(const coavoid_vehicle_node_t *node, int64_t now)
-{
-    return node->cycle_start == node->first_cycle_start && now < gather_end(node);
 }
 
 /* Plans for itself in the decoupled order (plan_in_order); when it finds no plan there, it
