@@ -463,8 +463,9 @@ typedef struct {
     size_t obstacle_count;
     const coa_track_t *tracks; /* positions at scenario t = 0 (epoch) */
     size_t track_count;
-    /* Every tile and track estimate goes out again this many times a cycle, back to back
-     * (0: once, the default): against loss, as COAVOID_NODE_DEFAULT_COPIES. */
+    /* Every tile and track estimate goes out again this many times a cycle (twice as many
+     * in its first cycle), back to back (0: once, the default): against loss, as
+     * COAVOID_NODE_DEFAULT_COPIES. */
     uint32_t copies;
 } coavoid_world_config_t;
 

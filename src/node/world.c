@@ -220,6 +220,10 @@ int coavoid_world_cycle(coavoid_world_t *node, int64_t now)
     if (node->started && k <= node->cycle) {
         return COA_OK;
     }
+    /* In its first cycle no node has an earlier estimate to extrapolate when every copy is
+     * lost (later, the last one stands in for a cycle), and a decoupled fleet searches its
+     * order from what it knows then: twice the copies, as a vehicle's first intent has. */
+    const uint32_t copies = node->started ? node->config.copies : 2u * node->config.copies;
     node->started = true;
     node->cycle = k;
     const int64_t cycle_start = coavoid_node_cycle_utime(c, k);
@@ -227,7 +231,7 @@ int coavoid_world_cycle(coavoid_world_t *node, int64_t now)
     int first_error = COA_OK;
     /* Each message goes out 1 + copies times, each freshly stamped: a track lost to the
      * coordinator in the first cycles is one it cannot plan around. */
-    for (uint32_t send = 0; send <= node->config.copies; send++) {
+    for (uint32_t send = 0; send <= copies; send++) {
         int rc = world_send(node, now, k, &ctx);
         first_error = first_error == COA_OK ? rc : first_error;
     }

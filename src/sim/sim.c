@@ -586,8 +586,9 @@ static int sim_net(sim_run_t *r)
     c.drop = o->drop != NULL ? sim_drop : NULL;
     c.drop_user = r;
     if (c.delay_us > 0 || c.jitter_us > 0) {
+        /* The world's first cycle sends twice the copies. */
         const size_t per_cycle = (COAVOID_OBSTACLE_MAP_T_MAX_TILES + r->s->track_count) *
-                                     (1u + COAVOID_NODE_DEFAULT_COPIES) +
+                                     (1u + 2u * COAVOID_NODE_DEFAULT_COPIES) +
                                  SIM_NET_VEHICLE_MESSAGES * n + SIM_NET_COORDINATOR_MESSAGES(n);
         c.message_capacity = 2u * per_cycle;
         c.copy_capacity = 2u * per_cycle * (n + 1u);
