@@ -373,6 +373,59 @@ START_TEST(test_standby_when_an_accept_is_unheard)
 }
 END_TEST
 
+/* ---- centralised: a failure notice, then nothing (docs/protocol.md, "The answer wait") ---- */
+
+typedef struct {
+    int64_t notice_at; /* when the coordinator's first failure notice went out (0: not yet) */
+    uint32_t notices, dropped;
+} notice_t;
+
+/* The coordinator's failure notices of its first cycle with one go out; everything after
+ * them (the larger group's plan sent at the same time included) is lost. */
+static bool gone_after_notice(void *user, const char *channel, uint32_t from, uint32_t to,
+                              const void *data, size_t size, int64_t now)
+{
+    (void)to;
+    notice_t *s = user;
+    if (from != COAVOID_NODE_COORDINATOR_ID) {
+        return false;
+    }
+    coavoid_plan_t m;
+    const bool notice = is(channel, COAVOID_CHANNEL_PLAN) &&
+                        coavoid_plan_t_decode(data, 0, (int)size, &m) >= 0 &&
+                        m.status != COAVOID_PLAN_T_STATUS_SOLVED;
+    if (notice && (s->notice_at == 0 || now == s->notice_at)) {
+        s->notice_at = now;
+        s->notices++;
+        return false;
+    }
+    const bool dropped = s->notice_at != 0;
+    s->dropped += dropped ? 1u : 0u;
+    return dropped;
+}
+
+/* Encounter 70 of 3 UAVs (montecarlo, seed 1; centralised solves it, and so does the
+ * order 1, 3, 2): in cycle 0 the coordinator's search for UAVs 1 and 3 fails, it tells
+ * them so, and stops before the plan of all three goes out. Told of the failure, they
+ * took it as their answer and flew on; UAVs 2 and 3 lost separation at t = 2 s. */
+START_TEST(test_failure_notice_then_gone)
+{
+    notice_t s;
+    memset(&s, 0, sizeof s);
+    coavoid_sim_config_t c;
+    memset(&c, 0, sizeof c);
+    c.scenario_path = COAVOID_TEST_ENCOUNTERS "/failure_notice_70.json";
+    c.mode = "centralised";
+    c.drop = gone_after_notice;
+    c.drop_user = &s;
+    memset(&scripted, 0, sizeof scripted);
+    fly_config(&c, &scripted);
+    ck_assert_uint_ge(s.notices, 1);
+    ck_assert_uint_gt(s.dropped, 0);
+    ck_assert_uint_ge(scripted.outcome.fallbacks, 1);
+}
+END_TEST
+
 /* ---- decoupled: the order search (docs/protocol.md, "Priority negotiation") ---- */
 
 /* Flies an encounter decoupled, with the drop script `script` (NULL: no loss), as JSON
@@ -567,6 +620,7 @@ static Suite *protocol_suite(void)
     tcase_add_test(tc, test_coordinator_gone_after_proposal);
     tcase_add_test(tc, test_coordinator_gone_after_one_commit);
     tcase_add_test(tc, test_standby_when_an_accept_is_unheard);
+    tcase_add_test(tc, test_failure_notice_then_gone);
     suite_add_tcase(suite, tc);
     TCase *order = tcase_create("decoupled order search");
     tcase_set_timeout(order, 120);

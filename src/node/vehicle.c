@@ -1262,7 +1262,7 @@ static void distrust_from(coavoid_vehicle_node_t *node, int64_t k, int64_t now)
 }
 
 /* Following its coordinator, answer_wait_us into the cycle, with a conflict of its own and
- * no answer adopted (no plan of the coordinator's it flies, or was told failed): it plans
+ * no plan of the coordinator's adopted (told that a search failed for it or not): it plans
  * for itself in this cycle and announces it. Holding no plan, it accepted none, so no
  * COMMIT can include it: it decides as a decoupled UAV (decide()), waiting up to a quarter
  * cycle for the UAVs before it that answer themselves at the same time. Holding an
@@ -1274,8 +1274,8 @@ static void distrust_from(coavoid_vehicle_node_t *node, int64_t k, int64_t now)
 static int answer_overdue(coavoid_vehicle_node_t *node, int64_t now)
 {
     node->answer_checked = true;
-    if (node->cycle_plan_adopted || node->cycle_plan_failed) {
-        return 0;
+    if (node->cycle_plan_adopted) {
+        return 0; /* a failed search it was told of is no answer by now: on_plan */
     }
     coa_predict_result_t result;
     int rc = predict(node, gather(node, now), &result);
@@ -1705,9 +1705,11 @@ static void on_plan(void *owner, const coavoid_plan_t *msg, const coavoid_lcm_pl
     }
     if (row != SIZE_MAX && result->status != COA_PLAN_SOLVED && !info->abandoned && node->started &&
         msg->valid_from_utime == node->cycle_start && now < msg->valid_until_utime) {
-        /* The coordinator tried this cycle and found nothing: it answered. Planning for
-         * itself would not do better than the coordinator's search over the same UAVs,
-         * and would take it out of the coordinator's next, larger ones. */
+        /* The coordinator tried this cycle and found nothing: it answered for this cycle
+         * (the next is not one of distrust), and may still send a larger plan that
+         * includes it. A UAV that holds neither that nor a plan of its own by the answer
+         * wait plans for itself all the same: the coordinator may have stopped right
+         * after the notice, and flying on into a conflict answers nothing. */
         node->cycle_plan_failed = true;
     }
     if (result->status == COA_PLAN_SOLVED && node->started &&
