@@ -280,11 +280,11 @@ typedef struct {
      * negotiation as it was before the search. false (the default): search. */
     bool greedy_negotiation;
     /* Following the coordinator, how long into a cycle it waits for an answer to a
-     * conflict of its own (a plan committed, or one saying the search failed) before it
-     * plans for itself within that cycle, or commits a plan every UAV of it accepted
-     * (docs/protocol.md, "The answer wait"). 0: the default, dt / 2 + 4 resend_us: the
-     * coordinator plans at dt / 4, gives its UAVs dt / 4 to accept, and sends its ABORT
-     * with four copies. */
+     * conflict of its own (a plan committed; one saying the search failed is none by
+     * then) before it plans for itself within that cycle, or commits a plan every UAV of
+     * it accepted (docs/protocol.md, "The answer wait"). 0: the default, dt / 2 + 4
+     * resend_us: the coordinator plans at dt / 4, gives its UAVs dt / 4 to accept, and
+     * sends its ABORT with four copies. */
     int64_t answer_wait_us;
 } coavoid_vehicle_node_config_t;
 
