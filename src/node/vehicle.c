@@ -292,6 +292,15 @@ static coavoid_lcm_intent_info_t intent_info(const coavoid_vehicle_node_t *node,
     return info;
 }
 
+/* Copies of its first cycle's intent: twice intent_copies. Every peer's order search
+ * starts from the intents as the cycle began (docs/protocol.md, "Priority negotiation"),
+ * and a peer that lost every copy of one UAV's first one plans the group without it
+ * while the others plan it in. O(1). */
+static uint32_t first_copies(const coavoid_vehicle_node_t *node)
+{
+    return 2u * node->config.intent_copies;
+}
+
 /* Publishes its intent of this cycle as it stands at `now` (its state moved on, the same
  * plan), and schedules its copies. COA_OK or a negative error (a fault). */
 static int publish_intent(coavoid_vehicle_node_t *node, int64_t now)
@@ -310,12 +319,8 @@ static int publish_intent(coavoid_vehicle_node_t *node, int64_t now)
     if (rc != COA_OK) {
         node->fault = true;
     }
-    /* Its first cycle's intent goes out with twice the copies: every peer's order search
-     * starts from the intents as the cycle began (docs/protocol.md, "Priority
-     * negotiation"), and a peer that lost every copy of one UAV's first one plans the
-     * group without it while the others plan it in. */
     const bool first = node->cycle_start == node->first_cycle_start;
-    node->intent_copies_left = node->config.intent_copies * (first ? 2u : 1u);
+    node->intent_copies_left = first ? first_copies(node) : node->config.intent_copies;
     node->intent_copy_at = now + node->config.resend_us;
     return rc;
 }
@@ -422,11 +427,10 @@ static bool peer_first(const coavoid_vehicle_node_t *node, size_t i)
 }
 
 /* When the last copy of the first intents published as the first cycle began is due
- * (publish_intent: twice intent_copies, resend_us apart). */
+ * (publish_intent: first_copies(), resend_us apart). */
 static int64_t gather_end(const coavoid_vehicle_node_t *node)
 {
-    const int64_t copies = 2 * (int64_t)node->config.intent_copies;
-    return node->first_cycle_start + copies * node->config.resend_us;
+    return node->first_cycle_start + (int64_t)first_copies(node) * node->config.resend_us;
 }
 
 /* Whether, in its first cycle, the copies of the first intents its peers published as the
@@ -1705,9 +1709,9 @@ static void on_plan(void *owner, const coavoid_plan_t *msg, const coavoid_lcm_pl
     }
     if (row != SIZE_MAX && result->status != COA_PLAN_SOLVED && !info->abandoned && node->started &&
         msg->valid_from_utime == node->cycle_start && now < msg->valid_until_utime) {
-        /* The coordinator tried this cycle and found nothing: it answered for this cycle
-         * (the next is not one of distrust), and may still send a larger plan that
-         * includes it. A UAV that holds neither that nor a plan of its own by the answer
+        /* The coordinator tried this cycle and found nothing: that answers the cycle for
+         * update_trust (a UAV told so is not unanswered at its end), and it may still send
+         * a larger plan that includes it. A UAV that holds neither that nor a plan of its own by the answer
          * wait plans for itself all the same: the coordinator may have stopped right
          * after the notice, and flying on into a conflict answers nothing. */
         node->cycle_plan_failed = true;
