@@ -467,6 +467,18 @@ START_TEST(test_order_search_in_the_first_cycle)
 }
 END_TEST
 
+/* Encounter 231 of 5 UAVs (montecarlo, seed 1): order 1, 2, 5, 3, 4, the first that
+ * solves the first horizon, leaves from t = 1 s no order that solves, because of a track
+ * and the hill that enter the horizon a step later; 2, 5, 3, 4, 1 does not. The search
+ * looks two steps beyond the horizon before it agrees an order (lost separation at t =
+ * 1-2 s without). */
+START_TEST(test_order_search_looks_ahead)
+{
+    fly_decoupled(COAVOID_TEST_ENCOUNTERS "/lookahead_231.json", NULL, NULL, &scripted);
+    ck_assert_int_eq(scripted.verdict, COAVOID_SIM_SEPARATED);
+}
+END_TEST
+
 /* ---- decoupled: the first cycle (docs/protocol.md, "The first cycle") ---- */
 
 typedef struct {
@@ -626,6 +638,7 @@ static Suite *protocol_suite(void)
     tcase_set_timeout(order, 120);
     tcase_add_test(order, test_order_search_keeps_separation);
     tcase_add_test(order, test_order_search_in_the_first_cycle);
+    tcase_add_test(order, test_order_search_looks_ahead);
     suite_add_tcase(suite, order);
     TCase *first = tcase_create("decoupled first cycle");
     tcase_set_timeout(first, 120);

@@ -999,13 +999,17 @@ void coavoid_node_view_build_before(coavoid_node_view_t *view, const coavoid_nod
 }
 
 int coavoid_node_problem_tracks(coavoid_node_problem_tracks_t *out, const coavoid_node_view_t *view,
-                                const bool *include, const coavoid_node_common_t *c)
+                                const bool *include, const coavoid_node_common_t *c,
+                                uint32_t horizon)
 {
+    if (horizon + 1u > COAVOID_NODE_MAX_PROBLEM_SAMPLES) {
+        return COA_ERR_ARGUMENT;
+    }
     size_t n = 0;
     size_t paths = 0;
     for (size_t i = 0; i < view->real_track_count; i++, n++) {
         out->tracks[n] = view->tracks[i];
-        if (coa_track_sample(&out->tracks[n], c->dt, c->horizon, out->storage[n]) != COA_OK) {
+        if (coa_track_sample(&out->tracks[n], c->dt, horizon, out->storage[n]) != COA_OK) {
             return COA_ERR_ARGUMENT;
         }
         out->samples[n] = out->storage[n];
@@ -1027,12 +1031,16 @@ int coavoid_node_problem_tracks(coavoid_node_problem_tracks_t *out, const coavoi
         tr->position = plan->samples[0];
         tr->path = path;
         tr->path_count = plan->count;
-        if (view->live_current[i]) {
+        if (view->live_current[i] && horizon < plan->count) {
             /* Its own samples: the positions it flies, bit for bit. */
             out->samples[n] = plan->samples;
         } else {
-            if (coa_track_sample(tr, c->dt, c->horizon, out->storage[n]) != COA_OK) {
+            if (coa_track_sample(tr, c->dt, horizon, out->storage[n]) != COA_OK) {
                 return COA_ERR_ARGUMENT;
+            }
+            if (view->live_current[i]) {
+                /* As far as it reaches bit for bit too; beyond, along its last leg. */
+                memcpy(out->storage[n], plan->samples, plan->count * sizeof plan->samples[0]);
             }
             out->samples[n] = out->storage[n];
         }
@@ -1040,7 +1048,7 @@ int coavoid_node_problem_tracks(coavoid_node_problem_tracks_t *out, const coavoi
     }
     for (size_t i = view->real_track_count; i < view->track_count; i++, n++) {
         out->tracks[n] = view->tracks[i];
-        if (coa_track_sample(&out->tracks[n], c->dt, c->horizon, out->storage[n]) != COA_OK) {
+        if (coa_track_sample(&out->tracks[n], c->dt, horizon, out->storage[n]) != COA_OK) {
             return COA_ERR_ARGUMENT;
         }
         out->samples[n] = out->storage[n];
@@ -1052,16 +1060,16 @@ int coavoid_node_problem_tracks(coavoid_node_problem_tracks_t *out, const coavoi
 int coavoid_node_problem(coa_problem_t *problem, coavoid_node_problem_tracks_t *tracks,
                          const coavoid_node_view_t *view, const bool *include,
                          const coavoid_node_inbox_t *in, const coa_vehicle_t *vehicles,
-                         const coa_vec3_t *const *references, size_t count)
+                         const coa_vec3_t *const *references, size_t count, uint32_t horizon)
 {
     const coavoid_node_common_t *c = &in->common;
-    int rc = coavoid_node_problem_tracks(tracks, view, include, c);
+    int rc = coavoid_node_problem_tracks(tracks, view, include, c, horizon);
     if (rc != COA_OK) {
         return rc;
     }
     memset(problem, 0, sizeof *problem);
     problem->dt = c->dt;
-    problem->horizon = c->horizon;
+    problem->horizon = horizon;
     problem->vehicles = vehicles;
     problem->vehicle_count = count;
     problem->references = references;
@@ -1128,14 +1136,14 @@ coa_planner_config_t coavoid_node_planner_config(uint32_t horizon, size_t search
     return c;
 }
 
-int coavoid_node_solver_init(coavoid_node_solver_t *s, uint32_t horizon, size_t searched,
-                             uint32_t beta)
+int coavoid_node_solver_init(coavoid_node_solver_t *s, uint32_t horizon, uint32_t plan_horizon,
+                             size_t searched, uint32_t beta)
 {
     memset(s, 0, sizeof *s);
     const size_t pairs = coavoid_node_max_pairs();
     const size_t predictor_size = coa_predictor_workspace_size(
         COAVOID_NODE_MAX_PEERS, COAVOID_NODE_TRACK_CAPACITY, horizon, pairs);
-    const coa_planner_config_t config = coavoid_node_planner_config(horizon, searched, beta);
+    const coa_planner_config_t config = coavoid_node_planner_config(plan_horizon, searched, beta);
     const size_t planner_size = coa_planner_workspace_size(&config);
     if (predictor_size == 0u || planner_size == 0u) {
         return COA_ERR_ARGUMENT;

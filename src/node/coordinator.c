@@ -91,7 +91,7 @@ coavoid_coordinator_t *coavoid_coordinator_create(const coavoid_coordinator_conf
     const coavoid_node_common_t *c = &config->common;
     const size_t max_centralised = config->max_centralised == 0u ? 3u : config->max_centralised;
     coavoid_node_solver_t solver;
-    int rc = coavoid_node_solver_init(&solver, c->horizon, max_centralised, c->beta);
+    int rc = coavoid_node_solver_init(&solver, c->horizon, c->horizon, max_centralised, c->beta);
     if (rc != COA_OK) {
         *error = rc;
         return NULL;
@@ -266,7 +266,8 @@ static int cluster_problem(coavoid_coordinator_t *node, size_t count, coa_proble
         node->references[m] = view->live_arrays[i].reference;
     }
     return coavoid_node_problem(problem, &node->problem_tracks, view, node->include, &node->inbox,
-                                node->vehicles, node->references, count);
+                                node->vehicles, node->references, count,
+                                node->config.common.horizon);
 }
 
 /* Plans the cluster, centralised when it is small enough. A joint search can fill its beta

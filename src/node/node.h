@@ -333,11 +333,12 @@ typedef struct coavoid_vehicle_node coavoid_vehicle_node_t;
 coa_planner_config_t coavoid_node_planner_config(uint32_t horizon, size_t searched, uint32_t beta);
 
 /* Creates a vehicle node publishing and subscribing on lcm (not owned). Allocates the node,
- * its one-UAV planner (beta) and its predictor once: about 1.4 MB of node, 1.2 MB of
- * predictor and conflicts at N = 24, and the workspace of coavoid_node_planner_config(N, 1,
- * beta) (1.1 MB at N = 24 and beta 20000). The order search's share of the node is 0.1 MB
- * (each peer's intent of the cycle before, 90 kB, kept in the inbox, which a coordinator's
- * holds too; its problem's UAVs and references, 12 kB), fixed like the rest. Returns NULL
+ * its one-UAV planner and its predictor once: the node's tables, the predictor and
+ * conflicts for N, and the workspace of coavoid_node_planner_config(N + 2, 1, beta) (the
+ * order search looks two steps beyond the horizon; a one-UAV planner's size does not
+ * depend on beta). The order search's share is each peer's intent of the cycle before,
+ * kept in the inbox (a coordinator's holds it too), and its problem's UAVs, references and
+ * rows, fixed like the rest (docs/benchmarks.md has the sizes). Returns NULL
  * on bad config (invalid vehicle, horizon >
  * COAVOID_NODE_MAX_HORIZON, ...: COA_ERR_ARGUMENT, also when LCM refuses a subscription) or
  * out of memory (COA_ERR_WORKSPACE), with *error set (error may be NULL). */
@@ -355,7 +356,8 @@ void coavoid_vehicle_node_destroy(coavoid_vehicle_node_t *node);
  * (coa_predict); decoupled, one more and at most two one-UAV searches of beta
  * expansions, and (without greedy_negotiation) the order search: two predictions, and with a
  * conflict near it one decoupled plan of at most 8 UAVs, or when the order fails at most
- * 120 orders of at most 8 one-UAV searches each. No memory is allocated. */
+ * 120 orders of at most 8 one-UAV searches each, over N and, when one solves, once more
+ * over N + 2 (the look-ahead). No memory is allocated. */
 int coavoid_vehicle_node_cycle(coavoid_vehicle_node_t *node, int64_t now);
 
 /* Completes a decoupled wait once its condition holds at `now` (the intents arrived, or

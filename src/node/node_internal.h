@@ -26,6 +26,13 @@
 _Static_assert(COAVOID_NODE_MAX_SAMPLES == (unsigned)COAVOID_INTENT_T_MAX_SAMPLES &&
                    COAVOID_NODE_MAX_SAMPLES == (unsigned)COAVOID_PLAN_T_MAX_SAMPLES,
                "an intent and a plan carry N + 1 samples of the node's largest horizon");
+/* How many steps beyond the horizon a vehicle's order search looks when it chooses among
+ * the orders that solve the horizon (vehicle.c, look_ahead): enough to tell apart, in
+ * 5-UAV encounter 231 of seed 1, the order whose plan leaves no way on from the one that
+ * does (one step does; two leave a margin). A problem holds up to N + 1 + LOOKAHEAD
+ * samples. */
+#define COAVOID_NODE_LOOKAHEAD 2u
+#define COAVOID_NODE_MAX_PROBLEM_SAMPLES (COAVOID_NODE_MAX_SAMPLES + COAVOID_NODE_LOOKAHEAD)
 
 /* Room for one obstacle map (all its tiles: boxes, then polytopes) and its vertices. */
 #define COAVOID_NODE_MAX_MAP_OBSTACLES COAVOID_LCM_MAP_MAX_OBSTACLES
@@ -215,7 +222,7 @@ typedef struct {
     size_t count;
     coa_track_t tracks[COAVOID_NODE_TRACK_CAPACITY];
     const coa_vec3_t *samples[COAVOID_NODE_TRACK_CAPACITY];
-    coa_vec3_t storage[COAVOID_NODE_TRACK_CAPACITY][COAVOID_NODE_MAX_SAMPLES];
+    coa_vec3_t storage[COAVOID_NODE_TRACK_CAPACITY][COAVOID_NODE_MAX_PROBLEM_SAMPLES];
     coa_track_point_t paths[COAVOID_NODE_MAX_PEERS][COAVOID_NODE_MAX_SAMPLES];
 } coavoid_node_problem_tracks_t;
 
@@ -304,8 +311,9 @@ void coavoid_node_view_build(coavoid_node_view_t *view, const coavoid_node_inbox
 void coavoid_node_view_build_before(coavoid_node_view_t *view, const coavoid_node_inbox_t *in,
                                     int64_t cycle_start, int64_t now, int64_t before);
 
-/* The planning problem of `count` UAVs (vehicles and references[i], horizon + 1 samples
- * each: the caller's, and the problem points to them) around the inbox's obstacles, the
+/* The planning problem of `count` UAVs over `horizon` steps (the common N, or up to
+ * COAVOID_NODE_LOOKAHEAD more; vehicles and references[i], horizon + 1 samples each: the
+ * caller's, and the problem points to them) around the inbox's obstacles, the
  * view's tracks and the live UAVs `include` marks as moving obstacles (tracks, filled in
  * *tracks): what the coordinator plans a cluster in, and a vehicle's order search.
  * Returns COA_OK or COA_ERR_ARGUMENT (a track that cannot be sampled). Cost as
@@ -313,7 +321,7 @@ void coavoid_node_view_build_before(coavoid_node_view_t *view, const coavoid_nod
 int coavoid_node_problem(coa_problem_t *problem, coavoid_node_problem_tracks_t *tracks,
                          const coavoid_node_view_t *view, const bool *include,
                          const coavoid_node_inbox_t *in, const coa_vehicle_t *vehicles,
-                         const coa_vec3_t *const *references, size_t count);
+                         const coa_vec3_t *const *references, size_t count, uint32_t horizon);
 
 /* Whether a outranks b in the decoupled order (ascending priority, ties by ascending id).
  * O(1). */
@@ -326,10 +334,13 @@ bool coavoid_node_precedes(int32_t rank_a, uint32_t priority_a, uint16_t id_a, i
 
 /* Fills out with the planner's tracks: every real and stale track of the view and each
  * live UAV i with include[i] (its positions as a path; exactly its samples when the intent
- * is for this cycle), each sampled over samples 0..N. Returns COA_OK or COA_ERR_ARGUMENT
- * (a track that does not sample). Cost O(tracks * (N + path)). No memory. */
+ * is for this cycle, as far as it reaches, then along its last leg), each sampled over
+ * samples 0..horizon (N, or up to COAVOID_NODE_LOOKAHEAD more). Returns COA_OK or
+ * COA_ERR_ARGUMENT (a track that does not sample, or a horizon beyond that). Cost
+ * O(tracks * (horizon + path)). No memory. */
 int coavoid_node_problem_tracks(coavoid_node_problem_tracks_t *out, const coavoid_node_view_t *view,
-                                const bool *include, const coavoid_node_common_t *c);
+                                const bool *include, const coavoid_node_common_t *c,
+                                uint32_t horizon);
 
 /* The predictor's configuration for one cycle of a node: t = 0 at the cycle's start,
  * the common dt, horizon, sigma rates and threshold. Cannot fail; O(1). */
@@ -350,12 +361,14 @@ int coavoid_node_predict(coa_predictor_t *predictor, const coavoid_node_common_t
  * cannot run out (13,280). O(1). */
 size_t coavoid_node_max_pairs(void);
 
-/* Allocates *s for a horizon of N steps and a planner of `searched` UAVs at beta. Returns
+/* Allocates *s for predictions over N steps (horizon) and a planner of `searched` UAVs at
+ * beta over at most plan_horizon steps (>= horizon: a vehicle's order search looks
+ * further). Returns
  * COA_OK, COA_ERR_ARGUMENT (sizes the core refuses; nothing allocated) or COA_ERR_WORKSPACE
  * (out of memory; nothing kept). Memory: the predictor's and planner's workspaces
  * (coa_predictor_workspace_size, coa_planner_workspace_size) and the conflict array. */
-int coavoid_node_solver_init(coavoid_node_solver_t *s, uint32_t horizon, size_t searched,
-                             uint32_t beta);
+int coavoid_node_solver_init(coavoid_node_solver_t *s, uint32_t horizon, uint32_t plan_horizon,
+                             size_t searched, uint32_t beta);
 
 /* Frees what coavoid_node_solver_init allocated; a zeroed *s is fine. */
 void coavoid_node_solver_fini(coavoid_node_solver_t *s);

@@ -144,9 +144,10 @@ struct coavoid_vehicle_node {
     uint8_t order_kind[COAVOID_NODE_MAX_PEERS];
     size_t order_member[ORDER_MEMBERS_MAX];
     coa_vehicle_t order_vehicles[ORDER_MEMBERS_MAX];
-    coa_vec3_t order_reference[ORDER_MEMBERS_MAX][COAVOID_NODE_MAX_SAMPLES];
+    coa_vec3_t order_reference[ORDER_MEMBERS_MAX][COAVOID_NODE_MAX_PROBLEM_SAMPLES];
     const coa_vec3_t *order_references[ORDER_MEMBERS_MAX];
     int32_t order_offsets[ORDER_MEMBERS_MAX * COAVOID_NODE_MAX_SAMPLES];
+    int32_t ahead_offsets[ORDER_MEMBERS_MAX * COAVOID_NODE_MAX_PROBLEM_SAMPLES]; /* look_ahead */
     int64_t agreed_cycle;
     size_t searched_first; /* first intents of the cycle its last search saw (first_intents) */
     size_t agreed_count;
@@ -371,7 +372,8 @@ static coa_problem_t own_problem(const coavoid_vehicle_node_t *node, coa_vehicle
 static int search_self(coavoid_vehicle_node_t *node, int64_t now, coa_plan_result_t *result)
 {
     const coavoid_node_common_t *c = &node->config.common;
-    int rc = coavoid_node_problem_tracks(&node->problem_tracks, &node->view, node->include, c);
+    int rc = coavoid_node_problem_tracks(&node->problem_tracks, &node->view, node->include, c,
+                                         c->horizon);
     if (rc != COA_OK) {
         return rc;
     }
@@ -1054,12 +1056,14 @@ static size_t order_members(coavoid_vehicle_node_t *node, size_t self)
     return count >= 2u && conflict ? count : 0u;
 }
 
-/* The members' problem: each from the offset its intent of the cycle before flies at the
- * cycle's start, along that intent's reference from there (its last sample, which that
- * intent does not reach, carried on along its last leg: every member extrapolates alike),
- * or in its first cycle from its first intent's offset along its reference; around
+/* The members' problem over `horizon` steps (N, or N + COAVOID_NODE_LOOKAHEAD): each from
+ * the offset its intent of the cycle before flies at the cycle's start, along that
+ * intent's reference from there (past its last sample, which that intent does not reach,
+ * carried on along its last leg: every member extrapolates alike), or in its first cycle
+ * from its first intent's offset along its reference (and past it likewise); around
  * everything else of the view (coavoid_node_problem). Returns its error. */
-static int order_problem(coavoid_vehicle_node_t *node, size_t count, coa_problem_t *problem)
+static int order_problem(coavoid_vehicle_node_t *node, size_t count, uint32_t horizon,
+                         coa_problem_t *problem)
 {
     const uint32_t n = node->config.common.horizon;
     const coavoid_node_view_t *view = &node->view;
@@ -1073,18 +1077,28 @@ static int order_problem(coavoid_vehicle_node_t *node, size_t count, coa_problem
         node->include[i] = false;
         node->order_vehicles[m] = view->live_vehicle[i];
         node->order_references[m] = r;
+        uint32_t known = n + 1u; /* samples of r taken from the intent */
         if (node->order_kind[i] == SNAPSHOT_FIRST) {
-            memcpy(r, a->reference, ((size_t)n + 1u) * sizeof r[0]); /* of this cycle */
-            continue;
+            memcpy(r, a->reference, known * sizeof r[0]); /* of this cycle */
+        } else {
+            node->order_vehicles[m].initial_offset = a->offsets[1];
+            known = n;
+            memcpy(r, &a->reference[1], known * sizeof r[0]);
         }
-        node->order_vehicles[m].initial_offset = a->offsets[1];
-        memcpy(r, &a->reference[1], n * sizeof r[0]);
-        r[n].x = a->reference[n].x + (a->reference[n].x - a->reference[n - 1u].x);
-        r[n].y = a->reference[n].y + (a->reference[n].y - a->reference[n - 1u].y);
-        r[n].z = a->reference[n].z + (a->reference[n].z - a->reference[n - 1u].z);
+        /* r[k] is the intent's sample k + shift; past its last, n, along its last leg. */
+        const uint32_t shift = n + 1u - known;
+        const coa_vec3_t last = a->reference[n];
+        const coa_vec3_t leg = {last.x - a->reference[n - 1u].x, last.y - a->reference[n - 1u].y,
+                                last.z - a->reference[n - 1u].z};
+        for (uint32_t k = known; k <= horizon; k++) {
+            const coa_real_t j = (coa_real_t)(k + shift - n);
+            r[k].x = last.x + j * leg.x;
+            r[k].y = last.y + j * leg.y;
+            r[k].z = last.z + j * leg.z;
+        }
     }
     return coavoid_node_problem(problem, &node->problem_tracks, view, node->include, &node->inbox,
-                                node->order_vehicles, node->order_references, count);
+                                node->order_vehicles, node->order_references, count, horizon);
 }
 
 /* The members' decoupled order as the intents of the cycle's start announce it (rank,
@@ -1151,6 +1165,41 @@ static void order_withdraw(coavoid_vehicle_node_t *node)
     }
 }
 
+/* The order search found an order that solves the horizon (*result, rows in
+ * order_offsets); the first order that solves it does not know what comes after, and its
+ * plan may leave the fleet no way on a step later where another order's would (5-UAV
+ * encounter 231 of seed 1). So it looks COAVOID_NODE_LOOKAHEAD steps further, each member
+ * and track carried on along its last leg: when that order also solves the longer
+ * horizon, nothing changes; otherwise the first order that does (tried from that one, as
+ * coa_plan_decoupled tries them) replaces it, its rows cut to the horizon. When none
+ * does, the order stays. Every member looks alike, so they still agree. Returns COA_OK
+ * or an error of the search. Cost: at most one more search of the order over N +
+ * COAVOID_NODE_LOOKAHEAD steps (search_order's). Memory: ahead_offsets. */
+static int look_ahead(coavoid_vehicle_node_t *node, size_t count, coa_plan_result_t *result)
+{
+    const uint32_t n = node->config.common.horizon;
+    const uint32_t far = n + COAVOID_NODE_LOOKAHEAD;
+    coa_problem_t problem;
+    int rc = order_problem(node, count, far, &problem);
+    if (rc != COA_OK) {
+        return rc;
+    }
+    size_t order[ORDER_MEMBERS_MAX];
+    memcpy(order, result->order, count * sizeof order[0]);
+    coa_plan_result_t ahead;
+    rc = coa_plan_decoupled(node->solver.planner, &problem, order, ORDER_TRIES_MAX,
+                            node->ahead_offsets, &ahead);
+    if (rc != COA_OK || ahead.status != COA_PLAN_SOLVED || ahead.orders_tried <= 1u) {
+        return rc; /* the order holds beyond the horizon, or no order does */
+    }
+    for (size_t m = 0; m < count; m++) {
+        memcpy(&node->order_offsets[m * (n + 1u)], &node->ahead_offsets[m * (far + 1u)],
+               ((size_t)n + 1u) * sizeof node->order_offsets[0]);
+    }
+    *result = ahead;
+    return COA_OK;
+}
+
 /* The order search, at the start of a decoupled cycle and again within it (decide_own,
  * search_again). From the intents as they stood when the cycle began (snapshot: each
  * UAV's last of the cycle before, its own included, whatever came since), it predicts, and
@@ -1178,7 +1227,7 @@ static int search_order(coavoid_vehicle_node_t *node)
         return COA_OK;
     }
     coa_problem_t problem;
-    int rc = order_problem(node, count, &problem);
+    int rc = order_problem(node, count, node->config.common.horizon, &problem);
     if (rc != COA_OK) {
         return rc;
     }
@@ -1195,6 +1244,11 @@ static int search_order(coavoid_vehicle_node_t *node)
     if (result.status != COA_PLAN_SOLVED) {
         order_withdraw(node);
         return 0;
+    }
+    rc = look_ahead(node, count, &result);
+    if (rc != COA_OK) {
+        order_withdraw(node);
+        return rc;
     }
     order_agree(node, count, result.order, self);
     return 1;
@@ -1535,7 +1589,8 @@ static int plan_hits_known(coavoid_vehicle_node_t *node, const int32_t *offsets,
                 apply_row(node, i);
             }
         }
-        int rc = coavoid_node_problem_tracks(&node->problem_tracks, &node->view, node->include, c);
+        int rc = coavoid_node_problem_tracks(&node->problem_tracks, &node->view, node->include, c,
+                                             c->horizon);
         if (rc != COA_OK) {
             return rc;
         }
@@ -1818,7 +1873,8 @@ coavoid_vehicle_node_t *coavoid_vehicle_node_create(const coavoid_vehicle_node_c
     }
     const coavoid_node_common_t *c = &config->common;
     coavoid_node_solver_t solver;
-    int rc = coavoid_node_solver_init(&solver, c->horizon, 1u, c->beta);
+    int rc = coavoid_node_solver_init(&solver, c->horizon, c->horizon + COAVOID_NODE_LOOKAHEAD, 1u,
+                                      c->beta);
     if (rc != COA_OK) {
         *error = rc;
         return NULL;
