@@ -1184,10 +1184,8 @@ static int look_ahead(coavoid_vehicle_node_t *node, size_t count, coa_plan_resul
     if (rc != COA_OK) {
         return rc;
     }
-    size_t order[ORDER_MEMBERS_MAX];
-    memcpy(order, result->order, count * sizeof order[0]);
     coa_plan_result_t ahead;
-    rc = coa_plan_decoupled(node->solver.planner, &problem, order, ORDER_TRIES_MAX,
+    rc = coa_plan_decoupled(node->solver.planner, &problem, result->order, ORDER_TRIES_MAX,
                             node->ahead_offsets, &ahead);
     if (rc != COA_OK || ahead.status != COA_PLAN_SOLVED || ahead.orders_tried <= 1u) {
         return rc; /* the order holds beyond the horizon, or no order does */
@@ -1766,9 +1764,9 @@ static void on_plan(void *owner, const coavoid_plan_t *msg, const coavoid_lcm_pl
         msg->valid_from_utime == node->cycle_start && now < msg->valid_until_utime) {
         /* The coordinator tried this cycle and found nothing: that answers the cycle for
          * update_trust (a UAV told so is not unanswered at its end), and it may still send
-         * a larger plan that includes it. A UAV that holds neither that nor a plan of its own by the answer
-         * wait plans for itself all the same: the coordinator may have stopped right
-         * after the notice, and flying on into a conflict answers nothing. */
+         * a larger plan that includes it. A UAV that holds neither that nor a plan of its
+         * own by the answer wait plans for itself all the same: the coordinator may have
+         * stopped right after the notice, and flying on into a conflict answers nothing. */
         node->cycle_plan_failed = true;
     }
     if (result->status == COA_PLAN_SOLVED && node->started &&
