@@ -619,6 +619,24 @@ START_TEST(test_first_cycle_track_copies)
 }
 END_TEST
 
+/* Encounter 7 of 2 UAVs (montecarlo, seed 1; both orders solve it): with 1 ms of network
+ * delay UAV 1, first in the order, decided at t = 0 before the track's first estimate came
+ * and met the track over step 1. A UAV decides again when a track it held nothing of, or a
+ * new obstacle map, comes after it decided (lost with that rule removed). */
+START_TEST(test_first_cycle_track_heard_late)
+{
+    coavoid_sim_config_t c;
+    memset(&c, 0, sizeof c);
+    c.scenario_path = COAVOID_TEST_ENCOUNTERS "/track_heard_late_7.json";
+    c.mode = "decoupled";
+    c.decoupled = true;
+    c.delay = 0.001;
+    c.json = true;
+    fly_config(&c, &scripted);
+    ck_assert_int_eq(scripted.verdict, COAVOID_SIM_SEPARATED);
+}
+END_TEST
+
 static Suite *protocol_suite(void)
 {
     Suite *suite = suite_create("protocol");
@@ -646,6 +664,7 @@ static Suite *protocol_suite(void)
     tcase_add_test(first, test_first_cycle_decides_again_on_a_new_first_plan);
     tcase_add_test(first, test_first_cycle_keeps_clear_of_earlier_only);
     tcase_add_test(first, test_first_cycle_track_copies);
+    tcase_add_test(first, test_first_cycle_track_heard_late);
     suite_add_tcase(suite, first);
     return suite;
 }

@@ -388,6 +388,7 @@ static void on_track(const lcm_recv_buf_t *rbuf, const char *channel, void *user
         return;
     }
     senders_heard(&in->track_seq, (uint32_t)msg->source_id, now);
+    in->world_news += in->tracks[slot].used ? 0u : 1u;
     in->tracks[slot].used = true;
     in->tracks[slot].msg = *msg;
 }
@@ -481,6 +482,7 @@ static int map_tile_keep(coavoid_node_inbox_t *in, const coavoid_obstacle_map_t 
     in->map_id = msg->map_id;
     in->map_version = msg->version;
     in->have_map = true;
+    in->world_news++;
     obstacles_merge(in);
     return COA_OK;
 }
@@ -707,6 +709,7 @@ int coavoid_node_inbox_init(coavoid_node_inbox_t *in, const coavoid_node_common_
     in->map_version = 0;
     in->map_tiles_have = 0u;
     in->map_obstacle_count = 0;
+    in->world_news = 0u;
     coavoid_lcm_plan_rows_init(&in->plan_rows, in->plan_slots, COAVOID_NODE_PLAN_SLOTS);
     obstacles_merge(in);
     memset(in->own_hash, 0, sizeof in->own_hash);

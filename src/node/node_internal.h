@@ -162,6 +162,11 @@ struct coavoid_node_inbox {
 
     int64_t rejected_at_heartbeat; /* rx->rejected when the last heartbeat was sent */
 
+    /* Counts the tracks it took in while holding none of theirs, and the obstacle maps it
+     * put in use (wraps): what it knows of the world grew when it changed, which a vehicle
+     * that decided before then decides again on (vehicle.c, reconsider). */
+    uint32_t world_news;
+
     bool heard_coordinator;    /* a coordinator's status_t was received */
     int64_t coordinator_utime; /* when (driver clock) */
 

@@ -84,6 +84,9 @@ struct coavoid_vehicle_node {
     uint16_t decided_id[COAVOID_NODE_MAX_PEERS];
     int64_t decided_sequence[COAVOID_NODE_MAX_PEERS];
     uint32_t decided_digest[COAVOID_NODE_MAX_PEERS]; /* intent_digest of what it decided on */
+    uint32_t decided_news; /* the inbox's world_news when it last decided */
+    int64_t decided_cycle; /* the cycle it last decided in (note_order) */
+    int64_t news_cycle;    /* the last cycle it decided again on world news (reconsider) */
     int64_t redecided_cycle;
     uint32_t redecisions;
     /* The other UAVs' rows in this cycle's solved plans (the latest plan_id each): what
@@ -773,18 +776,21 @@ static void note_order(coavoid_vehicle_node_t *node)
 {
     const coavoid_node_view_t *view = &node->view;
     const bool centralised = node->config.mode == COAVOID_NODE_CENTRALISED;
+    const bool news = node->news_cycle == node->state.cycle;
     node->decided_count = 0;
+    node->decided_news = node->inbox.world_news;
+    node->decided_cycle = node->state.cycle;
     for (size_t i = 0; i < view->live_count; i++) {
         if (!peer_first(node, i)) {
             continue;
         }
-        /* Only overtaken()'s answered peers (UAVs started centralised) and newcomers use
-         * the digest. */
+        /* Only overtaken()'s answered peers (UAVs started centralised), newcomers and, in a
+         * cycle with world news, every UAV before it use the digest. */
         uint32_t digest = 0;
         for (size_t p = 0; p < COAVOID_NODE_MAX_PEERS; p++) {
             const coavoid_intent_t *m = &node->inbox.peers[p].msg;
             if (node->inbox.peers[p].used && (uint16_t)m->uav_id == view->live_id[i]) {
-                const bool digested = centralised || newcomer(node, &node->inbox.peers[p]);
+                const bool digested = centralised || news || newcomer(node, &node->inbox.peers[p]);
                 digest = digested ? intent_digest(m) : 0u;
                 break; /* one slot per UAV */
             }
@@ -818,13 +824,16 @@ static int32_t agreed_rank_of(const coavoid_vehicle_node_t *node, uint16_t id)
  * happens (each decides after the UAVs before it published, on all of theirs). Started
  * centralised, it also decides again on a UAV before it that answered its own conflict
  * at the answer wait (rank 0, mode decoupled) with another plan than the one it decided on
- * (intent_digest: a copy is not another plan). O(peers^2 + peers * samples). */
+ * (intent_digest: a copy is not another plan). In a cycle it decided again on world news
+ * (reconsider), so do the UAVs before it, with another plan too. O(peers^2 + peers *
+ * samples). */
 static bool overtaken(const coavoid_vehicle_node_t *node)
 {
     const coa_vehicle_t *self = &node->config.vehicle;
+    const bool news = node->news_cycle == node->state.cycle;
     for (size_t i = 0; i < COAVOID_NODE_MAX_PEERS; i++) {
         const coavoid_intent_t *m = &node->inbox.peers[i].msg;
-        const bool first = m->rank <= 0 && newcomer(node, &node->inbox.peers[i]);
+        const bool first = m->rank <= 0 && (newcomer(node, &node->inbox.peers[i]) || news);
         const bool answered = node->config.mode == COAVOID_NODE_CENTRALISED && m->rank <= 0 &&
                               m->mode == COAVOID_INTENT_T_MODE_DECOUPLED;
         if (!node->inbox.peers[i].used || m->plan_utime != node->cycle_start ||
@@ -1451,11 +1460,23 @@ static int search_again(coavoid_vehicle_node_t *node, int64_t now)
     return found == 1 ? fly_agreed(node, now) : decide(node, now);
 }
 
+/* Whether a track it held nothing of, or a new obstacle map, came since it decided in this
+ * cycle on its own (not a standby, nor a coordinator's plan it switched to): what it
+ * decided on lacked it. In its first cycle every node starts at once, so a UAV first in
+ * its order decides before the world's first estimates reach it whenever the network has
+ * any latency. O(1). */
+static bool world_news(const coavoid_vehicle_node_t *node)
+{
+    return node->decided_cycle == node->state.cycle && !node->cycle_plan_adopted &&
+           !node->standby_held && node->inbox.world_news != node->decided_news;
+}
+
 /* After it published this cycle's intent on its own decision: when it has been overtaken
- * (overtaken()), it decides again at once, waiting as before (until the cycle's priority
- * wait ends) and publishing its intent again, at most REDECISIONS_MAX times a cycle, so
- * that a raise reorders its cluster within the cycle it is made in rather than the next.
- * Returns as decide, 0 when there is nothing to do. */
+ * (overtaken()) or the world it knows grew since (world_news()), it decides again at
+ * once, waiting as before (until the cycle's priority wait ends) and publishing its intent
+ * again, at most REDECISIONS_MAX times a cycle, so that a raise reorders its cluster, and
+ * a track heard late is avoided, within the cycle rather than the next. Returns as
+ * decide, 0 when there is nothing to do. */
 static int reconsider(coavoid_vehicle_node_t *node, int64_t now)
 {
     if (!node->started || node->state.coordinated || !node->state.published) {
@@ -1471,10 +1492,12 @@ static int reconsider(coavoid_vehicle_node_t *node, int64_t now)
             return again;
         }
     }
-    if (node->redecisions >= REDECISIONS_MAX || !overtaken(node)) {
+    const bool news = world_news(node);
+    if (node->redecisions >= REDECISIONS_MAX || !(news || overtaken(node))) {
         return 0;
     }
     node->redecisions++;
+    node->news_cycle = news ? node->state.cycle : node->news_cycle;
     return decide_own(node, now);
 }
 
@@ -1893,7 +1916,7 @@ coavoid_vehicle_node_t *coavoid_vehicle_node_create(const coavoid_vehicle_node_c
     node->plan_offsets[0] = node->config.vehicle.initial_offset;
     node->state.cycle = -1;
     node->settled_cycle = -1;
-    node->redecided_cycle = node->agreed_cycle = -1;
+    node->redecided_cycle = node->agreed_cycle = node->news_cycle = node->decided_cycle = -1;
     node->state.offset = node->config.vehicle.initial_offset;
     node->state.last_outcome = -1;
     node->wait_deadline = INT64_MAX;
