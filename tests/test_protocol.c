@@ -344,6 +344,31 @@ START_TEST(test_coordinator_gone_after_proposal)
 }
 END_TEST
 
+/* Encounter 209 of 2 UAVs (montecarlo, seed 1), with 1 ms of network delay and the
+ * coordinator gone after the first 3 messages of cycle 0 (its plan, whole, and no COMMIT):
+ * its rows came 1 ms after the coordinator's collect, so the self-commit was due 1 ms
+ * after the answer wait. Both UAVs held the plan undecided, dropped it at the cycle's end,
+ * and UAV 1 met a track at t = 2 s. Each now commits the plan itself when it is due,
+ * within the cycle (lost, with both in doubt, without that second look). */
+START_TEST(test_self_commit_due_after_the_answer_wait)
+{
+    coavoid_sim_config_t c;
+    memset(&c, 0, sizeof c);
+    c.scenario_path = COAVOID_TEST_ENCOUNTERS "/self_commit_late_209.json";
+    c.mode = "centralised";
+    c.has_stop = true;
+    c.stop_step = 0;
+    c.has_stop_messages = true;
+    c.stop_messages = 3;
+    c.delay = 0.001;
+    c.json = true;
+    fly_config(&c, &scripted);
+    ck_assert_int_eq(scripted.verdict, COAVOID_SIM_SEPARATED);
+    ck_assert_uint_eq(scripted.outcome.plans_in_doubt, 0);
+    ck_assert_uint_eq(scripted.outcome.plans_switched, 2);
+}
+END_TEST
+
 START_TEST(test_coordinator_gone_after_one_commit)
 {
     script_t s = run(SCRIPT_GONE_AFTER_ONE_COMMIT);
@@ -649,6 +674,7 @@ static Suite *protocol_suite(void)
     tcase_add_test(tc, test_answers_never_arrive);
     tcase_add_test(tc, test_coordinator_gone_after_proposal);
     tcase_add_test(tc, test_coordinator_gone_after_one_commit);
+    tcase_add_test(tc, test_self_commit_due_after_the_answer_wait);
     tcase_add_test(tc, test_standby_when_an_accept_is_unheard);
     tcase_add_test(tc, test_failure_notice_then_gone);
     suite_add_tcase(suite, tc);

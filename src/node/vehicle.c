@@ -53,6 +53,10 @@ struct coavoid_vehicle_node {
      * within the cycle (answer_overdue), and whether that check has run this cycle. */
     int64_t answer_deadline;
     bool answer_checked;
+    /* When answer_overdue found the held plan's self-commit not yet due: when it is
+     * (INT64_MAX: none), and for which plan. */
+    int64_t self_commit_at;
+    int64_t self_commit_plan;
     bool answering;     /* deciding for itself since the answer wait of this cycle */
     bool self_answered; /* it answered its own conflict in the cycle before (distrust) */
     bool was_coordinated;
@@ -1326,6 +1330,21 @@ static void distrust_from(coavoid_vehicle_node_t *node, int64_t k, int64_t now)
     node->distrust_utime = now;
 }
 
+/* Every UAV of the plan it holds holds it and said so, and no decision came by the
+ * coordinator's ack timeout (dt / 4 by default) after it accepted, plus four resends (an
+ * ABORT goes out with four copies): a coordinator that heard those answers would have
+ * committed, so it stopped, or every copy of its decision was lost. It commits as the
+ * coordinator would: it switches and says SWITCHED, which its siblings take as the
+ * commit. Returns 1 (it published). */
+static int self_commit(coavoid_vehicle_node_t *node, int64_t now)
+{
+    node->self_commit_at = INT64_MAX;
+    node->state.plans_self_committed++;
+    switch_to_pending(node, now);
+    node->state.coordinated = false;
+    return 1;
+}
+
 /* Following its coordinator, answer_wait_us into the cycle, with a conflict of its own and
  * no plan of the coordinator's adopted (told that a search failed for it or not): it plans
  * for itself in this cycle and announces it. Holding no plan, it accepted none, so no
@@ -1367,17 +1386,13 @@ static int answer_overdue(coavoid_vehicle_node_t *node, int64_t now)
     const int64_t decided_by =
         node->pending_since + node->config.common.dt_us / 4 + 4 * node->config.resend_us;
     if (all_accepted(node) && now >= decided_by) {
-        /* Every UAV of the plan holds it and said so, and no decision came by the
-         * coordinator's ack timeout (dt / 4 by default) after it accepted, plus four
-         * resends (an ABORT goes out with four copies): a coordinator that heard those
-         * answers would have committed, so it stopped, or every copy of its decision was
-         * lost. It commits as the coordinator would: it switches and says SWITCHED, which
-         * its siblings take as the commit. */
-        node->state.plans_self_committed++;
-        switch_to_pending(node, now);
-        node->state.coordinated = false;
-        return 1;
+        return self_commit(node, now);
     }
+    /* Not yet due (the rows came after the coordinator's collect: delayed, or sent
+     * again): it commits when it is, within the cycle, if every UAV has accepted by then;
+     * meanwhile it holds a standby as any UAV whose plan is undecided. */
+    node->self_commit_at = decided_by;
+    node->self_commit_plan = node->pending_plan_id;
     bool planned = false;
     rc = standby(node, now, &planned);
     if (rc == COA_OK && planned) {
@@ -1917,6 +1932,7 @@ coavoid_vehicle_node_t *coavoid_vehicle_node_create(const coavoid_vehicle_node_c
     node->state.cycle = -1;
     node->settled_cycle = -1;
     node->redecided_cycle = node->agreed_cycle = node->news_cycle = node->decided_cycle = -1;
+    node->self_commit_at = INT64_MAX;
     node->state.offset = node->config.vehicle.initial_offset;
     node->state.last_outcome = -1;
     node->wait_deadline = INT64_MAX;
@@ -2077,6 +2093,7 @@ int coavoid_vehicle_node_cycle(coavoid_vehicle_node_t *node, int64_t now)
 
     int rc;
     node->answer_checked = false;
+    node->self_commit_at = INT64_MAX;
     node->answering = false;
     node->answer_deadline = node->cycle_start + node->config.answer_wait_us;
     if (coordinated) {
@@ -2119,6 +2136,13 @@ int coavoid_vehicle_node_poll(coavoid_vehicle_node_t *node, int64_t now)
         return 0; /* copies belong to their cycle */
     }
     int sent = send_copies(node, now);
+    if (now >= node->self_commit_at) {
+        node->self_commit_at = INT64_MAX;
+        if (node->pending && node->pending_plan_id == node->self_commit_plan &&
+            all_accepted(node)) {
+            return self_commit(node, now);
+        }
+    }
     if (node->state.coordinated && !node->answer_checked && now >= node->answer_deadline) {
         int overdue = answer_overdue(node, now);
         if (overdue != 0) {
@@ -2146,6 +2170,7 @@ int64_t coavoid_vehicle_node_deadline(const coavoid_vehicle_node_t *node)
     if (node->state.coordinated && !node->answer_checked && node->answer_deadline < deadline) {
         deadline = node->answer_deadline;
     }
+    deadline = node->self_commit_at < deadline ? node->self_commit_at : deadline;
     if (node->intent_copies_left > 0u && node->state.published && node->intent_copy_at < end) {
         deadline = node->intent_copy_at < deadline ? node->intent_copy_at : deadline;
     }
