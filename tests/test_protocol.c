@@ -252,6 +252,23 @@ static void fly_config(const coavoid_sim_config_t *c, flight_t *f)
     ck_assert(!f->outcome.loss_of_separation);
 }
 
+/* Flies an encounter with every message 1 ms late: decoupled, or centralised with the
+ * coordinator gone after its first `stop` messages of cycle 0. */
+static void fly_late(const char *path, bool decoupled, uint32_t stop, flight_t *f)
+{
+    coavoid_sim_config_t c;
+    memset(&c, 0, sizeof c);
+    c.scenario_path = path;
+    c.mode = decoupled ? "decoupled" : "centralised";
+    c.decoupled = decoupled;
+    c.has_stop = !decoupled;
+    c.has_stop_messages = !decoupled;
+    c.stop_messages = stop;
+    c.delay = 0.001;
+    c.json = true;
+    fly_config(&c, f);
+}
+
 /* Flies paper.json centralised under the script. */
 static void fly(script_t *s, flight_t *f)
 {
@@ -352,17 +369,7 @@ END_TEST
  * within the cycle (lost, with both in doubt, without that second look). */
 START_TEST(test_self_commit_due_after_the_answer_wait)
 {
-    coavoid_sim_config_t c;
-    memset(&c, 0, sizeof c);
-    c.scenario_path = COAVOID_TEST_ENCOUNTERS "/self_commit_late_209.json";
-    c.mode = "centralised";
-    c.has_stop = true;
-    c.stop_step = 0;
-    c.has_stop_messages = true;
-    c.stop_messages = 3;
-    c.delay = 0.001;
-    c.json = true;
-    fly_config(&c, &scripted);
+    fly_late(COAVOID_TEST_ENCOUNTERS "/self_commit_late_209.json", false, 3u, &scripted);
     ck_assert_int_eq(scripted.verdict, COAVOID_SIM_SEPARATED);
     ck_assert_uint_eq(scripted.outcome.plans_in_doubt, 0);
     ck_assert_uint_eq(scripted.outcome.plans_switched, 2);
@@ -650,14 +657,7 @@ END_TEST
  * new obstacle map, comes after it decided (lost with that rule removed). */
 START_TEST(test_first_cycle_track_heard_late)
 {
-    coavoid_sim_config_t c;
-    memset(&c, 0, sizeof c);
-    c.scenario_path = COAVOID_TEST_ENCOUNTERS "/track_heard_late_7.json";
-    c.mode = "decoupled";
-    c.decoupled = true;
-    c.delay = 0.001;
-    c.json = true;
-    fly_config(&c, &scripted);
+    fly_late(COAVOID_TEST_ENCOUNTERS "/track_heard_late_7.json", true, 0u, &scripted);
     ck_assert_int_eq(scripted.verdict, COAVOID_SIM_SEPARATED);
 }
 END_TEST
