@@ -1338,7 +1338,6 @@ static void distrust_from(coavoid_vehicle_node_t *node, int64_t k, int64_t now)
  * commit. Returns 1 (it published). */
 static int self_commit(coavoid_vehicle_node_t *node, int64_t now)
 {
-    node->self_commit_at = INT64_MAX;
     node->state.plans_self_committed++;
     switch_to_pending(node, now);
     node->state.coordinated = false;
