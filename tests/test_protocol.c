@@ -376,6 +376,21 @@ START_TEST(test_self_commit_due_after_the_answer_wait)
 }
 END_TEST
 
+/* Encounter 34 of 4 UAVs (montecarlo, seed 1), 1 ms of delay, the coordinator gone after
+ * the first 5 messages of cycle 0 (its plan of all four, and no COMMIT): each UAV commits
+ * the plan itself when due, which leaves it following no one. It then looked at its
+ * decision again as a UAV that planned for itself does, found itself overtaken, and
+ * planned its own way out of the joint plan its siblings fly: UAVs 1 and 4 met at
+ * t = 2 s. A plan committed this cycle is flown as committed. */
+START_TEST(test_self_committed_plan_is_flown)
+{
+    fly_late(COAVOID_TEST_ENCOUNTERS "/self_commit_flown_34.json", false, 5u, &scripted);
+    ck_assert_int_eq(scripted.verdict, COAVOID_SIM_SEPARATED);
+    ck_assert_uint_eq(scripted.outcome.plans_in_doubt, 0);
+    ck_assert_uint_eq(scripted.outcome.plans_switched, 4);
+}
+END_TEST
+
 START_TEST(test_coordinator_gone_after_one_commit)
 {
     script_t s = run(SCRIPT_GONE_AFTER_ONE_COMMIT);
@@ -675,6 +690,7 @@ static Suite *protocol_suite(void)
     tcase_add_test(tc, test_coordinator_gone_after_proposal);
     tcase_add_test(tc, test_coordinator_gone_after_one_commit);
     tcase_add_test(tc, test_self_commit_due_after_the_answer_wait);
+    tcase_add_test(tc, test_self_committed_plan_is_flown);
     tcase_add_test(tc, test_standby_when_an_accept_is_unheard);
     tcase_add_test(tc, test_failure_notice_then_gone);
     suite_add_tcase(suite, tc);

@@ -1493,8 +1493,9 @@ static bool world_news(const coavoid_vehicle_node_t *node)
  * decide, 0 when there is nothing to do. */
 static int reconsider(coavoid_vehicle_node_t *node, int64_t now)
 {
-    if (!node->started || node->state.coordinated || !node->state.published) {
-        return 0;
+    if (!node->started || node->state.coordinated || !node->state.published ||
+        node->cycle_plan_adopted) {
+        return 0; /* a coordinator's plan it switched to is flown by every sibling too */
     }
     if (node->redecided_cycle != node->state.cycle) {
         node->redecided_cycle = node->state.cycle;
