@@ -1182,24 +1182,22 @@ static void order_withdraw(coavoid_vehicle_node_t *node)
  * order_offsets); the first order that solves it does not know what comes after, and its
  * plan may leave the fleet no way on a step later where another order's would (5-UAV
  * encounter 231 of seed 1). So it looks COAVOID_NODE_LOOKAHEAD steps further, each member
- * and track carried on along its last leg: when that order also solves the longer
+ * and track carried on along its last leg (*problem, built that far and searched so far
+ * over N: its first N + 1 samples are the same): when that order also solves the longer
  * horizon, nothing changes; otherwise the first order that does (tried from that one, as
  * coa_plan_decoupled tries them) replaces it, its rows cut to the horizon. When none
  * does, the order stays. Every member looks alike, so they still agree. Returns COA_OK
  * or an error of the search. Cost: at most one more search of the order over N +
  * COAVOID_NODE_LOOKAHEAD steps (search_order's). Memory: ahead_offsets. */
-static int look_ahead(coavoid_vehicle_node_t *node, size_t count, coa_plan_result_t *result)
+static int look_ahead(coavoid_vehicle_node_t *node, size_t count, coa_problem_t *problem,
+                      coa_plan_result_t *result)
 {
     const uint32_t n = node->config.common.horizon;
     const uint32_t far = n + COAVOID_NODE_LOOKAHEAD;
-    coa_problem_t problem;
-    int rc = order_problem(node, count, far, &problem);
-    if (rc != COA_OK) {
-        return rc;
-    }
+    problem->horizon = far;
     coa_plan_result_t ahead;
-    rc = coa_plan_decoupled(node->solver.planner, &problem, result->order, ORDER_TRIES_MAX,
-                            node->ahead_offsets, &ahead);
+    int rc = coa_plan_decoupled(node->solver.planner, problem, result->order, ORDER_TRIES_MAX,
+                                node->ahead_offsets, &ahead);
     if (rc != COA_OK || ahead.status != COA_PLAN_SOLVED || ahead.orders_tried <= 1u) {
         return rc; /* the order holds beyond the horizon, or no order does */
     }
@@ -1237,11 +1235,14 @@ static int search_order(coavoid_vehicle_node_t *node)
         order_withdraw(node);
         return COA_OK;
     }
+    /* Built once as far as the look-ahead reaches; searched over N first. */
     coa_problem_t problem;
-    int rc = order_problem(node, count, node->config.common.horizon, &problem);
+    int rc =
+        order_problem(node, count, node->config.common.horizon + COAVOID_NODE_LOOKAHEAD, &problem);
     if (rc != COA_OK) {
         return rc;
     }
+    problem.horizon = node->config.common.horizon;
     size_t order[ORDER_MEMBERS_MAX];
     order_current(node, count, order);
     coa_plan_result_t result;
@@ -1256,7 +1257,7 @@ static int search_order(coavoid_vehicle_node_t *node)
         order_withdraw(node);
         return 0;
     }
-    rc = look_ahead(node, count, &result);
+    rc = look_ahead(node, count, &problem, &result);
     if (rc != COA_OK) {
         order_withdraw(node);
         return rc;
