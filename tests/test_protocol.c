@@ -361,6 +361,17 @@ START_TEST(test_coordinator_gone_after_proposal)
 }
 END_TEST
 
+/* Flies an encounter centralised with 1 ms of delay, the coordinator gone after its first
+ * `stop` messages (its first plan, whole, and no COMMIT): every one of its `uavs` UAVs
+ * commits the plan itself, none is in doubt, and separation is kept. */
+static void fly_self_committed(const char *path, uint32_t stop, uint32_t uavs)
+{
+    fly_late(path, false, stop, &scripted);
+    ck_assert_int_eq(scripted.verdict, COAVOID_SIM_SEPARATED);
+    ck_assert_uint_eq(scripted.outcome.plans_in_doubt, 0);
+    ck_assert_uint_eq(scripted.outcome.plans_switched, uavs);
+}
+
 /* Encounter 209 of 2 UAVs (montecarlo, seed 1), with 1 ms of network delay and the
  * coordinator gone after the first 3 messages of cycle 0 (its plan, whole, and no COMMIT):
  * its rows came 1 ms after the coordinator's collect, so the self-commit was due 1 ms
@@ -369,10 +380,7 @@ END_TEST
  * within the cycle (lost, with both in doubt, without that second look). */
 START_TEST(test_self_commit_due_after_the_answer_wait)
 {
-    fly_late(COAVOID_TEST_ENCOUNTERS "/self_commit_late_209.json", false, 3u, &scripted);
-    ck_assert_int_eq(scripted.verdict, COAVOID_SIM_SEPARATED);
-    ck_assert_uint_eq(scripted.outcome.plans_in_doubt, 0);
-    ck_assert_uint_eq(scripted.outcome.plans_switched, 2);
+    fly_self_committed(COAVOID_TEST_ENCOUNTERS "/self_commit_late_209.json", 3u, 2u);
 }
 END_TEST
 
@@ -384,10 +392,7 @@ END_TEST
  * t = 2 s. A plan committed this cycle is flown as committed. */
 START_TEST(test_self_committed_plan_is_flown)
 {
-    fly_late(COAVOID_TEST_ENCOUNTERS "/self_commit_flown_34.json", false, 5u, &scripted);
-    ck_assert_int_eq(scripted.verdict, COAVOID_SIM_SEPARATED);
-    ck_assert_uint_eq(scripted.outcome.plans_in_doubt, 0);
-    ck_assert_uint_eq(scripted.outcome.plans_switched, 4);
+    fly_self_committed(COAVOID_TEST_ENCOUNTERS "/self_commit_flown_34.json", 5u, 4u);
 }
 END_TEST
 
