@@ -1069,8 +1069,9 @@ static size_t order_members(coavoid_vehicle_node_t *node, size_t self)
     return count >= 2u && conflict ? count : 0u;
 }
 
-/* The members' problem over `horizon` steps (N, or N + COAVOID_NODE_LOOKAHEAD): each from
- * the offset its intent of the cycle before flies at the cycle's start, along that
+/* The members' problem over `horizon` steps (N + COAVOID_NODE_LOOKAHEAD: search_order
+ * searches it over N first, look_ahead whole): each from the offset its intent of the
+ * cycle before flies at the cycle's start, along that
  * intent's reference from there (past its last sample, which that intent does not reach,
  * carried on along its last leg: every member extrapolates alike), or in its first cycle
  * from its first intent's offset along its reference (and past it likewise); around
@@ -1486,7 +1487,8 @@ static bool world_news(const coavoid_vehicle_node_t *node)
            !node->standby_held && node->inbox.world_news != node->decided_news;
 }
 
-/* After it published this cycle's intent on its own decision: when it has been overtaken
+/* After it published this cycle's intent on its own decision (not a coordinator's plan
+ * it switched to in the cycle, which its siblings fly too): when it has been overtaken
  * (overtaken()) or the world it knows grew since (world_news()), it decides again at
  * once, waiting as before (until the cycle's priority wait ends) and publishing its intent
  * again, at most REDECISIONS_MAX times a cycle, so that a raise reorders its cluster, and
