@@ -1477,14 +1477,14 @@ static int search_again(coavoid_vehicle_node_t *node, int64_t now)
 }
 
 /* Whether a track it held nothing of, or a new obstacle map, came since it decided in this
- * cycle on its own (not a standby, nor a coordinator's plan it switched to): what it
- * decided on lacked it. In its first cycle every node starts at once, so a UAV first in
- * its order decides before the world's first estimates reach it whenever the network has
- * any latency. O(1). */
+ * cycle on its own (not a standby; reconsider() already leaves out a coordinator's plan it
+ * switched to): what it decided on lacked it. In its first cycle every node starts at
+ * once, so a UAV first in its order decides before the world's first estimates reach it
+ * whenever the network has any latency. O(1). */
 static bool world_news(const coavoid_vehicle_node_t *node)
 {
-    return node->decided_cycle == node->state.cycle && !node->cycle_plan_adopted &&
-           !node->standby_held && node->inbox.world_news != node->decided_news;
+    return node->decided_cycle == node->state.cycle && !node->standby_held &&
+           node->inbox.world_news != node->decided_news;
 }
 
 /* After it published this cycle's intent on its own decision (not a coordinator's plan
