@@ -1096,6 +1096,131 @@ static void fly_unanswered(int64_t answer_wait_us, coa_vec3_t p[2][9])
 
 static bool flown_conflict(const coa_vec3_t *pa, const coa_vec3_t *pb, int64_t n);
 
+/* Polls the nodes (in that order) at `at`, each after the messages of the one before. */
+static void poll_all(rig_t *r, coavoid_vehicle_node_t *const *v, size_t n, int64_t at)
+{
+    r->now = at;
+    for (size_t i = 0; i < n; i++) {
+        ck_assert_int_ge(coavoid_vehicle_node_poll(v[i], r->now), 0);
+        drain(r->lcm);
+    }
+}
+
+/* A head-on pair, both following, whose volumes meet 3 s after the start of cycle k (UAV 2
+ * starts 90 + 20 k m from UAV 1): in cycle k the coordinator's plan for UAV 1 alone (a
+ * climb to 16 m) comes at `plan_at` after the cycle's start and no COMMIT follows; UAV 1
+ * commits it itself when due (ack timeout + 4 resends after it accepted), UAV 2, holding
+ * nothing, answers its conflict at the answer wait. Flies cycles 0 to k - 1 (no conflict
+ * within the horizon of 4 steps) and cycle k up to the plan; v[0] is UAV 2. */
+static void fly_self_commit_beside(rig_t *r, int64_t k, int64_t plan_at,
+                                   coavoid_vehicle_node_t *v[2])
+{
+    static coa_vec3_t r1[2], r2[2];
+    const coa_real_t x2 = (coa_real_t)(90 + 20 * k);
+    v[0] = vehicle_node(r, uav(2, 2, r2, x2, x2 - 600, 0, 100), COAVOID_NODE_CENTRALISED);
+    v[1] = vehicle_node(r, uav(1, 1, r1, 0, 600, 0, 100), COAVOID_NODE_CENTRALISED);
+    for (int64_t j = 0; j <= k; j++) {
+        r->now = cycle(j);
+        for (int i = 0; i < 2; i++) {
+            ck_assert_int_eq(coavoid_vehicle_node_cycle(v[i], r->now), COA_OK);
+            drain(r->lcm);
+            ck_assert(coavoid_vehicle_node_state(v[i])->coordinated);
+        }
+        heartbeat(r->lcm, cycle(j) + DT_US / 4, j);
+        drain(r->lcm);
+        if (j < k) {
+            poll_until(r, v, 2, cycle(j + 1));
+        }
+    }
+    r->now = cycle(k) + plan_at;
+    coavoid_plan_t m = solved_plan(r->now, 0, cycle(k), 4, 1);
+    m.uav_ids[0] = 1;
+    m.row_uav_id = 1;
+    for (int32_t j = 0; j <= 4; j++) {
+        m.offsets[j] = 2 * j;
+    }
+    ck_assert_int_eq(coavoid_plan_t_publish(r->lcm, COAVOID_CHANNEL_PLAN, &m), 0);
+    drain(r->lcm);
+}
+
+/* A UAV answering its conflict at the answer wait waits for the UAVs before it whose
+ * intent says they follow, since they may answer theirs at the same moment; one whose
+ * intent is its row of a coordinator's plan of the cycle has switched to it, which is a
+ * decision: the answering UAV decides at once (here UAV 1 commits its plan itself at the
+ * answer wait, and says it follows from then on). */
+START_TEST(test_answer_does_not_wait_for_a_switched_uav)
+{
+    rig_t r;
+    rig_init(&r, 4);
+    coavoid_vehicle_node_t *v[2];
+    fly_self_commit_beside(&r, 0, DT_US / 4, v);
+    const coavoid_vehicle_node_state_t *s2 = coavoid_vehicle_node_state(v[0]);
+    const coavoid_vehicle_node_state_t *s1 = coavoid_vehicle_node_state(v[1]);
+    const int64_t answer_wait = cycle(0) + DT_US / 2 + 4 * (DT_US / 40);
+    poll_all(&r, v, 2, answer_wait);
+    ck_assert(s2->waiting); /* UAV 1 still followed when UAV 2 looked */
+    ck_assert_uint_eq(s1->plans_self_committed, 1);
+    ck_assert(!s1->coordinated);
+    poll_all(&r, v, 1, answer_wait);
+    ck_assert(!s2->waiting);
+    ck_assert(s2->published);
+    coavoid_vehicle_node_destroy(v[1]);
+    coavoid_vehicle_node_destroy(v[0]);
+    lcm_destroy(r.lcm);
+}
+END_TEST
+
+/* How many intents (new sequences: not copies) UAV `id` published. */
+typedef struct {
+    int32_t id;
+    int64_t last_sequence;
+    uint32_t intents;
+} intent_probe_t;
+
+static void on_intent_probe(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
+{
+    intent_probe_t *p = user;
+    (void)channel;
+    coavoid_intent_t m;
+    REQUIRE(coavoid_intent_t_decode(rbuf->data, 0, (int)rbuf->data_size, &m) >= 0);
+    if (m.uav_id == p->id && m.sequence > p->last_sequence) {
+        p->last_sequence = m.sequence;
+        p->intents++;
+    }
+}
+
+/* A UAV that answered its conflict decides again when a UAV before it then switches to
+ * its row of a coordinator's plan: here UAV 1's plan came late, so at the answer wait it
+ * flies a standby (UAV 2 decides around it), and when its self-commit falls due it
+ * switches to the plan's row, another plan than the standby. */
+START_TEST(test_switch_before_it_is_decided_on_again)
+{
+    rig_t r;
+    rig_init(&r, 4);
+    coavoid_vehicle_node_t *v[2];
+    intent_probe_t probe = {2, -1, 0};
+    ck_assert_ptr_nonnull(lcm_subscribe(r.lcm, COAVOID_CHANNEL_INTENT, on_intent_probe, &probe));
+    fly_self_commit_beside(&r, 2, DT_US * 4 / 10, v);
+    const coavoid_vehicle_node_state_t *s2 = coavoid_vehicle_node_state(v[0]);
+    const coavoid_vehicle_node_state_t *s1 = coavoid_vehicle_node_state(v[1]);
+    const int64_t answer_wait = cycle(2) + DT_US / 2 + 4 * (DT_US / 40);
+    poll_all(&r, v, 2, answer_wait);
+    poll_all(&r, v, 1, answer_wait);
+    ck_assert_uint_eq(s1->plans_self_committed, 0);
+    ck_assert_uint_eq(s1->plans_standby, 0); /* counted at the cycle's end */
+    ck_assert(!s2->waiting && s2->published);
+    const uint32_t decided = probe.intents;
+    const int64_t due = cycle(2) + DT_US * 4 / 10 + DT_US / 4 + 4 * (DT_US / 40);
+    poll_all(&r, v, 2, due);
+    ck_assert_uint_eq(s1->plans_self_committed, 1);
+    poll_all(&r, v, 1, due);
+    ck_assert_uint_gt(probe.intents, decided);
+    coavoid_vehicle_node_destroy(v[1]);
+    coavoid_vehicle_node_destroy(v[0]);
+    lcm_destroy(r.lcm);
+}
+END_TEST
+
 /* A UAV following a coordinator that has a conflict of its own and no answer (no plan it
  * holds, flies, or was told failed) by answer_wait_us plans for itself within the cycle:
  * with a conflict 3 s ahead that one UAV alone can climb clear of only from cycle 0, the
@@ -2460,6 +2585,8 @@ static Suite *node_suite(void)
     tcase_add_test(tc, test_faulty_coordinator_not_followed);
     tcase_add_test(tc, test_late_plans_fall_back);
     tcase_add_test(tc, test_unanswered_conflict_planned_within_cycle);
+    tcase_add_test(tc, test_answer_does_not_wait_for_a_switched_uav);
+    tcase_add_test(tc, test_switch_before_it_is_decided_on_again);
     tcase_add_test(tc, test_failed_plan_is_an_answer);
     tcase_add_test(tc, test_coordinator_skips_decoupled_uav);
     tcase_add_test(tc, test_coordinator_abandons_past_budget);

@@ -396,6 +396,18 @@ START_TEST(test_self_committed_plan_is_flown)
 }
 END_TEST
 
+/* Encounter 16 of 4 UAVs (montecarlo, seed 1), 1 ms of delay, the coordinator gone after
+ * the first 3 messages of cycle 0 (its plan of UAVs 1 and 3, and no COMMIT): UAVs 1 and 3
+ * commit it themselves, and UAVs 2 and 4, which held no plan, decide for themselves at the
+ * answer wait. Their order search counted UAVs 1 and 3 in, whose intents said they planned
+ * for themselves, and planned around rows those two never flew; in cycle 2 UAVs 2 and 4
+ * met. A UAV that flies a coordinator's plan says it follows for the rest of the cycle. */
+START_TEST(test_self_committed_plan_is_announced)
+{
+    fly_self_committed(COAVOID_TEST_ENCOUNTERS "/self_commit_mode_16.json", 3u, 2u);
+}
+END_TEST
+
 START_TEST(test_coordinator_gone_after_one_commit)
 {
     script_t s = run(SCRIPT_GONE_AFTER_ONE_COMMIT);
@@ -696,6 +708,7 @@ static Suite *protocol_suite(void)
     tcase_add_test(tc, test_coordinator_gone_after_one_commit);
     tcase_add_test(tc, test_self_commit_due_after_the_answer_wait);
     tcase_add_test(tc, test_self_committed_plan_is_flown);
+    tcase_add_test(tc, test_self_committed_plan_is_announced);
     tcase_add_test(tc, test_standby_when_an_accept_is_unheard);
     tcase_add_test(tc, test_failure_notice_then_gone);
     suite_add_tcase(suite, tc);

@@ -279,8 +279,12 @@ static coavoid_lcm_intent_info_t intent_info(const coavoid_vehicle_node_t *node,
     memset(&info, 0, sizeof info);
     info.utime = now;
     info.sequence = sequence;
-    info.mode = node->state.coordinated ? COAVOID_INTENT_T_MODE_CENTRALISED
-                                        : COAVOID_INTENT_T_MODE_DECOUPLED;
+    /* A coordinator's plan switched to in this cycle is flown to its end (reconsider()),
+     * coordinated or not (a self-commit, a standby that a COMMIT replaced): it says so, or
+     * a peer's order search would count it in and plan around a row it never flies. */
+    info.mode = node->state.coordinated || node->cycle_plan_adopted
+                    ? COAVOID_INTENT_T_MODE_CENTRALISED
+                    : COAVOID_INTENT_T_MODE_DECOUPLED;
     /* The state at `now`: it moves straight from sample k to sample k + 1. */
     coa_vec3_t p0 = node->own_samples[0];
     coa_vec3_t p1 = node->own_samples[1];
@@ -685,13 +689,20 @@ static int missed_conflict(coavoid_vehicle_node_t *node, int64_t now, bool *conf
     return COA_OK;
 }
 
+static bool row_flown(const coavoid_vehicle_node_t *node, uint16_t id, const int32_t *offsets,
+                      size_t count);
+
 /* Whether live UAV i has published what it decided for this cycle: an intent of this
  * cycle, which, when it decides at the answer wait itself (answering), must also say the
- * UAV plans for itself (one still following may be about to answer itself too). O(1). */
+ * UAV plans for itself or fly its row of a coordinator's plan of this cycle (one still
+ * following may be about to answer itself too). O(N). */
 static bool decided_peer(const coavoid_vehicle_node_t *node, size_t i)
 {
-    return node->view.live_current[i] &&
-           !(node->answering && node->view.live_info[i].mode == COAVOID_INTENT_T_MODE_CENTRALISED);
+    const coavoid_node_view_t *view = &node->view;
+    return view->live_current[i] &&
+           !(node->answering && view->live_info[i].mode == COAVOID_INTENT_T_MODE_CENTRALISED &&
+             !row_flown(node, view->live_id[i], view->live_arrays[i].offsets,
+                        view->live_plan[i].count));
 }
 
 /* Whether a UAV before it in the decoupled order (peer_first: ranks, then priorities) that
@@ -827,8 +838,9 @@ static int32_t agreed_rank_of(const coavoid_vehicle_node_t *node, uint16_t id)
  * than came later; intent_digest: a copy is not another plan). Without loss that never
  * happens (each decides after the UAVs before it published, on all of theirs). Started
  * centralised, it also decides again on a UAV before it that answered its own conflict
- * at the answer wait (rank 0, mode decoupled) with another plan than the one it decided on
- * (intent_digest: a copy is not another plan). In a cycle it decided again on world news
+ * at the answer wait (rank 0, mode decoupled), or switched to its row of a coordinator's
+ * plan (row_flown), with another plan than the one it decided on (intent_digest: a copy
+ * is not another plan). In a cycle it decided again on world news
  * (reconsider), so do the UAVs before it, with another plan too. O(peers^2 + peers *
  * samples). */
 static bool overtaken(const coavoid_vehicle_node_t *node)
@@ -838,8 +850,10 @@ static bool overtaken(const coavoid_vehicle_node_t *node)
     for (size_t i = 0; i < COAVOID_NODE_MAX_PEERS; i++) {
         const coavoid_intent_t *m = &node->inbox.peers[i].msg;
         const bool first = m->rank <= 0 && (newcomer(node, &node->inbox.peers[i]) || news);
-        const bool answered = node->config.mode == COAVOID_NODE_CENTRALISED && m->rank <= 0 &&
-                              m->mode == COAVOID_INTENT_T_MODE_DECOUPLED;
+        const bool answered =
+            node->config.mode == COAVOID_NODE_CENTRALISED && m->rank <= 0 &&
+            (m->mode == COAVOID_INTENT_T_MODE_DECOUPLED ||
+             row_flown(node, (uint16_t)m->uav_id, m->offsets, (size_t)m->sample_count));
         if (!node->inbox.peers[i].used || m->plan_utime != node->cycle_start ||
             (m->rank <= 0 && !first && !answered) ||
             !coavoid_node_precedes(m->rank, (uint32_t)m->priority, (uint16_t)m->uav_id,
@@ -1595,6 +1609,25 @@ static void apply_row(coavoid_vehicle_node_t *node, size_t i)
         a->offsets[j] = node->row_offsets[slot][j < count ? j : count - 1u];
         a->samples[j] = lifted(a->reference[j], a->offsets[j], dh);
     }
+}
+
+/* Whether UAV id's intent of this cycle (its `count` offsets) is its row of this cycle's
+ * plans: it flies a coordinator's plan it switched to, so it has decided for the cycle
+ * (decided_peer, overtaken). O(N). */
+static bool row_flown(const coavoid_vehicle_node_t *node, uint16_t id, const int32_t *offsets,
+                      size_t count)
+{
+    const size_t slot = row_slot(node, id);
+    if (slot == node->row_count) {
+        return false;
+    }
+    const uint32_t samples = node->row_samples[slot];
+    for (size_t j = 0; j < count; j++) {
+        if (offsets[j] != node->row_offsets[slot][j < samples ? j : samples - 1u]) {
+            return false;
+        }
+    }
+    return true;
 }
 
 /* Whether flying `offsets` (a plan's row from this cycle's start, `count` samples; past its
