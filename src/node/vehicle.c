@@ -849,13 +849,15 @@ static bool overtaken(const coavoid_vehicle_node_t *node)
     const bool news = node->news_cycle == node->state.cycle;
     for (size_t i = 0; i < COAVOID_NODE_MAX_PEERS; i++) {
         const coavoid_intent_t *m = &node->inbox.peers[i].msg;
+        if (!node->inbox.peers[i].used || m->plan_utime != node->cycle_start) {
+            continue; /* before the row comparison: no intent of this cycle to compare */
+        }
         const bool first = m->rank <= 0 && (newcomer(node, &node->inbox.peers[i]) || news);
         const bool answered =
             node->config.mode == COAVOID_NODE_CENTRALISED && m->rank <= 0 &&
             (m->mode == COAVOID_INTENT_T_MODE_DECOUPLED ||
              row_flown(node, (uint16_t)m->uav_id, m->offsets, (size_t)m->sample_count));
-        if (!node->inbox.peers[i].used || m->plan_utime != node->cycle_start ||
-            (m->rank <= 0 && !first && !answered) ||
+        if ((m->rank <= 0 && !first && !answered) ||
             !coavoid_node_precedes(m->rank, (uint32_t)m->priority, (uint16_t)m->uav_id,
                                    node->state.rank, self->priority, self->id)) {
             continue;
@@ -1592,6 +1594,13 @@ static void record_rows(coavoid_vehicle_node_t *node, const coavoid_plan_t *msg,
     }
 }
 
+/* Sample j of the row in `slot` (past its end the last offset holds). O(1). */
+static int32_t row_offset(const coavoid_vehicle_node_t *node, size_t slot, size_t j)
+{
+    const uint32_t count = node->row_samples[slot];
+    return node->row_offsets[slot][j < count ? j : count - 1u];
+}
+
 /* Moves live UAV i of the view onto its row from this cycle's plans, when it has one and
  * its intent is of this cycle (the same samples): reference + row offset * its dh, as it
  * will fly them if it adopts the plan. */
@@ -1604,9 +1613,8 @@ static void apply_row(coavoid_vehicle_node_t *node, size_t i)
     }
     const coa_real_t dh = coa_climb_step(&view->live_vehicle[i], node->config.common.dt);
     coavoid_lcm_intent_arrays_t *a = &view->live_arrays[i];
-    const uint32_t count = node->row_samples[slot];
     for (size_t j = 0; j < view->live_plan[i].count; j++) {
-        a->offsets[j] = node->row_offsets[slot][j < count ? j : count - 1u];
+        a->offsets[j] = row_offset(node, slot, j);
         a->samples[j] = lifted(a->reference[j], a->offsets[j], dh);
     }
 }
@@ -1621,9 +1629,8 @@ static bool row_flown(const coavoid_vehicle_node_t *node, uint16_t id, const int
     if (slot == node->row_count) {
         return false;
     }
-    const uint32_t samples = node->row_samples[slot];
     for (size_t j = 0; j < count; j++) {
-        if (offsets[j] != node->row_offsets[slot][j < samples ? j : samples - 1u]) {
+        if (offsets[j] != row_offset(node, slot, j)) {
             return false;
         }
     }
