@@ -2210,6 +2210,19 @@ START_TEST(test_bad_configs_refused)
     vc.priority_wait_us = -1;
     ck_assert_ptr_null(coavoid_vehicle_node_create(&vc, r.lcm, &error));
     vc.priority_wait_us = 0;
+    /* A joint plan of one UAV is its own plan; more than a planner searches together is
+     * none. */
+    vc.joint_members = 1u;
+    ck_assert_ptr_null(coavoid_vehicle_node_create(&vc, r.lcm, &error));
+    ck_assert_int_eq(error, COA_ERR_ARGUMENT);
+    vc.joint_members = COA_MAX_CENTRALISED + 1u;
+    ck_assert_ptr_null(coavoid_vehicle_node_create(&vc, r.lcm, &error));
+    vc.joint_members = 0u;
+    ck_assert_uint_eq(coavoid_node_joint_members(COAVOID_NODE_CENTRALISED, 1u), 0u);
+    ck_assert_uint_eq(coavoid_node_joint_members(COAVOID_NODE_CENTRALISED, 3u), 3u);
+    ck_assert_uint_eq(coavoid_node_joint_members(COAVOID_NODE_CENTRALISED, 30u),
+                      COAVOID_NODE_DEFAULT_JOINT_MEMBERS);
+    ck_assert_uint_eq(coavoid_node_joint_members(COAVOID_NODE_DECOUPLED, 4u), 0u);
     /* Its own obstacles: at most COAVOID_NODE_MAX_CONFIGURED_OBSTACLES, each valid. */
     coa_obstacle_t own[COAVOID_NODE_MAX_CONFIGURED_OBSTACLES + 1u];
     for (size_t i = 0; i <= COAVOID_NODE_MAX_CONFIGURED_OBSTACLES; i++) {

@@ -17,7 +17,9 @@
  *     makes every other UAV of the plan switch too: the plan is flown by all;
  *   - the coordinator gone after proposing, and one UAV's answers never reaching its
  *     siblings: it commits the plan itself, they cannot, and one of them flies the
- *     standby it planned at the answer wait; separation is kept.
+ *     standby it planned at the answer wait; separation is kept;
+ *   - the coordinator gone before its first message, in two random encounters no priority
+ *     order solves: the UAVs plan their group jointly and keep separation.
  * And, decoupled, the order search: two random encounters (tests/encounters/) that the
  * greedy priority negotiation alone flies into a loss of separation, one of them from
  * cycle 0, and that an order found in flight keeps separated. And the first cycle, where
@@ -408,6 +410,36 @@ START_TEST(test_self_committed_plan_is_announced)
 }
 END_TEST
 
+/* Flies an encounter centralised, the coordinator gone before its first message, every
+ * message `delay` seconds late: separation is kept, and UAVs flew rows of their group's
+ * joint plan. */
+static void fly_leaderless(const char *path, double delay)
+{
+    coavoid_sim_config_t c;
+    memset(&c, 0, sizeof c);
+    c.scenario_path = path;
+    c.mode = "centralised";
+    c.has_stop = true;
+    c.delay = delay;
+    c.json = true;
+    fly_config(&c, &scripted);
+    ck_assert_int_eq(scripted.verdict, COAVOID_SIM_SEPARATED);
+    ck_assert_uint_gt(scripted.outcome.joint_plans, 0);
+}
+
+/* Encounters 220 (no delay) and 40 (1 ms) of 4 UAVs (montecarlo, seed 1), the coordinator
+ * gone before its first message: no priority order solves either (`coavoid plan
+ * --reorder`), the coordinator's joint plan does. Planning for themselves from the answer
+ * wait on, the UAVs' order search found no order and their greedy raises lost separation
+ * at t = 2-4 s. When no order solves its group, each UAV now plans the group jointly, as
+ * its coordinator would, and flies its row (lost without that plan). */
+START_TEST(test_leaderless_joint_plan)
+{
+    fly_leaderless(COAVOID_TEST_ENCOUNTERS "/joint_plan_220.json", 0.0);
+    fly_leaderless(COAVOID_TEST_ENCOUNTERS "/joint_plan_40.json", 0.001);
+}
+END_TEST
+
 START_TEST(test_coordinator_gone_after_one_commit)
 {
     script_t s = run(SCRIPT_GONE_AFTER_ONE_COMMIT);
@@ -709,6 +741,7 @@ static Suite *protocol_suite(void)
     tcase_add_test(tc, test_self_commit_due_after_the_answer_wait);
     tcase_add_test(tc, test_self_committed_plan_is_flown);
     tcase_add_test(tc, test_self_committed_plan_is_announced);
+    tcase_add_test(tc, test_leaderless_joint_plan);
     tcase_add_test(tc, test_standby_when_an_accept_is_unheard);
     tcase_add_test(tc, test_failure_notice_then_gone);
     suite_add_tcase(suite, tc);

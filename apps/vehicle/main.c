@@ -225,6 +225,7 @@ static int run(void *options, coavoid_scenario_t *s)
     config.mode = o->decoupled ? COAVOID_NODE_DECOUPLED : COAVOID_NODE_CENTRALISED;
     config.coordinator_id = o->coordinator_id; /* 0: the default */
     config.intent_copies = COAVOID_NODE_DEFAULT_COPIES;
+    config.joint_members = coavoid_node_joint_members(config.mode, s->vehicle_count);
     config.coordinator_timeout_us =
         o->timeout_text != NULL ? llround(o->timeout * 1e6) : llround(2.5 * (double)dt_us);
     config.priority_wait_us = o->wait_text != NULL ? llround(o->wait * 1e6) : dt_us / 2;

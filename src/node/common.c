@@ -1139,6 +1139,14 @@ coa_planner_config_t coavoid_node_planner_config(uint32_t horizon, size_t search
     return c;
 }
 
+size_t coavoid_node_joint_members(coavoid_node_mode_t mode, size_t fleet)
+{
+    if (mode != COAVOID_NODE_CENTRALISED || fleet < 2u) {
+        return 0u;
+    }
+    return fleet < COAVOID_NODE_DEFAULT_JOINT_MEMBERS ? fleet : COAVOID_NODE_DEFAULT_JOINT_MEMBERS;
+}
+
 int coavoid_node_solver_init(coavoid_node_solver_t *s, uint32_t horizon, uint32_t plan_horizon,
                              size_t searched, uint32_t beta)
 {

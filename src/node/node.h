@@ -189,6 +189,14 @@
  * (docs/evaluation.md measures the count). */
 #define COAVOID_NODE_DEFAULT_COPIES 4u
 
+/* The joint plan of a vehicle's group when no priority order solves it (joint_members,
+ * joint_beta of coavoid_vehicle_node_config_t): groups of up to this many UAVs, in the
+ * drivers and the simulation, for vehicles that follow a coordinator; and the search's
+ * bound on stored nodes by default. 5,000 nodes solve every group of the sweep's 2-5 UAV
+ * encounters that the coordinator's 20,000 do (docs/evaluation.md). */
+#define COAVOID_NODE_DEFAULT_JOINT_MEMBERS 5u
+#define COAVOID_NODE_DEFAULT_JOINT_BETA 5000u
+
 typedef enum {
     COAVOID_NODE_CENTRALISED = 0, /* follow the coordinator; plan for itself when it is silent */
     COAVOID_NODE_DECOUPLED = 1    /* always plan for itself in priority order */
@@ -286,6 +294,17 @@ typedef struct {
      * resend_us: the coordinator plans at dt / 4, gives its UAVs dt / 4 to accept, and
      * sends its ABORT with four copies. */
     int64_t answer_wait_us;
+    /* Deciding for itself, when its order search finds that no priority order solves its
+     * group (docs/protocol.md, "Priority negotiation", step 5): it plans the group jointly,
+     * as a coordinator would, in one search of at most joint_beta stored nodes, when the
+     * group has at most joint_members UAVs. Every member does the same from the same
+     * intents, so all find the same rows without a message: every vehicle of a fleet must
+     * have the same two values, as it has the same dt and horizon (the drivers and the
+     * simulation: coavoid_node_joint_members). joint_members 0 (the default): never; else
+     * 2..COA_MAX_CENTRALISED, and its planner is one for a joint search of that many UAVs
+     * (docs/benchmarks.md has the bytes). joint_beta 0: COAVOID_NODE_DEFAULT_JOINT_BETA. */
+    size_t joint_members;
+    uint32_t joint_beta;
 } coavoid_vehicle_node_config_t;
 
 /* What a vehicle did; read by drivers, the simulation and tests. */
@@ -322,6 +341,9 @@ typedef struct {
     /* Times its order search found a new order for its cluster and it took its place in
      * it (docs/protocol.md, "Priority negotiation"). */
     uint32_t orders_agreed;
+    /* Of those, the times no order solved and it flew its row of the group's joint plan
+     * (joint_members). */
+    uint32_t joint_plans;
     coavoid_lcm_rx_stats_t rx;
 } coavoid_vehicle_node_state_t;
 
@@ -332,16 +354,24 @@ typedef struct coavoid_vehicle_node coavoid_vehicle_node_t;
  * unbounded), so that no valid intent meets a planner too small for it. */
 coa_planner_config_t coavoid_node_planner_config(uint32_t horizon, size_t searched, uint32_t beta);
 
+/* The joint_members the drivers and the simulation give every vehicle of a fleet of
+ * `fleet` UAVs flying `mode`: following a coordinator, up to
+ * COAVOID_NODE_DEFAULT_JOINT_MEMBERS and no more than the fleet (0 below 2 UAVs); in
+ * decoupled mode 0, the paper's decoupled planning. O(1). */
+size_t coavoid_node_joint_members(coavoid_node_mode_t mode, size_t fleet);
+
 /* Creates a vehicle node publishing and subscribing on lcm (not owned). Allocates the node,
- * its one-UAV planner and its predictor once: the node's tables, the predictor and
- * conflicts for N, and the workspace of coavoid_node_planner_config(N + 2, 1, beta) (the
- * order search looks two steps beyond the horizon; a one-UAV planner's size does not
- * depend on beta). The order search's share is each peer's intent of the cycle before,
- * kept in the inbox (a coordinator's holds it too), and its problem's UAVs, references and
- * rows, fixed like the rest (docs/benchmarks.md has the sizes). Returns NULL
- * on bad config (invalid vehicle, horizon >
- * COAVOID_NODE_MAX_HORIZON, ...: COA_ERR_ARGUMENT, also when LCM refuses a subscription) or
- * out of memory (COA_ERR_WORKSPACE), with *error set (error may be NULL). */
+ * its planner and its predictor once: the node's tables, the predictor and conflicts for
+ * N, and the workspace of coavoid_node_planner_config(N + 2, 1, beta) (the order search
+ * looks two steps beyond the horizon; a one-UAV planner's size does not depend on beta),
+ * or with joint_members that of coavoid_node_planner_config(N + 2, joint_members,
+ * joint_beta), which also runs its one-UAV searches. The order search's share is each
+ * peer's intent of the cycle before, kept in the inbox (a coordinator's holds it too), and
+ * its problem's UAVs, references and rows, fixed like the rest (docs/benchmarks.md has the
+ * sizes). Returns NULL on bad config (invalid vehicle, horizon > COAVOID_NODE_MAX_HORIZON,
+ * joint_members 1 or above COA_MAX_CENTRALISED, ...: COA_ERR_ARGUMENT, also when LCM
+ * refuses a subscription) or out of memory (COA_ERR_WORKSPACE), with *error set (error may
+ * be NULL). */
 coavoid_vehicle_node_t *coavoid_vehicle_node_create(const coavoid_vehicle_node_config_t *config,
                                                     lcm_t *lcm, int *error);
 /* Unsubscribes and frees. NULL is fine. */

@@ -1226,6 +1226,32 @@ static int look_ahead(coavoid_vehicle_node_t *node, size_t count, coa_problem_t 
     return COA_OK;
 }
 
+/* No priority order solves the group (search_order, *problem over the horizon): with
+ * joint_members, it plans the group jointly as a coordinator would (coa_plan_centralised,
+ * at most joint_beta stored nodes), from the same problem. Every member has the same
+ * problem and the search is deterministic, so each finds the same rows, as with an order;
+ * it takes its place in the order the ranks announce (`order`: order_current's), its row
+ * the joint plan's. Returns 1 when agreed; 0 when the group has more than joint_members
+ * UAVs or the search finds no plan (infeasible, or out of beta: the greedy raise
+ * remains); or an error of the search. Cost: one joint search (2n tables, then at most
+ * joint_beta stored nodes a group). Memory: the node's planner, sized for it at create. */
+static int search_joint(coavoid_vehicle_node_t *node, size_t count, size_t self,
+                        const coa_problem_t *problem, const size_t *order)
+{
+    if (count > node->config.joint_members) {
+        return 0;
+    }
+    coa_plan_result_t result;
+    const int rc =
+        coa_plan_centralised(node->solver.planner, problem, node->order_offsets, &result);
+    if (rc != COA_OK || result.status != COA_PLAN_SOLVED) {
+        return rc;
+    }
+    order_agree(node, count, order, self);
+    node->state.joint_plans++;
+    return 1;
+}
+
 /* The order search, at the start of a decoupled cycle and again within it (decide_own,
  * search_again). From the intents as they stood when the cycle began (snapshot: each
  * UAV's last of the cycle before, its own included, whatever came since), it predicts, and
@@ -1234,13 +1260,15 @@ static int look_ahead(coavoid_vehicle_node_t *node, size_t count, coa_problem_t 
  * fails it tries the others (at most ORDER_TRIES_MAX), and when one solves takes its
  * place in it (order_agree). Every member has the same intents when none was lost, so
  * each finds the same order and rows without a message or a central node, and the ranks
- * they announce make the order hold for anyone who did not. Changes nothing when the
- * current order solves or none does (but withdraws an order it agreed earlier in the
- * cycle: order_withdraw). Returns 1 when it agreed a new order, 0 when not, or an error
- * of the search (then the greedy raise remains). Cost: one view, two predictions; with a
+ * they announce make the order hold for anyone who did not. When none does, the group's
+ * joint plan may (search_joint). Changes nothing when the current order solves, or
+ * nothing does (but withdraws an order it agreed earlier in the cycle: order_withdraw).
+ * Returns 1 when it agreed a new order or a joint plan, 0 when not, or an error of the
+ * search (then the greedy raise remains). Cost: one view, two predictions; with a
  * conflict, a decoupled plan of at most ORDER_MEMBERS_MAX UAVs, and when the order fails
  * at most ORDER_TRIES_MAX orders of at most ORDER_MEMBERS_MAX single-UAV searches each
- * (coa_plan_decoupled's cost). Memory: the node's (order_*) and its solver's workspace. */
+ * (coa_plan_decoupled's cost), and when none solves search_joint's. Memory: the node's
+ * (order_*) and its solver's workspace. */
 static int search_order(coavoid_vehicle_node_t *node)
 {
     const size_t self = snapshot(node, node->cycle_start - node->config.common.dt_us);
@@ -1271,8 +1299,11 @@ static int search_order(coavoid_vehicle_node_t *node)
     }
     node->state.plans_run++;
     if (result.status != COA_PLAN_SOLVED) {
-        order_withdraw(node);
-        return 0;
+        rc = search_joint(node, count, self, &problem, order);
+        if (rc != 1) {
+            order_withdraw(node);
+        }
+        return rc;
     }
     rc = look_ahead(node, count, &problem, &result);
     if (rc != COA_OK) {
@@ -1925,6 +1956,9 @@ static void fill_defaults(coavoid_vehicle_node_config_t *config)
     if (config->answer_wait_us <= 0) {
         config->answer_wait_us = half + 4 * config->resend_us;
     }
+    if (config->joint_beta == 0u) {
+        config->joint_beta = COAVOID_NODE_DEFAULT_JOINT_BETA;
+    }
 }
 
 coavoid_vehicle_node_t *coavoid_vehicle_node_create(const coavoid_vehicle_node_config_t *config,
@@ -1941,7 +1975,8 @@ coavoid_vehicle_node_t *coavoid_vehicle_node_create(const coavoid_vehicle_node_c
         config->coordinator_timeout_us < 0 || config->priority_wait_us < 0 ||
         !isfinite((double)config->sigma_horizontal) || !isfinite((double)config->sigma_vertical) ||
         config->sigma_horizontal < (coa_real_t)0 || config->sigma_vertical < (coa_real_t)0 ||
-        !(coa_climb_step(&config->vehicle, config->common.dt) > (coa_real_t)0)) {
+        !(coa_climb_step(&config->vehicle, config->common.dt) > (coa_real_t)0) ||
+        config->joint_members == 1u || config->joint_members > COA_MAX_CENTRALISED) {
         return NULL;
     }
     const uint16_t coordinator_id = config->coordinator_id != 0u
@@ -1951,9 +1986,15 @@ coavoid_vehicle_node_t *coavoid_vehicle_node_create(const coavoid_vehicle_node_c
         return NULL; /* its own heartbeats and plans would be taken for its coordinator's */
     }
     const coavoid_node_common_t *c = &config->common;
+    coavoid_vehicle_node_config_t filled = *config;
+    filled.coordinator_id = coordinator_id;
+    fill_defaults(&filled);
+    /* One planner: its own searches, the order search's, and its group's joint plan. */
+    const bool joint = filled.joint_members > 0u;
     coavoid_node_solver_t solver;
-    int rc = coavoid_node_solver_init(&solver, c->horizon, c->horizon + COAVOID_NODE_LOOKAHEAD, 1u,
-                                      c->beta);
+    int rc = coavoid_node_solver_init(&solver, c->horizon, c->horizon + COAVOID_NODE_LOOKAHEAD,
+                                      joint ? filled.joint_members : 1u,
+                                      joint ? filled.joint_beta : c->beta);
     if (rc != COA_OK) {
         *error = rc;
         return NULL;
@@ -1965,9 +2006,7 @@ coavoid_vehicle_node_t *coavoid_vehicle_node_create(const coavoid_vehicle_node_c
         return NULL;
     }
     node->solver = solver;
-    node->config = *config;
-    node->config.coordinator_id = coordinator_id;
-    fill_defaults(&node->config);
+    node->config = filled;
     node->dh = coa_climb_step(&node->config.vehicle, c->dt);
     node->plan_start = 0;
     node->plan_count = 1;

@@ -769,6 +769,7 @@ static int sim_vehicles(sim_run_t *r)
         config.vehicle = s->vehicles[i];
         config.mode = r->o->decoupled ? COAVOID_NODE_DECOUPLED : COAVOID_NODE_CENTRALISED;
         config.intent_copies = COAVOID_NODE_DEFAULT_COPIES;
+        config.joint_members = coavoid_node_joint_members(config.mode, r->n);
         config.common.rx_lcm = coavoid_sim_net_rx(r->net, SIM_NET_VEHICLE(j));
         r->vehicles[j] = coavoid_vehicle_node_create(
             &config, coavoid_sim_net_tx(r->net, SIM_NET_VEHICLE(j)), &error);
@@ -1129,11 +1130,13 @@ static void sim_agreement_counts(const sim_run_t *r, coavoid_sim_outcome_t *outc
     outcome->plans_switched = 0;
     outcome->plans_in_doubt = 0;
     outcome->plans_standby = 0;
+    outcome->joint_plans = 0;
     for (size_t j = 0; j < r->n; j++) {
         const coavoid_vehicle_node_state_t *st = coavoid_vehicle_node_state(r->vehicles[j]);
         outcome->plans_switched += st->plans_switched;
         outcome->plans_in_doubt += st->plans_in_doubt;
         outcome->plans_standby += st->plans_standby;
+        outcome->joint_plans += st->joint_plans;
     }
 }
 

@@ -118,6 +118,8 @@ typedef struct {
     uint32_t plans_switched; /* UAVs that switched to a committed plan */
     uint32_t plans_in_doubt; /* UAVs whose accepted plan got no decision in its cycle */
     uint32_t plans_standby;  /* ... of which flew the standby they planned at the answer wait */
+    uint32_t joint_plans;    /* the UAVs' rows flown of their group's joint plan, no
+                                priority order solving it (node.h's joint_members) */
 } coavoid_sim_outcome_t;
 
 /* The largest --steps, and with it --coordinator-stops: more is more likely a typo than a
