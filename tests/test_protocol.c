@@ -254,9 +254,9 @@ static void fly_config(const coavoid_sim_config_t *c, flight_t *f)
     ck_assert(!f->outcome.loss_of_separation);
 }
 
-/* Flies an encounter with every message 1 ms late: decoupled, or centralised with the
- * coordinator gone after its first `stop` messages of cycle 0. */
-static void fly_late(const char *path, bool decoupled, uint32_t stop, flight_t *f)
+/* Flies an encounter with every message `delay` seconds late: decoupled, or centralised
+ * with the coordinator gone after its first `stop` messages of cycle 0. */
+static void fly_delayed(const char *path, bool decoupled, uint32_t stop, double delay, flight_t *f)
 {
     coavoid_sim_config_t c;
     memset(&c, 0, sizeof c);
@@ -266,9 +266,15 @@ static void fly_late(const char *path, bool decoupled, uint32_t stop, flight_t *
     c.has_stop = !decoupled;
     c.has_stop_messages = !decoupled;
     c.stop_messages = stop;
-    c.delay = 0.001;
+    c.delay = delay;
     c.json = true;
     fly_config(&c, f);
+}
+
+/* As fly_delayed, 1 ms late. */
+static void fly_late(const char *path, bool decoupled, uint32_t stop, flight_t *f)
+{
+    fly_delayed(path, decoupled, stop, 0.001, f);
 }
 
 /* Flies paper.json centralised under the script. */
@@ -415,14 +421,7 @@ END_TEST
  * joint plan. */
 static void fly_leaderless(const char *path, double delay)
 {
-    coavoid_sim_config_t c;
-    memset(&c, 0, sizeof c);
-    c.scenario_path = path;
-    c.mode = "centralised";
-    c.has_stop = true;
-    c.delay = delay;
-    c.json = true;
-    fly_config(&c, &scripted);
+    fly_delayed(path, false, 0u, delay, &scripted);
     ck_assert_int_eq(scripted.verdict, COAVOID_SIM_SEPARATED);
     ck_assert_uint_gt(scripted.outcome.joint_plans, 0);
 }
