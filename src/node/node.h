@@ -192,8 +192,8 @@
 /* The joint plan of a vehicle's group when no priority order solves it (joint_members,
  * joint_beta of coavoid_vehicle_node_config_t): groups of up to this many UAVs, in the
  * drivers and the simulation, for vehicles that follow a coordinator; and the search's
- * bound on stored nodes by default. 5,000 nodes solve every group of the sweep's 2-5 UAV
- * encounters that the coordinator's 20,000 do (docs/evaluation.md). */
+ * bound on stored nodes by default, which solves the encounters that needed it in
+ * docs/evaluation.md ("The sweep with the group's joint plan"; 2,000 do not solve all). */
 #define COAVOID_NODE_DEFAULT_JOINT_MEMBERS 5u
 #define COAVOID_NODE_DEFAULT_JOINT_BETA 5000u
 
