@@ -224,15 +224,19 @@ static coavoid_lcm_sequence_table_t *sequence_table(coavoid_node_inbox_t *in,
     return in->secure ? NULL : &s->table;
 }
 
-/* FNV-1a (64 bits) of a message's bytes. */
-static uint64_t fingerprint(const void *data, size_t size)
+uint64_t coavoid_node_fnv(uint64_t h, const void *data, size_t size)
 {
     const uint8_t *p = data;
-    uint64_t h = UINT64_C(14695981039346656037);
     for (size_t i = 0; i < size; i++) {
         h = (h ^ p[i]) * UINT64_C(1099511628211);
     }
     return h;
+}
+
+/* FNV-1a (64 bits) of a message's bytes. */
+static uint64_t fingerprint(const void *data, size_t size)
+{
+    return coavoid_node_fnv(COAVOID_NODE_FNV_OFFSET, data, size);
 }
 
 static bool sent_by_self(const coavoid_node_inbox_t *in, const void *data, size_t size)
@@ -1058,6 +1062,76 @@ int coavoid_node_problem_tracks(coavoid_node_problem_tracks_t *out, const coavoi
     }
     out->count = n;
     return COA_OK;
+}
+
+#define NODE_MIX(h, value) coavoid_node_fnv((h), &(value), sizeof(value))
+
+static uint64_t vec_digest(uint64_t h, const coa_vec3_t *p)
+{
+    h = NODE_MIX(h, p->x);
+    h = NODE_MIX(h, p->y);
+    return NODE_MIX(h, p->z);
+}
+
+static uint64_t vehicle_digest(uint64_t h, const coa_vehicle_t *v)
+{
+    h = NODE_MIX(h, v->id);
+    h = NODE_MIX(h, v->priority);
+    h = NODE_MIX(h, v->cruise_speed);
+    h = NODE_MIX(h, v->climb_rate);
+    h = NODE_MIX(h, v->steep_factor);
+    h = NODE_MIX(h, v->volume.radius);
+    h = NODE_MIX(h, v->volume.half_height);
+    h = NODE_MIX(h, v->route_count);
+    for (size_t r = 0; r < v->route_count; r++) {
+        h = vec_digest(h, &v->route[r]);
+    }
+    h = NODE_MIX(h, v->initial_offset);
+    return NODE_MIX(h, v->max_offset);
+}
+
+static uint64_t obstacle_digest(uint64_t h, const coa_obstacle_t *o)
+{
+    h = NODE_MIX(h, o->kind);
+    if (o->kind == COA_OBSTACLE_BOX) {
+        return vec_digest(vec_digest(h, &o->box.min), &o->box.max);
+    }
+    h = NODE_MIX(h, o->polytope.count);
+    for (size_t k = 0; k < o->polytope.count; k++) {
+        h = vec_digest(h, &o->polytope.vertices[k]);
+    }
+    return h;
+}
+
+static uint64_t samples_digest(uint64_t h, const coa_vec3_t *samples, uint32_t horizon)
+{
+    for (uint32_t k = 0; k <= horizon; k++) {
+        h = vec_digest(h, &samples[k]);
+    }
+    return h;
+}
+
+uint64_t coavoid_node_problem_digest(const coa_problem_t *problem)
+{
+    uint64_t h = COAVOID_NODE_FNV_OFFSET;
+    h = NODE_MIX(h, problem->dt);
+    h = NODE_MIX(h, problem->horizon);
+    h = NODE_MIX(h, problem->vehicle_count);
+    for (size_t i = 0; i < problem->vehicle_count; i++) {
+        h = vehicle_digest(h, &problem->vehicles[i]);
+        h = samples_digest(h, problem->references[i], problem->horizon);
+    }
+    h = NODE_MIX(h, problem->obstacle_count);
+    for (size_t o = 0; o < problem->obstacle_count; o++) {
+        h = obstacle_digest(h, &problem->obstacles[o]);
+    }
+    h = NODE_MIX(h, problem->track_count);
+    for (size_t j = 0; j < problem->track_count; j++) {
+        h = NODE_MIX(h, problem->tracks[j].volume.radius);
+        h = NODE_MIX(h, problem->tracks[j].volume.half_height);
+        h = samples_digest(h, problem->track_samples[j], problem->horizon);
+    }
+    return h;
 }
 
 int coavoid_node_problem(coa_problem_t *problem, coavoid_node_problem_tracks_t *tracks,

@@ -316,6 +316,18 @@ void coavoid_node_view_build(coavoid_node_view_t *view, const coavoid_node_inbox
 void coavoid_node_view_build_before(coavoid_node_view_t *view, const coavoid_node_inbox_t *in,
                                     int64_t cycle_start, int64_t now, int64_t before);
 
+/* FNV-1a (64 bits) of size bytes at data, continuing from h (COAVOID_NODE_FNV_OFFSET to
+ * start). O(size). */
+#define COAVOID_NODE_FNV_OFFSET UINT64_C(14695981039346656037)
+uint64_t coavoid_node_fnv(uint64_t h, const void *data, size_t size);
+
+/* A digest of everything a planner reads of a problem (coa_problem_t, plan.h): dt, the
+ * horizon, each UAV's fields and route, its references, each obstacle (its kind, box or
+ * polytope's vertices), each track's volume and samples; each value by its own bytes, so
+ * padding never enters it. Equal problems have equal digests; two problems that differ
+ * share one with probability 2^-64. O(size of the problem). */
+uint64_t coavoid_node_problem_digest(const coa_problem_t *problem);
+
 /* The planning problem of `count` UAVs over `horizon` steps (the common N, or up to
  * COAVOID_NODE_LOOKAHEAD more; vehicles and references[i], horizon + 1 samples each: the
  * caller's, and the problem points to them) around the inbox's obstacles, the

@@ -160,6 +160,10 @@ struct coavoid_vehicle_node {
     size_t agreed_count;
     uint16_t agreed_id[ORDER_MEMBERS_MAX];
     int32_t agreed_rank[ORDER_MEMBERS_MAX];
+    /* The joint plan's last search that found none (search_joint): its cycle and its
+     * problem's digest. */
+    int64_t joint_failed_cycle;
+    uint64_t joint_failed_digest;
 
     coavoid_node_solver_t solver;
     coavoid_node_inbox_t inbox;
@@ -1233,7 +1237,8 @@ static int look_ahead(coavoid_vehicle_node_t *node, size_t count, coa_problem_t 
  * it takes its place in the order the ranks announce (`order`: order_current's), its row
  * the joint plan's. Returns 1 when agreed; 0 when the group has more than joint_members
  * UAVs or the search finds no plan (infeasible, or out of beta: the greedy raise
- * remains); or an error of the search. Cost: one joint search (2n tables, then at most
+ * remains; the same problem again in the cycle is not searched again); or an error of the
+ * search. Cost: a digest of the problem, and one joint search (2n tables, then at most
  * joint_beta stored nodes a group). Memory: the node's planner, sized for it at create. */
 static int search_joint(coavoid_vehicle_node_t *node, size_t count, size_t self,
                         const coa_problem_t *problem, const size_t *order)
@@ -1241,9 +1246,19 @@ static int search_joint(coavoid_vehicle_node_t *node, size_t count, size_t self,
     if (count > node->config.joint_members) {
         return 0;
     }
+    /* The order search runs several times a cycle on the same intents (overtaken, a
+     * first intent, world news); the same problem fails the same way. */
+    const uint64_t digest = coavoid_node_problem_digest(problem);
+    if (node->joint_failed_cycle == node->state.cycle && node->joint_failed_digest == digest) {
+        return 0;
+    }
     coa_plan_result_t result;
     const int rc =
         coa_plan_centralised(node->solver.planner, problem, node->order_offsets, &result);
+    if (rc == COA_OK && result.status != COA_PLAN_SOLVED) {
+        node->joint_failed_cycle = node->state.cycle;
+        node->joint_failed_digest = digest;
+    }
     if (rc != COA_OK || result.status != COA_PLAN_SOLVED) {
         return rc;
     }
@@ -2014,6 +2029,7 @@ coavoid_vehicle_node_t *coavoid_vehicle_node_create(const coavoid_vehicle_node_c
     node->state.cycle = -1;
     node->settled_cycle = -1;
     node->redecided_cycle = node->agreed_cycle = node->news_cycle = node->decided_cycle = -1;
+    node->joint_failed_cycle = -1;
     node->self_commit_at = INT64_MAX;
     node->state.offset = node->config.vehicle.initial_offset;
     node->state.last_outcome = -1;
