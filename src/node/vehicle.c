@@ -1255,12 +1255,13 @@ static int search_joint(coavoid_vehicle_node_t *node, size_t count, size_t self,
     coa_plan_result_t result;
     const int rc =
         coa_plan_centralised(node->solver.planner, problem, node->order_offsets, &result);
-    if (rc == COA_OK && result.status != COA_PLAN_SOLVED) {
+    if (rc != COA_OK) {
+        return rc;
+    }
+    if (result.status != COA_PLAN_SOLVED) {
         node->joint_failed_cycle = node->state.cycle;
         node->joint_failed_digest = digest;
-    }
-    if (rc != COA_OK || result.status != COA_PLAN_SOLVED) {
-        return rc;
+        return 0;
     }
     order_agree(node, count, order, self);
     node->state.joint_plans++;
