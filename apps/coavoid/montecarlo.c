@@ -18,11 +18,12 @@
 #define MC_DEFAULT_SEED 1u
 #define MC_DEFAULT_COUNT 100u
 #define MC_MAX_COUNT 100000u
+#define MC_MAX_FIRST 1000000000u
 
 #define MONTECARLO_USAGE                                                                    \
-    "usage: coavoid montecarlo --vehicles N[,N...] [--count C] [--seed S] [--beta B]\n"     \
-    "                          [--max-orders M] [--csv FILE] [--svg FILE] [--json]\n"       \
-    "                          [--save DIR] [--jobs J] [--quiet]\n"                         \
+    "usage: coavoid montecarlo --vehicles N[,N...] [--count C] [--first I] [--seed S]\n"    \
+    "                          [--beta B] [--max-orders M] [--csv FILE] [--svg FILE]\n"     \
+    "                          [--json] [--save DIR] [--jobs J] [--quiet]\n"                \
     "                          [--fly [--loss P] [--delay S] [--jitter S] [--net-seed N]\n" \
     "                                 [--coordinator-stops-sweep all|ends]]\n"              \
     "       coavoid montecarlo --figure-from A.csv,B.csv,... --svg FILE\n"                  \
@@ -38,6 +39,9 @@
     "options:\n"                                                                            \
     "  --vehicles N,...  UAVs per encounter, each %u..%u, e.g. 2,3,4 (required)\n"          \
     "  --count C         encounters per N, 1..%u; default %u\n"                             \
+    "  --first I         the first encounter's index, 0..%u; default 0: runs encounters\n"  \
+    "                    I..I+C-1 of the seed, so a long run split in parts (one --first\n" \
+    "                    each) gives the rows of one run\n"                                 \
     "  --seed S          the encounters' random seed, an integer >= 0; default %u\n"        \
     "  --beta B          closed-set bound, B >= 1, for every search; default %u, lowered\n" \
     "                    per N where the centralised workspace would pass 1 GiB\n"          \
@@ -93,7 +97,8 @@ static void montecarlo_help(void)
 {
     printf(MONTECARLO_USAGE, coavoid_encounter_montecarlo.horizon, coavoid_encounter_montecarlo.dt,
            COAVOID_ENCOUNTER_MIN_VEHICLES, COAVOID_ENCOUNTER_MAX_VEHICLES, MC_MAX_COUNT,
-           MC_DEFAULT_COUNT, MC_DEFAULT_SEED, COAVOID_DEFAULT_BETA, COAVOID_MONTECARLO_MAX_JOBS);
+           MC_DEFAULT_COUNT, MC_MAX_FIRST, MC_DEFAULT_SEED, COAVOID_DEFAULT_BETA,
+           COAVOID_MONTECARLO_MAX_JOBS);
     printf(MONTECARLO_USAGE_FLY, COAVOID_MC_FIGURE_MAX_FILES);
 }
 
@@ -105,6 +110,8 @@ typedef struct {
     uint32_t size_count;
     const char *count_text;
     uint32_t count;
+    const char *first_text;
+    uint32_t first;
     const char *seed_text;
     uint64_t seed;
     const char *beta_text;
@@ -206,6 +213,10 @@ static int mc_option(int argc, char **argv, int *i, void *options)
         status = coavoid_cli_count_option(argc, argv, i, "--count", NULL, false, MC_MAX_COUNT,
                                           &o->count_text, &value);
         o->count = (uint32_t)value;
+    } else if (coavoid_cli_option_is(arg, "--first")) {
+        status = coavoid_cli_count_option(argc, argv, i, "--first", NULL, true, MC_MAX_FIRST,
+                                          &o->first_text, &value);
+        o->first = (uint32_t)value;
     } else if (coavoid_cli_option_is(arg, "--seed")) {
         status = coavoid_cli_count_option(argc, argv, i, "--seed", NULL, true, UINT64_MAX,
                                           &o->seed_text, &value);
@@ -264,10 +275,10 @@ static int figure_options(const mc_options_t *o)
     if (o->svg == NULL) {
         return coavoid_cli_fail(CLI_EXIT_INVALID, "--figure-from: needs --svg FILE");
     }
-    if (o->vehicles_text != NULL || o->count_text != NULL || o->seed_text != NULL ||
-        o->beta_text != NULL || o->max_orders_text != NULL || o->csv != NULL || o->save != NULL ||
-        o->json || o->jobs_text != NULL || o->quiet || o->fly ||
-        coavoid_cli_network_given(&o->network) || o->net_seed_text != NULL ||
+    if (o->vehicles_text != NULL || o->count_text != NULL || o->first_text != NULL ||
+        o->seed_text != NULL || o->beta_text != NULL || o->max_orders_text != NULL ||
+        o->csv != NULL || o->save != NULL || o->json || o->jobs_text != NULL || o->quiet ||
+        o->fly || coavoid_cli_network_given(&o->network) || o->net_seed_text != NULL ||
         o->sweep_text != NULL) {
         return coavoid_cli_fail(CLI_EXIT_INVALID,
                                 "--figure-from: takes --svg only (it runs no encounters)");
@@ -341,6 +352,7 @@ static coavoid_montecarlo_config_t mc_engine_config(const mc_options_t *o)
     memcpy(c.vehicles, o->sizes, sizeof c.vehicles);
     c.size_count = o->size_count;
     c.count = o->count;
+    c.first = o->first;
     c.seed = o->seed;
     c.beta = o->beta_text != NULL ? o->beta : 0u;                   /* 0: the default */
     c.max_orders = o->max_orders_text != NULL ? o->max_orders : 0u; /* 0: every order */

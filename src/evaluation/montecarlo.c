@@ -372,8 +372,8 @@ static void *worker(void *arg)
         coavoid_mc_result_t result;
         char err[sizeof run->error];
         const coavoid_montecarlo_config_t *c = &run->mc->config;
-        int rc = solve_encounter(c->seed, item_size(run, item), item % c->count, c->save, &planners,
-                                 &result, err, sizeof err);
+        int rc = solve_encounter(c->seed, item_size(run, item), c->first + item % c->count, c->save,
+                                 &planners, &result, err, sizeof err);
         if (rc == 0 && c->fly) {
             rc = fly_encounter(c, item_size(run, item), &result, err, sizeof err);
         }
@@ -643,9 +643,9 @@ static int check_config(const coavoid_montecarlo_config_t *c, coavoid_run_error_
 {
     if (c->size_count == 0 || c->size_count > COAVOID_MONTECARLO_MAX_SIZES || c->count == 0 ||
         c->jobs == 0 || c->jobs > COAVOID_MONTECARLO_MAX_JOBS ||
-        c->count > UINT32_MAX / COAVOID_MONTECARLO_MAX_SIZES) {
+        c->count > UINT32_MAX / COAVOID_MONTECARLO_MAX_SIZES || c->first > UINT32_MAX - c->count) {
         return coavoid_run_fail(e, COAVOID_RUN_ERR_INPUT,
-                                "montecarlo: UAV counts, --count or --jobs out of range");
+                                "montecarlo: UAV counts, --count, --first or --jobs out of range");
     }
     const double dt = coavoid_encounter_montecarlo.dt;
     if (c->fly && (!(c->loss >= 0.0 && c->loss < 1.0) || !(c->delay >= 0.0) ||

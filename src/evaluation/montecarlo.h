@@ -54,6 +54,10 @@ typedef struct {
     uint32_t vehicles[COAVOID_MONTECARLO_MAX_SIZES];
     uint32_t size_count;
     uint32_t count;
+    /* The first encounter's index: each UAV count runs encounters first..first+count-1 of
+     * the seed's sequence (each is drawn from its own index, so a long run can be split
+     * into parts that together give the same rows); first + count <= UINT32_MAX. */
+    uint32_t first;
     uint64_t seed;
     /* The closed-set bound of every search, >= 1; 0: per UAV count, coavoid_default_beta
      * of its centralised planner (the programs' sizing policy, scenario.h). */

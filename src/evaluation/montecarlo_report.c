@@ -211,8 +211,13 @@ static void text_summary(FILE *f, const coavoid_montecarlo_config_t *o, const mc
                          uint32_t sizes)
 {
     const coavoid_encounter_design_t *d = &coavoid_encounter_montecarlo;
-    fprintf(f, "montecarlo: seed %llu, %lu encounters per UAV count, %u steps of %g s\n",
-            (unsigned long long)o->seed, (unsigned long)o->count, d->horizon, d->dt);
+    fprintf(f, "montecarlo: seed %llu, %lu encounters per UAV count", (unsigned long long)o->seed,
+            (unsigned long)o->count);
+    if (o->first > 0) {
+        fprintf(f, " (%lu to %lu)", (unsigned long)o->first,
+                (unsigned long)(o->first + o->count - 1u));
+    }
+    fprintf(f, ", %u steps of %g s\n", d->horizon, d->dt);
     for (uint32_t k = 0; k < sizes; k++) {
         const mc_summary_t *z = &s[k];
         fprintf(f, "\n%lu UAVs: %lu encounters (%lu redraws), beta %lu, max orders %lu\n",
@@ -416,6 +421,7 @@ static int json_summary(FILE *f, const coavoid_montecarlo_config_t *o, const mc_
         root != NULL && cJSON_AddStringToObject(root, "command", "montecarlo") != NULL &&
         cJSON_AddRawToObject(root, "seed", seed) != NULL &&
         cJSON_AddNumberToObject(root, "count", o->count) != NULL &&
+        cJSON_AddNumberToObject(root, "first", o->first) != NULL &&
         cJSON_AddNumberToObject(root, "horizon", coavoid_encounter_montecarlo.horizon) != NULL &&
         cJSON_AddNumberToObject(root, "dt", coavoid_encounter_montecarlo.dt) != NULL &&
         (list = cJSON_AddArrayToObject(root, "sizes")) != NULL;

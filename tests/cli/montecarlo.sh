@@ -31,10 +31,10 @@ with open(csv_path, newline="") as f:
     rows = [dict(zip(header, r)) for r in reader]
 b = json.load(open(json_path))
 assert b["command"] == "montecarlo" and b["horizon"] >= 1 and b["dt"] > 0, b
-count = b["count"]
+count, first = b["count"], b["first"]
 sizes = [s["vehicles"] for s in b["sizes"]]
 # Every encounter once per method, in order: sizes as given, then index, then method.
-expect = [(n, j, m) for n in sizes for j in range(count) for m in methods]
+expect = [(n, j, m) for n in sizes for j in range(first, first + count) for m in methods]
 got = [(int(r["vehicles"]), int(r["index"]), r["method"]) for r in rows]
 assert got == expect, (got[:6], expect[:6])
 for r in rows:
@@ -153,6 +153,15 @@ PY
 fi
 if expect_ok jobs montecarlo "${set_a[@]}" --jobs 2 --csv "$tmp/c.csv"; then
     rows_equal "--jobs 2" "$tmp/a.csv" "$tmp/c.csv"
+fi
+# A run split in two parts (--first) gives the whole run's rows: each encounter is drawn
+# from its own index, not from those before it.
+if expect_ok "first 0" montecarlo --vehicles 2 --count 2 --seed 7 --beta 2000 --quiet --csv "$tmp/p0.csv" &&
+    expect_ok "first 2" montecarlo --vehicles 2 --count 3 --first 2 --seed 7 --beta 2000 --quiet \
+        --csv "$tmp/p2.csv" --svg "$tmp/p2.svg" --json; then
+    cp "$tmp/out" "$tmp/p2.json"
+    check "first 2" "$tmp/p2.csv" "$tmp/p2.json" "$tmp/p2.svg"
+    rows_equal "parts" <(grep -E '^(seed|7,2,)' "$tmp/a.csv") <(cat "$tmp/p0.csv" && tail -n +2 "$tmp/p2.csv")
 fi
 # Another seed draws other encounters.
 if expect_ok other_seed montecarlo --vehicles 2 --count 5 --seed 8 --quiet --csv "$tmp/d.csv"; then
@@ -326,6 +335,9 @@ expect_bad "vehicles no value" "--vehicles" montecarlo --vehicles
 expect_bad "count 0" "--count" montecarlo --vehicles 2 --count 0
 expect_bad "count huge" "--count" montecarlo --vehicles 2 --count 99999999999999999999
 expect_bad "seed negative" "--seed" montecarlo --vehicles 2 --seed -1
+expect_bad "first negative" "--first" montecarlo --vehicles 2 --first -1
+expect_bad "first huge" "--first" montecarlo --vehicles 2 --first 1000000001
+expect_bad "figure with first" "--figure-from" montecarlo --figure-from "$tmp/f0.csv" --svg "$tmp/g.svg" --first 2
 expect_bad "beta 0" "--beta" montecarlo --vehicles 2 --beta 0
 expect_bad "beta too large" "--beta" montecarlo --vehicles 5 --beta 4000000000
 expect_bad "max orders 0" "--max-orders" montecarlo --vehicles 2 --max-orders 0
