@@ -19,11 +19,15 @@
 #include "drivers.h"
 #include "scenario.h"
 
+/* Its joint search's workspace grows by 2 bytes per node (docs/benchmarks.md). */
+#define VEHICLE_MAX_JOINT_BETA 1000000u
+
 #define VEHICLE_USAGE                                                                             \
     "usage: coavoid-vehicle --scenario FILE --id ID [--mode centralised|decoupled]\n"             \
     "                       [--lcm-url URL] [--epoch UTIME] [--speed S] [--steps K]\n"            \
     "                       [--coordinator-timeout S] [--coordinator-id ID]\n"                    \
-    "                       [--priority-wait S] (--key FILE --trust FILE | --insecure)\n"         \
+    "                       [--priority-wait S] [--joint-members N [--joint-beta B]]\n"           \
+    "                       (--key FILE --trust FILE | --insecure)\n"                             \
     "       coavoid-vehicle --scenario FILE --list-ids\n"                                         \
     "\n"                                                                                          \
     "Flies the UAV with this id from the scenario in real time, exchanging intents and\n"         \
@@ -42,12 +46,19 @@
     "                      65001, coavoid-coordinator's\n"                                        \
     "  --priority-wait S   decoupled: scenario seconds it waits for the intents of the\n"         \
     "                      higher-priority UAVs that pass near it, 0 <= S < dt; default dt / 2\n" \
+    "  --joint-members N   centralised: while it plans for itself, it plans its group\n"          \
+    "                      jointly, as the coordinator would, where no priority order\n"          \
+    "                      solves it, for groups of up to N UAVs (2 to 6; 0: never, and\n"        \
+    "                      its planner is then one UAV's); default the scenario's UAVs, at\n"     \
+    "                      most 5. Give every vehicle of the fleet the same\n"                    \
+    "  --joint-beta B      centralised: the nodes that joint search may store, 1 to\n"            \
+    "                      1000000; default 5000; the same on every vehicle\n"                    \
     "  --list-ids          print the scenario's vehicle ids, one per line, and exit (for\n"       \
     "                      scripts that start one process per UAV)\n"                             \
     "  -h, --help          show this help\n"                                                      \
     "\n"                                                                                          \
     "At the end (after K cycles, or on SIGINT/SIGTERM) it prints one summary line on\n"           \
-    "stderr: cycles, plans run and adopted, fallbacks to its own planning, messages\n"            \
+    "stderr: cycles, plans run and adopted, fallbacks to its own planning, joint plans\n"         \
     "received and rejected.\n"                                                                    \
     "\n"                                                                                          \
     "exit status: 0 done, 2 invalid input or usage (one line on stderr), 3 internal error\n"
@@ -65,6 +76,10 @@ typedef struct {
     uint16_t coordinator_id;
     const char *wait_text;
     double wait;
+    const char *joint_members_text;
+    uint64_t joint_members;
+    const char *joint_beta_text;
+    uint64_t joint_beta;
     coavoid_rt_options_t rt;
 } vehicle_options_t;
 
@@ -129,6 +144,20 @@ static int vehicle_option(int argc, char **argv, int *i, void *options)
         o->coordinator_id = (uint16_t)value;
     } else if (coavoid_cli_option_is(arg, "--priority-wait")) {
         status = parse_seconds(argc, argv, i, "--priority-wait", true, &o->wait_text, &o->wait);
+    } else if (coavoid_cli_option_is(arg, "--joint-members")) {
+        status = coavoid_cli_count_option(argc, argv, i, "--joint-members", "0 or 2 to 6", true,
+                                          COA_MAX_CENTRALISED, &o->joint_members_text,
+                                          &o->joint_members);
+        if (status == CLI_CONTINUE && o->joint_members == 1u) {
+            status = coavoid_cli_fail(CLI_EXIT_INVALID,
+                                      "--joint-members: must be 0 or 2 to %u, got 1 (a group of "
+                                      "one is planned alone)",
+                                      COA_MAX_CENTRALISED);
+        }
+    } else if (coavoid_cli_option_is(arg, "--joint-beta")) {
+        status =
+            coavoid_cli_count_option(argc, argv, i, "--joint-beta", NULL, false,
+                                     VEHICLE_MAX_JOINT_BETA, &o->joint_beta_text, &o->joint_beta);
     }
     return status;
 }
@@ -150,8 +179,9 @@ static int parse_options(int argc, char **argv, vehicle_options_t *o)
     }
     if (o->list_ids) {
         if (o->id_text != NULL || o->mode != NULL || o->timeout_text != NULL ||
-            o->coordinator_text != NULL || o->wait_text != NULL || o->rt.lcm_url != NULL ||
-            o->rt.epoch_text != NULL || o->rt.speed_text != NULL || o->rt.steps_text != NULL) {
+            o->coordinator_text != NULL || o->wait_text != NULL || o->joint_members_text != NULL ||
+            o->joint_beta_text != NULL || o->rt.lcm_url != NULL || o->rt.epoch_text != NULL ||
+            o->rt.speed_text != NULL || o->rt.steps_text != NULL) {
             return coavoid_cli_fail(CLI_EXIT_INVALID, "--list-ids: takes only --scenario FILE");
         }
         return CLI_CONTINUE;
@@ -167,6 +197,15 @@ static int parse_options(int argc, char **argv, vehicle_options_t *o)
     if (o->decoupled && o->coordinator_text != NULL) {
         return coavoid_cli_fail(CLI_EXIT_INVALID,
                                 "--coordinator-id: only valid with --mode centralised");
+    }
+    /* The joint plan is the coordinator's plan, made by its vehicles when it is gone. */
+    if (o->decoupled && (o->joint_members_text != NULL || o->joint_beta_text != NULL)) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: only valid with --mode centralised",
+                                o->joint_members_text != NULL ? "--joint-members" : "--joint-beta");
+    }
+    if (o->joint_beta_text != NULL && o->joint_members_text != NULL && o->joint_members == 0u) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                "--joint-beta: --joint-members 0 plans no group jointly");
     }
     if (o->coordinator_text != NULL && o->coordinator_id == o->id) {
         return coavoid_cli_fail(CLI_EXIT_INVALID, "--coordinator-id: %u is this vehicle's own id",
@@ -190,11 +229,12 @@ static void vehicle_report(void *user, const char *name, const coavoid_rt_result
 {
     const coavoid_vehicle_node_state_t *st = coavoid_vehicle_node_state(user);
     fprintf(stderr,
-            "%s: %lld cycles, plans run %u, plans adopted %u, fallbacks %u, messages received "
-            "%lld, rejected %lld (last: %s)%s\n",
+            "%s: %lld cycles, plans run %u, plans adopted %u, fallbacks %u, joint plans %u, "
+            "messages received %lld, rejected %lld (last: %s)%s\n",
             name, (long long)result->cycles, (unsigned)st->plans_run, (unsigned)st->plans_adopted,
-            (unsigned)st->fallbacks, (long long)st->rx.received, (long long)st->rx.rejected,
-            st->rx.last_reason != NULL ? st->rx.last_reason : "none", tail);
+            (unsigned)st->fallbacks, (unsigned)st->joint_plans, (long long)st->rx.received,
+            (long long)st->rx.rejected, st->rx.last_reason != NULL ? st->rx.last_reason : "none",
+            tail);
 }
 
 /* Everything after the options and the scenario. Returns the exit status. */
@@ -225,7 +265,10 @@ static int run(void *options, coavoid_scenario_t *s)
     config.mode = o->decoupled ? COAVOID_NODE_DECOUPLED : COAVOID_NODE_CENTRALISED;
     config.coordinator_id = o->coordinator_id; /* 0: the default */
     config.intent_copies = COAVOID_NODE_DEFAULT_COPIES;
-    config.joint_members = coavoid_node_joint_members(config.mode, s->vehicle_count);
+    config.joint_members = o->joint_members_text != NULL
+                               ? (size_t)o->joint_members
+                               : coavoid_node_joint_members(config.mode, s->vehicle_count);
+    config.joint_beta = (uint32_t)o->joint_beta; /* 0: the default */
     config.coordinator_timeout_us =
         o->timeout_text != NULL ? llround(o->timeout * 1e6) : llround(2.5 * (double)dt_us);
     config.priority_wait_us = o->wait_text != NULL ? llround(o->wait * 1e6) : dt_us / 2;

@@ -16,7 +16,11 @@
 #   e) a path that drops every IP datagram over 1,500 bytes (an nftables rule in the
 #      namespace): every message fits one datagram, so the flight is the same as with no
 #      loss, and as `coavoid sim`'s;
-# (the flights: late_encounter.json for a and b, paper.json with a lead-in for c, d, e)
+#   f) centralised vehicles whose coordinator never speaks, on an encounter no priority
+#      order solves: they plan their group jointly and stay separated; with
+#      --joint-members 0 they do not, and lose separation;
+# (the flights: late_encounter.json for a and b, paper.json with a lead-in for c, d, e,
+# tests/encounters/joint_plan_220.json for f)
 # and every bad option or input of the drivers exits 2 with one line, the missing
 # multicast route included. Every process signs and checks with keys from
 # `coavoid keygen`; `--insecure` runs are named as such.
@@ -159,7 +163,9 @@ sleep_until_cycle() {
 
 # fleet NAME SCENARIO MODE STEPS KILL_AT [COORDINATOR_ARGS...]: lcm-logger, the world, the
 # coordinator (centralised) and one vehicle per UAV, on one epoch; with KILL_AT (a number
-# of cycles, or -), the coordinator gets SIGTERM then. With $attack set, the attacker too
+# of cycles, or -), the coordinator gets SIGTERM then. MODE leaderless: the vehicles fly
+# centralised but no coordinator runs (it is gone before its first message); each vehicle
+# also gets the options in $vehicle_args. With $attack set, the attacker too
 # (forge.c's attack, its options in $forge_args; "replay-log" replays $replay_log with
 # lcm-logplayer instead). Leaves in $tmp/NAME: log.lcm, each
 # process's stderr (NAME.txt) and exit status (NAME.rc), log.json (log.py's summary) and
@@ -167,7 +173,8 @@ sleep_until_cycle() {
 fleet() {
     local name=$1 scenario=$2 mode=$3 steps=$4 kill_at=$5
     shift 5
-    local dir=$tmp/$name
+    local dir=$tmp/$name vmode=$mode
+    [ "$mode" = leaderless ] && vmode=centralised
     mkdir -p "$dir"
     lcm-logger -q -f --lcm-url="$url" "$dir/log.lcm" >"$dir/logger.out" 2>&1 &
     local logger=$!
@@ -199,8 +206,9 @@ fleet() {
     local id
     for id in $(ids "$scenario"); do
         # shellcheck disable=SC2046
-        "$vehicle" --scenario "$scenario" --id "$id" --mode "$mode" "${common[@]}" \
-            $(key "vehicle-$id") 2>"$dir/vehicle-$id.txt" &
+        # shellcheck disable=SC2086 # vehicle_args are options
+        "$vehicle" --scenario "$scenario" --id "$id" --mode "$vmode" "${common[@]}" \
+            $(key "vehicle-$id") ${vehicle_args:-} 2>"$dir/vehicle-$id.txt" &
         pids+=($!) names+=("vehicle-$id")
     done
     if [ "$kill_at" != - ]; then
@@ -216,7 +224,7 @@ fleet() {
     kill -INT "$logger"
     wait "$logger"
     python3 "$tmp/log.py" "$dir/log.lcm" "$tmp/py" >"$dir/log.json" 2>"$dir/log.err"
-    "$bin" summary "$dir/log.lcm" "$scenario" --mode "$mode" --json --epoch "$epoch" \
+    "$bin" summary "$dir/log.lcm" "$scenario" --mode "$vmode" --json --epoch "$epoch" \
         --trust "$keys/trust.txt" >"$dir/summary.json" 2>"$dir/summary.err"
     echo $? >"$dir/summary.rc"
     if [ -n "${VERBOSE:-}" ]; then
@@ -296,6 +304,16 @@ bin=$vehicle expect_bad "vehicle, priority wait of a whole cycle" "--priority-wa
     --scenario "$headon" --id 1 --mode decoupled --priority-wait 1 --insecure
 bin=$vehicle expect_bad "vehicle, coordinator timeout when decoupled" "--coordinator-timeout" \
     --scenario "$headon" --id 1 --mode decoupled --coordinator-timeout 2
+bin=$vehicle expect_bad "vehicle, a joint plan of one" "--joint-members" --scenario "$headon" --id 1 \
+    --joint-members 1 --insecure
+bin=$vehicle expect_bad "vehicle, a joint plan of 7" "--joint-members" --scenario "$headon" --id 1 \
+    --joint-members 7 --insecure
+bin=$vehicle expect_bad "vehicle, a joint plan when decoupled" "--joint-members" \
+    --scenario "$headon" --id 1 --mode decoupled --joint-members 3 --insecure
+bin=$vehicle expect_bad "vehicle, a joint beta with no joint plan" "--joint-beta" \
+    --scenario "$headon" --id 1 --joint-members 0 --joint-beta 100 --insecure
+bin=$vehicle expect_bad "vehicle, joint beta 0" "--joint-beta" --scenario "$headon" --id 1 \
+    --joint-beta 0 --insecure
 bin=$vehicle expect_bad "vehicle, an unknown LCM provider" "--lcm-url" --scenario "$headon" --id 1 \
     --lcm-url "nope://" --insecure
 bin=$vehicle expect_bad "vehicle, a stray argument" "unexpected argument" "$headon"
@@ -588,5 +606,34 @@ s is not None and s['loss_of_separation'] is False and s['steps'] == 48
         nft delete table inet coavoid_mtu
     fi
 fi
+
+# ---- f) no coordinator at all: the vehicles plan their group jointly ----
+
+# 4-UAV encounter 220 of the Monte Carlo set (tests/encounters/joint_plan_220.json),
+# flown by vehicles that follow a coordinator that never speaks: each plans for itself
+# once its timeout passes, and no priority order solves the group, so each plans the
+# group jointly from the same intents, finds the same plan and flies its row
+# (docs/protocol.md, "Priority negotiation", step 5): separation kept, as in
+# test_protocol's simulation of it. With --joint-members 0 they have only the greedy
+# raise, and lose it: the option reaches the node.
+keys220=$tmp/keys220
+mkdir -p "$keys220"
+joint=$src/tests/encounters/joint_plan_220.json
+if ! "$bin" keygen "$joint" --dir "$keys220" >"$tmp/keygen220.out" 2>&1; then
+    fail "coavoid keygen (220): $(cat "$tmp/keygen220.out")"
+fi
+speed=${SPEED:-4}
+keys=$keys220 fleet leaderless "$joint" leaderless 24 -
+check leaderless "
+rc == {'world': 0, 'vehicle-1': 0, 'vehicle-2': 0, 'vehicle-3': 0, 'vehicle-4': 0, 'summary': 0}
+all(num(f'vehicle-{i}', 'rejected') == 0 for i in (1, 2, 3, 4))
+log['plans'] == [] and 'COAVOID_PLAN' not in log['counts']
+all(num(f'vehicle-{i}', 'joint plans') >= 1 for i in (1, 2, 3, 4))
+s is not None and s['loss_of_separation'] is False and s['steps'] == 24"
+keys=$keys220 vehicle_args="--joint-members 0" fleet leaderless-alone "$joint" leaderless 24 -
+check leaderless-alone "
+rc == {'world': 0, 'vehicle-1': 0, 'vehicle-2': 0, 'vehicle-3': 0, 'vehicle-4': 0, 'summary': 1}
+all(num(f'vehicle-{i}', 'joint plans') == 0 for i in (1, 2, 3, 4))
+s is not None and s['loss_of_separation'] is True"
 
 finish
