@@ -2223,6 +2223,35 @@ START_TEST(test_bad_configs_refused)
     ck_assert_uint_eq(coavoid_node_joint_members(COAVOID_NODE_CENTRALISED, 30u),
                       COAVOID_NODE_DEFAULT_JOINT_MEMBERS);
     ck_assert_uint_eq(coavoid_node_joint_members(COAVOID_NODE_DECOUPLED, 4u), 0u);
+    /* The memo of failed joint searches: a power of two of keys, or none. */
+    uint64_t keys[8];
+    coavoid_node_joint_memo_t memo;
+    ck_assert_int_eq(coavoid_node_joint_memo_init(&memo, keys, 6u), COA_ERR_ARGUMENT);
+    ck_assert(!coavoid_node_joint_memo_has(&memo, 5u));
+    coavoid_node_joint_memo_add(&memo, 5u); /* a refused memo remembers nothing */
+    ck_assert(!coavoid_node_joint_memo_has(&memo, 5u));
+    ck_assert_int_eq(coavoid_node_joint_memo_init(&memo, NULL, 8u), COA_ERR_ARGUMENT);
+    ck_assert_int_eq(coavoid_node_joint_memo_init(&memo, NULL, 0u), COA_OK);
+    coavoid_node_joint_memo_add(&memo, 5u);
+    ck_assert(!coavoid_node_joint_memo_has(&memo, 5u));
+    ck_assert(!coavoid_node_joint_memo_has(NULL, 5u));
+    ck_assert_int_eq(coavoid_node_joint_memo_init(&memo, keys, 8u), COA_OK);
+    /* Keys that share a slot (the same low bits), 0 among them: each found, none else. */
+    const uint64_t same_slot[4] = {0u, 8u, UINT64_C(16) << 32, 24u};
+    for (size_t k = 0; k < 4u; k++) {
+        ck_assert(!coavoid_node_joint_memo_has(&memo, same_slot[k]));
+        coavoid_node_joint_memo_add(&memo, same_slot[k]);
+        coavoid_node_joint_memo_add(&memo, same_slot[k]); /* once only */
+    }
+    ck_assert_uint_eq(memo.count, 4u);
+    for (size_t k = 0; k < 4u; k++) {
+        ck_assert(coavoid_node_joint_memo_has(&memo, same_slot[k]));
+    }
+    /* Half full: it adds nothing more, and a look-up still ends. */
+    coavoid_node_joint_memo_add(&memo, 3u);
+    ck_assert_uint_eq(memo.count, 4u);
+    ck_assert(!coavoid_node_joint_memo_has(&memo, 3u));
+    ck_assert(!coavoid_node_joint_memo_has(&memo, 32u));
     /* Its own obstacles: at most COAVOID_NODE_MAX_CONFIGURED_OBSTACLES, each valid. */
     coa_obstacle_t own[COAVOID_NODE_MAX_CONFIGURED_OBSTACLES + 1u];
     for (size_t i = 0; i <= COAVOID_NODE_MAX_CONFIGURED_OBSTACLES; i++) {

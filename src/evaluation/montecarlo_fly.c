@@ -26,14 +26,19 @@ static uint64_t fly_seed(uint64_t seed, uint32_t n, uint32_t index)
 
 #define FLY_MAX_CYCLES COAVOID_MC_MAX_CYCLES
 
+/* The encounter's memo of failed joint searches, kept across its runs (node.h): a 5-UAV
+ * encounter's stopped runs repeat a few failing problems thousands of times. */
+#define FLY_JOINT_MEMO_KEYS 4096u
+
 /* Where a run's coordinator stops (none: has_stop false), where to record its messages
- * per cycle (NULL: nowhere), and its tape (sim.h: recorded unstopped, replayed stopped;
- * NULL: none). */
+ * per cycle (NULL: nowhere), its tape (sim.h: recorded unstopped, replayed stopped;
+ * NULL: none), and the encounter's memo of failed joint searches. */
 typedef struct {
     bool has_stop;
     uint32_t step, messages;
     uint32_t *sent; /* FLY_MAX_CYCLES counts */
     coavoid_sim_tape_t *tape;
+    coavoid_node_joint_memo_t *memo;
 } fly_stop_t;
 
 /* The network's seed of encounter r's runs. */
@@ -73,6 +78,7 @@ static int fly_mode(const coavoid_montecarlo_config_t *c, const char *json, int 
     sc.coordinator_messages = stop->sent;
     sc.coordinator_messages_size = stop->sent != NULL ? FLY_MAX_CYCLES : 0u;
     sc.tape = stop->tape;
+    sc.joint_memo = stop->memo;
     sc.replay = stop->has_stop;
     coavoid_sim_outcome_t outcome;
     coavoid_run_error_t e;
@@ -96,7 +102,7 @@ static int fly_mode(const coavoid_montecarlo_config_t *c, const char *json, int 
 
 /* One stopped run of the sweep (cycle k, cut m) into r->sweep. 0, or -1 with err. */
 static int fly_stop(const coavoid_montecarlo_config_t *c, const char *json, coavoid_mc_result_t *r,
-                    coavoid_sim_tape_t *tape, uint32_t k, uint32_t m, char *err, size_t err_size)
+                    const fly_stop_t *unstopped, uint32_t k, uint32_t m, char *err, size_t err_size)
 {
     coavoid_mc_sweep_t *w = &r->sweep;
     if (w->runs >= COAVOID_MC_MAX_STOPS) {
@@ -105,7 +111,7 @@ static int fly_stop(const coavoid_montecarlo_config_t *c, const char *json, coav
                  (unsigned long)r->index, (unsigned long)r->vehicles, COAVOID_MC_MAX_STOPS);
         return -1;
     }
-    const fly_stop_t stop = {true, k, m, NULL, tape};
+    const fly_stop_t stop = {true, k, m, NULL, unstopped->tape, unstopped->memo};
     coavoid_mc_flown_t f;
     if (fly_mode(c, json, COAVOID_MC_FLY_CENTRALISED, r, &stop, &f, err, err_size) != 0) {
         return -1;
@@ -123,10 +129,11 @@ static int fly_stop(const coavoid_montecarlo_config_t *c, const char *json, coav
 
 /* The coordinator-stop sweep of the encounter (config stops_sweep) into r->sweep: every
  * cycle of the unstopped centralised run, which sent sent[k] messages in cycle k and was
- * recorded on tape, which every stopped run replays. */
+ * recorded on its tape, which every stopped run replays (with its memo). */
 static int fly_sweep(const coavoid_montecarlo_config_t *c, const char *json, coavoid_mc_result_t *r,
-                     const uint32_t *sent, coavoid_sim_tape_t *tape, char *err, size_t err_size)
+                     const fly_stop_t *unstopped, char *err, size_t err_size)
 {
+    const uint32_t *sent = unstopped->sent;
     coavoid_mc_sweep_t *w = &r->sweep;
     w->cycles = 2u * coavoid_encounter_montecarlo.horizon + 1u;
     for (uint32_t k = 0; k < w->cycles; k++) {
@@ -134,7 +141,7 @@ static int fly_sweep(const coavoid_montecarlo_config_t *c, const char *json, coa
         const uint32_t points = w->sent[k] > 0u ? w->sent[k] : 1u;
         for (uint32_t m = 0; m < points; m++) {
             if (coavoid_mc_stop_flown(m, w->sent[k], c->stops_ends) &&
-                fly_stop(c, json, r, tape, k, m, err, err_size) != 0) {
+                fly_stop(c, json, r, unstopped, k, m, err, err_size) != 0) {
                 return -1;
             }
         }
@@ -163,15 +170,20 @@ int coavoid_mc_fly(const coavoid_montecarlo_config_t *c, const coavoid_mc_size_t
         snprintf(err, err_size, "out of memory for the coordinator's tape");
         return -1;
     }
+    uint64_t keys[FLY_JOINT_MEMO_KEYS];
+    coavoid_node_joint_memo_t memo;
+    (void)coavoid_node_joint_memo_init(&memo, keys, FLY_JOINT_MEMO_KEYS);
     int rc = 0;
     for (int mode = 0; mode < COAVOID_MC_FLY_MODES && rc == 0; mode++) {
         /* The cut points and the tape are the centralised run's. */
         const bool central = mode == COAVOID_MC_FLY_CENTRALISED;
-        const fly_stop_t stop = {false, 0u, 0u, central ? sent : NULL, central ? tape : NULL};
+        const fly_stop_t stop = {false, 0u, 0u, central ? sent : NULL, central ? tape : NULL,
+                                 &memo};
         rc = fly_mode(c, json, mode, r, &stop, &r->flown[mode], err, err_size);
     }
+    const fly_stop_t unstopped = {false, 0u, 0u, sent, tape, &memo};
     if (rc == 0 && c->stops_sweep) {
-        rc = fly_sweep(c, json, r, sent, tape, err, err_size);
+        rc = fly_sweep(c, json, r, &unstopped, err, err_size);
     }
     coavoid_sim_tape_destroy(tape);
     return rc;

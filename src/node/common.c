@@ -1213,6 +1213,51 @@ coa_planner_config_t coavoid_node_planner_config(uint32_t horizon, size_t search
     return c;
 }
 
+int coavoid_node_joint_memo_init(coavoid_node_joint_memo_t *memo, uint64_t *keys, size_t capacity)
+{
+    memset(memo, 0, sizeof *memo);
+    if ((capacity & (capacity - 1u)) != 0u || (keys == NULL && capacity > 0u)) {
+        return COA_ERR_ARGUMENT;
+    }
+    if (capacity > 0u) {
+        memset(keys, 0, capacity * sizeof keys[0]);
+    }
+    memo->keys = keys;
+    memo->capacity = capacity;
+    return COA_OK;
+}
+
+/* The key's slot, or the empty one where it would go. 0 is the empty slot's, so key 0
+ * is stored as 1 (one more collision in 2^64). */
+static size_t memo_slot(const coavoid_node_joint_memo_t *memo, uint64_t *key)
+{
+    *key = *key != 0u ? *key : 1u;
+    const size_t mask = memo->capacity - 1u;
+    size_t k = (size_t)(*key ^ (*key >> 32)) & mask;
+    while (memo->keys[k] != 0u && memo->keys[k] != *key) {
+        k = (k + 1u) & mask;
+    }
+    return k;
+}
+
+bool coavoid_node_joint_memo_has(const coavoid_node_joint_memo_t *memo, uint64_t key)
+{
+    return memo != NULL && memo->capacity > 0u && memo->keys[memo_slot(memo, &key)] == key;
+}
+
+void coavoid_node_joint_memo_add(coavoid_node_joint_memo_t *memo, uint64_t key)
+{
+    /* Never past half full: a probe stays short, and always ends at an empty slot. */
+    if (memo == NULL || memo->capacity == 0u || 2u * (memo->count + 1u) > memo->capacity) {
+        return;
+    }
+    const size_t k = memo_slot(memo, &key);
+    if (memo->keys[k] == 0u) {
+        memo->keys[k] = key;
+        memo->count++;
+    }
+}
+
 size_t coavoid_node_joint_members(coavoid_node_mode_t mode, size_t fleet)
 {
     if (mode != COAVOID_NODE_CENTRALISED || fleet < 2u) {

@@ -264,6 +264,31 @@ int64_t coavoid_node_cycle_of(const coavoid_node_common_t *c, int64_t utime);
 
 /* ---- vehicle ---- */
 
+/* Problems whose joint search (joint_members) found no plan, so that vehicles that search
+ * alike need not search one again. A vehicle on its own needs none: it skips a problem it
+ * failed on earlier in the cycle by itself. The simulation flies every member of a group
+ * in one process, and each searches the group's same problem; a sweep of coordinator
+ * stops flies an encounter again and again from the same start: one memo shared by them
+ * turns those repeats into look-ups (the search is deterministic, so the flight is the
+ * same). Keys are 64-bit digests of the problem and the search's bound: exact up to a
+ * collision (2^-64 a pair). The caller owns the keys (capacity, a power of two); once
+ * half of them are used it remembers nothing more (still exact, only slower). Not
+ * thread-safe: one memo a thread. */
+typedef struct {
+    uint64_t *keys;  /* 0: an empty slot */
+    size_t capacity; /* a power of two, or 0: remembers nothing */
+    size_t count;
+} coavoid_node_joint_memo_t;
+
+/* Empties memo over keys[0..capacity-1]. COA_ERR_ARGUMENT (memo left remembering nothing)
+ * when capacity is neither 0 nor a power of two, or keys is NULL with capacity > 0.
+ * O(capacity). */
+int coavoid_node_joint_memo_init(coavoid_node_joint_memo_t *memo, uint64_t *keys, size_t capacity);
+/* Whether memo (NULL: none) holds key, and adds it (nothing once half full). Expected
+ * O(1): linear probing in a table at most half full. */
+bool coavoid_node_joint_memo_has(const coavoid_node_joint_memo_t *memo, uint64_t key);
+void coavoid_node_joint_memo_add(coavoid_node_joint_memo_t *memo, uint64_t key);
+
 typedef struct {
     coavoid_node_common_t common;
     coa_vehicle_t vehicle; /* its route is the caller's and must outlive the node */
@@ -305,6 +330,10 @@ typedef struct {
      * (docs/benchmarks.md has the bytes). joint_beta 0: COAVOID_NODE_DEFAULT_JOINT_BETA. */
     size_t joint_members;
     uint32_t joint_beta;
+    /* NULL, or a memo of failed joint searches shared with vehicles that search alike
+     * (coavoid_node_joint_memo_t: the simulation's; the same joint_beta on each); not
+     * owned, and it must outlive the node. */
+    coavoid_node_joint_memo_t *joint_memo;
 } coavoid_vehicle_node_config_t;
 
 /* What a vehicle did; read by drivers, the simulation and tests. */

@@ -1237,9 +1237,10 @@ static int look_ahead(coavoid_vehicle_node_t *node, size_t count, coa_problem_t 
  * it takes its place in the order the ranks announce (`order`: order_current's), its row
  * the joint plan's. Returns 1 when agreed; 0 when the group has more than joint_members
  * UAVs or the search finds no plan (infeasible, or out of beta: the greedy raise
- * remains; the same problem again in the cycle is not searched again); or an error of the
- * search. Cost: a digest of the problem, and one joint search (2n tables, then at most
- * joint_beta stored nodes a group). Memory: the node's planner, sized for it at create. */
+ * remains; the same problem again in the cycle, or one the memo holds, is not searched
+ * again); or an error of the search. Cost: a digest of the problem, and one joint search
+ * (2n tables, then at most joint_beta stored nodes a group). Memory: the node's planner,
+ * sized for it at create. */
 static int search_joint(coavoid_vehicle_node_t *node, size_t count, size_t self,
                         const coa_problem_t *problem, const size_t *order)
 {
@@ -1247,9 +1248,13 @@ static int search_joint(coavoid_vehicle_node_t *node, size_t count, size_t self,
         return 0;
     }
     /* The order search runs several times a cycle on the same intents (overtaken, a
-     * first intent, world news); the same problem fails the same way. */
+     * first intent, world news); the same problem fails the same way, and so it does in
+     * the search of any vehicle that shares the memo (the same beta: in the key). */
     const uint64_t digest = coavoid_node_problem_digest(problem);
-    if (node->joint_failed_cycle == node->state.cycle && node->joint_failed_digest == digest) {
+    const uint64_t key =
+        coavoid_node_fnv(digest, &node->config.joint_beta, sizeof node->config.joint_beta);
+    if ((node->joint_failed_cycle == node->state.cycle && node->joint_failed_digest == digest) ||
+        coavoid_node_joint_memo_has(node->config.joint_memo, key)) {
         return 0;
     }
     coa_plan_result_t result;
@@ -1261,6 +1266,7 @@ static int search_joint(coavoid_vehicle_node_t *node, size_t count, size_t self,
     if (result.status != COA_PLAN_SOLVED) {
         node->joint_failed_cycle = node->state.cycle;
         node->joint_failed_digest = digest;
+        coavoid_node_joint_memo_add(node->config.joint_memo, key);
         return 0;
     }
     order_agree(node, count, order, self);

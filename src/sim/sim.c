@@ -39,6 +39,8 @@
  * its commits (32 per UAV + 32, with margin); the world every tile and track. More would
  * be a queue overflow: an error of the run, never a loss. */
 #define SIM_NET_VEHICLE_MESSAGES 32u
+/* A run's own memo of failed joint searches (a group fails a problem or two a cycle). */
+#define SIM_JOINT_MEMO_KEYS 256u
 #define SIM_NET_COORDINATOR_MESSAGES(n) (32u * (n) + 32u)
 typedef struct {
     /* The run's parameters (sim_check, sim_planner_sizes). */
@@ -61,7 +63,11 @@ typedef struct {
     uint64_t coordinator_sent; /* its messages out at the start of the cycle (config's record) */
     uint32_t stop_cycle_sent;  /* --coordinator-stops: its messages out in the cycle it stopped */
     bool replaying;            /* config's tape replayed in the coordinator's place */
-    size_t coordinator_calls;  /* its calls so far, recorded or replayed */
+    /* The vehicles' memo of failed joint searches: config's, or the run's own. */
+    coavoid_node_joint_memo_t *joint_memo;
+    coavoid_node_joint_memo_t own_memo;
+    uint64_t own_keys[SIM_JOINT_MEMO_KEYS];
+    size_t coordinator_calls; /* its calls so far, recorded or replayed */
     /* What the run holds (sim_run_free releases it). */
     coavoid_sim_net_t *net;
     int net_error; /* the network's first error (coavoid_sim_net_pump) */
@@ -770,6 +776,7 @@ static int sim_vehicles(sim_run_t *r)
         config.mode = r->o->decoupled ? COAVOID_NODE_DECOUPLED : COAVOID_NODE_CENTRALISED;
         config.intent_copies = COAVOID_NODE_DEFAULT_COPIES;
         config.joint_members = coavoid_node_joint_members(config.mode, r->n);
+        config.joint_memo = r->joint_memo;
         config.common.rx_lcm = coavoid_sim_net_rx(r->net, SIM_NET_VEHICLE(j));
         r->vehicles[j] = coavoid_vehicle_node_create(
             &config, coavoid_sim_net_tx(r->net, SIM_NET_VEHICLE(j)), &error);
@@ -1204,6 +1211,8 @@ int coavoid_sim_fly(const coavoid_sim_config_t *c, coavoid_scenario_t *s, FILE *
     r.s = s;
     r.file = c->scenario_path;
     r.n = s->vehicle_count;
+    (void)coavoid_node_joint_memo_init(&r.own_memo, r.own_keys, SIM_JOINT_MEMO_KEYS);
+    r.joint_memo = c->joint_memo != NULL ? c->joint_memo : &r.own_memo;
     int rc = sim_check(&r, s);
     if (rc == SIM_GO_ON) {
         rc = sim_planner_sizes(&r);

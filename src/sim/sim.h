@@ -28,6 +28,7 @@
 #include <stdio.h>
 
 #include "auth.h"
+#include "node.h"
 #include "run.h"
 #include "scenario.h"
 #include "tape.h"
@@ -72,6 +73,11 @@ typedef struct {
      * before a call is not the tape's) is an internal error, never a silent difference. */
     coavoid_sim_tape_t *tape;
     bool replay;
+    /* NULL, or a memo of the joint searches that found no plan (node.h,
+     * coavoid_node_joint_memo_t) for the run's vehicles, kept by the caller across runs of
+     * the same scenario (a sweep's stopped runs repeat the unstopped run's searches); NULL:
+     * the run's own, shared by its vehicles. The flight is the same either way. */
+    coavoid_node_joint_memo_t *joint_memo;
     bool json;            /* the result as JSON (default: text) */
     const char *svg_path; /* NULL, or where the figure goes */
     /* The nodes sign and check every message (default), with the simulation's fixed keys
