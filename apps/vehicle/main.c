@@ -50,16 +50,16 @@
     "                      jointly, as the coordinator would, where no priority order\n"          \
     "                      solves it, for groups of up to N UAVs (2 to 6; 0: never, and\n"        \
     "                      its planner is then one UAV's); default the scenario's UAVs, at\n"     \
-    "                      most 5. Give every vehicle of the fleet the same\n"                    \
+    "                      most 5; the same on every vehicle of the fleet\n"                      \
     "  --joint-beta B      centralised: the nodes that joint search may store, 1 to\n"            \
-    "                      1000000; default 5000; the same on every vehicle\n"                    \
+    "                      1000000; default 5000; the same on every vehicle of the fleet\n"       \
     "  --list-ids          print the scenario's vehicle ids, one per line, and exit (for\n"       \
     "                      scripts that start one process per UAV)\n"                             \
     "  -h, --help          show this help\n"                                                      \
     "\n"                                                                                          \
     "At the end (after K cycles, or on SIGINT/SIGTERM) it prints one summary line on\n"           \
     "stderr: cycles, plans run and adopted, fallbacks to its own planning, joint plans\n"         \
-    "received and rejected.\n"                                                                    \
+    "flown, messages received and rejected.\n"                                                    \
     "\n"                                                                                          \
     "exit status: 0 done, 2 invalid input or usage (one line on stderr), 3 internal error\n"
 

@@ -173,15 +173,14 @@ int coavoid_mc_fly(const coavoid_montecarlo_config_t *c, const coavoid_mc_size_t
     uint64_t keys[FLY_JOINT_MEMO_KEYS];
     coavoid_node_joint_memo_t memo;
     (void)coavoid_node_joint_memo_init(&memo, keys, FLY_JOINT_MEMO_KEYS);
+    /* The cut points and the tape are the centralised run's. */
+    const fly_stop_t unstopped = {false, 0u, 0u, sent, tape, &memo};
+    const fly_stop_t decoupled = {false, 0u, 0u, NULL, NULL, &memo};
     int rc = 0;
     for (int mode = 0; mode < COAVOID_MC_FLY_MODES && rc == 0; mode++) {
-        /* The cut points and the tape are the centralised run's. */
-        const bool central = mode == COAVOID_MC_FLY_CENTRALISED;
-        const fly_stop_t stop = {false, 0u, 0u, central ? sent : NULL, central ? tape : NULL,
-                                 &memo};
-        rc = fly_mode(c, json, mode, r, &stop, &r->flown[mode], err, err_size);
+        const fly_stop_t *stop = mode == COAVOID_MC_FLY_CENTRALISED ? &unstopped : &decoupled;
+        rc = fly_mode(c, json, mode, r, stop, &r->flown[mode], err, err_size);
     }
-    const fly_stop_t unstopped = {false, 0u, 0u, sent, tape, &memo};
     if (rc == 0 && c->stops_sweep) {
         rc = fly_sweep(c, json, r, &unstopped, err, err_size);
     }

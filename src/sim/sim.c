@@ -63,8 +63,7 @@ typedef struct {
     uint64_t coordinator_sent; /* its messages out at the start of the cycle (config's record) */
     uint32_t stop_cycle_sent;  /* --coordinator-stops: its messages out in the cycle it stopped */
     bool replaying;            /* config's tape replayed in the coordinator's place */
-    /* The vehicles' memo of failed joint searches: config's, or the run's own. */
-    coavoid_node_joint_memo_t *joint_memo;
+    /* The vehicles' memo of failed joint searches when config has none. */
     coavoid_node_joint_memo_t own_memo;
     uint64_t own_keys[SIM_JOINT_MEMO_KEYS];
     size_t coordinator_calls; /* its calls so far, recorded or replayed */
@@ -776,7 +775,7 @@ static int sim_vehicles(sim_run_t *r)
         config.mode = r->o->decoupled ? COAVOID_NODE_DECOUPLED : COAVOID_NODE_CENTRALISED;
         config.intent_copies = COAVOID_NODE_DEFAULT_COPIES;
         config.joint_members = coavoid_node_joint_members(config.mode, r->n);
-        config.joint_memo = r->joint_memo;
+        config.joint_memo = r->o->joint_memo != NULL ? r->o->joint_memo : &r->own_memo;
         config.common.rx_lcm = coavoid_sim_net_rx(r->net, SIM_NET_VEHICLE(j));
         r->vehicles[j] = coavoid_vehicle_node_create(
             &config, coavoid_sim_net_tx(r->net, SIM_NET_VEHICLE(j)), &error);
@@ -1212,7 +1211,6 @@ int coavoid_sim_fly(const coavoid_sim_config_t *c, coavoid_scenario_t *s, FILE *
     r.file = c->scenario_path;
     r.n = s->vehicle_count;
     (void)coavoid_node_joint_memo_init(&r.own_memo, r.own_keys, SIM_JOINT_MEMO_KEYS);
-    r.joint_memo = c->joint_memo != NULL ? c->joint_memo : &r.own_memo;
     int rc = sim_check(&r, s);
     if (rc == SIM_GO_ON) {
         rc = sim_planner_sizes(&r);
