@@ -1111,36 +1111,85 @@ static void fx_head_on(fx_t *f, uint32_t horizon, double half)
     fx_vehicle(f, 2u, 1u, 10.0, 4.0, 2u, 5.0, half, V(60, 0, 100), V(-60, 0, 100));
 }
 
+/* Whether (units, effort) is lexicographically at most the result's lower bound... the
+ * other way round: whether the result's bound is at most (units, effort). */
+static bool bound_at_most(const coa_plan_result_t *r, u128_t units, uint32_t effort)
+{
+    u128_t b = to_u128(r->bound_units);
+    return b < units || (b == units && r->bound_effort <= effort);
+}
+
 /* Head-on, each UAV's plan alone goes through the other and neither can go around the
  * other at its own optimal cost, so independence detection merges the two and only a
- * joint search finds the optimum (which shares the manoeuvre: head_on_is_separated). */
-START_TEST(tiny_beta_is_budget_exhausted)
+ * joint search finds the optimum (which shares the manoeuvre: head_on_is_separated). At a
+ * tiny beta that search runs out, and the answer is the incumbent, the priority order's
+ * plan, with a lower bound below the optimum. Held within one climb step of their
+ * references, no priority order has a plan (one UAV alone flies level, the other cannot
+ * get clear of it) while the joint one does (one up, one down): at a tiny beta nothing is
+ * found and nothing is proven. */
+START_TEST(tiny_beta_answers_the_incumbent)
 {
     static fx_t f;
     static int32_t rows[MAXV * (MAXN + 1u)];
     ws_t w;
     coa_plan_result_t r;
+    coa_plan_result_t d;
+    u128_t optimum;
+    uint32_t effort;
 
     fx_head_on(&f, 12u, 3.0);
     fx_finish(&f);
-    w = ws_make(2u, 3u);
-    ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
-    ck_assert_int_eq(r.status, COA_PLAN_BUDGET_EXHAUSTED);
-    ck_assert_uint_eq(r.largest_group, 2u);
-    /* The one joint search stopped when its pool of beta nodes was full, not before. */
-    ck_assert_uint_eq(r.nodes_generated, 3u);
-    ck_assert(to_u128(r.deviation_units) == 0u); /* nothing proven, no costs */
-    ws_free(&w);
-
-    /* With room, the same problem is solved: the budget was the only obstacle. */
     w = ws_make(2u, 20000u);
     ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
     ck_assert_int_eq(r.status, COA_PLAN_SOLVED);
-    ck_assert_uint_eq(r.largest_group, 2u);
+    ck_assert(r.optimal);
+    ck_assert_int_eq(r.limit, COA_PLAN_LIMIT_NONE);
+    ck_assert(to_u128(r.bound_units) == to_u128(r.deviation_units));
+    ck_assert_uint_eq(r.bound_effort, r.effort);
+    ck_assert_double_eq_tol(r.bound_deviation, r.deviation, 1e-9 * r.deviation);
     ck_assert_uint_gt(r.nodes_generated, 3u);
-    ck_assert_uint_le(r.nodes_generated, 20000u);
+    check_solved_plan(&f, rows, &r);
+    optimum = to_u128(r.deviation_units);
+    effort = r.effort;
+    ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, NULL, 1u, rows, &d), COA_OK);
+    ck_assert_int_eq(d.status, COA_PLAN_SOLVED);
+    ck_assert(to_u128(d.deviation_units) > optimum); /* the joint plan shares the climb */
+    ws_free(&w);
+
+    w = ws_make(2u, 3u);
+    ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
+    ck_assert_int_eq(r.status, COA_PLAN_SOLVED);
+    ck_assert(!r.optimal);
+    ck_assert_int_eq(r.limit, COA_PLAN_LIMIT_BETA);
+    ck_assert_uint_eq(r.largest_group, 2u);
+    ck_assert_uint_eq(r.nodes_generated, 3u); /* stopped when the pool was full */
+    ck_assert(to_u128(r.deviation_units) == to_u128(d.deviation_units));
+    ck_assert_uint_eq(r.effort, d.effort);
+    ck_assert(bound_at_most(&r, optimum, effort));
+    ck_assert(to_u128(r.bound_units) > 0u);
+    check_solved_plan(&f, rows, &r);
+
+    f.veh[0].max_offset = 1;
+    f.veh[1].max_offset = 1;
+    fx_finish(&f);
+    ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
+    ck_assert_int_eq(r.status, COA_PLAN_BUDGET_EXHAUSTED);
+    ck_assert_int_eq(r.limit, COA_PLAN_LIMIT_BETA);
+    ck_assert(!r.optimal);
+    ck_assert(to_u128(r.deviation_units) == 0u); /* no plan, no costs */
+    ck_assert(to_u128(r.bound_units) > 0u);
+    ws_free(&w);
+    w = ws_make(2u, 20000u);
+    ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, NULL, 2u, rows, &d), COA_OK);
+    ck_assert_int_eq(d.status, COA_PLAN_INFEASIBLE);
+    ck_assert(d.all_orders_covered);
+    ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
+    ck_assert_int_eq(r.status, COA_PLAN_SOLVED);
+    ck_assert(r.optimal);
     check_solved_plan(&f, rows, &r);
     ws_free(&w);
+    fx_head_on(&f, 12u, 3.0);
+    fx_finish(&f);
 
     /* Decoupled: B has to move around A, but it reads that off its table against A's
      * plan and stores no node, so even the smallest beta is enough. */
@@ -1151,6 +1200,90 @@ START_TEST(tiny_beta_is_budget_exhausted)
     ck_assert_uint_eq(r.orders_tried, 1u);
     ck_assert_int_gt(r.effort, 0u);
     check_decoupled_attempt(&f, rows, &r);
+    ws_free(&w);
+}
+END_TEST
+
+/* One budgeted call against the unbudgeted result u of the same problem: it spends at
+ * most the budget; what it claims holds (a plan is conflict-free, a bound is at most the
+ * optimum, OPTIMAL only at the optimum, infeasible only when it is); and a budget that
+ * ran out says so. */
+static void check_budgeted(const fx_t *f, const int32_t *rows, const coa_plan_result_t *r,
+                           const coa_plan_result_t *u, uint64_t budget)
+{
+    ck_assert_uint_le(r->work, budget);
+    if (r->limit != COA_PLAN_LIMIT_WORK) {
+        ck_assert_int_eq(r->status, u->status);
+    }
+    if (r->status == COA_PLAN_INFEASIBLE) {
+        ck_assert_int_eq(u->status, COA_PLAN_INFEASIBLE);
+        return;
+    }
+    if (u->status == COA_PLAN_SOLVED && u->optimal) {
+        ck_assert(bound_at_most(r, to_u128(u->deviation_units), u->effort));
+    }
+    if (r->status == COA_PLAN_SOLVED) {
+        check_solved_plan(f, rows, r);
+        ck_assert(!r->optimal || (to_u128(r->deviation_units) == to_u128(u->deviation_units) &&
+                                  r->effort == u->effort));
+    } else {
+        ck_assert_int_eq(r->status, COA_PLAN_BUDGET_EXHAUSTED);
+        ck_assert_int_eq(r->limit, COA_PLAN_LIMIT_WORK);
+    }
+}
+
+/* The work budget (plan.h, "Work"): random problems of 2-3 UAVs planned without a budget,
+ * then with budgets below what they took (each call stays within its budget and claims
+ * only what holds), and with four times it (the same answer, the same work). */
+START_TEST(work_budget_bounds_every_call)
+{
+    static fx_t f;
+    static int32_t rows[MAXV * (MAXN + 1u)];
+    ws_t w = ws_make(3u, 30000u);
+    uint64_t rng = 0x5eed0b0du;
+    unsigned stopped = 0u;
+    unsigned trial;
+
+    ck_assert_int_eq(coa_planner_set_work(NULL, 1u), COA_ERR_ARGUMENT);
+    for (trial = 0; trial < 200u; ++trial) {
+        size_t n = 2u + pick(&rng, 2u);
+        coa_plan_result_t u;
+        coa_plan_result_t r;
+        uint64_t cuts[3];
+        size_t c;
+        int mode;
+        fx_random(&f, &rng, n, 2u + pick(&rng, 4u), (n == 3u) ? 2u : 3u);
+        for (mode = 0; mode < 2; ++mode) {
+#define PLAN(res)                                              \
+    (mode == 0 ? coa_plan_centralised(w.pl, &f.p, rows, (res)) \
+               : coa_plan_decoupled(w.pl, &f.p, NULL, 6u, rows, (res)))
+            ck_assert_int_eq(coa_planner_set_work(w.pl, 0u), COA_OK);
+            ck_assert_int_eq(PLAN(&u), COA_OK);
+            ck_assert_int_eq(u.limit == COA_PLAN_LIMIT_WORK, 0);
+            if (u.work == 0u) { /* decided at t = 0 without work */
+                ck_assert_int_eq(u.status, COA_PLAN_INFEASIBLE);
+                continue;
+            }
+            cuts[0] = 1u;
+            cuts[1] = u.work / 3u + 1u;
+            cuts[2] = u.work - 1u;
+            for (c = 0; c < 3u; ++c) {
+                ck_assert_int_eq(coa_planner_set_work(w.pl, cuts[c]), COA_OK);
+                ck_assert_int_eq(PLAN(&r), COA_OK);
+                check_budgeted(&f, rows, &r, &u, cuts[c]);
+                stopped += r.limit == COA_PLAN_LIMIT_WORK ? 1u : 0u;
+            }
+            ck_assert_int_eq(coa_planner_set_work(w.pl, 4u * u.work), COA_OK);
+            ck_assert_int_eq(PLAN(&r), COA_OK);
+            ck_assert_int_eq(r.status, u.status);
+            ck_assert_int_eq(r.limit, u.limit);
+            ck_assert_uint_eq(r.work, u.work);
+            ck_assert(to_u128(r.deviation_units) == to_u128(u.deviation_units));
+            ck_assert_uint_eq(r.effort, u.effort);
+#undef PLAN
+        }
+    }
+    ck_assert_uint_gt(stopped, 600u);
     ws_free(&w);
 }
 END_TEST
@@ -1311,7 +1444,7 @@ START_TEST(workspace_size_is_exact)
     fx_head_on(&f, 12u, 3.0);
     fx_finish(&f);
     ck_assert_int_eq(coa_plan_centralised(pl, &f.p, rows, &r), COA_OK);
-    ck_assert_int_eq(r.status, COA_PLAN_BUDGET_EXHAUSTED);
+    ck_assert_int_eq(r.limit, COA_PLAN_LIMIT_BETA);
     ck_assert_uint_eq(r.nodes_generated, c2.beta);
     ck_assert_uint_eq(r.workspace_bytes, bytes);
     ck_assert_int_eq(coa_plan_decoupled(pl, &f.p, NULL, 2u, rows, &r), COA_OK);
@@ -1791,10 +1924,16 @@ START_TEST(goal_on_top_is_taken_at_the_budget)
         w = ws_make(2u, beta);
         ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
         ck_assert_uint_eq(r.largest_group, 2u);
-        if (r.status == COA_PLAN_BUDGET_EXHAUSTED) {
+        if (r.limit == COA_PLAN_LIMIT_BETA) {
+            /* The answer is then the incumbent, with a bound below the optimum. */
             ck_assert_uint_eq(r.nodes_generated, beta);
+            ck_assert_int_eq(r.status, COA_PLAN_SOLVED);
+            ck_assert(!r.optimal && to_u128(r.deviation_units) > optimum);
+            ck_assert(bound_at_most(&r, optimum, effort));
+            check_solved_plan(&f, rows, &r);
             ++exhausted;
         } else {
+            ck_assert(r.optimal);
             ck_assert_int_eq(r.status, COA_PLAN_SOLVED);
             ck_assert_uint_le(r.nodes_generated, beta);
             ck_assert(to_u128(r.deviation_units) == optimum);
@@ -1915,10 +2054,13 @@ START_TEST(proof_for_every_order_outranks_budget)
     ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
     ck_assert_int_eq(r.status, COA_PLAN_INFEASIBLE);
     ck_assert_uint_eq(r.nodes_generated, 0u);
-    /* Without the wall, beta is what stops it. */
+    /* Without the wall, beta is what stops the joint search; the priority order's plan
+     * is the answer. */
     f.p.obstacle_count = 0u;
     ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
-    ck_assert_int_eq(r.status, COA_PLAN_BUDGET_EXHAUSTED);
+    ck_assert_int_eq(r.status, COA_PLAN_SOLVED);
+    ck_assert_int_eq(r.limit, COA_PLAN_LIMIT_BETA);
+    ck_assert(!r.optimal);
     ck_assert_uint_eq(r.nodes_generated, 1u);
     ws_free(&w);
 }
@@ -2046,7 +2188,8 @@ static Suite *plan_suite(void)
     tcase_add_test(tc, max_beta_inverts_workspace_size);
     tcase_add_test(tc, planner_takes_problems_within_its_config);
     tcase_add_test(tc, initial_conflict_is_infeasible_without_expanding);
-    tcase_add_test(tc, tiny_beta_is_budget_exhausted);
+    tcase_add_test(tc, tiny_beta_answers_the_incumbent);
+    tcase_add_test(tc, work_budget_bounds_every_call);
     tcase_add_test(tc, max_offset_is_respected);
     tcase_add_test(tc, head_on_is_separated);
     tcase_add_test(tc, problem_check_and_helpers);

@@ -383,6 +383,46 @@ static dec_verdict_t decoupled_compare(const fx_t *e, const coa_plan_result_t *o
 /* ------------------------------------------------------------------------------------ */
 /* The comparison                                                                        */
 
+/* The new planner's anytime claims against the reference's exact answer ro (solved or
+ * infeasible): within a third of the work its unbudgeted call took (rn_work), a plan is
+ * conflict-free, a lower bound is at most the optimum, OPTIMAL is claimed only at the
+ * optimum's cost and infeasible only when no plan exists. Returns whether the budget
+ * stopped the call (and, in *optimal, whether it still proved its plan optimal). */
+static bool check_anytime(coa_planner_t *pl, fx_t *e, const coa_plan_result_t *ro, uint64_t rn_work,
+                          int32_t *rows, unsigned trial, bool *optimal)
+{
+    const size_t n = e->p.vehicle_count;
+    const uint64_t cut = rn_work / 3u + 1u;
+    coa_plan_result_t rb;
+    REQUIRE(coa_planner_set_work(pl, cut) == COA_OK);
+    REQUIRE(coa_plan_centralised(pl, &e->p, rows, &rb) == COA_OK);
+    REQUIRE(coa_planner_set_work(pl, 0u) == COA_OK);
+    REQUIRE_MSG(rb.work <= cut, "trial %u: spent %llu of a budget of %llu", trial,
+                (unsigned long long)rb.work, (unsigned long long)cut);
+    *optimal = rb.optimal;
+    if (rb.status == COA_PLAN_INFEASIBLE) {
+        REQUIRE_MSG(ro->status == COA_PLAN_INFEASIBLE, "trial %u: infeasible claimed", trial);
+        return rb.limit == COA_PLAN_LIMIT_WORK;
+    }
+    if (ro->status == COA_PLAN_SOLVED) {
+        int c = coa_cost_compare(rb.bound_units, ro->deviation_units);
+        REQUIRE_MSG(c < 0 || (c == 0 && rb.bound_effort <= ro->effort),
+                    "trial %u: lower bound above the optimum", trial);
+    }
+    if (rb.status == COA_PLAN_SOLVED) {
+        REQUIRE_MSG(coa_plan_find_conflict(&e->p, rows, ALL, n, NULL, NULL) == 0 &&
+                        rows_well_formed(e, rows, ALL, n),
+                    "trial %u: the budgeted plan is not conflict-free", trial);
+        REQUIRE(ro->status == COA_PLAN_SOLVED);
+        REQUIRE_MSG(!rb.optimal || (cost_eq(rb.deviation_units, ro->deviation_units) &&
+                                    rb.effort == ro->effort),
+                    "trial %u: OPTIMAL claimed at another cost", trial);
+    } else {
+        REQUIRE(rb.status == COA_PLAN_BUDGET_EXHAUSTED && rb.limit == COA_PLAN_LIMIT_WORK);
+    }
+    return rb.limit == COA_PLAN_LIMIT_WORK;
+}
+
 START_TEST(new_planner_matches_old_on_random_encounters)
 {
     static fx_t e;
@@ -397,8 +437,10 @@ START_TEST(new_planner_matches_old_on_random_encounters)
     unsigned skipped[MAXV + 1u] = {0u};
     unsigned solved[MAXV + 1u] = {0u};
     unsigned infeasible[MAXV + 1u] = {0u};
-    unsigned merged = 0u;       /* new centralised searched two or more UAVs jointly */
-    unsigned dec_compared = 0u; /* decoupled calls compared */
+    unsigned merged = 0u;         /* new centralised searched two or more UAVs jointly */
+    unsigned budget_stopped = 0u; /* anytime: calls the work budget stopped */
+    unsigned budget_optimal = 0u; /* of them, still proven optimal */
+    unsigned dec_compared = 0u;   /* decoupled calls compared */
     unsigned dec_solved = 0u;
     unsigned dec_reordered = 0u;  /* solved by an order other than the first */
     unsigned dec_skipped = 0u;    /* the old planner ran out of beta */
@@ -470,6 +512,8 @@ START_TEST(new_planner_matches_old_on_random_encounters)
                             (unsigned long long)rn.deviation_units.hi,
                             (unsigned long long)rn.deviation_units.lo, rn.effort);
                 REQUIRE(fabs(ro.deviation - rn.deviation) <= 1e-9 * (1.0 + ro.deviation));
+                REQUIRE(rn.optimal && cost_eq(rn.bound_units, rn.deviation_units) &&
+                        rn.bound_effort == rn.effort);
                 ++solved[n];
                 merged += rn.largest_group >= 2u ? 1u : 0u;
             } else {
@@ -477,6 +521,13 @@ START_TEST(new_planner_matches_old_on_random_encounters)
             }
             ++compared[n];
             ++total_compared;
+            {
+                bool optimal = false;
+                if (check_anytime(nw.pl, &e, &ro, rn.work, nrows, trial, &optimal)) {
+                    ++budget_stopped;
+                    budget_optimal += optimal ? 1u : 0u;
+                }
+            }
         }
 
         /* Decoupled, in priority order, without and with reordering. */
@@ -525,14 +576,17 @@ START_TEST(new_planner_matches_old_on_random_encounters)
            "(%u merged groups); decoupled compared %u (%u solved, %u by reordering; %u "
            "skipped), %u of them diverged after a tie (%u with another status, %u with another "
            "cost); encounters: %u conflicting, %u with a box, %u with a track, %u bounded, %u "
-           "off-reference\n",
+           "off-reference; anytime: %u calls stopped by a third of their work (%u still "
+           "proven optimal)\n",
            compared[2], solved[2], infeasible[2], skipped[2], compared[3], solved[3], infeasible[3],
            skipped[3], compared[4], solved[4], infeasible[4], skipped[4], total_compared, TRIALS,
            merged, dec_compared, dec_solved, dec_reordered, dec_skipped, dec_tie, dec_tie_status,
-           dec_tie_cost, gen.conflicting, gen.with_box, gen.with_track, gen.bounded, gen.offset);
+           dec_tie_cost, gen.conflicting, gen.with_box, gen.with_track, gen.bounded, gen.offset,
+           budget_stopped, budget_optimal);
     fflush(stdout);
 
     ck_assert_uint_ge(total_compared, 2000u);
+    ck_assert_uint_ge(budget_stopped, 1500u);
     /* The old planner's beta is kept small so that its 4-UAV searches are fast: the cases
      * it cannot finish are skipped, but they must stay few. */
     ck_assert_uint_lt(total_skipped * 10u, TRIALS);

@@ -27,7 +27,8 @@ _Static_assert(COAVOID_DEFAULT_MAX_ORDERS == 7u * 6u * 5u * 4u * 3u * 2u * 1u &&
 /* A printf format so that the limits it quotes come from one place. */
 #define PLAN_USAGE                                                                            \
     "usage: coavoid plan SCENARIO.json --mode centralised|decoupled\n"                        \
-    "                    [--priority ID,ID,...] [--beta N] [--reorder [--max-orders N]]\n"    \
+    "                    [--priority ID,ID,...] [--beta N] [--work W]\n"                      \
+    "                    [--reorder [--max-orders N]]\n"                                      \
     "\n"                                                                                      \
     "Reads a scenario (JSON, at most %u MiB) and prints the plan result as JSON.\n"           \
     "\n"                                                                                      \
@@ -38,6 +39,9 @@ _Static_assert(COAVOID_DEFAULT_MAX_ORDERS == 7u * 6u * 5u * 4u * 3u * 2u * 1u &&
     "  --beta N            nodes a joint search may store, N >= 1; overrides the\n"           \
     "                      scenario's \"beta\"; default %u, lowered so the workspace stays\n" \
     "                      within 1 GiB (a node is 70 + 2 bytes per UAV)\n"                   \
+    "  --work W            work units the planning call may spend (about 10 ns each),\n"      \
+    "                      W >= 0, 0 for no limit; default %llu; centralised, the best\n"     \
+    "                      plan found by then is the answer, with its lower bound\n"          \
     "  --reorder           decoupled: when a UAV fails, try other priority orders\n"          \
     "  --max-orders N      with --reorder: try at most N orders, N >= 1; default %u\n"        \
     "                      (every order of up to %u UAVs); stats.all_orders_covered\n"        \
@@ -58,6 +62,8 @@ typedef struct {
     const char *priority; /* NULL: priority order */
     const char *beta_text;
     uint32_t beta;
+    const char *work_text; /* NULL: COAVOID_DEFAULT_WORK */
+    uint64_t work;
     bool reorder;
     const char *max_orders_text; /* NULL: COAVOID_DEFAULT_MAX_ORDERS */
     uint32_t max_orders;
@@ -66,7 +72,8 @@ typedef struct {
 static void plan_help(void)
 {
     printf(PLAN_USAGE, COAVOID_SCENARIO_MAX_BYTES / (1024u * 1024u), COA_MAX_CENTRALISED,
-           COAVOID_DEFAULT_BETA, COAVOID_DEFAULT_MAX_ORDERS, COAVOID_DEFAULT_MAX_ORDERS_COVER);
+           COAVOID_DEFAULT_BETA, (unsigned long long)COAVOID_DEFAULT_WORK,
+           COAVOID_DEFAULT_MAX_ORDERS, COAVOID_DEFAULT_MAX_ORDERS_COVER);
 }
 
 static int plan_option(int argc, char **argv, int *i, void *options)
@@ -84,6 +91,9 @@ static int plan_option(int argc, char **argv, int *i, void *options)
         status = coavoid_cli_count_option(argc, argv, i, "--beta", "an integer >= 1", false,
                                           UINT32_MAX, &o->beta_text, &value);
         o->beta = (uint32_t)value;
+    } else if (coavoid_cli_option_is(arg, "--work")) {
+        status = coavoid_cli_count_option(argc, argv, i, "--work", "an integer >= 0", true,
+                                          UINT64_MAX, &o->work_text, &o->work);
     } else if (coavoid_cli_option_is(arg, "--reorder")) {
         status = coavoid_cli_flag_option(arg, "--reorder", &o->reorder);
     } else if (coavoid_cli_option_is(arg, "--max-orders")) {
@@ -196,6 +206,7 @@ static int plan(void *options, coavoid_scenario_t *s)
         .order = o->priority != NULL ? order : NULL,
         .has_beta = o->beta_text != NULL,
         .beta = o->beta,
+        .work = o->work_text != NULL ? o->work : COAVOID_DEFAULT_WORK,
         .max_orders = o->reorder ? o->max_orders : 1u,
     };
     coavoid_run_error_t e;

@@ -7,8 +7,10 @@
  * samples k = 0..N. A plan gives every UAV an altitude offset at every sample; it is
  * conflict-free when no step of it conflicts (geometry.h) with another UAV's step, an
  * obstacle or a track's step. Its cost is lexicographic: the deviation area first, then
- * the effort (trajectory.h). Both front ends return an optimal plan (for decoupled:
- * optimal for each UAV given the ones before it) or prove there is none, on one engine:
+ * the effort (trajectory.h). The decoupled front end returns a plan optimal for each UAV
+ * given the ones before it, or proves there is none; the centralised one is anytime: it
+ * returns the best plan it found within its limits, with a proven lower bound on the
+ * optimum, and says when the two meet (optimal). Both run on one engine:
  *
  *   - Centralised: optimal for the whole group. Every UAV is first planned alone; while
  *     the plans of two groups of UAVs conflict, one group is re-planned around the
@@ -71,7 +73,37 @@
  * bounds each of them. An initial conflict (t = 0), or a UAV whose table is dead at its
  * initial offset, is infeasible with nothing expanded. nodes_expanded counts expansions,
  * a node taken back off the open list for more children counting again.
-
+ *
+ * Anytime (centralised). When the vehicles' own plans conflict, the planner first finds
+ * an incumbent: the decoupled order search (coa_plan_decoupled with reordering, from the
+ * priority order, stopped at the first order that works, at most 7! orders and half of
+ * what is left of the work budget). Every joint search of a group without fixed vehicles
+ * is then capped by the incumbent's rows of its members (a plan of the group alone) when
+ * they cost less than the members' plan in turn: nothing dearer is stored. When beta or
+ * the work budget stops independence detection, each group's optimum alone (or, for the
+ * group whose search stopped, the least f left open, and at least its parts' optima) is a
+ * lower bound on what the group costs in any plan, so their sum bounds the whole; the
+ * answer is then the incumbent, optimal when the bound reaches its cost, or no plan
+ * (COA_PLAN_BUDGET_EXHAUSTED, only when no priority order tried worked) with the bound.
+ * So a centralised answer never costs more than the first priority order that works, and
+ * COA_PLAN_SOLVED with result.optimal false carries a plan and [bound, cost] around the
+ * optimum. Among plans of the optimal cost, the one returned is the first found: the
+ * incumbent when it is proven optimal, else the joint searches' (ties as the open list
+ * orders them); deterministic, and the same in both precisions.
+ *
+ * Work. A planning call can be given a budget of work units (coa_planner_set_work), which
+ * it never passes: work is charged before it is done, and the call stops at the first
+ * charge that does not fit (result.limit COA_PLAN_LIMIT_WORK). A unit is about one cheap
+ * step of the planner: a table costs 5 units per cell of each row plus 5 per offset
+ * tested against each obstacle, track or fixed vehicle whose box the row touches (a
+ * polytope 1 + vertices / 8 units per test, its MPR test evaluating the support function
+ * several times); a cost-from-start table 5 per cell; a pair table 1 per cell; a joint
+ * search 1 + c per member choice made with c members chosen before it and 4 + m per
+ * complete combination of m choosers; each check of the groups' plans N n^2. The same
+ * call with the same budget does the same work everywhere (the count never depends on a
+ * clock), so a budget is a deterministic bound on time: docs/benchmarks.md gives the time
+ * per unit measured on the host.
+ *
  * Costs. The search minimises, lexicographically, the integer deviation
  * sum_i W_i * coa_area_scaled(a, b, S) (S = coa_area_scale and W_i 2^E =
  * coa_deviation_weights over all the problem's UAVs, whichever are searched), one unit
@@ -93,14 +125,16 @@
  *     T = sum over k = 0..N of min(2 k s + 1, 2 L + 1) cells of 8 bytes (N, s and L the
  *     config's horizon, steep factor and offset bound): every offset reachable in k
  *     steps, within the bound; 1,225 cells (9.8 kB) for N = 24 and s = 2;
- *   - for vehicles > 1: per member an entry list of one table row and its saved plan row,
+ *   - for vehicles > 1: per member an entry list of one table row, its saved plan row and
+ *     its incumbent row,
  *     and the node pool of beta nodes of 70 + 2 * vehicles bytes: key and g 16 each
  *     (128-bit packed costs), parent, heap entry and position 4 each, 2 hash slots of 4,
  *     sample 2, offsets 2 per UAV, and 16 bytes of pair-table arena (a pair table that
  *     does not fit is left out: a weaker heuristic, never a wrong one);
  *   - a fixed header (the per-call context, a few kB).
  * Running out of room can only happen through beta and is always reported as
- * COA_PLAN_BUDGET_EXHAUSTED, never as infeasible. docs/embedded.md has the bytes for
+ * COA_PLAN_BUDGET_EXHAUSTED (or, centralised, as a plan not proven optimal), never as
+ * infeasible. docs/embedded.md has the bytes for
  * each vehicle count on the host and on a Cortex-M4F. The planner keeps state between
  * calls in its buffer: one planner serves one thread at a time.
  *
@@ -142,11 +176,19 @@ typedef struct {
 } coa_problem_t;
 
 typedef enum {
-    COA_PLAN_SOLVED = 0, /* a plan was found and it is optimal */
+    COA_PLAN_SOLVED = 0, /* a conflict-free plan; centralised, optimal when result.optimal */
     COA_PLAN_INFEASIBLE =
         1, /* the search space is exhausted: no plan exists (decoupled: for this order) */
-    COA_PLAN_BUDGET_EXHAUSTED = 2 /* a joint search filled its beta nodes: nothing proven */
+    COA_PLAN_BUDGET_EXHAUSTED = 2 /* beta or the work budget ran out before any plan was
+                                     found: no plan, and none proven impossible */
 } coa_plan_status_t;
+
+/* Which limit ended a planning call early (file comment, "Anytime"). */
+typedef enum {
+    COA_PLAN_LIMIT_NONE = 0, /* nothing: the call finished its search */
+    COA_PLAN_LIMIT_BETA = 1, /* a joint search filled its beta nodes */
+    COA_PLAN_LIMIT_WORK = 2  /* the call spent its work budget */
+} coa_plan_limit_t;
 
 #define COA_NO_VEHICLE ((size_t)-1)
 
@@ -182,6 +224,16 @@ typedef struct {
                                   and each joint search of a group */
     size_t largest_group;    /* centralised: the most UAVs searched together (0 when
                                   nothing was searched) */
+    /* Centralised (file comment, "Anytime"): a lower bound on the optimum, exact and
+     * lexicographic: no plan costs less than (bound_units, bound_effort); bound_deviation
+     * is bound_units in m^2. 0 when nothing is known (decoupled, infeasible, or the
+     * budget ran out before every vehicle's table was built). */
+    double bound_deviation;
+    coa_cost_t bound_units;
+    uint32_t bound_effort;
+    bool optimal;           /* solved and proven optimal: the cost meets the bound */
+    coa_plan_limit_t limit; /* the limit that ended the call early, if any */
+    uint64_t work;          /* work units the call spent (file comment, "Work") */
 } coa_plan_result_t;
 
 typedef struct coa_planner coa_planner_t;
@@ -236,6 +288,12 @@ uint32_t coa_planner_max_beta(const coa_planner_config_t *config, size_t bytes);
  * before it used (one by one, or all when that is cheaper). */
 coa_planner_t *coa_planner_init(void *buffer, size_t size, const coa_planner_config_t *config);
 
+/* Sets the work budget of each of the planner's later calls, in work units (file
+ * comment, "Work"); 0, what coa_planner_init sets, is no limit. A coordinator gives each
+ * call what is left of its cycle. Returns COA_OK, COA_ERR_ARGUMENT for NULL, or
+ * COA_ERR_WORKSPACE for a buffer coa_planner_init did not build. Cost O(1), no memory. */
+int coa_planner_set_work(coa_planner_t *planner, uint64_t work);
+
 /* Checks a problem in full (counts, finite numbers, every vehicle and track, unique ids,
  * obstacles, non-NULL and finite samples) before a search trusts it. Returns COA_OK,
  * COA_ERR_ARGUMENT, or COA_ERR_RANGE when the costs cannot be exact: the deviation
@@ -246,8 +304,9 @@ coa_planner_t *coa_planner_init(void *buffer, size_t size, const coa_planner_con
  * vehicles) + tracks * (path + N) + polytope vertices), no memory. */
 int coa_problem_check(const coa_problem_t *problem);
 
-/* Centralised plan of every vehicle of the problem, optimal for the whole group
- * (independence detection over searches of groups: file comment).
+/* Centralised plan of every vehicle of the problem, anytime (file comment, "Anytime"):
+ * independence detection over searches of groups, capped by an incumbent found by the
+ * decoupled order search.
  * offsets: vehicle_count * (horizon+1) int32, row i is vehicle i; filled when solved,
  * unspecified otherwise (the searches of groups write their rows as they go). Returns
  * COA_OK with the outcome in *result, or COA_ERR_ARGUMENT (NULL, problem check failed),
@@ -255,11 +314,15 @@ int coa_problem_check(const coa_problem_t *problem);
  * factor or offset bound beyond its config, or not a planner). On an error *result is
  * cleared (when not NULL). An initial conflict (t = 0) is COA_PLAN_INFEASIBLE with no
  * node expanded; so is a vehicle that cannot reach k = N alone. A group without a plan
- * makes the call infeasible, a group out of beta makes it budget exhausted. The result's
- * order is 0..n-1, orders_tried 1, failed_vehicle COA_NO_VEHICLE; the costs are 0 unless
- * solved. Cost: the problem check, 2n tables, then fewer than n^2 joint searches (each
- * with its pair tables) of at most beta stored nodes each (see the file comment); no
- * memory beyond the workspace and O(1) stack. */
+ * makes the call infeasible. When beta or the work budget stops it (result.limit), the
+ * answer is the incumbent (COA_PLAN_SOLVED, optimal when the bound meets its cost) or,
+ * without one, COA_PLAN_BUDGET_EXHAUSTED; bound_* hold the lower bound in every outcome
+ * but infeasible. The result's order is 0..n-1, orders_tried 1, failed_vehicle
+ * COA_NO_VEHICLE; the costs are 0 unless solved. Cost: the problem check, 2n tables, the
+ * incumbent's order search (at most 7! orders of n tables), then fewer than n^2 joint
+ * searches (each with its pair tables) of at most beta stored nodes each (see the file
+ * comment), all within the work budget when one is set; no memory beyond the workspace
+ * and O(1) stack. */
 int coa_plan_centralised(coa_planner_t *planner, const coa_problem_t *problem, int32_t *offsets,
                          coa_plan_result_t *result);
 
@@ -288,6 +351,9 @@ int coa_plan_centralised(coa_planner_t *planner, const coa_problem_t *problem, i
  * no attempt ran out of beta; otherwise budget exhausted. orders_tried counts the
  * attempts; nodes are summed over every search, re-plans included. The costs cover the
  * planned_count vehicles of the reported order. Rows of other vehicles are unspecified.
+ * With a work budget (file comment, "Work") that runs out, the search stops there: status
+ * budget exhausted unless a proof covers every order, result.limit COA_PLAN_LIMIT_WORK,
+ * and the report keeps only the planned rows no later attempt overwrote.
  * Errors as coa_plan_centralised (the planner needs room for one vehicle), and
  * COA_ERR_ARGUMENT when max_orders is 0 or `order` is not a permutation.
  * Cost: in the worst case min(max_orders, n!) attempts of at most n single-UAV tables and

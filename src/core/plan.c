@@ -12,6 +12,7 @@
  *                                     go and cost from the start, and one more)
  *   int16_t  entries[vehicles * W]   (joint searches only, as everything below)
  *   int32_t  saved_rows[vehicles * (N + 1)]
+ *   int32_t  best_rows[vehicles * (N + 1)] (the incumbent)
  *   coa_cost_t pair_arena[C]         (pair tables: 16-byte cells)
  *   coa_cost_t key[C], g[C]          (packed 128-bit costs)
  *   uint32_t parent[C], heap_pos[C], heap[C]
@@ -41,6 +42,7 @@ typedef struct {
     size_t at_cells;
     size_t at_entries;
     size_t at_saved;
+    size_t at_best;
     size_t at_pairs;
     size_t at_key;
     size_t at_g;
@@ -83,6 +85,7 @@ static bool layout_nodes(const coa_planner_config_t *c, size_t *cursor, plan_lay
            reserve(cursor, off, sizeof(int16_t), &lo->at_entries) &&
            size_mul(c->vehicles, (size_t)c->horizon + 1u, &rows) &&
            reserve(cursor, rows, sizeof(int32_t), &lo->at_saved) &&
+           reserve(cursor, rows, sizeof(int32_t), &lo->at_best) &&
            reserve(cursor, lo->pair_cells, sizeof(coa_cost_t), &lo->at_pairs) &&
            reserve(cursor, n, sizeof(coa_cost_t), &lo->at_key) &&
            reserve(cursor, n, sizeof(coa_cost_t), &lo->at_g) &&
@@ -167,6 +170,7 @@ static void point_into(coa_planner_t *pl, unsigned char *base, const plan_layout
     }
     pl->entries = (int16_t *)(void *)(base + lo->at_entries);
     pl->saved_rows = (int32_t *)(void *)(base + lo->at_saved);
+    pl->best_rows = (int32_t *)(void *)(base + lo->at_best);
     pl->pair_arena = (coa_cost_t *)(void *)(base + lo->at_pairs);
     pl->key = (coa_cost_t *)(void *)(base + lo->at_key);
     pl->g = (coa_cost_t *)(void *)(base + lo->at_g);
@@ -216,6 +220,18 @@ coa_planner_t *coa_planner_init(void *buffer, size_t size, const coa_planner_con
     pl->m = 1u;
     pl->magic = PLAN_MAGIC;
     return pl;
+}
+
+int coa_planner_set_work(coa_planner_t *planner, uint64_t work)
+{
+    if (planner == NULL) {
+        return COA_ERR_ARGUMENT;
+    }
+    if (planner->magic != PLAN_MAGIC) {
+        return COA_ERR_WORKSPACE;
+    }
+    planner->work_limit = work;
+    return COA_OK;
 }
 
 int coa_planner_config_of(const coa_problem_t *problem, size_t vehicles, uint32_t beta,
@@ -337,17 +353,16 @@ static coa_cost_t worst_f(const coa_problem_t *p, const uint64_t *weights, uint3
  * (weights that do not fit 64 bits) can refuse a problem today; the check stays so that
  * raising a limit cannot silently break exactness. Fills the weights and the scale on
  * success. */
-static int check_range(const coa_problem_t *p, uint64_t *weights, uint32_t *scale)
+static int check_range(const coa_problem_t *p, uint64_t *weights, uint32_t *scale, int *exponent)
 {
     uint32_t s;
-    int exponent;
     int rc;
 
     s = coa_area_scale(p->vehicles, p->vehicle_count);
     if (s == 0u) {
         return COA_ERR_ARGUMENT;
     }
-    rc = coa_deviation_weights(p->vehicles, p->vehicle_count, p->dt, weights, &exponent);
+    rc = coa_deviation_weights(p->vehicles, p->vehicle_count, p->dt, weights, exponent);
     if (rc != COA_OK) {
         return rc;
     }
@@ -362,11 +377,12 @@ int coa_problem_check(const coa_problem_t *problem)
 {
     uint64_t weights[COA_MAX_VEHICLES];
     uint32_t scale;
+    int exponent;
     int rc = check_arguments(problem);
     if (rc != COA_OK) {
         return rc;
     }
-    return check_range(problem, weights, &scale);
+    return check_range(problem, weights, &scale, &exponent);
 }
 
 int coa_priority_order(const coa_vehicle_t *vehicles, size_t n, size_t *order)
@@ -510,6 +526,13 @@ static void result_clear(coa_plan_result_t *r)
     r->all_orders_covered = false;
     r->searches = 0u;
     r->largest_group = 0u;
+    r->bound_deviation = 0.0;
+    r->bound_units.hi = 0u;
+    r->bound_units.lo = 0u;
+    r->bound_effort = 0u;
+    r->optimal = false;
+    r->limit = COA_PLAN_LIMIT_NONE;
+    r->work = 0u;
 }
 
 /* Validates the call and loads the problem's cost parameters into the planner. */
@@ -529,7 +552,7 @@ static int load(coa_planner_t *pl, const coa_problem_t *problem, const int32_t *
     if (rc != COA_OK) {
         return rc;
     }
-    rc = check_range(problem, pl->weight, &pl->scale);
+    rc = check_range(problem, pl->weight, &pl->scale, &pl->exponent);
     if (rc != COA_OK) {
         return rc;
     }
@@ -546,6 +569,9 @@ static int load(coa_planner_t *pl, const coa_problem_t *problem, const int32_t *
         }
     }
     coa_plan_search_release(pl);
+    pl->work_used = 0u;
+    pl->out_of_work = false;
+    pl->have_best = false;
     pl->problem = problem;
     pl->rows = (int32_t *)(uintptr_t)offsets;
     for (i = 0; i < problem->vehicle_count; ++i) {
@@ -610,6 +636,15 @@ static bool packed_range_ok(const coa_planner_t *pl)
            (UINT64_C(1) << (64u - PLAN_EFF_BITS - 2u));
 }
 
+/* The work the call spent, and whether the budget ended it. */
+static void plan_result_work(const coa_planner_t *pl, coa_plan_result_t *r)
+{
+    r->work = pl->work_used;
+    if (pl->out_of_work) {
+        r->limit = COA_PLAN_LIMIT_WORK;
+    }
+}
+
 int coa_plan_centralised(coa_planner_t *planner, const coa_problem_t *problem, int32_t *offsets,
                          coa_plan_result_t *result)
 {
@@ -641,7 +676,12 @@ int coa_plan_centralised(coa_planner_t *planner, const coa_problem_t *problem, i
         }
         result->planned_count = problem->vehicle_count;
         coa_plan_fill_costs(planner, result->order, problem->vehicle_count, result);
+        if (result->optimal) {
+            /* The same cost: the formula's m^2, not the units' conversion. */
+            result->bound_deviation = result->deviation;
+        }
     }
+    plan_result_work(planner, result);
     return COA_OK;
 }
 
@@ -654,6 +694,9 @@ static coa_plan_status_t plan_one(coa_planner_t *pl, const size_t *order, size_t
     const int32_t start = pl->problem->vehicles[v].initial_offset;
     coa_plan_table_build(pl, &pl->scratch, v, order, level);
     ++r->searches;
+    if (pl->out_of_work) {
+        return COA_PLAN_BUDGET_EXHAUSTED;
+    }
     if (cell_dead(plan_table_at(&pl->scratch, 0u, start))) {
         return COA_PLAN_INFEASIBLE;
     }
@@ -824,6 +867,7 @@ int coa_plan_decoupled(coa_planner_t *planner, const coa_problem_t *problem, con
             }
             result->planned_count = o.n;
             coa_plan_fill_costs(planner, o.cur, o.n, result);
+            plan_result_work(planner, result);
             return COA_OK;
         }
         o.any_budget = o.any_budget || st == COA_PLAN_BUDGET_EXHAUSTED;
@@ -836,7 +880,7 @@ int coa_plan_decoupled(coa_planner_t *planner, const coa_problem_t *problem, con
              * attempts before the order space ran out. */
             o.proven = o.proven || coa_plan_any_initial_conflict(planner);
         }
-        if (o.proven) {
+        if (o.proven || planner->out_of_work) {
             break;
         }
         if (!orders_next(&o, fail)) {
@@ -845,7 +889,30 @@ int coa_plan_decoupled(coa_planner_t *planner, const coa_problem_t *problem, con
         }
     }
     orders_report(planner, &o, result);
+    plan_result_work(planner, result);
     return COA_OK;
+}
+
+bool coa_plan_orders_first(coa_planner_t *pl, uint32_t max_orders, coa_plan_result_t *r)
+{
+    orders_t o;
+    coa_plan_result_t counted;
+
+    result_clear(&counted);
+    (void)orders_init(pl->problem, NULL, &o); /* priority order: cannot fail */
+    while (counted.orders_tried < max_orders) {
+        coa_plan_status_t st;
+        size_t fail = orders_attempt(pl, &o, &counted, &st);
+        if (fail == o.n || pl->out_of_work || (fail == 0u && st == COA_PLAN_INFEASIBLE) ||
+            !orders_next(&o, fail)) {
+            r->searches += counted.searches;
+            r->nodes_expanded += counted.nodes_expanded;
+            return fail == o.n;
+        }
+    }
+    r->searches += counted.searches;
+    r->nodes_expanded += counted.nodes_expanded;
+    return false;
 }
 
 /* ------------------------------------------------------------------------------------ */

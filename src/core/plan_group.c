@@ -23,28 +23,46 @@
  */
 #include "plan_internal.h"
 
+#include <math.h>
+
 /* ------------------------------------------------------------------------------------ */
 /* Costs                                                                                 */
 
-/* The packed cost of vehicle v's row. */
-static coa_cost_t row_cost(const coa_planner_t *pl, size_t v)
+/* The packed cost of the rows of the vehicles in `members` (a bit mask) in `rows` (all
+ * the problem's vehicles, pl->rows or the incumbent's). */
+static coa_cost_t rows_cost_in(const coa_planner_t *pl, const int32_t *rows, uint32_t members)
 {
-    uint64_t eff;
-    coa_cost_t dev =
-        coa_plan_row_units(pl, v, &pl->rows[v * ((size_t)pl->problem->horizon + 1u)], &eff);
-    return plan_pack(dev, eff);
-}
-
-static coa_cost_t rows_cost(const coa_planner_t *pl, uint32_t members)
-{
+    const size_t row = (size_t)pl->problem->horizon + 1u;
     coa_cost_t sum = {0u, 0u};
     size_t v;
     for (v = 0; v < pl->problem->vehicle_count; ++v) {
         if ((members & (UINT32_C(1) << v)) != 0u) {
-            sum = plan_cost_add(sum, row_cost(pl, v));
+            uint64_t eff;
+            coa_cost_t dev = coa_plan_row_units(pl, v, &rows[v * row], &eff);
+            sum = plan_cost_add(sum, plan_pack(dev, eff));
         }
     }
     return sum;
+}
+
+static coa_cost_t rows_cost(const coa_planner_t *pl, uint32_t members)
+{
+    return rows_cost_in(pl, pl->rows, members);
+}
+
+/* Copies the rows of `members` from `from` to `to` (all the problem's vehicles each). */
+static void rows_copy(const coa_planner_t *pl, int32_t *to, const int32_t *from, uint32_t members)
+{
+    const size_t row = (size_t)pl->problem->horizon + 1u;
+    size_t v;
+    size_t k;
+    for (v = 0; v < pl->problem->vehicle_count; ++v) {
+        if ((members & (UINT32_C(1) << v)) != 0u) {
+            for (k = 0; k < row; ++k) {
+                to[v * row + k] = from[v * row + k];
+            }
+        }
+    }
 }
 
 /* ------------------------------------------------------------------------------------ */
@@ -237,14 +255,19 @@ static bool members_in_turn(coa_planner_t *pl, coa_cost_t *cost, coa_plan_result
     return true;
 }
 
-static coa_cost_t sum_alone(const plan_group_t *g)
+static coa_cost_t costs_sum(const coa_cost_t *c, size_t n)
 {
     coa_cost_t sum = {0u, 0u};
     size_t i;
-    for (i = 0; i < g->count; ++i) {
-        sum = plan_cost_add(sum, g->alone[i]);
+    for (i = 0; i < n; ++i) {
+        sum = plan_cost_add(sum, c[i]);
     }
     return sum;
+}
+
+static coa_cost_t sum_alone(const plan_group_t *g)
+{
+    return costs_sum(g->alone, g->count);
 }
 
 /* Keeps (or puts back) the rows of the group's members. */
@@ -308,7 +331,20 @@ static bool group_setup(coa_planner_t *pl, uint32_t members, uint32_t fixed,
     }
     group_spans(pl, members, fixed);
     rows_save(pl, false);
-    g->capped = members_in_turn(pl, &cap, r);
+    g->capped = members_in_turn(pl, &cap, r) && !pl->out_of_work;
+    if (fixed == 0u && pl->have_best) {
+        /* The incumbent's rows of the members are a plan of the group alone too. */
+        coa_cost_t best = rows_cost_in(pl, pl->best_rows, members);
+        if (!g->capped || plan_cost_compare(best, cap) < 0) {
+            rows_copy(pl, pl->rows, pl->best_rows, members);
+            cap = best;
+            g->capped = true;
+        }
+    }
+    if (pl->out_of_work) {
+        rows_save(pl, true);
+        return false;
+    }
     if (g->capped) {
         int c = plan_cost_compare(cap, sum_alone(g));
         if (c <= 0 || (bound != NULL && plan_cost_compare(cap, *bound) <= 0)) {
@@ -325,18 +361,31 @@ static bool group_setup(coa_planner_t *pl, uint32_t members, uint32_t fixed,
     return false;
 }
 
-/* A joint search of `members` around `fixed`, at most `bound` when not NULL. */
+/* A joint search of `members` around `fixed`, at most `bound` when not NULL. Budget
+ * exhausted (beta or work): *bound2 is a lower bound on twice the group's optimum (0 when
+ * the search did not start). */
 static coa_plan_status_t search_group(coa_planner_t *pl, uint32_t members, uint32_t fixed,
-                                      const coa_cost_t *bound, coa_plan_result_t *r)
+                                      const coa_cost_t *bound, coa_plan_result_t *r,
+                                      coa_cost_t *bound2)
 {
     plan_search_out_t out;
+    *bound2 = (coa_cost_t){0u, 0u};
     if (group_setup(pl, members, fixed, bound, r)) {
         return COA_PLAN_SOLVED;
+    }
+    if (pl->out_of_work) {
+        return COA_PLAN_BUDGET_EXHAUSTED;
     }
     coa_plan_search(pl, &out);
     r->nodes_expanded += out.expanded;
     r->nodes_generated += out.stored;
     ++r->searches;
+    if (out.status == COA_PLAN_BUDGET_EXHAUSTED) {
+        *bound2 = out.bound2;
+        if (!pl->out_of_work) {
+            r->limit = COA_PLAN_LIMIT_BETA;
+        }
+    }
     return out.status;
 }
 
@@ -436,7 +485,9 @@ static bool replan_around(coa_planner_t *pl, const groups_t *g, size_t x, size_t
     int32_t start;
 
     if (popcount32(g->members[x]) > 1u) {
-        return search_group(pl, g->members[x], g->members[y], &g->cost[x], r) == COA_PLAN_SOLVED;
+        coa_cost_t ignored;
+        return search_group(pl, g->members[x], g->members[y], &g->cost[x], r, &ignored) ==
+               COA_PLAN_SOLVED;
     }
     for (u = 0; u < pl->problem->vehicle_count; ++u) {
         if ((g->members[y] & (UINT32_C(1) << u)) != 0u) {
@@ -448,6 +499,9 @@ static bool replan_around(coa_planner_t *pl, const groups_t *g, size_t x, size_t
     start = pl->problem->vehicles[v].initial_offset;
     coa_plan_table_build(pl, &pl->scratch, v, against, n);
     ++r->searches;
+    if (pl->out_of_work) {
+        return false;
+    }
     root = plan_table_at(&pl->scratch, 0u, start);
     if (cell_dead(root) || plan_cost_compare(plan_cell_cost(pl, v, root), g->cost[x]) != 0) {
         return false;
@@ -457,11 +511,14 @@ static bool replan_around(coa_planner_t *pl, const groups_t *g, size_t x, size_t
     return true;
 }
 
-/* Group y joins group x (x < y), which is planned again as a whole. */
+/* Group y joins group x (x < y), which is planned again as a whole. Budget exhausted:
+ * g->cost[x] becomes a lower bound on the merged group's optimum. */
 static coa_plan_status_t merge(coa_planner_t *pl, groups_t *g, size_t x, size_t y,
                                coa_plan_result_t *r)
 {
+    const coa_cost_t before = plan_cost_add(g->cost[x], g->cost[y]);
     coa_plan_status_t st;
+    coa_cost_t bound2;
     size_t i;
     g->members[x] |= g->members[y];
     for (i = y; i + 1u < g->count; ++i) {
@@ -472,9 +529,15 @@ static coa_plan_status_t merge(coa_planner_t *pl, groups_t *g, size_t x, size_t 
     if (popcount32(g->members[x]) > r->largest_group) {
         r->largest_group = popcount32(g->members[x]);
     }
-    st = search_group(pl, g->members[x], 0u, NULL, r);
+    st = search_group(pl, g->members[x], 0u, NULL, r, &bound2);
     if (st == COA_PLAN_SOLVED) {
         g->cost[x] = rows_cost(pl, g->members[x]);
+    } else if (st == COA_PLAN_BUDGET_EXHAUSTED) {
+        /* Costs are integers: half of a doubled bound, rounded up, is still a bound. */
+        coa_cost_t half = plan_cost_add(bound2, (coa_cost_t){0u, 1u});
+        half.lo = (half.lo >> 1) | (half.hi << 63);
+        half.hi >>= 1;
+        g->cost[x] = plan_cost_compare(half, before) > 0 ? half : before;
     }
     return st;
 }
@@ -490,12 +553,18 @@ static coa_plan_status_t alone(coa_planner_t *pl, groups_t *g, coa_plan_result_t
         uint64_t root;
         coa_plan_table_build(pl, &pl->to_go[v], v, NULL, 0u);
         ++r->searches;
+        if (pl->out_of_work) {
+            return COA_PLAN_BUDGET_EXHAUSTED;
+        }
         root = plan_table_at(&pl->to_go[v], 0u, start);
         if (cell_dead(root)) {
             return COA_PLAN_INFEASIBLE;
         }
         if (pr->vehicle_count > 1u) {
-            coa_plan_table_build_from_start(&pl->from_start[v], &pl->to_go[v]);
+            coa_plan_table_build_from_start(pl, &pl->from_start[v], &pl->to_go[v]);
+            if (pl->out_of_work) {
+                return COA_PLAN_BUDGET_EXHAUSTED;
+            }
         }
         coa_plan_table_walk(pl, &pl->to_go[v], 0u, start);
         r->nodes_expanded += pr->horizon;
@@ -506,8 +575,106 @@ static coa_plan_status_t alone(coa_planner_t *pl, groups_t *g, coa_plan_result_t
     return COA_PLAN_SOLVED;
 }
 
+/* The incumbent's order search may spend at most half of what is left of a limited
+ * budget, so that the joint searches keep the other half, and tries at most this many
+ * orders (7!, every order of 7 vehicles) when the budget is not limited. */
+#define INCUMBENT_ORDERS 5040u
+
+static uint32_t all_vehicles(const coa_planner_t *pl)
+{
+    return (uint32_t)((UINT64_C(1) << pl->problem->vehicle_count) - 1u);
+}
+
+/* The incumbent: the first priority order that works, tried as the decoupled front end
+ * tries them (plan.h), kept in pl->best_rows with its cost. Leaves pl->rows undefined. */
+static void incumbent(coa_planner_t *pl, coa_plan_result_t *r)
+{
+    const uint64_t limit = pl->work_limit;
+    if (limit != 0u) {
+        pl->work_limit = pl->work_used + (limit - pl->work_used) / 2u;
+    }
+    pl->have_best = coa_plan_orders_first(pl, INCUMBENT_ORDERS, r);
+    pl->work_limit = limit;
+    pl->out_of_work = false;
+    if (pl->have_best) {
+        rows_copy(pl, pl->best_rows, pl->rows, all_vehicles(pl));
+        pl->best_cost = rows_cost(pl, all_vehicles(pl));
+    }
+}
+
+/* The result's lower bound, from a packed cost. */
+static void set_bound(const coa_planner_t *pl, coa_plan_result_t *r, coa_cost_t packed)
+{
+    coa_cost_t dev;
+    dev.lo = (packed.lo >> PLAN_EFF_BITS) | (packed.hi << (64u - PLAN_EFF_BITS));
+    dev.hi = packed.hi >> PLAN_EFF_BITS;
+    r->bound_units = dev;
+    r->bound_effort = (uint32_t)(packed.lo & ((UINT64_C(1) << PLAN_EFF_BITS) - 1u));
+    r->bound_deviation =
+        ldexp(ldexp((double)dev.hi, 64) + (double)dev.lo, pl->exponent) / (double)pl->scale;
+}
+
+static coa_cost_t groups_sum(const groups_t *g)
+{
+    return costs_sum(g->cost, g->count);
+}
+
+/* A limit ended independence detection: every group's cost is its optimum alone or a lower
+ * bound on it, so their sum bounds the whole. The incumbent is the answer, optimal when
+ * the bound meets it; without one nothing was found. */
+static coa_plan_status_t finish_early(coa_planner_t *pl, const groups_t *g, coa_plan_result_t *r)
+{
+    coa_cost_t bound = groups_sum(g);
+    if (!pl->have_best) {
+        set_bound(pl, r, bound);
+        return COA_PLAN_BUDGET_EXHAUSTED;
+    }
+    rows_copy(pl, pl->rows, pl->best_rows, all_vehicles(pl));
+    if (plan_cost_compare(bound, pl->best_cost) >= 0) {
+        bound = pl->best_cost;
+        r->optimal = true;
+    }
+    set_bound(pl, r, bound);
+    return COA_PLAN_SOLVED;
+}
+
+/* The whole plan is optimal: the groups' optima alone, whose sum it costs. */
+static coa_plan_status_t finish_optimal(coa_planner_t *pl, const groups_t *g, coa_plan_result_t *r)
+{
+    set_bound(pl, r, groups_sum(g));
+    r->optimal = true;
+    return COA_PLAN_SOLVED;
+}
+
+/* Each vehicle's own plan again (the incumbent's search overwrote the rows). */
+static void walk_alone(coa_planner_t *pl)
+{
+    size_t v;
+    for (v = 0; v < pl->problem->vehicle_count; ++v) {
+        coa_plan_table_walk(pl, &pl->to_go[v], 0u, pl->problem->vehicles[v].initial_offset);
+    }
+}
+
+/* One round of independence detection on the first conflict between groups a and b: a
+ * re-plan of one around the other, else a merge. */
+static coa_plan_status_t resolve(coa_planner_t *pl, groups_t *g, size_t a, size_t b,
+                                 coa_plan_result_t *r)
+{
+    size_t x = a < b ? a : b;
+    size_t y = a < b ? b : a;
+    if (!tried_before(pl, g->members[x], g->members[y]) &&
+        (replan_around(pl, g, x, y, r) || replan_around(pl, g, y, x, r))) {
+        return COA_PLAN_SOLVED;
+    }
+    if (pl->out_of_work) {
+        return COA_PLAN_BUDGET_EXHAUSTED;
+    }
+    return merge(pl, g, x, y, r);
+}
+
 coa_plan_status_t coa_plan_independence(coa_planner_t *pl, coa_plan_result_t *r)
 {
+    const size_t n = pl->problem->vehicle_count;
     coa_plan_status_t st;
     groups_t g;
     size_t a;
@@ -519,19 +686,32 @@ coa_plan_status_t coa_plan_independence(coa_planner_t *pl, coa_plan_result_t *r)
         return st;
     }
     near_all(pl);
-    while (groups_conflict(pl, &g, &a, &b)) {
-        size_t x = a < b ? a : b;
-        size_t y = a < b ? b : a;
-        if (!tried_before(pl, g.members[x], g.members[y]) &&
-            (replan_around(pl, &g, x, y, r) || replan_around(pl, &g, y, x, r))) {
-            continue;
+    for (;;) {
+        /* Charged before the check runs: O(N n^2) volume tests. */
+        if (!plan_work(pl, (uint64_t)pl->problem->horizon * n * n)) {
+            return finish_early(pl, &g, r);
         }
-        st = merge(pl, &g, x, y, r);
-        if (st != COA_PLAN_SOLVED) {
+        if (!groups_conflict(pl, &g, &a, &b)) {
+            return finish_optimal(pl, &g, r);
+        }
+        /* The first conflict, while every group is still a vehicle alone: the incumbent,
+         * which caps every joint search of a group without fixed vehicles from here on. */
+        if (g.count == n && pl->tried_count == 0u) {
+            incumbent(pl, r);
+            if (pl->have_best && plan_cost_compare(pl->best_cost, groups_sum(&g)) <= 0) {
+                rows_copy(pl, pl->rows, pl->best_rows, all_vehicles(pl));
+                return finish_optimal(pl, &g, r);
+            }
+            walk_alone(pl);
+        }
+        st = resolve(pl, &g, a, b, r);
+        if (st == COA_PLAN_INFEASIBLE) {
             return st;
         }
+        if (st == COA_PLAN_BUDGET_EXHAUSTED) {
+            return finish_early(pl, &g, r);
+        }
     }
-    return COA_PLAN_SOLVED;
 }
 
 /* ------------------------------------------------------------------------------------ */
@@ -545,7 +725,7 @@ void coa_plan_test_group_setup(coa_planner_t *pl, uint32_t members)
 
     for (v = 0; v < pl->problem->vehicle_count; ++v) {
         coa_plan_table_build(pl, &pl->to_go[v], v, NULL, 0u);
-        coa_plan_table_build_from_start(&pl->from_start[v], &pl->to_go[v]);
+        coa_plan_table_build_from_start(pl, &pl->from_start[v], &pl->to_go[v]);
     }
     near_all(pl);
     group_collect(pl, members, 0u);

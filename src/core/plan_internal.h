@@ -33,6 +33,8 @@
 #define PLAN_EFF_BITS 18u    /* effort bits of a packed cost */
 #define PLAN_PAIRS (PLAN_MAXM * (PLAN_MAXM - 1u) / 2u)
 #define PLAN_OUT INT16_MIN /* a group member's offset while it is not in the search */
+/* Work (plan.h, "Work"): a polytope test costs one unit per this many vertices, plus one. */
+#define PLAN_WORK_VERTICES 8u
 
 /* ------------------------------------------------------------------------------------ */
 /* Tables                                                                                */
@@ -152,6 +154,8 @@ typedef struct {
     coa_plan_status_t status;
     uint64_t expanded;
     uint64_t stored;
+    coa_cost_t bound2; /* budget exhausted: the least doubled f left open, a lower bound on
+                          twice the group's optimum */
 } plan_search_out_t;
 
 #define PLAN_MAX_TRIED 64u /* pairs of groups independence detection tried to re-plan */
@@ -218,7 +222,36 @@ struct coa_planner {
     /* Independence detection: pairs of groups (member bit masks) it tried to re-plan. */
     uint32_t tried[PLAN_MAX_TRIED][2];
     size_t tried_count;
+
+    /* The work budget (plan.h, "Work"): units spent by this call, the limit (0: none),
+     * and whether it ran out; once it has, every loop that charges work stops early and
+     * the front end reports COA_PLAN_LIMIT_WORK. */
+    uint64_t work_limit;
+    uint64_t work_used;
+    bool out_of_work;
+
+    /* Centralised: the incumbent, the cheapest plan of every vehicle found so far (rows
+     * of all the problem's vehicles), and its packed cost. */
+    int32_t *best_rows;
+    bool have_best;
+    coa_cost_t best_cost;
+    int exponent; /* the deviation unit's power of two, 2^E (coa_deviation_weights) */
 };
+
+/* Charges `units` of work before they are done: false, charging nothing, when they do not
+ * fit what is left of the budget (and from then on), so work_used never passes the limit. */
+static inline bool plan_work(coa_planner_t *pl, uint64_t units)
+{
+    if (pl->out_of_work) {
+        return false;
+    }
+    if (pl->work_limit != 0u && units > pl->work_limit - pl->work_used) {
+        pl->out_of_work = true;
+        return false;
+    }
+    pl->work_used += units;
+    return true;
+}
 
 /* ------------------------------------------------------------------------------------ */
 /* Packed costs                                                                          */
@@ -384,7 +417,7 @@ void coa_plan_table_build(coa_planner_t *pl, plan_table_t *t, size_t v, const si
                           size_t nfixed);
 
 /* Builds cost-from-start table f of the vehicle of cost-to-go table t, over t's moves. */
-void coa_plan_table_build_from_start(plan_table_t *f, const plan_table_t *t);
+void coa_plan_table_build_from_start(coa_planner_t *pl, plan_table_t *f, const plan_table_t *t);
 
 /* The moves out of offset `from` at sample k of cost-to-go table t, sorted (see
  * plan_moves_t). */
@@ -432,6 +465,12 @@ bool coa_plan_any_initial_conflict(const coa_planner_t *pl);
 /* Independence detection over the loaded problem (plan_group.c): the centralised plan's
  * status; the rows of every vehicle when solved. */
 coa_plan_status_t coa_plan_independence(coa_planner_t *pl, coa_plan_result_t *r);
+
+/* The decoupled order search over the loaded problem, from the priority order, stopped at
+ * the first order that works (its rows of every vehicle then in pl->rows: true), after
+ * max_orders attempts, when every order is ruled out or tried, or when the work budget
+ * runs out. Adds its searches and table walks to r's counters. */
+bool coa_plan_orders_first(coa_planner_t *pl, uint32_t max_orders, coa_plan_result_t *r);
 
 /* One joint search over pl->group. When solved, writes the members' rows of pl->rows.
  * Precondition: coa_plan_search_release since the last search. */

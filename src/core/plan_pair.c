@@ -368,6 +368,10 @@ static void pair_build(coa_planner_t *pl, size_t a, size_t b, const coa_cost_t *
         return;
     }
     for (k = p->last + 1u; k-- > p->first;) {
+        const int16_t *c = &p->row_lo[4u * (size_t)(k - p->first)];
+        if (!plan_work(pl, width(c[0], c[1]) * width(c[2], c[3]))) {
+            return; /* out of work: the search that follows stops at once */
+        }
         pair_row(pl, p, a, b, k, slack);
     }
     p->present = true;

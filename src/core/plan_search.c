@@ -36,6 +36,7 @@
 #define KEY_SHIFT 2u
 #define K_EXPANDED 0x8000u /* node_k bit: expanded at least once (closed) */
 #define K_SAMPLE 0x7fffu
+#define PLAN_WORK_LEAF 4u /* work units of a complete combination, beyond its members' */
 
 static size_t node_sample(const coa_planner_t *pl, uint32_t n)
 {
@@ -724,7 +725,8 @@ static bool leaf(coa_planner_t *pl, expansion_t *e, plan_search_out_t *out)
 }
 
 /* The combinations whose doubled f is at most the key, depth first in option order;
- * branches that cannot get there are cut. False: the pool is full. */
+ * branches that cannot get there are cut. False: the pool is full, or the work budget
+ * ran out (one unit per combination visited, plan.h "Work"). */
 static bool enumerate(coa_planner_t *pl, expansion_t *e, plan_search_out_t *out)
 {
     const size_t count = e->ch.count;
@@ -735,6 +737,12 @@ static bool enumerate(coa_planner_t *pl, expansion_t *e, plan_search_out_t *out)
     for (;;) {
         coa_cost_t inc;
         coa_cost_t bound;
+        /* Weighed by what the step costs: a member's move or entry tests and prices its
+         * pairs with the c members chosen before it; a leaf finds, prices and stores the
+         * child (plan.h, "Work"). */
+        if (!plan_work(pl, c == count ? PLAN_WORK_LEAF + c : 1u + c)) {
+            return false;
+        }
         if (c == count) {
             if (!leaf(pl, e, out)) {
                 return false;
@@ -927,6 +935,7 @@ void coa_plan_search(coa_planner_t *pl, plan_search_out_t *out)
     out->status = COA_PLAN_INFEASIBLE;
     out->expanded = 0u;
     out->stored = 0u;
+    out->bound2 = (coa_cost_t){0u, 0u};
     pl->m = pl->group.count;
     if (!root_add(pl, out)) {
         if (pl->used >= pl->capacity && pl->capacity > 0u) {
@@ -944,6 +953,8 @@ void coa_plan_search(coa_planner_t *pl, plan_search_out_t *out)
             out->status = COA_PLAN_SOLVED;
             return;
         }
+        /* The least f open: what the search has proven no plan costs less than. */
+        out->bound2 = pl->key[n];
         heap_pop(pl);
         ++out->expanded;
         if (!expand(pl, n, out)) {

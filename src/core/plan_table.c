@@ -69,7 +69,7 @@ typedef struct {
 } row_item_t;
 
 typedef struct {
-    const coa_planner_t *pl;
+    coa_planner_t *pl;
     const plan_table_t *t;
     uint32_t k;
     int32_t lo;
@@ -77,6 +77,16 @@ typedef struct {
     uint64_t *row;    /* row k: only the action bits are set while conflicts are cleared */
     coa_box_t bounds; /* every step of the row lies in it */
 } row_ctx_t;
+
+/* Work units of one exact test against the item (plan.h, "Work"): a polytope's MPR test
+ * evaluates its support function, O(vertices), several times. */
+static uint64_t item_weight(const row_item_t *it)
+{
+    if (it->obstacle != NULL && it->obstacle->kind == COA_OBSTACLE_POLYTOPE) {
+        return 1u + it->obstacle->polytope.count / PLAN_WORK_VERTICES;
+    }
+    return 1u;
+}
 
 static bool item_conflict(const row_item_t *it, const coa_sweep_t *s)
 {
@@ -122,10 +132,11 @@ static void row_item_range(const row_ctx_t *r, const coa_box_t *item, int32_t *l
     }
 }
 
-/* Clears, in row k, the actions whose step conflicts with the item. */
-static void row_clear_item(const row_ctx_t *r, const row_item_t *it)
+/* Clears, in row k, the actions whose step conflicts with the item. False: the work
+ * budget ran out first (the row is then unfinished). */
+static bool row_clear_item(const row_ctx_t *r, const row_item_t *it)
 {
-    const coa_planner_t *pl = r->pl;
+    coa_planner_t *pl = r->pl;
     const plan_table_t *t = r->t;
     coa_real_t slack =
         (box_scale(&r->bounds) + box_scale(&it->bounds)) * (coa_real_t)(SLACK_ULPS * REAL_EPSILON);
@@ -136,9 +147,12 @@ static void row_clear_item(const row_ctx_t *r, const row_item_t *it)
     int32_t hi;
 
     if (!coa_boxes_touch(&r->bounds, &item)) {
-        return;
+        return true;
     }
     row_item_range(r, &item, &lo, &hi);
+    if (hi >= lo && !plan_work(pl, (uint64_t)(hi - lo + 1) * PLAN_ACTIONS * item_weight(it))) {
+        return false;
+    }
     for (o = lo; o <= hi; ++o) {
         uint64_t *c = &r->row[o - r->lo];
         uint32_t a;
@@ -156,36 +170,39 @@ static void row_clear_item(const row_ctx_t *r, const row_item_t *it)
             }
         }
     }
+    return true;
 }
 
 /* Clears, in row k, every action whose step conflicts with an obstacle, a track or a
- * fixed vehicle. */
-static void row_clear_conflicts(const row_ctx_t *r, const size_t *fixed, size_t nfixed)
+ * fixed vehicle. False: the work budget ran out first. */
+static bool row_clear_conflicts(const row_ctx_t *r, const size_t *fixed, size_t nfixed)
 {
     const coa_problem_t *pr = r->pl->problem;
     row_item_t it;
     size_t j;
+    bool ok = true;
 
-    for (j = 0; j < pr->obstacle_count; ++j) {
+    for (j = 0; ok && j < pr->obstacle_count; ++j) {
         it.obstacle = &pr->obstacles[j];
         it.bounds = coa_obstacle_bounds(it.obstacle);
-        row_clear_item(r, &it);
+        ok = row_clear_item(r, &it);
     }
     it.obstacle = NULL;
-    for (j = 0; j < pr->track_count; ++j) {
+    for (j = 0; ok && j < pr->track_count; ++j) {
         it.moving.volume = pr->tracks[j].volume;
         it.moving.p0 = pr->track_samples[j][r->k];
         it.moving.p1 = pr->track_samples[j][r->k + 1u];
         it.bounds = coa_sweep_bounds(&it.moving);
-        row_clear_item(r, &it);
+        ok = row_clear_item(r, &it);
     }
-    for (j = 0; j < nfixed; ++j) {
+    for (j = 0; ok && j < nfixed; ++j) {
         const int32_t *row = &r->pl->rows[fixed[j] * ((size_t)pr->horizon + 1u)];
         it.moving = coa_plan_vehicle_sweep(pr, r->pl->dh, fixed[j], r->k, row[r->k], r->k + 1u,
                                            row[r->k + 1u]);
         it.bounds = coa_sweep_bounds(&it.moving);
-        row_clear_item(r, &it);
+        ok = row_clear_item(r, &it);
     }
+    return ok;
 }
 
 /* ------------------------------------------------------------------------------------ */
@@ -276,8 +293,13 @@ void coa_plan_table_build(coa_planner_t *pl, plan_table_t *tb, size_t v, const s
         r.hi = plan_row_hi(tb, k);
         r.row = row_of(tb, k);
         r.bounds = row_bounds(pl, tb, k);
+        if (!plan_work(pl, (uint64_t)(r.hi - r.lo + 1) * PLAN_ACTIONS)) {
+            return;
+        }
         row_moves(tb, k, r.lo, r.hi, r.row);
-        row_clear_conflicts(&r, fixed, nfixed);
+        if (!row_clear_conflicts(&r, fixed, nfixed)) {
+            return;
+        }
         row_costs(tb, k, r.lo, r.hi, r.row);
     }
 }
@@ -327,7 +349,7 @@ void coa_plan_table_moves(const plan_table_t *t, uint32_t k, int32_t from, plan_
 /* ------------------------------------------------------------------------------------ */
 /* Cost from the start, and plans                                                        */
 
-void coa_plan_table_build_from_start(plan_table_t *f, const plan_table_t *t)
+void coa_plan_table_build_from_start(coa_planner_t *pl, plan_table_t *f, const plan_table_t *t)
 {
     uint32_t k;
     int32_t o;
@@ -345,6 +367,9 @@ void coa_plan_table_build_from_start(plan_table_t *f, const plan_table_t *t)
     }
     *cell_of(f, 0u, t->origin) = cell_pack(0u, 0u, 0u);
     for (k = 0; k < t->horizon; ++k) {
+        if (!plan_work(pl, (uint64_t)(plan_row_hi(t, k) - plan_row_lo(t, k) + 1) * PLAN_ACTIONS)) {
+            return;
+        }
         for (o = plan_row_lo(t, k); o <= plan_row_hi(t, k); ++o) {
             uint64_t here = *cell_of(f, k, o);
             uint32_t mask = cell_mask(*cell_of(t, k, o));

@@ -102,6 +102,37 @@ static int add_vehicle(cJSON *array, const coavoid_scenario_t *s, size_t index, 
     return 0;
 }
 
+/* Centralised: whether the plan is proven optimal, and the lower bound on the optimum
+ * (none when infeasible). 0, or -1 out of memory. */
+static int build_bound(cJSON *root, const coa_plan_result_t *r)
+{
+    if (cJSON_AddBoolToObject(root, "optimal", r->optimal) == NULL) {
+        return -1;
+    }
+    if (r->status != COA_PLAN_INFEASIBLE) {
+        cJSON *bound = cJSON_AddObjectToObject(root, "bound");
+        if (bound == NULL || !add_number(bound, "deviation", r->bound_deviation) ||
+            !add_number(bound, "effort", r->bound_effort)) {
+            return -1;
+        }
+    }
+    return 0;
+}
+
+/* The contract's name of the limit that ended a call early. */
+static const char *limit_name(coa_plan_limit_t limit)
+{
+    switch (limit) {
+    case COA_PLAN_LIMIT_BETA:
+        return "beta";
+    case COA_PLAN_LIMIT_WORK:
+        return "work";
+    case COA_PLAN_LIMIT_NONE:
+    default:
+        return "none";
+    }
+}
+
 /* The result's scenario, mode, status, planning order and, when there is one, the failed
  * vehicle and the cost. 0, or -1 out of memory, -2 an inconsistent result (err set). */
 static int build_head(cJSON *root, const coavoid_output_plan_t *plan, char *err, size_t err_size)
@@ -146,7 +177,7 @@ static int build_head(cJSON *root, const coavoid_output_plan_t *plan, char *err,
             return -1;
         }
     }
-    return 0;
+    return plan->decoupled ? 0 : build_bound(root, r);
 }
 
 /* The search statistics. 0, or -1 out of memory. */
@@ -158,7 +189,9 @@ static int build_stats(cJSON *root, const coavoid_output_plan_t *plan)
         !add_number(stats, "nodes_generated", (double)r->nodes_generated) ||
         !add_number(stats, "time_us", (double)plan->time_us) ||
         !add_number(stats, "workspace_bytes", (double)r->workspace_bytes) ||
-        !add_number(stats, "beta", plan->beta) ||
+        !add_number(stats, "beta", plan->beta) || !add_number(stats, "work", (double)r->work) ||
+        !add_number(stats, "work_budget", (double)plan->work_budget) ||
+        cJSON_AddStringToObject(stats, "limit", limit_name(r->limit)) == NULL ||
         (plan->decoupled && !add_number(stats, "orders_tried", r->orders_tried))) {
         return -1;
     }

@@ -24,6 +24,7 @@ typedef struct {
     const int32_t *offsets; /* vehicle_count rows of horizon+1, row i is vehicle i */
     int64_t time_us;        /* wall time of the planning call */
     uint32_t beta;          /* the closed-set bound the planner ran with */
+    uint64_t work_budget;   /* the work budget it ran with (0: none) */
 } coavoid_output_plan_t;
 
 /* Writes the result object (and a newline) to `out`. Returns 0, or -1 with the reason in

@@ -127,6 +127,7 @@ static int plan_search(const coavoid_plan_config_t *c, const coavoid_scenario_t 
     memset(&result, 0, sizeof result);
     struct timespec start, end;
     int rc;
+    (void)coa_planner_set_work(planner, c->work); /* a planner coa_planner_init built */
     clock_gettime(CLOCK_MONOTONIC, &start);
     if (c->decoupled) {
         rc = coa_plan_decoupled(planner, problem, c->order, c->max_orders, offsets, &result);
@@ -141,8 +142,8 @@ static int plan_search(const coavoid_plan_config_t *c, const coavoid_scenario_t 
         return coavoid_run_fail(e, COAVOID_RUN_ERR_INTERNAL,
                                 "internal error: the planner failed (%s)", coa_status_name(rc));
     }
-    coavoid_output_plan_t view = {s,   c->decoupled, &result, offsets, elapsed_us(&start, &end),
-                                  beta};
+    coavoid_output_plan_t view = {s,    c->decoupled, &result, offsets, elapsed_us(&start, &end),
+                                  beta, c->work};
     if (coavoid_output_plan(out, &view, err, sizeof err) != 0) {
         return coavoid_run_fail(e, COAVOID_RUN_ERR_INTERNAL, "%s", err);
     }

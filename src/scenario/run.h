@@ -59,6 +59,7 @@ typedef struct {
                                   order to plan; NULL: the scenario's priorities */
     bool has_beta;             /* beta given (--beta): it overrides the scenario's */
     uint32_t beta;
+    uint64_t work;       /* the planning call's work budget (plan.h, "Work"); 0: no limit */
     uint32_t max_orders; /* decoupled: priority orders to try, >= 1; 1 plans just one */
 } coavoid_plan_config_t;
 

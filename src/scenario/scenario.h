@@ -115,6 +115,10 @@ long coavoid_scenario_vehicle_index(const coavoid_scenario_t *s, long id);
  * COAVOID_DEFAULT_WORKSPACE_MAX (a default that asks a laptop for gigabytes is a trap).
  * Why 200,000: docs/benchmarks.md and docs/evaluation.md ("beta"). */
 #define COAVOID_DEFAULT_BETA 200000u
+/* The programs' default work budget of one planning call (plan.h, "Work"), in work units:
+ * at most about a second of one core of the machines docs/benchmarks.md measures, at the
+ * slowest work unit measured there. */
+#define COAVOID_DEFAULT_WORK UINT64_C(10000000)
 #define COAVOID_DEFAULT_WORKSPACE_MAX ((size_t)1u << 30)
 
 /* The planner config of a scenario (coa_planner_config_of: its horizon, largest steep

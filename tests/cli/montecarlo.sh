@@ -172,17 +172,19 @@ if expect_ok other_seed montecarlo --vehicles 2 --count 5 --seed 8 --quiet --csv
         fail "seed 8 gave the rows of seed 7, or not 15 rows"
     fi
 fi
-# beta 1 cannot solve a conflict: every centralised search runs out of it, and says so.
+# beta 1 cannot finish a joint search: the centralised answer is then its incumbent, the
+# first priority order that works, so it solves just what reordering solves, and the
+# encounters no order solves are budget exhausted (nothing proven).
 if expect_ok budget montecarlo --vehicles 3 --count 3 --beta 1 --quiet --csv "$tmp/e.csv" --svg "$tmp/e.svg" --json; then
     cp "$tmp/out" "$tmp/e.json"
     check budget "$tmp/e.csv" "$tmp/e.json" "$tmp/e.svg"
     if python3 -c '
 import json, sys
-m = json.load(open(sys.argv[1]))["sizes"][0]["methods"][0]
-sys.exit(0 if m["budget_exhausted"] == 3 and m["solved"] == 0 else m)' "$tmp/e.json"; then
+c, _, r = json.load(open(sys.argv[1]))["sizes"][0]["methods"]
+sys.exit(0 if c["solved"] == r["solved"] and c["budget_exhausted"] == 3 - c["solved"] - c["infeasible"] else (c, r))' "$tmp/e.json"; then
         pass
     else
-        fail "beta 1: centralised not reported as budget exhausted"
+        fail "beta 1: centralised does not answer what reordering solves"
     fi
 fi
 
@@ -196,11 +198,12 @@ if expect_ok text montecarlo --vehicles 2,3 --count 3 --quiet; then
     fi
 fi
 
-# With beta 1 nothing is solved: the ratio rows have no numbers (a ratio is at least 1,
-# so 0.000 there would be a made-up value), but still the shares.
+# Seed 1's first two 3-UAV encounters fail in the fixed order: its ratio row has no
+# numbers (a ratio is at least 1, so 0.000 there would be a made-up value), but still the
+# shares.
 if expect_ok text_empty montecarlo --vehicles 3 --count 2 --beta 1 --quiet; then
-    rows=$(grep -E '^  decoupled_(fixed|reordered) +0 ' "$tmp/out")
-    if [ "$(printf '%s\n' "$rows" | grep -c -- ' -  *- ')" -eq 2 ] &&
+    rows=$(grep -E '^  decoupled_fixed +0 ' "$tmp/out")
+    if [ "$(printf '%s\n' "$rows" | grep -c -- ' -  *- ')" -eq 1 ] &&
         ! printf '%s\n' "$rows" | grep -q '0\.000'; then
         pass
     else

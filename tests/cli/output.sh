@@ -133,7 +133,7 @@ def area(a, b):
 
 solved = status == "solved"
 allowed = {"scenario", "mode", "status", "priority_order", "failed_vehicle", "cost", "stats",
-           "vehicles"}
+           "vehicles", "optimal", "bound"}
 expect(isinstance(r, dict), "result is not an object")
 expect(set(r) <= allowed, "unexpected fields %s" % (set(r) - allowed))
 expect(r.get("scenario") == scenario["name"], "scenario %r" % r.get("scenario"))
@@ -165,8 +165,28 @@ if solved:
 else:
     expect("cost" not in r, "cost present though not solved")
 
+if mode == "centralised":
+    # Anytime: OPTIMAL, and a lower bound on the optimum but when infeasible; the bound
+    # never above the cost, and equal to it when optimal.
+    expect(isinstance(r.get("optimal"), bool), "optimal %r" % r.get("optimal"))
+    expect(not r.get("optimal") or solved, "optimal but not solved")
+    bound = r.get("bound")
+    if status == "infeasible":
+        expect("bound" not in r, "bound present though infeasible")
+    else:
+        expect(isinstance(bound, dict) and set(bound) == {"deviation", "effort"}, "bound %r" % bound)
+        expect(is_num(bound.get("deviation")) and is_int(bound.get("effort")), "bound %r" % bound)
+        if solved:
+            c = r.get("cost") or {}
+            lex = (bound["deviation"], bound["effort"]) <= (c.get("deviation"), c.get("effort"))
+            expect(lex, "bound %r above the cost %r" % (bound, c))
+            expect(not r.get("optimal") or (bound["deviation"], bound["effort"]) ==
+                   (c.get("deviation"), c.get("effort")), "optimal, but bound %r is not the cost" % bound)
+else:
+    expect("optimal" not in r and "bound" not in r, "decoupled result reports a bound")
+
 stats = r.get("stats")
-keys = ["nodes_expanded", "nodes_generated", "time_us", "workspace_bytes"]
+keys = ["nodes_expanded", "nodes_generated", "time_us", "workspace_bytes", "work", "work_budget"]
 if mode == "decoupled":
     keys.append("orders_tried")
 expect(isinstance(stats, dict), "stats %r" % stats)
@@ -180,6 +200,9 @@ else:
     expect("orders_tried" not in (stats or {}) and "all_orders_covered" not in (stats or {}),
            "centralised stats report orders")
 expect((stats or {}).get("workspace_bytes", 0) > 0, "stats.workspace_bytes is 0")
+expect((stats or {}).get("limit") in ("none", "beta", "work"), "stats.limit %r" % (stats or {}).get("limit"))
+expect((stats or {}).get("work_budget", 0) == 0 or stats["work"] <= stats["work_budget"],
+       "stats.work passes the budget")
 
 vs = r.get("vehicles")
 expect(isinstance(vs, list), "vehicles %r" % vs)
@@ -334,13 +357,33 @@ expect_stats stuck_reorder 'st["all_orders_covered"] is True and 1 < st["orders_
 expect_result stuck_max1 1 infeasible decoupled "$t" 2,1,3 1 plan "$t" --mode decoupled --reorder --max-orders 1
 expect_stats stuck_max1 'st["orders_tried"] == 1 and st["all_orders_covered"] is False'
 
-# ---- budget exhausted: beta 1 cannot reach k = 10 ----
-expect_result budget_central 1 budget_exhausted centralised "$h" "" "" plan "$h" --mode centralised --beta 1
+# ---- limits: beta 1 cannot reach k = 10 ----
+# The joint search stops at once; the answer is the incumbent (the priority order's plan,
+# one UAV around the other), not proven optimal, with a bound below the optimum.
+expect_result budget_central 0 solved centralised "$h" "" "" plan "$h" --mode centralised --beta 1
+expect_stats budget_central 'st["limit"] == "beta" and r["optimal"] is False and r["bound"]["deviation"] < r["cost"]["deviation"]'
+# Held within three climb steps (6 m) of their references, no priority order separates
+# them (one flies level, the other cannot get 10 m clear), the joint plan does (one up,
+# one down: 12 m): at beta
+# 1 nothing is found and nothing proven; with room it is optimal; with a work budget of 1
+# unit the first table does not fit.
+python3 -c 'import json,sys; s=json.load(open(sys.argv[1])); [v.update(max_offset=3) for v in s["vehicles"]]; json.dump(s, open(sys.argv[2], "w"))' "$h" "$tmp/held.json"
+expect_result held_beta1 1 budget_exhausted centralised "$tmp/held.json" "" "" plan "$tmp/held.json" --mode centralised --beta 1
+expect_stats held_beta1 'st["limit"] == "beta" and r["optimal"] is False and "cost" not in r'
+expect_result held_decoupled 1 infeasible decoupled "$tmp/held.json" 1,2 "" plan "$tmp/held.json" --mode decoupled --reorder
+expect_result held_central 0 solved centralised "$tmp/held.json" "" "" plan "$tmp/held.json" --mode centralised --beta 20000
+expect_stats held_central 'st["limit"] == "none" and r["optimal"] is True and st["work"] <= st["work_budget"] == 10000000'
+expect_result held_work1 1 budget_exhausted centralised "$tmp/held.json" "" "" plan "$tmp/held.json" --mode centralised --work 1
+expect_stats held_work1 'st["limit"] == "work" and st["work"] <= 1 and st["work_budget"] == 1'
+expect_result held_work0 0 solved centralised "$tmp/held.json" "" "" plan "$tmp/held.json" --mode centralised --work 0
+expect_stats held_work0 'st["work_budget"] == 0 and st["work"] > 0 and r["optimal"] is True'
+expect_result work1_decoupled 1 budget_exhausted decoupled "$h" 1,2 "" plan "$h" --mode decoupled --work 1
 # decoupled reads each UAV's plan off its exact table and stores no search node: beta 1 is
 # enough, and a decoupled plan never runs out of beta
 expect_result beta1_decoupled 0 solved decoupled "$h" 1,2 "" plan "$h" --mode decoupled --beta 1
 python3 -c 'import json,sys; s=json.load(open(sys.argv[1])); s["beta"]=1; json.dump(s, open(sys.argv[2], "w"))' "$h" "$tmp/beta1.json"
-expect_result scenario_beta 1 budget_exhausted centralised "$tmp/beta1.json" "" "" plan "$tmp/beta1.json" --mode centralised
+expect_result scenario_beta 0 solved centralised "$tmp/beta1.json" "" "" plan "$tmp/beta1.json" --mode centralised
+expect_stats scenario_beta 'st["limit"] == "beta" and st["beta"] == 1 and r["optimal"] is False' 
 expect_result beta_overrides 0 solved centralised "$tmp/beta1.json" "" "" plan "$tmp/beta1.json" --mode centralised --beta 20000
 
 # ---- output is the same JSON each run, apart from the time ----
