@@ -1119,6 +1119,66 @@ static bool bound_at_most(const coa_plan_result_t *r, u128_t units, uint32_t eff
     return b < units || (b == units && r->bound_effort <= effort);
 }
 
+/* Whether result a costs lexicographically less than b. */
+static bool result_cheaper(const coa_plan_result_t *a, const coa_plan_result_t *b)
+{
+    u128_t x = to_u128(a->deviation_units);
+    u128_t y = to_u128(b->deviation_units);
+    return x < y || (x == y && a->effort < b->effort);
+}
+
+/* The incumbent is the cheapest priority order, not only the first that works: with beta 1
+ * no joint search of two or more finishes, so a centralised plan that is not proven
+ * optimal is exactly the cheapest of the decoupled plans of every order (all 24 are
+ * within the incumbent's reach), and a proven one costs no more. */
+START_TEST(incumbent_is_the_cheapest_order)
+{
+    static fx_t f;
+    static int32_t rows[MAXV * (MAXN + 1u)];
+    ws_t w = ws_make(4u, 1u);
+    uint64_t rng = 0x5eed0033u;
+    unsigned improved = 0u; /* the cheapest order is not the first that works */
+    unsigned bounded = 0u;
+    unsigned trial;
+
+    for (trial = 0; trial < 60u; ++trial) {
+        size_t perm[4] = {0u, 1u, 2u, 3u};
+        coa_plan_result_t best = {0};
+        coa_plan_result_t first;
+        coa_plan_result_t r;
+        bool any = false;
+        unsigned p;
+
+        fx_random(&f, &rng, 4u, 6u + pick(&rng, 4u), 3u);
+        for (p = 0; p < 24u; ++p) {
+            ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, perm, 1u, rows, &r), COA_OK);
+            if (r.status == COA_PLAN_SOLVED && (!any || result_cheaper(&r, &best))) {
+                best = r;
+                any = true;
+            }
+            next_permutation(perm, 4u);
+        }
+        ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, NULL, 24u, rows, &first), COA_OK);
+        ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
+        if (!any) {
+            continue; /* no order works: only a finished joint search can answer */
+        }
+        ck_assert_int_eq(r.status, COA_PLAN_SOLVED);
+        check_solved_plan(&f, rows, &r);
+        ck_assert(!result_cheaper(&best, &r));
+        if (!r.optimal) {
+            ck_assert(!result_cheaper(&r, &best));
+            ++bounded;
+        }
+        improved += result_cheaper(&best, &first) ? 1u : 0u;
+    }
+    ws_free(&w);
+    /* The set must exercise what the test is about. */
+    ck_assert_uint_ge(bounded, 20u);
+    ck_assert_uint_ge(improved, 10u);
+}
+END_TEST
+
 /* Head-on, each UAV's plan alone goes through the other and neither can go around the
  * other at its own optimal cost, so independence detection merges the two and only a
  * joint search finds the optimum (which shares the manoeuvre: head_on_is_separated). At a
@@ -2189,6 +2249,7 @@ static Suite *plan_suite(void)
     tcase_add_test(tc, planner_takes_problems_within_its_config);
     tcase_add_test(tc, initial_conflict_is_infeasible_without_expanding);
     tcase_add_test(tc, tiny_beta_answers_the_incumbent);
+    tcase_add_test(tc, incumbent_is_the_cheapest_order);
     tcase_add_test(tc, work_budget_bounds_every_call);
     tcase_add_test(tc, max_offset_is_respected);
     tcase_add_test(tc, head_on_is_separated);

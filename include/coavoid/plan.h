@@ -76,8 +76,11 @@
  *
  * Anytime (centralised). When the vehicles' own plans conflict, the planner first finds
  * an incumbent: the decoupled order search (coa_plan_decoupled with reordering, from the
- * priority order, stopped at the first order that works, at most 7! orders and half of
- * what is left of the work budget). Every joint search of a group without fixed vehicles
+ * priority order, at most 7! orders), which finds the first order that works within half
+ * of what is left of the work budget and then, within a quarter of it counted from the
+ * start, goes on through the other orders as a branch and bound (an order is abandoned
+ * at the first vehicle where the costs so far and the others' costs alone reach the best
+ * plan's) and keeps the cheapest plan. Every joint search of a group without fixed vehicles
  * is then capped by the incumbent's rows of its members (a plan of the group alone) when
  * they cost less than the members' plan in turn: nothing dearer is stored. When beta or
  * the work budget stops independence detection, each group's optimum alone (or, for the
@@ -85,10 +88,11 @@
  * lower bound on what the group costs in any plan, so their sum bounds the whole; the
  * answer is then the incumbent, optimal when the bound reaches its cost, or no plan
  * (COA_PLAN_BUDGET_EXHAUSTED, only when no priority order tried worked) with the bound.
- * So a centralised answer never costs more than the first priority order that works, and
+ * So a centralised answer never costs more than the cheapest priority order it tried
+ * (every order, when the order search ran to its end; at least the first that works), and
  * COA_PLAN_SOLVED with result.optimal false carries a plan and [bound, cost] around the
  * optimum. Among plans of the optimal cost, the one returned is the first found: the
- * incumbent when it is proven optimal, else the joint searches' (ties as the open list
+ * incumbent (the first order found at its cost) when it is proven optimal, else the joint searches' (ties as the open list
  * orders them); deterministic, and the same in both precisions.
  *
  * Work. A planning call can be given a budget of work units (coa_planner_set_work), which
@@ -99,7 +103,8 @@
  * polytope 1 + vertices / 8 units per test, its MPR test evaluating the support function
  * several times); a cost-from-start table 5 per cell; a pair table 1 per cell; a joint
  * search 1 + c per member choice made with c members chosen before it and 4 + m per
- * complete combination of m choosers; each check of the groups' plans N n^2. The same
+ * complete combination of m choosers, and for a new child of five members 20 more and of
+ * six 50 (the pair matching of its heuristic); each check of the groups' plans N n^2. The same
  * call with the same budget does the same work everywhere (the count never depends on a
  * clock), so a budget is a deterministic bound on time: docs/benchmarks.md gives the time
  * per unit measured on the host.

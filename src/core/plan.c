@@ -893,26 +893,98 @@ int coa_plan_decoupled(coa_planner_t *planner, const coa_problem_t *problem, con
     return COA_OK;
 }
 
-bool coa_plan_orders_first(coa_planner_t *pl, uint32_t max_orders, coa_plan_result_t *r)
+/* Vehicle v's planned row as a packed cost. */
+static coa_cost_t row_cost(const coa_planner_t *pl, size_t v)
 {
+    uint64_t eff;
+    const coa_cost_t dev =
+        coa_plan_row_units(pl, v, &pl->rows[v * ((size_t)pl->problem->horizon + 1u)], &eff);
+    return plan_pack(dev, eff);
+}
+
+/* Where the order search of coa_plan_orders_best stands: the packed cost of the first
+ * `level` vehicles of the current order, and the least the others can add (their costs
+ * alone, which no plan among others beats). */
+typedef struct {
+    coa_cost_t prefix[COA_MAX_VEHICLES + 1u];
+    coa_cost_t alone_from[COA_MAX_VEHICLES + 1u];
+} orders_costs_t;
+
+static void alone_from(const coa_planner_t *pl, const orders_t *o, orders_costs_t *c)
+{
+    size_t i = o->n;
+    c->alone_from[i] = (coa_cost_t){0u, 0u};
+    while (i-- > 0u) {
+        const size_t v = o->cur[i];
+        const uint64_t cell =
+            plan_table_at(&pl->to_go[v], 0u, pl->problem->vehicles[v].initial_offset);
+        c->alone_from[i] = plan_cost_add(c->alone_from[i + 1u], plan_cell_cost(pl, v, cell));
+    }
+}
+
+/* One attempt of the current order from o->start, abandoned (as a failure at that level)
+ * once its vehicles so far and the rest alone cost at least the best plan's. Returns the
+ * level that failed or was abandoned (n: a cheaper plan, in pl->rows). */
+static size_t orders_attempt_below(coa_planner_t *pl, orders_t *o, orders_costs_t *c,
+                                   coa_plan_result_t *r, coa_plan_status_t *st)
+{
+    size_t level;
+    ++r->orders_tried;
+    alone_from(pl, o, c);
+    *st = COA_PLAN_SOLVED;
+    for (level = o->start; level < o->n; ++level) {
+        o->tried[level] |= UINT32_C(1) << o->cur[level];
+        *st = plan_one(pl, o->cur, level, r);
+        if (*st != COA_PLAN_SOLVED) {
+            return level;
+        }
+        c->prefix[level + 1u] = plan_cost_add(c->prefix[level], row_cost(pl, o->cur[level]));
+        if (pl->have_best &&
+            plan_cost_compare(plan_cost_add(c->prefix[level + 1u], c->alone_from[level + 1u]),
+                              pl->best_cost) >= 0) {
+            return level;
+        }
+    }
+    return o->n;
+}
+
+bool coa_plan_orders_best(coa_planner_t *pl, uint32_t max_orders, uint64_t improve_limit,
+                          coa_plan_result_t *r)
+{
+    const size_t row = (size_t)pl->problem->horizon + 1u;
     orders_t o;
+    orders_costs_t c;
     coa_plan_result_t counted;
+    size_t fail = 0u;
+    coa_plan_status_t st = COA_PLAN_SOLVED;
 
     result_clear(&counted);
+    c.prefix[0] = (coa_cost_t){0u, 0u};
+    pl->have_best = false;
     (void)orders_init(pl->problem, NULL, &o); /* priority order: cannot fail */
-    while (counted.orders_tried < max_orders) {
-        coa_plan_status_t st;
-        size_t fail = orders_attempt(pl, &o, &counted, &st);
-        if (fail == o.n || pl->out_of_work || (fail == 0u && st == COA_PLAN_INFEASIBLE) ||
-            !orders_next(&o, fail)) {
-            r->searches += counted.searches;
-            r->nodes_expanded += counted.nodes_expanded;
-            return fail == o.n;
+    while (counted.orders_tried < max_orders && !pl->out_of_work &&
+           !(fail == 0u && st == COA_PLAN_INFEASIBLE)) {
+        fail = orders_attempt_below(pl, &o, &c, &counted, &st);
+        if (fail == o.n) {
+            size_t i;
+            for (i = 0; i < o.n * row; ++i) {
+                pl->best_rows[i] = pl->rows[i];
+            }
+            pl->best_cost = c.prefix[o.n];
+            if (!pl->have_best && improve_limit < pl->work_limit) {
+                pl->work_limit = improve_limit;
+                pl->out_of_work = improve_limit <= pl->work_used; /* no improvement left */
+            }
+            pl->have_best = true;
+            fail = o.n - 1u; /* on to the next order */
+        }
+        if (!orders_next(&o, fail)) {
+            break;
         }
     }
     r->searches += counted.searches;
     r->nodes_expanded += counted.nodes_expanded;
-    return false;
+    return pl->have_best;
 }
 
 /* ------------------------------------------------------------------------------------ */

@@ -585,21 +585,21 @@ static uint32_t all_vehicles(const coa_planner_t *pl)
     return (uint32_t)((UINT64_C(1) << pl->problem->vehicle_count) - 1u);
 }
 
-/* The incumbent: the first priority order that works, tried as the decoupled front end
- * tries them (plan.h), kept in pl->best_rows with its cost. Leaves pl->rows undefined. */
+/* The incumbent: the cheapest plan of the priority orders tried (coa_plan_orders_best),
+ * kept in pl->best_rows with its cost. Finding one may take up to half of the work left;
+ * improving it, up to a quarter, counted from the start: the joint searches keep the rest.
+ * Leaves pl->rows undefined. */
 static void incumbent(coa_planner_t *pl, coa_plan_result_t *r)
 {
     const uint64_t limit = pl->work_limit;
+    uint64_t improve = 0u;
     if (limit != 0u) {
         pl->work_limit = pl->work_used + (limit - pl->work_used) / 2u;
+        improve = pl->work_used + (limit - pl->work_used) / 4u;
     }
-    pl->have_best = coa_plan_orders_first(pl, INCUMBENT_ORDERS, r);
+    (void)coa_plan_orders_best(pl, INCUMBENT_ORDERS, improve, r);
     pl->work_limit = limit;
     pl->out_of_work = false;
-    if (pl->have_best) {
-        rows_copy(pl, pl->best_rows, pl->rows, all_vehicles(pl));
-        pl->best_cost = rows_cost(pl, all_vehicles(pl));
-    }
 }
 
 /* The result's lower bound, from a packed cost. */

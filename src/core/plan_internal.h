@@ -466,11 +466,17 @@ bool coa_plan_any_initial_conflict(const coa_planner_t *pl);
  * status; the rows of every vehicle when solved. */
 coa_plan_status_t coa_plan_independence(coa_planner_t *pl, coa_plan_result_t *r);
 
-/* The decoupled order search over the loaded problem, from the priority order, stopped at
- * the first order that works (its rows of every vehicle then in pl->rows: true), after
- * max_orders attempts, when every order is ruled out or tried, or when the work budget
- * runs out. Adds its searches and table walks to r's counters. */
-bool coa_plan_orders_first(coa_planner_t *pl, uint32_t max_orders, coa_plan_result_t *r);
+/* The incumbent (centralised, after every vehicle's own table): the decoupled order search
+ * over the loaded problem from the priority order, tried as the decoupled front end tries
+ * orders, and on past the first order that works as a branch and bound: an order is
+ * abandoned at the first vehicle where the costs so far and the rest's costs alone reach
+ * the best plan's. The cheapest plan is kept in pl->best_rows and pl->best_cost (true:
+ * one was found). Once one is, the work limit drops to improve_limit (when lower). Stops
+ * after max_orders attempts, when every order is ruled out or tried, or when the work
+ * budget runs out. Adds its searches and table walks to r's counters; leaves pl->rows
+ * undefined. */
+bool coa_plan_orders_best(coa_planner_t *pl, uint32_t max_orders, uint64_t improve_limit,
+                          coa_plan_result_t *r);
 
 /* One joint search over pl->group. When solved, writes the members' rows of pl->rows.
  * Precondition: coa_plan_search_release since the last search. */

@@ -36,7 +36,8 @@
 #define KEY_SHIFT 2u
 #define K_EXPANDED 0x8000u /* node_k bit: expanded at least once (closed) */
 #define K_SAMPLE 0x7fffu
-#define PLAN_WORK_LEAF 4u /* work units of a complete combination, beyond its members' */
+#define PLAN_WORK_LEAF 4u  /* work units of a complete combination, beyond its members' */
+#define PLAN_WORK_MATCH 2u /* work units of a direct matching of four members */
 
 static size_t node_sample(const coa_planner_t *pl, uint32_t n)
 {
@@ -235,24 +236,14 @@ static coa_cost_t cost_larger(coa_cost_t a, coa_cost_t b)
  * leaves of every expansion ask for it (the pass over subsets cost a quarter of a 4-UAV
  * search's instructions). Surcharges are >= 0, so a larger set never loses: two members
  * give their pair, three the larger of their largest pair and their triangle, four the
- * largest of their three perfect matchings and four triangles. */
-static bool matching_direct(const coa_cost_t *s, size_t m, uint32_t mask, coa_cost_t *out)
+ * largest of their three perfect matchings and four triangles. at[] lists the members. */
+static coa_cost_t matching_direct(const coa_cost_t *s, size_t m, const size_t *at, size_t count)
 {
     static const uint8_t triangles[4][3] = {{0, 1, 2}, {0, 1, 3}, {0, 2, 3}, {1, 2, 3}};
     static const uint8_t perfect[3][4] = {{0, 1, 2, 3}, {0, 2, 1, 3}, {0, 3, 1, 2}};
-    size_t at[4];
-    size_t count = 0u;
     size_t i;
     coa_cost_t best = {0u, 0u};
 
-    for (i = 0; i < m; ++i) {
-        if ((mask & (1u << i)) != 0u) {
-            if (count == 4u) {
-                return false;
-            }
-            at[count++] = i;
-        }
-    }
     if (count == 2u) {
         best = plan_cost_twice(s[plan_pair_index(at[0], at[1], m)]);
     } else if (count == 3u) {
@@ -276,56 +267,79 @@ static bool matching_direct(const coa_cost_t *s, size_t m, uint32_t mask, coa_co
                                                   s[plan_pair_index(at[t[1]], at[t[2]], m)])));
         }
     }
-    *out = best;
-    return true;
+    return best;
+}
+
+/* The members of at[] but positions a, b and c (a < b < c; SIZE_MAX: none). */
+static size_t members_without(const size_t *at, size_t count, size_t a, size_t b, size_t c,
+                              size_t *out)
+{
+    size_t i;
+    size_t n = 0u;
+    for (i = 0; i < count; ++i) {
+        if (i != a && i != b && i != c) {
+            out[n++] = at[i];
+        }
+    }
+    return n;
 }
 
 /* The largest half-integral fractional matching of the surcharges s[] among the members
- * of `mask` (doubled: an edge twice, a triangle's edges once each): directly up to four
- * members, else by a pass over the subsets of the mask (the lowest member is left alone,
- * matched to one other, or in a triangle). */
+ * at[] (doubled: an edge twice, a triangle's edges once each): the first member is left
+ * alone, matched to one other, or in a triangle, and the rest is matched the same way
+ * down to four members, which matching_direct says (6 members: 26 direct calls, against
+ * 64 subsets of a pass over them). */
+static coa_cost_t matching_list(const coa_cost_t *s, size_t m, const size_t *at, size_t count)
+{
+    size_t rest[PLAN_MAXM];
+    size_t j;
+    size_t l;
+    coa_cost_t best;
+
+    if (count <= 4u) {
+        return matching_direct(s, m, at, count);
+    }
+    best = matching_list(s, m, rest, members_without(at, count, 0u, SIZE_MAX, SIZE_MAX, rest));
+    for (j = 1u; j < count; ++j) {
+        size_t n = members_without(at, count, 0u, j, SIZE_MAX, rest);
+        coa_cost_t pair = plan_cost_twice(s[plan_pair_index(at[0], at[j], m)]);
+        best = cost_larger(best, plan_cost_add(pair, matching_list(s, m, rest, n)));
+        for (l = j + 1u; l < count; ++l) {
+            coa_cost_t tri = plan_cost_add(plan_cost_add(s[plan_pair_index(at[0], at[j], m)],
+                                                         s[plan_pair_index(at[0], at[l], m)]),
+                                           s[plan_pair_index(at[j], at[l], m)]);
+            n = members_without(at, count, 0u, j, l, rest);
+            best = cost_larger(best, plan_cost_add(tri, matching_list(s, m, rest, n)));
+        }
+    }
+    return best;
+}
+
+/* The work units of matching(mask) beyond a leaf's own: PLAN_WORK_MATCH per direct call
+ * past the first (members: 5 -> 11 calls, 6 -> 26; each call adds one per member, less
+ * the pairs and triangles of the first and the calls under them). */
+static uint64_t matching_work(uint32_t mask)
+{
+    static const uint8_t calls[PLAN_MAXM + 1u] = {1, 1, 1, 1, 1, 11, 26};
+    uint32_t count = 0u;
+    for (; mask != 0u; mask &= mask - 1u) {
+        ++count;
+    }
+    return (uint64_t)(calls[count] - 1u) * PLAN_WORK_MATCH;
+}
+
+/* matching_list of the members of `mask`. */
 static coa_cost_t matching(const coa_cost_t *s, size_t m, uint32_t mask)
 {
-    coa_cost_t best[1u << PLAN_MAXM];
-    uint32_t sub;
-
-    if (matching_direct(s, m, mask, &best[0])) {
-        return best[0];
-    }
-    best[0] = (coa_cost_t){0u, 0u};
-    /* The non-empty subsets of the mask in increasing order ((sub - mask) & mask steps
-     * to the next one), so that every smaller subset is done first. */
-    for (sub = (0u - mask) & mask; sub != 0u; sub = (sub - mask) & mask) {
-        uint32_t rest;
-        size_t i = 0u;
-        size_t j;
-        size_t l;
-        while ((sub & (1u << i)) == 0u) {
-            ++i;
-        }
-        rest = sub & ~(1u << i);
-        best[sub] = best[rest];
-        for (j = i + 1u; j < m; ++j) {
-            coa_cost_t v;
-            if ((rest & (1u << j)) == 0u) {
-                continue;
-            }
-            v = plan_cost_add(plan_cost_twice(s[plan_pair_index(i, j, m)]),
-                              best[rest & ~(1u << j)]);
-            best[sub] = cost_larger(v, best[sub]);
-            for (l = j + 1u; l < m; ++l) {
-                if ((rest & (1u << l)) == 0u) {
-                    continue;
-                }
-                v = plan_cost_add(
-                    plan_cost_add(s[plan_pair_index(i, j, m)], s[plan_pair_index(i, l, m)]),
-                    plan_cost_add(s[plan_pair_index(j, l, m)],
-                                  best[rest & ~(1u << j) & ~(1u << l)]));
-                best[sub] = cost_larger(v, best[sub]);
-            }
+    size_t at[PLAN_MAXM];
+    size_t count = 0u;
+    size_t i;
+    for (i = 0; i < m; ++i) {
+        if ((mask & (1u << i)) != 0u) {
+            at[count++] = i;
         }
     }
-    return best[mask];
+    return matching_list(s, m, at, count);
 }
 
 typedef struct {
@@ -712,6 +726,9 @@ static bool leaf(coa_planner_t *pl, expansion_t *e, plan_search_out_t *out)
     coa_cost_t f2;
     if (n != PLAN_NONE && (pl->node_k[n] & K_EXPANDED) != 0u) {
         return true;
+    }
+    if (!plan_work(pl, matching_work(e->in_child))) {
+        return false;
     }
     f2 = plan_cost_add(e->partial[e->ch.count], matching(e->s, pl->group.count, e->in_child));
     if (plan_cost_compare(f2, e->key) > 0) {
