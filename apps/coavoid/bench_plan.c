@@ -33,14 +33,16 @@ _Static_assert(BP_MIN_VEHICLES == 2u && BP_MAX_VEHICLES == 6u, "--vehicles' hint
 
 #define BENCH_PLAN_USAGE                                                                    \
     "usage: coavoid bench plan [--vehicles N] [--count C] [--seed S] [--repeat R]\n"        \
-    "                          [--beta B] [--scenario FILE] [--json]\n"                     \
+    "                          [--beta B] [--work W] [--scenario FILE] [--json]\n"          \
     "\n"                                                                                    \
     "Times the planner, centralised and decoupled, on the paper scenario and on C random\n" \
     "encounters each of 2, 3, 4 and 5 UAVs (6 with --vehicles 6) converging on one point\n" \
     "(staggered altitudes, half with a terrain box; %u steps of %g s), or on the N-UAV\n"   \
     "encounters only with --vehicles. One run plans every problem of a set once; prints\n"  \
-    "per set and mode the median, min and max run time over R runs, the nodes expanded,\n"  \
-    "nodes per second, the workspace and the outcomes (a table, or a JSON object with\n"    \
+    "per set and mode the median, min and max run time over R runs, the median and\n"       \
+    "largest time of one problem, the nodes expanded, nodes per second, the work, the\n"    \
+    "workspace, the outcomes (centralised: proven optimal or bounded) and the median\n"     \
+    "ratio of a centralised plan to its lower bound (a table, or a JSON object with\n"      \
     "--json).\n"                                                                            \
     "See docs/benchmarks.md.\n"                                                             \
     "\n"                                                                                    \
@@ -51,6 +53,8 @@ _Static_assert(BP_MIN_VEHICLES == 2u && BP_MAX_VEHICLES == 6u, "--vehicles' hint
     "  --repeat R       timed runs, 1..%u; default %u\n"                                    \
     "  --beta B         closed-set bound, B >= 1; default the scenario's, else %u;\n"       \
     "                   either way lowered where the workspace would pass 1 GiB\n"          \
+    "  --work W         work units each planning call may spend, 0 for no limit;\n"         \
+    "                   default %llu (as coavoid plan's)\n"                                 \
     "  --scenario FILE  the scenario timed as 'paper' (without --vehicles);\n"              \
     "                   default %s, relative to the working directory\n"                    \
     "  --json           print a JSON object instead of a table\n"                           \
@@ -65,7 +69,7 @@ static void bench_plan_help(void)
 {
     printf(BENCH_PLAN_USAGE, BP_HORIZON, BP_DT, BP_MIN_VEHICLES, BP_MAX_VEHICLES, BP_MAX_COUNT,
            BP_DEFAULT_COUNT, BP_DEFAULT_SEED, BP_MAX_REPEAT, BP_DEFAULT_REPEAT,
-           COAVOID_DEFAULT_BETA, BP_DEFAULT_SCENARIO);
+           COAVOID_DEFAULT_BETA, (unsigned long long)COAVOID_DEFAULT_WORK, BP_DEFAULT_SCENARIO);
 }
 
 typedef struct {
@@ -79,6 +83,8 @@ typedef struct {
     uint32_t repeat;
     const char *beta_text;
     uint32_t beta;
+    const char *work_text; /* NULL: COAVOID_DEFAULT_WORK */
+    uint64_t work;
     const char *scenario;
     bool json;
 } bp_options_t;
@@ -119,6 +125,9 @@ static int bp_option(int argc, char **argv, int *i, void *options)
         status = coavoid_cli_count_option(argc, argv, i, "--beta", "an integer >= 1", false,
                                           UINT32_MAX, &o->beta_text, &value);
         o->beta = (uint32_t)value;
+    } else if (coavoid_cli_option_is(arg, "--work")) {
+        status = coavoid_cli_count_option(argc, argv, i, "--work", "an integer >= 0", true,
+                                          UINT64_MAX, &o->work_text, &o->work);
     } else if (coavoid_cli_option_is(arg, "--scenario")) {
         status = coavoid_cli_text_option(argc, argv, i, "--scenario", "a scenario file", false,
                                          &o->scenario);
@@ -179,6 +188,7 @@ int coavoid_bench_plan(int argc, char **argv)
     config.seed = o.seed;
     config.repeat = o.repeat;
     config.beta = o.beta_text != NULL ? o.beta : 0u; /* 0: the scenario's, or the default */
+    config.work = o.work_text != NULL ? o.work : COAVOID_DEFAULT_WORK;
     coavoid_bench_plan_result_t result;
     coavoid_run_error_t e;
     int rc = coavoid_bench_plan_run(&config, &result, &e);

@@ -22,7 +22,8 @@
 
 #define MONTECARLO_USAGE                                                                    \
     "usage: coavoid montecarlo --vehicles N[,N...] [--count C] [--first I] [--seed S]\n"    \
-    "                          [--beta B] [--max-orders M] [--csv FILE] [--svg FILE]\n"     \
+    "                          [--beta B] [--max-orders M] [--work W] [--csv FILE]\n"       \
+    "                          [--svg FILE]\n"                                              \
     "                          [--json] [--save DIR] [--jobs J] [--quiet]\n"                \
     "                          [--fly [--loss P] [--delay S] [--jitter S] [--net-seed N]\n" \
     "                                 [--coordinator-stops-sweep all|ends]]\n"              \
@@ -47,6 +48,8 @@
     "                    per N where the centralised workspace would pass 1 GiB\n"          \
     "  --max-orders M    reordering: at most M priority orders, M >= 1; default N!\n"       \
     "                    (every order)\n"                                                   \
+    "  --work W          work units each planning call may spend, 0 for no limit;\n"        \
+    "                    default %llu (as coavoid plan's)\n"                                \
     "  --csv FILE        one row per encounter and method (times in time_us)\n"             \
     "  --svg FILE        success rates and the ratio's cumulative distribution\n"           \
     "  --save DIR        write each encounter as DIR/montecarlo-SEED-N-INDEX.json (an\n"    \
@@ -98,7 +101,7 @@ static void montecarlo_help(void)
     printf(MONTECARLO_USAGE, coavoid_encounter_montecarlo.horizon, coavoid_encounter_montecarlo.dt,
            COAVOID_ENCOUNTER_MIN_VEHICLES, COAVOID_ENCOUNTER_MAX_VEHICLES, MC_MAX_COUNT,
            MC_DEFAULT_COUNT, MC_MAX_FIRST, MC_DEFAULT_SEED, COAVOID_DEFAULT_BETA,
-           COAVOID_MONTECARLO_MAX_JOBS);
+           (unsigned long long)COAVOID_DEFAULT_WORK, COAVOID_MONTECARLO_MAX_JOBS);
     printf(MONTECARLO_USAGE_FLY, COAVOID_MC_FIGURE_MAX_FILES);
 }
 
@@ -118,6 +121,8 @@ typedef struct {
     uint32_t beta;
     const char *max_orders_text;
     uint32_t max_orders;
+    const char *work_text; /* NULL: COAVOID_DEFAULT_WORK */
+    uint64_t work;
     const char *csv;
     const char *svg;
     const char *save; /* a directory for every encounter's scenario, or NULL */
@@ -225,6 +230,9 @@ static int mc_option(int argc, char **argv, int *i, void *options)
         status = coavoid_cli_count_option(argc, argv, i, "--beta", "an integer >= 1", false,
                                           UINT32_MAX, &o->beta_text, &value);
         o->beta = (uint32_t)value;
+    } else if (coavoid_cli_option_is(arg, "--work")) {
+        status = coavoid_cli_count_option(argc, argv, i, "--work", "an integer >= 0", true,
+                                          UINT64_MAX, &o->work_text, &o->work);
     } else if (coavoid_cli_option_is(arg, "--max-orders")) {
         status = coavoid_cli_count_option(argc, argv, i, "--max-orders", "an integer >= 1", false,
                                           UINT32_MAX, &o->max_orders_text, &value);
@@ -277,9 +285,9 @@ static int figure_options(const mc_options_t *o)
     }
     if (o->vehicles_text != NULL || o->count_text != NULL || o->first_text != NULL ||
         o->seed_text != NULL || o->beta_text != NULL || o->max_orders_text != NULL ||
-        o->csv != NULL || o->save != NULL || o->json || o->jobs_text != NULL || o->quiet ||
-        o->fly || coavoid_cli_network_given(&o->network) || o->net_seed_text != NULL ||
-        o->sweep_text != NULL) {
+        o->work_text != NULL || o->csv != NULL || o->save != NULL || o->json ||
+        o->jobs_text != NULL || o->quiet || o->fly || coavoid_cli_network_given(&o->network) ||
+        o->net_seed_text != NULL || o->sweep_text != NULL) {
         return coavoid_cli_fail(CLI_EXIT_INVALID,
                                 "--figure-from: takes --svg only (it runs no encounters)");
     }
@@ -356,6 +364,7 @@ static coavoid_montecarlo_config_t mc_engine_config(const mc_options_t *o)
     c.seed = o->seed;
     c.beta = o->beta_text != NULL ? o->beta : 0u;                   /* 0: the default */
     c.max_orders = o->max_orders_text != NULL ? o->max_orders : 0u; /* 0: every order */
+    c.work = o->work_text != NULL ? o->work : COAVOID_DEFAULT_WORK;
     c.jobs = o->jobs;
     c.csv = o->csv;
     c.svg = o->svg;

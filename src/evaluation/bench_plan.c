@@ -118,35 +118,96 @@ static coa_planner_config_t set_planner(const bp_set_t *set, size_t searched, ui
     return config;
 }
 
-/* One run over the set: adds the time (ms) and fills the tallies of row. */
-static int run_once(coa_planner_t *planner, const bp_set_t *set, bool decoupled, int32_t *offsets,
-                    double *ms, coavoid_bench_plan_row_t *row, coavoid_run_error_t *e)
+/* The tallies of one plan's result. ratios[] gets the plan's ratio to its bound. */
+static void tally(const coa_plan_result_t *result, bool decoupled, coavoid_bench_plan_row_t *row,
+                  double *ratios, size_t *ratio_count)
 {
+    row->nodes_expanded += result->nodes_expanded;
+    row->nodes_generated += result->nodes_generated;
+    row->work += result->work;
+    row->solved += result->status == COA_PLAN_SOLVED;
+    row->infeasible += result->status == COA_PLAN_INFEASIBLE;
+    row->budget_exhausted += result->status == COA_PLAN_BUDGET_EXHAUSTED;
+    if (decoupled || result->status != COA_PLAN_SOLVED) {
+        return;
+    }
+    row->optimal += result->optimal;
+    row->bounded += !result->optimal;
+    if (result->bound_deviation > 0) {
+        ratios[(*ratio_count)++] =
+            result->optimal ? 1.0 : result->deviation / result->bound_deviation;
+    }
+}
+
+/* One run over the set: adds the time (ms), each problem's into problem_ms[], and fills
+ * the tallies of row. */
+static int run_once(coa_planner_t *planner, const bp_set_t *set, bool decoupled, uint64_t work,
+                    int32_t *offsets, double *ms, double *problem_ms, coavoid_bench_plan_row_t *row,
+                    coavoid_run_error_t *e)
+{
+    size_t ratio_count = 0;
+    double *ratios = calloc(set->count, sizeof *ratios);
+    if (ratios == NULL) {
+        return coavoid_run_fail(e, COAVOID_RUN_ERR_INPUT, "%s: out of memory", set->label);
+    }
     *ms = 0;
-    row->nodes_expanded = row->nodes_generated = 0;
-    row->solved = row->infeasible = row->budget_exhausted = 0;
-    for (uint32_t j = 0; j < set->count; j++) {
+    row->nodes_expanded = row->nodes_generated = row->work = 0;
+    row->solved = row->infeasible = row->budget_exhausted = row->optimal = row->bounded = 0;
+    int status = COAVOID_RUN_DONE;
+    for (uint32_t j = 0; status == COAVOID_RUN_DONE && j < set->count; j++) {
         coa_problem_t problem = coavoid_scenario_problem(&set->problems[j]);
         coa_plan_result_t result;
         memset(&result, 0, sizeof result);
         struct timespec start, end;
+        (void)coa_planner_set_work(planner, work);
         clock_gettime(CLOCK_MONOTONIC, &start);
         int rc = decoupled ? coa_plan_decoupled(planner, &problem, NULL, 1u, offsets, &result)
                            : coa_plan_centralised(planner, &problem, offsets, &result);
         clock_gettime(CLOCK_MONOTONIC, &end);
         if (rc != COA_OK) {
-            return coavoid_run_fail(
+            status = coavoid_run_fail(
                 e, rc == COA_ERR_RANGE ? COAVOID_RUN_ERR_INPUT : COAVOID_RUN_ERR_INTERNAL,
                 "%s, problem %u: the planner failed (%s)", set->label, j, coa_status_name(rc));
+            break;
         }
-        *ms += coavoid_timing_elapsed_ms(&start, &end);
-        row->nodes_expanded += result.nodes_expanded;
-        row->nodes_generated += result.nodes_generated;
-        row->solved += result.status == COA_PLAN_SOLVED;
-        row->infeasible += result.status == COA_PLAN_INFEASIBLE;
-        row->budget_exhausted += result.status == COA_PLAN_BUDGET_EXHAUSTED;
+        problem_ms[j] = coavoid_timing_elapsed_ms(&start, &end);
+        *ms += problem_ms[j];
+        tally(&result, decoupled, row, ratios, &ratio_count);
     }
-    return COAVOID_RUN_DONE;
+    if (status == COAVOID_RUN_DONE && ratio_count > 0) {
+        double lo = 0;
+        coavoid_timing_summarise(ratios, (uint32_t)ratio_count, &row->ratio_median, &lo,
+                                 &row->ratio_max);
+    }
+    free(ratios);
+    return status;
+}
+
+/* Each problem's median time over the runs (times[k * count + j]: run k, problem j), and
+ * their median and largest over the problems. */
+static int problems_summarise(const double *times, uint32_t count, uint32_t repeat,
+                              coavoid_bench_plan_row_t *row)
+{
+    double *each = calloc(count, sizeof *each);
+    double *runs = calloc(repeat, sizeof *runs);
+    if (each == NULL || runs == NULL) {
+        free(each);
+        free(runs);
+        return -1;
+    }
+    for (uint32_t j = 0; j < count; j++) {
+        double lo = 0;
+        double hi = 0;
+        for (uint32_t k = 0; k < repeat; k++) {
+            runs[k] = times[(size_t)k * count + j];
+        }
+        coavoid_timing_summarise(runs, repeat, &each[j], &lo, &hi);
+    }
+    double lo = 0;
+    coavoid_timing_summarise(each, count, &row->problem_median_ms, &lo, &row->problem_max_ms);
+    free(each);
+    free(runs);
+    return 0;
 }
 
 static int run_set(const coavoid_bench_plan_config_t *o, const bp_set_t *set, bool decoupled,
@@ -168,9 +229,10 @@ static int run_set(const coavoid_bench_plan_config_t *o, const bp_set_t *set, bo
     void *workspace = size != 0 ? malloc(size) : NULL;
     int32_t *offsets = calloc((size_t)set->vehicles * (COA_MAX_HORIZON + 1u), sizeof *offsets);
     double *times = calloc(o->repeat, sizeof *times);
+    double *problem_ms = calloc((size_t)o->repeat * set->count, sizeof *problem_ms);
     int status = COAVOID_RUN_DONE;
     coa_planner_t *planner = NULL;
-    if (workspace == NULL || offsets == NULL || times == NULL) {
+    if (workspace == NULL || offsets == NULL || times == NULL || problem_ms == NULL) {
         status = coavoid_run_fail(e, COAVOID_RUN_ERR_INPUT,
                                   "%s: out of memory for %zu bytes of workspace", set->label, size);
     } else if ((planner = coa_planner_init(workspace, size, &config)) == NULL) {
@@ -183,14 +245,16 @@ static int run_set(const coavoid_bench_plan_config_t *o, const bp_set_t *set, bo
     double ms = 0;
     if (status == COAVOID_RUN_DONE) { /* untimed: warms caches and the workspace's pages */
         first = *row;
-        status = run_once(planner, set, decoupled, offsets, &ms, &first, e);
+        status = run_once(planner, set, decoupled, o->work, offsets, &ms, problem_ms, &first, e);
     }
     for (uint32_t k = 0; status == COAVOID_RUN_DONE && k < o->repeat; k++) {
-        status = run_once(planner, set, decoupled, offsets, &times[k], row, e);
+        status = run_once(planner, set, decoupled, o->work, offsets, &times[k],
+                          &problem_ms[(size_t)k * set->count], row, e);
         if (status == COAVOID_RUN_DONE &&
             (row->nodes_expanded != first.nodes_expanded ||
              row->nodes_generated != first.nodes_generated || row->solved != first.solved ||
-             row->budget_exhausted != first.budget_exhausted)) {
+             row->budget_exhausted != first.budget_exhausted || row->work != first.work ||
+             row->optimal != first.optimal)) {
             status = coavoid_run_fail(e, COAVOID_RUN_ERR_INTERNAL,
                                       "internal error: %s, run %lu differs from the "
                                       "first",
@@ -199,7 +263,11 @@ static int run_set(const coavoid_bench_plan_config_t *o, const bp_set_t *set, bo
     }
     if (status == COAVOID_RUN_DONE) {
         coavoid_timing_summarise(times, o->repeat, &row->median_ms, &row->min_ms, &row->max_ms);
+        if (problems_summarise(problem_ms, set->count, o->repeat, row) != 0) {
+            status = coavoid_run_fail(e, COAVOID_RUN_ERR_INPUT, "%s: out of memory", set->label);
+        }
     }
+    free(problem_ms);
     free(times);
     free(offsets);
     free(workspace);
@@ -216,25 +284,34 @@ static double nodes_per_s(const coavoid_bench_plan_row_t *row)
 static int report_text(FILE *f, const coavoid_bench_plan_config_t *o,
                        const coavoid_bench_plan_row_t *rows, size_t count)
 {
-    fprintf(f, "benchmark: plan\nseed: %llu\nrepeat: %lu\ncount: %lu\n",
-            (unsigned long long)o->seed, (unsigned long)o->repeat, (unsigned long)o->count);
-    fprintf(f, "%-7s %-11s %8s %6s %10s %6s %5s %6s %10s %10s %10s %14s %12s %15s\n", "set", "mode",
-            "problems", "solved", "infeasible", "budget", "uavs", "beta", "median_ms", "min_ms",
-            "max_ms", "nodes_expanded", "nodes_per_s", "workspace_bytes");
+    fprintf(f, "benchmark: plan\nseed: %llu\nrepeat: %lu\ncount: %lu\nwork: %llu\n",
+            (unsigned long long)o->seed, (unsigned long)o->repeat, (unsigned long)o->count,
+            (unsigned long long)o->work);
+    fprintf(f,
+            "%-7s %-11s %8s %6s %7s %7s %10s %6s %5s %6s %10s %10s %10s %9s %9s %7s %14s %12s %12s "
+            "%15s\n",
+            "set", "mode", "problems", "solved", "optimal", "bounded", "infeasible", "budget",
+            "uavs", "beta", "median_ms", "min_ms", "max_ms", "prob_med", "prob_max", "ratio",
+            "nodes_expanded", "nodes_per_s", "work", "workspace_bytes");
     for (size_t i = 0; i < count; i++) {
         const coavoid_bench_plan_row_t *r = &rows[i];
         fprintf(f,
-                "%-7s %-11s %8lu %6lu %10lu %6lu %5lu %5lu%s %10.3f %10.3f %10.3f %14llu %12.0f "
-                "%15zu\n",
+                "%-7s %-11s %8lu %6lu %7lu %7lu %10lu %6lu %5lu %5lu%s %10.3f %10.3f %10.3f %9.3f "
+                "%9.3f "
+                "%7.3f %14llu %12.0f %12llu %15zu\n",
                 r->set, r->decoupled ? "decoupled" : "centralised", (unsigned long)r->problems,
-                (unsigned long)r->solved, (unsigned long)r->infeasible,
-                (unsigned long)r->budget_exhausted, (unsigned long)r->vehicles,
-                (unsigned long)r->beta, r->beta_lowered ? "*" : " ", r->median_ms, r->min_ms,
-                r->max_ms, (unsigned long long)r->nodes_expanded, nodes_per_s(r),
-                r->workspace_bytes);
+                (unsigned long)r->solved, (unsigned long)r->optimal, (unsigned long)r->bounded,
+                (unsigned long)r->infeasible, (unsigned long)r->budget_exhausted,
+                (unsigned long)r->vehicles, (unsigned long)r->beta, r->beta_lowered ? "*" : " ",
+                r->median_ms, r->min_ms, r->max_ms, r->problem_median_ms, r->problem_max_ms,
+                r->ratio_median, (unsigned long long)r->nodes_expanded, nodes_per_s(r),
+                (unsigned long long)r->work, r->workspace_bytes);
     }
-    fprintf(f, "times: per run over the set's problems; budget: budget exhausted; "
-               "beta*: lowered to keep the workspace within 1 GiB\n");
+    fprintf(f, "times: per run over the set's problems; prob_med, prob_max: per problem (its "
+               "median over the runs); budget: no plan found within beta or the work budget; "
+               "optimal, bounded: centralised plans proven optimal or not; ratio: the median "
+               "centralised plan's deviation over its lower bound; beta*: lowered to keep the "
+               "workspace within 1 GiB\n");
     return fflush(f) == 0 && !ferror(f) ? 0 : -1;
 }
 
@@ -250,6 +327,7 @@ static int report_json(FILE *f, const coavoid_bench_plan_config_t *o,
               cJSON_AddRawToObject(root, "seed", seed) != NULL &&
               cJSON_AddNumberToObject(root, "repeat", o->repeat) != NULL &&
               cJSON_AddNumberToObject(root, "count", o->count) != NULL &&
+              cJSON_AddNumberToObject(root, "work", (double)o->work) != NULL &&
               (list = cJSON_AddArrayToObject(root, "results")) != NULL;
     for (size_t i = 0; ok && i < count; i++) {
         const coavoid_bench_plan_row_t *r = &rows[i];
@@ -271,7 +349,14 @@ static int report_json(FILE *f, const coavoid_bench_plan_config_t *o,
              cJSON_AddNumberToObject(row, "workspace_bytes", (double)r->workspace_bytes) != NULL &&
              cJSON_AddNumberToObject(row, "solved", r->solved) != NULL &&
              cJSON_AddNumberToObject(row, "infeasible", r->infeasible) != NULL &&
-             cJSON_AddNumberToObject(row, "budget_exhausted", r->budget_exhausted) != NULL;
+             cJSON_AddNumberToObject(row, "budget_exhausted", r->budget_exhausted) != NULL &&
+             cJSON_AddNumberToObject(row, "optimal", r->optimal) != NULL &&
+             cJSON_AddNumberToObject(row, "bounded", r->bounded) != NULL &&
+             cJSON_AddNumberToObject(row, "problem_median_ms", r->problem_median_ms) != NULL &&
+             cJSON_AddNumberToObject(row, "problem_max_ms", r->problem_max_ms) != NULL &&
+             cJSON_AddNumberToObject(row, "ratio_median", r->ratio_median) != NULL &&
+             cJSON_AddNumberToObject(row, "ratio_max", r->ratio_max) != NULL &&
+             cJSON_AddNumberToObject(row, "work", (double)r->work) != NULL;
     }
     if (!ok) {
         cJSON_Delete(root);

@@ -54,6 +54,8 @@ typedef struct {
      * COAVOID_DEFAULT_BETA. Either way lowered to coavoid_default_beta where the workspace
      * would pass COAVOID_DEFAULT_WORKSPACE_MAX (the programs' sizing policy, scenario.h). */
     uint32_t beta;
+    /* Work units each planning call may spend (coa_planner_set_work); 0: no limit. */
+    uint64_t work;
 } coavoid_bench_plan_config_t;
 
 /* Room for a set's name with its NUL. */
@@ -69,6 +71,15 @@ typedef struct {
     uint64_t nodes_expanded, nodes_generated;
     size_t workspace_bytes;
     uint32_t solved, infeasible, budget_exhausted;
+    /* Centralised: the solved plans proven optimal, and the others (bounded). */
+    uint32_t optimal, bounded;
+    /* Over the problems, each timed by its median over the runs: the median and largest. */
+    double problem_median_ms, problem_max_ms;
+    /* Over the centralised plans found: the median and largest ratio of the plan's
+     * deviation to its proven lower bound (1 when optimal; 0 when no plan has a positive
+     * bound). */
+    double ratio_median, ratio_max;
+    uint64_t work; /* work units spent in one run over the set */
 } coavoid_bench_plan_row_t;
 
 typedef struct {

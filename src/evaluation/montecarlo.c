@@ -217,6 +217,7 @@ static int solve_method(int m, const coa_problem_t *problem, const coavoid_mc_si
     coa_plan_result_t result;
     struct timespec start, end;
     memset(&result, 0, sizeof result);
+    (void)coa_planner_set_work(m == COAVOID_MC_CENTRALISED ? p->central : p->decoupled, size->work);
     clock_gettime(CLOCK_MONOTONIC, &start);
     int rc = m == COAVOID_MC_CENTRALISED
                  ? coa_plan_centralised(p->central, problem, p->offsets, &result)
@@ -241,6 +242,9 @@ static int solve_method(int m, const coa_problem_t *problem, const coavoid_mc_si
     o->generated = result.nodes_generated;
     o->orders_tried = result.orders_tried;
     o->time_us = coavoid_timing_elapsed_ms(&start, &end) * 1e3;
+    o->optimal = result.optimal;
+    o->bound_deviation = result.bound_deviation;
+    o->work = result.work;
     if (result.status == COA_PLAN_SOLVED && r->defect[0] == '\0') {
         size_t vehicle = 0;
         uint32_t step = 0;
@@ -692,6 +696,7 @@ static int mc_sizes(const coavoid_montecarlo_config_t *c, coavoid_mc_size_t *siz
         coa_planner_config_t shape = mc_config(n, COAVOID_DEFAULT_BETA);
         sizes[k].beta = c->beta != 0 ? c->beta : coavoid_default_beta(&shape);
         sizes[k].max_orders = c->max_orders != 0 ? c->max_orders : factorial(n);
+        sizes[k].work = c->work;
         shape.beta = sizes[k].beta;
         if (coa_planner_workspace_size(&shape) == 0) {
             return coavoid_run_fail(e, COAVOID_RUN_ERR_INPUT,

@@ -64,6 +64,8 @@ typedef struct {
     uint32_t beta;
     /* Reordering's limit on priority orders, >= 1; 0: every order (N!). */
     uint32_t max_orders;
+    /* Work units each planning call may spend (coa_planner_set_work); 0: no limit. */
+    uint64_t work;
     uint32_t jobs;   /* worker threads, 1..COAVOID_MONTECARLO_MAX_JOBS */
     const char *csv; /* a file for one row per encounter and method, or NULL */
     const char *svg; /* a file for the figure, written by the report, or NULL */

@@ -27,6 +27,9 @@ typedef struct {
     uint64_t expanded, generated;
     uint32_t orders_tried;
     double time_us;
+    bool optimal;           /* centralised: the plan is proven optimal */
+    double bound_deviation; /* centralised: the proven lower bound on the optimum (m^2) */
+    uint64_t work;          /* work units spent */
 } coavoid_mc_outcome_t;
 
 /* The two closed-loop modes of fly, in the order of every report. */
@@ -81,6 +84,7 @@ typedef struct {
     uint32_t n;
     uint32_t beta;
     uint32_t max_orders;
+    uint64_t work; /* each planning call's work budget; 0: none */
 } coavoid_mc_size_t;
 
 struct coavoid_montecarlo {

@@ -77,6 +77,10 @@ typedef struct {
     uint32_t fails_where_central_solves, solves_where_central_fails;
     double mean_deviation_both; /* mean deviation (m^2) over the encounters both solve */
     double central_mean_deviation_both;
+    /* Centralised: the plans proven optimal and the others, and each plan's deviation over
+     * its lower bound (1 when optimal) where the bound is positive. */
+    uint32_t optimal, bounded;
+    mc_dist_t bound_ratio;
 } mc_method_summary_t;
 
 /* One closed-loop mode (fly) over a UAV count's encounters. */
@@ -158,6 +162,26 @@ static void summarise_sweep(const coavoid_mc_result_t *results, uint32_t count, 
     }
 }
 
+/* The centralised plans' outcomes: proven optimal or bounded, and plan over bound. */
+static void bound_ratios(const coavoid_mc_result_t *results, uint32_t count, double *x,
+                         mc_method_summary_t *ms)
+{
+    uint32_t n = 0, equal = 0;
+    for (uint32_t j = 0; j < count; j++) {
+        const coavoid_mc_outcome_t *c = &results[j].m[COAVOID_MC_CENTRALISED];
+        if (c->status != COA_PLAN_SOLVED) {
+            continue;
+        }
+        ms->optimal += c->optimal;
+        ms->bounded += !c->optimal;
+        if (c->bound_deviation > 0) {
+            x[n++] = c->optimal ? 1.0 : c->deviation / c->bound_deviation;
+            equal += c->optimal;
+        }
+    }
+    ms->bound_ratio = distribution(x, n, equal);
+}
+
 /* Summarises the count results of one size; x: room for count doubles. */
 static void summarise(const coavoid_mc_result_t *results, uint32_t count,
                       const coavoid_mc_size_t *size, double *x, mc_summary_t *s)
@@ -184,6 +208,7 @@ static void summarise(const coavoid_mc_result_t *results, uint32_t count,
         }
         ms->expanded = distribution(x, count, 0u);
         if (m == COAVOID_MC_CENTRALISED) {
+            bound_ratios(results, count, x, ms);
             continue;
         }
         uint32_t both = 0, equal = 0;
@@ -235,6 +260,14 @@ static void text_summary(FILE *f, const coavoid_montecarlo_config_t *o, const mc
                     100 * ms->low, 100 * ms->high, ms->time_ms.median, ms->time_ms.p90,
                     ms->time_ms.max, ms->expanded.median);
         }
+        const mc_method_summary_t *cm = &z->m[COAVOID_MC_CENTRALISED];
+        fprintf(f,
+                "  centralised plans: %lu proven optimal, %lu bounded; plan / lower bound: "
+                "median %.3f, p90 %.3f, max %.3f\n",
+                (unsigned long)cm->optimal, (unsigned long)cm->bounded,
+                cm->bound_ratio.count > 0 ? cm->bound_ratio.median : 0.0,
+                cm->bound_ratio.count > 0 ? cm->bound_ratio.p90 : 0.0,
+                cm->bound_ratio.count > 0 ? cm->bound_ratio.max : 0.0);
         fprintf(f, "  deviation ratio to centralised, over the encounters both solve:\n");
         fprintf(f, "  %-20s %6s %7s %7s %7s %7s %7s %7s %7s %7s %9s %9s\n", "method", "both", "min",
                 "p25", "median", "p75", "p90", "max", "mean", "=1", "fails*", "solves*");
@@ -449,6 +482,11 @@ static int json_summary(FILE *f, const coavoid_montecarlo_config_t *o, const mc_
                  cJSON_AddNumberToObject(mo, "wilson_high", ms->high) != NULL &&
                  add_dist(mo, "time_ms", &ms->time_ms, false) &&
                  add_dist(mo, "nodes_expanded", &ms->expanded, false);
+            if (ok && m == COAVOID_MC_CENTRALISED) {
+                ok = cJSON_AddNumberToObject(mo, "optimal", ms->optimal) != NULL &&
+                     cJSON_AddNumberToObject(mo, "bounded", ms->bounded) != NULL &&
+                     add_dist(mo, "bound_ratio", &ms->bound_ratio, true);
+            }
             if (ok && m != COAVOID_MC_CENTRALISED) {
                 ok = add_dist(mo, "deviation_ratio", &ms->ratio, true) &&
                      cJSON_AddNumberToObject(mo, "fails_where_centralised_solves",

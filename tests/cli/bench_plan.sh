@@ -17,12 +17,13 @@ check() {
     if python3 - "$tmp/out" "$asserts" >"$tmp/py" 2>&1 <<'PY'; then pass; else fail "$name: $(tail -n 5 "$tmp/py")"; fi
 import json, sys
 b = json.load(open(sys.argv[1]))
-assert list(b) == ["benchmark", "seed", "repeat", "count", "results"], list(b)
+assert list(b) == ["benchmark", "seed", "repeat", "count", "work", "results"], list(b)
 assert b["benchmark"] == "plan"
 rows = b["results"]
 keys = ["set", "mode", "vehicles", "problems", "beta", "beta_lowered", "median_ms", "min_ms",
         "max_ms", "nodes_expanded", "nodes_generated", "nodes_per_s", "workspace_bytes",
-        "solved", "infeasible", "budget_exhausted"]
+        "solved", "infeasible", "budget_exhausted", "optimal", "bounded", "problem_median_ms",
+        "problem_max_ms", "ratio_median", "ratio_max", "work"]
 for r in rows:
     assert list(r) == keys, f"keys {list(r)}"
     assert r["mode"] in ("centralised", "decoupled"), r
@@ -32,6 +33,14 @@ for r in rows:
             assert isinstance(r[k], (int, float)) and not isinstance(r[k], bool) and r[k] >= 0, (k, r)
     assert r["min_ms"] <= r["median_ms"] <= r["max_ms"], r
     assert r["solved"] + r["infeasible"] + r["budget_exhausted"] == r["problems"], r
+    assert r["problem_median_ms"] <= r["problem_max_ms"], r
+    assert b["work"] == 0 or r["work"] <= b["work"] * r["problems"], r
+    if r["mode"] == "centralised":
+        assert r["optimal"] + r["bounded"] == r["solved"], r
+        assert r["ratio_median"] <= r["ratio_max"], r
+        assert r["ratio_median"] >= 1 or (r["ratio_median"] == 0 and r["ratio_max"] == 0), r
+    else:
+        assert r["optimal"] == r["bounded"] == 0 and r["ratio_median"] == 0, r
     assert r["workspace_bytes"] > 0 and r["beta"] >= 1, r
     assert r["workspace_bytes"] <= 1 << 30, r
 # Each set in both modes, centralised first.
@@ -48,18 +57,19 @@ if expect_ok table bench plan --vehicles 2 --count 2 --repeat 1; then
     if python3 - "$tmp/out" >"$tmp/py" 2>&1 <<'PY'; then pass; else fail "table: $(tail -n 5 "$tmp/py")"; fi
 import sys
 lines = open(sys.argv[1]).read().splitlines()
-assert lines[:4] == ["benchmark: plan", "seed: 1", "repeat: 1", "count: 2"], lines[:4]
-cols = lines[4].split()
-assert cols == ["set", "mode", "problems", "solved", "infeasible", "budget", "uavs", "beta",
-                "median_ms", "min_ms", "max_ms", "nodes_expanded", "nodes_per_s",
-                "workspace_bytes"], cols
-rows = [l.split() for l in lines[5:7]]
+assert lines[:5] == ["benchmark: plan", "seed: 1", "repeat: 1", "count: 2", "work: 10000000"], lines[:5]
+cols = lines[5].split()
+assert cols == ["set", "mode", "problems", "solved", "optimal", "bounded", "infeasible", "budget",
+                "uavs", "beta", "median_ms", "min_ms", "max_ms", "prob_med", "prob_max", "ratio",
+                "nodes_expanded", "nodes_per_s", "work", "workspace_bytes"], cols
+rows = [l.split() for l in lines[6:8]]
 assert [r[:3] for r in rows] == [["2", "UAVs", "centralised"], ["2", "UAVs", "decoupled"]], rows
 for r in rows:
     assert len(r) == len(cols) + 1, r  # "2 UAVs" is two words
-    assert r[3] == "2" and int(r[4]) + int(r[5]) + int(r[6]) == 2 and r[7] == "2", r
-assert lines[7].startswith("times: "), lines[7:]
-assert len(lines) == 8, lines
+    assert r[3] == "2" and int(r[4]) + int(r[7]) + int(r[8]) == 2 and r[9] == "2", r
+assert int(rows[0][5]) + int(rows[0][6]) == int(rows[0][4]), rows[0]
+assert lines[8].startswith("times: "), lines[8:]
+assert len(lines) == 9, lines
 PY
 fi
 
@@ -77,7 +87,7 @@ if expect_ok same_seed bench plan --json --vehicles=2 --count=2 --repeat=2; then
     if python3 - "$tmp/first" "$tmp/out.last" <<'PY'; then pass; else fail "same seed, different work"; fi
 import json, sys
 a, b = (json.load(open(p))["results"] for p in sys.argv[1:])
-work = lambda rows: [(r["nodes_expanded"], r["nodes_generated"], r["solved"]) for r in rows]
+work = lambda rows: [(r["nodes_expanded"], r["nodes_generated"], r["solved"], r["work"]) for r in rows]
 sys.exit(0 if work(a) == work(b) else f"{work(a)} vs {work(b)}")
 PY
 fi
@@ -89,6 +99,14 @@ if expect_ok small_beta bench plan --vehicles 5 --count 1 --repeat 1 --beta 2 --
 rows[0]["solved"] == 1 and rows[0]["nodes_generated"] == 2 and rows[0]["beta"] == 2
 rows[1]["infeasible"] == 1
 rows[0]["vehicles"] == 5 and not rows[0]["beta_lowered"]
+'
+fi
+# A work budget too small for the joint search: the incumbent or nothing, never past the
+# budget (per problem), and the budget is printed.
+if expect_ok small_work bench plan --vehicles 5 --count 2 --repeat 1 --work 300000 --json; then
+    check small_work '
+b["work"] == 300000 and rows[0]["bounded"] + rows[0]["budget_exhausted"] == 2 - rows[0]["infeasible"] - rows[0]["optimal"]
+rows[0]["work"] <= 2 * 300000
 '
 fi
 # A beta whose centralised workspace would pass 1 GiB (74 bytes a node for two UAVs) is
@@ -137,6 +155,8 @@ expect_bad "repeat 0" "--repeat" bench plan --vehicles 2 --repeat 0
 expect_bad "seed negative" "--seed" bench plan --vehicles 2 --seed -1
 expect_bad "seed 2^64" "--seed" bench plan --vehicles 2 --seed 18446744073709551616
 expect_bad "beta 0" "--beta" bench plan --vehicles 2 --beta 0
+expect_bad "work negative" "--work" bench plan --vehicles 2 --work -1
+expect_bad "work missing" "--work" bench plan --vehicles 2 --work
 expect_bad "json value" "--json" bench plan --vehicles 2 --json=yes
 expect_bad "unknown option" "--bogus" bench plan --vehicles 2 --bogus
 expect_bad "argument" "'extra'" bench plan --vehicles 2 extra

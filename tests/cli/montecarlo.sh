@@ -81,6 +81,12 @@ for s in b["sizes"]:
         nodes = sorted(int(e[m["method"]]["expanded"]) for e in enc.values())
         assert close(m["nodes_expanded"]["median"], quantile(nodes, 0.5)), m
         if m["method"] == "centralised":
+            # Every plan found is proven optimal or bounded; plan over bound is >= 1.
+            assert m["optimal"] + m["bounded"] == m["solved"], m
+            br = m["bound_ratio"]
+            assert br["count"] <= m["solved"], m
+            assert br["count"] == 0 or 1 <= br["min"] <= br["median"] <= br["max"], m
+            assert br["count"] == 0 or close(br["equal_share"] * br["count"], m["optimal"]) or m["optimal"] > br["count"], m
             continue
         both = [e for e in enc.values()
                 if e["centralised"]["status"] == "solved" and e[m["method"]]["status"] == "solved"]

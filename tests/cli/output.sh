@@ -386,6 +386,28 @@ expect_result scenario_beta 0 solved centralised "$tmp/beta1.json" "" "" plan "$
 expect_stats scenario_beta 'st["limit"] == "beta" and st["beta"] == 1 and r["optimal"] is False' 
 expect_result beta_overrides 0 solved centralised "$tmp/beta1.json" "" "" plan "$tmp/beta1.json" --mode centralised --beta 20000
 
+# ---- the input limits, within the default budget ----
+# The dearest scenarios the limits accept (scripts/limits_scenarios.py; docs/security.md
+# gives their times without a budget) end within the default work budget in both modes,
+# and the one whose tables alone pass it (400 steps, steep factor 10) says the budget
+# stopped it.
+if python3 "$src/scripts/limits_scenarios.py" "$tmp/limits"; then pass; else fail "limits_scenarios.py failed"; fi
+for f in limits-24 limits-400; do
+    for m in centralised decoupled; do
+        "$bin" plan "$tmp/limits/$f.json" --mode "$m" >"$tmp/lim.out" 2>"$tmp/lim.err"
+        rc=$?
+        if python3 - "$tmp/lim.out" "$rc" "$f" <<'PY' >"$tmp/py" 2>&1; then pass; else fail "$f $m: $(tail -n 3 "$tmp/py")"; fi
+import json, sys
+r = json.load(open(sys.argv[1]))
+st = r["stats"]
+assert st["work_budget"] == 10000000 and 0 < st["work"] <= st["work_budget"], st
+assert (r["status"] == "solved") == (sys.argv[2] == "0"), (r["status"], sys.argv[2])
+assert st["limit"] == "work" or r["status"] in ("solved", "infeasible"), (r["status"], st)
+assert sys.argv[3] != "limits-400" or (st["limit"] == "work" and r["status"] == "budget_exhausted"), (r["status"], st)
+PY
+    done
+done
+
 # ---- output is the same JSON each run, apart from the time ----
 "$bin" plan "$h" --mode centralised >"$tmp/again.out" 2>/dev/null
 if python3 - "$tmp/headon_central.out" "$tmp/again.out" <<'PY'
