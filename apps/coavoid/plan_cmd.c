@@ -39,7 +39,7 @@ _Static_assert(COAVOID_DEFAULT_MAX_ORDERS == 7u * 6u * 5u * 4u * 3u * 2u * 1u &&
     "  --beta N            nodes a joint search may store, N >= 1; overrides the\n"           \
     "                      scenario's \"beta\"; default %u, lowered so the workspace stays\n" \
     "                      within 1 GiB (a node is 70 + 2 bytes per UAV)\n"                   \
-    "  --work W            work units the planning call may spend (about 10 ns each),\n"      \
+    "  --work W            work units the planning call may spend (10-40 ns each),\n"         \
     "                      W >= 0, 0 for no limit; default %llu; centralised, the best\n"     \
     "                      plan found by then is the answer, with its lower bound\n"          \
     "  --reorder           decoupled: when a UAV fails, try other priority orders\n"          \

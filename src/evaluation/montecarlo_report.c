@@ -290,7 +290,8 @@ static void text_summary(FILE *f, const coavoid_montecarlo_config_t *o, const mc
                     r->p75, r->p90, r->max, r->mean, 100 * r->equal_share, fails, solves);
         }
     }
-    fprintf(f, "\nbudget: beta exhausted (nothing proven); =1: the same exact deviation as "
+    fprintf(f, "\nbudget: no plan found within beta or the work budget (nothing proven); "
+               "bounded: a plan\nnot proven optimal; =1: the same exact deviation as "
                "centralised;\nfails*: share of encounters it fails and centralised solves; "
                "solves*: it solves and centralised fails\n");
 }
