@@ -1425,6 +1425,57 @@ START_TEST(test_coordinator_skips_decoupled_uav)
 }
 END_TEST
 
+/* A cycle's work (plan_work) bounds the coordinator's search: one too small for even the
+ * tables stops the centralised call within it, and the cluster is still answered (in
+ * priority order, decoupled, outside the budget); the default, from the cycle, lets it
+ * plan centrally. */
+START_TEST(test_coordinator_answers_within_its_work)
+{
+    for (int small = 1; small >= 0; small--) {
+        rig_t r;
+        rig_init(&r, 24);
+        plan_probe_t probe;
+        memset(&probe, 0, sizeof probe);
+        lcm_subscription_t *sub = lcm_subscribe(r.lcm, COAVOID_CHANNEL_PLAN, on_plan_probe, &probe);
+        coa_vec3_t r1[2], r2[2];
+        coavoid_vehicle_node_t *a =
+            vehicle_node(&r, uav(1, 1, r1, 0, 600, 0, 100), COAVOID_NODE_CENTRALISED);
+        coavoid_vehicle_node_t *b =
+            vehicle_node(&r, uav(2, 2, r2, 300, -300, 0, 100), COAVOID_NODE_CENTRALISED);
+        coavoid_coordinator_config_t cc;
+        memset(&cc, 0, sizeof cc);
+        cc.common = r.common;
+        cc.plan_work = small ? 2000u : 0u;
+        int error = -99;
+        coavoid_coordinator_t *co = coavoid_coordinator_create(&cc, r.lcm, &error);
+        ck_assert_ptr_nonnull(co);
+        ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
+        ck_assert_int_eq(coavoid_vehicle_node_cycle(b, r.now), COA_OK);
+        drain(r.lcm);
+        r.now = cycle(0) + DT_US / 4;
+        coordinate(r.lcm, co, r.now);
+        const coavoid_coordinator_state_t *s = coavoid_coordinator_state(co);
+        ck_assert_int_eq(probe.plans, 1);
+        ck_assert_int_eq(probe.status, COAVOID_PLAN_T_STATUS_SOLVED);
+        ck_assert_int_eq(probe.rows, 2);
+        if (small) {
+            ck_assert_uint_le(s->last_plan_work, 2000u);
+            ck_assert_uint_gt(s->last_plan_work, 0u);
+            ck_assert_uint_eq(s->plans_run, 2); /* the stopped search, then the order's */
+        } else {
+            ck_assert_uint_le(s->last_plan_work, coavoid_node_work_of((DT_US - DT_US / 4) / 2));
+            ck_assert_uint_eq(s->plans_run, 1);
+        }
+        ck_assert_uint_eq(coavoid_vehicle_node_state(b)->plans_adopted, 1);
+        lcm_unsubscribe(r.lcm, sub);
+        coavoid_coordinator_destroy(co);
+        coavoid_vehicle_node_destroy(b);
+        coavoid_vehicle_node_destroy(a);
+        lcm_destroy(r.lcm);
+    }
+}
+END_TEST
+
 /* A stopwatch that moves 10 ms each time it is read: any planning runs over a 5 ms budget. */
 static int64_t slow_stopwatch(void *user)
 {
@@ -2632,6 +2683,7 @@ static Suite *node_suite(void)
     tcase_add_test(tc, test_failed_plan_is_an_answer);
     tcase_add_test(tc, test_coordinator_skips_decoupled_uav);
     tcase_add_test(tc, test_coordinator_abandons_past_budget);
+    tcase_add_test(tc, test_coordinator_answers_within_its_work);
     tcase_add_test(tc, test_lower_priority_waits);
     tcase_add_test(tc, test_waits_for_near_higher_priority);
     tcase_add_test(tc, test_wait_ends_at_deadline);

@@ -285,34 +285,46 @@ static size_t members_without(const size_t *at, size_t count, size_t a, size_t b
 }
 
 /* The largest half-integral fractional matching of the surcharges s[] among the members
- * at[] (doubled: an edge twice, a triangle's edges once each): the first member is left
- * alone, matched to one other, or in a triangle, and the rest is matched the same way
- * down to four members, which matching_direct says (6 members: 26 direct calls, against
- * 64 subsets of a pass over them). */
-static coa_cost_t matching_list(const coa_cost_t *s, size_t m, const size_t *at, size_t count)
+ * at[] (count of them, 5 or 6; doubled: an edge twice, a triangle's edges once each),
+ * given `alone`, the matching of at[1..]: the first member is left alone, matched to one
+ * other, or in a triangle, and the rest (at most four) is matching_direct's. */
+static coa_cost_t matching_peel(const coa_cost_t *s, size_t m, const size_t *at, size_t count,
+                                coa_cost_t alone)
 {
     size_t rest[PLAN_MAXM];
     size_t j;
     size_t l;
-    coa_cost_t best;
+    coa_cost_t best = alone;
 
-    if (count <= 4u) {
-        return matching_direct(s, m, at, count);
-    }
-    best = matching_list(s, m, rest, members_without(at, count, 0u, SIZE_MAX, SIZE_MAX, rest));
     for (j = 1u; j < count; ++j) {
         size_t n = members_without(at, count, 0u, j, SIZE_MAX, rest);
         coa_cost_t pair = plan_cost_twice(s[plan_pair_index(at[0], at[j], m)]);
-        best = cost_larger(best, plan_cost_add(pair, matching_list(s, m, rest, n)));
+        best = cost_larger(best, plan_cost_add(pair, matching_direct(s, m, rest, n)));
         for (l = j + 1u; l < count; ++l) {
             coa_cost_t tri = plan_cost_add(plan_cost_add(s[plan_pair_index(at[0], at[j], m)],
                                                          s[plan_pair_index(at[0], at[l], m)]),
                                            s[plan_pair_index(at[j], at[l], m)]);
             n = members_without(at, count, 0u, j, l, rest);
-            best = cost_larger(best, plan_cost_add(tri, matching_list(s, m, rest, n)));
+            best = cost_larger(best, plan_cost_add(tri, matching_direct(s, m, rest, n)));
         }
     }
     return best;
+}
+
+/* The matching of the members at[]: directly up to four, peeled member by member above
+ * (6 members: 26 direct calls, against 64 subsets of a pass over them). No recursion: the
+ * firmware's stack bound is a sum of frames. */
+static coa_cost_t matching_list(const coa_cost_t *s, size_t m, const size_t *at, size_t count)
+{
+    _Static_assert(PLAN_MAXM <= 6u, "matching_list peels at most two members");
+    if (count <= 4u) {
+        return matching_direct(s, m, at, count);
+    }
+    if (count == 5u) {
+        return matching_peel(s, m, at, 5u, matching_direct(s, m, &at[1], 4u));
+    }
+    return matching_peel(s, m, at, 6u,
+                         matching_peel(s, m, &at[1], 5u, matching_direct(s, m, &at[2], 4u)));
 }
 
 /* The work units of matching(mask) beyond a leaf's own: PLAN_WORK_MATCH per direct call

@@ -1423,3 +1423,13 @@ int coavoid_node_publish_intent(coavoid_node_inbox_t *in, const coavoid_intent_t
     in->own_next = (in->own_next + 1u) % COAVOID_NODE_OWN_INTENTS;
     return send_sealed(tx, COAVOID_CHANNEL_INTENT, size);
 }
+
+uint64_t coavoid_node_work_of(int64_t us)
+{
+    if (us <= 0) {
+        return 0u;
+    }
+    return (uint64_t)us > UINT64_MAX / COAVOID_NODE_WORK_PER_US
+               ? UINT64_MAX
+               : (uint64_t)us * COAVOID_NODE_WORK_PER_US;
+}

@@ -48,6 +48,7 @@ struct coavoid_coordinator {
     int64_t status_sequence;
     int64_t last_plan_utime;
     int64_t cycle_stopwatch; /* its stopwatch when the cycle's planning began */
+    uint64_t cycle_work;     /* work units its searches may still spend this cycle */
 
     uint32_t labels[COAVOID_NODE_MAX_PEERS];
     bool include[COAVOID_NODE_MAX_PEERS];
@@ -113,6 +114,12 @@ coavoid_coordinator_t *coavoid_coordinator_create(const coavoid_coordinator_conf
     }
     if (node->config.ack_timeout_us <= 0) {
         node->config.ack_timeout_us = c->dt_us / 4 > 0 ? c->dt_us / 4 : 1;
+    }
+    if (node->config.plan_work == 0u) {
+        node->config.plan_work = coavoid_node_work_of(
+            node->config.plan_budget_us > 0 ? node->config.plan_budget_us
+                                            : (c->dt_us - node->config.collect_us) / 2);
+        node->config.plan_work += node->config.plan_work == 0u ? 1u : 0u;
     }
     if (node->config.resend_us <= 0) {
         node->config.resend_us = c->dt_us / 40 > 0 ? c->dt_us / 40 : 1;
@@ -284,14 +291,20 @@ static int cluster_plan(coavoid_coordinator_t *node, int64_t now, const coa_prob
     *centralised = count <= node->config.max_centralised;
     int64_t start = coavoid_node_stopwatch(c);
     if (*centralised) {
+        /* At least one unit: 0 would mean no limit. */
+        (void)coa_planner_set_work(planner, node->cycle_work > 0u ? node->cycle_work : 1u);
         rc = coa_plan_centralised(planner, problem, node->offsets, result);
+        node->cycle_work -= rc == COA_OK ? result->work : 0u;
+        node->state.last_plan_work = rc == COA_OK ? result->work : 0u;
         if (rc == COA_OK && result->status == COA_PLAN_BUDGET_EXHAUSTED && count > 1u) {
             node->state.plans_run++;
             node->state.clusters_planned++;
             *centralised = false;
+            (void)coa_planner_set_work(planner, 0u);
             rc = coa_plan_decoupled(planner, problem, NULL, 1u, node->offsets, result);
         }
     } else {
+        (void)coa_planner_set_work(planner, 0u);
         rc = coa_plan_decoupled(planner, problem, NULL, 1u, node->offsets, result);
     }
     int64_t duration = coavoid_node_stopwatch(c) - start;
@@ -677,6 +690,7 @@ static int replan_accepted(coavoid_coordinator_t *node, int64_t now, size_t inde
     }
     node->state.plans_replanned++;
     node->cycle_stopwatch = coavoid_node_stopwatch(&cf->common);
+    node->cycle_work = cf->plan_work;
     bool solved = false;
     return plan_cluster(node, now, node->cycle_start, count, &solved);
 }
@@ -811,6 +825,7 @@ int coavoid_coordinator_cycle(coavoid_coordinator_t *node, int64_t now)
         first_error = rc;
     }
     node->cycle_stopwatch = coavoid_node_stopwatch(c);
+    node->cycle_work = node->config.plan_work;
     size_t failed_size = plan_clusters(node, now, cycle_start, clusters, &first_error);
     failed_size = escalate(node, now, cycle_start, failed_size, &first_error);
     node->degraded = failed_size > 0u;

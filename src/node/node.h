@@ -197,6 +197,16 @@
 #define COAVOID_NODE_DEFAULT_JOINT_MEMBERS 5u
 #define COAVOID_NODE_DEFAULT_JOINT_BETA 5000u
 
+/* Work units (plan.h, "Work") a node's planner is given per microsecond of the time a
+ * planning call may take: 25, a unit at 40 ns, above the dearest cost of a unit measured
+ * on the host (docs/benchmarks.md, "Within a work budget"), so that a call ends within
+ * its time on such a core whatever it plans. A slower processor needs fewer. */
+#define COAVOID_NODE_WORK_PER_US 25u
+
+/* The work units of `us` microseconds at COAVOID_NODE_WORK_PER_US (0 when us <= 0, at
+ * most UINT64_MAX). O(1). */
+uint64_t coavoid_node_work_of(int64_t us);
+
 typedef enum {
     COAVOID_NODE_CENTRALISED = 0, /* follow the coordinator; plan for itself when it is silent */
     COAVOID_NODE_DECOUPLED = 1    /* always plan for itself in priority order */
@@ -330,9 +340,14 @@ typedef struct {
      * (docs/benchmarks.md has the bytes). joint_beta 0: COAVOID_NODE_DEFAULT_JOINT_BETA. */
     size_t joint_members;
     uint32_t joint_beta;
+    /* The work budget of that search (plan.h, "Work"), so that it ends within its time
+     * like the rest of the cycle; the same on every vehicle of a fleet, like joint_beta
+     * (a search stopped by it answers the same everywhere). 0: the default,
+     * coavoid_node_work_of(dt / 4). */
+    uint64_t joint_work;
     /* NULL, or a memo of failed joint searches shared with vehicles that search alike
-     * (coavoid_node_joint_memo_t: the simulation's; the same joint_beta on each); not
-     * owned, and it must outlive the node. */
+     * (coavoid_node_joint_memo_t: the simulation's; the same joint_beta and joint_work on
+     * each); not owned, and it must outlive the node. */
     coavoid_node_joint_memo_t *joint_memo;
 } coavoid_vehicle_node_config_t;
 
@@ -452,9 +467,17 @@ typedef struct {
      * in one cycle; 0: no budget (a simulation, whose stopwatch reads 0, never runs over).
      * A cluster it comes to past the budget, or whose search ends past it, is abandoned:
      * a plan_t with STATUS_ABANDONED tells its UAVs, which then plan for themselves
-     * rather than wait for a plan that would come late. One search is bounded by beta, so
-     * the overrun is at most one search. */
+     * rather than wait for a plan that would come late. */
     int64_t plan_budget_us;
+    /* The work units (plan.h, "Work") its centralised searches may spend in one cycle,
+     * all clusters together: each search gets what the cycle has left and answers within
+     * it (its best plan, with a bound, when it is stopped), so a search ends on time
+     * where plan_budget_us could only abandon it once it had overrun; deterministic, so a
+     * simulation plans the same on every machine. A cluster whose search finds no plan is
+     * planned decoupled in priority order (its UAVs' tables, outside the budget). 0: the
+     * default, coavoid_node_work_of(plan_budget_us when it is set, else (dt - collect_us)
+     * / 2). */
+    uint64_t plan_work;
     /* The agreement on a plan (docs/protocol.md): how long after proposing a plan it
      * waits for every UAV's accept before it aborts the plan and plans the UAVs that
      * accepted again (0: the default, dt / 4), and how often it sends again what was not
@@ -480,6 +503,7 @@ typedef struct {
     uint32_t plans_resent;     /* proposals sent again for want of an accept */
     int last_outcome;
     uint64_t last_nodes_expanded;
+    uint64_t last_plan_work; /* work units of its last centralised search */
     int64_t last_plan_duration_us;
     coavoid_lcm_rx_stats_t rx;
 } coavoid_coordinator_state_t;

@@ -1249,17 +1249,20 @@ static int search_joint(coavoid_vehicle_node_t *node, size_t count, size_t self,
     }
     /* The order search runs several times a cycle on the same intents (overtaken, a
      * first intent, world news); the same problem fails the same way, and so it does in
-     * the search of any vehicle that shares the memo (the same beta: in the key). */
+     * the search of any vehicle that shares the memo (the same beta and work: in the key). */
     const uint64_t digest = coavoid_node_problem_digest(problem);
-    const uint64_t key =
-        coavoid_node_fnv(digest, &node->config.joint_beta, sizeof node->config.joint_beta);
+    const uint64_t key = coavoid_node_fnv(
+        coavoid_node_fnv(digest, &node->config.joint_beta, sizeof node->config.joint_beta),
+        &node->config.joint_work, sizeof node->config.joint_work);
     if ((node->joint_failed_cycle == node->state.cycle && node->joint_failed_digest == digest) ||
         coavoid_node_joint_memo_has(node->config.joint_memo, key)) {
         return 0;
     }
     coa_plan_result_t result;
+    (void)coa_planner_set_work(node->solver.planner, node->config.joint_work);
     const int rc =
         coa_plan_centralised(node->solver.planner, problem, node->order_offsets, &result);
+    (void)coa_planner_set_work(node->solver.planner, 0u); /* its other searches: tables */
     if (rc != COA_OK) {
         return rc;
     }
@@ -1980,6 +1983,10 @@ static void fill_defaults(coavoid_vehicle_node_config_t *config)
     }
     if (config->joint_beta == 0u) {
         config->joint_beta = COAVOID_NODE_DEFAULT_JOINT_BETA;
+    }
+    if (config->joint_work == 0u) {
+        config->joint_work = coavoid_node_work_of(dt_us / 4);
+        config->joint_work += config->joint_work == 0u ? 1u : 0u;
     }
 }
 
