@@ -33,7 +33,8 @@ _Static_assert(BP_MIN_VEHICLES == 2u && BP_MAX_VEHICLES == 6u, "--vehicles' hint
 
 #define BENCH_PLAN_USAGE                                                                    \
     "usage: coavoid bench plan [--vehicles N] [--count C] [--seed S] [--repeat R]\n"        \
-    "                          [--beta B] [--work W] [--scenario FILE] [--json]\n"          \
+    "                          [--beta B] [--work W] [--scenario FILE] [--save DIR]\n"      \
+    "                          [--json]\n"                                                  \
     "\n"                                                                                    \
     "Times the planner, centralised and decoupled, on the paper scenario and on C random\n" \
     "encounters each of 2, 3, 4 and 5 UAVs (6 with --vehicles 6) converging on one point\n" \
@@ -57,6 +58,8 @@ _Static_assert(BP_MIN_VEHICLES == 2u && BP_MAX_VEHICLES == 6u, "--vehicles' hint
     "                   default %llu (as coavoid plan's)\n"                                 \
     "  --scenario FILE  the scenario timed as 'paper' (without --vehicles);\n"              \
     "                   default %s, relative to the working directory\n"                    \
+    "  --save DIR       write each random encounter as DIR/bench-SEED-N-INDEX.json (an\n"   \
+    "                   existing directory), for `coavoid plan` to replay\n"                \
     "  --json           print a JSON object instead of a table\n"                           \
     "  -h, --help       show this help\n"                                                   \
     "\n"                                                                                    \
@@ -86,6 +89,7 @@ typedef struct {
     const char *work_text; /* NULL: COAVOID_DEFAULT_WORK */
     uint64_t work;
     const char *scenario;
+    const char *save;
     bool json;
 } bp_options_t;
 
@@ -131,6 +135,8 @@ static int bp_option(int argc, char **argv, int *i, void *options)
     } else if (coavoid_cli_option_is(arg, "--scenario")) {
         status = coavoid_cli_text_option(argc, argv, i, "--scenario", "a scenario file", false,
                                          &o->scenario);
+    } else if (coavoid_cli_option_is(arg, "--save")) {
+        status = coavoid_cli_text_option(argc, argv, i, "--save", "a directory", false, &o->save);
     } else if (coavoid_cli_option_is(arg, "--json")) {
         status = coavoid_cli_flag_option(arg, "--json", &o->json);
     }
@@ -189,6 +195,7 @@ int coavoid_bench_plan(int argc, char **argv)
     config.repeat = o.repeat;
     config.beta = o.beta_text != NULL ? o.beta : 0u; /* 0: the scenario's, or the default */
     config.work = o.work_text != NULL ? o.work : COAVOID_DEFAULT_WORK;
+    config.save = o.save;
     coavoid_bench_plan_result_t result;
     coavoid_run_error_t e;
     int rc = coavoid_bench_plan_run(&config, &result, &e);

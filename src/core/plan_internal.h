@@ -446,7 +446,12 @@ coa_cost_t coa_plan_pair_surcharge(const coa_planner_t *pl, size_t a, size_t b, 
 /* Index of pair (a, b), a < b < m. */
 static inline size_t plan_pair_index(size_t a, size_t b, size_t m)
 {
-    return a * m - a * (a + 1u) / 2u + (b - a - 1u);
+    /* b (b - 1) / 2 + a: pairs by their larger member, so the index does not depend on m
+     * (the joint search asks for it at every step of its enumeration). */
+    static const uint8_t before[PLAN_MAXM] = {0u, 0u, 1u, 3u, 6u, 10u};
+    _Static_assert(PLAN_MAXM == 6u, "before[] lists b (b - 1) / 2 for b < PLAN_MAXM");
+    (void)m;
+    return (size_t)before[b] + a;
 }
 
 /* The exact deviation of vehicle v's row (N + 1 offsets) in the problem's units, as the

@@ -62,6 +62,11 @@ static int build_random_set(const coavoid_bench_plan_config_t *o, uint32_t n, bp
                                     "not fit %u bytes",
                                     j, n, COAVOID_ENCOUNTER_JSON_MAX);
         }
+        if (o->save != NULL && coavoid_encounter_save(o->save, "bench", o->seed, n, j, json) != 0) {
+            return coavoid_run_fail(e, COAVOID_RUN_ERR_INPUT,
+                                    "--save: cannot write encounter %u of %u UAVs in '%.200s'", j,
+                                    n, o->save);
+        }
         if (coavoid_scenario_parse(json, strlen(json), &set->problems[j], why, sizeof why) != 0 ||
             coavoid_scenario_sample(&set->problems[j], why, sizeof why) != 0) {
             return coavoid_run_fail(e, COAVOID_RUN_ERR_INTERNAL,

@@ -56,6 +56,9 @@ typedef struct {
     uint32_t beta;
     /* Work units each planning call may spend (coa_planner_set_work); 0: no limit. */
     uint64_t work;
+    /* An existing directory for every random encounter as DIR/bench-SEED-N-INDEX.json, or
+     * NULL. */
+    const char *save;
 } coavoid_bench_plan_config_t;
 
 /* Room for a set's name with its NUL. */

@@ -222,3 +222,20 @@ bool coavoid_encounter_json(const coavoid_encounter_design_t *d, uint64_t seed, 
     }
     return ok && append(buf, size, &used, "}");
 }
+
+int coavoid_encounter_save(const char *dir, const char *prefix, uint64_t seed, uint32_t n,
+                           uint32_t index, const char *json)
+{
+    char path[4096];
+    int length = snprintf(path, sizeof path, "%s/%s-%llu-%lu-%lu.json", dir, prefix,
+                          (unsigned long long)seed, (unsigned long)n, (unsigned long)index);
+    if (length < 0 || (size_t)length >= sizeof path) {
+        return -1;
+    }
+    FILE *f = fopen(path, "w");
+    if (f == NULL) {
+        return -1;
+    }
+    bool ok = fputs(json, f) >= 0 && fputc('\n', f) != EOF;
+    return fclose(f) == 0 && ok ? 0 : -1;
+}

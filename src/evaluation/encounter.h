@@ -77,4 +77,9 @@ bool coavoid_encounter_json(const coavoid_encounter_design_t *d, uint64_t seed, 
                             uint32_t index, uint32_t attempt, char *buf, size_t size,
                             coavoid_encounter_info_t *info);
 
+/* Writes json and a newline to DIR/PREFIX-SEED-N-INDEX.json (for `coavoid plan` to
+ * replay). Returns 0, or -1 when the path does not fit or the file cannot be written. */
+int coavoid_encounter_save(const char *dir, const char *prefix, uint64_t seed, uint32_t n,
+                           uint32_t index, const char *json);
+
 #endif /* COAVOID_EVALUATION_ENCOUNTER_H */

@@ -124,23 +124,6 @@ static int planners_ready(mc_planners_t *p, const coavoid_mc_size_t *size, char 
 }
 
 /* DIR/montecarlo-SEED-N-INDEX.json, so that `coavoid plan` can replay an encounter. */
-static int save_encounter(const char *dir, uint64_t seed, uint32_t n, uint32_t index,
-                          const char *json)
-{
-    char path[4096];
-    int length = snprintf(path, sizeof path, "%s/montecarlo-%llu-%lu-%lu.json", dir,
-                          (unsigned long long)seed, (unsigned long)n, (unsigned long)index);
-    if (length < 0 || (size_t)length >= sizeof path) {
-        return -1;
-    }
-    FILE *f = fopen(path, "w");
-    if (f == NULL) {
-        return -1;
-    }
-    bool ok = fputs(json, f) >= 0 && fputc('\n', f) != EOF;
-    return fclose(f) == 0 && ok ? 0 : -1;
-}
-
 /* The accepted draw of encounter (n, index), sampled, in *s; saved in save_dir unless
  * NULL. Returns 0 or -1 with err. */
 static int draw_encounter(uint64_t seed, const coavoid_mc_size_t *size, uint32_t index,
@@ -184,7 +167,8 @@ static int draw_encounter(uint64_t seed, const coavoid_mc_size_t *size, uint32_t
             return -1;
         }
         if (rc == 1 && step > 0) {
-            if (save_dir != NULL && save_encounter(save_dir, seed, n, index, json) != 0) {
+            if (save_dir != NULL &&
+                coavoid_encounter_save(save_dir, "montecarlo", seed, n, index, json) != 0) {
                 coavoid_scenario_free(s);
                 snprintf(err, err_size,
                          "--save: cannot write encounter %lu of %lu UAVs in "

@@ -109,6 +109,24 @@ b["work"] == 300000 and rows[0]["bounded"] + rows[0]["budget_exhausted"] == 2 - 
 rows[0]["work"] <= 2 * 300000
 '
 fi
+# --save writes each random encounter where `coavoid plan` replays it, to the same outcome.
+mkdir -p "$tmp/saved"
+if expect_ok save bench plan --vehicles 3 --count 2 --repeat 1 --save "$tmp/saved" --json; then
+    check save 'rows[0]["problems"] == 2'
+    solved=0
+    for j in 0 1; do
+        f="$tmp/saved/bench-1-3-$j.json"
+        if [ -f "$f" ] && "$bin" plan "$f" --mode centralised >"$tmp/replay" 2>/dev/null; then
+            solved=$((solved + 1))
+        fi
+    done
+    if python3 -c 'import json,sys; sys.exit(0 if json.load(open(sys.argv[1]))["results"][0]["solved"] == int(sys.argv[2]) else 1)' "$tmp/out.last" "$solved"; then
+        pass
+    else
+        fail "save: the saved encounters do not replay to the benchmark's outcomes ($solved solved)"
+    fi
+fi
+expect_bad "save missing dir" "--save" bench plan --vehicles 2 --count 1 --repeat 1 --save "$tmp/no/such/dir"
 # A beta whose centralised workspace would pass 1 GiB (74 bytes a node for two UAVs) is
 # lowered to the default (which fits), and says so; a decoupled planner stores no nodes, so its beta is never lowered.
 if expect_ok lowered_beta bench plan --vehicles 2 --count 1 --repeat 1 --beta 20000000 --json; then
