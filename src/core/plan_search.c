@@ -652,6 +652,22 @@ static bool beyond(const coa_planner_t *pl, const expansion_t *e, coa_cost_t bou
                                plan_cost_compare(bound, e->next) >= 0);
 }
 
+/* The matching of the surcharges among choosers 0..c (at most four) in the search at k1:
+ * a lower bound on the child's, which contains it. */
+static coa_cost_t chosen_matching(const coa_planner_t *pl, const expansion_t *e, size_t c,
+                                  uint32_t k1)
+{
+    size_t at[4];
+    size_t count = 0u;
+    size_t d;
+    for (d = 0; d <= c; ++d) {
+        if (in_search(&pl->group, e->ch.member[d], k1)) {
+            at[count++] = e->ch.member[d];
+        }
+    }
+    return matching_direct(e->s, pl->group.count, at, count);
+}
+
 /* Chooser c takes option choice[c]: its offset at k + 1, and, if it is in the search
  * there, its own cost to go and its surcharges with the members chosen before it. False
  * when a pair is dead there (no plan of the pair from that state). */
@@ -685,9 +701,12 @@ static bool choose(const coa_planner_t *pl, expansion_t *e, size_t c)
         }
     }
     /* The largest doubled surcharge among the pairs chosen so far (one pair is a matching
-     * of the child's): a lower bound, cheaper than the matching, which the leaf adds
-     * exactly (measured: the same expansions as with the matching here, 23% fewer
-     * instructions). */
+     * of the child's), and from three choosers on their matching in closed form: lower
+     * bounds on what the leaf adds exactly, which cut branches (4-8% fewer work units in
+     * 4-UAV searches than the largest pair alone). */
+    if (c >= 2u && c < 4u) {
+        best = cost_larger(best, chosen_matching(pl, e, c, k1));
+    }
     e->pairmax[c + 1u] = best;
     return true;
 }

@@ -116,9 +116,9 @@ long coavoid_scenario_vehicle_index(const coavoid_scenario_t *s, long id);
  * Why 200,000: docs/benchmarks.md and docs/evaluation.md ("beta"). */
 #define COAVOID_DEFAULT_BETA 200000u
 /* The programs' default work budget of one planning call (plan.h, "Work"), in work units:
- * at most about a second of one core of the machines docs/benchmarks.md measures, at the
- * slowest work unit measured there. */
-#define COAVOID_DEFAULT_WORK UINT64_C(10000000)
+ * below a second of one core at the slowest unit measured (docs/benchmarks.md, "Within a
+ * work budget"), and enough to prove every 4-UAV montecarlo encounter's plan optimal. */
+#define COAVOID_DEFAULT_WORK UINT64_C(20000000)
 #define COAVOID_DEFAULT_WORKSPACE_MAX ((size_t)1u << 30)
 
 /* The planner config of a scenario (coa_planner_config_of: its horizon, largest steep

@@ -57,7 +57,7 @@ if expect_ok table bench plan --vehicles 2 --count 2 --repeat 1; then
     if python3 - "$tmp/out" >"$tmp/py" 2>&1 <<'PY'; then pass; else fail "table: $(tail -n 5 "$tmp/py")"; fi
 import sys
 lines = open(sys.argv[1]).read().splitlines()
-assert lines[:5] == ["benchmark: plan", "seed: 1", "repeat: 1", "count: 2", "work: 10000000"], lines[:5]
+assert lines[:5] == ["benchmark: plan", "seed: 1", "repeat: 1", "count: 2", "work: 20000000"], lines[:5]
 cols = lines[5].split()
 assert cols == ["set", "mode", "problems", "solved", "optimal", "bounded", "infeasible", "budget",
                 "uavs", "beta", "median_ms", "min_ms", "max_ms", "prob_med", "prob_max", "ratio",

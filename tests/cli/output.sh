@@ -372,7 +372,7 @@ expect_result held_beta1 1 budget_exhausted centralised "$tmp/held.json" "" "" p
 expect_stats held_beta1 'st["limit"] == "beta" and r["optimal"] is False and "cost" not in r'
 expect_result held_decoupled 1 infeasible decoupled "$tmp/held.json" 1,2 "" plan "$tmp/held.json" --mode decoupled --reorder
 expect_result held_central 0 solved centralised "$tmp/held.json" "" "" plan "$tmp/held.json" --mode centralised --beta 20000
-expect_stats held_central 'st["limit"] == "none" and r["optimal"] is True and st["work"] <= st["work_budget"] == 10000000'
+expect_stats held_central 'st["limit"] == "none" and r["optimal"] is True and st["work"] <= st["work_budget"] == 20000000'
 expect_result held_work1 1 budget_exhausted centralised "$tmp/held.json" "" "" plan "$tmp/held.json" --mode centralised --work 1
 expect_stats held_work1 'st["limit"] == "work" and st["work"] <= 1 and st["work_budget"] == 1'
 expect_result held_work0 0 solved centralised "$tmp/held.json" "" "" plan "$tmp/held.json" --mode centralised --work 0
@@ -400,7 +400,7 @@ for f in limits-24 limits-400; do
 import json, sys
 r = json.load(open(sys.argv[1]))
 st = r["stats"]
-assert st["work_budget"] == 10000000 and 0 < st["work"] <= st["work_budget"], st
+assert st["work_budget"] == 20000000 and 0 < st["work"] <= st["work_budget"], st
 assert (r["status"] == "solved") == (sys.argv[2] == "0"), (r["status"], sys.argv[2])
 assert st["limit"] == "work" or r["status"] in ("solved", "infeasible"), (r["status"], st)
 assert sys.argv[3] != "limits-400" or (st["limit"] == "work" and r["status"] == "budget_exhausted"), (r["status"], st)
