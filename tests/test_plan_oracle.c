@@ -28,8 +28,9 @@
 #include "reference/plan_v1.h"
 #include "test_support.h"
 
-#define MAXV 4u /* UAVs of an encounter */
-#define MINN 8u /* horizon range */
+#define MAXV 5u     /* UAVs of an encounter */
+#define MAXV_OLD 4u /* ... compared with the old planner */
+#define MINN 8u     /* horizon range */
 #define MAXN 14u
 #define MAXSTEEP 4u  /* steep factors 2..MAXSTEEP */
 #define TRIALS 2500u /* encounters; at least 2000 must be compared */
@@ -45,7 +46,7 @@
 /* Expansions per search of each planner. The old one closes at most beta states and
  * stores up to 5^n children of each, so its pool is 1 + beta * 5^n nodes: one planner
  * per UAV count keeps each pool (and the hash table it clears) no larger than it needs. */
-static const uint32_t OLD_BETA[MAXV + 1u] = {0u, 0u, 20000u, 3000u, 1000u};
+static const uint32_t OLD_BETA[MAXV_OLD + 1u] = {0u, 0u, 20000u, 3000u, 1000u};
 #define NEW_BETA 200000u
 
 /* The problem holder, sized to an encounter. */
@@ -84,7 +85,7 @@ static const struct {
     double overlap_hi;
     uint32_t max_horizon[MAXV + 1u]; /* per UAV count; MINN is the least */
     uint32_t scenery[MAXV + 1u];     /* per UAV count: 1 in `scenery` has a box, 1 a track */
-} shape = {3.0, 0.8, 1.2, {0u, 0u, MAXN, 12u, 10u}, {0u, 0u, 4u, 5u, 12u}};
+} shape = {3.0, 0.8, 1.2, {0u, 0u, MAXN, 12u, 10u, 9u}, {0u, 0u, 4u, 5u, 12u, 12u}};
 
 static void enc_random(fx_t *e, uint64_t *rng, size_t n)
 {
@@ -210,7 +211,7 @@ static void enc_random(fx_t *e, uint64_t *rng, size_t n)
 /* ------------------------------------------------------------------------------------ */
 /* Planners                                                                              */
 
-static const size_t ALL[MAXV] = {0u, 1u, 2u, 3u};
+static const size_t ALL[MAXV] = {0u, 1u, 2u, 3u, 4u};
 
 typedef struct {
     void *mem;
@@ -452,7 +453,7 @@ START_TEST(new_planner_matches_old_on_random_encounters)
     unsigned trial;
     size_t m;
 
-    for (m = 2u; m <= MAXV; ++m) {
+    for (m = 2u; m <= MAXV_OLD; ++m) {
         old[m] = old_make(m, OLD_BETA[m]);
     }
     memset(&gen, 0, sizeof gen);
@@ -590,7 +591,7 @@ START_TEST(new_planner_matches_old_on_random_encounters)
     /* The old planner's beta is kept small so that its 4-UAV searches are fast: the cases
      * it cannot finish are skipped, but they must stay few. */
     ck_assert_uint_lt(total_skipped * 10u, TRIALS);
-    for (m = 2u; m <= MAXV; ++m) {
+    for (m = 2u; m <= MAXV_OLD; ++m) {
         /* Every UAV count is exercised, with both outcomes. */
         ck_assert_uint_gt(solved[m], compared[m] / 4u);
         ck_assert_uint_gt(infeasible[m], 0u);
@@ -603,7 +604,7 @@ START_TEST(new_planner_matches_old_on_random_encounters)
      * broke ties very differently would show here. */
     ck_assert_uint_lt(dec_tie * 20u, dec_compared);
 
-    for (m = 2u; m <= MAXV; ++m) {
+    for (m = 2u; m <= MAXV_OLD; ++m) {
         free(old[m].mem);
     }
     free(nw.mem);
@@ -695,6 +696,65 @@ static void head_on_pair(fx_t *e)
  * altitude (the references come within reach horizontally, but the level plans never
  * overlap vertically: 50 m against 6 m of half-heights). Two searches, alone (each plan
  * read off its table counts N expansions), and no other; the plan is level, cost 0. */
+/* Five UAVs are beyond the old planner (5^5 children a node), so the new one's own exact
+ * answer is the reference there: every call the work budget does not stop is exact on
+ * 2-4 UAVs above, and the anytime claims are checked against it the same way, on
+ * FIVE_COMPARED encounters whose exact answer takes at most FIVE_REFERENCE_WORK units
+ * (those beyond it are skipped, and counted). */
+#define FIVE_COMPARED 200u
+#define FIVE_TRIALS 400u
+#define FIVE_REFERENCE_WORK UINT64_C(400000000)
+
+START_TEST(anytime_claims_hold_for_five_uavs)
+{
+    static fx_t e;
+    static int32_t rows[MAXV * (MAXN + 1u)];
+    coa_planner_config_t cfg = big_config(5u, NEW_BETA);
+    new_ws_t nw = new_make(&cfg);
+    uint64_t rng = 0x5eed5f1feu;
+    unsigned compared = 0u;
+    unsigned solved = 0u;
+    unsigned skipped = 0u;
+    unsigned stopped = 0u;
+    unsigned still_optimal = 0u;
+    unsigned trial;
+
+    for (trial = 0; trial < FIVE_TRIALS && compared < FIVE_COMPARED; ++trial) {
+        coa_plan_result_t exact;
+        bool optimal = false;
+        enc_random(&e, &rng, 5u);
+        REQUIRE(coa_planner_set_work(nw.pl, FIVE_REFERENCE_WORK) == COA_OK);
+        REQUIRE(coa_plan_centralised(nw.pl, &e.p, rows, &exact) == COA_OK);
+        REQUIRE(coa_planner_set_work(nw.pl, 0u) == COA_OK);
+        if (exact.status == COA_PLAN_BUDGET_EXHAUSTED ||
+            (exact.status == COA_PLAN_SOLVED && !exact.optimal)) {
+            ++skipped;
+            continue;
+        }
+        if (exact.status == COA_PLAN_SOLVED) {
+            REQUIRE_MSG(coa_plan_find_conflict(&e.p, rows, ALL, 5u, NULL, NULL) == 0 &&
+                            rows_well_formed(&e, rows, ALL, 5u),
+                        "five, trial %u: the exact plan is not conflict-free", trial);
+            ++solved;
+        }
+        ++compared;
+        if (check_anytime(nw.pl, &e, &exact, exact.work, rows, trial, &optimal)) {
+            ++stopped;
+            still_optimal += optimal ? 1u : 0u;
+        }
+    }
+    printf("plan_oracle: five UAVs: %u compared (%u solved, %u infeasible), %u skipped in %u "
+           "trials; %u calls stopped by a third of their work (%u still proven optimal)\n",
+           compared, solved, compared - solved, skipped, trial, stopped, still_optimal);
+    fflush(stdout);
+    ck_assert_uint_eq(compared, FIVE_COMPARED);
+    ck_assert_uint_gt(solved, compared / 5u);
+    ck_assert_uint_gt(compared - solved, 0u);
+    ck_assert_uint_gt(stopped, compared / 5u);
+    free(nw.mem);
+}
+END_TEST
+
 START_TEST(independent_uavs_are_never_merged)
 {
     static fx_t e;
@@ -806,6 +866,7 @@ static Suite *plan_oracle_suite(void)
     tcase_add_test(tc, head_on_pair_is_merged);
     tcase_add_test(tc, only_interacting_uavs_are_merged);
     tcase_add_test(tc, new_planner_matches_old_on_random_encounters);
+    tcase_add_test(tc, anytime_claims_hold_for_five_uavs);
     suite_add_tcase(s, tc);
     return s;
 }
