@@ -44,6 +44,7 @@ typedef struct {
     coa_real_t dt;
     uint32_t horizon;
     uint32_t beta;
+    size_t planner_bytes; /* the buffer it plans in: 0, the whole of planner_buffer */
     bool decoupled;
     bool centralised;
     const coa_vehicle_t *vehicles;
@@ -71,6 +72,14 @@ static coa_intent_plan_t intents[FWC_MAX_VEHICLES];
 /* Every pair can conflict: n(n-1)/2 + n (tracks + obstacles), as `coavoid predict` sizes. */
 #define FWC_MAX_PAIRS 32u
 static coa_conflict_t conflicts[FWC_MAX_PAIRS];
+
+/* The part of planner_buffer problem p plans in. */
+static size_t buffer_bytes(const fwc_problem_t *p)
+{
+    return p->planner_bytes != 0u && p->planner_bytes < sizeof planner_buffer
+               ? p->planner_bytes
+               : sizeof planner_buffer;
+}
 
 /* SysTick, free-running on the processor clock: 24 bits, the wraps counted in the
  * interrupt. */
@@ -381,7 +390,7 @@ static bool run_problem(const fwc_problem_t *p)
         coa_planner_config_t config;
         coa_planner_t *planner = NULL;
         if (coa_planner_config_of(&problem, 1u, p->beta, &config) == COA_OK) {
-            planner = coa_planner_init(planner_buffer, sizeof planner_buffer, &config);
+            planner = coa_planner_init(planner_buffer, buffer_bytes(p), &config);
         }
         if (planner == NULL) {
             fail(p, "decoupled: the planner buffer is too small for this beta");
@@ -396,7 +405,7 @@ static bool run_problem(const fwc_problem_t *p)
         coa_planner_config_t config;
         coa_planner_t *planner = NULL;
         if (coa_planner_config_of(&problem, p->vehicle_count, p->beta, &config) == COA_OK) {
-            planner = coa_planner_init(planner_buffer, sizeof planner_buffer, &config);
+            planner = coa_planner_init(planner_buffer, buffer_bytes(p), &config);
         }
         if (planner == NULL) {
             fail(p, "centralised: the planner buffer is too small for this beta");

@@ -11,7 +11,9 @@ the host reads the JSON in double and its single-precision build rounds to float
 firmware gets the float literal; only exact values make both the same number. Refused
 otherwise. The scenario's "beta" is required (the firmware's buffer is fixed), and the
 field "qemu_modes" (ignored by coavoid, as every field the format does not define) lists
-the modes the firmware runs: "decoupled" (priority order, one order) and "centralised".
+the modes the firmware runs: "decoupled" (priority order, one order) and "centralised";
+"qemu_planner_bytes", when given, the planner buffer the firmware plans it in (at most the
+check's; the example firmware's is 32 KiB).
 The header is committed; tests/firmware/qemu.sh regenerates it and fails when it differs.
 """
 import json
@@ -46,6 +48,7 @@ def main():
         if "beta" not in s:
             sys.exit(f"gen_check_problems: {path}: needs a \"beta\" (the firmware's buffer is fixed)")
         modes = s.get("qemu_modes", ["decoupled"])
+        planner_bytes = int(s.get("qemu_planner_bytes", 0))
         if not modes or any(m not in ("decoupled", "centralised") for m in modes):
             sys.exit(f"gen_check_problems: {path}: qemu_modes: decoupled and/or centralised")
         vs, obs, trs = s["vehicles"], s.get("obstacles", []), s.get("tracks", [])
@@ -100,7 +103,7 @@ def main():
             body.append(f"static const coa_track_t p{p}_tracks[] = {{\n" + ",\n".join(rows) + "};")
         table.append(
             f"    {{.name = \"{name}\", .dt = {real(s['dt'], w)}, .horizon = {int(s['horizon'])}u, "
-            f".beta = {int(s['beta'])}u,\n"
+            f".beta = {int(s['beta'])}u, .planner_bytes = {planner_bytes}u,\n"
             f"     .decoupled = {'true' if 'decoupled' in modes else 'false'}, "
             f".centralised = {'true' if 'centralised' in modes else 'false'},\n"
             f"     .vehicles = p{p}_vehicles, .vehicle_count = {len(vs)}u,\n"
