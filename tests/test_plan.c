@@ -1216,13 +1216,15 @@ START_TEST(tiny_beta_answers_the_incumbent)
     ck_assert(to_u128(d.deviation_units) > optimum); /* the joint plan shares the climb */
     ws_free(&w);
 
-    w = ws_make(2u, 3u);
+    /* Beta 6: the root's expansion stores its children a window beyond its key, and the
+     * pool fills at the next one, whose key already bounds the optimum above 0. */
+    w = ws_make(2u, 6u);
     ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
     ck_assert_int_eq(r.status, COA_PLAN_SOLVED);
     ck_assert(!r.optimal);
     ck_assert_int_eq(r.limit, COA_PLAN_LIMIT_BETA);
     ck_assert_uint_eq(r.largest_group, 2u);
-    ck_assert_uint_eq(r.nodes_generated, 3u); /* stopped when the pool was full */
+    ck_assert_uint_eq(r.nodes_generated, 6u); /* stopped when the pool was full */
     ck_assert(to_u128(r.deviation_units) == to_u128(d.deviation_units));
     ck_assert_uint_eq(r.effort, d.effort);
     ck_assert(bound_at_most(&r, optimum, effort));
