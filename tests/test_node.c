@@ -1463,7 +1463,7 @@ START_TEST(test_coordinator_answers_within_its_work)
             ck_assert_uint_gt(s->last_plan_work, 0u);
             ck_assert_uint_eq(s->plans_run, 2); /* the stopped search, then the order's */
         } else {
-            ck_assert_uint_le(s->last_plan_work, coavoid_node_work_of((DT_US - DT_US / 4) / 2));
+            ck_assert_uint_le(s->last_plan_work, coavoid_node_work_of((DT_US - DT_US / 4) * 3 / 4));
             ck_assert_uint_eq(s->plans_run, 1);
         }
         ck_assert_uint_eq(coavoid_vehicle_node_state(b)->plans_adopted, 1);

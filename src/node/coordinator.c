@@ -118,7 +118,7 @@ coavoid_coordinator_t *coavoid_coordinator_create(const coavoid_coordinator_conf
     if (node->config.plan_work == 0u) {
         node->config.plan_work = coavoid_node_work_of(
             node->config.plan_budget_us > 0 ? node->config.plan_budget_us
-                                            : (c->dt_us - node->config.collect_us) / 2);
+                                            : (c->dt_us - node->config.collect_us) * 3 / 4);
         node->config.plan_work += node->config.plan_work == 0u ? 1u : 0u;
     }
     if (node->config.resend_us <= 0) {

@@ -475,8 +475,8 @@ typedef struct {
      * where plan_budget_us could only abandon it once it had overrun; deterministic, so a
      * simulation plans the same on every machine. A cluster whose search finds no plan is
      * planned decoupled in priority order (its UAVs' tables, outside the budget). 0: the
-     * default, coavoid_node_work_of(plan_budget_us when it is set, else (dt - collect_us)
-     * / 2). */
+     * default, coavoid_node_work_of(plan_budget_us when it is set, else three quarters of
+     * dt - collect_us, what coavoid-coordinator gives its planning in wall time). */
     uint64_t plan_work;
     /* The agreement on a plan (docs/protocol.md): how long after proposing a plan it
      * waits for every UAV's accept before it aborts the plan and plans the UAVs that
