@@ -1386,42 +1386,61 @@ static void on_plan_probe(const lcm_recv_buf_t *rbuf, const char *channel, void 
     }
 }
 
+/* Two UAVs crossing, a coordinator (configured as `cc`, its common part the rig's but a
+ * beta it gives) and a probe of its plans: cycle 0 flown up to the coordinator's plan. */
+typedef struct {
+    rig_t r;
+    plan_probe_t probe;
+    lcm_subscription_t *sub;
+    coa_vec3_t r1[2], r2[2];
+    coavoid_vehicle_node_t *a, *b;
+    coavoid_coordinator_t *co;
+} crossing_t;
+
+static void crossing_fly(crossing_t *x, coavoid_node_mode_t mode_a, coavoid_coordinator_config_t cc)
+{
+    rig_init(&x->r, 24);
+    memset(&x->probe, 0, sizeof x->probe);
+    x->sub = lcm_subscribe(x->r.lcm, COAVOID_CHANNEL_PLAN, on_plan_probe, &x->probe);
+    x->a = vehicle_node(&x->r, uav(1, 1, x->r1, 0, 600, 0, 100), mode_a);
+    x->b = vehicle_node(&x->r, uav(2, 2, x->r2, 300, -300, 0, 100), COAVOID_NODE_CENTRALISED);
+    const uint32_t beta = cc.common.beta; /* 0: the rig's */
+    cc.common = x->r.common;
+    cc.common.beta = beta != 0u ? beta : cc.common.beta;
+    int error = -99;
+    x->co = coavoid_coordinator_create(&cc, x->r.lcm, &error);
+    ck_assert_ptr_nonnull(x->co);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(x->a, x->r.now), COA_OK);
+    drain(x->r.lcm);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(x->b, x->r.now), COA_OK);
+    drain(x->r.lcm);
+    x->r.now = cycle(0) + DT_US / 4;
+    coordinate(x->r.lcm, x->co, x->r.now);
+}
+
+static void crossing_free(crossing_t *x)
+{
+    lcm_unsubscribe(x->r.lcm, x->sub);
+    coavoid_coordinator_destroy(x->co);
+    coavoid_vehicle_node_destroy(x->b);
+    coavoid_vehicle_node_destroy(x->a);
+    lcm_destroy(x->r.lcm);
+}
+
 /* The coordinator does not plan a UAV that says it plans for itself (a decoupled intent):
  * the others' plans would rely on a move it does not make. It plans the others around it. */
 START_TEST(test_coordinator_skips_decoupled_uav)
 {
-    rig_t r;
-    rig_init(&r, 24);
-    plan_probe_t probe;
-    memset(&probe, 0, sizeof probe);
-    lcm_subscription_t *sub = lcm_subscribe(r.lcm, COAVOID_CHANNEL_PLAN, on_plan_probe, &probe);
-    coa_vec3_t r1[2], r2[2];
-    coavoid_vehicle_node_t *a =
-        vehicle_node(&r, uav(1, 1, r1, 0, 600, 0, 100), COAVOID_NODE_DECOUPLED);
-    coavoid_vehicle_node_t *b =
-        vehicle_node(&r, uav(2, 2, r2, 300, -300, 0, 100), COAVOID_NODE_CENTRALISED);
+    static crossing_t x;
     coavoid_coordinator_config_t cc;
     memset(&cc, 0, sizeof cc);
-    cc.common = r.common;
-    cc.common.beta = 5000;
-    int error = -99;
-    coavoid_coordinator_t *co = coavoid_coordinator_create(&cc, r.lcm, &error);
-    ck_assert_ptr_nonnull(co);
-    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
-    drain(r.lcm);
-    ck_assert_int_eq(coavoid_vehicle_node_cycle(b, r.now), COA_OK);
-    drain(r.lcm);
-    r.now = cycle(0) + DT_US / 4;
-    coordinate(r.lcm, co, r.now);
-    ck_assert_int_eq(probe.plans, 1);
-    ck_assert_int_eq(probe.rows, 1);
-    ck_assert_int_eq(probe.ids[0], 2);
-    ck_assert_uint_eq(coavoid_vehicle_node_state(b)->plans_adopted, 1);
-    lcm_unsubscribe(r.lcm, sub);
-    coavoid_coordinator_destroy(co);
-    coavoid_vehicle_node_destroy(b);
-    coavoid_vehicle_node_destroy(a);
-    lcm_destroy(r.lcm);
+    cc.common.beta = 5000; /* crossing_fly fills the rest of common from the rig */
+    crossing_fly(&x, COAVOID_NODE_DECOUPLED, cc);
+    ck_assert_int_eq(x.probe.plans, 1);
+    ck_assert_int_eq(x.probe.rows, 1);
+    ck_assert_int_eq(x.probe.ids[0], 2);
+    ck_assert_uint_eq(coavoid_vehicle_node_state(x.b)->plans_adopted, 1);
+    crossing_free(&x);
 }
 END_TEST
 
@@ -1432,32 +1451,15 @@ END_TEST
 START_TEST(test_coordinator_answers_within_its_work)
 {
     for (int small = 1; small >= 0; small--) {
-        rig_t r;
-        rig_init(&r, 24);
-        plan_probe_t probe;
-        memset(&probe, 0, sizeof probe);
-        lcm_subscription_t *sub = lcm_subscribe(r.lcm, COAVOID_CHANNEL_PLAN, on_plan_probe, &probe);
-        coa_vec3_t r1[2], r2[2];
-        coavoid_vehicle_node_t *a =
-            vehicle_node(&r, uav(1, 1, r1, 0, 600, 0, 100), COAVOID_NODE_CENTRALISED);
-        coavoid_vehicle_node_t *b =
-            vehicle_node(&r, uav(2, 2, r2, 300, -300, 0, 100), COAVOID_NODE_CENTRALISED);
+        static crossing_t x;
         coavoid_coordinator_config_t cc;
         memset(&cc, 0, sizeof cc);
-        cc.common = r.common;
         cc.plan_work = small ? 2000u : 0u;
-        int error = -99;
-        coavoid_coordinator_t *co = coavoid_coordinator_create(&cc, r.lcm, &error);
-        ck_assert_ptr_nonnull(co);
-        ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
-        ck_assert_int_eq(coavoid_vehicle_node_cycle(b, r.now), COA_OK);
-        drain(r.lcm);
-        r.now = cycle(0) + DT_US / 4;
-        coordinate(r.lcm, co, r.now);
-        const coavoid_coordinator_state_t *s = coavoid_coordinator_state(co);
-        ck_assert_int_eq(probe.plans, 1);
-        ck_assert_int_eq(probe.status, COAVOID_PLAN_T_STATUS_SOLVED);
-        ck_assert_int_eq(probe.rows, 2);
+        crossing_fly(&x, COAVOID_NODE_CENTRALISED, cc);
+        const coavoid_coordinator_state_t *s = coavoid_coordinator_state(x.co);
+        ck_assert_int_eq(x.probe.plans, 1);
+        ck_assert_int_eq(x.probe.status, COAVOID_PLAN_T_STATUS_SOLVED);
+        ck_assert_int_eq(x.probe.rows, 2);
         if (small) {
             ck_assert_uint_le(s->last_plan_work, 2000u);
             ck_assert_uint_gt(s->last_plan_work, 0u);
@@ -1466,12 +1468,8 @@ START_TEST(test_coordinator_answers_within_its_work)
             ck_assert_uint_le(s->last_plan_work, coavoid_node_work_of((DT_US - DT_US / 4) * 3 / 4));
             ck_assert_uint_eq(s->plans_run, 1);
         }
-        ck_assert_uint_eq(coavoid_vehicle_node_state(b)->plans_adopted, 1);
-        lcm_unsubscribe(r.lcm, sub);
-        coavoid_coordinator_destroy(co);
-        coavoid_vehicle_node_destroy(b);
-        coavoid_vehicle_node_destroy(a);
-        lcm_destroy(r.lcm);
+        ck_assert_uint_eq(coavoid_vehicle_node_state(x.b)->plans_adopted, 1);
+        crossing_free(&x);
     }
 }
 END_TEST
