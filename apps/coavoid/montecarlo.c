@@ -51,7 +51,8 @@
     "  --work W          work units each planning call may spend, 0 for no limit;\n"        \
     "                    default %llu (as coavoid plan's)\n"                                \
     "  --csv FILE        one row per encounter and method (times in time_us)\n"             \
-    "  --svg FILE        success rates and the ratio's cumulative distribution\n"           \
+    "  --svg FILE        success rates, the ratio's cumulative distribution and the\n"      \
+    "                    centralised plans' over their lower bounds\n"                      \
     "  --save DIR        write each encounter as DIR/montecarlo-SEED-N-INDEX.json (an\n"    \
     "                    existing directory), for `coavoid plan` to replay\n"               \
     "  --json            print the summary as a JSON object\n"                              \

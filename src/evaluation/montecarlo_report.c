@@ -3,7 +3,8 @@
  * montecarlo_report.c: the reports of a Monte Carlo run (montecarlo.h): per UAV count and
  * method the outcomes, the success rate with its Wilson interval, the distributions of the
  * times, the nodes and the decoupled/centralised deviation ratio, printed as text or JSON,
- * and the figure (success rates beside the ratio's cumulative distribution) as SVG.
+ * and the figure (success rates, the decoupled/centralised ratio's cumulative distribution
+ * and the centralised plan over its lower bound's) as SVG.
  */
 #include "montecarlo.h"
 
@@ -512,7 +513,7 @@ static int json_summary(FILE *f, const coavoid_montecarlo_config_t *o, const mc_
 
 /* ---- the figure ---- */
 
-#define SVG_W 960.0
+#define SVG_W 1420.0
 #define SVG_H 420.0
 #define SVG_PANEL_TOP 60.0
 #define SVG_PANEL_H 260.0
@@ -520,6 +521,8 @@ static int json_summary(FILE *f, const coavoid_montecarlo_config_t *o, const mc_
 #define SVG_BAR_W 330.0
 #define SVG_CDF_LEFT 520.0
 #define SVG_CDF_W 400.0
+#define SVG_BOUND_LEFT 1000.0
+#define SVG_BOUND_W 380.0
 
 static const char *const method_colours[COAVOID_MC_METHODS] = {"#1f77b4", "#ff7f0e", "#2ca02c"};
 static const char *const size_colours[COAVOID_MONTECARLO_MAX_SIZES] = {
@@ -540,16 +543,53 @@ static double cdf_right(const mc_summary_t *s, uint32_t sizes)
     return right > 10.0 ? 10.0 : right;
 }
 
-static double cdf_x(double v, double right)
+/* A CDF panel: its left edge and width, and the largest ratio on its log axis. */
+typedef struct {
+    double left;
+    double width;
+    double right;
+} cdf_panel_t;
+
+static double cdf_x(const cdf_panel_t *p, double v)
 {
-    v = v > right ? right : v;
-    return SVG_CDF_LEFT + log(v) / log(right) * SVG_CDF_W;
+    v = v > p->right ? p->right : v;
+    return p->left + log(v) / log(p->right) * p->width;
 }
 
-/* The step function of the ratio's CDF of one size and method, merging steps closer than
- * half a pixel so that 1000 encounters stay a few hundred points. */
-static void svg_cdf(FILE *f, const coavoid_mc_result_t *results, uint32_t count, int m,
-                    double right, double *x, const char *colour, bool dashed)
+/* The step function of the CDF of x[0..n-1] (ratios >= 1, sorted here), merging steps
+ * closer than half a pixel so that 1000 encounters stay a few hundred points. */
+static void svg_steps(FILE *f, const cdf_panel_t *p, double *x, uint32_t n, const char *colour,
+                      bool dashed)
+{
+    if (n == 0) {
+        return;
+    }
+    qsort(x, n, sizeof *x, coavoid_timing_compare);
+    const double y0 = SVG_PANEL_TOP + SVG_PANEL_H;
+    fprintf(f, "<polyline fill=\"none\" stroke=\"%s\" stroke-width=\"1.8\"%s points=\"", colour,
+            dashed ? " stroke-dasharray=\"6 4\"" : "");
+    double last_px = p->left, last_py = y0;
+    fprintf(f, "%.1f,%.1f", last_px, last_py);
+    for (uint32_t j = 0; j < n;) {
+        uint32_t k = j;
+        while (k < n && x[k] == x[j]) {
+            k++;
+        }
+        double px = cdf_x(p, x[j]);
+        double py = y0 - (double)k / n * SVG_PANEL_H;
+        if (px - last_px >= 0.5 || k == n) {
+            fprintf(f, " %.1f,%.1f %.1f,%.1f", px, last_py, px, py);
+            last_px = px;
+        }
+        last_py = py;
+        j = k;
+    }
+    fprintf(f, " %.1f,%.1f\"/>\n", p->left + p->width, last_py);
+}
+
+/* The decoupled method m's deviation over the centralised plan's, both solved. */
+static void svg_cdf(FILE *f, const cdf_panel_t *p, const coavoid_mc_result_t *results,
+                    uint32_t count, int m, double *x, const char *colour, bool dashed)
 {
     uint32_t both = 0;
     for (uint32_t j = 0; j < count; j++) {
@@ -559,30 +599,53 @@ static void svg_cdf(FILE *f, const coavoid_mc_result_t *results, uint32_t count,
             x[both++] = coavoid_mc_cost_real(d->units) / coavoid_mc_cost_real(c->units);
         }
     }
-    if (both == 0) {
-        return;
+    svg_steps(f, p, x, both, colour, dashed);
+}
+
+/* The centralised plan's deviation over its lower bound (1 when proven optimal). */
+static uint32_t bound_values(const coavoid_mc_result_t *results, uint32_t count, double *x)
+{
+    uint32_t n = 0;
+    for (uint32_t j = 0; j < count; j++) {
+        const coavoid_mc_outcome_t *c = &results[j].m[COAVOID_MC_CENTRALISED];
+        if (c->status == COA_PLAN_SOLVED && c->bound_deviation > 0) {
+            x[n++] = c->optimal ? 1.0 : c->deviation / c->bound_deviation;
+        }
     }
-    qsort(x, both, sizeof *x, coavoid_timing_compare);
+    return n;
+}
+
+/* A CDF panel's frame: the title, the share grid, the ratio ticks and the box. */
+static void svg_cdf_frame(FILE *f, const cdf_panel_t *p, const char *title, const char *xlabel)
+{
     const double y0 = SVG_PANEL_TOP + SVG_PANEL_H;
-    fprintf(f, "<polyline fill=\"none\" stroke=\"%s\" stroke-width=\"1.8\"%s points=\"", colour,
-            dashed ? " stroke-dasharray=\"6 4\"" : "");
-    double last_px = SVG_CDF_LEFT, last_py = y0;
-    fprintf(f, "%.1f,%.1f", last_px, last_py);
-    for (uint32_t j = 0; j < both;) {
-        uint32_t k = j;
-        while (k < both && x[k] == x[j]) {
-            k++;
-        }
-        double px = cdf_x(x[j], right);
-        double py = y0 - (double)k / both * SVG_PANEL_H;
-        if (px - last_px >= 0.5 || k == both) {
-            fprintf(f, " %.1f,%.1f %.1f,%.1f", px, last_py, px, py);
-            last_px = px;
-        }
-        last_py = py;
-        j = k;
+    fprintf(f, "<text x=\"%.0f\" y=\"%.0f\" font-weight=\"bold\">%s</text>\n", p->left,
+            SVG_PANEL_TOP - 10, title);
+    for (int t = 0; t <= 4; t++) {
+        double py = y0 - t / 4.0 * SVG_PANEL_H;
+        fprintf(f,
+                "<line x1=\"%.0f\" y1=\"%.1f\" x2=\"%.0f\" y2=\"%.1f\" stroke=\"#ddd\"/>\n"
+                "<text x=\"%.0f\" y=\"%.1f\" text-anchor=\"end\">%.2f</text>\n",
+                p->left, py, p->left + p->width, py, p->left - 6, py + 4, t / 4.0);
     }
-    fprintf(f, " %.1f,%.1f\"/>\n", SVG_CDF_LEFT + SVG_CDF_W, last_py);
+    static const double ticks[] = {1.0, 1.25, 1.5, 2.0, 3.0, 5.0, 10.0};
+    for (size_t t = 0; t < sizeof ticks / sizeof ticks[0] && ticks[t] <= p->right * 1.0001; t++) {
+        double px = cdf_x(p, ticks[t]);
+        fprintf(f,
+                "<line x1=\"%.1f\" y1=\"%.0f\" x2=\"%.1f\" y2=\"%.0f\" stroke=\"#ddd\"/>\n"
+                "<text x=\"%.1f\" y=\"%.0f\" text-anchor=\"middle\">%g</text>\n",
+                px, SVG_PANEL_TOP, px, y0, px, y0 + 18, ticks[t]);
+    }
+    fprintf(f, "<text x=\"%.0f\" y=\"%.0f\" text-anchor=\"middle\">%s (log scale)</text>\n",
+            p->left + p->width / 2, y0 + 34, xlabel);
+    fprintf(f,
+            "<text transform=\"translate(%.0f %.0f) rotate(-90)\" text-anchor=\"middle\">"
+            "share of encounters</text>\n",
+            p->left - 44, SVG_PANEL_TOP + SVG_PANEL_H / 2);
+    fprintf(f,
+            "<rect x=\"%.0f\" y=\"%.0f\" width=\"%.0f\" height=\"%.0f\" fill=\"none\" "
+            "stroke=\"black\"/>\n",
+            p->left, SVG_PANEL_TOP, p->width, SVG_PANEL_H);
 }
 
 /* The figure's header and title (seed, count, the betas used). */
@@ -663,50 +726,20 @@ static void svg_rates(FILE *f, const mc_summary_t *s, uint32_t sizes)
             SVG_BAR_LEFT + 170, y0 + 44);
 }
 
-/* Right: the CDF of the deviation ratio per UAV count, fixed solid, reordered dashed. */
+/* Middle: the CDF of the deviation ratio per UAV count, fixed solid, reordered dashed. */
 static void svg_ratios(FILE *f, const coavoid_montecarlo_config_t *o,
                        const coavoid_montecarlo_t *run, const mc_summary_t *s, uint32_t sizes,
                        double *x)
 {
     const double y0 = SVG_PANEL_TOP + SVG_PANEL_H;
-    double right = cdf_right(s, sizes);
-    fprintf(f,
-            "<text x=\"%.0f\" y=\"%.0f\" font-weight=\"bold\">decoupled / centralised "
-            "deviation, both solved (CDF)</text>\n",
-            SVG_CDF_LEFT, SVG_PANEL_TOP - 10);
-    for (int t = 0; t <= 4; t++) {
-        double py = y0 - t / 4.0 * SVG_PANEL_H;
-        fprintf(f,
-                "<line x1=\"%.0f\" y1=\"%.1f\" x2=\"%.0f\" y2=\"%.1f\" stroke=\"#ddd\"/>\n"
-                "<text x=\"%.0f\" y=\"%.1f\" text-anchor=\"end\">%.2f</text>\n",
-                SVG_CDF_LEFT, py, SVG_CDF_LEFT + SVG_CDF_W, py, SVG_CDF_LEFT - 6, py + 4, t / 4.0);
-    }
-    static const double ticks[] = {1.0, 1.25, 1.5, 2.0, 3.0, 5.0, 10.0};
-    for (size_t t = 0; t < sizeof ticks / sizeof ticks[0] && ticks[t] <= right * 1.0001; t++) {
-        double px = cdf_x(ticks[t], right);
-        fprintf(f,
-                "<line x1=\"%.1f\" y1=\"%.0f\" x2=\"%.1f\" y2=\"%.0f\" stroke=\"#ddd\"/>\n"
-                "<text x=\"%.1f\" y=\"%.0f\" text-anchor=\"middle\">%g</text>\n",
-                px, SVG_PANEL_TOP, px, y0, px, y0 + 18, ticks[t]);
-    }
-    fprintf(f,
-            "<text x=\"%.0f\" y=\"%.0f\" text-anchor=\"middle\">deviation ratio "
-            "(log scale)</text>\n",
-            SVG_CDF_LEFT + SVG_CDF_W / 2, y0 + 34);
-    fprintf(f,
-            "<text transform=\"translate(%.0f %.0f) rotate(-90)\" text-anchor=\"middle\">"
-            "share of encounters</text>\n",
-            SVG_CDF_LEFT - 44, SVG_PANEL_TOP + SVG_PANEL_H / 2);
-    fprintf(f,
-            "<rect x=\"%.0f\" y=\"%.0f\" width=\"%.0f\" height=\"%.0f\" fill=\"none\" "
-            "stroke=\"black\"/>\n",
-            SVG_CDF_LEFT, SVG_PANEL_TOP, SVG_CDF_W, SVG_PANEL_H);
+    const cdf_panel_t p = {SVG_CDF_LEFT, SVG_CDF_W, cdf_right(s, sizes)};
+    svg_cdf_frame(f, &p, "decoupled / centralised deviation, both solved (CDF)", "deviation ratio");
     for (uint32_t k = 0; k < sizes; k++) {
         const coavoid_mc_result_t *first = &run->results[k * o->count];
         const char *colour = size_colours[(s[k].size.n - COAVOID_ENCOUNTER_MIN_VEHICLES) %
                                           COAVOID_MONTECARLO_MAX_SIZES];
-        svg_cdf(f, first, o->count, COAVOID_MC_FIXED, right, x, colour, false);
-        svg_cdf(f, first, o->count, COAVOID_MC_REORDERED, right, x, colour, true);
+        svg_cdf(f, &p, first, o->count, COAVOID_MC_FIXED, x, colour, false);
+        svg_cdf(f, &p, first, o->count, COAVOID_MC_REORDERED, x, colour, true);
         double ly = y0 + 56 + 16 * k;
         fprintf(f,
                 "<line x1=\"%.0f\" y1=\"%.0f\" x2=\"%.0f\" y2=\"%.0f\" stroke=\"%s\" "
@@ -718,9 +751,29 @@ static void svg_ratios(FILE *f, const coavoid_montecarlo_config_t *o,
             "<text x=\"%.0f\" y=\"%.0f\">solid: decoupled_fixed</text>\n"
             "<text x=\"%.0f\" y=\"%.0f\">dashed: decoupled_reordered</text>\n",
             SVG_CDF_LEFT + 110, y0 + 56, SVG_CDF_LEFT + 110, y0 + 72);
-    if (right >= 10.0) {
+    if (p.right >= 10.0) {
         fprintf(f, "<text x=\"%.0f\" y=\"%.0f\">ratios above 10 at the right edge</text>\n",
                 SVG_CDF_LEFT + 110, y0 + 88);
+    }
+}
+
+/* Right: the CDF of each centralised plan's deviation over its proven lower bound, per UAV
+ * count (1: proven optimal), from 1 to the largest seen (at least 2, at most 10). */
+static void svg_bounds(FILE *f, const coavoid_montecarlo_config_t *o,
+                       const coavoid_montecarlo_t *run, const mc_summary_t *s, uint32_t sizes,
+                       double *x)
+{
+    cdf_panel_t p = {SVG_BOUND_LEFT, SVG_BOUND_W, 2.0};
+    for (uint32_t k = 0; k < sizes; k++) {
+        const mc_dist_t *d = &s[k].m[COAVOID_MC_CENTRALISED].bound_ratio;
+        p.right = d->count > 0 && d->max > p.right ? d->max : p.right;
+    }
+    p.right = p.right > 10.0 ? 10.0 : p.right;
+    svg_cdf_frame(f, &p, "centralised plan / its lower bound (CDF)", "plan / bound");
+    for (uint32_t k = 0; k < sizes; k++) {
+        const char *colour = size_colours[(s[k].size.n - COAVOID_ENCOUNTER_MIN_VEHICLES) %
+                                          COAVOID_MONTECARLO_MAX_SIZES];
+        svg_steps(f, &p, x, bound_values(&run->results[k * o->count], o->count, x), colour, false);
     }
 }
 
@@ -735,6 +788,7 @@ static int write_svg(const char *path, const coavoid_montecarlo_config_t *o,
     svg_head(f, o, s, sizes);
     svg_rates(f, s, sizes);
     svg_ratios(f, o, run, s, sizes, x);
+    svg_bounds(f, o, run, s, sizes, x);
     fprintf(f, "</svg>\n");
     bool ok = !ferror(f);
     return fclose(f) == 0 && ok ? 0 : -1;

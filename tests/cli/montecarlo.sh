@@ -123,6 +123,7 @@ assert root.tag == "{http://www.w3.org/2000/svg}svg", root.tag
 texts = " ".join(t.text or "" for t in root.iter("{http://www.w3.org/2000/svg}text"))
 for n in sizes:
     assert f"{n} UAVs" in texts, texts
+assert "centralised plan / its lower bound (CDF)" in texts, texts
 bars = [r for r in root.iter("{http://www.w3.org/2000/svg}rect") if r.get("fill") not in ("white", "none")]
 assert len(bars) >= 3 * len(sizes), len(bars)
 PY
