@@ -503,6 +503,35 @@ coa_cost_t coa_plan_row_units(const coa_planner_t *pl, size_t v, const int32_t *
     return plan_units(pl, v, own);
 }
 
+coa_cost_t coa_plan_rows_cost(const coa_planner_t *pl, const int32_t *rows, uint32_t members)
+{
+    const size_t row = (size_t)pl->problem->horizon + 1u;
+    coa_cost_t sum = {0u, 0u};
+    size_t v;
+    for (v = 0; v < pl->problem->vehicle_count; ++v) {
+        if ((members & (UINT32_C(1) << v)) != 0u) {
+            uint64_t eff;
+            coa_cost_t dev = coa_plan_row_units(pl, v, &rows[v * row], &eff);
+            sum = plan_cost_add(sum, plan_pack(dev, eff));
+        }
+    }
+    return sum;
+}
+
+void coa_plan_rows_copy(const coa_planner_t *pl, int32_t *to, const int32_t *from, uint32_t members)
+{
+    const size_t row = (size_t)pl->problem->horizon + 1u;
+    size_t v;
+    size_t k;
+    for (v = 0; v < pl->problem->vehicle_count; ++v) {
+        if ((members & (UINT32_C(1) << v)) != 0u) {
+            for (k = 0; k < row; ++k) {
+                to[v * row + k] = from[v * row + k];
+            }
+        }
+    }
+}
+
 /* ------------------------------------------------------------------------------------ */
 /* Front ends                                                                            */
 
@@ -893,15 +922,6 @@ int coa_plan_decoupled(coa_planner_t *planner, const coa_problem_t *problem, con
     return COA_OK;
 }
 
-/* Vehicle v's planned row as a packed cost. */
-static coa_cost_t row_cost(const coa_planner_t *pl, size_t v)
-{
-    uint64_t eff;
-    const coa_cost_t dev =
-        coa_plan_row_units(pl, v, &pl->rows[v * ((size_t)pl->problem->horizon + 1u)], &eff);
-    return plan_pack(dev, eff);
-}
-
 /* Where the order search of coa_plan_orders_best stands: the packed cost of the first
  * `level` vehicles of the current order, and the least the others can add (their costs
  * alone, which no plan among others beats). */
@@ -915,10 +935,7 @@ static void alone_from(const coa_planner_t *pl, const orders_t *o, orders_costs_
     size_t i = o->n;
     c->alone_from[i] = (coa_cost_t){0u, 0u};
     while (i-- > 0u) {
-        const size_t v = o->cur[i];
-        const uint64_t cell =
-            plan_table_at(&pl->to_go[v], 0u, pl->problem->vehicles[v].initial_offset);
-        c->alone_from[i] = plan_cost_add(c->alone_from[i + 1u], plan_cell_cost(pl, v, cell));
+        c->alone_from[i] = plan_cost_add(c->alone_from[i + 1u], plan_cost_alone(pl, o->cur[i]));
     }
 }
 
@@ -938,7 +955,8 @@ static size_t orders_attempt_below(coa_planner_t *pl, orders_t *o, orders_costs_
         if (*st != COA_PLAN_SOLVED) {
             return level;
         }
-        c->prefix[level + 1u] = plan_cost_add(c->prefix[level], row_cost(pl, o->cur[level]));
+        c->prefix[level + 1u] = plan_cost_add(
+            c->prefix[level], coa_plan_rows_cost(pl, pl->rows, UINT32_C(1) << o->cur[level]));
         if (pl->have_best &&
             plan_cost_compare(plan_cost_add(c->prefix[level + 1u], c->alone_from[level + 1u]),
                               pl->best_cost) >= 0) {
@@ -951,7 +969,7 @@ static size_t orders_attempt_below(coa_planner_t *pl, orders_t *o, orders_costs_
 bool coa_plan_orders_best(coa_planner_t *pl, uint32_t max_orders, uint64_t improve_limit,
                           coa_plan_result_t *r)
 {
-    const size_t row = (size_t)pl->problem->horizon + 1u;
+    const uint32_t all = (uint32_t)((UINT64_C(1) << pl->problem->vehicle_count) - 1u);
     orders_t o;
     orders_costs_t c;
     coa_plan_result_t counted;
@@ -966,10 +984,7 @@ bool coa_plan_orders_best(coa_planner_t *pl, uint32_t max_orders, uint64_t impro
            !(fail == 0u && st == COA_PLAN_INFEASIBLE)) {
         fail = orders_attempt_below(pl, &o, &c, &counted, &st);
         if (fail == o.n) {
-            size_t i;
-            for (i = 0; i < o.n * row; ++i) {
-                pl->best_rows[i] = pl->rows[i];
-            }
+            coa_plan_rows_copy(pl, pl->best_rows, pl->rows, all);
             pl->best_cost = c.prefix[o.n];
             if (!pl->have_best && improve_limit < pl->work_limit) {
                 pl->work_limit = improve_limit;

@@ -28,41 +28,9 @@
 /* ------------------------------------------------------------------------------------ */
 /* Costs                                                                                 */
 
-/* The packed cost of the rows of the vehicles in `members` (a bit mask) in `rows` (all
- * the problem's vehicles, pl->rows or the incumbent's). */
-static coa_cost_t rows_cost_in(const coa_planner_t *pl, const int32_t *rows, uint32_t members)
-{
-    const size_t row = (size_t)pl->problem->horizon + 1u;
-    coa_cost_t sum = {0u, 0u};
-    size_t v;
-    for (v = 0; v < pl->problem->vehicle_count; ++v) {
-        if ((members & (UINT32_C(1) << v)) != 0u) {
-            uint64_t eff;
-            coa_cost_t dev = coa_plan_row_units(pl, v, &rows[v * row], &eff);
-            sum = plan_cost_add(sum, plan_pack(dev, eff));
-        }
-    }
-    return sum;
-}
-
 static coa_cost_t rows_cost(const coa_planner_t *pl, uint32_t members)
 {
-    return rows_cost_in(pl, pl->rows, members);
-}
-
-/* Copies the rows of `members` from `from` to `to` (all the problem's vehicles each). */
-static void rows_copy(const coa_planner_t *pl, int32_t *to, const int32_t *from, uint32_t members)
-{
-    const size_t row = (size_t)pl->problem->horizon + 1u;
-    size_t v;
-    size_t k;
-    for (v = 0; v < pl->problem->vehicle_count; ++v) {
-        if ((members & (UINT32_C(1) << v)) != 0u) {
-            for (k = 0; k < row; ++k) {
-                to[v * row + k] = from[v * row + k];
-            }
-        }
-    }
+    return coa_plan_rows_cost(pl, pl->rows, members);
 }
 
 /* ------------------------------------------------------------------------------------ */
@@ -303,8 +271,7 @@ static void group_collect(coa_planner_t *pl, uint32_t members, uint32_t fixed)
     for (v = 0; v < pl->problem->vehicle_count; ++v) {
         if ((members & (UINT32_C(1) << v)) != 0u) {
             g->vehicle[g->count] = v;
-            g->alone[g->count] = plan_cell_cost(
-                pl, v, plan_table_at(&pl->to_go[v], 0u, pl->problem->vehicles[v].initial_offset));
+            g->alone[g->count] = plan_cost_alone(pl, v);
             ++g->count;
         } else if ((fixed & (UINT32_C(1) << v)) != 0u) {
             g->fixed[g->fixed_count++] = v;
@@ -334,9 +301,9 @@ static bool group_setup(coa_planner_t *pl, uint32_t members, uint32_t fixed,
     g->capped = members_in_turn(pl, &cap, r) && !pl->out_of_work;
     if (fixed == 0u && pl->have_best) {
         /* The incumbent's rows of the members are a plan of the group alone too. */
-        coa_cost_t best = rows_cost_in(pl, pl->best_rows, members);
+        coa_cost_t best = coa_plan_rows_cost(pl, pl->best_rows, members);
         if (!g->capped || plan_cost_compare(best, cap) < 0) {
-            rows_copy(pl, pl->rows, pl->best_rows, members);
+            coa_plan_rows_copy(pl, pl->rows, pl->best_rows, members);
             cap = best;
             g->capped = true;
         }
@@ -629,7 +596,7 @@ static coa_plan_status_t finish_early(coa_planner_t *pl, const groups_t *g, coa_
         set_bound(pl, r, bound);
         return COA_PLAN_BUDGET_EXHAUSTED;
     }
-    rows_copy(pl, pl->rows, pl->best_rows, all_vehicles(pl));
+    coa_plan_rows_copy(pl, pl->rows, pl->best_rows, all_vehicles(pl));
     if (plan_cost_compare(bound, pl->best_cost) >= 0) {
         bound = pl->best_cost;
         r->optimal = true;
@@ -699,7 +666,7 @@ coa_plan_status_t coa_plan_independence(coa_planner_t *pl, coa_plan_result_t *r)
         if (g.count == n && pl->tried_count == 0u) {
             incumbent(pl, r);
             if (pl->have_best && plan_cost_compare(pl->best_cost, groups_sum(&g)) <= 0) {
-                rows_copy(pl, pl->rows, pl->best_rows, all_vehicles(pl));
+                coa_plan_rows_copy(pl, pl->rows, pl->best_rows, all_vehicles(pl));
                 return finish_optimal(pl, &g, r);
             }
             walk_alone(pl);

@@ -454,6 +454,13 @@ static inline size_t plan_pair_index(size_t a, size_t b, size_t m)
     return (size_t)before[b] + a;
 }
 
+/* Vehicle v's cost alone (its own table, from its initial offset), packed. */
+static inline coa_cost_t plan_cost_alone(const coa_planner_t *pl, size_t v)
+{
+    return plan_cell_cost(
+        pl, v, plan_table_at(&pl->to_go[v], 0u, pl->problem->vehicles[v].initial_offset));
+}
+
 /* The exact deviation of vehicle v's row (N + 1 offsets) in the problem's units, as the
  * search counts it, and its effort in *effort when not NULL. */
 coa_cost_t coa_plan_row_units(const coa_planner_t *pl, size_t v, const int32_t *row,
@@ -466,6 +473,14 @@ void coa_plan_fill_costs(const coa_planner_t *pl, const size_t *which, size_t co
 /* Whether some vehicle meets an obstacle, a track or another vehicle at t = 0 (positions
  * at k = 0 with the initial offsets): then no plan and no order avoids it. */
 bool coa_plan_any_initial_conflict(const coa_planner_t *pl);
+
+/* The packed cost of the rows of the vehicles in `members` (a bit mask) in `rows` (every
+ * vehicle's, N + 1 offsets each: pl->rows or the incumbent's). O(members N). */
+coa_cost_t coa_plan_rows_cost(const coa_planner_t *pl, const int32_t *rows, uint32_t members);
+
+/* Copies the rows of `members` from `from` to `to` (every vehicle's, N + 1 each). */
+void coa_plan_rows_copy(const coa_planner_t *pl, int32_t *to, const int32_t *from,
+                        uint32_t members);
 
 /* Independence detection over the loaded problem (plan_group.c): the centralised plan's
  * status; the rows of every vehicle when solved. */
