@@ -140,7 +140,7 @@ static void tally(const coa_plan_result_t *result, bool decoupled, coavoid_bench
     row->bounded += !result->optimal;
     if (result->bound_deviation > 0) {
         ratios[(*ratio_count)++] =
-            result->optimal ? 1.0 : result->deviation / result->bound_deviation;
+            coavoid_bound_ratio(result->optimal, result->deviation, result->bound_deviation);
     }
 }
 

@@ -8,6 +8,7 @@
 #ifndef COAVOID_EVALUATION_INTERNAL_H
 #define COAVOID_EVALUATION_INTERNAL_H
 
+#include <stdbool.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <time.h>
@@ -41,6 +42,13 @@ static inline void coavoid_timing_summarise(double *times, uint32_t r, double *m
     *median = r % 2u == 1u ? times[r / 2u] : 0.5 * (times[r / 2u - 1u] + times[r / 2u]);
     *min = times[0];
     *max = times[r - 1u];
+}
+
+/* A centralised plan's deviation over its proven lower bound (bound > 0): 1 when it is
+ * proven optimal, whose bound is its cost. */
+static inline double coavoid_bound_ratio(bool optimal, double deviation, double bound)
+{
+    return optimal ? 1.0 : deviation / bound;
 }
 
 #endif /* COAVOID_EVALUATION_INTERNAL_H */

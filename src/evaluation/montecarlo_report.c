@@ -163,23 +163,36 @@ static void summarise_sweep(const coavoid_mc_result_t *results, uint32_t count, 
     }
 }
 
+/* Each centralised plan's deviation over its positive lower bound into x; the count, and
+ * in *optimal (when not NULL) how many of them are proven optimal. */
+static uint32_t bound_values(const coavoid_mc_result_t *results, uint32_t count, double *x,
+                             uint32_t *optimal)
+{
+    uint32_t n = 0, proven = 0;
+    for (uint32_t j = 0; j < count; j++) {
+        const coavoid_mc_outcome_t *c = &results[j].m[COAVOID_MC_CENTRALISED];
+        if (c->status == COA_PLAN_SOLVED && c->bound_deviation > 0) {
+            x[n++] = coavoid_bound_ratio(c->optimal, c->deviation, c->bound_deviation);
+            proven += c->optimal;
+        }
+    }
+    if (optimal != NULL) {
+        *optimal = proven;
+    }
+    return n;
+}
+
 /* The centralised plans' outcomes: proven optimal or bounded, and plan over bound. */
 static void bound_ratios(const coavoid_mc_result_t *results, uint32_t count, double *x,
                          mc_method_summary_t *ms)
 {
-    uint32_t n = 0, equal = 0;
     for (uint32_t j = 0; j < count; j++) {
         const coavoid_mc_outcome_t *c = &results[j].m[COAVOID_MC_CENTRALISED];
-        if (c->status != COA_PLAN_SOLVED) {
-            continue;
-        }
-        ms->optimal += c->optimal;
-        ms->bounded += !c->optimal;
-        if (c->bound_deviation > 0) {
-            x[n++] = c->optimal ? 1.0 : c->deviation / c->bound_deviation;
-            equal += c->optimal;
-        }
+        ms->optimal += c->status == COA_PLAN_SOLVED && c->optimal;
+        ms->bounded += c->status == COA_PLAN_SOLVED && !c->optimal;
     }
+    uint32_t equal = 0;
+    uint32_t n = bound_values(results, count, x, &equal);
     ms->bound_ratio = distribution(x, n, equal);
 }
 
@@ -602,19 +615,6 @@ static void svg_cdf(FILE *f, const cdf_panel_t *p, const coavoid_mc_result_t *re
     svg_steps(f, p, x, both, colour, dashed);
 }
 
-/* The centralised plan's deviation over its lower bound (1 when proven optimal). */
-static uint32_t bound_values(const coavoid_mc_result_t *results, uint32_t count, double *x)
-{
-    uint32_t n = 0;
-    for (uint32_t j = 0; j < count; j++) {
-        const coavoid_mc_outcome_t *c = &results[j].m[COAVOID_MC_CENTRALISED];
-        if (c->status == COA_PLAN_SOLVED && c->bound_deviation > 0) {
-            x[n++] = c->optimal ? 1.0 : c->deviation / c->bound_deviation;
-        }
-    }
-    return n;
-}
-
 /* A CDF panel's frame: the title, the share grid, the ratio ticks and the box. */
 static void svg_cdf_frame(FILE *f, const cdf_panel_t *p, const char *title, const char *xlabel)
 {
@@ -773,7 +773,8 @@ static void svg_bounds(FILE *f, const coavoid_montecarlo_config_t *o,
     for (uint32_t k = 0; k < sizes; k++) {
         const char *colour = size_colours[(s[k].size.n - COAVOID_ENCOUNTER_MIN_VEHICLES) %
                                           COAVOID_MONTECARLO_MAX_SIZES];
-        svg_steps(f, &p, x, bound_values(&run->results[k * o->count], o->count, x), colour, false);
+        svg_steps(f, &p, x, bound_values(&run->results[k * o->count], o->count, x, NULL), colour,
+                  false);
     }
 }
 
