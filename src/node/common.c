@@ -1427,7 +1427,7 @@ int coavoid_node_publish_intent(coavoid_node_inbox_t *in, const coavoid_intent_t
 uint64_t coavoid_node_work_of(int64_t us)
 {
     if (us <= 0) {
-        return 0u;
+        return 1u;
     }
     return (uint64_t)us > UINT64_MAX / COAVOID_NODE_WORK_PER_US
                ? UINT64_MAX

@@ -119,7 +119,6 @@ coavoid_coordinator_t *coavoid_coordinator_create(const coavoid_coordinator_conf
         node->config.plan_work = coavoid_node_work_of(
             node->config.plan_budget_us > 0 ? node->config.plan_budget_us
                                             : (c->dt_us - node->config.collect_us) * 3 / 4);
-        node->config.plan_work += node->config.plan_work == 0u ? 1u : 0u;
     }
     if (node->config.resend_us <= 0) {
         node->config.resend_us = c->dt_us / 40 > 0 ? c->dt_us / 40 : 1;
@@ -294,8 +293,11 @@ static int cluster_plan(coavoid_coordinator_t *node, int64_t now, const coa_prob
         /* At least one unit: 0 would mean no limit. */
         (void)coa_planner_set_work(planner, node->cycle_work > 0u ? node->cycle_work : 1u);
         rc = coa_plan_centralised(planner, problem, node->offsets, result);
-        node->cycle_work -= rc == COA_OK ? result->work : 0u;
         node->state.last_plan_work = rc == COA_OK ? result->work : 0u;
+        /* A cycle with no work left gave its search 1 unit, which it may spend. */
+        node->cycle_work -= node->state.last_plan_work < node->cycle_work
+                                ? node->state.last_plan_work
+                                : node->cycle_work;
         if (rc == COA_OK && result->status == COA_PLAN_BUDGET_EXHAUSTED && count > 1u) {
             node->state.plans_run++;
             node->state.clusters_planned++;

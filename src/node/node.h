@@ -203,8 +203,8 @@
  * its time on such a core whatever it plans. A slower processor needs fewer. */
 #define COAVOID_NODE_WORK_PER_US 25u
 
-/* The work units of `us` microseconds at COAVOID_NODE_WORK_PER_US (0 when us <= 0, at
- * most UINT64_MAX). O(1). */
+/* The work units of `us` microseconds at COAVOID_NODE_WORK_PER_US, at least 1 (a budget
+ * of 0 sets no limit) and at most UINT64_MAX. O(1). */
 uint64_t coavoid_node_work_of(int64_t us);
 
 typedef enum {

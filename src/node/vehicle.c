@@ -1986,7 +1986,6 @@ static void fill_defaults(coavoid_vehicle_node_config_t *config)
     }
     if (config->joint_work == 0u) {
         config->joint_work = coavoid_node_work_of(dt_us / 4);
-        config->joint_work += config->joint_work == 0u ? 1u : 0u;
     }
 }
 
