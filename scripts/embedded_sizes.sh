@@ -21,9 +21,13 @@ objs=$arm/src/core/CMakeFiles/coavoid_core.dir
 arm_planner=$(struct_size arm-none-eabi-readelf "$objs/plan.c.obj" coa_planner)
 arm_predictor=$(struct_size arm-none-eabi-readelf "$objs/predict.c.obj" coa_predictor)
 
+# The host objects take the ARM build's COA_MAX_CENTRALISED: it sizes the header's arrays.
+maxc=$(sed -n 's/^COAVOID_MAX_CENTRALISED:[A-Z]*=//p' "$arm/CMakeCache.txt")
+[ -n "$maxc" ] || { echo "embedded_sizes: no COAVOID_MAX_CENTRALISED in $arm/CMakeCache.txt" >&2; exit 1; }
+defs=(-DCOA_SINGLE_PRECISION "-DCOA_MAX_CENTRALISED=${maxc}u")
 core="common geometry trajectory plan plan_table plan_pair plan_group plan_search predict"
 for f in $core; do
-  cc -std=c11 -g -O1 -DCOA_SINGLE_PRECISION -I"$src/include" -c "$src/src/core/$f.c" -o "$work/$f.o"
+  cc -std=c11 -g -O1 "${defs[@]}" -I"$src/include" -c "$src/src/core/$f.c" -o "$work/$f.o"
 done
 host_planner=$(struct_size readelf "$work/plan.o" coa_planner)
 host_predictor=$(struct_size readelf "$work/predict.o" coa_predictor)
@@ -85,6 +89,6 @@ int main(int argc, char **argv)
 }
 C
 objs_host=(); for f in $core; do objs_host+=("$work/$f.o"); done
-cc -std=c11 -DCOA_SINGLE_PRECISION -I"$src/include" "$work/sizes.c" "${objs_host[@]}" \
+cc -std=c11 "${defs[@]}" -I"$src/include" "$work/sizes.c" "${objs_host[@]}" \
   -lccd -lm -o "$work/sizes"
 "$work/sizes" "$host_planner" "$arm_planner" "$host_predictor" "$arm_predictor"

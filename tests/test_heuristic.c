@@ -52,7 +52,7 @@ __extension__ typedef unsigned __int128 u128_t;
 #define ROWW (2u * MAXN * MAXS + 1u) /* widest row */
 #define ACTS 5u
 #define INF (~(u128_t)0)
-#define EFF_BITS 18u /* the planner's packing (plan_internal.h) */
+#define EFF_BITS PLAN_EFF_BITS /* the planner's packing */
 
 /* The problem holder, sized to these problems. */
 #define FX_MAXV MAXM
@@ -65,7 +65,7 @@ static u128_t from_cost(coa_cost_t c)
 }
 
 /* A packed cost for messages: "deviation:effort" in decimal (INF: "inf"). The efforts
- * here stay far below 2^17, so a low part above it is a difference's negative effort
+ * here stay far below 2^(EFF_BITS - 1), so a low part above it is a difference's negative effort
  * (a surcharge's, say), shown as such. Eight rotating buffers: up to eight per message. */
 static const char *pk(u128_t x)
 {
@@ -74,13 +74,13 @@ static const char *pk(u128_t x)
     char *b = buf[turn++ % 8u];
     char digits[48];
     size_t n = 0u;
-    u128_t dev = x >> 18;
-    int eff = (int)(x & 0x3ffffu);
+    u128_t dev = x >> EFF_BITS;
+    int eff = (int)(x & ((1u << EFF_BITS) - 1u));
     if (x == ~(u128_t)0) {
         return "inf";
     }
-    if (eff >= (1 << 17)) {
-        eff -= 1 << 18;
+    if (eff >= (1 << (EFF_BITS - 1u))) {
+        eff -= 1 << EFF_BITS;
         dev += 1u;
     }
     do {

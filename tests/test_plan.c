@@ -18,6 +18,7 @@
 #include <string.h>
 
 #include "coavoid/coavoid.h"
+#include "plan_internal.h" /* coa_plan_test_bound_breaks */
 #include "test_support.h"
 
 #ifndef __SIZEOF_INT128__
@@ -2133,6 +2134,70 @@ END_TEST
  * a horizon at most the config's; each UAV's table no larger than the config's. Beyond
  * that it refuses with COA_ERR_WORKSPACE and a cleared result; within it, it plans as a
  * planner with room to spare does. */
+/* n UAVs converging on the origin from headings spread around the circle (jittered),
+ * each reaching it within a step of t = 4 s, at altitudes 2 m apart: every pair meets, so
+ * independence detection merges them into one group. 10 m/s, 2 m/s climb, 1 s steps. */
+static void fx_converging(fx_t *f, uint64_t *rng, size_t n, uint32_t horizon)
+{
+    size_t i;
+    fx_init(f, 1.0, horizon);
+    for (i = 0; i < n; ++i) {
+        double th = 6.283185307179586 * (double)i / (double)n + unif(rng, -0.2, 0.2);
+        double before = 10.0 * unif(rng, 3.5, 4.5); /* m flown to the origin */
+        double z = 100.0 + 2.0 * (double)i;
+        fx_vehicle(f, (uint16_t)(i + 1u), 1u, 10.0, 2.0, 2u, 4.0, 2.0,
+                   V(-before * cos(th), -before * sin(th), z),
+                   V((100.0 - before) * cos(th), (100.0 - before) * sin(th), z));
+    }
+    fx_finish(f);
+}
+
+/* Groups of 7 to 10 UAVs (their matchings within two sides, plan_internal.h): random
+ * encounters planned centrally within a work budget answer within it, a plan with its
+ * bound or infeasible proven, never worse than the priority order's plan, and the search's
+ * branch bounds never exceed a child's f. */
+START_TEST(large_groups_answer_within_the_budget)
+{
+    static fx_t f;
+    static int32_t rows[MAXV * (MAXN + 1u)];
+    static int32_t order_rows[MAXV * (MAXN + 1u)];
+    const uint64_t budget = 2000000u;
+    ws_t w = ws_make(MAXV, 20000u);
+    uint64_t rng = 0x1a7e6e0fu;
+    unsigned large = 0u;
+    unsigned solved = 0u;
+    unsigned trial;
+
+    for (trial = 0; trial < 40u; ++trial) {
+        const size_t n = 7u + trial % 4u;
+        coa_plan_result_t r;
+        coa_plan_result_t d;
+        fx_converging(&f, &rng, n, 8u);
+        ck_assert_int_eq(coa_planner_set_work(w.pl, 0u), COA_OK);
+        ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, NULL, 1u, order_rows, &d), COA_OK);
+        ck_assert_int_eq(coa_planner_set_work(w.pl, budget), COA_OK);
+        ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
+        ck_assert_uint_le(r.work, budget);
+        large += r.largest_group >= 7u ? 1u : 0u;
+        if (d.status == COA_PLAN_SOLVED) {
+            ck_assert_int_eq(r.status, COA_PLAN_SOLVED);
+            ck_assert(
+                to_u128(r.deviation_units) < to_u128(d.deviation_units) ||
+                (to_u128(r.deviation_units) == to_u128(d.deviation_units) && r.effort <= d.effort));
+        }
+        if (r.status == COA_PLAN_SOLVED) {
+            check_solved_plan(&f, rows, &r);
+            ck_assert(bound_at_most(&r, to_u128(r.deviation_units), r.effort));
+            ++solved;
+        }
+    }
+    ck_assert_uint_ge(large, 5u);
+    ck_assert_uint_ge(solved, 30u);
+    ck_assert_uint_eq(coa_plan_test_bound_breaks(w.pl), 0u);
+    ws_free(&w);
+}
+END_TEST
+
 START_TEST(planner_takes_problems_within_its_config)
 {
     static fx_t f;
@@ -2264,6 +2329,7 @@ static Suite *plan_suite(void)
     tcase_add_test(tc, reordering_rescues_boxed_in_vehicle);
     tcase_add_test(tc, reordering_reports_first_order_when_none_works);
     tcase_add_test(tc, centralised_matches_exhaustive_search);
+    tcase_add_test(tc, large_groups_answer_within_the_budget);
     tcase_add_test(tc, decoupled_each_vehicle_optimal_given_earlier);
     tcase_add_test(tc, reordering_finds_an_order_iff_one_exists);
     suite_add_tcase(s, tc);

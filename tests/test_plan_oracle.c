@@ -25,6 +25,7 @@
 #include <string.h>
 
 #include "coavoid/coavoid.h"
+#include "plan_internal.h" /* coa_plan_test_match_all */
 #include "reference/plan_v1.h"
 #include "test_support.h"
 
@@ -603,6 +604,7 @@ START_TEST(new_planner_matches_old_on_random_encounters)
     /* Divergences after a tie are legitimate but must stay the exception: a planner that
      * broke ties very differently would show here. */
     ck_assert_uint_lt(dec_tie * 20u, dec_compared);
+    ck_assert_uint_eq(coa_plan_test_bound_breaks(nw.pl), 0u);
 
     for (m = 2u; m <= MAXV_OLD; ++m) {
         free(old[m].mem);
@@ -751,6 +753,65 @@ START_TEST(anytime_claims_hold_for_five_uavs)
     ck_assert_uint_gt(solved, compared / 5u);
     ck_assert_uint_gt(compared - solved, 0u);
     ck_assert_uint_gt(stopped, compared / 5u);
+    ck_assert_uint_eq(coa_plan_test_bound_breaks(nw.pl), 0u);
+    free(nw.mem);
+}
+END_TEST
+
+/* Groups above PLAN_MATCH_ALL members match their surcharges within two sides. The same
+ * code split at two members (sides of 2 + 1 and 2 + 2) must keep every search exact on
+ * the encounters of 3 and 4 UAVs the old planner solves: a side-blind surcharge bound
+ * (a pair across the sides counted in a branch's bound, say) would make the heuristic
+ * inconsistent there and show as another cost or status. */
+#define SPLIT_TRIALS 600u
+
+START_TEST(split_matching_keeps_the_search_exact)
+{
+    static fx_t e;
+    static int32_t orows[MAXV * (MAXN + 1u)];
+    static int32_t nrows[MAXV * (MAXN + 1u)];
+    old_ws_t old[MAXV_OLD + 1u];
+    coa_planner_config_t cfg = big_config(MAXV_OLD, NEW_BETA);
+    new_ws_t nw = new_make(&cfg);
+    uint64_t rng = 0x5b117e5eedu;
+    unsigned compared = 0u;
+    unsigned split = 0u;
+    unsigned trial;
+    size_t m;
+
+    REQUIRE(coa_plan_test_match_all(nw.pl, 2u));
+    for (m = 3u; m <= MAXV_OLD; ++m) {
+        old[m] = old_make(m, OLD_BETA[m]);
+    }
+    for (trial = 0; trial < SPLIT_TRIALS; ++trial) {
+        const size_t n = 3u + trial % 2u;
+        coa_plan_result_t ro;
+        coa_plan_result_t rn;
+        enc_random(&e, &rng, n);
+        REQUIRE(ref_plan_centralised(old[n].pl, &e.p, orows, &ro) == COA_OK);
+        REQUIRE(coa_plan_centralised(nw.pl, &e.p, nrows, &rn) == COA_OK);
+        if (ro.status == COA_PLAN_BUDGET_EXHAUSTED) {
+            continue;
+        }
+        ++compared;
+        REQUIRE_MSG(ro.status == rn.status, "split, trial %u (%zu UAVs): status old %s, new %s",
+                    trial, n, status_name(ro.status), status_name(rn.status));
+        if (rn.status == COA_PLAN_SOLVED) {
+            REQUIRE_MSG(cost_eq(ro.deviation_units, rn.deviation_units) && ro.effort == rn.effort,
+                        "split, trial %u (%zu UAVs): another cost", trial, n);
+            REQUIRE(rn.optimal && coa_plan_find_conflict(&e.p, nrows, ALL, n, NULL, NULL) == 0);
+            split += rn.largest_group >= 3u ? 1u : 0u;
+        }
+    }
+    printf("plan_oracle: split matching: %u compared, %u solved by a joint search of 3 or 4\n",
+           compared, split);
+    fflush(stdout);
+    ck_assert_uint_eq(coa_plan_test_bound_breaks(nw.pl), 0u);
+    ck_assert_uint_ge(compared, SPLIT_TRIALS * 5u / 6u);
+    ck_assert_uint_gt(split, compared / 10u);
+    for (m = 3u; m <= MAXV_OLD; ++m) {
+        free(old[m].mem);
+    }
     free(nw.mem);
 }
 END_TEST
@@ -867,6 +928,7 @@ static Suite *plan_oracle_suite(void)
     tcase_add_test(tc, only_interacting_uavs_are_merged);
     tcase_add_test(tc, new_planner_matches_old_on_random_encounters);
     tcase_add_test(tc, anytime_claims_hold_for_five_uavs);
+    tcase_add_test(tc, split_matching_keeps_the_search_exact);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -26,7 +26,7 @@
 /* Without --vehicles a run times the sets up to 5 UAVs; 6 only on request, since one
  * 6-UAV set takes minutes where the others take seconds (docs/benchmarks.md). */
 #define BP_DEFAULT_MAX_VEHICLES 5u
-_Static_assert(BP_MIN_VEHICLES == 2u && BP_MAX_VEHICLES == 6u, "--vehicles' hint says 2 to 6");
+_Static_assert(BP_MIN_VEHICLES == 2u && BP_MAX_VEHICLES == 10u, "--vehicles' hint says 2 to 10");
 #define BP_DEFAULT_SCENARIO "scenarios/paper.json"
 #define BP_HORIZON coavoid_encounter_bench.horizon
 #define BP_DT coavoid_encounter_bench.dt
@@ -37,8 +37,8 @@ _Static_assert(BP_MIN_VEHICLES == 2u && BP_MAX_VEHICLES == 6u, "--vehicles' hint
     "                          [--json]\n"                                                  \
     "\n"                                                                                    \
     "Times the planner, centralised and decoupled, on the paper scenario and on C random\n" \
-    "encounters each of 2, 3, 4 and 5 UAVs (6 with --vehicles 6) converging on one point\n" \
-    "(staggered altitudes, half with a terrain box; %u steps of %g s), or on the N-UAV\n"   \
+    "encounters each of 2, 3, 4 and 5 UAVs converging on one point (staggered\n"            \
+    "altitudes, half with a terrain box; %u steps of %g s), or on the N-UAV (2 to 10)\n"    \
     "encounters only with --vehicles. One run plans every problem of a set once; prints\n"  \
     "per set and mode the median, min and max run time over R runs, the median and\n"       \
     "largest time of one problem, the nodes expanded, nodes per second, the work, the\n"    \
@@ -100,8 +100,8 @@ static int bp_option(int argc, char **argv, int *i, void *options)
     uint64_t value = 0;
     int status = CLI_UNKNOWN_OPTION;
     if (coavoid_cli_option_is(arg, "--vehicles")) {
-        /* 2..6, which coavoid_cli_count_option (1..max) cannot say. */
-        status = coavoid_cli_text_option(argc, argv, i, "--vehicles", "an integer from 2 to 6",
+        /* 2..10, which coavoid_cli_count_option (1..max) cannot say. */
+        status = coavoid_cli_text_option(argc, argv, i, "--vehicles", "an integer from 2 to 10",
                                          true, &o->vehicles_text);
         if (status == CLI_CONTINUE &&
             (!coavoid_cli_parse_count(o->vehicles_text, strlen(o->vehicles_text), BP_MAX_VEHICLES,

@@ -142,7 +142,7 @@ typedef struct {
     size_t figure_count;
 } mc_options_t;
 
-/* "2,3,4": each 2..6, each once. */
+/* "2,3,4": each 2..10, each once. */
 static int parse_sizes(mc_options_t *o)
 {
     const char *token = o->vehicles_text;
@@ -209,9 +209,9 @@ static int mc_option(int argc, char **argv, int *i, void *options)
         return status;
     }
     if (coavoid_cli_option_is(arg, "--vehicles")) {
-        status =
-            coavoid_cli_text_option(argc, argv, i, "--vehicles",
-                                    "UAV counts from 2 to 6, e.g. 2,3,4", false, &o->vehicles_text);
+        status = coavoid_cli_text_option(argc, argv, i, "--vehicles",
+                                         "UAV counts from 2 to 10, e.g. 2,3,4", false,
+                                         &o->vehicles_text);
         if (status == CLI_CONTINUE) {
             status = parse_sizes(o);
         }

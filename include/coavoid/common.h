@@ -70,8 +70,14 @@ typedef struct {
 #define COA_ERR_RANGE (-3)     /* the problem is too large for the integer cost or offset types */
 
 /* Limits of the core. They bound every loop and every fixed array. */
-#define COA_MAX_VEHICLES 32u     /* co-operative UAVs in one problem */
-#define COA_MAX_CENTRALISED 6u   /* UAVs in one centralised problem: each has a cost-to-go table */
+#define COA_MAX_VEHICLES 32u /* co-operative UAVs in one problem */
+/* UAVs in one centralised problem: each has a cost-to-go table, and the joint search's
+ * fixed arrays (its stack frame, the workspace's header) are sized for it. A build may set
+ * it from 2 to 10 (CMake COAVOID_MAX_CENTRALISED; the Cortex-M build's is 6), and the
+ * installed package's compile flags carry it. */
+#ifndef COA_MAX_CENTRALISED
+#define COA_MAX_CENTRALISED 10u
+#endif
 #define COA_MAX_STEEP_FACTOR 10u /* largest steep_factor; keeps the integer cost scale small */
 #define COA_MAX_HORIZON 10000u   /* N: samples k = 0..N */
 #define COA_MAX_OFFSET 32767     /* |altitude offset| in climb steps at any sample */

@@ -48,7 +48,11 @@
  * largest half-integral fractional matching of the pairs' surcharges, a surcharge being
  * a pair's exact joint cost to go (a table over the pair's common span, within the cap's
  * corridor) less the two own costs. Each matching is a sum of exact pair costs to go and
- * own costs over disjoint sets, so it is admissible and consistent; so is their maximum.
+ * own costs over disjoint sets, so it is admissible and consistent; so is their maximum
+ * over any family of matchings fixed for the search. A group of more than six members
+ * takes the matchings within two sides of at most six (the split, chosen before the
+ * search, whose sides' matchings of the pairs' least surcharges add up most): the exact
+ * matching of ten members would cost every child thousands of sums.
  * Expansion is partial (EPEA*, Goldenberg et al. 2014): the members' moves and the
  * entering members' offsets are enumerated depth first, each member's options in the
  * order of the increase of f they cause, cutting branches that cannot reach the
@@ -103,8 +107,10 @@
  * polytope 1 + vertices / 8 units per test, its MPR test evaluating the support function
  * several times); a cost-from-start table 5 per cell; a pair table 1 per cell; a joint
  * search 1 + c per member choice made with c members chosen before it and 4 + m per
- * complete combination of m choosers, and for a new child of five members 20 more and of
- * six 50 (the pair matching of its heuristic); each check of the groups' plans N n^2. The same
+ * complete combination of m choosers, and for a new child 20 more per side of five members
+ * and 50 per side of six (the pair matching of its heuristic; a second side 2 more at
+ * least), and choosing the sides of a group above six 4 + m per split tried; each
+ * check of the groups' plans N n^2. The same
  * call with the same budget does the same work everywhere (the count never depends on a
  * clock), so a budget is a deterministic bound on time: docs/benchmarks.md gives the time
  * per unit measured on the host.

@@ -218,6 +218,7 @@ coa_planner_t *coa_planner_init(void *buffer, size_t size, const coa_planner_con
     }
     pl->scratch.cells = &pl->cells[(pl->table_count - 1u) * pl->table_cells];
     pl->m = 1u;
+    pl->match_all = PLAN_MATCH_ALL;
     pl->magic = PLAN_MAGIC;
     return pl;
 }

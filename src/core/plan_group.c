@@ -277,6 +277,8 @@ static void group_collect(coa_planner_t *pl, uint32_t members, uint32_t fixed)
             g->fixed[g->fixed_count++] = v;
         }
     }
+    g->side[0] = (UINT32_C(1) << g->count) - 1u;
+    g->side[1] = 0u;
 }
 
 /* Everything a joint search of `members` around the rows of `fixed` (at most `bound`,

@@ -18,7 +18,7 @@
  * as a plain 128-bit integer), so that comparing two packed costs compares them
  * lexicographically, and sums and differences of packed costs are exact as long as the
  * effort part of every result stays in range (it is a sum of efforts of at most
- * COA_MAX_CENTRALISED vehicles over N steps, below 2^18).
+ * COA_MAX_CENTRALISED vehicles over N steps, below 2^19).
  */
 #ifndef COAVOID_CORE_PLAN_INTERNAL_H
 #define COAVOID_CORE_PLAN_INTERNAL_H
@@ -29,10 +29,14 @@
 
 #define PLAN_ACTIONS COA_ACTION_COUNT
 #define PLAN_MAXM COA_MAX_CENTRALISED
+_Static_assert(PLAN_MAXM >= 2u && PLAN_MAXM <= 10u, "COA_MAX_CENTRALISED is 2..10");
 #define PLAN_NONE UINT32_MAX /* no node, an empty slot, not in the heap */
-#define PLAN_EFF_BITS 18u    /* effort bits of a packed cost */
+#define PLAN_EFF_BITS 19u    /* effort bits of a packed cost */
 #define PLAN_PAIRS (PLAN_MAXM * (PLAN_MAXM - 1u) / 2u)
 #define PLAN_OUT INT16_MIN /* a group member's offset while it is not in the search */
+/* The most members whose surcharges the heuristic matches exactly (the peels of
+ * plan_search.c); larger groups match within two sides of at most this many. */
+#define PLAN_MATCH_ALL 6u
 /* Work (plan.h, "Work"): a polytope test costs one unit per this many vertices, plus one. */
 #define PLAN_WORK_VERTICES 8u
 
@@ -125,6 +129,10 @@ typedef struct {
     coa_cost_t bound; /* packed */
     bool capped;      /* a plan is known that costs `cap` (packed): prune above */
     coa_cost_t cap;
+    /* The heuristic's matching pairs members of the same side only (member bit masks;
+     * side[1] is 0, one side, up to PLAN_MATCH_ALL members): the family of matchings is
+     * fixed for the whole search, which keeps the heuristic consistent. */
+    uint32_t side[2];
 } plan_group_t;
 
 /* The exact joint cost-to-go of members a and b over rows first..last (sample `last`+1 is
@@ -235,7 +243,9 @@ struct coa_planner {
     int32_t *best_rows;
     bool have_best;
     coa_cost_t best_cost;
-    int exponent; /* the deviation unit's power of two, 2^E (coa_deviation_weights) */
+    int exponent;          /* the deviation unit's power of two, 2^E (coa_deviation_weights) */
+    uint32_t match_all;    /* PLAN_MATCH_ALL; a test hook lowers it to split small groups */
+    uint64_t bound_breaks; /* leaves below their branch's bound: a defect (test hook) */
 };
 
 /* Charges `units` of work before they are done: false, charging nothing, when they do not
@@ -437,6 +447,17 @@ void coa_plan_table_walk_back(coa_planner_t *pl, const plan_table_t *t, const pl
  * are left out). */
 void coa_plan_pairs_build(coa_planner_t *pl);
 
+/* The least surcharge members a < b pay over their pair table (their cheapest joint plan
+ * through its first row less their costs alone; 0 without a table): how much they
+ * interact, which chooses the group's sides. O(cells of that row). */
+coa_cost_t coa_plan_pair_weight(const coa_planner_t *pl, size_t a, size_t b);
+
+/* Chooses the group's sides (plan_group_t.side) after its pair tables are built: one side
+ * up to PLAN_MATCH_ALL members, else the split of the members into two sides of at most
+ * PLAN_MATCH_ALL whose matchings of the pairs' weights add up most (work charged per
+ * split tried; out of work, the best split so far). */
+void coa_plan_sides_choose(coa_planner_t *pl);
+
 /* The surcharge of members a < b at sample k (packed: their joint cost-to-go less the sum
  * of their own), 0 where the pair has no table or the sample is outside it, or
  * PLAN_COST_DEAD. */
@@ -448,8 +469,7 @@ static inline size_t plan_pair_index(size_t a, size_t b, size_t m)
 {
     /* b (b - 1) / 2 + a: pairs by their larger member, so the index does not depend on m
      * (the joint search asks for it at every step of its enumeration). */
-    static const uint8_t before[PLAN_MAXM] = {0u, 0u, 1u, 3u, 6u, 10u};
-    _Static_assert(PLAN_MAXM == 6u, "before[] lists b (b - 1) / 2 for b < PLAN_MAXM");
+    static const uint8_t before[10] = {0u, 0u, 1u, 3u, 6u, 10u, 15u, 21u, 28u, 36u};
     (void)m;
     return (size_t)before[b] + a;
 }
@@ -523,6 +543,15 @@ void coa_plan_test_group_setup(coa_planner_t *pl, uint32_t members);
  * when a pair is dead there. */
 bool coa_plan_test_heuristic(const coa_planner_t *pl, uint32_t k, const int16_t *off,
                              coa_cost_t *h2);
+
+/* Splits every group of more than `members` (2..PLAN_MATCH_ALL; false otherwise) into two
+ * sides of at most that many, as groups above PLAN_MATCH_ALL are. Precondition: the
+ * problems planned have no group of more than 2 * members. */
+bool coa_plan_test_match_all(coa_planner_t *pl, uint32_t members);
+
+/* The leaves the joint searches found below the bound their branch was let through with,
+ * since the planner's init: a defect of the branch bounds when not 0. */
+uint64_t coa_plan_test_bound_breaks(const coa_planner_t *pl);
 
 /* The doubled matching the heuristic adds (plan_search.c) of surcharges s[] (pairs of m
  * members in plan_pair_index order) among the members of mask. */

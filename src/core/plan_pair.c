@@ -393,6 +393,44 @@ void coa_plan_pairs_build(coa_planner_t *pl)
             pair_build(pl, a, b, g->capped ? &slack : NULL);
         }
     }
+    coa_plan_sides_choose(pl);
+}
+
+coa_cost_t coa_plan_pair_weight(const coa_planner_t *pl, size_t a, size_t b)
+{
+    const plan_group_t *g = &pl->group;
+    const plan_pair_t *p = &pl->pair[plan_pair_index(a, b, g->count)];
+    const coa_cost_t alone = plan_cost_add(g->alone[a], g->alone[b]);
+    coa_cost_t best = {0u, 0u};
+    bool any = false;
+    pair_view_t v;
+    int32_t oa;
+    int32_t ob;
+
+    if (!p->present) {
+        return best;
+    }
+    v = pair_view(p, p->first);
+    for (oa = v.a_lo; oa <= v.a_hi; ++oa) {
+        uint64_t fa = plan_table_at(plan_from_start(pl, a), p->first, oa);
+        for (ob = v.b_lo; ob <= v.b_hi && !cell_dead(fa); ++ob) {
+            uint64_t fb = plan_table_at(plan_from_start(pl, b), p->first, ob);
+            const coa_cost_t *c = pair_view_cell(&v, oa, ob);
+            coa_cost_t w;
+            if (cell_dead(fb) || c == NULL || plan_cost_dead(*c)) {
+                continue;
+            }
+            w = plan_cost_add(plan_cost_add(plan_cell_cost(pl, g->vehicle[a], fa),
+                                            plan_cell_cost(pl, g->vehicle[b], fb)),
+                              *c);
+            if (!any || plan_cost_compare(w, best) < 0) {
+                best = w;
+                any = true;
+            }
+        }
+    }
+    return any && plan_cost_compare(best, alone) > 0 ? plan_cost_sub(best, alone)
+                                                     : (coa_cost_t){0u, 0u};
 }
 
 coa_cost_t coa_plan_pair_surcharge(const coa_planner_t *pl, size_t a, size_t b, uint32_t k,

@@ -318,7 +318,7 @@ static coa_cost_t matching_peel(const coa_cost_t *s, size_t m, const size_t *at,
  * firmware's stack bound is a sum of frames. */
 static coa_cost_t matching_list(const coa_cost_t *s, size_t m, const size_t *at, size_t count)
 {
-    _Static_assert(PLAN_MAXM <= 6u, "matching_list peels at most two members");
+    _Static_assert(PLAN_MATCH_ALL == 6u, "matching_list peels at most two members");
     if (count <= 4u) {
         return matching_direct(s, m, at, count);
     }
@@ -329,21 +329,30 @@ static coa_cost_t matching_list(const coa_cost_t *s, size_t m, const size_t *at,
                          matching_peel(s, m, &at[1], 5u, matching_direct(s, m, &at[2], 4u)));
 }
 
-/* The work units of matching(mask) beyond a leaf's own: PLAN_WORK_MATCH per direct call
- * past the first (members: 5 -> 11 calls, 6 -> 26; each call adds one per member, less
- * the pairs and triangles of the first and the calls under them). */
-static uint64_t matching_work(uint32_t mask)
+static uint32_t member_count(uint32_t mask)
 {
-    static const uint8_t calls[PLAN_MAXM + 1u] = {1, 1, 1, 1, 1, 11, 26};
     uint32_t count = 0u;
     for (; mask != 0u; mask &= mask - 1u) {
         ++count;
     }
-    return (uint64_t)(calls[count] - 1u) * PLAN_WORK_MATCH;
+    return count;
+}
+
+/* The work units of matching(mask) beyond a leaf's own: PLAN_WORK_MATCH per direct call
+ * past the first (members: 5 -> 11 calls, 6 -> 26; each call adds one per member, less
+ * the pairs and triangles of the first and the calls under them), on each side. */
+static uint64_t matching_work(const plan_group_t *g, uint32_t mask)
+{
+    static const uint8_t calls[PLAN_MATCH_ALL + 1u] = {1, 1, 1, 1, 1, 11, 26};
+    uint64_t units = (uint64_t)(calls[member_count(mask & g->side[0])] - 1u) * PLAN_WORK_MATCH;
+    if (g->side[1] != 0u) {
+        units += (uint64_t)calls[member_count(mask & g->side[1])] * PLAN_WORK_MATCH;
+    }
+    return units;
 }
 
 /* matching_list of the members of `mask`. */
-static coa_cost_t matching(const coa_cost_t *s, size_t m, uint32_t mask)
+static coa_cost_t matching_of(const coa_cost_t *s, size_t m, uint32_t mask)
 {
     size_t at[PLAN_MAXM];
     size_t count = 0u;
@@ -354,6 +363,73 @@ static coa_cost_t matching(const coa_cost_t *s, size_t m, uint32_t mask)
         }
     }
     return matching_list(s, m, at, count);
+}
+
+/* The heuristic's matching of the members of `mask`: within each side of the group. */
+static coa_cost_t matching(const plan_group_t *g, const coa_cost_t *s, uint32_t mask)
+{
+    coa_cost_t r = matching_of(s, g->count, mask & g->side[0]);
+    if (g->side[1] != 0u) {
+        r = plan_cost_add(r, matching_of(s, g->count, mask & g->side[1]));
+    }
+    return r;
+}
+
+/* Whether members i and j are on the same side: their surcharge is in the matching. */
+static bool same_side(const plan_group_t *g, size_t i, size_t j)
+{
+    return (((g->side[0] >> i) ^ (g->side[0] >> j)) & 1u) == 0u;
+}
+
+/* The split of the members into two sides of at most PLAN_MATCH_ALL each (side 0 holds
+ * member 0) whose matchings of the pair weights w[] add up most. */
+static uint32_t sides_best(coa_planner_t *pl, const coa_cost_t *w)
+{
+    const size_t m = pl->group.count;
+    const uint32_t all = (1u << m) - 1u;
+    uint32_t best_side = all >> (m - pl->match_all);
+    coa_cost_t best = {0u, 0u};
+    bool any = false;
+    uint32_t a;
+
+    for (a = 1u; a < all; a += 2u) {
+        uint32_t na = member_count(a);
+        coa_cost_t v;
+        if (na > pl->match_all || m - na > pl->match_all) {
+            continue;
+        }
+        if (!plan_work(pl, 2u * PLAN_WORK_MATCH + m)) {
+            break;
+        }
+        v = plan_cost_add(matching_of(w, m, a), matching_of(w, m, all & ~a));
+        if (!any || plan_cost_compare(v, best) > 0) {
+            best = v;
+            best_side = a;
+            any = true;
+        }
+    }
+    return best_side;
+}
+
+void coa_plan_sides_choose(coa_planner_t *pl)
+{
+    plan_group_t *g = &pl->group;
+    coa_cost_t w[PLAN_PAIRS];
+    size_t i;
+    size_t j;
+
+    g->side[0] = (1u << g->count) - 1u;
+    g->side[1] = 0u;
+    if (g->count <= pl->match_all) {
+        return;
+    }
+    for (j = 1u; j < g->count; ++j) {
+        for (i = 0; i < j; ++i) {
+            w[plan_pair_index(i, j, g->count)] = coa_plan_pair_weight(pl, i, j);
+        }
+    }
+    g->side[0] = sides_best(pl, w);
+    g->side[1] = ((1u << g->count) - 1u) & ~g->side[0];
 }
 
 typedef struct {
@@ -394,7 +470,7 @@ static bool heuristic(const coa_planner_t *pl, uint32_t k, const int16_t *off, h
             s[plan_pair_index(i, j, m)] = c;
         }
     }
-    out->m2 = matching(s, m, mask);
+    out->m2 = matching(g, s, mask);
     out->h2 = plan_cost_add(plan_cost_twice(sum), out->m2);
     return true;
 }
@@ -471,7 +547,11 @@ typedef struct {
     coa_cost_t move_inc[PLAN_MAXM][PLAN_ACTIONS]; /* movers: increase() of each move */
     coa_cost_t rest_min[PLAN_MAXM + 1u];          /* least increase of choosers c.. */
     coa_sweep_t sweep[PLAN_MAXM][PLAN_ACTIONS];
-    uint8_t pair_ok[PLAN_MAXM][PLAN_MAXM][PLAN_ACTIONS][PLAN_ACTIONS]; /* 0 ?, 1 ok, 2 no */
+    /* 0 ?, 1 ok, 2 no: a mover's option against the fixed vehicles (its sweep is built
+     * once this is known), and against an earlier mover's (choosers d < c, by their
+     * plan_pair_index) */
+    uint8_t clear[PLAN_MAXM][PLAN_ACTIONS];
+    uint8_t pair_ok[PLAN_PAIRS][PLAN_ACTIONS][PLAN_ACTIONS];
 } choosers_t;
 
 /* The doubled, packed increase of the additive f that option t of chooser c causes: for
@@ -542,14 +622,17 @@ static void choosers_make(const coa_planner_t *pl, uint32_t n, choosers_t *ch)
         ch->rest_min[c] = plan_cost_add(least, ch->rest_min[c + 1u]);
     }
     for (c = 0; c < ch->count; ++c) {
-        size_t j;
-        for (j = 0; j < ch->count; ++j) {
-            uint32_t a;
-            for (a = 0; a < PLAN_ACTIONS; ++a) {
-                uint32_t b;
-                for (b = 0; b < PLAN_ACTIONS; ++b) {
-                    ch->pair_ok[c][j][a][b] = 0u;
-                }
+        uint32_t a;
+        for (a = 0; a < PLAN_ACTIONS; ++a) {
+            ch->clear[c][a] = 0u;
+        }
+    }
+    for (c = 0; c < ch->count * (ch->count - 1u) / 2u; ++c) {
+        uint32_t a;
+        for (a = 0; a < PLAN_ACTIONS; ++a) {
+            uint32_t b;
+            for (b = 0; b < PLAN_ACTIONS; ++b) {
+                ch->pair_ok[c][a][b] = 0u;
             }
         }
     }
@@ -581,14 +664,12 @@ static bool mover_clear(const coa_planner_t *pl, choosers_t *ch, uint32_t k, siz
     const uint32_t a = choice[c];
     size_t d;
 
-    if (ch->pair_ok[c][c][a][a] == 0u) {
-        /* pair_ok[c][c][a][a]: option a's sweep is built and was checked against the
-         * fixed vehicles (a mover is never paired with itself) */
+    if (ch->clear[c][a] == 0u) {
         ch->sweep[c][a] = coa_plan_vehicle_sweep(pl->problem, pl->dh, g->vehicle[i], k, off[i],
                                                  k + 1u, ch->moves[c].to[a]);
-        ch->pair_ok[c][c][a][a] = fixed_clear(pl, &ch->sweep[c][a], k) ? 1u : 2u;
+        ch->clear[c][a] = fixed_clear(pl, &ch->sweep[c][a], k) ? 1u : 2u;
     }
-    if (ch->pair_ok[c][c][a][a] != 1u) {
+    if (ch->clear[c][a] != 1u) {
         return false;
     }
     for (d = 0; d < c; ++d) {
@@ -602,7 +683,7 @@ static bool mover_clear(const coa_planner_t *pl, choosers_t *ch, uint32_t k, siz
         if (k < g->near_first[pi] || k > g->near_last[pi]) {
             continue;
         }
-        ok = &ch->pair_ok[d][c][choice[d]][a];
+        ok = &ch->pair_ok[plan_pair_index(d, c, ch->count)][choice[d]][a];
         if (*ok == 0u) {
             *ok = coa_conflict_volumes(&ch->sweep[d][choice[d]], &ch->sweep[c][a]) ? 2u : 1u;
         }
@@ -654,20 +735,27 @@ static bool beyond(const coa_planner_t *pl, const expansion_t *e, coa_cost_t bou
                                plan_cost_compare(bound, e->next) >= 0);
 }
 
-/* The matching of the surcharges among choosers 0..c (at most four) in the search at k1:
- * a lower bound on the child's, which contains it. */
+/* The matching of the surcharges among choosers 0..c (at most four) in the search at k1,
+ * within each side: a lower bound on the child's, which contains it. */
 static coa_cost_t chosen_matching(const coa_planner_t *pl, const expansion_t *e, size_t c,
                                   uint32_t k1)
 {
-    size_t at[4];
-    size_t count = 0u;
-    size_t d;
-    for (d = 0; d <= c; ++d) {
-        if (in_search(&pl->group, e->ch.member[d], k1)) {
-            at[count++] = e->ch.member[d];
+    const plan_group_t *g = &pl->group;
+    coa_cost_t r = {0u, 0u};
+    size_t side;
+    for (side = 0; side < 2u && g->side[side] != 0u; ++side) {
+        size_t at[4];
+        size_t count = 0u;
+        size_t d;
+        for (d = 0; d <= c; ++d) {
+            size_t i = e->ch.member[d];
+            if (in_search(g, i, k1) && ((g->side[side] >> i) & 1u) != 0u) {
+                at[count++] = i;
+            }
         }
+        r = plan_cost_add(r, matching_direct(e->s, g->count, at, count));
     }
-    return matching_direct(e->s, pl->group.count, at, count);
+    return r;
 }
 
 /* Chooser c takes option choice[c]: its offset at k + 1, and, if it is in the search
@@ -699,7 +787,9 @@ static bool choose(const coa_planner_t *pl, expansion_t *e, size_t c)
                 return false;
             }
             twice = plan_cost_twice(e->s[pi]);
-            best = plan_cost_compare(twice, best) > 0 ? twice : best;
+            if (same_side(g, i, j) && plan_cost_compare(twice, best) > 0) {
+                best = twice;
+            }
         }
     }
     /* The largest doubled surcharge among the pairs chosen so far (one pair is a matching
@@ -760,10 +850,16 @@ static bool leaf(coa_planner_t *pl, expansion_t *e, plan_search_out_t *out)
     if (n != PLAN_NONE && (pl->node_k[n] & K_EXPANDED) != 0u) {
         return true;
     }
-    if (!plan_work(pl, matching_work(e->in_child))) {
+    if (!plan_work(pl, matching_work(&pl->group, e->in_child))) {
         return false;
     }
-    f2 = plan_cost_add(e->partial[e->ch.count], matching(e->s, pl->group.count, e->in_child));
+    f2 = plan_cost_add(e->partial[e->ch.count], matching(&pl->group, e->s, e->in_child));
+    /* The branch bounds are lower bounds on the leaf's f, or branches that hold cheaper
+     * children than their bound were cut: counted for the tests, which require none. */
+    if (plan_cost_compare(f2, plan_cost_add(e->partial[e->ch.count], e->pairmax[e->ch.count])) <
+        0) {
+        ++pl->bound_breaks;
+    }
     if (plan_cost_compare(f2, e->key) > 0) {
         cut(e, f2);
         return true;
@@ -1028,7 +1124,21 @@ bool coa_plan_test_heuristic(const coa_planner_t *pl, uint32_t k, const int16_t 
     return true;
 }
 
+uint64_t coa_plan_test_bound_breaks(const coa_planner_t *pl)
+{
+    return pl->bound_breaks;
+}
+
+bool coa_plan_test_match_all(coa_planner_t *pl, uint32_t members)
+{
+    if (members < 2u || members > PLAN_MATCH_ALL) {
+        return false;
+    }
+    pl->match_all = members;
+    return true;
+}
+
 coa_cost_t coa_plan_test_matching(const coa_cost_t *s, size_t m, uint32_t mask)
 {
-    return matching(s, m, mask);
+    return matching_of(s, m, mask);
 }

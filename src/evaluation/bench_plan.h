@@ -2,7 +2,7 @@
 /*
  * bench_plan.h: the harness of `coavoid bench plan`: times the core's planner
  * (coa_plan_centralised and coa_plan_decoupled) on a scenario file (the paper's) and on
- * seeded random encounters of 2 to 6 UAVs (docs/benchmarks.md, "Planning").
+ * seeded random encounters of 2 to 10 UAVs (docs/benchmarks.md, "Planning").
  *
  * The encounters (encounter.h, design coavoid_encounter_bench, shared with montecarlo).
  * n UAVs converge on one point: their headings are spread evenly around it (plus up to

@@ -28,10 +28,10 @@
 #include <stddef.h>
 #include <stdint.h>
 
-/* One problem's JSON: 6 vehicles of about 330 characters, 3 hills of about 250, 2 tracks. */
-#define COAVOID_ENCOUNTER_JSON_MAX 8192u
+/* One problem's JSON: 10 vehicles of about 330 characters, 3 hills of about 250, 2 tracks. */
+#define COAVOID_ENCOUNTER_JSON_MAX 12288u
 #define COAVOID_ENCOUNTER_MIN_VEHICLES 2u
-#define COAVOID_ENCOUNTER_MAX_VEHICLES 6u
+#define COAVOID_ENCOUNTER_MAX_VEHICLES 10u
 
 typedef struct {
     const char *name;              /* "bench encounter", in each problem's name */

@@ -7,7 +7,7 @@
  * and figures from the same seed.
  *
  *   - prng.h: the seeded generator every random problem comes from (splitmix64);
- *   - encounter.h: random encounters of 2-6 UAVs as scenario JSON, in two designs;
+ *   - encounter.h: random encounters of 2-10 UAVs as scenario JSON, in two designs;
  *   - montecarlo.h: `coavoid montecarlo`, centralised against decoupled planning over
  *     thousands of encounters (docs/evaluation.md);
  *   - bench_predict.h, bench_plan.h: `coavoid bench predict` and `coavoid bench plan`,

@@ -153,8 +153,10 @@ static int fig_row(fig_data_t *d, fig_file_t *f, char *line, coavoid_run_error_t
     }
     const char *v = fields[FIG_COL_VEHICLES], *status = fields[FIG_COL_STATUS];
     const bool lost = strcmp(status, "loss_of_separation") == 0;
-    if (strlen(v) != 1u || v[0] < (char)('0' + COAVOID_ENCOUNTER_MIN_VEHICLES) ||
-        v[0] > (char)('0' + COAVOID_ENCOUNTER_MAX_VEHICLES)) {
+    char *v_end = NULL;
+    const unsigned long vehicles = strtoul(v, &v_end, 10);
+    if (v[0] < '0' || v[0] > '9' || *v_end != '\0' || vehicles < COAVOID_ENCOUNTER_MIN_VEHICLES ||
+        vehicles > COAVOID_ENCOUNTER_MAX_VEHICLES) {
         return fig_fail(e, f, "vehicles is not a UAV count montecarlo draws");
     }
     if (!lost && strcmp(status, "separated") != 0) {
@@ -168,7 +170,7 @@ static int fig_row(fig_data_t *d, fig_file_t *f, char *line, coavoid_run_error_t
     if (level < 0) {
         return fig_fail(e, f, "more distinct losses than the figure draws");
     }
-    const uint32_t n = (uint32_t)(v[0] - '0') - COAVOID_ENCOUNTER_MIN_VEHICLES;
+    const uint32_t n = (uint32_t)vehicles - COAVOID_ENCOUNTER_MIN_VEHICLES;
     fig_count_t *c = &d->count[level][n][mode];
     if (c->encounters == UINT32_MAX) {
         return fig_fail(e, f, "too many rows");

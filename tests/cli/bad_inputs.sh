@@ -342,8 +342,8 @@ expect_bad unknown_top_option "'--verbose'" --verbose
 expect_bad no_command 'command'
 
 # ---- limits that only the planner's sizes reveal ----
-mutate seven_vehicles 's["vehicles"] = [dict(s["vehicles"][0], id=i + 1, route=[[0, 100 * i, 100], [10, 100 * i, 100]]) for i in range(7)]'
-expect_bad centralised_too_many 'COA_MAX_CENTRALISED' plan "$tmp/seven_vehicles.json" --mode centralised
+mutate eleven_vehicles 's["vehicles"] = [dict(s["vehicles"][0], id=i + 1, route=[[0, 100 * i, 100], [10, 100 * i, 100]]) for i in range(11)]'
+expect_bad centralised_too_many 'COA_MAX_CENTRALISED' plan "$tmp/eleven_vehicles.json" --mode centralised
 
 expect_bad beta_workspace_overflow '--beta 4294967295: too large' plan "$good" --mode decoupled --beta 4294967295
 mutate scenario_beta_overflow 's["beta"] = 4294967295'

@@ -159,9 +159,9 @@ else
     fail "bench --help: $(head -c 300 "$tmp/help")"
 fi
 
-also="from 2 to 6"
+also="from 2 to 10"
 expect_bad "vehicles 1" "--vehicles" bench plan --vehicles 1
-expect_bad "vehicles 7" "--vehicles" bench plan --vehicles 7
+expect_bad "vehicles 11" "--vehicles" bench plan --vehicles 11
 expect_bad "vehicles 0" "--vehicles" bench plan --vehicles 0
 expect_bad "vehicles abc" "--vehicles" bench plan --vehicles abc
 expect_bad "vehicles missing" "--vehicles" bench plan --vehicles

@@ -305,7 +305,7 @@ fi
 head -n 5 "$tmp/f0.csv" >"$tmp/two.csv"; tail -n 3 "$tmp/f3.csv" >>"$tmp/two.csv"
 head -n 3 "$tmp/f0.csv" >"$tmp/short.csv"; printf '1,2,0,0,1,0,3,flown_decoupled,separated' >>"$tmp/short.csv"
 { head -n 1 "$tmp/f0.csv"; echo "1,2,0,0,1,0,3,flown_decoupled,separated,,,,,,,,0,0,0,9,,,"; } >"$tmp/fields.csv"
-{ head -n 1 "$tmp/f0.csv"; echo "1,7,0,0,1,0,3,flown_decoupled,separated,,,,,,,,0,0,0,9,,"; } >"$tmp/seven.csv"
+{ head -n 1 "$tmp/f0.csv"; echo "1,11,0,0,1,0,3,flown_decoupled,separated,,,,,,,,0,0,0,9,,"; } >"$tmp/eleven.csv"
 { head -n 1 "$tmp/f0.csv"; echo "1,2,0,0,1,0,3,flown_decoupled,crashed,,,,,,,,0,0,0,9,,"; } >"$tmp/status.csv"
 { head -n 1 "$tmp/f0.csv"; echo "1,2,0,0,1,0,3,flown_decoupled,separated,,,,,,,,1,0,0,9,,"; } >"$tmp/loss1.csv"
 { head -n 1 "$tmp/f0.csv"; echo "1,2,0,0,1,0,3,flown_decoupled,separated,,,,,,,,nan,0,0,9,,"; } >"$tmp/nan.csv"
@@ -324,7 +324,7 @@ expect_bad "figure other delay" "delay.csv:3: delay or jitter" montecarlo --figu
 expect_bad "figure no newline" "short.csv:4: a line too long, or no newline" montecarlo --figure-from "$tmp/short.csv" --svg "$tmp/g.svg"
 expect_bad "figure long line" "long.csv:2: a line too long" montecarlo --figure-from "$tmp/long.csv" --svg "$tmp/g.svg"
 expect_bad "figure fields" "fields.csv:2: not 22 fields" montecarlo --figure-from "$tmp/fields.csv" --svg "$tmp/g.svg"
-expect_bad "figure vehicles" "seven.csv:2: vehicles" montecarlo --figure-from "$tmp/seven.csv" --svg "$tmp/g.svg"
+expect_bad "figure vehicles" "eleven.csv:2: vehicles" montecarlo --figure-from "$tmp/eleven.csv" --svg "$tmp/g.svg"
 expect_bad "figure status" "status.csv:2: a flown row's status" montecarlo --figure-from "$tmp/status.csv" --svg "$tmp/g.svg"
 expect_bad "figure loss 1" "loss1.csv:2: loss, delay or jitter" montecarlo --figure-from "$tmp/loss1.csv" --svg "$tmp/g.svg"
 expect_bad "figure nan" "nan.csv:2: loss, delay or jitter" montecarlo --figure-from "$tmp/nan.csv" --svg "$tmp/g.svg"
@@ -332,9 +332,9 @@ expect_bad "figure no rows" "empty.csv:1: no flown rows" montecarlo --figure-fro
 expect_bad "figure svg unwritable" "--svg" montecarlo --figure-from "$tmp/f0.csv" --svg "$tmp/none/g.svg"
 
 expect_bad "vehicles missing" "--vehicles: required" montecarlo --count 2
-also="from 2 to 6"
+also="from 2 to 10"
 expect_bad "vehicles 1" "--vehicles" montecarlo --vehicles 1
-expect_bad "vehicles 7" "--vehicles" montecarlo --vehicles 2,7
+expect_bad "vehicles 11" "--vehicles" montecarlo --vehicles 2,11
 expect_bad "vehicles empty entry" "--vehicles" montecarlo --vehicles 2,,3
 expect_bad "vehicles trailing comma" "--vehicles" montecarlo --vehicles 2,
 expect_bad "vehicles abc" "--vehicles" montecarlo --vehicles abc

@@ -306,8 +306,8 @@ bin=$vehicle expect_bad "vehicle, coordinator timeout when decoupled" "--coordin
     --scenario "$headon" --id 1 --mode decoupled --coordinator-timeout 2
 bin=$vehicle expect_bad "vehicle, a joint plan of one" "--joint-members" --scenario "$headon" --id 1 \
     --joint-members 1 --insecure
-bin=$vehicle expect_bad "vehicle, a joint plan of 7" "--joint-members" --scenario "$headon" --id 1 \
-    --joint-members 7 --insecure
+bin=$vehicle expect_bad "vehicle, a joint plan of 11" "--joint-members" --scenario "$headon" --id 1 \
+    --joint-members 11 --insecure
 bin=$vehicle expect_bad "vehicle, a joint plan when decoupled" "--joint-members" \
     --scenario "$headon" --id 1 --mode decoupled --joint-members 3 --insecure
 bin=$vehicle expect_bad "vehicle, a joint beta with no joint plan" "--joint-beta" \
@@ -317,8 +317,8 @@ bin=$vehicle expect_bad "vehicle, joint beta 0" "--joint-beta" --scenario "$head
 bin=$vehicle expect_bad "vehicle, an unknown LCM provider" "--lcm-url" --scenario "$headon" --id 1 \
     --lcm-url "nope://" --insecure
 bin=$vehicle expect_bad "vehicle, a stray argument" "unexpected argument" "$headon"
-bin=$coordinator expect_bad "coordinator, --max-centralised 7" "--max-centralised" \
-    --scenario "$headon" --max-centralised 7
+bin=$coordinator expect_bad "coordinator, --max-centralised 11" "--max-centralised" \
+    --scenario "$headon" --max-centralised 11
 bin=$coordinator expect_bad "coordinator, --beta 0" "--beta" --scenario "$headon" --beta 0
 bin=$coordinator expect_bad "coordinator, --collect of a whole cycle" "--collect" \
     --scenario "$headon" --collect 1 --insecure
