@@ -1538,6 +1538,49 @@ END_TEST
  * not, and a buffer of exactly the size for beta gives beta back. config->beta plays no
  * part. A single-UAV planner's size does not depend on beta, so there any beta fits once
  * the header and the table do. */
+/* result.workspace_touched_bytes: every byte the planner writes in its workspace is
+ * counted (a buffer filled with a pattern before init keeps it outside the count), the
+ * count only grows, and small problems in a large workspace leave most of it untouched. */
+START_TEST(touched_bytes_cover_every_write)
+{
+    static fx_t f;
+    static int32_t rows[MAXV * (MAXN + 1u)];
+    const coa_planner_config_t c = {4u, 200000u, MAXN, 3u, -1};
+    const size_t bytes = coa_planner_workspace_size(&c);
+    unsigned char *mem = malloc(bytes);
+    uint64_t rng = 0x70c4edu;
+    size_t last = 0u;
+    unsigned trial;
+    coa_planner_t *pl;
+
+    ck_assert_ptr_nonnull(mem);
+    memset(mem, 0xA5, bytes);
+    pl = coa_planner_init(mem, bytes, &c);
+    ck_assert_ptr_nonnull(pl);
+    for (trial = 0; trial < 60u; ++trial) {
+        const size_t n = 2u + trial % 3u;
+        coa_plan_result_t r;
+        size_t changed = 0u;
+        size_t i;
+        fx_random(&f, &rng, n, 4u + pick(&rng, 8u), 3u);
+        if (trial % 2u == 0u) {
+            ck_assert_int_eq(coa_plan_centralised(pl, &f.p, rows, &r), COA_OK);
+        } else {
+            ck_assert_int_eq(coa_plan_decoupled(pl, &f.p, NULL, 6u, rows, &r), COA_OK);
+        }
+        for (i = 0; i < bytes; ++i) {
+            changed += mem[i] != 0xA5u ? 1u : 0u;
+        }
+        ck_assert_uint_le(changed, r.workspace_touched_bytes);
+        ck_assert_uint_ge(r.workspace_touched_bytes, last);
+        ck_assert_uint_le(r.workspace_touched_bytes, bytes);
+        last = r.workspace_touched_bytes;
+    }
+    ck_assert_uint_lt(last * 4u, bytes);
+    free(mem);
+}
+END_TEST
+
 START_TEST(max_beta_inverts_workspace_size)
 {
     static const uint32_t betas[] = {1u, 2u, 3u, 24u, 100u, 255u, 1000u, 4097u, 100000u};
@@ -2330,6 +2373,7 @@ static Suite *plan_suite(void)
     tcase_add_test(tc, reordering_reports_first_order_when_none_works);
     tcase_add_test(tc, centralised_matches_exhaustive_search);
     tcase_add_test(tc, large_groups_answer_within_the_budget);
+    tcase_add_test(tc, touched_bytes_cover_every_write);
     tcase_add_test(tc, decoupled_each_vehicle_optimal_given_earlier);
     tcase_add_test(tc, reordering_finds_an_order_iff_one_exists);
     suite_add_tcase(s, tc);

@@ -109,8 +109,9 @@
  * search 1 + c per member choice made with c members chosen before it and 4 + m per
  * complete combination of m choosers, and for a new child 20 more per side of five members
  * and 50 per side of six (the pair matching of its heuristic; a second side 2 more at
- * least), and choosing the sides of a group above six 4 + m per split tried; each
- * check of the groups' plans N n^2. The same
+ * least), and choosing the sides of a group above six 4 + m per split tried; growing
+ * the hash table 1 per node it holds and per 32 slots; each check of the groups' plans
+ * N n^2. The same
  * call with the same budget does the same work everywhere (the count never depends on a
  * clock), so a budget is a deterministic bound on time: docs/benchmarks.md gives the time
  * per unit measured on the host.
@@ -143,6 +144,11 @@
  *     sample 2, offsets 2 per UAV, and 16 bytes of pair-table arena (a pair table that
  *     does not fit is left out: a weaker heuristic, never a wrong one);
  *   - a fixed header (the per-call context, a few kB).
+ * A call writes only what it uses of this (result.workspace_touched_bytes): the tables of
+ * its problem's size, and for a joint search the nodes it stores and a hash table that
+ * starts at 256 slots and doubles before it is half full (each growth re-enters the
+ * search's nodes and is charged as work), so a small problem in a large workspace leaves
+ * most of its pages untouched.
  * Running out of room can only happen through beta and is always reported as
  * COA_PLAN_BUDGET_EXHAUSTED (or, centralised, as a plan not proven optimal), never as
  * infeasible. docs/embedded.md has the bytes for
@@ -216,6 +222,12 @@ typedef struct {
                                   search; 0 when none ran): duplicates of stored states,
                                   dead ones and those above the cap are not stored */
     size_t workspace_bytes;   /* size of the workspace the planner ran in */
+    /* The bytes of it the planner has written since coa_planner_init, every call
+     * counted (a high-water mark: its header, the tables' cells its problems reached,
+     * the incumbent's rows, and the nodes, pair cells and hash slots its largest search
+     * used; each array rounded up to 8 bytes): what a caller's memory actually holds of
+     * it, the rest untouched. */
+    size_t workspace_touched_bytes;
     /* Planning order as vehicle indices: decoupled, the order of the reported attempt;
      * centralised, 0..n-1. */
     size_t order[COA_MAX_VEHICLES];
@@ -294,9 +306,9 @@ uint32_t coa_planner_max_beta(const coa_planner_config_t *config, size_t bytes);
 /* Builds a planner inside `buffer`. Returns the handle (which points into the buffer, so
  * the buffer must not move while it is used), or NULL when buffer is NULL or not aligned
  * to COA_WORKSPACE_ALIGNMENT, the config is refused by coa_planner_workspace_size, or
- * size is smaller than it says. Writes only the first coa_planner_workspace_size bytes.
- * Cost O(hash slots) to clear them; each later search first clears the slots the one
- * before it used (one by one, or all when that is cheaper). */
+ * size is smaller than it says. Writes the header and the hash table's first 256 slots,
+ * nothing else: O(1). Each later search first clears the slots the one before it used
+ * (one by one, or all when that is cheaper). */
 coa_planner_t *coa_planner_init(void *buffer, size_t size, const coa_planner_config_t *config);
 
 /* Sets the work budget of each of the planner's later calls, in work units (file

@@ -204,9 +204,11 @@ coa_planner_t *coa_planner_init(void *buffer, size_t size, const coa_planner_con
     pl->row_width = lo.row_width;
     pl->capacity = lo.capacity;
     pl->slot_count = lo.slot_count;
+    pl->slot_active = lo.slot_count < PLAN_SLOTS_FIRST ? lo.slot_count : PLAN_SLOTS_FIRST;
+    pl->touched_slots = pl->slot_active;
     pl->pair_cells = lo.pair_cells;
     point_into(pl, (unsigned char *)buffer, &lo);
-    for (i = 0; i < pl->slot_count; ++i) {
+    for (i = 0; i < pl->slot_active; ++i) {
         pl->slot[i] = PLAN_NONE;
     }
     /* Tables 0..v-1 are the vehicles' costs to go, v..2v-1 their costs from the start,
@@ -547,6 +549,7 @@ static void result_clear(coa_plan_result_t *r)
     r->nodes_expanded = 0u;
     r->nodes_generated = 0u;
     r->workspace_bytes = 0u;
+    r->workspace_touched_bytes = 0u;
     for (i = 0; i < COA_MAX_VEHICLES; ++i) {
         r->order[i] = i;
     }
@@ -666,9 +669,47 @@ static bool packed_range_ok(const coa_planner_t *pl)
            (UINT64_C(1) << (64u - PLAN_EFF_BITS - 2u));
 }
 
-/* The work the call spent, and whether the budget ended it. */
+void coa_plan_touch_table(coa_planner_t *pl, const plan_table_t *t)
+{
+    const size_t i = (size_t)(t->cells - pl->cells) / pl->table_cells;
+    const uint64_t cells = coa_plan_table_cells(t->horizon, t->steep, t->limit);
+    if (cells > pl->touched_cells[i]) {
+        pl->touched_cells[i] = cells < pl->table_cells ? (size_t)cells : pl->table_cells;
+    }
+}
+
+static size_t round8(size_t bytes)
+{
+    return (bytes + 7u) / 8u * 8u;
+}
+
+/* result.workspace_touched_bytes: the header and what each array holds of it. */
+static size_t touched_bytes(const coa_planner_t *pl)
+{
+    const coa_planner_config_t *c = &pl->config;
+    const size_t nodes = pl->touched_nodes;
+    size_t b = round8(sizeof *pl);
+    size_t t;
+    for (t = 0; t < pl->table_count; ++t) {
+        b += pl->touched_cells[t] * sizeof(uint64_t);
+    }
+    if (pl->touched_rows) {
+        b += round8(c->vehicles * pl->row_width * sizeof(int16_t)) +
+             2u * round8(c->vehicles * ((size_t)c->horizon + 1u) * sizeof(int32_t));
+    }
+    b += pl->touched_pair_cells * sizeof(coa_cost_t);
+    if (nodes > 0u) {
+        b += 2u * nodes * sizeof(coa_cost_t) + 3u * round8(nodes * sizeof(uint32_t)) +
+             round8(nodes * sizeof(uint16_t)) + round8(nodes * c->vehicles * sizeof(int16_t));
+    }
+    b += round8((size_t)pl->touched_slots * sizeof(uint32_t));
+    return b;
+}
+
+/* The work the call spent, and whether the budget ended it; what it has touched. */
 static void plan_result_work(const coa_planner_t *pl, coa_plan_result_t *r)
 {
+    r->workspace_touched_bytes = touched_bytes(pl);
     r->work = pl->work_used;
     if (pl->out_of_work) {
         r->limit = COA_PLAN_LIMIT_WORK;
@@ -697,6 +738,7 @@ int coa_plan_centralised(coa_planner_t *planner, const coa_problem_t *problem, i
     result->workspace_bytes = planner->bytes;
     result->orders_tried = 1u;
     if (coa_plan_any_initial_conflict(planner)) {
+        plan_result_work(planner, result);
         return COA_OK; /* infeasible, nothing expanded */
     }
     result->status = coa_plan_independence(planner, result);
@@ -980,6 +1022,7 @@ bool coa_plan_orders_best(coa_planner_t *pl, uint32_t max_orders, uint64_t impro
     result_clear(&counted);
     c.prefix[0] = (coa_cost_t){0u, 0u};
     pl->have_best = false;
+    pl->touched_rows = true;
     (void)orders_init(pl->problem, NULL, &o); /* priority order: cannot fail */
     while (counted.orders_tried < max_orders && !pl->out_of_work &&
            !(fail == 0u && st == COA_PLAN_INFEASIBLE)) {

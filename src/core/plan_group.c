@@ -245,6 +245,7 @@ static void rows_save(coa_planner_t *pl, bool back)
     const size_t row = (size_t)pl->problem->horizon + 1u;
     size_t i;
     size_t k;
+    pl->touched_rows = true;
     for (i = 0; i < g->count; ++i) {
         int32_t *live = &pl->rows[g->vehicle[i] * row];
         int32_t *kept = &pl->saved_rows[i * row];

@@ -33,7 +33,8 @@ _Static_assert(PLAN_MAXM >= 2u && PLAN_MAXM <= 10u, "COA_MAX_CENTRALISED is 2..1
 #define PLAN_NONE UINT32_MAX /* no node, an empty slot, not in the heap */
 #define PLAN_EFF_BITS 19u    /* effort bits of a packed cost */
 #define PLAN_PAIRS (PLAN_MAXM * (PLAN_MAXM - 1u) / 2u)
-#define PLAN_OUT INT16_MIN /* a group member's offset while it is not in the search */
+#define PLAN_OUT INT16_MIN    /* a group member's offset while it is not in the search */
+#define PLAN_SLOTS_FIRST 256u /* the hash table's first size (plan_search.c) */
 /* The most members whose surcharges the heuristic matches exactly (the peels of
  * plan_search.c); larger groups match within two sides of at most this many. */
 #define PLAN_MATCH_ALL 6u
@@ -177,7 +178,12 @@ struct coa_planner {
     size_t row_width;    /* the widest row a table can have */
     uint32_t capacity;   /* nodes: beta (0: no joint search, vehicles == 1) */
     uint32_t slot_count; /* hash slots: 2 * capacity */
-    size_t pair_cells;   /* cells of the pair arena */
+    /* Slots the table uses: each search from PLAN_SLOTS_FIRST, doubled (every node
+     * entered again) before half of them hold nodes, up to slot_count; a small search
+     * touches only what it needs of a large workspace. */
+    uint32_t slot_active;
+    uint32_t touched_slots; /* the most slots a search used (workspace_touched_bytes) */
+    size_t pair_cells;      /* cells of the pair arena */
 
     uint64_t *cells;  /* table_count tables of table_cells */
     int16_t *entries; /* per member: its entry offsets, cheapest first (row_width) */
@@ -246,6 +252,14 @@ struct coa_planner {
     int exponent;          /* the deviation unit's power of two, 2^E (coa_deviation_weights) */
     uint32_t match_all;    /* PLAN_MATCH_ALL; a test hook lowers it to split small groups */
     uint64_t bound_breaks; /* leaves below their branch's bound: a defect (test hook) */
+
+    /* What the workspace's calls have written (result.workspace_touched_bytes): the cells
+     * of each table, the most nodes and pair cells one search held, and whether a
+     * centralised call wrote the members' entries and the saved and incumbent rows. */
+    size_t touched_cells[2u * PLAN_MAXM + 1u];
+    uint32_t touched_nodes;
+    size_t touched_pair_cells;
+    bool touched_rows;
 };
 
 /* Charges `units` of work before they are done: false, charging nothing, when they do not
@@ -473,6 +487,9 @@ static inline size_t plan_pair_index(size_t a, size_t b, size_t m)
     (void)m;
     return (size_t)before[b] + a;
 }
+
+/* Records that table t now holds its problem's cells (workspace_touched_bytes). */
+void coa_plan_touch_table(coa_planner_t *pl, const plan_table_t *t);
 
 /* Vehicle v's cost alone (its own table, from its initial offset), packed. */
 static inline coa_cost_t plan_cost_alone(const coa_planner_t *pl, size_t v)

@@ -393,6 +393,9 @@ void coa_plan_pairs_build(coa_planner_t *pl)
             pair_build(pl, a, b, g->capped ? &slack : NULL);
         }
     }
+    if (pl->pair_used > pl->touched_pair_cells) {
+        pl->touched_pair_cells = pl->pair_used;
+    }
     coa_plan_sides_choose(pl);
 }
 

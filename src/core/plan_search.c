@@ -91,15 +91,15 @@ static bool same_state(const coa_planner_t *pl, uint32_t n, uint32_t k, const in
 }
 
 /* The slot a hash starts probing at: the hash scaled to the table, which need not be a
- * power of two (it is exactly twice the pool). */
+ * power of two (in full, it is exactly twice the pool). */
 static uint32_t home_slot(const coa_planner_t *pl, uint32_t hash)
 {
-    return (uint32_t)(((uint64_t)hash * pl->slot_count) >> 32);
+    return (uint32_t)(((uint64_t)hash * pl->slot_active) >> 32);
 }
 
 static uint32_t next_slot(const coa_planner_t *pl, uint32_t slot)
 {
-    return slot + 1u == pl->slot_count ? 0u : slot + 1u;
+    return slot + 1u == pl->slot_active ? 0u : slot + 1u;
 }
 
 /* The node of this state, or PLAN_NONE and the empty slot where it would go. At most half
@@ -122,11 +122,43 @@ static uint32_t state_find(const coa_planner_t *pl, uint32_t k, const int16_t *o
     return PLAN_NONE;
 }
 
+/* Room in the table for one more node: before half its slots would hold nodes it doubles
+ * (up to its full size) and takes every node again, charged a unit per node and per 32
+ * slots cleared. False: out of work. */
+static bool slots_reserve(coa_planner_t *pl)
+{
+    uint32_t size;
+    uint32_t n;
+    if ((uint64_t)pl->used * 2u + 2u <= pl->slot_active || pl->slot_active == pl->slot_count) {
+        return true;
+    }
+    size = pl->slot_active > pl->slot_count / 2u ? pl->slot_count : 2u * pl->slot_active;
+    if (!plan_work(pl, size / 32u + pl->used)) {
+        return false;
+    }
+    pl->slot_active = size;
+    if (size > pl->touched_slots) {
+        pl->touched_slots = size;
+    }
+    for (n = 0; n < size; ++n) {
+        pl->slot[n] = PLAN_NONE;
+    }
+    for (n = 0; n < pl->used; ++n) {
+        uint32_t slot =
+            home_slot(pl, state_hash(pl, (uint32_t)node_sample(pl, n), node_off(pl, n)));
+        while (pl->slot[slot] != PLAN_NONE) {
+            slot = next_slot(pl, slot);
+        }
+        pl->slot[slot] = n;
+    }
+    return true;
+}
+
 void coa_plan_search_release(coa_planner_t *pl)
 {
     uint32_t n;
-    if ((uint64_t)pl->used * 4u >= (uint64_t)pl->slot_count) {
-        for (n = 0; n < pl->slot_count; ++n) {
+    if ((uint64_t)pl->used * 4u >= (uint64_t)pl->slot_active) {
+        for (n = 0; n < pl->slot_active; ++n) {
             pl->slot[n] = PLAN_NONE;
         }
     } else {
@@ -141,6 +173,9 @@ void coa_plan_search_release(coa_planner_t *pl)
             pl->slot[slot] = PLAN_NONE;
         }
     }
+    /* Every search starts from the first size, so that its growth, and the work charged
+     * for it, do not depend on the searches before it. */
+    pl->slot_active = pl->slot_count < PLAN_SLOTS_FIRST ? pl->slot_count : PLAN_SLOTS_FIRST;
     pl->used = 0u;
     pl->heap_count = 0u;
 }
@@ -510,6 +545,9 @@ static bool node_put(coa_planner_t *pl, const node_init_t *in, uint32_t n, uint3
             return false;
         }
         n = pl->used++;
+        if (pl->used > pl->touched_nodes) {
+            pl->touched_nodes = pl->used;
+        }
         pl->slot[slot] = n;
         pl->node_k[n] = (uint16_t)in->k;
         heap_place(pl, pl->heap_count++, n);
@@ -528,7 +566,11 @@ static bool node_put(coa_planner_t *pl, const node_init_t *in, uint32_t n, uint3
 static bool node_add(coa_planner_t *pl, const node_init_t *in, plan_search_out_t *out)
 {
     uint32_t slot = 0u;
-    uint32_t n = state_find(pl, in->k, in->off, &slot);
+    uint32_t n;
+    if (!slots_reserve(pl)) {
+        return false;
+    }
+    n = state_find(pl, in->k, in->off, &slot);
     return node_put(pl, in, n, slot, out);
 }
 
@@ -845,8 +887,12 @@ static bool child_add(coa_planner_t *pl, const expansion_t *e, coa_cost_t f2, ui
 static bool leaf(coa_planner_t *pl, expansion_t *e, plan_search_out_t *out)
 {
     uint32_t slot = 0u;
-    uint32_t n = state_find(pl, e->k + 1u, e->off, &slot);
+    uint32_t n;
     coa_cost_t f2;
+    if (!slots_reserve(pl)) {
+        return false;
+    }
+    n = state_find(pl, e->k + 1u, e->off, &slot);
     if (n != PLAN_NONE && (pl->node_k[n] & K_EXPANDED) != 0u) {
         return true;
     }

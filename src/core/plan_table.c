@@ -281,6 +281,7 @@ void coa_plan_table_build(coa_planner_t *pl, plan_table_t *tb, size_t v, const s
     tb->steep = veh->steep_factor;
     tb->growing = (uint32_t)tb->limit / tb->steep;
     tb->horizon = horizon;
+    coa_plan_touch_table(pl, tb);
     for (o = plan_row_lo(tb, horizon); o <= plan_row_hi(tb, horizon); ++o) {
         *cell_of(tb, horizon, o) = cell_pack(0u, 0u, 0u);
     }
@@ -360,6 +361,7 @@ void coa_plan_table_build_from_start(coa_planner_t *pl, plan_table_t *f, const p
     f->steep = t->steep;
     f->growing = t->growing;
     f->horizon = t->horizon;
+    coa_plan_touch_table(pl, f);
     for (k = 0; k <= t->horizon; ++k) {
         for (o = plan_row_lo(t, k); o <= plan_row_hi(t, k); ++o) {
             *cell_of(f, k, o) = CELL_DEAD;

@@ -130,6 +130,9 @@ static void tally(const coa_plan_result_t *result, bool decoupled, coavoid_bench
     row->nodes_expanded += result->nodes_expanded;
     row->nodes_generated += result->nodes_generated;
     row->work += result->work;
+    if (result->workspace_touched_bytes > row->touched_bytes) {
+        row->touched_bytes = result->workspace_touched_bytes;
+    }
     row->solved += result->status == COA_PLAN_SOLVED;
     row->infeasible += result->status == COA_PLAN_INFEASIBLE;
     row->budget_exhausted += result->status == COA_PLAN_BUDGET_EXHAUSTED;
@@ -294,28 +297,29 @@ static int report_text(FILE *f, const coavoid_bench_plan_config_t *o,
             (unsigned long long)o->work);
     fprintf(f,
             "%-7s %-11s %8s %6s %7s %7s %10s %6s %5s %6s %10s %10s %10s %9s %9s %7s %14s %12s %12s "
-            "%15s\n",
+            "%15s %13s\n",
             "set", "mode", "problems", "solved", "optimal", "bounded", "infeasible", "budget",
             "uavs", "beta", "median_ms", "min_ms", "max_ms", "prob_med", "prob_max", "ratio",
-            "nodes_expanded", "nodes_per_s", "work", "workspace_bytes");
+            "nodes_expanded", "nodes_per_s", "work", "workspace_bytes", "touched_bytes");
     for (size_t i = 0; i < count; i++) {
         const coavoid_bench_plan_row_t *r = &rows[i];
         fprintf(f,
                 "%-7s %-11s %8lu %6lu %7lu %7lu %10lu %6lu %5lu %5lu%s %10.3f %10.3f %10.3f %9.3f "
                 "%9.3f "
-                "%7.3f %14llu %12.0f %12llu %15zu\n",
+                "%7.3f %14llu %12.0f %12llu %15zu %13zu\n",
                 r->set, r->decoupled ? "decoupled" : "centralised", (unsigned long)r->problems,
                 (unsigned long)r->solved, (unsigned long)r->optimal, (unsigned long)r->bounded,
                 (unsigned long)r->infeasible, (unsigned long)r->budget_exhausted,
                 (unsigned long)r->vehicles, (unsigned long)r->beta, r->beta_lowered ? "*" : " ",
                 r->median_ms, r->min_ms, r->max_ms, r->problem_median_ms, r->problem_max_ms,
                 r->ratio_median, (unsigned long long)r->nodes_expanded, nodes_per_s(r),
-                (unsigned long long)r->work, r->workspace_bytes);
+                (unsigned long long)r->work, r->workspace_bytes, r->touched_bytes);
     }
     fprintf(f, "times: per run over the set's problems; prob_med, prob_max: per problem (its "
                "median over the runs); budget: no plan found within beta or the work budget; "
                "optimal, bounded: centralised plans proven optimal or not; ratio: the median "
-               "centralised plan's deviation over its lower bound; beta*: lowered to keep the "
+               "centralised plan's deviation over its lower bound; touched_bytes: of the "
+               "workspace, the most one problem's call wrote; beta*: lowered to keep the "
                "workspace within 1 GiB\n");
     return fflush(f) == 0 && !ferror(f) ? 0 : -1;
 }
@@ -352,6 +356,7 @@ static int report_json(FILE *f, const coavoid_bench_plan_config_t *o,
              cJSON_AddNumberToObject(row, "nodes_generated", (double)r->nodes_generated) != NULL &&
              cJSON_AddNumberToObject(row, "nodes_per_s", nodes_per_s(r)) != NULL &&
              cJSON_AddNumberToObject(row, "workspace_bytes", (double)r->workspace_bytes) != NULL &&
+             cJSON_AddNumberToObject(row, "touched_bytes", (double)r->touched_bytes) != NULL &&
              cJSON_AddNumberToObject(row, "solved", r->solved) != NULL &&
              cJSON_AddNumberToObject(row, "infeasible", r->infeasible) != NULL &&
              cJSON_AddNumberToObject(row, "budget_exhausted", r->budget_exhausted) != NULL &&

@@ -73,6 +73,7 @@ typedef struct {
     double median_ms, min_ms, max_ms;
     uint64_t nodes_expanded, nodes_generated;
     size_t workspace_bytes;
+    size_t touched_bytes; /* of the workspace, the most any problem's call had written */
     uint32_t solved, infeasible, budget_exhausted;
     /* Centralised: the solved plans proven optimal, and the others (bounded). */
     uint32_t optimal, bounded;

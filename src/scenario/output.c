@@ -189,6 +189,7 @@ static int build_stats(cJSON *root, const coavoid_output_plan_t *plan)
         !add_number(stats, "nodes_generated", (double)r->nodes_generated) ||
         !add_number(stats, "time_us", (double)plan->time_us) ||
         !add_number(stats, "workspace_bytes", (double)r->workspace_bytes) ||
+        !add_number(stats, "workspace_touched_bytes", (double)r->workspace_touched_bytes) ||
         !add_number(stats, "beta", plan->beta) || !add_number(stats, "work", (double)r->work) ||
         !add_number(stats, "work_budget", (double)plan->work_budget) ||
         cJSON_AddStringToObject(stats, "limit", limit_name(r->limit)) == NULL ||

@@ -22,7 +22,7 @@ assert b["benchmark"] == "plan"
 rows = b["results"]
 keys = ["set", "mode", "vehicles", "problems", "beta", "beta_lowered", "median_ms", "min_ms",
         "max_ms", "nodes_expanded", "nodes_generated", "nodes_per_s", "workspace_bytes",
-        "solved", "infeasible", "budget_exhausted", "optimal", "bounded", "problem_median_ms",
+        "touched_bytes", "solved", "infeasible", "budget_exhausted", "optimal", "bounded", "problem_median_ms",
         "problem_max_ms", "ratio_median", "ratio_max", "work"]
 for r in rows:
     assert list(r) == keys, f"keys {list(r)}"
@@ -43,6 +43,7 @@ for r in rows:
         assert r["optimal"] == r["bounded"] == 0 and r["ratio_median"] == 0, r
     assert r["workspace_bytes"] > 0 and r["beta"] >= 1, r
     assert r["workspace_bytes"] <= 1 << 30, r
+    assert 0 < r["touched_bytes"] <= r["workspace_bytes"], r
 # Each set in both modes, centralised first.
 assert [r["mode"] for r in rows] == ["centralised", "decoupled"] * (len(rows) // 2), rows
 for line in sys.argv[2].strip().splitlines():
@@ -61,7 +62,7 @@ assert lines[:5] == ["benchmark: plan", "seed: 1", "repeat: 1", "count: 2", "wor
 cols = lines[5].split()
 assert cols == ["set", "mode", "problems", "solved", "optimal", "bounded", "infeasible", "budget",
                 "uavs", "beta", "median_ms", "min_ms", "max_ms", "prob_med", "prob_max", "ratio",
-                "nodes_expanded", "nodes_per_s", "work", "workspace_bytes"], cols
+                "nodes_expanded", "nodes_per_s", "work", "workspace_bytes", "touched_bytes"], cols
 rows = [l.split() for l in lines[6:8]]
 assert [r[:3] for r in rows] == [["2", "UAVs", "centralised"], ["2", "UAVs", "decoupled"]], rows
 for r in rows:

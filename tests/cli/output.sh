@@ -186,7 +186,8 @@ else:
     expect("optimal" not in r and "bound" not in r, "decoupled result reports a bound")
 
 stats = r.get("stats")
-keys = ["nodes_expanded", "nodes_generated", "time_us", "workspace_bytes", "work", "work_budget"]
+keys = ["nodes_expanded", "nodes_generated", "time_us", "workspace_bytes", "workspace_touched_bytes",
+        "work", "work_budget"]
 if mode == "decoupled":
     keys.append("orders_tried")
 expect(isinstance(stats, dict), "stats %r" % stats)
@@ -200,6 +201,8 @@ else:
     expect("orders_tried" not in (stats or {}) and "all_orders_covered" not in (stats or {}),
            "centralised stats report orders")
 expect((stats or {}).get("workspace_bytes", 0) > 0, "stats.workspace_bytes is 0")
+expect(0 < (stats or {}).get("workspace_touched_bytes", 0) <= (stats or {}).get("workspace_bytes", 0),
+       "stats.workspace_touched_bytes is not within the workspace")
 expect((stats or {}).get("limit") in ("none", "beta", "work"), "stats.limit %r" % (stats or {}).get("limit"))
 expect((stats or {}).get("work_budget", 0) == 0 or stats["work"] <= stats["work_budget"],
        "stats.work passes the budget")
