@@ -1012,7 +1012,7 @@ static bool expand(coa_planner_t *pl, uint32_t n, plan_search_out_t *out)
         e.off[i] = node_off(pl, n)[i];
         e.in_child |= in_search(g, i, e.k + 1u) ? 1u << i : 0u;
     }
-    for (i = 0; i < PLAN_PAIRS; ++i) {
+    for (i = 0; i < g->count * (g->count - 1u) / 2u; ++i) {
         e.s[i] = (coa_cost_t){0u, 0u};
     }
     choosers_make(pl, n, &e.ch);
