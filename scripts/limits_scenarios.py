@@ -2,10 +2,11 @@
 # SPDX-License-Identifier: MIT
 """Writes the dearest scenarios the input limits accept (docs/security.md cites their times).
 
-  limits-24.json   6 UAVs converging over 24 steps, 256 polytopes of 256 vertices along
-                   their routes and 64 tracks crossing them: every table row touches items;
+  limits-24.json   10 UAVs (COA_MAX_CENTRALISED) converging over 24 steps, 256 polytopes
+                   of 256 vertices along their routes and 64 tracks crossing them: every
+                   table row touches items;
   limits-48.json   the same over 48 steps;
-  limits-400.json  one polytope beside 6 UAVs over 400 steps with steep factor 10: the
+  limits-400.json  one polytope beside 10 UAVs over 400 steps with steep factor 10: the
                    tables grow towards the workspace bound with almost nothing in them.
 
 Usage: limits_scenarios.py OUTDIR
@@ -41,14 +42,18 @@ def vehicles(n, reach, steep=2):
     return out
 
 
+UAVS = 10  # COA_MAX_CENTRALISED: the most one centralised problem takes
+
+
 def crowded(horizon):
     """Polytopes above and below every route, close enough that each row's box touches some."""
-    vs = vehicles(6, 10.0 * horizon / 2)
+    vs = vehicles(UAVS, 10.0 * horizon / 2)
     obstacles = []
+    per = (256 + UAVS - 1) // UAVS
     for j in range(256):
-        v = vs[j % 6]
+        v = vs[j % UAVS]
         s, e = v["route"]
-        f = (j // 6 + 0.5) / 43.0
+        f = (j // UAVS + 0.5) / per
         x, y = s[0] + f * (e[0] - s[0]) / 2.0, s[1] + f * (e[1] - s[1]) / 2.0
         z = 100.0 + (40.0 if j % 2 else -40.0)
         obstacles.append(polytope(x, y, z, 8.0))
@@ -58,13 +63,13 @@ def crowded(horizon):
         tracks.append({"id": j, "radius": 10.0, "half_height": 5.0,
                        "position": [300.0 * math.cos(a), 300.0 * math.sin(a), 150.0 + (j % 4) * 20.0],
                        "velocity": [-10.0 * math.cos(a), -10.0 * math.sin(a), 0.0]})
-    return {"name": "input limits: 6 UAVs, %d steps, 256 polytopes of 256 vertices, 64 tracks" % horizon,
+    return {"name": "input limits: %d UAVs, %d steps, 256 polytopes of 256 vertices, 64 tracks" % (UAVS, horizon),
             "dt": 1.0, "horizon": horizon, "vehicles": vs, "obstacles": obstacles, "tracks": tracks}
 
 
 def long_steep():
-    vs = vehicles(6, 2000.0, steep=10)
-    return {"name": "input limits: 6 UAVs, 400 steps, steep factor 10, one polytope",
+    vs = vehicles(UAVS, 2000.0, steep=10)
+    return {"name": "input limits: %d UAVs, 400 steps, steep factor 10, one polytope" % UAVS,
             "dt": 1.0, "horizon": 400, "vehicles": vs,
             "obstacles": [polytope(0.0, 0.0, 60.0, 8.0)]}
 
