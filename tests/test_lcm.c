@@ -1533,6 +1533,68 @@ START_TEST(test_auth_roles_and_freshness)
 }
 END_TEST
 
+/* The checks before any cryptography (coavoid_auth_precheck): what the tail alone
+ * refuses is refused with the reason the full check would give, without marking anything
+ * (a datagram that passes it is still fresh for coavoid_auth_accept); a forged signature
+ * under a fresh tail passes it and fails only at the signature. */
+START_TEST(test_auth_precheck)
+{
+    coavoid_auth_signer_t signer;
+    coavoid_auth_trust_t trust;
+    auth_pair(&signer, &trust, COAVOID_AUTH_VEHICLE, 3);
+    unsigned char buf[512];
+    const int size = signed_status(&signer, T0, buf, (int)sizeof buf);
+    const int64_t window = 2000000;
+    coavoid_auth_expect_t ex = {COAVOID_AUTH_STREAM_STATUS, COAVOID_AUTH_VEHICLE, T0, window,
+                                window};
+    size_t key = 99;
+    ck_assert_int_eq(coavoid_auth_precheck(&trust, buf, (size_t)size, &ex, &key), COA_OK);
+    ck_assert_uint_eq(key, 0);
+    /* Nothing marked: the same tail passes again, and is then accepted once. */
+    ck_assert_int_eq(coavoid_auth_precheck(&trust, buf, (size_t)size, &ex, &key), COA_OK);
+    ck_assert_int_eq(coavoid_auth_accept(&trust, 0, ex.stream, COAVOID_AUTH_VEHICLE, 3, T0, 0, T0,
+                                         window, window),
+                     COA_OK);
+    /* A copy of what was accepted: a replay, before its signature is looked at. */
+    ck_assert_int_eq(coavoid_auth_precheck(&trust, buf, (size_t)size, &ex, &key),
+                     COAVOID_AUTH_ERR_REPLAY);
+    /* The next one passes; with its signature broken it fails only at the signature. */
+    const int next = signed_status(&signer, T0 + 1, buf, (int)sizeof buf);
+    buf[next - 1] ^= 0x40;
+    ck_assert_int_eq(coavoid_auth_precheck(&trust, buf, (size_t)next, &ex, &key), COA_OK);
+    ck_assert_int_eq(coavoid_auth_verify(&trust, buf, (size_t)next, &key),
+                     COAVOID_AUTH_ERR_SIGNATURE);
+    /* Out of the window, another role, another channel's stream from a clean slate. */
+    ex.now = T0 + 10 * window;
+    ck_assert_int_eq(coavoid_auth_precheck(&trust, buf, (size_t)next, &ex, &key),
+                     COAVOID_AUTH_ERR_CLOCK);
+    ex.now = T0;
+    ex.role = COAVOID_AUTH_COORDINATOR;
+    ck_assert_int_eq(coavoid_auth_precheck(&trust, buf, (size_t)next, &ex, &key),
+                     COAVOID_AUTH_ERR_ROLE);
+    ex.role = COAVOID_AUTH_ANY_ROLE;
+    ck_assert_int_eq(coavoid_auth_precheck(&trust, buf, (size_t)next, &ex, &key), COA_OK);
+    ex.stream = COAVOID_AUTH_STREAMS;
+    ck_assert_int_eq(coavoid_auth_precheck(&trust, buf, (size_t)next, &ex, &key),
+                     COAVOID_AUTH_ERR_REPLAY);
+    ex.stream = COAVOID_AUTH_STREAM_STATUS;
+    /* Unsigned, too short, an unknown key. */
+    coavoid_status_t m = good_status();
+    unsigned char plain[512];
+    int n = coavoid_status_t_encode(plain, 0, (int)sizeof plain, &m);
+    ck_assert_int_eq(coavoid_auth_precheck(&trust, plain, (size_t)n, &ex, &key),
+                     COAVOID_AUTH_ERR_UNSIGNED);
+    ck_assert_int_eq(coavoid_auth_precheck(&trust, plain, 10, &ex, &key),
+                     COAVOID_AUTH_ERR_UNSIGNED);
+    signer.key_id = 8;
+    n = signed_status(&signer, T0 + 2, plain, (int)sizeof plain);
+    ck_assert_int_eq(coavoid_auth_precheck(&trust, plain, (size_t)n, &ex, &key),
+                     COAVOID_AUTH_ERR_KEY);
+    ck_assert_int_eq(coavoid_auth_precheck(NULL, plain, (size_t)n, &ex, &key),
+                     COAVOID_AUTH_ERR_UNSIGNED);
+}
+END_TEST
+
 /* Stamping works on the datagram alone: the numbers land where LCM decodes them, the
  * signature verifies, and seeded keys are repeatable. */
 START_TEST(test_auth_stamp)
@@ -1681,6 +1743,7 @@ static Suite *lcm_suite(void)
     tcase_add_test(tc, test_random_bytes);
     tcase_add_test(tc, test_auth_sign_verify);
     tcase_add_test(tc, test_auth_roles_and_freshness);
+    tcase_add_test(tc, test_auth_precheck);
     tcase_add_test(tc, test_auth_stamp);
     tcase_add_test(tc, test_auth_key_files);
     tcase_add_test(tc, test_agreement_check);

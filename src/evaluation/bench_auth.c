@@ -153,16 +153,21 @@ static int64_t read_be64(const unsigned char *p)
 }
 
 /* What a receiving node does with a datagram of `type` before it uses it (common.c,
- * signature_ok and sender_ok): the signature, then coavoid_auth_accept (the key's role,
- * freshness) at its clock
- * `now`. The numbers are read from the auth_t's bytes, where a node decodes them: the
- * decoding is the same with or without signatures, so it is not part of their cost. */
+ * signature_ok and sender_ok): the checks of its tail, the signature, then
+ * coavoid_auth_accept (the key's role, freshness) at its clock `now`. The numbers are
+ * read from the auth_t's bytes, where a node decodes them: the decoding is the same with
+ * or without signatures, so it is not part of their cost. */
 static int receive(coavoid_auth_trust_t *trust, size_t type, const unsigned char *d, size_t size,
                    int64_t now)
 {
     const size_t tail = size - COAVOID_AUTH_TAIL_BYTES;
+    const coavoid_auth_expect_t expect = {type, senders[kinds[type].sender].role, now,
+                                          BENCH_AUTH_WINDOW_US, BENCH_AUTH_WINDOW_US};
     size_t key = 0;
-    int rc = coavoid_auth_verify(trust, d, size, &key);
+    int rc = coavoid_auth_precheck(trust, d, size, &expect, &key);
+    if (rc == COA_OK) {
+        rc = coavoid_auth_verify(trust, d, size, &key);
+    }
     if (rc == COA_OK) {
         rc = coavoid_auth_accept(trust, key, type, senders[kinds[type].sender].role,
                                  (int32_t)senders[kinds[type].sender].node_id,
@@ -223,6 +228,56 @@ static int time_type(bench_t *b, size_t type, coavoid_bench_auth_type_t *out)
     return COA_OK;
 }
 
+/* Times `repeat` receptions of the intent datagram d (accepted once before), each to be
+ * refused with `expected`; another outcome is counted in b->failures. */
+static void time_refusal(bench_t *b, const unsigned char *d, size_t size, int64_t now, int expected,
+                         coavoid_bench_auth_refusal_t *out)
+{
+    for (uint32_t r = 0; r < b->repeat; r++) {
+        struct timespec t0, t1;
+        clock_gettime(CLOCK_MONOTONIC, &t0);
+        const int rc = receive(b->trust, COAVOID_AUTH_STREAM_INTENT, d, size, now);
+        clock_gettime(CLOCK_MONOTONIC, &t1);
+        b->failures += rc != expected;
+        b->verify_us[r] = elapsed_us(&t0, &t1);
+    }
+    summarise(b->verify_us, b->repeat, &out->median_us, &out->min_us, &out->max_us);
+}
+
+/* The three refusals of coavoid_bench_auth_refusal_t, after the types were timed (the
+ * intents' last numbers accepted). COA_OK, or COA_ERR_WORKSPACE when intents do not
+ * encode. */
+static int time_refusals(bench_t *b, coavoid_bench_auth_refusal_t *out)
+{
+    unsigned char *d = NULL;
+    const int size = encode_intent(&d);
+    if (size <= 0 || (size_t)size < COAVOID_AUTH_TAIL_BYTES) {
+        free(d);
+        return COA_ERR_WORKSPACE;
+    }
+    const size_t n = (size_t)size;
+    const int64_t now = BENCH_AUTH_EPOCH_US + (int64_t)b->repeat * 1000;
+    coavoid_auth_signer_t *s = &b->signers[SENDER_VEHICLE];
+    int rc = coavoid_auth_stamp(s, now, d, n);
+    b->failures +=
+        rc != COA_OK || receive(b->trust, COAVOID_AUTH_STREAM_INTENT, d, n, now) != COA_OK;
+    out[0].name = "copy";
+    time_refusal(b, d, n, now, COAVOID_AUTH_ERR_REPLAY, &out[0]);
+    unsigned char *tail = d + n - COAVOID_AUTH_TAIL_BYTES;
+    const unsigned char saved = tail[0];
+    tail[0] = 0x7f; /* a key id nobody trusts */
+    out[1].name = "outsider";
+    time_refusal(b, d, n, now, COAVOID_AUTH_ERR_KEY, &out[1]);
+    tail[0] = saved;
+    rc = coavoid_auth_stamp(s, now + 1, d, n);
+    b->failures += rc != COA_OK;
+    d[n - 1u] ^= 0x01u; /* the signature broken */
+    out[2].name = "forged";
+    time_refusal(b, d, n, now + 1, COAVOID_AUTH_ERR_SIGNATURE, &out[2]);
+    free(d);
+    return COA_OK;
+}
+
 /* ---- the cycles ---- */
 
 /* The messages of each type a node signs (sent) and checks (received) per cycle in a
@@ -263,20 +318,42 @@ static void count_messages(const coavoid_bench_auth_fleet_t *f, size_t node, uin
     }
 }
 
-/* A node's cycle: its counts times the types' median costs and sizes. */
+/* Of the datagrams a node receives per type, the repeats of a message it already has:
+ * every send after the first of an intent, map tile, track, and SWITCHED (count_messages),
+ * which its tail check refuses as copies before any signature. */
+static void count_copies(const coavoid_bench_auth_fleet_t *f, size_t node, uint32_t *copies)
+{
+    memset(copies, 0, COAVOID_BENCH_AUTH_TYPES * sizeof *copies);
+    if (node == COAVOID_BENCH_AUTH_WORLD) {
+        return;
+    }
+    const uint32_t repeats = COAVOID_NODE_DEFAULT_COPIES;
+    copies[COAVOID_AUTH_STREAM_INTENT] =
+        (node == COAVOID_BENCH_AUTH_VEHICLE ? f->vehicles - 1u : f->vehicles) * repeats;
+    copies[COAVOID_AUTH_STREAM_MAP] = f->maps * repeats;
+    copies[COAVOID_AUTH_STREAM_TRACK] = f->tracks * repeats;
+    copies[COAVOID_AUTH_STREAM_AGREEMENT] = f->plans * repeats;
+}
+
+/* A node's cycle: its counts times the types' median costs and sizes; a copy costs the
+ * tail check's refusal. */
 static void derive_node(const coavoid_bench_auth_result_t *r, const coavoid_bench_auth_fleet_t *f,
                         size_t node, coavoid_bench_auth_node_t *n)
 {
     static const char *const names[COAVOID_BENCH_AUTH_NODES] = {"vehicle", "coordinator", "world"};
+    uint32_t copies[COAVOID_BENCH_AUTH_TYPES];
     memset(n, 0, sizeof *n);
     n->name = names[node];
     count_messages(f, node, n->sent, n->received);
+    count_copies(f, node, copies);
     for (size_t t = 0; t < COAVOID_BENCH_AUTH_TYPES; t++) {
         const coavoid_bench_auth_type_t *type = &r->types[t];
         n->sent_total += n->sent[t];
         n->received_total += n->received[t];
+        n->copies_total += copies[t];
         n->sign_us += n->sent[t] * type->sign_median_us;
-        n->verify_us += n->received[t] * type->verify_median_us;
+        n->verify_us += (n->received[t] - copies[t]) * type->verify_median_us +
+                        copies[t] * r->refusals[0].median_us;
         n->traffic_bytes += (double)(n->sent[t] + n->received[t]) * (double)type->bytes;
     }
     n->us_per_cycle = n->sign_us + n->verify_us;
@@ -330,6 +407,10 @@ static int time_types(bench_t *b, coavoid_bench_auth_result_t *out, coavoid_run_
                                     "bench auth: %s does not encode (or memory is short)",
                                     kinds[t].name);
         }
+    }
+    if (time_refusals(b, out->refusals) != COA_OK) {
+        return coavoid_run_fail(e, COAVOID_RUN_ERR_INTERNAL,
+                                "bench auth: intent does not encode (or memory is short)");
     }
     out->verify_failures = b->failures;
     if (b->failures > 0u) {
@@ -422,19 +503,15 @@ static void type_rows(const coavoid_bench_auth_type_t *t, row_t *rows)
     memcpy(rows, all, sizeof all);
 }
 
-#define BENCH_AUTH_NODE_ROWS 9u
+#define BENCH_AUTH_NODE_ROWS 10u
 static void node_rows(const coavoid_bench_auth_node_t *n, row_t *rows)
 {
     const row_t all[BENCH_AUTH_NODE_ROWS] = {
-        {"sent", n->sent_total, 0},
-        {"received", n->received_total, 0},
-        {"sign_us", n->sign_us, 1},
-        {"verify_us", n->verify_us, 1},
-        {"us_per_cycle", n->us_per_cycle, 1},
-        {"dt_percent", n->dt_percent, 3},
-        {"traffic_bytes", n->traffic_bytes, 0},
-        {"auth_bytes", n->auth_bytes, 0},
-        {"memory_bytes", (double)n->memory_bytes, 0},
+        {"sent", n->sent_total, 0},       {"received", n->received_total, 0},
+        {"copies", n->copies_total, 0},   {"sign_us", n->sign_us, 1},
+        {"verify_us", n->verify_us, 1},   {"us_per_cycle", n->us_per_cycle, 1},
+        {"dt_percent", n->dt_percent, 3}, {"traffic_bytes", n->traffic_bytes, 0},
+        {"auth_bytes", n->auth_bytes, 0}, {"memory_bytes", (double)n->memory_bytes, 0},
     };
     memcpy(rows, all, sizeof all);
 }
@@ -466,6 +543,17 @@ static void fleet_rows(const coavoid_bench_auth_fleet_t *f, row_t *rows)
     memcpy(rows, all, sizeof all);
 }
 
+#define BENCH_AUTH_REFUSAL_ROWS 3u
+static void refusal_rows(const coavoid_bench_auth_refusal_t *x, row_t *rows)
+{
+    const row_t all[BENCH_AUTH_REFUSAL_ROWS] = {
+        {"median_us", x->median_us, 3},
+        {"min_us", x->min_us, 3},
+        {"max_us", x->max_us, 3},
+    };
+    memcpy(rows, all, sizeof all);
+}
+
 static int report_text(FILE *f, const coavoid_bench_auth_config_t *c,
                        const coavoid_bench_auth_result_t *r)
 {
@@ -478,6 +566,11 @@ static int report_text(FILE *f, const coavoid_bench_auth_config_t *c,
         type_rows(&r->types[t], rows);
         snprintf(prefix, sizeof prefix, "%s_", r->types[t].name);
         print_rows(f, prefix, rows, BENCH_AUTH_TYPE_ROWS);
+    }
+    for (size_t x = 0; x < COAVOID_BENCH_AUTH_REFUSALS; x++) {
+        refusal_rows(&r->refusals[x], rows);
+        snprintf(prefix, sizeof prefix, "refused_%s_", r->refusals[x].name);
+        print_rows(f, prefix, rows, BENCH_AUTH_REFUSAL_ROWS);
     }
     for (size_t i = 0; i < r->fleet_count; i++) {
         const coavoid_bench_auth_fleet_t *fl = &r->fleets[i];
@@ -514,6 +607,28 @@ static cJSON *json_types(const coavoid_bench_auth_result_t *r)
         }
     }
     return types;
+}
+
+/* The "refusals" array of the JSON report, or NULL (memory). */
+static cJSON *json_refusals(const coavoid_bench_auth_result_t *r)
+{
+    cJSON *all = cJSON_CreateArray();
+    row_t rows[BENCH_AUTH_REFUSAL_ROWS];
+    for (size_t x = 0; all != NULL && x < COAVOID_BENCH_AUTH_REFUSALS; x++) {
+        cJSON *o = cJSON_CreateObject();
+        if (o != NULL && cJSON_AddStringToObject(o, "refusal", r->refusals[x].name) == NULL) {
+            cJSON_Delete(o);
+            o = NULL;
+        }
+        refusal_rows(&r->refusals[x], rows);
+        o = json_rows(o, rows, BENCH_AUTH_REFUSAL_ROWS);
+        if (o == NULL || !cJSON_AddItemToArray(all, o)) {
+            cJSON_Delete(o);
+            cJSON_Delete(all);
+            return NULL;
+        }
+    }
+    return all;
 }
 
 /* One fleet's JSON object with its "nodes" array, or NULL (memory). */
@@ -555,10 +670,15 @@ static int report_json(FILE *f, const coavoid_bench_auth_config_t *c,
     }
     root = json_rows(root, rows, BENCH_AUTH_HEAD_ROWS);
     cJSON *types = root != NULL ? json_types(r) : NULL;
-    cJSON *fleets = types != NULL ? cJSON_CreateArray() : NULL;
+    cJSON *refusals = types != NULL ? json_refusals(r) : NULL;
+    cJSON *fleets = refusals != NULL ? cJSON_CreateArray() : NULL;
     bool ok = fleets != NULL && cJSON_AddItemToObject(root, "types", types);
     if (!ok) {
         cJSON_Delete(types);
+    }
+    if (!ok || !cJSON_AddItemToObject(root, "refusals", refusals)) {
+        cJSON_Delete(refusals);
+        ok = false;
     }
     for (size_t i = 0; ok && i < r->fleet_count; i++) {
         cJSON *fl = json_fleet(&r->fleets[i]);

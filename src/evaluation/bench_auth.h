@@ -86,6 +86,7 @@ typedef struct {
     uint32_t sent[COAVOID_BENCH_AUTH_TYPES];     /* messages it signs, per type */
     uint32_t received[COAVOID_BENCH_AUTH_TYPES]; /* messages it checks, per type */
     uint32_t sent_total, received_total;
+    uint32_t copies_total; /* of received: repeats, refused from their tail as copies */
     double sign_us, verify_us, us_per_cycle; /* from the median costs */
     double dt_percent;                       /* us_per_cycle of dt */
     double traffic_bytes;                    /* encoded bytes sent + checked */
@@ -98,8 +99,20 @@ typedef struct {
     coavoid_bench_auth_node_t nodes[COAVOID_BENCH_AUTH_NODES];
 } coavoid_bench_auth_fleet_t;
 
+/* What refusing a datagram costs a receiver, timed on intents (the largest): "copy", a
+ * copy of one it accepted (refused as a replay from its tail); "outsider", a key id it
+ * does not trust (refused from its tail); "forged", a known key's fresh tail with a
+ * signature that does not verify (refused by the signature check). Microseconds over the
+ * repeats. */
+#define COAVOID_BENCH_AUTH_REFUSALS 3u
+typedef struct {
+    const char *name;
+    double median_us, min_us, max_us;
+} coavoid_bench_auth_refusal_t;
+
 typedef struct {
     coavoid_bench_auth_type_t types[COAVOID_BENCH_AUTH_TYPES];
+    coavoid_bench_auth_refusal_t refusals[COAVOID_BENCH_AUTH_REFUSALS];
     coavoid_bench_auth_fleet_t fleets[COAVOID_BENCH_AUTH_MAX_FLEETS];
     size_t fleet_count;
     size_t trust_bytes, signer_bytes; /* sizeof each */

@@ -146,12 +146,77 @@ int coavoid_auth_stamp(coavoid_auth_signer_t *s, int64_t now, unsigned char *dat
     return rc;
 }
 
+static uint64_t get_be(const unsigned char *p, size_t bytes)
+{
+    uint64_t v = 0;
+    for (size_t i = 0; i < bytes; i++) {
+        v = v << 8 | p[i];
+    }
+    return v;
+}
+
 /* The key_id of a datagram's auth_t: the 4 big-endian bytes before its two int64s and
  * its signature. */
 static uint32_t datagram_key_id(const unsigned char *datagram, size_t size)
 {
-    const unsigned char *p = datagram + size - COAVOID_AUTH_TAIL_BYTES;
-    return (uint32_t)p[0] << 24 | (uint32_t)p[1] << 16 | (uint32_t)p[2] << 8 | (uint32_t)p[3];
+    return (uint32_t)get_be(datagram + size - COAVOID_AUTH_TAIL_BYTES, 4u);
+}
+
+/* The index of key_id in t, or t->count. */
+static size_t key_index(const coavoid_auth_trust_t *t, uint32_t key_id)
+{
+    size_t i = 0;
+    while (i < t->count && t->keys[i].key_id != key_id) {
+        i++;
+    }
+    return i;
+}
+
+/* Whether (timestamp, sequence) would be fresh on key's stream at now: within the window
+ * and after the last accepted. COA_OK, COAVOID_AUTH_ERR_CLOCK or _REPLAY; marks nothing. */
+static int fresh_at(const coavoid_auth_trust_t *t, size_t key, size_t stream, int64_t timestamp_us,
+                    int64_t sequence, int64_t now, int64_t max_age_us, int64_t max_ahead_us)
+{
+    if (timestamp_us < now - max_age_us || timestamp_us > now + max_ahead_us) {
+        return COAVOID_AUTH_ERR_CLOCK;
+    }
+    const int64_t last_timestamp = t->last_timestamp[key][stream];
+    if (timestamp_us < last_timestamp ||
+        (timestamp_us == last_timestamp && sequence <= t->last_sequence[key][stream])) {
+        return COAVOID_AUTH_ERR_REPLAY;
+    }
+    return COA_OK;
+}
+
+int coavoid_auth_precheck(const coavoid_auth_trust_t *t, const unsigned char *datagram, size_t size,
+                          const coavoid_auth_expect_t *expect, size_t *key)
+{
+    if (t == NULL || datagram == NULL || expect == NULL || key == NULL ||
+        size < COAVOID_AUTH_TAIL_BYTES + 8u) {
+        return COAVOID_AUTH_ERR_UNSIGNED;
+    }
+    const unsigned char *tail = datagram + size - COAVOID_AUTH_TAIL_BYTES;
+    const uint32_t id = datagram_key_id(datagram, size);
+    if (id == 0u) {
+        return COAVOID_AUTH_ERR_UNSIGNED;
+    }
+    const size_t i = key_index(t, id);
+    if (i == t->count) {
+        return COAVOID_AUTH_ERR_KEY;
+    }
+    if (expect->stream >= COAVOID_AUTH_STREAMS) {
+        return COAVOID_AUTH_ERR_REPLAY;
+    }
+    if (expect->role != COAVOID_AUTH_ANY_ROLE && t->keys[i].role != expect->role) {
+        return COAVOID_AUTH_ERR_ROLE;
+    }
+    const int rc = fresh_at(t, i, expect->stream, (int64_t)get_be(tail + 4, 8u),
+                            (int64_t)get_be(tail + 12, 8u), expect->now, expect->max_age_us,
+                            expect->max_ahead_us);
+    if (rc == COA_OK) {
+        *key = i;
+    }
+    return rc;
 }
 
 int coavoid_auth_verify(const coavoid_auth_trust_t *t, const unsigned char *datagram, size_t size,
@@ -164,10 +229,7 @@ int coavoid_auth_verify(const coavoid_auth_trust_t *t, const unsigned char *data
     if (id == 0u) {
         return COAVOID_AUTH_ERR_UNSIGNED;
     }
-    size_t i = 0;
-    while (i < t->count && t->keys[i].key_id != id) {
-        i++;
-    }
+    const size_t i = key_index(t, id);
     if (i == t->count) {
         return COAVOID_AUTH_ERR_KEY;
     }
@@ -197,18 +259,12 @@ int coavoid_auth_fresh(coavoid_auth_trust_t *t, size_t key, size_t stream, int64
     if (t == NULL || key >= t->count || stream >= COAVOID_AUTH_STREAMS) {
         return COAVOID_AUTH_ERR_REPLAY;
     }
-    if (timestamp_us < now - max_age_us || timestamp_us > now + max_ahead_us) {
-        return COAVOID_AUTH_ERR_CLOCK;
+    const int rc = fresh_at(t, key, stream, timestamp_us, sequence, now, max_age_us, max_ahead_us);
+    if (rc == COA_OK) {
+        t->last_timestamp[key][stream] = timestamp_us;
+        t->last_sequence[key][stream] = sequence;
     }
-    int64_t *last_timestamp = &t->last_timestamp[key][stream];
-    int64_t *last_sequence = &t->last_sequence[key][stream];
-    if (timestamp_us < *last_timestamp ||
-        (timestamp_us == *last_timestamp && sequence <= *last_sequence)) {
-        return COAVOID_AUTH_ERR_REPLAY;
-    }
-    *last_timestamp = timestamp_us;
-    *last_sequence = sequence;
-    return COA_OK;
+    return rc;
 }
 
 int coavoid_auth_accept(coavoid_auth_trust_t *t, size_t key, size_t stream,

@@ -143,6 +143,28 @@ int coavoid_auth_sign(const coavoid_auth_signer_t *s, unsigned char *datagram, s
  * numbers move on only on success. Cost: one Ed25519 signature over size - 64 bytes. */
 int coavoid_auth_stamp(coavoid_auth_signer_t *s, int64_t now, unsigned char *datagram, size_t size);
 
+/* What a receiver expects of a datagram on one channel, for coavoid_auth_precheck: its
+ * stream, the role its key must have (COAVOID_AUTH_ANY_ROLE where the message names it,
+ * as a heartbeat does), and the freshness window at the receiver's clock. */
+#define COAVOID_AUTH_ANY_ROLE ((coavoid_auth_role_t)0)
+typedef struct {
+    size_t stream;
+    coavoid_auth_role_t role;
+    int64_t now;
+    int64_t max_age_us;
+    int64_t max_ahead_us;
+} coavoid_auth_expect_t;
+
+/* The checks a datagram's auth tail allows before any cryptography, so that a copy, a
+ * replay or a made-up tail costs a receiver a key lookup instead of a signature check
+ * (docs/security.md, "Floods"): signed and long enough, its key_id in t, that key's role
+ * the expected one, and its (timestamp, sequence) fresh on the stream as
+ * coavoid_auth_fresh would find it, without marking it. COA_OK with *key (its index in
+ * t), or the COAVOID_AUTH_ERR_* the full check would end with. Reads only the datagram's
+ * last COAVOID_AUTH_TAIL_BYTES; O(keys), no memory. */
+int coavoid_auth_precheck(const coavoid_auth_trust_t *t, const unsigned char *datagram, size_t size,
+                          const coavoid_auth_expect_t *expect, size_t *key);
+
 /* Checks a received datagram's signature against the key its key_id names in t. Returns
  * COA_OK with *key (its index in t) or a COAVOID_AUTH_ERR_*; reads only the datagram. */
 int coavoid_auth_verify(const coavoid_auth_trust_t *t, const unsigned char *datagram, size_t size,

@@ -181,15 +181,23 @@ static void count_undecodable(coavoid_node_inbox_t *in, const char *reason)
     coavoid_lcm_rx_count(in->rx, COAVOID_LCM_ERR_DECODE, reason);
 }
 
-/* A received datagram's signature, over its raw bytes before anything decodes them (a
- * secure inbox only): true with the key's index in *key, else counted as refused. */
-static bool signature_ok(coavoid_node_inbox_t *in, const lcm_recv_buf_t *rbuf, size_t *key)
+/* A received datagram's auth tail and signature, over its raw bytes before anything
+ * decodes them (a secure inbox only): first what the tail says without cryptography (a
+ * known key of the channel's role, fresh on its stream: a copy or a replay ends here),
+ * then the signature. True with the key's index in *key, else counted as refused. */
+static bool signature_ok(coavoid_node_inbox_t *in, const lcm_recv_buf_t *rbuf, size_t stream,
+                         coavoid_auth_role_t role, size_t *key)
 {
     *key = 0;
     if (!in->secure) {
         return true;
     }
-    int rc = coavoid_auth_verify(&in->trust, rbuf->data, rbuf->data_size, key);
+    const coavoid_auth_expect_t expect = {stream, role, *in->common.clock, in->max_age_us,
+                                          in->common.dt_us};
+    int rc = coavoid_auth_precheck(&in->trust, rbuf->data, rbuf->data_size, &expect, key);
+    if (rc == COA_OK) {
+        rc = coavoid_auth_verify(&in->trust, rbuf->data, rbuf->data_size, key);
+    }
     if (rc != COA_OK) {
         coavoid_lcm_rx_count(in->rx, rc, coavoid_lcm_error_name(rc));
         return false;
@@ -278,7 +286,7 @@ static void on_intent(const lcm_recv_buf_t *rbuf, const char *channel, void *use
     if (in->self_uav != 0u && sent_by_self(in, rbuf->data, (size_t)size)) {
         return;
     }
-    if (!signature_ok(in, rbuf, &key)) {
+    if (!signature_ok(in, rbuf, COAVOID_AUTH_STREAM_INTENT, COAVOID_AUTH_VEHICLE, &key)) {
         return;
     }
     if (coavoid_intent_t_decode(rbuf->data, 0, size, msg) < 0) {
@@ -347,7 +355,8 @@ static void on_track(const lcm_recv_buf_t *rbuf, const char *channel, void *user
     int size = 0;
     size_t key = 0;
     (void)channel;
-    if (!received_size(rbuf, &size) || !signature_ok(in, rbuf, &key)) {
+    if (!received_size(rbuf, &size) ||
+        !signature_ok(in, rbuf, COAVOID_AUTH_STREAM_TRACK, COAVOID_AUTH_WORLD, &key)) {
         return;
     }
     if (coavoid_track_t_decode(rbuf->data, 0, size, msg) < 0) {
@@ -498,7 +507,8 @@ static void on_map(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
     int size = 0;
     size_t key = 0;
     (void)channel;
-    if (!received_size(rbuf, &size) || !signature_ok(in, rbuf, &key)) {
+    if (!received_size(rbuf, &size) ||
+        !signature_ok(in, rbuf, COAVOID_AUTH_STREAM_MAP, COAVOID_AUTH_WORLD, &key)) {
         return;
     }
     if (coavoid_obstacle_map_t_decode(rbuf->data, 0, size, msg) < 0) {
@@ -534,7 +544,8 @@ static void on_status(const lcm_recv_buf_t *rbuf, const char *channel, void *use
     int size = 0;
     size_t key = 0;
     (void)channel;
-    if (!received_size(rbuf, &size) || !signature_ok(in, rbuf, &key)) {
+    if (!received_size(rbuf, &size) ||
+        !signature_ok(in, rbuf, COAVOID_AUTH_STREAM_STATUS, COAVOID_AUTH_ANY_ROLE, &key)) {
         return;
     }
     if (coavoid_status_t_decode(rbuf->data, 0, size, msg) < 0) {
@@ -578,7 +589,8 @@ static void on_plan(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
     int size = 0;
     size_t key = 0;
     (void)channel;
-    if (!received_size(rbuf, &size) || !signature_ok(in, rbuf, &key)) {
+    if (!received_size(rbuf, &size) ||
+        !signature_ok(in, rbuf, COAVOID_AUTH_STREAM_PLAN, COAVOID_AUTH_COORDINATOR, &key)) {
         return;
     }
     if (coavoid_plan_t_decode(rbuf->data, 0, size, msg) < 0) {
@@ -627,7 +639,8 @@ static void on_agreement(const lcm_recv_buf_t *rbuf, const char *channel, void *
     int size = 0;
     size_t key = 0;
     (void)channel;
-    if (!received_size(rbuf, &size) || !signature_ok(in, rbuf, &key)) {
+    if (!received_size(rbuf, &size) ||
+        !signature_ok(in, rbuf, COAVOID_AUTH_STREAM_AGREEMENT, COAVOID_AUTH_ANY_ROLE, &key)) {
         return;
     }
     if (coavoid_agreement_t_decode(rbuf->data, 0, size, msg) < 0) {

@@ -36,8 +36,8 @@ for n in (3, 100):
     assert v[p + "tracks"] == n // 50, n
     for node in ("vehicle", "coordinator", "world"):
         q = p + node + "_"
-        for k in ("sent", "received", "sign_us", "verify_us", "us_per_cycle", "dt_percent",
-                  "traffic_bytes", "auth_bytes", "memory_bytes"):
+        for k in ("sent", "received", "copies", "sign_us", "verify_us", "us_per_cycle",
+                  "dt_percent", "traffic_bytes", "auth_bytes", "memory_bytes"):
             assert q + k in v, q + k
         assert v[q + "auth_bytes"] == 84 * (v[q + "sent"] + v[q + "received"]), q
         assert abs(v[q + "us_per_cycle"] - v[q + "sign_us"] - v[q + "verify_us"]) < 0.2, q
@@ -55,7 +55,17 @@ for n in (3, 100):
     assert v[p + "world_sent"] == sends * (maps + tracks) and v[p + "world_received"] == 0, n
     assert v[p + "world_memory_bytes"] == v["signer_bytes"], n
     assert v[p + "vehicle_memory_bytes"] == v["signer_bytes"] + v["trust_list_bytes"], n
-assert len(v) == 6 + 7 * len(types) + 2 * (4 + 3 * 9), len(v)
+# Refusals: all three timed (a failed refusal would show in verify_failures); never their
+# times.
+for x in ("copy", "outsider", "forged"):
+    lo, mid, hi = (v[f"refused_{x}_{s}_us"] for s in ("min", "median", "max"))
+    assert 0 <= lo <= mid <= hi, (x, lo, mid, hi)
+    # Copies: every send of an intent, map tile, track and SWITCHED after its first.
+    peers = n - 1
+    assert v[p + "vehicle_copies"] == (sends - 1) * (peers + maps + tracks + n), n
+    assert v[p + "coordinator_copies"] == (sends - 1) * (n + maps + tracks + n), n
+    assert v[p + "world_copies"] == 0, n
+assert len(v) == 6 + 7 * len(types) + 3 * 3 + 2 * (4 + 3 * 10), len(v)
 PY
 fi
 
@@ -69,6 +79,9 @@ assert [t["type"] for t in b["types"]] == ["intent", "plan", "track", "obstacle_
 for t in b["types"]:
     assert t["bytes"] > 84 and 0 < t["sign_min_us"] <= t["sign_median_us"] <= t["sign_max_us"], t
     assert 0 < t["verify_min_us"] <= t["verify_median_us"] <= t["verify_max_us"], t
+assert [x["refusal"] for x in b["refusals"]] == ["copy", "outsider", "forged"], b["refusals"]
+for x in b["refusals"]:
+    assert 0 <= x["min_us"] <= x["median_us"] <= x["max_us"], x
 assert len(b["fleets"]) == 1 and b["fleets"][0]["vehicles"] == 5, b["fleets"]
 nodes = b["fleets"][0]["nodes"]
 assert [n["node"] for n in nodes] == ["vehicle", "coordinator", "world"], nodes

@@ -474,7 +474,9 @@ s['replans'] == sum(num(f'vehicle-{i}', 'plans run') for i in (1, 2, 3))
 #               would erase the terrain and lock the real map out as older); a plan for
 #               UAV 1 from the coordinator's id flying it to UAV 2's altitude (centralised
 #               only: decoupled vehicles take no plans); UAV 2's intents 300 m higher. All
-#               refused: that key may not send them (-123);
+#               refused: that key may not send them (-123), or, for an intent stamped
+#               before vehicle 3's own last one under the same key, from its tail as not
+#               newer (-124);
 #   copy        UAV 2's real intents again with sequences 1000 higher: the signature fails
 #               (-122);
 #   replay      every message heard sent again 1.5 s later: not newer than the last from
@@ -514,7 +516,7 @@ rc['summary'] == 0 and rc['forge'] == 0"
 $same
 $forged
 $(reported -123 "$all")
-set(log['codes']['1']) <= {0, -123}"
+set(log['codes']['1']) <= {0, -123, -124}"
         check "attack-copy-$mode" "$survived
 $same
 $forged
