@@ -162,14 +162,21 @@ static uint32_t datagram_key_id(const unsigned char *datagram, size_t size)
     return (uint32_t)get_be(datagram + size - COAVOID_AUTH_TAIL_BYTES, 4u);
 }
 
-/* The index of key_id in t, or t->count. */
-static size_t key_index(const coavoid_auth_trust_t *t, uint32_t key_id)
+/* The index in t of the key a datagram of `size` bytes (checked long enough) names: COA_OK
+ * with *key, COAVOID_AUTH_ERR_UNSIGNED (key_id 0) or COAVOID_AUTH_ERR_KEY (not in t). */
+static int datagram_key(const coavoid_auth_trust_t *t, const unsigned char *datagram, size_t size,
+                        size_t *key)
 {
+    const uint32_t id = datagram_key_id(datagram, size);
+    if (id == 0u) {
+        return COAVOID_AUTH_ERR_UNSIGNED;
+    }
     size_t i = 0;
-    while (i < t->count && t->keys[i].key_id != key_id) {
+    while (i < t->count && t->keys[i].key_id != id) {
         i++;
     }
-    return i;
+    *key = i;
+    return i == t->count ? COAVOID_AUTH_ERR_KEY : COA_OK;
 }
 
 /* Whether (timestamp, sequence) would be fresh on key's stream at now: within the window
@@ -196,13 +203,10 @@ int coavoid_auth_precheck(const coavoid_auth_trust_t *t, const unsigned char *da
         return COAVOID_AUTH_ERR_UNSIGNED;
     }
     const unsigned char *tail = datagram + size - COAVOID_AUTH_TAIL_BYTES;
-    const uint32_t id = datagram_key_id(datagram, size);
-    if (id == 0u) {
-        return COAVOID_AUTH_ERR_UNSIGNED;
-    }
-    const size_t i = key_index(t, id);
-    if (i == t->count) {
-        return COAVOID_AUTH_ERR_KEY;
+    size_t i = 0;
+    int rc = datagram_key(t, datagram, size, &i);
+    if (rc != COA_OK) {
+        return rc;
     }
     if (expect->stream >= COAVOID_AUTH_STREAMS) {
         return COAVOID_AUTH_ERR_REPLAY;
@@ -210,9 +214,9 @@ int coavoid_auth_precheck(const coavoid_auth_trust_t *t, const unsigned char *da
     if (expect->role != COAVOID_AUTH_ANY_ROLE && t->keys[i].role != expect->role) {
         return COAVOID_AUTH_ERR_ROLE;
     }
-    const int rc = fresh_at(t, i, expect->stream, (int64_t)get_be(tail + 4, 8u),
-                            (int64_t)get_be(tail + 12, 8u), expect->now, expect->max_age_us,
-                            expect->max_ahead_us);
+    rc = fresh_at(t, i, expect->stream, (int64_t)get_be(tail + 4, 8u),
+                  (int64_t)get_be(tail + 12, 8u), expect->now, expect->max_age_us,
+                  expect->max_ahead_us);
     if (rc == COA_OK) {
         *key = i;
     }
@@ -225,13 +229,10 @@ int coavoid_auth_verify(const coavoid_auth_trust_t *t, const unsigned char *data
     if (t == NULL || datagram == NULL || key == NULL || size < COAVOID_AUTH_TAIL_BYTES + 8u) {
         return COAVOID_AUTH_ERR_UNSIGNED;
     }
-    const uint32_t id = datagram_key_id(datagram, size);
-    if (id == 0u) {
-        return COAVOID_AUTH_ERR_UNSIGNED;
-    }
-    const size_t i = key_index(t, id);
-    if (i == t->count) {
-        return COAVOID_AUTH_ERR_KEY;
+    size_t i = 0;
+    const int rc = datagram_key(t, datagram, size, &i);
+    if (rc != COA_OK) {
+        return rc;
     }
     const size_t signed_size = size - COAVOID_AUTH_SIGNATURE_BYTES;
     if (crypto_sign_verify_detached(datagram + signed_size, datagram, signed_size,
