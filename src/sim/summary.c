@@ -32,6 +32,8 @@
  *     scenario. The log is not a run of the
  *     scenario only when some scenario UAV has no accepted intent at all: that is an
  *     error naming the first disagreement when its intents were all ignored;
+ *   - an intent whose reference is off the scenario's route sampled from the run's start
+ *     (found in pass 2, once the start is known: its samples are not used);
  *   - a heartbeat of a UAV not in the scenario, or of a coordinator other than the run's
  *     (the coordinator id that sent the most heartbeats);
  *   - a heartbeat whose plans_run goes back from the node's last accepted heartbeat, or
@@ -826,7 +828,16 @@ typedef struct {
     bool *own;             /* n rows of K + 1: from the cycle's own intent */
     bool *known;           /* n rows of K + 1 */
     coa_vec3_t *reference; /* n rows */
-    int32_t *offsets;      /* n rows */
+    coa_vec3_t *route;     /* n rows: the scenario's reference, sampled from the epoch */
+    /* The routes from the run's own start (`origin`, the earliest plan_utime on its grid),
+     * where the intents' references are: cycle c is row entry c + shift (truth_steps + 1
+     * entries a row; no check when the epoch is off the origin's grid). */
+    coa_vec3_t *truth;
+    int64_t origin;
+    int64_t shift;
+    uint32_t truth_steps;
+    bool truth_known;
+    int32_t *offsets; /* n rows */
     int64_t own_samples;
     int64_t earlier_samples;
     int64_t missing_samples;
@@ -839,6 +850,8 @@ static void rebuilt_free(rebuilt_t *b)
     free(b->own);
     free(b->known);
     free(b->reference);
+    free(b->route);
+    free(b->truth);
     free(b->offsets);
 }
 
@@ -893,6 +906,52 @@ static int64_t last_complete_cycle(const log_summary_t *ls, int64_t epoch, uint3
     return k;
 }
 
+/* Whether an intent's reference point r is the route's point p, within what the two
+ * precisions' arithmetic can make of one position (1 mm, and 1e-5 of its size). */
+static bool on_route(const double *r, coa_vec3_t p)
+{
+    const double at[3] = {(double)p.x, (double)p.y, (double)p.z};
+    for (size_t i = 0; i < 3u; i++) {
+        if (!(fabs(r[i] - at[i]) <= 1e-3 + 1e-5 * fabs(at[i]))) {
+            return false;
+        }
+    }
+    return true;
+}
+
+/* Whether the accepted intent m of scenario UAV `index` flies the scenario's route: every
+ * reference sample it has on cycles 0..K is the route's point there. A well-formed intent
+ * from its UAV's own key that lies about where the UAV is would otherwise be believed. The
+ * first that does not is ignored as one that disagrees with the scenario. */
+static bool reference_agrees(log_summary_t *ls, const rebuilt_t *b, long index,
+                             const coavoid_intent_t *m, int64_t epoch)
+{
+    for (int32_t j = 0; b->truth_known && j < m->sample_count; j++) {
+        int64_t c = cycle_at(m->plan_utime + (int64_t)j * ls->dt_us, epoch, ls->dt_us);
+        if (c < 0 || c > (int64_t)b->steps) {
+            continue;
+        }
+        const int64_t t = c + b->shift;
+        if (t < 0 || t > (int64_t)b->truth_steps) {
+            continue;
+        }
+        const coa_vec3_t p = b->truth[(size_t)index * ((size_t)b->truth_steps + 1u) + (size_t)t];
+        if (on_route(m->reference[j], p)) {
+            continue;
+        }
+        ls->intents_ignored++;
+        if (ls->intent_ignored[0] == '\0') {
+            snprintf(ls->intent_ignored, sizeof ls->intent_ignored,
+                     "intent: UAV %ld's reference at cycle %lld (%.3f, %.3f, %.3f) is off the "
+                     "scenario's route (%.3f, %.3f, %.3f)",
+                     (long)m->uav_id, (long long)c, m->reference[j][0], m->reference[j][1],
+                     m->reference[j][2], (double)p.x, (double)p.y, (double)p.z);
+        }
+        return false;
+    }
+    return true;
+}
+
 /* Pass 2: the samples of every accepted intent onto the cycles 0..K. */
 static int fill_samples(log_summary_t *ls, log_reader_t *r, rebuilt_t *b, int64_t epoch)
 {
@@ -910,6 +969,9 @@ static int fill_samples(log_summary_t *ls, log_reader_t *r, rebuilt_t *b, int64_
         if (strcmp(e->channel, COAVOID_CHANNEL_INTENT) == 0) {
             long index = accept_intent(ls, e, false); /* ignored ones (-3) too are skipped */
             const coavoid_intent_t *m = &ls->intent;
+            if (index >= 0 && !reference_agrees(ls, b, index, m, epoch)) {
+                index = -3;
+            }
             for (int32_t j = 0; index >= 0 && j < m->sample_count; j++) {
                 /* The check bounds plan_utime to within an hour of a positive utime and j
                  * below 128, so this cannot overflow. */
@@ -935,20 +997,38 @@ static int fill_samples(log_summary_t *ls, log_reader_t *r, rebuilt_t *b, int64_
     return SIM_GO_ON;
 }
 
-/* Samples no intent covered: the scenario's reference, the offset held. */
-static int fill_gaps(const coavoid_scenario_t *s, rebuilt_t *b)
+/* Every UAV's route sampled on cycles 0..K from the epoch (b->route), and from the run's
+ * start over as many more cycles as the epoch is after it (b->truth). */
+static int sample_routes(const coavoid_scenario_t *s, rebuilt_t *b, int64_t epoch, int64_t dt_us)
 {
     const size_t row = (size_t)b->steps + 1u;
-    coa_vec3_t *scenario_reference = malloc(row * sizeof *scenario_reference);
-    if (scenario_reference == NULL) {
+    b->truth_known = b->origin > 0 && (epoch - b->origin) % dt_us == 0;
+    b->shift = b->truth_known ? (epoch - b->origin) / dt_us : 0;
+    b->truth_known = b->truth_known && b->shift <= (int64_t)COA_MAX_HORIZON - (int64_t)b->steps;
+    b->truth_steps = b->steps + (uint32_t)(b->truth_known && b->shift > 0 ? b->shift : 0);
+    const size_t truth_row = (size_t)b->truth_steps + 1u;
+    b->truth = calloc(s->vehicle_count * truth_row, sizeof *b->truth);
+    if (b->truth == NULL) {
         return COA_ERR_WORKSPACE;
     }
     for (size_t i = 0; i < s->vehicle_count; i++) {
-        int rc = coa_reference_sample(&s->vehicles[i], s->dt, b->steps, scenario_reference);
+        int rc = coa_reference_sample(&s->vehicles[i], s->dt, b->steps, &b->route[i * row]);
+        if (rc == COA_OK) {
+            rc = coa_reference_sample(&s->vehicles[i], s->dt, b->truth_steps,
+                                      &b->truth[i * truth_row]);
+        }
         if (rc != COA_OK) {
-            free(scenario_reference);
             return rc;
         }
+    }
+    return COA_OK;
+}
+
+/* Samples no intent covered: the scenario's reference, the offset held. */
+static void fill_gaps(const coavoid_scenario_t *s, rebuilt_t *b)
+{
+    const size_t row = (size_t)b->steps + 1u;
+    for (size_t i = 0; i < s->vehicle_count; i++) {
         int32_t held = s->vehicles[i].initial_offset;
         for (size_t k = 0; k < row; k++) {
             size_t at = i * row + k;
@@ -962,12 +1042,10 @@ static int fill_gaps(const coavoid_scenario_t *s, rebuilt_t *b)
                 continue;
             }
             b->missing_samples++;
-            b->reference[at] = scenario_reference[k];
+            b->reference[at] = b->route[at];
             b->offsets[at] = held;
         }
     }
-    free(scenario_reference);
-    return COA_OK;
 }
 
 /* ---- output ---- */
@@ -1276,7 +1354,8 @@ static int summary_pass1(log_summary_t *ls, rebuilt_t *b, int64_t *epoch, int64_
     if (status != SIM_GO_ON) {
         return status;
     }
-    *epoch = o->has_epoch ? o->epoch : run_epoch(ls);
+    b->origin = run_epoch(ls);
+    *epoch = o->has_epoch ? o->epoch : b->origin;
     if (*epoch < 0) {
         return coavoid_run_fail(ls->err, COAVOID_RUN_ERR_INTERNAL, "out of memory");
     }
@@ -1305,10 +1384,16 @@ static int summary_pass2(log_summary_t *ls, rebuilt_t *b, int64_t epoch, int64_t
     b->own = calloc(cells, sizeof *b->own);
     b->known = calloc(cells, sizeof *b->known);
     b->reference = calloc(cells, sizeof *b->reference);
+    b->route = calloc(cells, sizeof *b->route);
     b->offsets = calloc(cells, sizeof *b->offsets);
     if (b->best == NULL || b->own == NULL || b->known == NULL || b->reference == NULL ||
-        b->offsets == NULL) {
+        b->route == NULL || b->offsets == NULL) {
         return coavoid_run_fail(ls->err, COAVOID_RUN_ERR_INTERNAL, "out of memory");
+    }
+    if (sample_routes(ls->s, b, epoch, ls->dt_us) != COA_OK) {
+        return coavoid_run_fail(ls->err, COAVOID_RUN_ERR_INPUT,
+                                "%s: a route cannot be sampled over %lu steps", o->scenario_path,
+                                (unsigned long)b->steps);
     }
     log_reader_t r;
     memset(&r, 0, sizeof r);
@@ -1317,10 +1402,8 @@ static int summary_pass2(log_summary_t *ls, rebuilt_t *b, int64_t epoch, int64_t
         status = fill_samples(ls, &r, b, epoch);
     }
     log_close(&r);
-    if (status == SIM_GO_ON && fill_gaps(ls->s, b) != COA_OK) {
-        status = coavoid_run_fail(ls->err, COAVOID_RUN_ERR_INPUT,
-                                  "%s: a route cannot be sampled over %lu steps", o->scenario_path,
-                                  (unsigned long)b->steps);
+    if (status == SIM_GO_ON) {
+        fill_gaps(ls->s, b);
     }
     return status;
 }

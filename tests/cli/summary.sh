@@ -195,6 +195,8 @@ elif [ -f "$tmp/paper.json" ]; then
     #   intent:UAV:CYCLE:CHANGES   a copy of UAV's intent of cycle CYCLE (its sequence)
     #   status:NODE:SEQ:CHANGES    a copy of node NODE's heartbeat with sequence SEQ
     #   every-intent:UAV:CHANGES   every intent of UAV changed
+    #   reference:UAV:CYCLE:DX     a copy of UAV's intent of cycle CYCLE with every
+    #                              reference point moved DX m east
     # CHANGES: field=value or field+=delta, comma-separated.
     cat >"$tmp/mutate.py" <<'PY'
 import struct, sys
@@ -224,11 +226,14 @@ done, result = set(), []
 for utime, channel, payload in events:
     result.append([utime, channel, payload])
     for n, e in enumerate(edits):
-        if channel == b"COAVOID_INTENT" and e[0] in ("intent", "every-intent"):
+        if channel == b"COAVOID_INTENT" and e[0] in ("intent", "every-intent", "reference"):
             m = intent_t.decode(payload)
-            if m.uav_id != int(e[1]) or (e[0] == "intent" and m.sequence != int(e[2])):
+            if m.uav_id != int(e[1]) or (e[0] != "every-intent" and m.sequence != int(e[2])):
                 continue
-            if e[0] == "intent":
+            if e[0] == "reference":
+                m.reference = [[r[0] + float(e[3]), r[1], r[2]] for r in m.reference]
+                result.append([utime + 1, channel, m.encode()])
+            elif e[0] == "intent":
                 result.append([utime + 1, channel, change(m, e[3])])
             else:
                 result[-1][2] = change(m, e[2])
@@ -288,6 +293,12 @@ PY
                 if grep -qF -- "$line" "$tmp/out"; then pass; else fail "odd intent text lacks '$line'"; fi
             done
         fi
+    fi
+    # ... one of UAV 2 at cycle 24, well-formed and of its own performance, whose
+    # reference says it is 50 m east of its route: ignored, the flight the clean one's.
+    if write_mutated moved_reference reference:2:24:50; then
+        same_run "a moved reference" "$tmp/moved_reference.log" '{"intents_ignored": 1,
+            "first_ignored_intent": "UAV 2'"'"'s reference at cycle 24"}'
     fi
     # ... and one of UAV 1 at cycle 0 with another radius.
     if write_mutated odd_radius intent:1:0:radius+=5; then
