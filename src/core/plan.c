@@ -204,7 +204,7 @@ coa_planner_t *coa_planner_init(void *buffer, size_t size, const coa_planner_con
     pl->row_width = lo.row_width;
     pl->capacity = lo.capacity;
     pl->slot_count = lo.slot_count;
-    pl->slot_active = lo.slot_count < PLAN_SLOTS_FIRST ? lo.slot_count : PLAN_SLOTS_FIRST;
+    pl->slot_active = plan_slots_first(pl);
     pl->touched_slots = pl->slot_active;
     pl->pair_cells = lo.pair_cells;
     point_into(pl, (unsigned char *)buffer, &lo);

@@ -432,15 +432,6 @@ static bool tried_before(coa_planner_t *pl, uint32_t x, uint32_t y)
     return false;
 }
 
-static size_t popcount32(uint32_t x)
-{
-    size_t n = 0u;
-    for (; x != 0u; x &= x - 1u) {
-        ++n;
-    }
-    return n;
-}
-
 /* Group x re-planned around group y's rows at exactly x's cost (it cannot cost less: x's
  * rows are optimal for x alone). On success x's rows change and nothing else does. A
  * single vehicle's plan is read off its table built against y. */
@@ -454,7 +445,7 @@ static bool replan_around(coa_planner_t *pl, const groups_t *g, size_t x, size_t
     uint64_t root;
     int32_t start;
 
-    if (popcount32(g->members[x]) > 1u) {
+    if (plan_popcount(g->members[x]) > 1u) {
         coa_cost_t ignored;
         return search_group(pl, g->members[x], g->members[y], &g->cost[x], r, &ignored) ==
                COA_PLAN_SOLVED;
@@ -496,8 +487,8 @@ static coa_plan_status_t merge(coa_planner_t *pl, groups_t *g, size_t x, size_t 
         g->cost[i] = g->cost[i + 1u];
     }
     --g->count;
-    if (popcount32(g->members[x]) > r->largest_group) {
-        r->largest_group = popcount32(g->members[x]);
+    if (plan_popcount(g->members[x]) > r->largest_group) {
+        r->largest_group = plan_popcount(g->members[x]);
     }
     st = search_group(pl, g->members[x], 0u, NULL, r, &bound2);
     if (st == COA_PLAN_SOLVED) {

@@ -491,6 +491,22 @@ static inline size_t plan_pair_index(size_t a, size_t b, size_t m)
 /* Records that table t now holds its problem's cells (workspace_touched_bytes). */
 void coa_plan_touch_table(coa_planner_t *pl, const plan_table_t *t);
 
+/* The members of a bit mask (of vehicles or of group members). */
+static inline uint32_t plan_popcount(uint32_t mask)
+{
+    uint32_t n = 0u;
+    for (; mask != 0u; mask &= mask - 1u) {
+        ++n;
+    }
+    return n;
+}
+
+/* The hash table's size at the start of each search (plan_search.c, slots_reserve). */
+static inline uint32_t plan_slots_first(const coa_planner_t *pl)
+{
+    return pl->slot_count < PLAN_SLOTS_FIRST ? pl->slot_count : PLAN_SLOTS_FIRST;
+}
+
 /* Vehicle v's cost alone (its own table, from its initial offset), packed. */
 static inline coa_cost_t plan_cost_alone(const coa_planner_t *pl, size_t v)
 {

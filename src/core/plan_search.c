@@ -175,7 +175,7 @@ void coa_plan_search_release(coa_planner_t *pl)
     }
     /* Every search starts from the first size, so that its growth, and the work charged
      * for it, do not depend on the searches before it. */
-    pl->slot_active = pl->slot_count < PLAN_SLOTS_FIRST ? pl->slot_count : PLAN_SLOTS_FIRST;
+    pl->slot_active = plan_slots_first(pl);
     pl->used = 0u;
     pl->heap_count = 0u;
 }
@@ -364,24 +364,15 @@ static coa_cost_t matching_list(const coa_cost_t *s, size_t m, const size_t *at,
                          matching_peel(s, m, &at[1], 5u, matching_direct(s, m, &at[2], 4u)));
 }
 
-static uint32_t member_count(uint32_t mask)
-{
-    uint32_t count = 0u;
-    for (; mask != 0u; mask &= mask - 1u) {
-        ++count;
-    }
-    return count;
-}
-
 /* The work units of matching(mask) beyond a leaf's own: PLAN_WORK_MATCH per direct call
  * past the first (members: 5 -> 11 calls, 6 -> 26; each call adds one per member, less
  * the pairs and triangles of the first and the calls under them), on each side. */
 static uint64_t matching_work(const plan_group_t *g, uint32_t mask)
 {
     static const uint8_t calls[PLAN_MATCH_ALL + 1u] = {1, 1, 1, 1, 1, 11, 26};
-    uint64_t units = (uint64_t)(calls[member_count(mask & g->side[0])] - 1u) * PLAN_WORK_MATCH;
+    uint64_t units = (uint64_t)(calls[plan_popcount(mask & g->side[0])] - 1u) * PLAN_WORK_MATCH;
     if (g->side[1] != 0u) {
-        units += (uint64_t)calls[member_count(mask & g->side[1])] * PLAN_WORK_MATCH;
+        units += (uint64_t)calls[plan_popcount(mask & g->side[1])] * PLAN_WORK_MATCH;
     }
     return units;
 }
@@ -428,7 +419,7 @@ static uint32_t sides_best(coa_planner_t *pl, const coa_cost_t *w)
     uint32_t a;
 
     for (a = 1u; a < all; a += 2u) {
-        uint32_t na = member_count(a);
+        uint32_t na = plan_popcount(a);
         coa_cost_t v;
         if (na > pl->match_all || m - na > pl->match_all) {
             continue;
