@@ -587,21 +587,32 @@ static int report_text(FILE *f, const coavoid_bench_auth_config_t *c,
     return fflush(f) == 0 && !ferror(f) ? 0 : -1;
 }
 
+/* Appends {tag: name, then the rows} to `array`. False when memory is short (nothing
+ * appended, the object freed). */
+static bool json_append_named(cJSON *array, const char *tag, const char *name, const row_t *rows,
+                              size_t n)
+{
+    cJSON *o = cJSON_CreateObject();
+    if (o != NULL && cJSON_AddStringToObject(o, tag, name) == NULL) {
+        cJSON_Delete(o);
+        o = NULL;
+    }
+    o = json_rows(o, rows, n);
+    if (o == NULL || !cJSON_AddItemToArray(array, o)) {
+        cJSON_Delete(o);
+        return false;
+    }
+    return true;
+}
+
 /* The "types" array of the JSON report, or NULL (memory). */
 static cJSON *json_types(const coavoid_bench_auth_result_t *r)
 {
     cJSON *types = cJSON_CreateArray();
     row_t rows[BENCH_AUTH_TYPE_ROWS];
     for (size_t t = 0; types != NULL && t < COAVOID_BENCH_AUTH_TYPES; t++) {
-        cJSON *o = cJSON_CreateObject();
-        if (o != NULL && cJSON_AddStringToObject(o, "type", r->types[t].name) == NULL) {
-            cJSON_Delete(o);
-            o = NULL;
-        }
         type_rows(&r->types[t], rows);
-        o = json_rows(o, rows, BENCH_AUTH_TYPE_ROWS);
-        if (o == NULL || !cJSON_AddItemToArray(types, o)) {
-            cJSON_Delete(o);
+        if (!json_append_named(types, "type", r->types[t].name, rows, BENCH_AUTH_TYPE_ROWS)) {
             cJSON_Delete(types);
             return NULL;
         }
@@ -615,15 +626,9 @@ static cJSON *json_refusals(const coavoid_bench_auth_result_t *r)
     cJSON *all = cJSON_CreateArray();
     row_t rows[BENCH_AUTH_REFUSAL_ROWS];
     for (size_t x = 0; all != NULL && x < COAVOID_BENCH_AUTH_REFUSALS; x++) {
-        cJSON *o = cJSON_CreateObject();
-        if (o != NULL && cJSON_AddStringToObject(o, "refusal", r->refusals[x].name) == NULL) {
-            cJSON_Delete(o);
-            o = NULL;
-        }
         refusal_rows(&r->refusals[x], rows);
-        o = json_rows(o, rows, BENCH_AUTH_REFUSAL_ROWS);
-        if (o == NULL || !cJSON_AddItemToArray(all, o)) {
-            cJSON_Delete(o);
+        if (!json_append_named(all, "refusal", r->refusals[x].name, rows,
+                               BENCH_AUTH_REFUSAL_ROWS)) {
             cJSON_Delete(all);
             return NULL;
         }
@@ -639,15 +644,8 @@ static cJSON *json_fleet(const coavoid_bench_auth_fleet_t *fl)
     cJSON *o = json_rows(cJSON_CreateObject(), rows, BENCH_AUTH_FLEET_ROWS);
     cJSON *nodes = o != NULL ? cJSON_AddArrayToObject(o, "nodes") : NULL;
     for (size_t n = 0; nodes != NULL && n < COAVOID_BENCH_AUTH_NODES; n++) {
-        cJSON *node = cJSON_CreateObject();
-        if (node != NULL && cJSON_AddStringToObject(node, "node", fl->nodes[n].name) == NULL) {
-            cJSON_Delete(node);
-            node = NULL;
-        }
         node_rows(&fl->nodes[n], rows);
-        node = json_rows(node, rows, BENCH_AUTH_NODE_ROWS);
-        if (node == NULL || !cJSON_AddItemToArray(nodes, node)) {
-            cJSON_Delete(node);
+        if (!json_append_named(nodes, "node", fl->nodes[n].name, rows, BENCH_AUTH_NODE_ROWS)) {
             nodes = NULL;
         }
     }
