@@ -735,12 +735,12 @@ START_TEST(test_datagram_sizes)
     coavoid_obstacle_map_t map = good_map();
     coavoid_conflict_report_t report = good_report();
     coavoid_status_t status = good_status();
-    ck_assert_int_eq(coavoid_intent_t_encoded_size(&intent), 1390);
-    ck_assert_int_eq(coavoid_plan_t_encoded_size(&plan), 466);
-    ck_assert_int_eq(coavoid_track_t_encoded_size(&track), 720);
-    ck_assert_int_eq(coavoid_obstacle_map_t_encoded_size(&map), 1392);
-    ck_assert_int_eq(coavoid_conflict_report_t_encoded_size(&report), 1370);
-    ck_assert_int_eq(coavoid_status_t_encoded_size(&status), 172);
+    ck_assert_int_eq(coavoid_intent_t_encoded_size(&intent), 1398);
+    ck_assert_int_eq(coavoid_plan_t_encoded_size(&plan), 474);
+    ck_assert_int_eq(coavoid_track_t_encoded_size(&track), 728);
+    ck_assert_int_eq(coavoid_obstacle_map_t_encoded_size(&map), 1400);
+    ck_assert_int_eq(coavoid_conflict_report_t_encoded_size(&report), 1378);
+    ck_assert_int_eq(coavoid_status_t_encoded_size(&status), 180);
     ck_assert_int_le(coavoid_intent_t_encoded_size(&intent), COAVOID_LCM_MAX_DATAGRAM_BYTES);
     ck_assert_int_le(coavoid_obstacle_map_t_encoded_size(&map), COAVOID_LCM_MAX_DATAGRAM_BYTES);
     ck_assert_int_le(coavoid_conflict_report_t_encoded_size(&report),
@@ -1400,7 +1400,8 @@ END_TEST
 
 /* ---- signed messages (auth.h) ---- */
 
-/* A signer and a trust list that knows it as `role` for `node`, key id 7. */
+/* A signer and a trust list that knows it as `role` for `node`, key id 7, with a fleet key
+ * they share. */
 static void auth_pair(coavoid_auth_signer_t *signer, coavoid_auth_trust_t *trust,
                       coavoid_auth_role_t role, uint16_t node)
 {
@@ -1415,6 +1416,10 @@ static void auth_pair(coavoid_auth_signer_t *signer, coavoid_auth_trust_t *trust
     coavoid_auth_trust_init(trust);
     ck_assert_int_eq(coavoid_auth_trust_add(trust, &key), COA_OK);
     ck_assert_int_eq(coavoid_auth_trust_add(trust, &key), COA_ERR_ARGUMENT); /* repeated */
+    unsigned char fleet[COAVOID_AUTH_FLEET_KEY_BYTES];
+    ck_assert_int_eq(coavoid_auth_fleet_key(fleet), COA_OK);
+    ck_assert_int_eq(coavoid_auth_trust_set_fleet_key(trust, fleet), COA_OK);
+    coavoid_auth_signer_use_fleet(signer, trust);
 }
 
 /* The good status, signed at `now` into buf; its size. */
@@ -1428,9 +1433,9 @@ static int signed_status(coavoid_auth_signer_t *signer, int64_t now, unsigned ch
     return size;
 }
 
-/* A signed datagram verifies with its key, and any changed byte (the fingerprint, a
- * field, the key id, the time, the signature) makes it fail; unsigned and unknown keys
- * are told apart. */
+/* A signed datagram verifies with its key, and any changed byte before the tag (the
+ * fingerprint, a field, the key id, the time, the signature) makes it fail; any changed
+ * byte at all fails the fleet tag; unsigned and unknown keys are told apart. */
 START_TEST(test_auth_sign_verify)
 {
     coavoid_auth_signer_t signer;
@@ -1442,12 +1447,14 @@ START_TEST(test_auth_sign_verify)
     size_t key = 99;
     ck_assert_int_eq(coavoid_auth_verify(&trust, buf, (size_t)size, &key), COA_OK);
     ck_assert_uint_eq(key, 0);
+    ck_assert_int_eq(coavoid_auth_tag_check(&trust, buf, (size_t)size), COA_OK);
     for (int at = 0; at < size; at++) {
         buf[at] ^= 0x01;
         int rc = coavoid_auth_verify(&trust, buf, (size_t)size, &key);
         ck_assert_msg(rc == COAVOID_AUTH_ERR_SIGNATURE || rc == COAVOID_AUTH_ERR_KEY ||
-                          rc == COAVOID_AUTH_ERR_UNSIGNED,
+                          rc == COAVOID_AUTH_ERR_UNSIGNED || at >= size - 8,
                       "byte %d changed, verify %d", at, rc);
+        ck_assert_int_eq(coavoid_auth_tag_check(&trust, buf, (size_t)size), COAVOID_AUTH_ERR_TAG);
         buf[at] ^= 0x01;
     }
     coavoid_status_t m = good_status(); /* unsigned: key_id 0 */
@@ -1558,12 +1565,30 @@ START_TEST(test_auth_precheck)
     /* A copy of what was accepted: a replay, before its signature is looked at. */
     ck_assert_int_eq(coavoid_auth_precheck(&trust, buf, (size_t)size, &ex, &key),
                      COAVOID_AUTH_ERR_REPLAY);
-    /* The next one passes; with its signature broken it fails only at the signature. */
+    /* The next one passes. With its signature broken (an outsider's fresh stamp) it fails
+     * at the fleet tag; without a fleet key in the trust list only at the signature. */
     const int next = signed_status(&signer, T0 + 1, buf, (int)sizeof buf);
-    buf[next - 1] ^= 0x40;
+    ck_assert_int_eq(coavoid_auth_precheck(&trust, buf, (size_t)next, &ex, &key), COA_OK);
+    buf[next - 9] ^= 0x40;
+    ck_assert_int_eq(coavoid_auth_precheck(&trust, buf, (size_t)next, &ex, &key),
+                     COAVOID_AUTH_ERR_TAG);
+    trust.has_fleet_key = false;
     ck_assert_int_eq(coavoid_auth_precheck(&trust, buf, (size_t)next, &ex, &key), COA_OK);
     ck_assert_int_eq(coavoid_auth_verify(&trust, buf, (size_t)next, &key),
                      COAVOID_AUTH_ERR_SIGNATURE);
+    trust.has_fleet_key = true;
+    /* A member without the fleet key: its tag is zero, and refused as an outsider's. */
+    buf[next - 9] ^= 0x40;
+    signer.has_fleet_key = false;
+    ck_assert_int_eq(coavoid_auth_sign(&signer, buf, (size_t)next), COA_OK);
+    for (int at = next - 8; at < next; at++) {
+        ck_assert_uint_eq(buf[at], 0);
+    }
+    ck_assert_int_eq(coavoid_auth_precheck(&trust, buf, (size_t)next, &ex, &key),
+                     COAVOID_AUTH_ERR_TAG);
+    ck_assert_int_eq(coavoid_auth_verify(&trust, buf, (size_t)next, &key), COA_OK);
+    signer.has_fleet_key = true;
+    ck_assert_int_eq(coavoid_auth_sign(&signer, buf, (size_t)next), COA_OK);
     /* Out of the window, another role, another channel's stream from a clean slate. */
     ex.now = T0 + 10 * window;
     ck_assert_int_eq(coavoid_auth_precheck(&trust, buf, (size_t)next, &ex, &key),
@@ -1648,12 +1673,29 @@ START_TEST(test_auth_key_files)
     ck_assert_int_eq(coavoid_auth_signer_parse(&read, line, strlen(line), err, sizeof err), COA_OK);
     ck_assert(read.key_id == signer.key_id &&
               memcmp(read.secret_key, signer.secret_key, sizeof read.secret_key) == 0);
+    /* The fleet line round-trips; a second one, or a bad one, is refused. */
+    ck_assert(!back.has_fleet_key);
+    char fleet_text[3 * COAVOID_AUTH_LINE_MAX];
+    ck_assert_int_eq(coavoid_auth_fleet_line(trust.fleet_key, line, sizeof line), COA_OK);
+    snprintf(fleet_text, sizeof fleet_text, "%s%s", key_line, line);
+    ck_assert_int_eq(
+        coavoid_auth_trust_parse(&back, fleet_text, strlen(fleet_text), err, sizeof err), COA_OK);
+    ck_assert(back.has_fleet_key && back.count == 1 &&
+              memcmp(back.fleet_key, trust.fleet_key, sizeof back.fleet_key) == 0);
+    strcat(fleet_text, line);
+    ck_assert_int_eq(
+        coavoid_auth_trust_parse(&back, fleet_text, strlen(fleet_text), err, sizeof err),
+        COA_ERR_ARGUMENT);
+    ck_assert_str_eq(err, "line 3: a second fleet line");
+    ck_assert_int_eq(coavoid_auth_fleet_line(trust.fleet_key, line, 20), COA_ERR_ARGUMENT);
     const char *bad[][2] = {
         {"7 pilot 3 00", "line 1: ROLE must be coordinator, world or vehicle"},
         {"# ok\n7 vehicle 3 00ff", "line 2: PUBLIC_KEY_HEX must be 64 hex digits"},
         {"0 vehicle 3 00", "line 1: KEY_ID must be in 1..2147483647 and NODE_ID in 1..65535"},
         {"7 vehicle 70000 00", "line 1: KEY_ID must be in 1..2147483647 and NODE_ID in 1..65535"},
         {"7 vehicle 3", "line 1: expected KEY_ID ROLE NODE_ID PUBLIC_KEY_HEX"},
+        {"fleet 00ff", "line 1: expected fleet FLEET_KEY_HEX (64 hex digits)"},
+        {"fleet", "line 1: expected KEY_ID ROLE NODE_ID PUBLIC_KEY_HEX"},
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         ck_assert_int_eq(

@@ -20,9 +20,11 @@
 #define BENCH_AUTH_USAGE                                                                   \
     "usage: coavoid bench auth [--vehicles N[,N...]] [--repeat R] [--json]\n"              \
     "\n"                                                                                   \
-    "Times signing (coavoid_auth_stamp) and checking (verify, role, freshness) one\n"      \
-    "message of each type (intent, plan, track, obstacle_map, conflict_report, status)\n"  \
-    "at its encoded size, R times on one core, and prints the median, min and max.\n"      \
+    "Times signing (coavoid_auth_stamp) and checking (tail, fleet tag, signature, role,\n" \
+    "freshness) one message of each type (intent, plan, track, obstacle_map,\n"            \
+    "conflict_report, status, agreement) at its encoded size, R times on one core, and\n"  \
+    "prints the median, min and max; then the refusals of a copy, an unknown key, an\n"    \
+    "outsider's forgery (the fleet tag) and the same without a fleet key (signature).\n"   \
     "Then, for fleets of N UAVs on one channel, the messages a vehicle, the coordinator\n" \
     "and the world sign and check per cycle (worst case: one plan per UAV), their\n"       \
     "microseconds per cycle from the medians, the share of dt (%g s), and the bytes:\n"    \

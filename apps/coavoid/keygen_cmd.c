@@ -95,15 +95,36 @@ static int one_key(const keygen_options_t *o, const char *file, uint32_t key_id,
     return rc;
 }
 
+/* A new fleet key's line, appended to trust. */
+static int fleet_line(char *trust, size_t trust_size)
+{
+    unsigned char key[COAVOID_AUTH_FLEET_KEY_BYTES];
+    char line[COAVOID_AUTH_LINE_MAX];
+    const bool ok = coavoid_auth_fleet_key(key) == COA_OK &&
+                    coavoid_auth_fleet_line(key, line, sizeof line) == COA_OK &&
+                    strlen(trust) + strlen(line) < trust_size;
+    if (ok) {
+        strcat(trust, line);
+    }
+    memset(key, 0, sizeof key);
+    memset(line, 0, sizeof line);
+    return ok ? CLI_CONTINUE
+              : coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: no fleet key (libsodium)");
+}
+
 static int keygen(void *options, coavoid_scenario_t *s)
 {
     const keygen_options_t *o = options;
     static char trust[COA_MAX_VEHICLES * COAVOID_AUTH_LINE_MAX + 3u * COAVOID_AUTH_LINE_MAX];
     char name[32];
-    strcpy(trust, "# coavoid trust file: KEY_ID ROLE NODE_ID PUBLIC_KEY_HEX\n");
-    int rc =
-        one_key(o, "coordinator.key", COAVOID_AUTH_KEY_ID_COORDINATOR, COAVOID_AUTH_COORDINATOR,
-                (uint16_t)COAVOID_NODE_COORDINATOR_ID, trust, sizeof trust);
+    strcpy(trust, "# coavoid trust file: KEY_ID ROLE NODE_ID PUBLIC_KEY_HEX, and the fleet's\n"
+                  "# secret key (fleet FLEET_KEY_HEX): keep this file as a secret key\n");
+    int rc = fleet_line(trust, sizeof trust);
+    if (rc == CLI_CONTINUE) {
+        rc =
+            one_key(o, "coordinator.key", COAVOID_AUTH_KEY_ID_COORDINATOR, COAVOID_AUTH_COORDINATOR,
+                    (uint16_t)COAVOID_NODE_COORDINATOR_ID, trust, sizeof trust);
+    }
     if (rc == CLI_CONTINUE) {
         rc = one_key(o, "world.key", COAVOID_AUTH_KEY_ID_WORLD, COAVOID_AUTH_WORLD,
                      (uint16_t)COAVOID_NODE_WORLD_ID, trust, sizeof trust);

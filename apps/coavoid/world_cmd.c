@@ -19,7 +19,7 @@
 
 #define WORLD_USAGE                                                                          \
     "usage: coavoid world SCENARIO.json [--lcm-url URL] [--epoch UTIME] [--speed S]\n"       \
-    "                     [--steps K] (--key FILE [--trust FILE] | --insecure)\n"            \
+    "                     [--steps K] (--key FILE --trust FILE | --insecure)\n"              \
     "\n"                                                                                     \
     "Publishes the scenario's obstacle map and its tracks' estimates over LCM every cycle\n" \
     "of a real-time run, for the coordinator and the vehicles (coavoid-coordinator,\n"       \
@@ -67,8 +67,9 @@ static int world(void *options, coavoid_scenario_t *s)
     if (status != CLI_CONTINUE) {
         return status;
     }
-    /* It receives nothing: --trust only checks that --key is the world's. */
-    status = coavoid_rt_keys(&o->rt, COAVOID_AUTH_WORLD, (uint16_t)COAVOID_NODE_WORLD_ID, false,
+    /* It receives nothing: --trust checks that --key is the world's and gives the fleet
+     * key it tags with. */
+    status = coavoid_rt_keys(&o->rt, COAVOID_AUTH_WORLD, (uint16_t)COAVOID_NODE_WORLD_ID,
                              &config.common);
     if (status != CLI_CONTINUE) {
         return status;

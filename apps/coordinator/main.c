@@ -173,7 +173,7 @@ static int run(void *options, coavoid_scenario_t *s)
         return status;
     }
     status = coavoid_rt_keys(&o->rt, COAVOID_AUTH_COORDINATOR,
-                             (uint16_t)COAVOID_NODE_COORDINATOR_ID, true, &config.common);
+                             (uint16_t)COAVOID_NODE_COORDINATOR_ID, &config.common);
     if (status != CLI_CONTINUE) {
         return status;
     }

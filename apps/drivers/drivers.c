@@ -113,14 +113,24 @@ int coavoid_rt_load_trust(const char *path, coavoid_auth_trust_t *t)
     if (n < 0) {
         return CLI_EXIT_INVALID;
     }
-    if (coavoid_auth_trust_parse(t, text, (size_t)n, why, sizeof why) != COA_OK) {
+    int rc = coavoid_auth_trust_parse(t, text, (size_t)n, why, sizeof why);
+    memset(text, 0, sizeof text);
+    if (rc != COA_OK) {
         return coavoid_cli_fail(CLI_EXIT_INVALID, "--trust: %.200s: %s", path, why);
+    }
+    /* The fleet key is a secret: its file is kept as a secret key's is. */
+    struct stat st;
+    if (t->has_fleet_key && stat(path, &st) == 0 && (st.st_mode & (S_IRWXG | S_IRWXO)) != 0) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                "--trust: '%.200s' holds the fleet key and is readable by others "
+                                "(mode %03o): it must be its owner's only (chmod 600)",
+                                path, (unsigned)(st.st_mode & 0777));
     }
     return CLI_CONTINUE;
 }
 
 int coavoid_rt_keys(coavoid_rt_options_t *o, coavoid_auth_role_t role, uint16_t node_id,
-                    bool needs_trust, coavoid_node_common_t *common)
+                    coavoid_node_common_t *common)
 {
     if (o->insecure) {
         if (o->key_path != NULL || o->trust_path != NULL) {
@@ -130,7 +140,7 @@ int coavoid_rt_keys(coavoid_rt_options_t *o, coavoid_auth_role_t role, uint16_t 
         common->insecure = true;
         return CLI_CONTINUE;
     }
-    if (o->key_path == NULL || (needs_trust && o->trust_path == NULL)) {
+    if (o->key_path == NULL || o->trust_path == NULL) {
         return coavoid_cli_fail(CLI_EXIT_INVALID,
                                 "%s: required: every message is signed and checked "
                                 "(coavoid keygen writes keys), or --insecure to run without",
@@ -148,9 +158,6 @@ int coavoid_rt_keys(coavoid_rt_options_t *o, coavoid_auth_role_t role, uint16_t 
         return coavoid_cli_fail(CLI_EXIT_INVALID, "--key: %.200s: %s", o->key_path, why);
     }
     common->signer = &o->signer;
-    if (o->trust_path == NULL) {
-        return CLI_CONTINUE;
-    }
     if (coavoid_rt_load_trust(o->trust_path, &o->trust) != CLI_CONTINUE) {
         return CLI_EXIT_INVALID;
     }
@@ -160,6 +167,7 @@ int coavoid_rt_keys(coavoid_rt_options_t *o, coavoid_auth_role_t role, uint16_t 
                                 "%u, and public key must be listed there)",
                                 (unsigned long)o->signer.key_id, o->trust_path, (unsigned)node_id);
     }
+    coavoid_auth_signer_use_fleet(&o->signer, &o->trust);
     common->trust = &o->trust;
     return CLI_CONTINUE;
 }

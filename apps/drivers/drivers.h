@@ -63,19 +63,19 @@ int coavoid_rt_setup(const char *path, coavoid_scenario_t *s, coavoid_rt_options
 
 /* Reads the trust file at path (at most COAVOID_RT_KEY_FILE_MAX bytes) into t, for --trust.
  * Returns CLI_CONTINUE, or CLI_EXIT_INVALID after one line ("--trust: PATH: line N: why",
- * unreadable, too large). */
+ * unreadable, too large, or holding the fleet key while readable by others). */
 int coavoid_rt_load_trust(const char *path, coavoid_auth_trust_t *t);
 
-/* After coavoid_rt_setup: reads --key (a secret key file, readable by its owner only) and,
- * when the node receives (needs_trust) or it is given, --trust; checks that the trust file
- * lists this key as the node's (role and node_id, the same public key), so that a key
- * file of another node is refused at start, not by every receiver; and points
- * common->signer and common->trust at them. Or, with --insecure (and neither file),
+/* After coavoid_rt_setup: reads --key (a secret key file, readable by its owner only) and
+ * --trust; checks that the trust file lists this key as the node's (role and node_id, the
+ * same public key), so that a key file of another node is refused at start, not by every
+ * receiver; gives the signer the trust file's fleet key; and points common->signer and
+ * common->trust at them. Or, with --insecure (and neither file),
  * sets common->insecure. Returns CLI_CONTINUE, or CLI_EXIT_INVALID after one line naming
  * the option and why (missing, unreadable, too large, a bad line, not this node's key).
  * Cost: reading two files of at most COAVOID_RT_KEY_FILE_MAX bytes; no memory. */
 int coavoid_rt_keys(coavoid_rt_options_t *o, coavoid_auth_role_t role, uint16_t node_id,
-                    bool needs_trust, coavoid_node_common_t *common);
+                    coavoid_node_common_t *common);
 
 /* The usage lines of the shared options (for each driver's --help). */
 #define COAVOID_RT_OPTIONS_USAGE                                                          \

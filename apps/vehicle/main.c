@@ -256,7 +256,7 @@ static int run(void *options, coavoid_scenario_t *s)
         return coavoid_cli_fail(CLI_EXIT_INVALID, "--id: %s has no vehicle %u", o->scenario_path,
                                 (unsigned)o->id);
     }
-    status = coavoid_rt_keys(&o->rt, COAVOID_AUTH_VEHICLE, o->id, true, &config.common);
+    status = coavoid_rt_keys(&o->rt, COAVOID_AUTH_VEHICLE, o->id, &config.common);
     if (status != CLI_CONTINUE) {
         return status;
     }

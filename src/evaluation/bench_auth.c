@@ -101,12 +101,15 @@ typedef struct {
 } bench_t;
 
 /* Fills b->trust to COAVOID_AUTH_MAX_KEYS keys, the three senders' last (a receiver
- * searches its list by key id: the last are its worst case), and gives each sender its
- * seeded key pair. The other keys are never used to verify: their public keys stay zero.
+ * searches its list by key id: the last are its worst case), with a fleet key, and gives
+ * each sender its seeded key pair and the fleet key. The other keys are never used to verify: their public keys stay zero.
  * COA_OK or COA_ERR_ARGUMENT. */
 static int make_keys(bench_t *b)
 {
     coavoid_auth_trust_init(b->trust);
+    unsigned char fleet[COAVOID_AUTH_FLEET_KEY_BYTES];
+    memset(fleet, 0x5a, sizeof fleet);
+    (void)coavoid_auth_trust_set_fleet_key(b->trust, fleet);
     coavoid_auth_key_t key;
     memset(&key, 0, sizeof key);
     key.role = COAVOID_AUTH_VEHICLE;
@@ -123,6 +126,7 @@ static int make_keys(bench_t *b)
         coavoid_auth_signer_t *s = &b->signers[i];
         memset(s, 0, sizeof *s);
         s->key_id = senders[i].key_id;
+        coavoid_auth_signer_use_fleet(s, b->trust);
         memset(&key, 0, sizeof key);
         key.key_id = senders[i].key_id;
         key.role = senders[i].role;
@@ -193,8 +197,9 @@ static void summarise(double *v, size_t n, double *median, double *min, double *
 }
 
 /* Times `repeat` stamps and checks of one type on a datagram of its size. Each repeat is
- * signed one millisecond after the last, and checked at that time, so that every check
- * must pass (fresh numbers each time); one that does not is counted in b->failures.
+ * signed one millisecond after the last, the types one after another (a sender signs
+ * several types, and its clock only moves on), and checked at that time, so that every
+ * check must pass (fresh numbers each time); one that does not is counted in b->failures.
  * COA_OK, or COA_ERR_WORKSPACE when the type does not encode. */
 static int time_type(bench_t *b, size_t type, coavoid_bench_auth_type_t *out)
 {
@@ -206,7 +211,7 @@ static int time_type(bench_t *b, size_t type, coavoid_bench_auth_type_t *out)
     }
     coavoid_auth_signer_t *s = &b->signers[kinds[type].sender];
     for (uint32_t r = 0; r < b->repeat; r++) {
-        const int64_t now = BENCH_AUTH_EPOCH_US + (int64_t)r * 1000;
+        const int64_t now = BENCH_AUTH_EPOCH_US + ((int64_t)type * b->repeat + r) * 1000;
         struct timespec t0, t1, t2;
         clock_gettime(CLOCK_MONOTONIC, &t0);
         int rc = coavoid_auth_stamp(s, now, d, (size_t)size);
@@ -244,7 +249,7 @@ static void time_refusal(bench_t *b, const unsigned char *d, size_t size, int64_
     summarise(b->verify_us, b->repeat, &out->median_us, &out->min_us, &out->max_us);
 }
 
-/* The three refusals of coavoid_bench_auth_refusal_t, after the types were timed (the
+/* The refusals of coavoid_bench_auth_refusal_t, after the types were timed (the
  * intents' last numbers accepted). COA_OK, or COA_ERR_WORKSPACE when intents do not
  * encode. */
 static int time_refusals(bench_t *b, coavoid_bench_auth_refusal_t *out)
@@ -256,7 +261,7 @@ static int time_refusals(bench_t *b, coavoid_bench_auth_refusal_t *out)
         return COA_ERR_WORKSPACE;
     }
     const size_t n = (size_t)size;
-    const int64_t now = BENCH_AUTH_EPOCH_US + (int64_t)b->repeat * 1000;
+    const int64_t now = BENCH_AUTH_EPOCH_US + (int64_t)COAVOID_BENCH_AUTH_TYPES * b->repeat * 1000;
     coavoid_auth_signer_t *s = &b->signers[SENDER_VEHICLE];
     int rc = coavoid_auth_stamp(s, now, d, n);
     b->failures +=
@@ -266,14 +271,18 @@ static int time_refusals(bench_t *b, coavoid_bench_auth_refusal_t *out)
     unsigned char *tail = d + n - COAVOID_AUTH_TAIL_BYTES;
     const unsigned char saved = tail[0];
     tail[0] = 0x7f; /* a key id nobody trusts */
-    out[1].name = "outsider";
+    out[1].name = "unknown_key";
     time_refusal(b, d, n, now, COAVOID_AUTH_ERR_KEY, &out[1]);
     tail[0] = saved;
     rc = coavoid_auth_stamp(s, now + 1, d, n);
     b->failures += rc != COA_OK;
-    d[n - 1u] ^= 0x01u; /* the signature broken */
-    out[2].name = "forged";
-    time_refusal(b, d, n, now + 1, COAVOID_AUTH_ERR_SIGNATURE, &out[2]);
+    d[n - COAVOID_AUTH_TAG_BYTES - 1u] ^= 0x01u; /* the signature broken, the tag stale */
+    out[2].name = "outsider";
+    time_refusal(b, d, n, now + 1, COAVOID_AUTH_ERR_TAG, &out[2]);
+    b->trust->has_fleet_key = false;
+    out[3].name = "signature";
+    time_refusal(b, d, n, now + 1, COAVOID_AUTH_ERR_SIGNATURE, &out[3]);
+    b->trust->has_fleet_key = true;
     free(d);
     return COA_OK;
 }

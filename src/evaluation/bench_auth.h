@@ -100,11 +100,12 @@ typedef struct {
 } coavoid_bench_auth_fleet_t;
 
 /* What refusing a datagram costs a receiver, timed on intents (the largest): "copy", a
- * copy of one it accepted (refused as a replay from its tail); "outsider", a key id it
- * does not trust (refused from its tail); "forged", a known key's fresh tail with a
- * signature that does not verify (refused by the signature check). Microseconds over the
- * repeats. */
-#define COAVOID_BENCH_AUTH_REFUSALS 3u
+ * copy of one it accepted (refused as a replay from its tail); "unknown_key", a key id it
+ * does not trust (refused from its tail); "outsider", a known key's fresh tail with a
+ * signature that does not verify and no fleet tag, as an outsider forges it (refused by
+ * the fleet tag); "signature", the same datagram at a receiver without a fleet key
+ * (refused by the signature check). Microseconds over the repeats. */
+#define COAVOID_BENCH_AUTH_REFUSALS 4u
 typedef struct {
     const char *name;
     double median_us, min_us, max_us;

@@ -12,6 +12,12 @@
 _Static_assert(crypto_sign_BYTES == COAVOID_AUTH_SIGNATURE_BYTES, "an Ed25519 signature");
 _Static_assert(crypto_sign_PUBLICKEYBYTES == COAVOID_AUTH_PUBLIC_BYTES, "an Ed25519 public key");
 _Static_assert(crypto_sign_SECRETKEYBYTES == COAVOID_AUTH_SECRET_BYTES, "an Ed25519 secret key");
+_Static_assert(crypto_generichash_KEYBYTES == COAVOID_AUTH_FLEET_KEY_BYTES, "a BLAKE2b key");
+
+/* The tag is the first COAVOID_AUTH_TAG_BYTES of a keyed BLAKE2b of this length: libsodium's
+ * shortest, and the parameter block (so the hash) depends on it. */
+#define AUTH_TAG_HASH_BYTES 16u
+_Static_assert(AUTH_TAG_HASH_BYTES >= crypto_generichash_BYTES_MIN, "a BLAKE2b output size");
 
 int coavoid_auth_init(void)
 {
@@ -35,6 +41,59 @@ int coavoid_auth_keypair_seed(const unsigned char seed[COAVOID_AUTH_SEED_BYTES],
         return COA_ERR_ARGUMENT;
     }
     return crypto_sign_seed_keypair(public_key, secret_key, seed) == 0 ? COA_OK : COA_ERR_ARGUMENT;
+}
+
+int coavoid_auth_fleet_key(unsigned char key[COAVOID_AUTH_FLEET_KEY_BYTES])
+{
+    if (key == NULL || coavoid_auth_init() != COA_OK) {
+        return COA_ERR_ARGUMENT;
+    }
+    crypto_generichash_keygen(key);
+    return COA_OK;
+}
+
+int coavoid_auth_trust_set_fleet_key(coavoid_auth_trust_t *t,
+                                     const unsigned char key[COAVOID_AUTH_FLEET_KEY_BYTES])
+{
+    if (t == NULL || key == NULL) {
+        return COA_ERR_ARGUMENT;
+    }
+    memcpy(t->fleet_key, key, COAVOID_AUTH_FLEET_KEY_BYTES);
+    t->has_fleet_key = true;
+    return COA_OK;
+}
+
+void coavoid_auth_signer_use_fleet(coavoid_auth_signer_t *s, const coavoid_auth_trust_t *t)
+{
+    s->has_fleet_key = t->has_fleet_key;
+    memcpy(s->fleet_key, t->fleet_key, COAVOID_AUTH_FLEET_KEY_BYTES);
+}
+
+/* The tag of the datagram's first `tagged` bytes with `key`. */
+static void fleet_tag(const unsigned char key[COAVOID_AUTH_FLEET_KEY_BYTES],
+                      const unsigned char *datagram, size_t tagged,
+                      unsigned char tag[COAVOID_AUTH_TAG_BYTES])
+{
+    unsigned char hash[AUTH_TAG_HASH_BYTES];
+    crypto_generichash(hash, sizeof hash, datagram, tagged, key, COAVOID_AUTH_FLEET_KEY_BYTES);
+    memcpy(tag, hash, COAVOID_AUTH_TAG_BYTES);
+}
+
+int coavoid_auth_tag_check(const coavoid_auth_trust_t *t, const unsigned char *datagram,
+                           size_t size)
+{
+    if (t == NULL || datagram == NULL || size < COAVOID_AUTH_TAIL_BYTES + 8u) {
+        return COAVOID_AUTH_ERR_TAG;
+    }
+    if (!t->has_fleet_key) {
+        return COA_OK;
+    }
+    unsigned char tag[COAVOID_AUTH_TAG_BYTES];
+    const size_t tagged = size - COAVOID_AUTH_TAG_BYTES;
+    fleet_tag(t->fleet_key, datagram, tagged, tag);
+    return sodium_memcmp(tag, datagram + tagged, COAVOID_AUTH_TAG_BYTES) == 0
+               ? COA_OK
+               : COAVOID_AUTH_ERR_TAG;
 }
 
 void coavoid_auth_trust_init(coavoid_auth_trust_t *t)
@@ -110,11 +169,18 @@ int coavoid_auth_sign(const coavoid_auth_signer_t *s, unsigned char *datagram, s
     if (s == NULL || datagram == NULL || size < COAVOID_AUTH_TAIL_BYTES + 8u) {
         return COA_ERR_ARGUMENT;
     }
-    const size_t signed_size = size - COAVOID_AUTH_SIGNATURE_BYTES;
-    return crypto_sign_detached(datagram + signed_size, NULL, datagram, signed_size,
-                                s->secret_key) == 0
-               ? COA_OK
-               : COA_ERR_ARGUMENT;
+    const size_t tagged = size - COAVOID_AUTH_TAG_BYTES;
+    const size_t signed_size = tagged - COAVOID_AUTH_SIGNATURE_BYTES;
+    if (crypto_sign_detached(datagram + signed_size, NULL, datagram, signed_size, s->secret_key) !=
+        0) {
+        return COA_ERR_ARGUMENT;
+    }
+    if (s->has_fleet_key) {
+        fleet_tag(s->fleet_key, datagram, tagged, datagram + tagged);
+    } else {
+        memset(datagram + tagged, 0, COAVOID_AUTH_TAG_BYTES);
+    }
+    return COA_OK;
 }
 
 static void put_be(unsigned char *p, uint64_t v, size_t bytes)
@@ -142,7 +208,7 @@ int coavoid_auth_stamp(coavoid_auth_signer_t *s, int64_t now, unsigned char *dat
         s->last_timestamp = next.last_timestamp;
         s->sequence = next.sequence;
     }
-    sodium_memzero(next.secret_key, sizeof next.secret_key);
+    sodium_memzero(&next, sizeof next);
     return rc;
 }
 
@@ -218,6 +284,9 @@ int coavoid_auth_precheck(const coavoid_auth_trust_t *t, const unsigned char *da
                   (int64_t)get_be(tail + 12, 8u), expect->now, expect->max_age_us,
                   expect->max_ahead_us);
     if (rc == COA_OK) {
+        rc = coavoid_auth_tag_check(t, datagram, size);
+    }
+    if (rc == COA_OK) {
         *key = i;
     }
     return rc;
@@ -234,7 +303,7 @@ int coavoid_auth_verify(const coavoid_auth_trust_t *t, const unsigned char *data
     if (rc != COA_OK) {
         return rc;
     }
-    const size_t signed_size = size - COAVOID_AUTH_SIGNATURE_BYTES;
+    const size_t signed_size = size - COAVOID_AUTH_TAG_BYTES - COAVOID_AUTH_SIGNATURE_BYTES;
     if (crypto_sign_verify_detached(datagram + signed_size, datagram, signed_size,
                                     t->keys[i].public_key) != 0) {
         return COAVOID_AUTH_ERR_SIGNATURE;
@@ -357,6 +426,25 @@ static const char *trust_line(const char *line, coavoid_auth_key_t *key)
     return NULL;
 }
 
+/* A fleet line's key (after the word "fleet") into t. */
+static const char *fleet_line(const char *rest, coavoid_auth_trust_t *t)
+{
+    char hex[80], extra[2];
+    unsigned char key[COAVOID_AUTH_FLEET_KEY_BYTES];
+    if (t->has_fleet_key) {
+        return "a second fleet line";
+    }
+    if (sscanf(rest, "%79s %1s", hex, extra) != 1 ||
+        !hex_bytes(hex, key, COAVOID_AUTH_FLEET_KEY_BYTES)) {
+        sodium_memzero(hex, sizeof hex);
+        return "expected fleet FLEET_KEY_HEX (64 hex digits)";
+    }
+    (void)coavoid_auth_trust_set_fleet_key(t, key);
+    sodium_memzero(hex, sizeof hex);
+    sodium_memzero(key, sizeof key);
+    return NULL;
+}
+
 int coavoid_auth_trust_parse(coavoid_auth_trust_t *t, const char *text, size_t length, char *err,
                              size_t err_size)
 {
@@ -374,6 +462,13 @@ int coavoid_auth_trust_parse(coavoid_auth_trust_t *t, const char *text, size_t l
             return fail_line(err, err_size, number, "longer than 255 characters");
         }
         if (*p == '\0' || *p == '#') {
+            continue;
+        }
+        if (strncmp(p, "fleet", 5) == 0 && (p[5] == ' ' || p[5] == '\t')) {
+            const char *why = fleet_line(p + 5, t);
+            if (why != NULL) {
+                return fail_line(err, err_size, number, why);
+            }
             continue;
         }
         coavoid_auth_key_t key;
@@ -431,6 +526,19 @@ int coavoid_auth_signer_line(const coavoid_auth_signer_t *s, char *out, size_t s
     }
     sodium_bin2hex(hex, sizeof hex, s->secret_key, COAVOID_AUTH_SECRET_BYTES);
     int n = snprintf(out, size, "coavoid-secret-key %lu %s\n", (unsigned long)s->key_id, hex);
+    sodium_memzero(hex, sizeof hex);
+    return n > 0 && (size_t)n < size ? COA_OK : COA_ERR_ARGUMENT;
+}
+
+int coavoid_auth_fleet_line(const unsigned char key[COAVOID_AUTH_FLEET_KEY_BYTES], char *out,
+                            size_t size)
+{
+    char hex[2u * COAVOID_AUTH_FLEET_KEY_BYTES + 1u];
+    if (key == NULL || out == NULL) {
+        return COA_ERR_ARGUMENT;
+    }
+    sodium_bin2hex(hex, sizeof hex, key, COAVOID_AUTH_FLEET_KEY_BYTES);
+    int n = snprintf(out, size, "fleet %s\n", hex);
     sodium_memzero(hex, sizeof hex);
     return n > 0 && (size_t)n < size ? COA_OK : COA_ERR_ARGUMENT;
 }

@@ -1,28 +1,40 @@
 /* SPDX-License-Identifier: MIT */
 /*
  * auth.h: signed messages. Every message type ends with an auth_t (lcmtypes/auth_t.lcm):
- * the sender's key id, its clock when it signed, a sequence, and an Ed25519 signature. As
- * the last field of every type it is the last COAVOID_AUTH_TAIL_BYTES of every datagram,
- * the signature the last COAVOID_AUTH_SIGNATURE_BYTES, so that signing and checking work
- * on the datagram's bytes whatever its type:
+ * the sender's key id, its clock when it signed, a sequence, an Ed25519 signature and the
+ * fleet's tag. As the last field of every type it is the last COAVOID_AUTH_TAIL_BYTES of
+ * every datagram, the tag the last COAVOID_AUTH_TAG_BYTES and the signature the
+ * COAVOID_AUTH_SIGNATURE_BYTES before it, so that signing and checking work on the
+ * datagram's bytes whatever its type:
  *
  *   signed bytes = the datagram before its signature: the type's fingerprint, every field
- *                  in LCM's encoding, then key_id, timestamp_us and sequence.
+ *                  in LCM's encoding, then key_id, timestamp_us and sequence;
+ *   tagged bytes = the datagram before its tag: the signed bytes and the signature.
  *
  * (docs/messages.md, "Signed messages", defines it for other implementations.) The
  * fingerprint binds the type, and with it the channel, since each type has one.
  *
  * A receiver holds a trust list: the public keys it accepts, each with the role it may
- * speak for (the coordinator, the world, or one vehicle by id). coavoid_auth_verify
- * checks a datagram's signature against the key its key_id names; coavoid_auth_fresh
- * then accepts it only when it is newer than the last accepted from that key (timestamp,
- * then sequence) and within a window of the receiver's clock, so a copied or replayed
- * message is refused, and a sender that restarts (a later clock, its sequence from 0) is
- * accepted at once: nobody is locked out.
+ * speak for (the coordinator, the world, or one vehicle by id), and the fleet's key.
+ * coavoid_auth_precheck refuses what a datagram's tail and tag rule out, for the cost of
+ * a key lookup and one keyed hash; coavoid_auth_verify checks its signature against the
+ * key its key_id names; coavoid_auth_fresh then accepts it only when it is newer than the
+ * last accepted from that key (timestamp, then sequence) and within a window of the
+ * receiver's clock, so a copied or replayed message is refused, and a sender that
+ * restarts (a later clock, its sequence from 0) is accepted at once: nobody is locked out.
  *
- * Ed25519 by libsodium (crypto_sign_detached / crypto_sign_verify_detached). Memory: the
+ * Two keys, two questions. The fleet key, shared by every node of the fleet, answers "is
+ * this from inside the fleet?" cheaply, so that an outsider's flood costs a receiver a
+ * hash instead of a signature check; it cannot tell one member from another. The
+ * per-sender Ed25519 key answers "which member?", so that no vehicle can speak for
+ * another or for the coordinator. A trust list without a fleet key neither writes nor
+ * checks tags (each is zero).
+ *
+ * Ed25519 by libsodium (crypto_sign_detached / crypto_sign_verify_detached); the tag is
+ * the first 8 bytes of keyed BLAKE2b-128 (crypto_generichash, a 32-byte key). Memory: the
  * caller's structs; nothing is allocated. Cost: one signature or verification over the
- * datagram (tens of microseconds; docs/benchmarks.md).
+ * datagram (tens of microseconds), one keyed hash (about a microsecond on a PC;
+ * docs/benchmarks.md).
  */
 #ifndef COAVOID_LCM_AUTH_H
 #define COAVOID_LCM_AUTH_H
@@ -32,7 +44,10 @@
 #include <stdint.h>
 
 #define COAVOID_AUTH_SIGNATURE_BYTES 64u
-#define COAVOID_AUTH_TAIL_BYTES (4u + 8u + 8u + COAVOID_AUTH_SIGNATURE_BYTES)
+#define COAVOID_AUTH_TAG_BYTES 8u
+#define COAVOID_AUTH_TAIL_BYTES \
+    (4u + 8u + 8u + COAVOID_AUTH_SIGNATURE_BYTES + COAVOID_AUTH_TAG_BYTES)
+#define COAVOID_AUTH_FLEET_KEY_BYTES 32u
 #define COAVOID_AUTH_PUBLIC_BYTES 32u
 #define COAVOID_AUTH_SECRET_BYTES 64u
 /* Keys one receiver trusts: a coordinator, a world and every UAV a node holds, with room. */
@@ -69,19 +84,25 @@ typedef struct {
     unsigned char public_key[COAVOID_AUTH_PUBLIC_BYTES];
 } coavoid_auth_key_t;
 
-/* A receiver's trust list and, per key and stream, the newest message accepted from it
- * (17,928 bytes on x86-64). */
+/* A receiver's trust list, the fleet's key and, per key and stream, the newest message
+ * accepted from it (17,968 bytes on x86-64). */
 typedef struct {
     coavoid_auth_key_t keys[COAVOID_AUTH_MAX_KEYS];
     size_t count;
+    bool has_fleet_key; /* tags are written and checked */
+    unsigned char fleet_key[COAVOID_AUTH_FLEET_KEY_BYTES];
     int64_t last_timestamp[COAVOID_AUTH_MAX_KEYS][COAVOID_AUTH_STREAMS];
     int64_t last_sequence[COAVOID_AUTH_MAX_KEYS][COAVOID_AUTH_STREAMS];
 } coavoid_auth_trust_t;
 
 /* A sender's key, with the numbers of its next signature. */
+/* A sender's key, the fleet's key it tags with (coavoid_auth_signer_use_fleet), and the
+ * numbers of its next signature. */
 typedef struct {
     uint32_t key_id;
     unsigned char secret_key[COAVOID_AUTH_SECRET_BYTES];
+    bool has_fleet_key;
+    unsigned char fleet_key[COAVOID_AUTH_FLEET_KEY_BYTES];
     int64_t last_timestamp;
     int64_t sequence;
 } coavoid_auth_signer_t;
@@ -93,6 +114,7 @@ typedef struct {
 #define COAVOID_AUTH_ERR_ROLE (-123)      /* the key may not send this (role or node) */
 #define COAVOID_AUTH_ERR_REPLAY (-124)    /* not newer than the last from that key */
 #define COAVOID_AUTH_ERR_CLOCK (-125)     /* timestamp outside the receiver's window */
+#define COAVOID_AUTH_ERR_TAG (-126)       /* the fleet tag does not match: not from the fleet */
 
 /* Initialises libsodium; call once before anything else here (thread-safe, idempotent).
  * Returns COA_OK or COA_ERR_ARGUMENT when the library cannot start. */
@@ -109,6 +131,17 @@ int coavoid_auth_keypair(unsigned char public_key[COAVOID_AUTH_PUBLIC_BYTES],
 int coavoid_auth_keypair_seed(const unsigned char seed[COAVOID_AUTH_SEED_BYTES],
                               unsigned char public_key[COAVOID_AUTH_PUBLIC_BYTES],
                               unsigned char secret_key[COAVOID_AUTH_SECRET_BYTES]);
+
+/* A new fleet key from the system's random source. Returns COA_OK or COA_ERR_ARGUMENT. */
+int coavoid_auth_fleet_key(unsigned char key[COAVOID_AUTH_FLEET_KEY_BYTES]);
+
+/* Gives t the fleet key: from then on coavoid_auth_precheck requires every datagram's tag.
+ * Returns COA_OK or COA_ERR_ARGUMENT (NULL). */
+int coavoid_auth_trust_set_fleet_key(coavoid_auth_trust_t *t,
+                                     const unsigned char key[COAVOID_AUTH_FLEET_KEY_BYTES]);
+
+/* s tags what it signs with t's fleet key, or with none when t has none. O(1). */
+void coavoid_auth_signer_use_fleet(coavoid_auth_signer_t *s, const coavoid_auth_trust_t *t);
 
 /* Empties a trust list; adds a key (COA_ERR_ARGUMENT: list full, key_id 0 or repeated). */
 void coavoid_auth_trust_init(coavoid_auth_trust_t *t);
@@ -132,15 +165,17 @@ int coavoid_auth_signer_matches(const coavoid_auth_trust_t *t, const coavoid_aut
 void coavoid_auth_signer_clear(coavoid_auth_signer_t *s);
 
 /* Signs an encoded datagram of `size` bytes whose auth_t already holds the signer's
- * key_id and numbers (coavoid_auth_next): writes the signature into its last 64 bytes.
- * Returns COA_OK or COA_ERR_ARGUMENT (NULL, or too short to end with an auth_t). */
+ * key_id and numbers (coavoid_auth_next): writes the signature, then the fleet tag (zero
+ * when s has no fleet key). Returns COA_OK or COA_ERR_ARGUMENT (NULL, or too short to end
+ * with an auth_t). */
 int coavoid_auth_sign(const coavoid_auth_signer_t *s, unsigned char *datagram, size_t size);
 
 /* Stamps and signs an encoded datagram of `size` bytes in place, whatever its type: writes
  * the next numbers of s at `now` (coavoid_auth_next) into its auth_t, big-endian as LCM
  * encodes them, then the signature (coavoid_auth_sign). So a publisher needs no access to
  * the message's struct. Returns COA_OK or COA_ERR_ARGUMENT (NULL, or too short); s's
- * numbers move on only on success. Cost: one Ed25519 signature over size - 64 bytes. */
+ * numbers move on only on success. Cost: one Ed25519 signature over size - 72 bytes and
+ * one keyed hash over size - 8. */
 int coavoid_auth_stamp(coavoid_auth_signer_t *s, int64_t now, unsigned char *datagram, size_t size);
 
 /* What a receiver expects of a datagram on one channel, for coavoid_auth_precheck: its
@@ -155,15 +190,21 @@ typedef struct {
     int64_t max_ahead_us;
 } coavoid_auth_expect_t;
 
-/* The checks a datagram's auth tail allows before any cryptography, so that a copy, a
- * replay or a made-up tail costs a receiver a key lookup instead of a signature check
- * (docs/security.md, "Floods"): signed and long enough, its key_id in t, that key's role
- * the expected one, and its (timestamp, sequence) fresh on the stream as
- * coavoid_auth_fresh would find it, without marking it. COA_OK with *key (its index in
- * t), or the COAVOID_AUTH_ERR_* the full check would end with. Reads only the datagram's
- * last COAVOID_AUTH_TAIL_BYTES; O(keys), no memory. */
+/* The checks a datagram allows before its signature, so that a copy, a replay or an
+ * outsider's datagram costs a receiver a key lookup and a hash instead of a signature
+ * check (docs/security.md, "Floods"). From the tail alone: signed and long enough, its
+ * key_id in t, that key's role the expected one, and its (timestamp, sequence) fresh on
+ * the stream as coavoid_auth_fresh would find it, without marking it; then, when t has a
+ * fleet key, the tag (coavoid_auth_tag_check). COA_OK with *key (its index in t), or the
+ * COAVOID_AUTH_ERR_* of the first check that failed. O(keys) and one keyed hash over the
+ * datagram; no memory. */
 int coavoid_auth_precheck(const coavoid_auth_trust_t *t, const unsigned char *datagram, size_t size,
                           const coavoid_auth_expect_t *expect, size_t *key);
+
+/* Whether a datagram's tag is the fleet's: COA_OK (or t has no fleet key), or
+ * COAVOID_AUTH_ERR_TAG (also too short). Constant time in the tag. One keyed hash. */
+int coavoid_auth_tag_check(const coavoid_auth_trust_t *t, const unsigned char *datagram,
+                           size_t size);
 
 /* Checks a received datagram's signature against the key its key_id names in t. Returns
  * COA_OK with *key (its index in t) or a COAVOID_AUTH_ERR_*; reads only the datagram. */
@@ -198,7 +239,10 @@ int coavoid_auth_accept(coavoid_auth_trust_t *t, size_t key, size_t stream,
  * A trust file lists the keys a receiver accepts, one per line:
  *     KEY_ID ROLE NODE_ID PUBLIC_KEY_HEX
  * with ROLE coordinator, world or vehicle, NODE_ID the node it speaks for (1..65535) and
- * the public key as 64 hex digits; blank lines and lines starting with '#' are skipped.
+ * the public key as 64 hex digits, and at most one line
+ *     fleet FLEET_KEY_HEX
+ * with the fleet's key as 64 hex digits (a secret: a trust file that holds it is kept as
+ * a secret key file is); blank lines and lines starting with '#' are skipped.
  * A secret key file is one line: "coavoid-secret-key KEY_ID SECRET_KEY_HEX" (128 digits).
  * Both are files a user hands us: every line is bounded (COAVOID_AUTH_LINE_MAX) and
  * checked, and the first problem is reported as "line N: why". */
@@ -217,5 +261,10 @@ int coavoid_auth_signer_parse(coavoid_auth_signer_t *s, const char *text, size_t
  * (COAVOID_AUTH_LINE_MAX is enough). COA_OK or COA_ERR_ARGUMENT (too small, bad role). */
 int coavoid_auth_key_line(const coavoid_auth_key_t *k, char *out, size_t size);
 int coavoid_auth_signer_line(const coavoid_auth_signer_t *s, char *out, size_t size);
+
+/* The trust file's line of a fleet key ("fleet HEX\n") into out[size]. COA_OK or
+ * COA_ERR_ARGUMENT (NULL, or too small). */
+int coavoid_auth_fleet_line(const unsigned char key[COAVOID_AUTH_FLEET_KEY_BYTES], char *out,
+                            size_t size);
 
 #endif /* COAVOID_LCM_AUTH_H */

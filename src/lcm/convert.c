@@ -216,6 +216,8 @@ const char *coavoid_lcm_error_name(int status)
         return "auth: not newer than the last from that key (a copy or a replay)";
     case COAVOID_AUTH_ERR_CLOCK:
         return "auth: signed at a time outside the receiver's window";
+    case COAVOID_AUTH_ERR_TAG:
+        return "auth: the fleet tag does not match (not from the fleet)";
     default:
         return coa_status_name(status);
     }

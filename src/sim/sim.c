@@ -639,8 +639,8 @@ static int sim_open(sim_run_t *r)
     return sim_net(r);
 }
 
-/* One fleet key of the simulation into signer and the trust list: its seed is a fixed text
- * and the key id, so every run signs alike. */
+/* One node's key of the simulation into signer and the trust list: its seed is a fixed text
+ * and the key id, so every run signs alike; it tags with the trust list's fleet key. */
 static int sim_key(sim_run_t *r, coavoid_auth_signer_t *signer, uint32_t key_id,
                    coavoid_auth_role_t role, uint16_t node)
 {
@@ -652,6 +652,7 @@ static int sim_key(sim_run_t *r, coavoid_auth_signer_t *signer, uint32_t key_id,
     coavoid_auth_key_t key = {key_id, role, node, {0}};
     memset(signer, 0, sizeof *signer);
     signer->key_id = key_id;
+    coavoid_auth_signer_use_fleet(signer, &r->trust);
     if (coavoid_auth_keypair_seed(seed, key.public_key, signer->secret_key) != COA_OK ||
         coavoid_auth_trust_add(&r->trust, &key) != COA_OK) {
         return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INTERNAL,
@@ -660,7 +661,8 @@ static int sim_key(sim_run_t *r, coavoid_auth_signer_t *signer, uint32_t key_id,
     return SIM_GO_ON;
 }
 
-/* The fleet's keys, as coavoid keygen numbers them, unless the run is insecure. */
+/* The fleet's keys, as coavoid keygen numbers them, and a fixed fleet key, unless the run
+ * is insecure. */
 static int sim_keys(sim_run_t *r)
 {
     r->common.insecure = r->o->insecure;
@@ -674,6 +676,8 @@ static int sim_keys(sim_run_t *r)
     }
     coavoid_auth_trust_init(&r->trust);
     r->common.trust = &r->trust;
+    const unsigned char fleet_key[COAVOID_AUTH_FLEET_KEY_BYTES] = "coavoid simulation fleet key";
+    (void)coavoid_auth_trust_set_fleet_key(&r->trust, fleet_key);
     int rc = sim_key(r, &r->signers[0], COAVOID_AUTH_KEY_ID_COORDINATOR, COAVOID_AUTH_COORDINATOR,
                      (uint16_t)COAVOID_NODE_COORDINATOR_ID);
     if (rc == SIM_GO_ON) {

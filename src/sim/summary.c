@@ -491,8 +491,8 @@ static void auth_restart(log_summary_t *ls)
     }
 }
 
-/* Whether a valid message (its raw bytes in e, its decoded auth) is authentic: signed by a
- * key of the trust list that may send it as (role, id), and newer than the last of its
+/* Whether a valid message (its raw bytes in e, its decoded auth) is authentic: the fleet's
+ * tag, signed by a key of the trust list that may send it as (role, id), and newer than the last of its
  * stream from that key. Always true without a trust list. Counts into *counter (when
  * `count`) what is not. */
 static bool authentic(log_summary_t *ls, const lcm_eventlog_event_t *e, size_t stream,
@@ -503,7 +503,10 @@ static bool authentic(log_summary_t *ls, const lcm_eventlog_event_t *e, size_t s
         return true;
     }
     size_t key = 0;
-    int rc = coavoid_auth_verify(&ls->trust, e->data, (size_t)e->datalen, &key);
+    int rc = coavoid_auth_tag_check(&ls->trust, e->data, (size_t)e->datalen);
+    if (rc == COA_OK) {
+        rc = coavoid_auth_verify(&ls->trust, e->data, (size_t)e->datalen, &key);
+    }
     if (rc == COA_OK) {
         /* Order only (now = its own time, no window): the logger's clock is not the
          * nodes' (a run may be sped up). */

@@ -22,11 +22,11 @@ for line in lines:
     kv[k] = v
 assert kv.pop("benchmark") == "auth", kv
 v = {k: float(x) for k, x in kv.items()}
-assert v["repeat"] == 3 and v["verify_failures"] == 0 and v["auth_bytes_per_message"] == 84, v
+assert v["repeat"] == 3 and v["verify_failures"] == 0 and v["auth_bytes_per_message"] == 92, v
 assert v["signer_bytes"] > 64 and v["trust_list_bytes"] > 0, v
 types = ["intent", "plan", "track", "obstacle_map", "conflict_report", "status", "agreement"]
 for t in types:
-    assert v[t + "_bytes"] > 84, t
+    assert v[t + "_bytes"] > 92, t
     for what in ("sign", "verify"):
         lo, mid, hi = (v[f"{t}_{what}_{s}_us"] for s in ("min", "median", "max"))
         assert 0 < lo <= mid <= hi, (t, what, lo, mid, hi)
@@ -39,7 +39,7 @@ for n in (3, 100):
         for k in ("sent", "received", "copies", "sign_us", "verify_us", "us_per_cycle",
                   "dt_percent", "traffic_bytes", "auth_bytes", "memory_bytes"):
             assert q + k in v, q + k
-        assert v[q + "auth_bytes"] == 84 * (v[q + "sent"] + v[q + "received"]), q
+        assert v[q + "auth_bytes"] == 92 * (v[q + "sent"] + v[q + "received"]), q
         assert abs(v[q + "us_per_cycle"] - v[q + "sign_us"] - v[q + "verify_us"]) < 0.2, q
     # node.h's cycle, with C = 4 copies (COAVOID_NODE_DEFAULT_COPIES): a vehicle sends
     # its intent 1 + C times, a heartbeat, and ACCEPT and SWITCHED (1 + C times) on its
@@ -55,9 +55,9 @@ for n in (3, 100):
     assert v[p + "world_sent"] == sends * (maps + tracks) and v[p + "world_received"] == 0, n
     assert v[p + "world_memory_bytes"] == v["signer_bytes"], n
     assert v[p + "vehicle_memory_bytes"] == v["signer_bytes"] + v["trust_list_bytes"], n
-# Refusals: all three timed (a failed refusal would show in verify_failures); never their
+# Refusals: all four timed (a failed refusal would show in verify_failures); never their
 # times.
-for x in ("copy", "outsider", "forged"):
+for x in ("copy", "unknown_key", "outsider", "signature"):
     lo, mid, hi = (v[f"refused_{x}_{s}_us"] for s in ("min", "median", "max"))
     assert 0 <= lo <= mid <= hi, (x, lo, mid, hi)
     # Copies: every send of an intent, map tile, track and SWITCHED after its first.
@@ -65,7 +65,7 @@ for x in ("copy", "outsider", "forged"):
     assert v[p + "vehicle_copies"] == (sends - 1) * (peers + maps + tracks + n), n
     assert v[p + "coordinator_copies"] == (sends - 1) * (n + maps + tracks + n), n
     assert v[p + "world_copies"] == 0, n
-assert len(v) == 6 + 7 * len(types) + 3 * 3 + 2 * (4 + 3 * 10), len(v)
+assert len(v) == 6 + 7 * len(types) + 4 * 3 + 2 * (4 + 3 * 10), len(v)
 PY
 fi
 
@@ -77,9 +77,9 @@ assert b["benchmark"] == "auth" and b["repeat"] == 3 and b["verify_failures"] ==
 assert [t["type"] for t in b["types"]] == ["intent", "plan", "track", "obstacle_map",
                                           "conflict_report", "status", "agreement"], b["types"]
 for t in b["types"]:
-    assert t["bytes"] > 84 and 0 < t["sign_min_us"] <= t["sign_median_us"] <= t["sign_max_us"], t
+    assert t["bytes"] > 92 and 0 < t["sign_min_us"] <= t["sign_median_us"] <= t["sign_max_us"], t
     assert 0 < t["verify_min_us"] <= t["verify_median_us"] <= t["verify_max_us"], t
-assert [x["refusal"] for x in b["refusals"]] == ["copy", "outsider", "forged"], b["refusals"]
+assert [x["refusal"] for x in b["refusals"]] == ["copy", "unknown_key", "outsider", "signature"], b["refusals"]
 for x in b["refusals"]:
     assert 0 <= x["min_us"] <= x["median_us"] <= x["max_us"], x
 assert len(b["fleets"]) == 1 and b["fleets"][0]["vehicles"] == 5, b["fleets"]

@@ -469,16 +469,16 @@ s['replans'] == sum(num(f'vehicle-{i}', 'plans run') for i in (1, 2, 3))
 # Each flight of the paper's encounter ends with no loss of separation and the forgery
 # reported in the heartbeats of the nodes it reached (their refusals, with the last
 # refusal's code). Four attackers, one flight each, both modes:
-#   stolen      the attacker holds vehicle 3's secret key (a stolen vehicle) and signs with
-#               it: an empty map with the world's id and the largest version (unsigned, it
+#   stolen      the attacker holds vehicle 3's secret key and trust file (a stolen vehicle:
+#               the fleet key with it) and signs and tags with them: an empty map with the world's id and the largest version (unsigned, it
 #               would erase the terrain and lock the real map out as older); a plan for
 #               UAV 1 from the coordinator's id flying it to UAV 2's altitude (centralised
 #               only: decoupled vehicles take no plans); UAV 2's intents 300 m higher. All
 #               refused: that key may not send them (-123), or, for an intent stamped
 #               before vehicle 3's own last one under the same key, from its tail as not
 #               newer (-124);
-#   copy        UAV 2's real intents again with sequences 1000 higher: the signature fails
-#               (-122);
+#   copy        UAV 2's real intents again with sequences 1000 higher: the fleet tag fails
+#               (-126), before any signature check;
 #   replay      every message heard sent again 1.5 s later: not newer than the last from
 #               its key (-124);
 #   replay-log  the log of flight (a), an earlier run with the same keys, played back with
@@ -500,7 +500,7 @@ rc['summary'] == 0 and rc['forge'] == 0"
         else
             speed=$speed_decoupled all="1, 2, 3" stolen=map,intent
         fi
-        forge_args="--key $keys/vehicle-3.key" attack=$stolen \
+        forge_args="--key $keys/vehicle-3.key --trust $keys/trust.txt" attack=$stolen \
             fleet "attack-stolen-$mode" "$tmp/paper_lead_in.json" "$mode" 48 -
         for attack in copy replay replay-log; do
             forge_args= fleet "attack-$attack-$mode" "$tmp/paper_lead_in.json" "$mode" 48 -
@@ -520,7 +520,7 @@ set(log['codes']['1']) <= {0, -123, -124}"
         check "attack-copy-$mode" "$survived
 $same
 $forged
-$(reported -122 "$all")"
+$(reported -126 "$all")"
         check "attack-replay-$mode" "$survived
 $same
 $forged

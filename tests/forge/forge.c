@@ -18,7 +18,8 @@
  *   replay   every intent, heartbeat, plan, map and track it hears, sent again unchanged
  *            1.5 s later.
  * With --key FILE (a secret key file: a key stolen from a vehicle, say) it signs what it
- * forges (map, collide, intent) with that key; otherwise its messages are unsigned.
+ * forges (map, collide, intent) with that key, and with --trust FILE (the trust file
+ * stolen with it) tags them with the fleet key; otherwise its messages are unsigned.
  *
  * Its messages carry the nodes' time, taken from the intents it hears (a test's run is sped
  * up, so the wall clock would make them stale).
@@ -27,7 +28,7 @@
  *
  * usage: coavoid_test_forge --lcm-url URL --attack map|collide|intent|copy|replay[,...]
  *                           --seconds S [--target ID] [--other ID] [--coordinator-id ID]
- *                           [--key FILE]
+ *                           [--key FILE [--trust FILE]]
  * Prints how many messages it forged on stdout when it stops.
  */
 #define _POSIX_C_SOURCE 200809L
@@ -300,8 +301,28 @@ static int read_key(const char *path, coavoid_auth_signer_t *s)
     return 0;
 }
 
+/* The fleet key of the trust file at path into s; 0, or -1 with a line on stderr. */
+static int read_trust(const char *path, coavoid_auth_signer_t *s)
+{
+    static char text[65536];
+    static coavoid_auth_trust_t trust;
+    char err[128];
+    FILE *in = fopen(path, "r");
+    size_t n = in != NULL ? fread(text, 1, sizeof text - 1, in) : 0;
+    if (in != NULL) {
+        fclose(in);
+    }
+    if (coavoid_auth_trust_parse(&trust, text, n, err, sizeof err) != 0) {
+        fprintf(stderr, "forge: --trust %s: %s\n", path, in != NULL ? err : "cannot read");
+        return -1;
+    }
+    coavoid_auth_signer_use_fleet(s, &trust);
+    return 0;
+}
+
 static int parse(int argc, char **argv, forger_t *f, const char **url, double *seconds)
 {
+    const char *trust = NULL;
     for (int i = 1; i + 1 < argc; i += 2) {
         const char *k = argv[i], *v = argv[i + 1];
         if (strcmp(k, "--lcm-url") == 0) {
@@ -321,9 +342,14 @@ static int parse(int argc, char **argv, forger_t *f, const char **url, double *s
                 return -1;
             }
             f->sign = 1;
+        } else if (strcmp(k, "--trust") == 0) {
+            trust = v;
         } else {
             return -1;
         }
+    }
+    if (trust != NULL && (!f->sign || read_trust(trust, &f->signer) != 0)) {
+        return -1;
     }
     return (argc % 2 == 1 && f->attack != NULL && *seconds > 0) ? 0 : -1;
 }
@@ -339,7 +365,7 @@ int main(int argc, char **argv)
     if (parse(argc, argv, &f, &url, &seconds) != 0) {
         fprintf(stderr, "usage: coavoid_test_forge --lcm-url URL --attack "
                         "map|collide|intent|copy|replay --seconds S [--target ID] [--other ID] "
-                        "[--coordinator-id ID] [--key FILE]\n");
+                        "[--coordinator-id ID] [--key FILE [--trust FILE]]\n");
         return 2;
     }
     if (attacks(&f, "replay")) {
