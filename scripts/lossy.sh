@@ -8,8 +8,17 @@
 # holds what was sent. Each run's log is judged by `coavoid summary --trust`; one line per
 # run, then the count of runs that lost separation.
 #
+# Each run's line also says, of the first intent of each UAV and cycle, how late after the
+# cycle's start the logger heard it (the worst, in wall milliseconds, and how many were
+# later than 50 ms); each node's CPU seconds; and from the nodes' last heartbeats the
+# messages they refused and dropped unchecked, and the largest inbox rate they reported
+# (also in RUN/flood.json). With --flood, a flooder (tests/forge/flood.c) in a namespace
+# of its own sends copies of what it hears back to the group for the whole flight (the
+# logger drops them, so the log still holds what the fleet sent).
+#
 # usage: scripts/lossy.sh [--loss PERCENT] [--mode centralised|decoupled] [--runs R]
 #                         [--scenario FILE] [--speed S] [--build DIR] [--out DIR]
+#                         [--flood heard|fresh|signed [--flood-rate N] [--flood-key ID]]
 #
 #   --loss       percent of datagrams each receiver drops, 0..100; default 30
 #   --mode       centralised (default) or decoupled
@@ -19,10 +28,15 @@
 #   --build      the build directory (apps/coavoid, coavoid-coordinator, coavoid-vehicle);
 #                default build
 #   --out        where each run's log, summary and process lines go; default BUILD/lossy
+#   --flood      heard: copies with the stamps as heard; fresh: stamps moved ahead (both
+#                without keys, signatures broken); signed: signed and tagged afresh with
+#                a stolen vehicle key and the fleet key (flood.c's file comment)
+#   --flood-rate datagrams a second; default 100000 (signed: 10000)
+#   --flood-key  the UAV whose key is stolen (signed); default the scenario's last UAV
 #
 # Needs root (it makes namespaces, a bridge and nftables rules, all inside a private
 # network and mount namespace of its own: the host's network is never touched), iproute2,
-# nftables, lcm-logger and python3. A measurement, not a test: docs/evaluation.md has the
+# nftables, lcm-logger, lcm-gen and python3. A measurement, not a test: docs/evaluation.md has the
 # figures.
 set -euo pipefail
 
@@ -34,6 +48,9 @@ scenario=$root/scenarios/paper.json
 speed=2
 build=build
 out=
+flood=
+flood_rate=
+flood_key=
 
 die() {
     echo "lossy: $*" >&2
@@ -50,6 +67,9 @@ while [ $# -gt 0 ]; do
     --speed) [ $# -ge 2 ] || die "--speed: missing value"; speed=$2; shift 2 ;;
     --build) [ $# -ge 2 ] || die "--build: missing value"; build=$2; shift 2 ;;
     --out) [ $# -ge 2 ] || die "--out: missing value"; out=$2; shift 2 ;;
+    --flood) [ $# -ge 2 ] || die "--flood: missing value"; flood=$2; shift 2 ;;
+    --flood-rate) [ $# -ge 2 ] || die "--flood-rate: missing value"; flood_rate=$2; shift 2 ;;
+    --flood-key) [ $# -ge 2 ] || die "--flood-key: missing value"; flood_key=$2; shift 2 ;;
     -h | --help) sed -n '2,/^set -euo/p' "${BASH_SOURCE[0]}" | sed '$d' | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) die "unknown argument '$1' (see scripts/lossy.sh --help)" ;;
     esac
@@ -59,6 +79,13 @@ case $mode in centralised | decoupled) ;; *) die "--mode: '$mode' is not central
 [[ $runs =~ ^[1-9][0-9]*$ ]] || die "--runs: '$runs' is not a count"
 [[ $speed =~ ^[0-9]*\.?[0-9]+$ ]] || die "--speed: '$speed' is not a positive number"
 [ -f "$scenario" ] || die "--scenario: no file '$scenario'"
+case $flood in "" | heard | fresh | signed) ;; *) die "--flood: '$flood' is not heard, fresh or signed" ;; esac
+if [ -z "$flood_rate" ]; then
+    flood_rate=100000
+    [ "$flood" = signed ] && flood_rate=10000
+fi
+[[ $flood_rate =~ ^[1-9][0-9]*$ ]] || die "--flood-rate: '$flood_rate' is not a count a second"
+[ -z "$flood_key" ] || [[ $flood_key =~ ^[1-9][0-9]*$ ]] || die "--flood-key: '$flood_key' is not a UAV id"
 case $build in /*) ;; *) build=$PWD/$build ;; esac
 [ -n "$out" ] || out=$build/lossy
 coavoid=$build/apps/coavoid
@@ -67,7 +94,9 @@ vehicle=$build/apps/coavoid-vehicle
 for b in "$coavoid" "$coordinator" "$vehicle"; do
     [ -x "$b" ] || die "no $b: build first"
 done
-for c in ip nft lcm-logger python3 unshare; do
+flooder=$build/tests/coavoid_test_flood
+[ -z "$flood" ] || [ -x "$flooder" ] || die "no $flooder: build first"
+for c in ip nft lcm-logger lcm-gen python3 unshare; do
     command -v "$c" >/dev/null || die "needs $c"
 done
 [ "$(id -u)" -eq 0 ] || die "needs root (network namespaces)"
@@ -88,6 +117,8 @@ mapfile -t ids < <("$vehicle" --scenario "$scenario" --list-ids)
 names=(logger world)
 [ "$mode" = centralised ] && names+=(coordinator)
 for id in "${ids[@]}"; do names+=("vehicle-$id"); done
+[ -n "$flood" ] && names+=(flood)
+[ -n "$flood_key" ] || flood_key=${ids[-1]}
 
 # host NAME N LOSES: namespace NAME on the bridge as 10.77.0.N, dropping LOSES percent of
 # the datagrams it receives from the bridge (its own looped-back ones are never lost).
@@ -113,9 +144,16 @@ host() {
 }
 n=1
 for name in "${names[@]}"; do
-    if [ "$name" = logger ]; then host "$name" "$n" 0; else host "$name" "$n" "$loss"; fi
+    case $name in logger | flood) host "$name" "$n" 0 ;; *) host "$name" "$n" "$loss" ;; esac
+    [ "$name" = flood ] && flood_ip=10.77.0.$n
     n=$((n + 1))
 done
+if [ -n "$flood" ]; then
+    # The log holds what the fleet sent: the logger does not hear the flooder.
+    ip netns exec logger nft add table inet flood
+    ip netns exec logger nft add chain inet flood in '{ type filter hook input priority 0; }'
+    ip netns exec logger nft add rule inet flood in ip saddr "$flood_ip" counter drop
+fi
 
 mkdir -p "$out"
 out=$(cd "$out" && pwd)
@@ -125,6 +163,16 @@ mkdir -p "$keys"
 chmod 700 "$keys"
 "$coavoid" keygen "$scenario" --dir "$keys" >/dev/null
 url="udpm://239.255.76.67:7667?ttl=1"
+rm -rf "$out/py"
+lcm-gen -p --ppath "$out/py" "$root"/lcmtypes/*.lcm >/dev/null || die "lcm-gen -p failed"
+
+# cpu NAME FILE CMD...: runs CMD in namespace NAME, its CPU time into FILE (bash's `times`:
+# the last line is the user and system time of CMD).
+cpu() {
+    local name=$1 file=$2
+    shift 2
+    CPU_FILE=$file ip netns exec "$name" bash -c '"$@"; s=$?; times >"$CPU_FILE"; exit $s' _ "$@"
+}
 
 # ---- the runs ----
 
@@ -138,27 +186,39 @@ for run in $(seq "$runs"); do
     epoch=$(($(date +%s%N) / 1000 + 2000000))
     common=(--lcm-url "$url" --epoch "$epoch" --speed "$speed")
     pids=()
+    flooder_pid=
     for name in "${names[@]}"; do
         key=(--key "$keys/$name.key" --trust "$keys/trust.txt")
         case $name in
         logger) continue ;;
-        world) ip netns exec world "$coavoid" world "$scenario" "${common[@]}" "${key[@]}" \
+        flood)
+            stolen=()
+            [ "$flood" = signed ] && stolen=(--key "$keys/vehicle-$flood_key.key" --trust "$keys/trust.txt")
+            ip netns exec flood "$flooder" --lcm-url "$url" --mode "$flood" --rate "$flood_rate" \
+                "${stolen[@]}" >"$dir/flood.txt" 2>&1 &
+            flooder_pid=$!
+            continue ;;
+        world) cpu world "$dir/world.cpu" "$coavoid" world "$scenario" "${common[@]}" "${key[@]}" \
             2>"$dir/world.txt" & ;;
-        coordinator) ip netns exec coordinator "$coordinator" --scenario "$scenario" \
+        coordinator) cpu coordinator "$dir/coordinator.cpu" "$coordinator" --scenario "$scenario" \
             "${common[@]}" "${key[@]}" 2>"$dir/coordinator.txt" & ;;
-        *) ip netns exec "$name" "$vehicle" --scenario "$scenario" --id "${name#vehicle-}" \
+        *) cpu "$name" "$dir/$name.cpu" "$vehicle" --scenario "$scenario" --id "${name#vehicle-}" \
             --mode "$mode" "${common[@]}" "${key[@]}" 2>"$dir/$name.txt" & ;;
         esac
         pids+=($!)
     done
     for p in "${pids[@]}"; do wait "$p" || true; done
+    if [ -n "$flooder_pid" ]; then
+        kill -TERM "$flooder_pid" 2>/dev/null || true
+        wait "$flooder_pid" || true
+    fi
     sleep 0.3
     kill -INT "$logger"
     wait "$logger" || true
     "$coavoid" summary "$dir/log.lcm" "$scenario" --mode "$mode" --epoch "$epoch" --json \
         --trust "$keys/trust.txt" >"$dir/summary.json" 2>"$dir/summary.err" || true
-    line=$(python3 - "$dir" <<'PY'
-import glob, json, os, re, sys
+    line=$(python3 - "$dir" "$out/py" "$epoch" "$speed" "$flood" <<'PY'
+import glob, json, os, re, struct, sys
 d = sys.argv[1]
 try:
     s = json.load(open(os.path.join(d, "summary.json")))
@@ -169,9 +229,51 @@ fallbacks = 0
 for f in glob.glob(os.path.join(d, "vehicle-*.txt")):
     m = re.search(r"fallbacks (\d+)", open(f).read())
     fallbacks += int(m.group(1)) if m else 0
-print("loss of separation: %s, deviation %s m^2, effort %s, replans %s, fallbacks %d, "
-      "samples from an earlier plan %s" % ("yes" if s["loss_of_separation"] else "no",
-      s["deviation"], s["effort"], s["replans"], fallbacks, s["log"]["samples_earlier_plan"]))
+line = ("loss of separation: %s, deviation %s m^2, effort %s, replans %s, fallbacks %d, "
+        "samples from an earlier plan %s" % ("yes" if s["loss_of_separation"] else "no",
+        s["deviation"], s["effort"], s["replans"], fallbacks, s["log"]["samples_earlier_plan"]))
+sys.path.insert(0, sys.argv[2])
+from coavoid import intent_t, status_t
+epoch, speed = int(sys.argv[3]), float(sys.argv[4])
+data = open(os.path.join(d, "log.lcm"), "rb").read()
+i, first, status, codes, reasons = 0, {}, {}, {}, {}
+while i + 28 <= len(data):
+    _, _, ts, clen, dlen = struct.unpack_from(">IqqII", data, i)
+    channel = data[i + 28:i + 28 + clen].decode()
+    payload = data[i + 28 + clen:i + 28 + clen + dlen]
+    i += 28 + clen + dlen
+    if channel == "COAVOID_INTENT":
+        m = intent_t.decode(payload)
+        first.setdefault((m.uav_id, m.plan_utime), ts)
+    elif channel == "COAVOID_STATUS":
+        m = status_t.decode(payload)
+        r = status.get(m.node_id, (0, 0, 0))
+        status[m.node_id] = (m.messages_rejected, m.messages_dropped, max(m.inbox_rate, r[2]))
+        codes.setdefault(m.node_id, set()).add(m.last_reject_code)
+        reasons[m.node_id] = reasons.get(m.node_id, 0) | m.reasons
+# A cycle's start in wall time: scenario time runs `speed` times the wall's from epoch.
+late = [(ts - (epoch + (k - epoch) / speed)) / 1000 for (_, k), ts in first.items()]
+worst = max(late) if late else float("nan")
+cpu = []
+for f in sorted(glob.glob(os.path.join(d, "*.cpu"))):
+    u, sy = (float(x.rstrip("s").split("m")[0]) * 60 + float(x.rstrip("s").split("m")[1])
+             for x in open(f).read().split()[-2:])
+    cpu.append("%s %.1f" % (os.path.basename(f)[:-4], u + sy))
+nodes = ", ".join("%d: %d/%d/%d" % (k, *v) for k, v in sorted(status.items()))
+flood_txt = os.path.join(d, "flood.txt")
+flooded = open(flood_txt).read().strip() if sys.argv[5] else "no flood"
+sent = re.search(r"sent (\d+)", flooded)
+json.dump({"loss_of_separation": s["loss_of_separation"], "worst_late_ms": worst,
+           "late_over_50ms": sum(x > 50 for x in late), "intents": len(late),
+           "sent": int(sent.group(1)) if sent else 0,
+           "nodes": {str(k): {"refused": v[0], "dropped": v[1], "max_rate": v[2],
+                              "codes": sorted(codes[k]), "reasons": reasons[k]}
+                     for k, v in status.items()}},
+          open(os.path.join(d, "flood.json"), "w"))
+line += ("; intents heard late: worst %.1f ms, %d of %d over 50 ms; cpu s: %s; "
+         "refused/dropped/max rate: %s; %s" % (worst, sum(x > 50 for x in late), len(late),
+         ", ".join(cpu), nodes, flooded))
+print(line)
 PY
 )
     case $line in *"separation: yes"* | "no verdict"*) lost=$((lost + 1)) ;; esac

@@ -740,7 +740,7 @@ START_TEST(test_datagram_sizes)
     ck_assert_int_eq(coavoid_track_t_encoded_size(&track), 728);
     ck_assert_int_eq(coavoid_obstacle_map_t_encoded_size(&map), 1400);
     ck_assert_int_eq(coavoid_conflict_report_t_encoded_size(&report), 1378);
-    ck_assert_int_eq(coavoid_status_t_encoded_size(&status), 180);
+    ck_assert_int_eq(coavoid_status_t_encoded_size(&status), 192);
     ck_assert_int_le(coavoid_intent_t_encoded_size(&intent), COAVOID_LCM_MAX_DATAGRAM_BYTES);
     ck_assert_int_le(coavoid_obstacle_map_t_encoded_size(&map), COAVOID_LCM_MAX_DATAGRAM_BYTES);
     ck_assert_int_le(coavoid_conflict_report_t_encoded_size(&report),
@@ -1087,14 +1087,20 @@ START_TEST(test_reject_status)
     EXPECT(coavoid_status_t, status, m_.messages_rejected = 1001, COAVOID_LCM_ERR_COUNT);
     EXPECT(coavoid_status_t, status, m_.messages_received = -1, COAVOID_LCM_ERR_COUNT);
     EXPECT(coavoid_status_t, status, m_.last_reject_code = 1, COAVOID_LCM_ERR_VALUE);
+    EXPECT(coavoid_status_t, status, m_.messages_dropped = -1, COAVOID_LCM_ERR_COUNT);
+    EXPECT(coavoid_status_t, status, m_.inbox_rate = -1, COAVOID_LCM_ERR_COUNT);
     /* reasons: known bits only, none exactly when OK, a fatal one exactly when FAULT. */
     EXPECT(coavoid_status_t, status, m_.reasons = COAVOID_STATUS_T_REASON_NO_MAP,
            COAVOID_LCM_ERR_VALUE);
     EXPECT(coavoid_status_t, status, (m_.health = COAVOID_STATUS_T_HEALTH_DEGRADED, m_.reasons = 0),
            COAVOID_LCM_ERR_VALUE);
     EXPECT(coavoid_status_t, status,
-           (m_.health = COAVOID_STATUS_T_HEALTH_DEGRADED, m_.reasons = 1024),
+           (m_.health = COAVOID_STATUS_T_HEALTH_DEGRADED, m_.reasons = 2048),
            COAVOID_LCM_ERR_VALUE);
+    EXPECT(coavoid_status_t, status,
+           (m_.health = COAVOID_STATUS_T_HEALTH_DEGRADED,
+            m_.reasons = COAVOID_STATUS_T_REASON_INBOX_FLOOD),
+           COA_OK);
     EXPECT(coavoid_status_t, status,
            (m_.health = COAVOID_STATUS_T_HEALTH_DEGRADED,
             m_.reasons = COAVOID_STATUS_T_REASON_DUPLICATE_ID),

@@ -2355,7 +2355,7 @@ END_TEST
 /* ---- signed messages ---- */
 
 /* The signed tests' fleet: key ids as coavoid keygen numbers them (the coordinator 1, the
- * world 2, UAV i 100 + i), from fixed seeds; every node trusts every key. */
+ * world 2, UAV i 100 + i), from fixed seeds, and a fleet key; every node trusts every key. */
 typedef struct {
     coavoid_auth_trust_t trust;
     coavoid_auth_signer_t coordinator, world, uav[2]; /* uav[i]: UAV i + 1 */
@@ -2368,6 +2368,7 @@ static void fleet_key(fleet_keys_t *k, coavoid_auth_signer_t *s, uint32_t id,
     coavoid_auth_key_t key = {id, role, node, {0}};
     memset(s, 0, sizeof *s);
     s->key_id = id;
+    coavoid_auth_signer_use_fleet(s, &k->trust);
     ck_assert_int_eq(coavoid_auth_keypair_seed(seed, key.public_key, s->secret_key), COA_OK);
     ck_assert_int_eq(coavoid_auth_trust_add(&k->trust, &key), COA_OK);
 }
@@ -2375,6 +2376,8 @@ static void fleet_key(fleet_keys_t *k, coavoid_auth_signer_t *s, uint32_t id,
 static void fleet_keys(fleet_keys_t *k)
 {
     coavoid_auth_trust_init(&k->trust);
+    const unsigned char fleet[COAVOID_AUTH_FLEET_KEY_BYTES] = "test fleet key";
+    ck_assert_int_eq(coavoid_auth_trust_set_fleet_key(&k->trust, fleet), COA_OK);
     fleet_key(k, &k->coordinator, 1, COAVOID_AUTH_COORDINATOR,
               (uint16_t)COAVOID_NODE_COORDINATOR_ID);
     fleet_key(k, &k->world, 2, COAVOID_AUTH_WORLD, (uint16_t)COAVOID_NODE_WORLD_ID);
@@ -2416,6 +2419,8 @@ typedef struct {
     unsigned char bytes[TAP_BYTES];
     int32_t node;
     int32_t reasons;
+    int64_t dropped;
+    int32_t inbox_rate;
 } wiretap_t;
 
 static void on_tapped_intent(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
@@ -2438,6 +2443,8 @@ static void on_tapped_status(const lcm_recv_buf_t *rbuf, const char *channel, vo
     if (coavoid_status_t_decode(rbuf->data, 0, (int)rbuf->data_size, &m) > 0 &&
         m.node_id == t->node) {
         t->reasons = m.reasons;
+        t->dropped = m.messages_dropped;
+        t->inbox_rate = m.inbox_rate;
     }
 }
 
@@ -2497,7 +2504,7 @@ START_TEST(test_signed_messages)
     expect_refused(&r, s, COAVOID_AUTH_ERR_REPLAY, "UAV 2's intent again");
     buf[(size_t)tap.size - COAVOID_AUTH_TAIL_BYTES + 19u] ^= 1; /* its auth sequence, one higher */
     publish_bytes(r.lcm, COAVOID_CHANNEL_INTENT, buf, tap.size, NULL, 0);
-    expect_refused(&r, s, COAVOID_AUTH_ERR_SIGNATURE, "a copy numbered higher");
+    expect_refused(&r, s, COAVOID_AUTH_ERR_TAG, "a copy numbered higher");
     static coavoid_intent_t m;
     ck_assert_int_gt(coavoid_intent_t_decode(tap.bytes, 0, tap.size, &m), 0);
     m.sequence++;
@@ -2542,6 +2549,92 @@ START_TEST(test_signed_messages)
 
     lcm_unsubscribe(r.lcm, si);
     lcm_unsubscribe(r.lcm, ss);
+    coavoid_world_destroy(w);
+    coavoid_vehicle_node_destroy(b);
+    coavoid_vehicle_node_destroy(a);
+    lcm_destroy(r.lcm);
+}
+END_TEST
+
+/* The inbox budget: a stolen key's flood of fresh, validly signed intents costs a node at
+ * most COAVOID_NODE_CHECKS_PER_VEHICLE signature checks in a cycle; the rest are dropped
+ * unchecked, counted, and said in its next heartbeat with the rate it took them in at.
+ * Another key's message in the same cycle is still checked and accepted, and the next
+ * cycle's budget is whole again. */
+START_TEST(test_inbox_budget)
+{
+    static fleet_keys_t k;
+    fleet_keys(&k);
+    rig_t r;
+    rig_init(&r, 10);
+    static wiretap_t tap;
+    tap.node = 1;
+    tap.uav = 2;
+    lcm_subscription_t *ss = lcm_subscribe(r.lcm, COAVOID_CHANNEL_STATUS, on_tapped_status, &tap);
+    lcm_subscription_t *si = lcm_subscribe(r.lcm, COAVOID_CHANNEL_INTENT, on_tapped_intent, &tap);
+    coa_vec3_t r1[2], r2[2];
+    coavoid_vehicle_node_t *a =
+        signed_vehicle(&r, &k, uav(1, 1, r1, 0, 500, 0, 100), COAVOID_NODE_DECOUPLED);
+    coavoid_vehicle_node_t *b =
+        signed_vehicle(&r, &k, uav(2, 2, r2, 0, 500, 800, 100), COAVOID_NODE_DECOUPLED);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(b, r.now), COA_OK);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
+    drain(r.lcm);
+    const coavoid_vehicle_node_state_t *s = coavoid_vehicle_node_state(a);
+    ck_assert_int_eq(tap.dropped, 0);
+    ck_assert_int_eq(tap.reasons & COAVOID_STATUS_T_REASON_INBOX_FLOOD, 0);
+
+    /* UAV 2's key stolen: fresh intents of UAV 2, each signed, one after another, in
+     * cycle 1. */
+    r.now = cycle(1);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
+    drain(r.lcm);
+    r.now = cycle(1) + DT_US / 4;
+    static coavoid_intent_t m;
+    ck_assert_int_gt(coavoid_intent_t_decode(tap.bytes, 0, tap.size, &m), 0);
+    static unsigned char buf[TAP_BYTES];
+    const uint32_t flood = COAVOID_NODE_CHECKS_PER_VEHICLE + 10u;
+    int64_t received = s->rx.received;
+    for (uint32_t i = 0; i < flood; i++) {
+        m.sequence++;
+        const int size = coavoid_intent_t_encode(buf, 0, (int)sizeof buf, &m);
+        publish_bytes(r.lcm, COAVOID_CHANNEL_INTENT, buf, size, &k.uav[1], r.now);
+        drain(r.lcm);
+    }
+    ck_assert_int_eq(s->rx.received, received + COAVOID_NODE_CHECKS_PER_VEHICLE);
+    /* The world's map in the same cycle: another key, still checked. */
+    coavoid_world_config_t wc;
+    memset(&wc, 0, sizeof wc);
+    wc.common = r.common;
+    wc.common.signer = &k.world;
+    int error = -99;
+    coavoid_world_t *w = coavoid_world_create(&wc, r.lcm, &error);
+    ck_assert_ptr_nonnull(w);
+    ck_assert_int_eq(coavoid_world_cycle(w, r.now), COA_OK);
+    drain(r.lcm);
+    ck_assert_int_eq(s->rx.received, received + COAVOID_NODE_CHECKS_PER_VEHICLE + 1);
+    ck_assert_int_eq(s->rx.rejected, 0);
+
+    r.now = cycle(2);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
+    drain(r.lcm);
+    ck_assert(tap.reasons & COAVOID_STATUS_T_REASON_INBOX_FLOOD);
+    ck_assert_int_eq(tap.dropped, 10);
+    ck_assert_int_ge(tap.inbox_rate, (int32_t)flood);
+    /* A new cycle, a whole budget: UAV 2's next intent is checked and accepted. */
+    m.sequence++;
+    int size = coavoid_intent_t_encode(buf, 0, (int)sizeof buf, &m);
+    publish_bytes(r.lcm, COAVOID_CHANNEL_INTENT, buf, size, &k.uav[1], r.now + 1);
+    drain(r.lcm);
+    ck_assert_int_eq(s->rx.received, received + COAVOID_NODE_CHECKS_PER_VEHICLE + 2);
+    r.now = cycle(3);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
+    drain(r.lcm);
+    ck_assert_int_eq(tap.reasons & COAVOID_STATUS_T_REASON_INBOX_FLOOD, 0);
+    ck_assert_int_eq(tap.dropped, 10);
+
+    lcm_unsubscribe(r.lcm, ss);
+    lcm_unsubscribe(r.lcm, si);
     coavoid_world_destroy(w);
     coavoid_vehicle_node_destroy(b);
     coavoid_vehicle_node_destroy(a);
@@ -2696,6 +2789,7 @@ static Suite *node_suite(void)
     tcase_add_test(tc, test_every_datagram_fits);
     tcase_add_test(tc, test_bad_configs_refused);
     tcase_add_test(tc, test_signed_messages);
+    tcase_add_test(tc, test_inbox_budget);
     tcase_add_test(tc, test_keys_required);
     suite_add_tcase(s, tc);
     return s;

@@ -1502,7 +1502,7 @@ int8_t coavoid_lcm_health_of(int32_t reasons)
 /* Known REASON_* bits only, and the health they give. */
 static bool status_reasons_ok(const coavoid_status_t *msg)
 {
-    const int32_t known = 2 * COAVOID_STATUS_T_REASON_INSECURE - 1;
+    const int32_t known = 2 * COAVOID_STATUS_T_REASON_INBOX_FLOOD - 1;
     const int32_t r = msg->reasons;
     return r >= 0 && (r & ~known) == 0 && msg->health == coavoid_lcm_health_of(r);
 }
@@ -1557,6 +1557,9 @@ int coavoid_lcm_status_check(const coavoid_status_t *msg, const coavoid_lcm_cont
     }
     if (msg->last_reject_code > 0) {
         REJECT(COAVOID_LCM_ERR_VALUE, "status: last_reject_code positive");
+    }
+    if (msg->messages_dropped < 0 || msg->inbox_rate < 0) {
+        REJECT(COAVOID_LCM_ERR_COUNT, "status: messages_dropped or inbox_rate negative");
     }
     if (!status_reasons_ok(msg)) {
         REJECT(COAVOID_LCM_ERR_VALUE, "status: reasons unknown, or not what its health says");

@@ -181,20 +181,70 @@ static void count_undecodable(coavoid_node_inbox_t *in, const char *reason)
     coavoid_lcm_rx_count(in->rx, COAVOID_LCM_ERR_DECODE, reason);
 }
 
-/* A received datagram's auth tail and signature, over its raw bytes before anything
- * decodes them (a secure inbox only): first what the tail says without cryptography (a
- * known key of the channel's role, fresh on its stream: a copy or a replay ends here),
- * then the signature. True with the key's index in *key, else counted as refused. */
+/* Brings the inbox budget to the cycle of `now`: a new cycle starts it afresh. */
+static void budget_roll(coavoid_node_inbox_t *in, int64_t now)
+{
+    const int64_t cycle = coavoid_node_cycle_of(&in->common, now);
+    if (cycle != in->budget_cycle) {
+        in->last_cycle_datagrams = cycle == in->budget_cycle + 1 ? in->cycle_datagrams : 0u;
+        in->budget_cycle = cycle;
+        memset(in->checks, 0, sizeof in->checks);
+        in->cycle_checks = 0u;
+        in->cycle_datagrams = 0u;
+    }
+}
+
+/* An inbox budget of no cycle yet, nothing dropped. */
+static void budget_init(coavoid_node_inbox_t *in)
+{
+    in->budget_cycle = INT64_MIN;
+    memset(in->checks, 0, sizeof in->checks);
+    in->cycle_checks = 0u;
+    in->cycle_datagrams = 0u;
+    in->last_cycle_datagrams = 0u;
+    in->dropped = 0;
+    in->dropped_at_heartbeat = 0;
+}
+
+/* Whether the cycle's budget has a signature check left for key on stream; then it is
+ * spent. Otherwise the datagram is counted as dropped. */
+static bool budget_check(coavoid_node_inbox_t *in, size_t key, size_t stream)
+{
+    const uint16_t limit = in->trust.keys[key].role == COAVOID_AUTH_VEHICLE
+                               ? COAVOID_NODE_CHECKS_PER_VEHICLE
+                               : COAVOID_NODE_CHECKS_PER_KEY;
+    if (in->checks[key][stream] >= limit || in->cycle_checks >= COAVOID_NODE_CHECKS_PER_CYCLE) {
+        in->dropped++;
+        return false;
+    }
+    in->checks[key][stream]++;
+    in->cycle_checks++;
+    return true;
+}
+
+/* A received datagram's auth tail, fleet tag and signature, over its raw bytes before
+ * anything decodes them (a secure inbox only): first what the tail and the tag say (a
+ * known key of the channel's role, fresh on its stream, from the fleet: a copy, a replay
+ * or an outsider's datagram ends here), then, within the cycle's budget (node.h,
+ * COAVOID_NODE_CHECKS_PER_*), the signature. True with the key's index in *key, else
+ * counted as refused or dropped. Every datagram counts towards the cycle's inbox rate. */
 static bool signature_ok(coavoid_node_inbox_t *in, const lcm_recv_buf_t *rbuf, size_t stream,
                          coavoid_auth_role_t role, size_t *key)
 {
     *key = 0;
+    budget_roll(in, *in->common.clock);
+    if (in->cycle_datagrams < UINT32_MAX) {
+        in->cycle_datagrams++;
+    }
     if (!in->secure) {
         return true;
     }
     const coavoid_auth_expect_t expect = {stream, role, *in->common.clock, in->max_age_us,
                                           in->common.dt_us};
     int rc = coavoid_auth_precheck(&in->trust, rbuf->data, rbuf->data_size, &expect, key);
+    if (rc == COA_OK && !budget_check(in, *key, stream)) {
+        return false;
+    }
     if (rc == COA_OK) {
         rc = coavoid_auth_verify(&in->trust, rbuf->data, rbuf->data_size, key);
     }
@@ -734,6 +784,7 @@ int coavoid_node_inbox_init(coavoid_node_inbox_t *in, const coavoid_node_common_
     in->own_next = 0;
     in->foreign_intents = 0;
     in->rejected_at_heartbeat = 0;
+    budget_init(in);
     in->heard_coordinator = false;
     in->coordinator_utime = 0;
     in->on_plan = plan_handler;
@@ -1318,6 +1369,13 @@ void coavoid_node_solver_fini(coavoid_node_solver_t *s)
     memset(s, 0, sizeof *s);
 }
 
+/* Datagrams a second over the last whole cycle, saturated. */
+static int32_t inbox_rate(const coavoid_node_inbox_t *in)
+{
+    const double rate = (double)in->last_cycle_datagrams * 1e6 / (double)in->common.dt_us;
+    return rate >= (double)INT32_MAX ? INT32_MAX : (int32_t)rate;
+}
+
 int coavoid_node_publish_heartbeat(coavoid_node_inbox_t *in, coavoid_status_t *m, int64_t now,
                                    int64_t cycle_start, const coavoid_node_heartbeat_t *h)
 {
@@ -1328,7 +1386,12 @@ int coavoid_node_publish_heartbeat(coavoid_node_inbox_t *in, coavoid_status_t *m
     m->sequence = h->sequence;
     const bool refused = h->rx->rejected > in->rejected_at_heartbeat;
     in->rejected_at_heartbeat = h->rx->rejected;
+    budget_roll(in, now);
+    const bool flooded = in->dropped > in->dropped_at_heartbeat ||
+                         in->last_cycle_datagrams > COAVOID_NODE_INBOX_FLOOD;
+    in->dropped_at_heartbeat = in->dropped;
     m->reasons = h->reasons | (refused ? COAVOID_STATUS_T_REASON_MESSAGES_REFUSED : 0) |
+                 (flooded ? COAVOID_STATUS_T_REASON_INBOX_FLOOD : 0) |
                  (in->have_map ? 0 : COAVOID_STATUS_T_REASON_NO_MAP) |
                  (in->secure ? 0 : COAVOID_STATUS_T_REASON_INSECURE);
     m->health = coavoid_lcm_health_of(m->reasons);
@@ -1343,6 +1406,8 @@ int coavoid_node_publish_heartbeat(coavoid_node_inbox_t *in, coavoid_status_t *m
     m->messages_received = h->rx->received;
     m->messages_rejected = h->rx->rejected;
     m->last_reject_code = h->rx->last_reject_code;
+    m->messages_dropped = in->dropped;
+    m->inbox_rate = inbox_rate(in);
     coavoid_lcm_context_t ctx = coavoid_node_context(in, now, cycle_start);
     if (coavoid_lcm_status_check(m, &ctx, NULL) != COA_OK) {
         return COA_ERR_ARGUMENT;

@@ -177,6 +177,22 @@
 #define COAVOID_NODE_MAX_HORIZON 40u /* N: intent_t carries N + 1 samples, in one datagram */
 #define COAVOID_NODE_MAX_CONFIGURED_OBSTACLES 80u /* a node's own terrain database */
 
+/* The inbox budget (docs/security.md, "Floods"). A datagram whose tail and fleet tag
+ * pass (coavoid_auth_precheck) costs a signature check; per cycle, a node makes at most
+ * COAVOID_NODE_CHECKS_PER_VEHICLE of them for one vehicle's key on one channel (a UAV
+ * sends an intent, at most 4 more when overtaken in the decoupled order, a heartbeat and
+ * its answers on a few plans), COAVOID_NODE_CHECKS_PER_KEY for the coordinator's or the
+ * world's (a plan row per UAV and plan; 16 map tiles and 32 tracks), and
+ * COAVOID_NODE_CHECKS_PER_CYCLE in all, and drops the rest unchecked (counted, heartbeat
+ * REASON_INBOX_FLOOD). So a stolen vehicle key's flood costs a receiver at most
+ * COAVOID_NODE_CHECKS_PER_VEHICLE checks per channel and cycle. COAVOID_NODE_INBOX_FLOOD:
+ * datagrams per cycle (refused ones included) above which a node calls its inbox flooded
+ * even when it dropped nothing. */
+#define COAVOID_NODE_CHECKS_PER_VEHICLE 32u
+#define COAVOID_NODE_CHECKS_PER_KEY 128u
+#define COAVOID_NODE_CHECKS_PER_CYCLE 4096u
+#define COAVOID_NODE_INBOX_FLOOD 4096u
+
 /* The world's id (map_id of the obstacle map, source_id of tracks) by default. */
 #define COAVOID_NODE_WORLD_ID 65000u
 #define COAVOID_NODE_COORDINATOR_ID 65001u

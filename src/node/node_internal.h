@@ -162,6 +162,18 @@ struct coavoid_node_inbox {
 
     int64_t rejected_at_heartbeat; /* rx->rejected when the last heartbeat was sent */
 
+    /* The inbox budget of cycle budget_cycle (node.h, COAVOID_NODE_CHECKS_PER_*): the
+     * signature checks made per key and stream and in all, the datagrams taken in (this
+     * cycle's and the last's), and those dropped unchecked (since start, and when the
+     * last heartbeat was sent). */
+    int64_t budget_cycle;
+    uint16_t checks[COAVOID_AUTH_MAX_KEYS][COAVOID_AUTH_STREAMS];
+    uint32_t cycle_checks;
+    uint32_t cycle_datagrams;
+    uint32_t last_cycle_datagrams;
+    int64_t dropped;
+    int64_t dropped_at_heartbeat;
+
     /* Counts the tracks it took in while holding none of theirs, and the obstacle maps it
      * put in use (wraps): what it knows of the world grew when it changed, which a vehicle
      * that decided before then decides again on (vehicle.c, reconsider). */

@@ -1,0 +1,47 @@
+#!/bin/bash
+# SPDX-License-Identifier: MIT
+# A flood without keys does not cost the fleet its separation (docs/security.md,
+# "Floods"): the paper's encounter flown by the real processes, each in a network
+# namespace of its own (scripts/lossy.sh), while a flooder sends copies of every channel's
+# latest datagrams with their stamps moved ahead and their signatures broken, as fast as
+# it can up to 100,000 a second, for the whole flight, once per mode. Each flight must
+# keep separation, every node must refuse the flood by its fleet tag (-126) and drop
+# nothing unchecked (the tag, not the signature budget, stops it), and every UAV's first
+# intent of each cycle must be heard within 50 ms (wall) of the cycle's start, except in
+# decoupled cycles where it waits for the UAVs before it (bounded by the priority wait).
+# Everything it sends stays inside the namespaces of the run.
+#
+# usage: bash flood.sh <path-to-coavoid> <source-dir> <path-to-coavoid_test_flood>
+# (needs root for the namespaces; without them it says so and skips)
+set -u
+# shellcheck source=tests/cli/lib.bash
+. "$(dirname "${BASH_SOURCE[0]}")/lib.bash" "$@"
+build=$(cd "$(dirname "$bin")/.." && pwd)
+[ -x "${3:-}" ] || { fail "no flooder (argument 3: coavoid_test_flood)"; finish; exit; }
+if [ "$(id -u)" -ne 0 ] || ! unshare --net --mount true 2>/dev/null || ! command -v nft >/dev/null; then
+    echo "note: needs root, network namespaces and nftables: not flown"
+    finish
+    exit
+fi
+for mode in centralised decoupled; do
+    out=$tmp/$mode
+    if ! "$src/scripts/lossy.sh" --runs 1 --loss 0 --speed 4 --mode "$mode" --flood fresh \
+        --build "$build" --out "$out" >"$tmp/$mode.out" 2>&1; then
+        fail "$mode: lossy.sh failed: $(tail -n 3 "$tmp/$mode.out")"
+        continue
+    fi
+    late=50
+    [ "$mode" = decoupled ] && late=1e9 # a decoupled intent may wait for its predecessors
+    if python3 - "$out/run-1/flood.json" "$late" >"$tmp/py" 2>&1 <<'PY'; then pass; else fail "$mode: $(tail -n 5 "$tmp/py")"; fi
+import json, sys
+f = json.load(open(sys.argv[1]))
+assert f["loss_of_separation"] is False, f
+assert f["sent"] >= 10000, ("the flooder sent too little to judge", f["sent"])
+assert f["worst_late_ms"] <= float(sys.argv[2]), ("an intent heard late", f["worst_late_ms"])
+for node, n in f["nodes"].items():
+    assert n["refused"] >= 1000 and -126 in n["codes"], (node, n)
+    assert n["dropped"] == 0, (node, "dropped unchecked", n)
+    assert n["reasons"] & 4, (node, "refusals not in its health", n)
+PY
+done
+finish
