@@ -1316,6 +1316,18 @@ START_TEST(test_unanswered_conflict_planned_within_cycle)
 }
 END_TEST
 
+/* A refused plan answers nothing, and the UAV does not wait for the answer wait to say so
+ * (docs/protocol.md, "Refusals"): it plans for itself in the cycle the plan came, so with
+ * an answer wait past the cycle's end (under which an unanswered pair collides:
+ * test_unanswered_conflict_planned_within_cycle) the pair whose every plan is refused
+ * stays apart. */
+START_TEST(test_refused_plan_planned_within_cycle)
+{
+    coa_vec3_t p[2][9];
+    fly_answered_by(2 * DT_US, true, p);
+    ck_assert_msg(!flown_conflict(p[0], p[1], 8), "loss of separation after refusals");
+}
+END_TEST
 
 /* Whether two UAVs' flown positions (samples 0..n) conflict over any step. */
 static bool flown_conflict(const coa_vec3_t *pa, const coa_vec3_t *pb, int64_t n)
@@ -2759,6 +2771,7 @@ static Suite *node_suite(void)
     tcase_add_test(tc, test_faulty_coordinator_not_followed);
     tcase_add_test(tc, test_late_plans_fall_back);
     tcase_add_test(tc, test_unanswered_conflict_planned_within_cycle);
+    tcase_add_test(tc, test_refused_plan_planned_within_cycle);
     tcase_add_test(tc, test_answer_does_not_wait_for_a_switched_uav);
     tcase_add_test(tc, test_switch_before_it_is_decided_on_again);
     tcase_add_test(tc, test_failed_plan_is_an_answer);

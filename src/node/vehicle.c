@@ -1613,13 +1613,20 @@ static void answer_with_copies(coavoid_vehicle_node_t *node, int64_t now, int8_t
                                int64_t plan_id);
 
 /* A plan of this cycle for it that it will not fly: refused, and the coordinator told
- * (REFUSE), so that it plans the others again without waiting for its answer. */
+ * (REFUSE), so that it plans the others again without waiting for its answer. Following
+ * the coordinator, with no plan of the cycle adopted or held, it does not wait for the
+ * answer wait either: its deadline is now, so the next poll runs answer_overdue, which
+ * plans for itself in this cycle when it has a conflict (docs/protocol.md, "Refusals"). */
 static void refuse_plan(coavoid_vehicle_node_t *node, int64_t now, int64_t plan_id, int code,
                         const char *reason)
 {
     reject_plan(node, code, reason);
     node->state.plans_refused++;
     answer_with_copies(node, now, COAVOID_AGREEMENT_T_KIND_REFUSE, plan_id);
+    if (node->state.coordinated && !node->cycle_plan_adopted && !node->pending &&
+        !node->answer_checked && now < node->answer_deadline) {
+        node->answer_deadline = now;
+    }
 }
 
 /* The slot of UAV id's row of this cycle's plans: row_count when it has none. O(rows). */
