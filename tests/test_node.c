@@ -533,6 +533,71 @@ START_TEST(test_plan_into_terrain_refused)
 }
 END_TEST
 
+/* A vehicle configured with a floor (min_altitude 90 m; its volume's bottom flies at
+ * 95 m) refuses a plan whose dive takes that bottom below it at some sample, with a
+ * reason that says so, adopts one that descends only to the floor, and never flies
+ * below it. A floor no message could carry is refused at create. */
+START_TEST(test_plan_below_floor_refused)
+{
+    rig_t r;
+    rig_init(&r, 10);
+    r.common.has_floor = true;
+    r.common.min_altitude = (coa_real_t)90;
+    coa_vec3_t route[2];
+    coavoid_vehicle_node_t *a =
+        vehicle_node(&r, uav(1, 1, route, 0, 500, 0, 100), COAVOID_NODE_CENTRALISED);
+    const coavoid_vehicle_node_state_t *s = coavoid_vehicle_node_state(a);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
+    drain(r.lcm);
+    r.now = cycle(0) + DT_US / 4;
+    heartbeat(r.lcm, r.now, 0);
+    drain(r.lcm);
+    /* Offsets 0, -1, -2, ... (dh 2 m): the bottom reaches 89 m at sample 3. */
+    coavoid_plan_t m = solved_plan(r.now, 5, cycle(0), 10, 1);
+    m.uav_ids[0] = 1;
+    m.row_uav_id = 1;
+    for (int32_t k = 0; k <= 10; k++) {
+        m.offsets[k] = -k;
+    }
+    const int64_t rejected = s->rx.rejected;
+    ck_assert_int_eq(coavoid_plan_t_publish(r.lcm, COAVOID_CHANNEL_PLAN, &m), 0);
+    drain(r.lcm);
+    ck_assert_int_eq(s->plans_adopted, 0);
+    ck_assert_int_eq(s->rx.rejected, rejected + 1);
+    ck_assert_int_eq(s->rx.last_reject_code, COAVOID_LCM_ERR_VALUE);
+    ck_assert_str_eq(s->rx.last_reason, "plan: takes this UAV below its floor (min_altitude)");
+    /* Down to offset -2 and level there: the bottom at 91 m, above the floor: adopted. */
+    for (int32_t k = 0; k <= 10; k++) {
+        m.offsets[k] = k < 2 ? -k : -2;
+    }
+    m.plan_id = 6;
+    ck_assert_int_eq(coavoid_plan_t_publish(r.lcm, COAVOID_CHANNEL_PLAN, &m), 0);
+    commit_msg(r.lcm, r.now, (int32_t)COAVOID_NODE_COORDINATOR_ID, 6, cycle(0));
+    drain(r.lcm);
+    ck_assert_int_eq(s->plans_adopted, 1);
+    ck_assert_int_eq(s->rx.rejected, rejected + 1);
+    for (int64_t k = 1; k <= 10; k++) {
+        ck_assert_int_eq(coavoid_vehicle_node_cycle(a, cycle(k)), COA_OK);
+        drain(r.lcm);
+        ck_assert(s->position.z - (coa_real_t)5 >= (coa_real_t)90);
+    }
+    ck_assert_int_eq(s->offset, -2);
+    coavoid_vehicle_node_destroy(a);
+
+    coavoid_vehicle_node_config_t config;
+    memset(&config, 0, sizeof config);
+    config.common = r.common;
+    config.vehicle = uav(1, 1, route, 0, 500, 0, 100);
+    int error = COA_OK;
+    config.common.min_altitude = (coa_real_t)NAN;
+    ck_assert_ptr_null(coavoid_vehicle_node_create(&config, r.lcm, &error));
+    ck_assert_int_eq(error, COA_ERR_ARGUMENT);
+    config.common.min_altitude = (coa_real_t)2e7;
+    ck_assert_ptr_null(coavoid_vehicle_node_create(&config, r.lcm, &error));
+    lcm_destroy(r.lcm);
+}
+END_TEST
+
 /* A coordinator's plan is checked against the other UAVs too: a row that climbs UAV 1
  * into UAV 2 (flying 12 m above it on the same track) is refused while UAV 2 keeps its
  * intent, and adopted when the same plan moves UAV 2 out of the way (its row in the
@@ -1065,8 +1130,17 @@ static void poll_until(rig_t *r, coavoid_vehicle_node_t *const *v, size_t n, int
 
 /* Flies a head-on pair 90 m apart (their volumes meet 3 s ahead) under a coordinator that
  * sends heartbeats and never a plan (one stopped after its heartbeat in cycle 0), with the
- * given answer_wait_us; fills p with the flown positions of cycles 0..8. */
+ * given answer_wait_us; fills p with the flown positions of cycles 0..8. With `refused`,
+ * a plan for each UAV comes with every heartbeat, one it refuses (it does not start at
+ * the offset it flies), as an impostor's or a faulty coordinator's would. */
+static void fly_answered_by(int64_t answer_wait_us, bool refused, coa_vec3_t p[2][9]);
+
 static void fly_unanswered(int64_t answer_wait_us, coa_vec3_t p[2][9])
+{
+    fly_answered_by(answer_wait_us, false, p);
+}
+
+static void fly_answered_by(int64_t answer_wait_us, bool refused, coa_vec3_t p[2][9])
 {
     rig_t r;
     rig_init(&r, 24);
@@ -1087,6 +1161,13 @@ static void fly_unanswered(int64_t answer_wait_us, coa_vec3_t p[2][9])
         heartbeat_from(r.lcm, r.now, k, (int32_t)COAVOID_NODE_COORDINATOR_ID,
                        COAVOID_STATUS_T_HEALTH_OK);
         drain(r.lcm);
+        for (int i = 0; refused && i < 2; i++) {
+            const coavoid_vehicle_node_state_t *s = coavoid_vehicle_node_state(v[i]);
+            const uint32_t before = s->plans_refused;
+            plan_msg(r.lcm, r.now, 2 * k + i, cycle(k), (uint16_t)(i + 1), 24, s->offset + 7);
+            drain(r.lcm);
+            ck_assert_uint_eq(s->plans_refused, before + 1u);
+        }
         poll_until(&r, v, 2, cycle(k + 1));
     }
     coavoid_vehicle_node_destroy(v[1]);
@@ -1232,6 +1313,19 @@ START_TEST(test_unanswered_conflict_planned_within_cycle)
     ck_assert_msg(!flown_conflict(p[0], p[1], 8), "loss of separation with the rule");
     fly_unanswered(2 * DT_US, p);
     ck_assert_msg(flown_conflict(p[0], p[1], 8), "the encounter needs the rule");
+}
+END_TEST
+
+/* A refused plan answers nothing, and the UAV does not wait for the answer wait to say so
+ * (docs/protocol.md, "Refusals"): it plans for itself in the cycle the plan came, so with
+ * an answer wait past the cycle's end (under which an unanswered pair collides:
+ * test_unanswered_conflict_planned_within_cycle) the pair whose every plan is refused
+ * stays apart. */
+START_TEST(test_refused_plan_planned_within_cycle)
+{
+    coa_vec3_t p[2][9];
+    fly_answered_by(2 * DT_US, true, p);
+    ck_assert_msg(!flown_conflict(p[0], p[1], 8), "loss of separation after refusals");
 }
 END_TEST
 
@@ -2759,6 +2853,7 @@ static Suite *node_suite(void)
     tcase_add_test(tc, test_map_used_only_whole);
     tcase_add_test(tc, test_plan_ids_do_not_lock_out);
     tcase_add_test(tc, test_plan_into_terrain_refused);
+    tcase_add_test(tc, test_plan_below_floor_refused);
     tcase_add_test(tc, test_forged_map_keeps_terrain);
     tcase_add_test(tc, test_plan_into_other_uav_refused);
     tcase_add_test(tc, test_duplicate_id_reported);
@@ -2769,6 +2864,7 @@ static Suite *node_suite(void)
     tcase_add_test(tc, test_faulty_coordinator_not_followed);
     tcase_add_test(tc, test_late_plans_fall_back);
     tcase_add_test(tc, test_unanswered_conflict_planned_within_cycle);
+    tcase_add_test(tc, test_refused_plan_planned_within_cycle);
     tcase_add_test(tc, test_answer_does_not_wait_for_a_switched_uav);
     tcase_add_test(tc, test_switch_before_it_is_decided_on_again);
     tcase_add_test(tc, test_failed_plan_is_an_answer);

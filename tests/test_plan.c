@@ -1779,6 +1779,114 @@ START_TEST(head_on_is_separated)
 }
 END_TEST
 
+/* Whether every sample of the listed rows keeps its UAV's volume at or above `floor`:
+ * computed here in double from the references, not by the planner's rule. */
+static bool rows_above(const fx_t *f, const int32_t *rows, size_t count, double floor)
+{
+    size_t i;
+    uint32_t k;
+    for (i = 0; i < count; ++i) {
+        const coa_vehicle_t *v = &f->veh[i];
+        const double dh = (double)v->climb_rate * (double)f->p.dt;
+        for (k = 0; k <= f->p.horizon; ++k) {
+            const double z = (double)f->ref[i][k].z + (double)rows[i * ROW(f) + k] * dh;
+            if (z - (double)v->volume.half_height < floor) {
+                return false;
+            }
+        }
+    }
+    return true;
+}
+
+/* One UAV (bottom at 97 m) that a box in its way lets pass only below (its top at 94 m,
+ * two climb steps down: bottom 89 m) or, when the box ends at 130 m, far above. A floor
+ * at 90 m forbids the descent: every planner climbs over when it can, and answers
+ * infeasible when it cannot, never below the floor. */
+static void floor_under_a_box(double box_top)
+{
+    static fx_t f;
+    static int32_t rows[MAXV * (MAXN + 1u)];
+    ws_t w = ws_make(2u, 20000u);
+    coa_plan_result_t r;
+    int mode;
+
+    fx_init(&f, 1.0, 12u);
+    fx_vehicle(&f, 1u, 1u, 10.0, 4.0, 2u, 5.0, 3.0, V(-60, 0, 100), V(60, 0, 100));
+    fx_box(&f, V(-10, -50, 97), V(10, 50, box_top));
+    fx_finish(&f);
+    ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
+    ck_assert_int_eq(r.status, COA_PLAN_SOLVED);
+    ck_assert(!rows_above(&f, rows, 1u, 90.0)); /* without a floor it dives */
+    f.p.has_floor = true;
+    f.p.floor_z = R(90.0);
+    ck_assert_int_eq(coa_plan_find_conflict(&f.p, rows, ALL, 1u, NULL, NULL), 1);
+    for (mode = 0; mode < 3; ++mode) {
+        if (mode == 0) {
+            ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
+        } else {
+            ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, NULL, mode == 1 ? 1u : 4u, rows, &r),
+                             COA_OK);
+        }
+        if (box_top > 500.0) {
+            ck_assert_int_eq(r.status, COA_PLAN_INFEASIBLE);
+            continue;
+        }
+        ck_assert_int_eq(r.status, COA_PLAN_SOLVED);
+        check_solved_plan(&f, rows, &r);
+        ck_assert(rows_above(&f, rows, 1u, 90.0));
+        ck_assert_int_ge(rows[6], 9); /* over the box: bottom at 130 m or above */
+    }
+    ws_free(&w);
+}
+
+/* A floor is never crossed (plan.h, "Floor"): by a single UAV's table, centralised and
+ * decoupled; by the joint search of a head-on pair, which without it shares the manoeuvre
+ * (one climbs, one dives) and with it at their bottoms must climb both or one alone; and
+ * a UAV already below it at t = 0 is an initial conflict. */
+START_TEST(floor_is_never_crossed)
+{
+    static fx_t f;
+    static int32_t rows[MAXV * (MAXN + 1u)];
+    ws_t w = ws_make(2u, 20000u);
+    coa_plan_result_t r;
+    int mode;
+
+    floor_under_a_box(130.0);
+    floor_under_a_box(1000.0);
+
+    fx_head_on(&f, 12u, 3.0);
+    fx_finish(&f);
+    ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
+    ck_assert_int_eq(r.status, COA_PLAN_SOLVED);
+    ck_assert_uint_eq(r.largest_group, 2u);
+    ck_assert(!rows_above(&f, rows, 2u, 97.0));
+    f.p.has_floor = true;
+    f.p.floor_z = R(97.0); /* both bottoms: touching it is clear, one step down is not */
+    for (mode = 0; mode < 2; ++mode) {
+        if (mode == 0) {
+            ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
+            ck_assert_uint_eq(r.largest_group, 2u);
+        } else {
+            ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, NULL, 1u, rows, &r), COA_OK);
+        }
+        ck_assert_int_eq(r.status, COA_PLAN_SOLVED);
+        check_solved_plan(&f, rows, &r);
+        ck_assert(rows_above(&f, rows, 2u, 97.0));
+    }
+
+    f.p.floor_z = R(97.5); /* above both bottoms at t = 0 */
+    ck_assert_int_eq(coa_plan_centralised(w.pl, &f.p, rows, &r), COA_OK);
+    ck_assert_int_eq(r.status, COA_PLAN_INFEASIBLE);
+    ck_assert_uint_eq(r.nodes_expanded, 0u);
+    ck_assert_int_eq(coa_plan_decoupled(w.pl, &f.p, NULL, 2u, rows, &r), COA_OK);
+    ck_assert_int_eq(r.status, COA_PLAN_INFEASIBLE);
+    ck_assert(r.all_orders_covered);
+    f.p.floor_z = R(NAN);
+    ck_assert_int_eq(coa_problem_check(&f.p), COA_ERR_ARGUMENT);
+    ws_free(&w);
+}
+END_TEST
+
 START_TEST(problem_check_and_helpers)
 {
     static fx_t f;
@@ -2363,6 +2471,7 @@ static Suite *plan_suite(void)
     tcase_add_test(tc, work_budget_bounds_every_call);
     tcase_add_test(tc, max_offset_is_respected);
     tcase_add_test(tc, head_on_is_separated);
+    tcase_add_test(tc, floor_is_never_crossed);
     tcase_add_test(tc, problem_check_and_helpers);
     tcase_add_test(tc, tie_between_vehicles_goes_to_lower_effort);
     tcase_add_test(tc, single_vehicle_plans_need_no_budget);

@@ -241,6 +241,8 @@ int coavoid_rt_setup(const char *path, coavoid_scenario_t *s, coavoid_rt_options
                                 s->obstacle_count, COAVOID_NODE_MAX_CONFIGURED_OBSTACLES);
     }
     common->obstacles = s->obstacles;
+    common->has_floor = s->has_floor;
+    common->min_altitude = s->min_altitude;
     common->obstacle_count = s->obstacle_count;
     return CLI_CONTINUE;
 }

@@ -155,6 +155,17 @@
  * each vehicle count on the host and on a Cortex-M4F. The planner keeps state between
  * calls in its buffer: one planner serves one thread at a time.
  *
+ * Floor. A problem may set a floor (has_floor, floor_z): a minimum altitude for the
+ * bottom of every UAV's protected volume. A sample whose offset puts the volume's bottom
+ * below it is invalid exactly as a sample whose step meets an obstacle: its table cell is
+ * dead, so no table walk, no cost from the start, no pair table and no joint search (all
+ * of which take their moves from the tables) ever goes there, and a UAV below the floor
+ * at its initial offset is an initial conflict (infeasible, nothing expanded). The
+ * floor is tested at the samples only: between two samples a UAV moves in a straight
+ * line, so a step whose two ends are above the floor stays above it. Terrain itself comes
+ * in as obstacles (boxes and polytopes); the floor is the minimum altitude everywhere
+ * else.
+ *
  * Time. A table costs one pass over its cells with a conflict test for each action whose
  * step comes near (box test) an obstacle, a track or a fixed UAV; a pair table one pass
  * over its corridor with the pair's conflict tests. A joint expansion enumerates at most
@@ -190,6 +201,10 @@ typedef struct {
     size_t track_count;
     /* track_samples[j] holds horizon+1 samples of track j (coa_track_sample) */
     const coa_vec3_t *const *track_samples;
+    /* The floor (file comment, "Floor"): with has_floor, no UAV's protected volume may
+     * reach below floor_z (m, finite) at any sample; false: no floor, floor_z unread. */
+    bool has_floor;
+    coa_real_t floor_z;
 } coa_problem_t;
 
 typedef enum {
@@ -403,8 +418,17 @@ int coa_priority_order(const coa_vehicle_t *vehicles, size_t n, size_t *order);
 int coa_plan_vehicle_cost(const coa_vehicle_t *vehicle, coa_real_t dt, uint32_t horizon,
                           const int32_t *offsets, double *deviation, uint32_t *effort);
 
+/* Whether a UAV whose protected volume is `volume`, its centre at altitude z (its
+ * reference's z plus offset * dh, as the planner computes it), keeps the whole volume at
+ * or above floor_z: z - half_height >= floor_z (touching the floor is clear; NaN is not).
+ * The one rule of the floor for the planner and for a node checking a received plan.
+ * Cannot fail (volume non-NULL); O(1), no memory. */
+bool coa_above_floor(coa_real_t floor_z, const coa_volume_t *volume, coa_real_t z);
+
 /* Whether a full plan (rows for the vehicles listed in `which[0..count-1]`, others
- * ignored) is conflict-free against obstacles, tracks and each other by geometry.h.
+ * ignored) is conflict-free against obstacles, tracks and each other by geometry.h, and
+ * above the floor when the problem has one (a sample below it is a conflict of the step
+ * that reaches it, or of step 0 for sample 0).
  * Returns 0 (conflict-free), 1 (a conflict: the earliest step, and at that step the first
  * listed vehicle in conflict; *vehicle and *step say where when not NULL), or
  * COA_ERR_ARGUMENT (the problem's argument checks of coa_problem_check, the range check

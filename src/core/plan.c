@@ -302,7 +302,8 @@ static int check_arguments(const coa_problem_t *p)
             }
         }
     }
-    if (p->obstacle_count > 0u && p->obstacles == NULL) {
+    if ((p->obstacle_count > 0u && p->obstacles == NULL) ||
+        (p->has_floor && !real_ok(p->floor_z))) {
         return COA_ERR_ARGUMENT;
     }
     for (i = 0; i < p->obstacle_count; ++i) {
@@ -466,9 +467,18 @@ coa_sweep_t coa_plan_vehicle_sweep(const coa_problem_t *pr, const coa_real_t *dh
     return s;
 }
 
+bool coa_above_floor(coa_real_t floor_z, const coa_volume_t *volume, coa_real_t z)
+{
+    return z - volume->half_height >= floor_z;
+}
+
 bool coa_plan_static_clear(const coa_problem_t *pr, const coa_sweep_t *s, uint32_t k0, uint32_t k1)
 {
     size_t j;
+    if (pr->has_floor && (!coa_above_floor(pr->floor_z, &s->volume, s->p0.z) ||
+                          !coa_above_floor(pr->floor_z, &s->volume, s->p1.z))) {
+        return false;
+    }
     for (j = 0; j < pr->obstacle_count; ++j) {
         /* The problem check ruled out the polytope test's errors; were one to happen
          * anyway, counting it as a conflict is the safe side. */

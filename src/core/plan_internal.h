@@ -379,8 +379,8 @@ static inline const plan_table_t *plan_from_start(const coa_planner_t *pl, size_
 coa_sweep_t coa_plan_vehicle_sweep(const coa_problem_t *pr, const coa_real_t *dh, size_t v,
                                    uint32_t k0, int32_t a, uint32_t k1, int32_t b);
 
-/* Whether a sweep over samples k0 -> k1 is clear of every obstacle and track (k0 == k1:
- * the instant t_k0). */
+/* Whether a sweep over samples k0 -> k1 is clear of every obstacle and track, and its two
+ * ends above the floor when the problem has one (k0 == k1: the instant t_k0). */
 bool coa_plan_static_clear(const coa_problem_t *pr, const coa_sweep_t *s, uint32_t k0, uint32_t k1);
 
 /* A step's area in the planner's own units, coa_area_scaled(a, b, 2s) exactly, whose

@@ -8,8 +8,8 @@
  * least, lexicographically (deviation, then effort), over its actions that stay within the
  * offset bound, conflict with no obstacle, track or vehicle the table is built against
  * and reach a live state, of the step's cost plus the cost to go from there. A state with
- * no such action is dead. The pass visits each reachable state once and each of its five
- * actions once.
+ * no such action is dead, and so is one below the problem's floor (plan.h, "Floor"). The
+ * pass visits each reachable state once and each of its five actions once.
  *
  * Conflict tests dominate, so they are filtered twice before the exact test runs: per row
  * and obstacle (or track, or fixed vehicle), by the box that holds every step of the row,
@@ -267,6 +267,25 @@ static coa_box_t row_bounds(const coa_planner_t *pl, const plan_table_t *t, uint
     return box_union(b, &h);
 }
 
+/* Kills the states of row k whose volume reaches below the problem's floor (plan.h,
+ * "Floor"): a prefix of the row, since the altitude grows with the offset. The states the
+ * row before leads to are then dead, as beyond an obstacle. O(row) at most. */
+static void row_floor(const coa_planner_t *pl, const plan_table_t *t, uint32_t k)
+{
+    const coa_problem_t *pr = pl->problem;
+    int32_t o;
+    if (!pr->has_floor) {
+        return;
+    }
+    for (o = plan_row_lo(t, k); o <= plan_row_hi(t, k); ++o) {
+        coa_sweep_t s = coa_plan_vehicle_sweep(pr, pl->dh, t->vehicle, k, o, k, o);
+        if (coa_above_floor(pr->floor_z, &s.volume, s.p0.z)) {
+            return;
+        }
+        *cell_of(t, k, o) = CELL_DEAD;
+    }
+}
+
 void coa_plan_table_build(coa_planner_t *pl, plan_table_t *tb, size_t v, const size_t *fixed,
                           size_t nfixed)
 {
@@ -285,6 +304,7 @@ void coa_plan_table_build(coa_planner_t *pl, plan_table_t *tb, size_t v, const s
     for (o = plan_row_lo(tb, horizon); o <= plan_row_hi(tb, horizon); ++o) {
         *cell_of(tb, horizon, o) = cell_pack(0u, 0u, 0u);
     }
+    row_floor(pl, tb, horizon);
     for (k = horizon; k-- > 0u;) {
         row_ctx_t r;
         r.pl = pl;
@@ -302,6 +322,7 @@ void coa_plan_table_build(coa_planner_t *pl, plan_table_t *tb, size_t v, const s
             return;
         }
         row_costs(tb, k, r.lo, r.hi, r.row);
+        row_floor(pl, tb, k);
     }
 }
 

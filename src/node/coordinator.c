@@ -85,8 +85,9 @@ coavoid_coordinator_t *coavoid_coordinator_create(const coavoid_coordinator_conf
     }
     *error = COA_ERR_ARGUMENT;
     if (config == NULL || lcm == NULL || coavoid_node_common_check(&config->common) != COA_OK ||
-        config->max_centralised > COA_MAX_CENTRALISED || config->collect_us < 0 ||
-        config->collect_us >= config->common.dt_us || config->plan_budget_us < 0) {
+        !coavoid_node_floor_ok(&config->common) || config->max_centralised > COA_MAX_CENTRALISED ||
+        config->collect_us < 0 || config->collect_us >= config->common.dt_us ||
+        config->plan_budget_us < 0) {
         return NULL;
     }
     const coavoid_node_common_t *c = &config->common;
@@ -271,9 +272,12 @@ static int cluster_problem(coavoid_coordinator_t *node, size_t count, coa_proble
         node->vehicles[m] = view->live_vehicle[i];
         node->references[m] = view->live_arrays[i].reference;
     }
-    return coavoid_node_problem(problem, &node->problem_tracks, view, node->include, &node->inbox,
-                                node->vehicles, node->references, count,
-                                node->config.common.horizon);
+    int rc =
+        coavoid_node_problem(problem, &node->problem_tracks, view, node->include, &node->inbox,
+                             node->vehicles, node->references, count, node->config.common.horizon);
+    problem->has_floor = node->config.common.has_floor;
+    problem->floor_z = node->config.common.min_altitude;
+    return rc;
 }
 
 /* Plans the cluster, centralised when it is small enough. A joint search can fill its beta

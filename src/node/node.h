@@ -258,6 +258,12 @@ typedef struct {
      * terrain away. */
     const coa_obstacle_t *obstacles;
     size_t obstacle_count;
+    /* The floor (the scenario's min_altitude; plan.h, "Floor"): with has_floor, every plan
+     * the node makes keeps each UAV's protected volume at or above min_altitude (m, finite,
+     * within COAVOID_LCM_MAX_COORDINATE) at every sample, and a vehicle refuses a plan
+     * that would take it below (COAVOID_LCM_ERR_VALUE). false (the default): none. */
+    bool has_floor;
+    coa_real_t min_altitude;
     /* Signed messages (auth.h, docs/messages.md): the key it signs everything it publishes
      * with, and the keys it accepts messages from, each with its role. Both the caller's,
      * copied at create. Unless `insecure`, both are required (the world, which receives

@@ -279,6 +279,14 @@ typedef struct {
  * COA_ERR_ARGUMENT. O(1). */
 int coavoid_node_common_check(const coavoid_node_common_t *c);
 
+/* Whether a common configuration's floor is one a node can hold (node.h: none, or a
+ * finite min_altitude within COAVOID_LCM_MAX_COORDINATE). O(1). */
+static inline bool coavoid_node_floor_ok(const coavoid_node_common_t *c)
+{
+    return !c->has_floor || ((double)c->min_altitude >= -COAVOID_LCM_MAX_COORDINATE &&
+                             (double)c->min_altitude <= COAVOID_LCM_MAX_COORDINATE);
+}
+
 /* The validation context at `now` with t = 0 at `epoch`: messages up to a horizon and
  * stale_after old, at most one cycle ahead. Cannot fail; O(1). */
 coavoid_lcm_context_t coavoid_node_context(const coavoid_node_inbox_t *in, int64_t now,

@@ -379,6 +379,8 @@ static coa_problem_t own_problem(const coavoid_vehicle_node_t *node, coa_vehicle
     problem.tracks = node->problem_tracks.tracks;
     problem.track_count = node->problem_tracks.count;
     problem.track_samples = node->problem_tracks.samples;
+    problem.has_floor = c->has_floor;
+    problem.floor_z = c->min_altitude;
     return problem;
 }
 
@@ -1131,8 +1133,11 @@ static int order_problem(coavoid_vehicle_node_t *node, size_t count, uint32_t ho
             r[k].z = last.z + j * leg.z;
         }
     }
-    return coavoid_node_problem(problem, &node->problem_tracks, view, node->include, &node->inbox,
-                                node->order_vehicles, node->order_references, count, horizon);
+    int rc = coavoid_node_problem(problem, &node->problem_tracks, view, node->include, &node->inbox,
+                                  node->order_vehicles, node->order_references, count, horizon);
+    problem->has_floor = node->config.common.has_floor;
+    problem->floor_z = node->config.common.min_altitude;
+    return rc;
 }
 
 /* The members' decoupled order as the intents of the cycle's start announce it (rank,
@@ -1608,13 +1613,20 @@ static void answer_with_copies(coavoid_vehicle_node_t *node, int64_t now, int8_t
                                int64_t plan_id);
 
 /* A plan of this cycle for it that it will not fly: refused, and the coordinator told
- * (REFUSE), so that it plans the others again without waiting for its answer. */
+ * (REFUSE), so that it plans the others again without waiting for its answer. Following
+ * the coordinator, with no plan of the cycle adopted or held, it does not wait for the
+ * answer wait either: its deadline is now, so the next poll runs answer_overdue, which
+ * plans for itself in this cycle when it has a conflict (docs/protocol.md, "Refusals"). */
 static void refuse_plan(coavoid_vehicle_node_t *node, int64_t now, int64_t plan_id, int code,
                         const char *reason)
 {
     reject_plan(node, code, reason);
     node->state.plans_refused++;
     answer_with_copies(node, now, COAVOID_AGREEMENT_T_KIND_REFUSE, plan_id);
+    if (node->state.coordinated && !node->cycle_plan_adopted && !node->pending &&
+        !node->answer_checked && now < node->answer_deadline) {
+        node->answer_deadline = now;
+    }
 }
 
 /* The slot of UAV id's row of this cycle's plans: row_count when it has none. O(rows). */
@@ -1884,6 +1896,34 @@ static bool on_plan_row(void *owner, const coavoid_plan_t *msg)
     return again(node, *node->config.common.clock, msg);
 }
 
+/* Why this UAV cannot fly a plan's row of this cycle (`samples` offsets from the cycle's
+ * start; past its end the last offset holds), or NULL: an offset beyond its max_offset, a
+ * step it cannot take, or a sample that puts its volume below its floor (node.h), judged
+ * at the positions it would fly (reference + offset * dh, as the planner computes them).
+ * O(N). */
+static const char *row_unflyable(const coavoid_vehicle_node_t *node, const int32_t *mine,
+                                 size_t samples)
+{
+    const coavoid_node_common_t *c = &node->config.common;
+    const coa_vehicle_t *self = &node->config.vehicle;
+    for (size_t j = 0; j < samples; j++) {
+        if (self->max_offset >= 0 && (mine[j] > self->max_offset || mine[j] < -self->max_offset)) {
+            return "plan: an offset beyond this UAV's max_offset";
+        }
+        if (j > 0 && coa_action_between(mine[j - 1], mine[j], self->steep_factor) < 0) {
+            return "plan: a step this UAV cannot fly";
+        }
+    }
+    for (size_t j = 0; c->has_floor && j <= c->horizon; j++) {
+        const coa_vec3_t p =
+            lifted(node->own_reference[j], mine[j < samples ? j : samples - 1u], node->dh);
+        if (!coa_above_floor(c->min_altitude, &self->volume, p.z)) {
+            return "plan: takes this UAV below its floor (min_altitude)";
+        }
+    }
+    return NULL;
+}
+
 /* Step 4 of node.h: a coordinator's plan that lists it. */
 static void on_plan(void *owner, const coavoid_plan_t *msg, const coavoid_lcm_plan_info_t *info,
                     const coa_plan_result_t *result, const int32_t *offsets)
@@ -1938,17 +1978,10 @@ static void on_plan(void *owner, const coavoid_plan_t *msg, const coavoid_lcm_pl
                     "plan: does not start at the offset flown now");
         return;
     }
-    for (size_t j = 0; j < samples; j++) {
-        if (self->max_offset >= 0 && (mine[j] > self->max_offset || mine[j] < -self->max_offset)) {
-            refuse_plan(node, now, msg->plan_id, COAVOID_LCM_ERR_VALUE,
-                        "plan: an offset beyond this UAV's max_offset");
-            return;
-        }
-        if (j > 0 && coa_action_between(mine[j - 1], mine[j], self->steep_factor) < 0) {
-            refuse_plan(node, now, msg->plan_id, COAVOID_LCM_ERR_VALUE,
-                        "plan: a step this UAV cannot fly");
-            return;
-        }
+    const char *unflyable = row_unflyable(node, mine, samples);
+    if (unflyable != NULL) {
+        refuse_plan(node, now, msg->plan_id, COAVOID_LCM_ERR_VALUE, unflyable);
+        return;
     }
     int hit = plan_hits_known(node, mine, samples, now, false);
     if (hit != 0) {
@@ -1998,7 +2031,7 @@ coavoid_vehicle_node_t *coavoid_vehicle_node_create(const coavoid_vehicle_node_c
     }
     *error = COA_ERR_ARGUMENT;
     if (config == NULL || lcm == NULL || coavoid_node_common_check(&config->common) != COA_OK ||
-        coa_vehicle_check(&config->vehicle) != COA_OK ||
+        !coavoid_node_floor_ok(&config->common) || coa_vehicle_check(&config->vehicle) != COA_OK ||
         (config->mode != COAVOID_NODE_CENTRALISED && config->mode != COAVOID_NODE_DECOUPLED) ||
         config->coordinator_timeout_us < 0 || config->priority_wait_us < 0 ||
         !isfinite((double)config->sigma_horizontal) || !isfinite((double)config->sigma_vertical) ||

@@ -904,6 +904,30 @@ static bool parse_tracks(parser_t *p, const cJSON *root)
     return true;
 }
 
+/* The optional "min_altitude": a finite number of metres within
+ * +-COAVOID_SCENARIO_MAX_ALTITUDE. */
+static bool parse_floor(parser_t *p, const cJSON *root)
+{
+    coavoid_scenario_t *s = p->s;
+    char path[PATH_SIZE];
+    const cJSON *item;
+    if (!get_field(p, root, "", "min_altitude", OPTIONAL, &item, path)) {
+        return false;
+    }
+    s->has_floor = item != NULL;
+    if (item == NULL) {
+        return true;
+    }
+    if (!read_real(p, item, path, ANY_REAL, &s->min_altitude)) {
+        return false;
+    }
+    if (fabs(item->valuedouble) > COAVOID_SCENARIO_MAX_ALTITUDE) {
+        return fail(p, path, "must be within +-%.0f m (COAVOID_SCENARIO_MAX_ALTITUDE), got %.15g",
+                    COAVOID_SCENARIO_MAX_ALTITUDE, item->valuedouble);
+    }
+    return true;
+}
+
 static bool parse_root(parser_t *p, const cJSON *root)
 {
     coavoid_scenario_t *s = p->s;
@@ -931,7 +955,8 @@ static bool parse_root(parser_t *p, const cJSON *root)
     }
     s->horizon = (uint32_t)horizon;
     s->beta = s->has_beta ? (uint32_t)beta : 0u;
-    return parse_vehicles(p, root) && parse_obstacles(p, root) && parse_tracks(p, root);
+    return parse_floor(p, root) && parse_vehicles(p, root) && parse_obstacles(p, root) &&
+           parse_tracks(p, root);
 }
 
 /* Line and column (1-based, in bytes) of position `at` in text. */
@@ -1118,6 +1143,8 @@ coa_problem_t coavoid_scenario_problem(const coavoid_scenario_t *s)
     problem.tracks = s->tracks;
     problem.track_count = s->track_count;
     problem.track_samples = s->track_samples;
+    problem.has_floor = s->has_floor;
+    problem.floor_z = s->min_altitude;
     return problem;
 }
 

@@ -64,12 +64,20 @@
  * a tracker's prediction at one point per second for over four minutes. */
 #define COAVOID_SCENARIO_MAX_TRACK_POINTS 256u
 
+/* The largest |min_altitude|, in metres: the bound the messages put on every coordinate
+ * (COAVOID_LCM_MAX_COORDINATE), so that a node can fly any floor a scenario sets. */
+#define COAVOID_SCENARIO_MAX_ALTITUDE 1.0e7
+
 typedef struct {
     char *name;
     coa_real_t dt;
     uint32_t horizon;
     bool has_beta;
     uint32_t beta;
+    /* "min_altitude": the floor no UAV's protected volume may reach below (coa_problem_t's
+     * has_floor and floor_z); has_floor false when the field is absent. */
+    bool has_floor;
+    coa_real_t min_altitude;
 
     coa_vehicle_t *vehicles;
     size_t vehicle_count;

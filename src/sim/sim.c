@@ -753,6 +753,8 @@ static int sim_world(sim_run_t *r)
      * the world's map holds them all); the world's map adds to them. */
     r->common.obstacles = s->obstacles;
     r->common.obstacle_count = s->obstacle_count;
+    r->common.has_floor = s->has_floor;
+    r->common.min_altitude = s->min_altitude;
     return SIM_GO_ON;
 }
 

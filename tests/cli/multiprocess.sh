@@ -19,7 +19,9 @@
 #   f) centralised vehicles whose coordinator never speaks, on an encounter no priority
 #      order solves: they plan their group jointly and stay separated; with
 #      --joint-members 0 they do not, and lose separation;
-# (the flights: late_encounter.json for a and b, paper.json with a lead-in for c, d, e,
+#   (d, last) an attacker holding the coordinator's key dives UAV 1 far below the
+#      scenario's floor: the vehicle refuses every such plan and stays above it;
+# (the flights: late_encounter.json for a and b and the dive, paper.json with a lead-in for c, d, e,
 # tests/encounters/joint_plan_220.json for f)
 # and every bad option or input of the drivers exits 2 with one line, the missing
 # multicast route included. Every process signs and checks with keys from
@@ -529,6 +531,26 @@ $(reported -124 "$all")"
 $same
 all(log['rejected'][str(i)] >= 1 for i in ($all,))"
     done
+
+    # A stolen coordinator key: with it the attacker signs, for every intent of UAV 1, a
+    # plan of that cycle that dives it 4 m a second for the whole horizon, and the plan's
+    # COMMIT (forge.c's dive). Signature and role pass; the UAV's floor (the scenario's
+    # min_altitude, 85 m: 10 m under its volume's bottom) does not: it refuses every such
+    # plan (-102, COAVOID_LCM_ERR_VALUE) and its flown volume stays at or above the floor.
+    python3 - "$late" "$tmp/late_floor.json" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+s["min_altitude"] = 85
+json.dump(s, open(sys.argv[2], "w"))
+PY
+    speed=${SPEED:-4}
+    forge_args="--key $keys/coordinator.key --trust $keys/trust.txt" attack=dive \
+        fleet attack-dive "$tmp/late_floor.json" centralised 24 -
+    attack=
+    check attack-dive "$survived
+$forged
+$(reported -102 1)
+min(p[3] for v in s['vehicles'] if v['id'] == 1 for p in v['flown']) - 5 >= 85"
 fi
 
 # ---- e) a path that drops every datagram over 1,500 bytes ----

@@ -119,6 +119,30 @@ r["status"] == "solved"
 ' -- "$src/scenarios/headon.json" --mode "$mode"
 done
 
+# A floor (min_altitude) at the head-on pair's volume bottoms (95 m): without it some UAV
+# dives; with it neither goes below its reference, in either mode; 1 m higher, both start
+# below it: infeasible at t = 0.
+check headon_dives_without_floor 0 '
+min(min(veh(1)["offsets"]), min(veh(2)["offsets"])) < 0
+' -- "$src/scenarios/headon.json" --mode centralised
+python3 - "$src/scenarios/headon.json" "$work" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+for name, floor in (("floor", 95), ("floor_high", 96)):
+    s["min_altitude"] = floor
+    json.dump(s, open(f"{sys.argv[2]}/headon_{name}.json", "w"))
+PY
+for mode in centralised decoupled; do
+  check "headon_floor_$mode" 0 '
+r["status"] == "solved"
+min(veh(1)["offsets"]) >= 0 and min(veh(2)["offsets"]) >= 0
+moved(1) or moved(2)
+' -- "$work/headon_floor.json" --mode "$mode"
+  check "headon_floor_high_$mode" 1 '
+r["status"] == "infeasible"
+' -- "$work/headon_floor_high.json" --mode "$mode"
+done
+
 # The non-cooperative track and the polytope hill force a manoeuvre; both modes agree for
 # a single UAV.
 for s in track_crossing polytope_hill; do

@@ -26,7 +26,8 @@ int main(void)
         coa_reference_sample(&vehicles[1], 1.0, HORIZON, ref_b) != COA_OK) {
         return 1;
     }
-    const coa_problem_t problem = {1.0, HORIZON, vehicles, 2, refs, NULL, 0, NULL, 0, NULL};
+    const coa_problem_t problem = {1.0, HORIZON, vehicles, 2,    refs,  NULL,
+                                   0,   NULL,    0,        NULL, false, 0.0};
     coa_planner_config_t config;
     if (coa_planner_config_of(&problem, 2, BETA, &config) != COA_OK) {
         return 1;

@@ -16,17 +16,21 @@
  *            (the message's and the signature's) 1000 higher, the signature as it was:
  *            without signatures it would lock the real UAV out for cycles;
  *   replay   every intent, heartbeat, plan, map and track it hears, sent again unchanged
- *            1.5 s later.
+ *            1.5 s later;
+ *   dive     for every intent of UAV --target, a plan from the configured coordinator for
+ *            that cycle (a plan_id near the top) that dives it as steeply as it can over
+ *            the whole horizon, and the COMMIT of that plan: with the coordinator's key
+ *            (--key) only the UAV's own checks (its floor) stand in the way.
  * With --key FILE (a secret key file: a key stolen from a vehicle, say) it signs what it
- * forges (map, collide, intent) with that key, and with --trust FILE (the trust file
- * stolen with it) tags them with the fleet key; otherwise its messages are unsigned.
+ * forges (map, collide, intent, dive) with that key, and with --trust FILE (the trust
+ * file stolen with it) tags them with the fleet key; otherwise its messages are unsigned.
  *
  * Its messages carry the nodes' time, taken from the intents it hears (a test's run is sped
  * up, so the wall clock would make them stale).
  *
  * Several attacks run at once when --attack lists them with commas (map,collide).
  *
- * usage: coavoid_test_forge --lcm-url URL --attack map|collide|intent|copy|replay[,...]
+ * usage: coavoid_test_forge --lcm-url URL --attack map|collide|intent|copy|replay|dive[,...]
  *                           --seconds S [--target ID] [--other ID] [--coordinator-id ID]
  *                           [--key FILE [--trust FILE]]
  * Prints how many messages it forged on stdout when it stops.
@@ -188,6 +192,41 @@ static void forge_plan(forger_t *f, const coavoid_intent_t *t)
     FORGE_SEND(f, coavoid_plan_t, COAVOID_CHANNEL_PLAN, &m);
 }
 
+/* The dive attack: a one-UAV plan of the target's cycle, steep dives from its offset now,
+ * then the coordinator's COMMIT of it. */
+static void forge_dive(forger_t *f, const coavoid_intent_t *t)
+{
+    static coavoid_plan_t m;
+    memset(&m, 0, sizeof m);
+    m.utime = t->utime + 1;
+    m.coordinator_id = f->coordinator;
+    m.plan_id = INT64_MAX - 1 - f->forged;
+    m.valid_from_utime = t->plan_utime;
+    m.valid_until_utime = t->plan_utime + llround(t->step * 1e6);
+    m.dt = t->step;
+    m.horizon = t->sample_count - 1;
+    m.mode = COAVOID_PLAN_T_MODE_CENTRALISED;
+    m.status = COAVOID_PLAN_T_STATUS_SOLVED;
+    m.vehicle_count = 1;
+    m.planned_count = 1;
+    m.uav_ids[0] = f->target;
+    m.row_uav_id = f->target;
+    for (int32_t k = 0; k <= m.horizon; k++) {
+        const int64_t o = (int64_t)t->offsets[0] - (int64_t)t->steep_factor * k;
+        m.offsets[k] = (int32_t)(o < -32767 ? -32767 : o);
+    }
+    FORGE_SEND(f, coavoid_plan_t, COAVOID_CHANNEL_PLAN, &m);
+    static coavoid_agreement_t c;
+    memset(&c, 0, sizeof c);
+    c.utime = m.utime + 1;
+    c.kind = COAVOID_AGREEMENT_T_KIND_COMMIT;
+    c.node_id = f->coordinator;
+    c.coordinator_id = f->coordinator;
+    c.plan_id = m.plan_id;
+    c.valid_from_utime = m.valid_from_utime;
+    FORGE_SEND(f, coavoid_agreement_t, COAVOID_CHANNEL_AGREEMENT, &c);
+}
+
 /* UAV --other's intent, 300 m higher all along, newer than the real one. */
 static void forge_intent(forger_t *f, const coavoid_intent_t *real)
 {
@@ -277,6 +316,9 @@ static void on_intent(const lcm_recv_buf_t *rbuf, const char *channel, const coa
     if (msg->uav_id == f->target && attacks(f, "collide") && f->have_other) {
         forge_plan(f, msg);
     }
+    if (msg->uav_id == f->target && attacks(f, "dive")) {
+        forge_dive(f, msg);
+    }
     if (msg->uav_id == f->other && attacks(f, "intent")) {
         forge_intent(f, msg);
     }
@@ -363,9 +405,10 @@ int main(int argc, char **argv)
     const char *url = NULL;
     double seconds = 0;
     if (parse(argc, argv, &f, &url, &seconds) != 0) {
-        fprintf(stderr, "usage: coavoid_test_forge --lcm-url URL --attack "
-                        "map|collide|intent|copy|replay --seconds S [--target ID] [--other ID] "
-                        "[--coordinator-id ID] [--key FILE [--trust FILE]]\n");
+        fprintf(stderr,
+                "usage: coavoid_test_forge --lcm-url URL --attack "
+                "map|collide|intent|copy|replay|dive --seconds S [--target ID] [--other ID] "
+                "[--coordinator-id ID] [--key FILE [--trust FILE]]\n");
         return 2;
     }
     if (attacks(&f, "replay")) {
