@@ -1700,7 +1700,7 @@ START_TEST(test_auth_key_files)
         {"0 vehicle 3 00", "line 1: KEY_ID must be in 1..2147483647 and NODE_ID in 1..65535"},
         {"7 vehicle 70000 00", "line 1: KEY_ID must be in 1..2147483647 and NODE_ID in 1..65535"},
         {"7 vehicle 3", "line 1: expected KEY_ID ROLE NODE_ID PUBLIC_KEY_HEX"},
-        {"fleet 00ff", "line 1: expected fleet FLEET_KEY_HEX (64 hex digits)"},
+        {"fleet 00ff", "line 1: expected fleet FLEET_KEY_HEX (32 hex digits)"},
         {"fleet", "line 1: expected KEY_ID ROLE NODE_ID PUBLIC_KEY_HEX"},
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {

@@ -31,9 +31,9 @@
  * checks tags (each is zero).
  *
  * Ed25519 by libsodium (crypto_sign_detached / crypto_sign_verify_detached); the tag is
- * the first 8 bytes of keyed BLAKE2b-128 (crypto_generichash, a 32-byte key). Memory: the
+ * SipHash-2-4 (libsodium's crypto_shorthash: a 16-byte key, an 8-byte output). Memory: the
  * caller's structs; nothing is allocated. Cost: one signature or verification over the
- * datagram (tens of microseconds), one keyed hash (about a microsecond on a PC;
+ * datagram (tens of microseconds), one keyed hash (under a microsecond on a PC;
  * docs/benchmarks.md).
  */
 #ifndef COAVOID_LCM_AUTH_H
@@ -47,7 +47,7 @@
 #define COAVOID_AUTH_TAG_BYTES 8u
 #define COAVOID_AUTH_TAIL_BYTES \
     (4u + 8u + 8u + COAVOID_AUTH_SIGNATURE_BYTES + COAVOID_AUTH_TAG_BYTES)
-#define COAVOID_AUTH_FLEET_KEY_BYTES 32u
+#define COAVOID_AUTH_FLEET_KEY_BYTES 16u
 #define COAVOID_AUTH_PUBLIC_BYTES 32u
 #define COAVOID_AUTH_SECRET_BYTES 64u
 /* Keys one receiver trusts: a coordinator, a world and every UAV a node holds, with room. */
@@ -85,7 +85,7 @@ typedef struct {
 } coavoid_auth_key_t;
 
 /* A receiver's trust list, the fleet's key and, per key and stream, the newest message
- * accepted from it (17,968 bytes on x86-64). */
+ * accepted from it (20,000 bytes on x86-64). */
 typedef struct {
     coavoid_auth_key_t keys[COAVOID_AUTH_MAX_KEYS];
     size_t count;
@@ -241,7 +241,7 @@ int coavoid_auth_accept(coavoid_auth_trust_t *t, size_t key, size_t stream,
  * with ROLE coordinator, world or vehicle, NODE_ID the node it speaks for (1..65535) and
  * the public key as 64 hex digits, and at most one line
  *     fleet FLEET_KEY_HEX
- * with the fleet's key as 64 hex digits (a secret: a trust file that holds it is kept as
+ * with the fleet's key as 32 hex digits (a secret: a trust file that holds it is kept as
  * a secret key file is); blank lines and lines starting with '#' are skipped.
  * A secret key file is one line: "coavoid-secret-key KEY_ID SECRET_KEY_HEX" (128 digits).
  * Both are files a user hands us: every line is bounded (COAVOID_AUTH_LINE_MAX) and

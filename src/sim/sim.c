@@ -676,7 +676,7 @@ static int sim_keys(sim_run_t *r)
     }
     coavoid_auth_trust_init(&r->trust);
     r->common.trust = &r->trust;
-    const unsigned char fleet_key[COAVOID_AUTH_FLEET_KEY_BYTES] = "coavoid simulation fleet key";
+    const unsigned char fleet_key[COAVOID_AUTH_FLEET_KEY_BYTES] = "coavoid sim key";
     (void)coavoid_auth_trust_set_fleet_key(&r->trust, fleet_key);
     int rc = sim_key(r, &r->signers[0], COAVOID_AUTH_KEY_ID_COORDINATOR, COAVOID_AUTH_COORDINATOR,
                      (uint16_t)COAVOID_NODE_COORDINATOR_ID);
