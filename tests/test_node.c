@@ -2553,100 +2553,126 @@ static void expect_refused(rig_t *r, const coavoid_vehicle_node_state_t *s, int 
                   (long long)s->rx.rejected, s->rx.last_reject_code, code);
 }
 
+/* Two signed UAVs on one bus, 1 in mode_a and 2 decoupled, with a wiretap of UAV 2's
+ * intents and node 1's heartbeats. A test destroys its nodes, then signed_pair_fini. */
+typedef struct {
+    fleet_keys_t k;
+    rig_t r;
+    wiretap_t tap;
+    lcm_subscription_t *si, *ss;
+    coa_vec3_t r1[2], r2[2];
+    coavoid_vehicle_node_t *a, *b;
+} signed_pair_t;
+
+static void signed_pair(signed_pair_t *p, coavoid_node_mode_t mode_a)
+{
+    fleet_keys(&p->k);
+    rig_init(&p->r, 10);
+    memset(&p->tap, 0, sizeof p->tap);
+    p->tap.uav = 2;
+    p->tap.node = 1;
+    p->si = lcm_subscribe(p->r.lcm, COAVOID_CHANNEL_INTENT, on_tapped_intent, &p->tap);
+    p->ss = lcm_subscribe(p->r.lcm, COAVOID_CHANNEL_STATUS, on_tapped_status, &p->tap);
+    p->a = signed_vehicle(&p->r, &p->k, uav(1, 1, p->r1, 0, 500, 0, 100), mode_a);
+    p->b = signed_vehicle(&p->r, &p->k, uav(2, 2, p->r2, 0, 500, 800, 100), COAVOID_NODE_DECOUPLED);
+}
+
+static void signed_pair_fini(signed_pair_t *p)
+{
+    lcm_unsubscribe(p->r.lcm, p->si);
+    lcm_unsubscribe(p->r.lcm, p->ss);
+    lcm_destroy(p->r.lcm);
+}
+
+/* The signed fleet's world on the pair's bus. */
+static coavoid_world_t *signed_world(signed_pair_t *p)
+{
+    coavoid_world_config_t wc;
+    memset(&wc, 0, sizeof wc);
+    wc.common = p->r.common;
+    wc.common.signer = &p->k.world;
+    int error = -99;
+    coavoid_world_t *w = coavoid_world_create(&wc, p->r.lcm, &error);
+    ck_assert_ptr_nonnull(w);
+    return w;
+}
+
 /* Signed nodes accept each other's messages and say they are secure; every forgery is
  * refused with its own code: a replay, a changed byte, no signature, a key of another role
  * (the world's on an intent, a UAV's on a plan or a map), an unknown key, a time ahead of
  * the window. A UAV that restarts (its sequence from 0 again) is heard again at once. */
 START_TEST(test_signed_messages)
 {
-    static fleet_keys_t k;
-    fleet_keys(&k);
-    rig_t r;
-    rig_init(&r, 10);
-    static wiretap_t tap;
-    tap.uav = 2;
-    tap.node = 1;
-    lcm_subscription_t *si = lcm_subscribe(r.lcm, COAVOID_CHANNEL_INTENT, on_tapped_intent, &tap);
-    lcm_subscription_t *ss = lcm_subscribe(r.lcm, COAVOID_CHANNEL_STATUS, on_tapped_status, &tap);
-    coa_vec3_t r1[2], r2[2];
-    coavoid_vehicle_node_t *a =
-        signed_vehicle(&r, &k, uav(1, 1, r1, 0, 500, 0, 100), COAVOID_NODE_CENTRALISED);
-    coavoid_vehicle_node_t *b =
-        signed_vehicle(&r, &k, uav(2, 2, r2, 0, 500, 800, 100), COAVOID_NODE_DECOUPLED);
-    coavoid_world_config_t wc;
-    memset(&wc, 0, sizeof wc);
-    wc.common = r.common;
-    wc.common.signer = &k.world;
-    int error = -99;
-    coavoid_world_t *w = coavoid_world_create(&wc, r.lcm, &error);
-    ck_assert_ptr_nonnull(w);
-    ck_assert_int_eq(coavoid_world_cycle(w, r.now), COA_OK);
-    drain(r.lcm);
-    ck_assert_int_eq(coavoid_vehicle_node_cycle(b, r.now), COA_OK);
-    drain(r.lcm);
-    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
-    drain(r.lcm);
+    static signed_pair_t p;
+    signed_pair(&p, COAVOID_NODE_CENTRALISED);
+    coavoid_vehicle_node_t *a = p.a, *b = p.b;
+    coavoid_world_t *w = signed_world(&p);
+    ck_assert_int_eq(coavoid_world_cycle(w, p.r.now), COA_OK);
+    drain(p.r.lcm);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(b, p.r.now), COA_OK);
+    drain(p.r.lcm);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, p.r.now), COA_OK);
+    drain(p.r.lcm);
     const coavoid_vehicle_node_state_t *s = coavoid_vehicle_node_state(a);
     ck_assert_int_eq(s->rx.rejected, 0);
     ck_assert_int_ge(s->rx.received, 3); /* the map, UAV 2's intent and heartbeat */
-    ck_assert_int_eq(tap.reasons & COAVOID_STATUS_T_REASON_INSECURE, 0);
-    ck_assert_int_gt(tap.size, 0);
+    ck_assert_int_eq(p.tap.reasons & COAVOID_STATUS_T_REASON_INSECURE, 0);
+    ck_assert_int_gt(p.tap.size, 0);
 
     static unsigned char buf[TAP_BYTES];
-    memcpy(buf, tap.bytes, (size_t)tap.size);
-    publish_bytes(r.lcm, COAVOID_CHANNEL_INTENT, buf, tap.size, NULL, 0);
-    expect_refused(&r, s, COAVOID_AUTH_ERR_REPLAY, "UAV 2's intent again");
-    buf[(size_t)tap.size - COAVOID_AUTH_TAIL_BYTES + 19u] ^= 1; /* its auth sequence, one higher */
-    publish_bytes(r.lcm, COAVOID_CHANNEL_INTENT, buf, tap.size, NULL, 0);
-    expect_refused(&r, s, COAVOID_AUTH_ERR_TAG, "a copy numbered higher");
+    memcpy(buf, p.tap.bytes, (size_t)p.tap.size);
+    publish_bytes(p.r.lcm, COAVOID_CHANNEL_INTENT, buf, p.tap.size, NULL, 0);
+    expect_refused(&p.r, s, COAVOID_AUTH_ERR_REPLAY, "UAV 2's intent again");
+    buf[(size_t)p.tap.size - COAVOID_AUTH_TAIL_BYTES + 19u] ^=
+        1; /* its auth sequence, one higher */
+    publish_bytes(p.r.lcm, COAVOID_CHANNEL_INTENT, buf, p.tap.size, NULL, 0);
+    expect_refused(&p.r, s, COAVOID_AUTH_ERR_TAG, "a copy numbered higher");
     static coavoid_intent_t m;
-    ck_assert_int_gt(coavoid_intent_t_decode(tap.bytes, 0, tap.size, &m), 0);
+    ck_assert_int_gt(coavoid_intent_t_decode(p.tap.bytes, 0, p.tap.size, &m), 0);
     m.sequence++;
     memset(&m.auth, 0, sizeof m.auth);
     const int size = coavoid_intent_t_encode(buf, 0, (int)sizeof buf, &m);
-    publish_bytes(r.lcm, COAVOID_CHANNEL_INTENT, buf, size, NULL, 0);
-    expect_refused(&r, s, COAVOID_AUTH_ERR_UNSIGNED, "unsigned");
-    publish_bytes(r.lcm, COAVOID_CHANNEL_INTENT, buf, size, &k.world, r.now);
-    expect_refused(&r, s, COAVOID_AUTH_ERR_ROLE, "UAV 2's intent signed by the world");
-    coavoid_auth_signer_t stranger = k.uav[1];
+    publish_bytes(p.r.lcm, COAVOID_CHANNEL_INTENT, buf, size, NULL, 0);
+    expect_refused(&p.r, s, COAVOID_AUTH_ERR_UNSIGNED, "unsigned");
+    publish_bytes(p.r.lcm, COAVOID_CHANNEL_INTENT, buf, size, &p.k.world, p.r.now);
+    expect_refused(&p.r, s, COAVOID_AUTH_ERR_ROLE, "UAV 2's intent signed by the world");
+    coavoid_auth_signer_t stranger = p.k.uav[1];
     stranger.key_id = 999;
-    publish_bytes(r.lcm, COAVOID_CHANNEL_INTENT, buf, size, &stranger, r.now);
-    expect_refused(&r, s, COAVOID_AUTH_ERR_KEY, "an unknown key");
-    coavoid_auth_signer_t uav2 = k.uav[1];
-    publish_bytes(r.lcm, COAVOID_CHANNEL_INTENT, buf, size, &uav2, r.now + 2 * DT_US);
-    expect_refused(&r, s, COAVOID_AUTH_ERR_CLOCK, "signed two cycles ahead");
-    coavoid_plan_t plan = solved_plan(r.now, 1, r.now, 10, 1);
+    publish_bytes(p.r.lcm, COAVOID_CHANNEL_INTENT, buf, size, &stranger, p.r.now);
+    expect_refused(&p.r, s, COAVOID_AUTH_ERR_KEY, "an unknown key");
+    coavoid_auth_signer_t uav2 = p.k.uav[1];
+    publish_bytes(p.r.lcm, COAVOID_CHANNEL_INTENT, buf, size, &uav2, p.r.now + 2 * DT_US);
+    expect_refused(&p.r, s, COAVOID_AUTH_ERR_CLOCK, "signed two cycles ahead");
+    coavoid_plan_t plan = solved_plan(p.r.now, 1, p.r.now, 10, 1);
     plan.uav_ids[0] = 1;
     int n = coavoid_plan_t_encode(buf, 0, (int)sizeof buf, &plan);
-    publish_bytes(r.lcm, COAVOID_CHANNEL_PLAN, buf, n, &uav2, r.now);
-    expect_refused(&r, s, COAVOID_AUTH_ERR_ROLE, "a plan signed by UAV 2");
+    publish_bytes(p.r.lcm, COAVOID_CHANNEL_PLAN, buf, n, &uav2, p.r.now);
+    expect_refused(&p.r, s, COAVOID_AUTH_ERR_ROLE, "a plan signed by UAV 2");
     static coavoid_obstacle_map_t map;
     memset(&map, 0, sizeof map);
-    map.utime = r.now;
+    map.utime = p.r.now;
     map.map_id = (int32_t)COAVOID_NODE_WORLD_ID;
     map.version = INT64_MAX;
     n = coavoid_obstacle_map_t_encode(buf, 0, (int)sizeof buf, &map);
-    publish_bytes(r.lcm, COAVOID_CHANNEL_OBSTACLES, buf, n, &uav2, r.now);
-    expect_refused(&r, s, COAVOID_AUTH_ERR_ROLE, "a map signed by UAV 2");
+    publish_bytes(p.r.lcm, COAVOID_CHANNEL_OBSTACLES, buf, n, &uav2, p.r.now);
+    expect_refused(&p.r, s, COAVOID_AUTH_ERR_ROLE, "a map signed by UAV 2");
 
     /* UAV 2 restarts a cycle later: a new node, its numbering from 0, the same key. */
     coavoid_vehicle_node_destroy(b);
-    r.now = cycle(1);
-    b = signed_vehicle(&r, &k, uav(2, 2, r2, 10, 500, 800, 100), COAVOID_NODE_DECOUPLED);
-    ck_assert_int_eq(coavoid_vehicle_node_cycle(b, r.now), COA_OK);
+    p.r.now = cycle(1);
+    b = signed_vehicle(&p.r, &p.k, uav(2, 2, p.r2, 10, 500, 800, 100), COAVOID_NODE_DECOUPLED);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(b, p.r.now), COA_OK);
     const int64_t rejected = s->rx.rejected, received = s->rx.received;
-    drain(r.lcm);
-    ck_assert_int_gt(coavoid_intent_t_decode(tap.bytes, 0, tap.size, &m), 0);
+    drain(p.r.lcm);
+    ck_assert_int_gt(coavoid_intent_t_decode(p.tap.bytes, 0, p.tap.size, &m), 0);
     ck_assert_int_eq(m.sequence, 0);
     ck_assert_int_eq(s->rx.rejected, rejected);
     ck_assert_int_eq(s->rx.received, received + 2); /* its intent and heartbeat */
 
-    lcm_unsubscribe(r.lcm, si);
-    lcm_unsubscribe(r.lcm, ss);
     coavoid_world_destroy(w);
     coavoid_vehicle_node_destroy(b);
     coavoid_vehicle_node_destroy(a);
-    lcm_destroy(r.lcm);
+    signed_pair_fini(&p);
 }
 END_TEST
 
@@ -2657,82 +2683,63 @@ END_TEST
  * cycle's budget is whole again. */
 START_TEST(test_inbox_budget)
 {
-    static fleet_keys_t k;
-    fleet_keys(&k);
-    rig_t r;
-    rig_init(&r, 10);
-    static wiretap_t tap;
-    tap.node = 1;
-    tap.uav = 2;
-    lcm_subscription_t *ss = lcm_subscribe(r.lcm, COAVOID_CHANNEL_STATUS, on_tapped_status, &tap);
-    lcm_subscription_t *si = lcm_subscribe(r.lcm, COAVOID_CHANNEL_INTENT, on_tapped_intent, &tap);
-    coa_vec3_t r1[2], r2[2];
-    coavoid_vehicle_node_t *a =
-        signed_vehicle(&r, &k, uav(1, 1, r1, 0, 500, 0, 100), COAVOID_NODE_DECOUPLED);
-    coavoid_vehicle_node_t *b =
-        signed_vehicle(&r, &k, uav(2, 2, r2, 0, 500, 800, 100), COAVOID_NODE_DECOUPLED);
-    ck_assert_int_eq(coavoid_vehicle_node_cycle(b, r.now), COA_OK);
-    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
-    drain(r.lcm);
+    static signed_pair_t p;
+    signed_pair(&p, COAVOID_NODE_DECOUPLED);
+    coavoid_vehicle_node_t *a = p.a, *b = p.b;
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(b, p.r.now), COA_OK);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, p.r.now), COA_OK);
+    drain(p.r.lcm);
     const coavoid_vehicle_node_state_t *s = coavoid_vehicle_node_state(a);
-    ck_assert_int_eq(tap.dropped, 0);
-    ck_assert_int_eq(tap.reasons & COAVOID_STATUS_T_REASON_INBOX_FLOOD, 0);
+    ck_assert_int_eq(p.tap.dropped, 0);
+    ck_assert_int_eq(p.tap.reasons & COAVOID_STATUS_T_REASON_INBOX_FLOOD, 0);
 
     /* UAV 2's key stolen: fresh intents of UAV 2, each signed, one after another, in
      * cycle 1. */
-    r.now = cycle(1);
-    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
-    drain(r.lcm);
-    r.now = cycle(1) + DT_US / 4;
+    p.r.now = cycle(1);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, p.r.now), COA_OK);
+    drain(p.r.lcm);
+    p.r.now = cycle(1) + DT_US / 4;
     static coavoid_intent_t m;
-    ck_assert_int_gt(coavoid_intent_t_decode(tap.bytes, 0, tap.size, &m), 0);
+    ck_assert_int_gt(coavoid_intent_t_decode(p.tap.bytes, 0, p.tap.size, &m), 0);
     static unsigned char buf[TAP_BYTES];
     const uint32_t flood = COAVOID_NODE_CHECKS_PER_VEHICLE + 10u;
     int64_t received = s->rx.received;
     for (uint32_t i = 0; i < flood; i++) {
         m.sequence++;
         const int size = coavoid_intent_t_encode(buf, 0, (int)sizeof buf, &m);
-        publish_bytes(r.lcm, COAVOID_CHANNEL_INTENT, buf, size, &k.uav[1], r.now);
-        drain(r.lcm);
+        publish_bytes(p.r.lcm, COAVOID_CHANNEL_INTENT, buf, size, &p.k.uav[1], p.r.now);
+        drain(p.r.lcm);
     }
     ck_assert_int_eq(s->rx.received, received + COAVOID_NODE_CHECKS_PER_VEHICLE);
     /* The world's map in the same cycle: another key, still checked. */
-    coavoid_world_config_t wc;
-    memset(&wc, 0, sizeof wc);
-    wc.common = r.common;
-    wc.common.signer = &k.world;
-    int error = -99;
-    coavoid_world_t *w = coavoid_world_create(&wc, r.lcm, &error);
-    ck_assert_ptr_nonnull(w);
-    ck_assert_int_eq(coavoid_world_cycle(w, r.now), COA_OK);
-    drain(r.lcm);
+    coavoid_world_t *w = signed_world(&p);
+    ck_assert_int_eq(coavoid_world_cycle(w, p.r.now), COA_OK);
+    drain(p.r.lcm);
     ck_assert_int_eq(s->rx.received, received + COAVOID_NODE_CHECKS_PER_VEHICLE + 1);
     ck_assert_int_eq(s->rx.rejected, 0);
 
-    r.now = cycle(2);
-    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
-    drain(r.lcm);
-    ck_assert(tap.reasons & COAVOID_STATUS_T_REASON_INBOX_FLOOD);
-    ck_assert_int_eq(tap.dropped, 10);
-    ck_assert_int_ge(tap.inbox_rate, (int32_t)flood);
+    p.r.now = cycle(2);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, p.r.now), COA_OK);
+    drain(p.r.lcm);
+    ck_assert(p.tap.reasons & COAVOID_STATUS_T_REASON_INBOX_FLOOD);
+    ck_assert_int_eq(p.tap.dropped, 10);
+    ck_assert_int_ge(p.tap.inbox_rate, (int32_t)flood);
     /* A new cycle, a whole budget: UAV 2's next intent is checked and accepted. */
     m.sequence++;
     int size = coavoid_intent_t_encode(buf, 0, (int)sizeof buf, &m);
-    publish_bytes(r.lcm, COAVOID_CHANNEL_INTENT, buf, size, &k.uav[1], r.now + 1);
-    drain(r.lcm);
+    publish_bytes(p.r.lcm, COAVOID_CHANNEL_INTENT, buf, size, &p.k.uav[1], p.r.now + 1);
+    drain(p.r.lcm);
     ck_assert_int_eq(s->rx.received, received + COAVOID_NODE_CHECKS_PER_VEHICLE + 2);
-    r.now = cycle(3);
-    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
-    drain(r.lcm);
-    ck_assert_int_eq(tap.reasons & COAVOID_STATUS_T_REASON_INBOX_FLOOD, 0);
-    ck_assert_int_eq(tap.dropped, 10);
+    p.r.now = cycle(3);
+    ck_assert_int_eq(coavoid_vehicle_node_cycle(a, p.r.now), COA_OK);
+    drain(p.r.lcm);
+    ck_assert_int_eq(p.tap.reasons & COAVOID_STATUS_T_REASON_INBOX_FLOOD, 0);
+    ck_assert_int_eq(p.tap.dropped, 10);
 
-    lcm_unsubscribe(r.lcm, ss);
-    lcm_unsubscribe(r.lcm, si);
     coavoid_world_destroy(w);
     coavoid_vehicle_node_destroy(b);
     coavoid_vehicle_node_destroy(a);
-    lcm_destroy(r.lcm);
+    signed_pair_fini(&p);
 }
 END_TEST
 

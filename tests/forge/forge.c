@@ -168,23 +168,30 @@ static int32_t forged_offset(const forger_t *f, const coavoid_intent_t *t, int32
                      : (o0 - reach > goal ? o0 - reach : goal);
 }
 
+/* The identity of a forged plan for the target's cycle, of the target alone (a whole plan
+ * of one UAV in one message), its offsets left zero. */
+static void forged_plan_of(const forger_t *f, const coavoid_intent_t *t, coavoid_plan_t *m)
+{
+    memset(m, 0, sizeof *m);
+    m->utime = t->utime + 1;
+    m->coordinator_id = f->coordinator;
+    m->plan_id = INT64_MAX - 1 - f->forged;
+    m->valid_from_utime = t->plan_utime;
+    m->valid_until_utime = t->plan_utime + llround(t->step * 1e6);
+    m->dt = t->step;
+    m->horizon = t->sample_count - 1;
+    m->mode = COAVOID_PLAN_T_MODE_CENTRALISED;
+    m->status = COAVOID_PLAN_T_STATUS_SOLVED;
+    m->vehicle_count = 1;
+    m->planned_count = 1;
+    m->uav_ids[0] = f->target;
+    m->row_uav_id = f->target;
+}
+
 static void forge_plan(forger_t *f, const coavoid_intent_t *t)
 {
     static coavoid_plan_t m;
-    memset(&m, 0, sizeof m);
-    m.utime = t->utime + 1;
-    m.coordinator_id = f->coordinator;
-    m.plan_id = INT64_MAX - 1 - f->forged;
-    m.valid_from_utime = t->plan_utime;
-    m.valid_until_utime = t->plan_utime + llround(t->step * 1e6);
-    m.dt = t->step;
-    m.horizon = t->sample_count - 1;
-    m.mode = COAVOID_PLAN_T_MODE_CENTRALISED;
-    m.status = COAVOID_PLAN_T_STATUS_SOLVED;
-    m.vehicle_count = 1;
-    m.planned_count = 1;
-    m.uav_ids[0] = f->target;
-    m.row_uav_id = f->target; /* a whole plan of one UAV in one message */
+    forged_plan_of(f, t, &m);
     for (int32_t k = 0; k <= m.horizon; k++) {
         int32_t o = forged_offset(f, t, k);
         m.offsets[k] = o > 32767 ? 32767 : (o < -32767 ? -32767 : o);
@@ -197,20 +204,7 @@ static void forge_plan(forger_t *f, const coavoid_intent_t *t)
 static void forge_dive(forger_t *f, const coavoid_intent_t *t)
 {
     static coavoid_plan_t m;
-    memset(&m, 0, sizeof m);
-    m.utime = t->utime + 1;
-    m.coordinator_id = f->coordinator;
-    m.plan_id = INT64_MAX - 1 - f->forged;
-    m.valid_from_utime = t->plan_utime;
-    m.valid_until_utime = t->plan_utime + llround(t->step * 1e6);
-    m.dt = t->step;
-    m.horizon = t->sample_count - 1;
-    m.mode = COAVOID_PLAN_T_MODE_CENTRALISED;
-    m.status = COAVOID_PLAN_T_STATUS_SOLVED;
-    m.vehicle_count = 1;
-    m.planned_count = 1;
-    m.uav_ids[0] = f->target;
-    m.row_uav_id = f->target;
+    forged_plan_of(f, t, &m);
     for (int32_t k = 0; k <= m.horizon; k++) {
         const int64_t o = (int64_t)t->offsets[0] - (int64_t)t->steep_factor * k;
         m.offsets[k] = (int32_t)(o < -32767 ? -32767 : o);
