@@ -9,8 +9,10 @@
 # run, then the count of runs that lost separation.
 #
 # Each run's line also says, of the first intent of each UAV and cycle, how late after the
-# cycle's start the logger heard it (the worst, in wall milliseconds, and how many were
-# later than 50 ms); each node's CPU seconds; and from the nodes' last heartbeats the
+# cycle's start the logger heard it (the worst, in wall milliseconds, how many were later
+# than 50 ms, and how many a decoupled vehicle stamped 50 ms or more after the cycle's
+# start, held by its wait for the UAVs before it), and the worst of the vehicles'
+# heartbeats; each node's CPU seconds; and from the nodes' last heartbeats the
 # messages they refused and dropped unchecked, and the largest inbox rate they reported
 # (also in RUN/flood.json). With --flood, a flooder (tests/forge/flood.c) in a namespace
 # of its own sends copies of what it hears back to the group for the whole flight (the
@@ -217,7 +219,7 @@ for run in $(seq "$runs"); do
     wait "$logger" || true
     "$coavoid" summary "$dir/log.lcm" "$scenario" --mode "$mode" --epoch "$epoch" --json \
         --trust "$keys/trust.txt" >"$dir/summary.json" 2>"$dir/summary.err" || true
-    line=$(python3 - "$dir" "$out/py" "$epoch" "$speed" "$flood" <<'PY'
+    line=$(python3 - "$dir" "$out/py" "$epoch" "$speed" "$flood" "$scenario" <<'PY'
 import glob, json, os, re, struct, sys
 d = sys.argv[1]
 try:
@@ -235,8 +237,9 @@ line = ("loss of separation: %s, deviation %s m^2, effort %s, replans %s, fallba
 sys.path.insert(0, sys.argv[2])
 from coavoid import intent_t, status_t
 epoch, speed = int(sys.argv[3]), float(sys.argv[4])
+dt_us = round(json.load(open(sys.argv[6]))["dt"] * 1e6)
 data = open(os.path.join(d, "log.lcm"), "rb").read()
-i, first, status, codes, reasons = 0, {}, {}, {}, {}
+i, first, held, beats, status, codes, reasons = 0, {}, 0, {}, {}, {}, {}
 while i + 28 <= len(data):
     _, _, ts, clen, dlen = struct.unpack_from(">IqqII", data, i)
     channel = data[i + 28:i + 28 + clen].decode()
@@ -244,15 +247,21 @@ while i + 28 <= len(data):
     i += 28 + clen + dlen
     if channel == "COAVOID_INTENT":
         m = intent_t.decode(payload)
-        first.setdefault((m.uav_id, m.plan_utime), ts)
+        if (m.uav_id, m.plan_utime) not in first:
+            first[(m.uav_id, m.plan_utime)] = ts
+            # Held by the protocol: a decoupled vehicle's wait for the UAVs before it.
+            held += m.utime - m.plan_utime >= 50000
     elif channel == "COAVOID_STATUS":
         m = status_t.decode(payload)
+        if m.node_id < 65000:  # a vehicle's, sent with its intent, in its cycle
+            beats.setdefault((m.node_id, epoch + (m.utime - epoch) // dt_us * dt_us), ts)
         r = status.get(m.node_id, (0, 0, 0))
         status[m.node_id] = (m.messages_rejected, m.messages_dropped, max(m.inbox_rate, r[2]))
         codes.setdefault(m.node_id, set()).add(m.last_reject_code)
         reasons[m.node_id] = reasons.get(m.node_id, 0) | m.reasons
 # A cycle's start in wall time: scenario time runs `speed` times the wall's from epoch.
 late = [(ts - (epoch + (k - epoch) / speed)) / 1000 for (_, k), ts in first.items()]
+beat_late = [(ts - (epoch + (k - epoch) / speed)) / 1000 for (_, k), ts in beats.items()]
 worst = max(late) if late else float("nan")
 cpu = []
 for f in sorted(glob.glob(os.path.join(d, "*.cpu"))):
@@ -265,14 +274,16 @@ flooded = open(flood_txt).read().strip() if sys.argv[5] else "no flood"
 sent = re.search(r"sent (\d+)", flooded)
 json.dump({"loss_of_separation": s["loss_of_separation"], "worst_late_ms": worst,
            "late_over_50ms": sum(x > 50 for x in late), "intents": len(late),
+           "held_by_protocol": held, "worst_heartbeat_late_ms": max(beat_late, default=0),
            "sent": int(sent.group(1)) if sent else 0,
            "nodes": {str(k): {"refused": v[0], "dropped": v[1], "max_rate": v[2],
                               "codes": sorted(codes[k]), "reasons": reasons[k]}
                      for k, v in status.items()}},
           open(os.path.join(d, "flood.json"), "w"))
-line += ("; intents heard late: worst %.1f ms, %d of %d over 50 ms; cpu s: %s; "
-         "refused/dropped/max rate: %s; %s" % (worst, sum(x > 50 for x in late), len(late),
-         ", ".join(cpu), nodes, flooded))
+line += ("; intents heard late: worst %.1f ms, %d of %d over 50 ms (%d held by the "
+         "protocol), vehicles' heartbeats worst %.1f ms; cpu s: %s; refused/dropped/max rate: "
+         "%s; %s" % (worst, sum(x > 50 for x in late), len(late), held,
+                     max(beat_late, default=float("nan")), ", ".join(cpu), nodes, flooded))
 print(line)
 PY
 )

@@ -273,14 +273,18 @@ static int64_t rt_pending_deadline(const rt_run_t *r, size_t i, int64_t deadline
     return deadline == deadline_polled ? INT64_MAX : deadline;
 }
 
-/* Dispatches the messages waiting, each with the clock set just before, at most
- * RT_MAX_DRAIN at a time so that a flood cannot starve the nodes' own events. Returns
- * how many, or COAVOID_RT_ERR_LCM. */
-static int rt_drain(const rt_run_t *r)
+/* Dispatches the messages waiting, each with the clock set just before, until the next
+ * event is due at scenario time `wake` (one message at least), and at most RT_MAX_DRAIN at
+ * a time, so that a flood cannot delay the nodes' own events by more than one message's
+ * handling. Returns how many, or COAVOID_RT_ERR_LCM. */
+static int rt_drain(const rt_run_t *r, int64_t wake)
 {
     int handled = 0;
     while (handled < RT_MAX_DRAIN) {
         *r->loop->now = rt_now(r);
+        if (handled > 0 && *r->loop->now >= wake) {
+            break;
+        }
         errno = 0;
         int rc = lcm_handle_timeout(r->loop->lcm, 0);
         if (rc < 0) {
@@ -477,7 +481,7 @@ static int rt_wait_messages(const rt_run_t *r, rt_sched_t *sc, int fd, int64_t w
     if (rc <= 0) {
         return rc;
     }
-    rc = rt_drain(r);
+    rc = rt_drain(r, wake);
     if (rc < 0) {
         return rc;
     }

@@ -17,7 +17,9 @@
  *
  * The loop (coavoid_rt_run). Between events it waits on LCM's file descriptor and, for every
  * message, sets the clock variable the nodes read (common.clock) and lets LCM dispatch it
- * (lcm_handle_timeout). At its times it calls:
+ * (lcm_handle_timeout); it stops dispatching as soon as an event is due (after one message
+ * at least), so that a flood delays an event by one message's handling at most. At its
+ * times it calls:
  *   - at cycle_utime(k), k = first..K: the world's cycle, then each vehicle's cycle (a
  *     world alone in its process runs cycle k world_lead_us earlier);
  *   - at cycle_utime(k) + collect_us, k = first..K-1: the coordinator's cycle;
