@@ -181,26 +181,29 @@ static void count_undecodable(coavoid_node_inbox_t *in, const char *reason)
     coavoid_lcm_rx_count(in->rx, COAVOID_LCM_ERR_DECODE, reason);
 }
 
+/* A whole budget for cycle `cycle`, nothing checked or taken in yet. */
+static void budget_start(coavoid_node_inbox_t *in, int64_t cycle)
+{
+    in->budget_cycle = cycle;
+    memset(in->checks, 0, sizeof in->checks);
+    in->cycle_checks = 0u;
+    in->cycle_datagrams = 0u;
+}
+
 /* Brings the inbox budget to the cycle of `now`: a new cycle starts it afresh. */
 static void budget_roll(coavoid_node_inbox_t *in, int64_t now)
 {
     const int64_t cycle = coavoid_node_cycle_of(&in->common, now);
     if (cycle != in->budget_cycle) {
         in->last_cycle_datagrams = cycle == in->budget_cycle + 1 ? in->cycle_datagrams : 0u;
-        in->budget_cycle = cycle;
-        memset(in->checks, 0, sizeof in->checks);
-        in->cycle_checks = 0u;
-        in->cycle_datagrams = 0u;
+        budget_start(in, cycle);
     }
 }
 
 /* An inbox budget of no cycle yet, nothing dropped. */
 static void budget_init(coavoid_node_inbox_t *in)
 {
-    in->budget_cycle = INT64_MIN;
-    memset(in->checks, 0, sizeof in->checks);
-    in->cycle_checks = 0u;
-    in->cycle_datagrams = 0u;
+    budget_start(in, INT64_MIN);
     in->last_cycle_datagrams = 0u;
     in->dropped = 0;
     in->dropped_at_heartbeat = 0;
