@@ -17,7 +17,10 @@
  *   conflict NAME KIND A_ID B FIRST_STEP FIRST_TIME MIN_H MIN_V PROBABILITY
  *       (B an id, or an obstacle's index; the reals as the hexadecimal bits of the float,
  *       or of the double for the probability)
- * then `done` and an exit through SYS_EXIT (status 0; 1 when a problem could not run).
+ *   crypto ...      the message checks on the part, when built with libsodium
+ *                   (check_crypto.c, COAVOID_FW_CRYPTO)
+ * then `done` and an exit through semihosting (status 0; 1 when a problem could not run
+ * or a check gave a wrong result).
  *
  * Each `run` and `predict` line ends with `ticks T`: SysTick ticks of the processor clock
  * around the call. Under qemu -icount shift=0 (virtual time advances 1 ns per guest
@@ -30,6 +33,8 @@
 #include <stdint.h>
 #include <string.h>
 
+#include "check_crypto.h"
+#include "check_io.h"
 #include "firmware.h"
 
 #ifndef CCD_SINGLE
@@ -81,113 +86,12 @@ static size_t buffer_bytes(const fwc_problem_t *p)
                : sizeof planner_buffer;
 }
 
-/* SysTick, free-running on the processor clock: 24 bits, the wraps counted in the
- * interrupt. */
-#define SYST_CSR (*(volatile uint32_t *)0xE000E010u)
-#define SYST_RVR (*(volatile uint32_t *)0xE000E014u)
-#define SYST_CVR (*(volatile uint32_t *)0xE000E018u)
-#define SYST_PERIOD 0x1000000u
-
-static volatile uint32_t systick_wraps;
-
-void fw_systick_handler(void)
-{
-    systick_wraps = systick_wraps + 1u;
-}
-
-static uint64_t ticks_now(void)
-{
-    uint32_t wraps;
-    uint32_t value;
-    do {
-        wraps = systick_wraps;
-        value = SYST_CVR;
-    } while (wraps != systick_wraps);
-    return (uint64_t)wraps * SYST_PERIOD + (SYST_PERIOD - 1u - value);
-}
-
-/* A loop of exactly 2 * n + 1 instructions (subs and a taken bne per round, the last bne
- * not taken, plus the mov), for the calibration. */
-static void spin(uint32_t n)
-{
-    __asm__ volatile("mov r0, %0\n1:\n\tsubs r0, #1\n\tbne 1b" : : "r"(n) : "r0", "cc");
-}
-
-/* ARM semihosting (the "Angel" interface): operation in r0, argument in r1, bkpt 0xAB in
- * Thumb state; the debugger or emulator does the operation and resumes. */
-#define SYS_WRITE0 0x04u
-#define SYS_EXIT 0x18u
-#define ADP_STOPPED_APPLICATION_EXIT 0x20026u
-#define ADP_STOPPED_RUN_TIME_ERROR 0x20023u
-
-static void semihost(uint32_t op, const void *arg)
-{
-    __asm__ volatile("mov r0, %0\n\tmov r1, %1\n\tbkpt 0xab"
-                     :
-                     : "r"(op), "r"(arg)
-                     : "r0", "r1", "memory");
-}
-
-/* Output goes through a line buffer: one semihosting call per line, not per character. */
-static char line[512];
-static size_t line_length;
-
-static void put(const char *s)
-{
-    while (*s != '\0' && line_length + 2u < sizeof line) {
-        line[line_length++] = *s++;
-    }
-}
-
-static void end_line(void)
-{
-    line[line_length++] = '\n';
-    line[line_length] = '\0';
-    semihost(SYS_WRITE0, line);
-    line_length = 0;
-}
-
-static void put_u64(uint64_t v)
-{
-    char digits[21];
-    size_t i = sizeof digits - 1u;
-    digits[i] = '\0';
-    do {
-        digits[--i] = (char)('0' + (int)(v % 10u));
-        v /= 10u;
-    } while (v != 0u);
-    put(&digits[i]);
-}
-
-static void put_i64(int64_t v)
-{
-    if (v < 0) {
-        put("-");
-        put_u64(0u - (uint64_t)v);
-    } else {
-        put_u64((uint64_t)v);
-    }
-}
-
-static void put_hex64(uint64_t v)
-{
-    static const char hex[] = "0123456789abcdef";
-    char digits[17];
-    int i;
-    for (i = 15; i >= 0; --i) {
-        digits[i] = hex[v & 0xfu];
-        v >>= 4;
-    }
-    digits[16] = '\0';
-    put(digits);
-}
-
 static void put_field(const char *key, uint64_t v)
 {
-    put(" ");
-    put(key);
-    put(" ");
-    put_u64(v);
+    fwc_put(" ");
+    fwc_put(key);
+    fwc_put(" ");
+    fwc_put_u64(v);
 }
 
 static void report(const fwc_problem_t *p, const char *mode, int rc, const coa_plan_result_t *r,
@@ -198,49 +102,49 @@ static void report(const fwc_problem_t *p, const char *mode, int rc, const coa_p
     size_t k;
 
     memcpy(&bits, &r->deviation, sizeof bits);
-    put("run ");
-    put(p->name);
-    put(" ");
-    put(mode);
-    put(" rc ");
-    put_i64(rc);
+    fwc_put("run ");
+    fwc_put(p->name);
+    fwc_put(" ");
+    fwc_put(mode);
+    fwc_put(" rc ");
+    fwc_put_i64(rc);
     put_field("status", (uint64_t)r->status);
     put_field("expanded", r->nodes_expanded);
     put_field("generated", r->nodes_generated);
     put_field("effort", r->effort);
-    put(" deviation_bits ");
-    put_hex64(bits);
-    put(" units ");
-    put_hex64(r->deviation_units.hi);
-    put(":");
-    put_hex64(r->deviation_units.lo);
-    put(" order ");
+    fwc_put(" deviation_bits ");
+    fwc_put_hex64(bits);
+    fwc_put(" units ");
+    fwc_put_hex64(r->deviation_units.hi);
+    fwc_put(":");
+    fwc_put_hex64(r->deviation_units.lo);
+    fwc_put(" order ");
     for (j = 0; j < p->vehicle_count; ++j) {
-        put(j == 0u ? "" : ",");
-        put_u64(p->vehicles[r->order[j] < p->vehicle_count ? r->order[j] : 0u].id);
+        fwc_put(j == 0u ? "" : ",");
+        fwc_put_u64(p->vehicles[r->order[j] < p->vehicle_count ? r->order[j] : 0u].id);
     }
     put_field("planned", r->planned_count);
-    put(" failed ");
-    put(r->failed_vehicle < p->vehicle_count ? "" : "none");
+    fwc_put(" failed ");
+    fwc_put(r->failed_vehicle < p->vehicle_count ? "" : "none");
     if (r->failed_vehicle < p->vehicle_count) {
-        put_u64(p->vehicles[r->failed_vehicle].id);
+        fwc_put_u64(p->vehicles[r->failed_vehicle].id);
     }
     put_field("ticks", ticks);
-    end_line();
+    fwc_end_line();
     /* The rows the result says are a plan: the first planned_count of `order`. */
     for (j = 0; j < r->planned_count && j < p->vehicle_count; ++j) {
         size_t i = r->order[j];
-        put("offsets ");
-        put(p->name);
-        put(" ");
-        put(mode);
-        put(" ");
-        put_u64(p->vehicles[i].id);
+        fwc_put("offsets ");
+        fwc_put(p->name);
+        fwc_put(" ");
+        fwc_put(mode);
+        fwc_put(" ");
+        fwc_put_u64(p->vehicles[i].id);
         for (k = 0; k <= p->horizon; ++k) {
-            put(" ");
-            put_i64(offsets[i * (p->horizon + 1u) + k]);
+            fwc_put(" ");
+            fwc_put_i64(offsets[i * (p->horizon + 1u) + k]);
         }
-        end_line();
+        fwc_end_line();
     }
 }
 
@@ -248,17 +152,17 @@ static void put_real_bits(coa_real_t x)
 {
     uint32_t bits;
     memcpy(&bits, &x, sizeof bits);
-    put(" ");
-    put_hex64(bits);
+    fwc_put(" ");
+    fwc_put_hex64(bits);
 }
 
 static void fail(const fwc_problem_t *p, const char *why)
 {
-    put("error ");
-    put(p->name);
-    put(": ");
-    put(why);
-    end_line();
+    fwc_put("error ");
+    fwc_put(p->name);
+    fwc_put(": ");
+    fwc_put(why);
+    fwc_end_line();
 }
 
 /* One prediction cycle as `coavoid predict` runs it with its defaults (predict_cmd.c):
@@ -304,43 +208,43 @@ static bool run_predict(const fwc_problem_t *p)
                                          .samples = intent_samples[i],
                                          .count = p->horizon + 1u};
     }
-    start = ticks_now();
+    start = fwc_ticks_now();
     rc = coa_predict(predictor, &config, intents, n, p->obstacles, p->obstacle_count, p->tracks,
                      p->track_count, conflicts, pairs, &result);
-    start = ticks_now() - start;
-    put("predict ");
-    put(p->name);
-    put(" rc ");
-    put_i64(rc);
+    start = fwc_ticks_now() - start;
+    fwc_put("predict ");
+    fwc_put(p->name);
+    fwc_put(" rc ");
+    fwc_put_i64(rc);
     put_field("conflicts", rc == COA_OK ? result.conflict_count : 0u);
     put_field("ticks", start);
-    end_line();
+    fwc_end_line();
     for (i = 0; rc == COA_OK && i < result.conflict_count; ++i) {
         const coa_conflict_t *cf = &conflicts[i];
         uint64_t bits;
-        put("conflict ");
-        put(p->name);
-        put(" ");
-        put(kinds[cf->kind <= COA_CONFLICT_OBSTACLE ? cf->kind : 0]);
-        put(" ");
-        put_u64(p->vehicles[cf->a < n ? cf->a : 0u].id);
-        put(" ");
+        fwc_put("conflict ");
+        fwc_put(p->name);
+        fwc_put(" ");
+        fwc_put(kinds[cf->kind <= COA_CONFLICT_OBSTACLE ? cf->kind : 0]);
+        fwc_put(" ");
+        fwc_put_u64(p->vehicles[cf->a < n ? cf->a : 0u].id);
+        fwc_put(" ");
         if (cf->kind == COA_CONFLICT_VEHICLE) {
-            put_u64(p->vehicles[cf->b < n ? cf->b : 0u].id);
+            fwc_put_u64(p->vehicles[cf->b < n ? cf->b : 0u].id);
         } else if (cf->kind == COA_CONFLICT_TRACK) {
-            put_u64(p->tracks[cf->b < p->track_count ? cf->b : 0u].id);
+            fwc_put_u64(p->tracks[cf->b < p->track_count ? cf->b : 0u].id);
         } else {
-            put_u64(cf->b);
+            fwc_put_u64(cf->b);
         }
-        put(" ");
-        put_u64(cf->first_step);
+        fwc_put(" ");
+        fwc_put_u64(cf->first_step);
         put_real_bits(cf->first_time);
         put_real_bits(cf->min_horizontal);
         put_real_bits(cf->min_vertical);
         memcpy(&bits, &cf->probability, sizeof bits);
-        put(" ");
-        put_hex64(bits);
-        end_line();
+        fwc_put(" ");
+        fwc_put_hex64(bits);
+        fwc_end_line();
     }
     return rc == COA_OK;
 }
@@ -397,9 +301,9 @@ static bool run_problem(const fwc_problem_t *p)
             return false;
         }
         memset(offsets, 0, sizeof offsets);
-        start = ticks_now();
+        start = fwc_ticks_now();
         rc = coa_plan_decoupled(planner, &problem, NULL, 1u, offsets, &result);
-        report(p, "decoupled", rc, &result, ticks_now() - start);
+        report(p, "decoupled", rc, &result, fwc_ticks_now() - start);
     }
     if (p->centralised) {
         coa_planner_config_t config;
@@ -412,9 +316,9 @@ static bool run_problem(const fwc_problem_t *p)
             return false;
         }
         memset(offsets, 0, sizeof offsets);
-        start = ticks_now();
+        start = fwc_ticks_now();
         rc = coa_plan_centralised(planner, &problem, offsets, &result);
-        report(p, "centralised", rc, &result, ticks_now() - start);
+        report(p, "centralised", rc, &result, fwc_ticks_now() - start);
     }
     return true;
 }
@@ -425,28 +329,27 @@ int main(void)
     uint64_t start;
     size_t p;
 
-    put("coavoid firmware check: ");
-    put_u64(FWC_PROBLEM_COUNT);
-    put(" problems");
-    end_line();
-    SYST_RVR = SYST_PERIOD - 1u;
-    SYST_CVR = 0u;
-    SYST_CSR = 7u; /* processor clock, interrupt, enable */
-    spin(1000u);   /* past the first reload from the 0 written above */
-    start = ticks_now();
-    spin(1000000u);
-    start = ticks_now() - start;
-    put("calibrate ");
-    put_u64(2u * 1000000u + 1u);
-    put(" ");
-    put_u64(start);
-    end_line();
+    fwc_put("coavoid firmware check: ");
+    fwc_put_u64(FWC_PROBLEM_COUNT);
+    fwc_put(" problems");
+    fwc_end_line();
+    fwc_ticks_start();
+    start = fwc_ticks_now();
+    fwc_spin(1000000u);
+    start = fwc_ticks_now() - start;
+    fwc_put("calibrate ");
+    fwc_put_u64(2u * 1000000u + 1u);
+    fwc_put(" ");
+    fwc_put_u64(start);
+    fwc_end_line();
     for (p = 0; p < FWC_PROBLEM_COUNT; ++p) {
         ok = run_problem(&fwc_problems[p]) && ok;
     }
-    put(ok ? "done" : "done with errors");
-    end_line();
-    semihost(SYS_EXIT, (const void *)(uintptr_t)(ok ? ADP_STOPPED_APPLICATION_EXIT
-                                                    : ADP_STOPPED_RUN_TIME_ERROR));
+#ifdef COAVOID_FW_CRYPTO
+    ok = fwc_crypto_run(planner_buffer, sizeof planner_buffer) && ok;
+#endif
+    fwc_put(ok ? "done" : "done with errors");
+    fwc_end_line();
+    fwc_exit(ok);
     return ok ? 0 : 1;
 }

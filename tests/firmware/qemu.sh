@@ -4,7 +4,8 @@
 # runs coavoid-firmware-check.elf (apps/firmware/check.c, built by the `firmware` test's
 # cross build in BUILD/firmware-arm) in qemu's netduinoplus2 machine (Cortex-M4F, FPU)
 # with ARM semihosting, then qemu_compare.py compares every result with `coavoid plan` on
-# the same scenarios (tests/firmware/qemu/*.json) in both host builds (double and single).
+# the same scenarios (tests/firmware/qemu/*.json) in both host builds (double and single),
+# and the fleet tags and Ed25519 signatures the check computed with the host's libsodium.
 # Also fails when apps/firmware/check_problems.h is not what gen_check_problems.py makes
 # of those scenarios. A missing qemu-system-arm is a failure, not a skip.
 # Usage: qemu.sh SRC BUILD DOUBLE_COAVOID SINGLE_COAVOID

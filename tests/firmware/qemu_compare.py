@@ -26,7 +26,14 @@ Also prints the instructions each call executed on the emulated Cortex-M4F, when
 firmware was run under qemu -icount shift=0: its SysTick ticks times the ratio of its
 calibration loop (a known instruction count over its ticks). Guest instructions, not
 cycles or time (qemu is not cycle-accurate); printed, never compared.
+
+Message checks (apps/firmware/check_crypto.c's `crypto` lines): the fleet tag and the
+Ed25519 signature the firmware computed over its fixed datagrams must equal the host
+libsodium's, bit for bit, the signature must verify and the changed datagram must not; their
+instructions are printed as well.
 """
+import ctypes
+import ctypes.util
 import json
 import os
 import struct
@@ -41,6 +48,7 @@ STATUS = {0: "solved", 1: "infeasible", 2: "budget_exhausted"}
 def parse(path):
     runs, offsets, errors = {}, {}, []
     predicts, conflicts = {}, {}
+    crypto = []
     calibration = None
     done = False
     with open(path) as f:
@@ -60,11 +68,59 @@ def parse(path):
                 runs[(t[1], "predict")] = dict(zip(t[2::2], t[3::2]))
             elif t[0] == "conflict":
                 conflicts.setdefault(t[1], []).append(t[2:])
+            elif t[0] == "crypto":
+                crypto.append(t[1:])
             elif t[0] == "error":
                 errors.append(raw.strip())
             elif t[0] == "done":
                 done = True
-    return runs, offsets, errors, done, predicts, conflicts, calibration
+    return runs, offsets, errors, done, predicts, conflicts, calibration, crypto
+
+
+def host_crypto(size):
+    """The tag and signature check_crypto.c computes for a datagram of `size` bytes, by the
+    host's libsodium: the same patterns (byte i of the datagram 7i + 3, of the key seed i,
+    of the fleet key i + 16, each mod 256)."""
+    na = ctypes.CDLL(ctypes.util.find_library("sodium") or "libsodium.so.23")
+    if na.sodium_init() < 0:
+        sys.exit("qemu_compare.py: sodium_init failed")
+    pk, sk = ctypes.create_string_buffer(32), ctypes.create_string_buffer(64)
+    na.crypto_sign_ed25519_seed_keypair(pk, sk, bytes(range(32)))
+    signed = bytes((i * 7 + 3) & 0xFF for i in range(size - 72))
+    signature = ctypes.create_string_buffer(64)
+    na.crypto_sign_ed25519_detached(signature, None, signed, ctypes.c_ulonglong(len(signed)), sk)
+    tagged = signed + signature.raw
+    tag = ctypes.create_string_buffer(8)
+    na.crypto_shorthash_siphash24(tag, tagged, ctypes.c_ulonglong(len(tagged)),
+                                  bytes((i + 16) & 0xFF for i in range(16)))
+    return {"tag": tag.raw.hex(), "sign": signature.raw.hex()}
+
+
+def compare_crypto(crypto, bad):
+    """Checks the firmware's crypto lines against the host; returns how many were compared."""
+    want = {"tag": "hex", "sign": "hex", "verify": "0", "refuse": "-1"}
+    seen = {(t[0], t[1]) for t in crypto}
+    for what in want:
+        for size in ("192", "1398"):
+            if (what, size) not in seen:
+                bad.append(f"crypto {what} {size}: the firmware reported none")
+    compared = 0
+    for t in crypto:
+        what, size, value = t[0], int(t[1]), t[2]
+        if what in ("tag", "sign"):
+            host = host_crypto(size)[what]
+            if value != host:
+                bad.append(f"crypto {what} {size}: firmware {value} != host libsodium {host}")
+        elif what in want and t[3] != want[what]:
+            bad.append(f"crypto {what} {size}: firmware rc {t[3]}, expected {want[what]}")
+        compared += 1
+    return compared
+
+
+def print_crypto(crypto, per_tick):
+    print(f"{'message check':14} {'bytes':>6} {'instructions':>13}")
+    for t in crypto:
+        print(f"{t[0]:14} {t[1]:>6} {int(t[t.index('ticks') + 1]) * per_tick:13,.0f}")
 
 
 def area_scaled(a, b, scale):
@@ -142,7 +198,7 @@ def main():
         sys.exit("usage: qemu_compare.py FIRMWARE_OUTPUT DOUBLE_COAVOID SINGLE_COAVOID -- "
                  "SCENARIO.json...")
     out, binaries, scenarios = argv[0], argv[1:3], argv[4:]
-    runs, fw_offsets, errors, done, predicts, fw_conflicts, calibration = parse(out)
+    runs, fw_offsets, errors, done, predicts, fw_conflicts, calibration, crypto = parse(out)
     bad = []
     for e in errors:
         bad.append(f"firmware: {e}")
@@ -215,10 +271,12 @@ def main():
             expanded = int(kv.get("expanded", 0))
             per = f"{insns / expanded:14,.0f}" if expanded else f"{'-':>14}"
             print(f"{name:10} {mode:12} {expanded:9} {insns:13,.0f} {per}")
+        print_crypto(crypto, per_tick)
+    compared += compare_crypto(crypto, bad)
     for line in bad:
         print(f"firmware_qemu: DIFFERENT: {line}")
-    print(f"firmware_qemu: {compared} comparisons (scenario x (prediction + modes) x host build), "
-          f"{len(bad)} differences")
+    print(f"firmware_qemu: {compared} comparisons (plans and predictions of each host build, "
+          f"message checks), {len(bad)} differences")
     return 1 if bad else 0
 
 

@@ -8,13 +8,17 @@
 #   - prints text, data and bss of the ELF, the core and libccd, the largest stack frames
 #     (-fstack-usage) and the deepest call chains (-fcallgraph-info=su, callgraph.awk),
 #     failing on recursion or a dynamic frame.
-# Usage: run.sh SRC BUILD CCD_SOURCE_DIR (libccd's unpacked source, fetched beforehand by
-# scripts/fetch_libccd_source.sh: a test never downloads). A missing toolchain, newlib or
-# libccd source is a failure with what to install, not a skip: CI must run this.
+# Also builds libsodium's message checks (cmake/libsodium_arm.cmake) into the check ELF,
+# which must link them without a heap, and reports their sizes and stack.
+# Usage: run.sh SRC BUILD CCD_SOURCE_DIR SODIUM_SOURCE_DIR (the unpacked sources, fetched
+# beforehand by scripts/fetch_sources.sh: a test never downloads). A missing toolchain,
+# newlib or source is a failure with what to install, not a skip: CI must run this.
 set -euo pipefail
-src=${1:?usage: run.sh SRC BUILD CCD_SOURCE_DIR}
-build=${2:?usage: run.sh SRC BUILD CCD_SOURCE_DIR}
-ccd_src=${3:?usage: run.sh SRC BUILD CCD_SOURCE_DIR}
+usage="usage: run.sh SRC BUILD CCD_SOURCE_DIR SODIUM_SOURCE_DIR"
+src=${1:?$usage}
+build=${2:?$usage}
+ccd_src=${3:?$usage}
+sodium_src=${4:?$usage}
 arm=$build/firmware-arm
 cmake=${CMAKE:-cmake}
 prefix=arm-none-eabi-
@@ -28,18 +32,20 @@ libc=$("${prefix}gcc" -mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard
 [ -f "$libc" ] || die "newlib for Cortex-M4F hard float not found: apt-get install libnewlib-arm-none-eabi"
 
 [ -f "$ccd_src/src/ccd/config.h.cmake.in" ] ||
-  die "$ccd_src is not libccd's unpacked source: scripts/fetch_libccd_source.sh DIR, then -DCOAVOID_CCD_SOURCE_DIR=DIR/source"
+  die "$ccd_src is not libccd's unpacked source: scripts/fetch_sources.sh DIR, then -DCOAVOID_CCD_SOURCE_DIR=DIR/libccd"
+[ -f "$sodium_src/src/libsodium/include/sodium/version.h.in" ] ||
+  die "$sodium_src is not libsodium's unpacked source: scripts/fetch_sources.sh DIR, then -DCOAVOID_SODIUM_SOURCE_DIR=DIR/libsodium"
 # The ARM tree is this test's own: one built from another libccd source (an earlier
 # configure, or the configure step's own fetch: libccd's ExternalProject cannot switch
 # sources) starts again. $arm/ccd-source names the source it was built from.
-if [ -d "$arm" ] && [ "$(cat "$arm/ccd-source" 2>/dev/null)" != "$ccd_src" ]; then
+if [ -d "$arm" ] && [ "$(cat "$arm/ccd-source" 2>/dev/null)" != "$ccd_src $sodium_src" ]; then
   echo "firmware: $arm was not built from $ccd_src: rebuilding it"
   rm -rf "$arm"
 fi
 mkdir -p "$arm"
-echo "$ccd_src" > "$arm/ccd-source"
+echo "$ccd_src $sodium_src" > "$arm/ccd-source"
 args=(-S "$src" -B "$arm" -DCMAKE_TOOLCHAIN_FILE="$src/cmake/arm-none-eabi-cortex-m4f.cmake"
-  -DCOAVOID_CCD_SOURCE_DIR="$ccd_src")
+  -DCOAVOID_CCD_SOURCE_DIR="$ccd_src" -DCOAVOID_SODIUM_SOURCE_DIR="$sodium_src")
 # Configure output only when it fails (it says what is missing: a deb-src line, dpkg-dev).
 if ! log=$("$cmake" "${args[@]}" 2>&1); then
   echo "$log" >&2
@@ -53,8 +59,9 @@ fi
 core=$arm/src/core/libcoavoid_core.a
 elf=$arm/apps/firmware/coavoid-firmware.elf
 ccd=$arm/libccd-arm/lib/libccd.a
+sodium=$arm/libcoavoid_sodium_arm.a
 map=$arm/apps/firmware/coavoid-firmware.map
-for f in "$core" "$elf" "$ccd" "$map"; do
+for f in "$core" "$elf" "$ccd" "$sodium" "$map"; do
   [ -f "$f" ] || die "$f was not built"
 done
 grep -q '^#define CCD_SINGLE' "$arm/libccd-arm/include/ccd/config.h" ||
@@ -71,10 +78,14 @@ check_elf=$arm/apps/firmware/coavoid-firmware-check.elf
 [ -f "$check_elf" ] || die "$check_elf was not built"
 "$cmake" -DLINKED=ON -DLIB="$check_elf" -DNM="${prefix}nm" -P "$src/tests/check_core_symbols.cmake" ||
   die "the firmware check ELF contains a forbidden function"
+# (grep reads all of nm's output: -q would stop early and fail the pipe under pipefail)
+[ "$("${prefix}nm" "$check_elf" | grep -c ' T fwc_crypto_run$')" -eq 1 ] ||
+  die "the firmware check ELF has no message checks (fwc_crypto_run): libsodium was not built"
 
 echo "== size (bytes; an archive's total is every function, the ELF only what it links)"
 "${prefix}size" -t "$core" | tail -n 1 | sed 's/(TOTALS)/core (libcoavoid_core.a)/'
 "${prefix}size" -t "$ccd" | tail -n 1 | sed 's/(TOTALS)/libccd (libccd.a)/'
+"${prefix}size" -t "$sodium" | tail -n 1 | sed 's/(TOTALS)/libsodium: tag and Ed25519 (libcoavoid_sodium_arm.a)/'
 "${prefix}size" "$elf" | tail -n 1 | sed "s|$elf|firmware ELF|"
 
 # Stack frames: file:line:col:function <TAB> bytes <TAB> static|dynamic[,bounded].
@@ -98,18 +109,22 @@ report_frames firmware "$fw_objs" || die "unbounded stack frame in the firmware"
 report_frames check "$arm/apps/firmware/CMakeFiles/coavoid_firmware_check.dir" ||
   die "unbounded stack frame in the firmware check"
 report_frames libccd "$arm/libccd-arm-build/src" || true
+sodium_objs=$arm/CMakeFiles/coavoid_sodium_arm.dir
+report_frames libsodium "$sodium_objs" || die "unbounded stack frame in libsodium's message checks"
 # Call chains: the deepest sum of frames below each entry point, over the core's,
 # libccd's and the firmware's call graphs; libccd's only indirect calls are to the
 # callbacks geometry.c hands it. Recursion or a dynamic frame fails the test.
 echo "== stack (deepest call chain: frames summed, library leaves not included)"
 mapfile -t graphs < <(find "$arm/src/core/CMakeFiles/coavoid_core.dir" "$fw_objs" \
-  "$arm/libccd-arm-build/src" -name '*.ci' | sort)
+  "$arm/libccd-arm-build/src" "$sodium_objs" -name '*.ci' | sort)
 [ "${#graphs[@]}" -gt 0 ] || die "no .ci files (-fcallgraph-info=su missing?)"
-awk -v roots="main,fw_systick_handler,fw_task_cycle,coa_plan_decoupled,coa_plan_centralised,coa_predict" \
+awk -v roots="main,fw_systick_handler,fw_task_cycle,coa_plan_decoupled,coa_plan_centralised,coa_predict,crypto_shorthash_siphash24,crypto_sign_ed25519_detached,crypto_sign_ed25519_verify_detached" \
   -v indirect="sweep_support,poly_support,sweep_centre,poly_centre" \
   -f "$src/tests/firmware/callgraph.awk" "${graphs[@]}" || die "unbounded call chain"
 echo "== firmware ELF by origin (input sections from the map; flash = code + constants)"
 awk -f "$src/tests/firmware/mapsizes.awk" "$map"
+echo "== firmware check ELF by origin (the same; its message checks are libsodium's share)"
+awk -f "$src/tests/firmware/mapsizes.awk" "$arm/apps/firmware/coavoid-firmware-check.map"
 echo "== firmware sections (flash: .isr_vector .text .ARM.exidx + .data's image; SRAM: .data .bss; CCM: .stack)"
 "${prefix}size" -A "$elf" | awk '$1 ~ /^\.(isr_vector|text|ARM\.exidx|data|bss|stack)/ { printf "%-12s %7d bytes at 0x%08x\n", $1, $2, $3 }'
 echo "firmware: ARM core and firmware link without heap or stdio"

@@ -1,0 +1,120 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * check_crypto.c: the message checks of docs/messages.md on the part (check.c runs it when
+ * the cross build has libsodium, cmake/libsodium_arm.cmake), counted with check_io.h's
+ * clock: the fleet tag (SipHash-2-4), an Ed25519 signature, its verification, and the
+ * verification of a datagram with one byte changed, each over a heartbeat (192 bytes) and
+ * an intent (1,398 bytes), the smallest and a large datagram a vehicle checks every cycle.
+ *
+ * The datagrams, the key seed and the fleet key are fixed patterns (byte i of each below),
+ * so tests/firmware/qemu_compare.py computes the same tag and signature with the host's
+ * libsodium and compares them with these lines:
+ *   crypto tag BYTES HEX ticks T           the tag over the datagram's first BYTES - 8
+ *   crypto sign BYTES HEX ticks T          the signature over its first BYTES - 72
+ *   crypto verify BYTES rc RC ticks T      RC 0: the signature verifies
+ *   crypto refuse BYTES rc RC ticks T      the same with one signed byte changed: RC -1
+ */
+#include <stdbool.h>
+#include <stdint.h>
+#include <string.h>
+
+#include <sodium/crypto_shorthash_siphash24.h>
+#include <sodium/crypto_sign_ed25519.h>
+
+#include "check_crypto.h"
+#include "check_io.h"
+
+#define CRYPTO_TAG_BYTES 8u
+#define CRYPTO_SIGNATURE_BYTES 64u
+#define CRYPTO_LARGEST 1398u
+
+static unsigned char public_key[crypto_sign_ed25519_PUBLICKEYBYTES];
+static unsigned char secret_key[crypto_sign_ed25519_SECRETKEYBYTES];
+static unsigned char fleet_key[crypto_shorthash_siphash24_KEYBYTES];
+
+static void fill(unsigned char *bytes, size_t n, unsigned multiplier, unsigned offset)
+{
+    for (size_t i = 0; i < n; ++i) {
+        bytes[i] = (unsigned char)((i * multiplier + offset) & 0xffu);
+    }
+}
+
+static void put_result(const char *what, size_t bytes)
+{
+    fwc_put("crypto ");
+    fwc_put(what);
+    fwc_put(" ");
+    fwc_put_u64(bytes);
+}
+
+static void put_ticks(uint64_t ticks)
+{
+    fwc_put(" ticks ");
+    fwc_put_u64(ticks);
+    fwc_end_line();
+}
+
+/* Tags, signs and verifies one datagram of `bytes` bytes in place; false on a wrong result. */
+static bool check_size(unsigned char *datagram, size_t bytes)
+{
+    const size_t tagged = bytes - CRYPTO_TAG_BYTES;
+    const size_t signed_size = tagged - CRYPTO_SIGNATURE_BYTES;
+    unsigned char *const signature = datagram + signed_size;
+    fill(datagram, bytes, 7u, 3u);
+
+    uint64_t start = fwc_ticks_now();
+    crypto_sign_ed25519_detached(signature, NULL, datagram, signed_size, secret_key);
+    uint64_t ticks = fwc_ticks_now() - start;
+    put_result("sign", bytes);
+    fwc_put(" ");
+    fwc_put_hex(signature, CRYPTO_SIGNATURE_BYTES);
+    put_ticks(ticks);
+
+    start = fwc_ticks_now();
+    crypto_shorthash_siphash24(datagram + tagged, datagram, tagged, fleet_key);
+    ticks = fwc_ticks_now() - start;
+    put_result("tag", bytes);
+    fwc_put(" ");
+    fwc_put_hex(datagram + tagged, CRYPTO_TAG_BYTES);
+    put_ticks(ticks);
+
+    start = fwc_ticks_now();
+    const int good =
+        crypto_sign_ed25519_verify_detached(signature, datagram, signed_size, public_key);
+    ticks = fwc_ticks_now() - start;
+    put_result("verify", bytes);
+    fwc_put(" rc ");
+    fwc_put_i64(good);
+    put_ticks(ticks);
+
+    datagram[signed_size / 2u] ^= 0x01u;
+    start = fwc_ticks_now();
+    const int bad =
+        crypto_sign_ed25519_verify_detached(signature, datagram, signed_size, public_key);
+    ticks = fwc_ticks_now() - start;
+    put_result("refuse", bytes);
+    fwc_put(" rc ");
+    fwc_put_i64(bad);
+    put_ticks(ticks);
+    return good == 0 && bad == -1;
+}
+
+bool fwc_crypto_run(unsigned char *scratch, size_t size)
+{
+    if (size < CRYPTO_LARGEST) {
+        fwc_put("error crypto: the scratch buffer is too small");
+        fwc_end_line();
+        return false;
+    }
+    unsigned char seed[crypto_sign_ed25519_SEEDBYTES];
+    fill(seed, sizeof seed, 1u, 0u);
+    fill(fleet_key, sizeof fleet_key, 1u, 0x10u);
+    if (crypto_sign_ed25519_seed_keypair(public_key, secret_key, seed) != 0) {
+        fwc_put("error crypto: no key pair from the seed");
+        fwc_end_line();
+        return false;
+    }
+    const bool heartbeat = check_size(scratch, 192u);
+    const bool intent = check_size(scratch, CRYPTO_LARGEST);
+    return heartbeat && intent;
+}

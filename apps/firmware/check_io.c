@@ -1,0 +1,132 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * check_io.c: the firmware check's clock and output (check_io.h): SysTick counting the
+ * processor clock, and lines written through ARM semihosting.
+ */
+#include "check_io.h"
+
+/* SysTick, free-running on the processor clock: 24 bits, the wraps counted in the
+ * interrupt. */
+#define SYST_CSR (*(volatile uint32_t *)0xE000E010u)
+#define SYST_RVR (*(volatile uint32_t *)0xE000E014u)
+#define SYST_CVR (*(volatile uint32_t *)0xE000E018u)
+#define SYST_PERIOD 0x1000000u
+
+static volatile uint32_t systick_wraps;
+
+void fw_systick_handler(void)
+{
+    systick_wraps = systick_wraps + 1u;
+}
+
+/* A loop of exactly 2 * n + 1 instructions (subs and a taken bne per round, the last bne
+ * not taken, plus the mov), for the calibration. */
+void fwc_spin(uint32_t n)
+{
+    __asm__ volatile("mov r0, %0\n1:\n\tsubs r0, #1\n\tbne 1b" : : "r"(n) : "r0", "cc");
+}
+
+void fwc_ticks_start(void)
+{
+    SYST_RVR = SYST_PERIOD - 1u;
+    SYST_CVR = 0u;
+    SYST_CSR = 7u;   /* processor clock, interrupt, enable */
+    fwc_spin(1000u); /* past the first reload from the 0 written above */
+}
+
+uint64_t fwc_ticks_now(void)
+{
+    uint32_t wraps;
+    uint32_t value;
+    do {
+        wraps = systick_wraps;
+        value = SYST_CVR;
+    } while (wraps != systick_wraps);
+    return (uint64_t)wraps * SYST_PERIOD + (SYST_PERIOD - 1u - value);
+}
+
+/* ARM semihosting (the "Angel" interface): operation in r0, argument in r1, bkpt 0xAB in
+ * Thumb state; the debugger or emulator does the operation and resumes. */
+#define SYS_WRITE0 0x04u
+#define SYS_EXIT 0x18u
+#define ADP_STOPPED_APPLICATION_EXIT 0x20026u
+#define ADP_STOPPED_RUN_TIME_ERROR 0x20023u
+
+static void semihost(uint32_t op, const void *arg)
+{
+    __asm__ volatile("mov r0, %0\n\tmov r1, %1\n\tbkpt 0xab"
+                     :
+                     : "r"(op), "r"(arg)
+                     : "r0", "r1", "memory");
+}
+
+/* Output goes through a line buffer: one semihosting call per line, not per character. */
+static char line[512];
+static size_t line_length;
+
+void fwc_put(const char *s)
+{
+    while (*s != '\0' && line_length + 2u < sizeof line) {
+        line[line_length++] = *s++;
+    }
+}
+
+void fwc_end_line(void)
+{
+    line[line_length++] = '\n';
+    line[line_length] = '\0';
+    semihost(SYS_WRITE0, line);
+    line_length = 0;
+}
+
+void fwc_put_u64(uint64_t v)
+{
+    char digits[21];
+    size_t i = sizeof digits - 1u;
+    digits[i] = '\0';
+    do {
+        digits[--i] = (char)('0' + (int)(v % 10u));
+        v /= 10u;
+    } while (v != 0u);
+    fwc_put(&digits[i]);
+}
+
+void fwc_put_i64(int64_t v)
+{
+    if (v < 0) {
+        fwc_put("-");
+        fwc_put_u64(0u - (uint64_t)v);
+    } else {
+        fwc_put_u64((uint64_t)v);
+    }
+}
+
+void fwc_put_hex64(uint64_t v)
+{
+    static const char hex[] = "0123456789abcdef";
+    char digits[17];
+    int i;
+    for (i = 15; i >= 0; --i) {
+        digits[i] = hex[v & 0xfu];
+        v >>= 4;
+    }
+    digits[16] = '\0';
+    fwc_put(digits);
+}
+
+void fwc_put_hex(const unsigned char *bytes, size_t n)
+{
+    static const char hex[] = "0123456789abcdef";
+    char pair[3] = {0, 0, 0};
+    for (size_t i = 0; i < n; ++i) {
+        pair[0] = hex[bytes[i] >> 4];
+        pair[1] = hex[bytes[i] & 0xfu];
+        fwc_put(pair);
+    }
+}
+
+void fwc_exit(bool ok)
+{
+    semihost(SYS_EXIT, (const void *)(uintptr_t)(ok ? ADP_STOPPED_APPLICATION_EXIT
+                                                    : ADP_STOPPED_RUN_TIME_ERROR));
+}
