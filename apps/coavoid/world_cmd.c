@@ -81,26 +81,27 @@ static int world(void *options, coavoid_scenario_t *s)
     config.track_count = s->track_count;
     config.copies = COAVOID_NODE_DEFAULT_COPIES;
 
-    char err[512];
-    lcm_t *lcm = coavoid_rt_lcm_create(o->rt.lcm_url, err, sizeof err);
-    if (lcm == NULL) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s", err);
+    coavoid_rt_transport_t transport;
+    status = coavoid_rt_transport_open_send_only(&transport, o->rt.lcm_url);
+    if (status != CLI_CONTINUE) {
+        return status;
     }
     int error = COA_OK;
-    coavoid_world_t *node = coavoid_world_create(&config, lcm, &error);
+    coavoid_world_t *node = coavoid_world_create(&config, transport.lcm, &error);
     if (node == NULL) {
-        lcm_destroy(lcm);
+        coavoid_rt_transport_close(&transport);
         return coavoid_cli_fail(error == COA_ERR_ARGUMENT ? CLI_EXIT_INVALID : CLI_EXIT_INTERNAL,
                                 "world: %s: cannot publish it (%s)", o->path,
                                 coavoid_lcm_error_name(error));
     }
     coavoid_rt_loop_t loop;
-    coavoid_rt_loop_init(&loop, &o->rt, lcm, &now, &config.common, "world");
+    coavoid_rt_loop_init(&loop, &o->rt, &transport, &now, &config.common, "world");
     loop.world = node;
+    loop.deaf = true; /* it publishes the scenario's map and tracks, and hears nothing */
     loop.world_lead_us = config.common.dt_us / 4;
     status = coavoid_rt_drive(&loop, o->rt.lcm_url, world_report, s);
     coavoid_world_destroy(node);
-    lcm_destroy(lcm);
+    coavoid_rt_transport_close(&transport);
     return status;
 }
 

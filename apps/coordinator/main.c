@@ -200,15 +200,15 @@ static int run(void *options, coavoid_scenario_t *s)
     if (status != CLI_CONTINUE) {
         return status;
     }
-    char err[512];
-    lcm_t *lcm = coavoid_rt_lcm_create(o->rt.lcm_url, err, sizeof err);
-    if (lcm == NULL) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s", err);
+    coavoid_rt_transport_t transport;
+    status = coavoid_rt_transport_open(&transport, o->rt.lcm_url, &config.common);
+    if (status != CLI_CONTINUE) {
+        return status;
     }
     int error = COA_OK;
-    coavoid_coordinator_t *node = coavoid_coordinator_create(&config, lcm, &error);
+    coavoid_coordinator_t *node = coavoid_coordinator_create(&config, transport.lcm, &error);
     if (node == NULL) {
-        lcm_destroy(lcm);
+        coavoid_rt_transport_close(&transport);
         if (error == COA_ERR_WORKSPACE) {
             return coavoid_cli_fail(
                 CLI_EXIT_INVALID,
@@ -220,12 +220,12 @@ static int run(void *options, coavoid_scenario_t *s)
                                 "coordinator: cannot start (%s)", coavoid_lcm_error_name(error));
     }
     coavoid_rt_loop_t loop;
-    coavoid_rt_loop_init(&loop, &o->rt, lcm, &now, &config.common, "coordinator");
+    coavoid_rt_loop_init(&loop, &o->rt, &transport, &now, &config.common, "coordinator");
     loop.collect_us = config.collect_us;
     loop.coordinator = node;
     status = coavoid_rt_drive(&loop, o->rt.lcm_url, coordinator_report, node);
     coavoid_coordinator_destroy(node);
-    lcm_destroy(lcm);
+    coavoid_rt_transport_close(&transport);
     return status;
 }
 

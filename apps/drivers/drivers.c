@@ -249,13 +249,57 @@ int coavoid_rt_setup(const char *path, coavoid_scenario_t *s, coavoid_rt_options
 
 /* ---- the loop ---- */
 
-void coavoid_rt_loop_init(coavoid_rt_loop_t *loop, const coavoid_rt_options_t *o, lcm_t *lcm,
-                          int64_t *now, const coavoid_node_common_t *common, const char *name)
+int coavoid_rt_transport_open_send_only(coavoid_rt_transport_t *t, const char *url)
+{
+    char err[512];
+    t->rx = NULL;
+    t->lcm = coavoid_rt_lcm_create(url, err, sizeof err);
+    if (t->lcm == NULL) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s", err);
+    }
+    return CLI_CONTINUE;
+}
+
+int coavoid_rt_transport_open(coavoid_rt_transport_t *t, const char *url,
+                              coavoid_node_common_t *common)
+{
+    char err[512];
+    int status = coavoid_rt_transport_open_send_only(t, url);
+    if (status != CLI_CONTINUE) {
+        return status;
+    }
+    if (coavoid_rt_rx_is_udpm(url)) {
+        t->rx = coavoid_rt_rx_open(url, err, sizeof err);
+        if (t->rx == NULL) {
+            lcm_destroy(t->lcm);
+            t->lcm = NULL;
+            return coavoid_cli_fail(CLI_EXIT_INVALID, "%s", err);
+        }
+        common->rx_lcm = coavoid_rt_rx_lcm(t->rx);
+        common->transport_dropped = &coavoid_rt_rx_stats(t->rx)->kernel_dropped;
+    }
+    return CLI_CONTINUE;
+}
+
+void coavoid_rt_transport_close(coavoid_rt_transport_t *t)
+{
+    coavoid_rt_rx_close(t->rx);
+    if (t->lcm != NULL) {
+        lcm_destroy(t->lcm);
+    }
+    t->rx = NULL;
+    t->lcm = NULL;
+}
+
+void coavoid_rt_loop_init(coavoid_rt_loop_t *loop, const coavoid_rt_options_t *o,
+                          const coavoid_rt_transport_t *transport, int64_t *now,
+                          const coavoid_node_common_t *common, const char *name)
 {
     memset(loop, 0, sizeof *loop);
     loop->clock.epoch_utime = o->epoch_utime;
     loop->clock.speed = o->speed;
-    loop->lcm = lcm;
+    loop->lcm = transport->lcm;
+    loop->rx = transport->rx;
     loop->now = now;
     loop->common = common;
     loop->steps = o->steps;
@@ -271,7 +315,7 @@ int coavoid_rt_drive(const coavoid_rt_loop_t *loop, const char *lcm_url, coavoid
     }
     coavoid_rt_result_t result;
     int rc = coavoid_rt_run(loop, &result);
-    char tail[256];
+    char tail[512];
     coavoid_rt_result_text(&result, tail, sizeof tail);
     report(user, loop->name, &result, tail);
     if (rc != COA_OK) {

@@ -91,11 +91,33 @@ int coavoid_rt_keys(coavoid_rt_options_t *o, coavoid_auth_role_t role, uint16_t 
     "  --insecure          neither sign nor check signatures (tests only; its\n"          \
     "                      heartbeat says so); else --key and --trust are required\n"
 
+/* A driver's transport: the LCM its node publishes on and, for a udpm URL, the receiver
+ * its node subscribes on (realtime.h, "The receiver"). */
+typedef struct {
+    lcm_t *lcm;
+    coavoid_rt_rx_t *rx; /* NULL for other providers: LCM receives */
+} coavoid_rt_transport_t;
+
+/* Opens both for `url` and points common->rx_lcm at the receiver's LCM and
+ * common->transport_dropped at its count of drops at the socket. Returns
+ * CLI_CONTINUE, or CLI_EXIT_INVALID after one line on stderr (a bad URL, no multicast
+ * route), with nothing left open. */
+int coavoid_rt_transport_open(coavoid_rt_transport_t *t, const char *url,
+                              coavoid_node_common_t *common);
+
+/* The same for a node that subscribes to nothing (a world): LCM to publish on, no
+ * receiver; its loop is deaf (coavoid_rt_loop_t.deaf). */
+int coavoid_rt_transport_open_send_only(coavoid_rt_transport_t *t, const char *url);
+
+/* Closes what coavoid_rt_transport_open opened; after the node is destroyed. */
+void coavoid_rt_transport_close(coavoid_rt_transport_t *t);
+
 /* Sets the loop's fields every driver sets alike: the clock (epoch, speed) and steps from
- * the finished options, lcm, now, common, name, and warnings on stderr; the rest (the
- * nodes, collect_us, world_lead_us) is zero for the caller to set. O(1). */
-void coavoid_rt_loop_init(coavoid_rt_loop_t *loop, const coavoid_rt_options_t *o, lcm_t *lcm,
-                          int64_t *now, const coavoid_node_common_t *common, const char *name);
+ * the finished options, the transport, now, common, name, and warnings on stderr; the
+ * rest (the nodes, collect_us, world_lead_us) is zero for the caller to set. O(1). */
+void coavoid_rt_loop_init(coavoid_rt_loop_t *loop, const coavoid_rt_options_t *o,
+                          const coavoid_rt_transport_t *transport, int64_t *now,
+                          const coavoid_node_common_t *common, const char *name);
 
 /* Prints a driver's summary line on stderr from its node's state, starting with the
  * loop's name and ending with `tail` (coavoid_rt_result_text). */
@@ -105,7 +127,7 @@ typedef void (*coavoid_rt_report_t)(void *user, const char *name, const coavoid_
 /* What every driver does once its node is in the loop: installs the signal handlers, runs
  * the loop and calls report. Returns CLI_EXIT_OK, or CLI_EXIT_INTERNAL when a node call
  * failed, or after the line "NAME: cannot handle SIGINT/SIGTERM" (nothing ran) or "NAME:
- * LCM failed while running (URL)". The caller destroys its node and the LCM afterwards.
+ * LCM failed while running (URL)". The caller destroys its node and the transport afterwards.
  * Cost and memory: coavoid_rt_run's. */
 int coavoid_rt_drive(const coavoid_rt_loop_t *loop, const char *lcm_url, coavoid_rt_report_t report,
                      void *user);

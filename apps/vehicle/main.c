@@ -282,15 +282,15 @@ static int run(void *options, coavoid_scenario_t *s)
                                 o->wait, (double)s->dt);
     }
 
-    char err[512];
-    lcm_t *lcm = coavoid_rt_lcm_create(o->rt.lcm_url, err, sizeof err);
-    if (lcm == NULL) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s", err);
+    coavoid_rt_transport_t transport;
+    status = coavoid_rt_transport_open(&transport, o->rt.lcm_url, &config.common);
+    if (status != CLI_CONTINUE) {
+        return status;
     }
     int error = COA_OK;
-    coavoid_vehicle_node_t *node = coavoid_vehicle_node_create(&config, lcm, &error);
+    coavoid_vehicle_node_t *node = coavoid_vehicle_node_create(&config, transport.lcm, &error);
     if (node == NULL) {
-        lcm_destroy(lcm);
+        coavoid_rt_transport_close(&transport);
         return coavoid_cli_fail(error == COA_ERR_ARGUMENT ? CLI_EXIT_INVALID : CLI_EXIT_INTERNAL,
                                 "vehicle %u: cannot start (%s)", (unsigned)o->id,
                                 coavoid_lcm_error_name(error));
@@ -299,12 +299,12 @@ static int run(void *options, coavoid_scenario_t *s)
     snprintf(name, sizeof name, "vehicle %u", (unsigned)o->id);
     coavoid_vehicle_node_t *const vehicles[1] = {node};
     coavoid_rt_loop_t loop;
-    coavoid_rt_loop_init(&loop, &o->rt, lcm, &now, &config.common, name);
+    coavoid_rt_loop_init(&loop, &o->rt, &transport, &now, &config.common, name);
     loop.vehicles = vehicles;
     loop.vehicle_count = 1;
     status = coavoid_rt_drive(&loop, o->rt.lcm_url, vehicle_report, node);
     coavoid_vehicle_node_destroy(node);
-    lcm_destroy(lcm);
+    coavoid_rt_transport_close(&transport);
     return status;
 }
 

@@ -1372,6 +1372,15 @@ void coavoid_node_solver_fini(coavoid_node_solver_t *s)
     memset(s, 0, sizeof *s);
 }
 
+/* Dropped unchecked since start: over the inbox budget, or by the transport; saturated. */
+static int64_t dropped_unchecked(const coavoid_node_inbox_t *in)
+{
+    const uint64_t transport =
+        in->common.transport_dropped != NULL ? *in->common.transport_dropped : 0u;
+    const uint64_t total = (uint64_t)in->dropped + transport;
+    return total > (uint64_t)INT64_MAX || total < transport ? INT64_MAX : (int64_t)total;
+}
+
 /* Datagrams a second over the last whole cycle, saturated. */
 static int32_t inbox_rate(const coavoid_node_inbox_t *in)
 {
@@ -1390,9 +1399,10 @@ int coavoid_node_publish_heartbeat(coavoid_node_inbox_t *in, coavoid_status_t *m
     const bool refused = h->rx->rejected > in->rejected_at_heartbeat;
     in->rejected_at_heartbeat = h->rx->rejected;
     budget_roll(in, now);
-    const bool flooded = in->dropped > in->dropped_at_heartbeat ||
-                         in->last_cycle_datagrams > COAVOID_NODE_INBOX_FLOOD;
-    in->dropped_at_heartbeat = in->dropped;
+    const int64_t dropped = dropped_unchecked(in);
+    const bool flooded =
+        dropped > in->dropped_at_heartbeat || in->last_cycle_datagrams > COAVOID_NODE_INBOX_FLOOD;
+    in->dropped_at_heartbeat = dropped;
     m->reasons = h->reasons | (refused ? COAVOID_STATUS_T_REASON_MESSAGES_REFUSED : 0) |
                  (flooded ? COAVOID_STATUS_T_REASON_INBOX_FLOOD : 0) |
                  (in->have_map ? 0 : COAVOID_STATUS_T_REASON_NO_MAP) |
@@ -1409,7 +1419,7 @@ int coavoid_node_publish_heartbeat(coavoid_node_inbox_t *in, coavoid_status_t *m
     m->messages_received = h->rx->received;
     m->messages_rejected = h->rx->rejected;
     m->last_reject_code = h->rx->last_reject_code;
-    m->messages_dropped = in->dropped;
+    m->messages_dropped = dropped;
     m->inbox_rate = inbox_rate(in);
     coavoid_lcm_context_t ctx = coavoid_node_context(in, now, cycle_start);
     if (coavoid_lcm_status_check(m, &ctx, NULL) != COA_OK) {

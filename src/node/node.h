@@ -281,10 +281,14 @@ typedef struct {
      * gives each node its own, and decides itself which messages reach it and when
      * (src/sim); the node's code is the same either way. */
     lcm_t *rx_lcm;
+    /* Datagrams the transport dropped before any handler saw them, since start (the
+     * realtime receiver's count of drops at its socket), read at each heartbeat; NULL:
+     * none known. They count as dropped unchecked (messages_dropped, REASON_INBOX_FLOOD). */
+    const uint64_t *transport_dropped;
 } coavoid_node_common_t;
 
 /* Fills c with the defaults for (epoch, dt, horizon, clock): threshold 0.01, no sigma
- * growth, stale_after 2.5 cycles, stale_sigma_rate 1 m/s, beta 20000, no rx_lcm, no keys and not
+ * growth, stale_after 2.5 cycles, stale_sigma_rate 1 m/s, beta 20000, no rx_lcm, no transport_dropped, no keys and not
  * insecure (so a node is not created until the caller sets keys or insecure). Returns COA_OK or
  * COA_ERR_ARGUMENT (dt, horizon, epoch or clock invalid). */
 int coavoid_node_common_defaults(coavoid_node_common_t *c, int64_t epoch_utime, coa_real_t dt,

@@ -273,6 +273,21 @@ static int64_t rt_pending_deadline(const rt_run_t *r, size_t i, int64_t deadline
     return deadline == deadline_polled ? INT64_MAX : deadline;
 }
 
+/* One datagram delivered to the nodes: 1, 0 when none is waiting, or COAVOID_RT_ERR_LCM. */
+static int rt_deliver(const coavoid_rt_loop_t *loop)
+{
+    if (loop->rx != NULL) {
+        return coavoid_rt_rx_deliver(loop->rx);
+    }
+    errno = 0;
+    int rc = lcm_handle_timeout(loop->lcm, 0);
+    if (rc < 0) {
+        /* A signal during LCM's own select: the loop looks at the stop flag next. */
+        return errno == EINTR ? 0 : COAVOID_RT_ERR_LCM;
+    }
+    return rc > 0 ? 1 : 0;
+}
+
 /* Dispatches the messages waiting, each with the clock set just before, until the next
  * event is due at scenario time `wake` (one message at least), and at most RT_MAX_DRAIN at
  * a time, so that a flood cannot delay the nodes' own events by more than one message's
@@ -285,11 +300,9 @@ static int rt_drain(const rt_run_t *r, int64_t wake)
         if (handled > 0 && *r->loop->now >= wake) {
             break;
         }
-        errno = 0;
-        int rc = lcm_handle_timeout(r->loop->lcm, 0);
+        int rc = rt_deliver(r->loop);
         if (rc < 0) {
-            /* A signal during LCM's own select: the loop looks at the stop flag next. */
-            return errno == EINTR ? handled : COAVOID_RT_ERR_LCM;
+            return rc;
         }
         if (rc == 0) {
             break;
@@ -299,8 +312,9 @@ static int rt_drain(const rt_run_t *r, int64_t wake)
     return handled;
 }
 
-/* Waits until wall time `wake` or a message, whichever is first. Returns 1 when LCM has a
- * message, 0 on time-out or a signal, COAVOID_RT_ERR_LCM on failure. */
+/* Waits until wall time `wake` or a message, whichever is first (fd -1: until wake).
+ * Returns 1 when a message waits, 0 on time-out or a signal, COAVOID_RT_ERR_LCM on
+ * failure. */
 static int rt_wait(int fd, int64_t wake_wall)
 {
     int64_t wait_us = wake_wall - coavoid_rt_wall_utime();
@@ -312,7 +326,9 @@ static int rt_wait(int fd, int64_t wake_wall)
     }
     fd_set fds;
     FD_ZERO(&fds);
-    FD_SET(fd, &fds);
+    if (fd >= 0) {
+        FD_SET(fd, &fds);
+    }
     struct timeval tv;
     tv.tv_sec = (time_t)(wait_us / 1000000);
     tv.tv_usec = (suseconds_t)(wait_us % 1000000);
@@ -477,11 +493,14 @@ static int64_t rt_next_wake(const rt_run_t *r, rt_sched_t *sc, int64_t now)
 static int rt_wait_messages(const rt_run_t *r, rt_sched_t *sc, int fd, int64_t wake)
 {
     const coavoid_rt_loop_t *loop = r->loop;
-    int rc = rt_wait(fd, coavoid_rt_wall_at(&loop->clock, wake));
-    if (rc <= 0) {
-        return rc;
+    /* A batch part delivered leaves the descriptor quiet while there is work. */
+    if (loop->rx == NULL || !coavoid_rt_rx_pending(loop->rx)) {
+        int rc = rt_wait(fd, coavoid_rt_wall_at(&loop->clock, wake));
+        if (rc <= 0) {
+            return rc;
+        }
     }
-    rc = rt_drain(r, wake);
+    int rc = rt_drain(r, wake);
     if (rc < 0) {
         return rc;
     }
@@ -501,8 +520,10 @@ int coavoid_rt_run(const coavoid_rt_loop_t *loop, coavoid_rt_result_t *result)
     if (!rt_loop_ok(loop, result)) {
         return COA_ERR_ARGUMENT;
     }
-    int fd = lcm_get_fileno(loop->lcm);
-    if (fd < 0 || fd >= FD_SETSIZE) {
+    int fd = loop->deaf         ? -1
+             : loop->rx != NULL ? coavoid_rt_rx_fd(loop->rx)
+                                : lcm_get_fileno(loop->lcm);
+    if ((fd < 0 && !loop->deaf) || fd >= FD_SETSIZE) {
         return COAVOID_RT_ERR_LCM;
     }
     rt_run_t run = {loop, result, loop->common};
@@ -528,6 +549,10 @@ int coavoid_rt_run(const coavoid_rt_loop_t *loop, coavoid_rt_result_t *result)
         }
     }
     *loop->now = rt_now(r);
+    if (loop->rx != NULL) {
+        result->received = true;
+        result->rx = *coavoid_rt_rx_stats(loop->rx);
+    }
     return COA_OK;
 }
 
@@ -538,6 +563,15 @@ void coavoid_rt_result_text(const coavoid_rt_result_t *result, char *out, size_t
                                                           : "a signal";
     int n = snprintf(out, size, ", overruns %u, skipped %u", (unsigned)result->overruns,
                      (unsigned)result->skipped);
+    if (n >= 0 && (size_t)n < size && result->received) {
+        const coavoid_rt_rx_stats_t *x = &result->rx;
+        n += snprintf(out + n, size - (size_t)n,
+                      ", datagrams %llu (dropped at the socket %llu; malformed %llu, fragments "
+                      "%llu, oversize %llu)",
+                      (unsigned long long)x->datagrams, (unsigned long long)x->kernel_dropped,
+                      (unsigned long long)x->malformed, (unsigned long long)x->fragments,
+                      (unsigned long long)x->oversize);
+    }
     if (n >= 0 && (size_t)n < size && result->errors > 0) {
         n += snprintf(out + n, size - (size_t)n, ", errors %u (first: %s)",
                       (unsigned)result->errors, coavoid_lcm_error_name(result->first_error));

@@ -15,11 +15,12 @@
  * (dt - collect) / S wall seconds of its collect time. Processes on one host share one
  * wall clock; on several hosts they need synchronised clocks (NTP) to well under a cycle.
  *
- * The loop (coavoid_rt_run). Between events it waits on LCM's file descriptor and, for every
- * message, sets the clock variable the nodes read (common.clock) and lets LCM dispatch it
- * (lcm_handle_timeout); it stops dispatching as soon as an event is due (after one message
- * at least), so that a flood delays an event by one message's handling at most. At its
- * times it calls:
+ * The loop (coavoid_rt_run). Between events it waits on the receiver's descriptor (or
+ * LCM's, for providers other than udpm) and, for every datagram, sets the clock variable
+ * the nodes read (common.clock) and delivers it to their handlers (coavoid_rt_rx_deliver,
+ * or lcm_handle_timeout); it stops delivering as soon as an event is due (after one
+ * datagram at least), so that a flood delays an event by one datagram's handling at most.
+ * At its times it calls:
  *   - at cycle_utime(k), k = first..K: the world's cycle, then each vehicle's cycle (a
  *     world alone in its process runs cycle k world_lead_us earlier);
  *   - at cycle_utime(k) + collect_us, k = first..K-1: the coordinator's cycle;
@@ -89,12 +90,98 @@ int64_t coavoid_rt_wall_at(const coavoid_rt_clock_t *clock, int64_t scenario_uti
  * that is missing and how to add it. On success, anything LCM printed is passed on. */
 lcm_t *coavoid_rt_lcm_create(const char *url, char *err, size_t err_size);
 
+/* LCM itself or the receiver failed: waiting on a descriptor, lcm_handle or the socket
+ * returned an error, so the transport is unusable. */
+#define COAVOID_RT_ERR_LCM (-200)
+
+/* ---- the receiver ----
+ *
+ * LCM 1.3.1's udpm provider receives in a thread of its own, which reads every datagram
+ * as it arrives into a queue that grows without bound (its ring buffer grows by half
+ * whenever it is full) and hands them over one at a time through a pipe: about 20 us of
+ * CPU per datagram before a node can even refuse it, and memory in proportion to what
+ * arrives while the loop is busy. Under a flood that is where a node's CPU goes. So the
+ * drivers receive from a udpm group themselves: one non-blocking socket, read in batches
+ * of COAVOID_RT_RX_BATCH (recvmmsg) only when the loop asks for the next datagram, LCM's
+ * short-message framing checked here, and each datagram handed at once to the nodes'
+ * handlers through an in-process LCM (memq://, the lcm_t the nodes subscribe on:
+ * coavoid_node_common_t.rx_lcm), whose queue so never holds more than one. What the loop
+ * does not read in time the kernel drops at the socket, within its receive buffer, and
+ * counts (SO_RXQ_OVFL): kernel_dropped. The wire is LCM's: the nodes publish through LCM,
+ * and lcm-spy and lcm-logger hear the same datagrams. Every message of docs/messages.md
+ * fits one datagram, so LCM's fragments ("LC03") are counted and never reassembled.
+ *
+ * Memory: one allocation at open, about COAVOID_RT_RX_BATCH * COAVOID_RT_RX_DATAGRAM
+ * bytes (the batch), plus LCM's memq provider; nothing per datagram beyond memq's copy of
+ * the one being delivered. Not thread-safe. */
+#define COAVOID_RT_RX_BATCH 64u
+#define COAVOID_RT_RX_DATAGRAM 2048u /* longer datagrams are not ours: counted and dropped */
+
+/* coavoid_rt_rx_parse's results besides COA_OK. */
+#define COAVOID_RT_RX_MALFORMED (-210) /* not LCM's framing, or a channel name without its end */
+#define COAVOID_RT_RX_FRAGMENT (-211)  /* a fragment of a message longer than one datagram */
+
+typedef struct {
+    uint64_t datagrams;      /* read from the socket */
+    uint64_t delivered;      /* handed to the nodes' handlers (a channel some node subscribes to) */
+    uint64_t malformed;      /* refused by coavoid_rt_rx_parse */
+    uint64_t fragments;      /* LCM fragments, dropped */
+    uint64_t oversize;       /* longer than COAVOID_RT_RX_DATAGRAM, dropped */
+    uint64_t kernel_dropped; /* dropped at the socket, its buffer full, since open */
+} coavoid_rt_rx_stats_t;
+
+typedef struct {
+    uint32_t sequence;            /* the sender's, as LCM numbers its datagrams */
+    const char *channel;          /* NUL-terminated, 1..63 characters, inside the datagram */
+    const unsigned char *payload; /* the message, inside the datagram */
+    size_t payload_size;
+} coavoid_rt_rx_frame_t;
+
+/* One datagram in LCM's short-message framing: the magic "LC02" and a sequence number,
+ * both big-endian, the channel name and its NUL (at most 63 characters before it), then
+ * the message. COA_OK with *frame pointing into the datagram; COAVOID_RT_RX_FRAGMENT,
+ * COAVOID_RT_RX_MALFORMED, or COA_ERR_ARGUMENT for a NULL pointer. O(channel). Never
+ * reads outside datagram[0..size). */
+int coavoid_rt_rx_parse(const unsigned char *datagram, size_t size, coavoid_rt_rx_frame_t *frame);
+
+typedef struct coavoid_rt_rx coavoid_rt_rx_t;
+
+/* Whether url names LCM's UDP multicast provider (udpm://), which the receiver serves;
+ * other providers keep LCM's own receiving. */
+bool coavoid_rt_rx_is_udpm(const char *url);
+
+/* Joins the group of a udpm URL (udpm://GROUP[:PORT][?...]: port 7667 by default; the
+ * option recv_buf_size sets the socket's receive buffer, the others are the publisher's).
+ * NULL on failure, with one line in err: a malformed URL, no multicast route, no memory. */
+coavoid_rt_rx_t *coavoid_rt_rx_open(const char *url, char *err, size_t err_size);
+
+/* Leaves the group and frees everything; NULL is ignored. */
+void coavoid_rt_rx_close(coavoid_rt_rx_t *rx);
+
+/* The descriptor to wait on, the LCM the nodes subscribe on, the counters. O(1). */
+int coavoid_rt_rx_fd(const coavoid_rt_rx_t *rx);
+lcm_t *coavoid_rt_rx_lcm(const coavoid_rt_rx_t *rx);
+const coavoid_rt_rx_stats_t *coavoid_rt_rx_stats(const coavoid_rt_rx_t *rx);
+
+/* Whether datagrams of the last batch are still to be delivered (the descriptor may then
+ * be quiet while there is work). O(1). */
+bool coavoid_rt_rx_pending(const coavoid_rt_rx_t *rx);
+
+/* Delivers the next datagram: reads a batch when the last is used up, then hands one
+ * datagram to the nodes' handlers (they run inside this call) or counts it as dropped.
+ * Returns 1 (one datagram taken), 0 (none waiting), or COAVOID_RT_ERR_LCM when the socket
+ * or LCM failed. One recvmmsg per COAVOID_RT_RX_BATCH datagrams, no allocation beyond
+ * memq's copy. */
+int coavoid_rt_rx_deliver(coavoid_rt_rx_t *rx);
+
 /* ---- the loop ---- */
 
 typedef struct {
     coavoid_rt_clock_t clock;
-    lcm_t *lcm;
-    int64_t *now;                        /* the variable every node's common.clock points to */
+    lcm_t *lcm;          /* what the nodes publish on; LCM receives too when rx is NULL */
+    coavoid_rt_rx_t *rx; /* the receiver (udpm): the nodes subscribe on its LCM */
+    bool deaf;           /* the nodes subscribe to nothing (a world): the loop only waits */
+    int64_t *now;        /* the variable every node's common.clock points to */
     const coavoid_node_common_t *common; /* any node's: epoch (as scenario time), dt_us */
     int64_t steps;                       /* K */
     int64_t collect_us;                  /* the coordinator's, when there is one */
@@ -118,23 +205,23 @@ typedef struct {
     uint32_t errors;   /* node calls that returned an error */
     int first_error;   /* the first such code, 0 none */
     int signal;        /* the signal that stopped the loop, 0 when it ran to the end */
+    bool received;     /* the loop had a receiver: rx holds its counters at the end */
+    coavoid_rt_rx_stats_t rx;
 } coavoid_rt_result_t;
 
 /* Sets SIGINT and SIGTERM to ask the loop to stop (no SA_RESTART, so a wait is cut
  * short). Returns 0, or -1 when sigaction failed. */
 int coavoid_rt_install_signal_handlers(void);
 
-/* LCM itself failed: waiting on its descriptor or lcm_handle returned an error, so the
- * provider is unusable. */
-#define COAVOID_RT_ERR_LCM (-200)
-
 /* Runs the loop until cycle K is done or a signal asks it to stop. Returns COA_OK,
  * COA_ERR_ARGUMENT (no node, NULL lcm/now/common, steps < 1) or COAVOID_RT_ERR_LCM. Node
  * errors are counted in result, not returned. */
 int coavoid_rt_run(const coavoid_rt_loop_t *loop, coavoid_rt_result_t *result);
 
-/* The end of a driver's summary line: ", overruns N, skipped N" and, when a signal
- * stopped it, ", stopped by SIGTERM". Cannot fail (truncates to size). */
+/* The end of a driver's summary line: ", overruns N, skipped N", with a receiver
+ * ", datagrams N (dropped at the socket N)" and any malformed, fragments or oversize
+ * counts, and, when a signal stopped it, ", stopped by SIGTERM". Cannot fail (truncates
+ * to size). */
 void coavoid_rt_result_text(const coavoid_rt_result_t *result, char *out, size_t size);
 
 #endif /* COAVOID_REALTIME_H */

@@ -11,7 +11,9 @@
  * that the type hash holds and
  * the fuzzer reaches every field's validation instead of stopping at it.
  * Every datagram also goes through the signature check (auth.h) against a trust list of one
- * key, and kind 6 feeds the bytes to the trust and secret key file parsers. Nothing may
+ * key, and kind 6 feeds the bytes to the trust and secret key file parsers. Every input
+ * after its first byte is also a datagram off the socket for the drivers' receiver's
+ * framing (coavoid_rt_rx_parse), whose frame must lie inside it. Nothing may
  * crash, leak or trip a sanitizer, whatever the bytes.
  */
 #include <stddef.h>
@@ -21,6 +23,7 @@
 #include "auth.h"
 #include "coavoid_lcm.h"
 #include "lcm_examples.h"
+#include "realtime.h"
 
 #define FUZZ_BUF 20000
 
@@ -176,6 +179,21 @@ static void parse_key_files(const char *text, size_t n)
     (void)coavoid_auth_signer_parse(&signer, text, n, err, sizeof err);
 }
 
+/* LCM's framing as the drivers' receiver reads it: a frame inside the datagram, or none. */
+static void check_frame(const unsigned char *datagram, size_t size)
+{
+    coavoid_rt_rx_frame_t f;
+    if (coavoid_rt_rx_parse(datagram, size, &f) != COA_OK) {
+        return;
+    }
+    const unsigned char *name = (const unsigned char *)f.channel;
+    const size_t length = strlen(f.channel);
+    if (name != datagram + 8 || length < 1u || length > 63u || f.payload != name + length + 1u ||
+        f.payload + f.payload_size != datagram + size) {
+        __builtin_trap();
+    }
+}
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     static unsigned char buf[FUZZ_BUF];
@@ -183,6 +201,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (size < 1u || size > FUZZ_BUF) {
         return 0;
     }
+    check_frame(data + 1, size - 1u);
     const unsigned kind = (data[0] & 0x7fu) % 8u;
     if (kind == 7u) {
         parse_key_files((const char *)data + 1, size - 1u);
