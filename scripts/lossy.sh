@@ -13,14 +13,16 @@
 # than 50 ms, and how many a decoupled vehicle stamped 50 ms or more after the cycle's
 # start, held by its wait for the UAVs before it), and the worst of the vehicles'
 # heartbeats; each node's CPU seconds; and from the nodes' last heartbeats the
-# messages they refused and dropped unchecked, and the largest inbox rate they reported
-# (also in RUN/flood.json). With --flood, a flooder (tests/forge/flood.c) in a namespace
+# messages they refused and dropped unchecked, and the largest inbox rate they reported;
+# and from each node's summary line what reached its socket a wall second over the
+# flight, read or dropped there (all also in RUN/flood.json). With --flood, a flooder (tests/forge/flood.c) in a namespace
 # of its own sends copies of what it hears back to the group for the whole flight (the
 # logger drops them, so the log still holds what the fleet sent).
 #
 # usage: scripts/lossy.sh [--loss PERCENT] [--mode centralised|decoupled] [--runs R]
 #                         [--scenario FILE] [--speed S] [--build DIR] [--out DIR]
-#                         [--flood heard|fresh|signed [--flood-rate N] [--flood-key ID]]
+#                         [--flood heard|fresh|signed [--flood-rate N] [--flood-key ID]
+#                          [--flood-cpu C[,C...]]]
 #
 #   --loss       percent of datagrams each receiver drops, 0..100; default 30
 #   --mode       centralised (default) or decoupled
@@ -35,6 +37,10 @@
 #                a stolen vehicle key and the fleet key (flood.c's file comment)
 #   --flood-rate datagrams a second; default 100000 (signed: 10000)
 #   --flood-key  the UAV whose key is stolen (signed); default the scenario's last UAV
+#   --flood-cpu  CPUs C[,C...]: one flooder alone on each, sharing the rate, every other
+#                process of the runs on the remaining CPUs (taskset); the kernel delivers
+#                what a flooder sends on its CPU, so the fleet's CPUs carry only what the
+#                nodes themselves spend. Default: one flooder, nothing pinned
 #
 # Needs root (it makes namespaces, a bridge and nftables rules, all inside a private
 # network and mount namespace of its own: the host's network is never touched), iproute2,
@@ -53,6 +59,7 @@ out=
 flood=
 flood_rate=
 flood_key=
+flood_cpu=
 
 die() {
     echo "lossy: $*" >&2
@@ -72,6 +79,7 @@ while [ $# -gt 0 ]; do
     --flood) [ $# -ge 2 ] || die "--flood: missing value"; flood=$2; shift 2 ;;
     --flood-rate) [ $# -ge 2 ] || die "--flood-rate: missing value"; flood_rate=$2; shift 2 ;;
     --flood-key) [ $# -ge 2 ] || die "--flood-key: missing value"; flood_key=$2; shift 2 ;;
+    --flood-cpu) [ $# -ge 2 ] || die "--flood-cpu: missing value"; flood_cpu=$2; shift 2 ;;
     -h | --help) sed -n '2,/^set -euo/p' "${BASH_SOURCE[0]}" | sed '$d' | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) die "unknown argument '$1' (see scripts/lossy.sh --help)" ;;
     esac
@@ -88,6 +96,21 @@ if [ -z "$flood_rate" ]; then
 fi
 [[ $flood_rate =~ ^[1-9][0-9]*$ ]] || die "--flood-rate: '$flood_rate' is not a count a second"
 [ -z "$flood_key" ] || [[ $flood_key =~ ^[1-9][0-9]*$ ]] || die "--flood-key: '$flood_key' is not a UAV id"
+# The flooders' CPUs (one flooder each, sharing the rate); empty: one flooder, unpinned.
+flood_cpus=()
+if [ -n "$flood_cpu" ]; then
+    [ -n "$flood" ] || die "--flood-cpu: needs --flood"
+    command -v taskset >/dev/null || die "--flood-cpu: taskset not found (util-linux)"
+    cpus=$(nproc --all)
+    IFS=, read -r -a flood_cpus <<<"$flood_cpu"
+    for c in "${flood_cpus[@]}"; do
+        [[ $c =~ ^[0-9]+$ ]] && [ "$c" -lt "$cpus" ] ||
+            die "--flood-cpu: '$c' is not one of this machine's $cpus CPUs (0..$((cpus - 1)))"
+    done
+    others=$(seq 0 $((cpus - 1)) | grep -vxF -f <(printf '%s\n' "${flood_cpus[@]}") | paste -sd, || true)
+    [ -n "$others" ] || die "--flood-cpu: '$flood_cpu' leaves no CPU for the fleet"
+    taskset -p -c "$others" $$ >/dev/null || die "--flood-cpu: taskset failed"
+fi
 case $build in /*) ;; *) build=$PWD/$build ;; esac
 [ -n "$out" ] || out=$build/lossy
 coavoid=$build/apps/coavoid
@@ -188,7 +211,7 @@ for run in $(seq "$runs"); do
     epoch=$(($(date +%s%N) / 1000 + 2000000))
     common=(--lcm-url "$url" --epoch "$epoch" --speed "$speed")
     pids=()
-    flooder_pid=
+    flooder_pids=()
     for name in "${names[@]}"; do
         key=(--key "$keys/$name.key" --trust "$keys/trust.txt")
         case $name in
@@ -196,9 +219,17 @@ for run in $(seq "$runs"); do
         flood)
             stolen=()
             [ "$flood" = signed ] && stolen=(--key "$keys/vehicle-$flood_key.key" --trust "$keys/trust.txt")
-            ip netns exec flood "$flooder" --lcm-url "$url" --mode "$flood" --rate "$flood_rate" \
-                "${stolen[@]}" >"$dir/flood.txt" 2>&1 &
-            flooder_pid=$!
+            if [ ${#flood_cpus[@]} -eq 0 ]; then
+                ip netns exec flood "$flooder" --lcm-url "$url" --mode "$flood" \
+                    --rate "$flood_rate" "${stolen[@]}" >"$dir/flood-0.txt" 2>&1 &
+                flooder_pids+=($!)
+            fi
+            for c in "${flood_cpus[@]}"; do
+                ip netns exec flood taskset -c "$c" "$flooder" --lcm-url "$url" --mode "$flood" \
+                    --rate $((flood_rate / ${#flood_cpus[@]})) "${stolen[@]}" \
+                    >"$dir/flood-$c.txt" 2>&1 &
+                flooder_pids+=($!)
+            done
             continue ;;
         world) cpu world "$dir/world.cpu" "$coavoid" world "$scenario" "${common[@]}" "${key[@]}" \
             2>"$dir/world.txt" & ;;
@@ -210,10 +241,10 @@ for run in $(seq "$runs"); do
         pids+=($!)
     done
     for p in "${pids[@]}"; do wait "$p" || true; done
-    if [ -n "$flooder_pid" ]; then
-        kill -TERM "$flooder_pid" 2>/dev/null || true
-        wait "$flooder_pid" || true
-    fi
+    for p in "${flooder_pids[@]}"; do
+        kill -TERM "$p" 2>/dev/null || true
+        wait "$p" || true
+    done
     sleep 0.3
     kill -INT "$logger"
     wait "$logger" || true
@@ -240,8 +271,11 @@ epoch, speed = int(sys.argv[3]), float(sys.argv[4])
 dt_us = round(json.load(open(sys.argv[6]))["dt"] * 1e6)
 data = open(os.path.join(d, "log.lcm"), "rb").read()
 i, first, held, beats, status, codes, reasons = 0, {}, 0, {}, {}, {}, {}
+ts_first, ts_last = None, 0
 while i + 28 <= len(data):
     _, _, ts, clen, dlen = struct.unpack_from(">IqqII", data, i)
+    ts_first = ts if ts_first is None else ts_first
+    ts_last = ts
     channel = data[i + 28:i + 28 + clen].decode()
     payload = data[i + 28 + clen:i + 28 + clen + dlen]
     i += 28 + clen + dlen
@@ -269,21 +303,39 @@ for f in sorted(glob.glob(os.path.join(d, "*.cpu"))):
              for x in open(f).read().split()[-2:])
     cpu.append("%s %.1f" % (os.path.basename(f)[:-4], u + sy))
 nodes = ", ".join("%d: %d/%d/%d" % (k, *v) for k, v in sorted(status.items()))
-flood_txt = os.path.join(d, "flood.txt")
-flooded = open(flood_txt).read().strip() if sys.argv[5] else "no flood"
-sent = re.search(r"sent (\d+)", flooded)
+# What reached each node's socket: datagrams read and dropped there (its summary line),
+# a wall second over the flight's span in the log.
+span = (ts_last - ts_first) / 1e6 if ts_last > ts_first else float("nan")
+arrived = {}
+for f in sorted(glob.glob(os.path.join(d, "*.txt"))):
+    m = re.search(r"datagrams (\d+) \(dropped at the socket (\d+)", open(f).read())
+    if m:
+        arrived[os.path.basename(f)[:-4]] = (int(m.group(1)), int(m.group(2)))
+# The flooders' lines, their sends and rates added up.
+flood_lines = [open(f).read().strip() for f in sorted(glob.glob(os.path.join(d, "flood-*.txt")))]
+sent_each = [re.search(r"sent (\d+) in ([0-9.]+) s", t) for t in flood_lines]
+sent = sum(int(m.group(1)) for m in sent_each if m)
+rate = sum(int(m.group(1)) / float(m.group(2)) for m in sent_each if m and float(m.group(2)) > 0)
+flooded = ("flood: %d flooder(s) sent %d (%.0f a second)" % (len(flood_lines), sent, rate)
+           if sys.argv[5] else "no flood")
 json.dump({"loss_of_separation": s["loss_of_separation"], "worst_late_ms": worst,
            "late_over_50ms": sum(x > 50 for x in late), "intents": len(late),
            "held_by_protocol": held, "worst_heartbeat_late_ms": max(beat_late, default=0),
-           "sent": int(sent.group(1)) if sent else 0,
+           "sent": sent, "sent_a_second": rate,
            "nodes": {str(k): {"refused": v[0], "dropped": v[1], "max_rate": v[2],
                               "codes": sorted(codes[k]), "reasons": reasons[k]}
-                     for k, v in status.items()}},
+                     for k, v in status.items()},
+           "sockets": {k: {"datagrams": v[0], "dropped": v[1],
+                           "arrived_a_second": (v[0] + v[1]) / span}
+                       for k, v in arrived.items()}},
           open(os.path.join(d, "flood.json"), "w"))
+sockets = ", ".join("%s %.0f/s (%d dropped)" % (k, (v[0] + v[1]) / span, v[1])
+                    for k, v in arrived.items())
 line += ("; intents heard late: worst %.1f ms, %d of %d over 50 ms (%d held by the "
          "protocol), vehicles' heartbeats worst %.1f ms; cpu s: %s; refused/dropped/max rate: "
-         "%s; %s" % (worst, sum(x > 50 for x in late), len(late), held,
-                     max(beat_late, default=float("nan")), ", ".join(cpu), nodes, flooded))
+         "%s; at the sockets: %s; %s" % (worst, sum(x > 50 for x in late), len(late), held,
+                     max(beat_late, default=float("nan")), ", ".join(cpu), nodes, sockets,
+                     flooded))
 print(line)
 PY
 )

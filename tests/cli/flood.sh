@@ -6,9 +6,10 @@
 # latest datagrams with their stamps moved ahead and their signatures broken, as fast as
 # it can up to 100,000 a second, for the whole flight, once per mode. Each flight must
 # keep separation, every node must refuse the flood by its fleet tag (-126) and drop
-# nothing unchecked (the tag, not the signature budget, stops it), and every UAV's first
-# intent of each cycle must be heard within 50 ms (wall) of the cycle's start, except in
-# decoupled cycles where it waits for the UAVs before it (bounded by the priority wait).
+# nothing unchecked but at its socket (the tag, not the signature budget, stops it), and
+# every UAV's first intent of each cycle must be heard within 50 ms (wall) of the cycle's
+# start, except in decoupled cycles where it waits for the UAVs before it (bounded by the
+# priority wait).
 # Everything it sends stays inside the namespaces of the run.
 #
 # usage: bash flood.sh <path-to-coavoid> <source-dir> <path-to-coavoid_test_flood>
@@ -40,7 +41,10 @@ assert f["sent"] >= 10000, ("the flooder sent too little to judge", f["sent"])
 assert f["worst_late_ms"] <= float(sys.argv[2]), ("an intent heard late", f["worst_late_ms"])
 for node, n in f["nodes"].items():
     assert n["refused"] >= 1000 and -126 in n["codes"], (node, n)
-    assert n["dropped"] == 0, (node, "dropped unchecked", n)
+    # Dropped unchecked: only at the socket (its summary line's count), never over the
+    # signature budget, which the flood cannot reach.
+    socket = f["sockets"]["coordinator" if node == "65001" else "vehicle-" + node]
+    assert n["dropped"] <= socket["dropped"], (node, "dropped over its budget", n, socket)
     assert n["reasons"] & 4, (node, "refusals not in its health", n)
 PY
 done

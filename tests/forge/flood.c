@@ -17,7 +17,8 @@
  * It sends from a socket of its own with multicast loopback off, in LCM's short-message
  * framing ("LC02", a sequence number, the channel, the datagram): what it sends reaches
  * the other hosts on the link, not its own listener. It stops on SIGINT or SIGTERM, or
- * after --seconds, and prints how many it sent and how many distinct datagrams it heard.
+ * after --seconds, and prints how many it sent, at what rate from its first send, and how
+ * many datagrams it heard.
  *
  * usage: coavoid_test_flood --lcm-url udpm://GROUP:PORT[?...] --mode heard|fresh|signed
  *                           --rate N [--seconds S] [--key FILE --trust FILE]
@@ -59,6 +60,7 @@ typedef struct {
     slot_t slots[FLOOD_SLOTS];
     size_t used, next;
     int64_t heard, sent;
+    int64_t first_send; /* us, monotonic; 0 before the first */
     uint32_t sequence;
     coavoid_auth_signer_t signer;
     int sock;
@@ -172,6 +174,9 @@ static void send_copies(flooder_t *f, int64_t n)
             msgs[batch].msg_hdr.msg_iov = &iov[batch];
             msgs[batch].msg_hdr.msg_iovlen = 1;
             batch++;
+        }
+        if (f->first_send == 0) {
+            f->first_send = mono_us();
         }
         const int sent = sendmmsg(f->sock, msgs, batch, 0);
         if (sent <= 0) {
@@ -307,9 +312,10 @@ int main(int argc, char **argv)
         }
         usleep(500);
     }
-    const double seconds = (double)(mono_us() - start) / 1e6;
+    /* The rate counts from the first send: before the fleet speaks there is nothing to copy. */
+    const double seconds = f.first_send > 0 ? (double)(mono_us() - f.first_send) / 1e6 : 0.0;
     printf("flood: sent %lld in %.1f s (%.0f a second), heard %lld\n", (long long)f.sent, seconds,
-           (double)f.sent / (seconds > 0 ? seconds : 1), (long long)f.heard);
+           f.sent > 0 && seconds > 0 ? (double)f.sent / seconds : 0.0, (long long)f.heard);
     lcm_unsubscribe(lcm, sub);
     lcm_destroy(lcm);
     close(f.sock);
