@@ -4,7 +4,8 @@
  * short-message framing parsed exactly, and refused when malformed or a fragment, never
  * read beyond the datagram; then on a real socket, on a group and port of the test's own
  * with multicast loopback: datagrams delivered to a subscriber of the receiver's LCM in
- * the order sent, the others counted by kind; the socket's drops counted when it is not
+ * the order sent, the others counted by kind, those of channels not the fleet's never
+ * handed to LCM; the socket's drops counted when it is not
  * read in time, every datagram sent either read or dropped; a bad URL refused with one
  * line.
  */
@@ -177,18 +178,18 @@ START_TEST(receiver_delivers_and_counts)
     coavoid_rt_rx_t *rx = open_rx(port, "");
     ear_t ear = {{0}, 0};
     lcm_subscription_t *sub =
-        lcm_subscribe(coavoid_rt_rx_lcm(rx), "COAVOID_TEST", on_message, &ear);
+        lcm_subscribe(coavoid_rt_rx_lcm(rx), "COAVOID_STATUS", on_message, &ear);
     int s = open_sender(port);
     unsigned char d[4096];
     for (uint32_t v = 1; v <= 5u; v++) {
-        ck_assert_int_gt(send(s, d, frame(d, 0x4c433032u, v, "COAVOID_TEST", &v, sizeof v), 0), 0);
+        ck_assert_int_gt(send(s, d, frame(d, 0x4c433032u, v, "COAVOID_STATUS", &v, sizeof v), 0), 0);
     }
     const uint32_t v = 9u;
     ck_assert_int_gt(send(s, d, frame(d, 0x4c433032u, 6u, "OTHER", &v, sizeof v), 0), 0);
-    ck_assert_int_gt(send(s, d, frame(d, 0x4c433033u, 7u, "COAVOID_TEST", &v, sizeof v), 0), 0);
+    ck_assert_int_gt(send(s, d, frame(d, 0x4c433033u, 7u, "COAVOID_STATUS", &v, sizeof v), 0), 0);
     ck_assert_int_gt(send(s, d, 5u, 0), 0);
     static const unsigned char big[3000];
-    ck_assert_int_gt(send(s, d, frame(d, 0x4c433032u, 8u, "COAVOID_TEST", big, sizeof big), 0), 0);
+    ck_assert_int_gt(send(s, d, frame(d, 0x4c433032u, 8u, "COAVOID_STATUS", big, sizeof big), 0), 0);
     deliver_all(rx);
     const coavoid_rt_rx_stats_t *st = coavoid_rt_rx_stats(rx);
     ck_assert_uint_eq(ear.count, 5u);
@@ -196,7 +197,8 @@ START_TEST(receiver_delivers_and_counts)
         ck_assert_uint_eq(ear.seen[i], i + 1u);
     }
     ck_assert_uint_eq(st->datagrams, 9u);
-    ck_assert_uint_eq(st->delivered, 5u); /* OTHER has no subscriber */
+    ck_assert_uint_eq(st->delivered, 5u);
+    ck_assert_uint_eq(st->foreign, 1u); /* OTHER is not the fleet's */
     ck_assert_uint_eq(st->fragments, 1u);
     ck_assert_uint_eq(st->malformed, 1u);
     ck_assert_uint_eq(st->oversize, 1u);
@@ -215,7 +217,7 @@ START_TEST(receiver_counts_what_the_socket_dropped)
     int s = open_sender(port);
     unsigned char d[1500];
     const uint32_t v = 1u;
-    const size_t n = frame(d, 0x4c433032u, 1u, "COAVOID_TEST", &v, sizeof v);
+    const size_t n = frame(d, 0x4c433032u, 1u, "COAVOID_STATUS", &v, sizeof v);
     const uint64_t sent = 2000u;
     for (uint64_t i = 0; i < sent; i++) {
         ck_assert_int_gt(send(s, d, n, 0), 0);
@@ -227,6 +229,35 @@ START_TEST(receiver_counts_what_the_socket_dropped)
     const coavoid_rt_rx_stats_t *st = coavoid_rt_rx_stats(rx);
     ck_assert_uint_gt(st->kernel_dropped, 0u);
     ck_assert_uint_eq(st->datagrams + st->kernel_dropped, sent + 1u);
+    close(s);
+    coavoid_rt_rx_close(rx);
+}
+END_TEST
+
+/* LCM remembers every channel name it is given; the receiver gives it the fleet's only. */
+START_TEST(receiver_hands_on_the_fleet_channels_only)
+{
+    const unsigned port = test_port() + 2u;
+    coavoid_rt_rx_t *rx = open_rx(port, "");
+    int s = open_sender(port);
+    unsigned char d[256];
+    const uint32_t v = 1u;
+    const uint64_t sent = 3000u;
+    for (uint64_t i = 0; i < sent; i++) {
+        char name[32];
+        snprintf(name, sizeof name, "COAVOID_INTENT_%llu", (unsigned long long)i);
+        ck_assert_int_gt(send(s, d, frame(d, 0x4c433032u, 1u, name, &v, sizeof v), 0), 0);
+        if (i % 64u == 63u) {
+            deliver_all(rx); /* keeps the socket's buffer from overflowing */
+        }
+    }
+    deliver_all(rx);
+    const coavoid_rt_rx_stats_t *st = coavoid_rt_rx_stats(rx);
+    ck_assert_uint_eq(st->foreign + st->kernel_dropped, sent);
+    ck_assert_uint_eq(st->delivered, 0u);
+    ck_assert(coavoid_rt_rx_fleet_channel("COAVOID_AGREEMENT"));
+    ck_assert(!coavoid_rt_rx_fleet_channel("COAVOID_INTENTS"));
+    ck_assert(!coavoid_rt_rx_fleet_channel(NULL));
     close(s);
     coavoid_rt_rx_close(rx);
 }
@@ -265,6 +296,7 @@ static Suite *rx_suite(void)
     TCase *socket_case = tcase_create("socket");
     tcase_add_test(socket_case, receiver_delivers_and_counts);
     tcase_add_test(socket_case, receiver_counts_what_the_socket_dropped);
+    tcase_add_test(socket_case, receiver_hands_on_the_fleet_channels_only);
     tcase_add_test(socket_case, receiver_refuses_bad_urls);
     suite_add_tcase(s, socket_case);
     return s;

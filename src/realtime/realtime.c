@@ -567,10 +567,10 @@ void coavoid_rt_result_text(const coavoid_rt_result_t *result, char *out, size_t
         const coavoid_rt_rx_stats_t *x = &result->rx;
         n += snprintf(out + n, size - (size_t)n,
                       ", datagrams %llu (dropped at the socket %llu; malformed %llu, fragments "
-                      "%llu, oversize %llu)",
+                      "%llu, oversize %llu, foreign %llu)",
                       (unsigned long long)x->datagrams, (unsigned long long)x->kernel_dropped,
                       (unsigned long long)x->malformed, (unsigned long long)x->fragments,
-                      (unsigned long long)x->oversize);
+                      (unsigned long long)x->oversize, (unsigned long long)x->foreign);
     }
     if (n >= 0 && (size_t)n < size && result->errors > 0) {
         n += snprintf(out + n, size - (size_t)n, ", errors %u (first: %s)",

@@ -109,7 +109,10 @@ lcm_t *coavoid_rt_lcm_create(const char *url, char *err, size_t err_size);
  * does not read in time the kernel drops at the socket, within its receive buffer, and
  * counts (SO_RXQ_OVFL): kernel_dropped. The wire is LCM's: the nodes publish through LCM,
  * and lcm-spy and lcm-logger hear the same datagrams. Every message of docs/messages.md
- * fits one datagram, so LCM's fragments ("LC03") are counted and never reassembled.
+ * fits one datagram, so LCM's fragments ("LC03") are counted and never reassembled. Only
+ * the fleet's channels (node.h, COAVOID_CHANNEL_*) are handed on: LCM keeps a list of
+ * handlers for every channel name it has been given, for ever, so datagrams on ever new
+ * names would cost each node memory without bound; they are counted as foreign.
  *
  * Memory: one allocation at open, about COAVOID_RT_RX_BATCH * COAVOID_RT_RX_DATAGRAM
  * bytes (the batch), plus LCM's memq provider; nothing per datagram beyond memq's copy of
@@ -127,6 +130,7 @@ typedef struct {
     uint64_t malformed;      /* refused by coavoid_rt_rx_parse */
     uint64_t fragments;      /* LCM fragments, dropped */
     uint64_t oversize;       /* longer than COAVOID_RT_RX_DATAGRAM, dropped */
+    uint64_t foreign;        /* on a channel that is not the fleet's, dropped */
     uint64_t kernel_dropped; /* dropped at the socket, its buffer full, since open */
 } coavoid_rt_rx_stats_t;
 
@@ -145,6 +149,10 @@ typedef struct {
 int coavoid_rt_rx_parse(const unsigned char *datagram, size_t size, coavoid_rt_rx_frame_t *frame);
 
 typedef struct coavoid_rt_rx coavoid_rt_rx_t;
+
+/* Whether channel is one of the fleet's (node.h, COAVOID_CHANNEL_*): what the receiver
+ * hands on. O(1). */
+bool coavoid_rt_rx_fleet_channel(const char *channel);
 
 /* Whether url names LCM's UDP multicast provider (udpm://), which the receiver serves;
  * other providers keep LCM's own receiving. */
@@ -219,8 +227,8 @@ int coavoid_rt_install_signal_handlers(void);
 int coavoid_rt_run(const coavoid_rt_loop_t *loop, coavoid_rt_result_t *result);
 
 /* The end of a driver's summary line: ", overruns N, skipped N", with a receiver
- * ", datagrams N (dropped at the socket N)" and any malformed, fragments or oversize
- * counts, and, when a signal stopped it, ", stopped by SIGTERM". Cannot fail (truncates
+ * ", datagrams N (dropped at the socket N; ...)" with its malformed, fragment, oversize
+ * and foreign counts, and, when a signal stopped it, ", stopped by SIGTERM". Cannot fail (truncates
  * to size). */
 void coavoid_rt_result_text(const coavoid_rt_result_t *result, char *out, size_t size);
 

@@ -69,6 +69,20 @@ int coavoid_rt_rx_parse(const unsigned char *datagram, size_t size, coavoid_rt_r
     return COA_OK;
 }
 
+bool coavoid_rt_rx_fleet_channel(const char *channel)
+{
+    static const char *const fleet[] = {COAVOID_CHANNEL_INTENT,    COAVOID_CHANNEL_PLAN,
+                                        COAVOID_CHANNEL_TRACK,     COAVOID_CHANNEL_OBSTACLES,
+                                        COAVOID_CHANNEL_CONFLICTS, COAVOID_CHANNEL_STATUS,
+                                        COAVOID_CHANNEL_AGREEMENT};
+    for (size_t i = 0; channel != NULL && i < sizeof fleet / sizeof fleet[0]; i++) {
+        if (strcmp(channel, fleet[i]) == 0) {
+            return true;
+        }
+    }
+    return false;
+}
+
 bool coavoid_rt_rx_is_udpm(const char *url)
 {
     return url != NULL && strncmp(url, "udpm://", 7) == 0;
@@ -271,6 +285,10 @@ int coavoid_rt_rx_deliver(coavoid_rt_rx_t *rx)
     if (rc != COA_OK) {
         rx->stats.fragments += rc == COAVOID_RT_RX_FRAGMENT;
         rx->stats.malformed += rc != COAVOID_RT_RX_FRAGMENT;
+        return 1;
+    }
+    if (!coavoid_rt_rx_fleet_channel(frame.channel)) {
+        rx->stats.foreign++;
         return 1;
     }
     /* memq copies the message and queues it, or drops it when no node subscribes to its
