@@ -12,7 +12,7 @@
 # cycle's start the logger heard it (the worst, in wall milliseconds, how many were later
 # than 50 ms, and how many a decoupled vehicle stamped 50 ms or more after the cycle's
 # start, held by its wait for the UAVs before it), and the worst of the vehicles'
-# heartbeats; each node's CPU seconds; and from the nodes' last heartbeats the
+# heartbeats; each node's CPU seconds and peak memory; and from the nodes' last heartbeats the
 # messages they refused and dropped unchecked, and the largest inbox rate they reported;
 # and from each node's summary line what reached its socket a wall second over the
 # flight, read or dropped there (all also in RUN/flood.json). With --flood, a flooder (tests/forge/flood.c) in a namespace
@@ -199,6 +199,34 @@ cpu() {
     CPU_FILE=$file ip netns exec "$name" bash -c '"$@"; s=$?; times >"$CPU_FILE"; exit $s' _ "$@"
 }
 
+# peaks DIR EPOCH: until DIR/flying is gone, the peak resident memory (VmHWM) of every
+# process of the run (its command line holds --epoch EPOCH) into DIR/peaks.json, read
+# from /proc every 250 ms; a node's memory after its flight ends does not grow.
+peaks() {
+    python3 - "$1" "$2" <<'PEAKS'
+import json, os, re, sys, time
+d, epoch = sys.argv[1], sys.argv[2]
+peak = {}
+while os.path.exists(os.path.join(d, "flying")):
+    for pid in filter(str.isdigit, os.listdir("/proc")):
+        try:
+            argv = open("/proc/%s/cmdline" % pid, "rb").read().split(b"\0")
+            if b"--epoch" not in argv or argv[argv.index(b"--epoch") + 1].decode() != epoch:
+                continue
+            hwm = int(re.search(r"VmHWM:\s+(\d+)", open("/proc/%s/status" % pid).read()).group(1))
+        except (OSError, AttributeError, IndexError, ValueError):
+            continue
+        cmd = b" ".join(argv).decode(errors="replace")
+        m = re.search(r"--id (\d+)", cmd)
+        name = ("vehicle-" + m.group(1) if m else "coordinator" if "coordinator" in cmd
+                else "world" if " world " in cmd else None)
+        if name is not None and not cmd.startswith(("bash", "ip ")):
+            peak[name] = max(peak.get(name, 0), hwm)
+    time.sleep(0.25)
+json.dump(peak, open(os.path.join(d, "peaks.json"), "w"))
+PEAKS
+}
+
 # ---- the runs ----
 
 lost=0
@@ -240,7 +268,12 @@ for run in $(seq "$runs"); do
         esac
         pids+=($!)
     done
+    touch "$dir/flying"
+    peaks "$dir" "$epoch" &
+    peaks_pid=$!
     for p in "${pids[@]}"; do wait "$p" || true; done
+    rm -f "$dir/flying"
+    wait "$peaks_pid" || true
     for p in "${flooder_pids[@]}"; do
         kill -TERM "$p" 2>/dev/null || true
         wait "$p" || true
@@ -297,11 +330,17 @@ while i + 28 <= len(data):
 late = [(ts - (epoch + (k - epoch) / speed)) / 1000 for (_, k), ts in first.items()]
 beat_late = [(ts - (epoch + (k - epoch) / speed)) / 1000 for (_, k), ts in beats.items()]
 worst = max(late) if late else float("nan")
-cpu = []
+cpu, usage = [], {}
+try:
+    peaks = json.load(open(os.path.join(d, "peaks.json")))
+except (OSError, ValueError):
+    peaks = {}
 for f in sorted(glob.glob(os.path.join(d, "*.cpu"))):
     u, sy = (float(x.rstrip("s").split("m")[0]) * 60 + float(x.rstrip("s").split("m")[1])
              for x in open(f).read().split()[-2:])
-    cpu.append("%s %.1f" % (os.path.basename(f)[:-4], u + sy))
+    name = os.path.basename(f)[:-4]
+    usage[name] = {"cpu_s": u + sy, "peak_rss_kib": peaks.get(name, 0)}
+    cpu.append("%s %.1f/%.1f" % (name, u + sy, peaks.get(name, 0) / 1024))
 nodes = ", ".join("%d: %d/%d/%d" % (k, *v) for k, v in sorted(status.items()))
 # What reached each node's socket: datagrams read and dropped there (its summary line),
 # a wall second over the flight's span in the log.
@@ -327,12 +366,13 @@ json.dump({"loss_of_separation": s["loss_of_separation"], "worst_late_ms": worst
                      for k, v in status.items()},
            "sockets": {k: {"datagrams": v[0], "dropped": v[1],
                            "arrived_a_second": (v[0] + v[1]) / span}
-                       for k, v in arrived.items()}},
+                       for k, v in arrived.items()},
+           "processes": usage},
           open(os.path.join(d, "flood.json"), "w"))
 sockets = ", ".join("%s %.0f/s (%d dropped)" % (k, (v[0] + v[1]) / span, v[1])
                     for k, v in arrived.items())
 line += ("; intents heard late: worst %.1f ms, %d of %d over 50 ms (%d held by the "
-         "protocol), vehicles' heartbeats worst %.1f ms; cpu s: %s; refused/dropped/max rate: "
+         "protocol), vehicles' heartbeats worst %.1f ms; cpu s/peak MiB: %s; refused/dropped/max rate: "
          "%s; at the sockets: %s; %s" % (worst, sum(x > 50 for x in late), len(late), held,
                      max(beat_late, default=float("nan")), ", ".join(cpu), nodes, sockets,
                      flooded))

@@ -182,14 +182,16 @@ START_TEST(receiver_delivers_and_counts)
     int s = open_sender(port);
     unsigned char d[4096];
     for (uint32_t v = 1; v <= 5u; v++) {
-        ck_assert_int_gt(send(s, d, frame(d, 0x4c433032u, v, "COAVOID_STATUS", &v, sizeof v), 0), 0);
+        ck_assert_int_gt(send(s, d, frame(d, 0x4c433032u, v, "COAVOID_STATUS", &v, sizeof v), 0),
+                         0);
     }
     const uint32_t v = 9u;
     ck_assert_int_gt(send(s, d, frame(d, 0x4c433032u, 6u, "OTHER", &v, sizeof v), 0), 0);
     ck_assert_int_gt(send(s, d, frame(d, 0x4c433033u, 7u, "COAVOID_STATUS", &v, sizeof v), 0), 0);
     ck_assert_int_gt(send(s, d, 5u, 0), 0);
     static const unsigned char big[3000];
-    ck_assert_int_gt(send(s, d, frame(d, 0x4c433032u, 8u, "COAVOID_STATUS", big, sizeof big), 0), 0);
+    ck_assert_int_gt(send(s, d, frame(d, 0x4c433032u, 8u, "COAVOID_STATUS", big, sizeof big), 0),
+                     0);
     deliver_all(rx);
     const coavoid_rt_rx_stats_t *st = coavoid_rt_rx_stats(rx);
     ck_assert_uint_eq(ear.count, 5u);
