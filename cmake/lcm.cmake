@@ -20,4 +20,5 @@ endif()
 
 add_subdirectory(${PROJECT_SOURCE_DIR}/lcmtypes ${PROJECT_BINARY_DIR}/lcmtypes)
 
+add_subdirectory(${PROJECT_SOURCE_DIR}/src/auth ${PROJECT_BINARY_DIR}/src/auth)
 add_subdirectory(${PROJECT_SOURCE_DIR}/src/lcm ${PROJECT_BINARY_DIR}/src/lcm)

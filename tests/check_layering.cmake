@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: MIT
 # The layers of docs/design.md, checked on the sources: nothing under src/ or include/
-# includes a header of apps/ (by its name, or by a path into apps/), and the core
-# (src/core/, include/coavoid/) includes neither LCM nor stdio.
+# includes a header of apps/ (by its name, or by a path into apps/), the core
+# (src/core/, include/coavoid/) includes neither LCM nor stdio, and the message checks the
+# firmware compiles (src/auth/auth.c, auth.h) include no LCM, stdio or stdlib.
 # Usage: cmake -DSRC=<source tree> -P check_layering.cmake
 cmake_minimum_required(VERSION 3.16)
 if(NOT SRC)
@@ -24,6 +25,11 @@ foreach(f ${lib_files})
   if(rel MATCHES "^(src/core|include/coavoid)/")
     set(core TRUE)
   endif()
+  # The message checks that the firmware compiles too (src/auth/auth.c and its header).
+  set(part FALSE)
+  if(rel MATCHES "^src/auth/auth\\.[ch]$")
+    set(part TRUE)
+  endif()
   foreach(line ${includes})
     string(REGEX REPLACE "^[ \t]*#[ \t]*include[ \t]*[<\"]([^>\"]+)[>\"].*" "\\1" inc "${line}")
     get_filename_component(name ${inc} NAME)
@@ -34,6 +40,12 @@ foreach(f ${lib_files})
     if(core AND (inc MATCHES "^lcm/" OR inc MATCHES "^lcmtypes" OR inc MATCHES "coavoid_lcm" OR
                  inc STREQUAL "stdio.h"))
       message(SEND_ERROR "${rel}: the core includes ${inc} (no LCM, no stdio in the core)")
+      math(EXPR failures "${failures} + 1")
+    endif()
+    if(part AND (inc MATCHES "^lcm/" OR inc MATCHES "coavoid_lcm" OR inc STREQUAL "stdio.h" OR
+                 inc STREQUAL "stdlib.h" OR inc STREQUAL "sodium.h"))
+      message(SEND_ERROR "${rel}: includes ${inc} (the message checks build for the part: "
+                         "no LCM, no stdio, no heap, only the libsodium headers they use)")
       math(EXPR failures "${failures} + 1")
     endif()
   endforeach()

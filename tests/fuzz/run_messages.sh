@@ -10,9 +10,9 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 command -v clang >/dev/null || { echo "fuzz: clang is not installed" >&2; exit 1; }
 clang -std=c11 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all \
-  -I"$src/include" -I"$src/src/lcm" -I"$src/src/node" -I"$src/src/realtime" -I"$src/tests" \
+  -I"$src/include" -I"$src/src/lcm" -I"$src/src/auth" -I"$src/src/node" -I"$src/src/realtime" -I"$src/tests" \
   -I"$types/include" "$src/tests/fuzz/fuzz_messages.c" "$src/src/lcm/convert.c" \
-  "$src/src/lcm/auth.c" "$src/src/realtime/rx.c" \
+  "$src/src/auth/auth.c" "$src/src/auth/auth_files.c" "$src/src/realtime/rx.c" \
   "$src"/src/core/*.c "$types"/c/*.c -llcm -lsodium -lccd -lm -o "$work/fuzz_messages"
 mkdir -p "$work/corpus"
 # The six valid examples unchanged (mode byte 0-5), and raw bytes of each type (0x80-0x85);

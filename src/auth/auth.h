@@ -30,14 +30,20 @@
  * another or for the coordinator. A trust list without a fleet key neither writes nor
  * checks tags (each is zero).
  *
- * Ed25519 by libsodium (crypto_sign_detached / crypto_sign_verify_detached); the tag is
- * SipHash-2-4 (libsodium's crypto_shorthash: a 16-byte key, an 8-byte output). Memory: the
+ * Ed25519 by libsodium (crypto_sign_ed25519_detached / _verify_detached); the tag is
+ * SipHash-2-4 (crypto_shorthash_siphash24: a 16-byte key, an 8-byte output). Memory: the
  * caller's structs; nothing is allocated. Cost: one signature or verification over the
- * datagram (tens of microseconds), one keyed hash (under a microsecond on a PC;
- * docs/benchmarks.md).
+ * datagram (tens of microseconds on a PC, milliseconds on a Cortex-M4F), one keyed hash
+ * (under a microsecond on a PC; docs/benchmarks.md, docs/embedded.md).
+ *
+ * Two parts. Signing and checking (auth.c) use no stdio, no heap, no clock and no random
+ * numbers: the same code runs in the Linux drivers and on the part. Making keys and
+ * reading and writing their files (coavoid_auth_init, _keypair, _keypair_seed,
+ * _fleet_key, the _parse and _line functions: auth_files.c) is for the ground, and only
+ * the host build has it.
  */
-#ifndef COAVOID_LCM_AUTH_H
-#define COAVOID_LCM_AUTH_H
+#ifndef COAVOID_AUTH_H
+#define COAVOID_AUTH_H
 
 #include <stdbool.h>
 #include <stddef.h>
@@ -50,8 +56,12 @@
 #define COAVOID_AUTH_FLEET_KEY_BYTES 16u
 #define COAVOID_AUTH_PUBLIC_BYTES 32u
 #define COAVOID_AUTH_SECRET_BYTES 64u
-/* Keys one receiver trusts: a coordinator, a world and every UAV a node holds, with room. */
+/* Keys one receiver trusts: a coordinator, a world and every UAV a node holds, with room.
+ * A build may set fewer (a part's trust list holds its own fleet only: the cross build's
+ * is 16, 2,456 bytes on the Cortex-M4F); every translation unit of a build must agree. */
+#ifndef COAVOID_AUTH_MAX_KEYS
 #define COAVOID_AUTH_MAX_KEYS 128u
+#endif
 /* Freshness is kept per key and per stream (one stream per message type, numbered by the
  * caller: COAVOID_AUTH_STREAM_*), since UDP may reorder one sender's datagrams of
  * different types, and a heartbeat overtaken by the intent sent after it is no replay. */
@@ -95,7 +105,6 @@ typedef struct {
     int64_t last_sequence[COAVOID_AUTH_MAX_KEYS][COAVOID_AUTH_STREAMS];
 } coavoid_auth_trust_t;
 
-/* A sender's key, with the numbers of its next signature. */
 /* A sender's key, the fleet's key it tags with (coavoid_auth_signer_use_fleet), and the
  * numbers of its next signature. */
 typedef struct {
@@ -116,8 +125,9 @@ typedef struct {
 #define COAVOID_AUTH_ERR_CLOCK (-125)     /* timestamp outside the receiver's window */
 #define COAVOID_AUTH_ERR_TAG (-126)       /* the fleet tag does not match: not from the fleet */
 
-/* Initialises libsodium; call once before anything else here (thread-safe, idempotent).
- * Returns COA_OK or COA_ERR_ARGUMENT when the library cannot start. */
+/* Initialises libsodium; on the host, call once before anything else here (thread-safe,
+ * idempotent; the part's portable build needs none). Returns COA_OK or COA_ERR_ARGUMENT
+ * when the library cannot start. */
 int coavoid_auth_init(void);
 
 /* A new key pair from the system's random source. Returns COA_OK or COA_ERR_ARGUMENT. */
@@ -267,4 +277,4 @@ int coavoid_auth_signer_line(const coavoid_auth_signer_t *s, char *out, size_t s
 int coavoid_auth_fleet_line(const unsigned char key[COAVOID_AUTH_FLEET_KEY_BYTES], char *out,
                             size_t size);
 
-#endif /* COAVOID_LCM_AUTH_H */
+#endif /* COAVOID_AUTH_H */
