@@ -13,6 +13,11 @@
  *   crypto sign BYTES HEX ticks T          the signature over its first BYTES - 72
  *   crypto verify BYTES rc RC ticks T      RC 0: the signature verifies
  *   crypto refuse BYTES rc RC ticks T      the same with one signed byte changed: RC -1
+ * then the drivers' own path (src/auth/auth.c) on an intent:
+ *   crypto stamp BYTES rc 0 ticks T        a vehicle's signer stamps, signs and tags it
+ *   crypto check BYTES rc 0 ticks T        a receiver's precheck (tail, tag) and verify
+ *   crypto outsider BYTES rc -126 ticks T  an outsider's copy, refused by the tag
+ * and, before them, `crypto memory trust BYTES signer BYTES`: the structs' sizes on the part.
  */
 #include <stdbool.h>
 #include <stdint.h>
@@ -21,12 +26,17 @@
 #include <sodium/crypto_shorthash_siphash24.h>
 #include <sodium/crypto_sign_ed25519.h>
 
+#include "auth.h"
 #include "check_crypto.h"
+#include "coavoid/common.h"
 #include "check_io.h"
 
 #define CRYPTO_TAG_BYTES 8u
 #define CRYPTO_SIGNATURE_BYTES 64u
 #define CRYPTO_LARGEST 1398u
+#define CRYPTO_KEY_ID 101u               /* UAV 1's, as coavoid keygen numbers it */
+#define CRYPTO_NOW_US 1795000000000000LL /* a clock in 2026, us */
+#define CRYPTO_MAX_AGE_US 3000000LL      /* the freshness window either side */
 
 static unsigned char public_key[crypto_sign_ed25519_PUBLICKEYBYTES];
 static unsigned char secret_key[crypto_sign_ed25519_SECRETKEYBYTES];
@@ -99,9 +109,74 @@ static bool check_size(unsigned char *datagram, size_t bytes)
     return good == 0 && bad == -1;
 }
 
+/* The drivers' own path on the part (src/auth/auth.c): an intent stamped by a vehicle's
+ * signer (its numbers, the signature, the fleet tag) is checked by a receiver's trust list
+ * of that key, its tail and tag (coavoid_auth_precheck) then its signature
+ * (coavoid_auth_verify); an outsider's copy of it, with a later stamp and the signature
+ * broken, is refused by the tag. The trust list and the datagram are built in scratch. */
+typedef struct {
+    coavoid_auth_trust_t trust;
+    unsigned char datagram[CRYPTO_LARGEST];
+} auth_scratch_t;
+
+static int check_counted(const char *what, const coavoid_auth_trust_t *trust,
+                         const unsigned char *datagram, size_t bytes)
+{
+    const coavoid_auth_expect_t expect = {COAVOID_AUTH_STREAM_INTENT, COAVOID_AUTH_VEHICLE,
+                                          CRYPTO_NOW_US, CRYPTO_MAX_AGE_US, CRYPTO_MAX_AGE_US};
+    size_t key = 0;
+    const uint64_t start = fwc_ticks_now();
+    int rc = coavoid_auth_precheck(trust, datagram, bytes, &expect, &key);
+    if (rc == COA_OK) {
+        rc = coavoid_auth_verify(trust, datagram, bytes, &key);
+    }
+    const uint64_t ticks = fwc_ticks_now() - start;
+    put_result(what, bytes);
+    fwc_put(" rc ");
+    fwc_put_i64(rc);
+    put_ticks(ticks);
+    return rc;
+}
+
+static bool check_drivers_path(auth_scratch_t *s)
+{
+    coavoid_auth_trust_init(&s->trust);
+    coavoid_auth_key_t key = {CRYPTO_KEY_ID, COAVOID_AUTH_VEHICLE, 1u, {0}};
+    memcpy(key.public_key, public_key, sizeof key.public_key);
+    coavoid_auth_signer_t signer;
+    memset(&signer, 0, sizeof signer);
+    signer.key_id = CRYPTO_KEY_ID;
+    memcpy(signer.secret_key, secret_key, sizeof signer.secret_key);
+    if (coavoid_auth_trust_add(&s->trust, &key) != COA_OK ||
+        coavoid_auth_trust_set_fleet_key(&s->trust, fleet_key) != COA_OK) {
+        return false;
+    }
+    coavoid_auth_signer_use_fleet(&signer, &s->trust);
+    fwc_put("crypto memory trust ");
+    fwc_put_u64(sizeof s->trust);
+    fwc_put(" signer ");
+    fwc_put_u64(sizeof signer);
+    fwc_end_line();
+    fill(s->datagram, CRYPTO_LARGEST, 7u, 3u);
+    const uint64_t start = fwc_ticks_now();
+    const int stamped = coavoid_auth_stamp(&signer, CRYPTO_NOW_US, s->datagram, CRYPTO_LARGEST);
+    const uint64_t ticks = fwc_ticks_now() - start;
+    put_result("stamp", CRYPTO_LARGEST);
+    fwc_put(" rc ");
+    fwc_put_i64(stamped);
+    put_ticks(ticks);
+    const int good = check_counted("check", &s->trust, s->datagram, CRYPTO_LARGEST);
+    /* The outsider: a later stamp, a signature byte flipped, the tag as it was. */
+    s->datagram[CRYPTO_LARGEST - COAVOID_AUTH_TAIL_BYTES + 11u] ^= 0x01u;
+    s->datagram[CRYPTO_LARGEST - COAVOID_AUTH_TAG_BYTES - 1u] ^= 0x5au;
+    const int outsider = check_counted("outsider", &s->trust, s->datagram, CRYPTO_LARGEST);
+    coavoid_auth_signer_clear(&signer);
+    return stamped == COA_OK && good == COA_OK && outsider == COAVOID_AUTH_ERR_TAG;
+}
+
 bool fwc_crypto_run(unsigned char *scratch, size_t size)
 {
-    if (size < CRYPTO_LARGEST) {
+    if (size < sizeof(auth_scratch_t)) {
         fwc_put("error crypto: the scratch buffer is too small");
         fwc_end_line();
         return false;
@@ -116,5 +191,11 @@ bool fwc_crypto_run(unsigned char *scratch, size_t size)
     }
     const bool heartbeat = check_size(scratch, 192u);
     const bool intent = check_size(scratch, CRYPTO_LARGEST);
-    return heartbeat && intent;
+    /* scratch is the planner's buffer, aligned for any type. */
+    const bool drivers = check_drivers_path((auth_scratch_t *)(void *)scratch);
+    if (!drivers) {
+        fwc_put("error crypto: the drivers' checks gave a wrong result");
+        fwc_end_line();
+    }
+    return heartbeat && intent && drivers;
 }

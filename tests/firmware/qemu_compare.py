@@ -29,8 +29,9 @@ cycles or time (qemu is not cycle-accurate); printed, never compared.
 
 Message checks (apps/firmware/check_crypto.c's `crypto` lines): the fleet tag and the
 Ed25519 signature the firmware computed over its fixed datagrams must equal the host
-libsodium's, bit for bit, the signature must verify and the changed datagram must not; their
-instructions are printed as well.
+libsodium's, bit for bit, the signature must verify and the changed datagram must not; the
+drivers' own checks (src/auth/auth.c on the part) must stamp an intent, accept it and
+refuse an outsider's copy by its tag (-126); their instructions are printed as well.
 """
 import ctypes
 import ctypes.util
@@ -98,14 +99,18 @@ def host_crypto(size):
 
 def compare_crypto(crypto, bad):
     """Checks the firmware's crypto lines against the host; returns how many were compared."""
-    want = {"tag": "hex", "sign": "hex", "verify": "0", "refuse": "-1"}
+    want = {"tag": "hex", "sign": "hex", "verify": "0", "refuse": "-1", "stamp": "0",
+            "check": "0", "outsider": "-126"}
     seen = {(t[0], t[1]) for t in crypto}
-    for what in want:
-        for size in ("192", "1398"):
-            if (what, size) not in seen:
-                bad.append(f"crypto {what} {size}: the firmware reported none")
+    required = [(w, size) for w in ("tag", "sign", "verify", "refuse") for size in ("192", "1398")]
+    required += [(w, "1398") for w in ("stamp", "check", "outsider")]
+    for what, size in required:
+        if (what, size) not in seen:
+            bad.append(f"crypto {what} {size}: the firmware reported none")
     compared = 0
     for t in crypto:
+        if t[0] == "memory":
+            continue
         what, size, value = t[0], int(t[1]), t[2]
         if what in ("tag", "sign"):
             host = host_crypto(size)[what]
@@ -120,6 +125,9 @@ def compare_crypto(crypto, bad):
 def print_crypto(crypto, per_tick):
     print(f"{'message check':14} {'bytes':>6} {'instructions':>13}")
     for t in crypto:
+        if t[0] == "memory":
+            print("memory on the part: " + " ".join(t[1:]) + " (bytes)")
+            continue
         print(f"{t[0]:14} {t[1]:>6} {int(t[t.index('ticks') + 1]) * per_tick:13,.0f}")
 
 

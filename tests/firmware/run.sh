@@ -8,8 +8,8 @@
 #   - prints text, data and bss of the ELF, the core and libccd, the largest stack frames
 #     (-fstack-usage) and the deepest call chains (-fcallgraph-info=su, callgraph.awk),
 #     failing on recursion or a dynamic frame.
-# Also builds libsodium's message checks (cmake/libsodium_arm.cmake) into the check ELF,
-# which must link them without a heap, and reports their sizes and stack.
+# Also builds the message checks (src/auth on libsodium, cmake/libsodium_arm.cmake) into
+# the check ELF, which must link them without a heap, and reports their sizes and stack.
 # Usage: run.sh SRC BUILD CCD_SOURCE_DIR SODIUM_SOURCE_DIR (the unpacked sources, fetched
 # beforehand by scripts/fetch_sources.sh: a test never downloads). A missing toolchain,
 # newlib or source is a failure with what to install, not a skip: CI must run this.
@@ -86,6 +86,7 @@ echo "== size (bytes; an archive's total is every function, the ELF only what it
 "${prefix}size" -t "$core" | tail -n 1 | sed 's/(TOTALS)/core (libcoavoid_core.a)/'
 "${prefix}size" -t "$ccd" | tail -n 1 | sed 's/(TOTALS)/libccd (libccd.a)/'
 "${prefix}size" -t "$sodium" | tail -n 1 | sed 's/(TOTALS)/libsodium: tag and Ed25519 (libcoavoid_sodium_arm.a)/'
+"${prefix}size" -t "$arm/src/auth/libcoavoid_auth.a" | tail -n 1 | sed 's/(TOTALS)/message checks (libcoavoid_auth.a)/'
 "${prefix}size" "$elf" | tail -n 1 | sed "s|$elf|firmware ELF|"
 
 # Stack frames: file:line:col:function <TAB> bytes <TAB> static|dynamic[,bounded].
@@ -111,14 +112,16 @@ report_frames check "$arm/apps/firmware/CMakeFiles/coavoid_firmware_check.dir" |
 report_frames libccd "$arm/libccd-arm-build/src" || true
 sodium_objs=$arm/CMakeFiles/coavoid_sodium_arm.dir
 report_frames libsodium "$sodium_objs" || die "unbounded stack frame in libsodium's message checks"
+auth_objs=$arm/src/auth/CMakeFiles/coavoid_auth.dir
+report_frames auth "$auth_objs" || die "unbounded stack frame in the message checks (src/auth)"
 # Call chains: the deepest sum of frames below each entry point, over the core's,
 # libccd's and the firmware's call graphs; libccd's only indirect calls are to the
 # callbacks geometry.c hands it. Recursion or a dynamic frame fails the test.
 echo "== stack (deepest call chain: frames summed, library leaves not included)"
 mapfile -t graphs < <(find "$arm/src/core/CMakeFiles/coavoid_core.dir" "$fw_objs" \
-  "$arm/libccd-arm-build/src" "$sodium_objs" -name '*.ci' | sort)
+  "$arm/libccd-arm-build/src" "$sodium_objs" "$auth_objs" -name '*.ci' | sort)
 [ "${#graphs[@]}" -gt 0 ] || die "no .ci files (-fcallgraph-info=su missing?)"
-awk -v roots="main,fw_systick_handler,fw_task_cycle,coa_plan_decoupled,coa_plan_centralised,coa_predict,crypto_shorthash_siphash24,crypto_sign_ed25519_detached,crypto_sign_ed25519_verify_detached" \
+awk -v roots="main,fw_systick_handler,fw_task_cycle,coa_plan_decoupled,coa_plan_centralised,coa_predict,coavoid_auth_stamp,coavoid_auth_precheck,coavoid_auth_verify" \
   -v indirect="sweep_support,poly_support,sweep_centre,poly_centre" \
   -f "$src/tests/firmware/callgraph.awk" "${graphs[@]}" || die "unbounded call chain"
 echo "== firmware ELF by origin (input sections from the map; flash = code + constants)"
