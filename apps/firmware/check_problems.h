@@ -9,263 +9,135 @@
 #define FWC_MAX_HORIZON 30u
 #define FWC_PROBLEM_COUNT 6u
 
-static const coa_vec3_t p0_v0_route[] = {{0.0f, 0.0f, 100.0f}, {256.0f, 0.0f, 100.0f}};
-static const coa_vec3_t p0_v1_route[] = {{64.0f, 0.0f, 108.0f}, {-192.0f, 0.0f, 108.0f}};
-static const coa_vehicle_t p0_vehicles[] = {{.id = 1u,
-                                             .priority = 1u,
-                                             .cruise_speed = 10.0f,
-                                             .climb_rate = 2.0f,
-                                             .steep_factor = 2u,
-                                             .volume = {15.0f, 5.0f},
-                                             .route = p0_v0_route,
-                                             .route_count = 2u,
-                                             .initial_offset = 0,
-                                             .max_offset = -1},
-                                            {.id = 2u,
-                                             .priority = 2u,
-                                             .cruise_speed = 8.0f,
-                                             .climb_rate = 1.5f,
-                                             .steep_factor = 3u,
-                                             .volume = {15.0f, 5.0f},
-                                             .route = p0_v1_route,
-                                             .route_count = 2u,
-                                             .initial_offset = 0,
-                                             .max_offset = -1}};
-static const coa_vec3_t p1_v0_route[] = {{0.0f, 0.0f, 50.0f}, {400.0f, 0.0f, 50.0f}};
-static const coa_vehicle_t p1_vehicles[] = {{.id = 1u,
-                                             .priority = 1u,
-                                             .cruise_speed = 10.0f,
-                                             .climb_rate = 2.0f,
-                                             .steep_factor = 2u,
-                                             .volume = {15.0f, 5.0f},
-                                             .route = p1_v0_route,
-                                             .route_count = 2u,
-                                             .initial_offset = 0,
-                                             .max_offset = -1}};
-static const coa_vec3_t p1_o0_vertices[] = {{100.0f, -100.0f, 0.0f},
-                                            {200.0f, -100.0f, 0.0f},
-                                            {200.0f, 100.0f, 0.0f},
-                                            {100.0f, 100.0f, 0.0f},
-                                            {150.0f, 0.0f, 62.0f}};
+static const coa_vec3_t p0_v0_route[] = {
+    {0.0f, 0.0f, 100.0f},
+    {256.0f, 0.0f, 100.0f}};
+static const coa_vec3_t p0_v1_route[] = {
+    {64.0f, 0.0f, 108.0f},
+    {-192.0f, 0.0f, 108.0f}};
+static const coa_vehicle_t p0_vehicles[] = {
+    {.id = 1u, .priority = 1u, .cruise_speed = 10.0f, .climb_rate = 2.0f, .steep_factor = 2u,
+     .volume = {15.0f, 5.0f}, .route = p0_v0_route, .route_count = 2u, .initial_offset = 0, .max_offset = -1},
+    {.id = 2u, .priority = 2u, .cruise_speed = 8.0f, .climb_rate = 1.5f, .steep_factor = 3u,
+     .volume = {15.0f, 5.0f}, .route = p0_v1_route, .route_count = 2u, .initial_offset = 0, .max_offset = -1}};
+static const coa_vec3_t p1_v0_route[] = {
+    {0.0f, 0.0f, 50.0f},
+    {400.0f, 0.0f, 50.0f}};
+static const coa_vehicle_t p1_vehicles[] = {
+    {.id = 1u, .priority = 1u, .cruise_speed = 10.0f, .climb_rate = 2.0f, .steep_factor = 2u,
+     .volume = {15.0f, 5.0f}, .route = p1_v0_route, .route_count = 2u, .initial_offset = 0, .max_offset = -1}};
+static const coa_vec3_t p1_o0_vertices[] = {
+    {100.0f, -100.0f, 0.0f},
+    {200.0f, -100.0f, 0.0f},
+    {200.0f, 100.0f, 0.0f},
+    {100.0f, 100.0f, 0.0f},
+    {150.0f, 0.0f, 62.0f}};
 static const coa_obstacle_t p1_obstacles[] = {
     {.kind = COA_OBSTACLE_POLYTOPE, .polytope = {p1_o0_vertices, 5u}},
     {.kind = COA_OBSTACLE_BOX, .box = {{240.0f, -50.0f, 0.0f}, {260.0f, 50.0f, 52.5f}}}};
-static const coa_vec3_t p2_v0_route[] = {{0.0f, 0.0f, 100.0f}, {2000.0f, 0.0f, 100.0f}};
-static const coa_vec3_t p2_v1_route[] = {{0.0f, 0.0f, 116.0f}, {2000.0f, 0.0f, 116.0f}};
-static const coa_vec3_t p2_v2_route[] = {{300.0f, 0.0f, 112.0f}, {-1700.0f, 0.0f, 112.0f}};
-static const coa_vehicle_t p2_vehicles[] = {{.id = 1u,
-                                             .priority = 1u,
-                                             .cruise_speed = 10.0f,
-                                             .climb_rate = 2.0f,
-                                             .steep_factor = 2u,
-                                             .volume = {15.0f, 5.0f},
-                                             .route = p2_v0_route,
-                                             .route_count = 2u,
-                                             .initial_offset = 0,
-                                             .max_offset = -1},
-                                            {.id = 2u,
-                                             .priority = 2u,
-                                             .cruise_speed = 10.0f,
-                                             .climb_rate = 2.0f,
-                                             .steep_factor = 2u,
-                                             .volume = {15.0f, 5.0f},
-                                             .route = p2_v1_route,
-                                             .route_count = 2u,
-                                             .initial_offset = 0,
-                                             .max_offset = -1},
-                                            {.id = 3u,
-                                             .priority = 3u,
-                                             .cruise_speed = 10.0f,
-                                             .climb_rate = 3.0f,
-                                             .steep_factor = 2u,
-                                             .volume = {15.0f, 5.0f},
-                                             .route = p2_v2_route,
-                                             .route_count = 2u,
-                                             .initial_offset = 0,
-                                             .max_offset = -1}};
+static const coa_vec3_t p2_v0_route[] = {
+    {0.0f, 0.0f, 100.0f},
+    {2000.0f, 0.0f, 100.0f}};
+static const coa_vec3_t p2_v1_route[] = {
+    {0.0f, 0.0f, 116.0f},
+    {2000.0f, 0.0f, 116.0f}};
+static const coa_vec3_t p2_v2_route[] = {
+    {300.0f, 0.0f, 112.0f},
+    {-1700.0f, 0.0f, 112.0f}};
+static const coa_vehicle_t p2_vehicles[] = {
+    {.id = 1u, .priority = 1u, .cruise_speed = 10.0f, .climb_rate = 2.0f, .steep_factor = 2u,
+     .volume = {15.0f, 5.0f}, .route = p2_v0_route, .route_count = 2u, .initial_offset = 0, .max_offset = -1},
+    {.id = 2u, .priority = 2u, .cruise_speed = 10.0f, .climb_rate = 2.0f, .steep_factor = 2u,
+     .volume = {15.0f, 5.0f}, .route = p2_v1_route, .route_count = 2u, .initial_offset = 0, .max_offset = -1},
+    {.id = 3u, .priority = 3u, .cruise_speed = 10.0f, .climb_rate = 3.0f, .steep_factor = 2u,
+     .volume = {15.0f, 5.0f}, .route = p2_v2_route, .route_count = 2u, .initial_offset = 0, .max_offset = -1}};
 static const coa_obstacle_t p2_obstacles[] = {
     {.kind = COA_OBSTACLE_BOX, .box = {{100.0f, -60.0f, 0.0f}, {200.0f, 60.0f, 104.0f}}}};
-static const coa_vec3_t p3_v0_route[] = {{0.0f, 0.0f, 100.0f}, {256.0f, 0.0f, 100.0f}};
-static const coa_vec3_t p3_v1_route[] = {{120.0f, 0.0f, 104.0f}, {-136.0f, 0.0f, 104.0f}};
-static const coa_vec3_t p3_v2_route[] = {{60.0f, -60.0f, 108.0f}, {60.0f, 196.0f, 108.0f}};
-static const coa_vec3_t p3_v3_route[] = {{60.0f, 60.0f, 112.0f}, {60.0f, -196.0f, 112.0f}};
-static const coa_vehicle_t p3_vehicles[] = {{.id = 1u,
-                                             .priority = 1u,
-                                             .cruise_speed = 10.0f,
-                                             .climb_rate = 2.0f,
-                                             .steep_factor = 2u,
-                                             .volume = {15.0f, 5.0f},
-                                             .route = p3_v0_route,
-                                             .route_count = 2u,
-                                             .initial_offset = 0,
-                                             .max_offset = 8},
-                                            {.id = 2u,
-                                             .priority = 2u,
-                                             .cruise_speed = 10.0f,
-                                             .climb_rate = 2.0f,
-                                             .steep_factor = 2u,
-                                             .volume = {15.0f, 5.0f},
-                                             .route = p3_v1_route,
-                                             .route_count = 2u,
-                                             .initial_offset = 0,
-                                             .max_offset = 8},
-                                            {.id = 3u,
-                                             .priority = 3u,
-                                             .cruise_speed = 10.0f,
-                                             .climb_rate = 2.0f,
-                                             .steep_factor = 2u,
-                                             .volume = {15.0f, 5.0f},
-                                             .route = p3_v2_route,
-                                             .route_count = 2u,
-                                             .initial_offset = 0,
-                                             .max_offset = 8},
-                                            {.id = 4u,
-                                             .priority = 4u,
-                                             .cruise_speed = 10.0f,
-                                             .climb_rate = 2.0f,
-                                             .steep_factor = 2u,
-                                             .volume = {15.0f, 5.0f},
-                                             .route = p3_v3_route,
-                                             .route_count = 2u,
-                                             .initial_offset = 0,
-                                             .max_offset = 8}};
-static const coa_vec3_t p4_v0_route[] = {{0.0f, 0.0f, 100.0f}, {400.0f, 0.0f, 100.0f}};
-static const coa_vehicle_t p4_vehicles[] = {{.id = 1u,
-                                             .priority = 1u,
-                                             .cruise_speed = 10.0f,
-                                             .climb_rate = 2.0f,
-                                             .steep_factor = 2u,
-                                             .volume = {15.0f, 5.0f},
-                                             .route = p4_v0_route,
-                                             .route_count = 2u,
-                                             .initial_offset = 0,
-                                             .max_offset = 12}};
-static const coa_track_point_t p4_t1_path[] = {{0.0f, {260.0f, 104.0f, 98.0f}},
-                                               {8.0f, {260.0f, 72.0f, 100.5f}},
-                                               {16.0f, {260.0f, 40.0f, 103.0f}}};
-static const coa_track_t p4_tracks[] = {{.id = 901u,
-                                         .volume = {20.0f, 8.0f},
-                                         .position = {150.0f, -150.0f, 102.0f},
-                                         .velocity = {0.0f, 10.0f, 0.0f},
-                                         .sigma_horizontal = 5.0f,
-                                         .sigma_vertical = 2.0f},
-                                        {.id = 902u,
-                                         .volume = {10.0f, 4.0f},
-                                         .path = p4_t1_path,
-                                         .path_count = 3u,
-                                         .sigma_horizontal = 0.0f,
-                                         .sigma_vertical = 0.0f}};
-static const coa_vec3_t p5_v0_route[] = {{0.0f, 0.0f, 100.0f}, {256.0f, 0.0f, 100.0f}};
-static const coa_vec3_t p5_v1_route[] = {{200.0f, 0.0f, 104.0f}, {-56.0f, 0.0f, 104.0f}};
-static const coa_vec3_t p5_v2_route[] = {{100.0f, -130.0f, 112.0f}, {100.0f, 156.0f, 112.0f}};
-static const coa_vehicle_t p5_vehicles[] = {{.id = 1u,
-                                             .priority = 1u,
-                                             .cruise_speed = 10.0f,
-                                             .climb_rate = 2.0f,
-                                             .steep_factor = 2u,
-                                             .volume = {15.0f, 5.0f},
-                                             .route = p5_v0_route,
-                                             .route_count = 2u,
-                                             .initial_offset = 0,
-                                             .max_offset = 8},
-                                            {.id = 2u,
-                                             .priority = 2u,
-                                             .cruise_speed = 10.0f,
-                                             .climb_rate = 2.0f,
-                                             .steep_factor = 2u,
-                                             .volume = {15.0f, 5.0f},
-                                             .route = p5_v1_route,
-                                             .route_count = 2u,
-                                             .initial_offset = 0,
-                                             .max_offset = 8},
-                                            {.id = 3u,
-                                             .priority = 3u,
-                                             .cruise_speed = 10.0f,
-                                             .climb_rate = 1.5f,
-                                             .steep_factor = 3u,
-                                             .volume = {15.0f, 5.0f},
-                                             .route = p5_v2_route,
-                                             .route_count = 2u,
-                                             .initial_offset = 0,
-                                             .max_offset = 8}};
+static const coa_vec3_t p3_v0_route[] = {
+    {0.0f, 0.0f, 100.0f},
+    {256.0f, 0.0f, 100.0f}};
+static const coa_vec3_t p3_v1_route[] = {
+    {120.0f, 0.0f, 104.0f},
+    {-136.0f, 0.0f, 104.0f}};
+static const coa_vec3_t p3_v2_route[] = {
+    {60.0f, -60.0f, 108.0f},
+    {60.0f, 196.0f, 108.0f}};
+static const coa_vec3_t p3_v3_route[] = {
+    {60.0f, 60.0f, 112.0f},
+    {60.0f, -196.0f, 112.0f}};
+static const coa_vehicle_t p3_vehicles[] = {
+    {.id = 1u, .priority = 1u, .cruise_speed = 10.0f, .climb_rate = 2.0f, .steep_factor = 2u,
+     .volume = {15.0f, 5.0f}, .route = p3_v0_route, .route_count = 2u, .initial_offset = 0, .max_offset = 8},
+    {.id = 2u, .priority = 2u, .cruise_speed = 10.0f, .climb_rate = 2.0f, .steep_factor = 2u,
+     .volume = {15.0f, 5.0f}, .route = p3_v1_route, .route_count = 2u, .initial_offset = 0, .max_offset = 8},
+    {.id = 3u, .priority = 3u, .cruise_speed = 10.0f, .climb_rate = 2.0f, .steep_factor = 2u,
+     .volume = {15.0f, 5.0f}, .route = p3_v2_route, .route_count = 2u, .initial_offset = 0, .max_offset = 8},
+    {.id = 4u, .priority = 4u, .cruise_speed = 10.0f, .climb_rate = 2.0f, .steep_factor = 2u,
+     .volume = {15.0f, 5.0f}, .route = p3_v3_route, .route_count = 2u, .initial_offset = 0, .max_offset = 8}};
+static const coa_vec3_t p4_v0_route[] = {
+    {0.0f, 0.0f, 100.0f},
+    {400.0f, 0.0f, 100.0f}};
+static const coa_vehicle_t p4_vehicles[] = {
+    {.id = 1u, .priority = 1u, .cruise_speed = 10.0f, .climb_rate = 2.0f, .steep_factor = 2u,
+     .volume = {15.0f, 5.0f}, .route = p4_v0_route, .route_count = 2u, .initial_offset = 0, .max_offset = 12}};
+static const coa_track_point_t p4_t1_path[] = {
+    {0.0f, {260.0f, 104.0f, 98.0f}},
+    {8.0f, {260.0f, 72.0f, 100.5f}},
+    {16.0f, {260.0f, 40.0f, 103.0f}}};
+static const coa_track_t p4_tracks[] = {
+{.id = 901u, .volume = {20.0f, 8.0f},
+     .position = {150.0f, -150.0f, 102.0f}, .velocity = {0.0f, 10.0f, 0.0f},
+     .sigma_horizontal = 5.0f, .sigma_vertical = 2.0f},
+{.id = 902u, .volume = {10.0f, 4.0f},
+     .path = p4_t1_path, .path_count = 3u,
+     .sigma_horizontal = 0.0f, .sigma_vertical = 0.0f}};
+static const coa_vec3_t p5_v0_route[] = {
+    {0.0f, 0.0f, 100.0f},
+    {256.0f, 0.0f, 100.0f}};
+static const coa_vec3_t p5_v1_route[] = {
+    {200.0f, 0.0f, 104.0f},
+    {-56.0f, 0.0f, 104.0f}};
+static const coa_vec3_t p5_v2_route[] = {
+    {100.0f, -130.0f, 112.0f},
+    {100.0f, 156.0f, 112.0f}};
+static const coa_vehicle_t p5_vehicles[] = {
+    {.id = 1u, .priority = 1u, .cruise_speed = 10.0f, .climb_rate = 2.0f, .steep_factor = 2u,
+     .volume = {15.0f, 5.0f}, .route = p5_v0_route, .route_count = 2u, .initial_offset = 0, .max_offset = 8},
+    {.id = 2u, .priority = 2u, .cruise_speed = 10.0f, .climb_rate = 2.0f, .steep_factor = 2u,
+     .volume = {15.0f, 5.0f}, .route = p5_v1_route, .route_count = 2u, .initial_offset = 0, .max_offset = 8},
+    {.id = 3u, .priority = 3u, .cruise_speed = 10.0f, .climb_rate = 1.5f, .steep_factor = 3u,
+     .volume = {15.0f, 5.0f}, .route = p5_v2_route, .route_count = 2u, .initial_offset = 0, .max_offset = 8}};
 
-static const fwc_problem_t fwc_problems[FWC_PROBLEM_COUNT] = {{.name = "headon",
-                                                               .dt = 1.0f,
-                                                               .horizon = 5u,
-                                                               .beta = 60u,
-                                                               .planner_bytes = 0u,
-                                                               .decoupled = true,
-                                                               .centralised = true,
-                                                               .vehicles = p0_vehicles,
-                                                               .vehicle_count = 2u,
-                                                               .obstacles = NULL,
-                                                               .obstacle_count = 0u,
-                                                               .tracks = NULL,
-                                                               .track_count = 0u},
-                                                              {.name = "hill",
-                                                               .dt = 1.0f,
-                                                               .horizon = 30u,
-                                                               .beta = 330u,
-                                                               .planner_bytes = 0u,
-                                                               .decoupled = true,
-                                                               .centralised = true,
-                                                               .vehicles = p1_vehicles,
-                                                               .vehicle_count = 1u,
-                                                               .obstacles = p1_obstacles,
-                                                               .obstacle_count = 2u,
-                                                               .tracks = NULL,
-                                                               .track_count = 0u},
-                                                              {.name = "paper",
-                                                               .dt = 1.0f,
-                                                               .horizon = 24u,
-                                                               .beta = 300u,
-                                                               .planner_bytes = 0u,
-                                                               .decoupled = true,
-                                                               .centralised = false,
-                                                               .vehicles = p2_vehicles,
-                                                               .vehicle_count = 3u,
-                                                               .obstacles = p2_obstacles,
-                                                               .obstacle_count = 1u,
-                                                               .tracks = NULL,
-                                                               .track_count = 0u},
-                                                              {.name = "quad",
-                                                               .dt = 1.0f,
-                                                               .horizon = 12u,
-                                                               .beta = 150u,
-                                                               .planner_bytes = 32768u,
-                                                               .decoupled = true,
-                                                               .centralised = true,
-                                                               .vehicles = p3_vehicles,
-                                                               .vehicle_count = 4u,
-                                                               .obstacles = NULL,
-                                                               .obstacle_count = 0u,
-                                                               .tracks = NULL,
-                                                               .track_count = 0u},
-                                                              {.name = "track",
-                                                               .dt = 1.0f,
-                                                               .horizon = 30u,
-                                                               .beta = 300u,
-                                                               .planner_bytes = 0u,
-                                                               .decoupled = true,
-                                                               .centralised = true,
-                                                               .vehicles = p4_vehicles,
-                                                               .vehicle_count = 1u,
-                                                               .obstacles = NULL,
-                                                               .obstacle_count = 0u,
-                                                               .tracks = p4_tracks,
-                                                               .track_count = 2u},
-                                                              {.name = "triple",
-                                                               .dt = 1.0f,
-                                                               .horizon = 16u,
-                                                               .beta = 1000u,
-                                                               .planner_bytes = 0u,
-                                                               .decoupled = true,
-                                                               .centralised = true,
-                                                               .vehicles = p5_vehicles,
-                                                               .vehicle_count = 3u,
-                                                               .obstacles = NULL,
-                                                               .obstacle_count = 0u,
-                                                               .tracks = NULL,
-                                                               .track_count = 0u}};
+static const fwc_problem_t fwc_problems[FWC_PROBLEM_COUNT] = {
+    {.name = "headon", .dt = 1.0f, .horizon = 5u, .beta = 60u, .planner_bytes = 0u,
+     .decoupled = true, .centralised = true,
+     .vehicles = p0_vehicles, .vehicle_count = 2u,
+     .obstacles = NULL, .obstacle_count = 0u,
+     .tracks = NULL, .track_count = 0u},
+    {.name = "hill", .dt = 1.0f, .horizon = 30u, .beta = 330u, .planner_bytes = 0u,
+     .decoupled = true, .centralised = true,
+     .vehicles = p1_vehicles, .vehicle_count = 1u,
+     .obstacles = p1_obstacles, .obstacle_count = 2u,
+     .tracks = NULL, .track_count = 0u},
+    {.name = "paper", .dt = 1.0f, .horizon = 24u, .beta = 300u, .planner_bytes = 0u,
+     .decoupled = true, .centralised = false,
+     .vehicles = p2_vehicles, .vehicle_count = 3u,
+     .obstacles = p2_obstacles, .obstacle_count = 1u,
+     .tracks = NULL, .track_count = 0u},
+    {.name = "quad", .dt = 1.0f, .horizon = 12u, .beta = 150u, .planner_bytes = 32768u,
+     .decoupled = true, .centralised = true,
+     .vehicles = p3_vehicles, .vehicle_count = 4u,
+     .obstacles = NULL, .obstacle_count = 0u,
+     .tracks = NULL, .track_count = 0u},
+    {.name = "track", .dt = 1.0f, .horizon = 30u, .beta = 300u, .planner_bytes = 0u,
+     .decoupled = true, .centralised = true,
+     .vehicles = p4_vehicles, .vehicle_count = 1u,
+     .obstacles = NULL, .obstacle_count = 0u,
+     .tracks = p4_tracks, .track_count = 2u},
+    {.name = "triple", .dt = 1.0f, .horizon = 16u, .beta = 1000u, .planner_bytes = 0u,
+     .decoupled = true, .centralised = true,
+     .vehicles = p5_vehicles, .vehicle_count = 3u,
+     .obstacles = NULL, .obstacle_count = 0u,
+     .tracks = NULL, .track_count = 0u}};
 
 #endif /* COAVOID_CHECK_PROBLEMS_H */
