@@ -64,6 +64,15 @@ static void put_ticks(uint64_t ticks)
     fwc_end_line();
 }
 
+/* A line "crypto WHAT BYTES rc RC ticks T". */
+static void put_rc(const char *what, size_t bytes, int rc, uint64_t ticks)
+{
+    put_result(what, bytes);
+    fwc_put(" rc ");
+    fwc_put_i64(rc);
+    put_ticks(ticks);
+}
+
 /* Verifies the signature of a datagram of `bytes` bytes and reports it as `what`; its rc. */
 static int verify_counted(const char *what, const unsigned char *datagram, size_t bytes)
 {
@@ -71,11 +80,7 @@ static int verify_counted(const char *what, const unsigned char *datagram, size_
     const uint64_t start = fwc_ticks_now();
     const int rc = crypto_sign_ed25519_verify_detached(datagram + signed_size, datagram,
                                                        signed_size, public_key);
-    const uint64_t ticks = fwc_ticks_now() - start;
-    put_result(what, bytes);
-    fwc_put(" rc ");
-    fwc_put_i64(rc);
-    put_ticks(ticks);
+    put_rc(what, bytes, rc, fwc_ticks_now() - start);
     return rc;
 }
 
@@ -130,11 +135,7 @@ static int check_counted(const char *what, const coavoid_auth_trust_t *trust,
     if (rc == COA_OK) {
         rc = coavoid_auth_verify(trust, datagram, bytes, &key);
     }
-    const uint64_t ticks = fwc_ticks_now() - start;
-    put_result(what, bytes);
-    fwc_put(" rc ");
-    fwc_put_i64(rc);
-    put_ticks(ticks);
+    put_rc(what, bytes, rc, fwc_ticks_now() - start);
     return rc;
 }
 
@@ -160,11 +161,7 @@ static bool check_drivers_path(auth_scratch_t *s)
     fill(s->datagram, CRYPTO_LARGEST, 7u, 3u);
     const uint64_t start = fwc_ticks_now();
     const int stamped = coavoid_auth_stamp(&signer, CRYPTO_NOW_US, s->datagram, CRYPTO_LARGEST);
-    const uint64_t ticks = fwc_ticks_now() - start;
-    put_result("stamp", CRYPTO_LARGEST);
-    fwc_put(" rc ");
-    fwc_put_i64(stamped);
-    put_ticks(ticks);
+    put_rc("stamp", CRYPTO_LARGEST, stamped, fwc_ticks_now() - start);
     const int good = check_counted("check", &s->trust, s->datagram, CRYPTO_LARGEST);
     /* The outsider: a later stamp, a signature byte flipped, the tag as it was. */
     s->datagram[CRYPTO_LARGEST - COAVOID_AUTH_TAIL_BYTES + 11u] ^= 0x01u;
