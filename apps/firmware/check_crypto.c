@@ -30,6 +30,7 @@
 #include "check_crypto.h"
 #include "coavoid/common.h"
 #include "check_io.h"
+#include "check_messages.h"
 
 #define CRYPTO_TAG_BYTES 8u
 #define CRYPTO_SIGNATURE_BYTES 64u
@@ -139,7 +140,7 @@ static int check_counted(const char *what, const coavoid_auth_trust_t *trust,
     return rc;
 }
 
-static bool check_drivers_path(auth_scratch_t *s)
+static bool check_drivers_path(auth_scratch_t *s, size_t size)
 {
     coavoid_auth_trust_init(&s->trust);
     coavoid_auth_key_t key = {CRYPTO_KEY_ID, COAVOID_AUTH_VEHICLE, 1u, {0}};
@@ -167,8 +168,17 @@ static bool check_drivers_path(auth_scratch_t *s)
     s->datagram[CRYPTO_LARGEST - COAVOID_AUTH_TAIL_BYTES + 11u] ^= 0x01u;
     s->datagram[CRYPTO_LARGEST - COAVOID_AUTH_TAG_BYTES - 1u] ^= 0x5au;
     const int outsider = check_counted("outsider", &s->trust, s->datagram, CRYPTO_LARGEST);
+    bool messages = true;
+#ifdef COAVOID_FW_MESSAGES
+    /* The rest of scratch, past the trust list, 16-byte aligned. */
+    const size_t used = (sizeof *s + 15u) & ~(size_t)15u;
+    messages =
+        size > used && fwc_messages_run((unsigned char *)s + used, size - used, &signer, &s->trust);
+#else
+    (void)size;
+#endif
     coavoid_auth_signer_clear(&signer);
-    return stamped == COA_OK && good == COA_OK && outsider == COAVOID_AUTH_ERR_TAG;
+    return stamped == COA_OK && good == COA_OK && outsider == COAVOID_AUTH_ERR_TAG && messages;
 }
 
 bool fwc_crypto_run(unsigned char *scratch, size_t size)
@@ -189,7 +199,7 @@ bool fwc_crypto_run(unsigned char *scratch, size_t size)
     const bool heartbeat = check_size(scratch, 192u);
     const bool intent = check_size(scratch, CRYPTO_LARGEST);
     /* scratch is the planner's buffer, aligned for any type. */
-    const bool drivers = check_drivers_path((auth_scratch_t *)(void *)scratch);
+    const bool drivers = check_drivers_path((auth_scratch_t *)(void *)scratch, size);
     if (!drivers) {
         fwc_put("error crypto: the drivers' checks gave a wrong result");
         fwc_end_line();

@@ -31,7 +31,9 @@ Message checks (apps/firmware/check_crypto.c's `crypto` lines): the fleet tag an
 Ed25519 signature the firmware computed over its fixed datagrams must equal the host
 libsodium's, bit for bit, the signature must verify and the changed datagram must not; the
 drivers' own checks (src/auth/auth.c on the part) must stamp an intent, accept it and
-refuse an outsider's copy by its tag (-126); their instructions are printed as well.
+refuse an outsider's copy by its tag (-126); an intent built, encoded (1,398 bytes) and
+stamped on the part must come through a receiver's checks, decoder and conversion
+(`message` lines, apps/firmware/check_messages.c); their instructions are printed as well.
 """
 import ctypes
 import ctypes.util
@@ -71,6 +73,8 @@ def parse(path):
                 conflicts.setdefault(t[1], []).append(t[2:])
             elif t[0] == "crypto":
                 crypto.append(t[1:])
+            elif t[0] == "message":
+                crypto.append(["message-" + t[3], t[2], "rc", t[5], "ticks", t[7]])
             elif t[0] == "error":
                 errors.append(raw.strip())
             elif t[0] == "done":
@@ -102,8 +106,12 @@ def compare_crypto(crypto, bad):
     want = {"tag": "hex", "sign": "hex", "verify": "0", "refuse": "-1", "stamp": "0",
             "check": "0", "outsider": "-126"}
     seen = {(t[0], t[1]) for t in crypto}
+    want.update({"message-build": "0", "message-encode": "1398", "message-stamp": "0",
+                 "message-receive": "0"})
     required = [(w, size) for w in ("tag", "sign", "verify", "refuse") for size in ("192", "1398")]
     required += [(w, "1398") for w in ("stamp", "check", "outsider")]
+    required += [("message-" + w, "1398") for w in ("encode", "stamp", "receive")]
+    required += [("message-build", "0")]
     for what, size in required:
         if (what, size) not in seen:
             bad.append(f"crypto {what} {size}: the firmware reported none")
