@@ -166,6 +166,19 @@ static int open_socket(const struct in_addr *group, unsigned port, int rcvbuf, c
     return fd;
 }
 
+/* Points each of the batch's headers at its buffers, once: recvmmsg reads them and
+ * writes only each header's lengths and flags. */
+static void batch_init(coavoid_rt_rx_t *rx)
+{
+    for (unsigned i = 0; i < COAVOID_RT_RX_BATCH; i++) {
+        rx->iov[i].iov_base = rx->data[i];
+        rx->iov[i].iov_len = COAVOID_RT_RX_DATAGRAM;
+        rx->msgs[i].msg_hdr.msg_iov = &rx->iov[i];
+        rx->msgs[i].msg_hdr.msg_iovlen = 1;
+        rx->msgs[i].msg_hdr.msg_control = rx->control[i];
+    }
+}
+
 coavoid_rt_rx_t *coavoid_rt_rx_open(const char *url, char *err, size_t err_size)
 {
     struct in_addr group;
@@ -193,6 +206,7 @@ coavoid_rt_rx_t *coavoid_rt_rx_open(const char *url, char *err, size_t err_size)
         free(rx);
         return NULL;
     }
+    batch_init(rx);
     return rx;
 }
 
@@ -244,13 +258,7 @@ static void note_overflow(coavoid_rt_rx_t *rx, struct msghdr *msg)
 static int read_batch(coavoid_rt_rx_t *rx)
 {
     for (unsigned i = 0; i < COAVOID_RT_RX_BATCH; i++) {
-        rx->iov[i].iov_base = rx->data[i];
-        rx->iov[i].iov_len = COAVOID_RT_RX_DATAGRAM;
-        memset(&rx->msgs[i], 0, sizeof rx->msgs[i]);
-        rx->msgs[i].msg_hdr.msg_iov = &rx->iov[i];
-        rx->msgs[i].msg_hdr.msg_iovlen = 1;
-        rx->msgs[i].msg_hdr.msg_control = rx->control[i];
-        rx->msgs[i].msg_hdr.msg_controllen = RX_CONTROL_BYTES;
+        rx->msgs[i].msg_hdr.msg_controllen = RX_CONTROL_BYTES; /* the last read shrank it */
     }
     rx->count = rx->next = 0;
     int n = recvmmsg(rx->fd, rx->msgs, COAVOID_RT_RX_BATCH, MSG_DONTWAIT, NULL);
