@@ -35,9 +35,7 @@
 #define CRYPTO_TAG_BYTES 8u
 #define CRYPTO_SIGNATURE_BYTES 64u
 #define CRYPTO_LARGEST 1398u
-#define CRYPTO_KEY_ID 101u               /* UAV 1's, as coavoid keygen numbers it */
-#define CRYPTO_NOW_US 1795000000000000LL /* a clock in 2026, us */
-#define CRYPTO_MAX_AGE_US 3000000LL      /* the freshness window either side */
+#define CRYPTO_KEY_ID 101u /* UAV 1's, as coavoid keygen numbers it */
 
 static unsigned char public_key[crypto_sign_ed25519_PUBLICKEYBYTES];
 static unsigned char secret_key[crypto_sign_ed25519_SECRETKEYBYTES];
@@ -65,8 +63,7 @@ static void put_ticks(uint64_t ticks)
     fwc_end_line();
 }
 
-/* A line "crypto WHAT BYTES rc RC ticks T". */
-static void put_rc(const char *what, size_t bytes, int rc, uint64_t ticks)
+void fwc_crypto_line(const char *what, size_t bytes, int64_t rc, uint64_t ticks)
 {
     put_result(what, bytes);
     fwc_put(" rc ");
@@ -81,7 +78,7 @@ static int verify_counted(const char *what, const unsigned char *datagram, size_
     const uint64_t start = fwc_ticks_now();
     const int rc = crypto_sign_ed25519_verify_detached(datagram + signed_size, datagram,
                                                        signed_size, public_key);
-    put_rc(what, bytes, rc, fwc_ticks_now() - start);
+    fwc_crypto_line(what, bytes, rc, fwc_ticks_now() - start);
     return rc;
 }
 
@@ -129,14 +126,14 @@ static int check_counted(const char *what, const coavoid_auth_trust_t *trust,
                          const unsigned char *datagram, size_t bytes)
 {
     const coavoid_auth_expect_t expect = {COAVOID_AUTH_STREAM_INTENT, COAVOID_AUTH_VEHICLE,
-                                          CRYPTO_NOW_US, CRYPTO_MAX_AGE_US, CRYPTO_MAX_AGE_US};
+                                          FWC_NOW_US, FWC_MAX_AGE_US, FWC_MAX_AGE_US};
     size_t key = 0;
     const uint64_t start = fwc_ticks_now();
     int rc = coavoid_auth_precheck(trust, datagram, bytes, &expect, &key);
     if (rc == COA_OK) {
         rc = coavoid_auth_verify(trust, datagram, bytes, &key);
     }
-    put_rc(what, bytes, rc, fwc_ticks_now() - start);
+    fwc_crypto_line(what, bytes, rc, fwc_ticks_now() - start);
     return rc;
 }
 
@@ -161,8 +158,8 @@ static bool check_drivers_path(auth_scratch_t *s, size_t size)
     fwc_end_line();
     fill(s->datagram, CRYPTO_LARGEST, 7u, 3u);
     const uint64_t start = fwc_ticks_now();
-    const int stamped = coavoid_auth_stamp(&signer, CRYPTO_NOW_US, s->datagram, CRYPTO_LARGEST);
-    put_rc("stamp", CRYPTO_LARGEST, stamped, fwc_ticks_now() - start);
+    const int stamped = coavoid_auth_stamp(&signer, FWC_NOW_US, s->datagram, CRYPTO_LARGEST);
+    fwc_crypto_line("stamp", CRYPTO_LARGEST, stamped, fwc_ticks_now() - start);
     const int good = check_counted("check", &s->trust, s->datagram, CRYPTO_LARGEST);
     /* The outsider: a later stamp, a signature byte flipped, the tag as it was. */
     s->datagram[CRYPTO_LARGEST - COAVOID_AUTH_TAIL_BYTES + 11u] ^= 0x01u;

@@ -7,10 +7,10 @@
  * encodes it in LCM's wire encoding (the lcm-gen coder) and stamps it (src/auth); the
  * receiver prechecks and verifies it, decodes it and converts it to the core's types
  * (coavoid_lcm_intent_to_core, the check included). Lines:
- *   message intent BYTES build rc RC ticks T
- *   message intent BYTES encode rc RC ticks T    (RC: the encoder's length)
- *   message intent BYTES stamp rc RC ticks T
- *   message intent BYTES receive rc RC ticks T   (precheck, verify, decode, convert)
+ *   crypto message-build 0 rc RC ticks T
+ *   crypto message-encode BYTES rc RC ticks T    (RC: the encoder's length)
+ *   crypto message-stamp BYTES rc RC ticks T
+ *   crypto message-receive BYTES rc RC ticks T   (precheck, verify, decode, convert)
  * Nothing is allocated: the messages and the core's views live in the caller's scratch.
  */
 #include <stdbool.h>
@@ -18,12 +18,12 @@
 #include <string.h>
 
 #include "auth.h"
+#include "check_crypto.h"
 #include "check_io.h"
 #include "check_messages.h"
 #include "coavoid_lcm.h"
 
-#define MESSAGE_NOW_US 1795000000000000LL /* a clock in 2026, us */
-#define MESSAGE_SAMPLES 25u               /* N = 24, the example firmware's horizon */
+#define MESSAGE_SAMPLES 25u /* N = 24, the example firmware's horizon */
 
 typedef struct {
     coavoid_intent_t sent;
@@ -33,19 +33,6 @@ typedef struct {
     int32_t offsets[MESSAGE_SAMPLES];
     unsigned char datagram[COAVOID_LCM_MAX_DATAGRAM_BYTES];
 } message_scratch_t;
-
-static void put_step(const char *what, int bytes, int rc, uint64_t ticks)
-{
-    fwc_put("message intent ");
-    fwc_put_i64(bytes);
-    fwc_put(" ");
-    fwc_put(what);
-    fwc_put(" rc ");
-    fwc_put_i64(rc);
-    fwc_put(" ticks ");
-    fwc_put_u64(ticks);
-    fwc_end_line();
-}
 
 /* UAV 1 flying east at 100 m, 25 samples a second apart, climbing one step at sample 3. */
 static int build(message_scratch_t *s, const coavoid_lcm_context_t *ctx)
@@ -64,11 +51,11 @@ static int build(message_scratch_t *s, const coavoid_lcm_context_t *ctx)
     }
     coavoid_lcm_intent_info_t info;
     memset(&info, 0, sizeof info);
-    info.utime = MESSAGE_NOW_US;
+    info.utime = FWC_NOW_US;
     info.mode = COAVOID_INTENT_T_MODE_DECOUPLED;
     info.position = s->reference[0];
     info.velocity = (coa_vec3_t){(coa_real_t)10, (coa_real_t)0, (coa_real_t)0};
-    info.plan_utime = MESSAGE_NOW_US;
+    info.plan_utime = FWC_NOW_US;
     info.step = (coa_real_t)1;
     const char *reason = NULL;
     return coavoid_lcm_intent_from_core(&vehicle, &info, s->reference, s->offsets, MESSAGE_SAMPLES,
@@ -81,7 +68,7 @@ static int receive(message_scratch_t *s, const coavoid_auth_trust_t *trust, int 
                    const coavoid_lcm_context_t *ctx)
 {
     const coavoid_auth_expect_t expect = {COAVOID_AUTH_STREAM_INTENT, COAVOID_AUTH_VEHICLE,
-                                          MESSAGE_NOW_US, ctx->max_age_us, ctx->max_future_us};
+                                          FWC_NOW_US, ctx->max_age_us, ctx->max_future_us};
     size_t key = 0;
     int rc = coavoid_auth_precheck(trust, s->datagram, (size_t)bytes, &expect, &key);
     if (rc == COA_OK) {
@@ -110,22 +97,22 @@ bool fwc_messages_run(unsigned char *scratch, size_t size, coavoid_auth_signer_t
         return false;
     }
     message_scratch_t *s = (message_scratch_t *)(void *)scratch;
-    const coavoid_lcm_context_t ctx = {MESSAGE_NOW_US, 3000000, 3000000, MESSAGE_NOW_US};
+    const coavoid_lcm_context_t ctx = {FWC_NOW_US, FWC_MAX_AGE_US, FWC_MAX_AGE_US, FWC_NOW_US};
     uint64_t start = fwc_ticks_now();
     const int built = build(s, &ctx);
-    put_step("build", 0, built, fwc_ticks_now() - start);
+    fwc_crypto_line("message-build", 0u, built, fwc_ticks_now() - start);
     s->sent.auth.key_id = (int32_t)signer->key_id;
     start = fwc_ticks_now();
     const int bytes = coavoid_intent_t_encode(s->datagram, 0, (int)sizeof s->datagram, &s->sent);
-    put_step("encode", bytes, bytes, fwc_ticks_now() - start);
+    fwc_crypto_line("message-encode", (size_t)bytes, bytes, fwc_ticks_now() - start);
     if (built != COA_OK || bytes <= 0) {
         return false;
     }
     start = fwc_ticks_now();
-    const int stamped = coavoid_auth_stamp(signer, MESSAGE_NOW_US, s->datagram, (size_t)bytes);
-    put_step("stamp", bytes, stamped, fwc_ticks_now() - start);
+    const int stamped = coavoid_auth_stamp(signer, FWC_NOW_US, s->datagram, (size_t)bytes);
+    fwc_crypto_line("message-stamp", (size_t)bytes, stamped, fwc_ticks_now() - start);
     start = fwc_ticks_now();
     const int received = receive(s, trust, bytes, &ctx);
-    put_step("receive", bytes, received, fwc_ticks_now() - start);
+    fwc_crypto_line("message-receive", (size_t)bytes, received, fwc_ticks_now() - start);
     return stamped == COA_OK && received == COA_OK;
 }

@@ -33,7 +33,8 @@ libsodium's, bit for bit, the signature must verify and the changed datagram mus
 drivers' own checks (src/auth/auth.c on the part) must stamp an intent, accept it and
 refuse an outsider's copy by its tag (-126); an intent built, encoded (1,398 bytes) and
 stamped on the part must come through a receiver's checks, decoder and conversion
-(`message` lines, apps/firmware/check_messages.c); their instructions are printed as well.
+(`crypto message-*` lines, apps/firmware/check_messages.c); their instructions are
+printed as well.
 """
 import ctypes
 import ctypes.util
@@ -73,8 +74,6 @@ def parse(path):
                 conflicts.setdefault(t[1], []).append(t[2:])
             elif t[0] == "crypto":
                 crypto.append(t[1:])
-            elif t[0] == "message":
-                crypto.append(["message-" + t[3], t[2], "rc", t[5], "ticks", t[7]])
             elif t[0] == "error":
                 errors.append(raw.strip())
             elif t[0] == "done":
