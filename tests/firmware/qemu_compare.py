@@ -38,6 +38,7 @@ printed as well.
 """
 import ctypes
 import ctypes.util
+import functools
 import json
 import os
 import struct
@@ -81,6 +82,7 @@ def parse(path):
     return runs, offsets, errors, done, predicts, conflicts, calibration, crypto
 
 
+@functools.lru_cache(maxsize=None)
 def host_crypto(size):
     """The tag and signature check_crypto.c computes for a datagram of `size` bytes, by the
     host's libsodium: the same patterns (byte i of the datagram 7i + 3, of the key seed i,
