@@ -288,9 +288,10 @@ typedef struct {
 } coavoid_node_common_t;
 
 /* Fills c with the defaults for (epoch, dt, horizon, clock): threshold 0.01, no sigma
- * growth, stale_after 2.5 cycles, stale_sigma_rate 1 m/s, beta 20000, no rx_lcm, no transport_dropped, no keys and not
- * insecure (so a node is not created until the caller sets keys or insecure). Returns COA_OK or
- * COA_ERR_ARGUMENT (dt, horizon, epoch or clock invalid). */
+ * growth, stale_after 2.5 cycles, stale_sigma_rate 1 m/s, beta 20000, no rx_lcm, no
+ * transport_dropped, no keys and not insecure (so a node is not created until the caller
+ * sets keys or insecure). Returns COA_OK or COA_ERR_ARGUMENT (dt, horizon, epoch or clock
+ * invalid). */
 int coavoid_node_common_defaults(coavoid_node_common_t *c, int64_t epoch_utime, coa_real_t dt,
                                  uint32_t horizon, const int64_t *clock);
 
