@@ -101,19 +101,6 @@ void fwc_put_i64(int64_t v)
     }
 }
 
-void fwc_put_hex64(uint64_t v)
-{
-    static const char hex[] = "0123456789abcdef";
-    char digits[17];
-    int i;
-    for (i = 15; i >= 0; --i) {
-        digits[i] = hex[v & 0xfu];
-        v >>= 4;
-    }
-    digits[16] = '\0';
-    fwc_put(digits);
-}
-
 void fwc_put_hex(const unsigned char *bytes, size_t n)
 {
     static const char hex[] = "0123456789abcdef";
@@ -123,6 +110,16 @@ void fwc_put_hex(const unsigned char *bytes, size_t n)
         pair[1] = hex[bytes[i] & 0xfu];
         fwc_put(pair);
     }
+}
+
+void fwc_put_hex64(uint64_t v)
+{
+    unsigned char bytes[8];
+    for (int i = 7; i >= 0; --i) {
+        bytes[i] = (unsigned char)(v & 0xffu);
+        v >>= 8;
+    }
+    fwc_put_hex(bytes, sizeof bytes);
 }
 
 void fwc_exit(bool ok)
