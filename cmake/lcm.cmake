@@ -18,6 +18,15 @@ if(NOT LCM_INCLUDE_DIR OR NOT LCM_LIBRARY)
                       "or configure with -DCOAVOID_BUILD_LCM=OFF")
 endif()
 
+# LCM itself, for what publishes and subscribes (the nodes' transport, the simulation,
+# the drivers, the test tools): the message coders need none of it.
+if(NOT CMAKE_CROSSCOMPILING AND NOT TARGET coavoid::liblcm)
+  add_library(coavoid::liblcm INTERFACE IMPORTED)
+  set_target_properties(coavoid::liblcm PROPERTIES
+    INTERFACE_INCLUDE_DIRECTORIES ${LCM_INCLUDE_DIR}
+    INTERFACE_LINK_LIBRARIES ${LCM_LIBRARY})
+endif()
+
 add_subdirectory(${PROJECT_SOURCE_DIR}/lcmtypes ${PROJECT_BINARY_DIR}/lcmtypes)
 
 add_subdirectory(${PROJECT_SOURCE_DIR}/src/auth ${PROJECT_BINARY_DIR}/src/auth)

@@ -2,7 +2,8 @@
 # The layers of docs/design.md, checked on the sources: nothing under src/ or include/
 # includes a header of apps/ (by its name, or by a path into apps/), the core
 # (src/core/, include/coavoid/) includes neither LCM nor stdio, and the message checks the
-# firmware compiles (src/auth/auth.c, auth.h) include no LCM, stdio or stdlib.
+# firmware compiles (src/auth/auth.c, auth.h) include no LCM, stdio or stdlib, nor does
+# the vehicle protocol (src/protocol/).
 # Usage: cmake -DSRC=<source tree> -P check_layering.cmake
 cmake_minimum_required(VERSION 3.16)
 if(NOT SRC)
@@ -30,6 +31,11 @@ foreach(f ${lib_files})
   if(rel MATCHES "^src/auth/auth\\.[ch]$")
     set(part TRUE)
   endif()
+  # The vehicle protocol, which runs in the autopilot: no LCM, no stdio, no heap.
+  set(protocol FALSE)
+  if(rel MATCHES "^src/protocol/")
+    set(protocol TRUE)
+  endif()
   foreach(line ${includes})
     string(REGEX REPLACE "^[ \t]*#[ \t]*include[ \t]*[<\"]([^>\"]+)[>\"].*" "\\1" inc "${line}")
     get_filename_component(name ${inc} NAME)
@@ -46,6 +52,11 @@ foreach(f ${lib_files})
                  inc STREQUAL "stdlib.h" OR inc STREQUAL "sodium.h"))
       message(SEND_ERROR "${rel}: includes ${inc} (the message checks build for the part: "
                          "no LCM, no stdio, no heap, only the libsodium headers they use)")
+      math(EXPR failures "${failures} + 1")
+    endif()
+    if(protocol AND (inc MATCHES "^lcm/lcm\\.h$" OR inc STREQUAL "stdio.h" OR inc STREQUAL "stdlib.h"))
+      message(SEND_ERROR "${rel}: includes ${inc} (the vehicle protocol runs in the autopilot: "
+                         "no LCM, no stdio, no heap)")
       math(EXPR failures "${failures} + 1")
     endif()
   endforeach()

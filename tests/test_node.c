@@ -44,6 +44,16 @@
 #define EPOCH INT64_C(1000000000000000)
 #define DT_US INT64_C(1000000)
 
+/* Publishes an unsigned message as an insecure node would: LCM's encoding of the type on
+ * the channel; 0, or -1 when it does not encode or LCM refuses it. */
+#define TEST_PUBLISH(lcm, type, channel, msg) \
+    publish_encoded((lcm), (channel), type##_encode(publish_buf, 0, (int)sizeof publish_buf, (msg)))
+static uint8_t publish_buf[65536];
+static int publish_encoded(lcm_t *lcm, const char *channel, int size)
+{
+    return size < 0 ? -1 : lcm_publish(lcm, channel, publish_buf, (unsigned int)size);
+}
+
 typedef struct {
     lcm_t *lcm;
     int64_t now;
@@ -124,7 +134,7 @@ static coavoid_vehicle_node_t *vehicle_node_waiting(const rig_t *r, coa_vehicle_
     config.mode = mode;
     config.answer_wait_us = answer_wait_us;
     int error = -99;
-    coavoid_vehicle_node_t *node = coavoid_vehicle_node_create(&config, r->lcm, &error);
+    coavoid_vehicle_node_t *node = coavoid_vehicle_node_create(&config, r->lcm, NULL, &error);
     ck_assert_ptr_nonnull(node);
     ck_assert_int_eq(error, COA_OK);
     return node;
@@ -152,7 +162,7 @@ static void heartbeat_from(lcm_t *lcm, int64_t now, int64_t sequence, int32_t no
                     : 0;
     m.mode = COAVOID_STATUS_T_MODE_CENTRALISED;
     m.outcome = COAVOID_STATUS_T_OUTCOME_NONE;
-    ck_assert_int_eq(coavoid_status_t_publish(lcm, COAVOID_CHANNEL_STATUS, &m), 0);
+    ck_assert_int_eq(TEST_PUBLISH(lcm, coavoid_status_t, COAVOID_CHANNEL_STATUS, &m), 0);
 }
 
 static void heartbeat(lcm_t *lcm, int64_t now, int64_t sequence)
@@ -166,7 +176,7 @@ static void heartbeat(lcm_t *lcm, int64_t now, int64_t sequence)
     m.health = COAVOID_STATUS_T_HEALTH_OK;
     m.mode = COAVOID_STATUS_T_MODE_CENTRALISED;
     m.outcome = COAVOID_STATUS_T_OUTCOME_NONE;
-    ck_assert_int_eq(coavoid_status_t_publish(lcm, COAVOID_CHANNEL_STATUS, &m), 0);
+    ck_assert_int_eq(TEST_PUBLISH(lcm, coavoid_status_t, COAVOID_CHANNEL_STATUS, &m), 0);
 }
 
 /* A solved plan_t's header from the default coordinator for the cycle starting at
@@ -203,7 +213,7 @@ static void commit_msg(lcm_t *lcm, int64_t now, int32_t from, int64_t plan_id, i
     m.coordinator_id = from;
     m.plan_id = plan_id;
     m.valid_from_utime = valid_from;
-    ck_assert_int_eq(coavoid_agreement_t_publish(lcm, COAVOID_CHANNEL_AGREEMENT, &m), 0);
+    ck_assert_int_eq(TEST_PUBLISH(lcm, coavoid_agreement_t, COAVOID_CHANNEL_AGREEMENT, &m), 0);
 }
 
 /* A one-UAV plan_t from coordinator `from`: offsets 0, 1, 2, then level at 2, plus
@@ -218,7 +228,7 @@ static void plan_msg_from(lcm_t *lcm, int64_t now, int32_t from, int64_t plan_id
     for (int32_t k = 0; k <= horizon; k++) {
         m.offsets[k] = (k < 2 ? k : 2) + shift;
     }
-    ck_assert_int_eq(coavoid_plan_t_publish(lcm, COAVOID_CHANNEL_PLAN, &m), 0);
+    ck_assert_int_eq(TEST_PUBLISH(lcm, coavoid_plan_t, COAVOID_CHANNEL_PLAN, &m), 0);
     commit_msg(lcm, now, from, plan_id, valid_from);
 }
 
@@ -240,7 +250,7 @@ static void empty_map(lcm_t *lcm, int64_t now)
     m.map_id = (int32_t)COAVOID_NODE_WORLD_ID;
     m.version = 1;
     m.tile_count = 1;
-    ck_assert_int_eq(coavoid_obstacle_map_t_publish(lcm, COAVOID_CHANNEL_OBSTACLES, &m), 0);
+    ck_assert_int_eq(TEST_PUBLISH(lcm, coavoid_obstacle_map_t, COAVOID_CHANNEL_OBSTACLES, &m), 0);
 }
 
 /* ---- counting ---- */
@@ -480,7 +490,7 @@ static void dive_into_terrain(rig_t *r, const coavoid_vehicle_node_state_t *s)
     }
     const uint32_t adopted = s->plans_adopted;
     const int64_t rejected = s->rx.rejected;
-    ck_assert_int_eq(coavoid_plan_t_publish(r->lcm, COAVOID_CHANNEL_PLAN, &m), 0);
+    ck_assert_int_eq(TEST_PUBLISH(r->lcm, coavoid_plan_t, COAVOID_CHANNEL_PLAN, &m), 0);
     drain(r->lcm);
     ck_assert_int_eq(s->plans_adopted, adopted);
     ck_assert_int_eq(s->rx.rejected, rejected + 1);
@@ -560,7 +570,7 @@ START_TEST(test_plan_below_floor_refused)
         m.offsets[k] = -k;
     }
     const int64_t rejected = s->rx.rejected;
-    ck_assert_int_eq(coavoid_plan_t_publish(r.lcm, COAVOID_CHANNEL_PLAN, &m), 0);
+    ck_assert_int_eq(TEST_PUBLISH(r.lcm, coavoid_plan_t, COAVOID_CHANNEL_PLAN, &m), 0);
     drain(r.lcm);
     ck_assert_int_eq(s->plans_adopted, 0);
     ck_assert_int_eq(s->rx.rejected, rejected + 1);
@@ -571,7 +581,7 @@ START_TEST(test_plan_below_floor_refused)
         m.offsets[k] = k < 2 ? -k : -2;
     }
     m.plan_id = 6;
-    ck_assert_int_eq(coavoid_plan_t_publish(r.lcm, COAVOID_CHANNEL_PLAN, &m), 0);
+    ck_assert_int_eq(TEST_PUBLISH(r.lcm, coavoid_plan_t, COAVOID_CHANNEL_PLAN, &m), 0);
     commit_msg(r.lcm, r.now, (int32_t)COAVOID_NODE_COORDINATOR_ID, 6, cycle(0));
     drain(r.lcm);
     ck_assert_int_eq(s->plans_adopted, 1);
@@ -590,10 +600,10 @@ START_TEST(test_plan_below_floor_refused)
     config.vehicle = uav(1, 1, route, 0, 500, 0, 100);
     int error = COA_OK;
     config.common.min_altitude = (coa_real_t)NAN;
-    ck_assert_ptr_null(coavoid_vehicle_node_create(&config, r.lcm, &error));
+    ck_assert_ptr_null(coavoid_vehicle_node_create(&config, r.lcm, NULL, &error));
     ck_assert_int_eq(error, COA_ERR_ARGUMENT);
     config.common.min_altitude = (coa_real_t)2e7;
-    ck_assert_ptr_null(coavoid_vehicle_node_create(&config, r.lcm, &error));
+    ck_assert_ptr_null(coavoid_vehicle_node_create(&config, r.lcm, NULL, &error));
     lcm_destroy(r.lcm);
 }
 END_TEST
@@ -630,7 +640,7 @@ START_TEST(test_plan_into_other_uav_refused)
         for (int32_t k = 0; k <= 10; k++) {
             m.offsets[k] = row == 0 ? (k < 2 ? k : 2) : (k < 4 ? k : 4);
         }
-        ck_assert_int_eq(coavoid_plan_t_publish(r.lcm, COAVOID_CHANNEL_PLAN, &m), 0);
+        ck_assert_int_eq(TEST_PUBLISH(r.lcm, coavoid_plan_t, COAVOID_CHANNEL_PLAN, &m), 0);
     }
     drain(r.lcm);
     ck_assert_int_eq(s->plans_adopted, 0); /* accepted, not flown before the commit */
@@ -666,7 +676,8 @@ START_TEST(test_forged_map_keeps_terrain)
     map.map_id = COAVOID_NODE_WORLD_ID;
     map.version = INT64_MAX;
     map.tile_count = 1;
-    ck_assert_int_eq(coavoid_obstacle_map_t_publish(r.lcm, COAVOID_CHANNEL_OBSTACLES, &map), 0);
+    ck_assert_int_eq(TEST_PUBLISH(r.lcm, coavoid_obstacle_map_t, COAVOID_CHANNEL_OBSTACLES, &map),
+                     0);
     drain(r.lcm);
     ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
     drain(r.lcm);
@@ -682,7 +693,8 @@ START_TEST(test_forged_map_keeps_terrain)
     const double lid_min[3] = {-1000, -1000, 107}, lid_max[3] = {1000, 1000, 200};
     memcpy(map.box_min[0], lid_min, sizeof lid_min);
     memcpy(map.box_max[0], lid_max, sizeof lid_max);
-    ck_assert_int_eq(coavoid_obstacle_map_t_publish(r.lcm, COAVOID_CHANNEL_OBSTACLES, &map), 0);
+    ck_assert_int_eq(TEST_PUBLISH(r.lcm, coavoid_obstacle_map_t, COAVOID_CHANNEL_OBSTACLES, &map),
+                     0);
     drain(r.lcm);
     plan_msg(r.lcm, r.now, 0, cycle(0), 1, 10, 0);
     drain(r.lcm);
@@ -735,7 +747,7 @@ static void map_tile(lcm_t *lcm, int64_t now, int64_t version, int32_t index, in
         memcpy(m.box_min[0], lo, sizeof lo);
         memcpy(m.box_max[0], hi, sizeof hi);
     }
-    ck_assert_int_eq(coavoid_obstacle_map_t_publish(lcm, COAVOID_CHANNEL_OBSTACLES, &m), 0);
+    ck_assert_int_eq(TEST_PUBLISH(lcm, coavoid_obstacle_map_t, COAVOID_CHANNEL_OBSTACLES, &m), 0);
 }
 
 /* A map is used only whole: until every tile of a version has come, the node has no map
@@ -814,7 +826,7 @@ START_TEST(test_plan_adopted_only_whole)
     for (int32_t k = 0; k <= 10; k++) {
         m.offsets[k] = k < 2 ? k : 2;
     }
-    ck_assert_int_eq(coavoid_plan_t_publish(r.lcm, COAVOID_CHANNEL_PLAN, &m), 0);
+    ck_assert_int_eq(TEST_PUBLISH(r.lcm, coavoid_plan_t, COAVOID_CHANNEL_PLAN, &m), 0);
     drain(r.lcm);
     ck_assert_int_eq(s->plans_adopted, 0);
     ck_assert_int_eq(s->rx.rejected, rejected);
@@ -822,13 +834,13 @@ START_TEST(test_plan_adopted_only_whole)
     other.row_uav_id = 9;
     memset(other.offsets, 0, sizeof other.offsets);
     other.deviation = 5.0; /* not what its sibling said */
-    ck_assert_int_eq(coavoid_plan_t_publish(r.lcm, COAVOID_CHANNEL_PLAN, &other), 0);
+    ck_assert_int_eq(TEST_PUBLISH(r.lcm, coavoid_plan_t, COAVOID_CHANNEL_PLAN, &other), 0);
     drain(r.lcm);
     ck_assert_int_eq(s->plans_adopted, 0);
     ck_assert_int_eq(s->rx.rejected, rejected + 1);
     ck_assert_int_eq(s->rx.last_reject_code, COAVOID_LCM_ERR_VALUE);
     other.deviation = m.deviation;
-    ck_assert_int_eq(coavoid_plan_t_publish(r.lcm, COAVOID_CHANNEL_PLAN, &other), 0);
+    ck_assert_int_eq(TEST_PUBLISH(r.lcm, coavoid_plan_t, COAVOID_CHANNEL_PLAN, &other), 0);
     commit_msg(r.lcm, r.now, (int32_t)COAVOID_NODE_COORDINATOR_ID, 4, cycle(0));
     drain(r.lcm);
     ck_assert_int_eq(s->plans_adopted, 1);
@@ -942,7 +954,7 @@ START_TEST(test_refusals_degrade_health)
     cc.common = r.common;
     cc.common.beta = 1000;
     int error = -99;
-    coavoid_coordinator_t *co = coavoid_coordinator_create(&cc, r.lcm, &error);
+    coavoid_coordinator_t *co = coavoid_coordinator_create(&cc, r.lcm, NULL, &error);
     ck_assert_ptr_nonnull(co);
     /* A peer whose clock runs 1.5 cycles ahead: its intents come from the future. */
     int64_t ahead = r.now + 3 * DT_US / 2;
@@ -952,7 +964,7 @@ START_TEST(test_refusals_degrade_health)
     config.common.clock = &ahead;
     config.vehicle = uav(2, 2, r2, 0, 500, 800, 100);
     config.mode = COAVOID_NODE_DECOUPLED;
-    coavoid_vehicle_node_t *b = coavoid_vehicle_node_create(&config, r.lcm, &error);
+    coavoid_vehicle_node_t *b = coavoid_vehicle_node_create(&config, r.lcm, NULL, &error);
     ck_assert_ptr_nonnull(b);
     const char junk[3] = {1, 2, 3};
     for (int64_t k = 0; k <= 3; k++) {
@@ -1034,10 +1046,10 @@ START_TEST(test_configured_coordinator_only)
     config.mode = COAVOID_NODE_CENTRALISED;
     config.coordinator_id = 1;
     int error = -99;
-    ck_assert_ptr_null(coavoid_vehicle_node_create(&config, r.lcm, &error)); /* its own id */
+    ck_assert_ptr_null(coavoid_vehicle_node_create(&config, r.lcm, NULL, &error)); /* its own id */
     ck_assert_int_eq(error, COA_ERR_ARGUMENT);
     config.coordinator_id = 700;
-    coavoid_vehicle_node_t *a = coavoid_vehicle_node_create(&config, r.lcm, &error);
+    coavoid_vehicle_node_t *a = coavoid_vehicle_node_create(&config, r.lcm, NULL, &error);
     ck_assert_ptr_nonnull(a);
     const coavoid_vehicle_node_state_t *s = coavoid_vehicle_node_state(a);
     /* Cycles 0..5: only the default id speaks. After 2.5 cycles without its own
@@ -1220,7 +1232,7 @@ static void fly_self_commit_beside(rig_t *r, int64_t k, int64_t plan_at,
     for (int32_t j = 0; j <= 4; j++) {
         m.offsets[j] = 2 * j;
     }
-    ck_assert_int_eq(coavoid_plan_t_publish(r->lcm, COAVOID_CHANNEL_PLAN, &m), 0);
+    ck_assert_int_eq(TEST_PUBLISH(r->lcm, coavoid_plan_t, COAVOID_CHANNEL_PLAN, &m), 0);
     drain(r->lcm);
 }
 
@@ -1364,7 +1376,7 @@ START_TEST(test_late_plans_fall_back)
     cc.common = r.common;
     cc.common.beta = 5000;
     int error = -99;
-    coavoid_coordinator_t *co = coavoid_coordinator_create(&cc, r.lcm, &error);
+    coavoid_coordinator_t *co = coavoid_coordinator_create(&cc, r.lcm, NULL, &error);
     ck_assert_ptr_nonnull(co);
     coa_vec3_t p[2][31];
     for (int64_t k = 0; k <= 30; k++) {
@@ -1441,7 +1453,7 @@ START_TEST(test_failed_plan_is_an_answer)
         m.uav_ids[1] = 2;
         for (int32_t row = 0; row < 2; row++) { /* one message per UAV, no rows */
             m.row_uav_id = m.uav_ids[row];
-            ck_assert_int_eq(coavoid_plan_t_publish(r.lcm, COAVOID_CHANNEL_PLAN, &m), 0);
+            ck_assert_int_eq(TEST_PUBLISH(r.lcm, coavoid_plan_t, COAVOID_CHANNEL_PLAN, &m), 0);
         }
         drain(r.lcm);
     }
@@ -1502,7 +1514,7 @@ static void crossing_fly(crossing_t *x, coavoid_node_mode_t mode_a, coavoid_coor
     cc.common = x->r.common;
     cc.common.beta = beta != 0u ? beta : cc.common.beta;
     int error = -99;
-    x->co = coavoid_coordinator_create(&cc, x->r.lcm, &error);
+    x->co = coavoid_coordinator_create(&cc, x->r.lcm, NULL, &error);
     ck_assert_ptr_nonnull(x->co);
     ck_assert_int_eq(coavoid_vehicle_node_cycle(x->a, x->r.now), COA_OK);
     drain(x->r.lcm);
@@ -1601,7 +1613,7 @@ START_TEST(test_coordinator_abandons_past_budget)
     cc.common.stopwatch_user = &watch;
     cc.plan_budget_us = 5000;
     int error = -99;
-    coavoid_coordinator_t *co = coavoid_coordinator_create(&cc, r.lcm, &error);
+    coavoid_coordinator_t *co = coavoid_coordinator_create(&cc, r.lcm, NULL, &error);
     ck_assert_ptr_nonnull(co);
     for (int64_t k = 0; k <= 1; k++) {
         r.now = cycle(k);
@@ -1838,11 +1850,11 @@ static void net_rig_init_as(net_rig_t *r, const coa_vehicle_t *vehicles, bool gr
         coavoid_vehicle_node_config_t config;
         memset(&config, 0, sizeof config);
         config.common = r->common;
-        config.common.rx_lcm = coavoid_sim_net_rx(r->net, i);
         config.vehicle = vehicles[i];
         config.mode = COAVOID_NODE_DECOUPLED;
         config.greedy_negotiation = greedy;
-        r->v[i] = coavoid_vehicle_node_create(&config, coavoid_sim_net_tx(r->net, i), &error);
+        r->v[i] = coavoid_vehicle_node_create(&config, coavoid_sim_net_tx(r->net, i),
+                                              coavoid_sim_net_rx(r->net, i), &error);
         ck_assert_ptr_nonnull(r->v[i]);
     }
 }
@@ -2267,7 +2279,7 @@ START_TEST(test_every_datagram_fits)
     memset(&cc, 0, sizeof cc);
     cc.common = r.common;
     cc.common.beta = 5000;
-    coavoid_coordinator_t *co = coavoid_coordinator_create(&cc, r.lcm, &error);
+    coavoid_coordinator_t *co = coavoid_coordinator_create(&cc, r.lcm, NULL, &error);
     ck_assert_ptr_nonnull(co);
     static coa_vec3_t routes[6][2];
     coavoid_vehicle_node_t *v[6];
@@ -2340,26 +2352,26 @@ START_TEST(test_bad_configs_refused)
     vc.mode = COAVOID_NODE_DECOUPLED;
     int error = 0;
     vc.vehicle.cruise_speed = -1;
-    ck_assert_ptr_null(coavoid_vehicle_node_create(&vc, r.lcm, &error));
+    ck_assert_ptr_null(coavoid_vehicle_node_create(&vc, r.lcm, NULL, &error));
     ck_assert_int_eq(error, COA_ERR_ARGUMENT);
     vc.vehicle.cruise_speed = 10;
     vc.mode = (coavoid_node_mode_t)7;
-    ck_assert_ptr_null(coavoid_vehicle_node_create(&vc, r.lcm, &error));
+    ck_assert_ptr_null(coavoid_vehicle_node_create(&vc, r.lcm, NULL, &error));
     vc.mode = COAVOID_NODE_DECOUPLED;
     vc.common.horizon = 128;
-    ck_assert_ptr_null(coavoid_vehicle_node_create(&vc, r.lcm, &error));
+    ck_assert_ptr_null(coavoid_vehicle_node_create(&vc, r.lcm, NULL, &error));
     vc.common.horizon = 10;
-    ck_assert_ptr_null(coavoid_vehicle_node_create(&vc, NULL, &error));
+    ck_assert_ptr_null(coavoid_vehicle_node_create(&vc, NULL, NULL, &error));
     vc.priority_wait_us = -1;
-    ck_assert_ptr_null(coavoid_vehicle_node_create(&vc, r.lcm, &error));
+    ck_assert_ptr_null(coavoid_vehicle_node_create(&vc, r.lcm, NULL, &error));
     vc.priority_wait_us = 0;
     /* A joint plan of one UAV is its own plan; more than a planner searches together is
      * none. */
     vc.joint_members = 1u;
-    ck_assert_ptr_null(coavoid_vehicle_node_create(&vc, r.lcm, &error));
+    ck_assert_ptr_null(coavoid_vehicle_node_create(&vc, r.lcm, NULL, &error));
     ck_assert_int_eq(error, COA_ERR_ARGUMENT);
     vc.joint_members = COA_MAX_CENTRALISED + 1u;
-    ck_assert_ptr_null(coavoid_vehicle_node_create(&vc, r.lcm, &error));
+    ck_assert_ptr_null(coavoid_vehicle_node_create(&vc, r.lcm, NULL, &error));
     vc.joint_members = 0u;
     ck_assert_uint_eq(coavoid_node_joint_members(COAVOID_NODE_CENTRALISED, 1u), 0u);
     ck_assert_uint_eq(coavoid_node_joint_members(COAVOID_NODE_CENTRALISED, 3u), 3u);
@@ -2402,15 +2414,15 @@ START_TEST(test_bad_configs_refused)
     }
     vc.common.obstacles = own;
     vc.common.obstacle_count = COAVOID_NODE_MAX_CONFIGURED_OBSTACLES + 1u;
-    ck_assert_ptr_null(coavoid_vehicle_node_create(&vc, r.lcm, &error));
+    ck_assert_ptr_null(coavoid_vehicle_node_create(&vc, r.lcm, NULL, &error));
     own[0].box.max.z = -1; /* below its min */
     vc.common.obstacle_count = 1;
-    ck_assert_ptr_null(coavoid_vehicle_node_create(&vc, r.lcm, &error));
+    ck_assert_ptr_null(coavoid_vehicle_node_create(&vc, r.lcm, NULL, &error));
     vc.common.obstacles = NULL;
-    ck_assert_ptr_null(coavoid_vehicle_node_create(&vc, r.lcm, &error));
+    ck_assert_ptr_null(coavoid_vehicle_node_create(&vc, r.lcm, NULL, &error));
     vc.common.obstacles = own + 1;
     vc.common.obstacle_count = COAVOID_NODE_MAX_CONFIGURED_OBSTACLES;
-    coavoid_vehicle_node_t *fits = coavoid_vehicle_node_create(&vc, r.lcm, &error);
+    coavoid_vehicle_node_t *fits = coavoid_vehicle_node_create(&vc, r.lcm, NULL, &error);
     ck_assert_ptr_nonnull(fits);
     coavoid_vehicle_node_destroy(fits);
     vc.common.obstacles = NULL;
@@ -2420,11 +2432,11 @@ START_TEST(test_bad_configs_refused)
     memset(&cc, 0, sizeof cc);
     cc.common = r.common;
     cc.max_centralised = COA_MAX_CENTRALISED + 1u;
-    ck_assert_ptr_null(coavoid_coordinator_create(&cc, r.lcm, &error));
+    ck_assert_ptr_null(coavoid_coordinator_create(&cc, r.lcm, NULL, &error));
     ck_assert_int_eq(error, COA_ERR_ARGUMENT);
     cc.max_centralised = 2;
     cc.collect_us = DT_US;
-    ck_assert_ptr_null(coavoid_coordinator_create(&cc, r.lcm, &error));
+    ck_assert_ptr_null(coavoid_coordinator_create(&cc, r.lcm, NULL, &error));
 
     coavoid_world_config_t wc;
     memset(&wc, 0, sizeof wc);
@@ -2759,10 +2771,10 @@ START_TEST(test_keys_required)
     config.vehicle = uav(1, 1, route, 0, 500, 0, 100);
     config.mode = COAVOID_NODE_DECOUPLED;
     int error = -99;
-    ck_assert_ptr_null(coavoid_vehicle_node_create(&config, r.lcm, &error)); /* no key */
+    ck_assert_ptr_null(coavoid_vehicle_node_create(&config, r.lcm, NULL, &error)); /* no key */
     ck_assert_int_eq(error, COA_ERR_ARGUMENT);
     config.common.signer = &k.uav[0];
-    ck_assert_ptr_null(coavoid_vehicle_node_create(&config, r.lcm, &error)); /* no trust */
+    ck_assert_ptr_null(coavoid_vehicle_node_create(&config, r.lcm, NULL, &error)); /* no trust */
     ck_assert_int_eq(error, COA_ERR_ARGUMENT);
     coavoid_world_config_t wc;
     memset(&wc, 0, sizeof wc);
@@ -2777,7 +2789,7 @@ START_TEST(test_keys_required)
     lcm_subscription_t *ss = lcm_subscribe(r.lcm, COAVOID_CHANNEL_STATUS, on_tapped_status, &tap);
     config.common.signer = NULL;
     config.common.insecure = true;
-    coavoid_vehicle_node_t *a = coavoid_vehicle_node_create(&config, r.lcm, &error);
+    coavoid_vehicle_node_t *a = coavoid_vehicle_node_create(&config, r.lcm, NULL, &error);
     ck_assert_ptr_nonnull(a);
     ck_assert_int_eq(coavoid_vehicle_node_cycle(a, r.now), COA_OK);
     drain(r.lcm);
@@ -2818,7 +2830,7 @@ START_TEST(test_silent_uav_avoided_along_its_plan)
     coavoid_vehicle_node_t *a =
         vehicle_node(&r, uav(1, 2, r1, -30, 1970, 0, 124), COAVOID_NODE_DECOUPLED);
     const coavoid_vehicle_node_state_t *sa = coavoid_vehicle_node_state(a);
-    ck_assert_int_eq(coavoid_intent_t_publish(r.lcm, COAVOID_CHANNEL_INTENT, &m), 0);
+    ck_assert_int_eq(TEST_PUBLISH(r.lcm, coavoid_intent_t, COAVOID_CHANNEL_INTENT, &m), 0);
     drain(r.lcm);
     coa_vec3_t pa[31], q[31];
     for (int64_t k = 3; k <= 30; k++) {

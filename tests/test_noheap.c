@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * test_noheap.c: the planner and the predictor never touch the heap.
+ * test_noheap.c: the planner, the predictor and the vehicle protocol never touch the heap.
  *
  * The link wraps malloc, calloc, realloc and free (-Wl,--wrap=..., see CMakeLists.txt):
  * every call from a statically linked object (the core archive, this file, Check) goes
@@ -14,6 +14,9 @@
 
 #include "coavoid/coavoid.h"
 #include "coavoid/predict.h"
+#ifdef COAVOID_HAVE_PROTOCOL
+#include "protocol.h"
+#endif
 
 void *__real_malloc(size_t size);
 void *__real_calloc(size_t count, size_t size);
@@ -317,6 +320,193 @@ START_TEST(predictor_makes_no_heap_call)
 }
 END_TEST
 
+#ifdef COAVOID_HAVE_PROTOCOL
+/* ---- the vehicle protocol: two signed UAVs head-on, each in memory of its own, their
+ * datagrams carried by a queue; the heap is armed from the first init to the last poll. */
+
+#define FLIGHT_UAVS 2u
+#define FLIGHT_QUEUE 256u
+#define FLIGHT_EPOCH INT64_C(1000000000000000)
+
+typedef struct {
+    size_t channel; /* index into flight_channels */
+    size_t size;
+    uint8_t data[COAVOID_LCM_MAX_DATAGRAM_BYTES];
+} flight_datagram_t;
+
+static const char *const flight_channels[] = {COAVOID_CHANNEL_INTENT,    COAVOID_CHANNEL_STATUS,
+                                              COAVOID_CHANNEL_PLAN,      COAVOID_CHANNEL_TRACK,
+                                              COAVOID_CHANNEL_OBSTACLES, COAVOID_CHANNEL_AGREEMENT,
+                                              COAVOID_CHANNEL_CONFLICTS};
+static flight_datagram_t flight_queue[FLIGHT_QUEUE];
+static size_t flight_head, flight_tail;
+static unsigned flight_sent, flight_lost, flight_errors; /* no ck_assert while armed */
+static int64_t flight_now;
+static coavoid_vehicle_node_t *flight_uav[FLIGHT_UAVS];
+
+/* The link: a copy of each datagram, for every node (the sender's own echo included). */
+static int flight_send(void *user, const char *channel, const uint8_t *data, size_t size)
+{
+    (void)user;
+    size_t c = 0;
+    while (c < sizeof flight_channels / sizeof flight_channels[0] &&
+           strcmp(flight_channels[c], channel) != 0) {
+        c++;
+    }
+    if (c == sizeof flight_channels / sizeof flight_channels[0] ||
+        size > sizeof flight_queue[0].data || flight_tail - flight_head == FLIGHT_QUEUE) {
+        flight_lost++;
+        return COA_ERR_ARGUMENT;
+    }
+    flight_datagram_t *d = &flight_queue[flight_tail++ % FLIGHT_QUEUE];
+    d->channel = c;
+    d->size = size;
+    memcpy(d->data, data, size);
+    flight_sent++;
+    return COA_OK;
+}
+
+static void flight_deliver(void)
+{
+    while (flight_head != flight_tail) {
+        const flight_datagram_t d = flight_queue[flight_head++ % FLIGHT_QUEUE];
+        for (size_t i = 0; i < FLIGHT_UAVS; i++) {
+            (void)coavoid_vehicle_node_receive(flight_uav[i], flight_channels[d.channel], d.data,
+                                               d.size);
+        }
+    }
+}
+
+/* Cycle k: each starts it, then every poll due before the next cycle, in time order. */
+static void flight_cycle(int64_t k)
+{
+    const int64_t start = FLIGHT_EPOCH + k * INT64_C(1000000);
+    flight_now = start;
+    for (size_t i = 0; i < FLIGHT_UAVS; i++) {
+        flight_errors += coavoid_vehicle_node_cycle(flight_uav[i], start) != COA_OK ? 1u : 0u;
+        flight_deliver();
+    }
+    for (;;) {
+        int64_t next = INT64_MAX;
+        for (size_t i = 0; i < FLIGHT_UAVS; i++) {
+            const int64_t d = coavoid_vehicle_node_deadline(flight_uav[i]);
+            next = d < next ? d : next;
+        }
+        if (next >= start + INT64_C(1000000)) {
+            return;
+        }
+        flight_now = next > flight_now ? next : flight_now;
+        for (size_t i = 0; i < FLIGHT_UAVS; i++) {
+            flight_errors += coavoid_vehicle_node_poll(flight_uav[i], flight_now) < 0 ? 1u : 0u;
+            flight_deliver();
+        }
+    }
+}
+
+static void flight_keys(coavoid_auth_trust_t *trust, coavoid_auth_signer_t signer[FLIGHT_UAVS])
+{
+    const unsigned char fleet[COAVOID_AUTH_FLEET_KEY_BYTES] = "noheap fleet";
+    coavoid_auth_trust_init(trust);
+    ck_assert_int_eq(coavoid_auth_trust_set_fleet_key(trust, fleet), COA_OK);
+    for (uint16_t i = 0; i < FLIGHT_UAVS; i++) {
+        unsigned char seed[COAVOID_AUTH_SEED_BYTES] = {(unsigned char)(i + 1u), 9};
+        coavoid_auth_key_t key = {101u + i, COAVOID_AUTH_VEHICLE, (uint16_t)(i + 1u), {0}};
+        memset(&signer[i], 0, sizeof signer[i]);
+        signer[i].key_id = key.key_id;
+        coavoid_auth_signer_use_fleet(&signer[i], trust);
+        ck_assert_int_eq(coavoid_auth_keypair_seed(seed, key.public_key, signer[i].secret_key),
+                         COA_OK);
+        ck_assert_int_eq(coavoid_auth_trust_add(trust, &key), COA_OK);
+    }
+}
+
+static coavoid_vehicle_node_config_t flight_config(uint16_t id, coa_vec3_t route[2],
+                                                   const coavoid_auth_trust_t *trust,
+                                                   const coavoid_auth_signer_t *signer)
+{
+    coavoid_vehicle_node_config_t c;
+    memset(&c, 0, sizeof c);
+    ck_assert_int_eq(
+        coavoid_node_common_defaults(&c.common, FLIGHT_EPOCH, (coa_real_t)1, 12u, &flight_now),
+        COA_OK);
+    c.common.trust = trust;
+    c.common.signer = signer;
+    const coa_real_t x0 = id == 1u ? (coa_real_t)0 : (coa_real_t)400;
+    route[0].x = x0;
+    route[1].x = (coa_real_t)400 - x0;
+    route[0].y = route[1].y = (coa_real_t)0;
+    route[0].z = route[1].z = (coa_real_t)100;
+    c.vehicle.id = id;
+    c.vehicle.priority = id;
+    c.vehicle.cruise_speed = (coa_real_t)10;
+    c.vehicle.climb_rate = (coa_real_t)2;
+    c.vehicle.steep_factor = 2u;
+    c.vehicle.volume.radius = (coa_real_t)15;
+    c.vehicle.volume.half_height = (coa_real_t)5;
+    c.vehicle.route = route;
+    c.vehicle.route_count = 2u;
+    c.vehicle.max_offset = -1;
+    c.mode = COAVOID_NODE_DECOUPLED;
+    c.intent_copies = COAVOID_NODE_DEFAULT_COPIES;
+    return c;
+}
+
+START_TEST(vehicle_protocol_makes_no_heap_call)
+{
+    static coavoid_auth_trust_t trust;
+    static coavoid_auth_signer_t signer[FLIGHT_UAVS];
+    static coa_vec3_t route[FLIGHT_UAVS][2];
+    coavoid_vehicle_node_config_t config[FLIGHT_UAVS];
+    void *memory[FLIGHT_UAVS];
+    size_t size[FLIGHT_UAVS];
+    ck_assert_int_eq(coavoid_auth_init(), COA_OK);
+    flight_keys(&trust, signer);
+    for (uint16_t i = 0; i < FLIGHT_UAVS; i++) {
+        config[i] = flight_config((uint16_t)(i + 1u), route[i], &trust, &signer[i]);
+        size[i] = coavoid_vehicle_node_size(&config[i]);
+        ck_assert_uint_gt(size[i], 0u);
+        memory[i] = malloc(size[i]); /* the caller's memory, before the heap is armed */
+        ck_assert_ptr_nonnull(memory[i]);
+    }
+    const coavoid_node_link_t link = {flight_send, NULL};
+    int error[FLIGHT_UAVS] = {-99, -99};
+    heap_calls = 0u;
+    armed = true;
+    for (size_t i = 0; i < FLIGHT_UAVS; i++) {
+        flight_uav[i] = coavoid_vehicle_node_init(memory[i], size[i], &config[i], &link, &error[i]);
+    }
+    for (int64_t k = 0; k < 30 && flight_uav[0] != NULL && flight_uav[1] != NULL; k++) {
+        flight_cycle(k);
+    }
+    armed = false;
+
+    ck_assert_uint_eq(heap_calls, 0u);
+    ck_assert_int_eq(error[0], COA_OK);
+    ck_assert_int_eq(error[1], COA_OK);
+    ck_assert_uint_eq(flight_lost, 0u);
+    ck_assert_uint_eq(flight_errors, 0u);
+    const coavoid_vehicle_node_state_t *a = coavoid_vehicle_node_state(flight_uav[0]);
+    const coavoid_vehicle_node_state_t *b = coavoid_vehicle_node_state(flight_uav[1]);
+    /* They heard each other (signed, checked) and one of them climbed out of the way. */
+    ck_assert_int_gt(a->rx.received, 0);
+    ck_assert_int_eq(a->rx.rejected, 0);
+    ck_assert_int_gt(b->rx.received, 0);
+    ck_assert_int_eq(b->rx.rejected, 0);
+    ck_assert_uint_gt(a->plans_adopted + b->plans_adopted, 0u);
+    ck_assert_uint_gt(flight_sent, 60u);
+    /* Too small a block is a distinct error, not a node. */
+    int small = -99;
+    ck_assert_ptr_null(
+        coavoid_vehicle_node_init(memory[0], size[0] - 1u, &config[0], &link, &small));
+    ck_assert_int_eq(small, COA_ERR_WORKSPACE);
+    for (size_t i = 0; i < FLIGHT_UAVS; i++) {
+        coavoid_vehicle_node_fini(flight_uav[i]);
+        free(memory[i]);
+    }
+}
+END_TEST
+#endif /* COAVOID_HAVE_PROTOCOL */
+
 int main(void)
 {
     Suite *s = suite_create("noheap");
@@ -327,6 +517,9 @@ int main(void)
     tcase_set_timeout(tc, 120);
     tcase_add_test(tc, planner_makes_no_heap_call);
     tcase_add_test(tc, predictor_makes_no_heap_call);
+#ifdef COAVOID_HAVE_PROTOCOL
+    tcase_add_test(tc, vehicle_protocol_makes_no_heap_call);
+#endif
     suite_add_tcase(s, tc);
     sr = srunner_create(s);
     srunner_run_all(sr, CK_NORMAL);

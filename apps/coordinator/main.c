@@ -206,7 +206,8 @@ static int run(void *options, coavoid_scenario_t *s)
         return status;
     }
     int error = COA_OK;
-    coavoid_coordinator_t *node = coavoid_coordinator_create(&config, transport.lcm, &error);
+    coavoid_coordinator_t *node = coavoid_coordinator_create(
+        &config, transport.lcm, coavoid_rt_transport_rx_lcm(&transport), &error);
     if (node == NULL) {
         coavoid_rt_transport_close(&transport);
         if (error == COA_ERR_WORKSPACE) {

@@ -275,10 +275,14 @@ int coavoid_rt_transport_open(coavoid_rt_transport_t *t, const char *url,
             t->lcm = NULL;
             return coavoid_cli_fail(CLI_EXIT_INVALID, "%s", err);
         }
-        common->rx_lcm = coavoid_rt_rx_lcm(t->rx);
         common->transport_dropped = &coavoid_rt_rx_stats(t->rx)->kernel_dropped;
     }
     return CLI_CONTINUE;
+}
+
+lcm_t *coavoid_rt_transport_rx_lcm(const coavoid_rt_transport_t *t)
+{
+    return t->rx != NULL ? coavoid_rt_rx_lcm(t->rx) : NULL;
 }
 
 void coavoid_rt_transport_close(coavoid_rt_transport_t *t)

@@ -98,8 +98,8 @@ typedef struct {
     coavoid_rt_rx_t *rx; /* NULL for other providers: LCM receives */
 } coavoid_rt_transport_t;
 
-/* Opens both for `url` and points common->rx_lcm at the receiver's LCM and
- * common->transport_dropped at its count of drops at the socket. Returns
+/* Opens both for `url` and points common->transport_dropped at the receiver's count of
+ * drops at the socket (coavoid_rt_transport_rx_lcm: its LCM, for the node's create). Returns
  * CLI_CONTINUE, or CLI_EXIT_INVALID after one line on stderr (a bad URL, no multicast
  * route), with nothing left open. */
 int coavoid_rt_transport_open(coavoid_rt_transport_t *t, const char *url,
@@ -108,6 +108,9 @@ int coavoid_rt_transport_open(coavoid_rt_transport_t *t, const char *url,
 /* The same for a node that subscribes to nothing (a world): LCM to publish on, no
  * receiver; its loop is deaf (coavoid_rt_loop_t.deaf). */
 int coavoid_rt_transport_open_send_only(coavoid_rt_transport_t *t, const char *url);
+
+/* The LCM a node subscribes on: the receiver's, or NULL (the one it publishes on). O(1). */
+lcm_t *coavoid_rt_transport_rx_lcm(const coavoid_rt_transport_t *t);
 
 /* Closes what coavoid_rt_transport_open opened; after the node is destroyed. */
 void coavoid_rt_transport_close(coavoid_rt_transport_t *t);

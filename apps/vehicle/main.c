@@ -288,7 +288,8 @@ static int run(void *options, coavoid_scenario_t *s)
         return status;
     }
     int error = COA_OK;
-    coavoid_vehicle_node_t *node = coavoid_vehicle_node_create(&config, transport.lcm, &error);
+    coavoid_vehicle_node_t *node = coavoid_vehicle_node_create(
+        &config, transport.lcm, coavoid_rt_transport_rx_lcm(&transport), &error);
     if (node == NULL) {
         coavoid_rt_transport_close(&transport);
         return coavoid_cli_fail(error == COA_ERR_ARGUMENT ? CLI_EXIT_INVALID : CLI_EXIT_INTERNAL,

@@ -5,7 +5,8 @@
  * (decoupled for a cluster larger than its workspace), and publishes the plans, the
  * conflict report and its heartbeat.
  */
-#include "node_internal.h"
+#include "protocol_internal.h"
+#include "node_lcm.h"
 
 #include <limits.h>
 #include <math.h>
@@ -39,6 +40,8 @@ typedef struct {
 
 struct coavoid_coordinator {
     coavoid_coordinator_config_t config;
+    coavoid_node_lcm_t transport; /* its LCM subscriptions and the lcm it publishes on */
+    void *solver_memory;          /* node->solver's workspaces */
     coavoid_coordinator_state_t state;
     bool started;
     bool degraded; /* a cluster's plan failed in this cycle */
@@ -77,7 +80,7 @@ struct coavoid_coordinator {
 static int on_agreement(void *owner, const coavoid_agreement_t *msg);
 
 coavoid_coordinator_t *coavoid_coordinator_create(const coavoid_coordinator_config_t *config,
-                                                  lcm_t *lcm, int *error)
+                                                  lcm_t *lcm, lcm_t *rx_lcm, int *error)
 {
     int dummy;
     if (error == NULL) {
@@ -92,19 +95,23 @@ coavoid_coordinator_t *coavoid_coordinator_create(const coavoid_coordinator_conf
     }
     const coavoid_node_common_t *c = &config->common;
     const size_t max_centralised = config->max_centralised == 0u ? 3u : config->max_centralised;
-    coavoid_node_solver_t solver;
-    int rc = coavoid_node_solver_init(&solver, c->horizon, c->horizon, max_centralised, c->beta);
-    if (rc != COA_OK) {
-        *error = rc;
+    const coavoid_node_solver_shape_t shape = {c->horizon, c->horizon, max_centralised, c->beta};
+    const size_t solver_size = coavoid_node_solver_size(&shape);
+    if (solver_size == 0u) {
         return NULL;
     }
     coavoid_coordinator_t *node = calloc(1, sizeof *node);
-    if (node == NULL) {
-        coavoid_node_solver_fini(&solver);
-        *error = COA_ERR_WORKSPACE;
+    void *solver_memory = malloc(solver_size);
+    int rc = node != NULL && solver_memory != NULL
+                 ? coavoid_node_solver_place(&node->solver, solver_memory, solver_size, &shape)
+                 : COA_ERR_WORKSPACE;
+    if (rc != COA_OK) {
+        free(node);
+        free(solver_memory);
+        *error = rc;
         return NULL;
     }
-    node->solver = solver;
+    node->solver_memory = solver_memory;
     node->config = *config;
     node->config.max_centralised = max_centralised;
     if (node->config.id == 0u) {
@@ -127,17 +134,20 @@ coavoid_coordinator_t *coavoid_coordinator_create(const coavoid_coordinator_conf
     node->state.cycle = -1;
     node->state.last_outcome = -1;
     /* No UAV is its own: intents are all others'. */
+    coavoid_node_lcm_init(&node->transport, lcm, rx_lcm);
+    const coavoid_node_link_t link = coavoid_node_lcm_link(&node->transport);
     rc = coavoid_node_inbox_init(&node->inbox, c, 0u, node->config.id, 0u, COAVOID_NODE_MAX_PEERS,
-                                 lcm, &node->state.rx, false, NULL, node);
+                                 &link, &node->state.rx, false, NULL, node);
     if (rc == COA_OK) {
         node->inbox.coordinator_id = node->config.id; /* the agreements on its own plans */
-        rc = coavoid_node_inbox_agreements(&node->inbox, on_agreement);
+        coavoid_node_inbox_agreements(&node->inbox, on_agreement);
+        rc = coavoid_node_lcm_subscribe(&node->transport, &node->inbox);
         if (rc != COA_OK) {
             coavoid_node_inbox_fini(&node->inbox);
         }
     }
     if (rc != COA_OK) {
-        coavoid_node_solver_fini(&node->solver);
+        free(node->solver_memory);
         free(node);
         *error = rc;
         return NULL;
@@ -153,8 +163,9 @@ void coavoid_coordinator_destroy(coavoid_coordinator_t *node)
     if (node == NULL) {
         return;
     }
+    coavoid_node_lcm_unsubscribe(&node->transport);
     coavoid_node_inbox_fini(&node->inbox);
-    coavoid_node_solver_fini(&node->solver);
+    free(node->solver_memory);
     free(node);
 }
 

@@ -4,7 +4,8 @@
  * republishes every tile of the obstacle map (so that a node that joins late gets it) and each track's
  * estimate at the cycle's start.
  */
-#include "node_internal.h"
+#include "protocol_internal.h"
+#include "node_lcm.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -12,6 +13,7 @@
 
 struct coavoid_world {
     coavoid_world_config_t config;
+    coavoid_node_lcm_t transport; /* its LCM subscriptions and the lcm it publishes on */
     coavoid_node_tx_t tx;
     bool started;
     int64_t cycle;
@@ -129,7 +131,9 @@ coavoid_world_t *coavoid_world_create(const coavoid_world_config_t *config, lcm_
     if (w->config.id == 0u) {
         w->config.id = (uint16_t)COAVOID_NODE_WORLD_ID;
     }
-    coavoid_node_tx_init(&w->tx, lcm, &w->config.common);
+    coavoid_node_lcm_init(&w->transport, lcm, NULL);
+    const coavoid_node_link_t link = coavoid_node_lcm_link(&w->transport);
+    coavoid_node_tx_init(&w->tx, &link, &w->config.common);
     w->config.common.signer = NULL; /* copied: the caller's may go */
     w->config.common.trust = NULL;
     w->cycle = -1;

@@ -104,10 +104,10 @@ lcm_t *coavoid_rt_lcm_create(const char *url, char *err, size_t err_size);
  * drivers receive from a udpm group themselves: one non-blocking socket, read in batches
  * of COAVOID_RT_RX_BATCH (recvmmsg) only when the loop asks for the next datagram, LCM's
  * short-message framing checked here, and each datagram handed at once to the nodes'
- * handlers through an in-process LCM (memq://, the lcm_t the nodes subscribe on:
- * coavoid_node_common_t.rx_lcm), whose queue so never holds more than one. What the loop
- * does not read in time the kernel drops at the socket, within its receive buffer, and
- * counts (SO_RXQ_OVFL): kernel_dropped. The wire is LCM's: the nodes publish through LCM,
+ * handlers through an in-process LCM (memq://, the lcm_t the nodes subscribe on: the
+ * rx_lcm of the nodes' create functions), whose queue so never holds more than one. What
+ * the loop does not read in time the kernel drops at the socket, within its receive
+ * buffer, and counts (SO_RXQ_OVFL): kernel_dropped. The wire is LCM's: the nodes publish through LCM,
  * and lcm-spy and lcm-logger hear the same datagrams. Every message of docs/messages.md
  * fits one datagram, so LCM's fragments ("LC03") are counted and never reassembled. Only
  * the fleet's channels (node.h, COAVOID_CHANNEL_*) are handed on: LCM keeps a list of

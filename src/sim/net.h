@@ -2,8 +2,9 @@
 /*
  * net.h: the network between the nodes of a one-process run (sim.c), inside
  * coavoid::sim. Each node publishes on an lcm_t of its own (LCM's memq provider) and
- * subscribes on another (coavoid_node_common_t.rx_lcm); the network hears everything a
- * node publishes and decides, per receiver, whether and when the message reaches it:
+ * subscribes on another (the rx_lcm of coavoid_vehicle_node_create and
+ * coavoid_coordinator_create); the network hears everything a node publishes and
+ * decides, per receiver, whether and when the message reaches it:
  *   - back to the sender itself at once, never lost (a multicast socket's loopback);
  *   - to each other receiving node independently: dropped with that receiver's loss
  *     probability, else delivered after delay + a uniform jitter in [0, jitter]

@@ -782,9 +782,9 @@ static int sim_vehicles(sim_run_t *r)
         config.intent_copies = COAVOID_NODE_DEFAULT_COPIES;
         config.joint_members = coavoid_node_joint_members(config.mode, r->n);
         config.joint_memo = r->o->joint_memo != NULL ? r->o->joint_memo : &r->own_memo;
-        config.common.rx_lcm = coavoid_sim_net_rx(r->net, SIM_NET_VEHICLE(j));
-        r->vehicles[j] = coavoid_vehicle_node_create(
-            &config, coavoid_sim_net_tx(r->net, SIM_NET_VEHICLE(j)), &error);
+        r->vehicles[j] =
+            coavoid_vehicle_node_create(&config, coavoid_sim_net_tx(r->net, SIM_NET_VEHICLE(j)),
+                                        coavoid_sim_net_rx(r->net, SIM_NET_VEHICLE(j)), &error);
         if (r->vehicles[j] == NULL && error == COA_ERR_ARGUMENT) {
             return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT,
                                     "%s: vehicles[%zu]: cannot run as a node (%s)", r->file, i,
@@ -831,9 +831,9 @@ static int sim_coordinator(sim_run_t *r)
         coavoid_sim_tape_clear(r->o->tape);
         coavoid_sim_net_tap(r->net, SIM_NET_COORDINATOR, coavoid_sim_tape_message, r->o->tape);
     }
-    config.common.rx_lcm = coavoid_sim_net_rx(r->net, SIM_NET_COORDINATOR);
-    r->coordinator = coavoid_coordinator_create(
-        &config, coavoid_sim_net_tx(r->net, SIM_NET_COORDINATOR), &error);
+    r->coordinator =
+        coavoid_coordinator_create(&config, coavoid_sim_net_tx(r->net, SIM_NET_COORDINATOR),
+                                   coavoid_sim_net_rx(r->net, SIM_NET_COORDINATOR), &error);
     if (r->coordinator == NULL && error == COA_ERR_ARGUMENT) {
         return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT,
                                 "%s: beta: %lu cannot size the coordinator's planner", r->file,

@@ -9,7 +9,8 @@
 #     (-fstack-usage) and the deepest call chains (-fcallgraph-info=su, callgraph.awk),
 #     failing on recursion or a dynamic frame.
 # Also builds the message checks (src/auth on libsodium, cmake/libsodium_arm.cmake) into
-# the check ELF, which must link them without a heap, and reports their sizes and stack.
+# the check ELF, which must link them without a heap, and the vehicle protocol
+# (src/protocol), which must need no heap or stdio, and reports their sizes and stack.
 # Usage: run.sh SRC BUILD CCD_SOURCE_DIR SODIUM_SOURCE_DIR (the unpacked sources, fetched
 # beforehand by scripts/fetch_sources.sh: a test never downloads). A missing toolchain,
 # newlib or source is a failure with what to install, not a skip: CI must run this.
@@ -73,6 +74,11 @@ grep -q '^#define CCD_SINGLE' "$arm/libccd-arm/include/ccd/config.h" ||
   die "the ARM core archive references a forbidden function"
 "$cmake" -DLINKED=ON -DLIB="$elf" -DNM="${prefix}nm" -P "$src/tests/check_core_symbols.cmake" ||
   die "the firmware ELF contains a forbidden function"
+# The vehicle protocol, as an autopilot links it (src/protocol).
+protocol=$arm/src/protocol/libcoavoid_protocol.a
+[ -f "$protocol" ] || die "$protocol was not built"
+"$cmake" -DLIB="$protocol" -DNM="${prefix}nm" -P "$src/tests/check_core_symbols.cmake" ||
+  die "the ARM vehicle protocol archive references a forbidden function"
 # The check ELF (qemu.sh runs it) prints through semihosting calls of its own, not stdio.
 check_elf=$arm/apps/firmware/coavoid-firmware-check.elf
 [ -f "$check_elf" ] || die "$check_elf was not built"
@@ -87,6 +93,7 @@ echo "== size (bytes; an archive's total is every function, the ELF only what it
 "${prefix}size" -t "$ccd" | tail -n 1 | sed 's/(TOTALS)/libccd (libccd.a)/'
 "${prefix}size" -t "$sodium" | tail -n 1 | sed 's/(TOTALS)/libsodium: tag and Ed25519 (libcoavoid_sodium_arm.a)/'
 "${prefix}size" -t "$arm/src/auth/libcoavoid_auth.a" | tail -n 1 | sed 's/(TOTALS)/message checks (libcoavoid_auth.a)/'
+"${prefix}size" -t "$protocol" | tail -n 1 | sed 's/(TOTALS)/vehicle protocol (libcoavoid_protocol.a)/'
 "${prefix}size" "$elf" | tail -n 1 | sed "s|$elf|firmware ELF|"
 
 # Stack frames: file:line:col:function <TAB> bytes <TAB> static|dynamic[,bounded].
@@ -114,6 +121,8 @@ sodium_objs=$arm/CMakeFiles/coavoid_sodium_arm.dir
 report_frames libsodium "$sodium_objs" || die "unbounded stack frame in libsodium's message checks"
 auth_objs=$arm/src/auth/CMakeFiles/coavoid_auth.dir
 report_frames auth "$auth_objs" || die "unbounded stack frame in the message checks (src/auth)"
+report_frames protocol "$arm/src/protocol/CMakeFiles/coavoid_protocol.dir" ||
+  die "unbounded stack frame in the vehicle protocol"
 # Call chains: the deepest sum of frames below each entry point, over the core's,
 # libccd's and the firmware's call graphs; libccd's only indirect calls are to the
 # callbacks geometry.c hands it. Recursion or a dynamic frame fails the test.

@@ -294,12 +294,14 @@ static void on_any(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
     }
 }
 
-static void on_intent(const lcm_recv_buf_t *rbuf, const char *channel, const coavoid_intent_t *msg,
-                      void *user)
+static void on_intent(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
 {
     forger_t *f = user;
+    static coavoid_intent_t decoded;
+    const coavoid_intent_t *msg = &decoded;
     (void)channel;
-    if (sent_by_me(f, rbuf)) {
+    if (sent_by_me(f, rbuf) ||
+        coavoid_intent_t_decode(rbuf->data, 0, (int)rbuf->data_size, &decoded) < 0) {
         return;
     }
     f->clock_utime = msg->utime > f->clock_utime ? msg->utime : f->clock_utime;
@@ -416,8 +418,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "forge: cannot open %s\n", url != NULL ? url : "(default)");
         return 2;
     }
-    coavoid_intent_t_subscription_t *sub =
-        coavoid_intent_t_subscribe(f.lcm, COAVOID_CHANNEL_INTENT, on_intent, &f);
+    lcm_subscription_t *sub = lcm_subscribe(f.lcm, COAVOID_CHANNEL_INTENT, on_intent, &f);
     lcm_subscription_t *all =
         f.held != NULL ? lcm_subscribe(f.lcm, "COAVOID_.*", on_any, &f) : NULL;
     const int64_t end = wall_us() + (int64_t)(seconds * 1e6);
@@ -433,7 +434,7 @@ int main(int argc, char **argv)
         lcm_handle_timeout(f.lcm, f.held != NULL ? 5 : 50);
     }
     printf("forged %lld\n", (long long)f.forged);
-    coavoid_intent_t_unsubscribe(f.lcm, sub);
+    lcm_unsubscribe(f.lcm, sub);
     if (all != NULL) {
         lcm_unsubscribe(f.lcm, all);
     }

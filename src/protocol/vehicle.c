@@ -5,11 +5,10 @@
  * are needed, and otherwise plans for itself in priority order (steps 2 and 4 of node.h's
  * cycle).
  */
-#include "node_internal.h"
+#include "protocol_internal.h"
 
 #include <limits.h>
 #include <math.h>
-#include <stdlib.h>
 #include <string.h>
 
 /* Decided cycles without a conflict of its own after which a raised rank returns to 0
@@ -2022,53 +2021,11 @@ static void fill_defaults(coavoid_vehicle_node_config_t *config)
     }
 }
 
-coavoid_vehicle_node_t *coavoid_vehicle_node_create(const coavoid_vehicle_node_config_t *config,
-                                                    lcm_t *lcm, int *error)
+/* A vehicle before its first cycle: flying its initial offset, nothing decided. */
+static void vehicle_start(coavoid_vehicle_node_t *node, const coavoid_vehicle_node_config_t *config)
 {
-    int dummy;
-    if (error == NULL) {
-        error = &dummy;
-    }
-    *error = COA_ERR_ARGUMENT;
-    if (config == NULL || lcm == NULL || coavoid_node_common_check(&config->common) != COA_OK ||
-        !coavoid_node_floor_ok(&config->common) || coa_vehicle_check(&config->vehicle) != COA_OK ||
-        (config->mode != COAVOID_NODE_CENTRALISED && config->mode != COAVOID_NODE_DECOUPLED) ||
-        config->coordinator_timeout_us < 0 || config->priority_wait_us < 0 ||
-        !isfinite((double)config->sigma_horizontal) || !isfinite((double)config->sigma_vertical) ||
-        config->sigma_horizontal < (coa_real_t)0 || config->sigma_vertical < (coa_real_t)0 ||
-        !(coa_climb_step(&config->vehicle, config->common.dt) > (coa_real_t)0) ||
-        config->joint_members == 1u || config->joint_members > COA_MAX_CENTRALISED) {
-        return NULL;
-    }
-    const uint16_t coordinator_id = config->coordinator_id != 0u
-                                        ? config->coordinator_id
-                                        : (uint16_t)COAVOID_NODE_COORDINATOR_ID;
-    if (coordinator_id == config->vehicle.id) {
-        return NULL; /* its own heartbeats and plans would be taken for its coordinator's */
-    }
-    const coavoid_node_common_t *c = &config->common;
-    coavoid_vehicle_node_config_t filled = *config;
-    filled.coordinator_id = coordinator_id;
-    fill_defaults(&filled);
-    /* One planner: its own searches, the order search's, and its group's joint plan. */
-    const bool joint = filled.joint_members > 0u;
-    coavoid_node_solver_t solver;
-    int rc = coavoid_node_solver_init(&solver, c->horizon, c->horizon + COAVOID_NODE_LOOKAHEAD,
-                                      joint ? filled.joint_members : 1u,
-                                      joint ? filled.joint_beta : c->beta);
-    if (rc != COA_OK) {
-        *error = rc;
-        return NULL;
-    }
-    coavoid_vehicle_node_t *node = calloc(1, sizeof *node);
-    if (node == NULL) {
-        coavoid_node_solver_fini(&solver);
-        *error = COA_ERR_WORKSPACE;
-        return NULL;
-    }
-    node->solver = solver;
-    node->config = filled;
-    node->dh = coa_climb_step(&node->config.vehicle, c->dt);
+    node->config = *config;
+    node->dh = coa_climb_step(&node->config.vehicle, config->common.dt);
     node->plan_start = 0;
     node->plan_count = 1;
     node->plan_offsets[0] = node->config.vehicle.initial_offset;
@@ -2080,37 +2037,121 @@ coavoid_vehicle_node_t *coavoid_vehicle_node_create(const coavoid_vehicle_node_c
     node->state.offset = node->config.vehicle.initial_offset;
     node->state.last_outcome = -1;
     node->wait_deadline = INT64_MAX;
-    const bool centralised = node->config.mode == COAVOID_NODE_CENTRALISED;
-    rc = coavoid_node_inbox_init(&node->inbox, c, node->config.vehicle.id, node->config.vehicle.id,
-                                 coordinator_id, COAVOID_NODE_MAX_PEERS - 1u, lcm, &node->state.rx,
-                                 centralised, centralised ? on_plan : NULL, node);
-    if (rc == COA_OK && centralised) {
-        node->inbox.on_plan_row = on_plan_row;
-        rc = coavoid_node_inbox_agreements(&node->inbox, on_agreement);
-        if (rc != COA_OK) {
-            coavoid_node_inbox_fini(&node->inbox);
-        }
+}
+
+/* Checks config and fills *filled (its defaults) and *shape (its planner's and
+ * predictor's sizes). COA_OK or COA_ERR_ARGUMENT. */
+static int vehicle_prepare(const coavoid_vehicle_node_config_t *config,
+                           coavoid_vehicle_node_config_t *filled,
+                           coavoid_node_solver_shape_t *shape)
+{
+    if (config == NULL || coavoid_node_common_check(&config->common) != COA_OK ||
+        !coavoid_node_floor_ok(&config->common) || coa_vehicle_check(&config->vehicle) != COA_OK ||
+        (config->mode != COAVOID_NODE_CENTRALISED && config->mode != COAVOID_NODE_DECOUPLED) ||
+        config->coordinator_timeout_us < 0 || config->priority_wait_us < 0 ||
+        !isfinite((double)config->sigma_horizontal) || !isfinite((double)config->sigma_vertical) ||
+        config->sigma_horizontal < (coa_real_t)0 || config->sigma_vertical < (coa_real_t)0 ||
+        !(coa_climb_step(&config->vehicle, config->common.dt) > (coa_real_t)0) ||
+        config->joint_members == 1u || config->joint_members > COA_MAX_CENTRALISED) {
+        return COA_ERR_ARGUMENT;
     }
-    if (rc != COA_OK) {
-        coavoid_node_solver_fini(&node->solver);
-        free(node);
-        *error = rc;
+    *filled = *config;
+    if (filled->coordinator_id == 0u) {
+        filled->coordinator_id = (uint16_t)COAVOID_NODE_COORDINATOR_ID;
+    }
+    if (filled->coordinator_id == config->vehicle.id) {
+        return COA_ERR_ARGUMENT; /* its own heartbeats and plans would be its coordinator's */
+    }
+    fill_defaults(filled);
+    /* One planner: its own searches, the order search's, and its group's joint plan. */
+    const bool joint = filled->joint_members > 0u;
+    shape->horizon = config->common.horizon;
+    shape->plan_horizon = config->common.horizon + COAVOID_NODE_LOOKAHEAD;
+    shape->searched = joint ? filled->joint_members : 1u;
+    shape->beta = joint ? filled->joint_beta : config->common.beta;
+    return coavoid_node_solver_size(shape) > 0u ? COA_OK : COA_ERR_ARGUMENT;
+}
+
+/* The bytes of the vehicle's struct, rounded up to the workspace alignment. */
+static size_t vehicle_head(void)
+{
+    const size_t a = COA_WORKSPACE_ALIGNMENT;
+    return (sizeof(coavoid_vehicle_node_t) + a - 1u) / a * a;
+}
+
+size_t coavoid_vehicle_node_size(const coavoid_vehicle_node_config_t *config)
+{
+    coavoid_vehicle_node_config_t filled;
+    coavoid_node_solver_shape_t shape;
+    if (vehicle_prepare(config, &filled, &shape) != COA_OK) {
+        return 0u;
+    }
+    const size_t solver = coavoid_node_solver_size(&shape);
+    return solver > SIZE_MAX - vehicle_head() ? 0u : vehicle_head() + solver;
+}
+
+coavoid_vehicle_node_t *coavoid_vehicle_node_init(void *memory, size_t size,
+                                                  const coavoid_vehicle_node_config_t *config,
+                                                  const coavoid_node_link_t *link, int *error)
+{
+    int dummy;
+    error = error != NULL ? error : &dummy;
+    coavoid_vehicle_node_config_t filled;
+    coavoid_node_solver_shape_t shape;
+    *error = vehicle_prepare(config, &filled, &shape);
+    if (*error == COA_OK && (link == NULL || link->send == NULL)) {
+        *error = COA_ERR_ARGUMENT;
+    }
+    if (*error != COA_OK) {
         return NULL;
+    }
+    if (memory == NULL || ((uintptr_t)memory % COA_WORKSPACE_ALIGNMENT) != 0u ||
+        size < coavoid_vehicle_node_size(config)) {
+        *error = COA_ERR_WORKSPACE;
+        return NULL;
+    }
+    coavoid_vehicle_node_t *node = memory;
+    memset(node, 0, sizeof *node);
+    *error = coavoid_node_solver_place(&node->solver, (uint8_t *)memory + vehicle_head(),
+                                       size - vehicle_head(), &shape);
+    if (*error != COA_OK) {
+        return NULL;
+    }
+    vehicle_start(node, &filled);
+    const bool centralised = node->config.mode == COAVOID_NODE_CENTRALISED;
+    *error =
+        coavoid_node_inbox_init(&node->inbox, &config->common, filled.vehicle.id, filled.vehicle.id,
+                                filled.coordinator_id, COAVOID_NODE_MAX_PEERS - 1u, link,
+                                &node->state.rx, centralised, centralised ? on_plan : NULL, node);
+    if (*error != COA_OK) {
+        return NULL;
+    }
+    if (centralised) {
+        node->inbox.on_plan_row = on_plan_row;
+        coavoid_node_inbox_agreements(&node->inbox, on_agreement);
     }
     node->config.common.signer = NULL; /* copied by the inbox: the caller's may go */
     node->config.common.trust = NULL;
-    *error = COA_OK;
     return node;
 }
 
-void coavoid_vehicle_node_destroy(coavoid_vehicle_node_t *node)
+void coavoid_vehicle_node_fini(coavoid_vehicle_node_t *node)
 {
-    if (node == NULL) {
-        return;
+    if (node != NULL) {
+        coavoid_node_inbox_fini(&node->inbox);
     }
-    coavoid_node_inbox_fini(&node->inbox);
-    coavoid_node_solver_fini(&node->solver);
-    free(node);
+}
+
+int coavoid_vehicle_node_receive(coavoid_vehicle_node_t *node, const char *channel,
+                                 const void *data, size_t size)
+{
+    return node != NULL ? coavoid_node_inbox_receive(&node->inbox, channel, data, size)
+                        : COA_ERR_ARGUMENT;
+}
+
+coavoid_node_inbox_t *coavoid_vehicle_node_inbox(coavoid_vehicle_node_t *node)
+{
+    return &node->inbox;
 }
 
 /* Enters cycle k at `now`: the last cycle's plan outcomes cleared (its refusals kept for

@@ -1,26 +1,27 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * node_internal.h: what the vehicle and the coordinator share beyond node.h (common.c):
- *   - the inbox: the LCM subscriptions, decoding and validation of what arrives, the
+ * protocol_internal.h: what the vehicle and the coordinator share beyond protocol.h
+ * (common.c):
+ *   - the inbox: checking, decoding and validation of the datagrams a transport hands it
+ *     (coavoid_node_inbox_receive; node_lcm.h subscribes it to LCM), the
  *     counters, and the latest message of every sender (intents per UAV, tracks per
  *     source and track, the obstacle map, heartbeats);
  *   - the view of one cycle: the stored intents converted to the core's types on the
  *     cycle's clock (t = 0 at the cycle's start), stale UAVs turned into tracks;
  *   - the planner's track list for one problem (real tracks, UAVs as moving obstacles);
- *   - publishing into a buffer the node owns, so that nothing is allocated per cycle by
- *     our code (LCM's provider may allocate inside lcm_publish: that is LCM's).
- * Not part of the nodes' API: a driver includes node.h only.
+ *   - publishing into a buffer the node owns, handed to a link (coavoid_node_link_t), so
+ *     that nothing is allocated per cycle by our code (a transport may: LCM's provider
+ *     does inside lcm_publish).
+ * Not part of the API: a driver includes protocol.h or node.h only.
  */
-#ifndef COAVOID_NODE_INTERNAL_H
-#define COAVOID_NODE_INTERNAL_H
+#ifndef COAVOID_PROTOCOL_INTERNAL_H
+#define COAVOID_PROTOCOL_INTERNAL_H
 
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
-#include <lcm/lcm.h>
-
-#include "node.h"
+#include "protocol.h"
 
 #define COAVOID_NODE_MAX_SAMPLES (COAVOID_NODE_MAX_HORIZON + 1u)
 _Static_assert(COAVOID_NODE_MAX_SAMPLES == (unsigned)COAVOID_INTENT_T_MAX_SAMPLES &&
@@ -53,7 +54,7 @@ _Static_assert(COAVOID_NODE_MAX_SAMPLES == (unsigned)COAVOID_INTENT_T_MAX_SAMPLE
  * velocity guess is meaningless by then. */
 #define COAVOID_NODE_DROP_HORIZONS 1
 
-/* Encoded messages are written here before lcm_publish: one datagram at most. */
+/* Encoded messages are written here before they go to the link: one datagram at most. */
 #define COAVOID_NODE_TX_BYTES ((size_t)COAVOID_LCM_MAX_DATAGRAM_BYTES)
 
 /* Plans whose rows a UAV collects at once: the coordinator sends a plan's rows back to
@@ -64,9 +65,22 @@ _Static_assert(COAVOID_NODE_MAX_SAMPLES == (unsigned)COAVOID_INTENT_T_MAX_SAMPLE
 /* How many of its latest intents a node remembers, to tell them when they come back. */
 #define COAVOID_NODE_OWN_INTENTS 4u
 
+/* The channels an inbox listens to (coavoid_node_inbox_channel): intents, tracks, the
+ * obstacle map, heartbeats, plans and agreements; bit COAVOID_NODE_WANTS(X) of `wants`. */
+#define COAVOID_NODE_CHANNELS 6u
+enum {
+    COAVOID_NODE_CHANNEL_INTENT,
+    COAVOID_NODE_CHANNEL_TRACK,
+    COAVOID_NODE_CHANNEL_MAP,
+    COAVOID_NODE_CHANNEL_STATUS,
+    COAVOID_NODE_CHANNEL_PLAN,
+    COAVOID_NODE_CHANNEL_AGREEMENT
+};
+#define COAVOID_NODE_WANTS(x) (1u << COAVOID_NODE_CHANNEL_##x)
+
 /* Where a node encodes what it publishes, and the key it signs it with. */
 typedef struct {
-    lcm_t *lcm;
+    coavoid_node_link_t link;
     bool sign;                    /* false only for an insecure node */
     coavoid_auth_signer_t signer; /* a copy of common.signer, zeroed at fini */
     const int64_t *clock;         /* the driver's: the signatures' timestamps */
@@ -101,6 +115,9 @@ typedef struct {
 
 typedef struct coavoid_node_inbox coavoid_node_inbox_t;
 
+/* The inbox of a vehicle node, for its transport's subscriptions (node_lcm.c). O(1). */
+coavoid_node_inbox_t *coavoid_vehicle_node_inbox(coavoid_vehicle_node_t *node);
+
 /* Called for a whole plan: the message that completed it (every listed UAV's row decoded
  * and passed validation, from its coordinator); msg is the plan's first message, its
  * header. No sequence rule is applied to plans (vehicle.c orders those of one cycle,
@@ -125,9 +142,7 @@ struct coavoid_node_inbox {
      * every message must verify against it before it is decoded further. */
     bool secure;
     coavoid_auth_trust_t trust;
-    lcm_t *rx_lcm; /* where subs are: common.rx_lcm, or else the lcm it publishes on */
-    lcm_subscription_t *subs[7];
-    size_t sub_count;
+    unsigned wants;             /* COAVOID_NODE_WANTS bits: the channels it takes in */
     coavoid_lcm_rx_stats_t *rx; /* the owner's counters (its state's rx) */
 
     coavoid_node_senders_t intent_seq;
@@ -243,17 +258,26 @@ typedef struct {
     coa_track_point_t paths[COAVOID_NODE_MAX_PEERS][COAVOID_NODE_MAX_SAMPLES];
 } coavoid_node_problem_tracks_t;
 
-/* A node's prediction and planning memory, allocated once when it is created: room for
- * every pair coavoid_node_max_pairs allows, a predictor over MAX_PEERS plans and
- * TRACK_CAPACITY tracks, and a planner of `searched` UAVs a search. */
+/* A node's prediction and planning memory, in the caller's memory (one block laid out by
+ * coavoid_node_solver_place): room for every pair coavoid_node_max_pairs allows, a
+ * predictor over MAX_PEERS plans and TRACK_CAPACITY tracks, and a planner of `searched`
+ * UAVs a search. */
 typedef struct {
     coa_conflict_t *conflicts;
     size_t conflict_capacity;
-    void *predictor_memory;
     coa_predictor_t *predictor;
-    void *planner_memory;
     coa_planner_t *planner;
 } coavoid_node_solver_t;
+
+/* What a solver is sized for: predictions over `horizon` steps (N), and a planner of
+ * `searched` UAVs at beta over at most plan_horizon steps (>= horizon: a vehicle's order
+ * search looks further). */
+typedef struct {
+    uint32_t horizon;
+    uint32_t plan_horizon;
+    size_t searched;
+    uint32_t beta;
+} coavoid_node_solver_shape_t;
 
 /* What a node's heartbeat (status_t) says: who it is and how it is, as the node judges,
  * and the counters its state keeps (saturated to the message's types when sent). */
@@ -292,32 +316,49 @@ static inline bool coavoid_node_floor_ok(const coavoid_node_common_t *c)
 coavoid_lcm_context_t coavoid_node_context(const coavoid_node_inbox_t *in, int64_t now,
                                            int64_t epoch);
 
-/* Initialises the inbox and subscribes to intents, tracks and the obstacle map, and to
- * heartbeats (want_status) and plans (plan_handler non-NULL) when asked; counts into rx.
- * It publishes on lcm and subscribes on common->rx_lcm, or on lcm when that is NULL.
- * A coordinator's heartbeat or a plan from another node than coordinator_id is refused
- * (COAVOID_LCM_ERR_ID). Unless common->insecure, every message must carry a signature
- * of a key in common->trust whose role may send it, and be fresh (COAVOID_AUTH_ERR_*
- * otherwise, counted as refused).
- * Returns COA_OK, or COA_ERR_ARGUMENT when LCM refused a subscription or a secure node
- * has no trust list (everything subscribed so far is unsubscribed). The handlers cost
- * O(message) each (one signature verification, decoding and validation, O(senders) for
- * the sequence rule) and allocate nothing. */
+/* Initialises the inbox to take in intents, tracks and the obstacle map, and heartbeats
+ * (want_status) and plans (plan_handler non-NULL) when asked; counts into rx; publishes
+ * through link. A coordinator's heartbeat or a plan from another node than
+ * coordinator_id is refused (COAVOID_LCM_ERR_ID). Unless common->insecure, every message
+ * must carry a signature of a key in common->trust whose role may send it, and be fresh
+ * (COAVOID_AUTH_ERR_* otherwise, counted as refused).
+ * Returns COA_OK, or COA_ERR_ARGUMENT when a secure node has no trust list. O(senders);
+ * no memory. */
 int coavoid_node_inbox_init(coavoid_node_inbox_t *in, const coavoid_node_common_t *common,
                             uint16_t self_uav, uint16_t self_node, uint16_t coordinator_id,
-                            size_t peer_capacity, lcm_t *lcm, coavoid_lcm_rx_stats_t *rx,
-                            bool want_status, coavoid_node_plan_handler_t plan_handler,
-                            void *owner);
+                            size_t peer_capacity, const coavoid_node_link_t *link,
+                            coavoid_lcm_rx_stats_t *rx, bool want_status,
+                            coavoid_node_plan_handler_t plan_handler, void *owner);
 
-/* Subscribes to the agreements on plans (COAVOID_AGREEMENT) of the inbox's coordinator:
+/* Takes in the agreements on plans (COAVOID_AGREEMENT) of the inbox's coordinator too:
  * each that verifies, may be sent by its signer's role and passes
- * coavoid_lcm_agreement_check goes to handler (its own, come back, do not). Returns COA_OK
- * or COA_ERR_ARGUMENT (LCM refused; the caller finis the inbox). Handler cost: one
- * signature verification plus the handler's. */
-int coavoid_node_inbox_agreements(coavoid_node_inbox_t *in,
-                                  coavoid_node_agreement_handler_t handler);
+ * coavoid_lcm_agreement_check goes to handler (its own, come back, do not). O(1). */
+void coavoid_node_inbox_agreements(coavoid_node_inbox_t *in,
+                                   coavoid_node_agreement_handler_t handler);
 
-/* Unsubscribes everything. O(subscriptions). */
+/* The name of channel i (0..COAVOID_NODE_CHANNELS-1) when the inbox takes it in, else
+ * NULL: what a transport subscribes to, in this order. O(1). */
+const char *coavoid_node_inbox_channel(const coavoid_node_inbox_t *in, size_t i);
+
+/* One datagram as it arrived on `channel`, at the time *common.clock says: checked
+ * (tail, fleet tag, budget, signature, sender), decoded, validated and stored, or
+ * counted as refused or dropped; a whole plan or an agreement goes on to the owner's
+ * handler. Returns COA_OK when the inbox takes the channel in (whatever became of the
+ * datagram: a refusal is counted, never returned), COA_ERR_ARGUMENT for a channel it
+ * does not take in or a NULL argument. Cost: at most one signature verification, the
+ * decoding and validation, O(senders), plus the handler's; no memory. */
+int coavoid_node_inbox_receive(coavoid_node_inbox_t *in, const char *channel, const void *data,
+                               size_t size);
+
+/* Brings the inbox budget (node.h, COAVOID_NODE_CHECKS_PER_*) to the cycle of `now`: a
+ * new cycle starts it afresh, keeping the last whole cycle's datagram count. O(1). */
+void coavoid_node_inbox_roll(coavoid_node_inbox_t *in, int64_t now);
+
+/* How old an intent or a track may be before it is dropped rather than extrapolated:
+ * stale_after plus COAVOID_NODE_DROP_HORIZONS horizons. O(1). */
+int64_t coavoid_node_inbox_drop_after(const coavoid_node_inbox_t *in);
+
+/* Stops taking anything in and clears the copy of the signing key. O(1). */
 void coavoid_node_inbox_fini(coavoid_node_inbox_t *in);
 
 /* Forgets senders silent past stale_after (a restarted one numbers from 0 again) and
@@ -398,17 +439,18 @@ int coavoid_node_predict(coa_predictor_t *predictor, const coavoid_node_common_t
  * cannot run out (13,280). O(1). */
 size_t coavoid_node_max_pairs(void);
 
-/* Allocates *s for predictions over N steps (horizon) and a planner of `searched` UAVs at
- * beta over at most plan_horizon steps (>= horizon: a vehicle's order search looks
- * further). Returns
- * COA_OK, COA_ERR_ARGUMENT (sizes the core refuses; nothing allocated) or COA_ERR_WORKSPACE
- * (out of memory; nothing kept). Memory: the predictor's and planner's workspaces
- * (coa_predictor_workspace_size, coa_planner_workspace_size) and the conflict array. */
-int coavoid_node_solver_init(coavoid_node_solver_t *s, uint32_t horizon, uint32_t plan_horizon,
-                             size_t searched, uint32_t beta);
+/* The bytes of a solver of this shape: the predictor's and planner's workspaces
+ * (coa_predictor_workspace_size, coa_planner_workspace_size) and the conflict array,
+ * each rounded up to COA_WORKSPACE_ALIGNMENT; 0 for sizes the core refuses. O(1). */
+size_t coavoid_node_solver_size(const coavoid_node_solver_shape_t *shape);
 
-/* Frees what coavoid_node_solver_init allocated; a zeroed *s is fine. */
-void coavoid_node_solver_fini(coavoid_node_solver_t *s);
+/* Lays a solver of this shape out in memory (aligned to COA_WORKSPACE_ALIGNMENT, size
+ * bytes, the caller's, not moved while used). COA_OK, COA_ERR_ARGUMENT (sizes the core
+ * refuses) or COA_ERR_WORKSPACE (memory NULL, misaligned or smaller than
+ * coavoid_node_solver_size); *s is zeroed on failure. O(size of the workspaces' headers);
+ * allocates nothing. */
+int coavoid_node_solver_place(coavoid_node_solver_t *s, void *memory, size_t size,
+                              const coavoid_node_solver_shape_t *shape);
 
 /* Fills *m from h at `now`, validates it on the clock whose t = 0 is cycle_start
  * (coavoid_node_context) and publishes it. Its health is HEALTH_DEGRADED (unless a fault)
@@ -419,17 +461,18 @@ void coavoid_node_solver_fini(coavoid_node_solver_t *s);
 int coavoid_node_publish_heartbeat(coavoid_node_inbox_t *in, coavoid_status_t *m, int64_t now,
                                    int64_t cycle_start, const coavoid_node_heartbeat_t *h);
 
-/* Prepares tx for publishing on lcm as c says: signing with a copy of c->signer at c's
- * clock, unless c->insecure. fini zeroes the copy of the secret key. O(1); cannot fail
- * (c was checked). */
-void coavoid_node_tx_init(coavoid_node_tx_t *tx, lcm_t *lcm, const coavoid_node_common_t *c);
+/* Prepares tx for publishing through link as c says: signing with a copy of c->signer
+ * at c's clock, unless c->insecure. fini zeroes the copy of the secret key. O(1); cannot
+ * fail (c was checked). */
+void coavoid_node_tx_init(coavoid_node_tx_t *tx, const coavoid_node_link_t *link,
+                          const coavoid_node_common_t *c);
 void coavoid_node_tx_fini(coavoid_node_tx_t *tx);
 
 /* Publishing: encodes into tx->buf, signs it (coavoid_auth_stamp: one Ed25519 signature)
- * and publishes on the type's channel. COA_OK, or COA_ERR_WORKSPACE (over
- * COAVOID_LCM_MAX_DATAGRAM_BYTES: never sent, or does not encode) or COA_ERR_ARGUMENT (LCM
- * refused it, or it could not be signed). O(message); our code allocates nothing (the
- * provider may, inside lcm_publish). */
+ * and hands it to the link on the type's channel. COA_OK, or COA_ERR_WORKSPACE (over
+ * COAVOID_LCM_MAX_DATAGRAM_BYTES: never sent, or does not encode) or COA_ERR_ARGUMENT (the
+ * link refused it, or it could not be signed). O(message); our code allocates nothing
+ * (a transport may). */
 int coavoid_node_publish_plan(coavoid_node_tx_t *tx, const coavoid_plan_t *msg);
 int coavoid_node_publish_track(coavoid_node_tx_t *tx, const coavoid_track_t *msg);
 int coavoid_node_publish_map(coavoid_node_tx_t *tx, const coavoid_obstacle_map_t *msg);
@@ -444,4 +487,4 @@ int coavoid_node_publish_intent(coavoid_node_inbox_t *in, const coavoid_intent_t
 /* The common stopwatch's reading (us), 0 without one: durations are differences. O(1). */
 int64_t coavoid_node_stopwatch(const coavoid_node_common_t *c);
 
-#endif /* COAVOID_NODE_INTERNAL_H */
+#endif /* COAVOID_PROTOCOL_INTERNAL_H */
