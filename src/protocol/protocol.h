@@ -245,18 +245,88 @@ typedef struct {
     coavoid_node_joint_memo_t *joint_memo;
 } coavoid_vehicle_node_config_t;
 
+/* The vehicle's state machines (docs/protocol.md, "Vehicle", where both are drawn from
+ * their tables in vehicle_states.c). Two, because they are independent: a plan of the
+ * coordinator's may be held, switched to or dropped whatever the vehicle is deciding.
+ *
+ * Its phase: who decides the cycle, and how far it is. Entered at every cycle's start as
+ * FOLLOWING (it follows the coordinator) or DECIDING (fallback, or decoupled). */
+typedef enum {
+    COAVOID_VEHICLE_IDLE = 0,         /* before its first cycle */
+    COAVOID_VEHICLE_FOLLOWING,        /* follows the coordinator; the answer wait is ahead */
+    COAVOID_VEHICLE_FOLLOWED,         /* ... past the answer wait, nothing of its own to do */
+    COAVOID_VEHICLE_DECIDING,         /* decides for itself; waits for the UAVs before it */
+    COAVOID_VEHICLE_GATHERING,        /* ... first cycle: waits for the first intents' copies */
+    COAVOID_VEHICLE_DECIDED,          /* ... decided and published */
+    COAVOID_VEHICLE_ANSWERING,        /* unanswered at the answer wait: decides, waits */
+    COAVOID_VEHICLE_ANSWER_GATHERING, /* ... first cycle: waits for the first intents' copies */
+    COAVOID_VEHICLE_ANSWERED          /* ... decided and published */
+} coavoid_vehicle_phase_t;
+#define COAVOID_VEHICLE_PHASES 9u
+
+/* Its coordinator's plans of this cycle (docs/protocol.md, "One plan (at a vehicle of it)").
+ * NONE again at every cycle's start: a plan held then is dropped, in doubt. */
+typedef enum {
+    COAVOID_VEHICLE_PLAN_NONE = 0,        /* no plan of the cycle held or flown */
+    COAVOID_VEHICLE_PLAN_HOLDING,         /* holds an accepted plan, undecided */
+    COAVOID_VEHICLE_PLAN_STANDBY,         /* ... and flies a standby unless it is committed */
+    COAVOID_VEHICLE_PLAN_ON_STANDBY,      /* the held plan aborted: flies the standby */
+    COAVOID_VEHICLE_PLAN_SWITCHED,        /* flies a plan of the cycle (committed) */
+    COAVOID_VEHICLE_PLAN_SWITCHED_HOLDING /* ... and holds a newer one, undecided */
+} coavoid_vehicle_plan_t;
+#define COAVOID_VEHICLE_PLAN_STATES 6u
+
+/* What moves them: each event is allowed in some states only (vehicle_states.c), and one
+ * in any other is a fault of the node (state.protocol_faults, heartbeat INTERNAL_ERROR)
+ * that leaves the state as it was. */
+typedef enum {
+    /* the phase */
+    COAVOID_VEHICLE_EVENT_FOLLOW = 0,  /* a cycle starts, following the coordinator */
+    COAVOID_VEHICLE_EVENT_DECIDE,      /* a cycle starts, deciding for itself */
+    COAVOID_VEHICLE_EVENT_WAIT,        /* UAVs before it may still publish: it waits */
+    COAVOID_VEHICLE_EVENT_GATHER,      /* no plan below them while the first intents gather */
+    COAVOID_VEHICLE_EVENT_PUBLISH,     /* its intent of the cycle is published */
+    COAVOID_VEHICLE_EVENT_REDECIDE,    /* overtaken, or the world grew: it decides again */
+    COAVOID_VEHICLE_EVENT_ANSWER_WAIT, /* the answer wait passes while it follows */
+    COAVOID_VEHICLE_EVENT_UNANSWERED,  /* ... a conflict of its own and no plan: it decides */
+    COAVOID_VEHICLE_EVENT_STANDBY,     /* ... it holds an undecided plan: it plans a standby */
+    COAVOID_VEHICLE_EVENT_SELF_COMMIT, /* it commits the plan it holds itself */
+    /* its coordinator's plans */
+    COAVOID_VEHICLE_EVENT_ACCEPT, /* a whole plan for it checked: ACCEPT, and held */
+    COAVOID_VEHICLE_EVENT_COMMIT, /* COMMIT, a sibling's SWITCHED, or its own self-commit */
+    COAVOID_VEHICLE_EVENT_ABORT,  /* ABORT of the plan it holds */
+    COAVOID_VEHICLE_EVENT_CYCLE   /* the next cycle starts */
+} coavoid_vehicle_event_t;
+#define COAVOID_VEHICLE_EVENTS 14u
+
+/* The state a phase or plan state goes to on `event`; COAVOID_VEHICLE_PHASES (or
+ * COAVOID_VEHICLE_PLAN_STATES) when the event is not allowed there, or for an event of
+ * the other machine. O(1). */
+coavoid_vehicle_phase_t coavoid_vehicle_phase_next(coavoid_vehicle_phase_t from,
+                                                   coavoid_vehicle_event_t event);
+coavoid_vehicle_plan_t coavoid_vehicle_plan_next(coavoid_vehicle_plan_t from,
+                                                 coavoid_vehicle_event_t event);
+
+/* Names, for logs and the drawing in docs/protocol.md ("?" when out of range). O(1). */
+const char *coavoid_vehicle_phase_name(coavoid_vehicle_phase_t phase);
+const char *coavoid_vehicle_plan_name(coavoid_vehicle_plan_t plan);
+const char *coavoid_vehicle_event_name(coavoid_vehicle_event_t event);
+
 /* What a vehicle did; read by drivers, the simulation and tests. */
 typedef struct {
-    int64_t cycle;          /* the current cycle k (-1 before the first) */
-    int32_t offset;         /* offset flown at sample k */
-    coa_vec3_t reference;   /* reference at t_k */
-    coa_vec3_t position;    /* reference + offset * dh: where it is */
-    bool coordinated;       /* following the coordinator this cycle */
-    bool waiting;           /* decoupled: still waiting for higher priorities */
-    bool published;         /* published its intent for this cycle */
-    uint32_t plans_run;     /* its own planning calls since start */
-    uint32_t plans_adopted; /* plans adopted (own and coordinator's) */
-    int last_outcome;       /* coa_plan_status_t of its last call, -1 none */
+    coavoid_vehicle_phase_t phase; /* its state machines, as they stand */
+    coavoid_vehicle_plan_t plan;
+    uint32_t protocol_faults; /* events its machines did not allow, since start (0) */
+    int64_t cycle;            /* the current cycle k (-1 before the first) */
+    int32_t offset;           /* offset flown at sample k */
+    coa_vec3_t reference;     /* reference at t_k */
+    coa_vec3_t position;      /* reference + offset * dh: where it is */
+    bool coordinated;         /* following the coordinator this cycle */
+    bool waiting;             /* decoupled: still waiting for higher priorities */
+    bool published;           /* published its intent for this cycle */
+    uint32_t plans_run;       /* its own planning calls since start */
+    uint32_t plans_adopted;   /* plans adopted (own and coordinator's) */
+    int last_outcome;         /* coa_plan_status_t of its last call, -1 none */
     uint64_t last_nodes_expanded;
     int64_t last_plan_duration_us; /* measured by the driver's clock: 0 in simulation */
     uint32_t conflicts;            /* conflicts in its last prediction */
@@ -333,6 +403,13 @@ coavoid_vehicle_node_t *coavoid_vehicle_node_init(void *memory, size_t size,
 /* Zeroes the node's copy of its signing key; the caller then frees the memory. NULL is
  * fine. O(1). */
 void coavoid_vehicle_node_fini(coavoid_vehicle_node_t *node);
+
+/* The channels the node takes in, i = 0..COAVOID_NODE_CHANNELS - 1: the name of the i-th
+ * when it takes it in, else NULL (a decoupled vehicle takes no plans, agreements or
+ * heartbeats). What a transport subscribes to, or a firmware forwards from its link.
+ * O(1). */
+#define COAVOID_NODE_CHANNELS 6u
+const char *coavoid_vehicle_node_channel(const coavoid_vehicle_node_t *node, size_t i);
 
 /* One datagram as it arrived on `channel` (COAVOID_CHANNEL_*), at the time of the common
  * clock: checked, decoded, validated and stored, or counted as refused (node.h's file

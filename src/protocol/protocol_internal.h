@@ -67,7 +67,6 @@ _Static_assert(COAVOID_NODE_MAX_SAMPLES == (unsigned)COAVOID_INTENT_T_MAX_SAMPLE
 
 /* The channels an inbox listens to (coavoid_node_inbox_channel): intents, tracks, the
  * obstacle map, heartbeats, plans and agreements; bit COAVOID_NODE_WANTS(X) of `wants`. */
-#define COAVOID_NODE_CHANNELS 6u
 enum {
     COAVOID_NODE_CHANNEL_INTENT,
     COAVOID_NODE_CHANNEL_TRACK,

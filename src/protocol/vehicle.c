@@ -40,23 +40,16 @@ struct coavoid_vehicle_node {
     coavoid_vehicle_node_config_t config;
     coavoid_vehicle_node_state_t state;
     coa_real_t dh;
-    bool started;
     int64_t first_cycle_start;
     int64_t cycle_start;
     int64_t wait_deadline;
-    /* While waiting: it waits for its first cycle's intents to gather (plan_self), until
-     * gather_end(). */
-    bool gather_wait;
-    bool standby_held; /* it planned a standby at the answer wait of this cycle */
     /* Following: when a conflict of its own with no answer yet makes it plan for itself
-     * within the cycle (answer_overdue), and whether that check has run this cycle. */
+     * within the cycle (answer_overdue, the phase's ANSWER_WAIT). */
     int64_t answer_deadline;
-    bool answer_checked;
     /* When answer_overdue found the held plan's self-commit not yet due: when it is
      * (INT64_MAX: none), and for which plan. */
     int64_t self_commit_at;
     int64_t self_commit_plan;
-    bool answering;     /* deciding for itself since the answer wait of this cycle */
     bool self_answered; /* it answered its own conflict in the cycle before (distrust) */
     bool was_coordinated;
     bool cycle_conflict;    /* a conflict of its own in this cycle's prediction */
@@ -67,9 +60,8 @@ struct coavoid_vehicle_node {
     int64_t intent_sequence;
     int64_t status_sequence;
     int64_t last_plan_utime;
-    /* The coordinator's plans of this cycle: whether one was adopted, and the plan_id of
-     * the last one. Plans are ordered within a cycle only (node.h, step 4). */
-    bool cycle_plan_adopted;
+    /* The plan_id of the coordinator's plan of this cycle it switched to (state.plan).
+     * Plans are ordered within a cycle only (node.h, step 4). */
     int64_t cycle_plan_id;
     bool cycle_plan_failed;  /* one listed it, in time, but was not solved */
     bool cycle_plan_refused; /* one listed it and was refused (on_plan) */
@@ -102,8 +94,8 @@ struct coavoid_vehicle_node {
     int32_t row_offsets[COAVOID_NODE_MAX_PEERS][COAVOID_NODE_MAX_SAMPLES];
 
     /* The coordinator's plan it accepted this cycle and flies once it is committed
-     * (docs/protocol.md): its row, and the plan's UAVs, whose SWITCHED is a commit too. */
-    bool pending;
+     * (docs/protocol.md; state.plan holds it): its row, and the plan's UAVs, whose
+     * SWITCHED is a commit too. */
     int64_t pending_plan_id;
     uint32_t pending_count;
     int32_t pending_offsets[COAVOID_NODE_MAX_SAMPLES];
@@ -169,6 +161,83 @@ struct coavoid_vehicle_node {
     coavoid_node_view_t view;
     coavoid_node_problem_tracks_t problem_tracks;
 };
+
+/* ---- its state machines (protocol.h; the tables are vehicle_states.c) ---- */
+
+/* An event its machine does not allow where it stands: a fault, and nothing moves. */
+static void not_allowed(coavoid_vehicle_node_t *node)
+{
+    node->fault = true;
+    node->state.protocol_faults++;
+}
+
+/* Moves the phase on `event`, and what the state reports with it: following the
+ * coordinator (FOLLOWING, FOLLOWED), and waiting to decide. O(table). */
+static void phase_on(coavoid_vehicle_node_t *node, coavoid_vehicle_event_t event)
+{
+    const coavoid_vehicle_phase_t to = coavoid_vehicle_phase_next(node->state.phase, event);
+    if (to == COAVOID_VEHICLE_PHASES) {
+        not_allowed(node);
+        return;
+    }
+    node->state.phase = to;
+    node->state.coordinated = to == COAVOID_VEHICLE_FOLLOWING || to == COAVOID_VEHICLE_FOLLOWED;
+    node->state.waiting = to == COAVOID_VEHICLE_DECIDING || to == COAVOID_VEHICLE_GATHERING ||
+                          to == COAVOID_VEHICLE_ANSWERING || to == COAVOID_VEHICLE_ANSWER_GATHERING;
+}
+
+/* Moves its plan state on `event`. O(table). */
+static void plan_on(coavoid_vehicle_node_t *node, coavoid_vehicle_event_t event)
+{
+    const coavoid_vehicle_plan_t to = coavoid_vehicle_plan_next(node->state.plan, event);
+    if (to == COAVOID_VEHICLE_PLAN_STATES) {
+        not_allowed(node);
+        return;
+    }
+    node->state.plan = to;
+}
+
+static bool started(const coavoid_vehicle_node_t *node)
+{
+    return node->state.phase != COAVOID_VEHICLE_IDLE;
+}
+
+/* Deciding for itself since the answer wait of this cycle. */
+static bool answering(const coavoid_vehicle_node_t *node)
+{
+    const coavoid_vehicle_phase_t p = node->state.phase;
+    return p == COAVOID_VEHICLE_ANSWERING || p == COAVOID_VEHICLE_ANSWER_GATHERING ||
+           p == COAVOID_VEHICLE_ANSWERED;
+}
+
+/* Waiting for its first cycle's intents to gather (plan_self), until gather_end(). */
+static bool gather_wait(const coavoid_vehicle_node_t *node)
+{
+    return node->state.phase == COAVOID_VEHICLE_GATHERING ||
+           node->state.phase == COAVOID_VEHICLE_ANSWER_GATHERING;
+}
+
+/* Holds an accepted plan of this cycle, undecided. */
+static bool holds_plan(const coavoid_vehicle_node_t *node)
+{
+    const coavoid_vehicle_plan_t p = node->state.plan;
+    return p == COAVOID_VEHICLE_PLAN_HOLDING || p == COAVOID_VEHICLE_PLAN_STANDBY ||
+           p == COAVOID_VEHICLE_PLAN_SWITCHED_HOLDING;
+}
+
+/* Flies a coordinator's plan of this cycle it switched to. */
+static bool flies_plan(const coavoid_vehicle_node_t *node)
+{
+    return node->state.plan == COAVOID_VEHICLE_PLAN_SWITCHED ||
+           node->state.plan == COAVOID_VEHICLE_PLAN_SWITCHED_HOLDING;
+}
+
+/* Planned a standby at the answer wait of this cycle, and flies it unless committed. */
+static bool on_standby(const coavoid_vehicle_node_t *node)
+{
+    return node->state.plan == COAVOID_VEHICLE_PLAN_STANDBY ||
+           node->state.plan == COAVOID_VEHICLE_PLAN_ON_STANDBY;
+}
 
 static int32_t offset_at(const coavoid_vehicle_node_t *node, int64_t k)
 {
@@ -285,9 +354,8 @@ static coavoid_lcm_intent_info_t intent_info(const coavoid_vehicle_node_t *node,
     /* A coordinator's plan switched to in this cycle is flown to its end (reconsider()),
      * coordinated or not (a self-commit, a standby that a COMMIT replaced): it says so, or
      * a peer's order search would count it in and plan around a row it never flies. */
-    info.mode = node->state.coordinated || node->cycle_plan_adopted
-                    ? COAVOID_INTENT_T_MODE_CENTRALISED
-                    : COAVOID_INTENT_T_MODE_DECOUPLED;
+    info.mode = node->state.coordinated || flies_plan(node) ? COAVOID_INTENT_T_MODE_CENTRALISED
+                                                            : COAVOID_INTENT_T_MODE_DECOUPLED;
     /* The state at `now`: it moves straight from sample k to sample k + 1. */
     coa_vec3_t p0 = node->own_samples[0];
     coa_vec3_t p1 = node->own_samples[1];
@@ -345,10 +413,9 @@ static int publish_intent(coavoid_vehicle_node_t *node, int64_t now)
 static int finish(coavoid_vehicle_node_t *node, int64_t now)
 {
     int rc = publish_intent(node, now);
-    node->state.waiting = false;
+    phase_on(node, COAVOID_VEHICLE_EVENT_PUBLISH);
     node->state.published = rc == COA_OK;
     node->wait_deadline = INT64_MAX;
-    node->gather_wait = false;
     int status_rc = publish_status(node, now);
     if (rc != COA_OK) {
         return rc;
@@ -594,7 +661,7 @@ static int plan_self(coavoid_vehicle_node_t *node, int64_t now, uint32_t my)
     coa_plan_result_t result;
     int rc = plan_in_order(node, now, my, &result);
     if (rc == COA_OK && result.status != COA_PLAN_SOLVED && gathering(node, now)) {
-        node->gather_wait = true;
+        phase_on(node, COAVOID_VEHICLE_EVENT_GATHER);
         return 1;
     }
     if (rc == COA_OK && result.status != COA_PLAN_SOLVED) {
@@ -705,7 +772,7 @@ static bool decided_peer(const coavoid_vehicle_node_t *node, size_t i)
 {
     const coavoid_node_view_t *view = &node->view;
     return view->live_current[i] &&
-           !(node->answering && view->live_info[i].mode == COAVOID_INTENT_T_MODE_CENTRALISED &&
+           !(answering(node) && view->live_info[i].mode == COAVOID_INTENT_T_MODE_CENTRALISED &&
              !row_flown(node, view->live_id[i], view->live_arrays[i].offsets,
                         view->live_plan[i].count));
 }
@@ -1418,7 +1485,7 @@ static int self_commit(coavoid_vehicle_node_t *node, int64_t now)
 {
     node->state.plans_self_committed++;
     switch_to_pending(node, now);
-    node->state.coordinated = false;
+    phase_on(node, COAVOID_VEHICLE_EVENT_SELF_COMMIT);
     return 1;
 }
 
@@ -1434,8 +1501,8 @@ static int self_commit(coavoid_vehicle_node_t *node, int64_t now)
  * standby. */
 static int answer_overdue(coavoid_vehicle_node_t *node, int64_t now)
 {
-    node->answer_checked = true;
-    if (node->cycle_plan_adopted) {
+    phase_on(node, COAVOID_VEHICLE_EVENT_ANSWER_WAIT);
+    if (flies_plan(node)) {
         return 0; /* a failed search it was told of is no answer by now: on_plan */
     }
     coa_predict_result_t result;
@@ -1448,13 +1515,12 @@ static int answer_overdue(coavoid_vehicle_node_t *node, int64_t now)
         return 0;
     }
     node->cycle_conflict = true;
-    if (!node->pending) {
+    if (!holds_plan(node)) {
         /* Distrusted as an unanswered UAV's: it decides for itself in the next cycle too,
          * unless it hears the coordinator again by then. */
         distrust_from(node, node->state.cycle, now);
         node->self_answered = true;
-        node->state.coordinated = false;
-        node->answering = true;
+        phase_on(node, COAVOID_VEHICLE_EVENT_UNANSWERED);
         const int64_t last = node->cycle_start + node->config.common.dt_us - 1;
         const int64_t until = now + node->config.answer_wait_us / 2;
         node->wait_deadline = until < last ? until : last; /* decided within its cycle */
@@ -1473,8 +1539,9 @@ static int answer_overdue(coavoid_vehicle_node_t *node, int64_t now)
     bool planned = false;
     rc = standby(node, now, &planned);
     if (rc == COA_OK && planned) {
-        node->state.coordinated = false; /* it flies the standby unless one is committed */
-        node->standby_held = true;
+        /* It flies the standby unless the plan it holds is committed. */
+        phase_on(node, COAVOID_VEHICLE_EVENT_STANDBY);
+        plan_on(node, COAVOID_VEHICLE_EVENT_STANDBY);
         rc = publish_intent(node, now);
     }
     node->fault = node->fault || rc != COA_OK;
@@ -1490,7 +1557,7 @@ static int decide(coavoid_vehicle_node_t *node, int64_t now)
     const coavoid_node_view_t *view = &node->view;
     const size_t n = gather(node, now);
     if (now < node->wait_deadline && near_pending(node, n)) {
-        node->state.waiting = true;
+        phase_on(node, COAVOID_VEHICLE_EVENT_WAIT);
         return 0;
     }
     note_order(node);
@@ -1514,7 +1581,7 @@ static int decide(coavoid_vehicle_node_t *node, int64_t now)
         }
     }
     if (pending && now < node->wait_deadline) {
-        node->state.waiting = true;
+        phase_on(node, COAVOID_VEHICLE_EVENT_WAIT);
         return 0;
     }
     /* Every member of a cluster in conflict plans, in the decoupled order, as
@@ -1524,8 +1591,7 @@ static int decide(coavoid_vehicle_node_t *node, int64_t now)
      * priority no way out. */
     rc = plan_self(node, now, my);
     if (rc == 1) {
-        node->state.waiting = true;
-        return 0;
+        return 0; /* GATHERING */
     }
     if (rc != COA_OK) {
         node->fault = true;
@@ -1549,6 +1615,7 @@ static int search_again(coavoid_vehicle_node_t *node, int64_t now)
         return 0;
     }
     node->wait_deadline = node->cycle_start + node->config.priority_wait_us;
+    phase_on(node, COAVOID_VEHICLE_EVENT_REDECIDE);
     return found == 1 ? fly_agreed(node, now) : decide(node, now);
 }
 
@@ -1559,7 +1626,7 @@ static int search_again(coavoid_vehicle_node_t *node, int64_t now)
  * whenever the network has any latency. O(1). */
 static bool world_news(const coavoid_vehicle_node_t *node)
 {
-    return node->decided_cycle == node->state.cycle && !node->standby_held &&
+    return node->decided_cycle == node->state.cycle && !on_standby(node) &&
            node->inbox.world_news != node->decided_news;
 }
 
@@ -1572,8 +1639,7 @@ static bool world_news(const coavoid_vehicle_node_t *node)
  * decide, 0 when there is nothing to do. */
 static int reconsider(coavoid_vehicle_node_t *node, int64_t now)
 {
-    if (!node->started || node->state.coordinated || !node->state.published ||
-        node->cycle_plan_adopted) {
+    if (!started(node) || node->state.coordinated || !node->state.published || flies_plan(node)) {
         return 0; /* a coordinator's plan it switched to is flown by every sibling too */
     }
     if (node->redecided_cycle != node->state.cycle) {
@@ -1592,6 +1658,7 @@ static int reconsider(coavoid_vehicle_node_t *node, int64_t now)
     }
     node->redecisions++;
     node->news_cycle = news ? node->state.cycle : node->news_cycle;
+    phase_on(node, COAVOID_VEHICLE_EVENT_REDECIDE);
     return decide_own(node, now);
 }
 
@@ -1622,8 +1689,8 @@ static void refuse_plan(coavoid_vehicle_node_t *node, int64_t now, int64_t plan_
     reject_plan(node, code, reason);
     node->state.plans_refused++;
     answer_with_copies(node, now, COAVOID_AGREEMENT_T_KIND_REFUSE, plan_id);
-    if (node->state.coordinated && !node->cycle_plan_adopted && !node->pending &&
-        !node->answer_checked && now < node->answer_deadline) {
+    if (node->state.phase == COAVOID_VEHICLE_FOLLOWING && !flies_plan(node) && !holds_plan(node) &&
+        now < node->answer_deadline) {
         node->answer_deadline = now;
     }
 }
@@ -1781,7 +1848,7 @@ static int answer(coavoid_vehicle_node_t *node, int64_t now, int8_t kind, int64_
 static void hold(coavoid_vehicle_node_t *node, int64_t now, const coavoid_lcm_plan_info_t *info,
                  const int32_t *row, size_t samples)
 {
-    node->pending = true;
+    plan_on(node, COAVOID_VEHICLE_EVENT_ACCEPT);
     node->pending_plan_id = info->plan_id;
     node->pending_count = (uint32_t)samples;
     memcpy(node->pending_offsets, row, samples * sizeof row[0]);
@@ -1800,9 +1867,8 @@ static void hold(coavoid_vehicle_node_t *node, int64_t now, const coavoid_lcm_pl
  * announces its new intent at once, so that every node learns of the change this cycle. */
 static void switch_to_pending(coavoid_vehicle_node_t *node, int64_t now)
 {
-    node->pending = false;
+    plan_on(node, COAVOID_VEHICLE_EVENT_COMMIT);
     adopt(node, node->pending_offsets, node->pending_count);
-    node->cycle_plan_adopted = true;
     node->cycle_plan_id = node->pending_plan_id;
     node->state.plans_switched++;
     answer_with_copies(node, now, COAVOID_AGREEMENT_T_KIND_SWITCHED, node->cycle_plan_id);
@@ -1846,13 +1912,13 @@ static int on_agreement(void *owner, const coavoid_agreement_t *msg)
 {
     coavoid_vehicle_node_t *node = owner;
     const int64_t now = *node->config.common.clock;
-    const bool this_cycle = node->started && msg->valid_from_utime == node->cycle_start &&
+    const bool this_cycle = started(node) && msg->valid_from_utime == node->cycle_start &&
                             now < node->cycle_start + node->config.common.dt_us;
     if (!this_cycle) {
         return COA_OK; /* late, or of a plan it never held */
     }
-    const bool held = node->pending && msg->plan_id == node->pending_plan_id;
-    const bool flown = node->cycle_plan_adopted && msg->plan_id == node->cycle_plan_id;
+    const bool held = holds_plan(node) && msg->plan_id == node->pending_plan_id;
+    const bool flown = flies_plan(node) && msg->plan_id == node->cycle_plan_id;
     if (msg->kind == COAVOID_AGREEMENT_T_KIND_COMMIT && flown) {
         (void)answer(node, now, COAVOID_AGREEMENT_T_KIND_SWITCHED, msg->plan_id); /* unheard */
     } else if (held && (msg->kind == COAVOID_AGREEMENT_T_KIND_COMMIT ||
@@ -1862,7 +1928,7 @@ static int on_agreement(void *owner, const coavoid_agreement_t *msg)
     } else if (held && msg->kind == COAVOID_AGREEMENT_T_KIND_ACCEPT) {
         note_accept(node, msg->node_id);
     } else if (held && msg->kind == COAVOID_AGREEMENT_T_KIND_ABORT) {
-        node->pending = false;
+        plan_on(node, COAVOID_VEHICLE_EVENT_ABORT);
         node->answer_copies_left = 0;
         node->state.plans_aborted++;
     }
@@ -1872,16 +1938,16 @@ static int on_agreement(void *owner, const coavoid_agreement_t *msg)
 /* A plan of this cycle it already answered, sent again because its answer was lost:
  * answered again, as before (its own copies of the answer were all lost, or are not yet
  * sent). */
-static bool again(coavoid_vehicle_node_t *node, int64_t now, const coavoid_plan_t *msg)
+static bool answer_again(coavoid_vehicle_node_t *node, int64_t now, const coavoid_plan_t *msg)
 {
-    if (!node->started || msg->valid_from_utime != node->cycle_start) {
+    if (!started(node) || msg->valid_from_utime != node->cycle_start) {
         return false;
     }
-    if (node->pending && msg->plan_id == node->pending_plan_id) {
+    if (holds_plan(node) && msg->plan_id == node->pending_plan_id) {
         (void)answer(node, now, COAVOID_AGREEMENT_T_KIND_ACCEPT, msg->plan_id);
         return true;
     }
-    if (node->cycle_plan_adopted && msg->plan_id == node->cycle_plan_id) {
+    if (flies_plan(node) && msg->plan_id == node->cycle_plan_id) {
         (void)answer(node, now, COAVOID_AGREEMENT_T_KIND_SWITCHED, msg->plan_id);
         return true;
     }
@@ -1892,7 +1958,7 @@ static bool again(coavoid_vehicle_node_t *node, int64_t now, const coavoid_plan_
 static bool on_plan_row(void *owner, const coavoid_plan_t *msg)
 {
     coavoid_vehicle_node_t *node = owner;
-    return again(node, *node->config.common.clock, msg);
+    return answer_again(node, *node->config.common.clock, msg);
 }
 
 /* Why this UAV cannot fly a plan's row of this cycle (`samples` offsets from the cycle's
@@ -1936,7 +2002,7 @@ static void on_plan(void *owner, const coavoid_plan_t *msg, const coavoid_lcm_pl
             row = i;
         }
     }
-    if (row != SIZE_MAX && result->status != COA_PLAN_SOLVED && !info->abandoned && node->started &&
+    if (row != SIZE_MAX && result->status != COA_PLAN_SOLVED && !info->abandoned && started(node) &&
         msg->valid_from_utime == node->cycle_start && now < msg->valid_until_utime) {
         /* The coordinator tried this cycle and found nothing: that answers the cycle for
          * update_trust (a UAV told so is not unanswered at its end), and it may still send
@@ -1945,7 +2011,7 @@ static void on_plan(void *owner, const coavoid_plan_t *msg, const coavoid_lcm_pl
          * stopped right after the notice, and flying on into a conflict answers nothing. */
         node->cycle_plan_failed = true;
     }
-    if (result->status == COA_PLAN_SOLVED && node->started &&
+    if (result->status == COA_PLAN_SOLVED && started(node) &&
         msg->valid_from_utime == node->cycle_start && now < msg->valid_until_utime) {
         record_rows(node, msg, info, result, offsets);
     }
@@ -1953,7 +2019,7 @@ static void on_plan(void *owner, const coavoid_plan_t *msg, const coavoid_lcm_pl
         coavoid_lcm_rx_count(&node->state.rx, COA_OK, NULL); /* not a plan for it */
         return;
     }
-    if (!node->started || msg->valid_from_utime != node->cycle_start) {
+    if (!started(node) || msg->valid_from_utime != node->cycle_start) {
         reject_plan(node, COAVOID_LCM_ERR_TIME, "plan: valid_from is not this cycle's start");
         return;
     }
@@ -1961,7 +2027,7 @@ static void on_plan(void *owner, const coavoid_plan_t *msg, const coavoid_lcm_pl
         reject_plan(node, COAVOID_LCM_ERR_TIME, "plan: arrived after valid_until");
         return;
     }
-    if (node->cycle_plan_adopted && msg->plan_id <= node->cycle_plan_id) {
+    if (flies_plan(node) && msg->plan_id <= node->cycle_plan_id) {
         refuse_plan(node, now, msg->plan_id, COAVOID_LCM_ERR_SEQUENCE,
                     "plan: plan_id not after the one adopted this cycle");
         return;
@@ -2149,6 +2215,11 @@ int coavoid_vehicle_node_receive(coavoid_vehicle_node_t *node, const char *chann
                         : COA_ERR_ARGUMENT;
 }
 
+const char *coavoid_vehicle_node_channel(const coavoid_vehicle_node_t *node, size_t i)
+{
+    return node != NULL ? coavoid_node_inbox_channel(&node->inbox, i) : NULL;
+}
+
 coavoid_node_inbox_t *coavoid_vehicle_node_inbox(coavoid_vehicle_node_t *node)
 {
     return &node->inbox;
@@ -2161,13 +2232,11 @@ static void fly_to(coavoid_vehicle_node_t *node, int64_t k, int64_t now)
     /* A plan accepted and neither committed nor aborted within its cycle is not flown:
      * the coordinator commits only what every UAV accepted, so flying it on a guess
      * could split the plan; flying on as before is what an abort would have said. */
-    node->state.plans_in_doubt += node->pending ? 1u : 0u;
-    node->state.plans_standby += node->pending && node->standby_held ? 1u : 0u;
-    node->standby_held = false;
-    node->pending = false;
+    node->state.plans_in_doubt += holds_plan(node) ? 1u : 0u;
+    node->state.plans_standby += node->state.plan == COAVOID_VEHICLE_PLAN_STANDBY ? 1u : 0u;
+    plan_on(node, COAVOID_VEHICLE_EVENT_CYCLE);
     node->answer_copies_left = 0;
     node->intent_copies_left = 0;
-    node->cycle_plan_adopted = false;
     node->cycle_plan_failed = false;
     node->last_cycle_refused = node->cycle_plan_refused;
     node->cycle_plan_refused = false;
@@ -2248,15 +2317,14 @@ int coavoid_vehicle_node_cycle(coavoid_vehicle_node_t *node, int64_t now)
     if (k < 0) {
         return COA_ERR_ARGUMENT;
     }
-    if (node->started && k <= node->state.cycle) {
+    if (started(node) && k <= node->state.cycle) {
         return COA_OK;
     }
-    if (!node->started) {
-        node->started = true;
+    if (!started(node)) {
         node->first_cycle_start = coavoid_node_cycle_utime(c, k);
     }
     node->fault = false;
-    const bool previous_adopted = node->cycle_plan_adopted;
+    const bool previous_adopted = flies_plan(node);
     const bool previous_answered = previous_adopted || node->cycle_plan_failed;
     fly_to(node, k, now);
     const int predicted = update_trust(node, k, now, previous_adopted, previous_answered);
@@ -2270,17 +2338,12 @@ int coavoid_vehicle_node_cycle(coavoid_vehicle_node_t *node, int64_t now)
         node->state.fallbacks++;
     }
     node->was_coordinated = coordinated;
-    node->state.coordinated = coordinated;
     node->state.published = false;
-    node->state.waiting = false;
     node->wait_deadline = INT64_MAX;
-    node->gather_wait = false;
-
-    int rc;
-    node->answer_checked = false;
     node->self_commit_at = INT64_MAX;
-    node->answering = false;
     node->answer_deadline = node->cycle_start + node->config.answer_wait_us;
+    phase_on(node, coordinated ? COAVOID_VEHICLE_EVENT_FOLLOW : COAVOID_VEHICLE_EVENT_DECIDE);
+    int rc;
     if (coordinated) {
         drop_rank(node);
         rc = finish(node, now);
@@ -2317,18 +2380,18 @@ int coavoid_vehicle_node_poll(coavoid_vehicle_node_t *node, int64_t now)
     if (node == NULL) {
         return COA_ERR_ARGUMENT;
     }
-    if (!node->started || now >= node->cycle_start + node->config.common.dt_us) {
+    if (!started(node) || now >= node->cycle_start + node->config.common.dt_us) {
         return 0; /* copies belong to their cycle */
     }
     int sent = send_copies(node, now);
     if (now >= node->self_commit_at) {
         node->self_commit_at = INT64_MAX;
-        if (node->pending && node->pending_plan_id == node->self_commit_plan &&
+        if (holds_plan(node) && node->pending_plan_id == node->self_commit_plan &&
             all_accepted(node)) {
             return self_commit(node, now);
         }
     }
-    if (node->state.coordinated && !node->answer_checked && now >= node->answer_deadline) {
+    if (node->state.phase == COAVOID_VEHICLE_FOLLOWING && now >= node->answer_deadline) {
         int overdue = answer_overdue(node, now);
         if (overdue != 0) {
             return overdue;
@@ -2348,11 +2411,11 @@ int64_t coavoid_vehicle_node_deadline(const coavoid_vehicle_node_t *node)
         return INT64_MAX;
     }
     int64_t deadline = node->state.waiting ? node->wait_deadline : INT64_MAX;
-    if (node->state.waiting && node->gather_wait && gather_end(node) < deadline) {
+    if (gather_wait(node) && gather_end(node) < deadline) {
         deadline = gather_end(node);
     }
     const int64_t end = node->cycle_start + node->config.common.dt_us;
-    if (node->state.coordinated && !node->answer_checked && node->answer_deadline < deadline) {
+    if (node->state.phase == COAVOID_VEHICLE_FOLLOWING && node->answer_deadline < deadline) {
         deadline = node->answer_deadline;
     }
     deadline = node->self_commit_at < deadline ? node->self_commit_at : deadline;

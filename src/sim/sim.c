@@ -1163,6 +1163,14 @@ static int sim_report(sim_run_t *r, coavoid_sim_outcome_t *outcome)
         const coavoid_vehicle_node_state_t *st = coavoid_vehicle_node_state(r->vehicles[j]);
         replans += st->plans_run;
         fallbacks += st->fallbacks;
+        if (st->protocol_faults > 0u) {
+            /* An event its state machines do not allow: a bug of the protocol library. */
+            return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INTERNAL,
+                                    "internal error: UAV %u made %lu transitions its state "
+                                    "machines do not allow",
+                                    (unsigned)r->s->vehicles[r->index[j]].id,
+                                    (unsigned long)st->protocol_faults);
+        }
     }
     int rc = coavoid_judge_run(&r->judged, r->s, o->mode, r->steps, replans, r->references,
                                r->offsets, NULL);
