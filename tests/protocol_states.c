@@ -8,6 +8,7 @@
  *   protocol_states --check F  exit 0 when F holds exactly that block, 1 (saying so) if not
  *   protocol_states --write F  replaces the block in F
  */
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -130,44 +131,55 @@ static char *read_file(const char *path, size_t *length)
     return b.text;
 }
 
+/* --check or --write of the block in the document `path`; the exit status. */
+static int check_or_write(const char *path, bool write, const buffer_t *block)
+{
+    size_t length = 0;
+    char *doc = read_file(path, &length);
+    char *begin = strstr(doc, BEGIN);
+    char *end = begin != NULL ? strstr(begin, END) : NULL;
+    int status = 0;
+    if (end == NULL) {
+        fprintf(stderr, "protocol_states: %s has no vehicle-states block\n", path);
+        status = 1;
+    } else if (!write) {
+        end += strlen(END);
+        const size_t old = (size_t)(end - begin);
+        if (old != block->length || memcmp(begin, block->text, old) != 0) {
+            fprintf(stderr,
+                    "protocol_states: the state machines in %s are not those of "
+                    "src/protocol/vehicle_states.c: run protocol_states --write %s\n",
+                    path, path);
+            status = 1;
+        } else {
+            printf("protocol_states: %s draws the tables as they are\n", path);
+        }
+    } else {
+        end += strlen(END);
+        FILE *f = fopen(path, "wb");
+        if (f == NULL || fwrite(doc, 1, (size_t)(begin - doc), f) != (size_t)(begin - doc) ||
+            fputs(block->text, f) < 0 || fputs(end, f) < 0 || fclose(f) != 0) {
+            fprintf(stderr, "protocol_states: cannot write %s\n", path);
+            status = 2;
+        }
+    }
+    free(doc);
+    return status;
+}
+
 int main(int argc, char **argv)
 {
     buffer_t block = {NULL, 0, 0};
     draw(&block);
+    int status = 0;
     if (argc == 1) {
         fputs(block.text, stdout);
-        return 0;
-    }
-    if (argc != 3 || (strcmp(argv[1], "--check") != 0 && strcmp(argv[1], "--write") != 0)) {
+    } else if (argc != 3 || (strcmp(argv[1], "--check") != 0 && strcmp(argv[1], "--write") != 0)) {
         fprintf(stderr, "usage: protocol_states [--check FILE | --write FILE]\n");
-        return 2;
+        status = 2;
+    } else {
+        status = check_or_write(argv[2], strcmp(argv[1], "--write") == 0, &block);
     }
-    size_t length = 0;
-    char *doc = read_file(argv[2], &length);
-    char *begin = strstr(doc, BEGIN);
-    char *end = begin != NULL ? strstr(begin, END) : NULL;
-    if (end == NULL) {
-        fprintf(stderr, "protocol_states: %s has no vehicle-states block\n", argv[2]);
-        return 1;
-    }
-    end += strlen(END);
-    const size_t old = (size_t)(end - begin);
-    if (strcmp(argv[1], "--check") == 0) {
-        if (old != block.length || memcmp(begin, block.text, old) != 0) {
-            fprintf(stderr,
-                    "protocol_states: the state machines in %s are not those of "
-                    "src/protocol/vehicle_states.c: run protocol_states --write %s\n",
-                    argv[2], argv[2]);
-            return 1;
-        }
-        printf("protocol_states: %s draws the tables as they are\n", argv[2]);
-        return 0;
-    }
-    FILE *f = fopen(argv[2], "wb");
-    if (f == NULL || fwrite(doc, 1, (size_t)(begin - doc), f) != (size_t)(begin - doc) ||
-        fputs(block.text, f) < 0 || fputs(end, f) < 0 || fclose(f) != 0) {
-        fprintf(stderr, "protocol_states: cannot write %s\n", argv[2]);
-        return 2;
-    }
-    return 0;
+    free(block.text);
+    return status;
 }

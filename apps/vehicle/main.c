@@ -3,7 +3,7 @@
  * coavoid-vehicle: one simulated UAV of a scenario as a process of its own. It flies its
  * route, publishes its intent every cycle, follows the coordinator's plans while the
  * coordinator's heartbeat is heard and plans for itself in priority order when it is not
- * (or always, in decoupled mode). The node is src/node/vehicle.c; this file only reads
+ * (or always, in decoupled mode). The node is src/protocol's vehicle; this file only reads
  * the options and runs it in real time (realtime.h). See VEHICLE_USAGE below.
  */
 #define _POSIX_C_SOURCE 200809L

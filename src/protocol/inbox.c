@@ -200,6 +200,26 @@ static void peer_keep(coavoid_node_peer_t *peer, const coavoid_intent_t *msg)
     peer->msg = *msg;
 }
 
+/* UAV uav_id's slot among the peers, or a free one while fewer than peer_capacity are
+ * used, else COAVOID_NODE_MAX_PEERS. O(MAX_PEERS). */
+static size_t peer_slot(const coavoid_node_inbox_t *in, int32_t uav_id)
+{
+    size_t slot = COAVOID_NODE_MAX_PEERS;
+    size_t used = 0;
+    for (size_t i = 0; i < COAVOID_NODE_MAX_PEERS; i++) {
+        if (in->peers[i].used) {
+            used++;
+            slot = in->peers[i].msg.uav_id == uav_id ? i : slot;
+        }
+    }
+    for (size_t i = 0;
+         slot == COAVOID_NODE_MAX_PEERS && used < in->peer_capacity && i < COAVOID_NODE_MAX_PEERS;
+         i++) {
+        slot = in->peers[i].used ? slot : i;
+    }
+    return slot;
+}
+
 static void on_intent(coavoid_node_inbox_t *in, const uint8_t *data, int size)
 {
     coavoid_intent_t *msg = &in->rx_msg.intent;
@@ -232,24 +252,7 @@ static void on_intent(coavoid_node_inbox_t *in, const uint8_t *data, int size)
     const int64_t now = *in->common.clock;
     /* A place to keep it before the sequence rule, so that a full table does not
      * swallow a sequence number it then drops. */
-    size_t slot = COAVOID_NODE_MAX_PEERS;
-    size_t used = 0;
-    for (size_t i = 0; i < COAVOID_NODE_MAX_PEERS; i++) {
-        if (in->peers[i].used) {
-            used++;
-            if (in->peers[i].msg.uav_id == msg->uav_id) {
-                slot = i;
-            }
-        }
-    }
-    if (slot == COAVOID_NODE_MAX_PEERS && used < in->peer_capacity) {
-        for (size_t i = 0; i < COAVOID_NODE_MAX_PEERS; i++) {
-            if (!in->peers[i].used) {
-                slot = i;
-                break;
-            }
-        }
-    }
+    const size_t slot = peer_slot(in, msg->uav_id);
     if (slot == COAVOID_NODE_MAX_PEERS) {
         coavoid_lcm_rx_count(in->rx, COAVOID_LCM_ERR_SENDERS,
                              "intent: more UAVs than the node holds");
@@ -604,6 +607,34 @@ int coavoid_node_inbox_receive(coavoid_node_inbox_t *in, const char *channel, co
     return COA_ERR_ARGUMENT;
 }
 
+/* Nothing received yet: no senders, peers, tracks or map, nothing counted. */
+static void inbox_empty(coavoid_node_inbox_t *in)
+{
+    coavoid_lcm_rx_init(in->rx);
+    senders_init(&in->intent_seq);
+    senders_init(&in->track_seq);
+    senders_init(&in->map_seq);
+    senders_init(&in->status_seq);
+    memset(in->peers, 0, sizeof in->peers);
+    memset(in->tracks, 0, sizeof in->tracks);
+    in->have_map = false;
+    in->map_id = 0;
+    in->map_version = 0;
+    in->map_tiles_have = 0u;
+    in->map_obstacle_count = 0;
+    in->world_news = 0u;
+    coavoid_lcm_plan_rows_init(&in->plan_rows, in->plan_slots, COAVOID_NODE_PLAN_SLOTS);
+    obstacles_merge(in);
+    memset(in->own_hash, 0, sizeof in->own_hash);
+    memset(in->own_size, 0, sizeof in->own_size);
+    in->own_next = 0;
+    in->foreign_intents = 0;
+    in->rejected_at_heartbeat = 0;
+    budget_init(in);
+    in->heard_coordinator = false;
+    in->coordinator_utime = 0;
+}
+
 int coavoid_node_inbox_init(coavoid_node_inbox_t *in, const coavoid_node_common_t *common,
                             uint16_t self_uav, uint16_t self_node, uint16_t coordinator_id,
                             size_t peer_capacity, const coavoid_node_link_t *link,
@@ -634,29 +665,7 @@ int coavoid_node_inbox_init(coavoid_node_inbox_t *in, const coavoid_node_common_
     }
     in->common.signer = NULL; /* copied: the caller's may go */
     in->common.trust = NULL;
-    coavoid_lcm_rx_init(in->rx);
-    senders_init(&in->intent_seq);
-    senders_init(&in->track_seq);
-    senders_init(&in->map_seq);
-    senders_init(&in->status_seq);
-    memset(in->peers, 0, sizeof in->peers);
-    memset(in->tracks, 0, sizeof in->tracks);
-    in->have_map = false;
-    in->map_id = 0;
-    in->map_version = 0;
-    in->map_tiles_have = 0u;
-    in->map_obstacle_count = 0;
-    in->world_news = 0u;
-    coavoid_lcm_plan_rows_init(&in->plan_rows, in->plan_slots, COAVOID_NODE_PLAN_SLOTS);
-    obstacles_merge(in);
-    memset(in->own_hash, 0, sizeof in->own_hash);
-    memset(in->own_size, 0, sizeof in->own_size);
-    in->own_next = 0;
-    in->foreign_intents = 0;
-    in->rejected_at_heartbeat = 0;
-    budget_init(in);
-    in->heard_coordinator = false;
-    in->coordinator_utime = 0;
+    inbox_empty(in);
     in->on_plan = plan_handler;
     in->on_agreement = NULL;
     in->on_plan_row = NULL;

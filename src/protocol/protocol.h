@@ -43,11 +43,20 @@
 #define COAVOID_CHANNEL_STATUS "COAVOID_STATUS"
 #define COAVOID_CHANNEL_AGREEMENT "COAVOID_AGREEMENT"
 
-/* Capacities of one node's view of the airspace. */
-#define COAVOID_NODE_MAX_PEERS 64u   /* co-operative UAVs a node tracks, itself included */
-#define COAVOID_NODE_MAX_TRACKS 32u  /* non-cooperative tracks */
+/* Capacities of one node's view of the airspace. A build may set the first, second and
+ * fourth lower (-D, the same for every file that includes this header): an autopilot's
+ * vehicle sized for its fleet (the Cortex-M4F build sets 9, 4 and 16:
+ * src/protocol/CMakeLists.txt). */
+#ifndef COAVOID_NODE_MAX_PEERS
+#define COAVOID_NODE_MAX_PEERS 64u /* co-operative UAVs a node tracks, itself included */
+#endif
+#ifndef COAVOID_NODE_MAX_TRACKS
+#define COAVOID_NODE_MAX_TRACKS 32u /* non-cooperative tracks */
+#endif
 #define COAVOID_NODE_MAX_HORIZON 40u /* N: intent_t carries N + 1 samples, in one datagram */
+#ifndef COAVOID_NODE_MAX_CONFIGURED_OBSTACLES
 #define COAVOID_NODE_MAX_CONFIGURED_OBSTACLES 80u /* a node's own terrain database */
+#endif
 
 /* The inbox budget (docs/security.md, "Floods"). A datagram whose tail and fleet tag
  * pass (coavoid_auth_precheck) costs a signature check; per cycle, a node makes at most

@@ -28,7 +28,7 @@ _Static_assert(COAVOID_NODE_MAX_SAMPLES == (unsigned)COAVOID_INTENT_T_MAX_SAMPLE
                    COAVOID_NODE_MAX_SAMPLES == (unsigned)COAVOID_PLAN_T_MAX_SAMPLES,
                "an intent and a plan carry N + 1 samples of the node's largest horizon");
 /* How many steps beyond the horizon a vehicle's order search looks when it chooses among
- * the orders that solve the horizon (vehicle.c, look_ahead): enough to tell apart, in
+ * the orders that solve the horizon (vehicle_order.c, look_ahead): enough to tell apart, in
  * 5-UAV encounter 231 of seed 1, the order whose plan leaves no way on from the one that
  * does (one step does; two leave a margin). A problem holds up to N + 1 + LOOKAHEAD
  * samples. */
@@ -102,7 +102,7 @@ typedef struct {
     coavoid_intent_t msg; /* validated on arrival */
     /* The latest intent of an earlier cycle than msg's (has_prev): what a vehicle's order
      * search reads as the intents of a cycle's start, whether or not the UAV has already
-     * published its intent of the cycle (vehicle.c, search_order). */
+     * published its intent of the cycle (vehicle_order.c, coavoid_vehicle_search_order). */
     bool has_prev;
     coavoid_intent_t prev;
 } coavoid_node_peer_t;
@@ -119,7 +119,7 @@ coavoid_node_inbox_t *coavoid_vehicle_node_inbox(coavoid_vehicle_node_t *node);
 
 /* Called for a whole plan: the message that completed it (every listed UAV's row decoded
  * and passed validation, from its coordinator); msg is the plan's first message, its
- * header. No sequence rule is applied to plans (vehicle.c orders those of one cycle,
+ * header. No sequence rule is applied to plans (vehicle_agreement.c orders those of one cycle,
  * decides on adoption and counts the outcome itself). */
 typedef void (*coavoid_node_plan_handler_t)(void *owner, const coavoid_plan_t *msg,
                                             const coavoid_lcm_plan_info_t *info,
@@ -190,7 +190,7 @@ struct coavoid_node_inbox {
 
     /* Counts the tracks it took in while holding none of theirs, and the obstacle maps it
      * put in use (wraps): what it knows of the world grew when it changed, which a vehicle
-     * that decided before then decides again on (vehicle.c, reconsider). */
+     * that decided before then decides again on (vehicle_decide.c, coavoid_vehicle_reconsider). */
     uint32_t world_news;
 
     bool heard_coordinator;    /* a coordinator's status_t was received */

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /*
  * The vehicle's two state machines (protocol.h): every transition either may make, as a
- * table. vehicle.c moves only through these tables; docs/protocol.md draws them from
+ * table. The vehicle (vehicle*.c) moves only through these tables; docs/protocol.md draws them from
  * here (tests/protocol_states.c prints the drawing, and the protocol_states test compares
  * it with the document).
  */

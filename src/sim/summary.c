@@ -98,9 +98,10 @@
 
 /*
  * PLANS_PER_CYCLE: the most planning calls (plans_run increments) a node makes in one of its
- * cycles, from src/node:
- *   - a UAV (vehicle.c): it plans in decide() only, through plan_self(), which is followed
- *     at once by finish() (its intent and the cycle's heartbeat); after that the cycle
+ * cycles, from src/protocol and src/node:
+ *   - a UAV (src/protocol/vehicle_decide.c): it plans in coavoid_vehicle_decide() only,
+ *     through plan_self(), which is followed at once by finish() (its intent and the
+ *     cycle's heartbeat); after that the cycle
  *     is over for it (poll() does nothing unless it waits, and a second call of the same
  *     cycle returns at once). plan_self() searches once (search_self) and, when that
  *     fails with lower priorities outside its cluster in the way, once more around the
