@@ -92,3 +92,58 @@ objs_host=(); for f in $core; do objs_host+=("$work/$f.o"); done
 cc -std=c11 "${defs[@]}" -I"$src/include" "$work/sizes.c" "${objs_host[@]}" \
   -lccd -lm -o "$work/sizes"
 "$work/sizes" "$host_planner" "$arm_planner" "$host_predictor" "$arm_predictor"
+
+# The vehicle protocol (src/protocol) as the cross build sizes it: its struct from the ARM
+# objects' debug information, and coavoid_vehicle_node_size's other terms (the solver:
+# predictor, planner and conflicts) from the host's size functions at the ARM build's
+# capacities (its -D flags), moved to the target by their headers as above.
+pobjs=$arm/src/protocol/CMakeFiles/coavoid_protocol.dir
+flags=$pobjs/flags.make
+[ -f "$flags" ] || { echo "embedded_sizes: $flags not found (no src/protocol in the ARM build)" >&2; exit 1; }
+read -r -a pdefs <<< "$(sed -n 's/^C_DEFINES = //p' "$flags")"
+arm_vehicle=$(struct_size arm-none-eabi-readelf "$pobjs/vehicle.c.obj" coavoid_vehicle_node)
+arm_inbox=$(struct_size arm-none-eabi-readelf "$pobjs/inbox.c.obj" coavoid_node_inbox)
+[ -n "$arm_vehicle" ] && [ -n "$arm_inbox" ] ||
+  { echo "embedded_sizes: the vehicle's struct size not found (built without -g?)" >&2; exit 1; }
+arm_vehicle=$((arm_vehicle)) # readelf writes large sizes in hexadecimal
+arm_inbox=$((arm_inbox))
+cat > "$work/vehicle.c" <<'C'
+#include <stdio.h>
+#include <stdlib.h>
+#include "protocol_internal.h"
+static size_t round8(size_t a) { return (a + 7u) / 8u * 8u; }
+int main(int argc, char **argv)
+{
+    size_t hp = strtoul(argv[1], NULL, 10), ap = strtoul(argv[2], NULL, 10);
+    size_t hq = strtoul(argv[3], NULL, 10), aq = strtoul(argv[4], NULL, 10);
+    size_t vehicle = strtoul(argv[5], NULL, 10), inbox = strtoul(argv[6], NULL, 10);
+    const size_t n = COAVOID_NODE_MAX_PEERS;
+    const size_t pairs = n * (n - 1u) / 2u + n * COAVOID_NODE_TRACK_CAPACITY +
+                         n * COAVOID_NODE_MAX_OBSTACLES; /* coavoid_node_max_pairs */
+    (void)argc;
+    printf("vehicle protocol (%zu UAVs with itself, %u tracks, %u obstacles of its own), "
+           "Cortex-M4F bytes:\n", n, (unsigned)COAVOID_NODE_MAX_TRACKS,
+           (unsigned)COAVOID_NODE_MAX_CONFIGURED_OBSTACLES);
+    printf("  node struct %zu (inbox %zu)\n", vehicle, inbox);
+    static const uint32_t horizons[] = {12u, 24u};
+    for (size_t h = 0; h < 2u; ++h) {
+        const uint32_t N = horizons[h];
+        size_t predictor = coa_predictor_workspace_size(n, COAVOID_NODE_TRACK_CAPACITY, N, pairs);
+        predictor = predictor - round8(hq) + round8(aq);
+        /* A decoupled vehicle's planner: one UAV over N + 2 (the order search's look-ahead),
+         * the steep factor and unbounded offsets of coavoid_node_planner_config. */
+        coa_planner_config_t c = {1u, 20000u, N + 2u, COA_MAX_STEEP_FACTOR, -1};
+        size_t planner = coa_planner_workspace_size(&c) - round8(hp) + round8(ap);
+        size_t conflicts = round8(pairs * sizeof(coa_conflict_t)); /* fixed-width: 40 on both */
+        printf("  N %u: predictor %zu, one-UAV planner %zu, conflicts %zu (%zu pairs); "
+               "coavoid_vehicle_node_size %zu\n", N, predictor, planner, conflicts, pairs,
+               round8(vehicle) + round8(predictor) + round8(planner) + conflicts);
+    }
+    return 0;
+}
+C
+cc -std=c11 "${pdefs[@]}" -I"$src/include" -I"$src/src/protocol" -I"$src/src/lcm" \
+  -I"$src/src/auth" -I"$arm/lcmtypes/include" -I"$arm/lcmtypes/part-include" \
+  "$work/vehicle.c" "${objs_host[@]}" -lccd -lm -o "$work/vehicle"
+"$work/vehicle" "$host_planner" "$arm_planner" "$host_predictor" "$arm_predictor" \
+  "$arm_vehicle" "$arm_inbox"

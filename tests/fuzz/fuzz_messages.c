@@ -13,16 +13,21 @@
  * Every datagram also goes through the signature check (auth.h) against a trust list of one
  * key, and kind 6 feeds the bytes to the trust and secret key file parsers. Every input
  * after its first byte is also a datagram off the socket for the drivers' receiver's
- * framing (coavoid_rt_rx_parse), whose frame must lie inside it. Nothing may
- * crash, leak or trip a sanitizer, whatever the bytes.
+ * framing (coavoid_rt_rx_parse), whose frame must lie inside it. And every datagram of a
+ * type a vehicle takes in is handed to one (the vehicle protocol, protocol.h: insecure, so
+ * that what it decodes reaches its inbox, its plan collection and its check of a plan
+ * for it), which keeps what it stores from one input to the next and polls after each.
+ * Nothing may crash, leak or trip a sanitizer, whatever the bytes.
  */
 #include <stddef.h>
 #include <stdint.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "auth.h"
 #include "coavoid_lcm.h"
 #include "lcm_examples.h"
+#include "protocol.h"
 #include "realtime.h"
 
 #define FUZZ_BUF 20000
@@ -194,6 +199,65 @@ static void check_frame(const unsigned char *datagram, size_t size)
     }
 }
 
+static int64_t vehicle_clock = T0;
+
+static int drop_send(void *user, const char *channel, const uint8_t *data, size_t size)
+{
+    (void)user, (void)channel, (void)data, (void)size;
+    return COA_OK;
+}
+
+/* UAV 10 of the example plan, following its coordinator, in the cycle that starts at T0
+ * (epoch T0 - 5 s, dt 1 s, N 40): built once, in memory of its own, kept for the run. */
+static coavoid_vehicle_node_t *vehicle(void)
+{
+    static coavoid_vehicle_node_t *node;
+    static coa_vec3_t route[2] = {{0, 0, 100}, {1000, 0, 100}};
+    if (node != NULL) {
+        return node;
+    }
+    coavoid_vehicle_node_config_t c;
+    memset(&c, 0, sizeof c);
+    if (coavoid_node_common_defaults(&c.common, T0 - INT64_C(5000000), (coa_real_t)1, 40u,
+                                     &vehicle_clock) != COA_OK) {
+        abort();
+    }
+    c.common.insecure = true;
+    c.vehicle.id = 10;
+    c.vehicle.priority = 1;
+    c.vehicle.cruise_speed = (coa_real_t)10;
+    c.vehicle.climb_rate = (coa_real_t)2;
+    c.vehicle.steep_factor = 2;
+    c.vehicle.volume.radius = (coa_real_t)15;
+    c.vehicle.volume.half_height = (coa_real_t)5;
+    c.vehicle.route = route;
+    c.vehicle.route_count = 2;
+    c.vehicle.max_offset = -1;
+    c.mode = COAVOID_NODE_CENTRALISED;
+    const size_t size = coavoid_vehicle_node_size(&c);
+    static void *memory; /* for the whole run: a leak check at exit does not see it lost */
+    memory = size > 0u ? malloc(size) : NULL;
+    const coavoid_node_link_t link = {drop_send, NULL};
+    node = memory != NULL ? coavoid_vehicle_node_init(memory, size, &c, &link, NULL) : NULL;
+    if (node == NULL || coavoid_vehicle_node_cycle(node, T0) != COA_OK) {
+        abort();
+    }
+    return node;
+}
+
+/* The datagram to the vehicle on its type's channel, then a poll. */
+static void to_vehicle(unsigned kind, const unsigned char *buf, size_t n)
+{
+    static const char *const channels[] = {COAVOID_CHANNEL_INTENT,    COAVOID_CHANNEL_PLAN,
+                                           COAVOID_CHANNEL_TRACK,     COAVOID_CHANNEL_OBSTACLES,
+                                           COAVOID_CHANNEL_CONFLICTS, COAVOID_CHANNEL_STATUS,
+                                           COAVOID_CHANNEL_AGREEMENT};
+    coavoid_vehicle_node_t *node = vehicle();
+    vehicle_clock = T0 + 1000;
+    (void)coavoid_vehicle_node_receive(node, channels[kind], buf, n);
+    (void)coavoid_vehicle_node_poll(node, vehicle_clock);
+}
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     static unsigned char buf[FUZZ_BUF];
@@ -219,6 +283,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         n = base;
     }
     check_signature(buf, n);
+    to_vehicle(kind, buf, n);
     coavoid_lcm_context_t ctx = ctx_now();
     coavoid_lcm_sequence_table_t seq;
     coavoid_lcm_sequence_init(&seq, senders, sizeof senders / sizeof senders[0]);

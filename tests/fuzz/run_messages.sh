@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
 # Builds the message fuzzer (fuzz_messages.c) with clang (libFuzzer + ASan + UBSan) over the
-# types this build generated from lcmtypes/ and the drivers' receiver's framing (rx.c), and runs it for a fixed number of inputs from
+# types this build generated from lcmtypes/, the drivers' receiver's framing (rx.c) and the
+# vehicle protocol (src/protocol), and runs it for a fixed number of inputs from
 # one seed per type and mode. Usage: run_messages.sh SRC LCMTYPES_BUILD_DIR [RUNS]
 # A fixed run count, not a time limit, keeps the test's verdict independent of machine load.
 set -euo pipefail
@@ -10,9 +11,11 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 command -v clang >/dev/null || { echo "fuzz: clang is not installed" >&2; exit 1; }
 clang -std=c11 -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all \
-  -I"$src/include" -I"$src/src/lcm" -I"$src/src/auth" -I"$src/src/node" -I"$src/src/realtime" -I"$src/tests" \
+  -I"$src/include" -I"$src/src/lcm" -I"$src/src/auth" -I"$src/src/protocol" -I"$src/src/node" \
+  -I"$src/src/realtime" -I"$src/tests" \
   -I"$types/include" "$src/tests/fuzz/fuzz_messages.c" "$src/src/lcm/convert.c" \
   "$src/src/auth/auth.c" "$src/src/auth/auth_files.c" "$src/src/realtime/rx.c" \
+  "$src"/src/protocol/*.c \
   "$src"/src/core/*.c "$types"/c/*.c -llcm -lsodium -lccd -lm -o "$work/fuzz_messages"
 mkdir -p "$work/corpus"
 # The six valid examples unchanged (mode byte 0-5), and raw bytes of each type (0x80-0x85);
