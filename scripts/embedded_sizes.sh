@@ -132,7 +132,7 @@ int main(int argc, char **argv)
         predictor = predictor - round8(hq) + round8(aq);
         /* A decoupled vehicle's planner: one UAV over N + 2 (the order search's look-ahead),
          * the steep factor and unbounded offsets of coavoid_node_planner_config. */
-        coa_planner_config_t c = {1u, 20000u, N + 2u, COA_MAX_STEEP_FACTOR, -1};
+        coa_planner_config_t c = {1u, 20000u, N + 2u, COAVOID_NODE_MAX_STEEP_FACTOR, -1};
         size_t planner = coa_planner_workspace_size(&c) - round8(hp) + round8(ap);
         size_t conflicts = round8(pairs * sizeof(coa_conflict_t)); /* fixed-width: 40 on both */
         printf("  N %u: predictor %zu, one-UAV planner %zu, conflicts %zu (%zu pairs); "

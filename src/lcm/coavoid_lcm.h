@@ -205,14 +205,21 @@ typedef struct {
 int coavoid_lcm_plan_check(const coavoid_plan_t *msg, const coavoid_lcm_context_t *ctx,
                            const char **reason);
 
+/* The UAVs of the largest plan a receiver collects: every plan_t may list, unless a build
+ * sets fewer (a vehicle on the part: its fleet); a plan of more is refused
+ * (COAVOID_LCM_ERR_CAPACITY). */
+#ifndef COAVOID_LCM_PLAN_ROWS
+#define COAVOID_LCM_PLAN_ROWS COAVOID_PLAN_T_MAX_VEHICLES
+#endif
+
 /* The rows of the plans a receiver is collecting, in the caller's slots (one slot per
- * plan in progress, 5.8 kB each): a plan is whole when a message of each of its
- * vehicle_count UAVs has come. */
+ * plan in progress, 5.8 kB each with 32 rows): a plan is whole when a message of each of
+ * its vehicle_count UAVs has come. */
 typedef struct {
     bool used;
     coavoid_plan_t first; /* the first message of the plan: its header */
     uint32_t have;        /* bit i: the row of first.uav_ids[i] has come */
-    int32_t offsets[COAVOID_PLAN_T_MAX_VEHICLES][COAVOID_PLAN_T_MAX_SAMPLES];
+    int32_t offsets[COAVOID_LCM_PLAN_ROWS][COAVOID_PLAN_T_MAX_SAMPLES];
 } coavoid_lcm_plan_slot_t;
 
 typedef struct {

@@ -795,6 +795,9 @@ int coavoid_lcm_plan_collect(coavoid_lcm_plan_rows_t *rows, const coavoid_plan_t
     if ((size_t)msg->vehicle_count * ((size_t)msg->horizon + 1u) > capacity) {
         REJECT(COAVOID_LCM_ERR_CAPACITY, "plan: more offsets than the caller's array holds");
     }
+    if (msg->vehicle_count > (int32_t)COAVOID_LCM_PLAN_ROWS) {
+        REJECT(COAVOID_LCM_ERR_CAPACITY, "plan: more UAVs than this receiver collects");
+    }
     s = plan_slot(rows, msg);
     if (s->used && s->first.plan_id == msg->plan_id &&
         s->first.coordinator_id == msg->coordinator_id &&

@@ -123,7 +123,7 @@ coa_planner_config_t coavoid_node_planner_config(uint32_t horizon, size_t search
     c.vehicles = searched;
     c.beta = beta;
     c.horizon = horizon;
-    c.steep_factor = COA_MAX_STEEP_FACTOR;
+    c.steep_factor = COAVOID_NODE_MAX_STEEP_FACTOR;
     c.max_offset = -1;
     return c;
 }

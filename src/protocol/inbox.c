@@ -265,6 +265,10 @@ static void on_intent(coavoid_node_inbox_t *in, const uint8_t *data, int size)
     const char *reason = NULL;
     int rc = coavoid_lcm_intent_to_core(msg, &ctx, sequence_table(in, &in->intent_seq), &info,
                                         &vehicle, &plan, &in->rx_arrays, &reason);
+    if (rc == COA_OK && vehicle.steep_factor > COAVOID_NODE_MAX_STEEP_FACTOR) {
+        rc = COAVOID_LCM_ERR_CAPACITY; /* its planner could not plan that UAV */
+        reason = "intent: a steep factor above what this node plans with";
+    }
     coavoid_lcm_rx_count(in->rx, rc, reason);
     if (rc != COA_OK) {
         return;
@@ -384,9 +388,13 @@ static int map_tile_keep(coavoid_node_inbox_t *in, const coavoid_obstacle_map_t 
     if (in->have_map && msg->map_id == in->map_id && msg->version == in->map_version) {
         return COA_OK; /* the map in use, republished */
     }
+    if ((size_t)msg->tile_count > COAVOID_NODE_MAX_MAP_TILES) {
+        *reason = "obstacle_map: more tiles than this node holds";
+        return COAVOID_LCM_ERR_CAPACITY;
+    }
     const coavoid_obstacle_map_t *first = &in->map_tiles[0];
     bool same = false;
-    for (size_t i = 0; i < COAVOID_OBSTACLE_MAP_T_MAX_TILES && !same; i++) {
+    for (size_t i = 0; i < COAVOID_NODE_MAX_MAP_TILES && !same; i++) {
         const coavoid_obstacle_map_t *t = &in->map_tiles[i];
         same = (in->map_tiles_have & (UINT32_C(1) << i)) != 0u && t->map_id == msg->map_id &&
                t->version == msg->version;

@@ -54,6 +54,13 @@
 #define COAVOID_NODE_MAX_TRACKS 32u /* non-cooperative tracks */
 #endif
 #define COAVOID_NODE_MAX_HORIZON 40u /* N: intent_t carries N + 1 samples, in one datagram */
+/* The largest steep factor of the UAVs a node plans (itself, and its peers in its order
+ * search and joint plan): its planner's tables are sized for it. A build may set it lower
+ * (2..COA_MAX_STEEP_FACTOR: the Cortex-M4F build sets 2); a vehicle configured above it is
+ * refused at init, and a peer's intent above it is refused (counted). */
+#ifndef COAVOID_NODE_MAX_STEEP_FACTOR
+#define COAVOID_NODE_MAX_STEEP_FACTOR COA_MAX_STEEP_FACTOR
+#endif
 #ifndef COAVOID_NODE_MAX_CONFIGURED_OBSTACLES
 #define COAVOID_NODE_MAX_CONFIGURED_OBSTACLES 80u /* a node's own terrain database */
 #endif

@@ -35,13 +35,25 @@ _Static_assert(COAVOID_NODE_MAX_SAMPLES == (unsigned)COAVOID_INTENT_T_MAX_SAMPLE
 #define COAVOID_NODE_LOOKAHEAD 2u
 #define COAVOID_NODE_MAX_PROBLEM_SAMPLES (COAVOID_NODE_MAX_SAMPLES + COAVOID_NODE_LOOKAHEAD)
 
-/* Room for one obstacle map (all its tiles: boxes, then polytopes) and its vertices. */
-#define COAVOID_NODE_MAX_MAP_OBSTACLES COAVOID_LCM_MAP_MAX_OBSTACLES
+/* Room for one obstacle map: its tiles (a build may hold fewer than a map may have: a
+ * map of more is refused, counted, and the configured obstacles stay), their obstacles
+ * (boxes, then polytopes) and their vertices, as many as that many tiles can carry. */
+#ifndef COAVOID_NODE_MAX_MAP_TILES
+#define COAVOID_NODE_MAX_MAP_TILES ((size_t)COAVOID_OBSTACLE_MAP_T_MAX_TILES)
+#endif
+#define COAVOID_NODE_MIN_SIZE(a, b) ((size_t)(a) < (size_t)(b) ? (size_t)(a) : (size_t)(b))
+#define COAVOID_NODE_MAX_MAP_OBSTACLES                                          \
+    COAVOID_NODE_MIN_SIZE(                                                      \
+        COAVOID_LCM_MAP_MAX_OBSTACLES,                                          \
+        COAVOID_NODE_MAX_MAP_TILES *((size_t)COAVOID_OBSTACLE_MAP_T_MAX_BOXES + \
+                                     (size_t)COAVOID_OBSTACLE_MAP_T_MAX_POLYTOPES))
 /* What a node avoids: its configured obstacles, then the map's that are not among them. */
 #define COAVOID_NODE_MAX_OBSTACLES \
     ((size_t)COAVOID_NODE_MAX_CONFIGURED_OBSTACLES + COAVOID_NODE_MAX_MAP_OBSTACLES)
-#define COAVOID_NODE_MAX_VERTICES \
-    ((size_t)COAVOID_OBSTACLE_MAP_T_MAX_MAP_POLYTOPES * (size_t)COAVOID_OBSTACLE_MAP_T_MAX_VERTICES)
+#define COAVOID_NODE_MAX_VERTICES                                             \
+    COAVOID_NODE_MIN_SIZE((size_t)COAVOID_OBSTACLE_MAP_T_MAX_MAP_POLYTOPES *( \
+                              size_t)COAVOID_OBSTACLE_MAP_T_MAX_VERTICES,     \
+                          COAVOID_NODE_MAX_MAP_TILES *(size_t)COAVOID_OBSTACLE_MAP_T_MAX_VERTICES)
 
 /* Tracks one cycle can hold: the real ones plus every UAV as a moving obstacle (live or
  * stale: together at most MAX_PEERS). */
@@ -60,7 +72,9 @@ _Static_assert(COAVOID_NODE_MAX_SAMPLES == (unsigned)COAVOID_INTENT_T_MAX_SAMPLE
 /* Plans whose rows a UAV collects at once: the coordinator sends a plan's rows back to
  * back, so one is usually enough; more keep a plan whole when rows of another (a late
  * one, a forger's) come between. */
+#ifndef COAVOID_NODE_PLAN_SLOTS
 #define COAVOID_NODE_PLAN_SLOTS 4u
+#endif
 
 /* How many of its latest intents a node remembers, to tell them when they come back. */
 #define COAVOID_NODE_OWN_INTENTS 4u
@@ -157,7 +171,7 @@ struct coavoid_node_inbox {
     int64_t map_version;
     /* The tiles of the version being assembled (map_tiles_have: bit i, tile i has come):
      * it replaces the map in use once every tile has come, never before. */
-    coavoid_obstacle_map_t map_tiles[COAVOID_OBSTACLE_MAP_T_MAX_TILES];
+    coavoid_obstacle_map_t map_tiles[COAVOID_NODE_MAX_MAP_TILES];
     uint32_t map_tiles_have;
     coa_obstacle_t map_obstacles[COAVOID_NODE_MAX_MAP_OBSTACLES]; /* the map in use */
     size_t map_obstacle_count;
@@ -218,7 +232,7 @@ struct coavoid_node_inbox {
     /* The plans whose rows are being collected, and a whole plan's offsets. */
     coavoid_lcm_plan_slot_t plan_slots[COAVOID_NODE_PLAN_SLOTS];
     coavoid_lcm_plan_rows_t plan_rows;
-    int32_t rx_offsets[(size_t)COAVOID_PLAN_T_MAX_VEHICLES * COAVOID_NODE_MAX_SAMPLES];
+    int32_t rx_offsets[(size_t)COAVOID_LCM_PLAN_ROWS * COAVOID_NODE_MAX_SAMPLES];
     coavoid_node_tx_t tx;
 };
 

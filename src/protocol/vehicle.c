@@ -335,7 +335,8 @@ static int vehicle_prepare(const coavoid_vehicle_node_config_t *config,
         !isfinite((double)config->sigma_horizontal) || !isfinite((double)config->sigma_vertical) ||
         config->sigma_horizontal < (coa_real_t)0 || config->sigma_vertical < (coa_real_t)0 ||
         !(coa_climb_step(&config->vehicle, config->common.dt) > (coa_real_t)0) ||
-        config->joint_members == 1u || config->joint_members > COA_MAX_CENTRALISED) {
+        config->joint_members == 1u || config->joint_members > COA_MAX_CENTRALISED ||
+        config->vehicle.steep_factor > COAVOID_NODE_MAX_STEEP_FACTOR) {
         return COA_ERR_ARGUMENT;
     }
     *filled = *config;
