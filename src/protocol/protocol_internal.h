@@ -76,8 +76,11 @@ _Static_assert(COAVOID_NODE_MAX_SAMPLES == (unsigned)COAVOID_INTENT_T_MAX_SAMPLE
 #define COAVOID_NODE_PLAN_SLOTS 4u
 #endif
 
-/* How many of its latest intents a node remembers, to tell them when they come back. */
-#define COAVOID_NODE_OWN_INTENTS 4u
+/* How many of its latest intents a node remembers, to tell them when they come back: all
+ * it can send in one cycle (its intent and 8 copies in its first, then up to 4 decisions
+ * again with 4 copies each: 29), so that a copy that comes back late, behind a cycle whose
+ * planning overran, is still known as its own and not taken for a twin's. */
+#define COAVOID_NODE_OWN_INTENTS 32u
 
 /* The channels an inbox listens to (coavoid_node_inbox_channel): intents, tracks, the
  * obstacle map, heartbeats, plans and agreements; bit COAVOID_NODE_WANTS(X) of `wants`. */
