@@ -70,8 +70,7 @@ void coavoid_node_lcm_unsubscribe(coavoid_node_lcm_t *t)
  * in one block; the node's link points at the transport, so destroy finds the block. */
 static size_t transport_head(void)
 {
-    const size_t a = COA_WORKSPACE_ALIGNMENT;
-    return (sizeof(coavoid_node_lcm_t) + a - 1u) / a * a;
+    return coavoid_node_align_up(sizeof(coavoid_node_lcm_t));
 }
 
 coavoid_vehicle_node_t *coavoid_vehicle_node_create(const coavoid_vehicle_node_config_t *config,

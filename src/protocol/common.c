@@ -181,8 +181,7 @@ size_t coavoid_node_joint_members(coavoid_node_mode_t mode, size_t fleet)
     return fleet < COAVOID_NODE_DEFAULT_JOINT_MEMBERS ? fleet : COAVOID_NODE_DEFAULT_JOINT_MEMBERS;
 }
 
-/* x rounded up to the workspace alignment; 0 on overflow. */
-static size_t align_up(size_t x)
+size_t coavoid_node_align_up(size_t x)
 {
     const size_t a = COA_WORKSPACE_ALIGNMENT;
     return x > SIZE_MAX - (a - 1u) ? 0u : (x + a - 1u) / a * a;
@@ -194,11 +193,11 @@ static bool solver_parts(const coavoid_node_solver_shape_t *shape, size_t part[3
 {
     const coa_planner_config_t config =
         coavoid_node_planner_config(shape->plan_horizon, shape->searched, shape->beta);
-    part[0] =
-        align_up(coa_predictor_workspace_size(COAVOID_NODE_MAX_PEERS, COAVOID_NODE_TRACK_CAPACITY,
-                                              shape->horizon, coavoid_node_max_pairs()));
-    part[1] = align_up(coa_planner_workspace_size(&config));
-    part[2] = align_up(coavoid_node_max_pairs() * sizeof(coa_conflict_t));
+    part[0] = coavoid_node_align_up(
+        coa_predictor_workspace_size(COAVOID_NODE_MAX_PEERS, COAVOID_NODE_TRACK_CAPACITY,
+                                     shape->horizon, coavoid_node_max_pairs()));
+    part[1] = coavoid_node_align_up(coa_planner_workspace_size(&config));
+    part[2] = coavoid_node_align_up(coavoid_node_max_pairs() * sizeof(coa_conflict_t));
     return part[0] != 0u && part[1] != 0u && part[2] != 0u &&
            part[0] <= SIZE_MAX - part[1] - part[2] && part[1] <= SIZE_MAX - part[2];
 }

@@ -455,6 +455,10 @@ int coavoid_node_predict(coa_predictor_t *predictor, const coavoid_node_common_t
  * cannot run out (13,280). O(1). */
 size_t coavoid_node_max_pairs(void);
 
+/* x rounded up to COA_WORKSPACE_ALIGNMENT, where a caller's block places its next part
+ * (the solver's workspaces, a vehicle's solver after its struct); 0 on overflow. O(1). */
+size_t coavoid_node_align_up(size_t x);
+
 /* The bytes of a solver of this shape: the predictor's and planner's workspaces
  * (coa_predictor_workspace_size, coa_planner_workspace_size) and the conflict array,
  * each rounded up to COA_WORKSPACE_ALIGNMENT; 0 for sizes the core refuses. O(1). */

@@ -359,19 +359,22 @@ static int vehicle_prepare(const coavoid_vehicle_node_config_t *config,
 /* The bytes of the vehicle's struct, rounded up to the workspace alignment. */
 static size_t vehicle_head(void)
 {
-    const size_t a = COA_WORKSPACE_ALIGNMENT;
-    return (sizeof(coavoid_vehicle_node_t) + a - 1u) / a * a;
+    return coavoid_node_align_up(sizeof(coavoid_vehicle_node_t));
+}
+
+/* The block a vehicle whose solver has this shape needs: its struct, then the solver; 0
+ * on overflow. */
+static size_t vehicle_bytes(const coavoid_node_solver_shape_t *shape)
+{
+    const size_t solver = coavoid_node_solver_size(shape);
+    return solver > SIZE_MAX - vehicle_head() ? 0u : vehicle_head() + solver;
 }
 
 size_t coavoid_vehicle_node_size(const coavoid_vehicle_node_config_t *config)
 {
     coavoid_vehicle_node_config_t filled;
     coavoid_node_solver_shape_t shape;
-    if (vehicle_prepare(config, &filled, &shape) != COA_OK) {
-        return 0u;
-    }
-    const size_t solver = coavoid_node_solver_size(&shape);
-    return solver > SIZE_MAX - vehicle_head() ? 0u : vehicle_head() + solver;
+    return vehicle_prepare(config, &filled, &shape) == COA_OK ? vehicle_bytes(&shape) : 0u;
 }
 
 coavoid_vehicle_node_t *coavoid_vehicle_node_init(void *memory, size_t size,
@@ -390,7 +393,7 @@ coavoid_vehicle_node_t *coavoid_vehicle_node_init(void *memory, size_t size,
         return NULL;
     }
     if (memory == NULL || ((uintptr_t)memory % COA_WORKSPACE_ALIGNMENT) != 0u ||
-        size < coavoid_vehicle_node_size(config)) {
+        size < vehicle_bytes(&shape)) {
         *error = COA_ERR_WORKSPACE;
         return NULL;
     }
