@@ -118,7 +118,7 @@ int main(int argc, char **argv)
     size_t hq = strtoul(argv[3], NULL, 10), aq = strtoul(argv[4], NULL, 10);
     size_t vehicle = strtoul(argv[5], NULL, 10), inbox = strtoul(argv[6], NULL, 10);
     const size_t n = COAVOID_NODE_MAX_PEERS;
-    const size_t pairs = n * (n - 1u) / 2u + n * COAVOID_NODE_TRACK_CAPACITY +
+    const size_t pairs = n * (n - 1u) / 2u + n * COAVOID_NODE_MAX_TRACKS +
                          n * COAVOID_NODE_MAX_OBSTACLES; /* coavoid_node_max_pairs */
     (void)argc;
     printf("vehicle protocol (%zu UAVs with itself, %u tracks, %u obstacles of its own), "

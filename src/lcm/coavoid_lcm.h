@@ -130,12 +130,24 @@ typedef struct {
     int8_t rank;
 } coavoid_lcm_intent_info_t;
 
-/* The arrays an intent's core view points into (9.7 kB in double): the caller's, so that
- * nothing is allocated. */
+/* The samples of an intent or of a plan's row a receiver keeps: every one a message may
+ * carry (N + 1 = 41), unless a build sets fewer (a vehicle on the part: its fleet's
+ * horizon). An intent of more samples, or a plan of a longer horizon, is refused
+ * (COAVOID_LCM_ERR_CAPACITY); a sender's messages are not limited by it. */
+#ifndef COAVOID_LCM_MAX_SAMPLES
+#define COAVOID_LCM_MAX_SAMPLES COAVOID_INTENT_T_MAX_SAMPLES
+#endif
+_Static_assert(COAVOID_LCM_MAX_SAMPLES >= 2 &&
+                   COAVOID_LCM_MAX_SAMPLES <= COAVOID_INTENT_T_MAX_SAMPLES &&
+                   COAVOID_INTENT_T_MAX_SAMPLES == COAVOID_PLAN_T_MAX_SAMPLES,
+               "a receiver keeps 2 to MAX_SAMPLES samples of intents and plans alike");
+
+/* The arrays an intent's core view points into: the caller's, so that nothing is
+ * allocated. */
 typedef struct {
-    coa_vec3_t reference[COAVOID_INTENT_T_MAX_SAMPLES];
-    coa_vec3_t samples[COAVOID_INTENT_T_MAX_SAMPLES]; /* reference + offset * dh */
-    int32_t offsets[COAVOID_INTENT_T_MAX_SAMPLES];
+    coa_vec3_t reference[COAVOID_LCM_MAX_SAMPLES];
+    coa_vec3_t samples[COAVOID_LCM_MAX_SAMPLES]; /* reference + offset * dh */
+    int32_t offsets[COAVOID_LCM_MAX_SAMPLES];
 } coavoid_lcm_intent_arrays_t;
 
 /* Every rule of intent_t (its .lcm file): times, id, priority, mode, finite and bounded
@@ -213,13 +225,13 @@ int coavoid_lcm_plan_check(const coavoid_plan_t *msg, const coavoid_lcm_context_
 #endif
 
 /* The rows of the plans a receiver is collecting, in the caller's slots (one slot per
- * plan in progress, 5.8 kB each with 32 rows): a plan is whole when a message of each of
+ * plan in progress): a plan is whole when a message of each of
  * its vehicle_count UAVs has come. */
 typedef struct {
     bool used;
     coavoid_plan_t first; /* the first message of the plan: its header */
     uint32_t have;        /* bit i: the row of first.uav_ids[i] has come */
-    int32_t offsets[COAVOID_LCM_PLAN_ROWS][COAVOID_PLAN_T_MAX_SAMPLES];
+    int32_t offsets[COAVOID_LCM_PLAN_ROWS][COAVOID_LCM_MAX_SAMPLES];
 } coavoid_lcm_plan_slot_t;
 
 typedef struct {

@@ -461,6 +461,9 @@ int coavoid_lcm_intent_to_core(const coavoid_intent_t *msg, const coavoid_lcm_co
     if ((rc = coavoid_lcm_intent_check(msg, ctx, reason)) != COA_OK) {
         return rc;
     }
+    if (msg->sample_count > (int32_t)COAVOID_LCM_MAX_SAMPLES) {
+        REJECT(COAVOID_LCM_ERR_CAPACITY, "intent: more samples than this receiver keeps");
+    }
     if ((rc = sequence_rule(seq, msg->uav_id, msg->sequence, false, reason,
                             "intent: sequence not after the last one from this UAV",
                             "intent: sequence table full")) != COA_OK) {
@@ -797,6 +800,9 @@ int coavoid_lcm_plan_collect(coavoid_lcm_plan_rows_t *rows, const coavoid_plan_t
     }
     if (msg->vehicle_count > (int32_t)COAVOID_LCM_PLAN_ROWS) {
         REJECT(COAVOID_LCM_ERR_CAPACITY, "plan: more UAVs than this receiver collects");
+    }
+    if (msg->horizon >= (int32_t)COAVOID_LCM_MAX_SAMPLES) {
+        REJECT(COAVOID_LCM_ERR_CAPACITY, "plan: a longer horizon than this receiver keeps");
     }
     s = plan_slot(rows, msg);
     if (s->used && s->first.plan_id == msg->plan_id &&

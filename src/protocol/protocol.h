@@ -53,7 +53,9 @@
 #ifndef COAVOID_NODE_MAX_TRACKS
 #define COAVOID_NODE_MAX_TRACKS 32u /* non-cooperative tracks */
 #endif
-#define COAVOID_NODE_MAX_HORIZON 40u /* N: intent_t carries N + 1 samples, in one datagram */
+/* N: intent_t carries N + 1 samples, in one datagram; a build that keeps fewer samples
+ * (COAVOID_LCM_MAX_SAMPLES: the Cortex-M4F build keeps 25) flies a shorter horizon. */
+#define COAVOID_NODE_MAX_HORIZON ((unsigned)COAVOID_LCM_MAX_SAMPLES - 1u)
 /* The largest steep factor of the UAVs a node plans (itself, and its peers in its order
  * search and joint plan): its planner's tables are sized for it. A build may set it lower
  * (2..COA_MAX_STEEP_FACTOR: the Cortex-M4F build sets 2); a vehicle configured above it is

@@ -24,9 +24,8 @@
 #include "protocol.h"
 
 #define COAVOID_NODE_MAX_SAMPLES (COAVOID_NODE_MAX_HORIZON + 1u)
-_Static_assert(COAVOID_NODE_MAX_SAMPLES == (unsigned)COAVOID_INTENT_T_MAX_SAMPLES &&
-                   COAVOID_NODE_MAX_SAMPLES == (unsigned)COAVOID_PLAN_T_MAX_SAMPLES,
-               "an intent and a plan carry N + 1 samples of the node's largest horizon");
+_Static_assert(COAVOID_NODE_MAX_SAMPLES == (unsigned)COAVOID_LCM_MAX_SAMPLES,
+               "a node keeps N + 1 samples of an intent and a plan's row at its largest horizon");
 /* How many steps beyond the horizon a vehicle's order search looks when it chooses among
  * the orders that solve the horizon (vehicle_order.c, look_ahead): enough to tell apart, in
  * 5-UAV encounter 231 of seed 1, the order whose plan leaves no way on from the one that
@@ -450,9 +449,11 @@ int coavoid_node_predict(coa_predictor_t *predictor, const coavoid_node_common_t
                          const coavoid_node_inbox_t *in, coa_conflict_t *conflicts, size_t capacity,
                          coa_predict_result_t *result, uint32_t *labels, size_t *cluster_count);
 
-/* The predictor's pair bound for a node: every pair that can exist among MAX_PEERS
- * plans, TRACK_CAPACITY tracks and MAX_OBSTACLES obstacles, so that the broad phase
- * cannot run out (13,280). O(1). */
+/* The predictor's pair bound for a node: every pair that can exist among its UAVs, real
+ * tracks and obstacles, so that the broad phase cannot run out. A UAV is a plan or a
+ * stale UAV's track, never both, and there are at most MAX_PEERS of them (a vehicle
+ * counts itself): their pairs are at most MAX_PEERS (MAX_PEERS - 1) / 2, whatever the
+ * split, plus MAX_PEERS times the real tracks and the obstacles. O(1). */
 size_t coavoid_node_max_pairs(void);
 
 /* x rounded up to COA_WORKSPACE_ALIGNMENT, where a caller's block places its next part

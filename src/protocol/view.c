@@ -373,7 +373,7 @@ int coavoid_node_problem(coa_problem_t *problem, coavoid_node_problem_tracks_t *
 size_t coavoid_node_max_pairs(void)
 {
     const size_t n = COAVOID_NODE_MAX_PEERS;
-    return n * (n - 1u) / 2u + n * COAVOID_NODE_TRACK_CAPACITY + n * COAVOID_NODE_MAX_OBSTACLES;
+    return n * (n - 1u) / 2u + n * COAVOID_NODE_MAX_TRACKS + n * COAVOID_NODE_MAX_OBSTACLES;
 }
 
 coa_predict_config_t coavoid_node_predict_config(const coavoid_node_common_t *c)
