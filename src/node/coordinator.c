@@ -299,7 +299,7 @@ static int cluster_plan(coavoid_coordinator_t *node, int64_t now, const coa_prob
                         bool *centralised, coa_plan_result_t *result)
 {
     const coavoid_node_common_t *c = &node->config.common;
-    coa_planner_t *planner = node->solver.planner;
+    coa_planner_t *planner = coavoid_node_solver_planner(&node->solver);
     const size_t count = problem->vehicle_count;
     int rc;
     *centralised = count <= node->config.max_centralised;
@@ -827,9 +827,9 @@ int coavoid_coordinator_cycle(coavoid_coordinator_t *node, int64_t now)
     coa_predict_result_t result;
     size_t clusters = 0;
     coavoid_node_solver_t *sv = &node->solver;
-    int first_error = coavoid_node_predict(sv->predictor, c, view->live_plan, view->live_count,
-                                           view, &node->inbox, sv->conflicts, sv->conflict_capacity,
-                                           &result, node->labels, &clusters);
+    int first_error = coavoid_node_predict(coavoid_node_solver_predictor(sv), c, view->live_plan,
+                                           view->live_count, view, &node->inbox, sv->conflicts,
+                                           sv->conflict_capacity, &result, node->labels, &clusters);
     if (first_error != COA_OK) {
         memset(&result, 0, sizeof result);
         clusters = 0;

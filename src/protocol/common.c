@@ -187,8 +187,8 @@ size_t coavoid_node_align_up(size_t x)
     return x > SIZE_MAX - (a - 1u) ? 0u : (x + a - 1u) / a * a;
 }
 
-/* The three parts' sizes, each rounded up to the alignment; false when the core refuses
- * the sizes. */
+/* The three parts' sizes (predictor, planner, conflicts), each rounded up to the
+ * alignment; false when the core refuses the sizes. */
 static bool solver_parts(const coavoid_node_solver_shape_t *shape, size_t part[3])
 {
     const coa_planner_config_t config =
@@ -198,14 +198,20 @@ static bool solver_parts(const coavoid_node_solver_shape_t *shape, size_t part[3
                                      shape->horizon, coavoid_node_max_pairs()));
     part[1] = coavoid_node_align_up(coa_planner_workspace_size(&config));
     part[2] = coavoid_node_align_up(coavoid_node_max_pairs() * sizeof(coa_conflict_t));
-    return part[0] != 0u && part[1] != 0u && part[2] != 0u &&
-           part[0] <= SIZE_MAX - part[1] - part[2] && part[1] <= SIZE_MAX - part[2];
+    return part[0] != 0u && part[1] != 0u && part[2] != 0u && part[0] <= SIZE_MAX - part[2] &&
+           part[1] <= SIZE_MAX - part[2];
+}
+
+/* The shared workspace: the larger of the predictor's and the planner's. */
+static size_t solver_shared(const size_t part[3])
+{
+    return part[0] > part[1] ? part[0] : part[1];
 }
 
 size_t coavoid_node_solver_size(const coavoid_node_solver_shape_t *shape)
 {
     size_t part[3];
-    return solver_parts(shape, part) ? part[0] + part[1] + part[2] : 0u;
+    return solver_parts(shape, part) ? solver_shared(part) + part[2] : 0u;
 }
 
 int coavoid_node_solver_place(coavoid_node_solver_t *s, void *memory, size_t size,
@@ -216,23 +222,44 @@ int coavoid_node_solver_place(coavoid_node_solver_t *s, void *memory, size_t siz
     if (!solver_parts(shape, part)) {
         return COA_ERR_ARGUMENT;
     }
-    if (memory == NULL || size < part[0] + part[1] + part[2]) {
+    const size_t shared = solver_shared(part);
+    if (memory == NULL || size < shared + part[2]) {
         return COA_ERR_WORKSPACE;
     }
     uint8_t *p = memory;
-    const coa_planner_config_t config =
+    s->workspace = p;
+    s->workspace_size = shared;
+    s->horizon = shape->horizon;
+    s->planner_config =
         coavoid_node_planner_config(shape->plan_horizon, shape->searched, shape->beta);
-    s->predictor =
-        coa_predictor_init(p, part[0], COAVOID_NODE_MAX_PEERS, COAVOID_NODE_TRACK_CAPACITY,
-                           shape->horizon, coavoid_node_max_pairs());
-    s->planner = coa_planner_init(p + part[0], part[1], &config);
-    s->conflicts = (coa_conflict_t *)(void *)(p + part[0] + part[1]);
+    s->conflicts = (coa_conflict_t *)(void *)(p + shared);
     s->conflict_capacity = coavoid_node_max_pairs();
-    if (s->predictor == NULL || s->planner == NULL) {
+    /* Both are built once here, so that a misaligned block is refused now, not in flight. */
+    if (coavoid_node_solver_planner(s) == NULL || coavoid_node_solver_predictor(s) == NULL) {
         memset(s, 0, sizeof *s);
         return COA_ERR_WORKSPACE; /* misaligned memory */
     }
     return COA_OK;
+}
+
+coa_predictor_t *coavoid_node_solver_predictor(coavoid_node_solver_t *s)
+{
+    if (s->predictor == NULL && s->workspace != NULL) {
+        s->planner = NULL;
+        s->predictor =
+            coa_predictor_init(s->workspace, s->workspace_size, COAVOID_NODE_MAX_PEERS,
+                               COAVOID_NODE_TRACK_CAPACITY, s->horizon, coavoid_node_max_pairs());
+    }
+    return s->predictor;
+}
+
+coa_planner_t *coavoid_node_solver_planner(coavoid_node_solver_t *s)
+{
+    if (s->planner == NULL && s->workspace != NULL) {
+        s->predictor = NULL;
+        s->planner = coa_planner_init(s->workspace, s->workspace_size, &s->planner_config);
+    }
+    return s->planner;
 }
 
 uint64_t coavoid_node_work_of(int64_t us)

@@ -396,8 +396,9 @@ typedef struct {
     void *user;
 } coavoid_node_link_t;
 
-/* The bytes coavoid_vehicle_node_init needs for config: the node's tables, the predictor
- * and conflicts for N, and the workspace of coavoid_node_planner_config(N + 2, 1, beta)
+/* The bytes coavoid_vehicle_node_init needs for config: the node's tables, the conflicts
+ * for N, and one workspace for the larger of the predictor for N and the planner (they
+ * take turns in it) of coavoid_node_planner_config(N + 2, 1, beta)
  * (the order search looks two steps beyond the horizon; a one-UAV planner's size does not
  * depend on beta), or with joint_members that of coavoid_node_planner_config(N + 2,
  * joint_members, joint_beta), which also runs its one-UAV searches. The order search's

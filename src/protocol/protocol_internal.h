@@ -274,14 +274,20 @@ typedef struct {
 } coavoid_node_problem_tracks_t;
 
 /* A node's prediction and planning memory, in the caller's memory (one block laid out by
- * coavoid_node_solver_place): room for every pair coavoid_node_max_pairs allows, a
- * predictor over MAX_PEERS plans and TRACK_CAPACITY tracks, and a planner of `searched`
- * UAVs a search. */
+ * coavoid_node_solver_place): room for every pair coavoid_node_max_pairs allows, and one
+ * workspace that holds either a predictor over MAX_PEERS plans and TRACK_CAPACITY tracks
+ * or a planner of `searched` UAVs a search, whichever ran last: a node predicts, then
+ * plans, then predicts again, never both at once, and neither keeps anything a later call
+ * needs. coavoid_node_solver_predictor and coavoid_node_solver_planner hand it out. */
 typedef struct {
     coa_conflict_t *conflicts;
     size_t conflict_capacity;
-    coa_predictor_t *predictor;
-    coa_planner_t *planner;
+    void *workspace;
+    size_t workspace_size;
+    uint32_t horizon; /* the predictor's */
+    coa_planner_config_t planner_config;
+    coa_predictor_t *predictor; /* NULL while the planner holds the workspace */
+    coa_planner_t *planner;     /* NULL while the predictor holds it */
 } coavoid_node_solver_t;
 
 /* What a solver is sized for: predictions over `horizon` steps (N), and a planner of
@@ -460,9 +466,9 @@ size_t coavoid_node_max_pairs(void);
  * (the solver's workspaces, a vehicle's solver after its struct); 0 on overflow. O(1). */
 size_t coavoid_node_align_up(size_t x);
 
-/* The bytes of a solver of this shape: the predictor's and planner's workspaces
- * (coa_predictor_workspace_size, coa_planner_workspace_size) and the conflict array,
- * each rounded up to COA_WORKSPACE_ALIGNMENT; 0 for sizes the core refuses. O(1). */
+/* The bytes of a solver of this shape: the larger of the predictor's and the planner's
+ * workspaces (coa_predictor_workspace_size, coa_planner_workspace_size) and the conflict
+ * array, each rounded up to COA_WORKSPACE_ALIGNMENT; 0 for sizes the core refuses. O(1). */
 size_t coavoid_node_solver_size(const coavoid_node_solver_shape_t *shape);
 
 /* Lays a solver of this shape out in memory (aligned to COA_WORKSPACE_ALIGNMENT, size
@@ -472,6 +478,15 @@ size_t coavoid_node_solver_size(const coavoid_node_solver_shape_t *shape);
  * allocates nothing. */
 int coavoid_node_solver_place(coavoid_node_solver_t *s, void *memory, size_t size,
                               const coavoid_node_solver_shape_t *shape);
+
+/* The solver's predictor, or its planner, built afresh in the shared workspace when the
+ * other one ran last (a planner so built has no work budget: a caller that wants one sets
+ * it before each search). The handle is good until the other is asked for. NULL only for
+ * a solver that was not placed. Cost O(1) when it holds the workspace already, else the
+ * init's: the predictor's hash table (2 to 4 slots of 8 bytes per pair) or the planner's
+ * first slots; no memory. */
+coa_predictor_t *coavoid_node_solver_predictor(coavoid_node_solver_t *s);
+coa_planner_t *coavoid_node_solver_planner(coavoid_node_solver_t *s);
 
 /* Fills *m from h at `now`, validates it on the clock whose t = 0 is cycle_start
  * (coavoid_node_context) and publishes it. Its health is HEALTH_DEGRADED (unless a fault)

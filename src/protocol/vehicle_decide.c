@@ -53,7 +53,8 @@ int coavoid_vehicle_search_self(coavoid_vehicle_node_t *node, int64_t now,
     coa_problem_t problem = coavoid_vehicle_own_problem(node, &vehicle, references);
 
     int64_t start = coavoid_node_stopwatch(c);
-    rc = coa_plan_centralised(node->solver.planner, &problem, node->plan_out, result);
+    rc = coa_plan_centralised(coavoid_node_solver_planner(&node->solver), &problem, node->plan_out,
+                              result);
     int64_t duration = coavoid_node_stopwatch(c) - start;
     node->state.plans_run++;
     node->last_plan_utime = now;
@@ -309,9 +310,9 @@ int coavoid_vehicle_predict(coavoid_vehicle_node_t *node, size_t n, coa_predict_
 {
     size_t clusters = 0;
     coavoid_node_solver_t *sv = &node->solver;
-    int rc = coavoid_node_predict(sv->predictor, &node->config.common, node->plans, n, &node->view,
-                                  &node->inbox, sv->conflicts, sv->conflict_capacity, result,
-                                  node->labels, &clusters);
+    int rc = coavoid_node_predict(coavoid_node_solver_predictor(sv), &node->config.common,
+                                  node->plans, n, &node->view, &node->inbox, sv->conflicts,
+                                  sv->conflict_capacity, result, node->labels, &clusters);
     if (rc != COA_OK) {
         return rc;
     }
@@ -391,8 +392,8 @@ static bool near_pending(coavoid_vehicle_node_t *node, size_t n)
     coa_predict_config_t config = coavoid_node_predict_config(c);
     coa_predict_result_t result;
     coavoid_node_solver_t *sv = &node->solver;
-    if (coa_predict(sv->predictor, &config, node->tall, n, NULL, 0, NULL, 0, sv->conflicts,
-                    sv->conflict_capacity, &result) != COA_OK) {
+    if (coa_predict(coavoid_node_solver_predictor(sv), &config, node->tall, n, NULL, 0, NULL, 0,
+                    sv->conflicts, sv->conflict_capacity, &result) != COA_OK) {
         return true; /* cannot tell: wait, bounded by the deadline */
     }
     /* Vehicle pairs come first in ascending (a, b), so its own (a == 0) survive an

@@ -154,8 +154,8 @@ static int label_near(coavoid_vehicle_node_t *node, size_t n)
     }
     const coa_predict_config_t config = coavoid_node_predict_config(&node->config.common);
     coa_predict_result_t result;
-    int rc = coa_predict(sv->predictor, &config, node->tall, n, NULL, 0, NULL, 0, sv->conflicts,
-                         sv->conflict_capacity, &result);
+    int rc = coa_predict(coavoid_node_solver_predictor(sv), &config, node->tall, n, NULL, 0, NULL,
+                         0, sv->conflicts, sv->conflict_capacity, &result);
     if (rc == COA_OK && result.overflow) {
         rc = COA_ERR_WORKSPACE;
     }
@@ -182,8 +182,8 @@ static size_t order_members(coavoid_vehicle_node_t *node, size_t self)
     }
     coa_predict_result_t result;
     size_t clusters = 0;
-    if (coavoid_node_predict(sv->predictor, &node->config.common, node->plans, n, view,
-                             &node->inbox, sv->conflicts, sv->conflict_capacity, &result,
+    if (coavoid_node_predict(coavoid_node_solver_predictor(sv), &node->config.common, node->plans,
+                             n, view, &node->inbox, sv->conflicts, sv->conflict_capacity, &result,
                              node->labels, &clusters) != COA_OK) {
         return 0;
     }
@@ -344,8 +344,8 @@ static int look_ahead(coavoid_vehicle_node_t *node, size_t count, coa_problem_t 
     const uint32_t far = n + COAVOID_NODE_LOOKAHEAD;
     problem->horizon = far;
     coa_plan_result_t ahead;
-    int rc = coa_plan_decoupled(node->solver.planner, problem, result->order, ORDER_TRIES_MAX,
-                                node->ahead_offsets, &ahead);
+    int rc = coa_plan_decoupled(coavoid_node_solver_planner(&node->solver), problem, result->order,
+                                ORDER_TRIES_MAX, node->ahead_offsets, &ahead);
     if (rc != COA_OK || ahead.status != COA_PLAN_SOLVED || ahead.orders_tried <= 1u) {
         return rc; /* the order holds beyond the horizon, or no order does */
     }
@@ -386,10 +386,10 @@ static int search_joint(coavoid_vehicle_node_t *node, size_t count, size_t self,
         return 0;
     }
     coa_plan_result_t result;
-    (void)coa_planner_set_work(node->solver.planner, node->config.joint_work);
-    const int rc =
-        coa_plan_centralised(node->solver.planner, problem, node->order_offsets, &result);
-    (void)coa_planner_set_work(node->solver.planner, 0u); /* its other searches: tables */
+    coa_planner_t *planner = coavoid_node_solver_planner(&node->solver);
+    (void)coa_planner_set_work(planner, node->config.joint_work);
+    const int rc = coa_plan_centralised(planner, problem, node->order_offsets, &result);
+    (void)coa_planner_set_work(planner, 0u); /* its other searches: tables */
     if (rc != COA_OK) {
         return rc;
     }
@@ -443,8 +443,8 @@ int coavoid_vehicle_search_order(coavoid_vehicle_node_t *node)
     size_t order[ORDER_MEMBERS_MAX];
     order_current(node, count, order);
     coa_plan_result_t result;
-    rc = coa_plan_decoupled(node->solver.planner, &problem, order, ORDER_TRIES_MAX,
-                            node->order_offsets, &result);
+    rc = coa_plan_decoupled(coavoid_node_solver_planner(&node->solver), &problem, order,
+                            ORDER_TRIES_MAX, node->order_offsets, &result);
     if (rc != COA_OK || result.orders_tried <= 1u) {
         order_withdraw(node);
         return rc != COA_OK ? rc : 0; /* the order holds: a check, not a plan of its own */
