@@ -20,6 +20,8 @@
  *   - a row that does not start where the UAV flies: REFUSE;
  *   - the rows sent again: ACCEPT again;
  *   - no coordinator at all: FALLBACK once its timeout has passed (DECIDING, fallbacks).
+ * And how a node keeps a peer's intent: opened again, it is the message received, and
+ * converts to the core's types exactly as the received one does.
  */
 #include <check.h>
 #include <stdlib.h>
@@ -30,7 +32,9 @@
 #include <coavoid_lcmtypes/coavoid_plan_t.h>
 #include <coavoid_lcmtypes/coavoid_status_t.h>
 
+#include "lcm_examples.h"
 #include "protocol.h"
+#include "protocol_internal.h"
 
 #define EPOCH INT64_C(1000000000000000)
 #define DT_US INT64_C(1000000)
@@ -547,6 +551,52 @@ START_TEST(test_decoupled_decides)
 }
 END_TEST
 
+/* Every intent's view in the core's types, after a check on ctx. */
+static void intent_core(const coavoid_intent_t *m, coavoid_lcm_intent_arrays_t *arrays,
+                        coa_vehicle_t *vehicle, coa_intent_plan_t *plan)
+{
+    const coavoid_lcm_context_t ctx = ctx_now();
+    coavoid_lcm_intent_info_t info;
+    ck_assert_int_eq(coavoid_lcm_intent_to_core(m, &ctx, NULL, &info, vehicle, plan, arrays, NULL),
+                     COA_OK);
+}
+
+START_TEST(test_kept_intent_opens_as_received)
+{
+    static coavoid_node_intent_t kept;
+    static coavoid_intent_t opened;
+    static coavoid_lcm_intent_arrays_t a;
+    static coavoid_lcm_intent_arrays_t b;
+    coa_vehicle_t va;
+    coa_vehicle_t vb;
+    coa_intent_plan_t pa;
+    coa_intent_plan_t pb;
+    coavoid_intent_t m = good_intent();
+    m.sample_count = (int32_t)COAVOID_NODE_MAX_SAMPLES < m.sample_count
+                         ? (int32_t)COAVOID_NODE_MAX_SAMPLES
+                         : m.sample_count;
+    m.auth.key_id = 3; /* a field after the samples */
+    coavoid_node_intent_keep(&kept, &m);
+    ck_assert_int_eq(kept.utime, m.utime);
+    ck_assert_int_eq(kept.plan_utime, m.plan_utime);
+    ck_assert_int_eq(kept.uav_id, m.uav_id);
+    coavoid_node_intent_open(&kept, &opened);
+    ck_assert_int_eq(opened.auth.key_id, 3);
+    ck_assert_int_eq(opened.rank, m.rank);
+    ck_assert(opened.sigma_vertical == m.sigma_vertical);
+    ck_assert_int_eq(memcmp(opened.offsets, m.offsets, sizeof m.offsets), 0);
+#ifndef COA_SINGLE_PRECISION
+    ck_assert_int_eq(memcmp(&opened, &m, sizeof m), 0); /* kept whole */
+#endif
+    intent_core(&m, &a, &va, &pa);
+    intent_core(&opened, &b, &vb, &pb);
+    ck_assert_uint_eq(pa.count, pb.count);
+    ck_assert_int_eq(memcmp(a.reference, b.reference, pa.count * sizeof a.reference[0]), 0);
+    ck_assert_int_eq(memcmp(a.samples, b.samples, pa.count * sizeof a.samples[0]), 0);
+    ck_assert(va.cruise_speed == vb.cruise_speed && va.volume.radius == vb.volume.radius);
+}
+END_TEST
+
 static Suite *vehicle_suite(void)
 {
     Suite *s = suite_create("vehicle");
@@ -565,6 +615,9 @@ static Suite *vehicle_suite(void)
     tcase_add_test(tc, test_no_coordinator_falls_back);
     tcase_add_test(tc, test_decoupled_decides);
     suite_add_tcase(s, tc);
+    TCase *storage = tcase_create("storage");
+    tcase_add_test(storage, test_kept_intent_opens_as_received);
+    suite_add_tcase(s, storage);
     return s;
 }
 

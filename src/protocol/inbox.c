@@ -186,6 +186,36 @@ static bool sent_by_self(const coavoid_node_inbox_t *in, const void *data, size_
     return false;
 }
 
+void coavoid_node_intent_keep(coavoid_node_intent_t *kept, const coavoid_intent_t *msg)
+{
+    kept->utime = msg->utime;
+    kept->plan_utime = msg->plan_utime;
+    kept->uav_id = msg->uav_id;
+    memcpy(kept->head, msg, sizeof kept->head);
+    for (size_t j = 0; j < COAVOID_NODE_MAX_SAMPLES; j++) {
+        for (size_t d = 0; d < 3u; d++) {
+            kept->reference[j][d] = (coa_real_t)msg->reference[j][d];
+        }
+    }
+    memcpy(kept->offsets, msg->offsets, sizeof kept->offsets);
+    memcpy(kept->tail, (const uint8_t *)msg + COAVOID_NODE_INTENT_TAIL_AT, sizeof kept->tail);
+}
+
+const coavoid_intent_t *coavoid_node_intent_open(const coavoid_node_intent_t *kept,
+                                                 coavoid_intent_t *out)
+{
+    memset(out, 0, sizeof *out);
+    memcpy(out, kept->head, sizeof kept->head);
+    for (size_t j = 0; j < COAVOID_NODE_MAX_SAMPLES; j++) {
+        for (size_t d = 0; d < 3u; d++) {
+            out->reference[j][d] = (double)kept->reference[j][d];
+        }
+    }
+    memcpy(out->offsets, kept->offsets, sizeof kept->offsets);
+    memcpy((uint8_t *)out + COAVOID_NODE_INTENT_TAIL_AT, kept->tail, sizeof kept->tail);
+    return out;
+}
+
 /* Stores a UAV's new intent in its slot, keeping its last one of an earlier cycle. */
 static void peer_keep(coavoid_node_peer_t *peer, const coavoid_intent_t *msg)
 {
@@ -197,7 +227,7 @@ static void peer_keep(coavoid_node_peer_t *peer, const coavoid_intent_t *msg)
     }
     peer->used = true;
     peer->forgotten = false;
-    peer->msg = *msg;
+    coavoid_node_intent_keep(&peer->msg, msg);
 }
 
 /* UAV uav_id's slot among the peers, or a free one while fewer than peer_capacity are

@@ -112,16 +112,44 @@ typedef struct {
     size_t heard_count;
 } coavoid_node_senders_t;
 
+/* An intent as a node keeps it (coavoid_node_intent_keep): every field as received, but
+ * the node's samples only (a longer intent is refused on arrival) and its reference points
+ * in the core's precision, to which every use converts them first (so the opened message
+ * converts exactly as the received one did). What a node reads of it without opening it
+ * (coavoid_node_intent_open) is copied out: utime, plan_utime and uav_id. */
+#define COAVOID_NODE_INTENT_HEAD offsetof(coavoid_intent_t, reference)
+#define COAVOID_NODE_INTENT_TAIL_AT \
+    (offsetof(coavoid_intent_t, offsets) + sizeof(((coavoid_intent_t *)NULL)->offsets))
+_Static_assert(offsetof(coavoid_intent_t, offsets) ==
+                   COAVOID_NODE_INTENT_HEAD + sizeof(((coavoid_intent_t *)NULL)->reference),
+               "intent_t: the offsets follow the reference points");
+typedef struct {
+    int64_t utime;
+    int64_t plan_utime;
+    int32_t uav_id;
+    uint8_t head[COAVOID_NODE_INTENT_HEAD]; /* the fields before the reference points */
+    coa_real_t reference[COAVOID_NODE_MAX_SAMPLES][3];
+    int32_t offsets[COAVOID_NODE_MAX_SAMPLES];
+    uint8_t tail[sizeof(coavoid_intent_t) - COAVOID_NODE_INTENT_TAIL_AT]; /* and after them */
+} coavoid_node_intent_t;
+
 typedef struct {
     bool used;
-    bool forgotten;       /* its sequence was forgotten when it went stale */
-    coavoid_intent_t msg; /* validated on arrival */
+    bool forgotten;            /* its sequence was forgotten when it went stale */
+    coavoid_node_intent_t msg; /* validated on arrival */
     /* The latest intent of an earlier cycle than msg's (has_prev): what a vehicle's order
      * search reads as the intents of a cycle's start, whether or not the UAV has already
      * published its intent of the cycle (vehicle_order.c, coavoid_vehicle_search_order). */
     bool has_prev;
-    coavoid_intent_t prev;
+    coavoid_node_intent_t prev;
 } coavoid_node_peer_t;
+
+/* Keeps a validated intent (sample_count at most COAVOID_NODE_MAX_SAMPLES). O(samples). */
+void coavoid_node_intent_keep(coavoid_node_intent_t *kept, const coavoid_intent_t *msg);
+
+/* The kept intent as a whole message, in *out; returns out. O(samples). */
+const coavoid_intent_t *coavoid_node_intent_open(const coavoid_node_intent_t *kept,
+                                                 coavoid_intent_t *out);
 
 typedef struct {
     bool used;
@@ -262,6 +290,7 @@ typedef struct {
     /* A stale UAV's last plan as its track's path, and the conversion's scratch. */
     coa_track_point_t stale_paths[COAVOID_NODE_MAX_PEERS][COAVOID_NODE_MAX_SAMPLES];
     coavoid_lcm_intent_arrays_t stale_arrays;
+    coavoid_intent_t opened; /* scratch: a kept intent opened to be converted or read */
 } coavoid_node_view_t;
 
 /* The tracks of one planning problem, sampled over the horizon. */

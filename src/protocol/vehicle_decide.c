@@ -457,10 +457,11 @@ static void note_order(coavoid_vehicle_node_t *node)
          * cycle with world news, every UAV before it use the digest. */
         uint32_t digest = 0;
         for (size_t p = 0; p < COAVOID_NODE_MAX_PEERS; p++) {
-            const coavoid_intent_t *m = &node->inbox.peers[p].msg;
+            const coavoid_node_intent_t *m = &node->inbox.peers[p].msg;
             if (node->inbox.peers[p].used && (uint16_t)m->uav_id == view->live_id[i]) {
                 const bool digested = centralised || news || newcomer(node, &node->inbox.peers[p]);
-                digest = digested ? intent_digest(m) : 0u;
+                digest =
+                    digested ? intent_digest(coavoid_node_intent_open(m, &node->view.opened)) : 0u;
                 break; /* one slot per UAV */
             }
         }
@@ -497,15 +498,16 @@ static int32_t agreed_rank_of(const coavoid_vehicle_node_t *node, uint16_t id)
  * is not another plan). In a cycle it decided again on world news
  * (reconsider), so do the UAVs before it, with another plan too. O(peers^2 + peers *
  * samples). */
-static bool overtaken(const coavoid_vehicle_node_t *node)
+static bool overtaken(coavoid_vehicle_node_t *node)
 {
     const coa_vehicle_t *self = &node->config.vehicle;
     const bool news = node->news_cycle == node->state.cycle;
     for (size_t i = 0; i < COAVOID_NODE_MAX_PEERS; i++) {
-        const coavoid_intent_t *m = &node->inbox.peers[i].msg;
-        if (!node->inbox.peers[i].used || m->plan_utime != node->cycle_start) {
+        const coavoid_node_peer_t *peer = &node->inbox.peers[i];
+        if (!peer->used || peer->msg.plan_utime != node->cycle_start) {
             continue; /* before the row comparison: no intent of this cycle to compare */
         }
+        const coavoid_intent_t *m = coavoid_node_intent_open(&peer->msg, &node->view.opened);
         const bool first = m->rank <= 0 && (newcomer(node, &node->inbox.peers[i]) || news);
         const bool answered = node->config.mode == COAVOID_NODE_CENTRALISED && m->rank <= 0 &&
                               (m->mode == COAVOID_INTENT_T_MODE_DECOUPLED ||

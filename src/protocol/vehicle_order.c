@@ -119,7 +119,8 @@ static size_t snapshot(coavoid_vehicle_node_t *node, int64_t previous)
         const coavoid_node_peer_t *peer = &node->inbox.peers[p];
         if (coavoid_vehicle_first_intent(node, peer)) {
             node->searched_first++;
-            (void)snapshot_add(node, &peer->msg, SNAPSHOT_FIRST);
+            (void)snapshot_add(node, coavoid_node_intent_open(&peer->msg, &node->view.opened),
+                               SNAPSHOT_FIRST);
         }
     }
     if (node->order_own_kind == SNAPSHOT_NONE ||

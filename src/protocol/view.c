@@ -79,15 +79,17 @@ static bool stale_plan_track(const coavoid_intent_t *msg, const coavoid_lcm_cont
     return true;
 }
 
-/* Peer i's latest intent of a cycle that began before `before`: its latest, or the one
- * before it; NULL when it has none. O(1). */
-static const coavoid_intent_t *peer_intent(const coavoid_node_inbox_t *in, size_t i, int64_t before)
+/* Peer i's latest intent of a cycle that began before `before`, opened in *out: its
+ * latest, or the one before it; NULL when it has none. O(samples). */
+static const coavoid_intent_t *peer_intent(const coavoid_node_inbox_t *in, size_t i, int64_t before,
+                                           coavoid_intent_t *out)
 {
     const coavoid_node_peer_t *p = &in->peers[i];
     if (p->msg.plan_utime < before) {
-        return &p->msg;
+        return coavoid_node_intent_open(&p->msg, out);
     }
-    return p->has_prev && p->prev.plan_utime < before ? &p->prev : NULL;
+    return p->has_prev && p->prev.plan_utime < before ? coavoid_node_intent_open(&p->prev, out)
+                                                      : NULL;
 }
 
 /* The UAVs heard, by ascending id, so that plan indices (and the clusters' order) do not
@@ -140,7 +142,7 @@ static void view_live(coavoid_node_view_t *view, const coavoid_node_inbox_t *in,
 {
     const coavoid_node_common_t *c = &in->common;
     for (size_t s = 0; s < n; s++) {
-        const coavoid_intent_t *msg = peer_intent(in, order[s], before);
+        const coavoid_intent_t *msg = peer_intent(in, order[s], before, &view->opened);
         stale[s] = false;
         if (msg == NULL) {
             continue;
@@ -201,7 +203,7 @@ void coavoid_node_view_build_before(coavoid_node_view_t *view, const coavoid_nod
     view->real_track_count = view->track_count;
     /* The silent UAVs, until they are dropped: tracks along the last plan they announced. */
     for (size_t s = 0; s < n; s++) {
-        const coavoid_intent_t *msg = peer_intent(in, order[s], before);
+        const coavoid_intent_t *msg = peer_intent(in, order[s], before, &view->opened);
         if (!stale[s] || now - msg->utime > drop) {
             continue;
         }
