@@ -3,7 +3,7 @@
 # includes a header of apps/ (by its name, or by a path into apps/), the core
 # (src/core/, include/coavoid/) includes neither LCM nor stdio, and the message checks the
 # firmware compiles (src/auth/auth.c, auth.h) include no LCM, stdio or stdlib, nor does
-# the vehicle protocol (src/protocol/).
+# the vehicle protocol (src/protocol/) or its replay (src/replay/).
 # Usage: cmake -DSRC=<source tree> -P check_layering.cmake
 cmake_minimum_required(VERSION 3.16)
 if(NOT SRC)
@@ -31,9 +31,10 @@ foreach(f ${lib_files})
   if(rel MATCHES "^src/auth/auth\\.[ch]$")
     set(part TRUE)
   endif()
-  # The vehicle protocol, which runs in the autopilot: no LCM, no stdio, no heap.
+  # The vehicle protocol, which runs in the autopilot, and its replay there: no LCM, no stdio,
+  # no heap.
   set(protocol FALSE)
-  if(rel MATCHES "^src/protocol/")
+  if(rel MATCHES "^src/(protocol|replay)/")
     set(protocol TRUE)
   endif()
   foreach(line ${includes})

@@ -28,11 +28,12 @@
  * the one place where that option reaches the code: their sources are left out of the
  * build otherwise, not replaced by stubs. */
 #ifdef COAVOID_HAVE_NODE
-#define USAGE_NODES                                                                 \
-    "  sim         fly a scenario in closed loop over the nodes (deterministic)\n"  \
-    "  summary     judge a real-time run from its lcm-logger log (costs, figure)\n" \
-    "  world       publish a scenario's terrain and tracks to a real-time run\n"    \
-    "  keygen      write fresh signing keys and the trust file for a scenario's fleet\n"
+#define USAGE_NODES                                                                      \
+    "  sim         fly a scenario in closed loop over the nodes (deterministic)\n"       \
+    "  summary     judge a real-time run from its lcm-logger log (costs, figure)\n"      \
+    "  world       publish a scenario's terrain and tracks to a real-time run\n"         \
+    "  keygen      write fresh signing keys and the trust file for a scenario's fleet\n" \
+    "  replay      make a vehicle's record (sim --record-vehicle) again, and compare\n"
 #else
 #define USAGE_NODES ""
 #endif
@@ -89,6 +90,9 @@ int main(int argc, char **argv)
     }
     if (strcmp(command, "keygen") == 0) {
         return coavoid_command_keygen(argc, argv);
+    }
+    if (strcmp(command, "replay") == 0) {
+        return coavoid_command_replay(argc, argv);
     }
 #endif
     if (command[0] == '-') {

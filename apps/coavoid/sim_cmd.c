@@ -20,6 +20,7 @@
     "usage: coavoid sim SCENARIO.json --mode centralised|decoupled [--steps K] [--json]\n"      \
     "                   [--svg FILE] [--coordinator-stops STEP[:M]] [--insecure]\n"             \
     "                   [--loss P] [--delay S] [--jitter S] [--seed N]\n"                       \
+    "                   [--record-vehicle ID:FILE]\n"                                           \
     "\n"                                                                                        \
     "Flies the scenario in closed loop: every step each UAV publishes its intent, conflicts\n"  \
     "are predicted and planned for (by the coordinator, or by each UAV in priority order),\n"   \
@@ -45,6 +46,11 @@
     "  --jitter S           ... plus a uniform time in [0, S] seconds; default 0. A node\n"     \
     "                       hears its own at once; delay + jitter must be less than dt\n"       \
     "  --seed N             the network's random seed, an integer >= 0; default 1\n"            \
+    "  --record-vehicle ID:FILE\n"                                                              \
+    "                       write UAV ID's record to FILE: its configuration and keys, every\n" \
+    "                       datagram it received and call made, with their times, and what\n"   \
+    "                       it sent and its state after each call (`coavoid replay FILE`\n"     \
+    "                       makes them again and compares)\n"                                   \
     "  -h, --help           show this help\n"                                                   \
     "\n"                                                                                        \
     "Beyond the contract's fields the result has \"fallbacks\" (times a UAV went from\n"        \
@@ -78,6 +84,9 @@ typedef struct {
     uint32_t stop_messages;
     bool insecure;
     coavoid_cli_network_t network;
+    const char *record_text;
+    const char *record_path;
+    uint16_t record_uav;
 } sim_options_t;
 
 static void sim_help(void)
@@ -115,6 +124,31 @@ static int parse_stop(sim_options_t *o)
     return CLI_CONTINUE;
 }
 
+/* --record-vehicle ID:FILE, ID a UAV id (1..65535). */
+static int parse_record(sim_options_t *o)
+{
+    const char *text = o->record_text;
+    const char *colon = strchr(text, ':');
+    char id[8];
+    uint64_t value = 0;
+    size_t length = colon != NULL ? (size_t)(colon - text) : 0u;
+    bool ok = colon != NULL && length > 0u && length < sizeof id && colon[1] != '\0';
+    if (ok) {
+        memcpy(id, text, length);
+        id[length] = '\0';
+        ok = coavoid_cli_parse_index(id, 65535u, &value) && value >= 1u;
+    }
+    if (!ok) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                "--record-vehicle: must be ID:FILE, a UAV id from 1 to 65535 and "
+                                "a file to write, got '%.40s'",
+                                text);
+    }
+    o->record_uav = (uint16_t)value;
+    o->record_path = colon + 1;
+    return CLI_CONTINUE;
+}
+
 static int sim_option(int argc, char **argv, int *i, void *options)
 {
     sim_options_t *o = options;
@@ -141,6 +175,10 @@ static int sim_option(int argc, char **argv, int *i, void *options)
         status = coavoid_cli_text_option(argc, argv, i, "--coordinator-stops", "a step, 0 or more",
                                          true, &o->stop_text);
         status = status == CLI_CONTINUE ? parse_stop(o) : status;
+    } else if (coavoid_cli_option_is(arg, "--record-vehicle")) {
+        status = coavoid_cli_text_option(argc, argv, i, "--record-vehicle", "ID:FILE", false,
+                                         &o->record_text);
+        status = status == CLI_CONTINUE ? parse_record(o) : status;
     }
     return status;
 }
@@ -181,6 +219,8 @@ static int sim(void *options, coavoid_scenario_t *s)
         .stop_messages = o->stop_messages,
         .json = o->json,
         .svg_path = o->svg_path,
+        .record_path = o->record_path,
+        .record_uav = o->record_uav,
         .insecure = o->insecure,
         .network = coavoid_cli_network_given(&o->network),
         .loss = o->network.loss,

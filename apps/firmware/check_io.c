@@ -5,6 +5,8 @@
  */
 #include "check_io.h"
 
+#include <string.h>
+
 /* SysTick, free-running on the processor clock: 24 bits, the wraps counted in the
  * interrupt. */
 #define SYST_CSR (*(volatile uint32_t *)0xE000E010u)
@@ -58,6 +60,33 @@ static void semihost(uint32_t op, const void *arg)
                      :
                      : "r"(op), "r"(arg)
                      : "r0", "r1", "memory");
+}
+
+/* The operations that answer in r0: SYS_OPEN, SYS_READ. */
+#define SYS_OPEN 0x01u
+#define SYS_READ 0x06u
+#define SYS_OPEN_READ_BINARY 1u
+
+static int32_t semihost_answer(uint32_t op, const void *arg)
+{
+    register uint32_t r0 __asm__("r0") = op;
+    register const void *r1 __asm__("r1") = arg;
+    __asm__ volatile("bkpt 0xab" : "+r"(r0) : "r"(r1) : "memory");
+    return (int32_t)r0;
+}
+
+int32_t fwc_file_open(const char *name)
+{
+    const uint32_t args[3] = {(uint32_t)(uintptr_t)name, SYS_OPEN_READ_BINARY,
+                              (uint32_t)strlen(name)};
+    return semihost_answer(SYS_OPEN, args);
+}
+
+size_t fwc_file_read(int32_t handle, void *buffer, size_t n)
+{
+    const uint32_t args[3] = {(uint32_t)handle, (uint32_t)(uintptr_t)buffer, (uint32_t)n};
+    const int32_t left = semihost_answer(SYS_READ, args); /* bytes not read */
+    return left < 0 || (size_t)left > n ? 0u : n - (size_t)left;
 }
 
 /* Output goes through a line buffer: one semihosting call per line, not per character. */

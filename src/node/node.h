@@ -174,6 +174,14 @@ coavoid_vehicle_node_t *coavoid_vehicle_node_create(const coavoid_vehicle_node_c
 /* Unsubscribes and frees a node that create made. NULL is fine. */
 void coavoid_vehicle_node_destroy(coavoid_vehicle_node_t *node);
 
+/* What a vehicle made by create receives and sends, as it happens: each datagram with its
+ * channel, `sent` false for one handed to its inbox (before the inbox sees it), true for
+ * one it published. For a record of the vehicle (`coavoid sim --record-vehicle`,
+ * src/replay). tap NULL: nothing more. O(1). */
+typedef void (*coavoid_node_tap_t)(void *user, bool sent, const char *channel, const void *data,
+                                   size_t size);
+void coavoid_vehicle_node_tap(coavoid_vehicle_node_t *node, coavoid_node_tap_t tap, void *user);
+
 /* ---- coordinator ---- */
 
 typedef struct {

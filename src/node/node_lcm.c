@@ -16,7 +16,13 @@ static int lcm_send(void *user, const char *channel, const uint8_t *data, size_t
     if (size > (size_t)UINT_MAX) {
         return COA_ERR_ARGUMENT;
     }
-    return lcm_publish(t->tx, channel, data, (unsigned int)size) == 0 ? COA_OK : COA_ERR_ARGUMENT;
+    if (lcm_publish(t->tx, channel, data, (unsigned int)size) != 0) {
+        return COA_ERR_ARGUMENT;
+    }
+    if (t->tap != NULL) {
+        t->tap(t->tap_user, true, channel, data, size);
+    }
+    return COA_OK;
 }
 
 void coavoid_node_lcm_init(coavoid_node_lcm_t *t, lcm_t *tx, lcm_t *rx)
@@ -24,6 +30,9 @@ void coavoid_node_lcm_init(coavoid_node_lcm_t *t, lcm_t *tx, lcm_t *rx)
     t->tx = tx;
     t->rx = rx != NULL ? rx : tx;
     t->sub_count = 0;
+    t->in = NULL;
+    t->tap = NULL;
+    t->tap_user = NULL;
 }
 
 coavoid_node_link_t coavoid_node_lcm_link(coavoid_node_lcm_t *t)
@@ -35,19 +44,24 @@ coavoid_node_link_t coavoid_node_lcm_link(coavoid_node_lcm_t *t)
 /* A refusal is counted by the inbox; a channel it does not take in was not subscribed. */
 static void on_datagram(const lcm_recv_buf_t *rbuf, const char *channel, void *user)
 {
+    coavoid_node_lcm_t *t = user;
     if (rbuf != NULL && rbuf->data != NULL) {
-        (void)coavoid_node_inbox_receive(user, channel, rbuf->data, rbuf->data_size);
+        if (t->tap != NULL) {
+            t->tap(t->tap_user, false, channel, rbuf->data, rbuf->data_size);
+        }
+        (void)coavoid_node_inbox_receive(t->in, channel, rbuf->data, rbuf->data_size);
     }
 }
 
 int coavoid_node_lcm_subscribe(coavoid_node_lcm_t *t, coavoid_node_inbox_t *in)
 {
+    t->in = in;
     for (size_t i = 0; i < COAVOID_NODE_CHANNELS; i++) {
         const char *channel = coavoid_node_inbox_channel(in, i);
         if (channel == NULL) {
             continue;
         }
-        lcm_subscription_t *sub = lcm_subscribe(t->rx, channel, on_datagram, in);
+        lcm_subscription_t *sub = lcm_subscribe(t->rx, channel, on_datagram, t);
         if (sub == NULL) {
             coavoid_node_lcm_unsubscribe(t);
             return COA_ERR_ARGUMENT;
@@ -113,4 +127,13 @@ void coavoid_vehicle_node_destroy(coavoid_vehicle_node_t *node)
     coavoid_node_lcm_unsubscribe(t);
     coavoid_vehicle_node_fini(node);
     free(t);
+}
+
+void coavoid_vehicle_node_tap(coavoid_vehicle_node_t *node, coavoid_node_tap_t tap, void *user)
+{
+    if (node != NULL) {
+        coavoid_node_lcm_t *t = coavoid_vehicle_node_inbox(node)->tx.link.user;
+        t->tap = tap;
+        t->tap_user = user;
+    }
 }

@@ -18,6 +18,9 @@ typedef struct {
     lcm_t *rx; /* where it subscribes */
     lcm_subscription_t *subs[COAVOID_NODE_CHANNELS];
     size_t sub_count;
+    coavoid_node_inbox_t *in; /* what it subscribed */
+    coavoid_node_tap_t tap;   /* NULL, or told of every datagram (coavoid_vehicle_node_tap) */
+    void *tap_user;
 } coavoid_node_lcm_t;
 
 /* Prepares t to publish on tx and to subscribe on rx (NULL: tx); nothing subscribed yet.

@@ -20,6 +20,7 @@
 #include "net.h"
 #include "node.h"
 #include "sim.h"
+#include "record.h"
 #include "sim_internal.h"
 
 /* Cycle 0's utime: a fixed constant (2001-09-09), never the wall clock, so that every
@@ -83,6 +84,9 @@ typedef struct {
      * coordinator's, the world's, then each UAV's in scenario order. */
     coavoid_auth_trust_t trust;
     coavoid_auth_signer_t *signers;
+    /* With record_path: the record of one UAV, vehicles[recorded] (n: none). */
+    coavoid_sim_record_t record;
+    size_t recorded;
 } sim_run_t;
 
 static void sim_run_free(sim_run_t *r, size_t n)
@@ -94,6 +98,7 @@ static void sim_run_free(sim_run_t *r, size_t n)
         }
     }
     coavoid_world_destroy(r->world);
+    (void)coavoid_sim_record_close(&r->record);
     coavoid_sim_net_destroy(r->net);
     free(r->vehicles);
     free(r->index);
@@ -506,6 +511,15 @@ static int sim_check(sim_run_t *r, coavoid_scenario_t *s)
                                 "%s: tracks: %zu tracks, at most %u in a simulation", file,
                                 s->track_count, COAVOID_NODE_MAX_TRACKS);
     }
+    r->recorded = n;
+    bool known = r->o->record_path == NULL;
+    for (size_t i = 0; i < n && !known; i++) {
+        known = s->vehicles[i].id == r->o->record_uav;
+    }
+    if (!known) {
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT, "--record-vehicle: %s has no UAV %u",
+                                file, (unsigned)r->o->record_uav);
+    }
     r->steps = r->o->has_steps ? r->o->steps : 2u * s->horizon;
     r->samples = (size_t)r->steps + 1u;
     if (r->o->has_stop && r->o->stop_step > r->steps) {
@@ -782,9 +796,22 @@ static int sim_vehicles(sim_run_t *r)
         config.intent_copies = COAVOID_NODE_DEFAULT_COPIES;
         config.joint_members = coavoid_node_joint_members(config.mode, r->n);
         config.joint_memo = r->o->joint_memo != NULL ? r->o->joint_memo : &r->own_memo;
+        const bool recorded = r->o->record_path != NULL && config.vehicle.id == r->o->record_uav;
+        if (recorded) {
+            config.joint_memo = NULL; /* a replay searches on its own: so does the record */
+            if (!coavoid_sim_record_open(&r->record, r->o->record_path, &config)) {
+                return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT,
+                                        "--record-vehicle: cannot write '%.200s'",
+                                        r->o->record_path);
+            }
+        }
         r->vehicles[j] =
             coavoid_vehicle_node_create(&config, coavoid_sim_net_tx(r->net, SIM_NET_VEHICLE(j)),
                                         coavoid_sim_net_rx(r->net, SIM_NET_VEHICLE(j)), &error);
+        if (recorded && r->vehicles[j] != NULL) {
+            coavoid_vehicle_node_tap(r->vehicles[j], coavoid_sim_record_tap, &r->record);
+            r->recorded = j;
+        }
         if (r->vehicles[j] == NULL && error == COA_ERR_ARGUMENT) {
             return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INPUT,
                                     "%s: vehicles[%zu]: cannot run as a node (%s)", r->file, i,
@@ -856,6 +883,16 @@ static int sim_coordinator(sim_run_t *r)
 static int64_t sim_coordinator_deadline(const sim_run_t *r);
 static int sim_coordinator_poll(sim_run_t *r);
 
+/* Vehicle j's cycle (or poll) at r->now, recorded when it is the recorded one. */
+static int sim_vehicle_call(sim_run_t *r, size_t j, bool cycle)
+{
+    if (j == r->recorded) {
+        return coavoid_sim_record_call(&r->record, r->vehicles[j], cycle, r->now);
+    }
+    return cycle ? coavoid_vehicle_node_cycle(r->vehicles[j], r->now)
+                 : coavoid_vehicle_node_poll(r->vehicles[j], r->now);
+}
+
 /* Polls every node once at r->now, draining what each published. True when one did. */
 static bool sim_poll(sim_run_t *r, int *node_error, bool *lcm_ok)
 {
@@ -863,7 +900,7 @@ static bool sim_poll(sim_run_t *r, int *node_error, bool *lcm_ok)
     for (size_t j = 0; j <= r->n && *lcm_ok; j++) {
         int rc = 0;
         if (j < r->n) {
-            rc = coavoid_vehicle_node_poll(r->vehicles[j], r->now);
+            rc = sim_vehicle_call(r, j, false);
         } else if (r->coordinator != NULL || r->replaying) {
             rc = sim_coordinator_poll(r);
         }
@@ -1012,7 +1049,7 @@ static bool sim_cycle(sim_run_t *r, uint32_t k, int *node_error)
     *node_error = *node_error != COA_OK ? *node_error : rc;
     lcm_ok = lcm_ok && drain(r);
     for (size_t j = 0; j < r->n && lcm_ok; j++) {
-        rc = coavoid_vehicle_node_cycle(r->vehicles[j], r->now);
+        rc = sim_vehicle_call(r, j, true);
         *node_error = *node_error != COA_OK ? *node_error : rc;
         lcm_ok = drain(r);
     }
@@ -1171,6 +1208,10 @@ static int sim_report(sim_run_t *r, coavoid_sim_outcome_t *outcome)
                                     (unsigned)r->s->vehicles[r->index[j]].id,
                                     (unsigned long)st->protocol_faults);
         }
+    }
+    if (!coavoid_sim_record_close(&r->record)) {
+        return coavoid_run_fail(r->err, COAVOID_RUN_ERR_INTERNAL,
+                                "--record-vehicle: writing '%.200s' failed", o->record_path);
     }
     int rc = coavoid_judge_run(&r->judged, r->s, o->mode, r->steps, replans, r->references,
                                r->offsets, NULL);

@@ -80,6 +80,12 @@ typedef struct {
     coavoid_node_joint_memo_t *joint_memo;
     bool json;            /* the result as JSON (default: text) */
     const char *svg_path; /* NULL, or where the figure goes */
+    /* NULL, or where the record of UAV record_uav goes (src/replay, replay.h): its
+     * configuration and keys, every datagram it received and call it was given with their
+     * times, what it sent and its state after each call. That UAV searches jointly without
+     * the run's memo (joint_memo), which changes nothing of the flight. */
+    const char *record_path;
+    uint16_t record_uav;
     /* The nodes sign and check every message (default), with the simulation's fixed keys
      * (fixed, public, derived from the key ids: they make a run repeatable and protect nothing, as
      * nothing but the run's own nodes is on its in-process bus), or, insecure, neither: the flight is the same either way. */
@@ -150,8 +156,14 @@ typedef struct {
     const char *mode;     /* the mode the run was started in, as the result names it */
     bool json;            /* the result as JSON, with a "log" object */
     const char *svg_path; /* NULL, or where the figure goes */
-    bool has_epoch;       /* cycle 0's start given; otherwise the earliest plan_utime */
-    int64_t epoch;        /* microseconds, >= 1 */
+    /* NULL, or where the record of UAV record_uav goes (src/replay, replay.h): its
+     * configuration and keys, every datagram it received and call it was given with their
+     * times, what it sent and its state after each call. That UAV searches jointly without
+     * the run's memo (joint_memo), which changes nothing of the flight. */
+    const char *record_path;
+    uint16_t record_uav;
+    bool has_epoch; /* cycle 0's start given; otherwise the earliest plan_utime */
+    int64_t epoch;  /* microseconds, >= 1 */
     /* The run's trust list (the caller's), or NULL: then signatures are not checked. With
      * one, an intent, heartbeat or plan counts only when signed by a key that may send it
      * and newer (timestamp, sequence) than the last one of its type from that key in log

@@ -1,6 +1,8 @@
 # SPDX-License-Identifier: MIT
 # Flash and RAM of a GNU ld map file by origin: the core, libccd, the messages (LCM's
-# coders and src/lcm's validation), the drivers' message checks (src/auth), libsodium's primitives, the firmware's (or the firmware check's) own objects, and newlib with libgcc
+# coders and src/lcm's validation), the drivers' message checks (src/auth), libsodium's
+# primitives, the vehicle protocol (src/protocol), its replay (src/replay), the firmware's
+# own objects (the firmware's, the check's or the replay's), and newlib with libgcc
 # (everything else). Input sections only: the linker's
 # alignment padding is not counted (the ELF's totals include it).
 #   awk -f mapsizes.awk coavoid-firmware.map
@@ -27,7 +29,9 @@ kind != "" {
             else if (f ~ /libcoavoid_sodium_arm\.a/) c = "libsodium"
             else if (f ~ /libcoavoid_auth\.a/) c = "auth"
             else if (f ~ /libcoavoid_lcm(types)?\.a/) c = "messages"
-            else if (f ~ /coavoid_firmware(_check)?\.dir/) c = "firmware"
+            else if (f ~ /libcoavoid_protocol\.a/) c = "protocol"
+            else if (f ~ /libcoavoid_replay\.a/) c = "replay"
+            else if (f ~ /coavoid_firmware(_check|_replay)?\.dir/) c = "firmware"
             else c = "newlib+libgcc"
             total[c, kind] += hex($(i + 1))
             break
@@ -35,8 +39,8 @@ kind != "" {
     }
 }
 END {
-    split("core libccd messages auth libsodium firmware newlib+libgcc", order, " ")
+    split("core libccd messages auth libsodium protocol replay firmware newlib+libgcc", order, " ")
     printf "%-14s %8s %8s %8s\n", "", "flash", "data", "bss"
-    for (j = 1; j <= 7; j++)
+    for (j = 1; j <= 9; j++)
         printf "%-14s %8d %8d %8d\n", order[j], total[order[j], "flash"], total[order[j], "data"], total[order[j], "bss"]
 }

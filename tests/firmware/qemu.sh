@@ -26,9 +26,9 @@ command -v qemu-system-arm >/dev/null ||
   die "qemu-system-arm not found: apt-get install qemu-system-arm"
 [ -f "$arm/CMakeCache.txt" ] ||
   die "$arm is not configured: the firmware test (tests/firmware/run.sh) builds it first"
-if ! log=$("$cmake" --build "$arm" --target coavoid_firmware_check 2>&1); then
+if ! log=$("$cmake" --build "$arm" --target coavoid_firmware_check coavoid_firmware_replay 2>&1); then
   echo "$log" >&2
-  die "building coavoid-firmware-check.elf failed (see above)"
+  die "building the firmware's check and replay ELFs failed (see above)"
 fi
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
@@ -54,4 +54,23 @@ echo "== firmware check on qemu netduinoplus2 (exit $rc)"
 cat "$out"
 [ "$rc" -eq 0 ] || { echo "firmware_qemu: FAIL: the firmware check exited with $rc" >&2; failed=1; }
 python3 "$here/qemu_compare.py" "$out" "$double" "$single" -- "$here"/qemu/*.json || failed=1
+
+# The vehicle protocol on the part: UAV 1 of the paper's encounter, recorded by the
+# single-precision host build in each mode, replayed by coavoid-firmware-replay.elf
+# (apps/firmware/replay.c), which reads the records from its working directory and must
+# send every recorded byte and reach every recorded state. A centralised vehicle that does
+# not fit the part's block is reported, not replayed.
+replay=$arm/apps/firmware/coavoid-firmware-replay.elf
+for mode in decoupled centralised; do
+  "$single" sim "$src/scenarios/paper.json" --mode "$mode" \
+    --record-vehicle "1:$tmp/$mode.rec" > /dev/null || die "recording UAV 1 ($mode) failed"
+done
+(cd "$tmp" && timeout 120 qemu-system-arm -M netduinoplus2 -icount shift=0 -display none \
+  -monitor none -serial null -chardev file,id=semihosting,path="$tmp/replay.txt" \
+  -semihosting-config enable=on,target=native,chardev=semihosting -kernel "$replay")
+rc=$?
+echo "== vehicle replay on qemu netduinoplus2 (exit $rc)"
+cat "$tmp/replay.txt"
+[ "$rc" -eq 0 ] && grep -q '^replay decoupled.rec .*: all as recorded$' "$tmp/replay.txt" ||
+  { echo "firmware_qemu: FAIL: the vehicle on the part did not replay UAV 1 as recorded" >&2; failed=1; }
 exit "$failed"

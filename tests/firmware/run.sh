@@ -10,7 +10,8 @@
 #     failing on recursion or a dynamic frame.
 # Also builds the message checks (src/auth on libsodium, cmake/libsodium_arm.cmake) into
 # the check ELF, which must link them without a heap, and the vehicle protocol
-# (src/protocol), which must need no heap or stdio, and reports their sizes and stack.
+# (src/protocol) and its replay (src/replay, the replay ELF), which must need no heap or
+# stdio, and reports their sizes and stack.
 # Usage: run.sh SRC BUILD CCD_SOURCE_DIR SODIUM_SOURCE_DIR (the unpacked sources, fetched
 # beforehand by scripts/fetch_sources.sh: a test never downloads). A missing toolchain,
 # newlib or source is a failure with what to install, not a skip: CI must run this.
@@ -79,11 +80,20 @@ protocol=$arm/src/protocol/libcoavoid_protocol.a
 [ -f "$protocol" ] || die "$protocol was not built"
 "$cmake" -DLIB="$protocol" -DNM="${prefix}nm" -P "$src/tests/check_core_symbols.cmake" ||
   die "the ARM vehicle protocol archive references a forbidden function"
+replay=$arm/src/replay/libcoavoid_replay.a
+[ -f "$replay" ] || die "$replay was not built"
+"$cmake" -DLIB="$replay" -DNM="${prefix}nm" -P "$src/tests/check_core_symbols.cmake" ||
+  die "the ARM vehicle replay archive references a forbidden function"
 # The check ELF (qemu.sh runs it) prints through semihosting calls of its own, not stdio.
 check_elf=$arm/apps/firmware/coavoid-firmware-check.elf
 [ -f "$check_elf" ] || die "$check_elf was not built"
 "$cmake" -DLINKED=ON -DLIB="$check_elf" -DNM="${prefix}nm" -P "$src/tests/check_core_symbols.cmake" ||
   die "the firmware check ELF contains a forbidden function"
+# So does the replay ELF, the vehicle protocol linked as a firmware links it.
+replay_elf=$arm/apps/firmware/coavoid-firmware-replay.elf
+[ -f "$replay_elf" ] || die "$replay_elf was not built"
+"$cmake" -DLINKED=ON -DLIB="$replay_elf" -DNM="${prefix}nm" -P "$src/tests/check_core_symbols.cmake" ||
+  die "the firmware replay ELF contains a forbidden function"
 # (grep reads all of nm's output: -q would stop early and fail the pipe under pipefail)
 [ "$("${prefix}nm" "$check_elf" | grep -c ' T fwc_crypto_run$')" -eq 1 ] ||
   die "the firmware check ELF has no message checks (fwc_crypto_run): libsodium was not built"
@@ -137,6 +147,8 @@ echo "== firmware ELF by origin (input sections from the map; flash = code + con
 awk -f "$src/tests/firmware/mapsizes.awk" "$map"
 echo "== firmware check ELF by origin (the same; its message checks are libsodium's share)"
 awk -f "$src/tests/firmware/mapsizes.awk" "$arm/apps/firmware/coavoid-firmware-check.map"
+echo "== firmware replay ELF by origin (a vehicle of the protocol on the part: what it links)"
+awk -f "$src/tests/firmware/mapsizes.awk" "$arm/apps/firmware/coavoid-firmware-replay.map"
 echo "== firmware sections (flash: .isr_vector .text .ARM.exidx + .data's image; SRAM: .data .bss; CCM: .stack)"
 "${prefix}size" -A "$elf" | awk '$1 ~ /^\.(isr_vector|text|ARM\.exidx|data|bss|stack)/ { printf "%-12s %7d bytes at 0x%08x\n", $1, $2, $3 }'
 echo "firmware: ARM core and firmware link without heap or stdio"

@@ -28,6 +28,7 @@
 #include "coavoid_lcm.h"
 #include "lcm_examples.h"
 #include "protocol.h"
+#include "replay.h"
 #include "realtime.h"
 
 #define FUZZ_BUF 20000
@@ -184,6 +185,26 @@ static void parse_key_files(const char *text, size_t n)
     (void)coavoid_auth_signer_parse(&signer, text, n, err, sizeof err);
 }
 
+/* A vehicle's record (coavoid replay's input, src/replay): each record it holds parsed,
+ * and a configuration read. */
+static void parse_record(const uint8_t *data, size_t n)
+{
+    static coavoid_replay_t replay;
+    coavoid_replay_record_t rec;
+    size_t used = 0;
+    size_t at = n >= COAVOID_REPLAY_MAGIC_BYTES ? COAVOID_REPLAY_MAGIC_BYTES : n;
+    while (coavoid_replay_parse(data + at, n - at, &rec, &used) == COA_OK) {
+        if (used < COAVOID_REPLAY_HEADER_BYTES || used > n - at ||
+            rec.channel_length > COAVOID_REPLAY_MAX_CHANNEL) {
+            __builtin_trap();
+        }
+        if (rec.kind == COAVOID_REPLAY_CONFIG) {
+            (void)coavoid_replay_config(&replay, rec.payload, rec.payload_length);
+        }
+        at += used;
+    }
+}
+
 /* LCM's framing as the drivers' receiver reads it: a frame inside the datagram, or none. */
 static void check_frame(const unsigned char *datagram, size_t size)
 {
@@ -269,6 +290,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     const unsigned kind = (data[0] & 0x7fu) % 8u;
     if (kind == 7u) {
         parse_key_files((const char *)data + 1, size - 1u);
+        parse_record(data + 1, size - 1u);
         return 0;
     }
     const int raw = (data[0] & 0x80u) != 0;
