@@ -62,8 +62,9 @@ static void semihost(uint32_t op, const void *arg)
                      : "r0", "r1", "memory");
 }
 
-/* The operations that answer in r0: SYS_OPEN, SYS_READ. */
+/* The operations that answer in r0: SYS_OPEN, SYS_CLOSE, SYS_READ. */
 #define SYS_OPEN 0x01u
+#define SYS_CLOSE 0x02u
 #define SYS_READ 0x06u
 #define SYS_OPEN_READ_BINARY 1u
 
@@ -80,6 +81,12 @@ int32_t fwc_file_open(const char *name)
     const uint32_t args[3] = {(uint32_t)(uintptr_t)name, SYS_OPEN_READ_BINARY,
                               (uint32_t)strlen(name)};
     return semihost_answer(SYS_OPEN, args);
+}
+
+void fwc_file_close(int32_t handle)
+{
+    const uint32_t args[1] = {(uint32_t)handle};
+    (void)semihost_answer(SYS_CLOSE, args);
 }
 
 size_t fwc_file_read(int32_t handle, void *buffer, size_t n)

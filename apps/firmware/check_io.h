@@ -32,10 +32,11 @@ void fwc_put_hex(const unsigned char *bytes, size_t n);
 void fwc_end_line(void);
 
 /* A host file through semihosting, for reading (binary): its handle, negative when it
- * cannot be opened; and up to n of its bytes into buffer: how many were read (0 at the end
- * or on an error). */
+ * cannot be opened; up to n of its bytes into buffer: how many were read (0 at the end or
+ * on an error); and closed. */
 int32_t fwc_file_open(const char *name);
 size_t fwc_file_read(int32_t handle, void *buffer, size_t n);
+void fwc_file_close(int32_t handle);
 
 /* Ends the program through semihosting: exit status 0 when ok, 1 otherwise. */
 void fwc_exit(bool ok);

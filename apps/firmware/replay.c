@@ -168,6 +168,9 @@ int main(void)
         } else if (i == 0u) {
             ok = false; /* the decoupled vehicle must fit the part */
         }
+        if (file >= 0) {
+            fwc_file_close(file);
+        }
     }
     fwc_put(ok ? "done" : "done with errors");
     fwc_end_line();
