@@ -150,7 +150,8 @@ static bool replay_rest(const char *name, int32_t *file)
 
 int main(void)
 {
-    static const char *const records[] = {"decoupled.rec", "centralised.rec"};
+    /* The paper's UAV 1 in each mode; UAV 9 of nine converging, with 8 neighbours. */
+    static const char *const records[] = {"decoupled.rec", "centralised.rec", "nine.rec"};
     bool ok = true;
     fwc_ticks_start();
     const uint64_t start = fwc_ticks_now();
@@ -165,8 +166,8 @@ int main(void)
         if (replayed) {
             ok = replay_rest(records[i], &file) && ok;
             coavoid_vehicle_node_fini(replay.node);
-        } else if (i == 0u) {
-            ok = false; /* the decoupled vehicle must fit the part */
+        } else if (i != 1u) {
+            ok = false; /* a decoupled vehicle must fit the part */
         }
         if (file >= 0) {
             fwc_file_close(file);

@@ -7,7 +7,9 @@
 # the same scenarios (tests/firmware/qemu/*.json) in both host builds (double and single),
 # and the fleet tags and Ed25519 signatures the check computed with the host's libsodium.
 # Also fails when apps/firmware/check_problems.h is not what gen_check_problems.py makes
-# of those scenarios. A missing qemu-system-arm is a failure, not a skip.
+# of those scenarios. Then the vehicle protocol on the part: coavoid-firmware-replay.elf
+# flies the records of vehicles the single-precision build recorded, as recorded (below).
+# A missing qemu-system-arm is a failure, not a skip.
 # Usage: qemu.sh SRC BUILD DOUBLE_COAVOID SINGLE_COAVOID
 set -uo pipefail
 usage="usage: qemu.sh SRC BUILD DOUBLE_COAVOID SINGLE_COAVOID"
@@ -55,8 +57,9 @@ cat "$out"
 [ "$rc" -eq 0 ] || { echo "firmware_qemu: FAIL: the firmware check exited with $rc" >&2; failed=1; }
 python3 "$here/qemu_compare.py" "$out" "$double" "$single" -- "$here"/qemu/*.json || failed=1
 
-# The vehicle protocol on the part: UAV 1 of the paper's encounter, recorded by the
-# single-precision host build in each mode, replayed by coavoid-firmware-replay.elf
+# The vehicle protocol on the part: UAV 1 of the paper's encounter in each mode and UAV 9 of
+# nine converging (tests/firmware/replay/nine.json), recorded by the single-precision host
+# build, replayed by coavoid-firmware-replay.elf
 # (apps/firmware/replay.c), which reads the records from its working directory and must
 # send every recorded byte and reach every recorded state. A centralised vehicle that does
 # not fit the part's block is reported, not replayed.
@@ -65,12 +68,16 @@ for mode in decoupled centralised; do
   "$single" sim "$src/scenarios/paper.json" --mode "$mode" \
     --record-vehicle "1:$tmp/$mode.rec" > /dev/null || die "recording UAV 1 ($mode) failed"
 done
+# At the part's capacity: UAV 9 of nine converging on a point, last in priority.
+"$single" sim "$here/replay/nine.json" --mode decoupled --record-vehicle "9:$tmp/nine.rec" \
+  > /dev/null || die "recording UAV 9 of nine failed"
 (cd "$tmp" && timeout 120 qemu-system-arm -M netduinoplus2 -icount shift=0 -display none \
   -monitor none -serial null -chardev file,id=semihosting,path="$tmp/replay.txt" \
   -semihosting-config enable=on,target=native,chardev=semihosting -kernel "$replay")
 rc=$?
 echo "== vehicle replay on qemu netduinoplus2 (exit $rc)"
 cat "$tmp/replay.txt"
-[ "$rc" -eq 0 ] && grep -q '^replay decoupled.rec .*: all as recorded$' "$tmp/replay.txt" ||
-  { echo "firmware_qemu: FAIL: the vehicle on the part did not replay UAV 1 as recorded" >&2; failed=1; }
+[ "$rc" -eq 0 ] && grep -q '^replay decoupled.rec .*: all as recorded$' "$tmp/replay.txt" &&
+  grep -q '^replay nine.rec .*: all as recorded$' "$tmp/replay.txt" ||
+  { echo "firmware_qemu: FAIL: the vehicle on the part did not replay its records as recorded" >&2; failed=1; }
 exit "$failed"
