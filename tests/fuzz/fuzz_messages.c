@@ -28,6 +28,7 @@
 #include "coavoid_lcm.h"
 #include "lcm_examples.h"
 #include "protocol.h"
+#include "link.h"
 #include "replay.h"
 #include "realtime.h"
 
@@ -205,6 +206,25 @@ static void parse_record(const uint8_t *data, size_t n)
     }
 }
 
+/* The same bytes as they would come off a vehicle's serial link (link.h): every frame the
+ * receiver hands on fits its buffer and its CRC. */
+static void read_link(const uint8_t *data, size_t n)
+{
+    static uint8_t buffer[64];
+    coavoid_link_rx_t r;
+    coavoid_link_rx_init(&r, buffer, sizeof buffer);
+    for (size_t i = 0; i < n; i++) {
+        const size_t got = coavoid_link_rx_byte(&r, data[i]);
+        if (got > sizeof buffer - COAVOID_LINK_CRC_BYTES ||
+            (got > 0u &&
+             coavoid_link_crc32(0u, buffer, got) !=
+                 ((uint32_t)buffer[got] | (uint32_t)buffer[got + 1u] << 8 |
+                  (uint32_t)buffer[got + 2u] << 16 | (uint32_t)buffer[got + 3u] << 24))) {
+            __builtin_trap();
+        }
+    }
+}
+
 /* LCM's framing as the drivers' receiver reads it: a frame inside the datagram, or none. */
 static void check_frame(const unsigned char *datagram, size_t size)
 {
@@ -291,6 +311,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (kind == 7u) {
         parse_key_files((const char *)data + 1, size - 1u);
         parse_record(data + 1, size - 1u);
+        read_link(data + 1, size - 1u);
         return 0;
     }
     const int raw = (data[0] & 0x80u) != 0;

@@ -2,8 +2,9 @@
 # SPDX-License-Identifier: MIT
 # Builds the message fuzzer (fuzz_messages.c) with clang (libFuzzer + ASan + UBSan) over the
 # types this build generated from lcmtypes/, the drivers' receiver's framing (rx.c) and the
-# vehicle protocol (src/protocol) and the vehicle records coavoid replay reads (src/replay),
-# and runs it for a fixed number of inputs from one seed per type and mode. Usage: run_messages.sh SRC LCMTYPES_BUILD_DIR [RUNS]
+# vehicle protocol (src/protocol), the vehicle records coavoid replay reads and their
+# framing on a serial link (src/replay), and runs it for a fixed number of inputs from one
+# seed per type and mode. Usage: run_messages.sh SRC LCMTYPES_BUILD_DIR [RUNS]
 # A fixed run count, not a time limit, keeps the test's verdict independent of machine load.
 set -euo pipefail
 src=$1 types=$2 runs=${3:-20000}
@@ -26,8 +27,10 @@ for kind in 0 1 2 3 4 5; do
 done
 printf '\x06# fleet\n1 coordinator 65001 %064d\n101 vehicle 1 %064d\n' 0 0 >"$work/corpus/trust"
 printf '\x06coavoid-secret-key 101 %0128d\n' 0 >"$work/corpus/secret"
-# A datagram in LCM's framing, as the drivers' receiver reads it off the socket.
+# A vehicle's record (its magic and an empty configuration), and one frame of a link.
 printf '\x07COAVREC1\x01\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00' >"$work/corpus/record"
+printf '\x07\xc0abc\xc2\x41\x24\x35\xc0' >"$work/corpus/link"
+# A datagram in LCM's framing, as the drivers' receiver reads it off the socket.
 printf '\x80LC02\x00\x00\x00\x01COAVOID_INTENT\x00abc' >"$work/corpus/frame"
 "$work/fuzz_messages" -runs="$runs" -max_len=20000 -seed=1 "$work/corpus" 2>"$work/log" ||
   { tail -n 60 "$work/log"; exit 1; }
