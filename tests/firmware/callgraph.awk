@@ -3,7 +3,8 @@
 #   awk -v roots="main,coa_predict" -v indirect="f,g" -f callgraph.awk *.ci
 # For each root: the largest sum of frames along a call chain below it, and that chain.
 # An indirect call may reach any of the functions named in `indirect` (the callbacks the
-# core hands libccd). Calls that leave the graph (libc, libm, libgcc: built without
+# core hands libccd); an entry CALLER>TARGET names a function that only CALLER's indirect
+# calls reach (a handler table, a callback the caller was given). Calls that leave the graph (libc, libm, libgcc: built without
 # -fstack-usage) are listed; their frames are not in the sums. Recursion makes the depth
 # unbounded: it is reported and the exit status is 1.
 function strip(s) { gsub(/^"|"$/, "", s); return s }
@@ -41,8 +42,13 @@ function worst(n,   i, k, t, r, w, best, c, cands) {
         if (t == "__indirect_call") {
             c = split(indirect, cands, ",")
             for (k = 1; k <= c; k++) {
-                r = resolve(cands[k])
-                if (r == "") { missing[cands[k]] = 1; continue }
+                target = cands[k]
+                if (index(target, ">") > 0) {
+                    if (substr(target, 1, index(target, ">") - 1) != shortname(n)) continue
+                    target = substr(target, index(target, ">") + 1)
+                }
+                r = resolve(target)
+                if (r == "") { missing[target] = 1; continue }
                 w = worst(r)
                 if (w > best) { best = w; nextof[n] = r }
             }

@@ -143,6 +143,23 @@ mapfile -t graphs < <(find "$arm/src/core/CMakeFiles/coavoid_core.dir" "$fw_objs
 awk -v roots="main,fw_systick_handler,fw_task_cycle,coa_plan_decoupled,coa_plan_centralised,coa_predict,coavoid_auth_stamp,coavoid_auth_precheck,coavoid_auth_verify" \
   -v indirect="sweep_support,poly_support,sweep_centre,poly_centre" \
   -f "$src/tests/firmware/callgraph.awk" "${graphs[@]}" || die "unbounded call chain"
+# The vehicle protocol's calls, over its graphs and those it calls into (the messages',
+# src/auth's, libsodium's, the core's and libccd's). Its indirect calls reach the inbox's
+# channel handlers, the vehicle's plan and agreement callbacks, and the link the replay
+# ELF gives it (each caller's own, CALLER>TARGET); libccd's as above.
+mapfile -t vgraphs < <(find "$arm/src/core/CMakeFiles/coavoid_core.dir" "$arm/libccd-arm-build/src" \
+  "$sodium_objs" "$auth_objs" "$arm/src/protocol" "$arm/src/lcm" "$arm/lcmtypes" "$arm/src/replay" \
+  -name '*.ci' | sort)
+vindirect="sweep_support,poly_support,sweep_centre,poly_centre"
+for h in on_intent on_track on_map on_status on_plan on_agreement; do
+  vindirect="$vindirect,coavoid_node_inbox_receive>$h"
+done
+vindirect="$vindirect,on_plan>coavoid_vehicle_on_plan,on_plan>coavoid_vehicle_on_plan_row"
+vindirect="$vindirect,on_agreement>coavoid_vehicle_on_agreement"
+for m in intent status agreement; do vindirect="$vindirect,coavoid_node_publish_$m>replay_send"; done
+awk -v roots="coavoid_vehicle_node_cycle,coavoid_vehicle_node_poll,coavoid_vehicle_node_receive" \
+  -v indirect="$vindirect" -f "$src/tests/firmware/callgraph.awk" "${vgraphs[@]}" ||
+  die "unbounded call chain in the vehicle protocol"
 echo "== firmware ELF by origin (input sections from the map; flash = code + constants)"
 awk -f "$src/tests/firmware/mapsizes.awk" "$map"
 echo "== firmware check ELF by origin (the same; its message checks are libsodium's share)"
