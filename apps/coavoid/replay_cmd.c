@@ -63,8 +63,8 @@ static int replay_open(FILE *f, const char *path, uint8_t *buf, coavoid_replay_t
                                 path, rc);
     }
     const size_t size = coavoid_vehicle_node_size(&r->config);
-    const size_t a = COA_WORKSPACE_ALIGNMENT;
-    *memory = size > 0u ? aligned_alloc(a, (size + a - 1u) / a * a) : NULL;
+    /* malloc's alignment is the workspace's, as coavoid_vehicle_node_create relies on. */
+    *memory = size > 0u ? malloc(size) : NULL;
     rc = *memory != NULL ? coavoid_replay_start(r, *memory, size) : COA_ERR_ARGUMENT;
     if (rc != COA_OK) {
         return coavoid_cli_fail(CLI_EXIT_INVALID,

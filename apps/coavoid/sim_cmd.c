@@ -95,23 +95,31 @@ static void sim_help(void)
            COAVOID_LCM_MAX_SPEED, COAVOID_LCM_MAX_SIZE);
 }
 
+/* The whole number text[0..length) (shorter than `room` characters, at most `max`) into
+ * *value: false when it is not one. */
+static bool parse_prefix(const char *text, size_t length, size_t room, uint64_t max,
+                         uint64_t *value)
+{
+    char digits[16];
+    if (length >= room || length >= sizeof digits) {
+        return false;
+    }
+    memcpy(digits, text, length);
+    digits[length] = '\0';
+    return coavoid_cli_parse_index(digits, max, value);
+}
+
 /* --coordinator-stops STEP or STEP:M, each a whole number from 0 (M: messages, at most
  * COAVOID_SIM_MAX_STEPS too: far more than a coordinator sends in a cycle). */
 static int parse_stop(sim_options_t *o)
 {
     const char *text = o->stop_text;
     const char *colon = strchr(text, ':');
-    char step[16];
     uint64_t value = 0, messages = 0;
     size_t length = colon != NULL ? (size_t)(colon - text) : strlen(text);
-    bool ok = length < sizeof step;
-    if (ok) {
-        memcpy(step, text, length);
-        step[length] = '\0';
-        ok =
-            coavoid_cli_parse_index(step, COAVOID_SIM_MAX_STEPS, &value) &&
-            (colon == NULL || coavoid_cli_parse_index(colon + 1, COAVOID_SIM_MAX_STEPS, &messages));
-    }
+    bool ok =
+        parse_prefix(text, length, 16u, COAVOID_SIM_MAX_STEPS, &value) &&
+        (colon == NULL || coavoid_cli_parse_index(colon + 1, COAVOID_SIM_MAX_STEPS, &messages));
     if (!ok) {
         return coavoid_cli_fail(CLI_EXIT_INVALID,
                                 "--coordinator-stops: must be STEP or STEP:M, a step from 0 to %u "
@@ -129,15 +137,9 @@ static int parse_record(sim_options_t *o)
 {
     const char *text = o->record_text;
     const char *colon = strchr(text, ':');
-    char id[8];
     uint64_t value = 0;
-    size_t length = colon != NULL ? (size_t)(colon - text) : 0u;
-    bool ok = colon != NULL && length > 0u && length < sizeof id && colon[1] != '\0';
-    if (ok) {
-        memcpy(id, text, length);
-        id[length] = '\0';
-        ok = coavoid_cli_parse_index(id, 65535u, &value) && value >= 1u;
-    }
+    bool ok = colon != NULL && colon > text && colon[1] != '\0' &&
+              parse_prefix(text, (size_t)(colon - text), 8u, 65535u, &value) && value >= 1u;
     if (!ok) {
         return coavoid_cli_fail(CLI_EXIT_INVALID,
                                 "--record-vehicle: must be ID:FILE, a UAV id from 1 to 65535 and "

@@ -2,23 +2,15 @@
 /* A vehicle's replay (replay.h): the recorded calls made again, what it does compared. */
 #include <string.h>
 
+#include "protocol_internal.h"
 #include "replay_internal.h"
-
-static uint64_t fnv(uint64_t h, const void *data, size_t n)
-{
-    const uint8_t *p = data;
-    for (size_t i = 0; i < n; i++) {
-        h = (h ^ p[i]) * UINT64_C(1099511628211);
-    }
-    return h;
-}
 
 /* A datagram's identity: its channel and bytes. */
 static uint64_t datagram_hash(const char *channel, size_t channel_length, const void *data,
                               size_t size)
 {
-    const uint64_t h = fnv(UINT64_C(14695981039346656037), channel, channel_length);
-    return fnv(fnv(h, "", 1u), data, size);
+    const uint64_t h = coavoid_node_fnv(COAVOID_NODE_FNV_OFFSET, channel, channel_length);
+    return coavoid_node_fnv(coavoid_node_fnv(h, "", 1u), data, size);
 }
 
 /* The vehicle's link: what it sends is remembered, for the SENT records that follow. */
