@@ -2365,6 +2365,28 @@ START_TEST(test_bad_configs_refused)
     vc.priority_wait_us = -1;
     ck_assert_ptr_null(coavoid_vehicle_node_create(&vc, r.lcm, NULL, &error));
     vc.priority_wait_us = 0;
+    /* A duration past an hour (the fuzzer's configuration over the part's link once
+     * overflowed the answer wait's default, 4 resend intervals): refused, each one. */
+    int64_t *const durations[] = {&vc.coordinator_timeout_us, &vc.priority_wait_us, &vc.resend_us,
+                                  &vc.answer_wait_us, &vc.common.stale_after_us};
+    for (size_t d = 0; d < sizeof durations / sizeof durations[0]; d++) {
+        const int64_t kept = *durations[d];
+        *durations[d] = COAVOID_NODE_MAX_DURATION_US + 1;
+        ck_assert_ptr_null(coavoid_vehicle_node_create(&vc, r.lcm, NULL, &error));
+        ck_assert_int_eq(error, COA_ERR_ARGUMENT);
+        *durations[d] = INT64_C(3533689840342138880);
+        ck_assert_ptr_null(coavoid_vehicle_node_create(&vc, r.lcm, NULL, &error));
+        *durations[d] = kept;
+    }
+    /* ... and copies past COAVOID_NODE_MAX_COPIES, whose times (count times the resend
+     * interval) overflowed the same way. */
+    vc.intent_copies = COAVOID_NODE_MAX_COPIES + 1u;
+    vc.resend_us = COAVOID_NODE_MAX_DURATION_US;
+    ck_assert_ptr_null(coavoid_vehicle_node_create(&vc, r.lcm, NULL, &error));
+    vc.intent_copies = UINT32_MAX;
+    ck_assert_ptr_null(coavoid_vehicle_node_create(&vc, r.lcm, NULL, &error));
+    vc.intent_copies = 0u;
+    vc.resend_us = 0;
     /* A joint plan of one UAV is its own plan; more than a planner searches together is
      * none. */
     vc.joint_members = 1u;

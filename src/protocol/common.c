@@ -54,7 +54,8 @@ int coavoid_node_common_check(const coavoid_node_common_t *c)
     if (!(c->threshold > 0.0) || !(c->threshold <= 1.0) ||
         !rate_ok(c->vehicle_sigma_rate_horizontal) || !rate_ok(c->vehicle_sigma_rate_vertical) ||
         !rate_ok(c->track_sigma_rate_horizontal) || !rate_ok(c->track_sigma_rate_vertical) ||
-        !rate_ok(c->stale_sigma_rate) || c->stale_after_us < 1 || c->beta < 1u) {
+        !rate_ok(c->stale_sigma_rate) || c->stale_after_us < 1 ||
+        c->stale_after_us > COAVOID_NODE_MAX_DURATION_US || c->beta < 1u) {
         return COA_ERR_ARGUMENT;
     }
     if (!c->insecure && c->signer == NULL) {

@@ -83,6 +83,11 @@
 #define COAVOID_NODE_CHECKS_PER_CYCLE 4096u
 #define COAVOID_NODE_INBOX_FLOOD 4096u
 
+/* The longest duration a node may be configured with (a timeout, a wait, a resend
+ * interval, the staleness of an intent): an hour, the longest dt (COAVOID_LCM_MAX_STEP),
+ * so that no time a node computes from one can overflow. */
+#define COAVOID_NODE_MAX_DURATION_US (INT64_C(3600) * INT64_C(1000000))
+
 /* The world's id (map_id of the obstacle map, source_id of tracks) by default. */
 #define COAVOID_NODE_WORLD_ID 65000u
 #define COAVOID_NODE_COORDINATOR_ID 65001u
@@ -94,6 +99,10 @@
  * first plan cannot include, and a conflict one step ahead leaves no second cycle
  * (docs/evaluation.md measures the count). */
 #define COAVOID_NODE_DEFAULT_COPIES 4u
+/* The most copies a vehicle may be configured to send (intent_copies): a copy is a whole
+ * datagram to every node, so more is a flood of its own, and the times of its copies
+ * (count times resend_us) must not overflow. */
+#define COAVOID_NODE_MAX_COPIES 64u
 
 /* The joint plan of a vehicle's group when no priority order solves it (joint_members,
  * joint_beta of coavoid_vehicle_node_config_t): groups of up to this many UAVs, in the
@@ -411,7 +420,8 @@ size_t coavoid_vehicle_node_size(const coavoid_vehicle_node_config_t *config);
  * least coavoid_vehicle_node_size(config) bytes, not moved while the node lives) that
  * sends through link (copied; its user outlives the node). Returns the node (at memory),
  * or NULL with *error (error may be NULL): COA_ERR_ARGUMENT for a bad config (invalid
- * vehicle, horizon > COAVOID_NODE_MAX_HORIZON, joint_members 1 or above
+ * vehicle, a duration beyond COAVOID_NODE_MAX_DURATION_US, intent_copies beyond
+ * COAVOID_NODE_MAX_COPIES, horizon > COAVOID_NODE_MAX_HORIZON, joint_members 1 or above
  * COA_MAX_CENTRALISED, no trust list unless insecure, ...) or link, COA_ERR_WORKSPACE
  * for memory that is NULL, misaligned or too small. Nothing is allocated, now or later.
  * Cost: O(size) (it zeroes the node). */

@@ -332,6 +332,11 @@ static int vehicle_prepare(const coavoid_vehicle_node_config_t *config,
         !coavoid_node_floor_ok(&config->common) || coa_vehicle_check(&config->vehicle) != COA_OK ||
         (config->mode != COAVOID_NODE_CENTRALISED && config->mode != COAVOID_NODE_DECOUPLED) ||
         config->coordinator_timeout_us < 0 || config->priority_wait_us < 0 ||
+        config->coordinator_timeout_us > COAVOID_NODE_MAX_DURATION_US ||
+        config->priority_wait_us > COAVOID_NODE_MAX_DURATION_US ||
+        config->resend_us > COAVOID_NODE_MAX_DURATION_US ||
+        config->answer_wait_us > COAVOID_NODE_MAX_DURATION_US ||
+        config->intent_copies > COAVOID_NODE_MAX_COPIES ||
         !isfinite((double)config->sigma_horizontal) || !isfinite((double)config->sigma_vertical) ||
         config->sigma_horizontal < (coa_real_t)0 || config->sigma_vertical < (coa_real_t)0 ||
         !(coa_climb_step(&config->vehicle, config->common.dt) > (coa_real_t)0) ||
