@@ -16,20 +16,48 @@ uint32_t coavoid_link_crc32(uint32_t crc, const uint8_t *data, size_t n)
     return ~crc;
 }
 
-/* One byte, escaped, at out[*at] (room checked by the caller). */
-static void put_escaped(uint8_t byte, uint8_t *out, size_t *at)
+/* One byte escaped as SLIP does, through put. */
+static void put_escaped(uint8_t byte, coavoid_link_put_t put, void *user)
 {
     if (byte == COAVOID_LINK_END || byte == COAVOID_LINK_ESC) {
-        out[(*at)++] = COAVOID_LINK_ESC;
-        out[(*at)++] = byte == COAVOID_LINK_END ? COAVOID_LINK_ESC_END : COAVOID_LINK_ESC_ESC;
+        put(user, COAVOID_LINK_ESC);
+        put(user, byte == COAVOID_LINK_END ? COAVOID_LINK_ESC_END : COAVOID_LINK_ESC_ESC);
     } else {
-        out[(*at)++] = byte;
+        put(user, byte);
     }
+}
+
+void coavoid_link_put_frame(const uint8_t *const *parts, const size_t *lengths, size_t count,
+                            coavoid_link_put_t put, void *user)
+{
+    uint32_t crc = 0;
+    put(user, COAVOID_LINK_END);
+    for (size_t p = 0; p < count; p++) {
+        crc = coavoid_link_crc32(crc, parts[p], lengths[p]);
+        for (size_t i = 0; i < lengths[p]; i++) {
+            put_escaped(parts[p][i], put, user);
+        }
+    }
+    for (unsigned k = 0; k < COAVOID_LINK_CRC_BYTES; k++) {
+        put_escaped((uint8_t)(crc >> (8u * k)), put, user);
+    }
+    put(user, COAVOID_LINK_END);
+}
+
+/* Bytes into a buffer already known to be large enough. */
+typedef struct {
+    uint8_t *out;
+    size_t at;
+} buffer_put_t;
+
+static void buffer_put(void *user, uint8_t byte)
+{
+    buffer_put_t *b = user;
+    b->out[b->at++] = byte;
 }
 
 size_t coavoid_link_frame(const uint8_t *data, size_t n, uint8_t *out, size_t capacity)
 {
-    const uint32_t crc = coavoid_link_crc32(0u, data, n);
     size_t need = 2u;
     for (size_t i = 0; i < n; i++) {
         need += data[i] == COAVOID_LINK_END || data[i] == COAVOID_LINK_ESC ? 2u : 1u;
@@ -38,16 +66,10 @@ size_t coavoid_link_frame(const uint8_t *data, size_t n, uint8_t *out, size_t ca
     if (out == NULL || need > capacity) {
         return 0u;
     }
-    size_t at = 0;
-    out[at++] = COAVOID_LINK_END;
-    for (size_t i = 0; i < n; i++) {
-        put_escaped(data[i], out, &at);
-    }
-    for (unsigned k = 0; k < COAVOID_LINK_CRC_BYTES; k++) {
-        put_escaped((uint8_t)(crc >> (8u * k)), out, &at);
-    }
-    out[at++] = COAVOID_LINK_END;
-    return at;
+    buffer_put_t b = {out, 0u};
+    const uint8_t *const parts[] = {data};
+    coavoid_link_put_frame(parts, &n, 1u, buffer_put, &b);
+    return b.at;
 }
 
 void coavoid_link_rx_init(coavoid_link_rx_t *r, uint8_t *buffer, size_t capacity)

@@ -34,6 +34,14 @@ uint32_t coavoid_link_crc32(uint32_t crc, const uint8_t *data, size_t n);
  * too small (COAVOID_LINK_FRAMED_MAX(n) always suffices). O(n). */
 size_t coavoid_link_frame(const uint8_t *data, size_t n, uint8_t *out, size_t capacity);
 
+/* One byte onto the wire. */
+typedef void (*coavoid_link_put_t)(void *user, uint8_t byte);
+
+/* Frames the bytes of parts[0..count) (lengths[i] each, in turn) as one frame, as
+ * coavoid_link_frame does, one byte at a time through put: no buffer. O(bytes). */
+void coavoid_link_put_frame(const uint8_t *const *parts, const size_t *lengths, size_t count,
+                            coavoid_link_put_t put, void *user);
+
 /* A receiver: the frame being gathered, in the caller's buffer. */
 typedef struct {
     uint8_t *buffer;

@@ -80,7 +80,7 @@ int coavoid_replay_header(const uint8_t header[COAVOID_REPLAY_HEADER_BYTES], siz
     const uint64_t zero = coavoid_replay_get_u(&b, 1u);
     const uint64_t channel = coavoid_replay_get_u(&b, 2u);
     const uint64_t payload = coavoid_replay_get_u(&b, 4u);
-    if (kind < COAVOID_REPLAY_CONFIG || kind > COAVOID_REPLAY_STATE || zero != 0u ||
+    if (kind < COAVOID_REPLAY_CONFIG || kind > COAVOID_REPLAY_READY || zero != 0u ||
         channel > COAVOID_REPLAY_MAX_CHANNEL || payload > COAVOID_REPLAY_MAX_PAYLOAD) {
         return COAVOID_REPLAY_ERR_FORMAT;
     }
@@ -131,6 +131,35 @@ void coavoid_replay_write_state(int rc, const coavoid_vehicle_node_state_t *s,
     }
     coavoid_replay_put_u(&b, (uint64_t)s->rx.received, 8u);
     coavoid_replay_put_u(&b, (uint64_t)s->rx.rejected, 8u);
+}
+
+int coavoid_replay_read_state(const uint8_t *payload, size_t size, int *rc,
+                              coavoid_vehicle_node_state_t *s)
+{
+    if (payload == NULL || size != COAVOID_REPLAY_STATE_BYTES || rc == NULL || s == NULL) {
+        return COAVOID_REPLAY_ERR_FORMAT;
+    }
+    coavoid_replay_buf_t b = {(uint8_t *)(uintptr_t)payload, 0, size, 0, true};
+    uint32_t *const counters[] = {&s->protocol_faults, &s->plans_run,      &s->plans_adopted,
+                                  &s->conflicts,       &s->fallbacks,      &s->plans_accepted,
+                                  &s->plans_refused,   &s->plans_switched, &s->plans_aborted,
+                                  &s->plans_in_doubt,  &s->plans_standby,  &s->rank_raises,
+                                  &s->orders_agreed,   &s->joint_plans};
+    memset(s, 0, sizeof *s);
+    *rc = (int)(int32_t)(uint32_t)coavoid_replay_get_u(&b, 4u);
+    s->phase = (coavoid_vehicle_phase_t)coavoid_replay_get_u(&b, 1u);
+    s->plan = (coavoid_vehicle_plan_t)coavoid_replay_get_u(&b, 1u);
+    s->published = coavoid_replay_get_u(&b, 1u) != 0u;
+    s->waiting = coavoid_replay_get_u(&b, 1u) != 0u;
+    s->cycle = (int64_t)coavoid_replay_get_u(&b, 8u);
+    s->offset = (int32_t)(uint32_t)coavoid_replay_get_u(&b, 4u);
+    s->rank = (int32_t)(uint32_t)coavoid_replay_get_u(&b, 4u);
+    for (size_t i = 0; i < sizeof counters / sizeof counters[0]; i++) {
+        *counters[i] = (uint32_t)coavoid_replay_get_u(&b, 4u);
+    }
+    s->rx.received = (int64_t)coavoid_replay_get_u(&b, 8u);
+    s->rx.rejected = (int64_t)coavoid_replay_get_u(&b, 8u);
+    return COA_OK;
 }
 
 int coavoid_replay_next(coavoid_replay_read_t read, void *user, uint8_t *buf, size_t capacity,

@@ -53,7 +53,11 @@ typedef enum {
     COAVOID_REPLAY_CYCLE = 3,   /* coavoid_vehicle_node_cycle at `time` */
     COAVOID_REPLAY_POLL = 4,    /* coavoid_vehicle_node_poll at `time` */
     COAVOID_REPLAY_SENT = 5,    /* channel, payload: a datagram the vehicle sent */
-    COAVOID_REPLAY_STATE = 6    /* payload: its state after the call before */
+    COAVOID_REPLAY_STATE = 6,   /* payload: its state after the call before */
+    /* Only on a live link (session.h), never in a record: */
+    COAVOID_REPLAY_TIME = 7,      /* the ground's clock at `time`, no datagram */
+    COAVOID_REPLAY_SUBSCRIBE = 8, /* channel: one the vehicle takes in */
+    COAVOID_REPLAY_READY = 9      /* the vehicle took the frame before; payload: its state */
 } coavoid_replay_kind_t;
 
 /* Errors beyond the core's: the bytes are no record (truncated, a bad header or field),
@@ -100,6 +104,11 @@ size_t coavoid_replay_write_config(const coavoid_vehicle_node_config_t *config, 
 #define COAVOID_REPLAY_STATE_BYTES 96u
 void coavoid_replay_write_state(int rc, const coavoid_vehicle_node_state_t *state,
                                 uint8_t out[COAVOID_REPLAY_STATE_BYTES]);
+/* A state's payload read back: the call's return value and the fields it holds (phase,
+ * plan, published, waiting, cycle, offset, rank, the counters, rx.received and
+ * rx.rejected; the rest zero). COA_OK, or COAVOID_REPLAY_ERR_FORMAT for another length. O(1). */
+int coavoid_replay_read_state(const uint8_t *payload, size_t size, int *rc,
+                              coavoid_vehicle_node_state_t *state);
 
 /* A replay in progress: the configuration read from the record (its route, obstacles and
  * keys in here), the vehicle's clock, and what the vehicle sent in the current call. */

@@ -11,12 +11,14 @@
  * that the type hash holds and
  * the fuzzer reaches every field's validation instead of stopping at it.
  * Every datagram also goes through the signature check (auth.h) against a trust list of one
- * key, and kind 6 feeds the bytes to the trust and secret key file parsers. Every input
+ * key. Kind 7 (no message type) feeds the bytes to the trust and secret key file parsers. Every input
  * after its first byte is also a datagram off the socket for the drivers' receiver's
  * framing (coavoid_rt_rx_parse), whose frame must lie inside it. And every datagram of a
  * type a vehicle takes in is handed to one (the vehicle protocol, protocol.h: insecure, so
  * that what it decodes reaches its inbox, its plan collection and its check of a plan
  * for it), which keeps what it stores from one input to the next and polls after each.
+ * Its bytes are also a vehicle's record, the frames of a serial link, and the frames a
+ * vehicle on the part takes (session.h).
  * Nothing may crash, leak or trip a sanitizer, whatever the bytes.
  */
 #include <stddef.h>
@@ -30,6 +32,7 @@
 #include "protocol.h"
 #include "link.h"
 #include "replay.h"
+#include "session.h"
 #include "realtime.h"
 
 #define FUZZ_BUF 20000
@@ -225,6 +228,33 @@ static void read_link(const uint8_t *data, size_t n)
     }
 }
 
+static void drop_put(void *user, uint8_t byte)
+{
+    (void)user, (void)byte;
+}
+
+/* The same bytes as the frames a vehicle on the part takes (session.h): each record after
+ * the magic is a frame, then the whole input; a fresh session each input. Every frame
+ * gets an answer, whatever it holds. */
+static void take_frames(const uint8_t *data, size_t n)
+{
+    static coavoid_session_t session;
+    static uint8_t block[4u << 20] __attribute__((aligned(8)));
+    coavoid_replay_record_t rec;
+    size_t used = 0;
+    size_t at = n >= COAVOID_REPLAY_MAGIC_BYTES ? COAVOID_REPLAY_MAGIC_BYTES : n;
+    coavoid_vehicle_node_fini(session.replay.node);
+    coavoid_session_init(&session, block, sizeof block, drop_put, NULL);
+    while (coavoid_replay_parse(data + at, n - at, &rec, &used) == COA_OK) {
+        (void)coavoid_session_take(&session, data + at, used);
+        at += used;
+    }
+    (void)coavoid_session_take(&session, data, n);
+    if (session.frames == 0u) {
+        __builtin_trap();
+    }
+}
+
 /* LCM's framing as the drivers' receiver reads it: a frame inside the datagram, or none. */
 static void check_frame(const unsigned char *datagram, size_t size)
 {
@@ -312,6 +342,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         parse_key_files((const char *)data + 1, size - 1u);
         parse_record(data + 1, size - 1u);
         read_link(data + 1, size - 1u);
+        take_frames(data + 1, size - 1u);
         return 0;
     }
     const int raw = (data[0] & 0x80u) != 0;
