@@ -87,5 +87,6 @@ fw_status_t fw_task_cycle(coa_real_t now);
 void fw_example_inputs(void);
 
 void fw_systick_handler(void);
+void fw_usart1_handler(void);
 
 #endif /* COAVOID_FIRMWARE_H */

@@ -41,6 +41,14 @@ static void unused_handler(void)
     }
 }
 
+/* USART1's interrupt: the vehicle's link (usart.c) takes it; any other firmware never
+ * enables it. */
+__attribute__((weak)) void fw_usart1_handler(void)
+{
+    for (;;) {
+    }
+}
+
 void reset_handler(void)
 {
     const uint32_t *src = fw_data_load;
@@ -68,10 +76,12 @@ void reset_handler(void)
         .handler = unused_handler \
     }
 #define FW_IRQ2 FW_IRQ1, FW_IRQ1
-#define FW_IRQ8 FW_IRQ2, FW_IRQ2, FW_IRQ2, FW_IRQ2
+#define FW_IRQ4 FW_IRQ2, FW_IRQ2
+#define FW_IRQ8 FW_IRQ4, FW_IRQ4
 #define FW_IRQ16 FW_IRQ8, FW_IRQ8
 
-/* The Cortex-M4 exceptions, then the STM32F405's 82 interrupt lines (none used). */
+/* The Cortex-M4 exceptions, then the STM32F405's 82 interrupt lines: only USART1's (37)
+ * is used, by the vehicle's link. */
 __attribute__((section(".isr_vector"), used)) const fw_vector_t fw_vectors[16 + 82] = {
     {.stack_top = fw_stack_top},
     {.handler = reset_handler},
@@ -89,10 +99,13 @@ __attribute__((section(".isr_vector"), used)) const fw_vector_t fw_vectors[16 + 
     {.handler = 0},
     {.handler = unused_handler}, /* PendSV */
     {.handler = fw_systick_handler},
-    FW_IRQ16,
-    FW_IRQ16,
-    FW_IRQ16,
-    FW_IRQ16,
-    FW_IRQ16,
-    FW_IRQ2,
+    FW_IRQ16,                       /* 0..15 */
+    FW_IRQ16,                       /* 16..31 */
+    FW_IRQ4,                        /* 32..35 */
+    FW_IRQ1,                        /* 36 */
+    {.handler = fw_usart1_handler}, /* 37 */
+    FW_IRQ16,                       /* 38..53 */
+    FW_IRQ16,                       /* 54..69 */
+    FW_IRQ8,                        /* 70..77 */
+    FW_IRQ4,                        /* 78..81 */
 };

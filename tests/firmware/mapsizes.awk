@@ -1,10 +1,10 @@
 # SPDX-License-Identifier: MIT
 # Flash and RAM of a GNU ld map file by origin: the core, libccd, the messages (LCM's
 # coders and src/lcm's validation), the drivers' message checks (src/auth), libsodium's
-# primitives, the vehicle protocol (src/protocol), its replay (src/replay), the firmware's
-# own objects (the firmware's, the check's or the replay's), and newlib with libgcc
-# (everything else). Input sections only: the linker's
-# alignment padding is not counted (the ELF's totals include it).
+# primitives, the vehicle protocol (src/protocol), its replay and link (src/replay), the
+# firmware's own objects (the firmware's, the check's, the replay's or the vehicle's), and
+# newlib with libgcc (everything else). Input sections only: the linker's alignment padding
+# is not counted (the ELF's totals include it).
 #   awk -f mapsizes.awk coavoid-firmware.map
 function hex(h,   n, k) {
     n = 0; h = tolower(substr(h, 3))
@@ -31,7 +31,7 @@ kind != "" {
             else if (f ~ /libcoavoid_lcm(types)?\.a/) c = "messages"
             else if (f ~ /libcoavoid_protocol\.a/) c = "protocol"
             else if (f ~ /libcoavoid_replay\.a/) c = "replay"
-            else if (f ~ /coavoid_firmware(_check|_replay)?\.dir/) c = "firmware"
+            else if (f ~ /coavoid_firmware(_check|_replay|_vehicle)?\.dir/) c = "firmware"
             else c = "newlib+libgcc"
             total[c, kind] += hex($(i + 1))
             break

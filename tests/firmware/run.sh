@@ -94,6 +94,11 @@ replay_elf=$arm/apps/firmware/coavoid-firmware-replay.elf
 [ -f "$replay_elf" ] || die "$replay_elf was not built"
 "$cmake" -DLINKED=ON -DLIB="$replay_elf" -DNM="${prefix}nm" -P "$src/tests/check_core_symbols.cmake" ||
   die "the firmware replay ELF contains a forbidden function"
+# And the vehicle ELF, the vehicle of the fleet on the part behind its UART (apps/firmware/vehicle.c).
+vehicle_elf=$arm/apps/firmware/coavoid-firmware-vehicle.elf
+[ -f "$vehicle_elf" ] || die "$vehicle_elf was not built"
+"$cmake" -DLINKED=ON -DLIB="$vehicle_elf" -DNM="${prefix}nm" -P "$src/tests/check_core_symbols.cmake" ||
+  die "the firmware vehicle ELF contains a forbidden function"
 # (grep reads all of nm's output: -q would stop early and fail the pipe under pipefail)
 [ "$("${prefix}nm" "$check_elf" | grep -c ' T fwc_crypto_run$')" -eq 1 ] ||
   die "the firmware check ELF has no message checks (fwc_crypto_run): libsodium was not built"
@@ -160,12 +165,22 @@ for m in intent status agreement; do vindirect="$vindirect,coavoid_node_publish_
 awk -v roots="coavoid_vehicle_node_cycle,coavoid_vehicle_node_poll,coavoid_vehicle_node_receive" \
   -v indirect="$vindirect" -f "$src/tests/firmware/callgraph.awk" "${vgraphs[@]}" ||
   die "unbounded call chain in the vehicle protocol"
+# The vehicle ELF's main loop: a frame off the UART taken by the session (session.h), whose
+# node sends through the session's link, which frames onto the UART byte by byte.
+svindirect=${vindirect//replay_send/session_send}
+svindirect="$svindirect,coavoid_link_put_frame>put_byte,put_escaped>put_byte"
+vehicle_objs=$arm/apps/firmware/CMakeFiles/coavoid_firmware_vehicle.dir
+awk -v roots="main,fw_usart1_handler" -v indirect="$svindirect" -f "$src/tests/firmware/callgraph.awk" \
+  "${vgraphs[@]}" "$vehicle_objs/vehicle.c.ci" "$vehicle_objs/usart.c.ci" ||
+  die "unbounded call chain in the firmware vehicle"
 echo "== firmware ELF by origin (input sections from the map; flash = code + constants)"
 awk -f "$src/tests/firmware/mapsizes.awk" "$map"
 echo "== firmware check ELF by origin (the same; its message checks are libsodium's share)"
 awk -f "$src/tests/firmware/mapsizes.awk" "$arm/apps/firmware/coavoid-firmware-check.map"
 echo "== firmware replay ELF by origin (a vehicle of the protocol on the part: what it links)"
 awk -f "$src/tests/firmware/mapsizes.awk" "$arm/apps/firmware/coavoid-firmware-replay.map"
+echo "== firmware vehicle ELF by origin (the vehicle of the fleet on the part, behind its UART)"
+awk -f "$src/tests/firmware/mapsizes.awk" "$arm/apps/firmware/coavoid-firmware-vehicle.map"
 echo "== firmware sections (flash: .isr_vector .text .ARM.exidx + .data's image; SRAM: .data .bss; CCM: .stack)"
 "${prefix}size" -A "$elf" | awk '$1 ~ /^\.(isr_vector|text|ARM\.exidx|data|bss|stack)/ { printf "%-12s %7d bytes at 0x%08x\n", $1, $2, $3 }'
 echo "firmware: ARM core and firmware link without heap or stdio"
