@@ -18,5 +18,6 @@ int coavoid_command_sim(int argc, char **argv);        /* sim_cmd.c: needs the n
 int coavoid_command_summary(int argc, char **argv);    /* summary_cmd.c: needs the node library */
 int coavoid_command_keygen(int argc, char **argv);     /* keygen_cmd.c: needs the node library */
 int coavoid_command_replay(int argc, char **argv);     /* replay_cmd.c: needs the node library */
+int coavoid_command_bridge(int argc, char **argv);     /* bridge_cmd.c: needs the node library */
 
 #endif /* COAVOID_APP_COMMANDS_H */

@@ -13,6 +13,8 @@
  *   coavoid world SCENARIO.json [--lcm-url URL] [--epoch UTIME] [...] world_cmd.c
  *   coavoid sim SCENARIO.json --mode centralised|decoupled [...]    sim_cmd.c
  *   coavoid summary LOGFILE SCENARIO.json --mode MODE [...]         summary_cmd.c (LCM)
+ *   coavoid replay RECORD                                           replay_cmd.c (LCM)
+ *   coavoid bridge --uart PATH --scenario FILE --id ID [...]        bridge_cmd.c (LCM)
  *
  * Exit status: 0 success, 1 plan infeasible or budget exhausted, 2 invalid input or usage
  * (one line on stderr naming the input and why), 3 internal error.
@@ -23,7 +25,7 @@
 #include "cli.h"
 #include "commands.h"
 
-/* sim, summary, world and keygen run the nodes over LCM or make their keys: they are built, and listed, only with
+/* sim, summary, world, keygen, replay and bridge run the nodes over LCM or make their keys: they are built, and listed, only with
  * the node library (COAVOID_BUILD_LCM, which gives this program COAVOID_HAVE_NODE). This is
  * the one place where that option reaches the code: their sources are left out of the
  * build otherwise, not replaced by stubs. */
@@ -33,7 +35,8 @@
     "  summary     judge a real-time run from its lcm-logger log (costs, figure)\n"      \
     "  world       publish a scenario's terrain and tracks to a real-time run\n"         \
     "  keygen      write fresh signing keys and the trust file for a scenario's fleet\n" \
-    "  replay      make a vehicle's record (sim --record-vehicle) again, and compare\n"
+    "  replay      make a vehicle's record (sim --record-vehicle) again, and compare\n"  \
+    "  bridge      fly a vehicle on the part (the example firmware) over its serial link\n"
 #else
 #define USAGE_NODES ""
 #endif
@@ -93,6 +96,9 @@ int main(int argc, char **argv)
     }
     if (strcmp(command, "replay") == 0) {
         return coavoid_command_replay(argc, argv);
+    }
+    if (strcmp(command, "bridge") == 0) {
+        return coavoid_command_bridge(argc, argv);
     }
 #endif
     if (command[0] == '-') {

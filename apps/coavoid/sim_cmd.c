@@ -15,57 +15,62 @@
 #include "node.h"
 #include "scenario.h"
 #include "sim.h"
+#include "vehicle_options.h"
 
-#define SIM_USAGE                                                                               \
-    "usage: coavoid sim SCENARIO.json --mode centralised|decoupled [--steps K] [--json]\n"      \
-    "                   [--svg FILE] [--coordinator-stops STEP[:M]] [--insecure]\n"             \
-    "                   [--loss P] [--delay S] [--jitter S] [--seed N]\n"                       \
-    "                   [--record-vehicle ID:FILE]\n"                                           \
-    "\n"                                                                                        \
-    "Flies the scenario in closed loop: every step each UAV publishes its intent, conflicts\n"  \
-    "are predicted and planned for (by the coordinator, or by each UAV in priority order),\n"   \
-    "and every UAV flies one step of its plan. The nodes are those of the real-time apps,\n"    \
-    "over LCM's in-process provider on a simulated clock: the output is repeatable.\n"          \
-    "\n"                                                                                        \
-    "options:\n"                                                                                \
-    "  --mode centralised   a coordinator plans each conflicting cluster; the UAVs follow\n"    \
-    "                       it, and plan for themselves when its heartbeat stops\n"             \
-    "  --mode decoupled     no coordinator: each UAV plans for itself in priority order\n"      \
-    "  --steps K            fly K steps (samples 0..K), K >= 1; default 2 * horizon\n"          \
-    "  --json               print the simulation result as JSON (default: text)\n"              \
-    "  --svg FILE           write the figure (top view, altitude profiles) to FILE\n"           \
-    "  --coordinator-stops STEP[:M]\n"                                                          \
-    "                       centralised: stop the coordinator in cycle STEP (0..K): its\n"      \
-    "                       first M messages of that cycle go out (whatever they are),\n"       \
-    "                       then nothing more; STEP alone: before it sends any (M = 0)\n"       \
-    "  --insecure           the nodes neither sign nor check their messages (by default they\n" \
-    "                       do, with the simulation's fixed keys; the flight is the same)\n"    \
-    "  --loss P             each message reaches each other node with probability 1 - P,\n"     \
-    "                       independently (0 <= P < 1); default 0\n"                            \
-    "  --delay S            ... after S seconds (>= 0); default 0\n"                            \
-    "  --jitter S           ... plus a uniform time in [0, S] seconds; default 0. A node\n"     \
-    "                       hears its own at once; delay + jitter must be less than dt\n"       \
-    "  --seed N             the network's random seed, an integer >= 0; default 1\n"            \
-    "  --record-vehicle ID:FILE\n"                                                              \
-    "                       write UAV ID's record to FILE: its configuration and keys, every\n" \
-    "                       datagram it received and call made, with their times, and what\n"   \
-    "                       it sent and its state after each call (`coavoid replay FILE`\n"     \
-    "                       makes them again and compares)\n"                                   \
-    "  -h, --help           show this help\n"                                                   \
-    "\n"                                                                                        \
-    "Beyond the contract's fields the result has \"fallbacks\" (times a UAV went from\n"        \
-    "following the coordinator to planning for itself), with --coordinator-stops,\n"            \
-    "\"coordinator_stopped_at\" (with :M also \"coordinator_stopped_after\", M, and\n"          \
-    "\"coordinator_messages_cut\", what it published after them that no one got; in\n"          \
-    "text a \"coordinator:\" line), and with --loss, --delay or --jitter, \"network\" (those\n" \
-    "settings and the messages sent, copies delivered, dropped and in flight at the end).\n"    \
-    "\n"                                                                                        \
-    "The scenario's horizon may be at most %u steps (an intent carries N + 1 samples) and\n"    \
-    "it may have at most %u UAVs. What its messages carry over the run (references and\n"       \
-    "tracks up to t = (K + N) dt, with the climbs a UAV can make) must stay within their\n"     \
-    "bounds: positions %g m, speeds %g m/s, sizes and sigmas %g m.\n"                           \
-    "\n"                                                                                        \
-    "exit status: 0 no loss of separation, 1 a loss of separation, 2 invalid input or\n"        \
+#define SIM_USAGE                                                                                \
+    "usage: coavoid sim SCENARIO.json --mode centralised|decoupled [--steps K] [--json]\n"       \
+    "                   [--svg FILE] [--coordinator-stops STEP[:M]] [--insecure]\n"              \
+    "                   [--loss P] [--delay S] [--jitter S] [--seed N]\n"                        \
+    "                   [--record-vehicle ID:FILE] [--joint-members N]\n"                        \
+    "\n"                                                                                         \
+    "Flies the scenario in closed loop: every step each UAV publishes its intent, conflicts\n"   \
+    "are predicted and planned for (by the coordinator, or by each UAV in priority order),\n"    \
+    "and every UAV flies one step of its plan. The nodes are those of the real-time apps,\n"     \
+    "over LCM's in-process provider on a simulated clock: the output is repeatable.\n"           \
+    "\n"                                                                                         \
+    "options:\n"                                                                                 \
+    "  --mode centralised   a coordinator plans each conflicting cluster; the UAVs follow\n"     \
+    "                       it, and plan for themselves when its heartbeat stops\n"              \
+    "  --mode decoupled     no coordinator: each UAV plans for itself in priority order\n"       \
+    "  --steps K            fly K steps (samples 0..K), K >= 1; default 2 * horizon\n"           \
+    "  --json               print the simulation result as JSON (default: text)\n"               \
+    "  --svg FILE           write the figure (top view, altitude profiles) to FILE\n"            \
+    "  --coordinator-stops STEP[:M]\n"                                                           \
+    "                       centralised: stop the coordinator in cycle STEP (0..K): its\n"       \
+    "                       first M messages of that cycle go out (whatever they are),\n"        \
+    "                       then nothing more; STEP alone: before it sends any (M = 0)\n"        \
+    "  --insecure           the nodes neither sign nor check their messages (by default they\n"  \
+    "                       do, with the simulation's fixed keys; the flight is the same)\n"     \
+    "  --loss P             each message reaches each other node with probability 1 - P,\n"      \
+    "                       independently (0 <= P < 1); default 0\n"                             \
+    "  --delay S            ... after S seconds (>= 0); default 0\n"                             \
+    "  --jitter S           ... plus a uniform time in [0, S] seconds; default 0. A node\n"      \
+    "                       hears its own at once; delay + jitter must be less than dt\n"        \
+    "  --seed N             the network's random seed, an integer >= 0; default 1\n"             \
+    "  --record-vehicle ID:FILE\n"                                                               \
+    "                       write UAV ID's record to FILE: its configuration and keys, every\n"  \
+    "                       datagram it received and call made, with their times, and what\n"    \
+    "                       it sent and its state after each call (`coavoid replay FILE`\n"      \
+    "                       makes them again and compares)\n"                                    \
+    "  --joint-members N    centralised: every vehicle plans its group jointly, while it\n"      \
+    "                       plans for itself and no priority order solves it, for groups\n"      \
+    "                       of up to N UAVs (0: never; else at least 2), as the\n"               \
+    "                       vehicles' --joint-members; default the scenario's UAVs, at most 5\n" \
+    "  -h, --help           show this help\n"                                                    \
+    "\n"                                                                                         \
+    "Beyond the contract's fields the result has \"fallbacks\" (times a UAV went from\n"         \
+    "following the coordinator to planning for itself), with --coordinator-stops,\n"             \
+    "\"coordinator_stopped_at\" (with :M also \"coordinator_stopped_after\", M, and\n"           \
+    "\"coordinator_messages_cut\", what it published after them that no one got; in\n"           \
+    "text a \"coordinator:\" line), and with --loss, --delay or --jitter, \"network\" (those\n"  \
+    "settings and the messages sent, copies delivered, dropped and in flight at the end).\n"     \
+    "\n"                                                                                         \
+    "The scenario's horizon may be at most %u steps (an intent carries N + 1 samples) and\n"     \
+    "it may have at most %u UAVs. What its messages carry over the run (references and\n"        \
+    "tracks up to t = (K + N) dt, with the climbs a UAV can make) must stay within their\n"      \
+    "bounds: positions %g m, speeds %g m/s, sizes and sigmas %g m.\n"                            \
+    "\n"                                                                                         \
+    "exit status: 0 no loss of separation, 1 a loss of separation, 2 invalid input or\n"         \
     "usage (one line on stderr naming the input and why), 3 internal error\n"
 
 #define SIM_DEFAULT_SEED 1u
@@ -87,6 +92,8 @@ typedef struct {
     const char *record_text;
     const char *record_path;
     uint16_t record_uav;
+    const char *joint_text;
+    uint64_t joint_members;
 } sim_options_t;
 
 static void sim_help(void)
@@ -181,6 +188,8 @@ static int sim_option(int argc, char **argv, int *i, void *options)
         status = coavoid_cli_text_option(argc, argv, i, "--record-vehicle", "ID:FILE", false,
                                          &o->record_text);
         status = status == CLI_CONTINUE ? parse_record(o) : status;
+    } else if (coavoid_cli_option_is(arg, "--joint-members")) {
+        status = coavoid_joint_members_option(argc, argv, i, &o->joint_text, &o->joint_members);
     }
     return status;
 }
@@ -197,6 +206,10 @@ static int parse_sim_options(int argc, char **argv, sim_options_t *o)
     }
     if (o->mode == NULL) {
         return coavoid_cli_fail(CLI_EXIT_INVALID, "--mode: required (centralised or decoupled)");
+    }
+    if (o->decoupled && o->joint_text != NULL) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                "--joint-members: only valid with --mode centralised");
     }
     if (o->decoupled && o->stop_text != NULL) {
         return coavoid_cli_fail(
@@ -223,6 +236,8 @@ static int sim(void *options, coavoid_scenario_t *s)
         .svg_path = o->svg_path,
         .record_path = o->record_path,
         .record_uav = o->record_uav,
+        .has_joint_members = o->joint_text != NULL,
+        .joint_members = (size_t)o->joint_members,
         .insecure = o->insecure,
         .network = coavoid_cli_network_given(&o->network),
         .loss = o->network.loss,

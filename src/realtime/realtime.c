@@ -273,14 +273,18 @@ static int64_t rt_pending_deadline(const rt_run_t *r, size_t i, int64_t deadline
     return deadline == deadline_polled ? INT64_MAX : deadline;
 }
 
-/* One datagram delivered to the nodes: 1, 0 when none is waiting, or COAVOID_RT_ERR_LCM. */
-static int rt_deliver(const coavoid_rt_loop_t *loop)
+int coavoid_rt_stop_signal(void)
 {
-    if (loop->rx != NULL) {
-        return coavoid_rt_rx_deliver(loop->rx);
+    return (int)rt_stop_signal;
+}
+
+int coavoid_rt_deliver(lcm_t *lcm, coavoid_rt_rx_t *rx)
+{
+    if (rx != NULL) {
+        return coavoid_rt_rx_deliver(rx);
     }
     errno = 0;
-    int rc = lcm_handle_timeout(loop->lcm, 0);
+    int rc = lcm_handle_timeout(lcm, 0);
     if (rc < 0) {
         /* A signal during LCM's own select: the loop looks at the stop flag next. */
         return errno == EINTR ? 0 : COAVOID_RT_ERR_LCM;
@@ -300,7 +304,7 @@ static int rt_drain(const rt_run_t *r, int64_t wake)
         if (handled > 0 && *r->loop->now >= wake) {
             break;
         }
-        int rc = rt_deliver(r->loop);
+        int rc = coavoid_rt_deliver(r->loop->lcm, r->loop->rx);
         if (rc < 0) {
             return rc;
         }

@@ -221,6 +221,13 @@ typedef struct {
  * short). Returns 0, or -1 when sigaction failed. */
 int coavoid_rt_install_signal_handlers(void);
 
+/* The signal that asked the loop to stop, or 0 (none yet). O(1). */
+int coavoid_rt_stop_signal(void);
+
+/* One datagram delivered to the handlers subscribed on the receiver's LCM (rx), or on lcm
+ * when rx is NULL: 1, 0 when none is waiting, or COAVOID_RT_ERR_LCM. */
+int coavoid_rt_deliver(lcm_t *lcm, coavoid_rt_rx_t *rx);
+
 /* Runs the loop until cycle K is done or a signal asks it to stop. Returns COA_OK,
  * COA_ERR_ARGUMENT (no node, NULL lcm/now/common, steps < 1) or COAVOID_RT_ERR_LCM. Node
  * errors are counted in result, not returned. */

@@ -794,7 +794,9 @@ static int sim_vehicles(sim_run_t *r)
         config.vehicle = s->vehicles[i];
         config.mode = r->o->decoupled ? COAVOID_NODE_DECOUPLED : COAVOID_NODE_CENTRALISED;
         config.intent_copies = COAVOID_NODE_DEFAULT_COPIES;
-        config.joint_members = coavoid_node_joint_members(config.mode, r->n);
+        config.joint_members = r->o->has_joint_members
+                                   ? r->o->joint_members
+                                   : coavoid_node_joint_members(config.mode, r->n);
         config.joint_memo = r->o->joint_memo != NULL ? r->o->joint_memo : &r->own_memo;
         const bool recorded = r->o->record_path != NULL && config.vehicle.id == r->o->record_uav;
         if (recorded) {

@@ -78,6 +78,11 @@ typedef struct {
      * the same scenario (a sweep's stopped runs repeat the unstopped run's searches); NULL:
      * the run's own, shared by its vehicles. The flight is the same either way. */
     coavoid_node_joint_memo_t *joint_memo;
+    /* Centralised: with has_joint_members, every vehicle's joint_members (node.h: 0, never,
+     * or 2..COA_MAX_CENTRALISED), as coavoid-vehicle --joint-members gives a fleet; else
+     * coavoid_node_joint_members's. */
+    bool has_joint_members;
+    size_t joint_members;
     bool json;            /* the result as JSON (default: text) */
     const char *svg_path; /* NULL, or where the figure goes */
     /* NULL, or where the record of UAV record_uav goes (src/replay, replay.h): its

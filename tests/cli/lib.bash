@@ -115,3 +115,18 @@ in_multicast_netns() {
     rm -rf "$tmp"
     exec env COAVOID_TEST_IN_NETNS=1 unshare "$how" bash "$0" "$@"
 }
+
+# lead_in SCENARIO OUT SECONDS: SCENARIO with every UAV starting SECONDS further back
+# along its route's first leg (at its cruise speed), written to OUT: an encounter whose
+# first conflict enters the horizon only after every UAV has heard the others.
+lead_in() {
+    python3 - "$1" "$2" "$3" <<'PY'
+import json, math, sys
+s = json.load(open(sys.argv[1]))
+for v in s["vehicles"]:
+    a, b = v["route"][0], v["route"][1]
+    back = v["cruise_speed"] * float(sys.argv[3]) / math.hypot(b[0] - a[0], b[1] - a[1])
+    v["route"][0] = [a[j] - (b[j] - a[j]) * back for j in range(3)]
+json.dump(s, open(sys.argv[2], "w"))
+PY
+}

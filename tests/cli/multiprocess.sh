@@ -441,15 +441,7 @@ any(z != 100 for i in (1, 3) for z in $crossing)
 # alike). So the paper's flight gets a lead-in: every UAV starts 18 s further back along
 # its route, the first conflict enters the 24 s horizon at cycle 2, after every UAV has
 # heard the others, and the 48 cycles (2N, what summary judges) fly the paper's 30.
-python3 - "$paper" "$tmp/paper_lead_in.json" 18 <<'PY'
-import json, math, sys
-s = json.load(open(sys.argv[1]))
-for v in s["vehicles"]:
-    a, b = v["route"][0], v["route"][1]
-    back = v["cruise_speed"] * float(sys.argv[3]) / math.hypot(b[0] - a[0], b[1] - a[1])
-    v["route"][0] = [a[j] - (b[j] - a[j]) * back for j in range(3)]
-json.dump(s, open(sys.argv[2], "w"))
-PY
+lead_in "$paper" "$tmp/paper_lead_in.json" 18
 speed=$speed_decoupled
 fleet decoupled "$tmp/paper_lead_in.json" decoupled 48 -
 "$bin" sim "$tmp/paper_lead_in.json" --mode decoupled --steps 48 --json >"$tmp/decoupled/sim.json"
