@@ -25,7 +25,8 @@
     "Writes a fresh key pair for every node of the scenario's fleet: DIR/coordinator.key,\n" \
     "DIR/world.key and DIR/vehicle-ID.key for each UAV (secret keys, mode 0600), and\n"      \
     "DIR/trust.txt, the trust file listing their public keys with their roles (key ids:\n"   \
-    "the coordinator 1, the world 2, UAV ID 100 + ID). DIR must exist.\n"                    \
+    "the coordinator 1, the world 2, UAV ID 100 + ID). DIR is created (mode 0700) when it\n" \
+    "does not exist; its parent must.\n"                                                     \
     "\n"                                                                                     \
     "exit status: 0 written, 2 invalid input or usage, 3 a file could not be written\n"
 
@@ -112,9 +113,27 @@ static int fleet_line(char *trust, size_t trust_size)
               : coavoid_cli_fail(CLI_EXIT_INTERNAL, "internal error: no fleet key (libsodium)");
 }
 
+/* DIR as it is, or created for its owner only once the scenario is known to be good
+ * (a refused scenario leaves nothing behind). */
+static int make_dir(const char *dir)
+{
+    if (mkdir(dir, 0700) == 0 || errno == EEXIST) {
+        struct stat st;
+        return stat(dir, &st) == 0 && S_ISDIR(st.st_mode)
+                   ? CLI_CONTINUE
+                   : coavoid_cli_fail(CLI_EXIT_INVALID, "--dir: '%.200s' is not a directory", dir);
+    }
+    return coavoid_cli_fail(CLI_EXIT_INVALID, "--dir: cannot create '%.200s': %s", dir,
+                            strerror(errno));
+}
+
 static int keygen(void *options, coavoid_scenario_t *s)
 {
     const keygen_options_t *o = options;
+    int made = make_dir(o->dir);
+    if (made != CLI_CONTINUE) {
+        return made;
+    }
     static char trust[COA_MAX_VEHICLES * COAVOID_AUTH_LINE_MAX + 3u * COAVOID_AUTH_LINE_MAX];
     char name[32];
     strcpy(trust, "# coavoid trust file: KEY_ID ROLE NODE_ID PUBLIC_KEY_HEX, and the fleet's\n"
@@ -150,10 +169,6 @@ int coavoid_command_keygen(int argc, char **argv)
     }
     if (o.dir == NULL) {
         return coavoid_cli_fail(CLI_EXIT_INVALID, "--dir: required (where the keys go)");
-    }
-    struct stat st;
-    if (stat(o.dir, &st) != 0 || !S_ISDIR(st.st_mode)) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "--dir: '%.200s' is not a directory", o.dir);
     }
     return coavoid_cli_run_scenario(o.scenario_path, keygen, &o);
 }

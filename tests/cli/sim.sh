@@ -650,7 +650,25 @@ if expect_status "keygen" 0 keygen "$scenarios/paper.json" --dir "$tmp/keys" &&
     fi
 fi
 expect_bad "keygen without --dir" "--dir" keygen "$scenarios/paper.json"
-expect_bad "keygen into a missing directory" "not a directory" keygen "$scenarios/paper.json" \
-    --dir "$tmp/none"
+# A directory that does not exist is made, for its owner only (the README's first
+# `keygen ... --dir keys/` on a fresh checkout); a file in its place, a missing parent and
+# a refused scenario are errors that leave nothing behind.
+if expect_status "keygen into a new directory" 0 keygen "$scenarios/paper.json" --dir "$tmp/new"; then
+    if [ "$(stat -c %a "$tmp/new")" = 700 ] && [ -s "$tmp/new/trust.txt" ]; then
+        pass
+    else
+        fail "keygen into a new directory: $(stat -c '%a %n' "$tmp/new" "$tmp/new"/* 2>&1)"
+    fi
+fi
+: >"$tmp/plain"
+expect_bad "keygen into a file" "not a directory" keygen "$scenarios/paper.json" --dir "$tmp/plain"
+expect_bad "keygen, a missing parent" "cannot create" keygen "$scenarios/paper.json" \
+    --dir "$tmp/none/keys"
+expect_bad "keygen, a refused scenario" "$tmp/none.json" keygen "$tmp/none.json" --dir "$tmp/left"
+if [ -e "$tmp/left" ]; then
+    fail "keygen, a refused scenario: it created $tmp/left"
+else
+    pass
+fi
 
 finish
