@@ -102,6 +102,20 @@ static const coavoid_cli_command_t summary_command = {
     "summary",    "coavoid summary", 2, {"LOGFILE", "SCENARIO.json"}, "one log and one scenario",
     summary_help, summary_option};
 
+/* Whether the file at path begins as an lcm-logger log does (its first event's magic). */
+static bool is_lcm_log(const char *path)
+{
+    static const unsigned char magic[4] = {0xEDu, 0xA1u, 0xDAu, 0x01u};
+    unsigned char head[4] = {0};
+    FILE *f = fopen(path, "rb");
+    const bool log = f != NULL && fread(head, 1, sizeof head, f) == sizeof head &&
+                     memcmp(head, magic, sizeof magic) == 0;
+    if (f != NULL) {
+        fclose(f);
+    }
+    return log;
+}
+
 static int parse_summary_options(int argc, char **argv, summary_options_t *o)
 {
     const char *args[2] = {NULL, NULL};
@@ -112,6 +126,13 @@ static int parse_summary_options(int argc, char **argv, summary_options_t *o)
     }
     o->log_path = args[0];
     o->scenario_path = args[1];
+    /* The two given the other way round would read the log as JSON ("NUL byte"). */
+    if (is_lcm_log(o->scenario_path)) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID,
+                                "%.200s is an lcm-logger log, not a scenario: the log comes first "
+                                "(coavoid summary LOGFILE SCENARIO.json)",
+                                o->scenario_path);
+    }
     if (o->mode == NULL) {
         return coavoid_cli_fail(CLI_EXIT_INVALID, "--mode: required (centralised or decoupled)");
     }

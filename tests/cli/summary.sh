@@ -438,6 +438,7 @@ also= expect_bad "no mode" "--mode" summary "$log" "$headon"
 also= expect_bad "bad mode" "--mode" summary "$log" "$headon" --mode sideways
 also= expect_bad "mode twice" "--mode" summary "$log" "$headon" --mode decoupled --mode decoupled
 also= expect_bad "third argument" "unexpected argument" summary "$log" "$headon" "$headon" --mode decoupled
+also= expect_bad "log and scenario swapped" "the log comes first" summary "$headon" "$log" --mode decoupled
 also= expect_bad "unknown option" "unknown option" summary "$log" "$headon" --mode decoupled --fast
 also= expect_bad "epoch 0" "--epoch" summary "$log" "$headon" --mode decoupled --epoch 0
 also= expect_bad "epoch text" "--epoch" summary "$log" "$headon" --mode decoupled --epoch soon
