@@ -185,13 +185,9 @@ static void out_put(void *user, uint8_t byte)
 static void send_frame(bridge_run_t *r, coavoid_replay_kind_t kind, int64_t time,
                        const char *channel, const uint8_t *payload, size_t length)
 {
-    uint8_t header[COAVOID_REPLAY_HEADER_BYTES];
-    const size_t channel_length = channel != NULL ? strlen(channel) : 0u;
-    coavoid_replay_write_header(header, kind, time, channel_length, length);
-    const uint8_t *const parts[] = {header, (const uint8_t *)channel, payload};
-    const size_t lengths[] = {sizeof header, channel_length, length};
     r->out_length = 0;
-    coavoid_link_put_frame(parts, lengths, 3u, out_put, r);
+    coavoid_session_put_record(kind, time, channel, channel != NULL ? strlen(channel) : 0u, payload,
+                               length, out_put, r);
     if (link_write(r, r->out, r->out_length)) {
         r->result->frames_sent++;
         r->in_flight = true;
@@ -251,8 +247,7 @@ static void on_datagram(const lcm_recv_buf_t *rbuf, const char *channel, void *u
 static void subscribe(bridge_run_t *r, const coavoid_replay_record_t *rec)
 {
     char channel[COAVOID_REPLAY_MAX_CHANNEL + 1u];
-    memcpy(channel, rec->channel, rec->channel_length);
-    channel[rec->channel_length] = '\0';
+    coavoid_replay_channel(rec, channel);
     if (!coavoid_rt_rx_fleet_channel(channel) || r->sub_count == COAVOID_NODE_CHANNELS) {
         return;
     }
@@ -273,8 +268,7 @@ static void subscribe(bridge_run_t *r, const coavoid_replay_record_t *rec)
 static void publish(bridge_run_t *r, const coavoid_replay_record_t *rec)
 {
     char channel[COAVOID_REPLAY_MAX_CHANNEL + 1u];
-    memcpy(channel, rec->channel, rec->channel_length);
-    channel[rec->channel_length] = '\0';
+    coavoid_replay_channel(rec, channel);
     if (coavoid_rt_rx_fleet_channel(channel) && rec->payload_length <= COAVOID_RT_RX_DATAGRAM &&
         lcm_publish(r->b->lcm, channel, rec->payload, (unsigned)rec->payload_length) == 0) {
         r->result->published++;
@@ -300,7 +294,6 @@ static void ready(bridge_run_t *r, const coavoid_replay_record_t *rec)
         r->result->refused_code = code;
     }
     r->result->frames_refused += code < 0 ? 1u : 0u;
-    r->result->last_code = code;
     r->result->state = state;
     r->wake = rec->time;
     r->in_flight = false;

@@ -75,7 +75,6 @@ typedef struct {
     coavoid_rt_result_t loop; /* signal and the receiver's counters (cycles: the vehicle's) */
     bool configured;          /* the vehicle took its configuration */
     int refused_code;         /* ... or refused it with this code */
-    int last_code;            /* the last READY's code (session.h) */
     coavoid_vehicle_node_state_t state; /* the vehicle's, as its last READY gave it */
     uint64_t frames_sent;               /* to the vehicle */
     uint64_t frames_refused;            /* ... answered with an error */

@@ -133,6 +133,13 @@ void coavoid_replay_write_state(int rc, const coavoid_vehicle_node_state_t *s,
     coavoid_replay_put_u(&b, (uint64_t)s->rx.rejected, 8u);
 }
 
+void coavoid_replay_channel(const coavoid_replay_record_t *record,
+                            char out[COAVOID_REPLAY_MAX_CHANNEL + 1u])
+{
+    memcpy(out, record->channel, record->channel_length);
+    out[record->channel_length] = '\0';
+}
+
 int coavoid_replay_read_state(const uint8_t *payload, size_t size, int *rc,
                               coavoid_vehicle_node_state_t *s)
 {

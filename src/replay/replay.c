@@ -86,8 +86,7 @@ static int call(coavoid_replay_t *r, const coavoid_replay_record_t *rec, int *rc
     switch (rec->kind) {
     case COAVOID_REPLAY_RECEIVE: {
         char channel[COAVOID_REPLAY_MAX_CHANNEL + 1u];
-        memcpy(channel, rec->channel, rec->channel_length);
-        channel[rec->channel_length] = '\0';
+        coavoid_replay_channel(rec, channel);
         *rc = coavoid_vehicle_node_receive(r->node, channel, rec->payload, rec->payload_length);
         r->receives++;
         break;

@@ -88,6 +88,10 @@ int coavoid_replay_parse(const uint8_t *data, size_t size, coavoid_replay_record
  * only at the end of the record or on an error). */
 typedef size_t (*coavoid_replay_read_t)(void *user, void *out, size_t n);
 
+/* The record's channel as a C string, into out. O(channel). */
+void coavoid_replay_channel(const coavoid_replay_record_t *record,
+                            char out[COAVOID_REPLAY_MAX_CHANNEL + 1u]);
+
 /* The next record through read into buf (capacity bytes, which the record points into):
  * 1, 0 at the end (nothing more to read), or COAVOID_REPLAY_ERR_FORMAT (cut, bad, or
  * longer than capacity). O(the record's length). */

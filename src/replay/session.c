@@ -5,16 +5,24 @@
 #include "protocol_internal.h"
 #include "session.h"
 
-/* A record of kind, time, channel and payload, framed onto the wire. */
-static void send_record(const coavoid_session_t *s, coavoid_replay_kind_t kind, int64_t time,
-                        const char *channel, size_t channel_length, const uint8_t *payload,
-                        size_t payload_length)
+void coavoid_session_put_record(coavoid_replay_kind_t kind, int64_t time, const char *channel,
+                                size_t channel_length, const uint8_t *payload,
+                                size_t payload_length, coavoid_link_put_t put, void *user)
 {
     uint8_t header[COAVOID_REPLAY_HEADER_BYTES];
     coavoid_replay_write_header(header, kind, time, channel_length, payload_length);
     const uint8_t *const parts[] = {header, (const uint8_t *)channel, payload};
     const size_t lengths[] = {sizeof header, channel_length, payload_length};
-    coavoid_link_put_frame(parts, lengths, 3u, s->put, s->user);
+    coavoid_link_put_frame(parts, lengths, 3u, put, user);
+}
+
+/* A record of the vehicle's onto the wire. */
+static void send_record(const coavoid_session_t *s, coavoid_replay_kind_t kind, int64_t time,
+                        const char *channel, size_t channel_length, const uint8_t *payload,
+                        size_t payload_length)
+{
+    coavoid_session_put_record(kind, time, channel, channel_length, payload, payload_length, s->put,
+                               s->user);
 }
 
 /* The node's link: each datagram goes to the ground at once, during the call. */
@@ -121,8 +129,7 @@ static void send_channels(const coavoid_session_t *s)
 static void take_datagram(coavoid_session_t *s, const coavoid_replay_record_t *rec)
 {
     char channel[COAVOID_REPLAY_MAX_CHANNEL + 1u];
-    memcpy(channel, rec->channel, rec->channel_length);
-    channel[rec->channel_length] = '\0';
+    coavoid_replay_channel(rec, channel);
     note(s,
          coavoid_vehicle_node_receive(s->replay.node, channel, rec->payload, rec->payload_length));
     poll_at(s, s->replay.now);

@@ -45,6 +45,13 @@
 #define COAVOID_SESSION_MAX_RECORD \
     (COAVOID_REPLAY_HEADER_BYTES + COAVOID_REPLAY_MAX_CHANNEL + COAVOID_REPLAY_MAX_PAYLOAD)
 
+/* One record (kind, time, channel[0..channel_length), payload[0..payload_length); either
+ * may be NULL when its length is 0) framed onto the wire through put, as both ends send
+ * theirs. No buffer. O(bytes). */
+void coavoid_session_put_record(coavoid_replay_kind_t kind, int64_t time, const char *channel,
+                                size_t channel_length, const uint8_t *payload,
+                                size_t payload_length, coavoid_link_put_t put, void *user);
+
 typedef struct {
     coavoid_replay_t replay; /* the configuration's storage, the clock, the node */
     void *memory;            /* the node's block */
