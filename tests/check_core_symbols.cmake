@@ -6,7 +6,8 @@
 # uses). Used for the host core (tests/CMakeLists.txt) and for the Cortex-M4F archive and
 # firmware ELF (tests/firmware/run.sh), so the list is written once. Names with newlib's
 # reentrant forms (_malloc_r, _vfprintf_r, ...) and the system calls under them
-# (_sbrk, _write, ...) count too.
+# (_sbrk, _write, ...) count too. With -DNO_DATA=ON an archive must also define no
+# writable data (nm's D, d, B, b, C, G, g, S, s): the core keeps no mutable global.
 set(nm_args -u)
 if(LINKED)
   set(nm_args "")
@@ -29,5 +30,12 @@ endforeach()
 if(bad)
   list(REMOVE_DUPLICATES bad)
   message(FATAL_ERROR "${LIB} references forbidden symbols: ${bad}")
+endif()
+if(NO_DATA)
+  execute_process(COMMAND ${NM} ${LIB} OUTPUT_VARIABLE all RESULT_VARIABLE rc)
+  string(REGEX MATCHALL "[^\n]+ [DdBbCGgSs] [^\n]+" data "${all}")
+  if(data)
+    message(FATAL_ERROR "${LIB} defines writable data (no mutable global): ${data}")
+  endif()
 endif()
 message(STATUS "${LIB}: no heap, stdio, clock, thread or LCM symbol")
