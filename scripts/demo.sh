@@ -118,7 +118,7 @@ mkdir -p "$out"
 out=$(cd "$out" && pwd)
 log=$out/demo.lcm
 svg=$out/demo.svg
-mapfile -t ids < <("$vehicle" --scenario "$scenario" --list-ids)
+mapfile -t ids < <("$vehicle" "$scenario" --list-ids)
 [ "${#ids[@]}" -gt 0 ] || die "$scenario: no vehicles"
 # How long it will take, for the user (python3 is optional here).
 duration=
@@ -158,13 +158,13 @@ names=()
 pids+=($!) names+=(world)
 if [ "$mode" = centralised ]; then
     # shellcheck disable=SC2046
-    "$coordinator" --scenario "$scenario" "${common[@]}" $(key coordinator) \
+    "$coordinator" "$scenario" "${common[@]}" $(key coordinator) \
         2>"$out/coordinator.txt" &
     pids+=($!) names+=(coordinator)
 fi
 for id in "${ids[@]}"; do
     # shellcheck disable=SC2046
-    "$vehicle" --scenario "$scenario" --id "$id" --mode "$mode" "${common[@]}" \
+    "$vehicle" "$scenario" --id "$id" --mode "$mode" "${common[@]}" \
         $(key "vehicle-$id") 2>"$out/vehicle-$id.txt" &
     pids+=($!) names+=("vehicle-$id")
 done

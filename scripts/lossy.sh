@@ -138,7 +138,7 @@ ip link add br0 type bridge
 ip link set br0 type bridge mcast_snooping 0
 ip link set br0 up
 
-mapfile -t ids < <("$vehicle" --scenario "$scenario" --list-ids)
+mapfile -t ids < <("$vehicle" "$scenario" --list-ids)
 names=(logger world)
 [ "$mode" = centralised ] && names+=(coordinator)
 for id in "${ids[@]}"; do names+=("vehicle-$id"); done
@@ -261,9 +261,9 @@ for run in $(seq "$runs"); do
             continue ;;
         world) cpu world "$dir/world.cpu" "$coavoid" world "$scenario" "${common[@]}" "${key[@]}" \
             2>"$dir/world.txt" & ;;
-        coordinator) cpu coordinator "$dir/coordinator.cpu" "$coordinator" --scenario "$scenario" \
+        coordinator) cpu coordinator "$dir/coordinator.cpu" "$coordinator" "$scenario" \
             "${common[@]}" "${key[@]}" 2>"$dir/coordinator.txt" & ;;
-        *) cpu "$name" "$dir/$name.cpu" "$vehicle" --scenario "$scenario" --id "${name#vehicle-}" \
+        *) cpu "$name" "$dir/$name.cpu" "$vehicle" "$scenario" --id "${name#vehicle-}" \
             --mode "$mode" "${common[@]}" "${key[@]}" 2>"$dir/$name.txt" & ;;
         esac
         pids+=($!)

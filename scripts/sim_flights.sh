@@ -33,8 +33,8 @@ centralised|--mode centralised
 decoupled|--mode decoupled
 stop2|--mode centralised --coordinator-stops 2
 stop3-2|--mode centralised --coordinator-stops 3:2
-loss-c|--mode centralised --loss 0.3 --seed 7
-loss-d|--mode decoupled --loss 0.3 --seed 7
+loss-c|--mode centralised --loss 0.3 --net-seed 7
+loss-d|--mode decoupled --loss 0.3 --net-seed 7
 WAYS
 }
 export -f fly

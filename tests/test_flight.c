@@ -869,6 +869,10 @@ static int write_log(int argc, char **argv)
             hb.node_kind =
                 i < n ? COAVOID_STATUS_T_NODE_VEHICLE : COAVOID_STATUS_T_NODE_COORDINATOR;
             hb.sequence = c;
+            /* A UAV follows the coordinator's plan when there is one, as in a centralised
+             * run; else it plans for itself. */
+            hb.mode = i < n && !planned ? COAVOID_STATUS_T_MODE_DECOUPLED
+                                        : COAVOID_STATUS_T_MODE_CENTRALISED;
             hb.outcome = COAVOID_STATUS_T_OUTCOME_NONE;
             if (i == n && planned) {
                 hb.last_plan_utime = LOG_EPOCH + 1000;

@@ -13,20 +13,34 @@
 
 #include "coavoid/coavoid.h"
 
-int coavoid_cli_fail(int status, const char *fmt, ...)
+/* One line on stderr, "coavoid: " then the message; control characters that came from the
+ * input cannot split it. */
+static void print_line(const char *fmt, va_list ap)
 {
     char line[1024];
-    va_list ap;
-    va_start(ap, fmt);
     vsnprintf(line, sizeof line, fmt, ap);
-    va_end(ap);
     for (char *c = line; *c != '\0'; c++) {
         if ((unsigned char)*c < 0x20u || *c == 0x7f) {
             *c = '?';
         }
     }
     fprintf(stderr, "coavoid: %s\n", line);
+}
+
+int coavoid_cli_fail(int status, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    print_line(fmt, ap);
+    va_end(ap);
     return status;
+}
+
+void coavoid_cli_deprecated(const char *old, const char *use)
+{
+    /* The version that drops it: the next MINOR one (docs/library.md, "Versions"). */
+    coavoid_cli_fail(0, "warning: %s is deprecated and goes in %d.%d.0: use %s", old,
+                     COAVOID_VERSION_MAJOR, COAVOID_VERSION_MINOR + 1, use);
 }
 
 int coavoid_cli_run_status(int rc, const coavoid_run_error_t *e)
@@ -246,6 +260,10 @@ int coavoid_cli_parse_args(const coavoid_cli_command_t *c, int argc, char **argv
             c->help();
             return CLI_EXIT_OK;
         }
+        if (strcmp(arg, "--version") == 0) {
+            coavoid_cli_print_version(c->see);
+            return CLI_EXIT_OK;
+        }
         int status = c->option(argc, argv, &i, options);
         if (status == CLI_UNKNOWN_OPTION) {
             return coavoid_cli_fail(CLI_EXIT_INVALID,
@@ -256,11 +274,43 @@ int coavoid_cli_parse_args(const coavoid_cli_command_t *c, int argc, char **argv
             return status;
         }
     }
-    if (given < wanted) {
+    if (given < wanted && !c->arguments_optional) {
         return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: missing %s (see '%s --help')", c->name,
                                 c->arguments[given], c->see);
     }
     return CLI_CONTINUE;
+}
+
+int coavoid_cli_scenario_option(int argc, char **argv, int *i, const char **path)
+{
+    coavoid_cli_deprecated("--scenario FILE", "the scenario as the first argument");
+    return coavoid_cli_text_option(argc, argv, i, "--scenario", "a scenario file", false, path);
+}
+
+int coavoid_cli_scenario_given(const coavoid_cli_command_t *c, const char *argument,
+                               const char **path)
+{
+    if (argument != NULL && *path != NULL) {
+        return coavoid_cli_fail(
+            CLI_EXIT_INVALID, "%s: the scenario is given twice, as '%.80s' and --scenario '%.80s'",
+            c->name, argument, *path);
+    }
+    if (argument != NULL) {
+        *path = argument;
+    }
+    if (*path == NULL) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: missing %s (see '%s --help')", c->name,
+                                c->arguments[0], c->see);
+    }
+    return CLI_CONTINUE;
+}
+
+void coavoid_cli_print_version(const char *program)
+{
+    const char *space = strchr(program, ' ');
+    int length = space != NULL ? (int)(space - program) : (int)strlen(program);
+    printf("%.*s %s (%s precision)\n", length, program, COAVOID_VERSION,
+           sizeof(coa_real_t) == sizeof(float) ? "single" : "double");
 }
 
 int coavoid_cli_run_scenario(const char *path, int (*run)(void *options, coavoid_scenario_t *s),
@@ -310,7 +360,12 @@ int coavoid_cli_network_option(int argc, char **argv, int *i, bool with_seed,
         return real_option(argc, argv, i, "--jitter", "a time in seconds, 0 or more (below 3600)",
                            max_s, &n->jitter_text, &n->jitter);
     }
+    if (with_seed && coavoid_cli_option_is(arg, "--net-seed")) {
+        return coavoid_cli_count_option(argc, argv, i, "--net-seed", NULL, true, UINT64_MAX,
+                                        &n->seed_text, &n->seed);
+    }
     if (with_seed && coavoid_cli_option_is(arg, "--seed")) {
+        coavoid_cli_deprecated("--seed N (the network's seed)", "--net-seed N");
         return coavoid_cli_count_option(argc, argv, i, "--seed", NULL, true, UINT64_MAX,
                                         &n->seed_text, &n->seed);
     }

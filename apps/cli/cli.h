@@ -47,6 +47,10 @@ enum {
  * returns `status`, so that every check reads `return coavoid_cli_fail(...)`. */
 int coavoid_cli_fail(int status, const char *fmt, ...) CLI_PRINTF_LIKE(2, 3);
 
+/* Warns on stderr, as one coavoid_cli_fail line, that the spelling `old` still works and
+ * goes in the next MINOR version, and names what to `use` in its place. */
+void coavoid_cli_deprecated(const char *old, const char *use);
+
 /* A library's return (run.h: a verdict, or an error with its report in e) as the exit
  * status: COAVOID_RUN_DONE -> CLI_EXIT_OK, COAVOID_RUN_NOT_SOLVED -> CLI_EXIT_NOT_SOLVED, an
  * error -> its report on stderr (coavoid_cli_fail) and CLI_EXIT_INVALID or
@@ -77,9 +81,25 @@ typedef struct {
     const char *too_many;     /* why one more argument is refused: "one scenario only" */
     void (*help)(void);       /* prints the usage on stdout */
     cli_option_parser_t option;
+    bool arguments_optional; /* the drivers' scenario: an argument, or --scenario (the old
+                                spelling), checked by coavoid_cli_scenario_given */
 } coavoid_cli_command_t;
 
-/* Walks argv[c->first..]: "-h" or "--help" prints the help and returns CLI_EXIT_OK; every
+/* The drivers' scenario, the first argument as for every coavoid command; --scenario FILE,
+ * the old spelling, still works: coavoid_cli_scenario_option takes it at argv[*i] with a
+ * deprecation warning (coavoid_cli_text_option's returns), and coavoid_cli_scenario_given,
+ * after the arguments, sets *path from the argument and fails, with one line, when both or
+ * neither were given. */
+int coavoid_cli_scenario_option(int argc, char **argv, int *i, const char **path);
+int coavoid_cli_scenario_given(const coavoid_cli_command_t *c, const char *argument,
+                               const char **path);
+
+/* Prints "PROGRAM VERSION (PRECISION precision)" and a newline on stdout: what every
+ * program's --version shows, the program's name up to the first space of program. */
+void coavoid_cli_print_version(const char *program);
+
+/* Walks argv[c->first..]: "-h" or "--help" prints the help and returns CLI_EXIT_OK, and so
+ * does "--version" after coavoid_cli_print_version(c->see); every
  * other option goes to c->option; what is not an option is the next of c->arguments, and
  * args[j] (room for each) is set to argument j. A command that takes arguments also takes
  * "--" (the rest are arguments) and "-" (an argument). Returns CLI_CONTINUE, or
@@ -121,7 +141,8 @@ int coavoid_cli_mode_option(int argc, char **argv, int *i, const char **mode, bo
 
 /* The simulated network's options of `coavoid sim` and `coavoid montecarlo --fly`:
  * --loss P (0 <= P < 1), --delay S and --jitter S (seconds, >= 0; the simulation checks
- * them against the scenario's dt) and, with_seed, --seed N (an integer >= 0). Each *_text
+ * them against the scenario's dt) and, with_seed, --net-seed N (an integer >= 0; --seed N,
+ * its old spelling, with a deprecation warning). Each *_text
  * is NULL until given. */
 typedef struct {
     const char *loss_text, *delay_text, *jitter_text, *seed_text;

@@ -49,6 +49,7 @@
     "  --all-pairs    skip the broad phase: every pair is tested (the reference)\n"         \
     "  --json         print a JSON object instead of 'key: value' lines\n"                  \
     "  -h, --help     show this help\n"                                                     \
+    "      --version  print the version\n"                                                  \
     "\n"                                                                                    \
     "A benchmark is deterministic for a seed except for its times.\n"                       \
     "\n"                                                                                    \
@@ -90,6 +91,9 @@ static int parse_bench_options(int argc, char **argv, bench_options_t *o)
         int status = CLI_CONTINUE;
         if (strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0) {
             print_usage();
+            return CLI_EXIT_OK;
+        } else if (strcmp(arg, "--version") == 0) {
+            coavoid_cli_print_version("coavoid");
             return CLI_EXIT_OK;
         } else if (coavoid_cli_option_is(arg, "--vehicles")) {
             status = coavoid_cli_count_option(argc, argv, &i, "--vehicles", NULL, false,

@@ -37,6 +37,7 @@
     "  --repeat R        timed signatures and checks per type, 1..%u; default %u\n"        \
     "  --json            print a JSON object instead of 'key: value' lines\n"              \
     "  -h, --help        show this help\n"                                                 \
+    "      --version     print the version\n"                                              \
     "\n"                                                                                   \
     "exit status: 0 done, 2 invalid usage (one line on stderr naming the option and\n"     \
     "why), 3 internal error (a check that should pass failed)\n"
@@ -101,6 +102,9 @@ static int parse_options(int argc, char **argv, ba_options_t *o)
         int status = CLI_CONTINUE;
         if (strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0) {
             print_usage();
+            return CLI_EXIT_OK;
+        } else if (strcmp(arg, "--version") == 0) {
+            coavoid_cli_print_version("coavoid");
             return CLI_EXIT_OK;
         } else if (coavoid_cli_option_is(arg, "--vehicles")) {
             status = coavoid_cli_text_option(argc, argv, &i, "--vehicles", "UAV counts, e.g. 3,100",

@@ -62,6 +62,7 @@ _Static_assert(BP_MIN_VEHICLES == 2u && BP_MAX_VEHICLES == 10u, "--vehicles' hin
     "                   existing directory), for `coavoid plan` to replay\n"                \
     "  --json           print a JSON object instead of a table\n"                           \
     "  -h, --help       show this help\n"                                                   \
+    "      --version    print the version\n"                                                \
     "\n"                                                                                    \
     "A benchmark is deterministic for a seed except for its times.\n"                       \
     "\n"                                                                                    \
@@ -144,9 +145,14 @@ static int bp_option(int argc, char **argv, int *i, void *options)
 }
 
 /* bench's argv[2] is the benchmark's name, so options start at argv[3]. */
-static const coavoid_cli_command_t bench_plan_command = {
-    "bench plan", "coavoid bench plan", 3, {NULL, NULL}, "it takes options only", bench_plan_help,
-    bp_option};
+static const coavoid_cli_command_t bench_plan_command = {"bench plan",
+                                                         "coavoid bench plan",
+                                                         3,
+                                                         {NULL, NULL},
+                                                         "it takes options only",
+                                                         bench_plan_help,
+                                                         bp_option,
+                                                         false};
 
 static int parse_bp_options(int argc, char **argv, bp_options_t *o)
 {

@@ -19,7 +19,7 @@
 #define BRIDGE_DEFAULT_BAUD 921600L
 
 #define BRIDGE_USAGE                                                                               \
-    "usage: coavoid bridge --uart PATH [--baud B] --scenario FILE --id ID\n"                       \
+    "usage: coavoid bridge SCENARIO.json --uart PATH [--baud B] --id ID\n"                         \
     "                      [the options of coavoid-vehicle]\n"                                     \
     "\n"                                                                                           \
     "Flies UAV ID of the scenario on the part at the other end of PATH (the example\n"             \
@@ -33,6 +33,7 @@
     "                      or a Unix socket (qemu -serial unix:PATH,server=on,wait=off)\n"         \
     "  --baud B            a serial device's rate; default 921600\n" COAVOID_VEHICLE_OPTIONS_USAGE \
     "  -h, --help          show this help\n"                                                       \
+    "      --version       print the version\n"                                                    \
     "\n"                                                                                           \
     "At the end (after K cycles, or on SIGINT/SIGTERM) it prints one summary line on\n"            \
     "stderr: the vehicle's cycles, plans and messages as coavoid-vehicle's line has them,\n"       \
@@ -69,8 +70,8 @@ static int bridge_option(int argc, char **argv, int *i, void *options)
 }
 
 static const coavoid_cli_command_t bridge_command = {
-    "bridge",    "coavoid bridge", 2, {NULL, NULL}, "the scenario is --scenario FILE",
-    bridge_help, bridge_option};
+    "bridge",    "coavoid bridge", 2,   {"SCENARIO.json", NULL}, "one scenario only",
+    bridge_help, bridge_option,    true};
 
 static void bridge_report(const char *name, const coavoid_rt_bridge_result_t *r)
 {
@@ -169,7 +170,11 @@ int coavoid_command_bridge(int argc, char **argv)
     bridge_options_t o;
     memset(&o, 0, sizeof o);
     coavoid_vehicle_options_init(&o.v);
-    int status = coavoid_cli_parse_args(&bridge_command, argc, argv, &o, NULL);
+    const char *scenario = NULL;
+    int status = coavoid_cli_parse_args(&bridge_command, argc, argv, &o, &scenario);
+    if (status == CLI_CONTINUE) {
+        status = coavoid_cli_scenario_given(&bridge_command, scenario, &o.v.scenario_path);
+    }
     if (status == CLI_CONTINUE && o.uart == NULL) {
         status = coavoid_cli_fail(CLI_EXIT_INVALID, "--uart: required (the part's serial link)");
     }

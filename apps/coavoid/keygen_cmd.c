@@ -50,8 +50,8 @@ static int keygen_option(int argc, char **argv, int *i, void *options)
 }
 
 static const coavoid_cli_command_t keygen_command = {
-    "keygen",    "coavoid keygen", 2, {"SCENARIO.json", NULL}, "one scenario only",
-    keygen_help, keygen_option};
+    "keygen",    "coavoid keygen", 2,    {"SCENARIO.json", NULL}, "one scenario only",
+    keygen_help, keygen_option,    false};
 
 /* Writes text to DIR/name, created for its owner only. */
 static int write_private(const char *dir, const char *name, const char *text)

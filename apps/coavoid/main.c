@@ -51,6 +51,7 @@
 
 #define USAGE                                                                                  \
     "usage: coavoid <command> [options]\n"                                                     \
+    "       coavoid --version\n"                                                               \
     "\n"                                                                                       \
     "commands:\n"                                                                              \
     "  plan        plan collision-free altitude manoeuvres for a scenario\n"                   \
@@ -67,6 +68,10 @@ int main(int argc, char **argv)
     const char *command = argv[1];
     if (strcmp(command, "-h") == 0 || strcmp(command, "--help") == 0) {
         fputs(USAGE, stdout);
+        return CLI_EXIT_OK;
+    }
+    if (strcmp(command, "--version") == 0) {
+        coavoid_cli_print_version("coavoid");
         return CLI_EXIT_OK;
     }
     if (strcmp(command, "plan") == 0) {

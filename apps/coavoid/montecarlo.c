@@ -88,6 +88,7 @@
     "                    loss-of-separation rate against loss per N and mode; prints the\n"  \
     "                    points\n"                                                           \
     "  -h, --help        show this help\n"                                                   \
+    "      --version     print the version\n"                                                \
     "\n"                                                                                     \
     "A seed gives the same encounters and results on every machine with the same C\n"        \
     "maths library (headings use cos and sin), except the times.\n"                          \
@@ -274,9 +275,14 @@ static int mc_option(int argc, char **argv, int *i, void *options)
     return status;
 }
 
-static const coavoid_cli_command_t montecarlo_command = {
-    "montecarlo", "coavoid montecarlo", 2, {NULL, NULL}, "it takes options only", montecarlo_help,
-    mc_option};
+static const coavoid_cli_command_t montecarlo_command = {"montecarlo",
+                                                         "coavoid montecarlo",
+                                                         2,
+                                                         {NULL, NULL},
+                                                         "it takes options only",
+                                                         montecarlo_help,
+                                                         mc_option,
+                                                         false};
 
 /* --figure-from runs nothing: only --svg goes with it. */
 static int figure_options(const mc_options_t *o)

@@ -47,6 +47,7 @@ _Static_assert(COAVOID_DEFAULT_MAX_ORDERS == 7u * 6u * 5u * 4u * 3u * 2u * 1u &&
     "                      (every order of up to %u UAVs); stats.all_orders_covered\n"        \
     "                      says whether a failure is proven for every order\n"                \
     "  -h, --help          show this help\n"                                                  \
+    "      --version       print the version\n"                                               \
     "\n"                                                                                      \
     "Fields of the scenario that the format does not define are ignored.\n"                   \
     "\n"                                                                                      \
@@ -105,8 +106,8 @@ static int plan_option(int argc, char **argv, int *i, void *options)
 }
 
 static const coavoid_cli_command_t plan_command = {
-    "plan",    "coavoid plan", 2, {"SCENARIO.json", NULL}, "one scenario only",
-    plan_help, plan_option};
+    "plan",    "coavoid plan", 2,    {"SCENARIO.json", NULL}, "one scenario only",
+    plan_help, plan_option,    false};
 
 /* Returns CLI_CONTINUE, or the exit status (help printed: 0; a usage error: 2). */
 static int parse_plan_options(int argc, char **argv, plan_options_t *o)

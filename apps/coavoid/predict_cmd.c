@@ -35,6 +35,7 @@
     "                      horizontally and V m/s vertically of look-ahead time\n"           \
     "                      (H, V >= 0; default 0,0: a track's \"sigma\" as given)\n"         \
     "  -h, --help          show this help\n"                                                 \
+    "      --version       print the version\n"                                              \
     "\n"                                                                                     \
     "Conflicts are listed UAV pairs first, then tracks, then obstacles, each by a then b.\n" \
     "\n"                                                                                     \
@@ -101,8 +102,8 @@ static int predict_option(int argc, char **argv, int *i, void *options)
 }
 
 static const coavoid_cli_command_t predict_command = {
-    "predict",    "coavoid predict", 2, {"SCENARIO.json", NULL}, "one scenario only",
-    predict_help, predict_option};
+    "predict",    "coavoid predict", 2,    {"SCENARIO.json", NULL}, "one scenario only",
+    predict_help, predict_option,    false};
 
 /* Returns CLI_CONTINUE, or the exit status (help printed: 0; a usage error: 2). */
 static int parse_predict_options(int argc, char **argv, predict_options_t *o)

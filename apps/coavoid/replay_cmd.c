@@ -41,7 +41,8 @@ static int replay_option(int argc, char **argv, int *i, void *options)
 }
 
 static const coavoid_cli_command_t replay_command = {
-    "replay", "coavoid replay", 2, {"RECORD", NULL}, "one record only", replay_help, replay_option};
+    "replay",    "coavoid replay", 2,    {"RECORD", NULL}, "one record only",
+    replay_help, replay_option,    false};
 
 static size_t file_read(void *user, void *out, size_t n)
 {

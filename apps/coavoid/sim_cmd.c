@@ -20,7 +20,7 @@
 #define SIM_USAGE                                                                                \
     "usage: coavoid sim SCENARIO.json --mode centralised|decoupled [--steps K] [--json]\n"       \
     "                   [--svg FILE] [--coordinator-stops STEP[:M]] [--insecure]\n"              \
-    "                   [--loss P] [--delay S] [--jitter S] [--seed N]\n"                        \
+    "                   [--loss P] [--delay S] [--jitter S] [--net-seed N]\n"                    \
     "                   [--record-vehicle ID:FILE] [--joint-members N]\n"                        \
     "\n"                                                                                         \
     "Flies the scenario in closed loop: every step each UAV publishes its intent, conflicts\n"   \
@@ -46,7 +46,8 @@
     "  --delay S            ... after S seconds (>= 0); default 0\n"                             \
     "  --jitter S           ... plus a uniform time in [0, S] seconds; default 0. A node\n"      \
     "                       hears its own at once; delay + jitter must be less than dt\n"        \
-    "  --seed N             the network's random seed, an integer >= 0; default 1\n"             \
+    "  --net-seed N         the network's random seed, an integer >= 0; default 1 (--seed N,\n"  \
+    "                       its old spelling, works with a warning)\n"                           \
     "  --record-vehicle ID:FILE\n"                                                               \
     "                       write UAV ID's record to FILE: its configuration and keys, every\n"  \
     "                       datagram it received and call made, with their times, and what\n"    \
@@ -57,6 +58,7 @@
     "                       of up to N UAVs (0: never; else at least 2), as the\n"               \
     "                       vehicles' --joint-members; default the scenario's UAVs, at most 5\n" \
     "  -h, --help           show this help\n"                                                    \
+    "      --version        print the version\n"                                                 \
     "\n"                                                                                         \
     "Beyond the contract's fields the result has \"fallbacks\" (times a UAV went from\n"         \
     "following the coordinator to planning for itself), with --coordinator-stops,\n"             \
@@ -195,7 +197,8 @@ static int sim_option(int argc, char **argv, int *i, void *options)
 }
 
 static const coavoid_cli_command_t sim_command = {
-    "sim", "coavoid sim", 2, {"SCENARIO.json", NULL}, "one scenario only", sim_help, sim_option};
+    "sim",    "coavoid sim", 2,    {"SCENARIO.json", NULL}, "one scenario only",
+    sim_help, sim_option,    false};
 
 static int parse_sim_options(int argc, char **argv, sim_options_t *o)
 {

@@ -38,6 +38,7 @@
     "                  by a key that may send them, and newer than the last from that\n"          \
     "                  key, count; the others are ignored and counted as unauthenticated\n"       \
     "  -h, --help      show this help\n"                                                          \
+    "      --version   print the version\n"                                                       \
     "\n"                                                                                          \
     "Replans are the planning calls of every node up to the last sample, from the\n"              \
     "plans_run of their heartbeats (as coavoid sim counts them).\n"                               \
@@ -99,8 +100,8 @@ static int summary_option(int argc, char **argv, int *i, void *options)
 }
 
 static const coavoid_cli_command_t summary_command = {
-    "summary",    "coavoid summary", 2, {"LOGFILE", "SCENARIO.json"}, "one log and one scenario",
-    summary_help, summary_option};
+    "summary",    "coavoid summary", 2,    {"LOGFILE", "SCENARIO.json"}, "one log and one scenario",
+    summary_help, summary_option,    false};
 
 /* Whether the file at path begins as an lcm-logger log does (its first event's magic). */
 static bool is_lcm_log(const char *path)

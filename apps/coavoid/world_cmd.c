@@ -26,6 +26,7 @@
     "coavoid-vehicle).\n"                                                                    \
     "\n"                                                                                     \
     "options:\n" COAVOID_RT_OPTIONS_USAGE "  -h, --help          show this help\n"           \
+    "      --version       print the version\n"                                              \
     "\n"                                                                                     \
     "exit status: 0 done, 2 invalid input or usage (one line on stderr), 3 internal error\n"
 
@@ -40,8 +41,8 @@ static int world_option(int argc, char **argv, int *i, void *options)
 }
 
 static const coavoid_cli_command_t world_command = {
-    "world",    "coavoid world", 2, {"SCENARIO.json", NULL}, "one scenario only",
-    world_help, world_option};
+    "world",    "coavoid world", 2,    {"SCENARIO.json", NULL}, "one scenario only",
+    world_help, world_option,    false};
 
 typedef struct {
     const char *path;

@@ -23,7 +23,7 @@
 #define COORDINATOR_DEFAULT_MAX_CENTRALISED 3u
 
 #define COORDINATOR_USAGE                                                                         \
-    "usage: coavoid-coordinator --scenario FILE [--lcm-url URL] [--epoch UTIME] [--speed S]\n"    \
+    "usage: coavoid-coordinator SCENARIO.json [--lcm-url URL] [--epoch UTIME] [--speed S]\n"      \
     "                           [--steps K] [--beta B] [--max-centralised N] [--collect S]\n"     \
     "                           (--key FILE --trust FILE | --insecure)\n"                         \
     "\n"                                                                                          \
@@ -32,7 +32,8 @@
     "the horizon and the default beta; the vehicles and obstacles come from the messages.\n"      \
     "\n"                                                                                          \
     "options:\n"                                                                                  \
-    "  --scenario FILE     the scenario (docs/scenario-format.md)\n" COAVOID_RT_OPTIONS_USAGE     \
+    "  SCENARIO.json       the scenario (docs/scenario-format.md); --scenario FILE, its\n"        \
+    "                      old spelling, works with a warning\n" COAVOID_RT_OPTIONS_USAGE         \
     "  --beta B            nodes a joint search of its planner stores, B >= 1; default the\n"     \
     "                      scenario's \"beta\", else %u lowered so the workspace fits 1 GiB\n"    \
     "  --max-centralised N largest cluster planned centrally, 1..%u (default %u); the\n"          \
@@ -43,6 +44,7 @@
     "                      before the next cycle starts: planning gets (dt - S) / speed\n"        \
     "                      wall seconds\n"                                                        \
     "  -h, --help          show this help\n"                                                      \
+    "      --version       print the version\n"                                                   \
     "\n"                                                                                          \
     "At the end (after K cycles, or on SIGINT/SIGTERM) it prints one summary line on\n"           \
     "stderr.\n"                                                                                   \
@@ -76,8 +78,7 @@ static int coordinator_option(int argc, char **argv, int *i, void *options)
         return status;
     }
     if (coavoid_cli_option_is(arg, "--scenario")) {
-        status = coavoid_cli_text_option(argc, argv, i, "--scenario", "a scenario file", false,
-                                         &o->scenario_path);
+        status = coavoid_cli_scenario_option(argc, argv, i, &o->scenario_path);
     } else if (coavoid_cli_option_is(arg, "--beta")) {
         status = coavoid_cli_count_option(argc, argv, i, "--beta", "an integer >= 1", false,
                                           UINT32_MAX, &o->beta_text, &value);
@@ -100,22 +101,20 @@ static int coordinator_option(int argc, char **argv, int *i, void *options)
 }
 
 static const coavoid_cli_command_t coordinator_command = {
-    "coordinator",    "coavoid-coordinator", 1, {NULL, NULL}, "the scenario is --scenario FILE",
-    coordinator_help, coordinator_option};
+    "coordinator",    "coavoid-coordinator", 1,   {"SCENARIO.json", NULL}, "one scenario only",
+    coordinator_help, coordinator_option,    true};
 
 static int parse_options(int argc, char **argv, coordinator_options_t *o)
 {
     memset(o, 0, sizeof *o);
     coavoid_rt_options_init(&o->rt);
     o->max_centralised = COORDINATOR_DEFAULT_MAX_CENTRALISED;
-    int status = coavoid_cli_parse_args(&coordinator_command, argc, argv, o, NULL);
+    const char *scenario = NULL;
+    int status = coavoid_cli_parse_args(&coordinator_command, argc, argv, o, &scenario);
     if (status != CLI_CONTINUE) {
         return status;
     }
-    if (o->scenario_path == NULL) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "--scenario: required (a scenario file)");
-    }
-    return CLI_CONTINUE;
+    return coavoid_cli_scenario_given(&coordinator_command, scenario, &o->scenario_path);
 }
 
 static void coordinator_report(void *user, const char *name, const coavoid_rt_result_t *result,

@@ -46,8 +46,7 @@ int coavoid_vehicle_option(int argc, char **argv, int *i, coavoid_vehicle_option
         return status;
     }
     if (coavoid_cli_option_is(arg, "--scenario")) {
-        status = coavoid_cli_text_option(argc, argv, i, "--scenario", "a scenario file", false,
-                                         &o->scenario_path);
+        status = coavoid_cli_scenario_option(argc, argv, i, &o->scenario_path);
     } else if (coavoid_cli_option_is(arg, "--id")) {
         status = coavoid_cli_text_option(argc, argv, i, "--id", "a vehicle id", true, &o->id_text);
         if (status == CLI_CONTINUE &&
@@ -97,9 +96,6 @@ void coavoid_vehicle_options_init(coavoid_vehicle_options_t *o)
 
 int coavoid_vehicle_options_check(const coavoid_vehicle_options_t *o)
 {
-    if (o->scenario_path == NULL) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "--scenario: required (a scenario file)");
-    }
     if (o->id_text == NULL) {
         return coavoid_cli_fail(CLI_EXIT_INVALID, "--id: required (which vehicle of the scenario)");
     }

@@ -13,9 +13,10 @@
 
 #include "drivers.h"
 
-/* The usage lines of a vehicle's options, after --scenario and --id. */
+/* The usage lines of a vehicle's scenario and options. */
 #define COAVOID_VEHICLE_OPTIONS_USAGE                                                             \
-    "  --scenario FILE     the scenario (docs/scenario-format.md): route, dt, horizon, beta\n"    \
+    "  SCENARIO.json       the scenario (docs/scenario-format.md): route, dt, horizon, beta;\n"   \
+    "                      --scenario FILE, its old spelling, works with a warning\n"             \
     "  --id ID             which of its vehicles this process flies\n"                            \
     "  --mode centralised  follow the coordinator; plan for itself while the coordinator\n"       \
     "                      is silent (default)\n"                                                 \
@@ -66,7 +67,7 @@ int coavoid_vehicle_option(int argc, char **argv, int *i, coavoid_vehicle_option
  * COA_MAX_CENTRALISED, as cli.h's option functions do. */
 int coavoid_joint_members_option(int argc, char **argv, int *i, const char **text, uint64_t *value);
 
-/* After the options: --scenario and --id given, and the options that do not go together
+/* After the options and the scenario: --id given, and the options that do not go together
  * refused. CLI_CONTINUE, or CLI_EXIT_INVALID after one line. */
 int coavoid_vehicle_options_check(const coavoid_vehicle_options_t *o);
 

@@ -20,12 +20,12 @@
 #include "scenario.h"
 
 #define VEHICLE_USAGE                                                                       \
-    "usage: coavoid-vehicle --scenario FILE --id ID [--mode centralised|decoupled]\n"       \
+    "usage: coavoid-vehicle SCENARIO.json --id ID [--mode centralised|decoupled]\n"         \
     "                       [--lcm-url URL] [--epoch UTIME] [--speed S] [--steps K]\n"      \
     "                       [--coordinator-timeout S] [--coordinator-id ID]\n"              \
     "                       [--priority-wait S] [--joint-members N [--joint-beta B]]\n"     \
     "                       (--key FILE --trust FILE | --insecure)\n"                       \
-    "       coavoid-vehicle --scenario FILE --list-ids\n"                                   \
+    "       coavoid-vehicle SCENARIO.json --list-ids\n"                                     \
     "\n"                                                                                    \
     "Flies the UAV with this id from the scenario in real time, exchanging intents and\n"   \
     "plans over LCM with the other vehicles, the coordinator and `coavoid world`.\n"        \
@@ -34,6 +34,7 @@
     "  --list-ids          print the scenario's vehicle ids, one per line, and exit (for\n" \
     "                      scripts that start one process per UAV)\n"                       \
     "  -h, --help          show this help\n"                                                \
+    "      --version       print the version\n"                                             \
     "\n"                                                                                    \
     "At the end (after K cycles, or on SIGINT/SIGTERM) it prints one summary line on\n"     \
     "stderr: cycles, plans run and adopted, fallbacks to its own planning, joint plans\n"   \
@@ -61,26 +62,27 @@ static int vehicle_option(int argc, char **argv, int *i, void *options)
 }
 
 static const coavoid_cli_command_t vehicle_command = {
-    "vehicle",    "coavoid-vehicle", 1, {NULL, NULL}, "the scenario is --scenario FILE",
-    vehicle_help, vehicle_option};
+    "vehicle",    "coavoid-vehicle", 1,   {"SCENARIO.json", NULL}, "one scenario only",
+    vehicle_help, vehicle_option,    true};
 
 static int parse_options(int argc, char **argv, vehicle_options_t *o)
 {
     memset(o, 0, sizeof *o);
     coavoid_vehicle_options_init(&o->v);
-    int status = coavoid_cli_parse_args(&vehicle_command, argc, argv, o, NULL);
+    const char *scenario = NULL;
+    int status = coavoid_cli_parse_args(&vehicle_command, argc, argv, o, &scenario);
+    if (status == CLI_CONTINUE) {
+        status = coavoid_cli_scenario_given(&vehicle_command, scenario, &o->v.scenario_path);
+    }
     if (status != CLI_CONTINUE || !o->list_ids) {
         return status != CLI_CONTINUE ? status : coavoid_vehicle_options_check(&o->v);
     }
     const coavoid_vehicle_options_t *v = &o->v;
-    if (v->scenario_path == NULL) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "--scenario: required (a scenario file)");
-    }
     if (v->id_text != NULL || v->mode != NULL || v->timeout_text != NULL ||
         v->coordinator_text != NULL || v->wait_text != NULL || v->joint_members_text != NULL ||
         v->joint_beta_text != NULL || v->rt.lcm_url != NULL || v->rt.epoch_text != NULL ||
         v->rt.speed_text != NULL || v->rt.steps_text != NULL) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "--list-ids: takes only --scenario FILE");
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "--list-ids: takes only the scenario");
     }
     return CLI_CONTINUE;
 }

@@ -6,6 +6,7 @@
  *   trajectory.h vehicles, reference sampling, tracks, actions and exact integer costs
  *   plan.h       the allocation-free A* planner: centralised and decoupled
  *   predict.h    collision prediction over the horizon: conflicts, probability, clusters
+ *   version.h    COAVOID_VERSION
  */
 #ifndef COAVOID_COAVOID_H
 #define COAVOID_COAVOID_H
@@ -15,5 +16,6 @@
 #include "coavoid/trajectory.h"
 #include "coavoid/plan.h"
 #include "coavoid/predict.h"
+#include "coavoid/version.h"
 
 #endif /* COAVOID_COAVOID_H */

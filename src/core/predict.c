@@ -934,7 +934,8 @@ static void grid_shape(const coa_predictor_t *pr, grid_t *g)
         }
         sample[j] = h;
     }
-    const coa_real_t w = sample[s / 2u] * (coa_real_t)GRID_EXTENTS;
+    /* No mover, no sample: the scene is one cell (below). */
+    const coa_real_t w = s > 0u ? sample[s / 2u] * (coa_real_t)GRID_EXTENTS : (coa_real_t)0;
     const coa_real_t rx = x1 - g->x0;
     const coa_real_t ry = y1 - g->y0;
     g->nx = 1u;

@@ -82,7 +82,7 @@ static int on_agreement(void *owner, const coavoid_agreement_t *msg);
 coavoid_coordinator_t *coavoid_coordinator_create(const coavoid_coordinator_config_t *config,
                                                   lcm_t *lcm, lcm_t *rx_lcm, int *error)
 {
-    int dummy;
+    int dummy = 0;
     if (error == NULL) {
         error = &dummy;
     }

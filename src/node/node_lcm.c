@@ -90,7 +90,7 @@ static size_t transport_head(void)
 coavoid_vehicle_node_t *coavoid_vehicle_node_create(const coavoid_vehicle_node_config_t *config,
                                                     lcm_t *lcm, lcm_t *rx_lcm, int *error)
 {
-    int dummy;
+    int dummy = 0;
     error = error != NULL ? error : &dummy;
     *error = COA_ERR_ARGUMENT;
     const size_t size = config != NULL && lcm != NULL ? coavoid_vehicle_node_size(config) : 0u;

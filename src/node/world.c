@@ -100,7 +100,7 @@ static coavoid_lcm_context_t world_context(const coavoid_world_t *w, int64_t now
 
 coavoid_world_t *coavoid_world_create(const coavoid_world_config_t *config, lcm_t *lcm, int *error)
 {
-    int dummy;
+    int dummy = 0;
     if (error == NULL) {
         error = &dummy;
     }

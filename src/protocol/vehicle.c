@@ -386,7 +386,7 @@ coavoid_vehicle_node_t *coavoid_vehicle_node_init(void *memory, size_t size,
                                                   const coavoid_vehicle_node_config_t *config,
                                                   const coavoid_node_link_t *link, int *error)
 {
-    int dummy;
+    int dummy = 0;
     error = error != NULL ? error : &dummy;
     coavoid_vehicle_node_config_t filled;
     coavoid_node_solver_shape_t shape;

@@ -330,6 +330,7 @@ typedef struct {
     int32_t plans_run;
     uint16_t node;
     int8_t kind;
+    int8_t mode; /* COAVOID_STATUS_T_MODE_*: a UAV's says whether it follows a coordinator */
 } heartbeat_t;
 
 typedef struct {
@@ -598,7 +599,8 @@ static bool read_status(log_summary_t *ls, const lcm_eventlog_event_t *e)
         return true;
     }
     /* node_id is 1..65535 once the heartbeat is valid. */
-    heartbeat_t item = {m->utime, m->sequence, m->plans_run, (uint16_t)m->node_id, m->node_kind};
+    heartbeat_t item = {m->utime,     m->sequence, m->plans_run, (uint16_t)m->node_id,
+                        m->node_kind, m->mode};
     return heartbeat_add(&ls->heartbeats, item);
 }
 
@@ -821,6 +823,32 @@ static int judge_heartbeats(log_summary_t *ls, int64_t to, uint32_t *replans)
         total += (uint64_t)counts[i].most;
     }
     *replans = total > UINT32_MAX ? UINT32_MAX : (uint32_t)total;
+    return SIM_GO_ON;
+}
+
+/* A run said to be decoupled whose UAVs followed a coordinator was not: a UAV of the
+ * scenario reports MODE_CENTRALISED only while it flies a coordinator's plan, and a
+ * decoupled vehicle never does, whatever it hears. Only heartbeats of the run's cycles
+ * [from, to) count, so that an earlier run's log played into this one (an attack the
+ * fleet survives) is not taken for this run's. The converse cannot be told: a centralised
+ * fleet whose coordinator never spoke logs what a decoupled one does. */
+static int check_mode(log_summary_t *ls, int64_t from, int64_t to)
+{
+    if (strcmp(ls->o->mode, "decoupled") != 0) {
+        return SIM_GO_ON;
+    }
+    for (size_t q = 0; q < ls->heartbeats.count; q++) {
+        const heartbeat_t *h = &ls->heartbeats.items[q];
+        if (h->kind == COAVOID_STATUS_T_NODE_VEHICLE &&
+            h->mode == COAVOID_STATUS_T_MODE_CENTRALISED && h->utime >= from && h->utime < to &&
+            coavoid_scenario_vehicle_index(ls->s, (long)h->node) >= 0) {
+            return coavoid_run_fail(
+                ls->err, COAVOID_RUN_ERR_INPUT,
+                "%s: UAV %u followed a coordinator at %.3f s (its heartbeat): the run was "
+                "centralised, not --mode decoupled",
+                ls->o->log_path, (unsigned)h->node, (double)(h->utime - from) / 1e6);
+        }
+    }
     return SIM_GO_ON;
 }
 
@@ -1422,7 +1450,10 @@ static int summary_report(log_summary_t *ls, rebuilt_t *b, int64_t epoch)
     const coavoid_flight_eval_t *eval = &judged.eval;
     int status = SIM_GO_ON;
     uint32_t replans = 0;
-    status = judge_heartbeats(ls, epoch + ((int64_t)b->steps + 1) * ls->dt_us, &replans);
+    status = check_mode(ls, epoch, epoch + ((int64_t)b->steps + 1) * ls->dt_us);
+    if (status == SIM_GO_ON) {
+        status = judge_heartbeats(ls, epoch + ((int64_t)b->steps + 1) * ls->dt_us, &replans);
+    }
     if (status != SIM_GO_ON) {
         return status;
     }

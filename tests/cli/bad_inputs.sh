@@ -395,4 +395,61 @@ done
 if grep -q 'default 200000' <("$bin" plan --help); then pass; else fail "plan --help does not state the default beta"; fi
 if grep -q -- '--max-orders N .*default 5040' <("$bin" plan --help); then pass; else fail "plan --help does not state the default --max-orders"; fi
 
+# ---- --version: every program, every command, the number of include/coavoid/version.h ----
+want=$(sed -n 's/^#define COAVOID_VERSION_\(MAJOR\|MINOR\|PATCH\) \([0-9]*\)$/\2/p' \
+    "$src/include/coavoid/version.h" | paste -sd.)
+check_version() { # NAME COMMAND...: prints "NAME VERSION (single|double precision)", exit 0
+    local name=$1
+    shift
+    "$@" >"$tmp/out" 2>"$tmp/err"
+    local rc=$?
+    if [ "$rc" -eq 0 ] && [ ! -s "$tmp/err" ] &&
+        grep -qx "$name $want ([a-z]* precision)" "$tmp/out" && [ "$(wc -l <"$tmp/out")" -eq 1 ]; then
+        pass
+    else
+        fail "$* --version: exit $rc, '$(head -c 200 "$tmp/out")', expected '$name $want (... precision)'"
+    fi
+}
+check_version coavoid "$bin" --version
+for command in plan predict montecarlo "bench plan" "bench predict"; do
+    # shellcheck disable=SC2086
+    check_version coavoid "$bin" $command --version
+done
+drivers=$(dirname "$bin")
+if [ -x "$drivers/coavoid-vehicle" ]; then
+    for command in sim summary world keygen replay bridge "bench auth"; do
+        # shellcheck disable=SC2086
+        check_version coavoid "$bin" $command --version
+    done
+    check_version coavoid-vehicle "$drivers/coavoid-vehicle" --version
+    check_version coavoid-coordinator "$drivers/coavoid-coordinator" --version
+    # The drivers take the scenario as every command does, the first argument; --scenario
+    # FILE, the old spelling, works with one warning line; both, or neither, is an error.
+    paper=$src/scenarios/paper.json
+    "$drivers/coavoid-vehicle" "$paper" --list-ids >"$tmp/ids-new" 2>"$tmp/ids-new.err"
+    "$drivers/coavoid-vehicle" --scenario "$paper" --list-ids >"$tmp/ids-old" 2>"$tmp/ids-old.err"
+    rc=$?
+    if [ "$rc" -eq 0 ] && [ "$(cat "$tmp/ids-new")" = "$(printf '1\n2\n3')" ] && [ ! -s "$tmp/ids-new.err" ] &&
+        cmp -s "$tmp/ids-new" "$tmp/ids-old" && [ "$(wc -l <"$tmp/ids-old.err")" -eq 1 ] &&
+        grep -q '^coavoid: warning: --scenario FILE is deprecated .*first argument' "$tmp/ids-old.err"; then
+        pass
+    else
+        fail "coavoid-vehicle --scenario (old spelling): exit $rc, $(head -c 300 "$tmp/ids-old.err")"
+    fi
+    for d in coavoid-vehicle coavoid-coordinator; do
+        "$drivers/$d" "$paper" --scenario "$paper" --insecure >/dev/null 2>"$tmp/twice.err"
+        rc=$?
+        if [ "$rc" -eq 2 ] && grep -q 'the scenario is given twice' "$tmp/twice.err"; then pass; else
+            fail "$d: scenario given twice: exit $rc, $(head -c 300 "$tmp/twice.err")"
+        fi
+        "$drivers/$d" --insecure >/dev/null 2>"$tmp/none.err"
+        rc=$?
+        if [ "$rc" -eq 2 ] && [ "$(wc -l <"$tmp/none.err")" -eq 1 ] && grep -q "missing SCENARIO.json (see '$d --help')" "$tmp/none.err"; then
+            pass
+        else
+            fail "$d: no scenario: exit $rc, $(head -c 300 "$tmp/none.err")"
+        fi
+    done
+fi
+
 finish

@@ -152,7 +152,7 @@ fi
 key() { echo --key "$keys/$1.key" --trust "$keys/trust.txt"; }
 
 # ids SCENARIO: the scenario's vehicle ids.
-ids() { "$vehicle" --scenario "$1" --list-ids; }
+ids() { "$vehicle" "$1" --list-ids; }
 
 # sleep_until_cycle EPOCH CYCLE: sleeps until the wall time at which the scenario clock
 # (dt = 1 s) reaches CYCLE, a real number of cycles after EPOCH.
@@ -189,7 +189,7 @@ fleet() {
     pids+=($!) names+=(world)
     if [ "$mode" = centralised ]; then
         # shellcheck disable=SC2046
-        "$coordinator" --scenario "$scenario" "${common[@]}" $(key coordinator) "$@" \
+        "$coordinator" "$scenario" "${common[@]}" $(key coordinator) "$@" \
             2>"$dir/coordinator.txt" &
         cpid=$!
         pids+=("$cpid") names+=(coordinator)
@@ -209,7 +209,7 @@ fleet() {
     for id in $(ids "$scenario"); do
         # shellcheck disable=SC2046
         # shellcheck disable=SC2086 # vehicle_args are options
-        "$vehicle" --scenario "$scenario" --id "$id" --mode "$vmode" "${common[@]}" \
+        "$vehicle" "$scenario" --id "$id" --mode "$vmode" "${common[@]}" \
             $(key "vehicle-$id") ${vehicle_args:-} 2>"$dir/vehicle-$id.txt" &
         pids+=($!) names+=("vehicle-$id")
     done
@@ -288,44 +288,44 @@ PY
 headon=$scenarios/headon.json
 coavoid=$bin
 paper=$scenarios/paper.json
-bin=$vehicle expect_bad "vehicle without --id" "--id" --scenario "$headon"
-bin=$vehicle expect_bad "vehicle without --scenario" "--scenario" --id 1
-bin=$vehicle expect_bad "vehicle with an unknown id" "no vehicle 9" --scenario "$headon" --id 9
-bin=$vehicle expect_bad "vehicle id 0" "--id" --scenario "$headon" --id 0
-bin=$vehicle expect_bad "vehicle, bad mode" "--mode" --scenario "$headon" --id 1 --mode fast
-bin=$vehicle expect_bad "vehicle, a missing scenario" "$tmp/none.json" --scenario "$tmp/none.json" --id 1
-bin=$vehicle expect_bad "vehicle, speed 0" "--speed" --scenario "$headon" --id 1 --speed 0
-bin=$vehicle expect_bad "vehicle, speed nan" "--speed" --scenario "$headon" --id 1 --speed nan
-bin=$vehicle expect_bad "vehicle, steps 0" "--steps" --scenario "$headon" --id 1 --steps 0
-bin=$vehicle expect_bad "vehicle, an epoch in seconds" "--epoch" --scenario "$headon" --id 1 --epoch 17
-bin=$vehicle expect_bad "vehicle, a run that has ended" "ended" --scenario "$headon" --id 1 \
+bin=$vehicle expect_bad "vehicle without --id" "--id" "$headon"
+bin=$vehicle expect_bad "vehicle without a scenario" "missing SCENARIO.json" --id 1
+bin=$vehicle expect_bad "vehicle with an unknown id" "no vehicle 9" "$headon" --id 9
+bin=$vehicle expect_bad "vehicle id 0" "--id" "$headon" --id 0
+bin=$vehicle expect_bad "vehicle, bad mode" "--mode" "$headon" --id 1 --mode fast
+bin=$vehicle expect_bad "vehicle, a missing scenario" "$tmp/none.json" "$tmp/none.json" --id 1
+bin=$vehicle expect_bad "vehicle, speed 0" "--speed" "$headon" --id 1 --speed 0
+bin=$vehicle expect_bad "vehicle, speed nan" "--speed" "$headon" --id 1 --speed nan
+bin=$vehicle expect_bad "vehicle, steps 0" "--steps" "$headon" --id 1 --steps 0
+bin=$vehicle expect_bad "vehicle, an epoch in seconds" "--epoch" "$headon" --id 1 --epoch 17
+bin=$vehicle expect_bad "vehicle, a run that has ended" "ended" "$headon" --id 1 \
     --epoch 1000000 --steps 5
-bin=$vehicle expect_bad "vehicle, epoch given twice" "more than once" --scenario "$headon" --id 1 \
+bin=$vehicle expect_bad "vehicle, epoch given twice" "more than once" "$headon" --id 1 \
     --epoch 1 --epoch 2
 bin=$vehicle expect_bad "vehicle, priority wait of a whole cycle" "--priority-wait" \
-    --scenario "$headon" --id 1 --mode decoupled --priority-wait 1 --insecure
+    "$headon" --id 1 --mode decoupled --priority-wait 1 --insecure
 bin=$vehicle expect_bad "vehicle, coordinator timeout when decoupled" "--coordinator-timeout" \
-    --scenario "$headon" --id 1 --mode decoupled --coordinator-timeout 2
-bin=$vehicle expect_bad "vehicle, a joint plan of one" "--joint-members" --scenario "$headon" --id 1 \
+    "$headon" --id 1 --mode decoupled --coordinator-timeout 2
+bin=$vehicle expect_bad "vehicle, a joint plan of one" "--joint-members" "$headon" --id 1 \
     --joint-members 1 --insecure
-bin=$vehicle expect_bad "vehicle, a joint plan of 11" "--joint-members" --scenario "$headon" --id 1 \
+bin=$vehicle expect_bad "vehicle, a joint plan of 11" "--joint-members" "$headon" --id 1 \
     --joint-members 11 --insecure
 bin=$vehicle expect_bad "vehicle, a joint plan when decoupled" "--joint-members" \
-    --scenario "$headon" --id 1 --mode decoupled --joint-members 3 --insecure
+    "$headon" --id 1 --mode decoupled --joint-members 3 --insecure
 bin=$vehicle expect_bad "vehicle, a joint beta with no joint plan" "--joint-beta" \
-    --scenario "$headon" --id 1 --joint-members 0 --joint-beta 100 --insecure
-bin=$vehicle expect_bad "vehicle, joint beta 0" "--joint-beta" --scenario "$headon" --id 1 \
+    "$headon" --id 1 --joint-members 0 --joint-beta 100 --insecure
+bin=$vehicle expect_bad "vehicle, joint beta 0" "--joint-beta" "$headon" --id 1 \
     --joint-beta 0 --insecure
-bin=$vehicle expect_bad "vehicle, an unknown LCM provider" "--lcm-url" --scenario "$headon" --id 1 \
+bin=$vehicle expect_bad "vehicle, an unknown LCM provider" "--lcm-url" "$headon" --id 1 \
     --lcm-url "nope://" --insecure
-bin=$vehicle expect_bad "vehicle, a stray argument" "unexpected argument" "$headon"
+bin=$vehicle expect_bad "vehicle, a stray argument" "unexpected argument" "$headon" "$headon" --id 1
 bin=$coordinator expect_bad "coordinator, --max-centralised 11" "--max-centralised" \
-    --scenario "$headon" --max-centralised 11
-bin=$coordinator expect_bad "coordinator, --beta 0" "--beta" --scenario "$headon" --beta 0
+    "$headon" --max-centralised 11
+bin=$coordinator expect_bad "coordinator, --beta 0" "--beta" "$headon" --beta 0
 bin=$coordinator expect_bad "coordinator, --collect of a whole cycle" "--collect" \
-    --scenario "$headon" --collect 1 --insecure
+    "$headon" --collect 1 --insecure
 bin=$coordinator expect_bad "coordinator, an unknown option" "unknown option" \
-    --scenario "$headon" --id 1
+    "$headon" --id 1
 # A horizon whose intents would not fit one datagram (docs/messages.md).
 python3 - "$headon" "$tmp/long.json" <<'PY'
 import json, sys
@@ -333,30 +333,30 @@ s = json.load(open(sys.argv[1]))
 s["horizon"] = 41
 json.dump(s, open(sys.argv[2], "w"))
 PY
-bin=$vehicle expect_bad "vehicle, horizon 41" "at most 40" --scenario "$tmp/long.json" --id 1
-bin=$coordinator expect_bad "coordinator, horizon 41" "at most 40" --scenario "$tmp/long.json"
+bin=$vehicle expect_bad "vehicle, horizon 41" "at most 40" "$tmp/long.json" --id 1
+bin=$coordinator expect_bad "coordinator, horizon 41" "at most 40" "$tmp/long.json"
 expect_bad "world, horizon 41" "at most 40" world "$tmp/long.json"
 expect_bad "world without a scenario" "SCENARIO" world
 expect_bad "world, bad speed" "--speed" world "$headon" --speed -1
 # Keys: required unless --insecure, never both; a key file must be the node's own, its
 # owner's only, and every line of a trust file is checked.
-bin=$vehicle expect_bad "vehicle without --key" "--key: required" --scenario "$paper" --id 1
-bin=$vehicle expect_bad "vehicle without --trust" "--trust: required" --scenario "$paper" --id 1 \
+bin=$vehicle expect_bad "vehicle without --key" "--key: required" "$paper" --id 1
+bin=$vehicle expect_bad "vehicle without --trust" "--trust: required" "$paper" --id 1 \
     --key "$keys/vehicle-1.key"
-bin=$vehicle expect_bad "vehicle, --insecure with --key" "--insecure" --scenario "$paper" --id 1 \
+bin=$vehicle expect_bad "vehicle, --insecure with --key" "--insecure" "$paper" --id 1 \
     --insecure --key "$keys/vehicle-1.key"
-bin=$vehicle expect_bad "vehicle 2 with vehicle 1's key" "not this node's" --scenario "$paper" \
+bin=$vehicle expect_bad "vehicle 2 with vehicle 1's key" "not this node's" "$paper" \
     --id 2 --key "$keys/vehicle-1.key" --trust "$keys/trust.txt"
 bin=$coordinator expect_bad "coordinator with the world's key" "not this node's" \
-    --scenario "$paper" --key "$keys/world.key" --trust "$keys/trust.txt"
+    "$paper" --key "$keys/world.key" --trust "$keys/trust.txt"
 cp "$keys/vehicle-1.key" "$tmp/open.key" && chmod 644 "$tmp/open.key"
 bin=$vehicle expect_bad "vehicle, a key readable by others" "readable by others" \
-    --scenario "$paper" --id 1 --key "$tmp/open.key" --trust "$keys/trust.txt"
+    "$paper" --id 1 --key "$tmp/open.key" --trust "$keys/trust.txt"
 printf '1 coordinator 65001 00\n' >"$tmp/bad-trust.txt"
 bin=$vehicle expect_bad "vehicle, a bad trust line" "line 1: PUBLIC_KEY_HEX" \
-    --scenario "$paper" --id 1 --key "$keys/vehicle-1.key" --trust "$tmp/bad-trust.txt"
+    "$paper" --id 1 --key "$keys/vehicle-1.key" --trust "$tmp/bad-trust.txt"
 bin=$vehicle expect_bad "vehicle, a missing key file" "cannot read" \
-    --scenario "$paper" --id 1 --key "$tmp/none.key" --trust "$keys/trust.txt"
+    "$paper" --id 1 --key "$tmp/none.key" --trust "$keys/trust.txt"
 expect_bad "world without --key" "--key: required" world "$paper"
 # Without a multicast route (a fresh namespace inside this one) LCM cannot start; the
 # drivers say so in one line with the fix.
@@ -365,11 +365,11 @@ if [ -n "$netns" ]; then
     if [ "$(id -u)" -eq 0 ]; then how=--net; fi
     also="ip route add 224.0.0.0/4 dev lo" bin=unshare expect_bad \
         "vehicle without a multicast route" "no multicast route" \
-        "$how" "$vehicle" --scenario "$headon" --id 1 --insecure
+        "$how" "$vehicle" "$headon" --id 1 --insecure
     also="ip route add 224.0.0.0/4 dev lo" bin=unshare expect_bad \
         "world without a multicast route" "no multicast route" "$how" "$coavoid" world "$headon" --insecure
 fi
-if "$vehicle" --scenario "$paper" --list-ids >"$tmp/ids" 2>&1 &&
+if "$vehicle" "$paper" --list-ids >"$tmp/ids" 2>&1 &&
     [ "$(tr '\n' ' ' <"$tmp/ids")" = "1 2 3 " ]; then
     pass
 else

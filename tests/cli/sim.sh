@@ -8,7 +8,7 @@
 # byte; the UAVs fall back to planning for themselves when the coordinator stops, and stay
 # separated; the coordinator cut after M messages of a cycle (STEP:M); a scenario already in conflict reports its loss (exit 1) instead of crashing;
 # UAVs decide in priority order whatever their ids; the simulated network (--loss, --delay,
-# --jitter, --seed) and montecarlo's closed loop (--fly) over it; bad arguments and inputs, and numbers
+# --jitter, --net-seed) and montecarlo's closed loop (--fly) over it; bad arguments and inputs, and numbers
 # beyond what a message carries anywhere in the run, exit 2 with one line.
 #
 # usage: bash sim.sh <path-to-coavoid> <source-dir>   (VERBOSE=1 prints each result)
@@ -203,7 +203,7 @@ for args in "paper.json --mode centralised" "late_encounter.json --mode decouple
     if [ -s "$tmp/run1" ] && cmp -s "$tmp/run1" "$tmp/run2"; then pass; else fail "two runs of sim $args differ"; fi
 done
 
-# ---- the simulated network (--loss, --delay, --jitter, --seed) ----
+# ---- the simulated network (--loss, --delay, --jitter, --net-seed) ----
 
 # Zero loss, delay and jitter given: the same flight as without them, plus the network's
 # object; given a loss, a seed gives one run, another seed other deliveries; a delay
@@ -222,7 +222,7 @@ assert n["dropped"] == 0 and n["in_flight"] == 0 and n["delivered"] > n["sent"] 
 PY
 for m in centralised decoupled; do
     for run in a:5 b:5 c:6; do
-        "$bin" sim "$p" --mode $m --json --insecure --loss 0.3 --jitter 0.2 --seed "${run#*:}" >"$tmp/net-$m-${run%:*}" 2>&1
+        "$bin" sim "$p" --mode $m --json --insecure --loss 0.3 --jitter 0.2 --net-seed "${run#*:}" >"$tmp/net-$m-${run%:*}" 2>&1
     done
 done
 if python3 - "$tmp"/net-centralised-[abc] "$tmp"/net-decoupled-[abc] <<'PY'; then pass; else fail "sim --loss: one seed is not one run, or another seed the same"; fi
@@ -246,7 +246,16 @@ expect_bad "delay negative" "--delay" sim "$p" --mode decoupled --delay=-1
 expect_bad "delay nan" "--delay" sim "$p" --mode decoupled --delay nan
 expect_bad "jitter missing" "--jitter" sim "$p" --mode decoupled --jitter
 expect_bad "delay a cycle" "--delay" sim "$p" --mode decoupled --delay 0.5 --jitter 0.5
-expect_bad "seed word" "--seed" sim "$p" --mode decoupled --loss 0.1 --seed x
+expect_bad "seed word" "--net-seed" sim "$p" --mode decoupled --loss 0.1 --net-seed x
+# --seed N, the old spelling of --net-seed N, flies the same with one warning naming it.
+"$bin" sim "$p" --mode decoupled --insecure --loss 0.3 --net-seed 4 >"$tmp/seed-new" 2>"$tmp/seed-new.err"
+"$bin" sim "$p" --mode decoupled --insecure --loss 0.3 --seed 4 >"$tmp/seed-old" 2>"$tmp/seed-old.err"
+if cmp -s "$tmp/seed-new" "$tmp/seed-old" && [ ! -s "$tmp/seed-new.err" ] &&
+    [ "$(wc -l <"$tmp/seed-old.err")" -eq 1 ] && grep -q 'warning: --seed .*deprecated.*--net-seed' "$tmp/seed-old.err"; then
+    pass
+else
+    fail "sim --seed (old spelling): not the --net-seed flight with one warning: $(head -c 300 "$tmp/seed-old.err")"
+fi
 
 # ---- montecarlo --fly: the closed loop of the random encounters ----
 
@@ -296,7 +305,7 @@ while IFS=, read -r seed n index _ _ _ _ method status _ _ _ _ _ _ _ loss _ _ ne
     mode=${method#flown_} stop=()
     [ "$mode" = centralised_stop ] && mode=centralised stop=(--coordinator-stops "$s:$m")
     "$bin" sim "$tmp/mc/montecarlo-$seed-$n-$index.json" --mode "$mode" --insecure --loss "$loss" \
-        --seed "$net" "${stop[@]}" >/dev/null 2>&1
+        --net-seed "$net" "${stop[@]}" >/dev/null 2>&1
     rc=$?
     want=0; [ "$status" = loss_of_separation ] && want=1
     [ "$rc" = "$want" ] || { ok=0; echo "montecarlo-$seed-$n-$index $method ${stop[*]}: sim exits $rc, CSV says $status"; }
@@ -449,7 +458,7 @@ r["coordinator_stopped_after"] == 24 and r["coordinator_messages_sent"] == 18
 # With loss the cut is the same mechanism (the network's): a run repeats byte for byte.
 for run in 1 2; do
     "$bin" sim "$scenarios/paper.json" --mode centralised --coordinator-stops 0:4 --loss 0.3 \
-        --delay 0.2 --seed 5 >"$tmp/cut-loss$run.txt" 2>&1
+        --delay 0.2 --net-seed 5 >"$tmp/cut-loss$run.txt" 2>&1
 done
 if grep -Eq '^coordinator: stopped in cycle 0 after 4 of its messages \(4 went out in it, [0-9]+ more were cut\)$' "$tmp/cut-loss1.txt" \
     && grep -q '^network: ' "$tmp/cut-loss1.txt" && cmp -s "$tmp/cut-loss1.txt" "$tmp/cut-loss2.txt"; then

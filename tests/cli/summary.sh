@@ -408,6 +408,11 @@ PY
     also= expect_bad "long channel" "corrupt" summary "$tmp/long_channel.log" "$headon" --mode decoupled
 fi
 also= expect_bad "a scenario is not a log" "not an LCM log" summary "$headon" "$headon" --mode decoupled
+# A centralised run's log (its UAVs followed the coordinator's plan) said to be decoupled.
+if [ -f "$tmp/paper.log" ]; then
+    also= expect_bad "a centralised log as decoupled" "followed a coordinator at" \
+        summary "$tmp/paper.log" "$paper" --mode decoupled
+fi
 : >"$tmp/empty.log"
 also= expect_bad "empty log" "empty file" summary "$tmp/empty.log" "$headon" --mode decoupled
 also= expect_bad "no such log" "cannot open" summary "$tmp/nothing.log" "$headon" --mode decoupled

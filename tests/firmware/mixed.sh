@@ -75,20 +75,20 @@ lead_in "$src/scenarios/paper.json" "$scenario" 18
 # ---- the bridge's bad inputs, and parts that fail: one line, exit 2 or 3 ----
 
 paper=$src/scenarios/paper.json
-expect_bad "bridge without --uart" "--uart: required" bridge --scenario "$paper" --id 1 --insecure
-expect_bad "bridge, a missing --uart" "$tmp/none" bridge --uart "$tmp/none" --scenario "$paper" \
+expect_bad "bridge without --uart" "--uart: required" bridge "$paper" --id 1 --insecure
+expect_bad "bridge, a missing --uart" "$tmp/none" bridge --uart "$tmp/none" "$paper" \
     --id 1 --insecure
 : >"$tmp/plain"
 expect_bad "bridge, --uart a plain file" "neither a serial device nor a socket" bridge \
-    --uart "$tmp/plain" --scenario "$paper" --id 1 --insecure
+    --uart "$tmp/plain" "$paper" --id 1 --insecure
 expect_bad "bridge without --key" "--key: required" bridge --uart "$tmp/plain" \
-    --scenario "$paper" --id 1
+    "$paper" --id 1
 # failing_part NAME PATTERN BRIDGE_ARGS...: the bridge exits 3 within 20 s with one line
 # holding PATTERN, against the part at $tmp/NAME.sock (started by the caller).
 failing_part() {
     local name=$1 pattern=$2
     shift 2
-    timeout 20 "$bin" bridge --uart "$tmp/$name.sock" --scenario "$paper" --id 1 "$@" \
+    timeout 20 "$bin" bridge --uart "$tmp/$name.sock" "$paper" --id 1 "$@" \
         >"$tmp/$name.out" 2>"$tmp/$name.err"
     local rc=$?
     if [ "$rc" -ne 3 ] || ! grep -qF -- "$pattern" "$tmp/$name.err"; then
@@ -155,18 +155,18 @@ fly() {
     pids+=($!) names+=(world)
     if [ "$mode" = centralised ]; then
         # shellcheck disable=SC2046
-        "$coordinator" --scenario "$scenario" "${common[@]}" $(key coordinator) \
+        "$coordinator" "$scenario" "${common[@]}" $(key coordinator) \
             2>"$dir/coordinator.txt" &
         pids+=($!) names+=(coordinator)
     fi
     for i in 2 3; do
         # shellcheck disable=SC2046
-        "$vehicle" --scenario "$scenario" --id "$i" --mode "$mode" "${joint[@]}" "${common[@]}" \
+        "$vehicle" "$scenario" --id "$i" --mode "$mode" "${joint[@]}" "${common[@]}" \
             $(key "vehicle-$i") 2>"$dir/vehicle-$i.txt" &
         pids+=($!) names+=("vehicle-$i")
     done
     # shellcheck disable=SC2046
-    "$bin" bridge --uart "$dir/uart.sock" --scenario "$scenario" --id 1 --mode "$mode" \
+    "$bin" bridge --uart "$dir/uart.sock" "$scenario" --id 1 --mode "$mode" \
         "${joint[@]}" "${common[@]}" $(key vehicle-1) 2>"$dir/bridge-1.txt" &
     pids+=($!) names+=(bridge-1)
     for i in "${!pids[@]}"; do
