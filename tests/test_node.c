@@ -21,7 +21,7 @@
  *     reverse by their order search (from cycle 0, on their first intents), each flying
  *     its row and announcing its rank, in the same cycle, or in the next one when the
  *     rank was lost to the UAV it overtakes; the ranks return to 0 after the encounter;
- *     and with greedy_negotiation, the greedy raise alone does the same as before the
+ *     and with greedy_negotiation, the greedy raise alone does the same without the
  *     search: 2 raises its rank, 1 climbs around it (the same cycle, or the next when
  *     the raise was lost to it);
  *   - a silent UAV is avoided as a track;

@@ -1,10 +1,10 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * test_plan_oracle.c: the planner of src/core against the planner it replaced.
+ * test_plan_oracle.c: the planner of src/core against an independent exact planner.
  *
- * tests/reference/plan_v1.c is the planner as it was before the rewrite (a composite A*
- * over every 5^n joint action with a return-to-reference heuristic), kept as an oracle
- * and compiled into this suite only. Both front ends promise the same thing: centralised,
+ * tests/reference/plan_v1.c, "the old planner" below, is a composite A* over every 5^n
+ * joint action with a return-to-reference heuristic, kept as an oracle and compiled into
+ * this suite only. Both front ends promise the same thing: centralised,
  * an optimal plan (lexicographic deviation, then effort) or a proof that there is none;
  * decoupled, each UAV optimal given the ones before it, in the same order of attempts.
  * So on thousands of small random encounters, whenever the old planner reaches an answer

@@ -382,10 +382,10 @@ static void fly_self_committed(const char *path, uint32_t stop, uint32_t uavs)
 
 /* Encounter 209 of 2 UAVs (montecarlo, seed 1), with 1 ms of network delay and the
  * coordinator gone after the first 3 messages of cycle 0 (its plan, whole, and no COMMIT):
- * its rows came 1 ms after the coordinator's collect, so the self-commit was due 1 ms
- * after the answer wait. Both UAVs held the plan undecided, dropped it at the cycle's end,
- * and UAV 1 met a track at t = 2 s. Each now commits the plan itself when it is due,
- * within the cycle (lost, with both in doubt, without that second look). */
+ * its rows come 1 ms after the coordinator's collect, so the self-commit is due 1 ms
+ * after the answer wait. Each UAV commits the plan itself when it is due, within the
+ * cycle; without that second look both would hold the plan undecided, drop it at the
+ * cycle's end, and UAV 1 would meet a track at t = 2 s. */
 START_TEST(test_self_commit_due_after_the_answer_wait)
 {
     fly_self_committed(COAVOID_TEST_ENCOUNTERS "/self_commit_late_209.json", 3u, 2u);
@@ -394,10 +394,10 @@ END_TEST
 
 /* Encounter 34 of 4 UAVs (montecarlo, seed 1), 1 ms of delay, the coordinator gone after
  * the first 5 messages of cycle 0 (its plan of all four, and no COMMIT): each UAV commits
- * the plan itself when due, which leaves it following no one. It then looked at its
- * decision again as a UAV that planned for itself does, found itself overtaken, and
- * planned its own way out of the joint plan its siblings fly: UAVs 1 and 4 met at
- * t = 2 s. A plan committed this cycle is flown as committed. */
+ * the plan itself when due, which leaves it following no one. A plan committed this cycle
+ * is flown as committed: looking at its decision again as a UAV that planned for itself
+ * does, each would find itself overtaken and plan its own way out of the joint plan its
+ * siblings fly, and UAVs 1 and 4 would meet at t = 2 s. */
 START_TEST(test_self_committed_plan_is_flown)
 {
     fly_self_committed(COAVOID_TEST_ENCOUNTERS "/self_commit_flown_34.json", 5u, 4u);
@@ -407,9 +407,10 @@ END_TEST
 /* Encounter 16 of 4 UAVs (montecarlo, seed 1), 1 ms of delay, the coordinator gone after
  * the first 3 messages of cycle 0 (its plan of UAVs 1 and 3, and no COMMIT): UAVs 1 and 3
  * commit it themselves, and UAVs 2 and 4, which held no plan, decide for themselves at the
- * answer wait. Their order search counted UAVs 1 and 3 in, whose intents said they planned
- * for themselves, and planned around rows those two never flew; in cycle 2 UAVs 2 and 4
- * met. A UAV that flies a coordinator's plan says it follows for the rest of the cycle. */
+ * answer wait. A UAV that flies a coordinator's plan says it follows for the rest of the
+ * cycle: were its intents to say it planned for itself, the order search of UAVs 2 and 4
+ * would count UAVs 1 and 3 in and plan around rows those two never fly, and in cycle 2
+ * UAVs 2 and 4 would meet. */
 START_TEST(test_self_committed_plan_is_announced)
 {
     fly_self_committed(COAVOID_TEST_ENCOUNTERS "/self_commit_mode_16.json", 3u, 2u);
@@ -429,9 +430,9 @@ static void fly_leaderless(const char *path, double delay)
 /* Encounters 220 (no delay) and 40 (1 ms) of 4 UAVs (montecarlo, seed 1), the coordinator
  * gone before its first message: no priority order solves either (`coavoid plan
  * --reorder`), the coordinator's joint plan does. Planning for themselves from the answer
- * wait on, the UAVs' order search found no order and their greedy raises lost separation
- * at t = 2-4 s. When no order solves its group, each UAV now plans the group jointly, as
- * its coordinator would, and flies its row (lost without that plan). */
+ * wait on, the UAVs' order search finds no order, so each UAV plans the group jointly, as
+ * its coordinator would, and flies its row; by greedy raises alone they lose separation at
+ * t = 2-4 s. */
 START_TEST(test_leaderless_joint_plan)
 {
     fly_leaderless(COAVOID_TEST_ENCOUNTERS "/joint_plan_220.json", 0.0);
@@ -501,8 +502,9 @@ static bool gone_after_notice(void *user, const char *channel, uint32_t from, ui
 
 /* Encounter 70 of 3 UAVs (montecarlo, seed 1; centralised solves it, and so does the
  * order 1, 3, 2): in cycle 0 the coordinator's search for UAVs 1 and 3 fails, it tells
- * them so, and stops before the plan of all three goes out. Told of the failure, they
- * took it as their answer and flew on; UAVs 2 and 3 lost separation at t = 2 s. */
+ * them so, and stops before the plan of all three goes out. A failure notice is no answer
+ * at the answer wait: taking it as their answer and flying on, UAVs 2 and 3 would lose
+ * separation at t = 2 s. */
 START_TEST(test_failure_notice_then_gone)
 {
     notice_t s;
@@ -552,9 +554,9 @@ START_TEST(test_order_search_keeps_separation)
 END_TEST
 
 /* Encounter 345 of 3 UAVs (order 2, 1, 3 solves it): the greedy raises of cycle 0, where
- * nobody has an intent of the cycle before, left no order that solves it by cycle 1, and
- * UAVs 1 and 3 lost separation at t = 2 s. The UAVs search from their first intents, each
- * with the offset it starts at held. */
+ * nobody has an intent of the cycle before, leave no order that solves it by cycle 1, and
+ * UAVs 1 and 3 would lose separation at t = 2 s. The UAVs search from their first intents,
+ * each with the offset it starts at held. */
 START_TEST(test_order_search_in_the_first_cycle)
 {
     fly_decoupled(COAVOID_TEST_ENCOUNTERS "/order_search_345.json", NULL, NULL, &scripted);
@@ -643,10 +645,10 @@ static void first_send_lost(const char *path, uint32_t from, uint32_t to)
 }
 
 /* Encounter 40 of 5 UAVs (montecarlo, seed 1; the order 1..5 solves it): with 30 % of
- * the first cycle's copies lost, UAVs that had heard only some first intents found no
- * plan below them and (before the first cycle waited for the copies) raised their ranks
- * at once, reordering the cluster into a loss of separation at t = 1 s (at 30 % loss in
- * the Monte Carlo run, and with this pattern). */
+ * the first cycle's copies lost, UAVs that have heard only some first intents find no
+ * plan below them; raising their ranks at once (without the first cycle's wait for the
+ * copies) reorders the cluster into a loss of separation at t = 1 s (at 30 % loss in the
+ * Monte Carlo run, and with this pattern). */
 START_TEST(test_first_cycle_waits_for_copies)
 {
     const char *path = COAVOID_TEST_ENCOUNTERS "/first_cycle_40.json";
@@ -658,9 +660,9 @@ START_TEST(test_first_cycle_waits_for_copies)
 END_TEST
 
 /* Encounter 397 of 5 UAVs: UAV 3 misses UAV 2's first send and plans without it; UAVs 4
- * and 5 decide on that plan; UAV 3 plans again on 2's copy, and (before a newcomer's
- * new plan counted) 4 and 5 flew on the first: at 30 % loss, a loss of separation at
- * t = 3 s. */
+ * and 5 decide on that plan; UAV 3 plans again on 2's copy, and 4 and 5 decide again on
+ * its new plan: flying on the first (were a newcomer's new plan not to count), they lose
+ * separation at t = 3 s at 30 % loss. */
 START_TEST(test_first_cycle_decides_again_on_a_new_first_plan)
 {
     first_send_lost(COAVOID_TEST_ENCOUNTERS "/first_cycle_397.json", 2u, 3u);
@@ -668,10 +670,11 @@ START_TEST(test_first_cycle_decides_again_on_a_new_first_plan)
 END_TEST
 
 /* Encounter 568 of 4 UAVs (montecarlo, seed 2): UAV 1's first intent reaches UAVs 2 and 4
- * late. Both plan without it; 2 plans again on 1's copy and (before the first cycle kept
- * clear of no later UAV) kept clear of 4's plan made without 1, climbing where 4 had to go:
- * 4 found no plan, raised above all, and UAVs 1 and 4 lost separation at t = 2 s (at 30 %
- * loss in the Monte Carlo run, and with 1's first sends to 2 and 4 lost for 0.1 s). */
+ * late. Both plan without it; 2 plans again on 1's copy and, in the first cycle, keeps
+ * clear of no later UAV. Keeping clear of 4's plan made without 1, it would climb where 4
+ * has to go: 4 would find no plan and raise above all, and UAVs 1 and 4 lose separation at
+ * t = 2 s (at 30 % loss in the Monte Carlo run, and with 1's first sends to 2 and 4 lost
+ * for 0.1 s). */
 START_TEST(test_first_cycle_keeps_clear_of_earlier_only)
 {
     first_send_t s = {.from = 1u, .to = 1u << 2 | 1u << 4, .until = DT_US / 10};
@@ -700,10 +703,10 @@ static bool drop_first_tracks(void *user, const char *channel, uint32_t from, ui
 }
 
 /* Encounter 484 of 5 UAVs (montecarlo, seed 2; the order 1, 5, 2, 4, 3 solves it): UAV 3
- * missed all five sends of the track's first estimate (1 + COAVOID_NODE_DEFAULT_COPIES),
- * searched the order without the track, flew its row of another order, and no order was
- * left by cycle 1 (at 30 % loss in the Monte Carlo run, and with those five lost). The
- * world's first cycle sends twice the copies: a later one reaches it. */
+ * misses five sends of the track's first estimate (1 + COAVOID_NODE_DEFAULT_COPIES). The
+ * world's first cycle sends twice the copies, and a later one reaches it; with five sends
+ * only, it would search the order without the track, fly its row of another order, and
+ * leave no order by cycle 1 (at 30 % loss in the Monte Carlo run). */
 START_TEST(test_first_cycle_track_copies)
 {
     track_loss_t s = {.to = 3u, .sends = 1u + COAVOID_NODE_DEFAULT_COPIES};
@@ -715,9 +718,9 @@ START_TEST(test_first_cycle_track_copies)
 END_TEST
 
 /* Encounter 7 of 2 UAVs (montecarlo, seed 1; both orders solve it): with 1 ms of network
- * delay UAV 1, first in the order, decided at t = 0 before the track's first estimate came
- * and met the track over step 1. A UAV decides again when a track it held nothing of, or a
- * new obstacle map, comes after it decided (lost with that rule removed). */
+ * delay UAV 1, first in the order, decides at t = 0 before the track's first estimate
+ * comes. A UAV decides again when a track it held nothing of, or a new obstacle map, comes
+ * after it decided; without that rule UAV 1 meets the track over step 1. */
 START_TEST(test_first_cycle_track_heard_late)
 {
     fly_late(COAVOID_TEST_ENCOUNTERS "/track_heard_late_7.json", true, 0u, &scripted);

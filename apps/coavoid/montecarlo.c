@@ -75,13 +75,13 @@
     "                    0; delay + jitter must be under dt. The network's random\n"         \
     "                    stream comes from --net-seed and the encounter\n"                   \
     "  --net-seed N      with --fly: the network's seed, an integer >= 0, apart from the\n"  \
-    "                    encounters' --seed; default: --seed (as before the option)\n"       \
+    "                    encounters' --seed; default: --seed\n"                              \
     "  --coordinator-stops-sweep all|ends\n"                                                 \
     "                    with --fly: also fly each encounter centralised with the\n"         \
     "                    coordinator stopped at every cycle and, in it, after each number\n" \
     "                    of its messages it sent there unstopped (all), or after 0, 1,\n"    \
     "                    half and all but one of them (ends); report the runs that lose\n"   \
-    "                    separation, and those where decoupled keeps it (issue 14)\n"        \
+    "                    separation, and those where decoupled keeps it\n"                   \
     "  --figure-from A.csv,...\n"                                                            \
     "                    runs nothing: reads the CSVs of montecarlo --fly runs (one loss\n"  \
     "                    each, up to %u files) and writes with --svg the closed loop's\n"    \

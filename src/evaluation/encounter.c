@@ -13,8 +13,8 @@
 
 #define ENC_PI 3.14159265358979323846
 
-/* bench plan's design, as it was when bench_plan.c held the generator: its figures in
- * docs/benchmarks.md are for exactly these problems. */
+/* bench plan's design: docs/benchmarks.md's figures are for exactly these problems, so
+ * a change here changes every one of them. */
 const coavoid_encounter_design_t coavoid_encounter_bench = {
     .name = "bench encounter",
     .horizon = 20u,

@@ -17,9 +17,9 @@
  * a seed gives the same problems on every machine with the same libm (headings go through
  * cos and sin, which C does not require to round correctly), and adding problems or UAV
  * counts changes none of the others. The draws are made in a fixed order and a design's
- * optional parts draw nothing when they are off, so coavoid_encounter_bench (no quantum,
- * one box half the time) gives exactly the problems bench plan gave before this file
- * existed.
+ * optional parts draw nothing when they are off, so coavoid_encounter_bench's problems (no
+ * quantum, one box half the time) do not depend on the parts only montecarlo's design
+ * uses.
  */
 #ifndef COAVOID_EVALUATION_ENCOUNTER_H
 #define COAVOID_EVALUATION_ENCOUNTER_H

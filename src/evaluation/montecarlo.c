@@ -420,7 +420,7 @@ static void cost_text(coa_cost_t c, char *buf, size_t size)
 /* With fly, every row ends with the network (loss, delay, jitter), the encounter's
  * network seed and the stop point (empty but on flown_centralised_stop rows): a file says
  * what it measured (montecarlo --figure-from reads the loss), and `coavoid sim --seed
- * --coordinator-stops` replays a run. Without fly the rows are as before fly existed. */
+ * --coordinator-stops` replays a run. Without fly the rows have none of these columns. */
 static void csv_network(const coavoid_montecarlo_config_t *c, const coavoid_mc_result_t *r,
                         char *buf, size_t size)
 {

@@ -93,10 +93,10 @@ typedef struct {
     double loss, delay, jitter;
     /* The network's seed (fly): each encounter's stream is drawn from (net_seed, UAV
      * count, index), so that one set of encounters can meet other networks; has_net_seed
-     * false: from seed, as before there was a choice (the same numbers). */
+     * false: from seed. */
     bool has_net_seed;
     uint64_t net_seed;
-    /* With fly, issue 14 item 4: each encounter is also flown centralised with the
+    /* With fly: each encounter is also flown centralised with the
      * coordinator stopped at every cycle s = 0..2N and, in each, at every cut point
      * M = 0..C(s)-1 (C(s): the messages it sent in cycle s of the unstopped run; the run
      * is that run up to the cut, so these are all the places it can stop; M = C(s) is

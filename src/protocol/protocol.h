@@ -97,7 +97,7 @@
  * each receiver losing a share p of datagrams, a cycle's intent or heartbeat is lost to
  * it with p^5 rather than p: a UAV the coordinator does not hear of in cycle 0 is one its
  * first plan cannot include, and a conflict one step ahead leaves no second cycle
- * (docs/evaluation.md measures the count). */
+ * (docs/evaluation.md flies the protocol with these copies at up to 50 % loss). */
 #define COAVOID_NODE_DEFAULT_COPIES 4u
 /* The most copies a vehicle may be configured to send (intent_copies): a copy is a whole
  * datagram to every node, so more is a flood of its own, and the times of its copies
@@ -108,7 +108,7 @@
  * joint_beta of coavoid_vehicle_node_config_t): groups of up to this many UAVs, in the
  * drivers and the simulation, for vehicles that follow a coordinator; and the search's
  * bound on stored nodes by default, which solves the encounters that needed it in
- * docs/evaluation.md ("The sweep with the group's joint plan"; 2,000 do not solve all). */
+ * docs/evaluation.md ("The coordinator stopped anywhere"; 2,000 do not solve them all). */
 #define COAVOID_NODE_DEFAULT_JOINT_MEMBERS 5u
 #define COAVOID_NODE_DEFAULT_JOINT_BETA 5000u
 
@@ -241,7 +241,7 @@ typedef struct {
     uint32_t intent_copies;
     /* Deciding for itself: negotiate the order by the greedy raise alone, without the search
      * of the order (docs/protocol.md, "Priority negotiation"): no search's cost, and the
-     * negotiation as it was before the search. false (the default): search. */
+     * negotiation of a fleet without it. false (the default): search. */
     bool greedy_negotiation;
     /* Following the coordinator, how long into a cycle it waits for an answer to a
      * conflict of its own (a plan committed; one saying the search failed is none by

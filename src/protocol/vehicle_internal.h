@@ -17,8 +17,8 @@
  * cluster ends anyway; the bound keeps a cycle's work bounded whatever peers announce. */
 #define REDECISIONS_MAX 4u
 /* Raises of its rank per episode (raise_rank), at most: the first above every UAV before
- * it, the others only as far as they must. Over 100 encounters (seed 1, no loss, while
- * raises counted only the members of its cluster), 1, 2 and 3 left 8, 6 and 5 of the 60
+ * it, the others only as far as they must. Over 100 encounters (seed 1, no loss, raises
+ * counting only the members of its cluster), 1, 2 and 3 left 8, 6 and 5 of the 60
  * four-UAV encounters some order solves with a loss of separation; with 5 UAVs 3 and 5
  * left 12 and 11 of 29. More turns help little, and each reorders the cluster again. */
 #define RAISES_MAX 3u

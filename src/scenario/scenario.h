@@ -121,7 +121,8 @@ long coavoid_scenario_vehicle_index(const coavoid_scenario_t *s, long id);
  * coavoid-coordinator, bench plan, montecarlo): the scenario's "beta" or an option when one
  * is given, taken as given; otherwise COAVOID_DEFAULT_BETA, lowered until the workspace fits
  * COAVOID_DEFAULT_WORKSPACE_MAX (a default that asks a laptop for gigabytes is a trap).
- * Why 200,000: docs/benchmarks.md and docs/evaluation.md ("beta"). */
+ * Why 200,000: no montecarlo search of up to 5 UAVs runs out of it in 15-17 MB of workspace
+ * (docs/evaluation.md, "Without a work budget"). */
 #define COAVOID_DEFAULT_BETA 200000u
 /* The programs' default work budget of one planning call (plan.h, "Work"), in work units:
  * below a second of one core at the slowest unit measured (docs/benchmarks.md, "Within a

@@ -152,7 +152,7 @@ else
     fail "bench plan --help: $(head -c 300 "$tmp/help")"
 fi
 
-# `coavoid bench --help` names both benchmarks (it used to show only predict's usage).
+# `coavoid bench --help` names every benchmark, not only predict's usage.
 if "$bin" bench --help >"$tmp/help" 2>&1 && grep -q "coavoid bench plan" "$tmp/help" &&
     grep -q "coavoid bench predict" "$tmp/help"; then
     pass

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
-# The shipped scenarios' outcomes, as issue 2 and the paper's figures state them.
+# The shipped scenarios' outcomes, as the paper's figures state them.
 # Usage: scenarios.sh COAVOID SRC
 set -uo pipefail
 coavoid=$1 src=$2

@@ -466,7 +466,7 @@ if grep -Eq '^coordinator: stopped in cycle 0 after 4 of its messages \(4 went o
 else
     fail "sim --coordinator-stops 0:4 with loss: $(tail -n 2 "$tmp/cut-loss1.txt")"
 fi
-# Without :M the text is as before the cut existed: no coordinator line.
+# Without :M the text has no coordinator line.
 "$bin" sim "$scenarios/headon.json" --mode centralised --coordinator-stops 0 >"$tmp/stop0.txt" 2>&1
 if ! grep -q '^coordinator:' "$tmp/stop0.txt"; then pass; else fail "--coordinator-stops 0 prints a coordinator line"; fi
 

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * plan_v1.c: the planner as it was before issue 11 (test-only reference).
+ * plan_v1.c: a composite A* over every UAV's joint state (test-only reference).
  *
  * The composite A* search with every 5^n combination of actions as children, the
  * return-to-reference triangle heuristic and a node pool of 1 + beta * 5^n nodes, kept

@@ -1,9 +1,10 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * plan_v1.h: the planner as it was before issue 11, kept as a test-only reference
- * (plan_v1.c). Same contract as plan.h's coa_planner_workspace_size, coa_planner_init,
- * coa_plan_centralised and coa_plan_decoupled at that time: the workspace holds
- * 1 + beta * 5^max_vehicles nodes, beta bounds the states each search closes.
+ * plan_v1.h: a composite A* over every UAV's joint state, kept as a test-only reference
+ * (plan_v1.c). The entry points of plan.h (coa_planner_workspace_size, coa_planner_init,
+ * coa_plan_centralised, coa_plan_decoupled) for an exact search without tables or a work
+ * budget: the workspace holds 1 + beta * 5^max_vehicles nodes, beta bounds the states
+ * each search closes.
  */
 #ifndef COAVOID_TESTS_PLAN_V1_H
 #define COAVOID_TESTS_PLAN_V1_H
