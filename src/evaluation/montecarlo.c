@@ -8,6 +8,7 @@
 
 #include "montecarlo.h"
 
+#include <math.h>
 #include <pthread.h>
 #include <stdbool.h>
 #include <stdint.h>
@@ -36,6 +37,11 @@ const char *const coavoid_mc_method_names[COAVOID_MC_METHODS] = {"centralised", 
 const char *const coavoid_mc_fly_mode_names[COAVOID_MC_FLY_MODES] = {"centralised", "decoupled"};
 
 /* ---- one encounter ---- */
+
+double coavoid_mc_round(double value, double scale)
+{
+    return round(value * scale) / scale;
+}
 
 /* A planner for every encounter of the design: its horizon, steep factor 2 (the
  * generator's) and its offset band (unbounded when it draws none). */
@@ -222,15 +228,15 @@ static int solve_method(int m, const coa_problem_t *problem, const coavoid_mc_si
     }
     coavoid_mc_outcome_t *o = &r->m[m];
     o->status = result.status;
-    o->deviation = result.deviation;
+    o->deviation = coavoid_mc_round(result.deviation, 1e6);
     o->units = result.deviation_units;
     o->effort = result.effort;
     o->expanded = result.nodes_expanded;
     o->generated = result.nodes_generated;
     o->orders_tried = result.orders_tried;
-    o->time_us = coavoid_timing_elapsed_ms(&start, &end) * 1e3;
+    o->time_us = coavoid_mc_round(coavoid_timing_elapsed_ms(&start, &end) * 1e3, 10.0);
     o->optimal = result.optimal;
-    o->bound_deviation = result.bound_deviation;
+    o->bound_deviation = coavoid_mc_round(result.bound_deviation, 1e6);
     o->work = result.work;
     if (result.status == COA_PLAN_SOLVED && r->defect[0] == '\0') {
         size_t vehicle = 0;
@@ -412,37 +418,63 @@ static void cost_text(coa_cost_t c, char *buf, size_t size)
     buf[j] = '\0';
 }
 
-#define MC_CSV_HEADER                                                             \
-    "seed,vehicles,index,redraws,hills,tracks,first_conflict_step,method,status," \
-    "deviation,deviation_units,effort,expanded,generated,orders_tried,time_us\n"
+#define MC_CSV_HEADER COAVOID_MC_CSV_HEADER_LINE "\n"
 #define MC_CSV_HEADER_FLY COAVOID_MC_CSV_HEADER_FLY_LINE "\n"
 
-/* With fly, every row ends with the network (loss, delay, jitter), the encounter's
- * network seed and the stop point (empty but on flown_centralised_stop rows): a file says
- * what it measured (montecarlo --figure-from reads the loss), and `coavoid sim --seed
- * --coordinator-stops` replays a run. Without fly the rows have none of these columns. */
-static void csv_network(const coavoid_montecarlo_config_t *c, const coavoid_mc_result_t *r,
-                        char *buf, size_t size)
+/* A setting as the fewest of 15 or 17 digits that read back as the same double. */
+static void real_text(double v, char *buf, size_t size)
 {
-    buf[0] = '\0';
-    if (c->fly) {
-        snprintf(buf, size, "%.15g,%.15g,%.15g,%llu", c->loss, c->delay, c->jitter,
-                 (unsigned long long)r->net_seed);
+    snprintf(buf, size, "%.15g", v);
+    if (strtod(buf, NULL) != v) {
+        snprintf(buf, size, "%.17g", v);
     }
 }
 
-static void csv_rows(FILE *f, const coavoid_montecarlo_config_t *c, const coavoid_mc_result_t *r)
+/* What every row of an encounter carries besides its own columns (montecarlo_internal.h):
+ * with fly the network (loss, delay, jitter) and the encounter's network seed, so that a
+ * file says what it measured (--figure-from reads the loss) and `coavoid sim --net-seed
+ * --coordinator-stops` replays a run; the planners' limits and the run's encounters
+ * (MORE); with fly the sweep and --net-seed as given (FLOWN): --merge checks the parts of
+ * a run against each other with them. Empty strings where the run has no such columns. */
+typedef struct {
+    char network[128]; /* ",loss,delay,jitter,net_seed" */
+    char run[128];     /* ",beta,max_orders,work,first,count" */
+    char options[64];  /* ",coordinator_stops_sweep,net_seed_option" */
+} mc_row_tail_t;
+
+static void row_tail(const coavoid_montecarlo_config_t *c, const coavoid_mc_size_t *size,
+                     const coavoid_mc_result_t *r, mc_row_tail_t *t)
 {
-    const uint64_t seed = c->seed;
-    char network[128] = "";
-    if (c->fly) {
-        network[0] = ',';
-        csv_network(c, r, network + 1, sizeof network - 4u);
-        strcat(network, ",,");
+    memset(t, 0, sizeof *t);
+    snprintf(t->run, sizeof t->run, ",%lu,%lu,%llu,%lu,%lu", (unsigned long)size->beta,
+             (unsigned long)size->max_orders, (unsigned long long)size->work,
+             (unsigned long)c->first, (unsigned long)c->count);
+    if (!c->fly) {
+        return;
     }
+    char loss[32], delay[32], jitter[32];
+    real_text(c->loss, loss, sizeof loss);
+    real_text(c->delay, delay, sizeof delay);
+    real_text(c->jitter, jitter, sizeof jitter);
+    snprintf(t->network, sizeof t->network, ",%s,%s,%s,%llu", loss, delay, jitter,
+             (unsigned long long)r->net_seed);
+    char net_seed[32] = "";
+    if (c->has_net_seed) {
+        snprintf(net_seed, sizeof net_seed, "%llu", (unsigned long long)c->net_seed);
+    }
+    snprintf(t->options, sizeof t->options, ",%s,%s",
+             !c->stops_sweep ? "" : (c->stops_ends ? "ends" : "all"), net_seed);
+}
+
+/* A row per method: its costs only of a plan (a failed decoupled attempt's partial costs
+ * are not one), and centralised, whether the plan is proven optimal and the lower bound. */
+static void csv_rows(FILE *f, const coavoid_montecarlo_config_t *c, const coavoid_mc_size_t *size,
+                     const coavoid_mc_result_t *r)
+{
+    mc_row_tail_t t;
+    row_tail(c, size, r, &t);
     for (int m = 0; m < COAVOID_MC_METHODS; m++) {
         const coavoid_mc_outcome_t *o = &r->m[m];
-        /* Costs only of a plan: a failed decoupled attempt's partial costs are not one. */
         char costs[128] = ",,";
         if (o->status == COA_PLAN_SOLVED) {
             char units[48];
@@ -450,39 +482,50 @@ static void csv_rows(FILE *f, const coavoid_montecarlo_config_t *c, const coavoi
             snprintf(costs, sizeof costs, "%.6f,%s,%lu", o->deviation, units,
                      (unsigned long)o->effort);
         }
-        fprintf(f, "%llu,%lu,%lu,%lu,%lu,%lu,%lu,%s,%s,%s,%llu,%llu,%lu,%.1f%s\n",
-                (unsigned long long)seed, (unsigned long)r->vehicles, (unsigned long)r->index,
+        char bound[64] = ","; /* optimal, bound_deviation */
+        if (m == COAVOID_MC_CENTRALISED) {
+            snprintf(bound, sizeof bound, "%d,%.6f", o->optimal ? 1 : 0, o->bound_deviation);
+        }
+        fprintf(f, "%llu,%lu,%lu,%lu,%lu,%lu,%lu,%s,%s,%s,%llu,%llu,%lu,%.1f%s%s,%s%s%s%s\n",
+                (unsigned long long)c->seed, (unsigned long)r->vehicles, (unsigned long)r->index,
                 (unsigned long)r->redraws, (unsigned long)r->info.hills,
                 (unsigned long)r->info.tracks, (unsigned long)r->first_conflict_step,
                 coavoid_mc_method_names[m], coavoid_output_status_name(o->status), costs,
                 (unsigned long long)o->expanded, (unsigned long long)o->generated,
-                (unsigned long)o->orders_tried, o->time_us, network);
+                (unsigned long)o->orders_tried, o->time_us, t.network, c->fly ? ",," : "", bound,
+                t.run, c->fly ? ",,,," : "", t.options);
     }
 }
 
 /* A closed-loop row: method flown_NAME, status separated or loss_of_separation, the
- * plan's columns empty, the network's, and the stop point's (stop: "S,M", or ","). */
+ * plan's columns empty, the stop point (stop: "S,M", or ","), and the run's network
+ * traffic (counts: ",fallbacks,sent,delivered,dropped", or ",,,," on a stopped run's). */
 static void csv_flown_row(FILE *f, const coavoid_montecarlo_config_t *c,
                           const coavoid_mc_result_t *r, const char *name, bool lost,
-                          const char *network, const char *stop)
+                          const mc_row_tail_t *t, const char *stop, const char *counts)
 {
-    fprintf(f, "%llu,%lu,%lu,%lu,%lu,%lu,%lu,flown_%s,%s,,,,,,,,%s,%s\n",
+    fprintf(f, "%llu,%lu,%lu,%lu,%lu,%lu,%lu,flown_%s,%s,,,,,,,%s,%s,,%s%s%s\n",
             (unsigned long long)c->seed, (unsigned long)r->vehicles, (unsigned long)r->index,
             (unsigned long)r->redraws, (unsigned long)r->info.hills, (unsigned long)r->info.tracks,
             (unsigned long)r->first_conflict_step, name, lost ? "loss_of_separation" : "separated",
-            network, stop);
+            t->network, stop, t->run, counts, t->options);
 }
 
 /* With fly: a row per closed-loop mode; with the sweep, a row flown_centralised_stop per
  * stop point (stop_step, stop_messages: `coavoid sim --coordinator-stops S:M`). */
 static void csv_flown_rows(FILE *f, const coavoid_montecarlo_config_t *c,
-                           const coavoid_mc_result_t *r)
+                           const coavoid_mc_size_t *size, const coavoid_mc_result_t *r)
 {
-    char network[128];
-    csv_network(c, r, network, sizeof network);
+    mc_row_tail_t t;
+    row_tail(c, size, r, &t);
     for (int mode = 0; mode < COAVOID_MC_FLY_MODES; mode++) {
-        csv_flown_row(f, c, r, coavoid_mc_fly_mode_names[mode], r->flown[mode].loss_of_separation,
-                      network, ",");
+        const coavoid_mc_flown_t *flown = &r->flown[mode];
+        char counts[96];
+        snprintf(counts, sizeof counts, ",%lu,%llu,%llu,%llu", (unsigned long)flown->fallbacks,
+                 (unsigned long long)flown->sent, (unsigned long long)flown->delivered,
+                 (unsigned long long)flown->dropped);
+        csv_flown_row(f, c, r, coavoid_mc_fly_mode_names[mode], flown->loss_of_separation, &t, ",",
+                      counts);
     }
     const coavoid_mc_sweep_t *w = &r->sweep;
     uint32_t j = 0;
@@ -495,7 +538,7 @@ static void csv_flown_rows(FILE *f, const coavoid_montecarlo_config_t *c,
             char stop[32];
             snprintf(stop, sizeof stop, "%lu,%lu", (unsigned long)k, (unsigned long)m);
             const bool lost = (((unsigned)w->lost[j / 8u] >> (j % 8u)) & 1u) != 0u;
-            csv_flown_row(f, c, r, "centralised_stop", lost, network, stop);
+            csv_flown_row(f, c, r, "centralised_stop", lost, &t, stop, ",,,,");
             j++;
         }
     }
@@ -543,11 +586,12 @@ static void write_ready(mc_run_t *run, FILE *csv, mc_progress_t *prog, uint32_t 
     const coavoid_montecarlo_config_t *c = &run->mc->config;
     for (; *written < ready; (*written)++) {
         const coavoid_mc_result_t *r = &run->mc->results[*written];
+        const coavoid_mc_size_t *size = item_size(run, *written);
         if (csv != NULL) {
-            csv_rows(csv, c, r);
+            csv_rows(csv, c, size, r);
         }
         if (csv != NULL && c->fly) {
-            csv_flown_rows(csv, c, r);
+            csv_flown_rows(csv, c, size, r);
         }
         if (r->defect[0] != '\0') {
             if (prog->line_open) {

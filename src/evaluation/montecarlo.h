@@ -145,9 +145,10 @@ int coavoid_montecarlo_report(coavoid_montecarlo_t *mc, FILE *out, bool json,
  * jitter) and writes svg_path: per UAV count (colour) and mode (solid centralised, dashed
  * decoupled) the rate of encounters that lose separation, with its 95 % Wilson interval,
  * against the loss; prints the points as a table on out. The files are untrusted: each is
- * checked line by line (the --fly header, 22 fields, the UAV count, status and network of
- * every flown row, lines of at most 1,023 bytes and 5e7 lines), and the first problem is
- * COAVOID_RUN_ERR_INPUT with e naming the file and line. Memory: about 6 kB. */
+ * checked line by line (the --fly header, 22 fields, or 35 in a CSV --merge reads, the UAV
+ * count, status and network of every flown row, lines of at most 1,023 bytes and 5e7
+ * lines), and the first problem is COAVOID_RUN_ERR_INPUT with e naming the file and line.
+ * Memory: about 6 kB. */
 int coavoid_montecarlo_figure(const char *const *csv_paths, size_t count, const char *svg_path,
                               FILE *out, coavoid_run_error_t *e);
 

@@ -24,7 +24,7 @@
 
 #define FIG_LINE_MAX 1024u      /* a row is about 120 characters */
 #define FIG_LINES_MAX 50000000u /* per file: 100,000 encounters x 5 sizes x ~60 rows, and more */
-#define FIG_FIELDS 22u          /* MC_CSV_HEADER_FLY's columns */
+#define FIG_FIELDS ((uint32_t)COAVOID_MC_CSV_FLY_FIELDS) /* the most a --fly header has */
 #define FIG_COL_VEHICLES 1u
 #define FIG_COL_METHOD 7u
 #define FIG_COL_STATUS 8u
@@ -50,6 +50,7 @@ typedef struct {
 typedef struct {
     const char *path;
     unsigned long line;
+    uint32_t fields; /* its header's: 22, or 35 with the columns --merge reads */
     bool has_loss;
     double loss;
 } fig_file_t;
@@ -142,8 +143,8 @@ static int fig_level(fig_data_t *d, double loss)
 static int fig_row(fig_data_t *d, fig_file_t *f, char *line, coavoid_run_error_t *e)
 {
     char *fields[FIG_FIELDS + 1u];
-    if (split(line, fields) != FIG_FIELDS) {
-        return fig_fail(e, f, "not 22 fields");
+    if (split(line, fields) != f->fields) {
+        return fig_fail(e, f, f->fields == FIG_FIELDS ? "not 35 fields" : "not 22 fields");
     }
     int mode = strcmp(fields[FIG_COL_METHOD], "flown_centralised") == 0 ? COAVOID_MC_FLY_CENTRALISED
                : strcmp(fields[FIG_COL_METHOD], "flown_decoupled") == 0 ? COAVOID_MC_FLY_DECOUPLED
@@ -183,7 +184,7 @@ static int fig_row(fig_data_t *d, fig_file_t *f, char *line, coavoid_run_error_t
 /* Reads one file's lines into d. */
 static int fig_read(fig_data_t *d, const char *path, coavoid_run_error_t *e)
 {
-    fig_file_t f = {path, 0ul, false, 0.0};
+    fig_file_t f = {path, 0ul, 0u, false, 0.0};
     FILE *in = fopen(path, "r");
     if (in == NULL) {
         return coavoid_run_fail(e, COAVOID_RUN_ERR_INPUT, "--figure-from: cannot read '%.200s'",
@@ -203,9 +204,12 @@ static int fig_read(fig_data_t *d, const char *path, coavoid_run_error_t *e)
         }
         line[n - 1u] = '\0';
         if (f.line == 1u) {
-            rc = strcmp(line, COAVOID_MC_CSV_HEADER_FLY_LINE) == 0
-                     ? COAVOID_RUN_DONE
-                     : fig_fail(e, &f, "not the header of a montecarlo --fly CSV");
+            f.fields = strcmp(line, COAVOID_MC_CSV_HEADER_FLY_LINE) == 0 ? FIG_FIELDS
+                       : strcmp(line, COAVOID_MC_CSV_OLD_HEADER_FLY_LINE) == 0
+                           ? (uint32_t)(COAVOID_MC_CSV_PLAN_FIELDS + COAVOID_MC_CSV_NETWORK_FIELDS)
+                           : 0u;
+            rc = f.fields != 0u ? COAVOID_RUN_DONE
+                                : fig_fail(e, &f, "not the header of a montecarlo --fly CSV");
         } else {
             rc = fig_row(d, &f, line, e);
         }

@@ -102,11 +102,38 @@ struct coavoid_montecarlo {
 int coavoid_mc_fly(const coavoid_montecarlo_config_t *c, const coavoid_mc_size_t *size,
                    coavoid_mc_result_t *r, char *err, size_t err_size);
 
-/* The header of a montecarlo --fly CSV (without its newline): the figure checks it. */
-#define COAVOID_MC_CSV_HEADER_FLY_LINE                                            \
+/* The CSV's columns (docs/cli.md): a plan run's rows are PLAN then MORE; a --fly run's
+ * PLAN, NETWORK, MORE then FLOWN. MORE and FLOWN hold what the summary needs beyond the
+ * first columns (montecarlo --merge rebuilds it from them); CSVs written before them end
+ * after PLAN or NETWORK, which --figure-from still reads. */
+#define COAVOID_MC_CSV_PLAN                                                       \
     "seed,vehicles,index,redraws,hills,tracks,first_conflict_step,method,status," \
-    "deviation,deviation_units,effort,expanded,generated,orders_tried,time_us,"   \
-    "loss,delay,jitter,net_seed,stop_step,stop_messages"
+    "deviation,deviation_units,effort,expanded,generated,orders_tried,time_us"
+#define COAVOID_MC_CSV_NETWORK ",loss,delay,jitter,net_seed,stop_step,stop_messages"
+#define COAVOID_MC_CSV_MORE ",optimal,bound_deviation,beta,max_orders,work,first,count"
+#define COAVOID_MC_CSV_FLOWN \
+    ",fallbacks,sent,delivered,dropped,coordinator_stops_sweep,net_seed_option"
+/* The headers, without their newline. */
+#define COAVOID_MC_CSV_HEADER_LINE COAVOID_MC_CSV_PLAN COAVOID_MC_CSV_MORE
+#define COAVOID_MC_CSV_HEADER_FLY_LINE \
+    COAVOID_MC_CSV_PLAN COAVOID_MC_CSV_NETWORK COAVOID_MC_CSV_MORE COAVOID_MC_CSV_FLOWN
+#define COAVOID_MC_CSV_OLD_HEADER_LINE COAVOID_MC_CSV_PLAN
+#define COAVOID_MC_CSV_OLD_HEADER_FLY_LINE COAVOID_MC_CSV_PLAN COAVOID_MC_CSV_NETWORK
+/* Their columns: 16 in PLAN, 6 in NETWORK, 7 in MORE, 6 in FLOWN. */
+enum {
+    COAVOID_MC_CSV_PLAN_FIELDS = 16,
+    COAVOID_MC_CSV_NETWORK_FIELDS = 6,
+    COAVOID_MC_CSV_MORE_FIELDS = 7,
+    COAVOID_MC_CSV_FLOWN_FIELDS = 6,
+    COAVOID_MC_CSV_FIELDS = COAVOID_MC_CSV_PLAN_FIELDS + COAVOID_MC_CSV_MORE_FIELDS,
+    COAVOID_MC_CSV_FLY_FIELDS = COAVOID_MC_CSV_PLAN_FIELDS + COAVOID_MC_CSV_NETWORK_FIELDS +
+                                COAVOID_MC_CSV_MORE_FIELDS + COAVOID_MC_CSV_FLOWN_FIELDS,
+};
+
+/* The measured and computed values the CSV rounds (time_us to 0.1 us, deviations to
+ * 1e-6 m^2), rounded so in the results too: the summary of a run is then the summary of
+ * its CSV, to the last digit. */
+double coavoid_mc_round(double value, double scale);
 
 /* k successes of n (n >= 1): the rate and its 95 % Wilson interval. */
 void coavoid_mc_wilson(uint32_t k, uint32_t n, double *rate, double *low, double *high);

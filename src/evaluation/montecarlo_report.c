@@ -374,7 +374,7 @@ static void text_sweep(FILE *f, const coavoid_montecarlo_t *mc, const mc_summary
         }
         fprintf(f,
                 "  %lu UAVs, encounter %lu: %lu runs lost, first --coordinator-stops %lu:%lu "
-                "(coavoid sim --insecure --seed %llu)\n",
+                "(coavoid sim --insecure --net-seed %llu)\n",
                 (unsigned long)r->vehicles, (unsigned long)r->index, (unsigned long)r->sweep.losses,
                 (unsigned long)r->sweep.loss_step, (unsigned long)r->sweep.loss_messages,
                 (unsigned long long)r->net_seed);

@@ -23,7 +23,8 @@ import xml.etree.ElementTree as ET
 csv_path, json_path, svg_path = sys.argv[1:4]
 header = ["seed", "vehicles", "index", "redraws", "hills", "tracks", "first_conflict_step",
           "method", "status", "deviation", "deviation_units", "effort", "expanded",
-          "generated", "orders_tried", "time_us"]
+          "generated", "orders_tried", "time_us", "optimal", "bound_deviation", "beta",
+          "max_orders", "work", "first", "count"]
 methods = ["centralised", "decoupled_fixed", "decoupled_reordered"]
 with open(csv_path, newline="") as f:
     reader = csv.reader(f)
@@ -51,6 +52,13 @@ for r in rows:
     assert int(r["orders_tried"]) >= 1, r
     if r["method"] != "decoupled_reordered":
         assert int(r["orders_tried"]) == 1, r
+    # The run's encounters on every row; optimal and the bound on the centralised ones.
+    assert (int(r["first"]), int(r["count"])) == (first, count), r
+    if r["method"] == "centralised":
+        assert r["optimal"] in ("0", "1") and float(r["bound_deviation"]) >= 0, r
+        assert r["optimal"] == "0" or (solved and r["bound_deviation"] == r["deviation"]), r
+    else:
+        assert r["optimal"] == r["bound_deviation"] == "", r
 
 def quantile(x, p):  # numpy's default (linear), as the command's
     h = (len(x) - 1) * p
@@ -67,6 +75,7 @@ for s in b["sizes"]:
     for r in rows:
         if int(r["vehicles"]) == n:
             enc.setdefault(int(r["index"]), {})[r["method"]] = r
+            assert (int(r["beta"]), int(r["max_orders"])) == (s["beta"], s["max_orders"]), r
     assert s["redraws"] == sum(int(e["centralised"]["redraws"]) for e in enc.values()), s
     assert [m["method"] for m in s["methods"]] == methods, s
     for m in s["methods"]:
@@ -75,14 +84,15 @@ for s in b["sizes"]:
             st.count("solved"), st.count("infeasible"), st.count("budget_exhausted")), m
         assert close(m["success_rate"], m["solved"] / count), m
         assert 0 <= m["wilson_low"] <= m["success_rate"] <= m["wilson_high"] <= 1, m
-        times = sorted(float(e[m["method"]]["time_us"]) / 1000 for e in enc.values())
-        # the CSV rounds times to 0.1 us
-        assert abs(m["time_ms"]["max"] - times[-1]) < 1e-3, (m["time_ms"], times[-1])
+        times = sorted(float(e[m["method"]]["time_us"]) * 1e-3 for e in enc.values())
+        # the run's times are the CSV's (to 0.1 us)
+        assert close(m["time_ms"]["max"], times[-1]) and close(m["time_ms"]["median"], quantile(times, 0.5)), (m["time_ms"], times)
         nodes = sorted(int(e[m["method"]]["expanded"]) for e in enc.values())
         assert close(m["nodes_expanded"]["median"], quantile(nodes, 0.5)), m
         if m["method"] == "centralised":
             # Every plan found is proven optimal or bounded; plan over bound is >= 1.
             assert m["optimal"] + m["bounded"] == m["solved"], m
+            assert m["optimal"] == sum(1 for e in enc.values() if e["centralised"]["optimal"] == "1"), m
             br = m["bound_ratio"]
             assert br["count"] <= m["solved"], m
             assert br["count"] == 0 or 1 <= br["min"] <= br["median"] <= br["max"], m
