@@ -17,7 +17,7 @@
 
 #define MC_DEFAULT_SEED 1u
 #define MC_DEFAULT_COUNT 100u
-#define MC_MAX_COUNT 100000u
+#define MC_MAX_COUNT COAVOID_MONTECARLO_MAX_COUNT
 #define MC_MAX_FIRST 1000000000u
 
 #define MONTECARLO_USAGE                                                                    \
@@ -28,6 +28,7 @@
     "                          [--fly [--loss P] [--delay S] [--jitter S] [--net-seed N]\n" \
     "                                 [--coordinator-stops-sweep all|ends]]\n"              \
     "       coavoid montecarlo --figure-from A.csv,B.csv,... --svg FILE\n"                  \
+    "       coavoid montecarlo --merge A.csv,B.csv,... [--svg FILE] [--json]\n"             \
     "\n"                                                                                    \
     "Draws C random encounters of N UAVs (for each N listed) converging on a point over\n"  \
     "hills, with 0 to 2 non-cooperative tracks crossing (%u steps of %g s), and solves\n"   \
@@ -87,6 +88,12 @@
     "                    each, up to %u files) and writes with --svg the closed loop's\n"    \
     "                    loss-of-separation rate against loss per N and mode; prints the\n"  \
     "                    points\n"                                                           \
+    "  --merge A.csv,... runs nothing: reads the CSVs of the parts of one run (up to %u\n"   \
+    "                    runs with the same options but --first and --count, which\n"        \
+    "                    together cover encounters I..I+C-1, in any order) and prints\n"     \
+    "                    the summary (--json) and draws the figure (--svg) of the whole\n"   \
+    "                    run, the times being the parts'; exit 2 with one line naming\n"     \
+    "                    the file when the parts do not make one run\n"                      \
     "  -h, --help        show this help\n"                                                   \
     "      --version     print the version\n"                                                \
     "\n"                                                                                     \
@@ -104,7 +111,7 @@ static void montecarlo_help(void)
            COAVOID_ENCOUNTER_MIN_VEHICLES, COAVOID_ENCOUNTER_MAX_VEHICLES, MC_MAX_COUNT,
            MC_DEFAULT_COUNT, MC_MAX_FIRST, MC_DEFAULT_SEED, COAVOID_DEFAULT_BETA,
            (unsigned long long)COAVOID_DEFAULT_WORK, COAVOID_MONTECARLO_MAX_JOBS);
-    printf(MONTECARLO_USAGE_FLY, COAVOID_MC_FIGURE_MAX_FILES);
+    printf(MONTECARLO_USAGE_FLY, COAVOID_MC_FIGURE_MAX_FILES, COAVOID_MC_MERGE_MAX_FILES);
 }
 
 /* ---- options ---- */
@@ -138,9 +145,10 @@ typedef struct {
     uint64_t net_seed;
     const char *sweep_text;  /* --coordinator-stops-sweep: all or ends */
     const char *figure_text; /* --figure-from: the list as given */
-    char figure_list[4096];  /* its copy, cut at the commas */
-    const char *figures[COAVOID_MC_FIGURE_MAX_FILES];
-    size_t figure_count;
+    const char *merge_text;  /* --merge: the list as given */
+    char list[65536];        /* the list's copy, cut at the commas */
+    const char *files[COAVOID_MC_MERGE_MAX_FILES];
+    size_t file_count;
 } mc_options_t;
 
 /* "2,3,4": each 2..10, each once. */
@@ -174,25 +182,25 @@ static int parse_sizes(mc_options_t *o)
     }
 }
 
-/* --figure-from A.csv,B.csv,...: 1 to COAVOID_MC_FIGURE_MAX_FILES paths, none empty. */
-static int parse_figures(mc_options_t *o)
+/* --figure-from or --merge A.csv,B.csv,...: 1 to max paths, none empty, into o->files. */
+static int parse_files(mc_options_t *o, const char *option, const char *text, size_t max)
 {
-    if (strlen(o->figure_text) >= sizeof o->figure_list) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "--figure-from: longer than %zu characters",
-                                sizeof o->figure_list - 1u);
+    if (strlen(text) >= sizeof o->list) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: longer than %zu characters", option,
+                                sizeof o->list - 1u);
     }
-    strcpy(o->figure_list, o->figure_text);
-    for (char *p = o->figure_list;;) {
+    strcpy(o->list, text);
+    for (char *p = o->list;;) {
         char *comma = strchr(p, ',');
         if (comma != NULL) {
             *comma = '\0';
         }
-        if (*p == '\0' || o->figure_count == COAVOID_MC_FIGURE_MAX_FILES) {
+        if (*p == '\0' || o->file_count == max) {
             return coavoid_cli_fail(CLI_EXIT_INVALID,
-                                    "--figure-from: 1 to %u CSV files, comma-separated, none empty",
-                                    COAVOID_MC_FIGURE_MAX_FILES);
+                                    "%s: 1 to %zu CSV files, comma-separated, none empty", option,
+                                    max);
         }
-        o->figures[o->figure_count++] = p;
+        o->files[o->file_count++] = p;
         if (comma == NULL) {
             return CLI_CONTINUE;
         }
@@ -258,7 +266,9 @@ static int mc_option(int argc, char **argv, int *i, void *options)
     } else if (coavoid_cli_option_is(arg, "--figure-from")) {
         status = coavoid_cli_text_option(argc, argv, i, "--figure-from", "CSV files, A.csv,B.csv",
                                          false, &o->figure_text);
-        status = status == CLI_CONTINUE ? parse_figures(o) : status;
+    } else if (coavoid_cli_option_is(arg, "--merge")) {
+        status = coavoid_cli_text_option(argc, argv, i, "--merge", "CSV files, A.csv,B.csv", false,
+                                         &o->merge_text);
     } else if (coavoid_cli_option_is(arg, "--net-seed")) {
         status = coavoid_cli_count_option(argc, argv, i, "--net-seed", NULL, true, UINT64_MAX,
                                           &o->net_seed_text, &o->net_seed);
@@ -284,21 +294,29 @@ static const coavoid_cli_command_t montecarlo_command = {"montecarlo",
                                                          mc_option,
                                                          false};
 
-/* --figure-from runs nothing: only --svg goes with it. */
-static int figure_options(const mc_options_t *o)
+/* --figure-from and --merge run nothing: only --svg goes with the first, --svg and --json
+ * with the second (the parts' rows hold the run's options). */
+static int file_options(mc_options_t *o)
 {
-    if (o->svg == NULL) {
+    const char *option = o->figure_text != NULL ? "--figure-from" : "--merge";
+    if (o->figure_text != NULL && o->merge_text != NULL) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "--merge: not with --figure-from");
+    }
+    if (o->figure_text != NULL && o->svg == NULL) {
         return coavoid_cli_fail(CLI_EXIT_INVALID, "--figure-from: needs --svg FILE");
     }
     if (o->vehicles_text != NULL || o->count_text != NULL || o->first_text != NULL ||
         o->seed_text != NULL || o->beta_text != NULL || o->max_orders_text != NULL ||
-        o->work_text != NULL || o->csv != NULL || o->save != NULL || o->json ||
-        o->jobs_text != NULL || o->quiet || o->fly || coavoid_cli_network_given(&o->network) ||
-        o->net_seed_text != NULL || o->sweep_text != NULL) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID,
-                                "--figure-from: takes --svg only (it runs no encounters)");
+        o->work_text != NULL || o->csv != NULL || o->save != NULL ||
+        (o->json && o->figure_text != NULL) || o->jobs_text != NULL || o->quiet || o->fly ||
+        coavoid_cli_network_given(&o->network) || o->net_seed_text != NULL ||
+        o->sweep_text != NULL) {
+        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: takes %s only (it runs no encounters)",
+                                option, o->figure_text != NULL ? "--svg" : "--svg and --json");
     }
-    return CLI_CONTINUE;
+    return o->figure_text != NULL
+               ? parse_files(o, option, o->figure_text, COAVOID_MC_FIGURE_MAX_FILES)
+               : parse_files(o, option, o->merge_text, COAVOID_MC_MERGE_MAX_FILES);
 }
 
 static int parse_mc_options(int argc, char **argv, mc_options_t *o)
@@ -308,8 +326,8 @@ static int parse_mc_options(int argc, char **argv, mc_options_t *o)
     if (status != CLI_CONTINUE) {
         return status;
     }
-    if (o->figure_text != NULL) {
-        return figure_options(o);
+    if (o->figure_text != NULL || o->merge_text != NULL) {
+        return file_options(o);
     }
     if (o->vehicles_text == NULL) {
         return coavoid_cli_fail(CLI_EXIT_INVALID,
@@ -398,12 +416,17 @@ int coavoid_command_montecarlo(int argc, char **argv)
     }
     coavoid_run_error_t e;
     if (o.figure_text != NULL) {
-        int rc = coavoid_montecarlo_figure(o.figures, o.figure_count, o.svg, stdout, &e);
+        int rc = coavoid_montecarlo_figure(o.files, o.file_count, o.svg, stdout, &e);
         return coavoid_cli_run_status(rc, &e);
     }
-    const coavoid_montecarlo_config_t config = mc_engine_config(&o);
     coavoid_montecarlo_t *mc = NULL;
-    int rc = coavoid_montecarlo_run(&config, &mc, &e);
+    int rc = 0;
+    if (o.merge_text != NULL) {
+        rc = coavoid_montecarlo_merge(o.files, o.file_count, o.svg, print_defect, NULL, &mc, &e);
+    } else {
+        const coavoid_montecarlo_config_t config = mc_engine_config(&o);
+        rc = coavoid_montecarlo_run(&config, &mc, &e);
+    }
     if (rc == COAVOID_RUN_DONE) {
         rc = coavoid_montecarlo_report(mc, stdout, o.json, &e);
     }

@@ -259,7 +259,7 @@ static int solve_method(int m, const coa_problem_t *problem, const coavoid_mc_si
  * conflicts, so every plan moves someone (a deviation of 0 would be wrong, and the ratios
  * divide by it); a decoupled plan is a plan for the whole group, which the centralised
  * search cannot have proven absent, nor beaten. */
-static void cross_check(coavoid_mc_result_t *r)
+void coavoid_mc_cross_check(coavoid_mc_result_t *r)
 {
     const coavoid_mc_outcome_t *c = &r->m[COAVOID_MC_CENTRALISED];
     if (r->defect[0] == '\0' && c->status == COA_PLAN_SOLVED && c->units.hi == 0 &&
@@ -293,6 +293,18 @@ static void cross_check(coavoid_mc_result_t *r)
     }
 }
 
+void coavoid_mc_report_defect(const coavoid_montecarlo_config_t *c, const coavoid_mc_result_t *r)
+{
+    if (r->defect[0] == '\0' || c->defect == NULL) {
+        return;
+    }
+    char line[COAVOID_RUN_ERROR_MAX];
+    snprintf(line, sizeof line, "montecarlo: defect: seed %llu, %lu UAVs, encounter %lu: %s",
+             (unsigned long long)c->seed, (unsigned long)r->vehicles, (unsigned long)r->index,
+             r->defect);
+    c->defect(c->context, line);
+}
+
 static int solve_encounter(uint64_t seed, const coavoid_mc_size_t *size, uint32_t index,
                            const char *save_dir, mc_planners_t *p, coavoid_mc_result_t *r,
                            char *err, size_t err_size)
@@ -314,7 +326,7 @@ static int solve_encounter(uint64_t seed, const coavoid_mc_size_t *size, uint32_
     }
     coavoid_scenario_free(&s);
     if (status == 0) {
-        cross_check(r);
+        coavoid_mc_cross_check(r);
     }
     return status;
 }
@@ -593,21 +605,11 @@ static void write_ready(mc_run_t *run, FILE *csv, mc_progress_t *prog, uint32_t 
         if (csv != NULL && c->fly) {
             csv_flown_rows(csv, c, size, r);
         }
-        if (r->defect[0] != '\0') {
-            if (prog->line_open) {
-                fputc('\n', prog->f);
-                prog->line_open = false;
-            }
-            char line[COAVOID_RUN_ERROR_MAX];
-            snprintf(line, sizeof line,
-                     "montecarlo: defect: seed %llu, %lu UAVs, "
-                     "encounter %lu: %s",
-                     (unsigned long long)c->seed, (unsigned long)r->vehicles,
-                     (unsigned long)r->index, r->defect);
-            if (c->defect != NULL) {
-                c->defect(c->context, line);
-            }
+        if (r->defect[0] != '\0' && prog->line_open) {
+            fputc('\n', prog->f);
+            prog->line_open = false;
         }
+        coavoid_mc_report_defect(c, r);
     }
 }
 

@@ -47,6 +47,9 @@
     (COAVOID_ENCOUNTER_MAX_VEHICLES - COAVOID_ENCOUNTER_MIN_VEHICLES + 1u)
 /* Worker threads at most: beyond a machine's cores they only add workspaces. */
 #define COAVOID_MONTECARLO_MAX_JOBS 64u
+/* Encounters per UAV count that `coavoid montecarlo --count` runs, and --merge merges,
+ * at most. */
+#define COAVOID_MONTECARLO_MAX_COUNT 100000u
 
 typedef struct {
     /* The UAV counts, in the order of the reports, each of COAVOID_ENCOUNTER_MIN_VEHICLES to
@@ -151,6 +154,28 @@ int coavoid_montecarlo_report(coavoid_montecarlo_t *mc, FILE *out, bool json,
  * Memory: about 6 kB. */
 int coavoid_montecarlo_figure(const char *const *csv_paths, size_t count, const char *svg_path,
                               FILE *out, coavoid_run_error_t *e);
+
+/* CSV files montecarlo_merge reads at most: the parts of one run. */
+#define COAVOID_MC_MERGE_MAX_FILES 1024u
+
+/* A run rebuilt from the CSVs of its parts (runs of one config but first and count, whose
+ * encounters follow each other: a run split with --first), in any order, for
+ * coavoid_montecarlo_report to print and draw as the whole run's, times aside (each part
+ * timed its own plans), to svg_path when not NULL. The rows are checked against each
+ * other: one kind of run (the header), the same seed, planners' limits, network, sweep
+ * and network seed, the UAV counts in the same order, no encounter twice nor left out,
+ * every encounter's rows in order (its methods, flown modes and every cycle's stop
+ * points), at most COAVOID_MONTECARLO_MAX_COUNT encounters per UAV count. Every field is
+ * checked, lines are at most 1,023 bytes and 5e7 per file; the first problem is
+ * COAVOID_RUN_ERR_INPUT with e naming the file (and line). The cross-checks of the run
+ * (montecarlo.h) are made again on the rows, their defects handed to the callback as the
+ * run would, so that the report returns COAVOID_RUN_ERR_INTERNAL; only the plans'
+ * conflict check is not (the CSV has no plans). Returns COAVOID_RUN_DONE with *out set,
+ * to free with coavoid_montecarlo_free. Memory: the run's results (about 1.3 kB an
+ * encounter) and the files' first rows; each file is read twice, a line at a time. */
+int coavoid_montecarlo_merge(const char *const *csv_paths, size_t count, const char *svg_path,
+                             void (*defect)(void *context, const char *line), void *context,
+                             coavoid_montecarlo_t **out, coavoid_run_error_t *e);
 
 /* Frees a run (NULL is fine). */
 void coavoid_montecarlo_free(coavoid_montecarlo_t *mc);

@@ -135,6 +135,13 @@ enum {
  * its CSV, to the last digit. */
 double coavoid_mc_round(double value, double scale);
 
+/* The defects an encounter's outcomes show against each other (montecarlo.h): into
+ * r->defect, unless it already holds one. */
+void coavoid_mc_cross_check(coavoid_mc_result_t *r);
+
+/* Hands r's defect, if any, to c's defect callback as the line of a run. */
+void coavoid_mc_report_defect(const coavoid_montecarlo_config_t *c, const coavoid_mc_result_t *r);
+
 /* k successes of n (n >= 1): the rate and its 95 % Wilson interval. */
 void coavoid_mc_wilson(uint32_t k, uint32_t n, double *rate, double *low, double *high);
 

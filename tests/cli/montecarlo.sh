@@ -341,6 +341,95 @@ expect_bad "figure nan" "nan.csv:2: loss, delay or jitter" montecarlo --figure-f
 expect_bad "figure no rows" "empty.csv:1: no flown rows" montecarlo --figure-from "$tmp/empty.csv" --svg "$tmp/g.svg"
 expect_bad "figure svg unwritable" "--svg" montecarlo --figure-from "$tmp/f0.csv" --svg "$tmp/none/g.svg"
 
+# --merge: a run rebuilt from the CSVs of its parts (--first, --count) prints the whole
+# run's summary and draws its figure, times aside (each part timed its own plans), whatever
+# the parts' order; the whole run's own CSV gives its summary to the digit, times included
+# (a run's times are its CSV's). Parts that do not make one run are refused with one line
+# naming the file: the same encounter twice, one left out, other options, a row repeated,
+# changed or cut off, a CSV without the columns the summary needs.
+# same NAME A B: two summaries (text or JSON) are equal but for the planning times.
+same() {
+    if python3 - "$2" "$3" >"$tmp/py" 2>&1 <<'PY'; then pass; else fail "$1: $(tail -n 3 "$tmp/py")"; fi
+import json, re, sys
+def load(path):
+    text = open(path).read()
+    if text.startswith("{"):
+        b = json.loads(text)
+        for s in b["sizes"]:
+            for m in s["methods"]:
+                m.pop("time_ms")
+        return b
+    times = re.compile(r"^(  \S+ +\d+ +\d+ +\d+ +[\d.]+% +[\d.]+- *[\d.]+%)( +[\d.]+){3}")
+    lines = [times.sub(r"\1 t t t", line) for line in text.splitlines()]
+    assert sum(" t t t" in line for line in lines) >= 6, "no method rows"
+    return lines
+a, b = load(sys.argv[1]), load(sys.argv[2])
+sys.exit(0 if a == b else f"summaries differ: {a} {b}"[:600])
+PY
+}
+# equal NAME A B: two files are equal byte for byte.
+equal() { if cmp -s "$2" "$3"; then pass; else fail "$1: $(diff "$2" "$3" | head -c 400)"; fi; }
+run=(--vehicles "3,2" --seed 5 --beta 2000 --quiet)
+expect_ok "merge: whole" montecarlo "${run[@]}" --count 5 --csv "$tmp/w.csv" --svg "$tmp/w.svg" && cp "$tmp/out" "$tmp/w.txt"
+expect_ok "merge: whole json" montecarlo "${run[@]}" --count 5 --csv "$tmp/wj.csv" --json && cp "$tmp/out" "$tmp/wj.json"
+expect_ok "merge: part 1" montecarlo "${run[@]}" --count 2 --csv "$tmp/p1.csv"
+expect_ok "merge: part 2" montecarlo "${run[@]}" --first 2 --count 3 --csv "$tmp/p2.csv"
+if expect_ok "merge: the whole run's CSV" montecarlo --merge "$tmp/w.csv" --svg "$tmp/mw.svg"; then
+    equal "merge: the whole run's summary" "$tmp/w.txt" "$tmp/out"
+    equal "merge: the whole run's figure" "$tmp/w.svg" "$tmp/mw.svg"
+fi
+if expect_ok "merge: the whole run's CSV, json" montecarlo --merge "$tmp/wj.csv" --json; then
+    equal "merge: the whole run's JSON" "$tmp/wj.json" "$tmp/out"
+fi
+if expect_ok "merge: parts" montecarlo --merge "$tmp/p1.csv,$tmp/p2.csv" --svg "$tmp/m.svg"; then
+    same "merge: parts' summary" "$tmp/w.txt" "$tmp/out"
+    equal "merge: parts' figure" "$tmp/w.svg" "$tmp/m.svg"
+fi
+if expect_ok "merge: parts reversed" montecarlo --merge "$tmp/p2.csv,$tmp/p1.csv" --json --svg "$tmp/r.svg"; then
+    same "merge: parts reversed, JSON" "$tmp/wj.json" "$tmp/out"
+    equal "merge: parts reversed, figure" "$tmp/w.svg" "$tmp/r.svg"
+fi
+# The closed loop (--fly, a network seed of its own): its table, from its flown rows.
+fly=(--vehicles "2,3" --fly --loss 0.2 --net-seed 4 --beta 2000 --quiet)
+expect_ok "merge: fly whole" montecarlo "${fly[@]}" --count 3 --csv "$tmp/fw.csv" && cp "$tmp/out" "$tmp/fw.txt"
+expect_ok "merge: fly part 1" montecarlo "${fly[@]}" --count 1 --csv "$tmp/fp1.csv"
+expect_ok "merge: fly part 2" montecarlo "${fly[@]}" --first 1 --count 2 --csv "$tmp/fp2.csv"
+if expect_ok "merge: fly parts" montecarlo --merge "$tmp/fp2.csv,$tmp/fp1.csv"; then
+    same "merge: fly parts' summary" "$tmp/fw.txt" "$tmp/out"
+    if grep -q '^closed loop: .*loss 0.2, .*network seed 4$' "$tmp/out"; then pass; else fail "merge: fly: $(grep '^closed' "$tmp/out")"; fi
+fi
+expect_ok "merge: fly CSV to --figure-from" montecarlo --figure-from "$tmp/fw.csv" --svg "$tmp/ff.svg"
+# Bad parts.
+expect_ok "merge: part 3" montecarlo "${run[@]}" --first 3 --count 2 --csv "$tmp/p3.csv"
+expect_ok "merge: other beta" montecarlo --vehicles 3,2 --seed 5 --beta 3000 --quiet --first 2 --count 3 --csv "$tmp/pb.csv"
+expect_ok "merge: other seed" montecarlo --vehicles 3,2 --seed 6 --beta 2000 --quiet --first 2 --count 3 --csv "$tmp/ps.csv"
+sed '2s/,solved,/,solvedx,/' "$tmp/p1.csv" >"$tmp/status.csv"
+sed '3s/,[0-9]*$//' "$tmp/p1.csv" >"$tmp/fields.csv"
+sed '2p' "$tmp/p1.csv" >"$tmp/twice.csv"
+sed '$d' "$tmp/p1.csv" >"$tmp/cut.csv"
+head -c -1 "$tmp/p1.csv" >"$tmp/newline.csv"
+cut -d, -f1-16 "$tmp/p1.csv" >"$tmp/old.csv"
+many=$(printf "$tmp/p1.csv,%.0s" $(seq 1025)); many=${many%,}
+expect_bad "merge: overlap" "both hold encounter 0" montecarlo --merge "$tmp/p1.csv,$tmp/w.csv"
+expect_bad "merge: gap" "no part holds encounters 2 to 2" montecarlo --merge "$tmp/p3.csv,$tmp/p1.csv"
+expect_bad "merge: other beta" "pb.csv:2: beta 3000" montecarlo --merge "$tmp/p1.csv,$tmp/pb.csv"
+expect_bad "merge: other seed" "ps.csv:2: seed" montecarlo --merge "$tmp/p1.csv,$tmp/ps.csv"
+expect_bad "merge: fly and not" "fp1.csv:1: with --fly" montecarlo --merge "$tmp/p2.csv,$tmp/fp1.csv"
+expect_bad "merge: missing file" "cannot read" montecarlo --merge "$tmp/p1.csv,$tmp/none.csv"
+expect_bad "merge: status" "status.csv:2: status 'solvedx'" montecarlo --merge "$tmp/status.csv"
+expect_bad "merge: fields" "fields.csv:3: not 23 fields" montecarlo --merge "$tmp/fields.csv"
+expect_bad "merge: a row twice" "twice.csv:3: encounter 0 of 3 UAVs: a centralised row where decoupled_fixed" montecarlo --merge "$tmp/twice.csv"
+expect_bad "merge: cut short" "encounter 1 of 2 UAVs: some of its rows only" montecarlo --merge "$tmp/cut.csv"
+expect_bad "merge: no newline" "newline.csv:13: a line too long, or no newline" montecarlo --merge "$tmp/newline.csv"
+expect_bad "merge: old CSV" "old.csv:1: no columns optimal to count" montecarlo --merge "$tmp/old.csv"
+expect_bad "merge: not a CSV" "w.svg:1: not the header" montecarlo --merge "$tmp/w.svg"
+expect_bad "merge: 1025 files" "--merge: 1 to 1024" montecarlo --merge "$many"
+expect_bad "merge: empty entry" "--merge" montecarlo --merge "$tmp/p1.csv,,$tmp/p2.csv"
+expect_bad "merge: with vehicles" "--merge: takes --svg and --json only" montecarlo --merge "$tmp/p1.csv" --vehicles 2
+expect_bad "merge: with figure" "--merge: not with --figure-from" montecarlo --merge "$tmp/p1.csv" --figure-from "$tmp/fw.csv" --svg "$tmp/x.svg"
+expect_bad "merge: svg a part" "--svg" montecarlo --merge "$tmp/p1.csv,$tmp/p2.csv" --svg "$tmp/p2.csv"
+if [ "$(head -c 5 "$tmp/p2.csv")" = "seed," ]; then pass; else fail "merge: --svg overwrote a part"; fi
+
 expect_bad "vehicles missing" "--vehicles: required" montecarlo --count 2
 also="from 2 to 10"
 expect_bad "vehicles 1" "--vehicles" montecarlo --vehicles 1

@@ -341,6 +341,38 @@ for z in j["sizes"]:
         widest = max([widest] + [len(v) for v in cuts.values()])
     assert widest >= 3, "no cycle with a plan: the cuts between plan rows are not swept"
 PY
+# montecarlo --merge of the sweep (the run above, split here into its two encounters
+# as --first 0 --count 1 and --first 1 --count 1 would write them: the same rows): the
+# run's own JSON summary to the digit, whatever the parts' order; a part whose stop rows
+# are out of order, or end before the last cycle, is refused.
+python3 - "$tmp" <<'PY'
+import csv, sys
+d = sys.argv[1]
+rows = list(csv.reader(open(f"{d}/sweep.csv")))
+first, count = rows[0].index("first"), rows[0].index("count")
+def write(name, keep):
+    with open(f"{d}/{name}.csv", "w", newline="") as f:
+        w = csv.writer(f, lineterminator="\n")
+        w.writerow(rows[0])
+        for r in keep:
+            w.writerow(r)
+for i in ("0", "1"):
+    part = [r[:first] + [i, "1"] + r[count + 1:] for r in rows[1:] if r[2] == i]
+    write(f"sweep-{i}", part)
+    if i == "1":
+        write("sweep-cut", part[:-1])  # the last cycle's stop row
+        stops = [k for k, r in enumerate(part) if r[7] == "flown_centralised_stop"]
+        part[stops[1]], part[stops[2]] = part[stops[2]], part[stops[1]]
+        write("sweep-swapped", part)
+PY
+if "$bin" montecarlo --merge "$tmp/sweep-1.csv,$tmp/sweep-0.csv" --json >"$tmp/merged.json" 2>"$tmp/err" &&
+    cmp -s "$tmp/sweep.json" "$tmp/merged.json"; then
+    pass
+else
+    fail "montecarlo --merge of the sweep's parts: not the run's summary: $(head -c 300 "$tmp/err"; diff "$tmp/sweep.json" "$tmp/merged.json" | head -c 400)"
+fi
+expect_bad "mc merge sweep cut" "sweep-cut.csv: encounter 1 of 3 UAVs: stop rows of some cycles only" montecarlo --merge "$tmp/sweep-0.csv,$tmp/sweep-cut.csv"
+expect_bad "mc merge sweep order" "stop 0:2 out of order" montecarlo --merge "$tmp/sweep-0.csv,$tmp/sweep-swapped.csv"
 # --net-seed given as --seed is the default; another one draws another network.
 "$bin" montecarlo --vehicles 2 --count 3 --fly --loss 0.3 --quiet --csv "$tmp/ns-default.csv" >/dev/null 2>&1
 "$bin" montecarlo --vehicles 2 --count 3 --fly --loss 0.3 --net-seed 1 --quiet --csv "$tmp/ns-1.csv" >/dev/null 2>&1
