@@ -285,20 +285,31 @@ static int row_fields(const merge_t *m, const merge_file_t *f, char *line, char 
 
 /* ---- the parts' encounters ---- */
 
+/* Opens f and reads its header: its kind (header_kind), or an error. *in is the open file
+ * (NULL when it could not be opened), for the caller to close. */
+static int open_part(merge_file_t *f, FILE **in, char *line, size_t size, coavoid_run_error_t *e)
+{
+    *in = fopen(f->path, "r");
+    if (*in == NULL) {
+        return coavoid_run_fail(e, COAVOID_RUN_ERR_INPUT, "--merge: cannot read '%.200s'", f->path);
+    }
+    int rc = next_line(*in, f, line, size, e);
+    if (rc == 0) {
+        rc = coavoid_run_fail(e, COAVOID_RUN_ERR_INPUT, "--merge: %.200s: an empty file", f->path);
+    }
+    return rc == 1 ? header_kind(line, f, e) : rc;
+}
+
 /* File j's header and first row: its kind (every file the first's) and encounters. */
 static int scan_part(merge_t *m, size_t j, coavoid_run_error_t *e)
 {
     merge_file_t f = {m->paths[j], 0ul, NULL, 0u};
-    FILE *in = fopen(f.path, "r");
-    if (in == NULL) {
-        return coavoid_run_fail(e, COAVOID_RUN_ERR_INPUT, "--merge: cannot read '%.200s'", f.path);
-    }
+    FILE *in = NULL;
     char line[MERGE_LINE_MAX];
-    int rc = next_line(in, &f, line, sizeof line, e);
-    if (rc == 0) {
-        rc = coavoid_run_fail(e, COAVOID_RUN_ERR_INPUT, "--merge: %.200s: an empty file", f.path);
+    int rc = open_part(&f, &in, line, sizeof line, e);
+    if (in == NULL) {
+        return rc;
     }
-    rc = rc == 1 ? header_kind(line, &f, e) : rc;
     if (rc > 0 && j > 0u && (rc == 2) != m->fly) {
         rc = merge_fail(e, &f, "%s --fly, and '%.200s' %s (the parts of a run have its options)",
                         rc == 2 ? "with" : "without", m->paths[0], m->fly ? "with" : "without");
@@ -736,16 +747,13 @@ static int merge_row(merge_t *m, merge_file_t *f, char *line, coavoid_run_error_
 static int read_part(merge_t *m, size_t j, coavoid_run_error_t *e)
 {
     merge_file_t f = {m->paths[j], 0ul, &m->by_file[j], 0u};
-    FILE *in = fopen(f.path, "r");
-    if (in == NULL) {
-        return coavoid_run_fail(e, COAVOID_RUN_ERR_INPUT, "--merge: cannot read '%.200s'", f.path);
-    }
+    FILE *in = NULL;
     char line[MERGE_LINE_MAX];
-    int rc = next_line(in, &f, line, sizeof line, e);
-    if (rc == 1) {
-        rc = header_kind(line, &f, e);
-        rc = rc > 0 && (rc == 2) != m->fly ? merge_fail(e, &f, "another header than before") : rc;
+    int rc = open_part(&f, &in, line, sizeof line, e);
+    if (in == NULL) {
+        return rc;
     }
+    rc = rc > 0 && (rc == 2) != m->fly ? merge_fail(e, &f, "another header than before") : rc;
     while (rc > 0 && (rc = next_line(in, &f, line, sizeof line, e)) == 1) {
         rc = merge_row(m, &f, line, e);
         rc = rc == COAVOID_RUN_DONE ? 1 : rc;
