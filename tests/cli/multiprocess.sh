@@ -30,7 +30,9 @@
 # Where no namespace can be made (a container without CAP_SYS_ADMIN) it runs on the host's
 # multicast route instead, on a port of its own, and says so.
 #
-# usage: bash multiprocess.sh <path-to-coavoid> <source-dir>   (VERBOSE=1 shows more)
+# usage: bash multiprocess.sh <path-to-coavoid> <source-dir> [FORGE [PART]]   (VERBOSE=1 shows
+# more); PART is all (the default), centralised, decoupled or paths: ctest runs the three
+# parts as cli_multiprocess_PART, side by side.
 # The drivers are found beside coavoid (coavoid-coordinator, coavoid-vehicle).
 set -u
 # shellcheck source=tests/cli/lib.bash
@@ -41,6 +43,8 @@ coordinator=$apps/coavoid-coordinator
 vehicle=$apps/coavoid-vehicle
 # The attacker (tests/forge/forge.c), argument 3.
 forge=${3:-}
+# Which flights (argument 4): all, or one part of them (the end of this file).
+part=${4:-all}
 if [ ! -x "$coordinator" ] || [ ! -x "$vehicle" ]; then
     echo "FAIL: no coavoid-coordinator/coavoid-vehicle beside $bin (CMake adds this test only with LCM)" >&2
     exit 1
@@ -283,11 +287,22 @@ PY
     fi
 }
 
-# ---- bad options and inputs: exit 2, one line ----
-
 headon=$scenarios/headon.json
 coavoid=$bin
 paper=$scenarios/paper.json
+late=$scenarios/late_encounter.json
+# z of UAV i's flown samples 30..38 (the crossing of late_encounter.json), from the
+# summary's JSON.
+crossing='[p[3] for v in s["vehicles"] if v["id"] == i for p in v["flown"][30:39]]'
+# The paper's flight with a lead-in (c), and `coavoid sim`'s flight of it, decoupled: flown
+# and compared with by (c), (d) and (e).
+lead_in "$paper" "$tmp/paper_lead_in.json" 18
+mkdir -p "$tmp/decoupled"
+"$bin" sim "$tmp/paper_lead_in.json" --mode decoupled --steps 48 --json >"$tmp/decoupled/sim.json"
+
+# ---- bad options and inputs: exit 2, one line ----
+
+section_bad_inputs() {
 bin=$vehicle expect_bad "vehicle without --id" "--id" "$headon"
 bin=$vehicle expect_bad "vehicle without a scenario" "missing SCENARIO.json" --id 1
 bin=$vehicle expect_bad "vehicle with an unknown id" "no vehicle 9" "$headon" --id 9
@@ -384,14 +399,13 @@ if "$bin" --help | grep -q '^  world ' && "$bin" world --help | grep -q -- '--ep
 else
     fail "--help: world is not listed, or a driver's help lacks its options"
 fi
+}
 
 # ---- a) centralised: plans reach the vehicles, the encounters are resolved ----
 
 # A head-on pair in conflict from the start, and UAV 3 crossing UAV 1's path around
 # t = 35 s, which enters the horizon (20 s) later: the coordinator plans both.
-late=$scenarios/late_encounter.json
-# z of UAV i's flown samples 30..38 (the crossing), from the summary's JSON.
-crossing='[p[3] for v in s["vehicles"] if v["id"] == i for p in v["flown"][30:39]]'
+section_centralised() {
 fleet centralised "$late" centralised 40 -
 check centralised "
 rc == {'world': 0, 'coordinator': 0, 'vehicle-1': 0, 'vehicle-2': 0, 'vehicle-3': 0, 'summary': 0}
@@ -411,12 +425,14 @@ s is not None and s['loss_of_separation'] is False and s['steps'] == 40
 s['replans'] == num('coordinator', 'plans run')
 any(z != 100 for i in (1, 3) for z in $crossing)
 "
+}
 
 # ---- b) the coordinator stopped mid-encounter, before it resolved it ----
 
 # The same flight; SIGTERM at 12.6 s, after the coordinator resolved the head-on pair and
 # before UAV 3's crossing has entered its horizon. The UAVs hear its heartbeat stop, fall
 # back to planning for themselves (2.5 s later) and solve the crossing on their own.
+section_stopped() {
 fleet stopped "$late" centralised 40 12.6
 check stopped "
 rc == {'world': 0, 'coordinator': 0, 'vehicle-1': 0, 'vehicle-2': 0, 'vehicle-3': 0, 'summary': 0}
@@ -429,6 +445,7 @@ len(log['statuses']['65001']) in (12, 13)
 s is not None and s['loss_of_separation'] is False
 any(z != 100 for i in (1, 3) for z in $crossing)
 "
+}
 
 # ---- c) decoupled, no coordinator ----
 
@@ -441,10 +458,9 @@ any(z != 100 for i in (1, 3) for z in $crossing)
 # alike). So the paper's flight gets a lead-in: every UAV starts 18 s further back along
 # its route, the first conflict enters the 24 s horizon at cycle 2, after every UAV has
 # heard the others, and the 48 cycles (2N, what summary judges) fly the paper's 30.
-lead_in "$paper" "$tmp/paper_lead_in.json" 18
+section_decoupled() {
 speed=$speed_decoupled
 fleet decoupled "$tmp/paper_lead_in.json" decoupled 48 -
-"$bin" sim "$tmp/paper_lead_in.json" --mode decoupled --steps 48 --json >"$tmp/decoupled/sim.json"
 check decoupled "
 rc == {'world': 0, 'vehicle-1': 0, 'vehicle-2': 0, 'vehicle-3': 0, 'summary': 0}
 'COAVOID_PLAN' not in log['counts'] and '65001' not in log['statuses']
@@ -457,6 +473,7 @@ s['replans'] == sum(num(f'vehicle-{i}', 'plans run') for i in (1, 2, 3))
 (lambda m: (s['deviation'], s['effort'], s['replans']) == (m['deviation'], m['effort'], m['replans']))(json.load(open(os.path.join(d, 'sim.json'))))
 [v['flown'] for v in s['vehicles']] == [v['flown'] for v in json.load(open(os.path.join(d, 'sim.json')))['vehicles']]
 "
+}
 
 # ---- d) an attacker on the group (tests/forge/forge.c, lcm-logplayer) ----
 
@@ -479,50 +496,63 @@ s['replans'] == sum(num(f'vehicle-{i}', 'plans run') for i in (1, 2, 3))
 #               lcm-logplayer.
 # (test_node covers each refusal alone, unsigned messages included; a plan of the
 # coordinator's own that flies a UAV into another is refused as such there too.)
-if [ -z "$forge" ] || [ ! -x "$forge" ]; then
-    fail "no attacker program (argument 3: coavoid_test_forge): the attacks are not flown"
-else
-    replay_log=$tmp/centralised/log.lcm
-    survived="s is not None and s['loss_of_separation'] is False
+# (the attacker: argument 3)
+have_forge() {
+    if [ -z "$forge" ] || [ ! -x "$forge" ]; then
+        fail "no attacker program (argument 3: coavoid_test_forge): the attacks are not flown"
+        return 1
+    fi
+}
+survived="s is not None and s['loss_of_separation'] is False
 rc['summary'] == 0 and rc['forge'] == 0"
-    forged="num('forge', 'forged') >= 5"
-    # reported CODE NODES: each node's heartbeats counted refusals, CODE among their codes.
-    reported() { echo "all(log['rejected'][str(i)] >= 1 and $1 in log['codes'][str(i)] for i in ($2,))"; }
-    for mode in centralised decoupled; do
-        if [ "$mode" = centralised ]; then
-            speed=${SPEED:-4} all="1, 2, 3, 65001" stolen=map,collide,intent
-        else
-            speed=$speed_decoupled all="1, 2, 3" stolen=map,intent
-        fi
-        forge_args="--key $keys/vehicle-3.key --trust $keys/trust.txt" attack=$stolen \
-            fleet "attack-stolen-$mode" "$tmp/paper_lead_in.json" "$mode" 48 -
-        for attack in copy replay replay-log; do
-            forge_args= fleet "attack-$attack-$mode" "$tmp/paper_lead_in.json" "$mode" 48 -
-        done
-        attack=
-        # Decoupled, the attacked flights are `coavoid sim`'s to the step, as in (c): the
-        # attacker changed nothing.
-        same=True
-        if [ "$mode" = decoupled ]; then
-            same="[v['flown'] for v in s['vehicles']] == [v['flown'] for v in json.load(open('$tmp/decoupled/sim.json'))['vehicles']]"
-        fi
-        check "attack-stolen-$mode" "$survived
+forged="num('forge', 'forged') >= 5"
+# reported CODE NODES: each node's heartbeats counted refusals, CODE among their codes.
+reported() { echo "all(log['rejected'][str(i)] >= 1 and $1 in log['codes'][str(i)] for i in ($2,))"; }
+
+# section_attacks MODE: the four attackers on flights in MODE. The log replayed is that of
+# flight (a), centralised, with the same keys: an earlier run of the fleet.
+section_attacks() {
+    have_forge || return 0
+    local mode=$1
+    replay_log=$tmp/centralised/log.lcm
+    if [ "$mode" = centralised ]; then
+        speed=${SPEED:-4} all="1, 2, 3, 65001" stolen=map,collide,intent
+    else
+        speed=$speed_decoupled all="1, 2, 3" stolen=map,intent
+    fi
+    forge_args="--key $keys/vehicle-3.key --trust $keys/trust.txt" attack=$stolen \
+        fleet "attack-stolen-$mode" "$tmp/paper_lead_in.json" "$mode" 48 -
+    for attack in copy replay replay-log; do
+        forge_args= fleet "attack-$attack-$mode" "$tmp/paper_lead_in.json" "$mode" 48 -
+    done
+    attack=
+    # Decoupled, the attacked flights are `coavoid sim`'s to the step, as in (c): the
+    # attacker changed nothing.
+    same=True
+    if [ "$mode" = decoupled ]; then
+        same="[v['flown'] for v in s['vehicles']] == [v['flown'] for v in json.load(open('$tmp/decoupled/sim.json'))['vehicles']]"
+    fi
+    check "attack-stolen-$mode" "$survived
 $same
 $forged
 $(reported -123 "$all")
 set(log['codes']['1']) <= {0, -123, -124}"
-        check "attack-copy-$mode" "$survived
+    check "attack-copy-$mode" "$survived
 $same
 $forged
 $(reported -126 "$all")"
-        check "attack-replay-$mode" "$survived
+    check "attack-replay-$mode" "$survived
 $same
 $forged
 $(reported -124 "$all")"
-        check "attack-replay-log-$mode" "$survived
+    check "attack-replay-log-$mode" "$survived
 $same
 all(log['rejected'][str(i)] >= 1 for i in ($all,))"
-    done
+}
+
+# A stolen coordinator key (the dive).
+section_dive() {
+    have_forge || return 0
 
     # A stolen coordinator key: with it the attacker signs, for every intent of UAV 1, a
     # plan of that cycle that dives it 4 m a second for the whole horizon, and the plan's
@@ -543,7 +573,7 @@ PY
 $forged
 $(reported -102 1)
 min(p[3] for v in s['vehicles'] if v['id'] == 1 for p in v['flown']) - 5 >= 85"
-fi
+}
 
 # ---- e) a path that drops every datagram over 1,500 bytes ----
 
@@ -554,6 +584,7 @@ fi
 # notice, as on such a path): the paper's flight, centralised and decoupled, must be the
 # flight of `coavoid sim`, with and without the rule, every plan whole and the map in use
 # everywhere (no REASON_NO_MAP, 64, in the last heartbeats).
+section_paths() {
 if [ -z "$netns" ]; then
     echo "note: no private network namespace: the case of a path that drops large datagrams is not flown"
 elif ! command -v nft >/dev/null; then
@@ -622,6 +653,7 @@ s is not None and s['loss_of_separation'] is False and s['steps'] == 48
         nft delete table inet coavoid_mtu
     fi
 fi
+}
 
 # ---- f) no coordinator at all: the vehicles plan their group jointly ----
 
@@ -632,6 +664,7 @@ fi
 # (docs/protocol.md, "Priority negotiation", step 5): separation kept, as in
 # test_protocol's simulation of it. With --joint-members 0 they have only the greedy
 # raise, and lose it: the option reaches the node.
+section_leaderless() {
 keys220=$tmp/keys220
 mkdir -p "$keys220"
 joint=$src/tests/encounters/joint_plan_220.json
@@ -651,5 +684,43 @@ check leaderless-alone "
 rc == {'world': 0, 'vehicle-1': 0, 'vehicle-2': 0, 'vehicle-3': 0, 'vehicle-4': 0, 'summary': 1}
 all(num(f'vehicle-{i}', 'joint plans') == 0 for i in (1, 2, 3, 4))
 s is not None and s['loss_of_separation'] is True"
+}
+
+# ---- the parts: each a ctest of its own, so that they fly side by side ----
+# PART (argument 4; default all): centralised (the bad inputs, a, b, the centralised
+# attacks and the dive), decoupled (a, whose log the attacks replay, c and the decoupled
+# attacks) or paths (e and f).
+case $part in
+all)
+    section_bad_inputs
+    section_centralised
+    section_stopped
+    section_decoupled
+    section_attacks centralised
+    section_attacks decoupled
+    section_dive
+    section_paths
+    section_leaderless
+    ;;
+centralised)
+    section_bad_inputs
+    section_centralised
+    section_stopped
+    section_attacks centralised
+    section_dive
+    ;;
+decoupled)
+    section_centralised
+    section_decoupled
+    section_attacks decoupled
+    ;;
+paths)
+    section_paths
+    section_leaderless
+    ;;
+*)
+    fail "unknown part '$part' (all, centralised, decoupled or paths)"
+    ;;
+esac
 
 finish
