@@ -19,8 +19,11 @@ if [ "$(id -u)" -ne 0 ] || ! unshare --net --mount true 2>/dev/null || ! command
 fi
 speed=${SPEED:-4}
 run() { "$src/scripts/lossy.sh" --runs 1 --speed "$speed" --build "$build" --out "$tmp/$1" "${@:2}"; }
+# The flight must be the one-shot plan's; the coordinator's planning calls may be more than
+# the 3 of a quiet machine: on loaded cores a plan agreed a cycle later is planned again
+# (the same plan), which changes nothing flown.
 if run none --loss 0 >"$tmp/none.out" 2>&1 &&
-    grep -q "loss of separation: no, deviation 3240 m^2, effort 40, replans 3, fallbacks 0, samples from an earlier plan 0" "$tmp/none.out" &&
+    grep -Eq "loss of separation: no, deviation 3240 m\^2, effort 40, replans ([3-9]|[1-9][0-9]), fallbacks 0, samples from an earlier plan 0" "$tmp/none.out" &&
     grep -q ": 0 lost separation" "$tmp/none.out"; then
     pass
 else
