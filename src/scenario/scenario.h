@@ -132,8 +132,9 @@ long coavoid_scenario_vehicle_index(const coavoid_scenario_t *s, long id);
 
 /* The planner config of a scenario (coa_planner_config_of: its horizon, largest steep
  * factor and offset bound) for `searched` UAVs a search and `beta`. The scenario need not
- * be sampled. Cannot fail for a scenario that coavoid_scenario_load accepted and searched in
- * 1..COA_MAX_CENTRALISED, beta >= 1 (asserted). */
+ * be sampled. For a scenario that coavoid_scenario_load accepted and searched in
+ * 1..COA_MAX_CENTRALISED it is filled whatever beta is; with a beta beyond the planner's
+ * limits coa_planner_workspace_size() of it is 0, which the caller must check. */
 coa_planner_config_t coavoid_scenario_planner_config(const coavoid_scenario_t *s, size_t searched,
                                                      uint32_t beta);
 
