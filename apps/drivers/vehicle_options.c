@@ -24,9 +24,12 @@ static int parse_seconds(int argc, char **argv, int *i, const char *name, bool z
     return status;
 }
 
+/* The help and the hint below name the bound as text. */
+_Static_assert(COA_MAX_CENTRALISED == 10u, "--joint-members: 0 or 2 to 10");
+
 int coavoid_joint_members_option(int argc, char **argv, int *i, const char **text, uint64_t *value)
 {
-    int status = coavoid_cli_count_option(argc, argv, i, "--joint-members", "0 or 2 to 6", true,
+    int status = coavoid_cli_count_option(argc, argv, i, "--joint-members", "0 or 2 to 10", true,
                                           COA_MAX_CENTRALISED, text, value);
     if (status == CLI_CONTINUE && *value == 1u) {
         status = coavoid_cli_fail(CLI_EXIT_INVALID,

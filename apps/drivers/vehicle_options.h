@@ -30,7 +30,7 @@
     "                      higher-priority UAVs that pass near it, 0 <= S < dt; default dt / 2\n" \
     "  --joint-members N   centralised: while it plans for itself, it plans its group\n"          \
     "                      jointly, as the coordinator would, where no priority order\n"          \
-    "                      solves it, for groups of up to N UAVs (2 to 6; 0: never, and\n"        \
+    "                      solves it, for groups of up to N UAVs (2 to 10; 0: never, and\n"       \
     "                      its planner is then one UAV's); default the scenario's UAVs, at\n"     \
     "                      most 5; the same on every vehicle of the fleet\n"                      \
     "  --joint-beta B      centralised: the nodes that joint search may store, 1 to\n"            \
