@@ -73,13 +73,11 @@ static int coordinator_option(int argc, char **argv, int *i, void *options)
     coordinator_options_t *o = options;
     const char *arg = argv[*i];
     uint64_t value = 0;
-    int status = coavoid_rt_parse_option(argc, argv, i, &o->rt);
+    int status = coavoid_rt_driver_option(argc, argv, i, &o->rt, &o->scenario_path);
     if (status != CLI_UNKNOWN_OPTION) {
         return status;
     }
-    if (coavoid_cli_option_is(arg, "--scenario")) {
-        status = coavoid_cli_scenario_option(argc, argv, i, &o->scenario_path);
-    } else if (coavoid_cli_option_is(arg, "--beta")) {
+    if (coavoid_cli_option_is(arg, "--beta")) {
         status = coavoid_cli_count_option(argc, argv, i, "--beta", "an integer >= 1", false,
                                           UINT32_MAX, &o->beta_text, &value);
         o->beta = (uint32_t)value;

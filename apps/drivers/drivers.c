@@ -72,6 +72,15 @@ int coavoid_rt_parse_option(int argc, char **argv, int *i, coavoid_rt_options_t 
     return status;
 }
 
+int coavoid_rt_driver_option(int argc, char **argv, int *i, coavoid_rt_options_t *o,
+                             const char **scenario_path)
+{
+    if (coavoid_cli_option_is(argv[*i], "--scenario")) {
+        return coavoid_cli_scenario_option(argc, argv, i, scenario_path);
+    }
+    return coavoid_rt_parse_option(argc, argv, i, o);
+}
+
 /* ---- keys ---- */
 
 /* Reads the file at path (at most COAVOID_RT_KEY_FILE_MAX bytes) into buf; its length, or

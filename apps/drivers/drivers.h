@@ -40,6 +40,12 @@ void coavoid_rt_options_init(coavoid_rt_options_t *o);
  * argument (cli.h's option parser contract). */
 int coavoid_rt_parse_option(int argc, char **argv, int *i, coavoid_rt_options_t *o);
 
+/* The same for a driver that flies a scenario given as its argument (coavoid-vehicle,
+ * coavoid-coordinator, coavoid bridge): also --scenario FILE, the argument's old spelling,
+ * which sets *scenario_path with its warning (coavoid_cli_scenario_option). */
+int coavoid_rt_driver_option(int argc, char **argv, int *i, coavoid_rt_options_t *o,
+                             const char **scenario_path);
+
 /* After the scenario is loaded: steps defaults to 2 * horizon; the epoch defaults to now
  * (a process run alone starts at once; processes that run together must all be given
  * one --epoch); an epoch more than COAVOID_RT_MAX_EPOCH_AHEAD_US ahead, or one whose run of

@@ -44,13 +44,11 @@ int coavoid_vehicle_option(int argc, char **argv, int *i, coavoid_vehicle_option
 {
     const char *arg = argv[*i];
     uint64_t value = 0;
-    int status = coavoid_rt_parse_option(argc, argv, i, &o->rt);
+    int status = coavoid_rt_driver_option(argc, argv, i, &o->rt, &o->scenario_path);
     if (status != CLI_UNKNOWN_OPTION) {
         return status;
     }
-    if (coavoid_cli_option_is(arg, "--scenario")) {
-        status = coavoid_cli_scenario_option(argc, argv, i, &o->scenario_path);
-    } else if (coavoid_cli_option_is(arg, "--id")) {
+    if (coavoid_cli_option_is(arg, "--id")) {
         status = coavoid_cli_text_option(argc, argv, i, "--id", "a vehicle id", true, &o->id_text);
         if (status == CLI_CONTINUE &&
             !coavoid_cli_parse_count(o->id_text, strlen(o->id_text), 65535u, &value)) {
