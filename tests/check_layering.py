@@ -163,12 +163,16 @@ def check_sources(src, rows):
     return bad, count
 
 
+def target_name(token):
+    """A library's one name: coavoid_lcm and its alias coavoid::lcm are coavoid::lcm."""
+    return token.replace("coavoid_", "coavoid::", 1) if token.startswith("coavoid_") else token
+
+
 def linked_targets(cmake_text):
     found = set()
     for call in re.findall(r"target_link_libraries\s*\(([^)]*)\)", cmake_text):
         for token in re.findall(r"\bcoavoid(?:::|_)\w+", call):
-            found.add(token.replace("coavoid_", "coavoid::", 1) if token.startswith("coavoid_")
-                      else token)
+            found.add(target_name(token))
     return found
 
 
@@ -178,8 +182,7 @@ def check_links(src, rows):
     owner = {}  # a target may hold two layers (coavoid::auth: signatures and key files)
     for row in rows:
         for t in row["targets"]:
-            name = t.replace("coavoid_", "coavoid::", 1) if t.startswith("coavoid_") else t
-            owner.setdefault(name, set()).add(row["name"])
+            owner.setdefault(target_name(t), set()).add(row["name"])
     for folder in sorted(os.listdir(os.path.join(src, "src"))):
         path = os.path.join(src, "src", folder, "CMakeLists.txt")
         if not os.path.isfile(path):
