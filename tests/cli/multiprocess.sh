@@ -49,7 +49,9 @@ if [ ! -x "$coordinator" ] || [ ! -x "$vehicle" ]; then
     echo "FAIL: no coavoid-coordinator/coavoid-vehicle beside $bin (CMake adds this test only with LCM)" >&2
     exit 1
 fi
-url="udpm://239.255.76.67:7667?ttl=0"
+# Every fleet flies on a port of its own above port_base (fly): fleets side by side on the
+# one group hear only themselves, as LCM's udpm delivers by port.
+port_base=7667
 netns=1
 if ! in_multicast_netns "$@"; then
     # No namespace (a container without CAP_SYS_ADMIN, say): the host's own multicast
@@ -63,8 +65,8 @@ if ! in_multicast_netns "$@"; then
         finish
         exit
     fi
-    url="udpm://239.255.76.67:$((20000 + $$ % 20000))?ttl=0"
-    echo "note: on the host's network ($url)"
+    port_base=$((20000 + $$ % 2000 * 20))
+    echo "note: on the host's network (ports above $port_base)"
 fi
 # Scenario seconds per wall second. The coordinator's plans must arrive within
 # (dt - collect) / speed = 0.75 s / speed of wall time; SPEED overrides. The decoupled
@@ -74,9 +76,13 @@ fi
 # SPEED_DECOUPLED overrides.
 speed=${SPEED:-4}
 speed_decoupled=${SPEED_DECOUPLED:-2}
-# Wall time between starting the processes and cycle 0: room for them to start and
-# subscribe under the sanitizers.
-lead_us=1500000
+# Wall time between starting the processes and cycle 0: room for them, and the fleets
+# started beside them, to start and subscribe under the sanitizers.
+lead_us=2500000
+# How many fleets fly at once (fly); FLEETS overrides. Each waits on the scenario clock far
+# more than it computes (a flight of 48 cycles takes about 1.5 CPU seconds under the
+# sanitizers), so that side by side they keep the deadlines they keep alone.
+fleets_at_once=${FLEETS:-6}
 
 # The types generated from lcmtypes/ for Python: an independent decoder of the log.
 if ! lcm-gen -p --ppath "$tmp/py" "$src"/lcmtypes/*.lcm >/dev/null 2>&1; then
@@ -167,7 +173,8 @@ sleep_until_cycle() {
     sleep "$wait"
 }
 
-# fleet NAME SCENARIO MODE STEPS KILL_AT [COORDINATOR_ARGS...]: lcm-logger, the world, the
+# fleet NAME SCENARIO MODE STEPS KILL_AT [COORDINATOR_ARGS...]: on the port $port,
+# lcm-logger, the world, the
 # coordinator (centralised) and one vehicle per UAV, on one epoch; with KILL_AT (a number
 # of cycles, or -), the coordinator gets SIGTERM then. MODE leaderless: the vehicles fly
 # centralised but no coordinator runs (it is gone before its first message); each vehicle
@@ -179,7 +186,7 @@ sleep_until_cycle() {
 fleet() {
     local name=$1 scenario=$2 mode=$3 steps=$4 kill_at=$5
     shift 5
-    local dir=$tmp/$name vmode=$mode
+    local dir=$tmp/$name vmode=$mode url="udpm://239.255.76.67:${port:?fleet flies under fly}?ttl=0"
     [ "$mode" = leaderless ] && vmode=centralised
     mkdir -p "$dir"
     lcm-logger -q -f --lcm-url="$url" "$dir/log.lcm" >"$dir/logger.out" 2>&1 &
@@ -238,7 +245,43 @@ fleet() {
     fi
 }
 
-# check NAME ASSERTIONS: evaluates each line of ASSERTIONS (Python) over the run in
+# fly FLEET_ARGS...: fleet FLEET_ARGS... in the background, on the next port, once fewer
+# than $fleets_at_once fly; landed NAME waits for fleet NAME to end.
+declare -A flying=()
+port_next=$port_base
+fly() {
+    while [ "$(jobs -rp | wc -l)" -ge "$fleets_at_once" ]; do
+        wait -n
+    done
+    port_next=$((port_next + 1))
+    port=$port_next fleet "$@" &
+    flying[$1]=$!
+}
+landed() { wait "${flying[$1]}"; }
+land_all() {
+    local name
+    for name in "${!flying[@]}"; do
+        landed "$name"
+    done
+}
+
+# check NAME ASSERTIONS: judges fleet NAME (judge) once every fleet has landed (settle),
+# in the order the checks were asked for.
+checks=()
+check() {
+    printf '%s\n' "$2" >"$tmp/$1.asserts"
+    checks+=("$1")
+}
+settle() {
+    local name
+    land_all
+    for name in "${checks[@]}"; do
+        judge "$name" "$(cat "$tmp/$name.asserts")"
+    done
+    checks=()
+}
+
+# judge NAME ASSERTIONS: evaluates each line of ASSERTIONS (Python) over the run in
 # $tmp/NAME, with
 #   rc[p]      exit status of process p ("world", "coordinator", "vehicle-1", ...; and
 #              "summary", `coavoid summary`)
@@ -246,7 +289,7 @@ fleet() {
 #              ("plans adopted" -> the integer after it)
 #   log        log.py's summary of the log, and s the summary's JSON result (None when
 #              it failed)
-check() {
+judge() {
     local name=$1 asserts=$2
     local dir=$tmp/$name
     if ! python3 - "$dir" "$asserts" >"$tmp/py.out" 2>&1 <<'PY'; then
@@ -406,7 +449,7 @@ fi
 # A head-on pair in conflict from the start, and UAV 3 crossing UAV 1's path around
 # t = 35 s, which enters the horizon (20 s) later: the coordinator plans both.
 section_centralised() {
-fleet centralised "$late" centralised 40 -
+fly centralised "$late" centralised 40 -
 check centralised "
 rc == {'world': 0, 'coordinator': 0, 'vehicle-1': 0, 'vehicle-2': 0, 'vehicle-3': 0, 'summary': 0}
 all(num(f'vehicle-{i}', 'plans adopted') >= 1 for i in (1, 2, 3))
@@ -433,7 +476,7 @@ any(z != 100 for i in (1, 3) for z in $crossing)
 # before UAV 3's crossing has entered its horizon. The UAVs hear its heartbeat stop, fall
 # back to planning for themselves (2.5 s later) and solve the crossing on their own.
 section_stopped() {
-fleet stopped "$late" centralised 40 12.6
+fly stopped "$late" centralised 40 12.6
 check stopped "
 rc == {'world': 0, 'coordinator': 0, 'vehicle-1': 0, 'vehicle-2': 0, 'vehicle-3': 0, 'summary': 0}
 'stopped by SIGTERM' in line['coordinator']
@@ -460,7 +503,7 @@ any(z != 100 for i in (1, 3) for z in $crossing)
 # heard the others, and the 48 cycles (2N, what summary judges) fly the paper's 30.
 section_decoupled() {
 speed=$speed_decoupled
-fleet decoupled "$tmp/paper_lead_in.json" decoupled 48 -
+fly decoupled "$tmp/paper_lead_in.json" decoupled 48 -
 check decoupled "
 rc == {'world': 0, 'vehicle-1': 0, 'vehicle-2': 0, 'vehicle-3': 0, 'summary': 0}
 'COAVOID_PLAN' not in log['counts'] and '65001' not in log['statuses']
@@ -521,9 +564,17 @@ section_attacks() {
         speed=$speed_decoupled all="1, 2, 3" stolen=map,intent
     fi
     forge_args="--key $keys/vehicle-3.key --trust $keys/trust.txt" attack=$stolen \
-        fleet "attack-stolen-$mode" "$tmp/paper_lead_in.json" "$mode" 48 -
+        fly "attack-stolen-$mode" "$tmp/paper_lead_in.json" "$mode" 48 -
     for attack in copy replay replay-log; do
-        forge_args= fleet "attack-$attack-$mode" "$tmp/paper_lead_in.json" "$mode" 48 -
+        # The log replayed is whole, and of an earlier run: its every stamp (40 cycles of
+        # scenario time from its epoch) before this run's epoch. Replayed stamps inside the
+        # run would be newer than the fleet's own, which the nodes refuse by their clock
+        # window, but `coavoid summary`, which has no window (cli.md), would take.
+        if [ "$attack" = replay-log ]; then
+            landed centralised
+            speed=1 sleep_until_cycle "$(($(cat "$tmp/centralised/epoch") - lead_us))" 42
+        fi
+        forge_args='' fly "attack-$attack-$mode" "$tmp/paper_lead_in.json" "$mode" 48 -
     done
     attack=
     # Decoupled, the attacked flights are `coavoid sim`'s to the step, as in (c): the
@@ -567,7 +618,7 @@ json.dump(s, open(sys.argv[2], "w"))
 PY
     speed=${SPEED:-4}
     forge_args="--key $keys/coordinator.key --trust $keys/trust.txt" attack=dive \
-        fleet attack-dive "$tmp/late_floor.json" centralised 24 -
+        fly attack-dive "$tmp/late_floor.json" centralised 24 -
     attack=
     check attack-dive "$survived
 $forged
@@ -603,8 +654,10 @@ log['largest'] <= 1400
 s is not None and s['loss_of_separation'] is False and s['steps'] == 48
 (lambda m: (s['deviation'], s['effort'], s['replans']) == (m['deviation'], m['effort'], m['replans']))(json.load(open('$tmp/sim-centralised.json')))
 [v['flown'] for v in s['vehicles']] == [v['flown'] for v in json.load(open('$tmp/sim-centralised.json'))['vehicles']]"
-    fleet lossless "$tmp/paper_lead_in.json" centralised 48 -
+    fly lossless "$tmp/paper_lead_in.json" centralised 48 -
     check lossless "$same_as_sim"
+    # The rule holds for the whole namespace: the fleets flying without it land first.
+    land_all
     if ! nft add table inet coavoid_mtu ||
         ! nft add chain inet coavoid_mtu in '{ type filter hook input priority 0; }' ||
         ! nft add rule inet coavoid_mtu in meta length gt 1500 counter drop; then
@@ -636,13 +689,14 @@ PY
         else
             fail "the rule does not drop large datagrams: $(cat "$tmp/probe.out")"
         fi
-        fleet dropping "$tmp/paper_lead_in.json" centralised 48 -
+        fly dropping "$tmp/paper_lead_in.json" centralised 48 -
+        landed dropping
         nft list table inet coavoid_mtu >"$tmp/dropping/rule.txt" 2>&1
         check dropping "$same_as_sim
 int(re.search(r'packets (\\d+)', open(os.path.join(d, 'rule.txt')).read()).group(1)) >= 1"
         # Decoupled, through the same rule: the flight of (c), `coavoid sim`'s.
         speed=$speed_decoupled
-        fleet dropping-decoupled "$tmp/paper_lead_in.json" decoupled 48 -
+        fly dropping-decoupled "$tmp/paper_lead_in.json" decoupled 48 -
         check dropping-decoupled "rc == {'world': 0, 'vehicle-1': 0, 'vehicle-2': 0, 'vehicle-3': 0, 'summary': 0}
 all(num(f'vehicle-{i}', 'rejected') == 0 for i in (1, 2, 3))
 log['intents'] == {str(i): 49 for i in (1, 2, 3)}
@@ -650,6 +704,7 @@ all(log['reasons'][str(i)] & 64 == 0 for i in (1, 2, 3))
 log['largest'] <= 1400
 s is not None and s['loss_of_separation'] is False and s['steps'] == 48
 [v['flown'] for v in s['vehicles']] == [v['flown'] for v in json.load(open('$tmp/decoupled/sim.json'))['vehicles']]"
+        landed dropping-decoupled
         nft delete table inet coavoid_mtu
     fi
 fi
@@ -672,14 +727,14 @@ if ! "$bin" keygen "$joint" --dir "$keys220" >"$tmp/keygen220.out" 2>&1; then
     fail "coavoid keygen (220): $(cat "$tmp/keygen220.out")"
 fi
 speed=${SPEED:-4}
-keys=$keys220 fleet leaderless "$joint" leaderless 24 -
+keys=$keys220 fly leaderless "$joint" leaderless 24 -
 check leaderless "
 rc == {'world': 0, 'vehicle-1': 0, 'vehicle-2': 0, 'vehicle-3': 0, 'vehicle-4': 0, 'summary': 0}
 all(num(f'vehicle-{i}', 'rejected') == 0 for i in (1, 2, 3, 4))
 log['plans'] == [] and 'COAVOID_PLAN' not in log['counts']
 all(num(f'vehicle-{i}', 'joint plans') >= 1 for i in (1, 2, 3, 4))
 s is not None and s['loss_of_separation'] is False and s['steps'] == 24"
-keys=$keys220 vehicle_args="--joint-members 0" fleet leaderless-alone "$joint" leaderless 24 -
+keys=$keys220 vehicle_args="--joint-members 0" fly leaderless-alone "$joint" leaderless 24 -
 check leaderless-alone "
 rc == {'world': 0, 'vehicle-1': 0, 'vehicle-2': 0, 'vehicle-3': 0, 'vehicle-4': 0, 'summary': 1}
 all(num(f'vehicle-{i}', 'joint plans') == 0 for i in (1, 2, 3, 4))
@@ -689,7 +744,8 @@ s is not None and s['loss_of_separation'] is True"
 # ---- the parts: each a ctest of its own, so that they fly side by side ----
 # PART (argument 4; default all): centralised (the bad inputs, a, b, the centralised
 # attacks and the dive), decoupled (a, whose log the attacks replay, c and the decoupled
-# attacks) or paths (e and f).
+# attacks) or paths (f, and e once f has landed). Within a part the fleets fly side by
+# side (fly), and every check is judged once all have landed (settle).
 case $part in
 all)
     section_bad_inputs
@@ -699,8 +755,8 @@ all)
     section_attacks centralised
     section_attacks decoupled
     section_dive
-    section_paths
     section_leaderless
+    section_paths
     ;;
 centralised)
     section_bad_inputs
@@ -715,12 +771,12 @@ decoupled)
     section_attacks decoupled
     ;;
 paths)
-    section_paths
     section_leaderless
+    section_paths
     ;;
 *)
     fail "unknown part '$part' (all, centralised, decoupled or paths)"
     ;;
 esac
-
+settle
 finish
