@@ -233,6 +233,13 @@ int coavoid_cli_sample_scenario(const char *path, coavoid_scenario_t *s)
     return CLI_CONTINUE;
 }
 
+/* Argument j of c was not given: one line naming it, CLI_EXIT_INVALID. */
+static int missing_argument(const coavoid_cli_command_t *c, size_t j)
+{
+    return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: missing %s (see '%s --help')", c->name,
+                            c->arguments[j], c->see);
+}
+
 int coavoid_cli_parse_args(const coavoid_cli_command_t *c, int argc, char **argv, void *options,
                            const char **args)
 {
@@ -275,8 +282,7 @@ int coavoid_cli_parse_args(const coavoid_cli_command_t *c, int argc, char **argv
         }
     }
     if (given < wanted && !c->arguments_optional) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: missing %s (see '%s --help')", c->name,
-                                c->arguments[given], c->see);
+        return missing_argument(c, given);
     }
     return CLI_CONTINUE;
 }
@@ -299,8 +305,7 @@ int coavoid_cli_scenario_given(const coavoid_cli_command_t *c, const char *argum
         *path = argument;
     }
     if (*path == NULL) {
-        return coavoid_cli_fail(CLI_EXIT_INVALID, "%s: missing %s (see '%s --help')", c->name,
-                                c->arguments[0], c->see);
+        return missing_argument(c, 0);
     }
     return CLI_CONTINUE;
 }
