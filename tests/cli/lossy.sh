@@ -43,6 +43,9 @@ for mode in centralised decoupled; do
     run "l30-$mode" --runs 2 --speed 2 --loss 30 --mode "$mode"
 done
 wait
+# The flight must be the one-shot plan's; the coordinator's planning calls may be more than
+# the 3 of a quiet machine: on loaded cores a plan agreed a cycle later is planned again
+# (the same plan), which changes nothing flown.
 if ok none "loss of separation: no, deviation 3240 m\^2, effort 40, replans ([3-9]|[1-9][0-9]), fallbacks 0, samples from an earlier plan 0" \
     ": 0 lost separation"; then
     pass

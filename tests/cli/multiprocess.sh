@@ -174,14 +174,13 @@ sleep_until_cycle() {
 }
 
 # fleet NAME SCENARIO MODE STEPS KILL_AT [COORDINATOR_ARGS...]: on the port $port,
-# lcm-logger, the world, the
-# coordinator (centralised) and one vehicle per UAV, on one epoch; with KILL_AT (a number
-# of cycles, or -), the coordinator gets SIGTERM then. MODE leaderless: the vehicles fly
-# centralised but no coordinator runs (it is gone before its first message); each vehicle
-# also gets the options in $vehicle_args. With $attack set, the attacker too
-# (forge.c's attack, its options in $forge_args; "replay-log" replays $replay_log with
-# lcm-logplayer instead). Leaves in $tmp/NAME: log.lcm, each
-# process's stderr (NAME.txt) and exit status (NAME.rc), log.json (log.py's summary) and
+# lcm-logger, the world, the coordinator (centralised) and one vehicle per UAV, on one
+# epoch; with KILL_AT (a number of cycles, or -), the coordinator gets SIGTERM then. MODE
+# leaderless: the vehicles fly centralised but no coordinator runs (it is gone before its
+# first message); each vehicle also gets the options in $vehicle_args. With $attack set,
+# the attacker too (forge.c's attack, its options in $forge_args; "replay-log" replays
+# $replay_log with lcm-logplayer instead). Leaves in $tmp/NAME: log.lcm, each process's
+# stderr (NAME.txt) and exit status (NAME.rc), log.json (log.py's summary) and
 # summary.json (`coavoid summary --json` of the log).
 fleet() {
     local name=$1 scenario=$2 mode=$3 steps=$4 kill_at=$5
@@ -193,6 +192,9 @@ fleet() {
     local logger=$!
     local epoch=$(($(date +%s%N) / 1000 + lead_us))
     echo "$epoch" >"$dir/epoch"
+    # The scenario time past the run's last stamp (its cycles 0..STEPS), for a replay of its
+    # log that must come after it.
+    echo $((epoch + (steps + 1) * 1000000)) >"$dir/end"
     local common=(--lcm-url "$url" --epoch "$epoch" --speed "$speed" --steps "$steps")
     local pids=() names=() cpid=
     # shellcheck disable=SC2046 # key's words are options
@@ -566,13 +568,13 @@ section_attacks() {
     forge_args="--key $keys/vehicle-3.key --trust $keys/trust.txt" attack=$stolen \
         fly "attack-stolen-$mode" "$tmp/paper_lead_in.json" "$mode" 48 -
     for attack in copy replay replay-log; do
-        # The log replayed is whole, and of an earlier run: its every stamp (40 cycles of
-        # scenario time from its epoch) before this run's epoch. Replayed stamps inside the
-        # run would be newer than the fleet's own, which the nodes refuse by their clock
-        # window, but `coavoid summary`, which has no window (cli.md), would take.
+        # The log replayed is whole, and of an earlier run: its every stamp before this
+        # run's epoch (with a second to spare). Replayed stamps inside the run would be
+        # newer than the fleet's own, which the nodes refuse by their clock window, but
+        # `coavoid summary`, which has no window (cli.md), would take.
         if [ "$attack" = replay-log ]; then
             landed centralised
-            speed=1 sleep_until_cycle "$(($(cat "$tmp/centralised/epoch") - lead_us))" 42
+            speed=1 sleep_until_cycle "$(($(cat "$tmp/centralised/end") - lead_us))" 1
         fi
         forge_args='' fly "attack-$attack-$mode" "$tmp/paper_lead_in.json" "$mode" 48 -
     done
