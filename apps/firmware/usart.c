@@ -28,8 +28,9 @@
 #define USART_CR3_RTSE (1u << 8)
 #define USART_CR3_CTSE (1u << 9)
 
-/* The NVIC's enable register for interrupts 32..63: USART1 is 37. */
+/* The NVIC's set- and clear-enable registers for interrupts 32..63: USART1 is 37. */
 #define NVIC_ISER1 REG(0xE000E104u)
+#define NVIC_ICER1 REG(0xE000E184u)
 #define USART1_IRQ_BIT (1u << (37u - 32u))
 
 /* 921,600 baud from APB2 at 84 MHz, oversampling by 16: 84e6 / (16 * 921600) = 5.6966,
@@ -56,11 +57,15 @@ void fw_usart_init(void)
 }
 
 /* A byte into the ring; with the ring full, the byte stays in the register (RTS holds the
- * sender) and the interrupt is off until the main loop has made room. */
+ * sender) and the interrupt is off in the NVIC until the main loop has made room. Off in
+ * the NVIC, not by RXNEIE: qemu's USART (7.2) keeps its interrupt line up when RXNEIE is
+ * cleared, so the handler would be taken again at once, for ever, and the main loop
+ * never run to make room. The NVIC's enable registers are also written whole, so the
+ * handler and the main loop never race on a read-modify-write. */
 void fw_usart1_handler(void)
 {
     if (head - tail == FW_USART_RING) {
-        USART1_CR1 &= ~USART_CR1_RXNEIE;
+        NVIC_ICER1 = USART1_IRQ_BIT;
         return;
     }
     if ((USART1_SR & USART_SR_RXNE) != 0u) {
@@ -80,7 +85,7 @@ uint8_t fw_usart_get(void)
     __asm__ volatile("cpsie i" ::: "memory");
     const uint8_t byte = ring[tail % FW_USART_RING];
     tail = tail + 1u;
-    USART1_CR1 |= USART_CR1_RXNEIE; /* room again */
+    NVIC_ISER1 = USART1_IRQ_BIT; /* room again */
     return byte;
 }
 
@@ -89,4 +94,9 @@ void fw_usart_put(uint8_t byte)
     while ((USART1_SR & USART_SR_TXE) == 0u) {
     }
     USART1_DR = byte;
+}
+
+uint32_t fw_usart_buffered(void)
+{
+    return head - tail;
 }

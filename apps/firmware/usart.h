@@ -11,7 +11,8 @@
  * taking bytes, the receive register stays full, the USART deasserts RTS and the ground's
  * UART holds the next byte until the ring has room again. And the ground sends a frame
  * only after the vehicle's READY for the one before (session.h), so little waits. Under
- * qemu (netduinoplus2) the first -serial is USART1 and the same holding back is qemu's.
+ * qemu (netduinoplus2) the first -serial is USART1 and the same holding back is qemu's
+ * (tests/firmware/qemu.sh checks it with usart_check.c).
  */
 #ifndef COAVOID_FIRMWARE_USART_H
 #define COAVOID_FIRMWARE_USART_H
@@ -28,5 +29,8 @@ uint8_t fw_usart_get(void);
 
 /* Sends one byte; waits for room in the transmit register. */
 void fw_usart_put(uint8_t byte);
+
+/* How many bytes the ring holds, 0..FW_USART_RING. */
+uint32_t fw_usart_buffered(void);
 
 #endif
