@@ -59,6 +59,13 @@ if [ -z "${COAVOID_MIXED_BUILT:-}" ] &&
     exit 1
 fi
 speed=${SPEED:-0.4}
+# The part stands for a processor of its own, which the suite's other tests must not slow:
+# qemu runs at a higher priority where that is allowed (root). Behind busy cores it falls
+# behind the fleet's clock and the bridge's queue to it overflows (tests/README.md).
+qemu_cmd=(qemu-system-arm)
+if [ "$(nice -n -5 nice 2>/dev/null)" = -5 ]; then
+    qemu_cmd=(nice -n -5 qemu-system-arm)
+fi
 steps=48
 lead_us=2000000
 
@@ -127,7 +134,7 @@ else
 fi
 # The part itself refusing a vehicle it cannot hold: centralised with the joint plan of the
 # paper's three UAVs (553,056 bytes; its block has 111,104).
-qemu-system-arm -M netduinoplus2 -display none -monitor none \
+"${qemu_cmd[@]}" -M netduinoplus2 -display none -monitor none \
     -serial "unix:$tmp/refusing.sock,server=on,wait=off" -kernel "$elf" >/dev/null 2>&1 &
 refusing=$!
 for i in $(seq 50); do [ -S "$tmp/refusing.sock" ] && break; sleep 0.1; done
@@ -146,7 +153,7 @@ fly() {
     local joint=()
     [ "$mode" = centralised ] && joint=(--joint-members 0)
     mkdir -p "$dir"
-    qemu-system-arm -M netduinoplus2 -display none -monitor none \
+    "${qemu_cmd[@]}" -M netduinoplus2 -display none -monitor none \
         -serial "unix:$dir/uart.sock,server=on,wait=off" -kernel "$elf" >"$dir/qemu.txt" 2>&1 &
     local qemu=$!
     lcm-logger -q -f --lcm-url="$url" "$dir/log.lcm" >"$dir/logger.out" 2>&1 &
