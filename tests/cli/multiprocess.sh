@@ -765,8 +765,9 @@ s is not None and s['loss_of_separation'] is True"
 # ---- the parts: each a ctest of its own, so that they fly side by side ----
 # PART (argument 4; default all): centralised (the bad inputs, a, b, the centralised
 # attacks and the dive), decoupled (a, whose log the attacks replay, c and the decoupled
-# attacks) or paths (f, and e once f has landed). Within a part the fleets fly side by
-# side (fly), and every check is judged once all have landed (settle).
+# attacks) or paths (f, and e: its flight without the rule beside f's, its flights
+# through the rule once those have landed). Within a part the fleets fly side by side
+# (fly), and every check is judged once all have landed (settle).
 case $part in
 all)
     section_bad_inputs

@@ -45,13 +45,21 @@ if ! diff -u "$src/apps/firmware/check_problems.h" "$tmp/check_problems.h" >&2; 
   failed=1
 fi
 
-# Semihosting output to a file of its own: nothing else of qemu's (monitor, UART) mixes in.
+# semihosted SECONDS OUT QEMU_ARGS...: qemu's netduinoplus2 for at most SECONDS (exit 124
+# past them), the firmware's semihosting output to OUT, a file of its own: nothing else of
+# qemu's (monitor, UART) mixes in.
+semihosted() {
+  local seconds=$1 out=$2
+  shift 2
+  timeout "$seconds" qemu-system-arm -M netduinoplus2 -display none -monitor none \
+    -chardev file,id=semihosting,path="$out" \
+    -semihosting-config enable=on,target=native,chardev=semihosting "$@"
+}
+
 # -icount shift=0: virtual time is the guest instruction count (1 ns each), so the check's
 # SysTick readings count instructions, the same on every run and every host.
 out=$tmp/firmware.txt
-timeout 60 qemu-system-arm -M netduinoplus2 -icount shift=0 -display none -monitor none -serial null \
-  -chardev file,id=semihosting,path="$out" \
-  -semihosting-config enable=on,target=native,chardev=semihosting -kernel "$elf"
+semihosted 60 "$out" -icount shift=0 -serial null -kernel "$elf"
 rc=$?
 [ "$rc" -ne 124 ] || die "the firmware check did not exit within 60 s in qemu"
 echo "== firmware check on qemu netduinoplus2 (exit $rc)"
@@ -73,9 +81,7 @@ done
 # At the part's capacity: UAV 9 of nine converging on a point, last in priority.
 "$single" sim "$here/replay/nine.json" --mode decoupled --record-vehicle "9:$tmp/nine.rec" \
   > /dev/null || die "recording UAV 9 of nine failed"
-(cd "$tmp" && timeout 120 qemu-system-arm -M netduinoplus2 -icount shift=0 -display none \
-  -monitor none -serial null -chardev file,id=semihosting,path="$tmp/replay.txt" \
-  -semihosting-config enable=on,target=native,chardev=semihosting -kernel "$replay")
+(cd "$tmp" && semihosted 120 "$tmp/replay.txt" -icount shift=0 -serial null -kernel "$replay")
 rc=$?
 echo "== vehicle replay on qemu netduinoplus2 (exit $rc)"
 cat "$tmp/replay.txt"
@@ -88,10 +94,8 @@ cat "$tmp/replay.txt"
 # order. A handler taken again for ever while the ring is full (qemu keeps the USART's
 # interrupt up when RXNEIE is cleared) never lets it finish: the timeout says so.
 usart=$arm/apps/firmware/coavoid-firmware-usart-check.elf
-timeout 20 qemu-system-arm -M netduinoplus2 -display none -monitor none \
-  -serial "unix:$tmp/usart.sock,server=on,wait=off" \
-  -chardev file,id=semihosting,path="$tmp/usart.txt" \
-  -semihosting-config enable=on,target=native,chardev=semihosting -kernel "$usart" &
+semihosted 20 "$tmp/usart.txt" -serial "unix:$tmp/usart.sock,server=on,wait=off" \
+  -kernel "$usart" &
 qemu=$!
 python3 - "$tmp/usart.sock" 4096 <<'PY'
 import socket, sys, time
@@ -103,6 +107,8 @@ for _ in range(100):
         break
     except OSError:
         time.sleep(0.05)
+else:
+    sys.exit(f"cannot connect to the part's USART at {path}")
 s.sendall(bytes((i * 7 + 3) & 0xFF for i in range(n)))
 s.settimeout(25)
 try:
@@ -110,11 +116,15 @@ try:
 except OSError:
     pass
 PY
+sent=$?
 wait "$qemu"
 rc=$?
 echo "== receive ring on qemu netduinoplus2 (exit $rc)"
 cat "$tmp/usart.txt"
-if [ "$rc" -eq 124 ]; then
+if [ "$sent" -ne 0 ]; then
+  echo "firmware_qemu: FAIL: the receive check's bytes were not sent" >&2
+  failed=1
+elif [ "$rc" -eq 124 ]; then
   echo "firmware_qemu: FAIL: the receive check did not end within 20 s: its USART handler keeps the main loop from the full ring" >&2
   failed=1
 elif [ "$rc" -ne 0 ] || ! grep -q '^usart check: 4096 bytes in order through a full ring$' "$tmp/usart.txt"; then
